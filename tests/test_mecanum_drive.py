@@ -1,7 +1,7 @@
 """Mecanum (omnidirectional) drive: four wheels with 45° rollers (a KUKA youBot-like base) move the
 robot forward, sideways and round on the spot, in closed form; a .wbt robot whose wheels' friction
 a ContactProperties turns (Webots' way of simulating the rollers) is detected as one, without it
-it stays skid-steer; the batched simulation refuses such a world; a Python controller strafes."""
+it stays skid-steer; a Python controller strafes (the batched simulation: tests/test_batched_mecanum.py)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,6 @@ import pytest
 from _serve import run_controller, sensorium
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import WorldError, load_world, parse_world
 
@@ -161,13 +160,6 @@ def test_world_file_checks_name_the_field() -> None:
         parse_world({"robots": [bot(front_left_motor="wheel1")]})
     with pytest.raises(WorldError, match=r"mecanum_drive\.lx"):
         parse_world({"robots": [bot(lx=0)]})
-
-
-def test_batched_simulation_refuses_a_mecanum_robot_in_one_line() -> None:
-    with pytest.raises(BatchedError, match=r"robot 'yb' has a mecanum_drive; the batched simulation drives two-wheel, "
-                                           r"skid-steer and car-like robots only \(use Simulation\)") as err:
-        BatchedSimulation(wm.World(robots=[wm.Robot(**bot())]), 2)
-    assert "\n" not in str(err.value)
 
 
 # ---------------------------------------------------------------- .wbt worlds we write

@@ -19,7 +19,8 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   ``.objects``) and ``.segmentation_image``: this copy's, batched_recognition.py).
   The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
   side share one state, so commanding one of them commands its side. A car-like robot has
-  ``motors`` (its steering and driven wheels) and no ``drive``.
+  ``motors`` (its steering and driven wheels) and no ``drive``; so has a mecanum robot (its four
+  wheels, batched_mecanum.MecanumDrives).
 
 Anything else a callable reaches for raises AttributeError naming the view.
 """
@@ -42,8 +43,9 @@ __all__ = ["CopySim", "CopyRobot"]
 
 class _Motor:
     """A motor in one copy, over the batched state arrays that hold it (``target``, ``velocity``,
-    ``angle`` at ``index``): a wheel of a drive, or a car's steering or driven-wheel motor
-    (batched_car.CarDrives; a steering motor's target clamped to +-``limit``)."""
+    ``angle`` at ``index``): a wheel of a drive, a car's steering or driven-wheel motor
+    (batched_car.CarDrives; a steering motor's target clamped to +-``limit``), or a mecanum wheel
+    (batched_mecanum.MecanumDrives)."""
 
     def __init__(self, name: str, max_velocity: float, arrays: tuple[np.ndarray, np.ndarray, np.ndarray],
                  index: tuple[int, int, int], limit: float = math.inf):
@@ -65,6 +67,13 @@ class _Motor:
         k, j = cars.column(slot, name)
         return cls(name, float(cars.max_velocity[k, j]), (cars.target, cars.velocity, cars.angle), (copy, k, j),
                    float(cars.limit[k]) if j < 2 else math.inf)
+
+    @classmethod
+    def mecanum(cls, sim: BatchedSimulation, copy: int, slot: int, name: str) -> _Motor:
+        mec = sim.mecanum
+        assert mec is not None
+        k, j = mec.column(slot, name)
+        return cls(name, float(mec.max_velocity[k, j]), (mec.target, mec.velocity, mec.angle), (copy, k, j))
 
     @property
     def velocity(self) -> float:
@@ -167,6 +176,10 @@ class CopyRobot:
         elif sim.cars is not None and slot in sim.cars.car_of:     # a car: its motors (no drive view)
             self.drive = None
             self.motors = {name: _Motor.car(sim, copy, slot, name) for name in sim.cars.columns[sim.cars.car_of[slot]]}
+        elif sim.mecanum is not None and slot in sim.mecanum.of:     # a mecanum robot: its four wheels
+            self.drive = None
+            self.motors = {name: _Motor.mecanum(sim, copy, slot, name)
+                           for name in sim.mecanum.columns[sim.mecanum.of[slot]]}
         else:
             self.drive = None
             self.motors = {}

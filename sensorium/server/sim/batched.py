@@ -32,7 +32,9 @@ and an infra-red sensor or a camera to see its ink is refused. Textured robot bo
 (batched_textures.py). A skid-steer robot's wheels of one side are driven together (``set_wheels``).
 Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
 (``sim.cars.command``; their encoders read its motors), their moves through the same arc, contact
-and placing as the other robots.
+and placing as the other robots. Mecanum robots (``mecanum_drive``) are driven by
+:mod:`~sensorium.server.sim.batched_mecanum` (``sim.mecanum.command``, four wheel speeds), their
+moves through the single drive's exact twist step, then the same contact and placing.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
@@ -64,6 +66,7 @@ from sensorium.server.sim import batched_lidar
 from sensorium.server.sim import batched_recognition as recog
 from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batched_lights import CarriedLights, has_carried_lights
+from sensorium.server.sim.batched_mecanum import MecanumDrives, twist_steps
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import (
@@ -78,7 +81,7 @@ from sensorium.server.sim.contact import (
     spin_reach,
 )
 from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, support_ceiling
-from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, PlanarState, _rz
+from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, MecanumDrive, PlanarState, _rz
 from sensorium.server.sim.scene import (
     Scene,
     _entry,
@@ -284,9 +287,13 @@ class BatchedSimulation:
                               band_low=float(self.band_low[i])) if r.differential_drive
             else AckermannDrive(r.ackermann_drive, self.initial[i], up=up, ground=self.ground,
                                 band_low=float(self.band_low[i])) if r.ackermann_drive
+            else MecanumDrive(r.mecanum_drive, self.initial[i], up=up, ground=self.ground,
+                              band_low=float(self.band_low[i])) if r.mecanum_drive
             else None for i, r in enumerate(w.robots)]
         # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
         self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
+        # mecanum robots: their four wheels and body twist (batched_mecanum.py), None in a world without one
+        self.mecanum = (MecanumDrives(self._templates, C) if any(r.mecanum_drive for r in w.robots) else None)
         # -- per copy state
         self.time_ms = np.zeros(C, dtype=np.int64)
         self._every_copy = np.arange(C)             # (step's live copies when every copy steps; never written)
@@ -310,7 +317,7 @@ class BatchedSimulation:
         # -- kinematic contact: the solids' obstacles once, the robots' footprints (and headings) per copy
         use_contact = w.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = None
-        if use_contact and (self.has_drive.any() or self.cars is not None):
+        if use_contact and (self.has_drive.any() or self.cars is not None or self.mecanum is not None):
             solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
@@ -341,10 +348,6 @@ class BatchedSimulation:
         if w.world_info.coordinate_system not in _TO_ENU:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
-        for r in w.robots:            # a mecanum drive is not stepped here: refused, not left standing still
-            if r.mecanum_drive is not None:
-                raise BatchedError(f"{self.loaded.source}: robot {r.name!r} has a mecanum_drive; the batched "
-                                   "simulation drives two-wheel, skid-steer and car-like robots only (use Simulation)")
         for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
             drive = {m for _, m in r.drive_motors}
             joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]
@@ -594,6 +597,8 @@ class BatchedSimulation:
         self.wheel_angle[idx] = 0.0
         if self.cars is not None:
             self.cars.reset(idx)
+        if self.mecanum is not None:
+            self.mecanum.reset(idx)
         self.pressing[idx] = False
         self.led_value[idx] = 0                 # LEDs off, their lights too (WbLed::reset)
         if self.carried is not None:
@@ -677,6 +682,9 @@ class BatchedSimulation:
         if self.cars is not None and slot in self.cars.car_of:
             raise ValueError(f"{self.robot_names[slot]}: a car-like robot has no left and right wheels: "
                              "command it with cars.command(slot, right, left, wheel)")
+        if self.mecanum is not None and slot in self.mecanum.of:
+            raise ValueError(f"{self.robot_names[slot]}: a mecanum robot has no left and right wheels: "
+                             "command it with mecanum.command(slot, speeds) (copies, 4)")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         vmax = self.max_wheel[slot]
         left = np.asarray(left, dtype=np.float64)
@@ -729,9 +737,9 @@ class BatchedSimulation:
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:
         driven = self._driven
-        if self.cars is not None or self.to_enu is not None:
-            # car-like robots (batched_car.py): their moves join the numpy path's; a NUE world's
-            # poses are turned into its axes there (the C pass writes ENU poses)
+        if self.cars is not None or self.mecanum is not None or self.to_enu is not None:
+            # car-like and mecanum robots (batched_car.py, batched_mecanum.py): their moves join the
+            # numpy path's; a NUE world's poses are turned into its axes there (the C pass writes ENU poses)
             self._drive_numpy(live, driven, dt_ms / 1000.0)
             return
         if not len(driven):
@@ -799,14 +807,25 @@ class BatchedSimulation:
         if self.cars is not None:     # the cars' moves too, sorted into slot order below where it matters (_narrow)
             cars = self.cars.step(live, dt)
             copies, slots, v, w = (np.concatenate(pair) for pair in zip((copies, slots, v, w), cars))
-        if not len(copies):
+        # mecanum robots' moves (MecanumDrive.step's twist step), after the arcs' in the same arrays
+        mec = self.mecanum.step(live, dt) if self.mecanum is not None else None
+        if not len(copies) and (mec is None or not len(mec[0])):
             return
         x0, y0 = self.x[copies, slots], self.y[copies, slots]
         yaw0 = self.yaw[copies, slots]
-        if self.cars is not None and self.cars.offset:    # a car's origin off its rear axle
+        if not len(copies):
+            x, y, yaw = x0, y0, yaw0
+        elif self.cars is not None and self.cars.offset:    # a car's origin off its rear axle
             x, y, yaw = _offset_arc_steps(x0, y0, yaw0, v, w, dt, self.cars.rear_axle[slots])
         else:
             x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
+        if mec is not None and len(mec[0]):
+            mc, ms, vx, vy, mw = mec
+            mx0, my0, myaw0 = self.x[mc, ms], self.y[mc, ms], self.yaw[mc, ms]
+            mx, my, myaw = twist_steps(mx0, my0, myaw0, vx, vy, mw, dt)
+            copies, slots = np.concatenate([copies, mc]), np.concatenate([slots, ms])
+            x0, y0, yaw0 = np.concatenate([x0, mx0]), np.concatenate([y0, my0]), np.concatenate([yaw0, myaw0])
+            x, y, yaw = np.concatenate([x, mx]), np.concatenate([y, my]), np.concatenate([yaw, myaw])
         cos, sin = kin.libm_cos_sin(yaw)
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
@@ -1032,6 +1051,8 @@ class BatchedSimulation:
         v = np.where(wheel >= 0, self.wheel_angle[copies, slot, np.maximum(wheel, 0)], self._p_still[cols])
         if self.cars is not None:     # a car's motor's encoder (its steering or a driven wheel)
             self.cars.read_encoders(self.position, copies, cols, v)
+        if self.mecanum is not None:  # a mecanum wheel's encoder
+            self.mecanum.read_encoders(self.position, copies, cols, v)
         plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself
         for k in (~plain).nonzero()[0].tolist():
             col = int(cols[k])

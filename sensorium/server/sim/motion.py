@@ -356,10 +356,10 @@ class MecanumDrive(PlanarState):
     def twist(self, speeds: list[float]) -> tuple[float, float, float]:
         """(vx, vy, ωz) in the drive's frame for the four wheels' speeds (rad/s, the wheels' order)."""
         r = self.wheel_radius
-        vx = r * sum(speeds) / 4.0
-        vy = r * sum(s * u for u, (_, s, _) in zip(speeds, self.wheels)) / 4.0
-        w = r * sum(c * u for u, (_, _, c) in zip(speeds, self.wheels)) / self.c2
-        return vx, vy, w
+        tot = ts = tc = 0.0           # summed left to right (sum() compensates from Python 3.12 on), as
+        for u, (_, s, c) in zip(speeds, self.wheels):       # the batched simulation sums (batched_mecanum.py)
+            tot, ts, tc = tot + u, ts + s * u, tc + c * u
+        return r * tot / 4.0, r * ts / 4.0, r * tc / self.c2
 
     def step(self, dt_ms: int) -> Pose | None:
         """Advance one basic step; the new pose, or None when the wheels did not turn."""

@@ -1,0 +1,243 @@
+"""Mecanum (youBot-like) robots in the batched simulation: every copy steps as the single
+Simulation does, bit for bit (random wheel commands, position control included, contact on and off,
+walls, another mecanum robot and a two-wheel robot in the world, set_pose, every device read), the
+copies never see each other, a pure strafe ends where its closed form says, a strafe against a wall
+stops at its face; as an agent, its four normalised wheel speeds are the action of the single and
+the batched environments alike, bit for bit, and both pass Gymnasium's checker."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import parse_world
+from tests._motors import assert_same_readings
+
+R, LX, LY = 0.05, 0.228, 0.158        # the youBot's wheel radius, half wheelbase, half track
+STEP = 16
+DT = STEP / 1000.0
+# the drive's wheel order (front left, front right, rear left, rear right) with the youBot's names
+FL, FR, RL, RR = "wheel2", "wheel1", "wheel4", "wheel3"
+WHEELS = (FL, FR, RL, RR)
+HALF_W = 0.15                          # the body's half width (box 0.5 x 0.3)
+
+
+def youbot(name: str, x: float, y: float, **drive) -> dict:
+    return {"name": name, "pose": {"translation": [x, y, 0.1]},
+            "body": {"geometry": {"type": "box", "size": [0.5, 2 * HALF_W, 0.1]}},
+            "mecanum_drive": {"wheel_radius": R, "lx": LX, "ly": LY, **drive},
+            "devices": [{"device": "PositionSensor", "name": "fl sensor", "motor": FL},
+                        {"device": "PositionSensor", "name": "rr sensor", "motor": RR, "noise": 0.01},
+                        {"device": "GPS", "name": "gps", "accuracy": 0.002},
+                        {"device": "Compass", "name": "compass"},
+                        {"device": "InertialUnit", "name": "imu"},
+                        {"device": "Gyro", "name": "gyro"},
+                        {"device": "Accelerometer", "name": "acc"},
+                        {"device": "TouchSensor", "name": "bumper", "type": "bumper"},
+                        {"device": "DistanceSensor", "name": "front", "pose": {"translation": [0.26, 0.0, 0.0]},
+                         "lookup_table": [[0, 0, 0], [1.0, 1000, 0.05]]}]}
+
+
+def wall(name: str, x: float, y: float, sx: float, sy: float) -> dict:
+    return {"name": name, "pose": {"translation": [x, y, 0.25]}, "geometry": {"type": "box", "size": [sx, sy, 0.5]}}
+
+
+def world(contact: bool = True) -> object:
+    """Two youBot-like robots (one driving along its own +y), a two-wheel robot and a block in a 2.2 m square."""
+    two_wheel = {"name": "dd", "pose": {"translation": [-0.6, 0.6, 0.05]},
+                 "body": {"geometry": {"type": "cylinder", "radius": 0.1, "height": 0.1}},
+                 "differential_drive": {"wheel_radius": 0.03, "axle_length": 0.15, "max_wheel_speed": 20.0},
+                 "devices": [{"device": "GPS", "name": "gps"}]}
+    return parse_world({"world_info": {"basic_time_step": STEP, "contact": contact, "random_seed": 5},
+                        "solids": [wall("north", 0, 1.2, 2.6, 0.2), wall("south", 0, -1.2, 2.6, 0.2),
+                                   wall("east", 1.2, 0, 0.2, 2.2), wall("west", -1.2, 0, 0.2, 2.2),
+                                   wall("block", 0.5, -0.6, 0.3, 0.3)],
+                        "robots": [youbot("yb", 0.0, 0.0), youbot("yb2", 0.7, 0.6, forward=[0, 1]), two_wheel]})
+
+
+def wheel_speeds(vx: float, vy: float, w: float) -> np.ndarray:
+    """The four wheel speeds (front left, front right, rear left, rear right) of a body twist, the
+    youBot's rollers (standard mecanum inverse kinematics)."""
+    k = LX + LY
+    return np.array([vx - vy - k * w, vx + vy + k * w, vx + vy - k * w, vx - vy + k * w]) / R
+
+
+def random_commands(rng, w) -> dict:
+    """Per drive motor: (a held position, a velocity, whether it holds the position). A mecanum
+    robot's wheels 70 % of the time at one body twist, 0.45 m/s in a random direction (so that it
+    reaches walls and the other robots; the fastest wheel's speed may be clamped), else each at its
+    own random speed, full speed often."""
+    out = {}
+    for r in w.robots:
+        vmax = 14.81 if r.mecanum_drive is not None else 20.0
+        heading = rng.uniform(-math.pi, math.pi)
+        twist = (wheel_speeds(0.45 * math.cos(heading), 0.45 * math.sin(heading), rng.uniform(-0.5, 0.5))
+                 if rng.random() < 0.7 else None)
+        for j, (_, m) in enumerate(r.drive_motors):
+            vel = rng.choice([-vmax, vmax]) if rng.random() < 0.3 else rng.uniform(-vmax, vmax)
+            if twist is not None and r.mecanum_drive is not None:
+                vel = twist[j]
+            out[(r.name, m)] = (rng.uniform(-5.0, 5.0), float(vel), twist is None and rng.random() < 0.2)
+    return out
+
+
+def command(sim, cmds: dict) -> None:
+    for (name, m), (pos, vel, hold) in cmds.items():
+        motor = sim.robot(name).motors[m]
+        if hold:
+            motor.set_position(motor.position + pos)
+            motor.set_velocity(abs(vel))
+        else:
+            motor.set_position(math.inf)
+            motor.set_velocity(vel)
+
+
+def same_pose(sim, view, name: str) -> bool:
+    a, b = sim.robot(name).pose, view.robot(name).pose
+    return a.rotation.tobytes() == b.rotation.tobytes() and a.translation.tobytes() == b.translation.tobytes()
+
+
+@pytest.mark.parametrize("contact", [True, False])
+def test_every_copy_steps_as_the_single_simulation_bit_for_bit(contact):
+    """Three copies, each against its own Simulation (world seeds 5, 6, 7), 400 steps of random
+    commands changed every 40 steps (velocity and position control), a set_pose at step 200: every
+    robot's pose and every device's reading the same bits every step; contact clipped moves."""
+    from sensorium.gym.views import CopySim
+
+    w = world(contact)
+    n = 3
+    batched = BatchedSimulation(w, n)
+    batched.reset(np.arange(n), [5, 6, 7])
+    singles = [Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
+        update={"random_seed": s})})) for s in (5, 6, 7)]
+    views = [CopySim(batched, c) for c in range(n)]
+    for s in (*singles, *views):
+        for r in s.robots.values():
+            for d in r.model.devices:
+                r.device(d.name).enable(32 if d.device != "GPS" else 16)
+    rng = np.random.default_rng(8)
+    pressed = 0
+    for t in range(400):
+        if t % 40 == 0:
+            cmds = [random_commands(rng, w.world) for _ in range(n)]
+        if t == 200:
+            for s in (singles[1], views[1]):
+                s.robot("yb").set_pose(translation=[-0.5, -0.5, 0.1], rotation=[0, 0, 1, 0.7])
+        for c in range(n):
+            command(singles[c], cmds[c])
+            command(views[c], cmds[c])
+            singles[c].step()
+        batched.step()
+        for c in range(n):
+            for name in ("yb", "yb2", "dd"):
+                assert same_pose(singles[c], views[c], name), (t, c, name)
+                assert_same_readings(singles[c], views[c], name, (t, c))
+            pressed += sum(singles[c].robot(name).pressing for name in ("yb", "yb2"))
+    if contact:
+        assert pressed > 20 and batched.counters["contacts"] > 0      # walls and robots were met
+    else:
+        assert batched.contact is None and pressed == 0
+
+
+def test_strafe_turn_and_diagonal_in_closed_form_each_copy_its_own():
+    """Copy 0 strafes left, copy 1 turns on the spot, copy 2 moves diagonally (two wheels), copy 3
+    drives a general twist, copy 4 stands: each ends where its closed form says after N steps, and
+    equals its own single Simulation bit for bit."""
+    w = parse_world({"world_info": {"basic_time_step": STEP},
+                     "robots": [youbot("yb", 0.0, 0.0)]})
+    n, N = 5, 250
+    batched = BatchedSimulation(w, n)
+    slot = batched.slot("yb")
+    vx, vy, wz = 0.12, -0.07, 0.4
+    speeds = np.array([wheel_speeds(0.0, 0.2, 0.0), wheel_speeds(0.0, 0.0, 0.9), [0.0, 6.0, 6.0, 0.0],
+                       wheel_speeds(vx, vy, wz), [0.0] * 4])
+    batched.mecanum.command(slot, speeds)
+    batched.run(N)
+    t = N * DT
+    d = R * 6.0 / 2.0 * t
+    s, c = math.sin(wz * t), math.cos(wz * t)
+    expect = [(0.0, 0.2 * t, 0.0), (0.0, 0.0, math.remainder(0.9 * t, math.tau)), (d, d, 0.0),
+              ((vx * s - vy * (1 - c)) / wz, (vx * (1 - c) + vy * s) / wz, math.remainder(wz * t, math.tau)),
+              (0.0, 0.0, 0.0)]
+    for k in range(n):
+        rot, pos = batched.rot[k, slot], batched.pos[k, slot]
+        got = (pos[0], pos[1], math.atan2(rot[1, 0], rot[0, 0]))
+        assert got == pytest.approx(expect[k], abs=1e-9), k
+        assert pos[2] == 0.1
+        single = Simulation(w)
+        for name, u in zip(WHEELS, speeds[k]):
+            m = single.robot("yb").motor(name)
+            m.set_position(math.inf)
+            m.set_velocity(float(u))
+        single.run(N)
+        assert single.robot("yb").pose.translation.tobytes() == pos.tobytes(), k
+        assert single.robot("yb").pose.rotation.tobytes() == rot.tobytes(), k
+    assert (batched.rot[0, slot] == np.eye(3)).all()            # a pure strafe never turns
+
+
+def test_a_pure_strafe_is_exact_in_closed_form_every_step():
+    """All four wheels at ±ω in the strafe pattern: y = r·ω·t after every step, x and yaw exactly 0."""
+    w = parse_world({"world_info": {"basic_time_step": STEP}, "robots": [youbot("yb", 0.0, 0.0)]})
+    batched = BatchedSimulation(w, 2)
+    batched.mecanum.command(0, [[-4.0, 4.0, 4.0, -4.0], [4.0, -4.0, -4.0, 4.0]])    # left, right
+    for n in range(1, 101):
+        batched.step()
+        assert batched.pos[:, 0, 0].tolist() == [0.0, 0.0]
+        assert batched.pos[:, 0, 1] == pytest.approx([R * 4.0 * n * DT, -R * 4.0 * n * DT], abs=1e-12)
+        assert (batched.rot[:, 0] == np.eye(3)).all()
+
+
+LEFT, RIGHT, STAND = [-10.0, 10.0, 10.0, -10.0], [10.0, -10.0, -10.0, 10.0], [0.0] * 4
+
+
+def test_strafes_against_a_wall_and_a_robot_stop_there_and_copies_never_meet():
+    """A wall 1 m to the left of "yb", a robot "other" 1 m to its right. Copy 0: yb strafes right
+    into the standing other and stops against it; copy 1: both strafe right at the same speed, so
+    yb crosses where copy 0's other stands without meeting anything (copies never see each other);
+    copy 2: yb strafes left and stops with its left side on the wall's face. Each copy equals its
+    own single Simulation bit for bit; the bumper of the stopped ones reads 1."""
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": True},
+                     "solids": [wall("wall", 0.0, 1.0, 4.0, 0.2)],
+                     "robots": [youbot("yb", 0.0, 0.0), youbot("other", 0.0, -1.0)]})
+    plan = [{"yb": RIGHT, "other": STAND}, {"yb": RIGHT, "other": RIGHT}, {"yb": LEFT, "other": STAND}]
+    batched = BatchedSimulation(w, len(plan))
+    for name in ("yb", "other"):
+        batched.mecanum.command(batched.slot(name), [p[name] for p in plan])
+    bumper = batched.device("yb", "bumper")
+    batched.enable(bumper, 16)
+    batched.run(100)                                # 1.6 s at 0.5 m/s
+    yb, other = batched.slot("yb"), batched.slot("other")
+    assert batched.pos[0, yb, 1] == pytest.approx(-1.0 + 2 * HALF_W, abs=1e-6)      # side against side
+    assert batched.pos[0, other, 1] == -1.0
+    assert batched.pos[1, yb, 1] == pytest.approx(-0.8, abs=1e-9)
+    assert batched.pos[1, other, 1] == pytest.approx(-1.8, abs=1e-9)
+    assert batched.pos[2, yb, 1] == pytest.approx(0.9 - HALF_W, abs=1e-9)           # its left side on the face
+    assert batched.pos[:, yb, 0].tolist() == [0.0] * 3 and (batched.rot[:, yb] == np.eye(3)).all()
+    assert batched.value(bumper).tolist() == [1.0, 0.0, 1.0]
+    for c, p in enumerate(plan):
+        single = Simulation(w)
+        single.device("yb/bumper").enable(16)
+        for name, speeds in p.items():
+            for m, u in zip(WHEELS, speeds):
+                single.robot(name).motor(m).set_position(math.inf)
+                single.robot(name).motor(m).set_velocity(u)
+        single.run(100)
+        for name in ("yb", "other"):
+            pose = single.robot(name).pose
+            slot = batched.slot(name)
+            assert pose.translation.tobytes() == batched.pos[c, slot].tobytes(), (c, name)
+            assert pose.rotation.tobytes() == batched.rot[c, slot].tobytes(), (c, name)
+        assert single.device("yb/bumper").value == batched.value(bumper)[c]
+
+
+def test_set_wheels_on_a_mecanum_robot_says_how_to_command_it():
+    batched = BatchedSimulation(parse_world({"robots": [youbot("yb", 0.0, 0.0)]}), 2)
+    with pytest.raises(ValueError, match=r"^yb: a mecanum robot has no left and right wheels: command it with "
+                                         r"mecanum.command\(slot, speeds\) \(copies, 4\)$"):
+        batched.set_wheels(0, [1.0, 1.0], [1.0, 1.0])
+    with pytest.raises(ValueError, match=r"^mecanum wheel speeds must be \(copies, 4\)"):
+        batched.mecanum.command(0, [[1.0, 2.0]] * 2)
