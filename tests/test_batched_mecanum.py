@@ -8,6 +8,7 @@ the batched environments alike, bit for bit, and both pass Gymnasium's checker."
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -241,3 +242,157 @@ def test_set_wheels_on_a_mecanum_robot_says_how_to_command_it():
         batched.set_wheels(0, [1.0, 1.0], [1.0, 1.0])
     with pytest.raises(ValueError, match=r"^mecanum wheel speeds must be \(copies, 4\)"):
         batched.mecanum.command(0, [[1.0, 2.0]] * 2)
+
+
+# ---------------------------------------------------------------- a mecanum agent (Gymnasium)
+
+def agent_task(max_steps: int = 30, observations=("gps", "compass", "bumper", "front", "imu")):
+    from sensorium.gym import Task
+    from sensorium.gym.task import random_start
+
+    return Task(robot="yb", control_period_ms=32, max_steps=max_steps, observations=list(observations),
+                start=random_start((-0.8, 0.8), (-0.8, 0.8)))
+
+
+@pytest.mark.parametrize("actions", ["normalized", "wheel"])
+def test_sub_env_i_is_the_single_env_with_seed_i_across_autoresets(actions):
+    """Random four-wheel actions (all four at one extreme a third of the time), episodes of 30
+    actions, random starts, walls, a block and two other robots: every observation, reward, flag,
+    clock and pose of sub-env i equals the single env (the rebuilt Simulation) reset with seed + i,
+    bit for bit; the bumper was pressed."""
+    gymnasium = pytest.importorskip("gymnasium")
+    del gymnasium
+    from sensorium.gym import SensoriumEnv
+    from sensorium.gym.vector import SensoriumVectorEnv
+    from tests.test_gym_vector import _reset_both, _step_both
+
+    w = world(True)
+    n, seed = 3, 21
+    venv = SensoriumVectorEnv(w, agent_task(), n, actions=actions)
+    singles = [SensoriumEnv(w, agent_task(), actions=actions, engine="simulation") for _ in range(n)]
+    space = singles[0].action_space
+    assert space.shape == (4,) and venv.action_space.shape == (n, 4)
+    _reset_both(venv, singles, seed)
+    rng = np.random.default_rng(3)
+    done = np.zeros(n, dtype=bool)
+    resets, pressed = 0, 0
+    for t in range(90):
+        a = rng.uniform(space.low, space.high, (n, 4)).astype(np.float32)
+        if t % 3 == 0:          # a strafe, a turn or a drive at full speed
+            a = np.tile(np.array([[-1, 1, 1, -1], [-1, 1, -1, 1], [1, 1, 1, 1]][t % 9 // 3], dtype=np.float32)
+                        * space.high, (n, 1))
+        got, vobs = _step_both(venv, singles, a, done, t)
+        resets += got
+        pressed += int((vobs["bumper"][:, 0] == 1.0).sum())
+    assert resets >= 3 and pressed > 0
+
+
+def test_a_normalised_strafe_action_moves_the_agent_left_in_closed_form_in_both_engines():
+    """Action (-1, +1, +1, -1): every wheel at max_wheel_speed in the youBot's strafe pattern, so the
+    robot slides left at r·ω_max without turning: after k actions of 32 ms its pose is (0, r·ω·t, 0)
+    in the single env and in a batched sub-env alike, the same bits."""
+    from sensorium.gym import SensoriumEnv, Task
+    from sensorium.gym.vector import SensoriumVectorEnv
+
+    w = parse_world({"world_info": {"basic_time_step": STEP}, "robots": [youbot("yb", 0.0, 0.0)]})
+    task = Task(robot="yb", control_period_ms=32, max_steps=None, observations=["gps"])
+    env = SensoriumEnv(w, task)
+    venv = SensoriumVectorEnv(w, task, 2)
+    env.reset(seed=0)
+    venv.reset(seed=0)
+    strafe = np.array([-1.0, 1.0, 1.0, -1.0], dtype=np.float32)
+    warm = env.agent.warmup_steps
+    for k in range(1, 41):
+        info = env.step(strafe)[4]
+        vinfo = venv.step(np.stack([strafe, -strafe]))[4]
+        t = (k * 32) / 1000.0
+        assert info["pose"] == pytest.approx([0.0, R * 14.81 * t, 0.0], abs=1e-12), (k, warm)
+        assert info["pose"].tobytes() == vinfo["pose"][0].tobytes()
+        assert vinfo["pose"][1] == pytest.approx([0.0, -R * 14.81 * t, 0.0], abs=1e-12)
+
+
+def test_the_checker_passes_on_both_engines_and_a_sub_env():
+    from gymnasium.utils.env_checker import check_env
+
+    from sensorium.gym import SensoriumEnv
+    from sensorium.gym.vector import SensoriumVectorEnv
+
+    w = world(True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(SensoriumEnv(w, agent_task()), skip_render_check=True)
+        check_env(SensoriumEnv(w, agent_task(), engine="batched"), skip_render_check=True)
+        check_env(SensoriumVectorEnv(w, agent_task(), 3).sub_env(1), skip_render_check=True)
+
+
+@pytest.mark.parametrize("bad", [[np.nan, 0.0, 0.0, 0.0], [0.1, 0.2], [0.1, 0.2, 0.3, 0.4, 0.5]])
+def test_bad_actions_are_refused_in_one_line(bad):
+    from sensorium.gym import SensoriumEnv
+    from sensorium.gym.vector import SensoriumVectorEnv
+
+    w = world(True)
+    env = SensoriumEnv(w, agent_task())
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"^yb: action must be 4 finite values in \[-1, 1\] \(front left, front "
+                                         r"right, rear left, rear right\), got .*$") as e:
+        env.step(np.array(bad, dtype=np.float32))
+    assert "\n" not in str(e.value)
+    venv = SensoriumVectorEnv(w, agent_task(), 2)
+    venv.reset(seed=0)
+    if len(bad) == 4:
+        with pytest.raises(ValueError, match="^sub-env 1: action must be 4 finite values"):
+            venv.step(np.array([[0.0] * 4, bad], dtype=np.float32))
+    else:
+        with pytest.raises(ValueError, match=r"^actions must have shape \(2, 4\)"):
+            venv.step(np.zeros((2, len(bad)), dtype=np.float32))
+
+
+def test_pettingzoo_mecanum_robots_are_agents_and_both_engines_agree():
+    from sensorium.gym import Task
+    from sensorium.gym.multi import SensoriumParallelEnv
+
+    w = world(True)
+    assert SensoriumParallelEnv(w).possible_agents == ["yb", "yb2", "dd"]
+
+    def make(engine):
+        return SensoriumParallelEnv(w, {r: Task(robot=r, control_period_ms=32, max_steps=20, observations=["gps"])
+                                        for r in ("yb", "yb2", "dd")}, engine=engine)
+    a, b = make("simulation"), make("batched")
+    assert a.action_space("yb").shape == (4,) and a.action_space("dd").shape == (2,)
+    oa, _ = a.reset(seed=7)
+    ob, _ = b.reset(seed=7)
+    rng = np.random.default_rng(0)
+    for _ in range(25):
+        assert all(np.asarray(oa[k]["gps"]).tobytes() == np.asarray(ob[k]["gps"]).tobytes() for k in oa)
+        if not a.agents:
+            break
+        acts = {k: rng.uniform(-1, 1, a.action_space(k).shape).astype(np.float32) for k in a.agents}
+        oa, ra, ta, ua, _ = a.step(acts)
+        ob, rb, tb, ub, _ = b.step(acts)
+        assert (ra, ta, ua) == (rb, tb, ub)
+    assert not a.agents                                  # all truncated after 20 actions, robots stopped
+
+
+@pytest.mark.slow           # starts worker processes
+def test_the_workers_env_carries_four_wheel_actions_bit_for_bit():
+    """SensoriumWorkersEnv (two processes) shares (n, 4) actions: sub-env i equals the one-process
+    vector env's, autoresets included."""
+    from sensorium.gym.vector import SensoriumVectorEnv
+    from sensorium.gym.workers import SensoriumWorkersEnv
+    from tests.test_gym_workers import _same
+
+    w, n = world(True), 3
+    ref, envs = SensoriumVectorEnv(w, agent_task(max_steps=5), n), SensoriumWorkersEnv(w, agent_task(max_steps=5), n,
+                                                                                       workers=2)
+    try:
+        assert envs.action_space == ref.action_space and envs.single_action_space.shape == (4,)
+        _same(envs.reset(seed=2), ref.reset(seed=2), "reset")
+        rng = np.random.default_rng(1)
+        for t in range(12):
+            a = rng.uniform(-1, 1, (n, 4)).astype(np.float32)
+            _same(envs.step(a), ref.step(a), f"step {t}")
+        with pytest.raises(ValueError, match=r"^actions must have shape \(3, 4\)"):
+            envs.step(np.zeros((n, 2), dtype=np.float32))
+    finally:
+        ref.close()
+        envs.close()

@@ -40,6 +40,12 @@ Ackermann angles for it (``cot δ_inner = cot δ - track_front/2L``, outer ``+``
 ``max_steering_angle`` limit clamps (near full lock the inner wheel stops at the limit), and turn
 there at ``max_steering_speed`` (position control), so a new steering takes a few steps to reach.
 
+A mecanum robot (``mecanum_drive``, a youBot's base) acts with float32 ``(4,)`` = its four wheels'
+velocities in the drive's order (front left, front right, rear left, rear right): normalised, each in
+``[-1, 1]`` times ``max_wheel_speed``; ``actions="wheel"``: rad/s, bounded by it. All four at +1 drive
+forward, and with the default (youBot) rollers (-1, +1, +1, -1) strafes left and (-1, +1, -1, +1)
+turns left on the spot (README "mecanum"); the body twist is the wheels' least-squares fit.
+
 ``reset(seed=s)`` restarts the world with a world seed drawn from the environment's generator
 seeded with ``s``: every device noise stream, the start pose drawn by ``Task.start`` and the clock
 restart exactly, so the same seed and actions give a bit-identical episode. ``engine``: where the
@@ -108,17 +114,17 @@ class Agent:
         robots = {r.name: r for r in w.robots}
         name = task.robot or default_robot
         if name is None:
-            driven = [r.name for r in w.robots if r.differential_drive is not None or r.ackermann_drive is not None]
+            driven = [r.name for r in w.robots if has_drive(r)]
             if not driven:
-                raise ValueError(f"{loaded.source}: no robot with a differential_drive or an ackermann_drive to act "
-                                 "as the agent")
+                raise ValueError(f"{loaded.source}: no robot with a differential_drive, an ackermann_drive or a "
+                                 "mecanum_drive to act as the agent")
             name = driven[0]
         if name not in robots:
             raise ValueError(f"{loaded.source}: task robot {name!r} not in the world (robots: {', '.join(robots)})")
         model = robots[name]
-        if model.differential_drive is None and model.ackermann_drive is None:
-            raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive or ackermann_drive "
-                             "to act with")
+        if not has_drive(model):
+            raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive, ackermann_drive or "
+                             "mecanum_drive to act with")
         self.robot = name
         ctrl = basic if task.control_period_ms is None else task.control_period_ms
         if not whole(ctrl) or ctrl <= 0 or ctrl % basic:
@@ -159,19 +165,23 @@ class Agent:
         self.flatten = bool(flatten)
         self.observation_space: spaces.Space = (spaces.flatten_space(self.dict_space) if self.flatten
                                                 else self.dict_space)
-        # a car-like robot acts with (steering, speed): see :meth:`commands`
+        # a car-like robot acts with (steering, speed), a mecanum one with its four wheels: see :meth:`commands`
         self.car: wm.AckermannDrive | None = model.ackermann_drive
+        self.mecanum: wm.MecanumDrive | None = model.mecanum_drive
+        self.n_actions = 4 if self.mecanum is not None else 2
+        """The action's length: 2 (left, right or steering, speed), 4 for a mecanum robot's wheels."""
         if self.car is None:
-            assert model.differential_drive is not None
-            self.vmax = vmax = float(model.differential_drive.max_wheel_speed)
-            raw = spaces.Box(-vmax, vmax, shape=(2,), dtype=np.float32)
+            drive = model.differential_drive if self.mecanum is None else self.mecanum
+            assert drive is not None
+            self.vmax = vmax = float(drive.max_wheel_speed)
+            raw = spaces.Box(-vmax, vmax, shape=(self.n_actions,), dtype=np.float32)
         else:
             self.vmax = float(self.car.max_wheel_speed)
             self.max_steer = float(self.car.max_steering_angle)
             self.scale = np.array([self.max_steer, self.vmax])
             raw = spaces.Box(-self.scale.astype(np.float32), self.scale.astype(np.float32), dtype=np.float32)
-        self.action_space = (spaces.Box(-1.0, 1.0, shape=(2,), dtype=np.float32) if actions == "normalized"
-                             else raw)
+        self.action_space = (spaces.Box(-1.0, 1.0, shape=(self.n_actions,), dtype=np.float32)
+                             if actions == "normalized" else raw)
 
     def start(self, sim: Simulation, rng: np.random.Generator) -> None:
         """After a rebuild: start pose, wheels at rest in velocity control, devices enabled."""
@@ -179,7 +189,9 @@ class Agent:
         if self.task.start is not None:
             self.task.start(sim, robot, rng)
         # (a car's steering motors stay as built: position control at 0, at max_steering_speed)
-        wheels = robot.motors.values() if self.car is None else [robot.motors[n] for _, n in self.car.driven]
+        wheels = (robot.motors.values() if self.car is None and self.mecanum is None
+                  else [robot.motors[n] for _, n in (self.car.driven if self.car is not None
+                                                     else self.mecanum.motor_fields)])
         for m in wheels:
             m.set_position(math.inf)
             m.set_velocity(0.0)
@@ -202,18 +214,22 @@ class Agent:
 
     def commands(self, action) -> np.ndarray:
         """An action -> float64 (2,): (left, right) wheel velocities (rad/s), or a car's (steering
-        angle (rad, positive left), driven wheels' velocity (rad/s)); clamped later by the motors."""
+        angle (rad, positive left), driven wheels' velocity (rad/s)); a mecanum robot's (4,) wheel
+        velocities (rad/s, the drive's order); clamped later by the motors."""
         a = np.asarray(action, dtype=np.float64).reshape(-1)
-        if a.shape != (2,) or not np.all(np.isfinite(a)):
+        if a.shape != (self.n_actions,) or not np.all(np.isfinite(a)):
             what = ("values in [-1, 1]" if self.actions == "normalized"
                     else "wheel velocities" if self.car is None else "values (rad, rad/s)")
-            names = "left, right" if self.car is None else "steering, speed"
+            names = ("steering, speed" if self.car is not None
+                     else "front left, front right, rear left, rear right" if self.mecanum is not None
+                     else "left, right")
             # (the values as a list: an array's repr would break the line)
-            raise ValueError(f"{self.robot}: action must be 2 finite {what} ({names}), got {a.tolist()!r}")
+            raise ValueError(f"{self.robot}: action must be {self.n_actions} finite {what} ({names}), "
+                             f"got {a.tolist()!r}")
         return self.scaled(a)
 
     def scaled(self, a: np.ndarray) -> np.ndarray:
-        """Finite float64 actions (..., 2) -> the commands of :meth:`commands`, row by row (the vector
+        """Finite float64 actions (..., n_actions) -> the commands of :meth:`commands`, row by row (the vector
         env's actions of every sub-env at once)."""
         # a normalized action beyond [-1, 1] asks for more than the wheels give: clipped before the
         # scaling, which is the motors' clamp for any finite value (1e308 * vmax would overflow to inf)
@@ -245,6 +261,10 @@ class Agent:
             robot.motors[self.car.left_steer].set_position(left)
             for _, name in self.car.driven:
                 robot.motors[name].set_velocity(float(v[1]))
+            return
+        if self.mecanum is not None:
+            for (_, name), u in zip(self.mecanum.motor_fields, v.tolist()):
+                robot.motors[name].set_velocity(u)
             return
         drive = robot.drive
         for m in drive.lefts:        # every wheel of a side (a skid-steer robot has several)
@@ -286,6 +306,12 @@ class Agent:
         pose = sim.robot(self.robot).pose
         return {"time_ms": sim.time_ms, "steps": steps,
                 "pose": np.array(planar_pose(self.axes, pose.translation, pose.rotation))}
+
+
+def has_drive(model: wm.Robot) -> bool:
+    """Whether a robot can act as an agent: it has a two-wheel (or skid-steer), car-like or mecanum drive."""
+    return (model.differential_drive is not None or model.ackermann_drive is not None
+            or model.mecanum_drive is not None)
 
 
 OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "GPS", "Compass", "InertialUnit",

@@ -5,7 +5,8 @@
     obs, infos = env.reset(seed=0)
     obs, rewards, terms, truncs, infos = env.step({a: env.action_space(a).sample() for a in env.agents})
 
-Every agent is a robot with a differential drive or a car-like robot (an ackermann drive) and its own :class:`~sensorium.gym.task.Task`
+Every agent is a robot with a differential drive, a car-like robot (an ackermann drive) or a mecanum
+robot (four wheel speeds) and its own :class:`~sensorium.gym.task.Task`
 (spaces as in :class:`~sensorium.gym.env.SensoriumEnv`); all act every control period, which must
 be the same for all. An agent that terminates or truncates leaves ``agents`` and its robot stops;
 the world keeps running for the others. Resets are exact as in the single-agent environment.
@@ -28,7 +29,7 @@ import numpy as np
 from gymnasium.utils import seeding
 from pettingzoo import ParallelEnv
 
-from sensorium.gym.env import DEFAULT_PRECISION, Agent, batched_engine, check_precision, load, rebuild
+from sensorium.gym.env import DEFAULT_PRECISION, Agent, batched_engine, check_precision, has_drive, load, rebuild
 from sensorium.gym.render import TopDown, TopDownRendering, check_render_size
 from sensorium.gym.task import Task
 from sensorium.gym.views import CopySim
@@ -47,11 +48,10 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
                  engine: str = "auto"):
         self.loaded = load(world)
         if tasks is None:
-            tasks = {r.name: Task(robot=r.name) for r in self.loaded.world.robots
-                     if r.differential_drive is not None or r.ackermann_drive is not None}
+            tasks = {r.name: Task(robot=r.name) for r in self.loaded.world.robots if has_drive(r)}
         if not tasks:
-            raise ValueError(f"{self.loaded.source}: no robot with a differential_drive or an ackermann_drive to act "
-                             "as an agent")
+            raise ValueError(f"{self.loaded.source}: no robot with a differential_drive, an ackermann_drive or a "
+                             "mecanum_drive to act as an agent")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
         self.render_mode = render_mode
@@ -123,6 +123,6 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
             infos[a] = ag.info(self.sim, self.steps)
         for a in list(self.agents):
             if terms[a] or truncs[a]:
-                self._agents[a].act(self.sim, np.zeros(2))      # a finished robot stops where it is
+                self._agents[a].act(self.sim, np.zeros(self._agents[a].n_actions))   # a finished robot stops where it is
                 self.agents.remove(a)
         return obs, rewards, terms, truncs, infos

@@ -25,7 +25,7 @@ rewards and flags (tests compare them step by step, resets included).
 * ``sub_env(i)``: sub-environment *i* as a plain ``gymnasium.Env`` (reset and step it alone; for
   checkers and tests).
 * Options as ``SensoriumEnv``: ``actions`` (``"normalized"``: [-1, 1], the default; ``"wheel"``:
-  rad/s; a car-like agent's (steering, speed) as there), ``flatten`` (one Box), ``precision``; a task's reward and termination use their
+  rad/s; a car-like agent's (steering, speed), a mecanum agent's four wheels as there), ``flatten`` (one Box), ``precision``; a task's reward and termination use their
   vectorised form when they have one (``ReachLight``, ``AvoidObstacles``, :mod:`.task`), else
   they are called per copy with views of that copy.
 * ``threads``: the threads a cast of >= 16,384 rays (all copies' lidar beams) may be split over
@@ -222,7 +222,10 @@ class SensoriumVectorEnv(VectorEnv):
             for c in copies.tolist():
                 view = self._view(c)
                 self.task.start(view, view.robot(self.agent.robot), self._rngs[c])
-        if self.agent.car is None:
+        if self.agent.mecanum is not None:      # a mecanum robot: its four wheels at rest in velocity control
+            assert self.sim.mecanum is not None
+            self.sim.mecanum.command(self.slot, np.zeros((len(copies), 4)), copies)
+        elif self.agent.car is None:
             self.sim.set_wheels(self.slot, np.zeros(len(copies)), np.zeros(len(copies)), copies)
         else:       # a car: its driven wheels at rest in velocity control (its steering as built)
             assert self.sim.cars is not None
@@ -246,14 +249,18 @@ class SensoriumVectorEnv(VectorEnv):
             self.sim.step(active)
 
     def _act(self, copies: np.ndarray, actions: np.ndarray) -> None:
-        a = np.asarray(actions, dtype=np.float64).reshape(len(copies), 2)
+        width = self.agent.n_actions
+        a = np.asarray(actions, dtype=np.float64).reshape(len(copies), width)
         if not np.isfinite(a).all():
             bad = int(np.flatnonzero(~np.isfinite(a).all(axis=1))[0])
-            raise ValueError(f"sub-env {int(copies[bad])}: action must be 2 finite values, got {actions[bad]!r}")
+            raise ValueError(f"sub-env {int(copies[bad])}: action must be {width} finite values, got {actions[bad]!r}")
         cmd = self.agent.scaled(a)          # (the single env's commands, row by row)
         # (every copy in order: the simulation's own default, a slice rather than a gather)
         which = None if copies is self._every else copies
-        if self.agent.car is None:
+        if self.agent.mecanum is not None:     # a mecanum robot: its four wheels (the drive's order)
+            assert self.sim.mecanum is not None
+            self.sim.mecanum.command(self.slot, cmd, which)
+        elif self.agent.car is None:
             self.sim.set_wheels(self.slot, cmd[:, 0], cmd[:, 1], which)
         elif len(copies):       # a car: its steering motors to the Ackermann angles, its driven wheels to the speed
             assert self.sim.cars is not None
@@ -389,8 +396,8 @@ class SensoriumVectorEnv(VectorEnv):
         if self._needs_reset.any():
             raise RuntimeError("call reset() before step()")
         actions = np.asarray(actions)
-        if actions.shape != (n, 2):
-            raise ValueError(f"actions must have shape ({n}, 2), got {actions.shape}")
+        if actions.shape != (n, self.agent.n_actions):
+            raise ValueError(f"actions must have shape ({n}, {self.agent.n_actions}), got {actions.shape}")
         resetting = self._autoreset.copy() if self.autoreset_mode == AutoresetMode.NEXT_STEP else np.zeros(n, bool)
         if self.autoreset_mode == AutoresetMode.DISABLED and self._autoreset.any():
             raise RuntimeError(f"sub-envs {self._autoreset.nonzero()[0].tolist()} ended: reset them "

@@ -145,28 +145,28 @@ def _layout(agent: Agent) -> list[tuple[str | None, tuple[int, ...], np.dtype]]:
     return [(k, tuple(b.shape or ()), np.dtype(b.dtype)) for k, b in agent.dict_space.spaces.items()]
 
 
-def _shapes(layout) -> dict[str | None, tuple[tuple[int, ...], np.dtype]]:
-    """Every shared array's shape of one copy and dtype: the observation's arrays, actions, rewards,
-    flags, and the infos' arrays and masks."""
+def _shapes(layout, width: int) -> dict[str | None, tuple[tuple[int, ...], np.dtype]]:
+    """Every shared array's shape of one copy and dtype: the observation's arrays, actions (``width``
+    values: Agent.n_actions), rewards, flags, and the infos' arrays and masks."""
     shapes: dict[str | None, tuple[tuple[int, ...], np.dtype]] = {key: (shape, dtype) for key, shape, dtype in layout}
-    shapes.update({"@actions": ((2,), np.dtype(np.float64)), "@rewards": ((), np.dtype(np.float64)),
+    shapes.update({"@actions": ((width,), np.dtype(np.float64)), "@rewards": ((), np.dtype(np.float64)),
                    "@terminations": ((), np.dtype(bool)), "@truncations": ((), np.dtype(bool))})
     for key, (shape, dtype) in BASE_INFO.items():
         shapes["@" + key], shapes["@_" + key] = (shape, dtype), ((), np.dtype(bool))
     return shapes
 
 
-def _buffers(ctx, layout, n: int) -> dict:
+def _buffers(ctx, layout, n: int, width: int) -> dict:
     """The shared buffers (raw bytes, zeroed), one per array of :func:`_shapes`."""
     return {key: ctx.RawArray("B", max(1, n * int(np.prod(shape, dtype=np.int64)) * dtype.itemsize))
-            for key, (shape, dtype) in _shapes(layout).items()}
+            for key, (shape, dtype) in _shapes(layout, width).items()}
 
 
-def _arrays(raws: dict, layout, n: int) -> dict:
+def _arrays(raws: dict, layout, n: int, width: int) -> dict:
     """numpy views of the shared buffers, each (n, *shape of one copy)."""
     return {key: np.frombuffer(memoryview(raws[key]).cast("B"), dtype=dtype,
                                count=n * int(np.prod(shape, dtype=np.int64))).reshape(n, *shape)
-            for key, (shape, dtype) in _shapes(layout).items()}
+            for key, (shape, dtype) in _shapes(layout, width).items()}
 
 
 # ---------------------------------------------------------------------- the worker process
@@ -220,7 +220,7 @@ def _serve(conn: Connection, go, done, control, w: int, poll_s: float, parent: i
 
         loaded, task, options = cloudpickle.loads(payload)
         env = SensoriumVectorEnv(loaded, task, hi - lo, **options)
-        mine = {key: a[lo:hi] for key, a in _arrays(raws, layout, n).items()}
+        mine = {key: a[lo:hi] for key, a in _arrays(raws, layout, n, env.agent.n_actions).items()}
     except Exception as exc:  # noqa: BLE001 - every failure goes to the parent as one message
         answer(_FAILED, _describe(exc))
         return
@@ -375,8 +375,9 @@ class SensoriumWorkersEnv(VectorEnv):
         self._autoreset = np.zeros(n, dtype=bool)
 
         ctx = mp.get_context("spawn")
-        raws = _buffers(ctx, self._layout, n)
-        self._shared = _arrays(raws, self._layout, n)
+        self._width = agent.n_actions
+        raws = _buffers(ctx, self._layout, n, self._width)
+        self._shared = _arrays(raws, self._layout, n, self._width)
         control = ctx.RawArray("q", 2 * self.workers)
         self._command, self._status = _control(control)
         self._gos = [ctx.Semaphore(0) for _ in range(self.workers)]
@@ -532,8 +533,8 @@ class SensoriumWorkersEnv(VectorEnv):
         if self._needs_reset.any():
             raise RuntimeError("call reset() before step()")
         actions = np.asarray(actions)
-        if actions.shape != (n, 2):
-            raise ValueError(f"actions must have shape ({n}, 2), got {actions.shape}")
+        if actions.shape != (n, self._width):
+            raise ValueError(f"actions must have shape ({n}, {self._width}), got {actions.shape}")
         if self.autoreset_mode == AutoresetMode.DISABLED and self._autoreset.any():
             raise RuntimeError(f"sub-envs {self._autoreset.nonzero()[0].tolist()} ended: reset them "
                                "(options={'reset_mask': ...}) before stepping (autoreset is disabled)")
@@ -542,7 +543,8 @@ class SensoriumWorkersEnv(VectorEnv):
         moving = ~self._autoreset if self.autoreset_mode == AutoresetMode.NEXT_STEP else np.ones(n, dtype=bool)
         bad = np.flatnonzero(moving & ~np.isfinite(a).all(axis=1))
         if len(bad):
-            raise ValueError(f"sub-env {int(bad[0])}: action must be 2 finite values, got {actions[bad[0]]!r}")
+            raise ValueError(f"sub-env {int(bad[0])}: action must be {self._width} finite values, "
+                             f"got {actions[bad[0]]!r}")
         self._shared["@actions"][...] = a
         infos = self._call([("step", None)] * self.workers)
         obs = self._observations()
