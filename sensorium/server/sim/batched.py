@@ -803,7 +803,11 @@ class BatchedSimulation:
     def _drive_numpy(self, live: np.ndarray, driven: np.ndarray, dt: float) -> None:
         """:meth:`_drive` without the C helper (the same values)."""
         self.pressing[live] = False
-        copies, slots, v, w = self._drive_wheels(live, driven, dt)
+        if len(driven):
+            copies, slots, v, w = self._drive_wheels(live, driven, dt)
+        else:         # no two-wheel or skid-steer robot (cars, mecanum robots): nothing to gather
+            copies = slots = _NONE
+            v = w = _EMPTY
         if self.cars is not None:     # the cars' moves too, sorted into slot order below where it matters (_narrow)
             cars = self.cars.step(live, dt)
             copies, slots, v, w = (np.concatenate(pair) for pair in zip((copies, slots, v, w), cars))
@@ -1558,6 +1562,8 @@ class _Stream:
 
 _NONE = np.zeros(0, dtype=np.int64)
 _NONE.setflags(write=False)
+_EMPTY = np.zeros(0)
+_EMPTY.setflags(write=False)
 
 
 def _by_table(devices: list) -> list[tuple]:

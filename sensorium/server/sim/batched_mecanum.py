@@ -89,15 +89,19 @@ class MecanumDrives:
     def step(self, live: np.ndarray, dt: float) -> tuple[np.ndarray, ...]:
         """Advance the live copies' wheels one step; the moving robots' (copies, slots, vx, vy, ωz):
         MecanumDrive.step up to its twist step (a robot moves when any wheel turned)."""
-        tgt = self.target[live]
-        vel = self.velocity[live]
-        ang = self.angle[live]
+        every = len(live) == len(self.angle)        # every copy (live is then 0 ... C-1): no gathers
+        tgt = self.target if every else self.target[live]
+        vel = self.velocity if every else self.velocity[live]
+        ang = self.angle if every else self.angle[live]
         remaining = tgt - ang                                   # WheelMotor.advance, element by element
         with np.errstate(invalid="ignore"):
             speed = np.minimum(np.abs(vel), np.abs(remaining) / dt) if dt > 0 else np.zeros_like(vel)
             held = np.where(remaining != 0.0, np.copysign(speed, remaining), 0.0)
         u = np.where(np.isinf(tgt), vel, held)                  # (live, M, 4)
-        self.angle[live] = ang + u * dt
+        if every:
+            ang += u * dt
+        else:
+            self.angle[live] = ang + u * dt
         ci, ri = (u != 0.0).any(axis=2).nonzero()
         u = u[ci, ri]                                           # (n, 4): the moving robots' wheel speeds
         r, s, c = self.radius[ri], self.sign[ri], self.c[ri]
@@ -130,18 +134,25 @@ def twist_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, vx: np.ndarray, v
                 dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """motion.twist_step for many robots, element by element the same float64 operations (a = dt,
     b = 0 where ω is 0; sin(ω·dt)/ω and 2 sin²(ω·dt/2)/ω elsewhere)."""
+    k = len(w)
     turning = w != 0.0
-    a = np.full(len(w), dt)
-    b = np.zeros(len(w))
-    t = turning.nonzero()[0]
-    if len(t):
-        wt = w[t]
-        # one libm pass for both sines: sin(0.5·ω·dt) and sin(ω·dt)
-        _, sines = libm_cos_sin(np.concatenate([0.5 * wt * dt, wt * dt]))
-        half, full = sines[:len(t)], sines[len(t):]
-        a[t] = full / wt
-        b[t] = 2.0 * half * half / wt
+    n_turning = int(np.count_nonzero(turning))
+    # one libm pass for every sine and cosine: sin(0.5·ω·dt) and sin(ω·dt) of the turning robots,
+    # cos and sin of every heading
+    t = slice(None) if n_turning == k else turning.nonzero()[0]
+    wt = w[t]
+    cos, sin = libm_cos_sin(np.concatenate([0.5 * wt * dt, wt * dt, yaw]))
+    c, s = cos[2 * n_turning:], sin[2 * n_turning:]
+    if n_turning == k:
+        a = sin[k:2 * k] / w
+        b = 2.0 * sin[:k] * sin[:k] / w
+    else:
+        a = np.full(k, dt)
+        b = np.zeros(k)
+        if n_turning:
+            half = sin[:n_turning]
+            a[t] = sin[n_turning:2 * n_turning] / wt
+            b[t] = 2.0 * half * half / wt
     dx, dy = a * vx - b * vy, b * vx + a * vy
-    c, s = libm_cos_sin(yaw)
     return (x + c * dx - s * dy, y + s * dx + c * dy,
             np.remainder(yaw + w * dt + math.pi, _TWO_PI) - math.pi)
