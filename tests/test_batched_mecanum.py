@@ -1,9 +1,10 @@
 """Mecanum (youBot-like) robots in the batched simulation: every copy steps as the single
 Simulation does, bit for bit (random wheel commands, position control included, contact on and off,
-walls, another mecanum robot and a two-wheel robot in the world, set_pose, every device read), the
-copies never see each other, a pure strafe ends where its closed form says, a strafe against a wall
-stops at its face; as an agent, its four normalised wheel speeds are the action of the single and
-the batched environments alike, bit for bit, and both pass Gymnasium's checker."""
+walls, another mecanum robot and a two-wheel robot in the world, set_pose, every device read; a
+ramp it rides; a NUE world), the copies never see each other, a pure strafe ends where its closed
+form says, a strafe against a wall stops at its face; as an agent, its four normalised wheel speeds
+are the action of the single and the batched environments alike, bit for bit, and both pass
+Gymnasium's checker."""
 
 from __future__ import annotations
 
@@ -396,3 +397,70 @@ def test_the_workers_env_carries_four_wheel_actions_bit_for_bit():
     finally:
         ref.close()
         envs.close()
+
+
+def lockstep(w, steps: int, seeds=(5, 6)) -> tuple[BatchedSimulation, int, int]:
+    """Copies of ``w`` (one per seed) and a Simulation per copy with random commands changed every
+    40 steps (:func:`random_commands`): every robot's pose and readings the same bits every step.
+    Returns the batched simulation and the copy-steps in which a robot was tilted (on a slope) and
+    pressed against something."""
+    from sensorium.gym.views import CopySim
+
+    n = len(seeds)
+    batched = BatchedSimulation(w, n)
+    batched.reset(np.arange(n), list(seeds))
+    singles = [Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
+        update={"random_seed": s})})) for s in seeds]
+    views = [CopySim(batched, c) for c in range(n)]
+    for s in (*singles, *views):
+        for r in s.robots.values():
+            for d in r.model.devices:
+                r.device(d.name).enable(16)
+    rng = np.random.default_rng(len(w.world.robots))
+    tilted = pressed = 0
+    for t in range(steps):
+        if t % 40 == 0:
+            cmds = [random_commands(rng, w.world) for _ in range(n)]
+        for c in range(n):
+            command(singles[c], cmds[c])
+            command(views[c], cmds[c])
+            singles[c].step()
+        batched.step()
+        for c in range(n):
+            for name in singles[c].robots:
+                assert same_pose(singles[c], views[c], name), (t, c, name)
+                assert_same_readings(singles[c], views[c], name, (t, c))
+                pressed += bool(singles[c].robot(name).pressing)
+        tilted += int(batched.tilted.sum())
+    return batched, tilted, pressed
+
+
+def test_a_mecanum_robot_rides_a_ramp_as_in_the_single_simulation():
+    """An elevation grid under the robot's start (a ramp rising 0.3 m over 1.5 m along x): the copies
+    ride up and down it, tilted, the same bits as their Simulations."""
+    ramp = {"name": "ramp", "pose": {"translation": [-1.0, -1.0, 0.0]},
+            "geometry": {"type": "elevation_grid", "x_dimension": 4, "x_spacing": 0.5, "y_dimension": 4,
+                         "y_spacing": 0.5, "height": [0.0, 0.1, 0.2, 0.3] * 4}}
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": True},
+                     "solids": [ramp, wall("east", 1.2, 0, 0.2, 2.6)],
+                     "robots": [youbot("yb", -0.4, -0.4)]})
+    batched, tilted, _ = lockstep(w, 240)
+    assert batched.ground is not None and tilted > 50          # it rode the ramp's slope
+
+
+def test_a_nue_world_batches_mecanum_robots_bit_for_bit():
+    """A NUE world (y up): the robot drives, strafes and turns on its ground plane between four walls,
+    as in its Simulation, the same bits (poses turned into the world's axes), pressed against them."""
+    body = {"geometry": {"type": "box", "size": [0.5, 0.1, 2 * HALF_W]}}
+    robot = {"name": "yb", "pose": {"translation": [0.0, 0.1, 0.0]}, "body": body,
+             "mecanum_drive": {"wheel_radius": R, "lx": LX, "ly": LY},
+             "devices": [{"device": "GPS", "name": "gps"}, {"device": "InertialUnit", "name": "imu"},
+                         {"device": "PositionSensor", "name": "fl sensor", "motor": FL}]}
+    w = parse_world({"world_info": {"basic_time_step": STEP, "coordinate_system": "NUE", "contact": True},
+                     "solids": [{"name": n, "pose": {"translation": [x, 0.25, z]},
+                                 "geometry": {"type": "box", "size": [sx, 0.5, sz]}}
+                                for n, x, z, sx, sz in (("w", 0.0, -0.7, 2.0, 0.2), ("e", 0.0, 0.7, 2.0, 0.2),
+                                                        ("n", 0.9, 0.0, 0.2, 1.6), ("s", -0.9, 0.0, 0.2, 1.6))],
+                     "robots": [robot]})
+    batched, _, pressed = lockstep(w, 240)
+    assert batched.to_enu is not None and pressed > 0
