@@ -983,6 +983,20 @@ class Contact:
         self._zlo = np.array([o.z_range[0] for o in obs], dtype=np.float64)
         self._zhi = np.array([o.z_range[1] for o in obs], dtype=np.float64)
 
+    def reshape(self, index: int, parts: list[tuple[geo.Primitive, Pose]]) -> None:
+        """Robot ``index``'s bounding shapes moved on its joints: its footprint is made again from
+        ``parts`` (as the constructor's ``robots`` give them, robot frame), at its world-file pose and
+        heading as the first was (:func:`drive_footprint`), and its broad-phase disc, spin reach and
+        height band with it. Called only for a robot one of whose joints carrying bounding shapes
+        moved (sim/simulation.py ``RobotState.move_links``)."""
+        pose, yaw = self.initial[index]
+        foot = self.feet[index] = drive_footprint(parts, pose, self._to_enu, yaw)
+        nan = math.nan
+        self._radius[index] = foot.radius if foot else nan
+        self._spin[index] = spin_reach([foot])[0]
+        self._z_low[index] = foot.z_low if foot else nan
+        self._z_high[index] = foot.z_high if foot else nan
+
     def place(self, index: int, pose: Pose, yaw: float | None = None) -> None:
         """A robot was moved from outside (set_pose, reset): no contact check, as in Webots.
         ``yaw``: its drive's heading there (None: :func:`heading` of the pose)."""
