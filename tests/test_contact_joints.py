@@ -82,6 +82,24 @@ def test_a_bumper_swung_away_by_a_hinge_stops_touching_and_the_body_drives_on_to
     assert xy(sim, "r")[0] == pytest.approx(FACE - 0.2 - 5 * 0.016, abs=1e-9) and bumper.value == 0.0
 
 
+def test_a_reset_and_a_supervisor_s_joint_move_reshape_the_footprint():
+    """The slider pushed 0.1 m out, then the world reset: the footprint is the loaded one again (its
+    front 0.22 m ahead); placed at 0.05 by hand (a Supervisor's setJointPosition, Simulation.joints_moved),
+    the footprint's front is 0.27 m ahead."""
+    sim = world([WALL], [bumper_robot("LinearMotor", (1, 0, 0))])
+    loaded = sim.contact.feet[0].points.copy()
+    assert float(loaded[:, 0].max()) == pytest.approx(0.22, abs=1e-15)
+    sim.robot("r").motor("j").set_position(0.1)
+    sim.step()
+    assert float(sim.contact.feet[0].points[:, 0].max()) == pytest.approx(0.32, abs=1e-15)
+    sim.reset()
+    assert (sim.contact.feet[0].points == loaded).all()
+    robot = sim.robot("r")
+    robot.motor("j").place(0.05)
+    sim.joints_moved(robot)
+    assert float(sim.contact.feet[0].points[:, 0].max()) == pytest.approx(0.27, abs=1e-15)
+
+
 def test_another_robot_s_arm_swung_into_the_path_stops_a_robot_at_its_face():
     """A standing robot (no drive) at (1, 0.5) holds a 0.1 x 0.6 m arm on a hinge about z through its
     origin, lying along +x (clear of the path y = 0); turned a quarter turn clockwise it lies along
