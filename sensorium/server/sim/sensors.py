@@ -925,7 +925,8 @@ class TouchSensor(Device):
     """Webots TouchSensor. A bumper with bounding shapes of its own (the robot's shapes whose
     ``of_device`` names it) reads 1 when, at the end of the step, one of them touches a solid or
     another robot as kinematic contact sees them (contact.pieces_touch: a gap of at most
-    contact.TOUCH, bands overlapping), else 0; a bumper without any reads 1 when contact clipped its
+    contact.TOUCH, bands overlapping), else 0 -- each shape where its joint holds it now, the pieces
+    made again only when such a joint moved; a bumper without any reads 1 when contact clipped its
     robot's move in the step. ``force`` and ``force-3d`` read NaN (they need physics)."""
 
     kinematic = True
