@@ -218,16 +218,33 @@ def test_a_turn_whose_end_is_past_a_thin_post_is_not_pushed_through_it():
     assert 0.0 < kept <= 0.49 - math.asin(0.15)
 
 
-def test_in_a_corner_a_push_into_the_other_wall_falls_back_to_the_cut_short_turn():
+@pytest.mark.parametrize("sense", [1.0, -1.0])
+def test_in_a_corner_a_turn_pushes_the_robot_off_both_walls_at_once(sense):
     # flush against two walls at once (y = -0.1 below, x = -0.2 behind): either way its turn puts a
-    # corner into both, and a push off one leaves it in the other: the turn is cut short, as before
+    # corner into both, and a push off one alone leaves it in the other; the least move out of both
+    # is diagonal, to where the turned rectangle touches both: its reach behind, 0.2 cos h + 0.1 sin |h|,
+    # and below, 0.2 sin |h| + 0.1 cos h, at heading h. The reach behind grows until |h| = atan(1/2)
+    # (22 steps); from there only the wall below pushes, and the centre stays as far off the wall
+    # behind as the turn took it (nothing pulls it back)
     corner = [block("s", -3.0, 3.0, -0.3, -0.1), block("w", -0.4, -0.2, -3.0, 3.0)]
     sim = world(corner, [box_robot("r", 0.0, 0.0, size=(0.4, 0.2))])
-    for left, right in ((-1.0, 1.0), (1.0, -1.0)):
-        drive(sim, "r", left, right)
-        for _ in range(5):
-            sim.step()
-            assert heading(sim, "r") == 0.0 and (xy(sim, "r") == 0.0).all() and sim.robot("r").pressing
+    drive(sim, "r", -sense, sense)
+    furthest = 0.0
+    for k in range(1, 31):
+        sim.step()
+        h = heading(sim, "r")
+        assert h == pytest.approx(sense * k * PER_STEP, abs=1e-12) and sim.robot("r").pressing
+        a = abs(h)
+        furthest = max(furthest, 0.2 * math.cos(a) + 0.1 * math.sin(a))
+        x, y = xy(sim, "r")
+        assert x == pytest.approx(furthest - 0.2, abs=1e-9)
+        assert y == pytest.approx(0.2 * math.sin(a) + 0.1 * math.cos(a) - 0.1, abs=1e-9)
+        c = corners(sim, "r", (0.4, 0.2))
+        assert float(c[:, 0].min()) >= -0.2 - 1e-9 and float(c[:, 1].min()) >= -0.1 - 1e-9
+    assert furthest == pytest.approx(math.hypot(0.2, 0.1), abs=1e-4)    # its diagonal's half, at atan(1/2)
+
+
+def test_in_a_corridor_narrower_than_the_turn_the_turn_is_cut_short():
     # a corridor 0.21 m wide: the first step's push off the wall below (0.0043 m) fits, the next
     # would push it into the wall above (the footprint 0.4 sin h + 0.2 cos h across): cut short
     sim = world([block("s", -3.0, 3.0, -0.3, -0.1), block("n", -3.0, 3.0, 0.11, 0.3)],
@@ -388,7 +405,8 @@ def _flush_pen_world():
 def test_the_batched_engine_pushes_turning_robots_off_walls_as_the_single_simulation_bit_for_bit(native, monkeypatch):
     """Robots flush against walls, head-on and in a corner, spun and driven at random: the batched
     engine (its C drive pass and its numpy path, whose broad phases grow a turning move by what its
-    push may need) keeps the single simulation's poses, pressing flags and contacts bit for bit."""
+    push may need) keeps the single simulation's poses, pressing flags and contacts bit for bit, the
+    corner's pushes off both walls at once included."""
     from sensorium.server.raycast import packets
     from sensorium.server.sim.batched import BatchedSimulation
     if native and packets.library() is None:
@@ -401,6 +419,14 @@ def test_the_batched_engine_pushes_turning_robots_off_walls_as_the_single_simula
         pushes.append(got is not None)
         return got
     monkeypatch.setattr(C.Contact, "_push", counted)
+    corner_pushes = []                        # pushes off both walls of the pen's corner (robot c's)
+    both = C.Contact._push_off_both
+
+    def counted_both(self, *args):
+        got = both(self, *args)
+        corner_pushes.append(got is not None)
+        return got
+    monkeypatch.setattr(C.Contact, "_push_off_both", counted_both)
     n = 3
     bs = BatchedSimulation(_flush_pen_world(), n)
     if not native:
@@ -419,7 +445,7 @@ def test_the_batched_engine_pushes_turning_robots_off_walls_as_the_single_simula
                     drive(singles[c], name, lr[r, c, 0], lr[r, c, 1])
         _step_both(bs, singles, step)
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
-    assert pushes.count(True) > 20 and pushes.count(False) > 0
+    assert pushes.count(True) > 20 and pushes.count(False) > 0 and corner_pushes.count(True) > 0
 
 
 def test_a_drive_whose_forward_is_the_robot_s_y_axis_stops_with_the_face_along_y():

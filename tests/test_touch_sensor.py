@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from sensorium.schemas import messages as msgs
 from sensorium.schemas import world as wm
@@ -222,3 +223,36 @@ def test_a_wbt_touch_sensor_bumper_reads_with_its_bounding_object(tmp_path: Path
     for _ in range(150):
         sim.step()
     assert [sim.device(f"r/{n}").value for n in ("left", "right", "plain")] == [1.0, 0.0, 1.0]
+
+
+def test_a_slow_bumper_reads_the_touch_at_its_reading_s_step_only():
+    """Pins the documented departure (README "Bumpers"): a reading is the touch at the end of the
+    step it is due on. Two bumpers with identical plates (0.02 m deep, front face 0.22 m ahead of
+    the centre) on a box robot 0.03 m from a wall, driven at 0.016 m per 16 ms step: the plates
+    touch the wall at the end of step 2 (the move clipped there), the robot backs off on steps 3
+    and 4. The bumper read every step reads 0, 1, 0, 0; the one read every 64 ms reads 0 at step 4
+    -- Webots' would read 1 (WbTouchSensor keeps a collision of any step until the next reading)."""
+    plate = {"pose": {"translation": [0.21, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.2, 0.1]}}
+    data = {"world_info": {"basic_time_step": 16},
+            "solids": [{"name": "wall", "pose": {"translation": [0.35, 0.0, 0.1]},
+                        "geometry": {"type": "box", "size": [0.2, 2.0, 0.2]}}],
+            "robots": [{"name": "r", "pose": {"translation": [0.0, 0.0, 0.1]},
+                        "body": {"geometry": {"type": "box", "size": [0.4, 0.2, 0.2]}},
+                        "shapes": [{**plate, "of_device": "fast"}, {**plate, "of_device": "slow"}],
+                        "devices": [{"device": "TouchSensor", "name": "fast"}, {"device": "TouchSensor", "name": "slow"}],
+                        "differential_drive": {"wheel_radius": 0.1, "axle_length": 0.3, "max_wheel_speed": 1000}}]}
+    sim = Simulation(wm.World.model_validate(data))
+    fast, slow = sim.device("r/fast"), sim.device("r/slow")
+    fast.enable(16)
+    slow.enable(64)
+    drive(sim, 10.0)                                       # 0.016 m per step: the wall's face 0.03 m ahead
+    read = []
+    for k in range(1, 5):
+        sim.step()
+        read.append(fast.value)
+        if k == 2:
+            assert sim.robot("r").pose.translation[0] == pytest.approx(0.03, abs=1e-9)
+            drive(sim, -10.0)
+    assert read == [0.0, 1.0, 0.0, 0.0]
+    assert sim.robot("r").pose.translation[0] == pytest.approx(0.03 - 2 * 0.016, abs=1e-9)
+    assert slow.measurements == 1 and slow.value == 0.0

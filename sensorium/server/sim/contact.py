@@ -29,7 +29,8 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   sweeping through the turn overlaps nothing it did not already overlap, or deeper (each vertex's
   arc about the centre tested in closed form, :func:`turn_gap_holds`); where the turn would go into something,
   the whole turn is kept and the centre pushed off it the least distance, to touching
-  (:meth:`Contact._push`, closed form), unless that push meets something else: then the turn is
+  (:meth:`Contact._push`, closed form; in a corner of two polygons, off both at once:
+  :meth:`Contact._push_off_both`), unless that push meets something else: then the turn is
   cut short, found by halving to 2^-12 of the step's turn (either counts as a contact); then its centre moves along the chord from
   its start to its end pose (poses are only observed at the end of steps, and the end point is
   the exact arc end unless contact clips it) at the heading it kept. The chord is tested against
@@ -46,8 +47,8 @@ the contact's tangent (slide), up to three times per step (corners). A robot pus
 a wall therefore stops at the contact distance; one meeting it obliquely keeps the tangential
 part of its motion, as a Webots robot rubbing along a wall does. A disc turns freely; a shaped
 robot can always back out along its heading (a move that goes no deeper is free), turn the way
-that frees its corner, and turn the other way pushed off the wall but in a corner or a corridor
-too narrow for the push. Deterministic: robots are resolved in world order, each against the others'
+that frees its corner, and turn the other way pushed off the wall (off both walls of a corner)
+but in a corridor too narrow for the push. Deterministic: robots are resolved in world order, each against the others'
 current positions and headings. Float64 throughout.
 """
 
@@ -983,6 +984,20 @@ class Contact:
         self._zlo = np.array([o.z_range[0] for o in obs], dtype=np.float64)
         self._zhi = np.array([o.z_range[1] for o in obs], dtype=np.float64)
 
+    def reshape(self, index: int, parts: list[tuple[geo.Primitive, Pose]]) -> None:
+        """Robot ``index``'s bounding shapes moved on its joints: its footprint is made again from
+        ``parts`` (as the constructor's ``robots`` give them, robot frame), at its world-file pose and
+        heading as the first was (:func:`drive_footprint`), and its broad-phase disc, spin reach and
+        height band with it. Called only for a robot one of whose joints carrying bounding shapes
+        moved (sim/simulation.py ``RobotState.move_links``)."""
+        pose, yaw = self.initial[index]
+        foot = self.feet[index] = drive_footprint(parts, pose, self._to_enu, yaw)
+        nan = math.nan
+        self._radius[index] = foot.radius if foot else nan
+        self._spin[index] = spin_reach([foot])[0]
+        self._z_low[index] = foot.z_low if foot else nan
+        self._z_high[index] = foot.z_high if foot else nan
+
     def place(self, index: int, pose: Pose, yaw: float | None = None) -> None:
         """A robot was moved from outside (set_pose, reset): no contact check, as in Webots.
         ``yaw``: its drive's heading there (None: :func:`heading` of the pose)."""
@@ -1165,7 +1180,8 @@ class Contact:
         moved in the turn (``foot.radius`` times min(|turn|, 2): what the broad phase grew the move
         by), or its path or end meets another candidate (deeper than it already was). Each
         candidate the turn goes into is tried in turn, the deepest first: a wall of several
-        blocks pushes the robot off all of them at once, a corner of two walls does not."""
+        blocks pushes the robot off all of them at once; in a corner of two walls, where a push
+        off either leaves it in the other, :meth:`_push_off_both` pushes it out of both."""
         assert foot.points is not None
         shape = _turned(foot.points, yaw1)
         grown = [_grown(ob, shape, foot.round, p) for ob in cands]
@@ -1200,7 +1216,72 @@ class Contact:
                     break
             if ok:
                 return q
+        if len(pushes) == 2:         # a corner of two: the least move out of both, if that fits
+            return self._push_off_both(p, pushes[0][1], pushes[1][1], grown, now, cands, here, foot.round, limit)
         return None
+
+    def _push_off_both(self, p: np.ndarray, i: int, j: int, grown: list[tuple[Obstacle, float]], now: list[float],
+                       cands: list[Obstacle], here: np.ndarray, rnd: float, limit: float) -> np.ndarray | None:
+        """The push out of two candidates at once (a corner of two walls), when no push off one of
+        them alone fits: the least move of the centre ``p``, which the turned footprint puts inside
+        both (``grown``: each candidate grown by it), to a point outside both -- the nearest point
+        of the boundary of their union, which is on an edge of one outside the other (the edge's
+        nearest point to ``p``, clamped to the edge) or where an edge of each cross: exact, in closed
+        form, for two polygons (a box's, a mesh's; grown by a footprint without a round part), None
+        otherwise or where either overlapped the footprint before the turn (deeper than EPS). Then
+        checked as :meth:`_push` checks a push off one: no longer than ``limit``, not back toward
+        either side the robot came from, and neither its path nor its end meets another candidate."""
+        ga, ra = grown[i]
+        gb, rb = grown[j]
+        if (ra or rb or ga.radius or gb.radius or ga.normal is not None or gb.normal is not None
+                or len(ga.points) < 3 or len(gb.points) < 3 or min(now[i], now[j]) < -EPS):
+            return None
+        px, py = float(p[0]), float(p[1])
+        best = (math.inf, px, py)
+        for poly, other in ((ga, gb), (gb, ga)):
+            v = poly.points.tolist()
+            for k in range(len(v)):
+                (ax, ay), (bx, by) = v[k - 1], v[k]
+                ex, ey = bx - ax, by - ay
+                ee = ex * ex + ey * ey
+                t = min(max(((px - ax) * ex + (py - ay) * ey) / ee, 0.0), 1.0) if ee > 0.0 else 0.0
+                qx, qy = ax + t * ex, ay + t * ey
+                d = math.hypot(qx - px, qy - py)
+                if d < best[0] and _gap(np.array([qx, qy]), other, 0.0) >= -EPS:
+                    best = (d, qx, qy)
+        va, vb = ga.points.tolist(), gb.points.tolist()
+        for k in range(len(va)):
+            (ax, ay), (bx, by) = va[k - 1], va[k]
+            ex, ey = bx - ax, by - ay
+            for m in range(len(vb)):
+                (cx, cy), (dx, dy) = vb[m - 1], vb[m]
+                fx, fy = dx - cx, dy - cy
+                den = ex * fy - ey * fx
+                if den == 0.0:
+                    continue
+                wx, wy = cx - ax, cy - ay
+                s, u = (wx * fy - wy * fx) / den, (wx * ey - wy * ex) / den
+                if 0.0 <= s <= 1.0 and 0.0 <= u <= 1.0:
+                    qx, qy = ax + s * ex, ay + s * ey
+                    d = math.hypot(qx - px, qy - py)
+                    if d < best[0]:
+                        best = (d, qx, qy)
+        dist, qx, qy = best
+        if not 0.0 < dist <= limit:
+            return None
+        unit = np.array([(qx - px) / dist, (qy - py) / dist])
+        for k in (i, j):
+            self.checks += 1
+            _, back = _gap_normal(p, *_grown(cands[k], here, rnd, p))
+            if float(unit @ back) <= 0.0:
+                return None
+        step = (dist + BACK_OFF) * unit
+        q = p + step
+        for k, (g, before) in enumerate(zip(grown, now)):
+            self.checks += 1
+            if _gap(q, *g) < min(before, 0.0) - EPS or (k != i and k != j and time_of_impact(p, step, *g)[1] is not None):
+                return None
+        return q
 
     @staticmethod
     def _turn_may_meet(foot: Footprint, p: np.ndarray, turn: float, cands: list[Obstacle]) -> bool:

@@ -925,7 +925,8 @@ class TouchSensor(Device):
     """Webots TouchSensor. A bumper with bounding shapes of its own (the robot's shapes whose
     ``of_device`` names it) reads 1 when, at the end of the step, one of them touches a solid or
     another robot as kinematic contact sees them (contact.pieces_touch: a gap of at most
-    contact.TOUCH, bands overlapping), else 0; a bumper without any reads 1 when contact clipped its
+    contact.TOUCH, bands overlapping), else 0 -- each shape where its joint holds it now, the pieces
+    made again only when such a joint moved; a bumper without any reads 1 when contact clipped its
     robot's move in the step. ``force`` and ``force-3d`` read NaN (they need physics)."""
 
     kinematic = True
@@ -939,14 +940,28 @@ class TouchSensor(Device):
         self.values = np.full(3, math.nan)
         self._robot: Any = None
         self._own: list = []                   # its own bounding shapes (primitive, pose in the robot frame)
+        self._on: list = []                    # the joint each of them rides on (None: the body)
         self._pieces: list | None = None       # as contact takes them (contact.device_pieces), made when first due
+        self._held: list = []                  # the joints' displacements the pieces were made at
+        self._riding = False                   # whether any of its shapes rides on a joint
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
         if self.type_code == 0:
             base = robot.simulation.loaded.base_dir
-            self._own = [(primitive_from_model(p.geometry, base), pose_from_model(p.pose))
-                         for p in robot.model.shapes if p.of_device == self.name and p.seen_by in ("both", "bounding")]
+            own = [p for p in robot.model.shapes if p.of_device == self.name and p.seen_by in ("both", "bounding")]
+            self._own = [(primitive_from_model(p.geometry, base), pose_from_model(p.pose)) for p in own]
+            self._on = [p.on_joint for p in own]
+            self._riding = any(j is not None for j in self._on)
+            self._held = [None] * len(own)
+
+    def _held_now(self) -> list:
+        """Where the joints its shapes ride on hold them now: each one's displacement (a joint's
+        displacement is a new Pose whenever it moved, the same one while it stays)."""
+        if not self._riding:
+            return self._held
+        robot = self._robot
+        return [None if j is None else robot.link_pose(j) for j in self._on]
 
     def measure(self, now_ms: int) -> None:
         if self.type_code == 0:
@@ -958,8 +973,13 @@ class TouchSensor(Device):
                 if contact is None:            # contact off: nothing is touched
                     self.value = 0.0
                 else:
-                    if self._pieces is None:
-                        self._pieces = contact.pieces(robot.index, self._own)
+                    held = self._held_now()
+                    if self._pieces is None or any(a is not b for a, b in zip(held, self._held)):
+                        # made again only when a joint it rides on moved since they were made
+                        own = [(prim, local if at is None else at.compose(local))
+                               for (prim, local), at in zip(self._own, held)]
+                        self._pieces = contact.pieces(robot.index, own)
+                        self._held = held
                     self.value = 1.0 if contact.touching(robot.index, self._pieces) else 0.0
         self._mark(now_ms)
 

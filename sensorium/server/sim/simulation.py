@@ -39,6 +39,7 @@ from sensorium.server.sim.scene import (
     light_from_model,
     primitive_from_model,
     robot_bounding_parts,
+    robot_parts,
     solid_parts,
 )
 from sensorium.server.sim.sensors import (
@@ -162,6 +163,11 @@ class RobotState:
                     self.riders.setdefault(dev.on_joint, []).append(dev)
                     dev.link_body = sim.scene.device_body(index, dev.on_joint)
                     dev.move_with(self.links.poses[dev.on_joint])
+        # the joints carrying bounding shapes: kinematic contact's footprint (and a bumper's pieces)
+        # follow them, made again only on a step one of them moved (move_links)
+        self._bound_joints = frozenset(shape.on_joint for shape in model.shapes
+                                       if shape.on_joint is not None and shape.seen_by in ("both", "bounding"))
+        self._bounding: list[tuple[Any, Pose, str | None]] | None = None     # made when first asked for
         for dev in self.devices.values():
             dev.bind(self)
         self.device_list = device_entries(model, self.devices, self.motors)
@@ -201,13 +207,35 @@ class RobotState:
         if self.links is None:
             return False
         moved = False
-        for joint in self.links.update():
+        changed = self.links.update()
+        for joint in changed:
             displacement = self.links.poses[joint]
             self._sim.scene.set_link_pose(self.index, joint, displacement)
             for dev in self.riders.get(joint, ()):
                 dev.move_with(displacement)
                 moved = True
+        if changed and self._bound_joints and not self._bound_joints.isdisjoint(changed):
+            contact = self._sim.contact
+            if contact is not None:      # its footprint where the joints hold its shapes now
+                contact.reshape(self.index, self.bounding_parts())
         return moved
+
+    def bounding_parts(self) -> list[tuple[Any, Pose]]:
+        """The robot's bounding shapes (primitive, pose in the robot frame) where its joints hold
+        them now: :func:`~sensorium.server.sim.scene.robot_bounding_parts` (the same order), each
+        shape on a joint (``on_joint``) moved by its link's displacement."""
+        if self._bounding is None:
+            base = self._sim.loaded.base_dir
+            self._bounding = [(primitive_from_model(shape.geometry, base), local, getattr(shape, "on_joint", None))
+                              for _, local, shape in robot_parts(self.model) if shape.seen_by in ("both", "bounding")]
+        poses = self.links.poses if self.links is not None else {}
+        return [(prim, local if joint is None or joint not in poses else poses[joint].compose(local))
+                for prim, local, joint in self._bounding]
+
+    def link_pose(self, joint: str) -> Pose | None:
+        """The displacement (robot frame) of what rides on ``joint`` from its world-file place now
+        (None: nothing rides on it, or it is no joint that moves)."""
+        return None if self.links is None else self.links.poses.get(joint)
 
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         """Move the robot (supervisor-style, kinematically, no contact check — as Webots' field
