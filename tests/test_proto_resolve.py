@@ -331,3 +331,31 @@ def test_messages_about_proto_nodes_name_the_proto_file_and_the_instance(tmp_pat
     w = world_file(tmp_path, 'Pose { children [ Odd { } ] }\n', ["Odd.proto"])
     (line,) = [m for m in load_world(w).warnings if "Wobbler" in m]
     assert line.startswith(f"{tmp_path / 'Odd.proto'}:2:47 (in PROTO Odd at {w}:3:19): Wobbler: not a built-in node")
+
+
+def test_every_command_reading_a_world_file_takes_the_proto_options() -> None:
+    """`sensorium snapshot WORLD.wbt OUT --webots-home DIR` was refused ('unrecognized arguments'):
+    every command with a world argument finds a .wbt world's PROTOs the same way."""
+    import argparse
+
+    from sensorium.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    reading = {name: p for name, p in sub.choices.items() if any(a.dest == "world" for a in p._actions)}
+    assert {"validate", "snapshot", "probe", "serve", "convert"} <= set(reading)
+    for name, p in reading.items():
+        dests = {a.dest for a in p._actions}
+        assert {"webots_home", "proto_path"} <= dests, name
+
+
+def test_snapshot_finds_the_protos_of_the_webots_home_it_is_given(tmp_path: Path, monkeypatch) -> None:
+    from sensorium.cli import main as cli
+
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)          # restored after the test (the flag sets it)
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots")
+    w = world_file(tmp_path / "w", "Viewpoint { position -1 0 0.1 }\nAcmeBot { }\n",
+                   [f"{RAW}/R2023b/projects/robots/acme/bot/protos/AcmeBot.proto"])
+    out = tmp_path / "shot.png"
+    assert cli(["snapshot", str(w), str(out), "--size", "8x6", "--webots-home", str(home)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
