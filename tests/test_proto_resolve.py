@@ -359,3 +359,25 @@ def test_snapshot_finds_the_protos_of_the_webots_home_it_is_given(tmp_path: Path
     out = tmp_path / "shot.png"
     assert cli(["snapshot", str(w), str(out), "--size", "8x6", "--webots-home", str(home)]) == 0
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_world_before_r2022b_finds_its_protos_by_name(tmp_path: Path, monkeypatch) -> None:
+    """Webots R2022a had no EXTERNPROTO: a world (and its PROTOs) named a PROTO by its type, found as
+    TYPE.proto in the project's protos folder or the installation (Webots' own youbot.wbt of that
+    release: Youbot, KukaBox). It used to lose the robot; R2022b and later worlds must declare them."""
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots", version="R2022a")
+    project = tmp_path / "project"
+    proto_file(project / "protos" / "parts", "Knob", "[ ] { Solid { name \"knob\" boundingObject Box { } } }")
+    proto_file(project / "protos", "Gadget", "[ ] { Solid { name \"gadget\" children [ Knob { } ] } }")
+    body = "AcmeBot { }\nGadget { }\n"
+    w = world_file(project / "worlds", body)
+    w.write_text(w.read_text().replace("R2023b", "R2022a"))
+    loaded = load_world(w, webots_home=home)
+    assert [r.name for r in loaded.world.robots] == ["acme"] and not loaded.losses
+    assert [d.name for d in loaded.world.robots[0].devices] == ["eye"]
+    (gadget,) = loaded.world.solids
+    assert gadget.name == "gadget" and [c.name for c in gadget.children] == ["knob"]
+    w.write_text(w.read_text().replace("R2022a", "R2023b"))      # since R2022b: declared, or not found
+    later = load_world(w, webots_home=home)
+    assert later.world.robots == [] and [x.name for x in later.losses] == ["AcmeBot", "Gadget"]
