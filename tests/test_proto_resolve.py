@@ -331,3 +331,53 @@ def test_messages_about_proto_nodes_name_the_proto_file_and_the_instance(tmp_pat
     w = world_file(tmp_path, 'Pose { children [ Odd { } ] }\n', ["Odd.proto"])
     (line,) = [m for m in load_world(w).warnings if "Wobbler" in m]
     assert line.startswith(f"{tmp_path / 'Odd.proto'}:2:47 (in PROTO Odd at {w}:3:19): Wobbler: not a built-in node")
+
+
+def test_every_command_reading_a_world_file_takes_the_proto_options() -> None:
+    """`sensorium snapshot WORLD.wbt OUT --webots-home DIR` was refused ('unrecognized arguments'):
+    every command with a world argument finds a .wbt world's PROTOs the same way."""
+    import argparse
+
+    from sensorium.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    reading = {name: p for name, p in sub.choices.items() if any(a.dest == "world" for a in p._actions)}
+    assert {"validate", "snapshot", "probe", "serve", "convert"} <= set(reading)
+    for name, p in reading.items():
+        dests = {a.dest for a in p._actions}
+        assert {"webots_home", "proto_path"} <= dests, name
+
+
+def test_snapshot_finds_the_protos_of_the_webots_home_it_is_given(tmp_path: Path, monkeypatch) -> None:
+    from sensorium.cli import main as cli
+
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)          # restored after the test (the flag sets it)
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots")
+    w = world_file(tmp_path / "w", "Viewpoint { position -1 0 0.1 }\nAcmeBot { }\n",
+                   [f"{RAW}/R2023b/projects/robots/acme/bot/protos/AcmeBot.proto"])
+    out = tmp_path / "shot.png"
+    assert cli(["snapshot", str(w), str(out), "--size", "8x6", "--webots-home", str(home)]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_world_before_r2022b_finds_its_protos_by_name(tmp_path: Path, monkeypatch) -> None:
+    """Webots R2022a had no EXTERNPROTO: a world (and its PROTOs) named a PROTO by its type, found as
+    TYPE.proto in the project's protos folder or the installation (Webots' own youbot.wbt of that
+    release: Youbot, KukaBox). It used to lose the robot; R2022b and later worlds must declare them."""
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots", version="R2022a")
+    project = tmp_path / "project"
+    proto_file(project / "protos" / "parts", "Knob", "[ ] { Solid { name \"knob\" boundingObject Box { } } }")
+    proto_file(project / "protos", "Gadget", "[ ] { Solid { name \"gadget\" children [ Knob { } ] } }")
+    body = "AcmeBot { }\nGadget { }\n"
+    w = world_file(project / "worlds", body)
+    w.write_text(w.read_text().replace("R2023b", "R2022a"))
+    loaded = load_world(w, webots_home=home)
+    assert [r.name for r in loaded.world.robots] == ["acme"] and not loaded.losses
+    assert [d.name for d in loaded.world.robots[0].devices] == ["eye"]
+    (gadget,) = loaded.world.solids
+    assert gadget.name == "gadget" and [c.name for c in gadget.children] == ["knob"]
+    w.write_text(w.read_text().replace("R2022a", "R2023b"))      # since R2022b: declared, or not found
+    later = load_world(w, webots_home=home)
+    assert later.world.robots == [] and [x.name for x in later.losses] == ["AcmeBot", "Gadget"]

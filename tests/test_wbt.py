@@ -619,6 +619,14 @@ def test_named_controllers_become_extern(tmp_path: Path) -> None:
         assert w.world.robots[0].controller == "<extern>"
 
 
+def test_a_named_controller_is_told_with_its_controller_args(tmp_path: Path) -> None:
+    """Webots starts a controller with its Robot's controllerArgs (Webots' youBot world gives its
+    controller "demo", without which it only waits for keys): the line says to pass them."""
+    p = write(tmp_path, 'Robot { name "r" controller "youbot" controllerArgs [ "demo" "two words" ] }\n')
+    assert (f"{p}:2:1: Robot 'r': controller 'youbot' is not started here; run it with `sensorium controller` and "
+            "its controllerArgs, `demo 'two words'` (the robot is an <extern> robot)") in load_world(p).warnings
+
+
 def test_mesh_losses_load_and_name_their_lines(tmp_path: Path) -> None:
     """A mesh Sensorium cannot read (a format it does not read, a missing file) is a loss naming the
     file and line; the world still loads (the rest of the solid too)."""

@@ -87,6 +87,7 @@ def info(args: argparse.Namespace) -> int:
     print(f"robots    {len(s['robots'])}")
     for r in s["robots"]:
         print(f"  {r['name']}{'' if r['synchronization'] else ' (asynchronous)'}: {len(r['devices'])} devices")
+        print(f"    {'(drive)':<14} {r['drive']}")
         for d in r["devices"]:
             print(f"    {d['name']:<14} {d['summary']}")
     for u in s.get("protos", []):

@@ -9,7 +9,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.scene import Scene
 from sensorium.server.world.loader import load_world
 
-__all__ = ["world_summary", "device_line"]
+__all__ = ["world_summary", "device_line", "drive_line"]
 
 
 def device_line(d) -> str:
@@ -28,6 +28,25 @@ def device_line(d) -> str:
         lights = f", {len(d.lights)} light(s) on while it is" if d.lights else ""
         return f"LED {'gradual' if d.gradual else f'{len(d.color)} colours'}{lights}"
     return d.device
+
+
+def drive_line(r: wm.Robot) -> str:
+    """How the robot moves: its drive, what the .wbt import made of its wheels (or none)."""
+    if r.mecanum_drive is not None:
+        m = r.mecanum_drive
+        return (f"mecanum: wheels of radius {m.wheel_radius:g} m at (±{m.lx:g}, ±{m.ly:g}) m, rollers "
+                f"{list(m.rollers)} (front left, front right, rear left, rear right: {m.front_left_motor}, "
+                f"{m.front_right_motor}, {m.rear_left_motor}, {m.rear_right_motor})")
+    if r.ackermann_drive is not None:
+        a = r.ackermann_drive
+        return (f"car-like (Ackermann): wheelbase {a.wheelbase:g} m, tracks {a.track_front:g}/{a.track_rear:g} m")
+    if r.differential_drive is not None:
+        d = r.differential_drive
+        skid = d.skid_steer
+        kind = (f"skid-steer, {1 + len(skid.left)} + {1 + len(skid.right)} wheels" if skid is not None
+                else f"two-wheel ({d.left_motor}, {d.right_motor})")
+        return f"{kind}: wheels of radius {d.wheel_radius:g} m, {d.axle_length:g} m apart"
+    return "none (the robot does not move itself)"
 
 
 def _geometry_line(s: wm.Solid) -> str:
@@ -55,6 +74,7 @@ def world_summary(path: str | Path) -> dict:
         "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
         "robots": [
             {"name": r.name, "synchronization": r.synchronization, "supervisor": r.supervisor,
+             "drive": drive_line(r),
              "devices": [{"name": d.name, "device": d.device, "summary": device_line(d)} for d in r.devices]}
             for r in w.robots
         ],

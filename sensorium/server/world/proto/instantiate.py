@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import os
 import platform
+import re
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -30,6 +31,7 @@ from sensorium.server.world.limits import ProtoLimits
 from sensorium.server.world.proto import template as tpl
 from sensorium.server.world.proto.errors import ProtoError
 from sensorium.server.world.proto.interface import (
+    BASE_NODES,
     FIELD_TYPES,
     FieldDecl,
     ProtoDef,
@@ -39,7 +41,7 @@ from sensorium.server.world.proto.interface import (
     refused,
     show,
 )
-from sensorium.server.world.proto.resolve import ProtoSearch, logical_location, resolve_url
+from sensorium.server.world.proto.resolve import ProtoSearch, logical_location, proto_index, resolve_url
 from sensorium.server.world.wbt.convert import SKIPPED
 from sensorium.server.world.wbt.parser import ExternProto, IsRef, Node, Parser, Tokens, WbtFile, WbtSyntaxError, short
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
@@ -134,6 +136,7 @@ class _Expander:
         self.instances = 0
         self.timings = {"proto files": 0.0, "template": 0.0}   # wall seconds (``sensorium bench --only loading``)
         self.coordinate_system = _coordinate_system(wbt.nodes)
+        self.by_name = _before_externproto(wbt.version)     # R2022a: types found by PROTO file name
         for p in wbt.protos:
             self.warnings += p.warnings
 
@@ -240,8 +243,26 @@ class _Expander:
             self.use(found, "", found.source)
         elif name in scope.declared:
             found = self.load(scope, scope.declared[name])
+        elif self.by_name and name not in BASE_NODES and (path := self.undeclared(name)) is not None:
+            found = self.load(scope, ExternProto(str(path), node.line, node.col))
         scope.found[name] = found
         return found
+
+    def undeclared(self, name: str) -> Path | None:
+        """A PROTO a world before R2022b uses without declaring it (Webots had no EXTERNPROTO then and
+        looked a type up by file name): NAME.proto in the world's project's ``protos`` folder, then
+        under the --proto-path folders, then in the installation's ``projects`` tree."""
+        file = f"{name}.proto"
+        project = Path(self.world).resolve().parent.parent / "protos"
+        home = self.search.home
+        for root in [project, *self.search.proto_path, *([home / "projects"] if home is not None else [])]:
+            try:
+                hit = proto_index(root).get(file) if root.is_dir() else None
+            except OSError:
+                hit = None
+            if hit is not None:
+                return hit
+        return None
 
     def load(self, scope: _Scope, decl: ExternProto) -> ProtoDef | None:
         try:
@@ -614,6 +635,12 @@ def _short_why(message: str) -> str:
     """The places tried, from a not-found message (the note stays one short line)."""
     looked = message.split("; looked in: ", 1)
     return "looked in: " + looked[1].split("; nothing is downloaded", 1)[0] if len(looked) == 2 else message
+
+
+def _before_externproto(version: str) -> bool:
+    """A world saved before R2022b, when Webots found PROTOs by name (it has no EXTERNPROTO)."""
+    m = re.match(r"R(\d{4})([a-z])", version or "")
+    return m is not None and (int(m.group(1)), m.group(2)) < (2022, "b")
 
 
 def _declared(decls: list[ExternProto]) -> dict[str, ExternProto]:

@@ -147,7 +147,7 @@ def _is_file(p: Path) -> bool:
         return False
 
 
-def _proto_index(folder: Path) -> dict[str, Path]:
+def proto_index(folder: Path) -> dict[str, Path]:
     """PROTO file name → first path under ``folder`` (bounded walk, sorted for a stable answer)."""
     key = str(folder)
     if key not in _INDEXES:
@@ -247,7 +247,7 @@ def _by_name(u: str, search: ProtoSearch, tried: list[str]) -> Path | None:
         return None
     for root in search.proto_path:
         tried.append(f"{root}/**/{name}")
-        hit = _proto_index(root).get(name)
+        hit = proto_index(root).get(name)
         if hit is not None and _is_file(hit):
             return hit
     return None

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import posixpath
+import shlex
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1105,8 +1106,11 @@ class Converter:
         if controller in ("", "void"):                      # Webots' other ways of saying "no controller"
             controller = "<none>"
         if controller not in ("<extern>", "<none>"):
+            # its controllerArgs too (Webots' youbot controller runs its demo only when given "demo")
+            args = f.strings("controllerArgs")
+            given = f" and its controllerArgs, `{shlex.join(args)}`" if args else ""
             self.warn(node, f"Robot {unique!r}: controller {controller!r} is not started here; run it with "
-                            f"`sensorium controller` (the robot is an <extern> robot)")
+                            f"`sensorium controller`{given} (the robot is an <extern> robot)")
             controller = "<extern>"
         extras = {"controller": controller, "supervisor": f.flag("supervisor", False),
                   "custom_data": f.string("customData", ""), "model": f.string("model", "")}
