@@ -216,14 +216,22 @@ class Launcher:
             self.starts[robot] += 1
         threading.Thread(target=self._watch, args=(run,), daemon=True, name=f"sensorium-wait-{robot}").start()
 
+    def replan(self, specs: list[ControllerSpec]) -> None:
+        """The controllers of a reloaded world (its file may name others now)."""
+        with self._lock:
+            self.specs = {s.robot: s for s in specs}
+            for s in specs:
+                self.starts.setdefault(s.robot, 0)
+
     def start_all(self) -> None:
         for robot in self.specs:
             self.start(robot)
 
     def _watch(self, run: _Running) -> None:
         code = run.proc.wait()
-        self._starting.discard(run.spec.robot)       # never attached (a crash at start): not waited for
-        self._wake_server()
+        if not run.ending:          # it may never have attached (a crash at start): not waited for any more
+            self._starting.discard(run.spec.robot)
+            self._wake_server()
         for t in run.readers:
             t.join()
         if not run.ending and not self._quitting():      # it ended by itself: the robot stays uncontrolled, the world goes on
@@ -269,6 +277,8 @@ class Launcher:
     # ------------------------------------------------------------------ restart / reload (server's loop thread)
     def restart(self, robot: str) -> None:
         """restartController: the server has ended the session; end the process, start it again."""
+        if robot in self.specs:
+            self._starting.add(robot)        # the world waits for the new process, as for the first one
         with self._lock:
             self._restarts.append(robot)
             run = self.running.get(robot)

@@ -8,6 +8,7 @@ import argparse
 import dataclasses
 import signal
 import sys
+from functools import partial
 from pathlib import Path
 
 from sensorium.cli.serve import DEFAULT_PUB, DEFAULT_RPC, add_world_options, bind_problem
@@ -43,7 +44,7 @@ def main(args: argparse.Namespace) -> int:
     import zmq
 
     from sensorium.launch import Launcher, controller_dirs, plan
-    from sensorium.server.daemon.serve import Server, ServeOptions
+    from sensorium.server.daemon.serve import ServeOptions, Server
     from sensorium.server.world.loader import WorldError
 
     world = Path(args.world)
@@ -80,7 +81,8 @@ def main(args: argparse.Namespace) -> int:
     if server is None:
         return 1
     robots = server.core.sim.loaded.world.robots
-    specs, problems = plan(robots, controller_dirs(world, [Path(d) for d in args.controllers_dir]))
+    dirs = controller_dirs(world, [Path(d) for d in args.controllers_dir])
+    specs, problems = plan(robots, dirs)
     if problems:
         server.close()
         for line in problems:
@@ -110,7 +112,10 @@ def main(args: argparse.Namespace) -> int:
         while True:
             current.core.launcher = launcher
             lockstep = current.core.lockstep
-            launcher.bind(lockstep.starting, current.transport.wake, lambda ls=lockstep: ls.shutting_down)
+            launcher.bind(lockstep.starting, current.transport.wake, partial(getattr, lockstep, "shutting_down"))
+            # as Webots, the world waits for every synchronous <extern> robot's controller too
+            robots = current.core.sim.loaded.world.robots
+            lockstep.starting.update(r.name for r in robots if r.controller == "<extern>" and r.synchronization)
             launcher.on_reload = current.stop
             print(current.ready_line, flush=True)
             launcher.start_all()
@@ -123,6 +128,13 @@ def main(args: argparse.Namespace) -> int:
             reopened = open_server(again)
             if reopened is None:
                 return 1
+            specs, problems = plan(reopened.core.sim.loaded.world.robots, dirs)   # the file may have changed
+            if problems:
+                reopened.close()
+                for line in problems:
+                    print(f"sensorium run: {line}", file=sys.stderr)
+                return 1
+            launcher.replan(specs)
             launcher.log(f"world reloaded from {world}")
             current = reopened
     finally:
