@@ -84,8 +84,11 @@ def test_world_file_field_defaults_to_extern_and_rejects_other_values():
     world = small_world()
     assert [r.controller for r in world.robots] == ["<extern>", "<extern>"]
     assert small_world(controller="<none>").robots[0].controller == "<none>"
-    with pytest.raises(ValidationError, match="controller"):
-        small_world(controller="my_controller")
+    # a controller's name (`sensorium run` starts controllers/NAME/; `serve` waits for it as <extern>)
+    assert small_world(controller="my_controller").robots[0].controller == "my_controller"
+    for bad in ("<other>", "../up", "a/b", ".."):
+        with pytest.raises(ValidationError, match="controller"):
+            small_world(controller=bad)
 
 
 def test_core_says_once_what_it_waits_for_and_again_after_the_last_controller_left():
@@ -122,7 +125,7 @@ def test_robot_model_rejects_unknown_controller_value_with_its_path():
     assert "controller" in str(e.value)
 
 
-def test_wbt_controllers_map_to_extern_or_none(tmp_path):
+def test_wbt_controllers_keep_their_name_or_map_to_extern_or_none(tmp_path):
     from sensorium.server.world.loader import load_world
 
     wbt = tmp_path / "w.wbt"
@@ -130,5 +133,5 @@ def test_wbt_controllers_map_to_extern_or_none(tmp_path):
                    'Robot { name "a" controller "e-puck_avoid" }\nRobot { name "b" controller "<none>" }\n'
                    'Robot { name "c" controller "" }\nRobot { name "d" }\n')
     loaded = load_world(wbt)
-    assert [r.controller for r in loaded.world.robots] == ["<extern>", "<none>", "<none>", "<extern>"]
-    assert any("e-puck_avoid" in w and "sensorium controller" in w for w in loaded.warnings)
+    assert [r.controller for r in loaded.world.robots] == ["e-puck_avoid", "<none>", "<none>", "<extern>"]
+    assert not any("e-puck_avoid" in w for w in loaded.warnings)
