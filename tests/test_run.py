@@ -13,7 +13,7 @@ import subprocess
 from pathlib import Path
 
 import pytest
-from _serve import REPO, Proc, sensorium, wait_until
+from _serve import REPO, Proc, run_controller, sensorium, wait_until
 
 from sensorium.launch import LaunchError, find_controller
 
@@ -282,3 +282,38 @@ def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path) -> 
     assert [line for line in proc.stdout().splitlines() if line.startswith("[boss]")] == [
         "[boss] boss starts (in C) at 0", "[boss] boss ends at 960", "[boss] boss starts (in C) at 0 after the reload",
         "[boss] boss ends at 1200"]
+
+
+UNDER_SERVE = '''from controller import Supervisor
+boss = Supervisor()
+boss.step(16)
+boss.getFromDef("ALPHA").restartController()
+boss.worldReload()
+boss.getSelf().restartController()
+print("still at", round(boss.getTime() * 1000))
+'''
+
+
+def test_under_serve_restart_and_reload_are_one_line_each_and_change_nothing(tmp_path: Path) -> None:
+    """Controllers you start yourself (`sensorium serve`) cannot be started again by the server."""
+    world = project(tmp_path, 'DEF ALPHA Robot { name "alpha" controller "a" }\n'
+                              'Robot { name "boss" controller "<extern>" supervisor TRUE }', {"boss.py": UNDER_SERVE})
+    lines, err = run_controller(world, lambda url: sensorium("controller", str(tmp_path / "controllers" / "boss" /
+                                                                              "boss.py"), "--url", url), robot="boss")
+    assert lines == ["still at 16"]
+    assert [line for line in err.splitlines() if line.startswith("Error:")] == [
+        "Error: wb_supervisor_node_restart_controller(): restart_controller: only `sensorium run` starts controllers; "
+        "an <extern> controller is restarted by whoever started it.",
+        "Error: wb_supervisor_world_reload(): world_reload: only `sensorium run` reloads a world (it starts the "
+        "controllers again).",
+        "Error: wb_supervisor_node_restart_controller(): restart_controller: only `sensorium run` starts controllers; "
+        "an <extern> controller is restarted by whoever started it."]
+
+
+def test_serve_says_which_robots_name_a_controller(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "ext" }', {})
+    proc = Proc(sensorium("serve", str(world), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"))
+    proc.wait_line("sensorium: serving world")
+    assert proc.stop() == 0
+    assert proc.stderr().splitlines()[0] == ("sensorium serve: robot 'alpha' ('a'): `sensorium run WORLD` starts this "
+                                             "controller; here it is <extern> (start it with `sensorium controller`)")

@@ -158,6 +158,13 @@ def main(args: argparse.Namespace) -> int:
     report = server.core.sim.loaded.report
     if report:          # what the load left out, once, before the ready line
         print(report.text(), file=sys.stderr, flush=True)
+    named = [r for r in server.core.sim.loaded.world.robots if r.controller not in ("<extern>", "<none>")]
+    if named:           # Webots would start these; `sensorium run` does
+        which = ", ".join(f"robot {r.name!r} ({r.controller!r})" for r in named)
+        one = len(named) == 1
+        print(f"sensorium serve: {which}: `sensorium run WORLD` starts {'this controller' if one else 'these controllers'}"
+              f"; here {'it is' if one else 'they are'} <extern> (start {'it' if one else 'each'} with "
+              "`sensorium controller`)", file=sys.stderr, flush=True)
     if server.transport.curve:
         from sensorium.server.daemon.transport import load_curve_keys
 
