@@ -23,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
+from urllib.parse import quote
 
 __all__ = ["ControllerSpec", "LaunchError", "Launcher", "find_controller", "plan"]
 
@@ -178,7 +179,7 @@ class Launcher:
 
     def _environment(self, spec: ControllerSpec) -> dict[str, str]:
         env = dict(os.environ)
-        env["SENSORIUM_CONTROLLER_URL"] = f"{self.url.rstrip('/')}/{spec.robot}"
+        env["SENSORIUM_CONTROLLER_URL"] = f"{self.url.rstrip('/')}/{quote(spec.robot, safe='')}"   # both clients decode it
         env.pop("WEBOTS_CONTROLLER_URL", None)
         env["PYTHONUNBUFFERED"] = "1"            # lines reach the console as they are printed
         env["PYTHONIOENCODING"] = "UTF-8"        # as Webots sets it

@@ -102,19 +102,19 @@ def test_controllers_are_found_in_webots_order_and_others_are_refused(tmp_path: 
 
 def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: Path) -> None:
     world = project(tmp_path, 'Robot { name "alpha" controller "a" controllerArgs [ "--say" "hello world" ] }\n'
-                              'Robot { name "beta" controller "b" }',
+                              'Robot { name "beta %41" controller "b" }',     # a name a URL must encode
                     {"a.py": COUNTER.replace("{step}", "16"), "b.py": COUNTER.replace("{step}", "32")})
     proc = run(world, "--until", "1600")
     assert proc.wait() == 0, proc.stderr()
     out = proc.stdout().splitlines()
     assert out[0].startswith("sensorium: serving world 'w' rpc=tcp://127.0.0.1:")
     assert "[alpha] alpha args ['--say', 'hello world'] in a" in out
-    assert "[beta] beta args [] in b" in out
+    assert "[beta %41] beta %41 args [] in b" in out
     # the world waited for both before it stepped: every step of both, from 0 to --until
     assert "[alpha] alpha stepped 100 until 1600" in out
-    assert "[beta] beta stepped 50 until 1600" in out
+    assert "[beta %41] beta %41 stepped 50 until 1600" in out
     assert "sensorium: stopped at 1600 ms after 100 steps" in proc.stderr()
-    for robot, folder in (("alpha", "a"), ("beta", "b")):
+    for robot, folder in (("alpha", "a"), ("beta %41", "b")):
         (pid,) = pids(tmp_path / "controllers" / folder, robot)
         assert not alive(pid)
 
