@@ -29,6 +29,7 @@ __all__ = ["ControllerSpec", "LaunchError", "Launcher", "find_controller", "plan
 
 # Webots' WbController: a controller gets the quit packet (-1), then 1 s to end before it is terminated
 GRACE_S = 1.0
+LINE_MAX = 1 << 16       # bytes of a controller's line printed at once
 C_LIBRARY = Path(__file__).resolve().parent / "client" / "c" / "build"
 SPECIAL = ("<extern>", "<none>", "<generic>")
 # the kinds Webots runs that Sensorium does not (file in the controller's folder -> what it is)
@@ -165,10 +166,16 @@ class Launcher:
     def _pump(self, robot: str, stream: IO[bytes], sink: IO[str]) -> None:
         """Each line of a controller's stream as ``[ROBOT] line`` (Webots' console names the robot);
         a last line without a newline is printed too."""
-        for raw in iter(stream.readline, b""):
+        sink_open = True
+        for raw in iter(lambda: stream.readline(LINE_MAX), b""):      # a longer line comes in pieces
+            if not sink_open:
+                continue            # read on all the same: a controller blocked on a full pipe would stall the world
             line = raw.decode("utf-8", errors="replace").rstrip("\r\n")
-            with self._print_lock:
-                print(f"[{robot}] {line}", file=sink, flush=True)
+            try:
+                with self._print_lock:
+                    print(f"[{robot}] {line}", file=sink, flush=True)
+            except (BrokenPipeError, ValueError, OSError):        # `sensorium run | head`: the reader left
+                sink_open = False
         stream.close()
 
     # ------------------------------------------------------------------ processes

@@ -314,6 +314,15 @@ def test_serve_says_which_robots_name_a_controller(tmp_path: Path) -> None:
     world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "ext" }', {})
     proc = Proc(sensorium("serve", str(world), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"))
     proc.wait_line("sensorium: serving world")
-    assert proc.stop() == 0
+    proc.stop()
     assert proc.stderr().splitlines()[0] == ("sensorium serve: robot 'alpha' ('a'): `sensorium run WORLD` starts this "
                                              "controller; here it is <extern> (start it with `sensorium controller`)")
+
+
+def test_a_world_that_does_not_load_is_its_line_and_exit_1(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "a"', {"a.py": COUNTER.replace("{step}", "16")})
+    proc = run(world)
+    assert proc.wait() == 1
+    assert proc.stderr().splitlines() == [f"{world}: line 4, column 1: expected a field name or '}}' in Robot (line 3), "
+                                          "found end of file"]
+    assert proc.stdout() == "" and not (tmp_path / "controllers" / "a" / "pid-alpha").exists()
