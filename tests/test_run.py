@@ -129,12 +129,15 @@ def test_a_missing_controller_is_one_line_and_nothing_runs(tmp_path: Path) -> No
 
 
 def test_a_controller_that_crashes_is_said_and_the_world_goes_on(tmp_path: Path) -> None:
-    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "beta" controller "quitter" }',
-                    {"a.py": COUNTER.replace("{step}", "16"), "quitter": "#!/bin/sh\necho leaving\nexit 3\n"})
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "beta" controller "quitter" }\n'
+                              'Robot { name "gamma" controller "segv" }',
+                    {"a.py": COUNTER.replace("{step}", "16"), "quitter": "#!/bin/sh\necho leaving\nexit 3\n",
+                     "segv": "#!/bin/sh\nkill -SEGV $$\n"})
     proc = run(world, "--until", "800")
     assert proc.wait() == 0, proc.stderr()
     assert "[beta] leaving" in proc.stdout().splitlines()
     assert "sensorium run: 'quitter' controller of robot 'beta' exited with status: 3." in proc.stderr()
+    assert "sensorium run: 'segv' controller of robot 'gamma' crashed (SIGSEGV)." in proc.stderr()
     assert "[alpha] alpha stepped 50 until 800" in proc.stdout().splitlines()
 
 
