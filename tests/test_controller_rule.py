@@ -135,3 +135,27 @@ def test_wbt_controllers_keep_their_name_or_map_to_extern_or_none(tmp_path):
     loaded = load_world(wbt)
     assert [r.controller for r in loaded.world.robots] == ["e-puck_avoid", "<none>", "<none>", "<extern>"]
     assert not any("e-puck_avoid" in w for w in loaded.warnings)
+
+
+def test_the_world_waits_for_controllers_being_started_and_an_ended_one_gets_minus_one():
+    """`sensorium run`: a robot in ``starting`` holds the world until its controller attaches;
+    ``end_controller`` (restartController) answers its pending step -1, releases it at once, and its
+    later requests are SHUTTING_DOWN (the client's step returns -1)."""
+    ls = machine({"a": True, "b": True})
+    a = ls.attach("a", peer=b"A", now=0.0)
+    ls.starting.add("b")
+    ls.request_step(a, "ra", BASIC, now=0.0)
+    assert steps_run(ls) == 0                          # b's controller is starting: the world waits
+    b = ls.attach("b", peer=b"B", now=0.0)
+    assert not ls.starting
+    ls.request_step(b, "rb", BASIC, now=0.0)
+    assert steps_run(ls, limit=1) == 1
+    ls.request_step(b, "rb2", BASIC, now=0.0)
+    session, done = ls.end_controller("b")
+    assert session is b and done is not None and (done.status, done.step.reply_to) == (-1, "rb2")
+    assert ls.session_for("b") is None and ls.end_controller("b") is None
+    with pytest.raises(LockstepError) as e:
+        ls.session(b.token)
+    assert e.value.code == ErrorCode.SHUTTING_DOWN and "restartController" in e.value.message
+    ls.request_step(a, "ra2", BASIC, now=0.0)
+    assert steps_run(ls, limit=1) == 1                 # the world no longer waits for b
