@@ -84,8 +84,11 @@ def test_world_file_field_defaults_to_extern_and_rejects_other_values():
     world = small_world()
     assert [r.controller for r in world.robots] == ["<extern>", "<extern>"]
     assert small_world(controller="<none>").robots[0].controller == "<none>"
-    with pytest.raises(ValidationError, match="controller"):
-        small_world(controller="my_controller")
+    # a controller's name (`sensorium run` starts controllers/NAME/; `serve` waits for it as <extern>)
+    assert small_world(controller="my_controller").robots[0].controller == "my_controller"
+    for bad in ("<other>", "../up", "a/b", ".."):
+        with pytest.raises(ValidationError, match="controller"):
+            small_world(controller=bad)
 
 
 def test_core_says_once_what_it_waits_for_and_again_after_the_last_controller_left():
@@ -122,7 +125,7 @@ def test_robot_model_rejects_unknown_controller_value_with_its_path():
     assert "controller" in str(e.value)
 
 
-def test_wbt_controllers_map_to_extern_or_none(tmp_path):
+def test_wbt_controllers_keep_their_name_or_map_to_extern_or_none(tmp_path):
     from sensorium.server.world.loader import load_world
 
     wbt = tmp_path / "w.wbt"
@@ -130,5 +133,29 @@ def test_wbt_controllers_map_to_extern_or_none(tmp_path):
                    'Robot { name "a" controller "e-puck_avoid" }\nRobot { name "b" controller "<none>" }\n'
                    'Robot { name "c" controller "" }\nRobot { name "d" }\n')
     loaded = load_world(wbt)
-    assert [r.controller for r in loaded.world.robots] == ["<extern>", "<none>", "<none>", "<extern>"]
-    assert any("e-puck_avoid" in w and "sensorium controller" in w for w in loaded.warnings)
+    assert [r.controller for r in loaded.world.robots] == ["e-puck_avoid", "<none>", "<none>", "<extern>"]
+    assert not any("e-puck_avoid" in w for w in loaded.warnings)
+
+
+def test_the_world_waits_for_controllers_being_started_and_an_ended_one_gets_minus_one():
+    """`sensorium run`: a robot in ``starting`` holds the world until its controller attaches;
+    ``end_controller`` (restartController) answers its pending step -1, releases it at once, and its
+    later requests are SHUTTING_DOWN (the client's step returns -1)."""
+    ls = machine({"a": True, "b": True})
+    a = ls.attach("a", peer=b"A", now=0.0)
+    ls.starting.add("b")
+    ls.request_step(a, "ra", BASIC, now=0.0)
+    assert steps_run(ls) == 0                          # b's controller is starting: the world waits
+    b = ls.attach("b", peer=b"B", now=0.0)
+    assert not ls.starting
+    ls.request_step(b, "rb", BASIC, now=0.0)
+    assert steps_run(ls, limit=1) == 1
+    ls.request_step(b, "rb2", BASIC, now=0.0)
+    session, done = ls.end_controller("b")
+    assert session is b and done is not None and (done.status, done.step.reply_to) == (-1, "rb2")
+    assert ls.session_for("b") is None and ls.end_controller("b") is None
+    with pytest.raises(LockstepError) as e:
+        ls.session(b.token)
+    assert e.value.code == ErrorCode.SHUTTING_DOWN and "restartController" in e.value.message
+    ls.request_step(a, "ra2", BASIC, now=0.0)
+    assert steps_run(ls, limit=1) == 1                 # the world no longer waits for b

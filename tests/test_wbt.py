@@ -609,22 +609,19 @@ def test_devices_are_listed_in_webots_tree_order(tmp_path: Path) -> None:
     assert devs[4].motor == "arm"     # the joint's sensor measures the joint its motor moves
 
 
-def test_named_controllers_become_extern(tmp_path: Path) -> None:
-    p = write(tmp_path, 'Robot { name "r" controller "e-puck_avoid_collision" }\n')
+def test_named_controllers_are_kept_with_their_args(tmp_path: Path) -> None:
+    """A controller's name and controllerArgs are kept (`sensorium run` starts it; `serve` waits for it
+    as an <extern> one); a name that is no folder name is an <extern> robot, with one warning."""
+    p = write(tmp_path, 'Robot { name "r" controller "e-puck_avoid_collision" controllerArgs [ "-v" "2" ] }\n'
+                        'Robot { name "s" controller "../up" }\nRobot { name "t" controller "" }\n')
     w = load_world(p)
-    assert w.world.robots[0].name == "r"
-    assert (f"{p}:2:1: Robot 'r': controller 'e-puck_avoid_collision' is not started here; run it with "
-            "`sensorium controller` (the robot is an <extern> robot)") in w.warnings
-    if "controller" in wm.Robot.model_fields:
-        assert w.world.robots[0].controller == "<extern>"
-
-
-def test_a_named_controller_is_told_with_its_controller_args(tmp_path: Path) -> None:
-    """Webots starts a controller with its Robot's controllerArgs (Webots' youBot world gives its
-    controller "demo", without which it only waits for keys): the line says to pass them."""
-    p = write(tmp_path, 'Robot { name "r" controller "youbot" controllerArgs [ "demo" "two words" ] }\n')
-    assert (f"{p}:2:1: Robot 'r': controller 'youbot' is not started here; run it with `sensorium controller` and "
-            "its controllerArgs, `demo 'two words'` (the robot is an <extern> robot)") in load_world(p).warnings
+    r, s, t = w.world.robots
+    assert (r.name, r.controller, r.controller_args) == ("r", "e-puck_avoid_collision", ["-v", "2"])
+    assert (s.controller, s.controller_args) == ("<extern>", [])
+    assert t.controller == "<none>"
+    assert [x for x in w.warnings if "controller" in x] == [
+        f"{p}:3:1: Robot 's': controller '../up' is no controller's name (a folder under controllers/): the robot "
+        "is an <extern> robot"]
 
 
 def test_mesh_losses_load_and_name_their_lines(tmp_path: Path) -> None:

@@ -258,6 +258,14 @@ def _serve_args(p: argparse.ArgumentParser) -> None:
     add_arguments(p)
 
 
+@command("run", "open a Webots project headless: serve the world and start every robot's controller named in it",
+         "sensorium.cli.run:main")
+def _run_args(p: argparse.ArgumentParser) -> None:
+    from sensorium.cli.run import add_arguments
+
+    add_arguments(p)
+
+
 @command("layout", "write a Foxglove layout (3D, plots, image, raw messages) for a recording or world file",
          "sensorium.cli.viewer:layout_cmd")
 def _layout_args(p: argparse.ArgumentParser) -> None:
@@ -322,8 +330,8 @@ def _bench_args(p: argparse.ArgumentParser) -> None:
 
 
 # commands that load a world: where a .wbt world's PROTO files are found (the one place these are declared)
-WORLD_COMMANDS = {"validate", "convert", "info", "probe", "snapshot", "serve", "layout", "demo", "sweep", "record", "replay",
-                  "export"}
+WORLD_COMMANDS = {"validate", "convert", "info", "probe", "snapshot", "serve", "run", "layout", "demo", "sweep", "record",
+                  "replay", "export"}
 
 
 def _add_proto_args(p: argparse.ArgumentParser) -> None:

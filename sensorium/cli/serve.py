@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import errno
 import os
+import shlex
 import sys
 
 __all__ = ["add_arguments", "main", "options"]
@@ -158,6 +159,15 @@ def main(args: argparse.Namespace) -> int:
     report = server.core.sim.loaded.report
     if report:          # what the load left out, once, before the ready line
         print(report.text(), file=sys.stderr, flush=True)
+    named = [r for r in server.core.sim.loaded.world.robots if r.controller not in ("<extern>", "<none>")]
+    if named:           # Webots would start these; `sensorium run` does
+        which = ", ".join(f"robot {r.name!r} ({r.controller!r}"
+                          + (f", controllerArgs `{shlex.join(r.controller_args)}`" if r.controller_args else "") + ")"
+                          for r in named)
+        one = len(named) == 1
+        print(f"sensorium serve: {which}: `sensorium run WORLD` starts {'this controller' if one else 'these controllers'}"
+              f"; here {'it is' if one else 'they are'} <extern> (start {'it' if one else 'each'} with "
+              "`sensorium controller`, its controllerArgs after the script)", file=sys.stderr, flush=True)
     if server.transport.curve:
         from sensorium.server.daemon.transport import load_curve_keys
 

@@ -102,7 +102,7 @@ def why_silent(view: ServerView) -> str:
         return "the server is paused (sensorium call set_mode '{mode: fast}')"
     robots = info.get("robots", [])
     if not any(r.get("attached") for r in robots):
-        waiting = [r["name"] for r in robots if r.get("controller", "<extern>") == "<extern>" and r.get("synchronization")]
+        waiting = [r["name"] for r in robots if r.get("controller", "<extern>") != "<none>" and r.get("synchronization")]
         if waiting:
             return (f"the world waits for a controller to attach to {' or '.join(repr(r) for r in waiting)} "
                     "(see PROTOCOL.md 3.7)")

@@ -671,6 +671,37 @@ def wb_supervisor_simulation_quit(status: int) -> None:
     r.terminated = True
 
 
+def _launcher_call(r: RobotClient, item: str, args: dict | None, func: str) -> None:
+    """A request only ``sensorium run`` serves (it starts the controllers): the server's line when it
+    refuses (an <extern> controller under ``sensorium serve``, a node that is no robot)."""
+    try:
+        _call(r, item, args)
+    except SensoriumError as err:
+        if err.code not in (ErrorCode.INVALID_ARGUMENT, ErrorCode.WRONG_STATE):
+            raise
+        print(f"Error: {func}(): {err.message}.", file=sys.stderr)
+
+
+def wb_supervisor_node_restart_controller(node: int | None) -> None:
+    """Webots' restartController, under ``sensorium run``: the robot's controller ends (its steps
+    return -1; killed after a grace period) and starts again from its file. Under ``sensorium serve``
+    (<extern> controllers, started by you) one error line, nothing done."""
+    func = "wb_supervisor_node_restart_controller"
+    r = _checked_node(node, func)
+    if r is not None:
+        _launcher_call(r, "restart_controller", {"node": int(node)}, func)  # type: ignore[arg-type]
+
+
+def wb_supervisor_world_reload() -> None:
+    """Webots' worldReload, under ``sensorium run``: the simulation ends (every controller's steps,
+    this one's too, return -1), the world file loads again (time 0) and every controller starts again.
+    Under ``sensorium serve`` one error line, nothing done."""
+    func = "wb_supervisor_world_reload"
+    r = _supervisor(func)
+    if r is not None:
+        _launcher_call(r, "world_reload", None, func)
+
+
 _unserved_warned: set[str] = set()
 
 

@@ -1015,6 +1015,8 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("load_node_state", "robot", NodeStateArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("import_node_from_string", "robot", ImportNodeArgs, IntArrayValue, attached=True, supervisor=True),
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("restart_controller", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("world_reload", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),
     ServiceSpec("set_label", "robot", SetLabelArgs, SuccessResult, attached=True, supervisor=True),

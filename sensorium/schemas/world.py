@@ -1273,11 +1273,29 @@ class Robot(Strict):
     name: str = Field(min_length=1)
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
     pose: Pose = Pose()
-    controller: Literal["<extern>", "<none>"] = Field(
-        default="<extern>",
+    controller: str = Field(
+        default="<extern>", min_length=1, max_length=255,
         description='"<extern>": driven by a controller you start (sensorium controller, a client); while no '
                     'synchronous controller is attached the server waits for one. "<none>": never controlled, '
-                    "never waited for (its motors keep their initial state)")
+                    "never waited for (its motors keep their initial state). A name (Webots' controller field, "
+                    "e.g. \"e-puck_avoid_collision\"): `sensorium run` starts the project's controllers/NAME/ "
+                    "for it; `sensorium serve` treats it as \"<extern>\"")
+    controller_args: list[Annotated[str, Field(max_length=4096)]] = Field(
+        default=[], max_length=1024, description="Webots controllerArgs: the arguments `sensorium run` gives the "
+        "controller (its argv after the program)")
+
+    @field_validator("controller")
+    @classmethod
+    def _controller_name(cls, v: str) -> str:
+        """Webots' special values, or the name of a folder under the project's controllers/."""
+        if v.startswith("<"):
+            if v not in ("<extern>", "<none>", "<generic>"):
+                raise ValueError(f'controller {v!r}: "<extern>", "<none>", "<generic>" or a controller\'s name')
+        elif v in (".", "..") or any(c in v for c in "/\\\0"):
+            raise ValueError(f"controller {v!r}: a controller's name is a folder name under controllers/ "
+                             "(no '/', '\\', '.' or '..')")
+        return v
+
     synchronization: bool = True
     supervisor: bool = Field(default=False, description="its controller may use the Supervisor services (Webots)")
     custom_data: str = Field(default="", max_length=1 << 20, description="Webots customData (get/setCustomData)")

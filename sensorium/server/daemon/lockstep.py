@@ -34,6 +34,7 @@ __all__ = ["Lockstep", "LockstepError", "Session", "PendingStep", "StepDone", "M
 MODES = ("fast", "realtime", "pause")
 STATUS_QUIT = -1
 REST_MAX_S = 60.0      # longest rest of a robot whose controllers keep vanishing
+ENDED_KEPT = 1024       # tokens of ended controllers remembered (their late requests answer SHUTTING_DOWN)
 REST_CLEAR_S = 60.0    # a session heard from for this long after attaching is no vanishing one: the count restarts
 RTF_WINDOW_S = 1.0
 
@@ -127,6 +128,10 @@ class Lockstep:
         self._rest: dict[str, tuple[int, float]] = {}
         self._rt_next: float | None = None          # realtime: earliest wall time of the next step
         self._rtf: deque[tuple[float, int]] = deque()
+        self._ended: dict[str, str] = {}             # token -> robot of controllers ended (end_controller)
+        # robots whose controller `sensorium run` started and that have not attached yet: the world waits
+        # for them, as Webots waits for the controllers it starts (set by the launcher's thread: one add/discard)
+        self.starting: set[str] = set()
 
     # ------------------------------------------------------------------ sessions
     @property
@@ -148,6 +153,10 @@ class Lockstep:
     def session(self, token: str) -> Session:
         s = self._by_token.get(token)
         if s is None:
+            robot = self._ended.get(token)
+            if robot is not None:         # its controller was ended: its steps answer -1, as when quitting
+                raise LockstepError(ErrorCode.SHUTTING_DOWN, f"the controller of robot {robot!r} was ended "
+                                                             "(restartController)")
             raise LockstepError(ErrorCode.NOT_ATTACHED, "no such session (detached, dropped after missing "
                                                         "heartbeats, or never attached)")
         return s
@@ -175,6 +184,7 @@ class Lockstep:
         while token in self._by_token:
             token = self._new_token()
         s = Session(token, robot, peer, self.robots[robot], now, attached_at=now, slot=self._slots[robot])
+        self.starting.discard(robot)
         self.generation += 1
         self._by_robot[robot] = s
         self._by_slot[s.slot] = s
@@ -182,6 +192,21 @@ class Lockstep:
         self._by_token[token] = s
         self._by_peer.setdefault(peer, []).append(s)
         return s
+
+    def end_controller(self, robot: str) -> tuple[Session, StepDone | None] | None:
+        """End the controller attached to ``robot`` (Webots' restartController): its session is
+        released at once, so the world waits for it no more; a pending step is answered with -1 and
+        its later requests with ``SHUTTING_DOWN`` (the client's steps return -1). None if no
+        controller is attached."""
+        s = self._by_robot.get(robot)
+        if s is None:
+            return None
+        done = StepDone(s, s.pending, STATUS_QUIT, self.time_ms) if s.pending is not None else None
+        self._remove(s)
+        self._ended[s.token] = robot
+        if len(self._ended) > ENDED_KEPT:                # the oldest ones have long gone
+            del self._ended[next(iter(self._ended))]
+        return s, done
 
     def detach(self, token: str) -> tuple[Session, StepDone | None]:
         """Release a robot; a pending step is answered with -1 (the controller is leaving)."""
@@ -295,7 +320,7 @@ class Lockstep:
     def can_advance(self) -> bool:
         """Lockstep rule alone (no mode, no pacing): no attached synchronous controller without a
         step pending, and either some step pending or nobody to wait for (:attr:`free_running`)."""
-        if self.shutting_down:
+        if self.shutting_down or self.starting:
             return False
         any_pending = False
         any_synchronous = False

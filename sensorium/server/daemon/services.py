@@ -116,6 +116,8 @@ class Core(DeviceServices):
         self.pub_endpoint = pub_endpoint
         self.max_request = max_request
         self.open_controls = open_controls       # world-wide controls for any caller (roles.py)
+        # ``sensorium run``'s controller launcher (restart(robot), reload()): restartController and worldReload
+        self.launcher: Any = None
         self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
         self._log_counts: dict[str, int] = {}             # first line of a message -> times seen
         self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
@@ -166,7 +168,8 @@ class Core(DeviceServices):
                         S.spec("device", item), getattr(self, f"_motor_{item}"), robot_name, None, motor_name)
             for spec in S.SERVICES:
                 if spec.scope == "robot":
-                    handler = (partial(self._supervisor, spec.item) if spec.supervisor
+                    handler = (partial(self._supervisor, spec.item)
+                               if spec.supervisor and not hasattr(self, f"_robot_{spec.item}")
                                else getattr(self, f"_robot_{spec.item}"))
                     routes[f"/{robot_name}/robot/{spec.item}"] = Route(spec, handler, robot_name, None)
         for spec in S.SERVICES:
@@ -351,7 +354,9 @@ class Core(DeviceServices):
         """Say once (and again after the last controller left) what the world waits for."""
         ls = self.lockstep
         waiting = ls.waiting_for()
-        if waiting:
+        if waiting and self.launcher is not None:         # `sensorium run` starts them: nothing to say
+            self._announced = True
+        elif waiting:
             names = " or ".join(repr(r) for r in waiting)
             self.log(f"waiting for a controller to attach to robot {names} (controller \"<extern>\", "
                      f"synchronization true): the world steps when attached controllers ask it to; "
@@ -735,6 +740,34 @@ class Core(DeviceServices):
         return {"value": self.sim.robots[c.robot].model.model}
 
     # ------------------------------------------------------------------ supervisor services
+    def _robot_restart_controller(self, c: Call) -> dict:
+        """Webots' restartController: the robot's controller ends (a pending step answers -1, the
+        world waits for it no more) and the launcher (``sensorium run``) starts it again."""
+        if self.launcher is None:
+            raise ServiceError(ErrorCode.WRONG_STATE, "restart_controller: only `sensorium run` starts controllers; "
+                                                      "an <extern> controller is restarted by whoever started it")
+        try:
+            target = supervisor.robot_of_node(self.sim, c.args.node)
+        except ValueError as exc:
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"restart_controller: {exc}") from None
+        ended = self.lockstep.end_controller(target)
+        if ended is not None:
+            s, done = ended
+            self._released(s)
+            if done is not None:
+                c.extra.append(self._step_reply(done))
+        self.launcher.restart(target)
+        return {"success": True}
+
+    def _robot_world_reload(self, c: Call) -> dict:
+        """Webots' worldReload: ``sensorium run`` stops this simulation (every step answers -1), loads
+        the world file again (time 0) and starts every controller again."""
+        if self.launcher is None:
+            raise ServiceError(ErrorCode.WRONG_STATE, "world_reload: only `sensorium run` reloads a world (it "
+                                                      "starts the controllers again)")
+        self.launcher.reload()
+        return {"success": True}
+
     def _supervisor(self, item: str, c: Call) -> dict:
         """Every Supervisor service: :data:`supervisor.HANDLERS` (ValueError → INVALID_ARGUMENT)."""
         try:

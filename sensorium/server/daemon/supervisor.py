@@ -234,6 +234,14 @@ def node_by_id(sim: Any, node: int) -> Node:
     return found
 
 
+def robot_of_node(sim: Any, node: int) -> str:
+    """The name of the robot node ``node`` is (restartController); ValueError for another node."""
+    found = node_by_id(sim, node)
+    if found.type != "Robot" or found.nested:
+        raise ValueError(f"node {node} ({found.type} {found.name!r}) is no robot")
+    return str(found.key)
+
+
 def node_from_id(sim: Any, node: int) -> Node | None:
     """Webots' ``getFromId``: the node, or None (NULL) for an id that is no node."""
     try:

@@ -439,6 +439,26 @@ void wb_supervisor_node_remove(WbNodeRef node) {
   sn_reply_free(&rep);
 }
 
+/* Webots' restartController and worldReload, served under `sensorium run` (which starts the
+   controllers); under `sensorium serve` the server refuses them and one error line is printed. */
+void wb_supervisor_node_restart_controller(WbNodeRef node) {
+  const char *func = "wb_supervisor_node_restart_controller";
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/restart_controller", 1, args_node, &node->id, func, &rep) != 0)
+    return;
+  sn_reply_free(&rep);
+}
+
+void wb_supervisor_world_reload(void) {
+  const char *func = "wb_supervisor_world_reload";
+  sn_robot *rb = supervisor(func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/world_reload", 0, NULL, NULL, func, &rep) != 0)
+    return;
+  sn_reply_free(&rep);
+}
+
 typedef struct {
   int64_t node;
   double position;

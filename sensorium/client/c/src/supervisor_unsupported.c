@@ -21,9 +21,6 @@ bool wb_supervisor_world_save(const char *filename) {
   return false;
 }
 
-void wb_supervisor_world_reload(void) {
-  SN_UNSUPPORTED();
-}
 
 
 void wb_supervisor_movie_start_recording(const char *filename, int width, int height, int codec, int quality, int acceleration, bool caption) {
@@ -115,9 +112,6 @@ bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
 
 
 
-void wb_supervisor_node_restart_controller(WbNodeRef node) {
-  SN_UNSUPPORTED();
-}
 
 const char *wb_supervisor_node_export_string(WbNodeRef node) {
   SN_UNSUPPORTED();

@@ -214,6 +214,9 @@ class Node:
     def remove(self) -> None:
         wb.wb_supervisor_node_remove(self._ref)
 
+    def restartController(self) -> None:
+        wb.wb_supervisor_node_restart_controller(self._ref)
+
     def setJointPosition(self, position: float, index: int = 1) -> None:
         """Webots' ``setJointPosition``: the joint (this node) at ``position`` on its axis ``index`` at
         once, its motor targeting it (README "Supervisor": resets)."""
@@ -346,6 +349,9 @@ class Supervisor(Robot):
     def simulationGetMode(self) -> int:
         return wb.wb_supervisor_simulation_get_mode()
 
+    def worldReload(self) -> None:
+        wb.wb_supervisor_world_reload()
+
     def simulationQuit(self, status: int) -> None:
         wb.wb_supervisor_simulation_quit(status)
 
@@ -373,7 +379,7 @@ _NAN = math.nan
 _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
     Supervisor: {
         "getSelected": ("node_get_selected", None),
-        "worldLoad": ("world_load", None), "worldSave": ("world_save", False), "worldReload": ("world_reload", None),
+        "worldLoad": ("world_load", None), "worldSave": ("world_save", False),
         "movieStartRecording": ("movie_start_recording", None),
         "movieStopRecording": ("movie_stop_recording", None), "movieIsReady": ("movie_is_ready", True),
         "movieFailed": ("movie_failed", True), "animationStartRecording": ("animation_start_recording", False),
@@ -390,7 +396,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
         "exportString": ("node_export_string", ""),
         "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3),
         "getStaticBalance": ("node_get_static_balance", False),
-        "restartController": ("node_restart_controller", None), "moveViewpoint": ("node_move_viewpoint", None),
+        "moveViewpoint": ("node_move_viewpoint", None),
         "setVisibility": ("node_set_visibility", None), "addForce": ("node_add_force", None),
         "addForceWithOffset": ("node_add_force_with_offset", None), "addTorque": ("node_add_torque", None)},
     Proto: {

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import math
 import posixpath
-import shlex
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -1105,19 +1104,22 @@ class Converter:
         controller = f.string("controller", "<extern>")
         if controller in ("", "void"):                      # Webots' other ways of saying "no controller"
             controller = "<none>"
-        if controller not in ("<extern>", "<none>"):
-            # its controllerArgs too (Webots' youbot controller runs its demo only when given "demo")
-            args = f.strings("controllerArgs")
-            given = f" and its controllerArgs, `{shlex.join(args)}`" if args else ""
-            self.warn(node, f"Robot {unique!r}: controller {controller!r} is not started here; run it with "
-                            f"`sensorium controller`{given} (the robot is an <extern> robot)")
+        if not controller.startswith("<") and (controller in (".", "..") or any(c in controller for c in "/\\\0")):
+            self.warn(node, f"Robot {unique!r}: controller {controller!r} is no controller's name (a folder under "
+                            "controllers/): the robot is an <extern> robot")
             controller = "<extern>"
-        extras = {"controller": controller, "supervisor": f.flag("supervisor", False),
+        elif controller.startswith("<") and controller not in ("<extern>", "<none>", "<generic>"):
+            self.warn(node, f"Robot {unique!r}: controller {controller!r} is unknown: the robot is an <extern> robot")
+            controller = "<extern>"
+        # a named controller is kept: `sensorium run` starts it, `sensorium serve` waits for it as <extern>
+        extras = {"controller": controller, "controller_args": f.strings("controllerArgs"),
+                  "supervisor": f.flag("supervisor", False),
                   "custom_data": f.string("customData", ""), "model": f.string("model", "")}
-        defaults = {"controller": "<extern>", "supervisor": False, "custom_data": "", "model": ""}
+        defaults: dict[str, Any] = {"controller": "<extern>", "controller_args": [], "supervisor": False,
+                                    "custom_data": "", "model": ""}
         for key, value in extras.items():
             if key in self.robot_fields:
-                if key != "controller" or f.has("controller"):
+                if (key != "controller" or f.has("controller")) and (key != "controller_args" or value):
                     data[key] = value
             elif value != defaults[key]:
                 self.warn(node, f"Robot field {key}: not supported by this version; ignored")

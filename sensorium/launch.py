@@ -1,0 +1,331 @@
+"""``sensorium run``: open a Webots project headless, the way Webots does: serve the world and start
+every robot's controller named in it, print their output with the robot's name, restart them on
+``restartController``, reload the world on ``worldReload``, end them all at the end.
+
+Where a controller is found, as Webots' WbController does for a project: ``controllers/NAME/`` next to
+the world's ``worlds/`` folder (then each ``--controllers-dir``); in that folder the first of
+``Dockerfile``, ``NAME`` (an executable), ``build/release/NAME``, ``NAME.class``, ``NAME.jar``,
+``NAME.py``, ``NAME.m``, ``NAME.bsg``. Python and executables run (as ``sensorium controller`` runs
+them: the controller's folder as working directory, ``controllerArgs`` as arguments, the URL in the
+environment); the others are refused with one line. Webots' own controllers and extra project paths
+are not searched (they are not here).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any
+from urllib.parse import quote
+
+__all__ = ["ControllerSpec", "LaunchError", "Launcher", "find_controller", "plan"]
+
+# Webots' WbController: a controller gets the quit packet (-1), then 1 s to end before it is terminated
+GRACE_S = 1.0
+LINE_MAX = 1 << 16       # bytes of a controller's line printed at once
+C_LIBRARY = Path(__file__).resolve().parent / "client" / "c" / "build"
+SPECIAL = ("<extern>", "<none>", "<generic>")
+# the kinds Webots runs that Sensorium does not (file in the controller's folder -> what it is)
+UNSUPPORTED = {"Dockerfile": "a Docker controller", ".class": "a Java controller", ".jar": "a Java controller",
+               ".m": "a MATLAB controller", ".bsg": "a BotStudio controller"}
+
+
+class LaunchError(Exception):
+    """A controller that cannot be started: one line for the user."""
+
+
+@dataclass(frozen=True)
+class ControllerSpec:
+    robot: str
+    name: str                  # the world's controller field
+    folder: Path               # controllers/NAME: the working directory
+    program: Path              # NAME.py or the executable
+    python: bool
+    args: tuple[str, ...] = ()
+
+
+def controller_dirs(world: Path, extra: list[Path]) -> list[Path]:
+    """Where controllers are looked for: the project's ``controllers/`` (the world's folder's parent),
+    then ``--controllers-dir`` folders in their order."""
+    return [world.resolve().parent.parent / "controllers", *(Path(d).resolve() for d in extra)]
+
+
+def find_controller(robot: str, name: str, args: list[str], dirs: list[Path]) -> ControllerSpec:
+    """The controller ``name`` of ``robot`` in the first of ``dirs`` that has a ``NAME/`` folder, by
+    Webots' order of files. Raises LaunchError naming where it looked or what is not supported."""
+    for base in dirs:
+        folder = base / name
+        if not folder.is_dir():
+            continue
+        candidates: list[tuple[str, Path]] = [
+            ("Dockerfile", folder / "Dockerfile"), ("exe", folder / name), ("exe", folder / "build" / "release" / name),
+            (".class", folder / f"{name}.class"), (".jar", folder / f"{name}.jar"), ("py", folder / f"{name}.py"),
+            (".m", folder / f"{name}.m"), (".bsg", folder / f"{name}.bsg")]
+        for kind, path in candidates:
+            if not path.is_file():
+                continue
+            if kind == "py":
+                return ControllerSpec(robot, name, folder, path, True, tuple(args))
+            if kind == "exe":
+                if not os.access(path, os.X_OK):
+                    raise LaunchError(f"robot {robot!r}: controller {path} is not executable (chmod +x)")
+                return ControllerSpec(robot, name, folder, path, False, tuple(args))
+            raise LaunchError(f"robot {robot!r}: controller {path} is {UNSUPPORTED[kind]}, which Sensorium does not "
+                              "run (Python controllers and executables run; start it as an <extern> controller)")
+        hint = ""
+        if (folder / f"{name}.c").is_file() or (folder / f"{name}.cpp").is_file():
+            hint = " (its C/C++ source is there: compile it against sensorium/client/c)"
+        raise LaunchError(f"robot {robot!r}: controller {name!r}: {folder} has none of {name}, {name}.py "
+                          f"(nor {name}.class, .jar, .m, .bsg, Dockerfile){hint}")
+    looked = ", ".join(str(d / name) for d in dirs)
+    raise LaunchError(f"robot {robot!r}: controller {name!r} not found (looked for the folder {looked})")
+
+
+def plan(robots: list[Any], dirs: list[Path]) -> tuple[list[ControllerSpec], list[str]]:
+    """The controllers to start for the world's robots, and every problem (one line each)."""
+    specs, problems = [], []
+    for r in robots:
+        if r.controller in SPECIAL:
+            continue
+        try:
+            specs.append(find_controller(r.name, r.controller, list(r.controller_args), dirs))
+        except LaunchError as exc:
+            problems.append(str(exc))
+    return specs, problems
+
+
+def _describe(code: int) -> str:
+    """Webots' words for a controller's end."""
+    if code == 0:
+        return "exited successfully."
+    if code < 0:
+        try:
+            sig = signal.Signals(-code).name
+        except ValueError:
+            sig = f"signal {-code}"
+        return f"crashed ({sig})."
+    return f"exited with status: {code}."
+
+
+@dataclass
+class _Running:
+    spec: ControllerSpec
+    proc: subprocess.Popen
+    readers: list[threading.Thread] = field(default_factory=list)
+    ending: bool = False       # ended by us (restart, reload, quit): no "exited" line of its own
+
+
+class Launcher:
+    """Start, watch, restart and end the controller processes of one ``sensorium run``.
+
+    ``url`` is the server's RPC endpoint; each controller gets ``url/ROBOT`` in
+    ``SENSORIUM_CONTROLLER_URL``. ``out``/``err`` receive the controllers' lines, ``[ROBOT] line``,
+    and the launcher's own lines (``log``). Thread-safe: ``restart`` and ``reload`` are called from
+    the server's loop thread and only queue work."""
+
+    def __init__(self, specs: list[ControllerSpec], url: str, *, out: IO[str] | None = None,
+                 err: IO[str] | None = None, grace_s: float = GRACE_S):
+        self.specs = {s.robot: s for s in specs}
+        self.url = url
+        self.out = out or sys.stdout
+        self.err = err or sys.stderr
+        self.grace_s = grace_s
+        self.running: dict[str, _Running] = {}
+        self.starts: dict[str, int] = {s.robot: 0 for s in specs}
+        self._lock = threading.Lock()            # running, starts
+        self._print_lock = threading.Lock()
+        self._restarts: list[str] = []
+        self._wake = threading.Event()
+        self._closed = False
+        self.reload_requested = False
+        self.on_reload: Callable[[], None] | None = None     # stops the server (run's loop reloads)
+        self._starting: set[str] = set()         # the lockstep's: the world waits until these attach
+        self._wake_server: Callable[[], None] = lambda: None
+        self._quitting: Callable[[], bool] = lambda: False
+        self._worker = threading.Thread(target=self._work, name="sensorium-launcher", daemon=True)
+        self._worker.start()
+
+    def bind(self, starting: set[str], wake: Callable[[], None], quitting: Callable[[], bool]) -> None:
+        """Serve this server (again after a reload): ``starting`` is its lockstep's set of robots
+        whose controller was started and has not attached (the world waits for them), ``wake``
+        makes its loop look again, ``quitting`` says it is ending (no "exited" lines then)."""
+        self._starting, self._wake_server, self._quitting = starting, wake, quitting
+
+    # ------------------------------------------------------------------ output
+    def log(self, text: str) -> None:
+        with self._print_lock:
+            print(f"sensorium run: {text}", file=self.err, flush=True)
+
+    def _pump(self, robot: str, stream: IO[bytes], sink: IO[str]) -> None:
+        """Each line of a controller's stream as ``[ROBOT] line`` (Webots' console names the robot);
+        a last line without a newline is printed too."""
+        sink_open = True
+        for raw in iter(lambda: stream.readline(LINE_MAX), b""):      # a longer line comes in pieces
+            if not sink_open:
+                continue            # read on all the same: a controller blocked on a full pipe would stall the world
+            line = raw.decode("utf-8", errors="replace").rstrip("\r\n")
+            try:
+                with self._print_lock:
+                    print(f"[{robot}] {line}", file=sink, flush=True)
+            except (BrokenPipeError, ValueError, OSError):        # `sensorium run | head`: the reader left
+                sink_open = False
+        stream.close()
+
+    # ------------------------------------------------------------------ processes
+    def _command(self, spec: ControllerSpec) -> list[str]:
+        if spec.python:   # as `sensorium controller` runs it: `controller` importable, its folder as cwd
+            return [sys.executable, "-m", "sensorium", "controller", str(spec.program), "--", *spec.args]
+        return [str(spec.program), *spec.args]
+
+    def _environment(self, spec: ControllerSpec) -> dict[str, str]:
+        env = dict(os.environ)
+        env["SENSORIUM_CONTROLLER_URL"] = f"{self.url.rstrip('/')}/{quote(spec.robot, safe='')}"   # both clients decode it
+        env.pop("WEBOTS_CONTROLLER_URL", None)
+        env["PYTHONUNBUFFERED"] = "1"            # lines reach the console as they are printed
+        env["PYTHONIOENCODING"] = "UTF-8"        # as Webots sets it
+        package_root = str(Path(__file__).resolve().parent.parent)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH", "")) if p)
+        if not spec.python and C_LIBRARY.is_dir():   # Webots puts its libController on the path likewise
+            env["LD_LIBRARY_PATH"] = os.pathsep.join(p for p in (str(C_LIBRARY), env.get("LD_LIBRARY_PATH", "")) if p)
+        return env
+
+    def start(self, robot: str) -> None:
+        spec = self.specs[robot]
+        with self._lock:
+            now = self.running.get(robot)
+            if now is not None and now.proc.poll() is None:      # a restart and a reload at once: one process
+                return
+        self._starting.add(robot)
+        try:
+            proc = subprocess.Popen(self._command(spec), cwd=spec.folder, env=self._environment(spec),
+                                    stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                    start_new_session=True)    # its own group: ended by us, with its children
+        except OSError as exc:
+            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {exc.strerror or exc}")
+            self._starting.discard(robot)
+            self._wake_server()
+            return
+        run = _Running(spec, proc)
+        assert proc.stdout is not None and proc.stderr is not None
+        for stream, sink in ((proc.stdout, self.out), (proc.stderr, self.err)):
+            t = threading.Thread(target=self._pump, args=(robot, stream, sink), daemon=True,
+                                 name=f"sensorium-run-{robot}")
+            t.start()
+            run.readers.append(t)
+        with self._lock:
+            self.running[robot] = run
+            self.starts[robot] += 1
+        threading.Thread(target=self._watch, args=(run,), daemon=True, name=f"sensorium-wait-{robot}").start()
+
+    def replan(self, specs: list[ControllerSpec]) -> None:
+        """The controllers of a reloaded world (its file may name others now)."""
+        with self._lock:
+            self.specs = {s.robot: s for s in specs}
+            for s in specs:
+                self.starts.setdefault(s.robot, 0)
+
+    def start_all(self) -> None:
+        for robot in self.specs:
+            self.start(robot)
+
+    def _watch(self, run: _Running) -> None:
+        code = run.proc.wait()
+        if not run.ending:          # it may never have attached (a crash at start): not waited for any more
+            self._starting.discard(run.spec.robot)
+            self._wake_server()
+        for t in run.readers:
+            t.join()
+        if not run.ending and not self._quitting():      # it ended by itself: the robot stays uncontrolled, the world goes on
+            self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}' {_describe(code)}")
+
+    def _end(self, run: _Running, grace_s: float) -> None:
+        """End one controller: it was told (-1) by the server; after ``grace_s`` its process group
+        gets SIGTERM, then SIGKILL. Its output is read to the end."""
+        run.ending = True
+        proc = run.proc
+        try:
+            proc.wait(grace_s)
+        except subprocess.TimeoutExpired:
+            self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}': forced termination (it did not "
+                     f"end {grace_s:g} s after its last step)")
+            for sig, wait_s in ((signal.SIGTERM, 1.0), (signal.SIGKILL, None)):
+                try:
+                    os.killpg(proc.pid, sig)
+                except ProcessLookupError:
+                    break
+                try:
+                    proc.wait(wait_s)
+                    break
+                except subprocess.TimeoutExpired:
+                    continue
+        try:     # what it left in its group (a controller's own children) goes too
+            os.killpg(proc.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
+        for t in run.readers:
+            t.join()
+
+    def end_all(self, grace_s: float | None = None) -> None:
+        """End every controller (the server already answered their steps with -1)."""
+        with self._lock:
+            runs = list(self.running.values())
+            self.running.clear()
+        grace = self.grace_s if grace_s is None else grace_s
+        deadline = time.monotonic() + grace
+        for run in runs:
+            self._end(run, max(0.0, deadline - time.monotonic()))
+
+    # ------------------------------------------------------------------ restart / reload (server's loop thread)
+    def restart(self, robot: str) -> None:
+        """restartController: the server has ended the session; end the process, start it again."""
+        if robot in self.specs:
+            self._starting.add(robot)        # the world waits for the new process, as for the first one
+        with self._lock:
+            self._restarts.append(robot)
+            run = self.running.get(robot)
+            if run is not None:
+                run.ending = True
+        self._wake.set()
+
+    def reload(self) -> None:
+        """worldReload: stop the server (every step -1); ``run`` then reloads and starts all again."""
+        self.reload_requested = True
+        with self._lock:
+            for run in self.running.values():
+                run.ending = True
+        if self.on_reload is not None:
+            self.on_reload()
+
+    def _work(self) -> None:
+        while True:
+            self._wake.wait()
+            self._wake.clear()
+            if self._closed:
+                return
+            while True:
+                with self._lock:
+                    if not self._restarts:
+                        break
+                    robot = self._restarts.pop(0)
+                    run = self.running.pop(robot, None)
+                if robot not in self.specs:
+                    self.log(f"robot '{robot}' has no controller `sensorium run` started (an <extern> one?): "
+                             "restartController ended its session only")
+                    continue
+                if run is not None:
+                    self._end(run, self.grace_s)
+                if not self._closed:
+                    self.start(robot)
+
+    def close(self) -> None:
+        self._closed = True
+        self._wake.set()
+        self._worker.join()
+        self.end_all()

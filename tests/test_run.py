@@ -1,0 +1,335 @@
+"""``sensorium run WORLD``: a Webots project of our own (worlds/ and controllers/ in a tmp folder)
+runs with one command: its named controllers are found and started as Webots starts them (their
+folder, their controllerArgs), their lines come out as ``[ROBOT] ...``, the world ends at ``--until``
+with every controller gone; restartController and worldReload restart them."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import stat
+import subprocess
+from pathlib import Path
+
+import pytest
+from _serve import REPO, Proc, run_controller, sensorium, wait_until
+
+from sensorium.launch import LaunchError, find_controller
+
+WORLD = '''#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 16 }
+{robots}
+'''
+
+# a controller that says where it runs, with which arguments, counts its steps and writes its pid
+COUNTER = '''import os, sys
+from controller import Robot
+robot = Robot()
+with open(f"pid-{robot.getName()}", "a") as f:
+    f.write(f"{os.getpid()}\\n")
+print(robot.getName(), "args", sys.argv[1:], "in", os.path.basename(os.getcwd()))
+steps = 0
+while robot.step({step}) != -1:
+    steps += 1
+print(robot.getName(), "stepped", steps, "until", round(robot.getTime() * 1000))
+'''
+
+
+def project(tmp_path: Path, robots: str, controllers: dict[str, str]) -> Path:
+    """worlds/w.wbt with ``robots``, and controllers/NAME/NAME.py (or an executable NAME) for each."""
+    (tmp_path / "worlds").mkdir()
+    world = tmp_path / "worlds" / "w.wbt"
+    world.write_text(WORLD.replace("{robots}", robots))
+    for name, text in controllers.items():
+        folder = tmp_path / "controllers" / name.split(".")[0]
+        folder.mkdir(parents=True, exist_ok=True)
+        path = folder / name
+        path.write_text(text)
+        if not name.endswith(".py"):
+            path.chmod(path.stat().st_mode | stat.S_IXUSR)
+    return world
+
+
+def run(world: Path, *extra: str, env: dict | None = None) -> Proc:
+    return Proc(sensorium("run", str(world), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0", *extra),
+                env=env)
+
+
+def pids(folder: Path, robot: str) -> list[int]:
+    path = folder / f"pid-{robot}"
+    return [int(x) for x in path.read_text().split()] if path.exists() else []
+
+
+def alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+# ---------------------------------------------------------------------- finding controllers (no process)
+
+def test_controllers_are_found_in_webots_order_and_others_are_refused(tmp_path: Path) -> None:
+    base = tmp_path / "controllers"
+    (base / "both").mkdir(parents=True)
+    (base / "both" / "both.py").write_text("")
+    exe = base / "both" / "both"
+    exe.write_text("#!/bin/sh\n")
+    exe.chmod(0o755)
+    spec = find_controller("r", "both", ["x"], [base])          # an executable comes before NAME.py
+    assert (spec.program, spec.python, spec.folder, spec.args) == (exe, False, base / "both", ("x",))
+    exe.unlink()
+    assert find_controller("r", "both", [], [base]).program == base / "both" / "both.py"
+
+    (base / "java").mkdir()
+    (base / "java" / "java.jar").write_text("")
+    with pytest.raises(LaunchError, match=r"java\.jar is a Java controller, which Sensorium does not run"):
+        find_controller("r", "java", [], [base])
+    (base / "src").mkdir()
+    (base / "src" / "src.c").write_text("")
+    with pytest.raises(LaunchError, match=r"has none of src, src\.py .*its C/C\+\+ source is there"):
+        find_controller("r", "src", [], [base])
+    other = tmp_path / "more"
+    with pytest.raises(LaunchError) as info:
+        find_controller("r", "gone", [], [base, other])
+    assert str(info.value) == (f"robot 'r': controller 'gone' not found (looked for the folder {base / 'gone'}, "
+                               f"{other / 'gone'})")
+
+
+# ---------------------------------------------------------------------- running a project
+
+def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" controllerArgs [ "--say" "hello world" ] }\n'
+                              'Robot { name "beta %41" controller "b" }',     # a name a URL must encode
+                    {"a.py": COUNTER.replace("{step}", "16"), "b.py": COUNTER.replace("{step}", "32")})
+    proc = run(world, "--until", "1600")
+    assert proc.wait() == 0, proc.stderr()
+    out = proc.stdout().splitlines()
+    assert out[0].startswith("sensorium: serving world 'w' rpc=tcp://127.0.0.1:")
+    assert "[alpha] alpha args ['--say', 'hello world'] in a" in out
+    assert "[beta %41] beta %41 args [] in b" in out
+    # the world waited for both before it stepped: every step of both, from 0 to --until
+    assert "[alpha] alpha stepped 100 until 1600" in out
+    assert "[beta %41] beta %41 stepped 50 until 1600" in out
+    assert "sensorium: stopped at 1600 ms after 100 steps" in proc.stderr()
+    for robot, folder in (("alpha", "a"), ("beta %41", "b")):
+        (pid,) = pids(tmp_path / "controllers" / folder, robot)
+        assert not alive(pid)
+
+
+def test_a_missing_controller_is_one_line_and_nothing_runs(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }', {})
+    proc = run(world)
+    assert proc.wait() == 1
+    assert proc.stderr().strip() == (f"sensorium run: robot 'alpha': controller 'nowhere' not found (looked for the "
+                                     f"folder {tmp_path / 'controllers' / 'nowhere'})")
+    assert proc.stdout() == ""
+
+
+def test_a_controller_that_crashes_is_said_and_the_world_goes_on(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "beta" controller "quitter" }\n'
+                              'Robot { name "gamma" controller "segv" }',
+                    {"a.py": COUNTER.replace("{step}", "16"), "quitter": "#!/bin/sh\necho leaving\nexit 3\n",
+                     "segv": "#!/bin/sh\nkill -SEGV $$\n"})
+    proc = run(world, "--until", "800")
+    assert proc.wait() == 0, proc.stderr()
+    assert "[beta] leaving" in proc.stdout().splitlines()
+    assert "sensorium run: 'quitter' controller of robot 'beta' exited with status: 3." in proc.stderr()
+    assert "sensorium run: 'segv' controller of robot 'gamma' crashed (SIGSEGV)." in proc.stderr()
+    assert "[alpha] alpha stepped 50 until 800" in proc.stdout().splitlines()
+
+
+def test_an_extern_robot_waits_for_a_controller_started_by_hand(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "ext" controller "<extern>" }',
+                    {"a.py": COUNTER.replace("{step}", "16")})
+    hand = tmp_path / "hand.py"
+    hand.write_text(COUNTER.replace("{step}", "16"))
+    proc = run(world, "--until", "800")
+    ready = proc.wait_line("sensorium: serving world")
+    url = ready.split("rpc=")[1].split()[0]
+    wait_until(lambda: f"--robot ext --url {url}" in proc.stderr(), what="the <extern> hint")
+    with Proc(sensorium("controller", str(hand), "--robot", "ext", "--url", url)) as manual:
+        assert manual.wait() == 0, manual.stderr()
+        assert manual.stdout().splitlines()[-1].startswith("ext stepped ")
+    assert proc.wait() == 0, proc.stderr()
+    assert "[alpha] alpha stepped 50 until 800" in proc.stdout().splitlines()
+
+
+def test_sigterm_ends_every_controller_even_one_that_will_not_go(tmp_path: Path) -> None:
+    stubborn = ('import os, signal, time\nfrom controller import Robot\nsignal.signal(signal.SIGTERM, signal.SIG_IGN)\n'
+                'robot = Robot()\nopen("pid-" + robot.getName(), "w").write(str(os.getpid()))\n'
+                'while robot.step(16) != -1:\n    pass\nprint("ignoring the end")\nwhile True:\n    time.sleep(1)\n')
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "mule" controller "mule" }',
+                    {"a.py": COUNTER.replace("{step}", "16"), "mule.py": stubborn})
+    proc = run(world, "--grace", "0.2")
+    proc.wait_line("sensorium: serving world")
+    wait_until(lambda: pids(tmp_path / "controllers" / "mule", "mule") and pids(tmp_path / "controllers" / "a", "alpha"),
+               what="both controllers started")
+    proc.p.send_signal(signal.SIGTERM)
+    assert proc.wait() == 0, proc.stderr()
+    assert "[mule] ignoring the end" in proc.stdout().splitlines()
+    assert "'mule' controller of robot 'mule': forced termination" in proc.stderr()
+    for pid in (*pids(tmp_path / "controllers" / "mule", "mule"), *pids(tmp_path / "controllers" / "a", "alpha")):
+        assert not alive(pid)
+
+
+RESTARTER = '''import os
+from controller import Supervisor
+boss = Supervisor()
+again = os.path.exists("reloaded")
+print("boss starts at", boss.getTime(), "after the reload" if again else "")
+while boss.step(16) != -1:
+    t = round(boss.getTime() * 1000)
+    if t == 480:
+        boss.getFromDef("ALPHA").restartController()
+    if t == 960 and not again:
+        open("reloaded", "w").close()
+        boss.worldReload()
+print("boss ends at", round(boss.getTime() * 1000))
+'''
+
+STARTS = '''from controller import Robot
+robot = Robot()
+with open("starts.txt", "a") as f:
+    f.write(f"{round(robot.getTime() * 1000)}\\n")
+while robot.step(16) != -1:
+    pass
+'''
+
+
+def test_restart_controller_and_world_reload_start_controllers_again(tmp_path: Path) -> None:
+    world = project(tmp_path, 'DEF ALPHA Robot { name "alpha" controller "starts" }\n'
+                              'Robot { name "boss" controller "boss" supervisor TRUE }',
+                    {"starts.py": STARTS, "boss.py": RESTARTER})
+    proc = run(world, "--until", "1200")
+    assert proc.wait() == 0, proc.stderr()
+    # started at 0, restarted at 480; the reload at 960: time 0 again, restarted at 480; ends at 1200
+    assert (tmp_path / "controllers" / "starts" / "starts.txt").read_text().split() == ["0", "480", "0", "480"]
+    out = proc.stdout().splitlines()
+    assert [line for line in out if line.startswith("[boss]")] == [
+        "[boss] boss starts at 0.0 ", "[boss] boss ends at 960", "[boss] boss starts at 0.0 after the reload",
+        "[boss] boss ends at 1200"]
+    assert sum(line.startswith("sensorium: serving world 'w'") for line in out) == 2
+    assert "sensorium run: world reloaded from" in proc.stderr()
+    assert "sensorium: stopped at 1200 ms" in proc.stderr()
+
+
+C_STARTS = r'''#include <math.h>
+#include <stdio.h>
+#include <webots/robot.h>
+
+int main(void) {
+  wb_robot_init();
+  FILE *f = fopen("starts.txt", "a");
+  fprintf(f, "%ld\n", lround(wb_robot_get_time() * 1000));
+  fclose(f);
+  while (wb_robot_step(16) != -1) {
+  }
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+C_BOSS = r'''#include <math.h>
+#include <stdio.h>
+#include <unistd.h>
+#include <webots/robot.h>
+#include <webots/supervisor.h>
+
+int main(int argc, char **argv) {
+  wb_robot_init();
+  int again = access("reloaded", F_OK) == 0;
+  printf("boss starts (%s) at %g%s\n", argc > 1 ? argv[1] : "", wb_robot_get_time(), again ? " after the reload" : "");
+  fflush(stdout);
+  while (wb_robot_step(16) != -1) {
+    long t = lround(wb_robot_get_time() * 1000);
+    if (t == 480)
+      wb_supervisor_node_restart_controller(wb_supervisor_node_get_from_def("ALPHA"));
+    if (t == 960 && !again) {
+      fclose(fopen("reloaded", "w"));
+      wb_supervisor_world_reload();
+    }
+  }
+  printf("boss ends at %ld\n", lround(wb_robot_get_time() * 1000));
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path) -> None:
+    """Compiled controllers (our libController) are started as executables with their arguments; the
+    C restartController and worldReload do what the Python ones do."""
+    if shutil.which("cc") is None or shutil.which("make") is None:
+        pytest.skip("needs a C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
+    clib = REPO / "sensorium" / "client" / "c"
+    build = tmp_path / "cbuild"
+    done = subprocess.run(["make", "-s", "-C", str(clib), f"BUILD={build}"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    libs = subprocess.run(["make", "-s", "-C", str(clib), "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+    world = project(tmp_path, 'DEF ALPHA Robot { name "alpha" controller "starts" }\n'
+                              'Robot { name "boss" controller "boss" controllerArgs [ "in C" ] supervisor TRUE }', {})
+    for name, source in (("starts", C_STARTS), ("boss", C_BOSS)):
+        folder = tmp_path / "controllers" / name
+        folder.mkdir(parents=True)
+        (folder / f"{name}.c").write_text(source)
+        done = subprocess.run(["cc", "-std=c99", "-Wall", "-Werror", f"-I{clib / 'include'}", str(folder / f"{name}.c"),
+                               "-o", str(folder / name), str(build / "libController.a"), *libs, "-lm"],
+                              capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+    proc = run(world, "--until", "1200")
+    assert proc.wait() == 0, proc.stderr()
+    assert (tmp_path / "controllers" / "starts" / "starts.txt").read_text().split() == ["0", "480", "0", "480"]
+    assert [line for line in proc.stdout().splitlines() if line.startswith("[boss]")] == [
+        "[boss] boss starts (in C) at 0", "[boss] boss ends at 960", "[boss] boss starts (in C) at 0 after the reload",
+        "[boss] boss ends at 1200"]
+
+
+UNDER_SERVE = '''from controller import Supervisor
+boss = Supervisor()
+boss.step(16)
+boss.getFromDef("ALPHA").restartController()
+boss.worldReload()
+boss.getSelf().restartController()
+print("still at", round(boss.getTime() * 1000))
+'''
+
+
+def test_under_serve_restart_and_reload_are_one_line_each_and_change_nothing(tmp_path: Path) -> None:
+    """Controllers you start yourself (`sensorium serve`) cannot be started again by the server."""
+    world = project(tmp_path, 'DEF ALPHA Robot { name "alpha" controller "a" }\n'
+                              'Robot { name "boss" controller "<extern>" supervisor TRUE }', {"boss.py": UNDER_SERVE})
+    lines, err = run_controller(world, lambda url: sensorium("controller", str(tmp_path / "controllers" / "boss" /
+                                                                              "boss.py"), "--url", url), robot="boss")
+    assert lines == ["still at 16"]
+    assert [line for line in err.splitlines() if line.startswith("Error:")] == [
+        "Error: wb_supervisor_node_restart_controller(): restart_controller: only `sensorium run` starts controllers; "
+        "an <extern> controller is restarted by whoever started it.",
+        "Error: wb_supervisor_world_reload(): world_reload: only `sensorium run` reloads a world (it starts the "
+        "controllers again).",
+        "Error: wb_supervisor_node_restart_controller(): restart_controller: only `sensorium run` starts controllers; "
+        "an <extern> controller is restarted by whoever started it."]
+
+
+def test_serve_says_which_robots_name_a_controller(tmp_path: Path) -> None:
+    """... with the controllerArgs to give (Webots' youBot world gives its controller "demo", without which
+    it only waits for keys)."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" controllerArgs [ "demo" "two words" ] }\n'
+                              'Robot { name "ext" }', {})
+    proc = Proc(sensorium("serve", str(world), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"))
+    proc.wait_line("sensorium: serving world")
+    proc.stop()
+    assert proc.stderr().splitlines()[0] == (
+        "sensorium serve: robot 'alpha' ('a', controllerArgs `demo 'two words'`): `sensorium run WORLD` starts this "
+        "controller; here it is <extern> (start it with `sensorium controller`, its controllerArgs after the script)")
+
+
+def test_a_world_that_does_not_load_is_its_line_and_exit_1(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "a"', {"a.py": COUNTER.replace("{step}", "16")})
+    proc = run(world)
+    assert proc.wait() == 1
+    assert proc.stderr().splitlines() == [f"{world}: line 4, column 1: expected a field name or '}}' in Robot (line 3), "
+                                          "found end of file"]
+    assert proc.stdout() == "" and not (tmp_path / "controllers" / "a" / "pid-alpha").exists()
