@@ -1546,9 +1546,12 @@ class Converter:
             axis = pf.vec("axis", axis_default) if pf else axis_default
             anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf and params_field == "jointParameters" else None
             if not found:
-                if found_sensors:
-                    self.warn(node, f"PositionSensor on a Hinge2Joint axis without a motor ({params_field}): "
-                                    "listed, reads no value")
+                if found_sensors:       # joint_devices gave it the axis's position: it reads that, still
+                    still = float(found_sensors[0].get("position", 0.0))
+                    what = "a free wheel, which Webots' physics rolls" if not steers else "a free steering axis"
+                    self.warn(node, f"PositionSensor on a Hinge2Joint axis without a motor ({params_field}, "
+                                    f"{what}): listed, reads the axis's position in the world file ({still:g}) "
+                                    "and keeps it (nothing turns it here)")
                 continue
             m = self.fields(found[0])
             turn = frame.rotation @ np.asarray(axis)
