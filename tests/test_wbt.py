@@ -943,3 +943,20 @@ def test_an_open_cylinder_used_twice_is_said_once(tmp_path: Path) -> None:
     w = load_world(p)
     assert [x for x in w.warnings if "bottom/side/top" in x] == [
         f"{p}:2:114: Cylinder with bottom/side/top FALSE: rays see the whole closed cylinder"]
+
+
+def test_a_cameras_zoom_is_said_for_what_it_changes(tmp_path: Path) -> None:
+    """A Zoom (the e-puck's camera has one, Webots' defaults) renders nothing by itself: it is the range
+    a controller's setFov() may take. The line said 'zoom (zoom) is not rendered here; the image is
+    Webots' without it'; it now says what is not read and what the image is."""
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+              'Camera { fieldOfView 0.84 zoom Zoom { } }\n'
+              'Camera { name "tele" zoom Zoom { minFieldOfView 0.2 maxFieldOfView 1 } }\n] }\n')
+    w = load_world(p)
+    assert [x.split(": ", 1)[1] for x in w.warnings] == [
+        "Camera 'camera' of robot 'r': its Zoom (0.5 to 1.5 rad) is not read: setFov() takes only the "
+        "field of view (0.84 rad) and getMinFov()/getMaxFov() answer it, as without a Zoom; the image is Webots' at "
+        "that field of view",
+        "Camera 'tele' of robot 'r': its Zoom (0.2 to 1 rad) is not read: setFov() takes only the "
+        "field of view (0.7854 rad) and getMinFov()/getMaxFov() answer it, as without a Zoom; the image is Webots' at "
+        "that field of view"]
