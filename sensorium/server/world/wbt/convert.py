@@ -452,6 +452,11 @@ class Converter:
             self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
             self.scaled_solid(node, owner)
+        elif t == "Fluid":               # a Solid of water or air that immersed solids float in (physics only)
+            self.warn(node, f"Fluid {f.string('name', 'fluid')!r}: buoyancy, drag and its stream are not simulated "
+                            "(no physics); its shapes are kept as a solid that cameras, lidars and infra-red sensors "
+                            "see, its boundingObject (the fluid's volume) is no obstacle")
+            self.solid(node, frame, owner, "fluid", bounding=False)
         elif t == "Charger":             # a Solid that recharges robots' batteries (no battery here)
             self.warn(node, f"Charger {f.string('name', 'solid')!r}: recharging is not simulated (robots have no "
                             "battery here); its shapes and lights are kept as a solid")
@@ -1007,9 +1012,10 @@ class Converter:
         return inside(children[0]) if children else []
 
     # ------------------------------------------------------------ solids and robots
-    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> dict | None:
+    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid", bounding: bool = True) -> dict | None:
         """A Solid (``default``: its name when it has none: a device's default name); its entry (None
-        when it is part of a robot's body)."""
+        when it is part of a robot's body). ``bounding`` False: its boundingObject is left out (a
+        Fluid's: the volume immersed solids float in, which nothing collides with)."""
         f = self.fields(node)
         inner = self.child_frame(node, frame)
         # an empty name (Webots' radar sample's target boxes: name "") is the default one: names here
@@ -1018,7 +1024,7 @@ class Converter:
         if owner.kind == "robot":   # part of the robot's body
             target = self.carried_target(node, name, inner, owner)
             start = len(owner.parts)
-            self.solid_contents(node, inner, owner)
+            self.solid_contents(node, inner, owner, bounding)
             if target is not None:
                 target["_members"] = [id(p) for p in owner.parts[start:]]
             return None
@@ -1044,7 +1050,7 @@ class Converter:
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
         # a nested solid's spot lights: a LightSensor turns them by this solid's own rotation (not the Poses above)
         own = Frame.identity() if owner.kind == "world" else Frame(np.eye(3), np.zeros(3), own_rotation=inner.own_rotation)
-        self.solid_contents(node, own, mine)
+        self.solid_contents(node, own, mine, bounding)
         out = self.solid_dict(mine, data)
         out["_at"] = self.at(node)
         if owner.kind == "world":
@@ -1080,11 +1086,12 @@ class Converter:
         for target in robot.get("radar_targets", ()):
             target["shapes"] = sorted({index[m] for m in target.pop("_members") if m in index})
 
-    def solid_contents(self, node: Node, frame: Frame, owner: Owner) -> None:
+    def solid_contents(self, node: Node, frame: Frame, owner: Owner, bounding: bool = True) -> None:
         f = self.fields(node)
         for child in f.nodes("children"):
             self.visit(child, frame, owner)
-        self.bounding(f.node_("boundingObject"), frame, owner)
+        if bounding:
+            self.bounding(f.node_("boundingObject"), frame, owner)
 
     def solid_dict(self, owner: Owner, data: dict) -> dict:
         if owner.parts:
