@@ -258,10 +258,11 @@ def test_unknown_proto_is_skipped_with_its_position(tmp_path: Path) -> None:
     with pytest.raises(WorldError, match=r'line 2, column 1: EXTERNPROTO E-puck: "https://example.org/E-puck.proto" not found'):
         load_world(p)
     # a Webots node not read here is said to be one (not a PROTO whose file is missing)
-    p = write(tmp_path, 'Fluid { name "water" children [ Shape { geometry Box { size 1 1 0.1 } } ] }\n')
+    p = write(tmp_path, 'Billboard { children [ Shape { geometry Box { size 1 1 0.1 } } ] }\n')
     (loss,) = load_world(p).report.losses
     assert (loss.name, loss.where, loss.why) == (
-        "water", f"{p}:2:1", "Fluid: a Webots node not read here (or not in its place); skipped (with everything inside it)")
+        "Billboard", f"{p}:2:1",
+        "Billboard: a Webots node not read here (or not in its place); skipped (with everything inside it)")
 
 
 def test_device_through_nested_rotated_poses_closed_form(tmp_path: Path) -> None:
