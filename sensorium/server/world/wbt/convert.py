@@ -484,8 +484,12 @@ class Converter:
                         self.skipped["Track.animatedGeometry"] += 1
                     motors, sensors = self.joint_devices(node, owner)
                     if motors or sensors or f.nodes("device"):
-                        self.warn(node, f"Track {f.string('name', 'solid')!r}: its motor's position moves "
-                                        "kinematically (its sensor reads it); the belt and its wheels do not move here")
+                        what = ("its motor's position moves kinematically (its sensor reads it)" if motors and sensors
+                                else "its motor's position moves kinematically" if motors     # Webots' ConveyorBelt
+                                else "its sensor reads a still position (no motor)" if sensors
+                                else "its devices do nothing")
+                        self.warn(node, f"Track {f.string('name', 'solid')!r}: {what}; the belt and its wheels do not "
+                                        "move here")
                 self.device_contents(node, inner, owner, data)
             elif t == "Connector":       # a solid that robots' connectors dock with (Webots allows it)
                 out = self.solid(node, frame, owner, "connector")
