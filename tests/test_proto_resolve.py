@@ -331,3 +331,19 @@ def test_messages_about_proto_nodes_name_the_proto_file_and_the_instance(tmp_pat
     w = world_file(tmp_path, 'Pose { children [ Odd { } ] }\n', ["Odd.proto"])
     (line,) = [m for m in load_world(w).warnings if "Wobbler" in m]
     assert line.startswith(f"{tmp_path / 'Odd.proto'}:2:47 (in PROTO Odd at {w}:3:19): Wobbler: not a built-in node")
+
+
+def test_snapshot_takes_the_proto_flags_its_messages_name(tmp_path: Path, monkeypatch, capsys) -> None:
+    """A world whose PROTO is in a Webots installation: `snapshot` said "give --webots-home DIR" and
+    then refused that option; it takes --webots-home and --proto-path as the other world commands do."""
+    from sensorium.cli import main as cli
+
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots")
+    w = world_file(tmp_path / "w", "AcmeBot { }\n", [f"{RAW}/R2023b/projects/robots/acme/bot/protos/AcmeBot.proto"])
+    out = tmp_path / "shot.png"
+    assert cli(["snapshot", str(w), str(out)]) == 1
+    assert "--webots-home" in capsys.readouterr().err
+    assert cli(["snapshot", str(w), str(out), "--webots-home", str(home), "--size", "32x24"]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

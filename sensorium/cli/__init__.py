@@ -322,7 +322,8 @@ def _bench_args(p: argparse.ArgumentParser) -> None:
 
 
 # commands that load a world: where a .wbt world's PROTO files are found (the one place these are declared)
-WORLD_COMMANDS = {"validate", "convert", "info", "probe", "serve", "layout", "demo", "sweep", "record", "replay", "export"}
+WORLD_COMMANDS = {"validate", "convert", "info", "probe", "serve", "layout", "demo", "sweep", "record", "replay", "export",
+                  "snapshot"}
 
 
 def _add_proto_args(p: argparse.ArgumentParser) -> None:
