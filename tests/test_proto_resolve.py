@@ -348,19 +348,6 @@ def test_every_command_reading_a_world_file_takes_the_proto_options() -> None:
         assert {"webots_home", "proto_path"} <= dests, name
 
 
-def test_snapshot_finds_the_protos_of_the_webots_home_it_is_given(tmp_path: Path, monkeypatch) -> None:
-    from sensorium.cli import main as cli
-
-    monkeypatch.delenv("WEBOTS_HOME", raising=False)          # restored after the test (the flag sets it)
-    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
-    home = fake_webots(tmp_path / "webots")
-    w = world_file(tmp_path / "w", "Viewpoint { position -1 0 0.1 }\nAcmeBot { }\n",
-                   [f"{RAW}/R2023b/projects/robots/acme/bot/protos/AcmeBot.proto"])
-    out = tmp_path / "shot.png"
-    assert cli(["snapshot", str(w), str(out), "--size", "8x6", "--webots-home", str(home)]) == 0
-    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-
-
 def test_a_world_before_r2022b_finds_its_protos_by_name(tmp_path: Path, monkeypatch) -> None:
     """Webots R2022a had no EXTERNPROTO: a world (and its PROTOs) named a PROTO by its type, found as
     TYPE.proto in the project's protos folder or the installation (Webots' own youbot.wbt of that
@@ -381,3 +368,19 @@ def test_a_world_before_r2022b_finds_its_protos_by_name(tmp_path: Path, monkeypa
     w.write_text(w.read_text().replace("R2022a", "R2023b"))      # since R2022b: declared, or not found
     later = load_world(w, webots_home=home)
     assert later.world.robots == [] and [x.name for x in later.losses] == ["AcmeBot", "Gadget"]
+
+
+def test_snapshot_takes_the_proto_flags_its_messages_name(tmp_path: Path, monkeypatch, capsys) -> None:
+    """A world whose PROTO is in a Webots installation: `snapshot` said "give --webots-home DIR" and
+    then refused that option; it takes --webots-home and --proto-path as the other world commands do."""
+    from sensorium.cli import main as cli
+
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    home = fake_webots(tmp_path / "webots")
+    w = world_file(tmp_path / "w", "AcmeBot { }\n", [f"{RAW}/R2023b/projects/robots/acme/bot/protos/AcmeBot.proto"])
+    out = tmp_path / "shot.png"
+    assert cli(["snapshot", str(w), str(out)]) == 1
+    assert "--webots-home" in capsys.readouterr().err
+    assert cli(["snapshot", str(w), str(out), "--webots-home", str(home), "--size", "32x24"]) == 0
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -136,3 +136,19 @@ def test_a_webots_supervisor_reads_proto_names_scenery_values_and_tracks_a_field
     assert out["tracked"] == [[1.0, 0.0, 0.1], [1.0, 0.5, 0.1]]
     err = ctl.stderr()
     assert "not served" not in err and "Error" not in err, err
+
+
+def test_a_proto_built_on_another_solid_node_is_named_after_its_proto(tmp_path):
+    """Webots' ratslife feeder is a PROTO whose base node is a Charger (a Solid node kept here as a
+    solid): it was named 'Solid'; like a PROTO built on a Fluid or on a device outside any robot, it
+    now answers its PROTO's name, as a PROTO built on a Solid does."""
+    world = tmp_path / "feeders.wbt"
+    world.write_text(HEADER + 'PROTO Feeder [ field SFVec3f translation 0 0 0 ] '
+                     '{ Charger { translation IS translation children [ Shape { geometry Box { size 0.1 0.1 0.1 } } ] } }\n'
+                     'PROTO Pond [ ] { Fluid { children [ Shape { geometry Box { size 1 1 0.1 } } ] } }\n'
+                     'PROTO Beacon [ ] { Emitter { translation 0 1 0 children [ Shape { geometry Sphere { radius 0.05 } } ] } }\n'
+                     'DEF F Feeder { translation 1 0 0 }\nDEF P Pond { }\nDEF B Beacon { }\n'
+                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    lv = _live(world)
+    refs = [boss(lv, "get_from_def", {"name": name}) for name in ("F", "P", "B")]
+    assert [[r["proto"], r["type"]] for r in refs] == [["Feeder", "Solid"], ["Pond", "Solid"], ["Beacon", "Solid"]]

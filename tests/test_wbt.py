@@ -258,10 +258,11 @@ def test_unknown_proto_is_skipped_with_its_position(tmp_path: Path) -> None:
     with pytest.raises(WorldError, match=r'line 2, column 1: EXTERNPROTO E-puck: "https://example.org/E-puck.proto" not found'):
         load_world(p)
     # a Webots node not read here is said to be one (not a PROTO whose file is missing)
-    p = write(tmp_path, 'Fluid { name "water" children [ Shape { geometry Box { size 1 1 0.1 } } ] }\n')
+    p = write(tmp_path, 'Billboard { children [ Shape { geometry Box { size 1 1 0.1 } } ] }\n')
     (loss,) = load_world(p).report.losses
     assert (loss.name, loss.where, loss.why) == (
-        "water", f"{p}:2:1", "Fluid: a Webots node not read here (or not in its place); skipped (with everything inside it)")
+        "Billboard", f"{p}:2:1",
+        "Billboard: a Webots node not read here (or not in its place); skipped (with everything inside it)")
 
 
 def test_device_through_nested_rotated_poses_closed_form(tmp_path: Path) -> None:
@@ -791,6 +792,18 @@ def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
         ("left motor", True), ("right motor", True)]
 
 
+def test_a_track_with_a_motor_alone_is_said_without_a_sensor(tmp_path: Path) -> None:
+    """A conveyor belt as Webots builds one (a Robot whose Track holds a LinearMotor and no
+    PositionSensor): its line said "(its sensor reads it)" of a sensor it does not have."""
+    p = write(tmp_path, 'Robot { name "belt" children [\n'
+              'Track { translation 0 0 0.45 children [ DEF B Shape { geometry Box { size 8 0.7 0.3 } } ] '
+              'boundingObject USE B device [ LinearMotor { name "belt_motor" maxVelocity 0.2 } ] }\n] }\n')
+    w = load_world(p)
+    assert [x.split(": ", 1)[1] for x in w.warnings if "Track" in x] == [
+        "Track 'solid': its motor's position moves kinematically; the belt and its wheels do not move here"]
+    assert [(d.device, d.name) for d in w.world.robots[0].devices] == [("LinearMotor", "belt_motor")]
+
+
 def test_a_device_not_simulated_is_said_in_the_load_report(tmp_path: Path) -> None:
     """A Microphone is listed (a controller's getDevice finds it, its functions answer Webots' "no
     value") but not simulated: the load report says so, one line at the device's own place, so
@@ -948,3 +961,20 @@ def test_an_open_cylinder_used_twice_is_said_once(tmp_path: Path) -> None:
     w = load_world(p)
     assert [x for x in w.warnings if "bottom/side/top" in x] == [
         f"{p}:2:114: Cylinder with bottom/side/top FALSE: rays see the whole closed cylinder"]
+
+
+def test_a_cameras_zoom_is_said_for_what_it_changes(tmp_path: Path) -> None:
+    """A Zoom (the e-puck's camera has one, Webots' defaults) renders nothing by itself: it is the range
+    a controller's setFov() may take. The line said 'zoom (zoom) is not rendered here; the image is
+    Webots' without it'; it now says what is not read and what the image is."""
+    p = write(tmp_path, 'Robot { name "r" children [\n'
+              'Camera { fieldOfView 0.84 zoom Zoom { } }\n'
+              'Camera { name "tele" zoom Zoom { minFieldOfView 0.2 maxFieldOfView 1 } }\n] }\n')
+    w = load_world(p)
+    assert [x.split(": ", 1)[1] for x in w.warnings] == [
+        "Camera 'camera' of robot 'r': its Zoom (0.5 to 1.5 rad) is not read: setFov() takes only the "
+        "field of view (0.84 rad) and getMinFov()/getMaxFov() answer it, as without a Zoom; the image is Webots' at "
+        "that field of view",
+        "Camera 'tele' of robot 'r': its Zoom (0.2 to 1 rad) is not read: setFov() takes only the "
+        "field of view (0.7854 rad) and getMinFov()/getMaxFov() answer it, as without a Zoom; the image is Webots' at "
+        "that field of view"]

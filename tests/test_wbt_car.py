@@ -154,4 +154,32 @@ def test_a_sensor_on_a_steering_axis_without_a_motor_is_said_once(tmp_path: Path
     assert "RotationalMotor" not in bare
     w = load_world(write(tmp_path, car(bare + hinge2_front("left", T / 2))))
     said = [x for x in w.warnings if "PositionSensor" in x]
-    assert len(said) == 1 and "Hinge2Joint axis without a motor (jointParameters)" in said[0], said
+    assert len(said) == 1 and "Hinge2Joint axis without a motor (jointParameters, a free steering axis)" in said[0]
+
+
+def test_a_free_front_wheels_encoder_reads_its_still_position_as_its_line_says(tmp_path: Path) -> None:
+    # Webots' Car with rear-wheel drive: the front Hinge2Joints' second axis (device2) has a PositionSensor
+    # and a Brake but no motor (a free wheel physics rolls); here nothing turns it: it reads the world's position
+    def front(side: str, y: float, position: float) -> str:
+        return hinge2_front(side, y).replace(
+            "jointParameters2 JointParameters { axis 0 1 0 }",
+            f"jointParameters2 JointParameters {{ axis 0 1 0 position {position} }} "
+            f'device2 [ PositionSensor {{ name "{side}_front_sensor" }} Brake {{ name "{side}_front_brake" }} ]')
+    w = load_world(write(tmp_path, car(front("right", -T / 2, 0.7) + front("left", T / 2, 0.0))))
+    assert w.world.robots[0].ackermann_drive is not None
+    said = sorted(x for x in w.warnings if "Hinge2Joint axis without a motor" in x)
+    assert len(said) == 2, w.warnings
+    assert all("(jointParameters2, a free wheel, which Webots' physics rolls): listed, reads the axis's position "
+               "in the world file" in x and "and keeps it (nothing turns it here)" in x for x in said), said
+    assert {x.split("world file (")[1].split(")")[0] for x in said} == {"0.7", "0"}
+    sim = Simulation(w)
+    r = sim.robot("car")
+    for name in ("right_rear_wheel", "left_rear_wheel"):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(10.0)
+    right, left = r.device("right_front_sensor"), r.device("left_front_sensor")
+    right.enable(16)
+    left.enable(16)
+    sim.run(20)
+    assert r.pose.translation[0] > 1.0          # the car drove; its free front wheels' encoders kept still
+    assert (right.value, left.value) == (0.7, 0.0)

@@ -20,8 +20,14 @@ from sensorium.schemas import world as wm
 KINDS = ("robots", "solids", "lights")
 
 
-# the base types a simulated node of each kind has (a PROTO instance of another base is not named after it)
-BASES = {"robots": ("Robot",), "solids": ("Solid",), "lights": ("PointLight", "SpotLight", "DirectionalLight")}
+# the base types a simulated node of each kind has (a PROTO instance of another base is not named after it):
+# a top-level solid here is a Solid or another of Webots' Solid nodes the converter keeps as one (a
+# Charger, a Fluid, a device or a Track outside any robot: Webots' ratslife feeder is a Charger PROTO)
+SOLID_BASES = ("Solid", "Charger", "Fluid", "Track", "DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED",
+               "RangeFinder", "Camera", "Display", "Speaker", "Microphone", "Emitter", "Receiver", "GPS", "Compass",
+               "Accelerometer", "Gyro", "InertialUnit", "TouchSensor", "Pen", "Connector", "Radar", "Altimeter",
+               "VacuumGripper", "Radio", "Skin")
+BASES = {"robots": ("Robot",), "solids": SOLID_BASES, "lights": ("PointLight", "SpotLight", "DirectionalLight")}
 
 
 @dataclass(frozen=True, slots=True)

@@ -129,6 +129,11 @@ class ProtoDef:
 # ------------------------------------------------------------------------------------ reading
 
 
+# what a PROTO body written before R2022a (y up) places along its axes: poses, directions and geometry
+_POSED = re.compile(r"\b(translation|rotation|location|direction|Box|Cylinder|Capsule|Cone|Plane|ElevationGrid|"
+                    r"Coordinate|Mesh|CadShape)\b")
+
+
 def read_proto_file(path: Path, source: str, limits: ProtoLimits) -> ProtoDef:
     """A PROTO file: header comments, EXTERNPROTO declarations, interface, body text."""
     text = read_text(path, "PROTO", limits.proto_file_bytes)
@@ -153,7 +158,7 @@ def read_proto_file(path: Path, source: str, limits: ProtoLimits) -> ProtoDef:
     proto.externprotos = decls
     proto.header = header_comments(text)
     proto.version = f"R{year}{letter}"
-    if (year, letter) < (2022, "a"):
+    if (year, letter) < (2022, "a") and _POSED.search(proto.body):    # a PROTO of devices alone has no poses to turn
         proto.warnings.append(f"{source}:1:1: PROTO {proto.name} was written for Webots R{year}{letter}, before "
                               "R2022a's z-up, FLU conventions: its poses may come out wrong")
     return proto

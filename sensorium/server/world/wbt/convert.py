@@ -452,6 +452,11 @@ class Converter:
             self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
             self.scaled_solid(node, owner)
+        elif t == "Fluid":               # a Solid of water or air that immersed solids float in (physics only)
+            self.warn(node, f"Fluid {f.string('name', 'fluid')!r}: buoyancy, drag and its stream are not simulated "
+                            "(no physics); its shapes are kept as a solid that cameras, lidars and infra-red sensors "
+                            "see, its boundingObject (the fluid's volume) is no obstacle")
+            self.solid(node, frame, owner, "fluid", bounding=False)
         elif t == "Charger":             # a Solid that recharges robots' batteries (no battery here)
             self.warn(node, f"Charger {f.string('name', 'solid')!r}: recharging is not simulated (robots have no "
                             "battery here); its shapes and lights are kept as a solid")
@@ -479,8 +484,12 @@ class Converter:
                         self.skipped["Track.animatedGeometry"] += 1
                     motors, sensors = self.joint_devices(node, owner)
                     if motors or sensors or f.nodes("device"):
-                        self.warn(node, f"Track {f.string('name', 'solid')!r}: its motor's position moves "
-                                        "kinematically (its sensor reads it); the belt and its wheels do not move here")
+                        what = ("its motor's position moves kinematically (its sensor reads it)" if motors and sensors
+                                else "its motor's position moves kinematically" if motors     # Webots' ConveyorBelt
+                                else "its sensor reads a still position (no motor)" if sensors
+                                else "its devices do nothing")
+                        self.warn(node, f"Track {f.string('name', 'solid')!r}: {what}; the belt and its wheels do not "
+                                        "move here")
                 self.device_contents(node, inner, owner, data)
             elif t == "Connector":       # a solid that robots' connectors dock with (Webots allows it)
                 out = self.solid(node, frame, owner, "connector")
@@ -1007,9 +1016,10 @@ class Converter:
         return inside(children[0]) if children else []
 
     # ------------------------------------------------------------ solids and robots
-    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid") -> dict | None:
+    def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid", bounding: bool = True) -> dict | None:
         """A Solid (``default``: its name when it has none: a device's default name); its entry (None
-        when it is part of a robot's body)."""
+        when it is part of a robot's body). ``bounding`` False: its boundingObject is left out (a
+        Fluid's: the volume immersed solids float in, which nothing collides with)."""
         f = self.fields(node)
         inner = self.child_frame(node, frame)
         # an empty name (Webots' radar sample's target boxes: name "") is the default one: names here
@@ -1018,7 +1028,7 @@ class Converter:
         if owner.kind == "robot":   # part of the robot's body
             target = self.carried_target(node, name, inner, owner)
             start = len(owner.parts)
-            self.solid_contents(node, inner, owner)
+            self.solid_contents(node, inner, owner, bounding)
             if target is not None:
                 target["_members"] = [id(p) for p in owner.parts[start:]]
             return None
@@ -1044,7 +1054,7 @@ class Converter:
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
         # a nested solid's spot lights: a LightSensor turns them by this solid's own rotation (not the Poses above)
         own = Frame.identity() if owner.kind == "world" else Frame(np.eye(3), np.zeros(3), own_rotation=inner.own_rotation)
-        self.solid_contents(node, own, mine)
+        self.solid_contents(node, own, mine, bounding)
         out = self.solid_dict(mine, data)
         out["_at"] = self.at(node)
         if owner.kind == "world":
@@ -1080,11 +1090,12 @@ class Converter:
         for target in robot.get("radar_targets", ()):
             target["shapes"] = sorted({index[m] for m in target.pop("_members") if m in index})
 
-    def solid_contents(self, node: Node, frame: Frame, owner: Owner) -> None:
+    def solid_contents(self, node: Node, frame: Frame, owner: Owner, bounding: bool = True) -> None:
         f = self.fields(node)
         for child in f.nodes("children"):
             self.visit(child, frame, owner)
-        self.bounding(f.node_("boundingObject"), frame, owner)
+        if bounding:
+            self.bounding(f.node_("boundingObject"), frame, owner)
 
     def solid_dict(self, owner: Owner, data: dict) -> dict:
         if owner.parts:
@@ -1216,6 +1227,9 @@ class Converter:
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
             for name, what in unread_image_fields(node.type, node.fields):
+                if name == "zoom":      # a Zoom changes no image by itself: it is the range setFov() may take
+                    self.warn(node, self.zoom_line(node, data["name"], owner.data["name"]))
+                    continue
                 self.warn(node, f"{node.type} {data['name']!r} of robot {owner.data['name']!r}: {name} ({what}) is "
                                 "not rendered here; the image is Webots' without it")
             self.ride(data)
@@ -1226,6 +1240,17 @@ class Converter:
             self.device_contents(node, inner, owner, data)
             return
         self.device_contents(node, inner, owner, None)
+
+    def zoom_line(self, node: Node, device: str, robot: str) -> str:
+        """The line for a Camera's Zoom: the image is Webots' until a controller zooms, but the zoom range
+        (Webots' defaults 0.5 to 1.5 rad) is not read, so ``setFov`` takes only the field of view."""
+        zoom = self.fields(node).node_("zoom")
+        zf = self.fields(zoom) if zoom is not None else None
+        low, high = (zf.num("minFieldOfView", 0.5), zf.num("maxFieldOfView", 1.5)) if zf else (0.5, 1.5)
+        fov = self.fields(node).num("fieldOfView", 0.7854)
+        return (f"Camera {device!r} of robot {robot!r}: its Zoom ({low:g} to {high:g} rad) is not read: setFov() "
+                f"takes only the field of view ({fov:g} rad) and getMinFov()/getMaxFov() answer it, as without a "
+                "Zoom; the image is Webots' at that field of view")
 
     def device_contents(self, node: Node, frame: Frame, owner: Owner, device: dict | None) -> None:
         """A device's own Solid contents: robot body shapes marked as the device's own (its visual
@@ -1552,9 +1577,12 @@ class Converter:
             axis = pf.vec("axis", axis_default) if pf else axis_default
             anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf and params_field == "jointParameters" else None
             if not found:
-                if found_sensors:
-                    self.warn(node, f"PositionSensor on a Hinge2Joint axis without a motor ({params_field}): "
-                                    "listed, reads no value")
+                if found_sensors:       # joint_devices gave it the axis's position: it reads that, still
+                    still = float(found_sensors[0].get("position", 0.0))
+                    what = "a free wheel, which Webots' physics rolls" if not steers else "a free steering axis"
+                    self.warn(node, f"PositionSensor on a Hinge2Joint axis without a motor ({params_field}, "
+                                    f"{what}): listed, reads the axis's position in the world file ({still:g}) "
+                                    "and keeps it (nothing turns it here)")
                 continue
             m = self.fields(found[0])
             turn = frame.rotation @ np.asarray(axis)
