@@ -161,6 +161,62 @@ def test_bumpers_with_their_own_shapes_read_in_every_copy_as_the_single_simulati
     assert seen["pressed"] > 100 and seen["free"] > 1000 and seen["one_side"] > 20, seen
 
 
+SLOW_PERIODS = {"a": {"left": 48, "right": 64, "rear": 32}, "b": {"front": 80}, "c": {"nose": 48, "body_bumper": 64}}
+
+
+def test_slow_bumpers_keep_a_touch_until_read_in_every_copy_as_the_single_simulation(native):  # noqa: F811
+    """The shaped bumpers read every 32 to 80 ms in a 16 ms world, random per-copy wheel commands
+    that push the robots into the walls, the ball and one another and pull them off again, some
+    bumpers disabled and enabled again in some copies, a reset with a new seed: every reading of
+    every copy equals its Simulation's, bit for bit, with the C helper and without it -- among them
+    readings of 1 where the bumper touched only on a step between two readings (or while disabled)
+    and no longer touches at the reading's step."""
+    seeds = [5, 6, 7, 8]
+    lw = load_world(SHAPED)
+
+    def world(seed: int) -> LoadedWorld:
+        w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
+        return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+
+    bs = BatchedSimulation(world(0), len(seeds))
+    bs.reset(np.arange(len(seeds)), seeds)
+    sims = [Simulation(world(s)) for s in seeds]
+    for c in range(len(seeds)):
+        _enable_both(bs, sims, SLOW_PERIODS, c)
+    rng = np.random.default_rng(11)
+    seen = {"pressed": 0, "latched": 0}
+    for step in range(300):
+        if step % 10 == 0:               # short pushes: into something and off it within a period
+            for robot in SLOW_PERIODS:
+                ahead, turn = rng.uniform(-14.0, 14.0, (len(seeds), 1)), rng.uniform(-3.0, 3.0, (len(seeds), 1))
+                _wheels_both(bs, sims, robot, np.concatenate([ahead - turn, ahead + turn], axis=1))
+        if step in (60, 150):            # some bumpers off in copies 0 and 2 ...
+            for robot, n in (("a", "left"), ("b", "front")):
+                _enable_both(bs, sims, {robot: {n: 0}}, 0)
+                _enable_both(bs, sims, {robot: {n: 0}}, 2)
+        if step in (90, 180):            # ... and on again at other periods
+            for robot, n, p in (("a", "left", 64), ("b", "front", 32)):
+                _enable_both(bs, sims, {robot: {n: p}}, 0)
+                _enable_both(bs, sims, {robot: {n: p}}, 2)
+        if step == 200:
+            bs.reset([3], [42])
+            sims[3] = Simulation(world(42))
+            _enable_both(bs, sims, SLOW_PERIODS, 3)
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot, names in SLOW_PERIODS.items():
+                for n in names:
+                    dev = s.robot(robot).device(n)
+                    want = np.float64(dev.value)
+                    got = bs.value(bs.device(robot, n))[c]
+                    assert want.tobytes() == got.tobytes(), (step, c, robot, n, want, got)
+                    if dev.measured_at_ms == s.time_ms and want == 1.0:
+                        seen["pressed"] += 1
+                        seen["latched"] += not dev.touching()
+    assert seen["pressed"] > 30 and seen["latched"] >= 5, seen
+
+
 def _placed_shaped(copies: int) -> tuple[BatchedSimulation, np.ndarray]:
     """shaped_bumpers.yaml in ``copies`` copies with its shaped bumpers enabled every step, and
     their columns."""

@@ -225,34 +225,165 @@ def test_a_wbt_touch_sensor_bumper_reads_with_its_bounding_object(tmp_path: Path
     assert [sim.device(f"r/{n}").value for n in ("left", "right", "plain")] == [1.0, 0.0, 1.0]
 
 
-def test_a_slow_bumper_reads_the_touch_at_its_reading_s_step_only():
-    """Pins the documented departure (README "Bumpers"): a reading is the touch at the end of the
-    step it is due on. Two bumpers with identical plates (0.02 m deep, front face 0.22 m ahead of
-    the centre) on a box robot 0.03 m from a wall, driven at 0.016 m per 16 ms step: the plates
-    touch the wall at the end of step 2 (the move clipped there), the robot backs off on steps 3
-    and 4. The bumper read every step reads 0, 1, 0, 0; the one read every 64 ms reads 0 at step 4
-    -- Webots' would read 1 (WbTouchSensor keeps a collision of any step until the next reading)."""
+# -- between readings: a box robot (0.4 x 0.2 m) with plates 0.02 m deep whose front face is 0.22 m
+# ahead of its centre, each plate its own bumper's, 0.03 m from a wall's face; at 10 rad/s its
+# wheels (radius 0.1) move it 0.016 m per 16 ms step, so driven ahead it touches the wall at the end
+# of step 2 (clipped at 0.03 m) and, backed off from step 3, is 0.002 m behind its start after step 4.
+PLATES = ("fast", "slow", "off", "kept", "late")
+
+
+def plates_world() -> wm.World:
     plate = {"pose": {"translation": [0.21, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.2, 0.1]}}
-    data = {"world_info": {"basic_time_step": 16},
-            "solids": [{"name": "wall", "pose": {"translation": [0.35, 0.0, 0.1]},
-                        "geometry": {"type": "box", "size": [0.2, 2.0, 0.2]}}],
-            "robots": [{"name": "r", "pose": {"translation": [0.0, 0.0, 0.1]},
-                        "body": {"geometry": {"type": "box", "size": [0.4, 0.2, 0.2]}},
-                        "shapes": [{**plate, "of_device": "fast"}, {**plate, "of_device": "slow"}],
-                        "devices": [{"device": "TouchSensor", "name": "fast"}, {"device": "TouchSensor", "name": "slow"}],
-                        "differential_drive": {"wheel_radius": 0.1, "axle_length": 0.3, "max_wheel_speed": 1000}}]}
-    sim = Simulation(wm.World.model_validate(data))
-    fast, slow = sim.device("r/fast"), sim.device("r/slow")
-    fast.enable(16)
-    slow.enable(64)
-    drive(sim, 10.0)                                       # 0.016 m per step: the wall's face 0.03 m ahead
-    read = []
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16},
+        "solids": [{"name": "wall", "pose": {"translation": [0.35, 0.0, 0.1]},
+                    "geometry": {"type": "box", "size": [0.2, 2.0, 0.2]}}],
+        "robots": [{"name": "r", "pose": {"translation": [0.0, 0.0, 0.1]},
+                    "body": {"geometry": {"type": "box", "size": [0.4, 0.2, 0.2]}},
+                    "shapes": [{**plate, "of_device": n} for n in PLATES],
+                    "devices": [{"device": "TouchSensor", "name": n} for n in PLATES],
+                    "differential_drive": {"wheel_radius": 0.1, "axle_length": 0.3, "max_wheel_speed": 1000}}]})
+
+
+class Both:
+    """One Simulation per copy and a BatchedSimulation of as many copies, driven alike; each reading
+    of every copy compared bit for bit with its Simulation's."""
+
+    def __init__(self, copies: int):
+        from sensorium.server.sim.batched import BatchedSimulation
+        self.sims = [Simulation(plates_world()) for _ in range(copies)]
+        self.bs = BatchedSimulation(plates_world(), copies)
+        self.slot = self.bs.slot("r")
+
+    def enable(self, name: str, period: int, copies=None) -> None:
+        for c in range(len(self.sims)) if copies is None else copies:
+            self.sims[c].device(f"r/{name}").enable(period)
+        self.bs.enable(self.bs.device("r", name), period, copies=copies)
+
+    def drive(self, w: float, copies=None) -> None:
+        idx = range(len(self.sims)) if copies is None else copies
+        for c in idx:
+            drive(self.sims[c], w)
+        self.bs.set_wheels(self.slot, [w] * len(idx), [w] * len(idx), copies=None if copies is None else list(idx))
+
+    def step(self) -> None:
+        self.bs.step()
+        for s in self.sims:
+            s.step()
+
+    def value(self, name: str) -> list[float]:
+        """Every copy's reading (the Simulations'), after checking the batched one has its bits."""
+        got = self.bs.value(self.bs.device("r", name))
+        want = np.array([s.device(f"r/{name}").value for s in self.sims], dtype=np.float64)
+        assert got.tobytes() == want.tobytes(), (name, got, want)
+        return want.tolist()
+
+
+def test_a_slow_bumper_reads_a_touch_of_any_step_since_its_last_reading():
+    """WbTouchSensor keeps each step's collision until the next reading clears it. Copy 0 touches
+    the wall on step 2 only and backs off; copy 1 stands still; copy 2 moves one step (0.016 m, still
+    0.014 m from the wall) and stops. The bumper read every step reads 0, 1, 0, 0 in copy 0; the one
+    read every 64 ms reads 1 at step 4 there (the step-2 touch), 0 in the others, and 0 everywhere at
+    step 8 (nothing touched since step 4); in both engines, bit for bit."""
+    both = Both(3)
+    both.enable("fast", 16)
+    both.enable("slow", 64)
+    both.drive(10.0, copies=[0, 2])
+    fast, slow = [], []
+    for k in range(1, 9):
+        both.step()
+        fast.append(both.value("fast"))
+        slow.append(both.value("slow"))
+        if k == 1:
+            both.drive(0.0, copies=[2])
+        if k == 2:
+            assert both.sims[0].robot("r").pose.translation[0] == pytest.approx(0.03, abs=1e-9)
+            both.drive(-10.0, copies=[0])
+    assert [f[0] for f in fast] == [0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    assert all(f[1] == f[2] == 0.0 for f in fast)
+    assert both.sims[0].robot("r").pose.translation[0] == pytest.approx(0.03 - 6 * 0.016, abs=1e-9)
+    assert both.sims[2].robot("r").pose.translation[0] == pytest.approx(0.016, abs=1e-9)
+    assert all(math.isnan(v) for v in slow[2]) and slow[3] == [1.0, 0.0, 0.0] and slow[7] == [0.0, 0.0, 0.0]
+    assert both.sims[0].device("r/slow").measurements == 2
+
+
+def test_a_touch_while_disabled_reads_at_the_first_reading_after_enable():
+    """The same touch on step 2 in both engines. ``off`` (64 ms) is disabled after step 1, before
+    the touch; ``kept`` (64 ms) after step 3, after the touch but before its reading; both are enabled
+    again (64 ms) after step 4, so their first reading is at step 8, far from the wall: 1, as
+    WbTouchSensor's flag, which only a reading clears, is set by a collision while disabled too; at
+    step 12 they read 0. ``late`` is enabled for the first time after step 4: never enabled before,
+    it was never asked and reads 0 at step 8 (Webots' reads 1: its flag is set from the start; see
+    README "Bumpers")."""
+    both = Both(2)
+    both.enable("off", 64)
+    both.enable("kept", 64)
+    both.drive(10.0, copies=[0])
+    got = {n: [] for n in ("off", "kept", "late")}
+    for k in range(1, 13):
+        both.step()
+        for n in got:
+            got[n].append(both.value(n))
+        if k == 1:
+            both.enable("off", 0)
+        if k == 2:
+            both.drive(-10.0, copies=[0])
+        if k == 3:
+            both.enable("kept", 0)
+        if k == 4:
+            for n in got:
+                both.enable(n, 64)
+    for n in ("off", "kept"):
+        assert all(math.isnan(v) for row in got[n][:7] for v in row), n
+        assert got[n][7] == [1.0, 0.0] and got[n][11] == [0.0, 0.0], n
+    assert got["late"][7] == [0.0, 0.0] and got["late"][11] == [0.0, 0.0]
+
+
+def test_a_simulation_reset_keeps_a_kept_touch_and_a_copy_s_reset_clears_it():
+    """Touched on step 2, ``slow`` (64 ms) not yet read: a Simulation's reset (a Supervisor's
+    simulationReset; WbTouchSensor never clears its flag but by a reading) after step 3 leaves it
+    1 at step 4, the robot back at its start; a batched copy reset after step 3 is a freshly built
+    world, its bumper enabled again at 64 ms reads 0 at its first reading (step 7)."""
+    sim = Simulation(plates_world())
+    sim.device("r/slow").enable(64)
+    drive(sim, 10.0)
     for k in range(1, 5):
         sim.step()
-        read.append(fast.value)
-        if k == 2:
-            assert sim.robot("r").pose.translation[0] == pytest.approx(0.03, abs=1e-9)
-            drive(sim, -10.0)
-    assert read == [0.0, 1.0, 0.0, 0.0]
-    assert sim.robot("r").pose.translation[0] == pytest.approx(0.03 - 2 * 0.016, abs=1e-9)
-    assert slow.measurements == 1 and slow.value == 0.0
+        if k == 3:
+            sim.reset()
+    assert sim.robot("r").pose.translation[0] == 0.0 and sim.device("r/slow").value == 1.0
+    both = Both(1)
+    both.enable("slow", 64)
+    both.drive(10.0)
+    bs, ref = both.bs, both.bs.device("r", "slow")
+    for k in range(1, 8):
+        bs.step()
+        if k == 3:
+            bs.reset([0], [0])
+            bs.enable(ref, 64)
+    assert bs.time_ms[0] == 64 and bs.value(ref)[0] == 0.0
+
+
+def test_a_bumper_due_every_step_is_never_asked_between_readings():
+    """A bumper read every basic step is never sampled in between (its reading is the touch of its
+    step, as before); a disabled bumper never enabled is never asked. The batched engine does not
+    even look for bumpers between readings until one is enabled less often than every step (or
+    disabled after an enable)."""
+    both = Both(2)
+    both.enable("fast", 16)
+    both.drive(10.0)
+    for _ in range(4):
+        both.step()
+        both.value("fast")
+    assert not both.bs.kinematic.latching and both.value("fast") == [1.0, 1.0]
+    both.enable("slow", 32, copies=[1])
+    assert both.bs.kinematic.latching
+    sim = Simulation(plates_world())
+    sim.device("r/fast").enable(16)
+    calls = {n: 0 for n in PLATES}
+    for n in PLATES:
+        dev = sim.device(f"r/{n}")
+        dev.sample = (lambda n=n, f=dev.sample: (calls.__setitem__(n, calls[n] + 1), f())[1])
+    drive(sim, 10.0)
+    sim.run(6)
+    assert calls == {n: 0 for n in PLATES} and sim.device("r/fast").value == 1.0

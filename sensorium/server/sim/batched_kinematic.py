@@ -28,6 +28,13 @@ two steps are kept for every slot, and per device the robot's pose when it was e
 many poses it has seen since (1 at ``enable``, at most 3), so its poses are composed only when it
 is due.
 
+A bumper keeps a touch until it is read, as the single TouchSensor (WbTouchSensor's flag): per copy
+and bumper a ``touched`` flag, or-ed after each step where an armed bumper (enabled at least once
+since the copy was built or reset) is not due and has not touched yet -- those (copy, bumper) pairs
+measured together by the due bumpers' own test -- and cleared by its reading, which is 1 when the
+flag was set. Nothing of this runs while every bumper enabled is due every step and none was
+disabled after an enable (``latching``).
+
 A GPS in a WGS84 world adds the reference's UTM east / north and altitude (computed once, by the
 single model's call) and reads its rows back to latitude / longitude by the single model's inverse
 UTM series, called row by row (:func:`wgs84_positions`).
@@ -395,6 +402,12 @@ class KinematicDevices:
         self.bumper_hulls: dict[int, list] = {}          # per piece its points and axes (_bumper_shapes)
         self._solid_cache: dict[int, tuple] = {}         # a solid's hull (_solid_hull)
         self.robot_hulls: dict[int, tuple] = {}          # a shaped robot's footprint hull, own frame
+        # bumpers between readings (TouchSensor.sample): the touch since the last reading, whether
+        # enabled since the copy was built or reset, and whether any may be asked between readings
+        nb = len(self.devices["TouchSensor"])
+        self.touched = np.zeros((C, nb), dtype=bool)
+        self.armed = np.zeros((C, nb), dtype=bool)
+        self.latching = False
         self.enable_rot = {k: np.zeros((C, len(self.devices[k]), 3, 3)) for k in MOTION}
         self.enable_pos = {k: np.zeros((C, len(self.devices[k]), 3)) for k in MOTION}
 
@@ -409,10 +422,18 @@ class KinematicDevices:
         self.quaternion[idx] = math.nan
         for k in MOTION:
             self.seen[k][idx] = 0
+        self.touched[idx] = False
+        self.armed[idx] = False
 
     def enabled(self, kind: str, column: int, idx) -> None:
         """``enable`` of a device in the copies ``idx``: a gyro or an accelerometer starts its poses
-        over from the robot's pose now (_MotionSensor.enable)."""
+        over from the robot's pose now (_MotionSensor.enable); a bumper enabled is armed (and one
+        due less often than every step, or disabled once armed, is asked between readings)."""
+        if kind == "TouchSensor":
+            per = self.sim.period[kind][idx, column]
+            if ((per > self.sim.basic_time_step) | ((per == 0) & self.armed[idx, column])).any():
+                self.latching = True
+            self.armed[idx, column] |= per > 0
         if kind in MOTION:
             slot = self.slot[kind][column]
             self.seen[kind][idx, column] = 1
@@ -438,8 +459,10 @@ class KinematicDevices:
     def measure(self, live: np.ndarray) -> None:
         """Every due device of these kinds in the copies ``live``, at their end-of-step poses; then
         the poses gyros and accelerometers keep (every step, as the single simulation's ``track``)."""
+        if self.latching:
+            self._sample_bumpers(live)
         for kind, fn in (("GPS", self._gps), ("Compass", self._compass), ("InertialUnit", self._unit),
-                         ("Gyro", self._gyro), ("Accelerometer", self._accelerometer), ("TouchSensor", self._bumper),
+                         ("Gyro", self._gyro), ("Accelerometer", self._accelerometer), ("TouchSensor", self._bumper_read),
                          ("Altimeter", self._altimeter)):
             if self.devices[kind]:
                 copies, cols = self.sim._due(kind, live)
@@ -607,6 +630,27 @@ class KinematicDevices:
         q = inertial_quaternions(matrix_quaternions(rot), gauss, noise, x, y, z, self.resolution["InertialUnit"][cols])
         self.quaternion[copies, cols] = q
         return roll_pitch_yaw(q, self.axes)
+
+    def _sample_bumpers(self, live: np.ndarray) -> None:
+        """TouchSensor.sample in the copies ``live``: every armed bumper that is not due and has not
+        touched since its last reading is asked whether it touches now (:meth:`_bumper`, all of
+        them at once), its flag set where it does."""
+        sim = self.sim
+        per = sim.period["TouchSensor"][live]
+        due = (per > 0) & (sim.time_ms[live][:, None] - sim.last["TouchSensor"][live] >= per)
+        ci, cols = (self.armed[live] & ~self.touched[live] & ~due).nonzero()
+        if len(ci):
+            copies = live[ci]
+            self.touched[copies, cols] = self._bumper(copies, cols) != 0.0
+
+    def _bumper_read(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        """A due bumper's reading (TouchSensor.measure): 1 where it touched since its last reading
+        or touches now, its flag cleared."""
+        out = self._bumper(copies, cols)
+        if self.latching:
+            out = np.where(self.touched[copies, cols], 1.0, out)
+            self.touched[copies, cols] = False
+        return out
 
     def _bumper(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """TouchSensor.measure of a bumper: one without shapes of its own reads 1 where the copy's

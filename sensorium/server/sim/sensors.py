@@ -923,11 +923,16 @@ class Altimeter(Device):
 
 class TouchSensor(Device):
     """Webots TouchSensor. A bumper with bounding shapes of its own (the robot's shapes whose
-    ``of_device`` names it) reads 1 when, at the end of the step, one of them touches a solid or
+    ``of_device`` names it) touches on a step when, at the end of it, one of them touches a solid or
     another robot as kinematic contact sees them (contact.pieces_touch: a gap of at most
-    contact.TOUCH, bands overlapping), else 0 -- each shape where its joint holds it now, the pieces
-    made again only when such a joint moved; a bumper without any reads 1 when contact clipped its
-    robot's move in the step. ``force`` and ``force-3d`` read NaN (they need physics)."""
+    contact.TOUCH, bands overlapping) -- each shape where its joint holds it now, the pieces made
+    again only when such a joint moved; a bumper without any touches on a step contact clipped its
+    robot's move. A reading is 1 when it touched on any step since its previous reading, else 0
+    (WbTouchSensor: each step's collisions set its flag, only a reading clears it): after each step
+    the simulation asks the bumpers that are not due -- enabled ones between two readings, and
+    disabled ones that were enabled before (``armed``) -- whether they touch (:meth:`sample`), each
+    only until it touched. A bumper never enabled is never asked. ``force`` and ``force-3d`` read NaN
+    (they need physics; Webots' force readings are each reading's step's value, never kept)."""
 
     kinematic = True
     TYPE_CODES: ClassVar[dict[str, int]] = {"bumper": 0, "force": 1, "force-3d": 2}
@@ -944,6 +949,8 @@ class TouchSensor(Device):
         self._pieces: list | None = None       # as contact takes them (contact.device_pieces), made when first due
         self._held: list = []                  # the joints' displacements the pieces were made at
         self._riding = False                   # whether any of its shapes rides on a joint
+        self.touched = False                   # a bumper touched on a step since its last reading
+        self.armed = False                     # a bumper enabled at least once: asked between readings
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
@@ -963,24 +970,37 @@ class TouchSensor(Device):
         robot = self._robot
         return [None if j is None else robot.link_pose(j) for j in self._on]
 
+    def touching(self) -> bool:
+        """Whether a bumper touches at the end of this step (see the class)."""
+        robot = self._robot
+        if not self._own:                      # no shapes of its own: its robot's contact
+            return bool(robot.pressing)
+        contact = robot.simulation.contact
+        if contact is None:                    # contact off: nothing is touched
+            return False
+        held = self._held_now()
+        if self._pieces is None or any(a is not b for a, b in zip(held, self._held)):
+            # made again only when a joint it rides on moved since they were made
+            own = [(prim, local if at is None else at.compose(local)) for (prim, local), at in zip(self._own, held)]
+            self._pieces = contact.pieces(robot.index, own)
+            self._held = held
+        return contact.touching(robot.index, self._pieces)
+
+    def enable(self, period_ms: int) -> None:
+        super().enable(period_ms)
+        if self.type_code == 0 and self.schedule.period_ms > 0:
+            self.armed = True
+
+    def sample(self) -> None:
+        """A step on which an armed bumper is not due: remember whether it touched (asked until it
+        did; the next reading clears it)."""
+        if not self.touched:
+            self.touched = self.touching()
+
     def measure(self, now_ms: int) -> None:
         if self.type_code == 0:
-            robot = self._robot
-            if not self._own:                  # no shapes of its own: its robot's contact
-                self.value = 1.0 if robot.pressing else 0.0
-            else:
-                contact = robot.simulation.contact
-                if contact is None:            # contact off: nothing is touched
-                    self.value = 0.0
-                else:
-                    held = self._held_now()
-                    if self._pieces is None or any(a is not b for a, b in zip(held, self._held)):
-                        # made again only when a joint it rides on moved since they were made
-                        own = [(prim, local if at is None else at.compose(local))
-                               for (prim, local), at in zip(self._own, held)]
-                        self._pieces = contact.pieces(robot.index, own)
-                        self._held = held
-                    self.value = 1.0 if contact.touching(robot.index, self._pieces) else 0.0
+            self.value = 1.0 if self.touched or self.touching() else 0.0
+            self.touched = False
         self._mark(now_ms)
 
     def readings(self) -> dict:
