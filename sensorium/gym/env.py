@@ -12,7 +12,7 @@ width)`` range image bounded by ``[0, max_range]``, with "no hit" (``inf`` in We
 position, a compass its north vector, an inertial unit its roll, pitch, yaw, a gyro its angular
 velocity, an accelerometer its specific force: float32 ``(3,)`` boxes (:func:`_space`; a disabled
 axis's NaN reads the box's low bound, as any missing value); a bumper (TouchSensor) a float32 ``(1,)``
-box in [0, 1] (1 while its robot pushes against something), an altimeter its height, a float32
+box in [0, 1] (1 when it touched something since its last reading), an altimeter its height, a float32
 ``(1,)`` box within the world bounds (a force TouchSensor reads NaN without physics: left out by
 default, refused when named); a camera
 (only when named in ``Task.observations``: images are not observed by default) is a uint8
@@ -393,7 +393,7 @@ def _space(cfg, world_info: wm.WorldInfo) -> spaces.Box:
     if cfg.device in ("Gyro", "Accelerometer"):   # through the lookup table (none: what the motion can give)
         bound = motion_bound(cfg.device, world_info)
         return _table_box(cfg, (3,), (-bound, bound))
-    if cfg.device == "TouchSensor":             # a bumper: 1 while pushing against something, else 0
+    if cfg.device == "TouchSensor":             # a bumper: 1 when it touched since its last reading, else 0
         return spaces.Box(np.float32(0.0), np.float32(1.0), shape=(1,), dtype=np.float32)
     if cfg.device == "Altimeter":               # a height within the world bounds (+ the reference altitude)
         offset = altitude_offset(world_info)

@@ -665,7 +665,8 @@ class TouchSensor(_Device):
     ``of_device`` names it: a .wbt TouchSensor's boundingObject): 1 when they touch a solid or
     another robot at the end of the step (within 1e-6 m, as kinematic contact sees them), else 0;
     ``bumper`` without: 1 while the robot's body pushes against a solid or another robot (kinematic
-    contact clipped its motion in the last basic step), else 0 (README "Bumpers"). ``force`` and
+    contact clipped its motion in the last basic step), else 0; a touch on any basic step since the
+    last reading reads 1, as Webots keeps it until read (README "Bumpers"). ``force`` and
     ``force-3d`` need physics: they read NaN (Webots' "no value"), said once when the world loads."""
 
     device: Literal["TouchSensor"]
