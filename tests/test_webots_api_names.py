@@ -8,6 +8,8 @@ here by name."""
 from __future__ import annotations
 
 import inspect
+import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -71,3 +73,84 @@ def test_check_python_reports_a_dropped_name(tmp_path):
         "controller.Robot.getUrdf: parameter 'prefix' defaults to '', Webots' to 'x'",
         "controller.Robot.nowhere: missing (a property in Webots)",
         "controller.Robot.EVENT_QUIT = -1, Webots' is -2"], run.stderr
+
+
+# ---------------------------------------------------------------------- C and C++
+
+sys.path.insert(0, str(API))
+import check_c  # noqa: E402
+
+CLIB = REPO / "sensorium" / "client" / "c"
+INCLUDE = CLIB / "include"
+needs_cc = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None or shutil.which("c++") is None,
+                              reason="needs a POSIX C/C++ toolchain (build-essential, libzmq3-dev, libmsgpack-dev, ...)")
+
+
+@pytest.fixture(scope="module")
+def clib(tmp_path_factory) -> tuple[Path, list[str]]:
+    build = tmp_path_factory.mktemp("libcontroller")
+    for args in ([f"BUILD={build}"], ["libs"]):
+        done = subprocess.run(["make", "-s", "-C", str(CLIB), *args], capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stdout + done.stderr
+    return build, done.stdout.split()
+
+
+def test_the_c_listing_is_read_whole():
+    names = check_c.c_functions()
+    assert len(names) == len(set(names)) == 550
+    for name in ("wb_robot_init", "wb_supervisor_node_get_pose", "wbu_driver_get_wipers_mode", "wb_radio_send",
+                 "wbu_string_replace", "wb_robot_wwi_receive_text", "wb_supervisor_movie_get_status"):
+        assert name in names
+
+
+@needs_cc
+def test_every_webots_c_function_is_declared_alike_and_linked(clib, tmp_path):
+    """A C controller calling any function of Webots' headers compiles (the same prototype) and
+    links against libController.so: the compiler names each function that differs or is missing."""
+    build, _ = clib
+    src = tmp_path / "api_names.c"
+    program = check_c.c_program(INCLUDE)
+    src.write_text(program, encoding="utf-8")
+    done = subprocess.run(["cc", "-std=c11", "-Wno-deprecated-declarations", f"-I{INCLUDE}", f"-I{API}", str(src),
+                           "-o", str(tmp_path / "api_names"), f"-L{build}", "-lController"],
+                          capture_output=True, text=True, timeout=300)
+    differ = check_c.failing_lines(program, done.stderr, src.name)
+    differ += [f"{f}: not in libController" for f in re.findall(r"undefined reference to `(\w+)'", done.stderr)]
+    assert differ == [] and done.returncode == 0, done.stderr[-3000:]
+
+
+@needs_cc
+def test_every_webots_cpp_method_is_callable_alike(clib, tmp_path):
+    """Each public method of Webots' C++ classes can be called as Webots declares it (const ones on a
+    const object, default arguments left out) and answers a value of Webots' return type."""
+    build, libs = clib
+    src = tmp_path / "api_names.cpp"
+    program = check_c.cpp_program(INCLUDE)
+    src.write_text(program, encoding="utf-8")
+    done = subprocess.run(["c++", "-std=c++11", "-Wall", "-Wextra", f"-I{INCLUDE}", str(src), "-o",
+                           str(tmp_path / "api_names_cpp"), str(build / "libController.a"), *libs],
+                          capture_output=True, text=True, timeout=300)
+    assert check_c.failing_lines(program, done.stderr, src.name) == [] and done.returncode == 0, done.stderr[-3000:]
+
+
+@needs_cc
+def test_the_comparison_names_a_changed_prototype_and_a_dropped_method(tmp_path):
+    """The checks themselves: a prototype Sensorium declares otherwise, and a C++ method it lacks,
+    come out by name."""
+    listing = tmp_path / "c_functions.h"
+    listing.write_text((API / "c_functions.h").read_text().replace(
+        "void wb_joystick_set_constant_force(int level);", "void wb_joystick_set_constant_force(double level);"))
+    program = check_c.c_program(INCLUDE)
+    src = tmp_path / "api_names.c"
+    src.write_text(program)
+    done = subprocess.run(["cc", "-std=c11", "-fsyntax-only", "-Wno-deprecated-declarations", f"-I{INCLUDE}",
+                           f"-I{tmp_path}", str(src)], capture_output=True, text=True, timeout=300)
+    assert done.returncode != 0 and re.search(r"conflicting types for .wb_joystick_set_constant_force.", done.stderr)
+    cpp = tmp_path / "cpp_methods.txt"
+    cpp.write_text("class Camera : Device\nint getWidth() const\ndouble getShutterSpeed() const\n")
+    program = check_c.cpp_program(INCLUDE, cpp)
+    src = tmp_path / "api_names.cpp"
+    src.write_text(program)
+    done = subprocess.run(["c++", "-std=c++11", "-fsyntax-only", f"-I{INCLUDE}", str(src)], capture_output=True,
+                          text=True, timeout=300)
+    assert check_c.failing_lines(program, done.stderr, src.name) == ["Camera::getShutterSpeed() const -> double"]
