@@ -78,6 +78,10 @@ def cpp_checks(listing: Path = HERE / "cpp_methods.txt") -> list[str]:
         def qual(t: str, cls: str = cls) -> str:
             return re.sub(_NESTED, rf"{cls}::\1", t)
 
+        if line.startswith("enum "):
+            name, value = line[len("enum "):].split(" = ")
+            checks.append(f'static_assert({cls}::{name} == {value}, "x");  // {cls}::{name} == {value}')
+            continue
         if line.startswith("ctor "):
             params = _params(line[len("ctor ("):-1])
             label = f"{cls}({', '.join(t for t, _ in params)})"

@@ -18,6 +18,7 @@ Device *deviceFromTag(WbDeviceTag tag);  // defined in Robot.hpp
 class Brake : public Device {
 public:
   enum Type { ROTATIONAL = WB_ROTATIONAL, LINEAR = WB_LINEAR };
+  enum { ANGULAR = WB_ROTATIONAL };  // Webots' older name, kept since R2018b
   explicit Brake(WbDeviceTag tag) : Device(tag) {}
   explicit Brake(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void setDampingConstant(double dampingConstant) const { wb_brake_set_damping_constant(tag_, dampingConstant); }

@@ -57,6 +57,7 @@ public:
 class PositionSensor : public Device {
 public:
   enum Type { ROTATIONAL = WB_ROTATIONAL, LINEAR = WB_LINEAR };
+  enum { ANGULAR = WB_ROTATIONAL };  // Webots' older name, kept since R2018b
   explicit PositionSensor(WbDeviceTag tag) : Device(tag) {}
   explicit PositionSensor(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_position_sensor_enable(tag_, samplingPeriod); }
