@@ -30,7 +30,7 @@ def c_functions(listing: Path = HERE / "c_functions.h") -> list[str]:
 
 def c_program(include: Path) -> str:
     headers = sorted(p.relative_to(include).as_posix() for p in (include / "webots").rglob("*.h"))
-    lines = [f"#include <{h}>" for h in headers] + ['#include "c_functions.h"', "",
+    lines = ["#include <stddef.h>"] + [f"#include <{h}>" for h in headers] + ['#include "c_functions.h"', "",
                                                     "typedef void (*any_function)(void);",
                                                     "const any_function table[] = {"]
     lines += [f"  (any_function){name}," for name in c_functions()]
@@ -66,6 +66,10 @@ def cpp_checks(listing: Path = HERE / "cpp_methods.txt") -> list[str]:
     for raw in listing.read_text(encoding="utf-8").splitlines():
         line = raw.strip()
         if not line or line.startswith("#"):
+            continue
+        if line.startswith("type "):
+            n += 1
+            checks.append(f"typedef {line[len('type '):]} type_{n};  // the type webots::{line[len('type '):]}")
             continue
         if line.startswith("class "):
             m = re.match(r"class (\w+)(?: : (\w+))?$", line)
