@@ -891,3 +891,34 @@ _Static_assert(offsetof(WbCameraRecognitionObject, size_on_image) < sizeof(WbCam
 _Static_assert(offsetof(WbCameraRecognitionObject, number_of_colors) < sizeof(WbCameraRecognitionObject), "WbCameraRecognitionObject.number_of_colors");
 _Static_assert(offsetof(WbCameraRecognitionObject, colors) < sizeof(WbCameraRecognitionObject), "WbCameraRecognitionObject.colors");
 _Static_assert(offsetof(WbCameraRecognitionObject, model) < sizeof(WbCameraRecognitionObject), "WbCameraRecognitionObject.model");
+
+/* macros a controller uses: camera.h's and range_finder.h's pixel readers, robot_wwi.h's text sender,
+ * utils/ansi_codes.h's escape sequences */
+static inline int webots_api_macros(const unsigned char *image, const float *range) {
+  wb_robot_wwi_send_text("text");
+  return wb_camera_image_get_red(image, 2, 1, 0) + wb_camera_image_get_green(image, 2, 1, 0) +
+         wb_camera_image_get_blue(image, 2, 1, 0) + wb_camera_image_get_gray(image, 2, 1, 0) +
+         wb_camera_image_get_grey(image, 2, 1, 0) + (int)wb_range_finder_image_get_depth(range, 2, 1, 0);
+}
+static const char *const webots_api_ansi_codes[] = {
+  ANSI_RESET,
+  ANSI_BOLD,
+  ANSI_UNDERLINE,
+  ANSI_BLACK_BACKGROUND,
+  ANSI_RED_BACKGROUND,
+  ANSI_GREEN_BACKGROUND,
+  ANSI_YELLOW_BACKGROUND,
+  ANSI_BLUE_BACKGROUND,
+  ANSI_MAGENTA_BACKGROUND,
+  ANSI_CYAN_BACKGROUND,
+  ANSI_WHITE_BACKGROUND,
+  ANSI_BLACK_FOREGROUND,
+  ANSI_RED_FOREGROUND,
+  ANSI_GREEN_FOREGROUND,
+  ANSI_YELLOW_FOREGROUND,
+  ANSI_BLUE_FOREGROUND,
+  ANSI_MAGENTA_FOREGROUND,
+  ANSI_CYAN_FOREGROUND,
+  ANSI_WHITE_FOREGROUND,
+  ANSI_CLEAR_SCREEN,
+};

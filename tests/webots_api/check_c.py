@@ -23,8 +23,9 @@ _NESTED = r"\b(Type|Mode|UserInputEvent|SimulationMode|IndicatorState|ControlMod
 
 
 def c_functions(listing: Path = HERE / "c_functions.h") -> list[str]:
-    """The function names c_functions.h declares, in order."""
-    text = re.sub(r"/\*.*?\*/", "", listing.read_text(encoding="utf-8"), flags=re.S)
+    """The function names c_functions.h declares, in order (its prototypes come before its constants)."""
+    text = listing.read_text(encoding="utf-8").split("/* constants a controller uses")[0]
+    text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
     return re.findall(r"^[^\s#][^;]*?\b(wbu?_\w+)\s*\(", text, re.M)
 
 
