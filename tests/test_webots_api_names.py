@@ -154,3 +154,12 @@ def test_the_comparison_names_a_changed_prototype_and_a_dropped_method(tmp_path)
     done = subprocess.run(["c++", "-std=c++11", "-fsyntax-only", f"-I{INCLUDE}", str(src)], capture_output=True,
                           text=True, timeout=300)
     assert check_c.failing_lines(program, done.stderr, src.name) == ["Camera::getShutterSpeed() const -> double"]
+
+
+def test_importing_webots_ctypes_handle_ends_with_one_line():
+    """``controller.wb`` (Webots' ctypes handle on its libController) is the one name left out: a
+    controller importing it ends with status 1 and one line saying so, not a traceback."""
+    run = subprocess.run([sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv[1]); from controller.wb import wb",
+                          str(REPO / "sensorium" / "client" / "webots")], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 1 and run.stdout == ""
+    assert run.stderr.count("\n") == 1 and run.stderr.startswith("Error: controller.wb (Webots' ctypes handle")
