@@ -873,6 +873,30 @@ def test_heartbeat_thread_stops_on_cleanup(server):
     assert not any(t.name == "sensorium-heartbeat" and t.is_alive() for t in threading.enumerate())
 
 
+def test_webots_signatures_and_by_name_construction_offline(global_robot, capsys):
+    """Webots' keywords and defaults work (``step(time_step=...)``, ``enable(p=...)``), a sensor built
+    by name is enabled at the basic time step as in Webots (one from ``getDevice`` is not), and so is
+    a hand-built ``Keyboard()``; the robot's own keyboard stays off."""
+    controller = _controller_module()
+    robot = controller.Robot()
+    by_name = controller.DistanceSensor("ds")
+    assert by_name.getSamplingPeriod() == 32 and by_name.sampling_period == 32
+    assert controller.LightSensor("ls", 64).getSamplingPeriod() == 64
+    assert robot.getDevice("lid").getSamplingPeriod() == 0
+    assert robot.step(time_step=32) == 0 and robot.getTime() == 0.032
+    assert by_name.getValue() == distance_value(32)
+    robot.getDevice("ls").enable(p=96)
+    assert robot.getDevice("ls").sampling_period == 96
+    assert robot.keyboard.getSamplingPeriod() == 0
+    assert controller.Keyboard().getSamplingPeriod() == 32
+    assert controller.Keyboard().get_key() == "" and robot.keyboard.getKeyCode() == -1
+    capsys.readouterr()
+    robot.battery_sensor_sampling_period = None         # Webots: None enables at the basic time step
+    assert robot.batterySensorGetSamplingPeriod() == robot.battery_sensor_sampling_period == 32
+    with pytest.raises(TypeError):
+        robot.step(duration=32)                         # not Webots' name
+
+
 def test_keyboard_mode_and_supervisor_refusal_offline(global_robot, capsys):
     controller = _controller_module()
     robot = controller.Robot()

@@ -12,8 +12,8 @@ class Brake(Device):
     ROTATIONAL = wb.WB_ROTATIONAL
     LINEAR = wb.WB_LINEAR
 
-    def setDampingConstant(self, dampingConstant: float) -> None:  # noqa: N803 - Webots' parameter name
-        wb.wb_brake_set_damping_constant(self._tag, dampingConstant)
+    def setDampingConstant(self, c: float) -> None:
+        wb.wb_brake_set_damping_constant(self._tag, c)
 
     def getType(self) -> int:
         return wb.wb_brake_get_type(self._tag)
@@ -31,5 +31,6 @@ class Brake(Device):
         return Robot.device_by_tag(wb.wb_brake_get_position_sensor(self._tag))
 
     type = property(getType)
+    dampingConstant = property(fset=setDampingConstant)  # noqa: N815 - Webots' name
     motor = property(getMotor)
     position_sensor = property(getPositionSensor)

@@ -115,8 +115,8 @@ class Camera(Sensor):
     def getMaxFov(self) -> float:
         return wb.wb_camera_get_max_fov(self._tag)
 
-    def setFov(self, fov: float) -> None:
-        wb.wb_camera_set_fov(self._tag, fov)
+    def setFov(self, f: float) -> None:
+        wb.wb_camera_set_fov(self._tag, f)
 
     def getExposure(self) -> float:
         return wb.wb_camera_get_exposure(self._tag)
@@ -136,8 +136,8 @@ class Camera(Sensor):
     def getMaxFocalDistance(self) -> float:
         return wb.wb_camera_get_max_focal_distance(self._tag)
 
-    def setFocalDistance(self, focal_distance: float) -> None:
-        wb.wb_camera_set_focal_distance(self._tag, focal_distance)
+    def setFocalDistance(self, d: float) -> None:
+        wb.wb_camera_set_focal_distance(self._tag, d)
 
     def getNear(self) -> float:
         return wb.wb_camera_get_near(self._tag)
@@ -146,8 +146,8 @@ class Camera(Sensor):
     def hasRecognition(self) -> bool:
         return wb.wb_camera_has_recognition(self._tag)
 
-    def recognitionEnable(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
-        wb.wb_camera_recognition_enable(self._tag, samplingPeriod)
+    def recognitionEnable(self, sampling_period: int) -> None:
+        wb.wb_camera_recognition_enable(self._tag, sampling_period)
 
     def recognitionDisable(self) -> None:
         wb.wb_camera_recognition_disable(self._tag)

@@ -9,8 +9,8 @@ from .device import Device
 
 
 class Connector(Device):
-    def enablePresence(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
-        wb.wb_connector_enable_presence(self._tag, samplingPeriod)
+    def enablePresence(self, sampling_period: int) -> None:
+        wb.wb_connector_enable_presence(self._tag, sampling_period)
 
     def disablePresence(self) -> None:
         wb.wb_connector_disable_presence(self._tag)

@@ -61,12 +61,16 @@ class Sensor(Device):
     _get_sampling_period: Callable[[int], int]
 
     def __init__(self, name: str | int, sampling_period: int | None = None):
+        """By name (``DistanceSensor("ds0")``), as Webots: enabled at ``sampling_period``, the basic
+        time step by default; by tag (what ``Robot.getDevice`` does), only when a period is given."""
         super().__init__(name)
+        if sampling_period is None and isinstance(name, str):
+            sampling_period = int(wb.wb_robot_get_basic_time_step())
         if sampling_period is not None:
             self.enable(sampling_period)
 
-    def enable(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
-        self._enable(self._tag, samplingPeriod)
+    def enable(self, p: int) -> None:
+        self._enable(self._tag, p)
 
     def disable(self) -> None:
         self._enable(self._tag, 0)

@@ -42,8 +42,8 @@ class Display(Device):
     def setOpacity(self, opacity: float) -> None:
         wb.wb_display_set_opacity(self._tag, opacity)
 
-    def setFont(self, font: str, size: int, antiAliasing: bool) -> None:
-        wb.wb_display_set_font(self._tag, font, size, antiAliasing)
+    def setFont(self, font: str, size: int, anti_aliasing: bool) -> None:
+        wb.wb_display_set_font(self._tag, font, size, anti_aliasing)
 
     def attachCamera(self, camera: Any) -> None:
         wb.wb_display_attach_camera(self._tag, getattr(camera, "_tag", camera))
@@ -85,14 +85,19 @@ class Display(Device):
     def imageCopy(self, x: int, y: int, width: int, height: int) -> Any:
         return wb.wb_display_image_copy(self._tag, int(x), int(y), int(width), int(height))
 
-    def imagePaste(self, ir: Any, x: int, y: int, blend: bool = False) -> None:
-        wb.wb_display_image_paste(self._tag, ir, int(x), int(y), blend)
+    def imagePaste(self, image: Any, x: int, y: int, blend: bool = False) -> None:
+        wb.wb_display_image_paste(self._tag, image, int(x), int(y), blend)
 
     def imageLoad(self, filename: str) -> Any:
         return wb.wb_display_image_load(self._tag, filename)
 
-    def imageSave(self, ir: Any, filename: str) -> None:
-        wb.wb_display_image_save(self._tag, ir, filename)
+    def imageSave(self, image: Any, filename: str) -> None:
+        wb.wb_display_image_save(self._tag, image, filename)
 
-    def imageDelete(self, ir: Any) -> None:
-        wb.wb_display_image_delete(self._tag, ir)
+    def imageDelete(self, image: Any) -> None:
+        wb.wb_display_image_delete(self._tag, image)
+
+    # Webots' write-only properties
+    color = property(fset=setColor)
+    alpha = property(fset=setAlpha)
+    opacity = property(fset=setOpacity)

@@ -7,11 +7,14 @@ from sensorium.client import wb
 
 class Joystick:
     def __init__(self, sampling_period: int | None = None):
+        """Enabled at ``sampling_period`` (the basic time step by default, as Webots); 0 leaves it off."""
+        if sampling_period is None:
+            sampling_period = int(wb.wb_robot_get_basic_time_step())
         if sampling_period:
             self.enable(sampling_period)
 
-    def enable(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
-        wb.wb_joystick_enable(samplingPeriod)
+    def enable(self, p: int) -> None:
+        wb.wb_joystick_enable(p)
 
     def disable(self) -> None:
         wb.wb_joystick_disable()
@@ -55,7 +58,7 @@ class Joystick:
     def setForceAxis(self, axis: int) -> None:
         wb.wb_joystick_set_force_axis(axis)
 
-    sampling_period = property(getSamplingPeriod)
+    sampling_period = property(getSamplingPeriod, lambda self, p: self.enable(0 if p is None else p))
     is_connected = property(isConnected)
     model = property(getModel)
     number_of_axes = property(getNumberOfAxes)

@@ -26,11 +26,14 @@ class Keyboard:
     ALT = wb.WB_KEYBOARD_ALT
 
     def __init__(self, sampling_period: int | None = None):
-        if sampling_period is not None:
+        """Enabled at ``sampling_period`` (the basic time step by default, as Webots); 0 leaves it off."""
+        if sampling_period is None:
+            sampling_period = int(wb.wb_robot_get_basic_time_step())
+        if sampling_period:
             self.enable(sampling_period)
 
-    def enable(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
-        wb.wb_keyboard_enable(samplingPeriod)
+    def enable(self, p: int) -> None:
+        wb.wb_keyboard_enable(p)
 
     def disable(self) -> None:
         wb.wb_keyboard_disable()
@@ -41,4 +44,25 @@ class Keyboard:
     def getKey(self) -> int:
         return wb.wb_keyboard_get_key()
 
-    sampling_period = property(getSamplingPeriod)
+    def getKeyCode(self) -> int:
+        return wb.wb_keyboard_get_key()
+
+    def get_key(self) -> str:
+        """Webots' text of the next key: modifiers first (``"shift-"``, ``"control-"``, and Webots'
+        ``"atl-"`` for Alt), then the key's name or its character; ``""`` when no key is pressed."""
+        k = wb.wb_keyboard_get_key()
+        if k < 0:
+            return ""
+        text = "".join(prefix for bit, prefix in ((Keyboard.SHIFT, "shift-"), (Keyboard.CONTROL, "control-"),
+                                                  (Keyboard.ALT, "atl-")) if k & bit)
+        k &= Keyboard.KEY
+        return text + _KEY_NAMES.get(k, chr(k))
+
+    sampling_period = property(getSamplingPeriod, lambda self, p: self.enable(0 if p is None else p))
+
+
+_KEY_NAMES = {Keyboard.END: "end", Keyboard.HOME: "home", Keyboard.LEFT: "left", Keyboard.RIGHT: "right",
+              Keyboard.UP: "up", Keyboard.DOWN: "down", Keyboard.PAGEUP: "page up", Keyboard.PAGEDOWN: "page down",
+              Keyboard.NUMPAD_END: "numpad end", Keyboard.NUMPAD_HOME: "numpad home",
+              Keyboard.NUMPAD_LEFT: "numpad left", Keyboard.NUMPAD_RIGHT: "numpad right",
+              Keyboard.NUMPAD_UP: "numpad up", Keyboard.NUMPAD_DOWN: "numpad down"}

@@ -9,8 +9,8 @@ from .device import Device
 
 
 class LED(Device):
-    def set(self, value: int) -> None:
-        wb.wb_led_set(self._tag, value)
+    def set(self, v: int) -> None:
+        wb.wb_led_set(self._tag, v)
 
     def get(self) -> int:
         return wb.wb_led_get(self._tag)

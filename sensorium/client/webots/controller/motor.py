@@ -131,6 +131,8 @@ class Motor(Device):
     multiplier = property(getMultiplier)
     force_feedback = property(getForceFeedback)
     torque_feedback = property(getTorqueFeedback)
+    force_feedback_sampling_period = property(getForceFeedbackSamplingPeriod, enableForceFeedback)
+    torque_feedback_sampling_period = property(getTorqueFeedbackSamplingPeriod, enableTorqueFeedback)
     force = property(fset=setForce)
     torque = property(fset=setTorque)
 

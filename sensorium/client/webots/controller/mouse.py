@@ -23,11 +23,14 @@ class MouseState:
 
 class Mouse:
     def __init__(self, sampling_period: int | None = None):
+        """Enabled at ``sampling_period`` (the basic time step by default, as Webots); 0 leaves it off."""
+        if sampling_period is None:
+            sampling_period = int(wb.wb_robot_get_basic_time_step())
         if sampling_period:
             self.enable(sampling_period)
 
-    def enable(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
-        wb.wb_mouse_enable(samplingPeriod)
+    def enable(self, p: int) -> None:
+        wb.wb_mouse_enable(p)
 
     def disable(self) -> None:
         wb.wb_mouse_disable()
@@ -48,4 +51,4 @@ class Mouse:
     def is3dPositionEnabled(self) -> bool:
         return wb.wb_mouse_is_3d_position_enabled()
 
-    sampling_period = property(getSamplingPeriod)
+    sampling_period = property(getSamplingPeriod, lambda self, p: self.enable(0 if p is None else p))

@@ -1,6 +1,6 @@
 """Webots' ``controller.node`` module (``from controller.node import Node``): the class lives in
 ``supervisor.py`` here."""
 
-from .supervisor import Node
+from .supervisor import ContactPoint, Node
 
-__all__ = ["Node"]
+__all__ = ["ContactPoint", "Node"]

@@ -8,7 +8,8 @@ from .device import Sensor
 
 
 class PositionSensor(Sensor):
-    ANGULAR = wb.WB_ROTATIONAL
+    ROTATIONAL = wb.WB_ROTATIONAL
+    ANGULAR = ROTATIONAL                # Webots' name before R2021
     LINEAR = wb.WB_LINEAR
 
     _enable = staticmethod(wb.wb_position_sensor_enable)

@@ -20,6 +20,11 @@ class RadarTarget:
     speed: float
     azimuth: float
 
+    @property
+    def receiver_power(self) -> float:
+        """Webots' Python name of ``received_power``."""
+        return self.received_power
+
 
 class Radar(Sensor):
     _enable = staticmethod(wb.wb_radar_enable)

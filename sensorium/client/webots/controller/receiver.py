@@ -62,6 +62,7 @@ class Receiver(Sensor):
         wb.wb_receiver_set_channel(self._tag, channel)
 
     queue_length = property(getQueueLength)
+    data = property(getBytes)
     data_size = property(getDataSize)
     string = property(getString)
     signal_strength = property(getSignalStrength)

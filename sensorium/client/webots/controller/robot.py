@@ -71,9 +71,9 @@ class Robot:
             return
         wb.wb_robot_init()
         Robot.created = self
-        self.keyboard = Keyboard()
-        self.mouse = Mouse()
-        self.joystick = Joystick()
+        self.keyboard = Keyboard(0)         # 0: not enabled (Webots' Keyboard() enables at the basic time step)
+        self.mouse = Mouse(0)
+        self.joystick = Joystick(0)
         self.devices: dict[str, Device] = {}
         for i in range(wb.wb_robot_get_number_of_devices()):
             tag = wb.wb_robot_get_device_by_index(i)
@@ -82,13 +82,13 @@ class Robot:
             self.devices[wb.wb_device_get_name(tag)] = cls(tag)
 
     # -- stepping
-    def step(self, duration: int | None = None) -> int:
-        """Run ``duration`` ms of simulated time (default: the basic time step); -1 when the
+    def step(self, time_step: int | None = None) -> int:
+        """Run ``time_step`` ms of simulated time (default: the basic time step); -1 when the
         simulation ends."""
-        return wb.wb_robot_step(duration)
+        return wb.wb_robot_step(time_step)
 
-    def stepBegin(self, duration: int | None = None) -> int:
-        return wb.wb_robot_step_begin(duration)
+    def stepBegin(self, time_step: int | None = None) -> int:
+        return wb.wb_robot_step_begin(time_step)
 
     def stepEnd(self) -> int:
         return wb.wb_robot_step_end()
@@ -211,6 +211,15 @@ class Robot:
     mode = property(getMode)
     project_path = property(getProjectPath)
     world_path = property(getWorldPath)
+
+    @property
+    def battery_sensor_sampling_period(self) -> int:
+        return self.batterySensorGetSamplingPeriod()
+
+    @battery_sensor_sampling_period.setter
+    def battery_sensor_sampling_period(self, sampling_period: int | None) -> None:
+        """Webots: ``None`` enables the battery sensor at the basic time step."""
+        self.batterySensorEnable(int(self.getBasicTimeStep()) if sampling_period is None else sampling_period)
 
 
 def _deprecated_getter(method: str) -> Any:

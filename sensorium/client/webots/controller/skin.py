@@ -10,3 +10,5 @@ class Skin(UnsimulatedDevice):
     _NO_VALUES = {"getBoneCount": 0, "getBoneName": "", "getBoneOrientation": None, "getBonePosition": None,
                   "setBoneOrientation": None, "setBonePosition": None}
     _PROPERTIES = {"bone_count": "getBoneCount"}
+    _PARAMS = {"getBoneName": "index", "getBoneOrientation": "index, absolute", "getBonePosition": "index, absolute",
+               "setBoneOrientation": "index, orientation, absolute", "setBonePosition": "index, position, absolute"}

@@ -19,6 +19,7 @@ from typing import Any
 from sensorium.client import nodes, wb
 
 from .robot import Robot
+from .unsimulated import signed
 
 
 class Field:
@@ -31,7 +32,14 @@ class Field:
     SF_COLOR = wb.WB_SF_COLOR
     SF_STRING = wb.WB_SF_STRING
     SF_NODE = wb.WB_SF_NODE
+    MF_BOOL = 0x11              # Webots' WbFieldType values of the MF types Sensorium has no field of
+    MF_INT32 = 0x12
+    MF_FLOAT = 0x13
+    MF_VEC2F = 0x14
+    MF_VEC3F = 0x15
+    MF_ROTATION = 0x16
     MF_COLOR = wb.WB_MF_COLOR
+    MF_STRING = 0x18
     MF_NODE = wb.WB_MF_NODE
 
     def __init__(self, ref: tuple[int, str, int]):
@@ -92,14 +100,14 @@ class Field:
     def setSFFloat(self, value: float) -> None:
         wb.wb_supervisor_field_set_sf_float(self._ref, value)
 
-    def setSFVec3f(self, values: list[float]) -> None:
-        wb.wb_supervisor_field_set_sf_vec3f(self._ref, values)
+    def setSFVec3f(self, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_sf_vec3f(self._ref, value)
 
-    def setSFRotation(self, values: list[float]) -> None:
-        wb.wb_supervisor_field_set_sf_rotation(self._ref, values)
+    def setSFRotation(self, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_sf_rotation(self._ref, value)
 
-    def setSFColor(self, values: list[float]) -> None:
-        wb.wb_supervisor_field_set_sf_color(self._ref, values)
+    def setSFColor(self, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_sf_color(self._ref, value)
 
     def importMFNodeFromString(self, position: int, nodeString: str) -> None:  # noqa: N803 - Webots' name
         wb.wb_supervisor_field_import_mf_node_from_string(self._ref, position, nodeString)
@@ -250,8 +258,12 @@ class Node:
         return None
 
     id = property(getId)
-    def_name = property(getDef)
+    DEF = property(getDef)
+    def_name = DEF
+    type = property(getType)
     type_name = property(getTypeName)
+    base_type_name = property(getBaseTypeName)
+    # Webots' number_of_fields and number_of_base_node_fields: see the end of this file
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, Node) and other._ref == self._ref
@@ -305,8 +317,8 @@ class Supervisor(Robot):
     def getRoot(self) -> Node | None:
         return _node_of(wb.wb_supervisor_node_get_root())
 
-    def getFromDef(self, name: str) -> Node | None:
-        return _node(self._lookup("get_from_def", {"name": name}, "wb_supervisor_node_get_from_def", name))
+    def getFromDef(self, d: str) -> Node | None:
+        return _node(self._lookup("get_from_def", {"name": d}, "wb_supervisor_node_get_from_def", d))
 
     def getSelf(self) -> Node | None:
         return _node(self._lookup("get_self", None, "wb_supervisor_node_get_self", "self"))
@@ -314,9 +326,9 @@ class Supervisor(Robot):
     def getFromId(self, id: int) -> Node | None:  # noqa: A002 - Webots' parameter name
         return _node_of(wb.wb_supervisor_node_get_from_id(id))
 
-    def getFromDevice(self, device: Any) -> Node | None:
-        """The node of one of this robot's devices (a Device object, as Webots takes)."""
-        tag = device.getTag() if hasattr(device, "getTag") else device
+    def getFromDevice(self, tag: Any) -> Node | None:
+        """The node of one of this robot's devices (a Device object, as Webots takes, or its tag)."""
+        tag = tag.getTag() if hasattr(tag, "getTag") else tag
         return _node_of(wb.wb_supervisor_node_get_from_device(tag))
 
     @staticmethod
@@ -334,8 +346,8 @@ class Supervisor(Robot):
                  transparency: float = 0.0, font: str = "Arial") -> None:
         wb.wb_supervisor_set_label(id, label, x, y, size, color, transparency, font)
 
-    def exportImage(self, file: str, quality: int) -> None:
-        wb.wb_supervisor_export_image(file, quality)
+    def exportImage(self, filename: str, quality: int) -> None:
+        wb.wb_supervisor_export_image(filename, quality)
 
     def simulationReset(self) -> None:
         wb.wb_supervisor_simulation_reset()
@@ -352,6 +364,8 @@ class Supervisor(Robot):
     def worldReload(self) -> None:
         wb.wb_supervisor_world_reload()
 
+    simulation_mode = property(simulationGetMode, simulationSetMode)
+
     def simulationQuit(self, status: int) -> None:
         wb.wb_supervisor_simulation_quit(status)
 
@@ -364,64 +378,76 @@ class Proto:
         self._ref = ref
 
 
-def _unserved(method: str, func: str, value: Any) -> Callable[..., Any]:
-    def call(self: object, *args: Any, **kwargs: Any) -> Any:
+def _unserved(method: str, func: str, value: Any, params: str) -> Callable[..., Any]:
+    def call(self: object, *args: Any) -> Any:
         wb.supervisor_unserved(func)
         return list(value) if isinstance(value, list) else value
 
     call.__name__ = call.__qualname__ = method
     call.__doc__ = f"Not served by Sensorium: one error line, Webots' \"no value\" ({value!r})."
-    return call
+    return signed(call, params)
 
 
 _NAN = math.nan
-# Webots' methods beyond the subset: Python name -> (the C function it stands for, its "no value")
-_UNSERVED: dict[type, dict[str, tuple[str, Any]]] = {
+# Webots' methods beyond the subset: Python name -> (the C function it stands for, its "no value", Webots' parameters)
+_UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
     Supervisor: {
-        "getSelected": ("node_get_selected", None),
-        "worldLoad": ("world_load", None), "worldSave": ("world_save", False),
-        "movieStartRecording": ("movie_start_recording", None),
-        "movieStopRecording": ("movie_stop_recording", None), "movieIsReady": ("movie_is_ready", True),
-        "movieFailed": ("movie_failed", True), "animationStartRecording": ("animation_start_recording", False),
-        "animationStopRecording": ("animation_stop_recording", False),
-        "virtualRealityHeadsetIsUsed": ("virtual_reality_headset_is_used", False),
-        "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3),
-        "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9)},
+        "getSelected": ("node_get_selected", None, ""),
+        "worldLoad": ("world_load", None, "filename"), "worldSave": ("world_save", False, "filename=None"),
+        "movieStartRecording": ("movie_start_recording", None,
+                                "filename, width, height, codec, quality, acceleration, caption"),
+        "movieStopRecording": ("movie_stop_recording", None, ""), "movieIsReady": ("movie_is_ready", True, ""),
+        "movieFailed": ("movie_failed", True, ""),
+        "animationStartRecording": ("animation_start_recording", False, "filename"),
+        "animationStopRecording": ("animation_stop_recording", False, ""),
+        "virtualRealityHeadsetIsUsed": ("virtual_reality_headset_is_used", False, ""),
+        "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3, ""),
+        "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9, "")},
     Node: {
-        "getProto": ("node_get_proto", None), "getFromProtoDef": ("node_get_from_proto_def", None),
-        "getNumberOfFields": ("node_get_number_of_fields", -1),
-        "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1),
-        "getFieldByIndex": ("node_get_field_by_index", None), "getBaseNodeField": ("node_get_base_node_field", None),
-        "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None),
-        "exportString": ("node_export_string", ""),
-        "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3),
-        "getStaticBalance": ("node_get_static_balance", False),
-        "moveViewpoint": ("node_move_viewpoint", None),
-        "setVisibility": ("node_set_visibility", None), "addForce": ("node_add_force", None),
-        "addForceWithOffset": ("node_add_force_with_offset", None), "addTorque": ("node_add_torque", None)},
+        "getProto": ("node_get_proto", None, ""), "getFromProtoDef": ("node_get_from_proto_def", None, "DEF"),
+        "getNumberOfFields": ("node_get_number_of_fields", -1, ""),
+        "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1, ""),
+        "getFieldByIndex": ("node_get_field_by_index", None, "index"),
+        "getBaseNodeField": ("node_get_base_node_field", None, "fieldName"),
+        "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None, "index"),
+        "exportString": ("node_export_string", "", ""),
+        "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3, ""),
+        "getStaticBalance": ("node_get_static_balance", False, ""),
+        "moveViewpoint": ("node_move_viewpoint", None, ""),
+        "setVisibility": ("node_set_visibility", None, "fromNode, visible"),
+        "addForce": ("node_add_force", None, "force, relative"),
+        "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),
+        "addTorque": ("node_add_torque", None, "torque, relative")},
     Proto: {
-        "getTypeName": ("proto_get_type_name", ""), "isDerived": ("proto_is_derived", False),
-        "getParent": ("proto_get_parent", None), "getField": ("proto_get_field", None),
-        "getFieldByIndex": ("proto_get_field_by_index", None), "getNumberOfFields": ("proto_get_number_of_fields", -1)},
+        "getTypeName": ("proto_get_type_name", "", ""), "isDerived": ("proto_is_derived", False, ""),
+        "getParent": ("proto_get_parent", None, ""), "getField": ("proto_get_field", None, "name"),
+        "getFieldByIndex": ("proto_get_field_by_index", None, "index"),
+        "getNumberOfFields": ("proto_get_number_of_fields", -1, "")},
     Field: {
-        "getActualField": ("field_get_actual_field", None), "removeMF": ("field_remove_mf", None),
-        "removeSF": ("field_remove_sf", None),
+        "getActualField": ("field_get_actual_field", None, ""), "removeMF": ("field_remove_mf", None, "index"),
+        "removeSF": ("field_remove_sf", None, ""),
         # no SFNode field here takes an import (a joint's jointParameters and endPoint are read-only)
-        "importSFNodeFromString": ("field_import_sf_node_from_string", None)},
+        "importSFNodeFromString": ("field_import_sf_node_from_string", None, "nodeString")},
 }
 _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 2, "Vec3f": [_NAN] * 3,
                     "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
 for _kind, _none in _FIELD_NO_VALUES.items():
     _c = _kind.lower()
     if _kind not in ("Node", "Color"):         # getMFNode (the root's children), getMFColor (skyColor) are served
-        _UNSERVED[Field][f"getMF{_kind}"] = (f"field_get_mf_{_c}", _none)
-        _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None)
-        _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None)
+        _UNSERVED[Field][f"getMF{_kind}"] = (f"field_get_mf_{_c}", _none, "index")
+    if _kind != "Node":                        # setMFNode and insertMFNode are not Webots' (importMFNodeFromString)
+        _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None, "index, value")
+        _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None, "index, value")
     if _kind == "Vec2f":             # the SF field type no node here has
-        _UNSERVED[Field][f"getSF{_kind}"] = (f"field_get_sf_{_c}", _none)
+        _UNSERVED[Field][f"getSF{_kind}"] = (f"field_get_sf_{_c}", _none, "")
     if _kind in ("Int32", "Vec2f", "String"):  # SFString fields are read-only here
-        _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None)
+        _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None, "value")
 for _cls, _methods in _UNSERVED.items():
-    for _method, (_func, _value) in _methods.items():
+    for _method, (_func, _value, _params) in _methods.items():
         assert not hasattr(_cls, _method), _method        # never hides a served method
-        setattr(_cls, _method, _unserved(_method, "wb_supervisor_" + _func, _value))
+        setattr(_cls, _method, _unserved(_method, "wb_supervisor_" + _func, _value, _params))
+Node.number_of_fields = property(lambda self: self.getNumberOfFields())                     # type: ignore[attr-defined]
+Node.number_of_base_node_fields = property(lambda self: self.getNumberOfBaseNodeFields())   # type: ignore[attr-defined]
+Proto.type_name = property(lambda self: self.getTypeName())                # type: ignore[attr-defined]
+Proto.number_of_fields = property(lambda self: self.getNumberOfFields())   # type: ignore[attr-defined]
+Proto.is_derived = property(lambda self: self.isDerived())                 # type: ignore[attr-defined]

@@ -14,8 +14,8 @@ class VacuumGripper(Device):
         if sampling_period is not None:
             self.enablePresence(sampling_period)
 
-    def enablePresence(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
-        wb.wb_vacuum_gripper_enable_presence(self._tag, samplingPeriod)
+    def enablePresence(self, sampling_period: int) -> None:
+        wb.wb_vacuum_gripper_enable_presence(self._tag, sampling_period)
 
     def disablePresence(self) -> None:
         wb.wb_vacuum_gripper_disable_presence(self._tag)

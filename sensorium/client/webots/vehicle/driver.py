@@ -13,6 +13,7 @@ from typing import Any
 
 from sensorium.client import wb
 from sensorium.client.webots.controller.supervisor import Supervisor
+from sensorium.client.webots.controller.unsimulated import signed
 
 _UNMODELLED = ("Sensorium's car is kinematic (a bicycle model of its steering and wheel motors): no engine, "
                "gearbox, brakes, lights or wipers")
@@ -34,9 +35,9 @@ def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float
     return math.atan(1.0 / (cot - half)), math.atan(1.0 / (cot + half))
 
 
-def unmodelled(func: str, answer: Any) -> Callable[..., Any]:
+def unmodelled(func: str, answer: Any, params: str = "") -> Callable[..., Any]:
     """A method standing for the C function ``func`` that does nothing and answers ``answer``,
-    after one line the first time it is called in this process."""
+    after one line the first time it is called in this process; it takes Webots' ``params``."""
     said: list[bool] = []
 
     def method(self: object, *args: Any, **kwargs: Any) -> Any:
@@ -46,7 +47,7 @@ def unmodelled(func: str, answer: Any) -> Callable[..., Any]:
         return answer
 
     method.__doc__ = f"Not simulated (no engine model): one line the first time, then {answer!r}."
-    return method
+    return signed(method, params)
 
 
 class Driver(Supervisor):
@@ -174,28 +175,35 @@ class Driver(Supervisor):
         """``SPEED`` once a cruising speed is set, ``None`` before (Webots' undefined mode)."""
         return self._mode
 
-    def step(self, duration: int | None = None) -> int:
+    def step(self, time_step: int | None = None) -> int:
         """One basic time step (Webots' ``wbu_driver_step``); -1 when the simulation ends."""
-        return super().step(duration)
+        return super().step(time_step)
+
+    @staticmethod
+    def isInitialisationPossible() -> bool:
+        """Whether this controller's robot is a car the vehicle library drives (its world entry has an
+        ``ackermann_drive``); attaches to the robot as ``Robot()`` does."""
+        wb.wb_robot_init()
+        return wb.current().ackermann_drive is not None
 
     # -- no engine, gearbox, brakes, lights or wipers here
-    setThrottle = unmodelled("wbu_driver_set_throttle", None)
+    setThrottle = unmodelled("wbu_driver_set_throttle", None, "throttle")
     getThrottle = unmodelled("wbu_driver_get_throttle", 0.0)
-    setBrakeIntensity = unmodelled("wbu_driver_set_brake_intensity", None)
+    setBrakeIntensity = unmodelled("wbu_driver_set_brake_intensity", None, "brakeIntensity")
     getBrakeIntensity = unmodelled("wbu_driver_get_brake_intensity", 0.0)
-    setGear = unmodelled("wbu_driver_set_gear", None)
+    setGear = unmodelled("wbu_driver_set_gear", None, "gear")
     getGear = unmodelled("wbu_driver_get_gear", 0)
     getGearNumber = unmodelled("wbu_driver_get_gear_number", 0)
     getRpm = unmodelled("wbu_driver_get_rpm", 0.0)
-    setIndicator = unmodelled("wbu_driver_set_indicator", None)
+    setIndicator = unmodelled("wbu_driver_set_indicator", None, "indicator")
     getIndicator = unmodelled("wbu_driver_get_indicator", INDICATOR_OFF)
-    setHazardFlashers = unmodelled("wbu_driver_set_hazard_flashers", None)
+    setHazardFlashers = unmodelled("wbu_driver_set_hazard_flashers", None, "hazardFlasher")
     getHazardFlashers = unmodelled("wbu_driver_get_hazard_flashers", False)
-    setDippedBeams = unmodelled("wbu_driver_set_dipped_beams", None)
+    setDippedBeams = unmodelled("wbu_driver_set_dipped_beams", None, "state")
     getDippedBeams = unmodelled("wbu_driver_get_dipped_beams", False)
-    setAntifogLights = unmodelled("wbu_driver_set_antifog_lights", None)
+    setAntifogLights = unmodelled("wbu_driver_set_antifog_lights", None, "state")
     getAntifogLights = unmodelled("wbu_driver_get_antifog_lights", False)
-    setWiperMode = unmodelled("wbu_driver_set_wiper_mode", None)
+    setWiperMode = unmodelled("wbu_driver_set_wiper_mode", None, "mode")
     getWiperMode = unmodelled("wbu_driver_get_wiper_mode", DOWN)
 
     # Webots' properties
@@ -203,3 +211,13 @@ class Driver(Supervisor):
     target_cruising_speed = property(getTargetCruisingSpeed, setCruisingSpeed)
     current_speed = property(getCurrentSpeed)
     control_mode = property(getControlMode)
+    throttle = property(getThrottle, setThrottle)
+    brake_intensity = property(getBrakeIntensity, setBrakeIntensity)
+    gear = property(getGear, setGear)
+    gear_number = property(getGearNumber)
+    rpm = property(getRpm)
+    indicator = property(getIndicator, setIndicator)
+    hazard_flashers = property(getHazardFlashers, setHazardFlashers)
+    dipped_beams = property(getDippedBeams, setDippedBeams)
+    antifog_lights = property(getAntifogLights, setAntifogLights)
+    wiper_mode = property(getWiperMode, setWiperMode)

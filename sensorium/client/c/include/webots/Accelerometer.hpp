@@ -12,6 +12,7 @@ namespace webots {
 class Accelerometer : public Device {
 public:
   explicit Accelerometer(WbDeviceTag tag) : Device(tag) {}
+  explicit Accelerometer(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_accelerometer_enable(tag_, samplingPeriod); }
   void disable() { wb_accelerometer_disable(tag_); }
   int getSamplingPeriod() const { return wb_accelerometer_get_sampling_period(tag_); }

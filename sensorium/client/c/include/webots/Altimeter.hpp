@@ -12,6 +12,7 @@ namespace webots {
 class Altimeter : public Device {
 public:
   explicit Altimeter(WbDeviceTag tag) : Device(tag) {}
+  explicit Altimeter(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_altimeter_enable(tag_, samplingPeriod); }
   void disable() { wb_altimeter_disable(tag_); }
   int getSamplingPeriod() const { return wb_altimeter_get_sampling_period(tag_); }

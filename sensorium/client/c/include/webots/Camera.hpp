@@ -14,6 +14,7 @@ typedef WbCameraRecognitionObject CameraRecognitionObject;
 class Camera : public Device {
 public:
   explicit Camera(WbDeviceTag tag) : Device(tag) {}
+  explicit Camera(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_camera_enable(tag_, samplingPeriod); }
   void disable() { wb_camera_disable(tag_); }
   int getSamplingPeriod() const { return wb_camera_get_sampling_period(tag_); }
@@ -32,7 +33,7 @@ public:
   double getMinFocalDistance() const { return wb_camera_get_min_focal_distance(tag_); }
   void setFocalDistance(double focalDistance) { wb_camera_set_focal_distance(tag_, focalDistance); }
   double getNear() const { return wb_camera_get_near(tag_); }
-  int saveImage(const std::string &filename, int quality) { return wb_camera_save_image(tag_, filename.c_str(), quality); }
+  int saveImage(const std::string &filename, int quality) const { return wb_camera_save_image(tag_, filename.c_str(), quality); }
   bool hasRecognition() const { return wb_camera_has_recognition(tag_); }
   void recognitionEnable(int samplingPeriod) { wb_camera_recognition_enable(tag_, samplingPeriod); }
   void recognitionDisable() { wb_camera_recognition_disable(tag_); }

@@ -12,6 +12,7 @@ namespace webots {
 class Compass : public Device {
 public:
   explicit Compass(WbDeviceTag tag) : Device(tag) {}
+  explicit Compass(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_compass_enable(tag_, samplingPeriod); }
   void disable() { wb_compass_disable(tag_); }
   int getSamplingPeriod() const { return wb_compass_get_sampling_period(tag_); }

@@ -12,6 +12,7 @@ namespace webots {
 class Connector : public Device {
 public:
   explicit Connector(WbDeviceTag tag) : Device(tag) {}
+  explicit Connector(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enablePresence(int samplingPeriod) { wb_connector_enable_presence(tag_, samplingPeriod); }
   void disablePresence() { wb_connector_disable_presence(tag_); }
   int getPresenceSamplingPeriod() const { return wb_connector_get_presence_sampling_period(tag_); }

@@ -14,6 +14,7 @@ class Display : public Device {
 public:
   enum { RGB = WB_IMAGE_RGB, RGBA = WB_IMAGE_RGBA, ARGB = WB_IMAGE_ARGB, BGRA = WB_IMAGE_BGRA, ABGR = WB_IMAGE_ABGR };
   explicit Display(WbDeviceTag tag) : Device(tag) {}
+  explicit Display(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   int getWidth() const { return wb_display_get_width(tag_); }
   int getHeight() const { return wb_display_get_height(tag_); }
   void setColor(int color) { wb_display_set_color(tag_, color); }
@@ -31,12 +32,12 @@ public:
   void fillRectangle(int x, int y, int width, int height) { wb_display_fill_rectangle(tag_, x, y, width, height); }
   void fillOval(int cx, int cy, int a, int b) { wb_display_fill_oval(tag_, cx, cy, a, b); }
   void fillPolygon(const int *x, const int *y, int size) { wb_display_fill_polygon(tag_, x, y, size); }
-  ImageRef *imageNew(int width, int height, const void *data, int format) { return wrap(wb_display_image_new(tag_, width, height, data, format)); }
-  ImageRef *imageLoad(const std::string &filename) { return wrap(wb_display_image_load(tag_, filename.c_str())); }
-  ImageRef *imageCopy(int x, int y, int width, int height) { return wrap(wb_display_image_copy(tag_, x, y, width, height)); }
-  void imagePaste(ImageRef *ir, int x, int y, bool blend) { wb_display_image_paste(tag_, ir ? ir->getRef() : NULL, x, y, blend); }
-  void imageSave(ImageRef *ir, const std::string &filename) { wb_display_image_save(tag_, ir ? ir->getRef() : NULL, filename.c_str()); }
-  void imageDelete(ImageRef *ir) {  // the handle is gone with its image, as in Webots
+  ImageRef *imageNew(int width, int height, const void *data, int format) const { return wrap(wb_display_image_new(tag_, width, height, data, format)); }
+  ImageRef *imageLoad(const std::string &filename) const { return wrap(wb_display_image_load(tag_, filename.c_str())); }
+  ImageRef *imageCopy(int x, int y, int width, int height) const { return wrap(wb_display_image_copy(tag_, x, y, width, height)); }
+  void imagePaste(ImageRef *ir, int x, int y, bool blend = false) { wb_display_image_paste(tag_, ir ? ir->getRef() : NULL, x, y, blend); }
+  void imageSave(ImageRef *ir, const std::string &filename) const { wb_display_image_save(tag_, ir ? ir->getRef() : NULL, filename.c_str()); }
+  void imageDelete(ImageRef *ir) const {  // the handle is gone with its image, as in Webots
     wb_display_image_delete(tag_, ir ? ir->getRef() : NULL);
     delete ir;
   }

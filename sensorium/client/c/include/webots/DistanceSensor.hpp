@@ -11,6 +11,7 @@ class DistanceSensor : public Device {
 public:
   enum Type { GENERIC = 0, INFRA_RED, SONAR, LASER };
   explicit DistanceSensor(WbDeviceTag tag) : Device(tag) {}
+  explicit DistanceSensor(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_distance_sensor_enable(tag_, samplingPeriod); }
   void disable() { wb_distance_sensor_disable(tag_); }
   int getSamplingPeriod() const { return wb_distance_sensor_get_sampling_period(tag_); }

@@ -13,6 +13,7 @@ class Emitter : public Device {
 public:
   enum { CHANNEL_BROADCAST = WB_CHANNEL_BROADCAST };
   explicit Emitter(WbDeviceTag tag) : Device(tag) {}
+  explicit Emitter(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   int send(const void *data, int size) { return wb_emitter_send(tag_, data, size); }
   int getBufferSize() const { return wb_emitter_get_buffer_size(tag_); }
   void setChannel(int channel) { wb_emitter_set_channel(tag_, channel); }

@@ -13,6 +13,7 @@ class GPS : public Device {
 public:
   enum CoordinateSystem { LOCAL = WB_GPS_LOCAL_COORDINATE, WGS84 = WB_GPS_WGS84_COORDINATE };
   explicit GPS(WbDeviceTag tag) : Device(tag) {}
+  explicit GPS(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_gps_enable(tag_, samplingPeriod); }
   void disable() { wb_gps_disable(tag_); }
   int getSamplingPeriod() const { return wb_gps_get_sampling_period(tag_); }

@@ -12,6 +12,7 @@ namespace webots {
 class Gyro : public Device {
 public:
   explicit Gyro(WbDeviceTag tag) : Device(tag) {}
+  explicit Gyro(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_gyro_enable(tag_, samplingPeriod); }
   void disable() { wb_gyro_disable(tag_); }
   int getSamplingPeriod() const { return wb_gyro_get_sampling_period(tag_); }

@@ -12,6 +12,7 @@ namespace webots {
 class InertialUnit : public Device {
 public:
   explicit InertialUnit(WbDeviceTag tag) : Device(tag) {}
+  explicit InertialUnit(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_inertial_unit_enable(tag_, samplingPeriod); }
   void disable() { wb_inertial_unit_disable(tag_); }
   int getSamplingPeriod() const { return wb_inertial_unit_get_sampling_period(tag_); }

@@ -10,6 +10,7 @@ namespace webots {
 class LED : public Device {
 public:
   explicit LED(WbDeviceTag tag) : Device(tag) {}
+  explicit LED(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void set(int value) { wb_led_set(tag_, value); }
   int get() const { return wb_led_get(tag_); }
 };

@@ -12,6 +12,7 @@ typedef WbLidarPoint LidarPoint;
 class Lidar : public Device {
 public:
   explicit Lidar(WbDeviceTag tag) : Device(tag) {}
+  explicit Lidar(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_lidar_enable(tag_, samplingPeriod); }
   void disable() { wb_lidar_disable(tag_); }
   void enablePointCloud() { wb_lidar_enable_point_cloud(tag_); }

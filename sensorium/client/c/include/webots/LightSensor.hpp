@@ -10,6 +10,7 @@ namespace webots {
 class LightSensor : public Device {
 public:
   explicit LightSensor(WbDeviceTag tag) : Device(tag) {}
+  explicit LightSensor(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_light_sensor_enable(tag_, samplingPeriod); }
   void disable() { wb_light_sensor_disable(tag_); }
   int getSamplingPeriod() const { return wb_light_sensor_get_sampling_period(tag_); }

@@ -9,6 +9,7 @@ namespace webots {
 class LinearMotor : public Motor {
 public:
   explicit LinearMotor(WbDeviceTag tag) : Motor(tag) {}
+  explicit LinearMotor(const std::string &name) : Motor(name) {}  // Webots: prefer Robot::getDevice
 };
 
 }  // namespace webots

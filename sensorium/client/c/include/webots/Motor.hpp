@@ -11,6 +11,7 @@ namespace webots {
 
 class PositionSensor;
 class Motor;
+class Brake;
 namespace internal {
 Device *deviceFromTag(WbDeviceTag tag);  // defined in Robot.hpp
 }
@@ -19,6 +20,7 @@ class Motor : public Device {
 public:
   enum Type { ROTATIONAL = WB_ROTATIONAL, LINEAR = WB_LINEAR };
   explicit Motor(WbDeviceTag tag) : Device(tag) {}
+  explicit Motor(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void setPosition(double position) { wb_motor_set_position(tag_, position); }
   void setVelocity(double velocity) { wb_motor_set_velocity(tag_, velocity); }
   double getTargetPosition() const { return wb_motor_get_target_position(tag_); }
@@ -28,7 +30,7 @@ public:
   double getMaxVelocity() const { return wb_motor_get_max_velocity(tag_); }
   Type getType() const { return static_cast<Type>(wb_motor_get_type(tag_)); }
   inline PositionSensor *getPositionSensor() const;
-  Device *getBrake() const { return 0; }
+  inline Brake *getBrake() const;
   // what needs physics: ignored, NaN (kinematic wheels; see webots/motor.h)
   void setAcceleration(double acceleration) { wb_motor_set_acceleration(tag_, acceleration); }
   double getAcceleration() const { return wb_motor_get_acceleration(tag_); }
@@ -55,20 +57,31 @@ public:
 class PositionSensor : public Device {
 public:
   enum Type { ROTATIONAL = WB_ROTATIONAL, LINEAR = WB_LINEAR };
+  enum { ANGULAR = WB_ROTATIONAL };  // Webots' older name, kept since R2018b
   explicit PositionSensor(WbDeviceTag tag) : Device(tag) {}
+  explicit PositionSensor(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_position_sensor_enable(tag_, samplingPeriod); }
   void disable() { wb_position_sensor_disable(tag_); }
   int getSamplingPeriod() const { return wb_position_sensor_get_sampling_period(tag_); }
   double getValue() const { return wb_position_sensor_get_value(tag_); }
   Type getType() const { return static_cast<Type>(wb_position_sensor_get_type(tag_)); }
   Motor *getMotor() const { return static_cast<Motor *>(internal::deviceFromTag(wb_position_sensor_get_motor(tag_))); }
-  Device *getBrake() const { return 0; }
+  inline Brake *getBrake() const;
 };
 
 inline PositionSensor *Motor::getPositionSensor() const {
   return static_cast<PositionSensor *>(internal::deviceFromTag(wb_motor_get_position_sensor(tag_)));
 }
 
+}  // namespace webots
+
+#include <webots/Brake.hpp>  // Brake's class is complete below (whichever of the two headers came first)
+
+namespace webots {
+inline Brake *Motor::getBrake() const { return static_cast<Brake *>(internal::deviceFromTag(wb_motor_get_brake(tag_))); }
+inline Brake *PositionSensor::getBrake() const {
+  return static_cast<Brake *>(internal::deviceFromTag(wb_position_sensor_get_brake(tag_)));
+}
 }  // namespace webots
 
 #endif

@@ -120,7 +120,10 @@ public:
   void enableContactPointsTracking(int samplingPeriod, bool includeDescendants = false) const {
     wb_supervisor_node_enable_contact_points_tracking(ref_, samplingPeriod, includeDescendants);
   }
-  void disableContactPointsTracking() const { wb_supervisor_node_disable_contact_points_tracking(ref_); }
+  void disableContactPointsTracking(bool includeDescendants = false) const {  // Webots ignores the flag too
+    (void)includeDescendants;
+    wb_supervisor_node_disable_contact_points_tracking(ref_);
+  }
   int getNumberOfContactPoints(bool includeDescendants = false) const {
     return wb_supervisor_node_get_number_of_contact_points(ref_, includeDescendants);
   }

@@ -9,9 +9,12 @@
 
 namespace webots {
 
+typedef WbRadarTarget RadarTarget;
+
 class Radar : public Device {
 public:
   explicit Radar(WbDeviceTag tag) : Device(tag) {}
+  explicit Radar(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_radar_enable(tag_, samplingPeriod); }
   void disable() { wb_radar_disable(tag_); }
   int getSamplingPeriod() const { return wb_radar_get_sampling_period(tag_); }

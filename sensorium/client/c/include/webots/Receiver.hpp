@@ -13,6 +13,7 @@ class Receiver : public Device {
 public:
   enum { CHANNEL_BROADCAST = WB_CHANNEL_BROADCAST };
   explicit Receiver(WbDeviceTag tag) : Device(tag) {}
+  explicit Receiver(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_receiver_enable(tag_, samplingPeriod); }
   void disable() { wb_receiver_disable(tag_); }
   int getSamplingPeriod() const { return wb_receiver_get_sampling_period(tag_); }

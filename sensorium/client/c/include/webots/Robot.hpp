@@ -133,6 +133,10 @@ public:
     const char *text = wb_robot_wwi_receive_text();
     return text != NULL ? text : "";
   }
+  void *windowCustomFunction(void *) { return NULL; }  // no robot window here: nothing to call
+  // deprecated since Webots 2018a (the custom data)
+  std::string getData() const { return wb_robot_get_custom_data(); }
+  void setData(const std::string &data) { wb_robot_set_custom_data(data.c_str()); }
   DistanceSensor *getDistanceSensor(const std::string &name) { return typed<DistanceSensor>(name, WB_NODE_DISTANCE_SENSOR); }
   LightSensor *getLightSensor(const std::string &name) { return typed<LightSensor>(name, WB_NODE_LIGHT_SENSOR); }
   Lidar *getLidar(const std::string &name) { return typed<Lidar>(name, WB_NODE_LIDAR); }

@@ -9,6 +9,7 @@ namespace webots {
 class RotationalMotor : public Motor {
 public:
   explicit RotationalMotor(WbDeviceTag tag) : Motor(tag) {}
+  explicit RotationalMotor(const std::string &name) : Motor(name) {}  // Webots: prefer Robot::getDevice
 };
 
 }  // namespace webots

@@ -12,6 +12,7 @@ namespace webots {
 class Skin : public Device {
 public:
   explicit Skin(WbDeviceTag tag) : Device(tag) {}
+  explicit Skin(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void setBoneOrientation(int index, const double orientation[4], bool absolute) { wb_skin_set_bone_orientation(tag_, index, orientation, absolute); }
   void setBonePosition(int index, const double position[3], bool absolute) { wb_skin_set_bone_position(tag_, index, position, absolute); }
   int getBoneCount() const { return wb_skin_get_bone_count(tag_); }

@@ -12,6 +12,7 @@ namespace webots {
 class Speaker : public Device {
 public:
   explicit Speaker(WbDeviceTag tag) : Device(tag) {}
+  explicit Speaker(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   static void playSound(Speaker *left, Speaker *right, const std::string &sound, double volume, double pitch,
                         double balance, bool loop) {
     wb_speaker_play_sound(left ? left->getTag() : 0, right ? right->getTag() : 0, sound.c_str(), volume, pitch,

@@ -13,6 +13,7 @@ class TouchSensor : public Device {
 public:
   enum Type { BUMPER = WB_TOUCH_SENSOR_BUMPER, FORCE = WB_TOUCH_SENSOR_FORCE, FORCE3D = WB_TOUCH_SENSOR_FORCE3D };
   explicit TouchSensor(WbDeviceTag tag) : Device(tag) {}
+  explicit TouchSensor(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enable(int samplingPeriod) { wb_touch_sensor_enable(tag_, samplingPeriod); }
   void disable() { wb_touch_sensor_disable(tag_); }
   int getSamplingPeriod() const { return wb_touch_sensor_get_sampling_period(tag_); }

@@ -12,6 +12,7 @@ namespace webots {
 class VacuumGripper : public Device {
 public:
   explicit VacuumGripper(WbDeviceTag tag) : Device(tag) {}
+  explicit VacuumGripper(const std::string &name) : Device(name) {}  // Webots: prefer Robot::getDevice
   void enablePresence(int samplingPeriod) { wb_vacuum_gripper_enable_presence(tag_, samplingPeriod); }
   void disablePresence() { wb_vacuum_gripper_disable_presence(tag_); }
   int getPresenceSamplingPeriod() const { return wb_vacuum_gripper_get_presence_sampling_period(tag_); }

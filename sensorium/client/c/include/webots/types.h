@@ -36,6 +36,7 @@ typedef struct WbImageStructPrivate *WbImageRef;
 typedef struct WbMotionStructPrivate *WbMotionRef;
 typedef struct WbProtoInfoStructPrivate *WbProtoRef;
 
+#define WB_ANGULAR 0  // Webots' older name of WB_ROTATIONAL, kept since R2018b
 typedef enum { WB_ROTATIONAL = 0, WB_LINEAR } WbJointType;
 
 /* The user input events wb_robot_wait_for_user_input_event() waits for (flags, or-ed). */

@@ -24,8 +24,15 @@ public:
   typedef enum { SPEED = ::SPEED, TORQUE = ::TORQUE } ControlMode;
   typedef enum { DOWN = ::DOWN, SLOW = ::SLOW, NORMAL = ::NORMAL, FAST = ::FAST } WiperMode;
 
-  Driver() : internal::VehicleInit(wbu_driver_init) {}
-  virtual ~Driver() { wbu_driver_cleanup(); }
+  Driver() : internal::VehicleInit(wbu_driver_init) { instance() = this; }
+  virtual ~Driver() {
+    wbu_driver_cleanup();
+    if (instance() == this)
+      instance() = 0;
+  }
+  static Driver *getDriverInstance() { return instance(); }
+  // whether this controller's robot is a car the library drives (Webots: for webots_ros2)
+  static bool isInitialisationPossible() { return wbu_driver_initialization_is_possible(); }
 
   int step() { return wbu_driver_step(); }
 
@@ -60,6 +67,12 @@ public:
 
 protected:
   explicit Driver(void (*init)(void)) : internal::VehicleInit(init) {}  // Car: wbu_car_init
+
+private:
+  static Driver *&instance() {
+    static Driver *created = 0;
+    return created;
+  }
 };
 
 }  // namespace webots
