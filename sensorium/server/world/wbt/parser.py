@@ -45,6 +45,13 @@ _TOKEN = re.compile(r"""
 """, re.VERBOSE | re.DOTALL)
 
 
+_NUM = r"[+-]?(?:0[xX][0-9a-fA-F]+|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(?![A-Za-z_])"
+# a run of numbers read in one go (big meshes: one token instead of one per number); the run stops
+# at anything else (a comment, a word, a bracket), which is then tokenized as before
+_RUN = re.compile(_NUM + r"(?:[\s,]+" + _NUM + r")*")
+_NUM_AT = re.compile(_NUM)
+RUN_MIN = 16        # shorter runs stay single "num" tokens
+
 _SIGNED_NONFINITE = re.compile(r"[+-](?:nan|inf(?:inity)?)(?![^\s,\[\]{}])", re.IGNORECASE)
 
 
@@ -74,10 +81,12 @@ _Lines = Lines
 
 
 class Token:
-    """One token: kind ("num", "str", "name", "tmpl", "{", "}", "[", "]", "eof"), text, offset; its
-    line and column are computed when asked (errors and node positions only)."""
+    """One token: kind ("num", "str", "name", "tmpl", "{", "}", "[", "]", "eof", or "nums": a run of
+    numbers), text, offset; its line and column are computed when asked (errors and node positions
+    only). A "nums" token's text and offset are its first number's (an error quoting it reads as one
+    about that number); ``values`` are its numbers (floats, every one finite) and ``end`` where the run ends."""
 
-    __slots__ = ("kind", "text", "pos", "lines")
+    __slots__ = ("kind", "text", "pos", "lines", "values", "end")
 
     def __init__(self, kind: str, text: str, pos: int, lines: Lines):
         self.kind, self.text, self.pos, self.lines = kind, text, pos, lines
@@ -158,6 +167,7 @@ class Tokens:
         self.items: list[Token] = []
         self._it: Iterator[re.Match[str]] | None = _TOKEN.finditer(text, start, len(text) if end is None else end)
         self.end = len(text) if end is None else end
+        self._plain = 0         # numbers before this offset are single tokens (a run found too short or not plain)
 
     def get(self, j: int) -> Token:
         items = self.items
@@ -166,29 +176,64 @@ class Tokens:
         return items[j] if j < len(items) else items[-1]
 
     def _more(self, n: int) -> None:
-        it, items, lines = self._it, self.items, self.lines
-        assert it is not None
-        for m in it:
-            kind = m.lastgroup
-            if kind == "ws" or kind == "comment":
-                continue
-            value = m.group()
-            if kind == "punct":
-                items.append(Token(value, value, m.start(), lines))
-            elif kind == "bad":
-                line, col = lines.at(m.start())
-                what = "unterminated string" if value == '"' else f"unexpected character {value!r}"
-                signed = _SIGNED_NONFINITE.match(self.text, m.start(), self.end) if value in "+-" else None
-                if signed:
-                    what = f"number {quote(signed.group(), 40)} is not finite (a world's numbers must be finite)"
-                raise WbtSyntaxError(self.source, line, col, what)
+        items, lines = self.items, self.lines
+        while self._it is not None:
+            it = self._it
+            for m in it:
+                kind = m.lastgroup
+                if kind == "ws" or kind == "comment":
+                    continue
+                value = m.group()
+                if kind == "punct":
+                    items.append(Token(value, value, m.start(), lines))
+                elif kind == "num" and m.start() >= self._plain and (run := self._run(m.start())) is not None:
+                    items.append(run)
+                    self._it = _TOKEN.finditer(self.text, run.end, self.end)     # on after the run
+                    n -= 1
+                    if n <= 0:
+                        return
+                    break
+                elif kind == "bad":
+                    line, col = lines.at(m.start())
+                    what = "unterminated string" if value == '"' else f"unexpected character {value!r}"
+                    signed = _SIGNED_NONFINITE.match(self.text, m.start(), self.end) if value in "+-" else None
+                    if signed:
+                        what = f"number {quote(signed.group(), 40)} is not finite (a world's numbers must be finite)"
+                    raise WbtSyntaxError(self.source, line, col, what)
+                else:
+                    items.append(Token(kind, value, m.start(), lines))  # type: ignore[arg-type]
+                n -= 1
+                if n <= 0:
+                    return
             else:
-                items.append(Token(kind, value, m.start(), lines))  # type: ignore[arg-type]
-            n -= 1
-            if n <= 0:
-                return
-        self._it = None
+                self._it = None
         items.append(Token("eof", "", self.end, lines))
+
+    def _run(self, pos: int) -> Token | None:
+        """The run of numbers starting at ``pos`` as one "nums" token, when it holds at least
+        ``RUN_MIN`` numbers, all decimal and finite (else None, and its numbers are read one by one,
+        so a hex or out-of-range number gets its own error as before)."""
+        m = _RUN.match(self.text, pos, self.end)
+        assert m is not None
+        text = m.group()
+        parts = text.replace(",", " ").split()
+        if len(parts) < RUN_MIN or "x" in text or "X" in text:
+            self._plain = m.end()
+            return None
+        values = list(map(float, parts))
+        if not all(map(math.isfinite, values)):                 # a value beyond ±1.8e308
+            self._plain = m.end()
+            return None
+        tok = Token("nums", parts[0], pos, self.lines)
+        tok.values, tok.end = values, m.end()
+        return tok
+
+    def explode(self, j: int) -> None:
+        """Item ``j``, a "nums" token, replaced by one "num" token per number (contexts that read one
+        number at a time)."""
+        run = self.items[j]
+        self.items[j:j + 1] = [Token("num", m.group(), m.start(), self.lines)
+                               for m in _NUM_AT.finditer(self.text, run.pos, run.end)]
 
 
 def tokenize(text: str, source: str, lines: Lines | None = None) -> list[Token]:
@@ -339,21 +384,45 @@ class Parser:
             while self.peek().kind != "]":
                 if self.peek().kind == "eof":
                     raise self.error(self.peek(), f"end of file inside the list opened at line {tok.line}, column {tok.col}")
-                items.append(self.item(depth))
+                if self.peek().kind == "nums":
+                    items += self.run(self.take())
+                else:
+                    items.append(self.item(depth))
             self.take()
             return items
-        if tok.kind == "num":
-            nums = []
-            while self.peek().kind == "num":
-                nums.append(self.number(self.take()))
+        if tok.kind == "num" or tok.kind == "nums":
+            nums: list[float] = []
+            while True:
+                kind = self.peek().kind
+                if kind == "num":
+                    nums.append(self.number(self.take()))
+                elif kind == "nums":
+                    nums += self.take().values
+                else:
+                    break
             self.nonfinite()
             self.values += len(nums)
             self._grew(tok)
             return nums[0] if len(nums) == 1 else tuple(nums)
         return self.item(depth)
 
+    def run(self, tok: Token) -> list[float]:
+        """A "nums" token's numbers, each counted as a value (the error names the number that passes
+        the bound, as one read alone would)."""
+        values = tok.values
+        self.values += len(values)
+        if self.values > self.limits.values:
+            self.values -= len(values)
+            for m in _NUM_AT.finditer(self.toks.text, tok.pos, tok.end):
+                self.values += 1
+                self._grew(Token("num", m.group(), m.start(), tok.lines))
+        return values
+
     def item(self, depth: int) -> Any:
         tok = self.peek()
+        if tok.kind == "nums":          # one number at a time here (accepted values, ...)
+            self.toks.explode(self.i)
+            tok = self.peek()
         if tok.kind == "num":
             self.values += 1
             self._grew(tok)
