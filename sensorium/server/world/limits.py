@@ -17,11 +17,13 @@ worlds that deliberately ask for more. The table is in README "Security and limi
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, fields
 from typing import Any
 
+import numpy as np
 from pydantic import BaseModel
 
 from sensorium.schemas.devices import KINDS
@@ -125,6 +127,27 @@ def _string_limit(key: str, limits: WorldLimits) -> int:
     return limits.string_chars
 
 
+_NUMBER_TYPES = frozenset({float, int})
+_SCALAR_TYPES = frozenset({float, int, bool, type(None)})
+BLOCK_MIN = 32       # lists shorter than this are walked item by item
+
+
+def number_block(value: Any, scalars: frozenset[type] = _NUMBER_TYPES) -> tuple[int, set[type]] | None:
+    """``(levels, leaf types)`` when ``value`` is a long list or tuple (``BLOCK_MIN`` items or more)
+    of scalars (types within ``scalars``: numbers by default) or of lists/tuples of them (a mesh's
+    points, its faces): ``levels`` is 1 or 2. None otherwise. Types are gathered at C speed, so a
+    long run of numbers is checked in one pass instead of an item at a time."""
+    if not isinstance(value, (list, tuple)) or len(value) < BLOCK_MIN:
+        return None
+    kinds = set(map(type, value))
+    if kinds <= scalars:
+        return 1, kinds
+    if not kinds <= {list, tuple}:
+        return None
+    leaves = set(map(type, itertools.chain.from_iterable(value)))
+    return (2, leaves) if leaves <= scalars else None
+
+
 def check_data(data: Any, limits: WorldLimits) -> None:
     """The parsed (not yet validated) data: depth, number of values, string lengths. Iterative (a
     deep structure cannot overflow the stack). Raises ``LimitError`` naming the field path."""
@@ -143,6 +166,12 @@ def check_data(data: Any, limits: WorldLimits) -> None:
                     raise LimitError(path, f"key {quote(k)} longer than {limits.name_chars} characters")
                 todo.append((v, f"{path}.{k}" if path else str(k), str(k), depth + 1))
         elif isinstance(value, (list, tuple)):
+            block = number_block(value, _SCALAR_TYPES)
+            if block is not None and depth + block[0] <= limits.nesting_depth:     # no string, no deeper level
+                count += len(value) + (sum(map(len, value)) if block[0] == 2 else 0)
+                if count > limits.values:
+                    raise LimitError("", f"more than {limits.values} values {RAISE}")
+                continue
             for i in reversed(range(len(value))):
                 todo.append((value[i], f"{path}[{i}]", key, depth + 1))
         elif isinstance(value, str):
@@ -188,15 +217,17 @@ def check_counts(data: Any, limits: WorldLimits) -> None:
 # ------------------------------------------------------------------------------------ work
 
 
-def _walk(model: Any, path: str = "") -> Iterator[tuple[str, Any]]:
-    """Every (path, value) of a validated model: nested models, lists, tuples (iterative)."""
+def _walk(model: Any, path: str = "", *, numbers: bool = False) -> Iterator[tuple[str, Any]]:
+    """Every (path, value) of a validated model: nested models, lists, tuples (iterative). A long
+    list of numbers (``number_block``: a mesh's vertices, ...) is yielded but not walked into (it
+    holds no model), unless ``numbers``."""
     todo: list[tuple[str, Any]] = [(path, model)]
     while todo:
         p, v = todo.pop()
         yield p, v
         if isinstance(v, BaseModel):       # pushed in reverse: yielded in file order
             todo.extend((f"{p}.{name}" if p else name, getattr(v, name)) for name in reversed(type(v).model_fields))
-        elif isinstance(v, (list, tuple)):
+        elif isinstance(v, (list, tuple)) and (numbers or number_block(v) is None):
             todo.extend((f"{p}[{i}]", v[i]) for i in reversed(range(len(v))))
 
 
@@ -226,6 +257,16 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
     return len(faces) if faces is not None else 0
 
 
+def _numbers_fine(v: Any, block: tuple[int, set[type]], cap: float) -> bool:
+    """Every float of a number block (``number_block``) finite, at most ``cap`` in magnitude, and 0
+    or at least 1e-30 (ints are not checked, as in the walk); one numpy pass."""
+    flat = itertools.chain.from_iterable(v) if block[0] == 2 else v
+    if block[1] != {float}:       # ints too: only the floats count
+        flat = (x for x in flat if type(x) is float)
+    mag = np.abs(np.fromiter(flat, dtype=np.float64))
+    return bool(np.all(np.isfinite(mag)) and not np.any(mag > cap) and not np.any((mag > 0.0) & (mag < 1e-30)))
+
+
 _GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh", "triangles", "elevation_grid"}
 
 
@@ -237,17 +278,25 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
         num = (lambda x: f"{x:,}") if isinstance(n, int) else (lambda x: f"{x:g}")
         problems.append((path, f"{what} {num(n)} exceeds the limit of {num(cap)} {RAISE}"))
 
+    def number(path: str, v: float) -> None:
+        mag = abs(v)
+        if not math.isfinite(v):
+            problems.append((path, f"expected a finite number, got {v!r}"))
+        elif mag > limits.number_magnitude:
+            over(path, "the magnitude of", v, limits.number_magnitude)
+        elif 0.0 < mag < 1e-30:
+            problems.append((path, f"{v!r} is too close to 0 (use 0, or a magnitude of at least 1e-30)"))
+
     triangles = 0
     lights = 0                              # occluding light sensors cast a ray per light
     for path, v in _walk(world):
         if isinstance(v, float):
-            mag = abs(v)
-            if not math.isfinite(v):
-                problems.append((path, f"expected a finite number, got {v!r}"))
-            elif mag > limits.number_magnitude:
-                over(path, "the magnitude of", v, limits.number_magnitude)
-            elif 0.0 < mag < 1e-30:
-                problems.append((path, f"{v!r} is too close to 0 (use 0, or a magnitude of at least 1e-30)"))
+            number(path, v)
+        elif isinstance(v, (list, tuple)) and (block := number_block(v)) is not None:
+            if float in block[1] and not _numbers_fine(v, block, limits.number_magnitude):
+                for p, x in _walk(v, path, numbers=True):    # one problem per number, as an item-by-item walk finds them
+                    if isinstance(x, float):
+                        number(p, x)
         elif isinstance(v, BaseModel):
             kind = getattr(v, "type", None)
             if kind in _GEOMETRY_TYPES and path.endswith("geometry"):
