@@ -11,6 +11,7 @@ radians, time in integer milliseconds.
 
 from __future__ import annotations
 
+import itertools
 import math
 import types
 import typing
@@ -38,6 +39,9 @@ def _nonzero_direction(v: Vec3) -> Vec3:
     return v
 
 
+_SCALARS = {float, int, str, type(None)}
+
+
 def _not_a_number(value: Any, tp: Any) -> tuple[Any] | None:
     """``(v,)`` for the first bool in ``value`` where the annotation ``tp`` wants a number, else
     None. Pydantic's lax mode reads ``true`` as 1: a YAML ``basic_time_step: true`` became a 1 ms
@@ -54,9 +58,10 @@ def _not_a_number(value: Any, tp: Any) -> tuple[Any] | None:
     if origin not in (tuple, list) or not isinstance(value, (list, tuple)) or not args:
         return None
     if origin is list or (len(args) == 2 and args[1] is Ellipsis):
-        if args[0] is float or args[0] is int:      # a long run of numbers (heights): its types at C speed
-            if bool not in set(map(type, value)):
-                return None
+        kinds = set(map(type, value))               # a long run of numbers (heights, vertices): types at C speed
+        if bool not in kinds and (kinds <= _SCALARS or (kinds <= {list, tuple}
+                                                        and set(map(type, itertools.chain.from_iterable(value))) <= _SCALARS)):
+            return None                             # no bool in it, none deeper
         return next((bad for v in value if (bad := _not_a_number(v, args[0])) is not None), None)
     return next((bad for v, a in zip(value, args) if (bad := _not_a_number(v, a)) is not None), None)
 
