@@ -17,6 +17,7 @@ a quaternion.
 
 from __future__ import annotations
 
+import itertools
 import math
 import posixpath
 from collections import Counter
@@ -895,22 +896,16 @@ class Converter:
         if index and min(index) < -1:
             raise f.error("coordIndex", f"{min(index)} is not a vertex index (-1 ends a face)")
         tex, tex_index = fx.tex_coords(node, f, len(index), self.warn)
-        faces: list[list[int]] = []
-        tex_faces: list[list[int]] = []
-        poly: list[int] = []
-        for n_i, i in enumerate([*index, -1]):
-            if i >= 0:
-                poly.append(n_i)
-                continue
-            for k in range(1, len(poly) - 1):
-                corners = (poly[0], poly[k], poly[k + 1])
-                faces.append([index[c] for c in corners])
-                if tex_index is not None:
-                    tex_faces.append([tex_index[c] for c in corners])
-            poly = []
+        corners = fan_corners(index)
+        faces = _pick(index, corners)
+        tex_faces = _pick(tex_index, corners) if tex_index is not None else []
         if not faces:
             raise f.error("coordIndex", "an IndexedFaceSet needs at least one polygon")
-        out = {"type": "triangles", "vertices": [[v * s for v in p] for p in points], "faces": faces}
+        if points and type(s) is float:     # the same products as one at a time, at C speed
+            vertices = (np.asarray(points, dtype=np.float64) * s).tolist()
+        else:
+            vertices = [[v * s for v in p] for p in points]
+        out = {"type": "triangles", "vertices": vertices, "faces": faces}
         if tex is not None:
             out["tex_coords"], out["tex_coord_faces"] = tex, tex_faces
         return out, ""
@@ -1812,6 +1807,29 @@ def _clean_part(p: dict) -> dict:
     return out
 
 
+def fan_corners(index: list[int]) -> np.ndarray:
+    """An IndexedFaceSet's polygons (``index`` positions between -1s) fan-triangulated, as Webots
+    does: per triangle, the positions in ``index`` of its three corners (first, k, k + 1), shape
+    (n, 3); polygons of fewer than three corners give none."""
+    idx = np.asarray([*index, -1], dtype=np.int64)
+    ends = np.flatnonzero(idx < 0)
+    starts = np.concatenate(([0], ends[:-1] + 1))
+    per = np.maximum(ends - starts - 2, 0)              # triangles per polygon
+    first = np.repeat(starts, per)
+    k = np.arange(int(per.sum())) - np.repeat(np.cumsum(per) - per, per) + 1
+    return np.stack([first, first + k, first + k + 1], axis=1)
+
+
+def _pick(values: list[int], corners: np.ndarray) -> list[list[int]]:
+    """``values`` at each triangle's corner positions: lists of Python ints."""
+    if not len(corners):
+        return []
+    try:
+        return np.asarray(values, dtype=np.int64)[corners].tolist()
+    except OverflowError:       # an index beyond 64 bits: refused later, by value
+        return [[values[a], values[b], values[c]] for a, b, c in corners.tolist()]
+
+
 def strip_origins(data: Any, path: str, origin: dict[str, tuple[int, int, str]]) -> Any:
     """Remove the ``_at`` bookkeeping keys, recording converted path → (line, col, node type)."""
     if isinstance(data, dict):
@@ -1819,5 +1837,15 @@ def strip_origins(data: Any, path: str, origin: dict[str, tuple[int, int, str]])
             origin[path] = data["_at"]
         return {k: strip_origins(v, f"{path}.{k}" if path else k, origin) for k, v in data.items() if k != "_at"}
     if isinstance(data, list):
+        kinds = set(map(type, data))            # a mesh's numbers: copied at C speed (no dict inside)
+        if _flat(kinds):
+            return list(data)
+        if kinds == {list} and _flat(set(map(type, itertools.chain.from_iterable(data)))):
+            return [list(v) for v in data]
         return [strip_origins(v, f"{path}[{i}]", origin) for i, v in enumerate(data)]
     return data
+
+
+def _flat(kinds: set[type]) -> bool:
+    """No dict or list among these types (what strip_origins would walk into)."""
+    return not any(issubclass(k, (dict, list)) for k in kinds)

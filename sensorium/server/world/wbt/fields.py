@@ -98,8 +98,15 @@ class Fields:
 
     def integers(self, name: str) -> list[int]:
         """An MFInt32 field (``coordIndex``): every value a whole number."""
+        nums = self.numbers(name)
+        try:
+            out = list(map(int, nums))
+            if out == nums:     # every one whole (compared at C speed)
+                return out
+        except (ValueError, OverflowError):
+            pass
         out = []
-        for v in self.numbers(name):
+        for v in nums:
             if v != int(v):
                 raise self.error(name, f"expected integers, got {v}")
             out.append(int(v))
@@ -156,6 +163,8 @@ class Fields:
     def numbers(self, name: str) -> list[float]:
         """An MF field of numbers, flattened (``[ 0 0 0, 1 1 0 ]`` → six numbers)."""
         v = self.node.fields.get(name, [])
+        if isinstance(v, list) and set(map(type, v)) == {float}:     # a long run as parsed: copied at C speed
+            return list(v)
         out: list[float] = []
         for x in v if isinstance(v, list) else [v]:
             if isinstance(x, tuple):
@@ -172,7 +181,7 @@ class Fields:
         flat = self.numbers(name)
         if len(flat) % width:
             raise self.error(name, f"expected groups of {width} numbers, got {len(flat)} numbers")
-        return [tuple(flat[i:i + width]) for i in range(0, len(flat), width)]
+        return list(zip(*[iter(flat)] * width))       # consecutive groups of width
 
 
 def _projection(f: Fields) -> str:
