@@ -189,6 +189,8 @@ class _Expander:
             if isinstance(value, Node):
                 return of(value)
             if isinstance(value, list):
+                if set(map(type, value)) <= _VALUE_TYPES:      # numbers, strings, booleans (a mesh's points)
+                    return 0, len(value), None
                 n = v = 0
                 uses: Uses = None
                 for x in value:
@@ -363,7 +365,7 @@ class _Expander:
     def value(self, value: Any, chain: tuple[str, ...], depth: int) -> Any:
         if isinstance(value, Node):
             return self.node(value, chain, depth + 1)
-        if isinstance(value, list) and any(isinstance(x, Node) for x in value):
+        if isinstance(value, list) and not set(map(type, value)) <= _VALUE_TYPES and any(isinstance(x, Node) for x in value):
             out = [self.node(x, chain, depth + 1) if isinstance(x, Node) else x for x in value]
             return value if all(a is b for a, b in zip(out, value)) else out
         if isinstance(value, IsRef):
@@ -621,6 +623,9 @@ class _Expander:
         """Nodes marked by id must stay alive while the expansion runs (ids are reused)."""
         self._kept = getattr(self, "_kept", [])
         self._kept.append(node)
+
+
+_VALUE_TYPES = {float, int, str, bool}     # list items that are neither nodes nor None (types gathered at C speed)
 
 
 def _copy(node: Node, **changes: Any) -> Node:
