@@ -17,8 +17,11 @@ worlds that deliberately ask for more. The table is in README "Security and limi
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
+import types
+import typing
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, fields
 from typing import Any
@@ -127,25 +130,22 @@ def _string_limit(key: str, limits: WorldLimits) -> int:
     return limits.string_chars
 
 
-_NUMBER_TYPES = frozenset({float, int})
 _SCALAR_TYPES = frozenset({float, int, bool, type(None)})
 BLOCK_MIN = 32       # lists shorter than this are walked item by item
 
 
-def number_block(value: Any, scalars: frozenset[type] = _NUMBER_TYPES) -> tuple[int, set[type]] | None:
-    """``(levels, leaf types)`` when ``value`` is a long list or tuple (``BLOCK_MIN`` items or more)
-    of scalars (types within ``scalars``: numbers by default) or of lists/tuples of them (a mesh's
-    points, its faces): ``levels`` is 1 or 2. None otherwise. Types are gathered at C speed, so a
-    long run of numbers is checked in one pass instead of an item at a time."""
+def _scalar_block(value: Any) -> int:
+    """1 when ``value`` is a long list or tuple (``BLOCK_MIN`` items or more) of numbers, booleans or
+    nulls, 2 when it is one of lists/tuples of them (a mesh's points, its faces), else 0 (types
+    gathered at C speed: a long run of numbers is counted in one pass, not an item at a time)."""
     if not isinstance(value, (list, tuple)) or len(value) < BLOCK_MIN:
-        return None
+        return 0
     kinds = set(map(type, value))
-    if kinds <= scalars:
-        return 1, kinds
+    if kinds <= _SCALAR_TYPES:
+        return 1
     if not kinds <= {list, tuple}:
-        return None
-    leaves = set(map(type, itertools.chain.from_iterable(value)))
-    return (2, leaves) if leaves <= scalars else None
+        return 0
+    return 2 if set(map(type, itertools.chain.from_iterable(value))) <= _SCALAR_TYPES else 0
 
 
 def check_data(data: Any, limits: WorldLimits) -> None:
@@ -166,9 +166,9 @@ def check_data(data: Any, limits: WorldLimits) -> None:
                     raise LimitError(path, f"key {quote(k)} longer than {limits.name_chars} characters")
                 todo.append((v, f"{path}.{k}" if path else str(k), str(k), depth + 1))
         elif isinstance(value, (list, tuple)):
-            block = number_block(value, _SCALAR_TYPES)
-            if block is not None and depth + block[0] <= limits.nesting_depth:     # no string, no deeper level
-                count += len(value) + (sum(map(len, value)) if block[0] == 2 else 0)
+            levels = _scalar_block(value)
+            if levels and depth + levels <= limits.nesting_depth:     # no string, no deeper level
+                count += len(value) + (sum(map(len, value)) if levels == 2 else 0)
                 if count > limits.values:
                     raise LimitError("", f"more than {limits.values} values {RAISE}")
                 continue
@@ -219,16 +219,53 @@ def check_counts(data: Any, limits: WorldLimits) -> None:
 
 def _walk(model: Any, path: str = "", *, numbers: bool = False) -> Iterator[tuple[str, Any]]:
     """Every (path, value) of a validated model: nested models, lists, tuples (iterative). A long
-    list of numbers (``number_block``: a mesh's vertices, ...) is yielded but not walked into (it
-    holds no model), unless ``numbers``."""
-    todo: list[tuple[str, Any]] = [(path, model)]
-    while todo:
-        p, v = todo.pop()
+    list of numbers (a model field typed as one: a mesh's vertices, ...) is yielded but not walked
+    into (it holds no model), unless ``numbers``."""
+    for p, v, _ in _walk_typed(model, path, numbers=numbers):
         yield p, v
+
+
+Block = tuple[int, type]     # a model field of numbers: (1, float) a list of floats, (2, int) a list of int rows, ...
+
+
+def _walk_typed(model: Any, path: str = "", *, numbers: bool = False) -> Iterator[tuple[str, Any, Block | None]]:
+    """``_walk``, each value with its ``Block`` when it is a long list of numbers (else None)."""
+    todo: list[tuple[str, Any, Block | None]] = [(path, model, None)]
+    while todo:
+        p, v, block = todo.pop()
+        yield p, v, block
         if isinstance(v, BaseModel):       # pushed in reverse: yielded in file order
-            todo.extend((f"{p}.{name}" if p else name, getattr(v, name)) for name in reversed(type(v).model_fields))
-        elif isinstance(v, (list, tuple)) and (numbers or number_block(v) is None):
-            todo.extend((f"{p}[{i}]", v[i]) for i in reversed(range(len(v))))
+            kinds = _number_fields(type(v))
+            for name in reversed(type(v).model_fields):
+                x = getattr(v, name)
+                b = kinds.get(name)
+                todo.append((f"{p}.{name}" if p else name, x,
+                             b if b is not None and isinstance(x, (list, tuple)) and len(x) >= BLOCK_MIN else None))
+        elif isinstance(v, (list, tuple)) and (numbers or block is None):
+            todo.extend((f"{p}[{i}]", v[i], None) for i in reversed(range(len(v))))
+
+
+@functools.cache
+def _number_fields(cls: type[BaseModel]) -> dict[str, Block]:
+    """The fields of a model class typed as lists of numbers or of fixed rows of numbers (every leaf
+    the same type, float or int): what validation guarantees they hold."""
+    out: dict[str, Block] = {}
+    for name, field in cls.model_fields.items():
+        tp = field.annotation
+        if typing.get_origin(tp) in (typing.Union, types.UnionType):
+            kinds = [a for a in typing.get_args(tp) if a is not type(None)]
+            tp = kinds[0] if len(kinds) == 1 else None
+        origin, args = typing.get_origin(tp), typing.get_args(tp)
+        if not (origin is list and len(args) == 1) and not (origin is tuple and len(args) == 2 and args[1] is Ellipsis):
+            continue
+        item = args[0]
+        if item is float or item is int:
+            out[name] = (1, item)
+        elif typing.get_origin(item) is tuple:
+            leaves = set(typing.get_args(item))
+            if len(leaves) == 1 and leaves <= {float, int}:
+                out[name] = (2, leaves.pop())
+    return out
 
 
 def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
@@ -257,13 +294,10 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
     return len(faces) if faces is not None else 0
 
 
-def _numbers_fine(v: Any, block: tuple[int, set[type]], cap: float) -> bool:
-    """Every float of a number block (``number_block``) finite, at most ``cap`` in magnitude, and 0
-    or at least 1e-30 (ints are not checked, as in the walk); one numpy pass."""
-    flat = itertools.chain.from_iterable(v) if block[0] == 2 else v
-    if block[1] != {float}:       # ints too: only the floats count
-        flat = (x for x in flat if type(x) is float)
-    mag = np.abs(np.fromiter(flat, dtype=np.float64))
+def _numbers_fine(v: Any, levels: int, cap: float) -> bool:
+    """Every number of a list of floats (``levels`` 1) or of rows of floats (2) finite, at most
+    ``cap`` in magnitude, and 0 or at least 1e-30; one numpy pass."""
+    mag = np.abs(np.fromiter(itertools.chain.from_iterable(v) if levels == 2 else v, dtype=np.float64))
     return bool(np.all(np.isfinite(mag)) and not np.any(mag > cap) and not np.any((mag > 0.0) & (mag < 1e-30)))
 
 
@@ -289,11 +323,11 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
 
     triangles = 0
     lights = 0                              # occluding light sensors cast a ray per light
-    for path, v in _walk(world):
+    for path, v, block in _walk_typed(world):
         if isinstance(v, float):
             number(path, v)
-        elif isinstance(v, (list, tuple)) and (block := number_block(v)) is not None:
-            if float in block[1] and not _numbers_fine(v, block, limits.number_magnitude):
+        elif block is not None:
+            if block[1] is float and not _numbers_fine(v, block[0], limits.number_magnitude):
                 for p, x in _walk(v, path, numbers=True):    # one problem per number, as an item-by-item walk finds them
                     if isinstance(x, float):
                         number(p, x)
