@@ -48,7 +48,9 @@ _TOKEN = re.compile(r"""
 _NUM = r"[+-]?(?:0[xX][0-9a-fA-F]+|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(?![A-Za-z_])"
 # a run of numbers read in one go (big meshes: one token instead of one per number); the run stops
 # at anything else (a comment, a word, a bracket), which is then tokenized as before
-_RUN = re.compile(_NUM + r"(?:[\s,]+" + _NUM + r")*")
+# (read a thousand numbers at a time: one match over a whole run keeps a backtracking frame per number)
+_RUN = re.compile(_NUM + r"(?:[\s,]+" + _NUM + r"){0,1023}")
+_RUN_MORE = re.compile(r"(?:[\s,]+" + _NUM + r"){1,1024}")
 _NUM_AT = re.compile(_NUM)
 RUN_MIN = 16        # shorter runs stay single "num" tokens
 
@@ -215,17 +217,20 @@ class Tokens:
         so a hex or out-of-range number gets its own error as before)."""
         m = _RUN.match(self.text, pos, self.end)
         assert m is not None
-        text = m.group()
+        end = m.end()
+        while (more := _RUN_MORE.match(self.text, end, self.end)) is not None:
+            end = more.end()
+        text = self.text[pos:end]
         parts = text.replace(",", " ").split()
         if len(parts) < RUN_MIN or "x" in text or "X" in text:
-            self._plain = m.end()
+            self._plain = end
             return None
         values = list(map(float, parts))
         if not all(map(math.isfinite, values)):                 # a value beyond ±1.8e308
-            self._plain = m.end()
+            self._plain = end
             return None
         tok = Token("nums", parts[0], pos, self.lines)
-        tok.values, tok.end = values, m.end()
+        tok.values, tok.end = values, end
         return tok
 
     def explode(self, j: int) -> None:
