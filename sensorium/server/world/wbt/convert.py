@@ -891,7 +891,7 @@ class Converter:
             return out, ""
         # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
         coord = f.node_("coord")
-        points = self.fields(coord).rows("point", 3, []) if coord is not None else []
+        points = self.fields(coord).flat_rows("point", 3) if coord is not None else []    # x y z x y z ...
         index = f.integers("coordIndex")
         if index and min(index) < -1:
             raise f.error("coordIndex", f"{min(index)} is not a vertex index (-1 ends a face)")
@@ -901,10 +901,10 @@ class Converter:
         tex_faces = _pick(tex_index, corners) if tex_index is not None else []
         if not faces:
             raise f.error("coordIndex", "an IndexedFaceSet needs at least one polygon")
-        if points and type(s) is float:     # the same products as one at a time, at C speed
-            vertices = (np.asarray(points, dtype=np.float64) * s).tolist()
+        if type(s) is float:                # the same products as one at a time, at C speed
+            vertices = (np.asarray(points, dtype=np.float64).reshape(-1, 3) * s).tolist()
         else:
-            vertices = [[v * s for v in p] for p in points]
+            vertices = [[v * s for v in points[i:i + 3]] for i in range(0, len(points), 3)]
         out = {"type": "triangles", "vertices": vertices, "faces": faces}
         if tex is not None:
             out["tex_coords"], out["tex_coord_faces"] = tex, tex_faces
@@ -1841,7 +1841,7 @@ def strip_origins(data: Any, path: str, origin: dict[str, tuple[int, int, str]])
         if _flat(kinds):
             return list(data)
         if kinds == {list} and _flat(set(map(type, itertools.chain.from_iterable(data)))):
-            return [list(v) for v in data]
+            return list(map(list, data))
         return [strip_origins(v, f"{path}[{i}]", origin) for i, v in enumerate(data)]
     return data
 

@@ -178,10 +178,15 @@ class Fields:
     def rows(self, name: str, width: int, default: list[tuple[float, ...]]) -> list[tuple[float, ...]]:
         if name not in self.node.fields:
             return default
+        flat = self.flat_rows(name, width)
+        return list(zip(*[iter(flat)] * width))       # consecutive groups of width
+
+    def flat_rows(self, name: str, width: int) -> list[float]:
+        """``rows``' numbers, not grouped (an absent field: none)."""
         flat = self.numbers(name)
         if len(flat) % width:
             raise self.error(name, f"expected groups of {width} numbers, got {len(flat)} numbers")
-        return list(zip(*[iter(flat)] * width))       # consecutive groups of width
+        return flat
 
 
 def _projection(f: Fields) -> str:
