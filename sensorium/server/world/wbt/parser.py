@@ -170,11 +170,13 @@ class Tokens:
         self._it: Iterator[re.Match[str]] | None = _TOKEN.finditer(text, start, len(text) if end is None else end)
         self.end = len(text) if end is None else end
         self._plain = 0         # numbers before this offset are single tokens (a run found too short or not plain)
+        self._owed = 0          # tokens to read after a run that passed the end of its chunk
 
     def get(self, j: int) -> Token:
         items = self.items
         while j >= len(items) and self._it is not None:
-            self._more(max(self.chunk, j + 1 - len(items)))
+            owed, self._owed = self._owed, 0
+            self._more(owed or max(self.chunk, j + 1 - len(items)))
         return items[j] if j < len(items) else items[-1]
 
     def _more(self, n: int) -> None:
@@ -191,7 +193,12 @@ class Tokens:
                 elif kind == "num" and m.start() >= self._plain and (run := self._run(m.start())) is not None:
                     items.append(run)
                     self._it = _TOKEN.finditer(self.text, run.end, self.end)     # on after the run
-                    n -= 1
+                    # counted as its numbers; past the chunk, the reading after it is owed: read when the
+                    # parser has taken the run, up to where a number-by-number reading would have read
+                    # on (a multiple of chunk), so a later syntax error is met at the same point
+                    n -= len(run.values)
+                    if n < 0:
+                        self._owed = n % self.chunk
                     if n <= 0:
                         return
                     break
@@ -418,6 +425,15 @@ class Parser:
         self.values += len(values)
         if self.values > self.limits.values:
             self.values -= len(values)
+            toks = self.toks
+            # a number-by-number reading would have read the chunk holding the number that passes
+            # the bound before counting it: when that chunk runs past the run, read on (a syntax
+            # error there is met first, as it would have been)
+            j = self.i - 1
+            first = j + sum(len(t.values) - 1 for t in toks.items[:j] if t.kind == "nums")
+            k = self.limits.values - self.values
+            if (first + k) // toks.chunk == (first + len(values) - 1) // toks.chunk:
+                toks.get(self.i)
             for m in _NUM_AT.finditer(self.toks.text, tok.pos, tok.end):
                 self.values += 1
                 self._grew(Token("num", m.group(), m.start(), tok.lines))
