@@ -58,9 +58,9 @@ def _not_a_number(value: Any, tp: Any) -> tuple[Any] | None:
     if origin not in (tuple, list) or not isinstance(value, (list, tuple)) or not args:
         return None
     if origin is list or (len(args) == 2 and args[1] is Ellipsis):
-        kinds = set(map(type, value))               # a long run of numbers (heights, vertices): types at C speed
-        if bool not in kinds and (kinds <= _SCALARS or (kinds <= {list, tuple}
-                                                        and set(map(type, itertools.chain.from_iterable(value))) <= _SCALARS)):
+        types_in = set(map(type, value))            # a long run of numbers (heights, vertices): types at C speed
+        rows = types_in <= {list, tuple} and set(map(type, itertools.chain.from_iterable(value))) <= _SCALARS
+        if bool not in types_in and (types_in <= _SCALARS or rows):
             return None                             # no bool in it, none deeper
         return next((bad for v in value if (bad := _not_a_number(v, args[0])) is not None), None)
     return next((bad for v, a in zip(value, args) if (bad := _not_a_number(v, a)) is not None), None)
