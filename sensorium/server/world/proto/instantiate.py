@@ -612,7 +612,7 @@ class _Expander:
                 found = True
             elif isinstance(value, Node):
                 found = self.holds_is(value) or found
-            elif isinstance(value, list):
+            elif isinstance(value, list) and not set(map(type, value)) <= _VALUE_TYPES:    # (a mesh's points: no node)
                 for x in value:
                     if isinstance(x, Node) and self.holds_is(x):
                         found = True
