@@ -52,6 +52,7 @@ _NUM = r"[+-]?(?:0[xX][0-9a-fA-F]+|(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)(?![A-Za
 _RUN = re.compile(_NUM + r"(?:[\s,]+" + _NUM + r"){0,1023}")
 _RUN_MORE = re.compile(r"(?:[\s,]+" + _NUM + r"){1,1024}")
 _NUM_AT = re.compile(_NUM)
+_SPAN = re.compile(r"[0-9eE+\-.,\s]+")
 RUN_MIN = 16        # shorter runs stay single "num" tokens
 
 _SIGNED_NONFINITE = re.compile(r"[+-](?:nan|inf(?:inity)?)(?![^\s,\[\]{}])", re.IGNORECASE)
@@ -222,23 +223,50 @@ class Tokens:
         """The run of numbers starting at ``pos`` as one "nums" token, when it holds at least
         ``RUN_MIN`` numbers, all decimal and finite (else None, and its numbers are read one by one,
         so a hex or out-of-range number gets its own error as before)."""
-        m = _RUN.match(self.text, pos, self.end)
-        assert m is not None
-        end = m.end()
-        while (more := _RUN_MORE.match(self.text, end, self.end)) is not None:
-            end = more.end()
-        text = self.text[pos:end]
-        parts = text.replace(",", " ").split()
-        if len(parts) < RUN_MIN or "x" in text or "X" in text:
-            self._plain = end
-            return None
-        values = list(map(float, parts))
-        if not all(map(math.isfinite, values)):                 # a value beyond ±1.8e308
+        fast = self._span(pos)
+        if fast is not None:
+            end, parts, values = fast
+        else:
+            m = _RUN.match(self.text, pos, self.end)
+            assert m is not None
+            end = m.end()
+            while (more := _RUN_MORE.match(self.text, end, self.end)) is not None:
+                end = more.end()
+            text = self.text[pos:end]
+            parts = text.replace(",", " ").split()
+            if len(parts) < RUN_MIN or "x" in text or "X" in text:
+                self._plain = end
+                return None
+            values = list(map(float, parts))
+        if len(parts) < RUN_MIN or not all(map(math.isfinite, values)):     # short, or beyond ±1.8e308
             self._plain = end
             return None
         tok = Token("nums", parts[0], pos, self.lines)
         tok.values, tok.end = values, end
         return tok
+
+    def _span(self, pos: int) -> tuple[int, list[str], list[float]] | None:
+        """The run at ``pos`` found the quick way, (end, its numbers' texts, values): the longest stretch of
+        digits, signs, dots, exponents and separators, cut after its last number, when every piece
+        is a decimal number (``float`` reads exactly the ``_NUM`` grammar on these characters) and
+        what follows cannot continue one (a letter, a digit of another script, ``_``). None: not
+        sure, the run is matched number by number."""
+        m = _SPAN.match(self.text, pos, self.end)
+        if m is None or (m.end() < self.end and self.text[m.end()].isdecimal()):    # a digit of another script (\d reads it)
+            return None
+        body = m.group().rstrip()
+        while body.endswith(","):
+            body = body[:-1].rstrip()
+        end = pos + len(body)
+        if end < self.end:
+            after = self.text[end]
+            if after.isalnum() or after == "_":
+                return None
+        parts = body.replace(",", " ").split()
+        try:
+            return end, parts, list(map(float, parts))
+        except ValueError:
+            return None
 
     def explode(self, j: int) -> None:
         """Item ``j``, a "nums" token, replaced by one "num" token per number (contexts that read one
