@@ -303,6 +303,13 @@ class Launcher:
         if self.on_reload is not None:
             self.on_reload()
 
+    def quit(self) -> None:
+        """simulationQuit: the server stops (every step -1); every controller ends as at ``--until``,
+        none is said to have exited by itself."""
+        with self._lock:
+            for run in self.running.values():
+                run.ending = True
+
     def _work(self) -> None:
         while True:
             self._wake.wait()

@@ -333,3 +333,54 @@ def test_a_world_that_does_not_load_is_its_line_and_exit_1(tmp_path: Path) -> No
     assert proc.stderr().splitlines() == [f"{world}: line 4, column 1: expected a field name or '}}' in Robot (line 3), "
                                           "found end of file"]
     assert proc.stdout() == "" and not (tmp_path / "controllers" / "a" / "pid-alpha").exists()
+
+
+# ---------------------------------------------------------------------- simulationQuit ends the whole run
+
+QUITTER = '''from controller import Supervisor
+boss = Supervisor()
+while boss.step(16) != -1:
+    if round(boss.getTime() * 1000) == 480:
+        boss.simulationQuit(3)
+        print("asked to quit at", round(boss.getTime() * 1000))
+print("boss ends at", round(boss.getTime() * 1000))
+'''
+
+
+def test_simulation_quit_ends_every_controller_and_the_run_exits_with_its_status(tmp_path: Path) -> None:
+    """As Webots quits: every controller's step answers -1 and it ends (a stubborn one is terminated
+    after its grace), the run exits with the status given: a CI job can use it as its verdict."""
+    stubborn = ('import os, signal, time\nfrom controller import Robot\nsignal.signal(signal.SIGTERM, signal.SIG_IGN)\n'
+                'robot = Robot()\nopen("pid-" + robot.getName(), "w").write(str(os.getpid()))\n'
+                'while robot.step(16) != -1:\n    pass\nprint("ignoring the end")\nwhile True:\n    time.sleep(1)\n')
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "mule" controller "mule" }\n'
+                              'Robot { name "boss" controller "boss" supervisor TRUE }',
+                    {"a.py": COUNTER.replace("{step}", "32"), "mule.py": stubborn, "boss.py": QUITTER})
+    proc = run(world, "--until", "100000", "--grace", "0.3")
+    assert proc.wait() == 3, proc.stderr()
+    out = proc.stdout().splitlines()
+    assert "[boss] asked to quit at 480" in out and "[boss] boss ends at 480" in out
+    assert "[alpha] alpha stepped 15 until 480" in out          # its step to 512 answered -1
+    assert "[mule] ignoring the end" in out
+    err = proc.stderr()
+    assert "sensorium: robot 'boss' quit the simulation (simulationQuit(3)) at 480 ms: every controller ends" in err
+    assert "'mule' controller of robot 'mule': forced termination" in err
+    assert "exited" not in err                                  # ended by the quit, not by themselves
+    assert "sensorium: stopped at 480 ms" in err
+    for pid in (*pids(tmp_path / "controllers" / "mule", "mule"), *pids(tmp_path / "controllers" / "a", "alpha")):
+        assert not alive(pid)
+
+
+def test_simulation_quit_of_an_extern_supervisor_stops_serve_with_its_status(tmp_path: Path) -> None:
+    """Webots quits for an extern controller's simulationQuit too: `serve` stops and exits with it."""
+    world = project(tmp_path, 'Robot { name "boss" controller "<extern>" supervisor TRUE }', {"boss.py": QUITTER})
+    with Proc(sensorium("serve", str(world), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0",
+                        "--mode", "fast")) as server:
+        url = server.wait_line("sensorium: serving world").split("rpc=")[1].split()[0]
+        with Proc(sensorium("controller", str(tmp_path / "controllers" / "boss" / "boss.py"), "--robot", "boss",
+                            "--url", url)) as boss:
+            assert boss.wait() == 0, boss.stderr()
+            assert boss.stdout().splitlines() == ["asked to quit at 480", "boss ends at 480"]
+            assert "Warning" not in boss.stderr() and "Error" not in boss.stderr()
+        assert server.wait() == 3, server.stderr()
+        assert "sensorium: stopped at 480 ms" in server.stderr()

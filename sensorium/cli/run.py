@@ -121,7 +121,7 @@ def main(args: argparse.Namespace) -> int:
             launcher.start_all()
             current.run(signals=False)
             launcher.end_all()
-            if not launcher.reload_requested or interrupted:
+            if not launcher.reload_requested or interrupted or current.core.quit_status is not None:
                 break
             launcher.reload_requested = False          # worldReload: the same file, time 0, the same endpoints
             again = dataclasses.replace(opts, rpc=current.transport.rpc_endpoint, pub=current.transport.pub_endpoint)
@@ -143,4 +143,4 @@ def main(args: argparse.Namespace) -> int:
             signal.signal(sig, handler)
     core = current.core
     print(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps", file=sys.stderr, flush=True)
-    return 0
+    return 0 if core.quit_status is None else core.quit_status & 0xFF     # simulationQuit(status), as Webots exits
