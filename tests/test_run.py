@@ -259,26 +259,39 @@ int main(int argc, char **argv) {
 '''
 
 
-def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path) -> None:
-    """Compiled controllers (our libController) are started as executables with their arguments; the
-    C restartController and worldReload do what the Python ones do."""
+CLIB = REPO / "sensorium" / "client" / "c"
+
+
+@pytest.fixture(scope="module")
+def clib(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
+    """Our libController built once for this file: (its build folder, the libraries to link)."""
     if shutil.which("cc") is None or shutil.which("make") is None:
         pytest.skip("needs a C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
-    clib = REPO / "sensorium" / "client" / "c"
-    build = tmp_path / "cbuild"
-    done = subprocess.run(["make", "-s", "-C", str(clib), f"BUILD={build}"], capture_output=True, text=True, timeout=300)
+    build = tmp_path_factory.mktemp("cbuild")
+    done = subprocess.run(["make", "-s", "-C", str(CLIB), f"BUILD={build}"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-    libs = subprocess.run(["make", "-s", "-C", str(clib), "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+    libs = subprocess.run(["make", "-s", "-C", str(CLIB), "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+    return build, libs
+
+
+def compile_controller(clib: tuple[Path, list[str]], folder: Path, name: str, source: str) -> None:
+    """controllers/NAME/NAME.c compiled to controllers/NAME/NAME against our libController."""
+    build, libs = clib
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / f"{name}.c").write_text(source)
+    done = subprocess.run(["cc", "-std=c99", "-Wall", "-Werror", f"-I{CLIB / 'include'}", str(folder / f"{name}.c"),
+                           "-o", str(folder / name), str(build / "libController.a"), *libs, "-lm"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+
+
+def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:
+    """Compiled controllers (our libController) are started as executables with their arguments; the
+    C restartController and worldReload do what the Python ones do."""
     world = project(tmp_path, 'DEF ALPHA Robot { name "alpha" controller "starts" }\n'
                               'Robot { name "boss" controller "boss" controllerArgs [ "in C" ] supervisor TRUE }', {})
     for name, source in (("starts", C_STARTS), ("boss", C_BOSS)):
-        folder = tmp_path / "controllers" / name
-        folder.mkdir(parents=True)
-        (folder / f"{name}.c").write_text(source)
-        done = subprocess.run(["cc", "-std=c99", "-Wall", "-Werror", f"-I{clib / 'include'}", str(folder / f"{name}.c"),
-                               "-o", str(folder / name), str(build / "libController.a"), *libs, "-lm"],
-                              capture_output=True, text=True, timeout=120)
-        assert done.returncode == 0, done.stderr
+        compile_controller(clib, tmp_path / "controllers" / name, name, source)
     proc = run(world, "--until", "1200")
     assert proc.wait() == 0, proc.stderr()
     assert (tmp_path / "controllers" / "starts" / "starts.txt").read_text().split() == ["0", "480", "0", "480"]
@@ -384,3 +397,42 @@ def test_simulation_quit_of_an_extern_supervisor_stops_serve_with_its_status(tmp
             assert "Warning" not in boss.stderr() and "Error" not in boss.stderr()
         assert server.wait() == 3, server.stderr()
         assert "sensorium: stopped at 480 ms" in server.stderr()
+
+
+C_CHATTY = r'''#include <stdio.h>
+#include <webots/robot.h>
+
+int main(void) {
+  printf("before init\n");
+  wb_robot_init();
+  printf("hello from C at %g\n", wb_robot_get_time());
+  fprintf(stderr, "a warning from C\n");
+  while (wb_robot_step(16) != -1) {
+  }
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+def test_a_c_controllers_lines_come_out_as_it_prints_them(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:
+    """wb_robot_init makes stdout and stderr line-buffered, as libController does: a controller that
+    prints without fflush and then steps on has its lines seen while it runs (a pipe would otherwise
+    hold them until 4 KiB gathered or the process ended)."""
+    py = ('import sys\nfrom controller import Robot\nrobot = Robot()\nprint("hello from Python")\n'
+          'print("a warning from Python", file=sys.stderr)\nwhile robot.step(16) != -1:\n    pass\n')
+    world = project(tmp_path, 'Robot { name "talker" controller "talker" }\nRobot { name "snake" controller "snake" }',
+                    {"snake.py": py})
+    compile_controller(clib, tmp_path / "controllers" / "talker", "talker", C_CHATTY)
+    proc = run(world)                      # no --until: the controllers step until we stop the run
+    try:
+        proc.wait_line("sensorium: serving world")
+        assert proc.wait_line("[talker] ") == "[talker] before init"
+        assert proc.wait_line("[talker] ") == "[talker] hello from C at 0"
+        assert proc.wait_line("[snake] ") == "[snake] hello from Python"          # PYTHONUNBUFFERED, as Webots
+        for line in ("[talker] a warning from C", "[snake] a warning from Python"):
+            wait_until(lambda line=line: line in proc.stderr(), what=f"the line {line!r}")
+        assert proc.p.poll() is None               # seen while the controller (and the run) go on
+    finally:
+        proc.p.send_signal(signal.SIGTERM)
+    assert proc.wait() == 0, proc.stderr()
