@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 from _serve import REPO, Proc, run_controller, sensorium, wait_until
 
-from sensorium.launch import LaunchError, find_controller
+from sensorium import launch
+from sensorium.launch import LaunchError, WebotsProjects, find_controller
 
 WORLD = '''#VRML_SIM R2023b utf8
 WorldInfo { basicTimeStep 16 }
@@ -95,7 +96,7 @@ def test_controllers_are_found_in_webots_order_and_others_are_refused(tmp_path: 
     with pytest.raises(LaunchError) as info:
         find_controller("r", "gone", [], [base, other])
     assert str(info.value) == (f"robot 'r': controller 'gone' not found (looked for the folder {base / 'gone'}, "
-                               f"{other / 'gone'})")
+                               f"{other / 'gone'}; --webots-home DIR also looks in Webots' own projects)")
 
 
 # ---------------------------------------------------------------------- running a project
@@ -121,10 +122,11 @@ def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: P
 
 def test_a_missing_controller_is_one_line_and_nothing_runs(tmp_path: Path) -> None:
     world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }', {})
-    proc = run(world)
+    proc = run(world, env={"WEBOTS_HOME": None})
     assert proc.wait() == 1
     assert proc.stderr().strip() == (f"sensorium run: robot 'alpha': controller 'nowhere' not found (looked for the "
-                                     f"folder {tmp_path / 'controllers' / 'nowhere'})")
+                                     f"folder {tmp_path / 'controllers' / 'nowhere'}; --webots-home DIR also looks "
+                                     "in Webots' own projects)")
     assert proc.stdout() == ""
 
 
@@ -436,3 +438,78 @@ def test_a_c_controllers_lines_come_out_as_it_prints_them(tmp_path: Path, clib: 
     finally:
         proc.p.send_signal(signal.SIGTERM)
     assert proc.wait() == 0, proc.stderr()
+
+
+# ---------------------------------------------------------------------- Webots' own controllers (--webots-home)
+
+def fake_webots(home: Path) -> Path:
+    """A Webots installation of our own: a default project's controller, a robot project whose PROTO
+    and controller live together, a sample project, two projects with a controller of one name."""
+    def controller(folder: Path, text: str = "") -> None:
+        folder.mkdir(parents=True)
+        (folder / f"{folder.name}.py").write_text(text)
+    controller(home / "resources" / "projects" / "controllers" / "void")
+    controller(home / "projects" / "robots" / "maker" / "bee" / "controllers" / "bee_wander",
+               COUNTER.replace("{step}", "32"))
+    (home / "projects" / "robots" / "maker" / "bee" / "protos").mkdir(parents=True)
+    (home / "projects" / "robots" / "maker" / "bee" / "protos" / "Bee.proto").write_text("")
+    controller(home / "projects" / "samples" / "devices" / "controllers" / "sampler")
+    controller(home / "projects" / "samples" / "devices" / "controllers" / "bee_wander")  # a second one
+    controller(home / "projects" / "samples" / "howto" / "twice" / "controllers" / "twin")
+    controller(home / "projects" / "samples" / "howto" / "again" / "controllers" / "twin")
+    return home
+
+
+def test_webots_own_controllers_are_found_by_a_bounded_index(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    home = fake_webots(tmp_path / "webots")
+    projects = home / "projects"
+    webots = WebotsProjects(home)
+    mine = tmp_path / "controllers"
+    mine.mkdir()
+    spec = find_controller("r", "sampler", [], [mine], webots)
+    assert (spec.folder, spec.webots) == (projects / "samples" / "devices" / "controllers" / "sampler", True)
+    assert find_controller("r", "void", [], [mine], webots).folder == home / "resources" / "projects" / "controllers" / "void"
+    # a name two projects have: the one whose protos/ define the robot's PROTO, as Webots looks there
+    assert find_controller("r", "bee_wander", [], [mine], webots, "Bee").folder == (
+        projects / "robots" / "maker" / "bee" / "controllers" / "bee_wander")
+    with pytest.raises(LaunchError) as info:
+        find_controller("r", "twin", [], [mine], webots)
+    assert str(info.value) == (
+        f"robot 'r': controller 'twin' is in several of Webots' projects ({projects / 'samples/howto/again/controllers/twin'}, "
+        f"{projects / 'samples/howto/twice/controllers/twin'}): give the one to use with --controllers-dir (its "
+        "controllers/ folder)")
+    # the project's own folder comes first
+    (mine / "sampler").mkdir()
+    (mine / "sampler" / "sampler.py").write_text("")
+    assert find_controller("r", "sampler", [], [mine], webots).webots is False
+    with pytest.raises(LaunchError, match=rf"controller 'none' not found \(looked for the folder {mine / 'none'}, and in "
+                                          rf"Webots' projects under {projects}\)"):
+        find_controller("r", "none", [], [mine], webots)
+    # bounded: deeper than WEBOTS_DEPTH is not looked at, nor more folders than WEBOTS_MAX_DIRS
+    deep = projects / "a" / "b" / "c" / "d" / "e" / "f" / "controllers" / "deep"
+    deep.mkdir(parents=True)
+    (deep / "deep.py").write_text("")
+    with pytest.raises(LaunchError, match="not found"):
+        find_controller("r", "deep", [], [mine], WebotsProjects(home))
+    monkeypatch.setattr(launch, "WEBOTS_MAX_DIRS", 3)
+    capped = WebotsProjects(home)
+    with pytest.raises(LaunchError, match=r"indexed only its first 3 folders"):
+        find_controller("r", "none", [], [mine], capped)
+
+
+def test_run_with_webots_home_starts_a_stock_controller_of_a_proto_robot(tmp_path: Path) -> None:
+    home = fake_webots(tmp_path / "webots")
+    (home / "projects" / "robots" / "maker" / "bee" / "protos" / "Bee.proto").write_text(
+        '#VRML_SIM R2023b utf8\nPROTO Bee [\n  field SFString name "bee"\n  field SFString controller "bee_wander"\n]\n'
+        '{\n  Robot {\n    name IS name\n    controller IS controller\n  }\n}\n')
+    (tmp_path / "worlds").mkdir()
+    world = tmp_path / "worlds" / "w.wbt"
+    world.write_text('#VRML_SIM R2023b utf8\n'
+                     'EXTERNPROTO "webots://projects/robots/maker/bee/protos/Bee.proto"\n'
+                     'WorldInfo { basicTimeStep 16 }\nBee { }\n')
+    proc = run(world, "--until", "320", "--webots-home", str(home))
+    assert proc.wait() == 0, proc.stderr()
+    folder = home / "projects" / "robots" / "maker" / "bee" / "controllers" / "bee_wander"
+    assert f"sensorium run: robot 'bee': controller 'bee_wander' found in Webots' projects: {folder / 'bee_wander.py'}" \
+        in proc.stderr().splitlines()
+    assert "[bee] bee stepped 10 until 320" in proc.stdout().splitlines()
