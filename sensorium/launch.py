@@ -346,12 +346,13 @@ class Launcher:
 
     def _watch(self, run: _Running) -> None:
         code = run.proc.wait()
+        quitting = self._quitting()         # as it ended (the world may reach its end while its output drains)
         if not run.ending:          # it may never have attached (a crash at start): not waited for any more
             self._starting.discard(run.spec.robot)
             self._wake_server()
         for t in run.readers:
             t.join()
-        if not run.ending and not self._quitting():      # it ended by itself: the robot stays uncontrolled, the world goes on
+        if not run.ending and not quitting:      # it ended by itself: the robot stays uncontrolled, the world goes on
             self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}' {_describe(code)}")
 
     def _end(self, run: _Running, grace_s: float) -> None:

@@ -143,6 +143,20 @@ def test_a_controller_that_crashes_is_said_and_the_world_goes_on(tmp_path: Path)
     assert "[alpha] alpha stepped 50 until 800" in proc.stdout().splitlines()
 
 
+def test_the_world_goes_on_to_until_when_every_started_controller_has_ended(tmp_path: Path) -> None:
+    """One controller fails right after it attached, the other ends after five steps: nothing is
+    left to wait for, so the world runs by itself to --until, as Webots' goes on without them."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "boom" }\nRobot { name "beta" controller "brief" }',
+                    {"boom.py": 'from controller import Robot\nRobot()\nraise SystemExit("no such device")\n',
+                     "brief.py": 'from controller import Robot\nr = Robot()\nfor _ in range(5):\n    r.step(16)\n'
+                                 'print("done at", round(r.getTime() * 1000))\n'})
+    proc = run(world, "--until", "800")
+    assert proc.wait() == 0, proc.stderr()
+    assert "[beta] done at 80" in proc.stdout().splitlines()
+    assert "[alpha] no such device" in proc.stderr().splitlines()
+    assert "sensorium: stopped at 800 ms after 50 steps" in proc.stderr().splitlines()
+
+
 def test_an_extern_robot_waits_for_a_controller_started_by_hand(tmp_path: Path) -> None:
     world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "ext" controller "<extern>" }',
                     {"a.py": COUNTER.replace("{step}", "16")})

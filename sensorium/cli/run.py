@@ -123,6 +123,9 @@ def main(args: argparse.Namespace) -> int:
             # as Webots, the world waits for every synchronous <extern> robot's controller too
             robots = current.core.sim.loaded.world.robots
             lockstep.starting.update(r.name for r in robots if r.controller == "<extern>" and r.synchronization)
+            # ... but a robot whose started controller has ended is uncontrolled: the world goes on
+            # without it, as Webots' does (only <extern> robots are waited for while none is attached)
+            lockstep.extern_synchronous = [r.name for r in robots if r.controller == "<extern>" and r.synchronization]
             launcher.on_reload = current.stop
             print(current.ready_line, flush=True)
             launcher.start_all()
