@@ -155,6 +155,7 @@ def test_the_world_goes_on_to_until_when_every_started_controller_has_ended(tmp_
     assert "[beta] done at 80" in proc.stdout().splitlines()
     assert "[alpha] no such device" in proc.stderr().splitlines()
     assert "sensorium: stopped at 800 ms after 50 steps" in proc.stderr().splitlines()
+    assert "steps by itself" not in proc.stderr()            # serve's line, not run's: the world waited for both
 
 
 def test_an_extern_robot_waits_for_a_controller_started_by_hand(tmp_path: Path) -> None:

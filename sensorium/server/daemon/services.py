@@ -357,10 +357,11 @@ class Core(DeviceServices):
     def _announce(self) -> None:
         """Say once (and again after the last controller left) what the world waits for."""
         ls = self.lockstep
-        waiting = ls.waiting_for()
-        if waiting and self.launcher is not None:         # `sensorium run` starts them: nothing to say
+        if self.launcher is not None:     # `sensorium run` starts the controllers and says when one ends
             self._announced = True
-        elif waiting:
+            return
+        waiting = ls.waiting_for()
+        if waiting:
             names = " or ".join(repr(r) for r in waiting)
             self.log(f"waiting for a controller to attach to robot {names} (controller \"<extern>\", "
                      f"synchronization true): the world steps when attached controllers ask it to; "
