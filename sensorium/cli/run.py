@@ -124,8 +124,10 @@ def main(args: argparse.Namespace) -> int:
             robots = current.core.sim.loaded.world.robots
             lockstep.starting.update(r.name for r in robots if r.controller == "<extern>" and r.synchronization)
             # ... but a robot whose started controller has ended is uncontrolled: the world goes on
-            # without it, as Webots' does (only <extern> robots are waited for while none is attached)
-            lockstep.extern_synchronous = [r.name for r in robots if r.controller == "<extern>" and r.synchronization]
+            # without it, as Webots' does (only robots left to an <extern> controller are waited for
+            # while none is attached: <extern> and, here, <generic> ones)
+            lockstep.extern_synchronous = [r.name for r in robots
+                                           if r.controller in ("<extern>", "<generic>") and r.synchronization]
             launcher.on_reload = current.stop
             print(current.ready_line, flush=True)
             launcher.start_all()
