@@ -350,6 +350,12 @@ class SimulationModeArgs(Args):
     mode: int = Field(ge=0, le=2, description="Webots WB_SUPERVISOR_SIMULATION_MODE_*: 0 pause, 1 real time, 2 fast")
 
 
+class SimulationQuitArgs(Args):
+    """``wb_supervisor_simulation_quit``: the simulation ends for every controller and the server exits."""
+
+    status: int = Field(ge=-2**31, le=2**31 - 1, description="the exit status of `sensorium run`/`serve` (Webots': its own)")
+
+
 class SetLabelArgs(Args):
     """``wb_supervisor_set_label``: a text over the exported picture (README 'Supervisor')."""
 
@@ -1017,6 +1023,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("restart_controller", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("world_reload", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("simulation_quit", "robot", SimulationQuitArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),
     ServiceSpec("set_label", "robot", SetLabelArgs, SuccessResult, attached=True, supervisor=True),
