@@ -518,16 +518,28 @@ def _hull_data(ob: Obstacle, rad: float) -> tuple[list, list]:
     got = ob.grown.get(rad)
     if got is None:
         pts = ob.points
-        n = len(pts)
+        v = pts.tolist()
+        n = len(v)
         edges = []
         if n >= 2:
+            rad_f = float(rad)
             for i in range(n):
-                a, b = pts[i], pts[(i + 1) % n]
-                e = b - a
-                out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
-                A, B = a + rad * out, b + rad * out
-                edges.append((A, B, out, float(A[0]), float(A[1]), float(out[0]), float(out[1])))
-        got = ob.grown[rad] = (pts.tolist(), edges)
+                (a0, a1), (b0, b1) = v[i], v[(i + 1) % n]
+                e0, e1 = b0 - a0, b1 - a1
+                el = math.hypot(e0, e1)
+                if el == 0.0:               # (no such edge once the points are made; numpy's inf and NaN)
+                    a, b = pts[i], pts[(i + 1) % n]
+                    e = b - a
+                    out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
+                    A, B = a + rad * out, b + rad * out
+                    edges.append((A, B, out, float(A[0]), float(A[1]), float(out[0]), float(out[1])))
+                    continue
+                # numpy's elementwise operations in plain floats: the same roundings, bit for bit
+                o0, o1 = e1 / el, -e0 / el
+                A0, A1 = a0 + rad_f * o0, a1 + rad_f * o1
+                edges.append((np.array([A0, A1]), np.array([b0 + rad_f * o0, b1 + rad_f * o1]), np.array([o0, o1]),
+                              A0, A1, o0, o1))
+        got = ob.grown[rad] = (v, edges)
     return got
 
 
@@ -1250,7 +1262,9 @@ class Contact:
         band_lo = self.heights[idx] + self._z_low[idx]
         band_hi = self.heights[idx] + self._z_high[idx]
         if len(self._obs):
-            solid_hit = (np.all((self._lo[None] <= box_hi[:, None]) & (self._hi[None] >= box_lo[:, None]), axis=2)
+            lo, hi = self._lo, self._hi
+            solid_hit = ((lo[None, :, 0] <= box_hi[:, None, 0]) & (lo[None, :, 1] <= box_hi[:, None, 1])
+                         & (hi[None, :, 0] >= box_lo[:, None, 0]) & (hi[None, :, 1] >= box_lo[:, None, 1])
                          & (self._zhi[None] > band_lo[:, None] + FLOOR) & (self._zlo[None] < band_hi[:, None] - EPS))
         robot_hit = None
         if len(self.feet) > 1:
@@ -1272,15 +1286,34 @@ class Contact:
         if robot_hit is not None:
             for m, j in zip(*(x.tolist() for x in np.nonzero(robot_hit))):
                 near_robots[m].append(j)
-        out = []
-        for m in range(k):
+        # the moves near nothing that no other move has near it end where _clip and _clip_shaped put
+        # them without candidates, start + (end - start), whatever the order: all at once (robots
+        # each moved once; a robot without a footprint ends at its end, in the loop below)
+        lone = ~np.isnan(self._radius[idx])
+        if len(self._obs):
+            lone &= ~solid_hit.any(axis=1)
+        if robot_hit is not None:
+            lone &= ~robot_hit.any(axis=1) & ~robot_hit.any(axis=0)[idx]
+        out: list = [None] * k
+        rest = range(k)
+        if lone.any() and len(set(indices)) == k:
+            moved = starts + (ends - starts)
+            li = idx[lone]
+            self.centres[li] = moved[lone]
+            if yaws is not None:
+                self.yaw[li] = yaws[lone, 1]
+            headings = self.yaw[idx].tolist()
+            for m in lone.nonzero()[0].tolist():
+                out[m] = (moved[m], False, headings[m])
+            rest = (~lone).nonzero()[0].tolist()
+        for m in rest:
             i = int(idx[m])
             yaw0, yaw1 = (float(self.yaw[i]),) * 2 if yaws is None else (float(yaws[m, 0]), float(yaws[m, 1]))
             foot = self.feet[i]
             if foot is None:
                 self.centres[i] = ends[m]
                 self.yaw[i] = yaw1
-                out.append((ends[m].copy(), False, yaw1))
+                out[m] = (ends[m].copy(), False, yaw1)
                 continue
             cands: list[Obstacle] = [self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m]))
                                      for j in near_solids[m]]
@@ -1294,7 +1327,7 @@ class Contact:
                 p, clipped, kept = self._clip_shaped(foot, starts[m].copy(), ends[m] - starts[m], yaw0, yaw1, cands)
             self.centres[i] = p
             self.yaw[i] = kept
-            out.append((p, clipped, kept))
+            out[m] = (p, clipped, kept)
         return out
 
     def pieces(self, index: int, parts: list[tuple[geo.Primitive, Pose]]) -> list[Footprint]:
