@@ -1356,8 +1356,17 @@ class Contact:
     @staticmethod
     def _in_band(ob: Obstacle, low: float, high: float) -> Obstacle:
         if ob.sphere:
-            cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
-            return Obstacle(ob.name, -1, ob.points, sphere_radius_in_band(cz, ob.radius, low, high), ob.z_range)
+            # a sphere's section in a band: made once per band (a robot on a flat floor keeps its band),
+            # kept among the sphere's own caches (tuple keys, never a grown radius)
+            key = ("band", low, high)
+            got = ob.grown.get(key)
+            if got is None:
+                cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
+                got = Obstacle(ob.name, -1, ob.points, sphere_radius_in_band(cz, ob.radius, low, high), ob.z_range)
+                if len(ob.grown) >= 64:
+                    ob.grown.clear()
+                ob.grown[key] = got
+            return got
         return ob
 
     def _clip(self, p: np.ndarray, d: np.ndarray, R: float, cands: list[Obstacle]) -> tuple[np.ndarray, bool]:
