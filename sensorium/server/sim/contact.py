@@ -40,7 +40,10 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   convex sets, :func:`_grown`), for a wall line its reach toward the wall — so a fast robot at a
   grazing angle cannot tunnel, whatever the step length. Features the chord
   certainly cannot reach (plain float screens, margins far above the tests' rounding) are not
-  tested: the answer of testing them all, bit for bit.
+  tested: the answer of testing them all, bit for bit. Likewise the turn test is answered before its
+  arcs where a screen proves it False (:func:`turn_gap_holds`), an obstacle grown by a turned
+  footprint is made once per heading (:func:`_grown`), and moves near nothing end all at once
+  (:meth:`Contact.resolve_all`): the same answers, bit for bit.
 
 On contact the robot stops at the contact point and the rest of its displacement is projected on
 the contact's tangent (slide), up to three times per step (corners). A robot pushed straight into
