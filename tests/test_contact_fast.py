@@ -28,7 +28,7 @@ EPS = C.EPS
 def _no_screens():
     """turn_gap_holds without its screens: the arcs answer every case."""
     with mock.patch.object(C, "_start_touching", lambda *a: False), \
-            mock.patch.object(C, "_end_inside", lambda *a: False), \
+            mock.patch.object(C, "_inside_in_turn", lambda *a: False), \
             mock.patch.object(C, "_end_nearer", lambda *a: False):
         yield
 
@@ -77,7 +77,7 @@ def _both(shape, rnd, turn, ob, p, gap) -> tuple[bool, bool]:
 
 
 def test_the_turn_screens_answer_as_the_arcs_on_adversarial_cases_and_are_taken():
-    fired = {"_start_touching": 0, "_end_inside": 0, "_end_nearer": 0}
+    fired = {"_start_touching": 0, "_inside_in_turn": 0, "_end_nearer": 0}
     real = {name: getattr(C, name) for name in fired}
 
     def counted(name):
@@ -252,3 +252,31 @@ def test_robots_near_nothing_end_at_once_and_skip_the_narrow_phase():
     # after it, stops at its new face
     assert not out[4][1] and out[4][0].tobytes() == (starts[4] + (ends[4] - starts[4])).tobytes()
     assert out[5][1] and abs(out[5][0][0] - (3.08 + 0.2)) < 1e-9 and out[5][0][1] == 3.0
+
+
+def test_a_box_spinning_against_walls_is_answered_without_the_arcs():
+    # a 0.4 x 0.2 m box robot spinning in place flush against a wall, and in a corner of two: every
+    # turn test it meets is answered by the screens (before: the arcs, about four per step)
+    from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.loader import parse_world
+
+    def world(x, y):
+        solids = [{"name": "floor", "geometry": {"type": "plane", "size": None}},
+                  {"name": "north", "geometry": {"type": "box", "size": [4, 0.1, 0.3]}, "pose": {"translation": [0, 0.45, 0.15]}},
+                  {"name": "east", "geometry": {"type": "box", "size": [0.1, 4, 0.3]}, "pose": {"translation": [0.55, 0, 0.15]}}]
+        bots = [{"name": "bot", "pose": {"translation": [x, y, 0.025]}, "differential_drive": {},
+                 "body": {"geometry": {"type": "box", "size": [0.4, 0.2, 0.05]}}}]
+        return {"world_info": {"basic_time_step": 32}, "solids": solids, "robots": bots}
+
+    arcs = []
+    real = C._arc_to_segments
+    with mock.patch.object(C, "_arc_to_segments", lambda *a: arcs.append(1) or real(*a)):
+        for x, y in ((-0.5, 0.3 - 1e-9), (0.3 - 1e-9, 0.3 - 1e-9)):
+            sim = Simulation(parse_world(world(x, y)))
+            left, right = sim.robot("bot").motors.values()
+            for m, v in ((left, -8.0), (right, 8.0)):
+                m.set_position(math.inf)
+                m.set_velocity(v)
+            sim.run(60)
+            assert sim.counters["contacts"] > 50 and sim.counters["contact_checks"] > 100
+    assert arcs == []

@@ -943,8 +943,8 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
     it); touching, ``start`` (the footprint's signed distance from ``ob`` at the turn's start, when
     the caller knows it) puts the polygons within EPS / 2 of touching (:func:`_start_touching`: a
     vertex and an edge that near at the start), or a vertex of one is inside the other at the
-    turn's end (:func:`_end_inside`: it crossed an edge on the way, unless they were not apart at
-    the start)."""
+    turn's end or halfway (:func:`_inside_in_turn`: it crossed an edge on the way, unless they were
+    not apart at the start)."""
     lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
     if ob.normal is not None:
         side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
@@ -983,7 +983,7 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
     # apart at the start and kept farther apart than the rounding (EPS) all through the turn
     if start is not None and _start_touching(start + rnd + ob.radius, ob, p, shape):
         return False
-    if _end_inside(shape, q, turn):
+    if _inside_in_turn(shape, q, turn):
         return False
     return _start_apart(shape, q) and apart() >= max(s, EPS)
 
@@ -1019,21 +1019,51 @@ def _end_nearer(shape: np.ndarray, q: np.ndarray, turn: float, limit: float) -> 
     return min(_vertex_edge(f, g), _vertex_edge(g, f)) + 1e-12 * size < limit
 
 
-def _end_inside(shape: np.ndarray, q: np.ndarray, turn: float) -> bool:
-    """Whether a vertex of ``hull(shape)`` turned by ``turn`` is inside ``hull(q)``, or one of
-    ``hull(q)``'s inside it, deeper than 1e-12 of the coordinates (far above rounding; hulls of 3
-    vertices or more, counter-clockwise). Then :func:`turn_gap_holds` answers False for two
-    polygons touching or overlapping by less than EPS: apart at the start, the vertex crossed an
-    edge during the turn, where the arcs' least (:func:`_arc_to_segments`, exact to rounding) is 0;
-    not apart, :func:`_start_apart` finds no separating axis, or one within rounding of none, where
-    a vertex is that near an edge at the start (the overlap's depth, found along an edge normal)."""
+def _inside_in_turn(shape: np.ndarray, q: np.ndarray, turn: float) -> bool:
+    """Whether, at the turn's end or halfway, a vertex of ``hull(shape)`` turned so is inside
+    ``hull(q)``, or one of ``hull(q)``'s inside it, deeper than 1e-12 of the coordinates (far above
+    rounding; hulls of 3 vertices or more, counter-clockwise); or a footprint vertex is inside
+    ``hull(q)`` where its arc reaches deepest past one of its edges (a corner whose arc dips into a
+    wall and out again). Then :func:`turn_gap_holds` answers False for two polygons
+    touching or overlapping by less than EPS: apart at the start, the vertex crossed an edge on the
+    way, where the arcs' least (:func:`_arc_to_segments`, exact to rounding) is 0; not apart,
+    :func:`_start_apart` finds no separating axis, or one within rounding of none, where a vertex
+    is that near an edge at the start (the overlap's depth, found along an edge normal)."""
     if len(shape) < 3 and len(q) < 3:
         return False
-    c, s = math.cos(turn), math.sin(turn)
-    f = [(x * c - y * s, x * s + y * c) for x, y in shape.tolist()]
     g = [(x, y) for x, y in q.tolist()]
-    tol = 1e-12 * (1.0 + max(max(abs(x), abs(y)) for x, y in f + g))
-    return (len(g) >= 3 and _any_inside(f, g, tol)) or (len(f) >= 3 and _any_inside(g, f, tol))
+    pts = shape.tolist()
+    for u in (turn, 0.5 * turn):
+        c, s = math.cos(u), math.sin(u)
+        f = [(x * c - y * s, x * s + y * c) for x, y in pts]
+        tol = 1e-12 * (1.0 + max(max(abs(x), abs(y)) for x, y in f + g))
+        if (len(g) >= 3 and _any_inside(f, g, tol)) or (len(f) >= 3 and _any_inside(g, f, tol)):
+            return True
+    if len(g) < 3:
+        return False
+    # and where each footprint vertex reaches deepest past each of the obstacle's edges on its arc
+    # (its turn pointing it against the edge's normal), when that heading is within the turn
+    lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
+    lines = []
+    for (ax, ay), (bx, by) in zip([g[-1]] + g[:-1], g):
+        ex, ey = bx - ax, by - ay
+        el = math.hypot(ex, ey)
+        if el > 0.0:
+            lines.append((ax, ay, ey / el, -ex / el))
+    if len(lines) < 3:
+        return False
+    for x, y in pts:
+        at = math.atan2(y, x)
+        for ax, ay, ox, oy in lines:
+            k = (math.atan2(-oy, -ox) - at - lo) % math.tau
+            if not k <= hi - lo:
+                continue
+            c, s = math.cos(lo + k), math.sin(lo + k)
+            px, py = x * c - y * s, x * s + y * c
+            if (px - ax) * ox + (py - ay) * oy < -tol and all(
+                    (px - bx) * nx + (py - by) * ny < -tol for bx, by, nx, ny in lines):
+                return True
+    return False
 
 
 def _any_inside(v: list, w: list, tol: float) -> bool:
@@ -1291,15 +1321,18 @@ class Contact:
                 near_robots[m].append(j)
         # the moves near nothing that no other move has near it end where _clip and _clip_shaped put
         # them without candidates, start + (end - start), whatever the order: all at once (robots
-        # each moved once; a robot without a footprint ends at its end, in the loop below)
-        lone = ~np.isnan(self._radius[idx])
-        if len(self._obs):
-            lone &= ~solid_hit.any(axis=1)
-        if robot_hit is not None:
-            lone &= ~robot_hit.any(axis=1) & ~robot_hit.any(axis=0)[idx]
+        # each moved once; a robot without a footprint ends at its end, in the loop below). For a
+        # few moves the loop is cheaper than the arrays
         out: list = [None] * k
-        rest = range(k)
-        if lone.any() and len(set(indices)) == k:
+        rest: list[int] | range = range(k)
+        lone = None
+        if k >= 4 and len(set(indices)) == k:
+            lone = ~np.isnan(self._radius[idx])
+            if len(self._obs):
+                lone &= ~solid_hit.any(axis=1)
+            if robot_hit is not None:
+                lone &= ~robot_hit.any(axis=1) & ~robot_hit.any(axis=0)[idx]
+        if lone is not None and lone.any():
             moved = starts + (ends - starts)
             li = idx[lone]
             self.centres[li] = moved[lone]
