@@ -684,7 +684,7 @@ def _grown(ob: Obstacle, shape: np.ndarray, rnd: float, p: np.ndarray) -> tuple[
 
 
 _GROWN: dict = {}          # _grown's obstacles made lately (the arrays they came from held, so no id is reused)
-_GROWN_MAX = 4096
+_GROWN_MAX = 512        # (a mesh grown by a footprint is hundreds of edges: a few MB at most)
 
 
 def _minkowski(a: list, b: list) -> list:
