@@ -15,12 +15,21 @@ from pathlib import Path
 
 PROTOS = Path(__file__).resolve().parent / "protos" / "minipuck"
 
-CAMERA = ('Camera { translation 0.03 0 -0.02 name "camera" width 52 height 39 fieldOfView 0.84 '
-          'near 0.005 far 2 }')
 
 
-def swarm_wbt(n: int, seed: int = 7, spacing: float = 0.12, camera: bool = True) -> str:
-    """The text of a world with ``n`` robots on a grid of pitch ``spacing`` (jittered, random headings)."""
+def camera(far: float = 2.0, housing: bool = False) -> str:
+    """The robot's 52 x 39 camera (``far`` 0: unbounded, Webots' default), with a small housing of its
+    own behind its lens (``housing``: a device with shapes, whose rays ride the robot's body)."""
+    box = ('children [ Pose { translation -0.004 0 0 children [ Shape { geometry Box { size 0.006 0.01 0.008 } } ] } ] '
+           if housing else "")
+    return (f'Camera {{ translation 0.03 0 -0.02 name "camera" width 52 height 39 fieldOfView 0.84 near 0.005 far {far:g} '
+            f"{box}}}")
+
+
+def swarm_wbt(n: int, seed: int = 7, spacing: float = 0.12, cameras: bool = True, far: float = 2.0,
+              housing: bool = False) -> str:
+    """The text of a world with ``n`` robots on a grid of pitch ``spacing`` (jittered, random headings),
+    each with a camera (see :func:`camera`) unless ``cameras`` is False."""
     rng = random.Random(seed)
     side = max(1, math.ceil(math.sqrt(n)))
     half = 0.5 * side * spacing + 0.1
@@ -41,7 +50,7 @@ def swarm_wbt(n: int, seed: int = 7, spacing: float = 0.12, camera: bool = True)
         x = (gx - 0.5 * (side - 1)) * spacing + rng.uniform(-0.015, 0.015)
         y = (gy - 0.5 * (side - 1)) * spacing + rng.uniform(-0.015, 0.015)
         yaw = rng.uniform(-math.pi, math.pi)
-        slot = f" extensionSlot [ {CAMERA} ]" if camera else ""
+        slot = f" extensionSlot [ {camera(far, housing)} ]" if cameras else ""
         lines.append(f'MiniPuck {{ translation {x:.4f} {y:.4f} 0 rotation 0 0 1 {yaw:.4f} name "puck{i}"{slot} }}')
     return "\n".join(lines) + "\n"
 
@@ -53,5 +62,6 @@ def write_swarm(n: int, path: Path, **kw) -> Path:
     return path
 
 
-if __name__ == "__main__":
-    print(write_swarm(int(sys.argv[1]), Path(sys.argv[2])))
+if __name__ == "__main__":   # N OUT.wbt [FAR [housing]]
+    print(write_swarm(int(sys.argv[1]), Path(sys.argv[2]), far=float(sys.argv[3]) if len(sys.argv) > 3 else 2.0,
+                      housing=len(sys.argv) > 4 and sys.argv[4] == "housing"))

@@ -106,3 +106,35 @@ def test_swarm_cameras_see_as_with_an_origin_array(tmp_path):
         assert a.normal.tobytes() == b.normal.tobytes() and a.shape.tobytes() == b.shape.tobytes()
         hits += int(np.isfinite(a.distance).sum())
     assert hits > 10000
+
+
+@pytest.mark.parametrize("far", [2.0, np.inf])
+def test_swarm_cameras_on_their_bodies_see_as_with_an_origin_array(tmp_path, monkeypatch, far):
+    """Cameras with shapes of their own (Webots' e-puck's has its housing) cast mounted on their
+    robot's body; unbounded (far 0 in the world file) their rays take the per-cast mounted broad
+    phase, which pairs a one-origin batch with the body's neighbours in view: the bits of the same
+    rays given an origin per ray (every neighbour a candidate of every ray)."""
+    sim = Simulation(load_world(str(write_swarm(30, tmp_path / "swarm.wbt", housing=True))))
+    cams = [d for d in sim.all_devices() if d.kind == "Camera"]
+    cams[0].enable(32)
+    sim.step()
+    engine = cams[0]._scene.engine
+    seen = []
+    real = movers._origin_candidates
+    monkeypatch.setattr(movers, "_origin_candidates", lambda *a: seen.append(1) or real(*a))
+    hits = paired = 0
+    for cam in cams:
+        body = cam._scene.device_body(cam.robot_index, cam.on_joint)
+        assert body is not None
+        pose = cam.world_pose(cam._robot.pose)
+        D = _unit(_frustum(40, 0.0, 0.42) @ np.asarray(pose.rotation).T)
+        O = np.broadcast_to(np.asarray(pose.translation, dtype=np.float64), D.shape)
+        mount = np.full(len(D), body)
+        del seen[:]
+        a = engine.cast(O, D, 0.005, far, kind=RayKind.VISUAL, mount=mount)
+        paired += bool(seen)        # the one-origin pairing ran (not for a camera facing a near wall: few neighbours)
+        b = engine.cast(np.array(O), D, 0.005, far, kind=RayKind.VISUAL, mount=mount)
+        assert a.distance.tobytes() == b.distance.tobytes()
+        assert a.normal.tobytes() == b.normal.tobytes() and a.shape.tobytes() == b.shape.tobytes()
+        hits += int(np.isfinite(a.distance).sum())
+    assert hits > 10000 and paired >= 20

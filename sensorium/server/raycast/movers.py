@@ -117,20 +117,27 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=None):
     return np.concatenate(prs), np.concatenate(pms)
 
 
-def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
+def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl, origin=None):
     """Same contract as ``_sphere_pairs``, for many movers and many rays.  A segment no longer than
     ``L_cap`` looks up ONE cell of a uniform grid, the cell of its midpoint; each mover is
     registered in every cell overlapped by the box of its bounding sphere grown by L_cap / 2.  A
     segment passing within r of a mover has its midpoint within r + L / 2 of the centre, so the
     lookup finds every candidate; the exact sphere test then runs on the candidate pairs only.
-    Longer segments (a lidar among short infra-red rays) take the dense test."""
+    Longer segments (a lidar among short infra-red rays) take the dense test.
+
+    Rays from one origin (a camera's pixels; O a broadcast array, or ``origin`` given) pair with
+    the movers in their view only (``_origin_cull``): the same pairs, in the same order."""
     n, M = len(O), len(C)
+    if origin is None and O.strides[0] == 0 and n:
+        origin = O[0]
+    if origin is not None and not _never_back(t_near):
+        origin = None
     L = lim - t_near
     valid = L >= 0.0                         # a negative segment sees nothing
     fin = valid & (L < _INF)
     Lf = L[fin]
     if len(Lf) == 0:
-        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl)
+        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=_among(C, radius, r2, origin, D, lim))
     # cell size from the MEDIAN segment length and mover radius (robust to a few long rays and
     # big movers: a big mover registers in more cells, a long segment takes the dense test)
     r_med = float(np.partition(radius, M // 2)[M // 2])
@@ -141,7 +148,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     span = float(((C + reach).max(0) - g0).max())
     cell = 2.0 * r_med + L_cap               # a typical grown sphere overlaps <= 2 cells per axis
     if 2.0 * cell >= span:                   # a grid of ~one cell would not prune anything
-        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl)
+        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=_among(C, radius, r2, origin, D, lim))
     short_m = fin & (L <= L_cap)
     every = bool(short_m.all())
     short = None if every else short_m.nonzero()[0]
@@ -149,8 +156,8 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     # one origin (a camera's pixels): movers culled by the cone of the directions and their reach,
     # then a table of rays x movers in view (the pairs the grid lookup would keep, in its order);
     # the grid registers every mover and pairs a ray with all movers of a cell as long as a segment
-    origin = O.strides[0] == 0 and len(Ds) > 0 and _never_back(t_near)
-    cull = _origin_cull(C, radius, r2, O[0], Ds, float((lim if every else lim[short]).max())) if origin else None
+    cull = (_origin_cull(C, radius, r2, origin, Ds, float((lim if every else lim[short]).max()))
+            if origin is not None and len(Ds) else None)
     if cull is not None:
         pr, pm = _origin_candidates(r2, Ds, cull)
         if not every:
@@ -172,7 +179,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
         longs = (valid & ~short_m).nonzero()[0]
         if len(longs):
             Dl = D.take(longs, axis=0)
-            cull = _origin_cull(C, radius, r2, O[0], Dl, float(lim[longs].max())) if origin else None
+            cull = _origin_cull(C, radius, r2, origin, Dl, float(lim[longs].max())) if origin is not None else None
             lp, lm = _sphere_pairs(C, r2, owner, O.take(longs, axis=0), Dl, _take(t_near, longs), lim[longs],
                                    _take(excl, longs), among=None if cull is None else cull[0])
             pr = np.concatenate([pr, longs[lp]])
@@ -188,6 +195,17 @@ def _never_back(t_near) -> bool:
     """No segment starts behind its origin (t_near >= 0 for every ray): a segment passing near a
     sphere whose centre lies well away from the origin then points towards it."""
     return bool(t_near >= 0.0) if not isinstance(t_near, np.ndarray) else bool(len(t_near) == 0 or t_near.min() >= 0.0)
+
+
+def _among(C, radius, r2, origin, D, lim):
+    """The movers rays from one ``origin`` (None: not known) can pass near whatever their
+    segments' lengths (``_origin_cull`` by direction only: ``_sphere_pairs``' one-origin test lists
+    the rays of a mover's cone however far it is), for ``_sphere_pairs``' per-mover test; None when
+    not known or when some segment ends behind the origin (its test point would lie behind it)."""
+    if origin is None or not len(D) or not bool(lim.min() >= 0.0):
+        return None
+    cull = _origin_cull(C, radius, r2, origin, D, _INF)
+    return None if cull is None else cull[0]
 
 
 def _origin_cull(C, radius, r2, o, D, lim_max: float):
@@ -336,6 +354,16 @@ def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndar
     pb, pm = _near_centres(C.take(used, axis=0), R[used], C, mt.radius)
     nb = (pm != used[pb]).nonzero()[0]      # CSR of each mover's neighbours (pb is sorted)
     src, dst = used[pb[nb]], pm[nb]
+    if (len(used) == 1 and O.strides[0] == 0 and len(dst) > _FEW and _never_back(t_near)
+            and bool(lim[mi].min() >= 0.0)):
+        # one origin on one body (a camera with shapes of its own): of the body's neighbours (in
+        # their order), those in view of its rays, and per ray those whose cone holds it
+        cull = _origin_cull(C.take(dst, axis=0), mt.radius[dst], mt.r2[dst], O[0], D.take(mi, axis=0),
+                            float(lim[mi].max()))
+        if cull is not None:
+            ri, pm = _origin_candidates(mt.r2[dst], D.take(mi, axis=0), cull)
+            pr, pm = _near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, mi[ri], dst[pm])
+            return pr, pm, (~mounted).nonzero()[0]
     cnt = np.bincount(src, minlength=M)
     ptr = np.cumsum(cnt) - cnt
     c = cnt[rows]
