@@ -138,3 +138,39 @@ def test_swarm_cameras_on_their_bodies_see_as_with_an_origin_array(tmp_path, mon
         assert a.normal.tobytes() == b.normal.tobytes() and a.shape.tobytes() == b.shape.tobytes()
         hits += int(np.isfinite(a.distance).sum())
     assert hits > 10000 and paired >= 20
+
+
+def test_swarm_cameras_kept_mounts_skip_neighbours_out_of_view(tmp_path, monkeypatch):
+    """A bounded camera with shapes of its own casts with a kept Mount (the lidar's one-origin
+    pairing: every neighbour's cone tested per cast); the neighbours out of the camera's view are
+    skipped, with the same bits as testing all of them."""
+    from sensorium.server.raycast.engine import Mount
+
+    sim = Simulation(load_world(str(write_swarm(30, tmp_path / "swarm.wbt", housing=True))))
+    cams = [d for d in sim.all_devices() if d.kind == "Camera"]
+    cams[0].enable(32)
+    sim.step()
+    engine = cams[0]._scene.engine
+    real = movers._among
+    skipped = []
+
+    def spy(C, *a):
+        got = real(C, *a)
+        skipped.append(0 if got is None else len(C) - len(got))
+        return got
+
+    hits = 0
+    for cam in cams:
+        body = cam._scene.device_body(cam.robot_index, cam.on_joint)
+        pose = cam.world_pose(cam._robot.pose)
+        D = _unit(_frustum(40, 0.0, 0.42) @ np.asarray(pose.rotation).T)
+        O = np.broadcast_to(np.asarray(pose.translation, dtype=np.float64), D.shape)
+        monkeypatch.setattr(movers, "_among", spy)
+        a = engine.cast(O, D, 0.005, 2.0, kind=RayKind.VISUAL, mount=Mount(np.full(len(D), body)))
+        monkeypatch.setattr(movers, "_among", lambda *a: None)
+        b = engine.cast(O, D, 0.005, 2.0, kind=RayKind.VISUAL, mount=Mount(np.full(len(D), body)))
+        assert a.distance.tobytes() == b.distance.tobytes()
+        assert a.normal.tobytes() == b.normal.tobytes() and a.shape.tobytes() == b.shape.tobytes()
+        hits += int(np.isfinite(a.distance).sum())
+    assert hits > 10000
+    assert sum(skipped) > 10 * len(cams)     # most neighbours are out of a 0.84 rad view

@@ -137,7 +137,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl, origin=None):
     fin = valid & (L < _INF)
     Lf = L[fin]
     if len(Lf) == 0:
-        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=_among(C, radius, r2, origin, D, lim))
+        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=_among(C, radius, r2, origin, D, t_near, lim))
     # cell size from the MEDIAN segment length and mover radius (robust to a few long rays and
     # big movers: a big mover registers in more cells, a long segment takes the dense test)
     r_med = float(np.partition(radius, M // 2)[M // 2])
@@ -148,7 +148,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl, origin=None):
     span = float(((C + reach).max(0) - g0).max())
     cell = 2.0 * r_med + L_cap               # a typical grown sphere overlaps <= 2 cells per axis
     if 2.0 * cell >= span:                   # a grid of ~one cell would not prune anything
-        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=_among(C, radius, r2, origin, D, lim))
+        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=_among(C, radius, r2, origin, D, t_near, lim))
     short_m = fin & (L <= L_cap)
     every = bool(short_m.all())
     short = None if every else short_m.nonzero()[0]
@@ -197,12 +197,12 @@ def _never_back(t_near) -> bool:
     return bool(t_near >= 0.0) if not isinstance(t_near, np.ndarray) else bool(len(t_near) == 0 or t_near.min() >= 0.0)
 
 
-def _among(C, radius, r2, origin, D, lim):
+def _among(C, radius, r2, origin, D, t_near, lim):
     """The movers rays from one ``origin`` (None: not known) can pass near whatever their
     segments' lengths (``_origin_cull`` by direction only: ``_sphere_pairs``' one-origin test lists
     the rays of a mover's cone however far it is), for ``_sphere_pairs``' per-mover test; None when
     not known or when some segment ends behind the origin (its test point would lie behind it)."""
-    if origin is None or not len(D) or not bool(lim.min() >= 0.0):
+    if origin is None or not len(D) or not bool(lim.min() >= 0.0) or not _never_back(t_near):
         return None
     cull = _origin_cull(C, radius, r2, origin, D, _INF)
     return None if cull is None else cull[0]
@@ -577,8 +577,11 @@ def one_origin_pairs(st: _MountState, mt: _Movers, C: np.ndarray, O: np.ndarray,
             _body_list(st, mt, C, counters)
     nb = st.dst
     if len(nb):
-        pr, pm = _sphere_pairs(C.take(nb, axis=0), mt.r2[nb], None if owner is None else owner[nb], O, D,
-                               t_near, lim, excl)
+        Cn = C.take(nb, axis=0)
+        # a camera's pixels (directions within a cone): the neighbours out of its view are skipped
+        among = _among(Cn, mt.radius[nb], mt.r2[nb], O[0], D, t_near, lim) if len(nb) > _FEW else None
+        pr, pm = _sphere_pairs(Cn, mt.r2[nb], None if owner is None else owner[nb], O, D, t_near, lim, excl,
+                               among=among)
         pm = nb[pm]
     else:
         pr = pm = np.zeros(0, dtype=np.int64)
