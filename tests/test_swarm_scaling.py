@@ -174,3 +174,23 @@ def test_swarm_cameras_kept_mounts_skip_neighbours_out_of_view(tmp_path, monkeyp
         hits += int(np.isfinite(a.distance).sum())
     assert hits > 10000
     assert sum(skipped) > 10 * len(cams)     # most neighbours are out of a 0.84 rad view
+
+
+def test_work_scan_counts_as_the_walk_with_paths(tmp_path):
+    """Loading checks every value of the world once: the scan without paths counts the triangles and
+    lights the walk with paths counts, and a number out of bounds is still named by its path."""
+    from sensorium.schemas.world import Mesh
+    from sensorium.server.world import limits as lim
+
+    loaded = load_world(str(write_swarm(6, tmp_path / "swarm.wbt", housing=True)))
+    world, limits = loaded.world, lim.WorldLimits()
+    problems: list = []
+    walked = lim._walk_work(world, limits, lambda g: 0, problems, lambda *a: problems.append(a))
+    assert lim._scan_work(world, limits, lambda g: 0) == walked and not problems
+    assert walked[0] > 6 * 100 and walked[1] >= 1          # the robots' triangles; the PointLight
+    assert not lim.has_model(world, Mesh)
+    pose = world.robots[3].pose
+    object.__setattr__(pose, "translation", (pose.translation[0], float("nan"), pose.translation[2]))
+    assert lim._scan_work(world, limits, lambda g: 0) is None
+    found = lim.check_work(world, limits, lambda g: 0)
+    assert found == [("robots[3].pose.translation[1]", "expected a finite number, got nan")]
