@@ -62,6 +62,9 @@ def test_one_origin_pairs_are_the_grid_pairs(seed, monkeypatch):
     assert cells
     assert one[0].tolist() == grid[0].tolist() and one[1].tolist() == grid[1].tolist()
     assert len(grid[0]) > 300
+    monkeypatch.setattr(movers, "_TABLE", 500)          # the rays x movers table in row blocks: the same
+    blocks = _pairs(C, radius, owner, np.broadcast_to(o, D.shape), D, t_near, lim, excl)
+    assert blocks[0].tolist() == grid[0].tolist() and blocks[1].tolist() == grid[1].tolist()
 
 
 def test_origin_cull_keeps_movers_in_view_and_reach():

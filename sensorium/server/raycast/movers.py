@@ -22,6 +22,7 @@ from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _ful
 from sensorium.server.world.geometry import Pose
 
 _FEW = 8   # one-origin batches against up to this many movers: one matrix-vector test per mover
+_TABLE = 1 << 18   # entries of a one-origin (rays, movers in view) table per block (2 MB of float64)
 
 
 def _segment_near_sphere(rel_x, rel_y, rel_z, dx, dy, dz, t_lo, t_hi, r2):
@@ -245,8 +246,17 @@ def _origin_candidates(r2, D, cull):
     if len(K) == 0:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
     thr = np.where(near, -_INF, np.sqrt(np.maximum(e2 - r2[K], 0.0)) * (1.0 - 1e-9) - 1e-12 * np.sqrt(e2))
-    ri, ki = (_mat(D, np.ascontiguousarray(rel.T)) >= thr).nonzero()   # row-major: by ray, then mover
-    return ri, K[ki]
+    relT = np.ascontiguousarray(rel.T)
+    rows = max(1, _TABLE // len(K))          # the table in row blocks: a few MB whatever the image and swarm
+    if rows >= len(D):
+        ri, ki = (_mat(D, relT) >= thr).nonzero()   # row-major: by ray, then mover
+        return ri, K[ki]
+    ris, kis = [], []
+    for a in range(0, len(D), rows):
+        r, k = (_mat(D[a:a + rows], relT) >= thr).nonzero()
+        ris.append(r + a)
+        kis.append(k)
+    return np.concatenate(ris), K[np.concatenate(kis)]
 
 
 def _cell_candidates(C, reach, g0, span: float, cell: float, Os, Ds, Ls, tn, n: int, short):
