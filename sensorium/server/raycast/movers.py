@@ -190,8 +190,6 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl, origin=None):
     return pr, pm
 
 
-
-
 def _never_back(t_near) -> bool:
     """No segment starts behind its origin (t_near >= 0 for every ray): a segment passing near a
     sphere whose centre lies well away from the origin then points towards it."""
