@@ -197,3 +197,27 @@ def test_work_scan_counts_as_the_walk_with_paths(tmp_path):
     assert lim._scan_work(world, limits, lambda g: 0) is None
     found = lim.check_work(world, limits, lambda g: 0)
     assert found == [("robots[3].pose.translation[1]", "expected a finite number, got nan")]
+
+
+def test_enclosing_shapes_judges_rotated_shapes_after_the_distance_test():
+    """Loading says which device sits inside one of its robot's closed shapes (a robot's shapes times
+    its devices, so most pairs are ruled out by distance before any rotation is made): a box 10 cm
+    long turned a quarter turn about z holds (0, 0.045, 0) and not (0.045, 0, 0); a sphere of radius
+    0.02 holds a point 0.0199 from its centre along a diagonal and not one 0.0201 away."""
+    from sensorium.server.world.wbt.inside import enclosing_shapes
+
+    box = {"geometry": {"type": "box", "size": [0.1, 0.02, 0.02]},
+           "pose": {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 1.0, math.pi / 2]}}
+    ball = {"geometry": {"type": "sphere", "radius": 0.02}, "pose": {"translation": [1.0, 1.0, 1.0]}}
+    robot = {"shapes": [box, ball]}
+
+    def inside(x, y, z):
+        dev = {"device": "Camera", "name": "c", "near": 0.0, "pose": {"translation": [x, y, z]}}
+        return [p["geometry"]["type"] for p in enclosing_shapes(robot, dev)]
+
+    s = 0.0199 / math.sqrt(3.0)
+    t = 0.0201 / math.sqrt(3.0)
+    assert inside(0.0, 0.045, 0.0) == ["box"]
+    assert inside(0.045, 0.0, 0.0) == []
+    assert inside(1.0 + s, 1.0 + s, 1.0 - s) == ["sphere"]
+    assert inside(1.0 + t, 1.0 + t, 1.0 - t) == []

@@ -290,14 +290,18 @@ def has_model(world: Any, cls: type) -> bool:
     """Whether some value of a validated model is an instance of ``cls`` (the walk of ``_walk``,
     without paths)."""
     todo: list[Any] = [world]
+    nested = (BaseModel, list, tuple)
     while todo:
         v = todo.pop()
         if isinstance(v, cls):
             return True
         if isinstance(v, BaseModel):
-            todo.extend(getattr(v, name) for name in type(v).model_fields)
+            for name in type(v).model_fields:
+                x = getattr(v, name)
+                if isinstance(x, nested):
+                    todo.append(x)
         elif isinstance(v, (list, tuple)):
-            todo.extend(x for x in v if isinstance(x, (BaseModel, list, tuple)))
+            todo.extend(x for x in v if isinstance(x, nested))
     return False
 
 
