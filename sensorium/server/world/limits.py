@@ -229,14 +229,10 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
 _GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh", "triangles", "elevation_grid"}
 
 
-def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> list[str | tuple[str, str]]:
-    """The work a validated world asks for. Returns problems as ``(path, message)``."""
-    problems: list[str | tuple[str, str]] = []
-
-    def over(path: str, what: str, n: float, cap: float) -> None:
-        num = (lambda x: f"{x:,}") if isinstance(n, int) else (lambda x: f"{x:g}")
-        problems.append((path, f"{what} {num(n)} exceeds the limit of {num(cap)} {RAISE}"))
-
+def _walk_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int], problems: list,
+               over: Callable[[str, str, float, float], None]) -> tuple[int, int]:
+    """(triangles, lights) of a validated world; every number out of bounds added to ``problems``,
+    named by its path."""
     triangles = 0
     lights = 0                              # occluding light sensors cast a ray per light
     for path, v in _walk(world):
@@ -254,6 +250,73 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
                 triangles += triangle_count(v, mesh_triangles)
             elif isinstance(kind, str) and kind.endswith("Light"):
                 lights += 1
+    return triangles, lights
+
+
+def _scan_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> tuple[int, int] | None:
+    """What ``_walk_work`` counts, the same values visited, without making a path for each (a
+    200-robot swarm holds about a million values; the paths were most of the walk's time): None
+    when some number is out of bounds (the caller then walks again with paths, to name it)."""
+    cap = limits.number_magnitude
+    triangles = lights = 0
+    todo: list[tuple[Any, bool]] = [(world, False)]     # (value, reached as a field named ...geometry)
+    pop, push = todo.pop, todo.append
+    while todo:
+        v, geometry_field = pop()
+        if isinstance(v, float):
+            mag = abs(v)
+            if not mag <= cap or 0.0 < mag < 1e-30:      # (NaN fails the first test)
+                return None
+        elif isinstance(v, BaseModel):
+            kind = getattr(v, "type", None)
+            if kind in _GEOMETRY_TYPES and geometry_field:
+                triangles += triangle_count(v, mesh_triangles)
+            elif isinstance(kind, str) and kind.endswith("Light"):
+                lights += 1
+            for name in type(v).model_fields:
+                push((getattr(v, name), name.endswith("geometry")))
+        elif isinstance(v, (list, tuple)):
+            for x in v:
+                if isinstance(x, float):             # numbers inline: most values are
+                    mag = abs(x)
+                    if not mag <= cap or 0.0 < mag < 1e-30:
+                        return None
+                elif isinstance(x, (BaseModel, list, tuple)):
+                    push((x, False))
+    return triangles, lights
+
+
+def has_model(world: Any, cls: type) -> bool:
+    """Whether some value of a validated model is an instance of ``cls`` (the walk of ``_walk``,
+    without paths)."""
+    todo: list[Any] = [world]
+    nested = (BaseModel, list, tuple)
+    while todo:
+        v = todo.pop()
+        if isinstance(v, cls):
+            return True
+        if isinstance(v, BaseModel):
+            for name in type(v).model_fields:
+                x = getattr(v, name)
+                if isinstance(x, nested):
+                    todo.append(x)
+        elif isinstance(v, (list, tuple)):
+            todo.extend(x for x in v if isinstance(x, nested))
+    return False
+
+
+def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> list[str | tuple[str, str]]:
+    """The work a validated world asks for. Returns problems as ``(path, message)``."""
+    problems: list[str | tuple[str, str]] = []
+
+    def over(path: str, what: str, n: float, cap: float) -> None:
+        num = (lambda x: f"{x:,}") if isinstance(n, int) else (lambda x: f"{x:g}")
+        problems.append((path, f"{what} {num(n)} exceeds the limit of {num(cap)} {RAISE}"))
+
+    counted = _scan_work(world, limits, mesh_triangles)
+    if counted is None:        # some number out of bounds: the walk with paths, to name each
+        counted = _walk_work(world, limits, mesh_triangles, problems, over)
+    triangles, lights = counted
     # robots, devices, lights and solids: check_counts, on the data before validation
     if triangles > limits.triangles:
         over("", "the world's triangles:", triangles, limits.triangles)
