@@ -278,5 +278,7 @@ def test_a_box_spinning_against_walls_is_answered_without_the_arcs():
                 m.set_position(math.inf)
                 m.set_velocity(v)
             sim.run(60)
-            assert sim.counters["contacts"] > 50 and sim.counters["contact_checks"] > 100
+            # pushed off while its corners pass their farthest reach toward the walls (the first
+            # quarter turn or so), then spinning clear of them
+            assert sim.counters["contacts"] >= 7 and sim.counters["contact_checks"] > 50
     assert arcs == []

@@ -30,7 +30,9 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   arc about the centre tested in closed form, :func:`turn_gap_holds`); where the turn would go into something,
   the whole turn is kept and the centre pushed off it the least distance, to touching
   (:meth:`Contact._push`, closed form; in a corner of two polygons, off both at once:
-  :meth:`Contact._push_off_both`), unless that push meets something else: then the turn is
+  :meth:`Contact._push_off_both`; where the turn ends clear of it but a corner's arc dips into it
+  on the way, past the peak of its reach, off by as far as the arc went in:
+  :meth:`Contact._push_sweep`), unless that push meets something else: then the turn is
   cut short, found by halving to 2^-12 of the step's turn (either counts as a contact); then its centre moves along the chord from
   its start to its end pose (poses are only observed at the end of steps, and the end point is
   the exact arc end unless contact clips it) at the heading it kept. The chord is tested against
@@ -1470,7 +1472,7 @@ class Contact:
         return end, clipped or kept != yaw1, kept
 
     def _push(self, foot: Footprint, p: np.ndarray, yaw: float, yaw1: float, turn: float,
-              cands: list[Obstacle], now: list[float]) -> np.ndarray | None:
+              cands: list[Obstacle], now: list[float], swept: bool = True) -> np.ndarray | None:
         """Where rigid contact pushes the robot's centre when the whole turn from ``yaw`` to ``yaw1``
         at ``p`` would put its footprint into a candidate (``now``: each one's signed distance at
         ``yaw``), or None: the least move, out of the candidate it would go deepest into, along
@@ -1495,11 +1497,34 @@ class Contact:
             if gap < target - EPS:
                 pushes.append((target - gap, i, normal))
         if not pushes:
-            return None
+            # the turned footprint overlaps nothing where the turn ends, but a corner's arc dips into
+            # something on the way (past the peak of its reach toward a wall): pushed off by that depth
+            return self._push_sweep(foot, p, yaw, turn, cands, now)
         into = {i for _, i, _ in pushes}
         rest = [j for j in range(len(cands)) if j not in into]
         if rest and not self._turn_clear(foot, p, yaw, turn, [cands[j] for j in rest], [now[j] for j in rest]):
-            return None
+            # the turn also sweeps into one it does not end in (a corner of two walls, the turn past
+            # the peak of its reach toward one of them): pushed off that one's sweep first
+            # (:meth:`_push_sweep`), then off the others from there, its sweep still clear
+            if not swept:
+                return None
+            others, before = [cands[j] for j in rest], [now[j] for j in rest]
+            base = self._push_sweep(foot, p, yaw, turn, others, before)
+            if base is None:
+                return None
+            here = _turned(foot.points, yaw)
+            for j in into:
+                self.checks += 1
+                if time_of_impact(p, base - p, *_grown(cands[j], here, foot.round, p))[1] is not None:
+                    return None
+            q = self._push(foot, base, yaw, yaw1, turn, cands,
+                           [_gap(base, *_grown(ob, here, foot.round, base)) for ob in cands], False)
+            if q is None or float(np.hypot(*(q - p))) > foot.radius * min(abs(turn), 2.0):
+                return None
+            after = [_gap(q, *_grown(ob, here, foot.round, q)) for ob in others]
+            if min(a - min(b, 0.0) for a, b in zip(after, before)) < -EPS or not self._turn_clear(foot, q, yaw, turn, others, after):
+                return None
+            return q
         limit = foot.radius * min(abs(turn), 2.0)
         here = _turned(foot.points, yaw)
         for dist, i, normal in sorted(pushes, key=lambda t: (-t[0], t[1])):
@@ -1520,6 +1545,61 @@ class Contact:
                 return q
         if len(pushes) == 2:         # a corner of two: the least move out of both, if that fits
             return self._push_off_both(p, pushes[0][1], pushes[1][1], grown, now, cands, here, foot.round, limit)
+        return None
+
+    def _push_sweep(self, foot: Footprint, p: np.ndarray, yaw: float, turn: float, cands: list[Obstacle],
+                    now: list[float]) -> np.ndarray | None:
+        """The push when the turn from ``yaw`` by ``turn`` at ``p`` ends overlapping nothing but sweeps
+        into a candidate on the way (a box robot's corner passing the peak of its reach toward a wall
+        it rests on), or None: the least move along one of that candidate's axes (its edge normals,
+        fixed; a wall line's normal) that keeps the footprint at least touching it at every heading of
+        the turn -- the turn's least separation along the axis (:func:`_least_along`, exact), so the
+        centre ends as far off as the footprint reached into it. Checked as :meth:`_push` checks a push:
+        not back toward the side the robot came from, no longer than any footprint point moved in the
+        turn, neither its path nor its end meets another candidate (deeper than it already was), and
+        the whole turn from there is clear of every candidate (:meth:`_turn_clear`)."""
+        assert foot.points is not None
+        if min(now) < -EPS:
+            return None
+        here = _turned(foot.points, yaw)
+        rnd = foot.round
+        lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
+        limit = foot.radius * min(abs(turn), 2.0)
+        grown = [_grown(ob, here, rnd, p) for ob in cands]
+        tries = []
+        for i, ob in enumerate(cands):
+            if self._turn_clear(foot, p, yaw, turn, [ob], [now[i]]):
+                continue
+            self.checks += 1
+            _, back = _gap_normal(p, *grown[i])
+            if ob.normal is not None:
+                side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
+                axes = (side * ob.normal)[None, :]
+                reach = -float(np.min(_least_along(here, lo, hi, -axes))) + rnd
+                need = np.array([reach - abs(float(ob.normal @ p) + ob.offset)])
+            else:
+                q = ob.points - p[None, :]
+                _, _, axes = _edges(q)
+                if not len(axes):
+                    continue
+                need = rnd + ob.radius - (_least_along(here, lo, hi, axes) - np.max(axes @ q.T, axis=1))
+            for k in range(len(axes)):
+                t = float(need[k])
+                if 0.0 < t <= limit and float(axes[k] @ back) > 0.0:
+                    tries.append((t, i, k, axes[k]))
+        for t, i, _, n in sorted(tries, key=lambda a: (a[0], a[1], a[2])):
+            step = (t + BACK_OFF) * n
+            q = p + step
+            after = []
+            for j, (g, before) in enumerate(zip(grown, now)):
+                self.checks += 1
+                gap = _gap(q, *_grown(cands[j], here, rnd, q))
+                if gap < min(before, 0.0) - EPS or (j != i and time_of_impact(p, step, *g)[1] is not None):
+                    break
+                after.append(gap)
+            else:
+                if self._turn_clear(foot, q, yaw, turn, cands, after):
+                    return q
         return None
 
     def _push_off_both(self, p: np.ndarray, i: int, j: int, grown: list[tuple[Obstacle, float]], now: list[float],
