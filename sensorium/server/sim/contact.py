@@ -1046,12 +1046,7 @@ def _inside_in_turn(shape: np.ndarray, q: np.ndarray, turn: float) -> bool:
     # and where each footprint vertex reaches deepest past each of the obstacle's edges on its arc
     # (its turn pointing it against the edge's normal), when that heading is within the turn
     lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
-    lines = []
-    for (ax, ay), (bx, by) in zip([g[-1]] + g[:-1], g):
-        ex, ey = bx - ax, by - ay
-        el = math.hypot(ex, ey)
-        if el > 0.0:
-            lines.append((ax, ay, ey / el, -ex / el))
+    lines = _edge_lines(g)
     if len(lines) < 3:
         return False
     for x, y in pts:
@@ -1068,15 +1063,22 @@ def _inside_in_turn(shape: np.ndarray, q: np.ndarray, turn: float) -> bool:
     return False
 
 
-def _any_inside(v: list, w: list, tol: float) -> bool:
-    """Whether a point of ``v`` is inside the counter-clockwise polygon ``w`` deeper than ``tol``
-    from each of its edges' lines."""
+def _edge_lines(w: list) -> list:
+    """The lines of the counter-clockwise polygon ``w``'s edges: (a point, its outward unit normal)
+    for each edge of non-zero length."""
     lines = []
     for (ax, ay), (bx, by) in zip([w[-1]] + w[:-1], w):
         ex, ey = bx - ax, by - ay
         el = math.hypot(ex, ey)
         if el > 0.0:
             lines.append((ax, ay, ey / el, -ex / el))
+    return lines
+
+
+def _any_inside(v: list, w: list, tol: float) -> bool:
+    """Whether a point of ``v`` is inside the counter-clockwise polygon ``w`` deeper than ``tol``
+    from each of its edges' lines."""
+    lines = _edge_lines(w)
     if len(lines) < 3:
         return False
     for px, py in v:
