@@ -1,0 +1,90 @@
+"""A Camera's Zoom (Webots' Zoom node): ``setFov`` within its range changes the field of view of the
+images taken from then on. Closed form: a lit wall whose edge is seen at a known angle from the
+camera; the edge's pixel column is where the pinhole formula puts it for each field of view. The
+Zoom's range and Webots' error lines, the .wbt converter, a simulation reset, and the Python and C
+clients alike."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from pydantic import ValidationError
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.simulation import Simulation
+
+W, H = 101, 9
+FOV = 1.0
+EDGE = 0.2          # rad: the wall's edge seen from the camera, to its left (+y)
+FACE = 1.95         # the wall's face: x = 1.95
+
+
+def world(zoom: dict | None = None) -> wm.World:
+    edge_y = FACE * math.tan(EDGE)
+    cam = {"device": "Camera", "name": "cam", "width": W, "height": H, "field_of_view": FOV}
+    if zoom is not None:
+        cam["zoom"] = zoom
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "random_seed": 5},
+        # the wall covers y <= edge_y (right of the edge as the camera sees it); black sky beyond
+        "solids": [{"name": "wall", "pose": {"translation": [2.0, edge_y - 5.0, 0.0]},
+                    "geometry": {"type": "box", "size": [0.1, 10.0, 20.0]}, "appearance": {"base_color": [1, 1, 1]}}],
+        "lights": [{"type": "DirectionalLight", "direction": [1.0, 0.0, 0.0], "intensity": 1.0}],
+        "robots": [{"name": "r", "devices": [cam]}]})
+
+
+def lit_columns(fov: float) -> np.ndarray:
+    """The pinhole formula: column c's centre ray makes tan = (W/2 - c - 1/2) / f to the left of the
+    axis, f = (W/2) / tan(fov/2); it meets the wall where that tangent is below tan(EDGE)."""
+    f = (W / 2) / math.tan(fov / 2)
+    c = np.arange(W)
+    return (W / 2 - c - 0.5) / f < math.tan(EDGE)
+
+
+def seen(sim: Simulation) -> np.ndarray:
+    cam = sim.device("r/cam")
+    sim.run(1)
+    return cam.image[H // 2, :, 2] > 0          # the centre row's red: the wall is lit, the sky black
+
+
+def test_set_fov_moves_the_edge_to_where_the_pinhole_formula_puts_it():
+    sim = Simulation(world({"min_field_of_view": 0.4, "max_field_of_view": 1.2}))
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    before = seen(sim)
+    np.testing.assert_array_equal(before, lit_columns(FOV))
+    assert before.argmax() == 32                # the first lit column: 50 - 92.5 tan 0.2 = 31.2
+    cam.set_fov(FOV / 2)
+    assert cam.describe()["fov"] == FOV / 2
+    after = seen(sim)
+    np.testing.assert_array_equal(after, lit_columns(FOV / 2))
+    assert after.argmax() == 10                 # 50 - 197.9 tan 0.2 = 9.9
+    k = np.frombuffer(cam.camera_info()["k"], dtype="<f8")
+    assert k[0] == pytest.approx((W / 2) / math.tan(FOV / 4))      # camera_info follows
+    sim.reset()                                 # the world file's field of view again
+    assert cam.describe()["fov"] == FOV
+    np.testing.assert_array_equal(seen(sim), lit_columns(FOV))
+
+
+def test_the_zoom_range_and_what_set_fov_refuses():
+    sim = Simulation(world({}))                 # Webots' defaults
+    cam = sim.device("r/cam")
+    d = cam.describe()
+    assert (d["fov"], d["min_fov"], d["max_fov"]) == (FOV, 0.5, 1.5)
+    for bad, why in [(0.45, r"out of the Zoom's range \[0.5, 1.5\]"), (1.6, "out of the Zoom's range"),
+                     (math.nan, "finite"), (math.inf, "finite")]:
+        with pytest.raises(ValueError, match=why):
+            cam.set_fov(bad)
+    assert cam.describe()["fov"] == FOV
+    plain = Simulation(world()).device("r/cam")   # no Zoom: min = max = fov, nothing changes it
+    d = plain.describe()
+    assert (d["min_fov"], d["max_fov"]) == (FOV, FOV)
+    with pytest.raises(ValueError, match="no Zoom node"):
+        plain.set_fov(FOV)
+    wide = Simulation(world({"min_field_of_view": 0.5, "max_field_of_view": 4.0})).device("r/cam")
+    with pytest.raises(ValueError, match=r"planar camera \(it must be in \(0, pi\)\)"):
+        wide.set_fov(math.pi)
+    with pytest.raises(ValidationError, match="min_field_of_view .* is above max_field_of_view"):
+        world({"min_field_of_view": 1.0, "max_field_of_view": 0.9})
