@@ -88,3 +88,71 @@ def test_the_zoom_range_and_what_set_fov_refuses():
         wide.set_fov(math.pi)
     with pytest.raises(ValidationError, match="min_field_of_view .* is above max_field_of_view"):
         world({"min_field_of_view": 1.0, "max_field_of_view": 0.9})
+
+
+EXPECTED = ["range 1 0.4 1.2", "edge 32", "refused 1", "fov 0.5", "edge 10"]
+REFUSALS = ["Error: wb_camera_set_fov() called with 'fov' argument outside of the [0, pi] range.",
+            "Error: wb_camera_set_fov() out of zoom range [0.400000, 1.200000]."]
+
+
+def world_file(tmp_path) -> str:
+    import yaml
+    path = tmp_path / "zoom.yaml"
+    path.write_text(yaml.safe_dump(world({"min_field_of_view": 0.4, "max_field_of_view": 1.2})
+                                   .model_dump(mode="json", exclude_defaults=True)))
+    return str(path)
+
+
+def first_lit(cam) -> int:
+    img = cam.getImage()
+    return next((x for x in range(W) if cam.imageGetRed(img, W, x, H // 2) > 0), -1)
+
+
+def test_the_python_client_zooms_and_follows_a_reset(tmp_path, capsys):
+    """tests/c/zoom.c's lines from the Python client; then a simulation reset: the next step's
+    reading brings the world file's field of view back to getFov."""
+    from _inproc import inproc_server
+
+    from sensorium.client import wb
+    from sensorium.client.webots.controller import Robot
+    with inproc_server(heartbeat_ms=5000, world=world_file(tmp_path)) as (core, transport):
+        wb.wb_robot_init(f"{transport.rpc_endpoint}/r")
+        try:
+            robot = Robot()
+            cam = robot.getDevice("cam")
+            lines = [f"range {cam.getFov():g} {cam.getMinFov():g} {cam.getMaxFov():g}"]
+            cam.enable(16)
+            robot.step(16)
+            lines.append(f"edge {first_lit(cam)}")
+            capsys.readouterr()
+            cam.setFov(4.0)
+            cam.setFov(0.3)
+            assert capsys.readouterr().err.splitlines() == REFUSALS
+            lines.append(f"refused {cam.getFov():g}")
+            cam.setFov(0.5)
+            lines.append(f"fov {cam.getFov():g}")
+            assert core.sim.device("r/cam").fov == 0.5
+            robot.step(16)
+            lines.append(f"edge {first_lit(cam)}")
+            assert lines == EXPECTED
+            core.sim.reset()
+            robot.step(16)
+            assert cam.getFov() == FOV and first_lit(cam) == 32
+        finally:
+            wb.wb_robot_cleanup()
+            Robot.created = None
+
+
+@pytest.mark.slow
+def test_the_c_client_zooms_as_the_python_client(tmp_path, tmp_path_factory):
+    import subprocess
+
+    from _serve import serve
+    from test_c_client import REPO, SAN_ENV, finish, sanitized_controller, start
+    exe = sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "zoom.c")
+    with serve(world_file(tmp_path), env=SAN_ENV) as server:
+        p: subprocess.Popen = start([exe], server.url("r"))
+        code, out, err = finish(p)
+    assert code == 0, err
+    assert out == EXPECTED
+    assert [x for x in err.splitlines() if x.startswith("Error")] == REFUSALS
