@@ -156,3 +156,36 @@ def test_the_c_client_zooms_as_the_python_client(tmp_path, tmp_path_factory):
     assert code == 0, err
     assert out == EXPECTED
     assert [x for x in err.splitlines() if x.startswith("Error")] == REFUSALS
+
+
+def test_recognition_follows_the_new_field_of_view():
+    """A recognised box's place and size on the image: Webots' projection (tests/test_recognition.py's
+    webots_box) at the zoomed field of view, no longer at the world file's."""
+    from test_recognition import aabb_corners, c_round
+
+    w, h = 64, 48
+
+    def box_on_image(fov: float) -> tuple[tuple[int, int], tuple[int, int]]:
+        corners = aabb_corners(np.array([1.9, 0.1, -0.4]), np.array([2.1, 0.5, 0.2]))
+        t = math.tan(fov / 2)
+        u = np.clip(0.5 - 0.5 * (corners[:, 1] / np.abs(corners[:, 0])) / t, 0, 1)
+        v = np.clip(0.5 - 0.5 * (corners[:, 2] / np.abs(corners[:, 0])) / (t * h / w), 0, 1)
+        pu, pv = ((w - 1) * u).astype(int), ((h - 1) * v).astype(int)
+        return ((c_round((pu.max() + pu.min()) / 2), c_round((pv.max() + pv.min()) / 2)),
+                (math.ceil(pu.max() - pu.min()), math.ceil(pv.max() - pv.min())))
+
+    sim = Simulation(wm.World.model_validate({
+        "world_info": {"basic_time_step": 16},
+        "solids": [{"name": "crate", "pose": {"translation": [2.0, 0.3, -0.1]},
+                    "geometry": {"type": "box", "size": [0.2, 0.4, 0.6]}, "recognition_colors": [[1, 0, 0]]}],
+        "robots": [{"name": "r", "devices": [{"device": "Camera", "name": "cam", "width": w, "height": h,
+                                              "field_of_view": 1.0, "recognition": {}, "zoom": {}}]}]}))
+    cam = sim.device("r/cam")
+    cam.recognition_enable(16)
+    sim.step()
+    [obj] = cam.objects
+    assert (obj.position_on_image, obj.size_on_image) == box_on_image(1.0)
+    cam.set_fov(0.6)
+    sim.step()
+    [obj] = cam.objects
+    assert (obj.position_on_image, obj.size_on_image) == box_on_image(0.6) != box_on_image(1.0)
