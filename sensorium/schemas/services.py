@@ -230,6 +230,10 @@ class ExposureArgs(Args):
     value: float = Field(ge=0.0, description="the camera's photometric exposure (Webots' exposure, >= 0)")
 
 
+class FovArgs(Args):
+    value: float = Field(description="rad, within the camera's Zoom range [min_fov, max_fov]")
+
+
 class LayerArgs(Args):
     layer: int = Field(ge=0, lt=1 << 31)
 
@@ -485,6 +489,8 @@ class CameraDescription(_Entry):
     height: int
     fov: float = Field(description="rad, horizontal")
     near: float
+    min_fov: float = Field(description="rad: the Zoom's minFieldOfView (fov without a Zoom)")
+    max_fov: float = Field(description="rad: the Zoom's maxFieldOfView (fov without a Zoom)")
     far: float = Field(description="0: no far plane")
     exposure: float
     projection: str = Field(description="planar, cylindrical or spherical")
@@ -1061,6 +1067,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("set_ink_color", "device", InkColorArgs, SuccessResult, attached=True),
     ServiceSpec("draw", "device", DrawArgs, DrawResult, attached=True),
     ServiceSpec("set_exposure", "device", ExposureArgs, SuccessResult, attached=True),
+    ServiceSpec("set_fov", "device", FovArgs, SuccessResult, attached=True),
     ServiceSpec("recognition_enable", "device", EnableArgs, SuccessResult, attached=True),
     ServiceSpec("get_recognition_sampling_period", "device", NoArgs, IntValue),
     ServiceSpec("enable_segmentation", "device", BoolArgs, SuccessResult, attached=True),
