@@ -7,12 +7,14 @@ the world's ``worlds/`` folder (then each ``--controllers-dir``); in that folder
 ``Dockerfile``, ``NAME`` (an executable), ``build/release/NAME``, ``NAME.class``, ``NAME.jar``,
 ``NAME.py``, ``NAME.m``, ``NAME.bsg``. Python and executables run (as ``sensorium controller`` runs
 them: the controller's folder as working directory, ``controllerArgs`` as arguments, the URL in the
-environment); the others are refused with one line. Webots' own controllers and extra project paths
-are not searched (they are not here).
+environment); the others are refused with one line. With ``--webots-home`` (or ``$WEBOTS_HOME``) a
+controller not found there is looked for in Webots' own projects (:class:`WebotsProjects`); extra
+project paths are not searched.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import subprocess
@@ -25,8 +27,11 @@ from pathlib import Path
 from typing import IO, Any
 from urllib.parse import quote
 
-__all__ = ["ControllerSpec", "LaunchError", "Launcher", "find_controller", "plan"]
+__all__ = ["ControllerSpec", "LaunchError", "Launcher", "WebotsProjects", "find_controller", "plan", "robot_protos"]
 
+WEBOTS_DEPTH = 6         # folders under a Webots installation's projects/ where controllers/ folders are looked for
+WEBOTS_MAX_DIRS = 20000  # folders of that tree indexed at most
+WEBOTS_SKIP = frozenset({"protos", "worlds", "plugins", "libraries", "textures", "meshes", "icons", "docs", "build"})
 # Webots' WbController: a controller gets the quit packet (-1), then 1 s to end before it is terminated
 GRACE_S = 1.0
 LINE_MAX = 1 << 16       # bytes of a controller's line printed at once
@@ -49,6 +54,7 @@ class ControllerSpec:
     program: Path              # NAME.py or the executable
     python: bool
     args: tuple[str, ...] = ()
+    webots: bool = False       # found in Webots' own projects (--webots-home)
 
 
 def controller_dirs(world: Path, extra: list[Path]) -> list[Path]:
@@ -57,45 +63,148 @@ def controller_dirs(world: Path, extra: list[Path]) -> list[Path]:
     return [world.resolve().parent.parent / "controllers", *(Path(d).resolve() for d in extra)]
 
 
-def find_controller(robot: str, name: str, args: list[str], dirs: list[Path]) -> ControllerSpec:
-    """The controller ``name`` of ``robot`` in the first of ``dirs`` that has a ``NAME/`` folder, by
-    Webots' order of files. Raises LaunchError naming where it looked or what is not supported."""
+class WebotsProjects:
+    """The ``controllers/NAME/`` folders of a Webots installation's own projects (``--webots-home``,
+    else ``$WEBOTS_HOME``), as Webots finds a stock controller for a world that names one: its
+    default project (``resources/projects/controllers``) first, then every project under
+    ``projects/`` (a robot's PROTO's project among them). The ``projects`` tree is indexed once, on
+    the first look-up, at most :data:`WEBOTS_DEPTH` folders deep and :data:`WEBOTS_MAX_DIRS` folders
+    in all."""
+
+    def __init__(self, home: Path):
+        home = Path(home).resolve()
+        self.home = home / "Contents" if (home / "Contents" / "projects").is_dir() else home   # a macOS Webots.app
+        self._index: dict[str, list[Path]] | None = None
+        self.truncated = False
+
+    def _build(self) -> dict[str, list[Path]]:
+        index: dict[str, list[Path]] = {}
+        stack = [(self.home / "projects", 0)]
+        visited = 0
+        while stack:
+            folder, depth = stack.pop()
+            try:
+                entries = sorted((e for e in os.scandir(folder) if e.is_dir(follow_symlinks=False)), key=lambda e: e.name)
+            except OSError:
+                continue
+            visited += 1
+            if visited > WEBOTS_MAX_DIRS:
+                self.truncated = True
+                break
+            for e in entries:
+                if e.name == "controllers":
+                    try:
+                        names = sorted(c.name for c in os.scandir(e.path) if c.is_dir())
+                    except OSError:
+                        continue
+                    for n in names:
+                        index.setdefault(n, []).append(Path(e.path) / n)
+                elif depth + 1 < WEBOTS_DEPTH and not e.name.startswith(".") and e.name not in WEBOTS_SKIP:
+                    stack.append((Path(e.path), depth + 1))
+        for paths in index.values():
+            paths.sort()
+        return index
+
+    def find(self, name: str) -> list[Path]:
+        """The folders named ``name`` in Webots' controllers folders (the default project's alone
+        when it has one)."""
+        default = self.home / "resources" / "projects" / "controllers" / name
+        if default.is_dir():
+            return [default]
+        if self._index is None:
+            self._index = self._build()
+        return list(self._index.get(name, []))
+
+    def where(self) -> str:
+        return f"{self.home / 'projects'}" + (f" (indexed only its first {WEBOTS_MAX_DIRS} folders)" if self.truncated else "")
+
+
+def _has_proto(project: Path, proto: str | None) -> bool:
+    """Does ``project`` (a folder holding ``controllers/``) define the PROTO ``proto`` (in its
+    ``protos/`` folder or 2 folders below)?"""
+    if not proto or not proto.replace("_", "").replace("-", "").isalnum():
+        return False
+    base = project / "protos"
+    return any(any(base.glob(f"{pattern}{proto}.proto")) for pattern in ("", "*/", "*/*/"))
+
+
+def _in_folder(robot: str, name: str, args: list[str], folder: Path) -> ControllerSpec:
+    """The controller in its folder, by Webots' order of files, or LaunchError."""
+    candidates: list[tuple[str, Path]] = [
+        ("Dockerfile", folder / "Dockerfile"), ("exe", folder / name), ("exe", folder / "build" / "release" / name),
+        (".class", folder / f"{name}.class"), (".jar", folder / f"{name}.jar"), ("py", folder / f"{name}.py"),
+        (".m", folder / f"{name}.m"), (".bsg", folder / f"{name}.bsg")]
+    for kind, path in candidates:
+        if not path.is_file():
+            continue
+        if kind == "py":
+            return ControllerSpec(robot, name, folder, path, True, tuple(args))
+        if kind == "exe":
+            if not os.access(path, os.X_OK):
+                raise LaunchError(f"robot {robot!r}: controller {path} is not executable (chmod +x)")
+            return ControllerSpec(robot, name, folder, path, False, tuple(args))
+        raise LaunchError(f"robot {robot!r}: controller {path} is {UNSUPPORTED[kind]}, which Sensorium does not "
+                          "run (Python controllers and executables run; start it as an <extern> controller)")
+    hint = ""
+    if (folder / f"{name}.c").is_file() or (folder / f"{name}.cpp").is_file():
+        hint = " (its C/C++ source is there: compile it against sensorium/client/c)"
+    raise LaunchError(f"robot {robot!r}: controller {name!r}: {folder} has none of {name}, {name}.py "
+                      f"(nor {name}.class, .jar, .m, .bsg, Dockerfile){hint}")
+
+
+def find_controller(robot: str, name: str, args: list[str], dirs: list[Path], webots: WebotsProjects | None = None,
+                    proto: str | None = None) -> ControllerSpec:
+    """The controller ``name`` of ``robot`` in the first of ``dirs`` that has a ``NAME/`` folder, else
+    in Webots' own projects (``webots``; where several have it, the one that defines the robot's
+    PROTO ``proto``, as Webots looks in the PROTO's project), by Webots' order of files. Raises
+    LaunchError naming where it looked or what is not supported."""
     for base in dirs:
         folder = base / name
-        if not folder.is_dir():
-            continue
-        candidates: list[tuple[str, Path]] = [
-            ("Dockerfile", folder / "Dockerfile"), ("exe", folder / name), ("exe", folder / "build" / "release" / name),
-            (".class", folder / f"{name}.class"), (".jar", folder / f"{name}.jar"), ("py", folder / f"{name}.py"),
-            (".m", folder / f"{name}.m"), (".bsg", folder / f"{name}.bsg")]
-        for kind, path in candidates:
-            if not path.is_file():
-                continue
-            if kind == "py":
-                return ControllerSpec(robot, name, folder, path, True, tuple(args))
-            if kind == "exe":
-                if not os.access(path, os.X_OK):
-                    raise LaunchError(f"robot {robot!r}: controller {path} is not executable (chmod +x)")
-                return ControllerSpec(robot, name, folder, path, False, tuple(args))
-            raise LaunchError(f"robot {robot!r}: controller {path} is {UNSUPPORTED[kind]}, which Sensorium does not "
-                              "run (Python controllers and executables run; start it as an <extern> controller)")
-        hint = ""
-        if (folder / f"{name}.c").is_file() or (folder / f"{name}.cpp").is_file():
-            hint = " (its C/C++ source is there: compile it against sensorium/client/c)"
-        raise LaunchError(f"robot {robot!r}: controller {name!r}: {folder} has none of {name}, {name}.py "
-                          f"(nor {name}.class, .jar, .m, .bsg, Dockerfile){hint}")
+        if folder.is_dir():
+            return _in_folder(robot, name, args, folder)
     looked = ", ".join(str(d / name) for d in dirs)
-    raise LaunchError(f"robot {robot!r}: controller {name!r} not found (looked for the folder {looked})")
+    if webots is None:
+        raise LaunchError(f"robot {robot!r}: controller {name!r} not found (looked for the folder {looked}; "
+                          "--webots-home DIR also looks in Webots' own projects)")
+    found = webots.find(name)
+    if len(found) > 1:
+        own = [f for f in found if _has_proto(f.parent.parent, proto)]
+        if len(own) == 1:
+            found = own
+        else:
+            raise LaunchError(f"robot {robot!r}: controller {name!r} is in several of Webots' projects ("
+                              f"{', '.join(str(f) for f in found)}): give the one to use with --controllers-dir "
+                              "(its controllers/ folder)")
+    if not found:
+        raise LaunchError(f"robot {robot!r}: controller {name!r} not found (looked for the folder {looked}, and "
+                          f"in Webots' projects under {webots.where()})")
+    spec = _in_folder(robot, name, args, found[0])
+    return dataclasses.replace(spec, webots=True)
 
 
-def plan(robots: list[Any], dirs: list[Path]) -> tuple[list[ControllerSpec], list[str]]:
+def robot_protos(world: Any) -> dict[str, str]:
+    """Each robot that is a top-level PROTO instance of a ``.wbt`` world (Webots looks for its
+    controller in the PROTO's project too): robot name -> PROTO name."""
+    out: dict[str, str] = {}
+    robots = list(getattr(world, "robots", []))
+    i = 0
+    for node in getattr(world, "top_nodes", None) or []:
+        if node.robots == 1 and node.proto and i < len(robots):
+            out[robots[i].name] = node.proto
+        i += node.robots
+    return out
+
+
+def plan(robots: list[Any], dirs: list[Path], webots: WebotsProjects | None = None,
+         protos: dict[str, str] | None = None) -> tuple[list[ControllerSpec], list[str]]:
     """The controllers to start for the world's robots, and every problem (one line each)."""
     specs, problems = [], []
     for r in robots:
         if r.controller in SPECIAL:
             continue
         try:
-            specs.append(find_controller(r.name, r.controller, list(r.controller_args), dirs))
+            specs.append(find_controller(r.name, r.controller, list(r.controller_args), dirs, webots,
+                                         (protos or {}).get(r.name)))
         except LaunchError as exc:
             problems.append(str(exc))
     return specs, problems
@@ -237,12 +346,13 @@ class Launcher:
 
     def _watch(self, run: _Running) -> None:
         code = run.proc.wait()
+        quitting = self._quitting()         # as it ended (the world may reach its end while its output drains)
         if not run.ending:          # it may never have attached (a crash at start): not waited for any more
             self._starting.discard(run.spec.robot)
             self._wake_server()
         for t in run.readers:
             t.join()
-        if not run.ending and not self._quitting():      # it ended by itself: the robot stays uncontrolled, the world goes on
+        if not run.ending and not quitting:      # it ended by itself: the robot stays uncontrolled, the world goes on
             self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}' {_describe(code)}")
 
     def _end(self, run: _Running, grace_s: float) -> None:
@@ -302,6 +412,13 @@ class Launcher:
                 run.ending = True
         if self.on_reload is not None:
             self.on_reload()
+
+    def quit(self) -> None:
+        """simulationQuit: the server stops (every step -1); every controller ends as at ``--until``,
+        none is said to have exited by itself."""
+        with self._lock:
+            for run in self.running.values():
+                run.ending = True
 
     def _work(self) -> None:
         while True:

@@ -248,7 +248,7 @@ def test_a_robot_shadows_the_wall_in_its_own_copy_only(precision: str):
 def test_template_recognition_and_exposure_changes_are_refused_in_one_line(texture_dir: Path):
     """A batched camera's template (its constants) refuses enabling recognition or segmentation
     (per copy: BatchedSimulation.recognition_enable, batched_recognition.py) and changing the exposure
-    (the world file's is kept), in one line, changing nothing; a camera without a Recognition node
+    or the field of view (a Zoom's setFov) (the world file's are kept), in one line, changing nothing; a camera without a Recognition node
     refuses recognition through the simulation too."""
     bs = BatchedSimulation(_world(0, texture_dir), 1)
     ref = bs.device("rover", "eye")
@@ -259,6 +259,9 @@ def test_template_recognition_and_exposure_changes_are_refused_in_one_line(textu
     with pytest.raises(ValueError, match=r"^rover/eye: batched cameras keep the world file's exposure \(use Simulation\)$"):
         tpl.set_exposure(2.0)
     assert tpl.exposure == 1.6
+    with pytest.raises(ValueError, match=r"^rover/eye: batched cameras keep the world file's field of view \(use Simulation\)$"):
+        tpl.set_fov(0.5)
+    assert tpl.fov == tpl.config.field_of_view
     with pytest.raises(ValueError, match=r"^rover/eye: this camera has no Recognition node$"):
         bs.recognition_enable(ref, 16)
     assert not bs.recognition.period.any()

@@ -108,6 +108,20 @@ SHAPED = Path(__file__).parent / "worlds" / "shaped_bumpers.yaml"
 SHAPED_PERIODS = {"a": {"left": 16, "right": 16, "rear": 32}, "b": {"front": 16}, "c": {"nose": 48, "body_bumper": 16}}
 
 
+def _shaped(seed: int) -> LoadedWorld:
+    """The shaped-bumpers world with ``seed`` as its random seed."""
+    lw = load_world(SHAPED)
+    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
+    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+
+
+def _shaped_engines(seeds: list[int]) -> tuple[BatchedSimulation, list[Simulation]]:
+    """That world as one copy per seed (reset with those seeds) and as a Simulation per seed."""
+    bs = BatchedSimulation(_shaped(0), len(seeds))
+    bs.reset(np.arange(len(seeds)), seeds)
+    return bs, [Simulation(_shaped(s)) for s in seeds]
+
+
 def test_bumpers_with_their_own_shapes_read_in_every_copy_as_the_single_simulation(native):  # noqa: F811
     """Bumpers with bounding shapes of their own (a round robot's left, right and rear boxes, a box
     robot's front bar, a small round nose beside a shapeless bumper), random per-copy wheel commands
@@ -116,15 +130,7 @@ def test_bumpers_with_their_own_shapes_read_in_every_copy_as_the_single_simulati
     built with that copy's seed, bit for bit, with the C helper and without it; the left and right
     bumpers disagree on some steps (each reads where its robot was hit)."""
     seeds = [5, 6, 7]
-    lw = load_world(SHAPED)
-
-    def world(seed: int) -> LoadedWorld:
-        w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
-        return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
-
-    bs = BatchedSimulation(world(0), len(seeds))
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(world(s)) for s in seeds]
+    bs, sims = _shaped_engines(seeds)
     for c in range(len(seeds)):
         _enable_both(bs, sims, SHAPED_PERIODS, c)
     # (commands under which robot a is hit on one side often: turning robots are pushed off walls
@@ -143,7 +149,7 @@ def test_bumpers_with_their_own_shapes_read_in_every_copy_as_the_single_simulati
             sims[2].robot("a").set_pose([0.5, 0.3, 0.0])
         if step == 120:
             bs.reset([1], [42])
-            sims[1] = Simulation(world(42))
+            sims[1] = Simulation(_shaped(42))
             _enable_both(bs, sims, SHAPED_PERIODS, 1)
         bs.step()
         for c, s in enumerate(sims):
@@ -172,15 +178,7 @@ def test_slow_bumpers_keep_a_touch_until_read_in_every_copy_as_the_single_simula
     readings of 1 where the bumper touched only on a step between two readings (or while disabled)
     and no longer touches at the reading's step."""
     seeds = [5, 6, 7, 8]
-    lw = load_world(SHAPED)
-
-    def world(seed: int) -> LoadedWorld:
-        w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
-        return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
-
-    bs = BatchedSimulation(world(0), len(seeds))
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(world(s)) for s in seeds]
+    bs, sims = _shaped_engines(seeds)
     for c in range(len(seeds)):
         _enable_both(bs, sims, SLOW_PERIODS, c)
     rng = np.random.default_rng(11)
@@ -200,7 +198,7 @@ def test_slow_bumpers_keep_a_touch_until_read_in_every_copy_as_the_single_simula
                 _enable_both(bs, sims, {robot: {n: p}}, 2)
         if step == 200:
             bs.reset([3], [42])
-            sims[3] = Simulation(world(42))
+            sims[3] = Simulation(_shaped(42))
             _enable_both(bs, sims, SLOW_PERIODS, 3)
         bs.step()
         for c, s in enumerate(sims):

@@ -86,6 +86,34 @@ def test_every_line_of_a_fan_matches_the_loop() -> None:
             assert list(zip(xs.tolist(), ys.tolist())) == bresenham(0, 0, x1, y1), (x1, y1)
 
 
+def test_a_clipped_line_is_the_visible_part_of_the_whole_line() -> None:
+    """Only the steps on a 20 x 12 display are computed, and they are the whole line's steps there."""
+    rng = np.random.default_rng(5)
+    for x0, y0, x1, y1 in rng.integers(-200, 200, size=(400, 4)).tolist():
+        xs, ys = dmod.line_pixels(x0, y0, x1, y1)
+        whole = [(x, y) for x, y in zip(xs.tolist(), ys.tolist()) if 0 <= x < 20 and 0 <= y < 12]
+        cx, cy = dmod.line_pixels(x0, y0, x1, y1, 20, 12)
+        clipped = [(x, y) for x, y in zip(cx.tolist(), cy.tolist()) if 0 <= x < 20 and 0 <= y < 12]
+        assert clipped == whole, (x0, y0, x1, y1)
+        assert len(cx) <= 20                # steps off the display are not computed
+
+
+INT_MIN = -(1 << 31)
+
+
+def test_a_line_to_int_min_draws_its_visible_part(disp) -> None:
+    """A controller drawing a beam of infinite range ((int)(x * inf) is INT_MIN in C, as Webots'
+    hokuyo sample does) gets the visible part of the line, as WbDisplay draws it, not a refusal:
+    from (10, 6) towards (INT_MIN, INT_MIN) is nearly the diagonal, leaving the display at its corner;
+    towards (INT_MIN, 6) the row to the left edge."""
+    draw(disp, ["line", 10, 6, INT_MIN, INT_MIN])
+    d = -INT_MIN + 10                       # the line's x extent; its y extent is -INT_MIN + 6
+    want = {(10 - k, 6 - (2 * (d - 4) * k + d) // (2 * d)) for k in range(11)}
+    assert painted(disp) == {(x, y) for x, y in want if y >= 0} and (10, 6) in want and (4, 0) in want
+    draw(disp, ["color", 0x00FF00], ["line", 10, 6, INT_MIN, 6], ["line", 3, 2, (1 << 31) - 1, 2])
+    assert painted(disp, 0xFF00FF00) == {(x, 6) for x in range(11)} | {(x, 2) for x in range(3, 20)}
+
+
 def test_rectangles_fill_and_frame(disp) -> None:
     draw(disp, ["color", 0xFF0000], ["rectangle", 2, 3, 5, 4, True])
     assert painted(disp, 0xFFFF0000) == {(x, y) for x in range(2, 7) for y in range(3, 7)}
@@ -197,7 +225,8 @@ def test_text_is_drawn_in_the_colour_at_its_corner(disp) -> None:
     (["oval", 1, 2, 0, 3, True], "command 0 (oval): a and b must be > 0"),
     (["color", 0x1000000], "command 0 (color): color must be an integer 0xRRGGBB"),
     (["alpha", 2.0], "command 0 (alpha): alpha must be a number in [0, 1]"),
-    (["pixel", 1 << 20, 0], "command 0 (pixel): x 1048576 is out of"),
+    (["pixel", 1 << 31, 0], "command 0 (pixel): x 2147483648 is out of a C int's range"),
+    (["rectangle", 1 << 20, 0, 2, 2, True], "command 0 (rectangle): x 1048576 is out of"),
     (["polygon", [0] * 2000, [0] * 2000, True], "command 0 (polygon): 2000 vertices, at most 1024"),
     (["text", "x" * 2000, 0, 0], "command 0 (text): 2000 characters, at most 1024"),
     (["load", 3, 2, 2, b"1234"], "command 0 (load): data must be 16 bytes"),

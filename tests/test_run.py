@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 from _serve import REPO, Proc, run_controller, sensorium, wait_until
 
-from sensorium.launch import LaunchError, find_controller
+from sensorium import launch
+from sensorium.launch import LaunchError, WebotsProjects, find_controller
 
 WORLD = '''#VRML_SIM R2023b utf8
 WorldInfo { basicTimeStep 16 }
@@ -95,7 +96,7 @@ def test_controllers_are_found_in_webots_order_and_others_are_refused(tmp_path: 
     with pytest.raises(LaunchError) as info:
         find_controller("r", "gone", [], [base, other])
     assert str(info.value) == (f"robot 'r': controller 'gone' not found (looked for the folder {base / 'gone'}, "
-                               f"{other / 'gone'})")
+                               f"{other / 'gone'}; --webots-home DIR also looks in Webots' own projects)")
 
 
 # ---------------------------------------------------------------------- running a project
@@ -121,10 +122,11 @@ def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: P
 
 def test_a_missing_controller_is_one_line_and_nothing_runs(tmp_path: Path) -> None:
     world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }', {})
-    proc = run(world)
+    proc = run(world, env={"WEBOTS_HOME": None})
     assert proc.wait() == 1
     assert proc.stderr().strip() == (f"sensorium run: robot 'alpha': controller 'nowhere' not found (looked for the "
-                                     f"folder {tmp_path / 'controllers' / 'nowhere'})")
+                                     f"folder {tmp_path / 'controllers' / 'nowhere'}; --webots-home DIR also looks "
+                                     "in Webots' own projects)")
     assert proc.stdout() == ""
 
 
@@ -139,6 +141,21 @@ def test_a_controller_that_crashes_is_said_and_the_world_goes_on(tmp_path: Path)
     assert "sensorium run: 'quitter' controller of robot 'beta' exited with status: 3." in proc.stderr()
     assert "sensorium run: 'segv' controller of robot 'gamma' crashed (SIGSEGV)." in proc.stderr()
     assert "[alpha] alpha stepped 50 until 800" in proc.stdout().splitlines()
+
+
+def test_the_world_goes_on_to_until_when_every_started_controller_has_ended(tmp_path: Path) -> None:
+    """One controller fails right after it attached, the other ends after five steps: nothing is
+    left to wait for, so the world runs by itself to --until, as Webots' goes on without them."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "boom" }\nRobot { name "beta" controller "brief" }',
+                    {"boom.py": 'from controller import Robot\nRobot()\nraise SystemExit("no such device")\n',
+                     "brief.py": 'from controller import Robot\nr = Robot()\nfor _ in range(5):\n    r.step(16)\n'
+                                 'print("done at", round(r.getTime() * 1000))\n'})
+    proc = run(world, "--until", "800")
+    assert proc.wait() == 0, proc.stderr()
+    assert "[beta] done at 80" in proc.stdout().splitlines()
+    assert "[alpha] no such device" in proc.stderr().splitlines()
+    assert "sensorium: stopped at 800 ms after 50 steps" in proc.stderr().splitlines()
+    assert "steps by itself" not in proc.stderr()            # serve's line, not run's: the world waited for both
 
 
 def test_an_extern_robot_waits_for_a_controller_started_by_hand(tmp_path: Path) -> None:
@@ -259,26 +276,39 @@ int main(int argc, char **argv) {
 '''
 
 
-def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path) -> None:
-    """Compiled controllers (our libController) are started as executables with their arguments; the
-    C restartController and worldReload do what the Python ones do."""
+CLIB = REPO / "sensorium" / "client" / "c"
+
+
+@pytest.fixture(scope="module")
+def clib(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
+    """Our libController built once for this file: (its build folder, the libraries to link)."""
     if shutil.which("cc") is None or shutil.which("make") is None:
         pytest.skip("needs a C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
-    clib = REPO / "sensorium" / "client" / "c"
-    build = tmp_path / "cbuild"
-    done = subprocess.run(["make", "-s", "-C", str(clib), f"BUILD={build}"], capture_output=True, text=True, timeout=300)
+    build = tmp_path_factory.mktemp("cbuild")
+    done = subprocess.run(["make", "-s", "-C", str(CLIB), f"BUILD={build}"], capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-    libs = subprocess.run(["make", "-s", "-C", str(clib), "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+    libs = subprocess.run(["make", "-s", "-C", str(CLIB), "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+    return build, libs
+
+
+def compile_controller(clib: tuple[Path, list[str]], folder: Path, name: str, source: str) -> None:
+    """controllers/NAME/NAME.c compiled to controllers/NAME/NAME against our libController."""
+    build, libs = clib
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / f"{name}.c").write_text(source)
+    done = subprocess.run(["cc", "-std=c99", "-Wall", "-Werror", f"-I{CLIB / 'include'}", str(folder / f"{name}.c"),
+                           "-o", str(folder / name), str(build / "libController.a"), *libs, "-lm"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+
+
+def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:
+    """Compiled controllers (our libController) are started as executables with their arguments; the
+    C restartController and worldReload do what the Python ones do."""
     world = project(tmp_path, 'DEF ALPHA Robot { name "alpha" controller "starts" }\n'
                               'Robot { name "boss" controller "boss" controllerArgs [ "in C" ] supervisor TRUE }', {})
     for name, source in (("starts", C_STARTS), ("boss", C_BOSS)):
-        folder = tmp_path / "controllers" / name
-        folder.mkdir(parents=True)
-        (folder / f"{name}.c").write_text(source)
-        done = subprocess.run(["cc", "-std=c99", "-Wall", "-Werror", f"-I{clib / 'include'}", str(folder / f"{name}.c"),
-                               "-o", str(folder / name), str(build / "libController.a"), *libs, "-lm"],
-                              capture_output=True, text=True, timeout=120)
-        assert done.returncode == 0, done.stderr
+        compile_controller(clib, tmp_path / "controllers" / name, name, source)
     proc = run(world, "--until", "1200")
     assert proc.wait() == 0, proc.stderr()
     assert (tmp_path / "controllers" / "starts" / "starts.txt").read_text().split() == ["0", "480", "0", "480"]
@@ -333,3 +363,168 @@ def test_a_world_that_does_not_load_is_its_line_and_exit_1(tmp_path: Path) -> No
     assert proc.stderr().splitlines() == [f"{world}: line 4, column 1: expected a field name or '}}' in Robot (line 3), "
                                           "found end of file"]
     assert proc.stdout() == "" and not (tmp_path / "controllers" / "a" / "pid-alpha").exists()
+
+
+# ---------------------------------------------------------------------- simulationQuit ends the whole run
+
+QUITTER = '''from controller import Supervisor
+boss = Supervisor()
+while boss.step(16) != -1:
+    if round(boss.getTime() * 1000) == 480:
+        boss.simulationQuit(3)
+        print("asked to quit at", round(boss.getTime() * 1000))
+print("boss ends at", round(boss.getTime() * 1000))
+'''
+
+
+def test_simulation_quit_ends_every_controller_and_the_run_exits_with_its_status(tmp_path: Path) -> None:
+    """As Webots quits: every controller's step answers -1 and it ends (a stubborn one is terminated
+    after its grace), the run exits with the status given: a CI job can use it as its verdict."""
+    stubborn = ('import os, signal, time\nfrom controller import Robot\nsignal.signal(signal.SIGTERM, signal.SIG_IGN)\n'
+                'robot = Robot()\nopen("pid-" + robot.getName(), "w").write(str(os.getpid()))\n'
+                'while robot.step(16) != -1:\n    pass\nprint("ignoring the end")\nwhile True:\n    time.sleep(1)\n')
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "mule" controller "mule" }\n'
+                              'Robot { name "boss" controller "boss" supervisor TRUE }',
+                    {"a.py": COUNTER.replace("{step}", "32"), "mule.py": stubborn, "boss.py": QUITTER})
+    proc = run(world, "--until", "100000", "--grace", "0.3")
+    assert proc.wait() == 3, proc.stderr()
+    out = proc.stdout().splitlines()
+    assert "[boss] asked to quit at 480" in out and "[boss] boss ends at 480" in out
+    assert "[alpha] alpha stepped 15 until 480" in out          # its step to 512 answered -1
+    assert "[mule] ignoring the end" in out
+    err = proc.stderr()
+    assert "sensorium: robot 'boss' quit the simulation (simulationQuit(3)) at 480 ms: every controller ends" in err
+    assert "'mule' controller of robot 'mule': forced termination" in err
+    assert "exited" not in err                                  # ended by the quit, not by themselves
+    assert "sensorium: stopped at 480 ms" in err
+    for pid in (*pids(tmp_path / "controllers" / "mule", "mule"), *pids(tmp_path / "controllers" / "a", "alpha")):
+        assert not alive(pid)
+
+
+def test_simulation_quit_of_an_extern_supervisor_stops_serve_with_its_status(tmp_path: Path) -> None:
+    """Webots quits for an extern controller's simulationQuit too: `serve` stops and exits with it."""
+    world = project(tmp_path, 'Robot { name "boss" controller "<extern>" supervisor TRUE }', {"boss.py": QUITTER})
+    with Proc(sensorium("serve", str(world), "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0",
+                        "--mode", "fast")) as server:
+        url = server.wait_line("sensorium: serving world").split("rpc=")[1].split()[0]
+        with Proc(sensorium("controller", str(tmp_path / "controllers" / "boss" / "boss.py"), "--robot", "boss",
+                            "--url", url)) as boss:
+            assert boss.wait() == 0, boss.stderr()
+            assert boss.stdout().splitlines() == ["asked to quit at 480", "boss ends at 480"]
+            assert "Warning" not in boss.stderr() and "Error" not in boss.stderr()
+        assert server.wait() == 3, server.stderr()
+        assert "sensorium: stopped at 480 ms" in server.stderr()
+
+
+C_CHATTY = r'''#include <stdio.h>
+#include <webots/robot.h>
+
+int main(void) {
+  printf("before init\n");
+  wb_robot_init();
+  printf("hello from C at %g\n", wb_robot_get_time());
+  fprintf(stderr, "a warning from C\n");
+  while (wb_robot_step(16) != -1) {
+  }
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+def test_a_c_controllers_lines_come_out_as_it_prints_them(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:
+    """wb_robot_init makes stdout and stderr line-buffered, as libController does: a controller that
+    prints without fflush and then steps on has its lines seen while it runs (a pipe would otherwise
+    hold them until 4 KiB gathered or the process ended)."""
+    py = ('import sys\nfrom controller import Robot\nrobot = Robot()\nprint("hello from Python")\n'
+          'print("a warning from Python", file=sys.stderr)\nwhile robot.step(16) != -1:\n    pass\n')
+    world = project(tmp_path, 'Robot { name "talker" controller "talker" }\nRobot { name "snake" controller "snake" }',
+                    {"snake.py": py})
+    compile_controller(clib, tmp_path / "controllers" / "talker", "talker", C_CHATTY)
+    proc = run(world)                      # no --until: the controllers step until we stop the run
+    try:
+        proc.wait_line("sensorium: serving world")
+        assert proc.wait_line("[talker] ") == "[talker] before init"
+        assert proc.wait_line("[talker] ") == "[talker] hello from C at 0"
+        assert proc.wait_line("[snake] ") == "[snake] hello from Python"          # PYTHONUNBUFFERED, as Webots
+        for line in ("[talker] a warning from C", "[snake] a warning from Python"):
+            wait_until(lambda line=line: line in proc.stderr(), what=f"the line {line!r}")
+        assert proc.p.poll() is None               # seen while the controller (and the run) go on
+    finally:
+        proc.p.send_signal(signal.SIGTERM)
+    assert proc.wait() == 0, proc.stderr()
+
+
+# ---------------------------------------------------------------------- Webots' own controllers (--webots-home)
+
+def fake_webots(home: Path) -> Path:
+    """A Webots installation of our own: a default project's controller, a robot project whose PROTO
+    and controller live together, a sample project, two projects with a controller of one name."""
+    def controller(folder: Path, text: str = "") -> None:
+        folder.mkdir(parents=True)
+        (folder / f"{folder.name}.py").write_text(text)
+    controller(home / "resources" / "projects" / "controllers" / "void")
+    controller(home / "projects" / "robots" / "maker" / "bee" / "controllers" / "bee_wander",
+               COUNTER.replace("{step}", "32"))
+    (home / "projects" / "robots" / "maker" / "bee" / "protos").mkdir(parents=True)
+    (home / "projects" / "robots" / "maker" / "bee" / "protos" / "Bee.proto").write_text("")
+    controller(home / "projects" / "samples" / "devices" / "controllers" / "sampler")
+    controller(home / "projects" / "samples" / "devices" / "controllers" / "bee_wander")  # a second one
+    controller(home / "projects" / "samples" / "howto" / "twice" / "controllers" / "twin")
+    controller(home / "projects" / "samples" / "howto" / "again" / "controllers" / "twin")
+    return home
+
+
+def test_webots_own_controllers_are_found_by_a_bounded_index(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    home = fake_webots(tmp_path / "webots")
+    projects = home / "projects"
+    webots = WebotsProjects(home)
+    mine = tmp_path / "controllers"
+    mine.mkdir()
+    spec = find_controller("r", "sampler", [], [mine], webots)
+    assert (spec.folder, spec.webots) == (projects / "samples" / "devices" / "controllers" / "sampler", True)
+    assert find_controller("r", "void", [], [mine], webots).folder == home / "resources" / "projects" / "controllers" / "void"
+    # a name two projects have: the one whose protos/ define the robot's PROTO, as Webots looks there
+    assert find_controller("r", "bee_wander", [], [mine], webots, "Bee").folder == (
+        projects / "robots" / "maker" / "bee" / "controllers" / "bee_wander")
+    with pytest.raises(LaunchError) as info:
+        find_controller("r", "twin", [], [mine], webots)
+    assert str(info.value) == (
+        f"robot 'r': controller 'twin' is in several of Webots' projects ({projects / 'samples/howto/again/controllers/twin'}, "
+        f"{projects / 'samples/howto/twice/controllers/twin'}): give the one to use with --controllers-dir (its "
+        "controllers/ folder)")
+    # the project's own folder comes first
+    (mine / "sampler").mkdir()
+    (mine / "sampler" / "sampler.py").write_text("")
+    assert find_controller("r", "sampler", [], [mine], webots).webots is False
+    with pytest.raises(LaunchError, match=rf"controller 'none' not found \(looked for the folder {mine / 'none'}, and in "
+                                          rf"Webots' projects under {projects}\)"):
+        find_controller("r", "none", [], [mine], webots)
+    # bounded: deeper than WEBOTS_DEPTH is not looked at, nor more folders than WEBOTS_MAX_DIRS
+    deep = projects / "a" / "b" / "c" / "d" / "e" / "f" / "controllers" / "deep"
+    deep.mkdir(parents=True)
+    (deep / "deep.py").write_text("")
+    with pytest.raises(LaunchError, match="not found"):
+        find_controller("r", "deep", [], [mine], WebotsProjects(home))
+    monkeypatch.setattr(launch, "WEBOTS_MAX_DIRS", 3)
+    capped = WebotsProjects(home)
+    with pytest.raises(LaunchError, match=r"indexed only its first 3 folders"):
+        find_controller("r", "none", [], [mine], capped)
+
+
+def test_run_with_webots_home_starts_a_stock_controller_of_a_proto_robot(tmp_path: Path) -> None:
+    home = fake_webots(tmp_path / "webots")
+    (home / "projects" / "robots" / "maker" / "bee" / "protos" / "Bee.proto").write_text(
+        '#VRML_SIM R2023b utf8\nPROTO Bee [\n  field SFString name "bee"\n  field SFString controller "bee_wander"\n]\n'
+        '{\n  Robot {\n    name IS name\n    controller IS controller\n  }\n}\n')
+    (tmp_path / "worlds").mkdir()
+    world = tmp_path / "worlds" / "w.wbt"
+    world.write_text('#VRML_SIM R2023b utf8\n'
+                     'EXTERNPROTO "webots://projects/robots/maker/bee/protos/Bee.proto"\n'
+                     'WorldInfo { basicTimeStep 16 }\nBee { }\n')
+    proc = run(world, "--until", "320", "--webots-home", str(home))
+    assert proc.wait() == 0, proc.stderr()
+    folder = home / "projects" / "robots" / "maker" / "bee" / "controllers" / "bee_wander"
+    assert f"sensorium run: robot 'bee': controller 'bee_wander' found in Webots' projects: {folder / 'bee_wander.py'}" \
+        in proc.stderr().splitlines()
+    assert "[bee] bee stepped 10 until 320" in proc.stdout().splitlines()

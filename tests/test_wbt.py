@@ -963,18 +963,22 @@ def test_an_open_cylinder_used_twice_is_said_once(tmp_path: Path) -> None:
         f"{p}:2:114: Cylinder with bottom/side/top FALSE: rays see the whole closed cylinder"]
 
 
-def test_a_cameras_zoom_is_said_for_what_it_changes(tmp_path: Path) -> None:
-    """A Zoom (the e-puck's camera has one, Webots' defaults) renders nothing by itself: it is the range
-    a controller's setFov() may take. The line said 'zoom (zoom) is not rendered here; the image is
-    Webots' without it'; it now says what is not read and what the image is."""
+def test_a_cameras_zoom_is_read_as_the_range_set_fov_takes(tmp_path: Path) -> None:
+    """A Zoom (the e-puck's camera has one, Webots' defaults) is the range a controller's setFov() may
+    take. It was not read (one line said so, and setFov took only the field of view); now it is the
+    camera's ``zoom``, without a word, and reset as WbZoom resets it (a negative minFieldOfView is 0,
+    one above maxFieldOfView is maxFieldOfView, each said)."""
     p = write(tmp_path, 'Robot { name "r" children [\n'
               'Camera { fieldOfView 0.84 zoom Zoom { } }\n'
-              'Camera { name "tele" zoom Zoom { minFieldOfView 0.2 maxFieldOfView 1 } }\n] }\n')
+              'Camera { name "tele" zoom Zoom { minFieldOfView 0.2 maxFieldOfView 1 } }\n'
+              'Camera { name "odd" zoom Zoom { minFieldOfView 2 maxFieldOfView 1 } }\n'
+              'Camera { name "neg" zoom Zoom { minFieldOfView -1 } }\n] }\n')
     w = load_world(p)
+    zooms = [(d.name, d.zoom) for d in w.world.robots[0].devices]
+    assert zooms == [("camera", wm.Zoom(min_field_of_view=0.5, max_field_of_view=1.5)),
+                     ("tele", wm.Zoom(min_field_of_view=0.2, max_field_of_view=1.0)),
+                     ("odd", wm.Zoom(min_field_of_view=1.0, max_field_of_view=1.0)),
+                     ("neg", wm.Zoom(min_field_of_view=0.0, max_field_of_view=1.5))]
     assert [x.split(": ", 1)[1] for x in w.warnings] == [
-        "Camera 'camera' of robot 'r': its Zoom (0.5 to 1.5 rad) is not read: setFov() takes only the "
-        "field of view (0.84 rad) and getMinFov()/getMaxFov() answer it, as without a Zoom; the image is Webots' at "
-        "that field of view",
-        "Camera 'tele' of robot 'r': its Zoom (0.2 to 1 rad) is not read: setFov() takes only the "
-        "field of view (0.7854 rad) and getMinFov()/getMaxFov() answer it, as without a Zoom; the image is Webots' at "
-        "that field of view"]
+        "Zoom.minFieldOfView: 2 is > maxFieldOfView 1; using 1 (as Webots does)",
+        "Zoom.minFieldOfView: -1 is negative; using 0 (as Webots does)"]

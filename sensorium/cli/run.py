@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import signal
 import sys
 from functools import partial
@@ -20,7 +21,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("world", help="world file of a Webots project (worlds/NAME.wbt; YAML or JSON too): its robots' "
                    "controllers are found in the project's controllers/NAME/")
     p.add_argument("--controllers-dir", action="append", default=[], metavar="DIR",
-                   help="also look for controllers/NAME/ folders here, after the project's (repeatable)")
+                   help="also look for controllers/NAME/ folders here, after the project's (repeatable); then, "
+                   "with --webots-home, in Webots' own projects")
     p.add_argument("--until", type=int, metavar="MS",
                    help="quit when the simulated time reaches MS milliseconds (controllers get -1, then end)")
     p.add_argument("--mode", choices=["fast", "realtime", "pause"], default="fast",
@@ -43,7 +45,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     import zmq
 
-    from sensorium.launch import Launcher, controller_dirs, plan
+    from sensorium.launch import Launcher, WebotsProjects, controller_dirs, plan, robot_protos
     from sensorium.server.daemon.serve import ServeOptions, Server
     from sensorium.server.world.loader import WorldError
 
@@ -82,7 +84,9 @@ def main(args: argparse.Namespace) -> int:
         return 1
     robots = server.core.sim.loaded.world.robots
     dirs = controller_dirs(world, [Path(d) for d in args.controllers_dir])
-    specs, problems = plan(robots, dirs)
+    home = os.environ.get("WEBOTS_HOME")            # --webots-home sets it (cli/__init__.py)
+    webots = WebotsProjects(Path(home)) if home and Path(home).is_dir() else None
+    specs, problems = plan(robots, dirs, webots, robot_protos(server.core.sim.loaded.world))
     if problems:
         server.close()
         for line in problems:
@@ -92,6 +96,9 @@ def main(args: argparse.Namespace) -> int:
     if report:
         print(report.text(), file=sys.stderr, flush=True)
     launcher = Launcher(specs, server.transport.rpc_endpoint, grace_s=args.grace)
+    for spec in specs:
+        if spec.webots:
+            launcher.log(f"robot '{spec.robot}': controller '{spec.name}' found in Webots' projects: {spec.program}")
     for r in robots:
         if r.controller == "<generic>":
             launcher.log(f"robot '{r.name}': Webots' <generic> controller is not here: the robot waits for an "
@@ -116,19 +123,25 @@ def main(args: argparse.Namespace) -> int:
             # as Webots, the world waits for every synchronous <extern> robot's controller too
             robots = current.core.sim.loaded.world.robots
             lockstep.starting.update(r.name for r in robots if r.controller == "<extern>" and r.synchronization)
+            # ... but a robot whose started controller has ended is uncontrolled: the world goes on
+            # without it, as Webots' does (only robots left to an <extern> controller are waited for
+            # while none is attached: <extern> and, here, <generic> ones)
+            lockstep.extern_synchronous = [r.name for r in robots
+                                           if r.controller in ("<extern>", "<generic>") and r.synchronization]
             launcher.on_reload = current.stop
             print(current.ready_line, flush=True)
             launcher.start_all()
             current.run(signals=False)
             launcher.end_all()
-            if not launcher.reload_requested or interrupted:
+            if not launcher.reload_requested or interrupted or current.core.quit_status is not None:
                 break
             launcher.reload_requested = False          # worldReload: the same file, time 0, the same endpoints
             again = dataclasses.replace(opts, rpc=current.transport.rpc_endpoint, pub=current.transport.pub_endpoint)
             reopened = open_server(again)
             if reopened is None:
                 return 1
-            specs, problems = plan(reopened.core.sim.loaded.world.robots, dirs)   # the file may have changed
+            specs, problems = plan(reopened.core.sim.loaded.world.robots, dirs, webots,   # the file may have changed
+                                   robot_protos(reopened.core.sim.loaded.world))
             if problems:
                 reopened.close()
                 for line in problems:
@@ -143,4 +156,4 @@ def main(args: argparse.Namespace) -> int:
             signal.signal(sig, handler)
     core = current.core
     print(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps", file=sys.stderr, flush=True)
-    return 0
+    return 0 if core.quit_status is None else core.quit_status & 0xFF     # simulationQuit(status), as Webots exits

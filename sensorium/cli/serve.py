@@ -219,4 +219,4 @@ def main(args: argparse.Namespace) -> int:
                   file=sys.stderr, flush=True)
     core = server.core
     print(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps", file=sys.stderr, flush=True)
-    return 0
+    return 0 if core.quit_status is None else core.quit_status & 0xFF     # simulationQuit(status), as Webots exits

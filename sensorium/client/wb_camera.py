@@ -227,27 +227,39 @@ def wb_camera_get_fov(tag: int) -> float:
     return float(_cam_const(tag, "fov", "wb_camera_get_fov"))
 
 
+def _zoom_range(dev: DeviceState, func: str) -> tuple[float, float]:
+    """The camera's Zoom range (Webots' min = max = fov without a Zoom node)."""
+    fov = float(_desc(dev, "fov", func))
+    return float(dev.desc.get("min_fov", fov)), float(dev.desc.get("max_fov", fov))
+
+
 def wb_camera_get_min_fov(tag: int) -> float:
-    """The field of view (a camera without a Zoom node: Webots' min = max = fov)."""
-    return float(_cam_const(tag, "fov", "wb_camera_get_min_fov"))
+    func = "wb_camera_get_min_fov"
+    return _zoom_range(_cam(tag, func), func)[0]
 
 
 def wb_camera_get_max_fov(tag: int) -> float:
-    return float(_cam_const(tag, "fov", "wb_camera_get_max_fov"))
+    func = "wb_camera_get_max_fov"
+    return _zoom_range(_cam(tag, func), func)[1]
 
 
 def wb_camera_set_fov(tag: int, fov: float) -> None:
-    """Webots' rule without a Zoom node: only the current field of view is in the zoom range."""
+    """Webots' checks (the projection's bound, then the Zoom's range, each its error line); a new field
+    of view is the server's for the next images, and getFov answers it at once (as Webots' library)."""
     func = "wb_camera_set_fov"
     dev = _cam(tag, func)
     cur = float(_desc(dev, "fov", func))
+    low, high = _zoom_range(dev, func)
     planar = dev.desc.get("projection", "planar") == "planar"
     hi = math.pi if planar else 2.0 * math.pi
-    if not isinstance(fov, (int, float)) or not 0.0 <= fov <= hi:
+    if isinstance(fov, bool) or not isinstance(fov, (int, float)) or not 0.0 <= fov <= hi:
         print(f"Error: {func}() called with 'fov' argument outside of the [0, {'pi' if planar else '2.0*pi'}] range.",
               file=sys.stderr)
+    elif not low <= fov <= high:
+        print(f"Error: {func}() out of zoom range [{low:f}, {high:f}].", file=sys.stderr)
     elif fov != cur:
-        print(f"Error: {func}() out of zoom range [{cur:f}, {cur:f}].", file=sys.stderr)
+        current().device_set(dev, "set_fov", float(fov), func)
+        dev.desc["fov"] = float(fov)
 
 
 def wb_camera_get_exposure(tag: int) -> float:

@@ -425,6 +425,8 @@ class RobotClient:
             if "point_cloud" in reading:
                 dev.cloud_bytes = bytes(reading["point_cloud"])
                 dev._cloud = None
+            if "fov" in reading:                  # a zoomed camera's (a simulation reset may change it)
+                dev.desc["fov"] = float(reading["fov"])
             for key in ("image", "recognition", "segmentation_image"):    # a camera's (wb_camera.py)
                 if key in reading:
                     dev.camera[key] = reading[key]

@@ -661,13 +661,12 @@ def wb_supervisor_simulation_get_mode() -> int:
 
 
 def wb_supervisor_simulation_quit(status: int) -> None:
-    """The server serves other controllers and runs until it is stopped; for this controller the
-    simulation ends as in Webots: its next steps return -1."""
+    """Webots' quit: the server stops, every controller's steps answer -1 (this one's next step at
+    once) and ``sensorium run``/``serve`` exit with ``status``."""
     r = _supervisor("wb_supervisor_simulation_quit")
     if r is None:
         return
-    print(f"Warning: wb_supervisor_simulation_quit({status}): the server runs on until it is stopped; robot "
-          f"'{r.name}' steps no more (wb_robot_step() returns -1).", file=sys.stderr)
+    _call(r, "simulation_quit", {"status": max(-2**31, min(2**31 - 1, int(status)))})
     r.terminated = True
 
 

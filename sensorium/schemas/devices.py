@@ -227,7 +227,7 @@ register(DeviceKind(
     description="RangeFinderDescription"))
 register(DeviceKind(
     "Camera", wm.Camera, "sensorium.server.sim.cameras:Camera",
-    services=(*_SENSOR, "set_exposure", "recognition_enable", "get_recognition_sampling_period",
+    services=(*_SENSOR, "set_exposure", "set_fov", "recognition_enable", "get_recognition_sampling_period",
               "enable_segmentation", "is_segmentation_enabled", "get_recognition_objects"),
     topics=(TopicDecl("image", msgs.IMAGE, "image"),
             TopicDecl("camera_info", msgs.CAMERA_INFO, "image", exists=lambda cfg, wi: cfg.projection == "planar"),

@@ -230,6 +230,10 @@ class ExposureArgs(Args):
     value: float = Field(ge=0.0, description="the camera's photometric exposure (Webots' exposure, >= 0)")
 
 
+class FovArgs(Args):
+    value: float = Field(description="rad, within the camera's Zoom range [min_fov, max_fov]")
+
+
 class LayerArgs(Args):
     layer: int = Field(ge=0, lt=1 << 31)
 
@@ -348,6 +352,12 @@ class IntArrayValue(Result):
 
 class SimulationModeArgs(Args):
     mode: int = Field(ge=0, le=2, description="Webots WB_SUPERVISOR_SIMULATION_MODE_*: 0 pause, 1 real time, 2 fast")
+
+
+class SimulationQuitArgs(Args):
+    """``wb_supervisor_simulation_quit``: the simulation ends for every controller and the server exits."""
+
+    status: int = Field(ge=-2**31, le=2**31 - 1, description="the exit status of `sensorium run`/`serve` (Webots': its own)")
 
 
 class SetLabelArgs(Args):
@@ -479,6 +489,8 @@ class CameraDescription(_Entry):
     height: int
     fov: float = Field(description="rad, horizontal")
     near: float
+    min_fov: float = Field(description="rad: the Zoom's minFieldOfView (fov without a Zoom)")
+    max_fov: float = Field(description="rad: the Zoom's maxFieldOfView (fov without a Zoom)")
     far: float = Field(description="0: no far plane")
     exposure: float
     projection: str = Field(description="planar, cylindrical or spherical")
@@ -1017,6 +1029,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("restart_controller", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("world_reload", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("simulation_quit", "robot", SimulationQuitArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),
     ServiceSpec("set_label", "robot", SetLabelArgs, SuccessResult, attached=True, supervisor=True),
@@ -1054,6 +1067,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("set_ink_color", "device", InkColorArgs, SuccessResult, attached=True),
     ServiceSpec("draw", "device", DrawArgs, DrawResult, attached=True),
     ServiceSpec("set_exposure", "device", ExposureArgs, SuccessResult, attached=True),
+    ServiceSpec("set_fov", "device", FovArgs, SuccessResult, attached=True),
     ServiceSpec("recognition_enable", "device", EnableArgs, SuccessResult, attached=True),
     ServiceSpec("get_recognition_sampling_period", "device", NoArgs, IntValue),
     ServiceSpec("enable_segmentation", "device", BoolArgs, SuccessResult, attached=True),

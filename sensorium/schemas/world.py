@@ -738,6 +738,22 @@ class Recognition(Strict):
     segmentation: bool = False
 
 
+class Zoom(Strict):
+    """Webots' Zoom node in a Camera's ``zoom`` field: the range a controller's ``setFov`` may
+    take (Webots' defaults 0.5 and 1.5 rad); the image itself is the camera's ``field_of_view``
+    until a controller zooms (README "Cameras and range finders")."""
+
+    min_field_of_view: float = Field(default=0.5, ge=0.0, allow_inf_nan=False)
+    max_field_of_view: float = Field(default=1.5, ge=0.0, allow_inf_nan=False)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> Zoom:
+        if self.min_field_of_view > self.max_field_of_view:
+            raise ValueError(f"zoom: min_field_of_view ({self.min_field_of_view:g}) is above max_field_of_view "
+                             f"({self.max_field_of_view:g})")
+        return self
+
+
 class Camera(_Imager):
     """Webots Camera: a ``width`` × ``height`` BGRA image by exact rays through the pixels (four per
     pixel with ``anti_aliasing``), shaded with the LightSensor's lighting, textures, transparency,
@@ -749,6 +765,7 @@ class Camera(_Imager):
     anti_aliasing: bool = False
     noise: float = Field(default=0.0, ge=0.0, le=1.0, description="σ of the per-channel Gaussian noise, in [0, 1] units")
     recognition: Recognition | None = None
+    zoom: Zoom | None = Field(default=None, description="Webots' Zoom node (NULL: none): the range setFov() may take")
     _what: ClassVar[str] = "camera"
 
 

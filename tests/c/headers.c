@@ -6,8 +6,8 @@
  *   headers online     then attaches to the server: Microphone and Radio (listed, not simulated), the
  *                      supervisor's contact points, the robot window's messages (none) and the default
  *                      robot window's functions (Webots' Thymio II demo calls them: no window, no effect), Supervisor
- *                      functions Sensorium does not serve, wb_supervisor_simulation_quit() (its next
- *                      step answers -1, the one after ends the process with status 0)
+ *                      functions Sensorium does not serve, wb_supervisor_simulation_quit() (the server
+ *                      exits; the next step answers -1, the one after ends the process with status 0)
  *   headers driver|car wbu_driver_init() / wbu_car_init(): one line, exit status 1 */
 #include <math.h>
 #include <stdio.h>

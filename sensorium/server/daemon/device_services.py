@@ -141,6 +141,9 @@ class DeviceServices:
     def _dev_set_exposure(self, c: Call) -> dict:
         return _configured(c, "set_exposure", c.args.value)
 
+    def _dev_set_fov(self, c: Call) -> dict:
+        return _configured(c, "set_fov", c.args.value)
+
     def _dev_recognition_enable(self, c: Call) -> dict:
         return _configured(c, "recognition_enable", c.args.value, code=ErrorCode.WRONG_STATE)
 

@@ -125,6 +125,7 @@ class Server:
         self.core = core
         self.transport = transport
         self.recorder: Any = None
+        core.request_stop = transport.stop         # simulationQuit
 
     @classmethod
     def open(cls, world: str | Path | None, options: ServeOptions | None = None) -> Server:

@@ -118,6 +118,10 @@ class Core(DeviceServices):
         self.open_controls = open_controls       # world-wide controls for any caller (roles.py)
         # ``sensorium run``'s controller launcher (restart(robot), reload()): restartController and worldReload
         self.launcher: Any = None
+        # simulationQuit: its status (the server's exit status; the first call counts) and how the
+        # server is stopped (Server sets it to its transport's stop)
+        self.quit_status: int | None = None
+        self.request_stop: Callable[[], None] = lambda: None
         self.log = log or (lambda line: print(f"sensorium: {line}", file=sys.stderr, flush=True))
         self._log_counts: dict[str, int] = {}             # first line of a message -> times seen
         self.lockstep = Lockstep({name: bool(r.synchronization) for name, r in sim.robots.items()},
@@ -353,10 +357,11 @@ class Core(DeviceServices):
     def _announce(self) -> None:
         """Say once (and again after the last controller left) what the world waits for."""
         ls = self.lockstep
-        waiting = ls.waiting_for()
-        if waiting and self.launcher is not None:         # `sensorium run` starts them: nothing to say
+        if self.launcher is not None:     # `sensorium run` starts the controllers and says when one ends
             self._announced = True
-        elif waiting:
+            return
+        waiting = ls.waiting_for()
+        if waiting:
             names = " or ".join(repr(r) for r in waiting)
             self.log(f"waiting for a controller to attach to robot {names} (controller \"<extern>\", "
                      f"synchronization true): the world steps when attached controllers ask it to; "
@@ -766,6 +771,19 @@ class Core(DeviceServices):
             raise ServiceError(ErrorCode.WRONG_STATE, "world_reload: only `sensorium run` reloads a world (it "
                                                       "starts the controllers again)")
         self.launcher.reload()
+        return {"success": True}
+
+    def _robot_simulation_quit(self, c: Call) -> dict:
+        """Webots' simulationQuit: Webots quits, for every controller, extern ones too: the server
+        stops (every step answers -1; ``sensorium run`` ends every controller after its grace) and
+        ``run``/``serve`` exit with ``status``. A second call changes nothing."""
+        if self.quit_status is None:
+            self.quit_status = int(c.args.status)
+            self.log(f"robot {c.robot!r} quit the simulation (simulationQuit({self.quit_status})) at "
+                     f"{self.sim.time_ms} ms: every controller ends")
+            if self.launcher is not None:
+                self.launcher.quit()
+            self.request_stop()
         return {"success": True}
 
     def _supervisor(self, item: str, c: Call) -> dict:

@@ -736,7 +736,8 @@ class RayEngine(TierTracer):
                 Os, Ds, ls = O.take(sub, axis=0), D.take(sub, axis=0), lim[sub]
                 tn, ex = _take(t_near, sub), _take(excl, sub)
             if len(C) > _FEW_MOVERS and len(Os) * len(C) > _DENSE_PAIRS:
-                pr, pm = _grid_pairs(C, mt.radius, mt.r2, owner, Os, Ds, tn, ls, ex)
+                pr, pm = _grid_pairs(C, mt.radius, mt.r2, owner, Os, Ds, tn, ls, ex,
+                                     origin=O[0] if O.strides[0] == 0 and len(O) else None)
             else:
                 pr, pm = _sphere_pairs(C, mt.r2, owner, Os, Ds, tn, ls, ex)
             if sub is not None:   # merge with the mounted rays' pairs, in ray order

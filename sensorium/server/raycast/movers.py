@@ -18,10 +18,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from sensorium.server.raycast import packets
-from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _minus, _take, _to_frame
+from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _mat, _minus, _take, _to_frame
 from sensorium.server.world.geometry import Pose
 
 _FEW = 8   # one-origin batches against up to this many movers: one matrix-vector test per mover
+_TABLE = 1 << 18   # entries of a one-origin (rays, movers in view) table per block (2 MB of float64)
 
 
 def _segment_near_sphere(rel_x, rel_y, rel_z, dx, dy, dz, t_lo, t_hi, r2):
@@ -35,12 +36,13 @@ def _segment_near_sphere(rel_x, rel_y, rel_z, dx, dy, dz, t_lo, t_hi, r2):
     return e2 - tc * (b + b - tc) <= r2 + 1e-12 * e2
 
 
-def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
+def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=None):
     """(ray, mover) index pairs whose segment [t_near, lim] passes within the mover's bounding
     sphere (centre C, squared radius r2) and whose owner is not excluded (``owner`` None: no
     check).  Small tables: one (rays, movers, 3) computation, pairs ordered by ray.  Large batches
     (a lidar): one mover at a time on contiguous columns, pairs ordered by mover (so the pairs of
-    any one mover are always in ray order)."""
+    any one mover are always in ray order); ``among`` (ascending mover indices, a superset of those
+    any ray can pass near) then skips the others' tests (the same pairs, the same arithmetic)."""
     n, M = len(O), len(C)
     one = O.strides[0] == 0 and n > 1   # one origin for all rays (a lidar): the per-mover path below
     if n * M <= _TINY and not one:  # a few rays and movers: plain floats (same test)
@@ -79,7 +81,7 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
     if not shared:
         ox, oy, oz, dx, dy, dz = (np.ascontiguousarray(a[:, k]) for a in (O, D) for k in range(3))
     prs, pms = [], []
-    for j in range(M):
+    for j in (range(M) if among is None else among.tolist()):
         if owner is not None and not isinstance(excl, np.ndarray) and owner[j] == excl:
             continue
         r = None
@@ -116,20 +118,27 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl):
     return np.concatenate(prs), np.concatenate(pms)
 
 
-def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
+def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl, origin=None):
     """Same contract as ``_sphere_pairs``, for many movers and many rays.  A segment no longer than
     ``L_cap`` looks up ONE cell of a uniform grid, the cell of its midpoint; each mover is
     registered in every cell overlapped by the box of its bounding sphere grown by L_cap / 2.  A
     segment passing within r of a mover has its midpoint within r + L / 2 of the centre, so the
     lookup finds every candidate; the exact sphere test then runs on the candidate pairs only.
-    Longer segments (a lidar among short infra-red rays) take the dense test."""
+    Longer segments (a lidar among short infra-red rays) take the dense test.
+
+    Rays from one origin (a camera's pixels; O a broadcast array, or ``origin`` given) pair with
+    the movers in their view only (``_origin_cull``): the same pairs, in the same order."""
     n, M = len(O), len(C)
+    if origin is None and O.strides[0] == 0 and n:
+        origin = O[0]
+    if origin is not None and not _never_back(t_near):
+        origin = None
     L = lim - t_near
     valid = L >= 0.0                         # a negative segment sees nothing
     fin = valid & (L < _INF)
     Lf = L[fin]
     if len(Lf) == 0:
-        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl)
+        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=_among(C, radius, r2, origin, D, t_near, lim))
     # cell size from the MEDIAN segment length and mover radius (robust to a few long rays and
     # big movers: a big mover registers in more cells, a long segment takes the dense test)
     r_med = float(np.partition(radius, M // 2)[M // 2])
@@ -140,7 +149,119 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     span = float(((C + reach).max(0) - g0).max())
     cell = 2.0 * r_med + L_cap               # a typical grown sphere overlaps <= 2 cells per axis
     if 2.0 * cell >= span:                   # a grid of ~one cell would not prune anything
-        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl)
+        return _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=_among(C, radius, r2, origin, D, t_near, lim))
+    short_m = fin & (L <= L_cap)
+    every = bool(short_m.all())
+    short = None if every else short_m.nonzero()[0]
+    Os, Ds, Ls = (O, D, L) if every else (O.take(short, axis=0), D.take(short, axis=0), L[short])
+    # one origin (a camera's pixels): movers culled by the cone of the directions and their reach,
+    # then a table of rays x movers in view (the pairs the grid lookup would keep, in its order);
+    # the grid registers every mover and pairs a ray with all movers of a cell as long as a segment
+    cull = (_origin_cull(C, radius, r2, origin, Ds, float((lim if every else lim[short]).max()))
+            if origin is not None and len(Ds) else None)
+    if cull is not None:
+        pr, pm = _origin_candidates(r2, Ds, cull)
+        if not every:
+            pr = short[pr]
+    else:
+        pr, pm = _cell_candidates(C, reach, g0, span, cell, Os, Ds, Ls, t_near if short is None else _take(t_near, short),
+                                  n, short)
+    # exact sphere test on the candidates
+    rel = C.take(pm, axis=0) - O.take(pr, axis=0)
+    Dp = D.take(pr, axis=0)
+    b = np.einsum("ij,ij->i", rel, Dp)
+    e2 = np.einsum("ij,ij->i", rel, rel)
+    tc = np.minimum(np.maximum(b, _take(t_near, pr)), lim[pr])
+    sel = e2 - tc * (b + b - tc) <= r2[pm] + 1e-12 * e2
+    if owner is not None:
+        sel &= owner[pm] != _take(excl, pr)
+    pr, pm = pr[sel], pm[sel]
+    if not every:
+        longs = (valid & ~short_m).nonzero()[0]
+        if len(longs):
+            Dl = D.take(longs, axis=0)
+            cull = _origin_cull(C, radius, r2, origin, Dl, float(lim[longs].max())) if origin is not None else None
+            lp, lm = _sphere_pairs(C, r2, owner, O.take(longs, axis=0), Dl, _take(t_near, longs), lim[longs],
+                                   _take(excl, longs), among=None if cull is None else cull[0])
+            pr = np.concatenate([pr, longs[lp]])
+            pm = np.concatenate([pm, lm])
+            order = np.argsort(pr, kind="stable")   # back in ray order (callers rely on it per mover)
+            pr, pm = pr[order], pm[order]
+    return pr, pm
+
+
+def _never_back(t_near) -> bool:
+    """No segment starts behind its origin (t_near >= 0 for every ray): a segment passing near a
+    sphere whose centre lies well away from the origin then points towards it."""
+    return bool(t_near >= 0.0) if not isinstance(t_near, np.ndarray) else bool(len(t_near) == 0 or t_near.min() >= 0.0)
+
+
+def _among(C, radius, r2, origin, D, t_near, lim):
+    """The movers rays from one ``origin`` (None: not known) can pass near whatever their
+    segments' lengths (``_origin_cull`` by direction only: ``_sphere_pairs``' one-origin test lists
+    the rays of a mover's cone however far it is), for ``_sphere_pairs``' per-mover test; None when
+    not known or when some segment ends behind the origin (its test point would lie behind it)."""
+    if origin is None or not len(D) or not bool(lim.min() >= 0.0) or not _never_back(t_near):
+        return None
+    cull = _origin_cull(C, radius, r2, origin, D, _INF)
+    return None if cull is None else cull[0]
+
+
+def _origin_cull(C, radius, r2, o, D, lim_max: float):
+    """For rays from one origin ``o`` (a camera's pixels) whose segments start at t_near >= 0 and end
+    at or before ``lim_max``: (the movers any of them can pass near, ascending; which of those have
+    the origin in or near their sphere), or None when the directions span a hemisphere or more.
+    A superset, with generous slack (1e-3 rad, 1e-6 relative): a segment passing within r of a
+    centre at distance d > r lies within angle asin(r/d) of the direction to it, hence within
+    th + asin(r/d) of the axis of the directions' cone (half-angle th), and reaches d - r."""
+    a = D.sum(axis=0)
+    na = math.sqrt(float(a @ a))
+    if not na > 0.0:
+        return None
+    a /= na
+    cmin = float((D @ a).min())
+    if not cmin > 0.0:      # wider than a hemisphere: no cull to speak of
+        return None
+    th = math.acos(min(1.0, cmin))
+    rel = C - o
+    e2 = _dot(rel, rel)
+    d = np.sqrt(e2)
+    near = e2 <= 2.0 * r2                    # the origin in or near the sphere: every ray a candidate
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ca = np.clip((rel @ a) / d, -1.0, 1.0)
+        half = np.arcsin(np.minimum(1.0, radius / d))
+    keep = near | ((np.arccos(ca) <= th + half + 1e-3) & (d - radius <= lim_max * (1.0 + 1e-6) + 1e-9 * (d + 1.0)))
+    K = keep.nonzero()[0]
+    return K, near[K], rel[K], e2[K]
+
+
+def _origin_candidates(r2, D, cull):
+    """Candidate (ray, mover) pairs of rays from one origin among the culled movers (``_origin_cull``):
+    one (rays, movers) table of D . rel against each mover's cone threshold (``_sphere_pairs``' test
+    for a lidar, whose slack covers the rounding of D . rel); a superset of the pairs passing the
+    segment/sphere test, ordered by ray, then mover (the grid lookup's order)."""
+    K, near, rel, e2 = cull
+    if len(K) == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    thr = np.where(near, -_INF, np.sqrt(np.maximum(e2 - r2[K], 0.0)) * (1.0 - 1e-9) - 1e-12 * np.sqrt(e2))
+    relT = np.ascontiguousarray(rel.T)
+    rows = max(1, _TABLE // len(K))          # the table in row blocks: a few MB whatever the image and swarm
+    if rows >= len(D):
+        ri, ki = (_mat(D, relT) >= thr).nonzero()   # row-major: by ray, then mover
+        return ri, K[ki]
+    ris, kis = [], []
+    for a in range(0, len(D), rows):
+        r, k = (_mat(D[a:a + rows], relT) >= thr).nonzero()
+        ris.append(r + a)
+        kis.append(k)
+    return np.concatenate(ris), K[np.concatenate(kis)]
+
+
+def _cell_candidates(C, reach, g0, span: float, cell: float, Os, Ds, Ls, tn, n: int, short):
+    """The grid lookup of ``_grid_pairs``: every mover registered in the cells its grown sphere
+    overlaps, each short segment looking up the cell of its midpoint; candidate pairs by ray, then
+    mover."""
+    M = len(C)
     cell = max(cell, span / 2.0 ** 20)       # <= 2^20 + 3 cells per axis: int64 keys G^3 < 2^61
     inv = 1.0 / cell
     G = int(span * inv) + 3                  # cells per axis, with an empty border ring (0, G-1)
@@ -162,11 +283,7 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
     smov = mov[order]
     first = np.zeros(G ** 3 + 1, dtype=np.int64) if G ** 3 <= 8 * (len(mkeys) + n) else None
     # short segments -> the cell of their midpoint (clipped into the empty border ring)
-    short_m = fin & (L <= L_cap)
-    every = bool(short_m.all())
-    short = None if every else short_m.nonzero()[0]
-    Os, Ds, Ls = (O, D, L) if every else (O.take(short, axis=0), D.take(short, axis=0), L[short])
-    mid = Os + ((t_near if short is None else _take(t_near, short)) + 0.5 * Ls)[:, None] * Ds
+    mid = Os + (tn + 0.5 * Ls)[:, None] * Ds
     q = np.floor((mid - g0) * inv) + 1.0
     np.clip(q, 0.0, G - 1.0, out=q)
     key = q.astype(np.int64) @ W
@@ -177,29 +294,9 @@ def _grid_pairs(C, radius, r2, owner, O, D, t_near, lim, excl):
         skeys = mkeys[order]
         start, stop = np.searchsorted(skeys, key, "left"), np.searchsorted(skeys, key, "right")
     c2 = stop - start
-    pr = np.repeat(np.arange(len(key)) if every else short, c2)
+    pr = np.repeat(np.arange(len(key)) if short is None else short, c2)
     pm = smov[np.repeat(start - (np.cumsum(c2) - c2), c2) + np.arange(len(pr))]
-    # exact sphere test on the candidates
-    rel = C.take(pm, axis=0) - O.take(pr, axis=0)
-    Dp = D.take(pr, axis=0)
-    b = np.einsum("ij,ij->i", rel, Dp)
-    e2 = np.einsum("ij,ij->i", rel, rel)
-    tc = np.minimum(np.maximum(b, _take(t_near, pr)), lim[pr])
-    sel = e2 - tc * (b + b - tc) <= r2[pm] + 1e-12 * e2
-    if owner is not None:
-        sel &= owner[pm] != _take(excl, pr)
-    pr, pm = pr[sel], pm[sel]
-    if not every:
-        longs = (valid & ~short_m).nonzero()[0]
-        if len(longs):
-            lp, lm = _sphere_pairs(C, r2, owner, O.take(longs, axis=0), D.take(longs, axis=0),
-                                   _take(t_near, longs), lim[longs], _take(excl, longs))
-            pr = np.concatenate([pr, longs[lp]])
-            pm = np.concatenate([pm, lm])
-            order = np.argsort(pr, kind="stable")   # back in ray order (callers rely on it per mover)
-            pr, pm = pr[order], pm[order]
     return pr, pm
-
 
 
 
@@ -265,6 +362,16 @@ def _mounted_pairs(mt: _Movers, C: np.ndarray, owner, O, D, t_near, lim: np.ndar
     pb, pm = _near_centres(C.take(used, axis=0), R[used], C, mt.radius)
     nb = (pm != used[pb]).nonzero()[0]      # CSR of each mover's neighbours (pb is sorted)
     src, dst = used[pb[nb]], pm[nb]
+    if (len(used) == 1 and O.strides[0] == 0 and len(dst) > _FEW and _never_back(t_near)
+            and bool(lim[mi].min() >= 0.0)):
+        # one origin on one body (a camera with shapes of its own): of the body's neighbours (in
+        # their order), those in view of its rays, and per ray those whose cone holds it
+        cull = _origin_cull(C.take(dst, axis=0), mt.radius[dst], mt.r2[dst], O[0], D.take(mi, axis=0),
+                            float(lim[mi].max()))
+        if cull is not None:
+            ri, pm = _origin_candidates(mt.r2[dst], D.take(mi, axis=0), cull)
+            pr, pm = _near_pairs(C, O, D, t_near, lim, excl, owner, mt.r2, mi[ri], dst[pm])
+            return pr, pm, (~mounted).nonzero()[0]
     cnt = np.bincount(src, minlength=M)
     ptr = np.cumsum(cnt) - cnt
     c = cnt[rows]
@@ -478,8 +585,11 @@ def one_origin_pairs(st: _MountState, mt: _Movers, C: np.ndarray, O: np.ndarray,
             _body_list(st, mt, C, counters)
     nb = st.dst
     if len(nb):
-        pr, pm = _sphere_pairs(C.take(nb, axis=0), mt.r2[nb], None if owner is None else owner[nb], O, D,
-                               t_near, lim, excl)
+        Cn = C.take(nb, axis=0)
+        # a camera's pixels (directions within a cone): the neighbours out of its view are skipped
+        among = _among(Cn, mt.radius[nb], mt.r2[nb], O[0], D, t_near, lim) if len(nb) > _FEW else None
+        pr, pm = _sphere_pairs(Cn, mt.r2[nb], None if owner is None else owner[nb], O, D, t_near, lim, excl,
+                               among=among)
         pm = nb[pm]
     else:
         pr = pm = np.zeros(0, dtype=np.int64)

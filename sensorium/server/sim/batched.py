@@ -337,6 +337,9 @@ class BatchedSimulation:
             self.foot_spin = spin_reach(feet)      # a turn's push off what it turns into (Contact._spin)
             # a disc footprint's own radius (foot_radius, the broad phase's, may be wider)
             self.foot_disc = np.array([f.disc_radius if f is not None and f.disc else nan for f in feet])
+            self._footless = any(f is None for f in feet)
+            self._bounds: list = []                # _solid_bounds' answer and the obstacle list it is for
+            self._bounds_of: list | None = None
         # -- devices: one template object per device (its constants); values per copy
         self._build_devices()
         self.counters = {"steps": 0, "copy_steps": 0, "measurements": 0, "resets": 0, "contacts": 0}
@@ -927,6 +930,71 @@ class BatchedSimulation:
             return ends[:, 0], ends[:, 1], _NONE
         return self._narrow(copies, slots, starts, ends, yaw0, solid_hit, robot_hit, near)
 
+    def _solid_bounds(self) -> list[tuple[float, float, float, float, float, float, float, float]]:
+        """Per solid obstacle (Contact._obs, made again when they change): its box (lo x, lo y, hi x,
+        hi y, as the obstacle's own), a disc holding it (centre x, y and radius, the vertices' mean and
+        the farthest vertex plus the round part, widened by 1e-12 of itself) and the largest magnitude
+        of its box's coordinates; a wall line's box and disc are infinite."""
+        ct = self.contact
+        assert ct is not None
+        if self._bounds_of is not ct._obs:
+            out = []
+            for ob in ct._obs:
+                (lx, ly), (hx, hy) = ob.lo.tolist(), ob.hi.tolist()
+                if ob.normal is not None or not len(ob.points):
+                    out.append((lx, ly, hx, hy, 0.0, 0.0, math.inf, math.inf))
+                    continue
+                pts = ob.points.tolist()
+                cx, cy = sum(x for x, _ in pts) / len(pts), sum(y for _, y in pts) / len(pts)
+                rho = max(math.hypot(x - cx, y - cy) for x, y in pts) + float(ob.radius)
+                size = max(abs(lx), abs(ly), abs(hx), abs(hy))
+                out.append((lx, ly, hx, hy, cx, cy, rho * (1.0 + 1e-12) + 1e-300, size))
+            self._bounds, self._bounds_of = out, ct._obs
+        return self._bounds
+
+    def _out_of_reach(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray,
+                      yaw0: np.ndarray, solid_hit: np.ndarray, robot_hit: np.ndarray | None,
+                      near: np.ndarray) -> np.ndarray:
+        """``near`` without the moves Contact._clip_shaped would end at once, its candidates all out of
+        the reach it tests (``_in_reaches``: its turn's, radius x (1 + min(|turn|, 2)), and its move's,
+        radius + |move|), which the broad phase, its box grown by both at once, took in: a shaped
+        robot's move (not still: a still one ends where it started, not start + 0) near solids only,
+        each certainly farther than that reach -- the distance from the start to the solid's box or
+        its bounding disc, whichever is larger, beyond the reach by more than twice the narrow phase's
+        margin (1e-6 of the coordinates) and far more than rounding. Such a move ends at start + move,
+        unclipped, at the heading asked for, as the moves near nothing end: the same bits. ``near``
+        itself is returned where no move is cleared."""
+        bounds = self._solid_bounds()
+        shaped, feet = self._shaped, self.feet
+        cleared = []
+        for m in near.nonzero()[0].tolist():
+            r = int(slots[m])
+            if not shaped[r]:
+                continue
+            (x, y), (ex, ey) = starts[m].tolist(), ends[m].tolist()
+            dx, dy = ex - x, ey - y
+            # (a robot among the candidates: left to the narrow phase; its row's bytes are 0 or 1)
+            if not (dx or dy) or (robot_hit is not None and b"\x01" in robot_hit[m].tobytes()):
+                continue
+            radius = feet[r].radius
+            turn = math.remainder(float(self.yaw[copies[m], r]) - float(yaw0[m]), math.tau)
+            reach = radius + math.hypot(dx, dy)
+            if turn != 0.0:
+                reach = max(reach, radius * (1.0 + min(abs(turn), 2.0)))
+            slack = reach + 2e-6 * (1.0 + abs(x) + abs(y) + reach)
+            for j in solid_hit[m].nonzero()[0].tolist():
+                lx, ly, hx, hy, cx, cy, rho, size = bounds[j]
+                gx = lx - x if lx > x else x - hx if x > hx else 0.0
+                gy = ly - y if ly > y else y - hy if y > hy else 0.0
+                if not max(math.hypot(gx, gy), math.hypot(x - cx, y - cy) - rho) > slack + 1e-12 * size:
+                    break
+            else:
+                cleared.append(m)
+        if cleared:
+            near = near.copy()
+            near[cleared] = False
+        return near
+
     def _narrow(self, copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, ends: np.ndarray, yaw0: np.ndarray,
                 solid_hit: np.ndarray | None, robot_hit: np.ndarray | None, near: np.ndarray):
         """The narrow phase of :meth:`_contact` once the broad phase found a move near something:
@@ -934,9 +1002,18 @@ class BatchedSimulation:
         footprint headings written); returns the final xy and the moves whose turn was cut short."""
         ct = self.contact
         assert ct is not None
-        out = ends.copy()
+        if solid_hit is not None:
+            cut = self._out_of_reach(copies, slots, starts, ends, yaw0, solid_hit, robot_hit, near)
+            if cut is not near and not cut.any():      # as _contact ends moves near nothing
+                moved = starts + (ends - starts)
+                if self._footless:
+                    moved = np.where(np.isnan(self.foot_radius[slots])[:, None], ends, moved)
+                self.centres[copies, slots] = moved
+                return ends[:, 0], ends[:, 1], _NONE
+            near = cut
         Rr = self.foot_radius[slots]
         footless = np.isnan(Rr)
+        out = ends.copy()
         # copies are independent: the moves of copies where nothing is near end where Contact._clip
         # without candidates puts them, all at once; the others' in slot order, as Contact.resolve_all
         # takes robots in world order (each sees the earlier slots of its copy where they ended, the

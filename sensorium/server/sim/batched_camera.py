@@ -30,7 +30,7 @@ rows are shaded, and its shadow rays aimed, with that copy's light arrays (the f
 its robots' at its poses: the single camera's arrays).
 
 Recognition and segmentation are batched_recognition.py's (enabled per copy through the simulation,
-never on the template). Changing the exposure is refused (the world file's exposure is used).
+never on the template). Changing the exposure or the field of view (a Zoom's setFov) is refused (the world file's are used).
 """
 
 from __future__ import annotations
@@ -66,6 +66,9 @@ class BatchedCamera(Camera):
 
     def set_exposure(self, exposure: float) -> None:
         raise ValueError(f"{self.path}: batched cameras keep the world file's exposure ({USE})")
+
+    def set_fov(self, fov: float) -> None:
+        raise ValueError(f"{self.path}: batched cameras keep the world file's field of view ({USE})")
 
 
 KINDS = ("Camera",)

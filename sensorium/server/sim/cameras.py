@@ -315,6 +315,7 @@ class Camera(Device):
         c = self.config
         self.geometry = imaging.ImageGeometry(c.width, c.height, c.field_of_view, c.projection)
         self.lens = lens_of(c)     # the image's; recognition and segmentation are Webots' undistorted ones
+        self.fov = float(c.field_of_view)    # a controller's setFov() changes it (a camera with a Zoom)
         self.image = np.zeros((c.height, c.width, 4), dtype=np.uint8)
         self.image[:, :, 3] = 255
         self.exposure = float(c.exposure)
@@ -347,7 +348,10 @@ class Camera(Device):
     def describe(self) -> dict:
         c = self.config
         rc = c.recognition
-        return {"width": int(c.width), "height": int(c.height), "fov": float(c.field_of_view), "near": float(c.near),
+        zoom = c.zoom
+        low, high = (self.fov, self.fov) if zoom is None else (zoom.min_field_of_view, zoom.max_field_of_view)
+        return {"width": int(c.width), "height": int(c.height), "fov": self.fov, "near": float(c.near),
+                "min_fov": float(low), "max_fov": float(high),
                 "far": float(c.far), "exposure": float(self.exposure), "projection": c.projection,
                 "anti_aliasing": bool(c.anti_aliasing), "noise": float(c.noise),
                 "has_recognition": rc is not None, "has_segmentation": bool(rc is not None and rc.segmentation),
@@ -381,6 +385,36 @@ class Camera(Device):
             raise ValueError(f"exposure must be a finite number >= 0, got {exposure!r}")
         self.exposure = float(exposure)
 
+    def set_fov(self, fov: float) -> None:
+        """Webots' ``wb_camera_set_fov`` on a camera with a Zoom: the images (and the recognition, the
+        segmentation, ``camera_info``) taken from now on see ``fov``; refused outside the Zoom's range."""
+        zoom = self.config.zoom
+        if zoom is None:
+            raise ValueError("this camera has no Zoom node: its field of view cannot change")
+        if isinstance(fov, bool) or not isinstance(fov, (int, float)) or not math.isfinite(fov):
+            raise ValueError(f"fov must be a finite number, got {fov!r}")
+        if not zoom.min_field_of_view <= fov <= zoom.max_field_of_view:
+            raise ValueError(f"fov {fov:g} is out of the Zoom's range [{zoom.min_field_of_view:g}, "
+                             f"{zoom.max_field_of_view:g}]")
+        planar = self.config.projection == "planar"
+        if fov <= 0.0 or (fov >= math.pi if planar else fov > 2.0 * math.pi):
+            raise ValueError(f"fov {fov:g} cannot be rendered by a {self.config.projection} camera (it must be in "
+                             f"{'(0, pi)' if planar else '(0, 2*pi]'})")
+        self._use_fov(float(fov))
+
+    def reset_fov(self) -> None:
+        """The world file's field of view again (a simulation reset)."""
+        self._use_fov(float(self.config.field_of_view))
+
+    def _use_fov(self, fov: float) -> None:
+        if fov == self.fov:
+            return
+        c = self.config
+        self.fov = fov
+        self.geometry = imaging.ImageGeometry(c.width, c.height, fov, c.projection)
+        self._rays = self._centre_rays = None      # rays, limits and the recognizer are made again for it
+        self._recognizer = None
+
     @property
     def recognition_objects(self) -> list[Any]:
         """The latest recognised objects (``objects``), by the name a batched copy's view gives them."""
@@ -402,6 +436,8 @@ class Camera(Device):
 
     def step_reading(self) -> dict:
         out: dict[str, Any] = {}
+        if self.config.zoom is not None:      # a reset may have changed it back
+            out["fov"] = self.fov
         if self.schedule.period_ms > 0:
             out["image"] = self.image_bytes()
         if self.recognition_schedule.period_ms > 0:

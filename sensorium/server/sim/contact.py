@@ -30,7 +30,9 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   arc about the centre tested in closed form, :func:`turn_gap_holds`); where the turn would go into something,
   the whole turn is kept and the centre pushed off it the least distance, to touching
   (:meth:`Contact._push`, closed form; in a corner of two polygons, off both at once:
-  :meth:`Contact._push_off_both`), unless that push meets something else: then the turn is
+  :meth:`Contact._push_off_both`; where the turn ends clear of it but a corner's arc dips into it
+  on the way, past the peak of its reach, off by as far as the arc went in:
+  :meth:`Contact._push_sweep`), unless that push meets something else: then the turn is
   cut short, found by halving to 2^-12 of the step's turn (either counts as a contact); then its centre moves along the chord from
   its start to its end pose (poses are only observed at the end of steps, and the end point is
   the exact arc end unless contact clips it) at the heading it kept. The chord is tested against
@@ -40,7 +42,10 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   convex sets, :func:`_grown`), for a wall line its reach toward the wall — so a fast robot at a
   grazing angle cannot tunnel, whatever the step length. Features the chord
   certainly cannot reach (plain float screens, margins far above the tests' rounding) are not
-  tested: the answer of testing them all, bit for bit.
+  tested: the answer of testing them all, bit for bit. Likewise the turn test is answered before its
+  arcs where a screen proves it False (:func:`turn_gap_holds`), an obstacle grown by a turned
+  footprint is made once per heading (:func:`_grown`), and moves near nothing end all at once
+  (:meth:`Contact.resolve_all`): the same answers, bit for bit.
 
 On contact the robot stops at the contact point and the rest of its displacement is projected on
 the contact's tangent (slide), up to three times per step (corners). A robot pushed straight into
@@ -88,9 +93,13 @@ class Obstacle:
     hi: np.ndarray = field(default_factory=lambda: np.zeros(2))
     # per grown radius: the vertices as floats and the edges offset by it (_hull_data; points never change)
     grown: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+    # lo, hi and the vertices as floats (_flat), made when first needed
+    flat: tuple | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         pts = self.points
+        if self.normal is None and 1 < len(pts) <= 16 and self._small_post_init():
+            return
         if len(pts) > 1:
             # vertices that coincide (a footprint 1e-12 m thin turned and moved 1e5 m from the origin
             # rounds two corners to one point): one of them, never an edge of no length or direction
@@ -106,6 +115,30 @@ class Obstacle:
         else:
             self.lo = self.points.min(axis=0) - self.radius
             self.hi = self.points.max(axis=0) + self.radius
+
+    def _small_post_init(self) -> bool:
+        """__post_init__ of a hull of a few vertices in plain floats (a grown footprint is made every
+        step it turns near something): done, True, where no two neighbours coincide, every coordinate
+        is finite and no extreme is a zero (whose sign numpy's min and max may pick otherwise); else
+        False, for numpy's way. The same lo and hi, bit for bit; the vertices then keep their array."""
+        v = self.points.tolist()
+        px, py = v[-1]
+        for x, y in v:
+            if x == px and y == py:
+                return False
+            px, py = x, y
+        xs = [p[0] for p in v]
+        ys = [p[1] for p in v]
+        if not -math.inf < sum(xs) + sum(ys) < math.inf:        # a NaN or an infinity (or a sum that overflows)
+            return False
+        x0, y0, x1, y1 = min(xs), min(ys), max(xs), max(ys)
+        if not (x0 and y0 and x1 and y1):
+            return False
+        r = self.radius
+        self.lo = np.array([x0 - r, y0 - r])
+        self.hi = np.array([x1 + r, y1 + r])
+        self.flat = (x0 - r, y0 - r, x1 + r, y1 + r, v)
+        return True
 
 
 @dataclass(slots=True)
@@ -490,16 +523,28 @@ def _hull_data(ob: Obstacle, rad: float) -> tuple[list, list]:
     got = ob.grown.get(rad)
     if got is None:
         pts = ob.points
-        n = len(pts)
+        v = pts.tolist()
+        n = len(v)
         edges = []
         if n >= 2:
+            rad_f = float(rad)
             for i in range(n):
-                a, b = pts[i], pts[(i + 1) % n]
-                e = b - a
-                out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
-                A, B = a + rad * out, b + rad * out
-                edges.append((A, B, out, float(A[0]), float(A[1]), float(out[0]), float(out[1])))
-        got = ob.grown[rad] = (pts.tolist(), edges)
+                (a0, a1), (b0, b1) = v[i], v[(i + 1) % n]
+                e0, e1 = b0 - a0, b1 - a1
+                el = math.hypot(e0, e1)
+                if el == 0.0:               # (no such edge once the points are made; numpy's inf and NaN)
+                    a, b = pts[i], pts[(i + 1) % n]
+                    e = b - a
+                    out = np.array([e[1], -e[0]]) / math.hypot(e[0], e[1])
+                    A, B = a + rad * out, b + rad * out
+                    edges.append((A, B, out, float(A[0]), float(A[1]), float(out[0]), float(out[1])))
+                    continue
+                # numpy's elementwise operations in plain floats: the same roundings, bit for bit
+                o0, o1 = e1 / el, -e0 / el
+                A0, A1 = a0 + rad_f * o0, a1 + rad_f * o1
+                edges.append((np.array([A0, A1]), np.array([b0 + rad_f * o0, b1 + rad_f * o1]), np.array([o0, o1]),
+                              A0, A1, o0, o1))
+        got = ob.grown[rad] = (v, edges)
     return got
 
 
@@ -618,13 +663,30 @@ def _grown(ob: Obstacle, shape: np.ndarray, rnd: float, p: np.ndarray) -> tuple[
         side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
         return ob, float(np.max(shape @ (-side * ob.normal))) + rnd
     q = ob.points
+    # the same obstacle grown by the same turned footprint is made once (a robot's turn, its push and
+    # its move grow its candidates by the footprint at the same headings, and the next step's turn
+    # starts at this one's end): keyed by the very vertex array (points never change), the radius'
+    # bits, what the grown one copies and the turned footprint's bits
+    key = (id(q), ob.radius.hex() if isinstance(ob.radius, float) else repr(ob.radius), ob.name, ob.owner,
+           id(ob.z_range), shape.shape, shape.tobytes())
+    hit = _GROWN.get(key)
+    if hit is not None and hit[0] is q and hit[1] is ob.z_range:
+        return hit[2], rnd
     if len(q) == 1:                     # a point (a pillar, a round robot): the footprint turned over
         pts = q[0] - shape
     elif len(q) >= 3 and len(shape) >= 3:
         pts = np.array(_minkowski(q.tolist(), (-shape).tolist()), dtype=np.float64)
     else:
         pts = _hull((q[:, None, :] - shape[None, :, :]).reshape(-1, 2))
-    return Obstacle(ob.name, ob.owner, pts, ob.radius, ob.z_range, edge_normals=True), rnd
+    g = Obstacle(ob.name, ob.owner, pts, ob.radius, ob.z_range, edge_normals=True)
+    if len(_GROWN) >= _GROWN_MAX:
+        _GROWN.clear()
+    _GROWN[key] = (q, ob.z_range, g)
+    return g, rnd
+
+
+_GROWN: dict = {}          # _grown's obstacles made lately (the arrays they came from held, so no id is reused)
+_GROWN_MAX = 512        # (a mesh grown by a footprint is hundreds of edges: a few MB at most)
 
 
 def _minkowski(a: list, b: list) -> list:
@@ -683,25 +745,101 @@ def _gap_normal(p: np.ndarray, ob: Obstacle, rho: float) -> tuple[float, np.ndar
 _STILL = np.zeros(2)
 
 
-def _in_reach(cands: list[Obstacle], p: np.ndarray, d: np.ndarray, radius: float) -> list[Obstacle]:
+def _in_reach(cands: list[Obstacle], p: np.ndarray, d: np.ndarray, radius: float,
+              memo: dict | None = None) -> list[Obstacle]:
     """The candidates a footprint within ``radius`` of its centre can meet moving from ``p`` by ``d``
     (sliding included: the path is no longer than ``|d|``): their boxes, then the shapes, within that
     reach of ``p``, with a margin far above rounding. The others cannot stop the move, so their grown shapes are not
-    built (a turning robot's broad phase reaches further, for the push)."""
+    built (a turning robot's broad phase reaches further, for the push). ``memo``: as :func:`_gap`'s."""
     reach = radius + math.hypot(float(d[0]), float(d[1]))
     x, y = float(p[0]), float(p[1])
     m = reach + 1e-6 * (1.0 + abs(x) + abs(y) + reach)
     margin = m - reach
-    return [ob for ob in cands
-            if not (ob.lo[0] > x + m or ob.hi[0] < x - m or ob.lo[1] > y + m or ob.hi[1] < y - m)
-            and _gap(p, ob, reach) <= margin]
+    out = []
+    for ob in cands:
+        lx, ly, hx, hy, _ = ob.flat or _flat(ob)
+        if not (lx > x + m or hx < x - m or ly > y + m or hy < y - m) and _gap(p, ob, reach, memo) <= margin:
+            out.append(ob)
+    return out
 
 
-def _gap(p: np.ndarray, ob: Obstacle, rho: float) -> float:
-    """The signed distance from ``p`` to ``ob ⊕ disc(rho)`` (negative inside)."""
+def _in_reaches(cands: list[Obstacle], p: np.ndarray, turn_radius: float | None, d: np.ndarray, radius: float,
+                memo: dict) -> tuple[list[Obstacle], list[Obstacle]]:
+    """``(_in_reach(cands, p, 0, turn_radius), _in_reach(cands, p, d, radius))`` in one pass, the first
+    ``[]`` for ``turn_radius`` None: the same tests, each candidate's distance from ``p`` found once."""
+    x, y = float(p[0]), float(p[1])
+    reach = radius + math.hypot(float(d[0]), float(d[1]))
+    m = reach + 1e-6 * (1.0 + abs(x) + abs(y) + reach)
+    margin = m - reach
+    near: list[Obstacle] = []
+    reached: list[Obstacle] = []
+    turning = turn_radius is not None
+    reach1 = m1 = margin1 = 0.0
+    if turn_radius is not None:
+        reach1 = turn_radius + math.hypot(0.0, 0.0)
+        m1 = reach1 + 1e-6 * (1.0 + abs(x) + abs(y) + reach1)
+        margin1 = m1 - reach1
+    for ob in cands:
+        lx, ly, hx, hy, _ = ob.flat or _flat(ob)
+        if (turning and not (lx > x + m1 or hx < x - m1 or ly > y + m1 or hy < y - m1)
+                and _gap(p, ob, reach1, memo) <= margin1):
+            near.append(ob)
+        if not (lx > x + m or hx < x - m or ly > y + m or hy < y - m) and _gap(p, ob, reach, memo) <= margin:
+            reached.append(ob)
+    return near, reached
+
+
+def _flat(ob: Obstacle) -> tuple:
+    """``ob``'s lo and hi as floats and its vertices as a list of [x, y] (made once: points never change)."""
+    (lx, ly), (hx, hy) = ob.lo.tolist(), ob.hi.tolist()
+    ob.flat = (lx, ly, hx, hy, ob.points.tolist())
+    return ob.flat
+
+
+def _gap(p: np.ndarray, ob: Obstacle, rho: float, memo: dict | None = None) -> float:
+    """The signed distance from ``p`` to ``ob ⊕ disc(rho)`` (negative inside). ``memo``: the distances
+    from this very ``p`` found so far, by obstacle (its id; the obstacles outlive the memo)."""
+    if memo is not None:
+        dist = memo.get(id(ob))
+        if dist is None:
+            dist = memo[id(ob)] = _base_gap(p, ob)
+    else:
+        dist = _base_gap(p, ob)
+    return dist - rho if ob.normal is not None else dist - (ob.radius + rho)
+
+
+def _base_gap(p: np.ndarray, ob: Obstacle) -> float:
+    """The distance from ``p`` to ``ob``'s line or hull (negative inside), before its radius and any."""
     if ob.normal is not None:
-        return abs(float(ob.normal @ p) + ob.offset) - rho
-    return _closest_on_list(float(p[0]), float(p[1]), ob.points.tolist())[0] - (ob.radius + rho)
+        return abs(float(ob.normal @ p) + ob.offset)
+    return _closest_dist(float(p[0]), float(p[1]), (ob.flat or _flat(ob))[4])
+
+
+def _closest_dist(px: float, py: float, v: list) -> float:
+    """The distance of :func:`_closest_on_list` alone, the same operations without the normal."""
+    n = len(v)
+    if n == 1:
+        return math.hypot(px - v[0][0], py - v[0][1])
+    best = math.inf
+    inside = n >= 3
+    deepest = -math.inf
+    for i in range(n if n >= 3 else 1):
+        ax, ay = v[i]
+        bx, by = v[(i + 1) % n]
+        ex, ey = bx - ax, by - ay
+        el = math.hypot(ex, ey)
+        rx, ry = px - ax, py - ay
+        t = min(max((rx * ex + ry * ey) / (el * el), 0.0), 1.0)
+        L = math.hypot(rx - t * ex, ry - t * ey)
+        if L < best:
+            best = L
+        if n >= 3:
+            side = rx * (ey / el) + ry * (-ex / el)
+            if side > 0.0:
+                inside = False
+            if side > deepest:
+                deepest = side
+    return deepest if inside else best
 
 
 # ---------------------------------------------------------------------- turns in place (exact arcs)
@@ -780,7 +918,7 @@ def _edges(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: np.ndarray,
-                   target: float) -> bool:
+                   target: float, start: float | None = None) -> bool:
     """Whether the footprint ``hull(shape) ⊕ disc(rnd)`` (turned to the turn's start, relative to
     its centre ``p``) turning in place by ``turn`` stays at a signed distance of at least ``target``
     from ``ob`` at every heading of the turn. Closed form, without sampling the turn: each vertex
@@ -799,7 +937,16 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
       vertex's arc to the footprint's edges (:func:`_arc_to_segments`): exact; they start at
       least that far apart and, to come nearer, would pass through that distance. Touching
       polygons that start apart and whose arcs stay more than EPS apart (far above the arcs'
-      rounding) never overlap either."""
+      rounding) never overlap either.
+
+    Screens answer False before the arcs where the arcs' answer is certainly False, by margins far
+    above the rounding, so the answer is the arcs' bit for bit: apart (s above EPS), a vertex and
+    an edge nearer than s at the turn's end (:func:`_end_nearer`; the arcs' candidate angles include
+    it); touching, ``start`` (the footprint's signed distance from ``ob`` at the turn's start, when
+    the caller knows it) puts the polygons within EPS / 2 of touching (:func:`_start_touching`: a
+    vertex and an edge that near at the start), or a vertex of one is inside the other at the
+    turn's end or halfway (:func:`_inside_in_turn`: it crossed an edge on the way, unless they were
+    not apart at the start)."""
     lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
     if ob.normal is not None:
         side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
@@ -834,9 +981,128 @@ def turn_gap_holds(shape: np.ndarray, rnd: float, turn: float, ob: Obstacle, p: 
         if float(np.max(sep)) >= s:
             return True
     if s > EPS or degenerate:
-        return apart() >= s
+        return not _end_nearer(shape, q, turn, s) and apart() >= s
     # apart at the start and kept farther apart than the rounding (EPS) all through the turn
+    if start is not None and _start_touching(start + rnd + ob.radius, ob, p, shape):
+        return False
+    if _inside_in_turn(shape, q, turn):
+        return False
     return _start_apart(shape, q) and apart() >= max(s, EPS)
+
+
+def _start_touching(gap: float, ob: Obstacle, p: np.ndarray, shape: np.ndarray) -> bool:
+    """Whether the polygons ``hull(shape)`` about ``p`` and ``ob``'s hull, whose distance (negative:
+    less the depth of their overlap) the caller found to be ``gap`` (:func:`_gap` of ``ob`` grown by
+    the footprint, :func:`_grown`), are certainly within EPS / 2 of touching. Then a vertex of one is
+    within EPS / 2 of an edge of the other at the start (apart: their nearest points include a
+    vertex; overlapping by less than that: moving one by the depth makes them touch, and no
+    vertex-to-edge distance changes by more than the move), so :func:`_arc_to_segments`, which
+    includes the turn's start, answers below EPS. The margin covers the rounding of both ways of
+    finding the distance (~1e-15 of the coordinates) and the vertices :func:`_minkowski` drops (at
+    most 1e-12 of the grown outline's edges inside it)."""
+    if not abs(gap) <= 0.5 * EPS:
+        return False
+    lx, ly, hx, hy, _ = ob.flat or _flat(ob)
+    reach = float(np.max(np.abs(shape)))
+    extent = (hx - lx) + (hy - ly) + 4.0 * reach
+    size = 1.0 + max(abs(lx), abs(ly), abs(hx), abs(hy)) + abs(float(p[0])) + abs(float(p[1])) + reach
+    return abs(gap) + 4e-12 * extent + 1e-13 * size <= 0.5 * EPS
+
+
+def _end_nearer(shape: np.ndarray, q: np.ndarray, turn: float, limit: float) -> bool:
+    """Whether some vertex of ``hull(shape)`` turned by ``turn`` (about the origin) and an edge of
+    ``hull(q)``, or the other way, are nearer than ``limit`` by far more than rounding (1e-12 of
+    the coordinates): :func:`_arc_to_segments` of either, whose candidate angles include the turn's
+    end, then answers below ``limit`` too. Plain floats, the same vertex-to-segment distances."""
+    c, s = math.cos(turn), math.sin(turn)
+    f = [(x * c - y * s, x * s + y * c) for x, y in shape.tolist()]
+    g = [(x, y) for x, y in q.tolist()]
+    size = 1.0 + max(max(abs(x), abs(y)) for x, y in f + g)
+    return min(_vertex_edge(f, g), _vertex_edge(g, f)) + 1e-12 * size < limit
+
+
+def _inside_in_turn(shape: np.ndarray, q: np.ndarray, turn: float) -> bool:
+    """Whether, at the turn's end or halfway, a vertex of ``hull(shape)`` turned so is inside
+    ``hull(q)``, or one of ``hull(q)``'s inside it, deeper than 1e-12 of the coordinates (far above
+    rounding; hulls of 3 vertices or more, counter-clockwise); or a footprint vertex is inside
+    ``hull(q)`` where its arc reaches deepest past one of its edges (a corner whose arc dips into a
+    wall and out again). Then :func:`turn_gap_holds` answers False for two polygons
+    touching or overlapping by less than EPS: apart at the start, the vertex crossed an edge on the
+    way, where the arcs' least (:func:`_arc_to_segments`, exact to rounding) is 0; not apart,
+    :func:`_start_apart` finds no separating axis, or one within rounding of none, where a vertex
+    is that near an edge at the start (the overlap's depth, found along an edge normal)."""
+    if len(shape) < 3 and len(q) < 3:
+        return False
+    g = [(x, y) for x, y in q.tolist()]
+    pts = shape.tolist()
+    for u in (turn, 0.5 * turn):
+        c, s = math.cos(u), math.sin(u)
+        f = [(x * c - y * s, x * s + y * c) for x, y in pts]
+        tol = 1e-12 * (1.0 + max(max(abs(x), abs(y)) for x, y in f + g))
+        if (len(g) >= 3 and _any_inside(f, g, tol)) or (len(f) >= 3 and _any_inside(g, f, tol)):
+            return True
+    if len(g) < 3:
+        return False
+    # and where each footprint vertex reaches deepest past each of the obstacle's edges on its arc
+    # (its turn pointing it against the edge's normal), when that heading is within the turn
+    lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
+    lines = _edge_lines(g)
+    if len(lines) < 3:
+        return False
+    for x, y in pts:
+        at = math.atan2(y, x)
+        for ax, ay, ox, oy in lines:
+            k = (math.atan2(-oy, -ox) - at - lo) % math.tau
+            if not k <= hi - lo:
+                continue
+            c, s = math.cos(lo + k), math.sin(lo + k)
+            px, py = x * c - y * s, x * s + y * c
+            if (px - ax) * ox + (py - ay) * oy < -tol and all(
+                    (px - bx) * nx + (py - by) * ny < -tol for bx, by, nx, ny in lines):
+                return True
+    return False
+
+
+def _edge_lines(w: list) -> list:
+    """The lines of the counter-clockwise polygon ``w``'s edges: (a point, its outward unit normal)
+    for each edge of non-zero length."""
+    lines = []
+    for (ax, ay), (bx, by) in zip([w[-1]] + w[:-1], w):
+        ex, ey = bx - ax, by - ay
+        el = math.hypot(ex, ey)
+        if el > 0.0:
+            lines.append((ax, ay, ey / el, -ex / el))
+    return lines
+
+
+def _any_inside(v: list, w: list, tol: float) -> bool:
+    """Whether a point of ``v`` is inside the counter-clockwise polygon ``w`` deeper than ``tol``
+    from each of its edges' lines."""
+    lines = _edge_lines(w)
+    if len(lines) < 3:
+        return False
+    for px, py in v:
+        if all((px - ax) * ox + (py - ay) * oy < -tol for ax, ay, ox, oy in lines):
+            return True
+    return False
+
+
+def _vertex_edge(v: list, w: list) -> float:
+    """The least distance from the points ``v`` to the edges of the convex polygon ``w`` (a point,
+    a segment or a closed outline)."""
+    n = len(w)
+    edges = [(w[0], w[0])] if n == 1 else [(w[0], w[1])] if n == 2 else [(w[i - 1], w[i]) for i in range(n)]
+    best = math.inf
+    for (ax, ay), (bx, by) in edges:
+        ex, ey = bx - ax, by - ay
+        ee = ex * ex + ey * ey
+        for px, py in v:
+            rx, ry = px - ax, py - ay
+            t = min(max((rx * ex + ry * ey) / ee, 0.0), 1.0) if ee > 0.0 else 0.0
+            d = math.hypot(rx - t * ex, ry - t * ey)
+            if d < best:
+                best = d
+    return best
 
 
 def _start_apart(shape: np.ndarray, q: np.ndarray) -> bool:
@@ -1033,7 +1299,9 @@ class Contact:
         band_lo = self.heights[idx] + self._z_low[idx]
         band_hi = self.heights[idx] + self._z_high[idx]
         if len(self._obs):
-            solid_hit = (np.all((self._lo[None] <= box_hi[:, None]) & (self._hi[None] >= box_lo[:, None]), axis=2)
+            lo, hi = self._lo, self._hi
+            solid_hit = ((lo[None, :, 0] <= box_hi[:, None, 0]) & (lo[None, :, 1] <= box_hi[:, None, 1])
+                         & (hi[None, :, 0] >= box_lo[:, None, 0]) & (hi[None, :, 1] >= box_lo[:, None, 1])
                          & (self._zhi[None] > band_lo[:, None] + FLOOR) & (self._zlo[None] < band_hi[:, None] - EPS))
         robot_hit = None
         if len(self.feet) > 1:
@@ -1055,15 +1323,37 @@ class Contact:
         if robot_hit is not None:
             for m, j in zip(*(x.tolist() for x in np.nonzero(robot_hit))):
                 near_robots[m].append(j)
-        out = []
-        for m in range(k):
+        # the moves near nothing that no other move has near it end where _clip and _clip_shaped put
+        # them without candidates, start + (end - start), whatever the order: all at once (robots
+        # each moved once; a robot without a footprint ends at its end, in the loop below). For a
+        # few moves the loop is cheaper than the arrays
+        out: list = [None] * k
+        rest: list[int] | range = range(k)
+        lone = None
+        if k >= 4 and len(set(indices)) == k:
+            lone = ~np.isnan(self._radius[idx])
+            if len(self._obs):
+                lone &= ~solid_hit.any(axis=1)
+            if robot_hit is not None:
+                lone &= ~robot_hit.any(axis=1) & ~robot_hit.any(axis=0)[idx]
+        if lone is not None and lone.any():
+            moved = starts + (ends - starts)
+            li = idx[lone]
+            self.centres[li] = moved[lone]
+            if yaws is not None:
+                self.yaw[li] = yaws[lone, 1]
+            headings = self.yaw[idx].tolist()
+            for m in lone.nonzero()[0].tolist():
+                out[m] = (moved[m], False, headings[m])
+            rest = (~lone).nonzero()[0].tolist()
+        for m in rest:
             i = int(idx[m])
             yaw0, yaw1 = (float(self.yaw[i]),) * 2 if yaws is None else (float(yaws[m, 0]), float(yaws[m, 1]))
             foot = self.feet[i]
             if foot is None:
                 self.centres[i] = ends[m]
                 self.yaw[i] = yaw1
-                out.append((ends[m].copy(), False, yaw1))
+                out[m] = (ends[m].copy(), False, yaw1)
                 continue
             cands: list[Obstacle] = [self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m]))
                                      for j in near_solids[m]]
@@ -1077,7 +1367,7 @@ class Contact:
                 p, clipped, kept = self._clip_shaped(foot, starts[m].copy(), ends[m] - starts[m], yaw0, yaw1, cands)
             self.centres[i] = p
             self.yaw[i] = kept
-            out.append((p, clipped, kept))
+            out[m] = (p, clipped, kept)
         return out
 
     def pieces(self, index: int, parts: list[tuple[geo.Primitive, Pose]]) -> list[Footprint]:
@@ -1106,8 +1396,17 @@ class Contact:
     @staticmethod
     def _in_band(ob: Obstacle, low: float, high: float) -> Obstacle:
         if ob.sphere:
-            cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
-            return Obstacle(ob.name, -1, ob.points, sphere_radius_in_band(cz, ob.radius, low, high), ob.z_range)
+            # a sphere's section in a band: made once per band (a robot on a flat floor keeps its band),
+            # kept among the sphere's own caches (tuple keys, never a grown radius)
+            key = ("band", low, high)
+            got = ob.grown.get(key)
+            if got is None:
+                cz = (ob.z_range[0] + ob.z_range[1]) / 2.0
+                got = Obstacle(ob.name, -1, ob.points, sphere_radius_in_band(cz, ob.radius, low, high), ob.z_range)
+                if len(ob.grown) >= 64:
+                    ob.grown.clear()
+                ob.grown[key] = got
+            return got
         return ob
 
     def _clip(self, p: np.ndarray, d: np.ndarray, R: float, cands: list[Obstacle]) -> tuple[np.ndarray, bool]:
@@ -1133,8 +1432,12 @@ class Contact:
         turn = math.remainder(yaw1 - yaw, math.tau)
         # what the turn, or a push of it (at most foot.radius * min(|turn|, 2)), can meet: the others
         # are left out of the turn's tests, which they cannot change
-        near = _in_reach(cands, p, _STILL, foot.radius * (1.0 + min(abs(turn), 2.0))) if turn != 0.0 else []
-        if near and self._turn_may_meet(foot, p, turn, near):
+        memo: dict = {}         # each candidate's distance from p, found once for the reach tests below
+        near, reached = _in_reaches(cands, p, foot.radius * (1.0 + min(abs(turn), 2.0)) if turn != 0.0 else None,
+                                    d, foot.radius, memo)
+        if not near and not reached:        # nothing within reach (most robots near something): the move
+            return (p + d if d[0] or d[1] else p), False, yaw1        # as _sweep makes it among none
+        if near and self._turn_may_meet(foot, p, turn, near, memo):
             here = _turned(foot.points, yaw)
             now = [_gap(p, *_grown(ob, here, foot.round, p)) for ob in near]
             if not self._turn_clear(foot, p, yaw, turn, near, now):
@@ -1161,14 +1464,17 @@ class Contact:
                         else:
                             hi = mid
                 kept = _wrap(yaw + turn * lo) if lo > 0.0 else yaw
-        shape = _turned(foot.points, kept)
-        end, clipped = self._sweep(p, d, [_grown(ob, shape, foot.round, p) for ob in _in_reach(cands, p, d, foot.radius)])
+        if reached:
+            shape = _turned(foot.points, kept)
+            end, clipped = self._sweep(p, d, [_grown(ob, shape, foot.round, p) for ob in reached])
+        else:
+            end, clipped = self._sweep(p, d, [])
         if kept != yaw1 and not clipped:
             self.contacts += 1
         return end, clipped or kept != yaw1, kept
 
     def _push(self, foot: Footprint, p: np.ndarray, yaw: float, yaw1: float, turn: float,
-              cands: list[Obstacle], now: list[float]) -> np.ndarray | None:
+              cands: list[Obstacle], now: list[float], swept: bool = True) -> np.ndarray | None:
         """Where rigid contact pushes the robot's centre when the whole turn from ``yaw`` to ``yaw1``
         at ``p`` would put its footprint into a candidate (``now``: each one's signed distance at
         ``yaw``), or None: the least move, out of the candidate it would go deepest into, along
@@ -1193,11 +1499,34 @@ class Contact:
             if gap < target - EPS:
                 pushes.append((target - gap, i, normal))
         if not pushes:
-            return None
+            # the turned footprint overlaps nothing where the turn ends, but a corner's arc dips into
+            # something on the way (past the peak of its reach toward a wall): pushed off by that depth
+            return self._push_sweep(foot, p, yaw, turn, cands, now)
         into = {i for _, i, _ in pushes}
         rest = [j for j in range(len(cands)) if j not in into]
         if rest and not self._turn_clear(foot, p, yaw, turn, [cands[j] for j in rest], [now[j] for j in rest]):
-            return None
+            # the turn also sweeps into one it does not end in (a corner of two walls, the turn past
+            # the peak of its reach toward one of them): pushed off that one's sweep first
+            # (:meth:`_push_sweep`), then off the others from there, its sweep still clear
+            if not swept:
+                return None
+            others, before = [cands[j] for j in rest], [now[j] for j in rest]
+            base = self._push_sweep(foot, p, yaw, turn, others, before)
+            if base is None:
+                return None
+            here = _turned(foot.points, yaw)
+            for j in into:
+                self.checks += 1
+                if time_of_impact(p, base - p, *_grown(cands[j], here, foot.round, p))[1] is not None:
+                    return None
+            q = self._push(foot, base, yaw, yaw1, turn, cands,
+                           [_gap(base, *_grown(ob, here, foot.round, base)) for ob in cands], False)
+            if q is None or float(np.hypot(*(q - p))) > foot.radius * min(abs(turn), 2.0):
+                return None
+            after = [_gap(q, *_grown(ob, here, foot.round, q)) for ob in others]
+            if min(a - min(b, 0.0) for a, b in zip(after, before)) < -EPS or not self._turn_clear(foot, q, yaw, turn, others, after):
+                return None
+            return q
         limit = foot.radius * min(abs(turn), 2.0)
         here = _turned(foot.points, yaw)
         for dist, i, normal in sorted(pushes, key=lambda t: (-t[0], t[1])):
@@ -1218,6 +1547,61 @@ class Contact:
                 return q
         if len(pushes) == 2:         # a corner of two: the least move out of both, if that fits
             return self._push_off_both(p, pushes[0][1], pushes[1][1], grown, now, cands, here, foot.round, limit)
+        return None
+
+    def _push_sweep(self, foot: Footprint, p: np.ndarray, yaw: float, turn: float, cands: list[Obstacle],
+                    now: list[float]) -> np.ndarray | None:
+        """The push when the turn from ``yaw`` by ``turn`` at ``p`` ends overlapping nothing but sweeps
+        into a candidate on the way (a box robot's corner passing the peak of its reach toward a wall
+        it rests on), or None: the least move along one of that candidate's axes (its edge normals,
+        fixed; a wall line's normal) that keeps the footprint at least touching it at every heading of
+        the turn -- the turn's least separation along the axis (:func:`_least_along`, exact), so the
+        centre ends as far off as the footprint reached into it. Checked as :meth:`_push` checks a push:
+        not back toward the side the robot came from, no longer than any footprint point moved in the
+        turn, neither its path nor its end meets another candidate (deeper than it already was), and
+        the whole turn from there is clear of every candidate (:meth:`_turn_clear`)."""
+        assert foot.points is not None
+        if min(now) < -EPS:
+            return None
+        here = _turned(foot.points, yaw)
+        rnd = foot.round
+        lo, hi = (0.0, turn) if turn >= 0.0 else (turn, 0.0)
+        limit = foot.radius * min(abs(turn), 2.0)
+        grown = [_grown(ob, here, rnd, p) for ob in cands]
+        tries = []
+        for i, ob in enumerate(cands):
+            if self._turn_clear(foot, p, yaw, turn, [ob], [now[i]]):
+                continue
+            self.checks += 1
+            _, back = _gap_normal(p, *grown[i])
+            if ob.normal is not None:
+                side = 1.0 if float(ob.normal @ p) + ob.offset >= 0.0 else -1.0
+                axes = (side * ob.normal)[None, :]
+                reach = -float(np.min(_least_along(here, lo, hi, -axes))) + rnd
+                need = np.array([reach - abs(float(ob.normal @ p) + ob.offset)])
+            else:
+                q = ob.points - p[None, :]
+                _, _, axes = _edges(q)
+                if not len(axes):
+                    continue
+                need = rnd + ob.radius - (_least_along(here, lo, hi, axes) - np.max(axes @ q.T, axis=1))
+            for k in range(len(axes)):
+                t = float(need[k])
+                if 0.0 < t <= limit and float(axes[k] @ back) > 0.0:
+                    tries.append((t, i, k, axes[k]))
+        for t, i, _, n in sorted(tries, key=lambda a: (a[0], a[1], a[2])):
+            step = (t + BACK_OFF) * n
+            q = p + step
+            after = []
+            for j, (g, before) in enumerate(zip(grown, now)):
+                self.checks += 1
+                gap = _gap(q, *_grown(cands[j], here, rnd, q))
+                if gap < min(before, 0.0) - EPS or (j != i and time_of_impact(p, step, *g)[1] is not None):
+                    break
+                after.append(gap)
+            else:
+                if self._turn_clear(foot, q, yaw, turn, cands, after):
+                    return q
         return None
 
     def _push_off_both(self, p: np.ndarray, i: int, j: int, grown: list[tuple[Obstacle, float]], now: list[float],
@@ -1284,14 +1668,15 @@ class Contact:
         return q
 
     @staticmethod
-    def _turn_may_meet(foot: Footprint, p: np.ndarray, turn: float, cands: list[Obstacle]) -> bool:
+    def _turn_may_meet(foot: Footprint, p: np.ndarray, turn: float, cands: list[Obstacle],
+                       memo: dict | None = None) -> bool:
         """False when no candidate comes within reach of the turn, which :meth:`_turn_clear` would
         then find clear: at every heading the footprint lies in the disc of ``foot.radius`` about
         ``p``; a candidate farther than that (by more than the distances' rounding) is met at none.
         Most robots near something are turning in its broad-phase reach, not this one."""
         reach = foot.radius
         margin = EPS + 1e-9 * (1.0 + abs(float(p[0])) + abs(float(p[1])) + reach)
-        return any(_gap(p, ob, reach) <= margin for ob in cands)
+        return any(_gap(p, ob, reach, memo) <= margin for ob in cands)
 
     def _turn_clear(self, foot: Footprint, p: np.ndarray, yaw: float, turn: float, cands: list[Obstacle],
                     now: list[float]) -> bool:
@@ -1312,7 +1697,7 @@ class Contact:
             if shape is None:
                 shape = _turned(foot.points, yaw)
             self.checks += 1
-            if not turn_gap_holds(shape, foot.round, turn, ob, p, min(gap, 0.0) - EPS):
+            if not turn_gap_holds(shape, foot.round, turn, ob, p, min(gap, 0.0) - EPS, gap):
                 return False
         return True
 

@@ -46,6 +46,7 @@ MAX_COMMANDS = 4096             # per display, per request
 MAX_POLYGON = 1024              # vertices of one polygon
 MAX_TEXT = 1024                 # characters of one text
 MAX_COORD = 1 << 16             # |coordinate| and radii
+C_INT = (-(1 << 31), (1 << 31) - 1)   # a C int: the points of pixels, lines and texts (drawn clipped)
 MAX_IMAGE_PIXELS = 1 << 22      # one stored image (copy, load)
 MAX_IMAGES = 256                # images a display keeps
 MAX_WORK = 1 << 20              # loop iterations one request may cost (oval rows, polygon rows, glyphs)
@@ -104,6 +105,16 @@ def _int(v: Any, what: str) -> int:
     return v
 
 
+def _point(v: Any, what: str) -> int:
+    """A pixel's, a line end's or a text's coordinate: any C int (a controller's (int)(x * inf) is
+    INT_MIN), as WbDisplay takes it; only what falls on the display is drawn."""
+    if isinstance(v, bool) or not isinstance(v, int):
+        raise ValueError(f"{what} must be an integer, got {v!r}")
+    if not C_INT[0] <= v <= C_INT[1]:
+        raise ValueError(f"{what} {v} is out of a C int's range [{C_INT[0]}, {C_INT[1]}]")
+    return v
+
+
 def _unit(v: Any, what: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0.0 <= float(v) <= 1.0:
         raise ValueError(f"{what} must be a number in [0, 1], got {v!r}")
@@ -126,16 +137,35 @@ _ARITY = {"color": 1, "alpha": 1, "opacity": 1, "font": 3, "pixel": 2, "line": 4
           "polygon": 3, "text": 3, "copy": 5, "paste": 4, "load": 4, "delete": 1, "attach": 1, "detach": 0}
 
 
-def line_pixels(x0: int, y0: int, x1: int, y1: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every pixel of WbDisplay's Bresenham line from (x0, y0) to (x1, y1), in order, unclipped."""
+def line_pixels(x0: int, y0: int, x1: int, y1: int, width: int | None = None,
+                height: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The pixels of WbDisplay's Bresenham line from (x0, y0) to (x1, y1), in order; with ``width``
+    and ``height`` only the steps whose major coordinate falls on the display (the others' pixels are
+    off it), so a line to INT_MIN costs what its visible part does. Exact integer arithmetic (WbDisplay's
+    doubled deltas overflow a C int beyond 2^30, where it draws no defined line)."""
     dx, dy = abs(x1 - x0), abs(y1 - y0)
     sx, sy = (1 if x1 >= x0 else -1), (1 if y1 >= y0 else -1)
+    major, n, start, step = (dx, width, x0, sx) if dx > dy else (dy, height, y0, sy)
+    lo, hi = 0, major
+    if n is not None:                    # the k with 0 <= start + step * k < n
+        a, b = (-start, n - 1 - start) if step > 0 else (start - n + 1, start)
+        lo, hi = max(lo, a), min(hi, b)
+        if lo > hi:
+            empty = np.zeros(0, dtype=np.int64)
+            return empty, empty
+    if 2 * major * (hi + 1) < 1 << 62:  # int64 holds every product
+        k = np.arange(lo, hi + 1, dtype=np.int64)
+        if dx > dy:
+            return x0 + sx * k, y0 + sy * ((2 * dy * k + dx) // (2 * dx))
+        minor = (2 * dx * k + dy) // (2 * dy) if dy else np.zeros(len(k), dtype=np.int64)
+        return x0 + sx * minor, y0 + sy * k
+    # a line beyond 2^30 or so: Python's integers for the few visible steps
+    ks = range(lo, hi + 1)
     if dx > dy:
-        k = np.arange(dx + 1, dtype=np.int64)
-        return x0 + sx * k, y0 + sy * ((2 * dy * k + dx) // (2 * dx))
-    k = np.arange(dy + 1, dtype=np.int64)
-    minor = (2 * dx * k + dy) // (2 * dy) if dy else np.zeros(1, dtype=np.int64)
-    return x0 + sx * minor, y0 + sy * k
+        return (np.array([x0 + sx * k for k in ks], dtype=np.int64),
+                np.array([y0 + sy * ((2 * dy * k + dx) // (2 * dx)) for k in ks], dtype=np.int64))
+    return (np.array([x0 + sx * ((2 * dx * k + dy) // (2 * dy)) for k in ks], dtype=np.int64),
+            np.array([y0 + sy * k for k in ks], dtype=np.int64))
 
 
 class Display(Device):
@@ -237,9 +267,9 @@ class Display(Device):
                 raise ValueError("font takes a name and a size > 0")
             return (op,), 0
         if op == "pixel":
-            return (op, _int(args[0], "x"), _int(args[1], "y")), 0
+            return (op, _point(args[0], "x"), _point(args[1], "y")), 0
         if op == "line":
-            return (op, *(_int(v, n) for v, n in zip(args, ("x1", "y1", "x2", "y2")))), 0
+            return (op, *(_point(v, n) for v, n in zip(args, ("x1", "y1", "x2", "y2")))), 0
         if op in ("rectangle", "oval"):
             names = ("x", "y", "width", "height") if op == "rectangle" else ("cx", "cy", "a", "b")
             a, b, c, d = (_int(v, n) for v, n in zip(args[:4], names))
@@ -262,7 +292,7 @@ class Display(Device):
                 raise ValueError("text must be a non-empty string")
             if len(text) > MAX_TEXT:
                 raise ValueError(f"{len(text)} characters, at most {MAX_TEXT}")
-            return (op, text, _int(args[1], "x"), _int(args[2], "y")), 1 + len(text)
+            return (op, text, _point(args[1], "x"), _point(args[2], "y")), 1 + len(text)
         if op == "copy":
             iid = _image_id(args[0])
             x, y, w, h = (_int(v, n) for v, n in zip(args[1:], ("x", "y", "width", "height")))
@@ -362,7 +392,7 @@ class Display(Device):
     def _op_line(self, x0: int, y0: int, x1: int, y1: int) -> bool:
         if max(x0, x1) < 0 or max(y0, y1) < 0 or min(x0, x1) >= self.width or min(y0, y1) >= self.height:
             return False
-        return self._blend(*line_pixels(x0, y0, x1, y1))
+        return self._blend(*line_pixels(x0, y0, x1, y1, self.width, self.height))
 
     def _op_rectangle(self, x: int, y: int, w: int, h: int, fill: bool) -> bool:
         W, H = self.width, self.height

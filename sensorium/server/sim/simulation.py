@@ -26,6 +26,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
+from sensorium.server.sim.cameras import Camera
 from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.ground import Ground, GroundWarning, band_low
@@ -402,6 +403,8 @@ class Simulation:
                     dev._mark(self.time_ms)
                 elif isinstance(dev, (VacuumGripper, Speaker)):    # the pump as loaded; silence
                     dev.reset()
+                elif isinstance(dev, Camera):      # a zoomed camera: the world file's fieldOfView
+                    dev.reset_fov()
         self.radio.reset()
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)

@@ -304,13 +304,11 @@ def _numbers_fine(v: Any, levels: int, cap: float) -> bool:
 _GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh", "triangles", "elevation_grid"}
 
 
-def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> list[str | tuple[str, str]]:
-    """The work a validated world asks for. Returns problems as ``(path, message)``."""
-    problems: list[str | tuple[str, str]] = []
-
-    def over(path: str, what: str, n: float, cap: float) -> None:
-        num = (lambda x: f"{x:,}") if isinstance(n, int) else (lambda x: f"{x:g}")
-        problems.append((path, f"{what} {num(n)} exceeds the limit of {num(cap)} {RAISE}"))
+def _walk_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int], problems: list,
+               over: Callable[[str, str, float, float], None]) -> tuple[int, int]:
+    """(triangles, lights) of a validated world; every number out of bounds added to ``problems``,
+    named by its path (a list of numbers checked in one numpy pass, walked number by number when it
+    holds a bad one)."""
 
     def number(path: str, v: float) -> None:
         mag = abs(v)
@@ -337,6 +335,81 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
                 triangles += triangle_count(v, mesh_triangles)
             elif isinstance(kind, str) and kind.endswith("Light"):
                 lights += 1
+    return triangles, lights
+
+
+def _scan_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> tuple[int, int] | None:
+    """What ``_walk_work`` counts, the same values visited, without making a path for each (a
+    200-robot swarm holds about a million values; the paths were most of the walk's time): None
+    when some number is out of bounds (the caller then walks again with paths, to name it)."""
+    cap = limits.number_magnitude
+    triangles = lights = 0
+    todo: list[tuple[Any, bool]] = [(world, False)]     # (value, reached as a field named ...geometry)
+    pop, push = todo.pop, todo.append
+    while todo:
+        v, geometry_field = pop()
+        if isinstance(v, float):
+            mag = abs(v)
+            if not mag <= cap or 0.0 < mag < 1e-30:      # (NaN fails the first test)
+                return None
+        elif isinstance(v, BaseModel):
+            kind = getattr(v, "type", None)
+            if kind in _GEOMETRY_TYPES and geometry_field:
+                triangles += triangle_count(v, mesh_triangles)
+            elif isinstance(kind, str) and kind.endswith("Light"):
+                lights += 1
+            blocks = _number_fields(type(v))
+            for name in type(v).model_fields:
+                x = getattr(v, name)
+                block = blocks.get(name)
+                if block is not None and isinstance(x, (list, tuple)) and len(x) >= BLOCK_MIN:   # a mesh's numbers
+                    if block[1] is float and not _numbers_fine(x, block[0], cap):
+                        return None
+                    continue
+                push((x, name.endswith("geometry")))
+        elif isinstance(v, (list, tuple)):
+            for x in v:
+                if isinstance(x, float):             # numbers inline: most values are
+                    mag = abs(x)
+                    if not mag <= cap or 0.0 < mag < 1e-30:
+                        return None
+                elif isinstance(x, (BaseModel, list, tuple)):
+                    push((x, False))
+    return triangles, lights
+
+
+def has_model(world: Any, cls: type) -> bool:
+    """Whether some value of a validated model is an instance of ``cls`` (the walk of ``_walk``,
+    without paths)."""
+    todo: list[Any] = [world]
+    nested = (BaseModel, list, tuple)
+    while todo:
+        v = todo.pop()
+        if isinstance(v, cls):
+            return True
+        if isinstance(v, BaseModel):
+            blocks = _number_fields(type(v))
+            for name in type(v).model_fields:
+                x = getattr(v, name)
+                if isinstance(x, nested) and name not in blocks:     # (a field of numbers holds no model)
+                    todo.append(x)
+        elif isinstance(v, (list, tuple)):
+            todo.extend(x for x in v if isinstance(x, nested))
+    return False
+
+
+def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int]) -> list[str | tuple[str, str]]:
+    """The work a validated world asks for. Returns problems as ``(path, message)``."""
+    problems: list[str | tuple[str, str]] = []
+
+    def over(path: str, what: str, n: float, cap: float) -> None:
+        num = (lambda x: f"{x:,}") if isinstance(n, int) else (lambda x: f"{x:g}")
+        problems.append((path, f"{what} {num(n)} exceeds the limit of {num(cap)} {RAISE}"))
+
+    counted = _scan_work(world, limits, mesh_triangles)
+    if counted is None:        # some number out of bounds: the walk with paths, to name each
+        counted = _walk_work(world, limits, mesh_triangles, problems, over)
+    triangles, lights = counted
     # robots, devices, lights and solids: check_counts, on the data before validation
     if triangles > limits.triangles:
         over("", "the world's triangles:", triangles, limits.triangles)

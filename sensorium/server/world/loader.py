@@ -576,13 +576,13 @@ def _check_joints(robot: wm.Robot, rp: str) -> list[Problem]:
 def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
                            allow_outside_meshes: bool, asset_files: frozenset[Path] = frozenset()) -> list[Problem]:
     """Every mesh url (confined, readable, bounded) and the work the world asks for."""
-    from sensorium.server.world.limits import _walk
+    from sensorium.server.world.limits import _walk, has_model
     from sensorium.server.world.meshes import MeshFileError, load_mesh, resolve_mesh_url
 
     problems: list[Problem] = []
     faces: dict[tuple[str, tuple[float, ...], int, str], int] = {}
     failed: set[str] = set()      # a file that failed is said once (a CadShape's materials each name it)
-    for path, geom in _walk(world):
+    for path, geom in (_walk(world) if has_model(world, wm.Mesh) else ()):   # (paths only when there are meshes)
         if not isinstance(geom, wm.Mesh):
             continue
         key = (geom.url, tuple(geom.scale), geom.material_index, geom.name)

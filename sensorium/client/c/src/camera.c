@@ -18,6 +18,7 @@
 struct sn_imaging {
   int width, height;
   double fov, near, min_range, max_range;
+  double min_fov, max_fov; /* camera: its Zoom's range (fov, fov without a Zoom) */
   float *range;          /* range finder: height rows of width floats */
   unsigned char *image;  /* camera: BGRA, height rows of 4 * width bytes */
   double exposure;
@@ -49,6 +50,8 @@ int sn_imaging_describe(sn_device *d, const msgpack_object *desc) {
   im->min_range = sn_double_or(desc, "minRange", NAN);
   im->max_range = sn_double_or(desc, "maxRange", NAN);
   im->exposure = sn_double_or(desc, "exposure", NAN);
+  im->min_fov = sn_double_or(desc, "min_fov", im->fov);
+  im->max_fov = sn_double_or(desc, "max_fov", im->fov);
   char *projection = sn_strdup_obj(sn_get(desc, "projection"));
   im->planar = projection == NULL || strcmp(projection, "planar") == 0;
   free(projection);
@@ -172,6 +175,7 @@ void sn_imaging_apply(sn_device *d, const msgpack_object *reading) {
     const msgpack_object *objs = sn_get(reading, "recognition");
     if (objs != NULL)
       read_objects(d, objs);
+    im->fov = sn_double_or(reading, "fov", im->fov); /* a zoomed camera's (a reset may change it) */
     return;
   }
   const msgpack_object *img = sn_get(reading, "range_image");
@@ -466,15 +470,15 @@ double wb_camera_get_fov(WbDeviceTag tag) {
   return d ? d->imaging->fov : NAN;
 }
 
-/* without a Zoom node, Webots' zoom range is the field of view itself */
+/* the Zoom's range; without a Zoom node, Webots' zoom range is the field of view itself */
 double wb_camera_get_min_fov(WbDeviceTag tag) {
   CAMERA("wb_camera_get_min_fov");
-  return d ? d->imaging->fov : NAN;
+  return d ? d->imaging->min_fov : NAN;
 }
 
 double wb_camera_get_max_fov(WbDeviceTag tag) {
   CAMERA("wb_camera_get_max_fov");
-  return d ? d->imaging->fov : NAN;
+  return d ? d->imaging->max_fov : NAN;
 }
 
 void wb_camera_set_fov(WbDeviceTag tag, double fov) {
@@ -486,8 +490,10 @@ void wb_camera_set_fov(WbDeviceTag tag, double fov) {
   if (!(fov >= 0.0 && fov <= hi))
     fprintf(stderr, "Error: %s() called with 'fov' argument outside of the [0, %s] range.\n", func,
             d->imaging->planar ? "pi" : "2.0*pi");
-  else if (fov != d->imaging->fov)
-    fprintf(stderr, "Error: %s() out of zoom range [%f, %f].\n", func, d->imaging->fov, d->imaging->fov);
+  else if (fov < d->imaging->min_fov || fov > d->imaging->max_fov)
+    fprintf(stderr, "Error: %s() out of zoom range [%f, %f].\n", func, d->imaging->min_fov, d->imaging->max_fov);
+  else if (fov != d->imaging->fov && sn_device_set(d, "set_fov", sn_arg_double, &fov, func))
+    d->imaging->fov = fov; /* the next images see it; getFov answers it now, as Webots' library */
 }
 
 double wb_camera_get_exposure(WbDeviceTag tag) {

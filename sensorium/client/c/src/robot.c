@@ -361,6 +361,13 @@ static char *only_robot(sn_conn *c) {
 }
 
 int wb_robot_init(void) {
+  /* As libController: stdout and stderr line-buffered, so a controller's lines reach `sensorium run`'s
+     pipe (or a log file) as they are printed, not when 4 KiB have gathered or the process ends; what
+     was printed before goes out now. */
+  fflush(stdout);
+  fflush(stderr);
+  setvbuf(stdout, NULL, _IOLBF, 4096);
+  setvbuf(stderr, NULL, _IOLBF, 4096);
   if (g_robot != NULL)
     return 1;
   g_timeout_ms = timeout_from_env();

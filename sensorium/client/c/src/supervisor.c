@@ -950,15 +950,21 @@ void wb_supervisor_field_import_mf_node_from_string(WbFieldRef field, int positi
 }
 
 /* ------------------------------------------------------------------ the simulation */
+static void args_status(sn_req *r, const void *arg) {
+  sn_req_key(r, "status");
+  msgpack_pack_int(&r->pk, *(const int *)arg);
+}
+
 void wb_supervisor_simulation_quit(int status) {
   const char *func = "wb_supervisor_simulation_quit";
   sn_robot *rb = supervisor(func);
   if (rb == NULL)
     return;
-  /* The server serves other controllers and runs until it is stopped; for this controller the
-     simulation ends as in Webots: its next steps return -1. */
-  fprintf(stderr, "Warning: %s(%d): the server runs on until it is stopped; robot '%s' "
-          "steps no more (wb_robot_step() returns -1).\n", func, status, rb->name);
+  /* As Webots quits: the server stops, every controller's steps answer -1 (this one's next step at
+     once) and `sensorium run`/`serve` exit with status. */
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/simulation_quit", 1, args_status, &status, func, &rep) == 0)
+    sn_reply_free(&rep);
   rb->terminated = true;
 }
 

@@ -4,7 +4,8 @@ name, their identity (type and PROTO name, DEF, parent), fields (``translation``
 and set, ``name``, ``model``, ``customData``, lights' ``on``/``intensity``/``color``/... read and
 set, WorldInfo's, Viewpoint's and Background's values read), world poses and velocities; reset the
 simulation and change its mode. The robot's world entry needs ``supervisor: true``.
-``simulationQuit`` ends this controller's steps (-1; the server runs on). Every other method of
+``simulationQuit(status)`` ends the simulation for every controller (-1) and the server exits with
+``status``, as Webots quits. Every other method of
 Webots' classes is there too: it does nothing, prints one error line the first time and answers
 Webots' "no value" (as the C library's functions)."""
 

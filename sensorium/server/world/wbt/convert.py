@@ -1222,9 +1222,6 @@ class Converter:
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
             for name, what in unread_image_fields(node.type, node.fields):
-                if name == "zoom":      # a Zoom changes no image by itself: it is the range setFov() may take
-                    self.warn(node, self.zoom_line(node, data["name"], owner.data["name"]))
-                    continue
                 self.warn(node, f"{node.type} {data['name']!r} of robot {owner.data['name']!r}: {name} ({what}) is "
                                 "not rendered here; the image is Webots' without it")
             self.ride(data)
@@ -1235,17 +1232,6 @@ class Converter:
             self.device_contents(node, inner, owner, data)
             return
         self.device_contents(node, inner, owner, None)
-
-    def zoom_line(self, node: Node, device: str, robot: str) -> str:
-        """The line for a Camera's Zoom: the image is Webots' until a controller zooms, but the zoom range
-        (Webots' defaults 0.5 to 1.5 rad) is not read, so ``setFov`` takes only the field of view."""
-        zoom = self.fields(node).node_("zoom")
-        zf = self.fields(zoom) if zoom is not None else None
-        low, high = (zf.num("minFieldOfView", 0.5), zf.num("maxFieldOfView", 1.5)) if zf else (0.5, 1.5)
-        fov = self.fields(node).num("fieldOfView", 0.7854)
-        return (f"Camera {device!r} of robot {robot!r}: its Zoom ({low:g} to {high:g} rad) is not read: setFov() "
-                f"takes only the field of view ({fov:g} rad) and getMinFov()/getMaxFov() answer it, as without a "
-                "Zoom; the image is Webots' at that field of view")
 
     def device_contents(self, node: Node, frame: Frame, owner: Owner, device: dict | None) -> None:
         """A device's own Solid contents: robot body shapes marked as the device's own (its visual

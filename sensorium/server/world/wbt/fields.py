@@ -236,6 +236,21 @@ def _lens(f: Fields) -> dict | None:
             "tangential_coefficients": list(lf.vec("tangentialCoefficients", (0.0, 0.0)))}
 
 
+def _zoom(f: Fields) -> dict | None:
+    """A Camera's Zoom node (Webots' defaults 0.5 and 1.5 rad), or None (NULL): a negative
+    minFieldOfView is 0 and one above maxFieldOfView is maxFieldOfView, as WbZoom resets them."""
+    node = f.node_("zoom")
+    if node is None:
+        return None
+    if node.type != "Zoom":
+        raise f.error("zoom", f"expected a Zoom node or NULL, got a {node.type} node")
+    zf = f.sub(node)
+    low, high = zf.non_negative("minFieldOfView", 0.5, 0.0), zf.num("maxFieldOfView", 1.5)
+    if low > high:
+        low = zf.used("minFieldOfView", low, high, f"is > maxFieldOfView {high:g}")
+    return {"min_field_of_view": low, "max_field_of_view": high}
+
+
 def _max_range(f: Fields, min_range: float, default: float) -> float:
     """A lidar's maxRange: one not above minRange is minRange + 1 (WbLidar::updateMaxRange)."""
     max_range = f.num("maxRange", default)
@@ -333,6 +348,9 @@ def device(node: Node, f: Fields) -> dict:
                                   "occlusion": rf.integer("occlusion", 1), "frame_color": list(rf.color("frameColor", (1.0, 0.0, 0.0))),
                                   "frame_thickness": rf.integer("frameThickness", 1),
                                   "segmentation": rf.flag("segmentation", False)}
+        zoom = _zoom(f)
+        if zoom is not None:
+            out["zoom"] = zoom
         return out
     if t == "PositionSensor":
         return {"device": t, "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}

@@ -20,13 +20,14 @@ from sensorium.server.world.poses import pose_from_values
 RENDERED = {"Camera", "RangeFinder", "Lidar"}        # rasterised in Webots: every closed shape is culled from inside
 PICKED = {"box", "sphere"}                           # Webots' infra-red picking: no hit from inside these
 CLOSED = {"box", "sphere", "cylinder", "capsule"}
+JUDGED = {"type", "size", "radius", "height", "subdivision"}   # the fields of a primitive ``contains`` judges
 IMAGERS = {"Camera", "RangeFinder"}                  # their rays start at ``near`` (default NEAR)
 NEAR = 0.01
 EPS = 1e-9
 
 # field -> (Webots' default, what it does there); a Node-valued field's default is None (NULL)
 UNREAD_IMAGE_FIELDS = {
-    "Camera": {"focus": (None, "depth of field"), "zoom": (None, "zoom"),
+    "Camera": {"focus": (None, "depth of field"),
                "lensFlare": (None, "lens flares"), "motionBlur": (0.0, "motion blur"),
                "noiseMaskUrl": ("", "a noise mask image"), "bloomThreshold": (-1.0, "bloom"),
                "ambientOcclusionRadius": (0.0, "ambient occlusion")},
@@ -62,7 +63,7 @@ def _local(pose: dict, point: np.ndarray) -> np.ndarray:
 def contains(geometry: dict, p: np.ndarray) -> bool:
     """Whether ``p`` (in the shape's frame) is strictly inside a closed primitive."""
     t = geometry.get("type")
-    if set(geometry) - {"type", "size", "radius", "height", "subdivision"}:    # scaled or stretched: not judged
+    if set(geometry) - JUDGED:    # scaled or stretched: not judged
         return False
     if t == "box":
         return bool(np.all(np.abs(p) < np.asarray(geometry["size"], dtype=np.float64) / 2.0 - EPS))
@@ -107,6 +108,13 @@ def enclosing_shapes(robot: dict, device: dict) -> list[dict]:
         if part.get("seen_by") == "bounding" or geometry.get("type") not in kinds:
             continue
         if part.get("of_device") == device["name"]:
+            continue
+        if set(geometry) - JUDGED:    # scaled or stretched: not judged (``contains``)
+            continue
+        # farther from the shape's centre than its farthest point: outside, whatever its rotation
+        # (a robot's shapes times its devices: most pairs end here, before any rotation is made)
+        if float(np.linalg.norm(
+                origin - np.asarray(part["pose"]["translation"], dtype=np.float64))) > reach(geometry) * (1.0 + 1e-9) + EPS:
             continue
         if not contains(geometry, _local(part["pose"], origin)):
             continue

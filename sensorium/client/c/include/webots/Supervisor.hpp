@@ -42,7 +42,7 @@ public:
   void simulationReset() { wb_supervisor_simulation_reset(); }
   void simulationSetMode(SimulationMode mode) { wb_supervisor_simulation_set_mode(static_cast<WbSimulationMode>(mode)); }
   SimulationMode simulationGetMode() const { return static_cast<SimulationMode>(wb_supervisor_simulation_get_mode()); }
-  void simulationQuit(int status) { wb_supervisor_simulation_quit(status); }  // this controller's steps end
+  void simulationQuit(int status) { wb_supervisor_simulation_quit(status); }  // every controller's steps end; the server exits with status
   // Webots' others: one error line per function, "no value" (see supervisor.h)
   Node *getRoot() const { return Node::findNode(wb_supervisor_node_get_root()); }
   Node *getFromId(int id) const { return Node::findNode(wb_supervisor_node_get_from_id(id)); }

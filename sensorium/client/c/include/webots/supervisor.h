@@ -4,8 +4,8 @@
  * (wb_supervisor_node_get_from_def, _get_self, _get_id), their "translation" (SFVec3f) and "rotation"
  * (SFRotation) fields, their world position and orientation, simulation reset and run mode; each such
  * call is one round trip, answered at once, and returned arrays stay valid until the same function is
- * called again for that node/field. wb_supervisor_simulation_quit() ends this controller's simulation
- * (its steps return -1; the server runs on). A node has no contact points (no physics): 0, NULL, a
+ * called again for that node/field. wb_supervisor_simulation_quit(status) ends the simulation for
+ * every controller (their steps return -1) and the server exits with status, as Webots quits. A node has no contact points (no physics): 0, NULL, a
  * NaN vector. Every other function is declared so a Webots controller compiles, does nothing, prints
  * one error line the first time it is called and answers Webots' "no value" (NULL, "", 0, false, -1
  * counts, NaN or a NaN vector; wb_supervisor_movie_is_ready() is true and _failed() true, so a loop
