@@ -222,15 +222,22 @@ def _image(f: Fields, spherical_as: str) -> dict:
     return out
 
 
+def _child(f: Fields, field: str, node_type: str) -> Fields | None:
+    """The fields of the SFNode ``field``, which must be a ``node_type`` node or NULL (None)."""
+    node = f.node_(field)
+    if node is None:
+        return None
+    if node.type != node_type:
+        raise f.error(field, f"expected a {node_type} node or NULL, got a {node.type} node")
+    return f.sub(node)
+
+
 def _lens(f: Fields) -> dict | None:
     """A Camera's or RangeFinder's Lens node (Webots' defaults), or None (NULL). Its centre is
     left to the loader, which resets it as Webots does (loader.lens_center_reset)."""
-    node = f.node_("lens")
-    if node is None:
+    lf = _child(f, "lens", "Lens")
+    if lf is None:
         return None
-    if node.type != "Lens":
-        raise f.error("lens", f"expected a Lens node or NULL, got a {node.type} node")
-    lf = f.sub(node)
     return {"center": list(lf.vec("center", (0.5, 0.5))),
             "radial_coefficients": list(lf.vec("radialCoefficients", (0.0, 0.0))),
             "tangential_coefficients": list(lf.vec("tangentialCoefficients", (0.0, 0.0)))}
@@ -239,12 +246,9 @@ def _lens(f: Fields) -> dict | None:
 def _zoom(f: Fields) -> dict | None:
     """A Camera's Zoom node (Webots' defaults 0.5 and 1.5 rad), or None (NULL): a negative
     minFieldOfView is 0 and one above maxFieldOfView is maxFieldOfView, as WbZoom resets them."""
-    node = f.node_("zoom")
-    if node is None:
+    zf = _child(f, "zoom", "Zoom")
+    if zf is None:
         return None
-    if node.type != "Zoom":
-        raise f.error("zoom", f"expected a Zoom node or NULL, got a {node.type} node")
-    zf = f.sub(node)
     low, high = zf.non_negative("minFieldOfView", 0.5, 0.0), zf.num("maxFieldOfView", 1.5)
     if low > high:
         low = zf.used("minFieldOfView", low, high, f"is > maxFieldOfView {high:g}")
