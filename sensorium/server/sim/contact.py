@@ -765,28 +765,10 @@ def _in_reach(cands: list[Obstacle], p: np.ndarray, d: np.ndarray, radius: float
 
 def _in_reaches(cands: list[Obstacle], p: np.ndarray, turn_radius: float | None, d: np.ndarray, radius: float,
                 memo: dict) -> tuple[list[Obstacle], list[Obstacle]]:
-    """``(_in_reach(cands, p, 0, turn_radius), _in_reach(cands, p, d, radius))`` in one pass, the first
-    ``[]`` for ``turn_radius`` None: the same tests, each candidate's distance from ``p`` found once."""
-    x, y = float(p[0]), float(p[1])
-    reach = radius + math.hypot(float(d[0]), float(d[1]))
-    m = reach + 1e-6 * (1.0 + abs(x) + abs(y) + reach)
-    margin = m - reach
-    near: list[Obstacle] = []
-    reached: list[Obstacle] = []
-    turning = turn_radius is not None
-    reach1 = m1 = margin1 = 0.0
-    if turn_radius is not None:
-        reach1 = turn_radius + math.hypot(0.0, 0.0)
-        m1 = reach1 + 1e-6 * (1.0 + abs(x) + abs(y) + reach1)
-        margin1 = m1 - reach1
-    for ob in cands:
-        lx, ly, hx, hy, _ = ob.flat or _flat(ob)
-        if (turning and not (lx > x + m1 or hx < x - m1 or ly > y + m1 or hy < y - m1)
-                and _gap(p, ob, reach1, memo) <= margin1):
-            near.append(ob)
-        if not (lx > x + m or hx < x - m or ly > y + m or hy < y - m) and _gap(p, ob, reach, memo) <= margin:
-            reached.append(ob)
-    return near, reached
+    """``(_in_reach(cands, p, 0, turn_radius), _in_reach(cands, p, d, radius))``, the first ``[]`` for
+    ``turn_radius`` None, sharing ``memo``: each candidate's distance from ``p`` is found once."""
+    near = [] if turn_radius is None else _in_reach(cands, p, _STILL, turn_radius, memo)
+    return near, _in_reach(cands, p, d, radius, memo)
 
 
 def _flat(ob: Obstacle) -> tuple:
