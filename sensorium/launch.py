@@ -407,15 +407,13 @@ class Launcher:
     def reload(self) -> None:
         """worldReload: stop the server (every step -1); ``run`` then reloads and starts all again."""
         self.reload_requested = True
-        with self._lock:
-            for run in self.running.values():
-                run.ending = True
+        self.quit()
         if self.on_reload is not None:
             self.on_reload()
 
     def quit(self) -> None:
-        """simulationQuit: the server stops (every step -1); every controller ends as at ``--until``,
-        none is said to have exited by itself."""
+        """simulationQuit (and a reload's first half): the server stops (every step -1); every
+        controller ends as at ``--until``, none is said to have exited by itself."""
         with self._lock:
             for run in self.running.values():
                 run.ending = True

@@ -79,18 +79,27 @@ def main(args: argparse.Namespace) -> int:
             print(f"sensorium run: {bind_problem(exc)}", file=sys.stderr)
         return None
 
+    dirs = controller_dirs(world, [Path(d) for d in args.controllers_dir])
+    home = os.environ.get("WEBOTS_HOME")            # --webots-home sets it (cli/__init__.py)
+    webots = WebotsProjects(Path(home)) if home and Path(home).is_dir() else None
+
+    def controllers(s: Server) -> list | None:
+        """The controllers to start for ``s``'s world, or None (closed, every problem said)."""
+        loaded = s.core.sim.loaded.world
+        specs, problems = plan(loaded.robots, dirs, webots, robot_protos(loaded))
+        if not problems:
+            return specs
+        s.close()
+        for line in problems:
+            print(f"sensorium run: {line}", file=sys.stderr)
+        return None
+
     server = open_server(opts)
     if server is None:
         return 1
     robots = server.core.sim.loaded.world.robots
-    dirs = controller_dirs(world, [Path(d) for d in args.controllers_dir])
-    home = os.environ.get("WEBOTS_HOME")            # --webots-home sets it (cli/__init__.py)
-    webots = WebotsProjects(Path(home)) if home and Path(home).is_dir() else None
-    specs, problems = plan(robots, dirs, webots, robot_protos(server.core.sim.loaded.world))
-    if problems:
-        server.close()
-        for line in problems:
-            print(f"sensorium run: {line}", file=sys.stderr)
+    specs = controllers(server)
+    if specs is None:
         return 1
     report = server.core.sim.loaded.report
     if report:
@@ -140,12 +149,8 @@ def main(args: argparse.Namespace) -> int:
             reopened = open_server(again)
             if reopened is None:
                 return 1
-            specs, problems = plan(reopened.core.sim.loaded.world.robots, dirs, webots,   # the file may have changed
-                                   robot_protos(reopened.core.sim.loaded.world))
-            if problems:
-                reopened.close()
-                for line in problems:
-                    print(f"sensorium run: {line}", file=sys.stderr)
+            specs = controllers(reopened)                # the file may have changed
+            if specs is None:
                 return 1
             launcher.replan(specs)
             launcher.log(f"world reloaded from {world}")
