@@ -157,21 +157,23 @@ def test_a_sensor_on_a_steering_axis_without_a_motor_is_said_once(tmp_path: Path
     assert len(said) == 1 and "Hinge2Joint axis without a motor (jointParameters, a free steering axis)" in said[0]
 
 
-def test_a_free_front_wheels_encoder_reads_its_still_position_as_its_line_says(tmp_path: Path) -> None:
-    # Webots' Car with rear-wheel drive: the front Hinge2Joints' second axis (device2) has a PositionSensor
-    # and a Brake but no motor (a free wheel physics rolls); here nothing turns it: it reads the world's position
-    def front(side: str, y: float, position: float) -> str:
-        return hinge2_front(side, y).replace(
-            "jointParameters2 JointParameters { axis 0 1 0 }",
-            f"jointParameters2 JointParameters {{ axis 0 1 0 position {position} }} "
-            f'device2 [ PositionSensor {{ name "{side}_front_sensor" }} Brake {{ name "{side}_front_brake" }} ]')
-    w = load_world(write(tmp_path, car(front("right", -T / 2, 0.7) + front("left", T / 2, 0.0))))
+def free_front(side: str, y: float, position: float, axis: str = "0 1 0") -> str:
+    """Webots' Car with rear-wheel drive: the front Hinge2Joints' second axis (device2) has a
+    PositionSensor and a Brake but no motor (a free wheel)."""
+    return hinge2_front(side, y).replace(
+        "jointParameters2 JointParameters { axis 0 1 0 }",
+        f"jointParameters2 JointParameters {{ axis {axis} position {position} }} "
+        f'device2 [ PositionSensor {{ name "{side}_front_sensor" }} Brake {{ name "{side}_front_brake" }} ]')
+
+
+def test_a_propulsion_cars_free_front_wheels_roll_from_their_world_file_angles(tmp_path: Path) -> None:
+    # the left one's axis is the car's right: rolling forward reads decreasing
+    w = load_world(write(tmp_path, car(free_front("right", -T / 2, 0.7) + free_front("left", T / 2, 0.0, "0 -1 0"))))
     assert w.world.robots[0].ackermann_drive is not None
-    said = sorted(x for x in w.warnings if "Hinge2Joint axis without a motor" in x)
-    assert len(said) == 2, w.warnings
-    assert all("(jointParameters2, a free wheel, which Webots' physics rolls): listed, reads the axis's position "
-               "in the world file" in x and "and keeps it (nothing turns it here)" in x for x in said), said
-    assert {x.split("world file (")[1].split(")")[0] for x in said} == {"0.7", "0"}
+    assert not [x for x in w.warnings if "without a motor" in x], w.warnings
+    sensors = {d.name: (d.free_wheel, d.free_wheel_sign, d.position) for d in w.world.robots[0].devices
+               if d.device == "PositionSensor" and d.motor is None}
+    assert sensors == {"right_front_sensor": ("right_front", 1, 0.7), "left_front_sensor": ("left_front", -1, 0.0)}
     sim = Simulation(w)
     r = sim.robot("car")
     for name in ("right_rear_wheel", "left_rear_wheel"):
@@ -180,6 +182,57 @@ def test_a_free_front_wheels_encoder_reads_its_still_position_as_its_line_says(t
     right, left = r.device("right_front_sensor"), r.device("left_front_sensor")
     right.enable(16)
     left.enable(16)
-    sim.run(20)
-    assert r.pose.translation[0] > 1.0          # the car drove; its free front wheels' encoders kept still
-    assert (right.value, left.value) == (0.7, 0.0)
+    n = 20
+    sim.run(n)
+    travel = R * 10.0 * n * 0.016                    # straight: v t, each free wheel turned by v t / r
+    assert r.pose.translation[0] == pytest.approx(travel, rel=1e-12)
+    assert (right.value, left.value) == pytest.approx((0.7 + travel / R, -travel / R), rel=1e-12)
+
+
+def test_a_traction_cars_free_rear_wheels_roll_with_their_own_track_and_radius(tmp_path: Path) -> None:
+    def free_rear(side: str, y: float) -> str:          # no motor: an encoder and a brake (Webots' Car)
+        wheel = (f'Solid {{ translation 0 {y} 0.4 rotation 1 0 0 1.5708 children [ DEF W Shape {{ geometry '
+                 f'Cylinder {{ radius 0.4 height 0.2 }} }} ] boundingObject USE W }}')
+        return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0.4 }} '
+                f'device [ PositionSensor {{ name "{side}_rear_sensor" }} Brake {{ name "{side}_rear_brake" }} ] '
+                f'endPoint {wheel} }}\n')
+
+    def driven_front(side: str, y: float) -> str:
+        return hinge2_front(side, y).replace(
+            "jointParameters2 JointParameters { axis 0 1 0 }",
+            "jointParameters2 JointParameters { axis 0 1 0 } "
+            f'device2 [ RotationalMotor {{ name "{side}_front_wheel" maxVelocity 80 }} ]')
+    track = 1.6
+    w = load_world(write(tmp_path, car(driven_front("right", -T / 2) + driven_front("left", T / 2),
+                                       free_rear("right", -track / 2) + free_rear("left", track / 2))))
+    assert not [x for x in w.warnings if "without a motor" in x or "drive" in x], w.warnings
+    d = w.world.robots[0].ackermann_drive
+    assert d is not None and d.type == "traction"
+    assert (d.track_rear, d.rear_wheel_radius, d.front_wheel_radius) == (pytest.approx(track), 0.4, R)
+    sim = Simulation(w)
+    r = sim.robot("car")
+    delta = 0.25
+    right_angle, left_angle = ackermann_angles(delta, L, T)
+    r.motor("right_steer").set_position(right_angle)
+    r.motor("left_steer").set_position(left_angle)
+    sim.run(10)
+    rs, ls = r.device("right_rear_sensor"), r.device("left_rear_sensor")
+    rs.enable(16)
+    ls.enable(16)
+    for name in ("right_front_wheel", "left_front_wheel"):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(20.0)
+    sim.run(1)
+    start, before = r.pose.translation.copy(), (rs.value, ls.value)
+    sim.run(200)
+    radius = L / math.tan(delta)            # the rear axle's centre's circle; each rear wheel's its own
+    phi = 2.0 * math.asin(math.hypot(*(r.pose.translation[:2] - start[:2])) / (2.0 * radius))
+    assert rs.value - before[0] == pytest.approx((radius - track / 2) * phi / 0.4, rel=1e-9)
+    assert ls.value - before[1] == pytest.approx((radius + track / 2) * phi / 0.4, rel=1e-9)
+
+
+def test_an_unmotorised_axis_on_no_car_keeps_its_line(tmp_path: Path) -> None:
+    # a free axis on a robot that is no car (one Hinge2Joint alone): still, and said, as before
+    w = load_world(write(tmp_path, car(free_front("right", -T / 2, 0.7), rear="")))
+    said = [x for x in w.warnings if "Hinge2Joint axis without a motor" in x]
+    assert len(said) == 1 and "and keeps it (nothing turns it here)" in said[0] and "(0.7)" in said[0]

@@ -554,7 +554,15 @@ class PositionSensor(_Device):
                                           "sensor on a joint nothing turns here (it reads ``position``)")
     position: float = Field(default=0.0, allow_inf_nan=False,
                             description="without a motor: the joint's position it reads (Webots jointParameters "
-                                        "position: rad, m on a slider); unused with a motor (the motor's own)")
+                                        "position: rad, m on a slider), a free wheel's at the start; unused with a "
+                                        "motor (the motor's own)")
+    free_wheel: Literal["right_front", "left_front", "right_rear", "left_rear"] | None = Field(
+        default=None, description="the encoder of a wheel of the robot's ackermann_drive that has no motor (Webots' "
+        "Car: the front wheels of a propulsion car, the rear ones of a traction car): it reads ``position`` plus the "
+        "angle the wheel has rolled, its contact point's travel along its rolling direction over its radius")
+    free_wheel_sign: Literal[1, -1] = Field(
+        default=1, description="1: the wheel's joint axis is the car's left, so rolling forward reads increasing; "
+                               "-1: its right (rolling forward reads decreasing)")
     noise: float = Field(default=0.0, ge=0.0, description="standard deviation of Gaussian noise (rad)")
     resolution: float = -1.0
 
@@ -1361,6 +1369,17 @@ class Robot(Strict):
             if bad:
                 raise ValueError(f"radar_targets[{i}] ({t.name}): shape index {bad[0]} is past the robot's "
                                  f"{len(self.shapes)} shapes")
+        for d in self.devices:
+            if isinstance(d, PositionSensor) and d.free_wheel is not None:
+                car = self.ackermann_drive
+                if car is None:
+                    raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel!r} needs the robot's "
+                                     "ackermann_drive")
+                if d.motor is not None:
+                    raise ValueError(f"PositionSensor {d.name!r}: give motor or free_wheel, not both")
+                if any(field == f"{d.free_wheel}_wheel" for field, _ in car.driven):
+                    raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel!r} has a motor in this "
+                                     f"{car.type} car (name its motor instead)")
         for i, node in enumerate(self.nodes):
             if node.parent >= i:
                 raise ValueError(f"nodes[{i}] ({node.type}): parent {node.parent} must be an earlier node's index "

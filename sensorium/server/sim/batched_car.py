@@ -22,7 +22,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched_kinematic import libm_each
-from sensorium.server.sim.motion import wheel_places
+from sensorium.server.sim.motion import FREE_WHEELS, wheel_places
 
 __all__ = ["CarDrives", "MOTORS"]
 
@@ -49,6 +49,10 @@ class CarDrives:
         self.wheel_x = np.zeros((K, MOTORS - 2))
         self.wheel_y = np.zeros((K, MOTORS - 2))
         self.wheel_r = np.zeros((K, MOTORS - 2))
+        # per car: its free wheels (no motor: AckermannDrive.free), key -> index, and each one's (x, y,
+        # radius, steering column or -1)
+        self.free: list[dict[str, int]] = []
+        self.free_place: list[list[tuple[float, float, float, int]]] = []
         # per robot slot: its rear axle's offset from its origin along forward (0 for every other robot)
         self.rear_axle = np.zeros(len(world.robots))
         for k, (i, r) in enumerate(cars):
@@ -65,12 +69,18 @@ class CarDrives:
             self.rear_axle[i] = float(a.rear_axle_offset)
             for j, (field, _) in enumerate(a.driven):
                 self.wheel_x[k, j], self.wheel_y[k, j], self.wheel_r[k, j] = place[field]
+            driven = {field for field, _ in a.driven}
+            free = [(field, steer) for field, steer in FREE_WHEELS if field not in driven]
+            self.free.append({field[:-6]: j for j, (field, _) in enumerate(free)})
+            self.free_place.append([(*place[field], steer) for field, steer in free])
         self.offset = bool(self.rear_axle.any())
         """Whether a car's origin is off its rear axle (its moves then go through the offset arc)."""
         self.target = np.zeros((copies, K, MOTORS))       # inf: velocity control
         self.velocity = np.zeros((copies, K, MOTORS))
         self.angle = np.zeros((copies, K, MOTORS))
+        self.free_turned = np.zeros((copies, K, 2))        # each free wheel's rolled angle (AckermannDrive.free_turned)
         self._encoders: np.ndarray | None = None          # per position sensor: (car, column) or (-1, -1)
+        self._free_encoders: np.ndarray | None = None     # per position sensor: (car, free wheel) or (-1, -1)
 
     # ------------------------------------------------------------------ control
     def reset(self, idx: np.ndarray) -> None:
@@ -78,6 +88,7 @@ class CarDrives:
         self.target[idx] = 0.0
         self.velocity[idx] = self.max_velocity
         self.angle[idx] = 0.0
+        self.free_turned[idx] = 0.0
 
     def column(self, slot: int, name: str) -> tuple[int, int]:
         """(car, column) of a car's motor."""
@@ -138,6 +149,7 @@ class CarDrives:
                 u_sum = u_sum + rolled[:, j]
                 h_sum = h_sum + libm_each(math.hypot, 1.0 - kl * self.wheel_y[k, j], kl * self.wheel_x[k, j])
             v = u_sum / h_sum
+            self._roll_free(copies, k, v, kl, dt)
             out.append((copies, np.full(len(copies), self.slots[k], dtype=np.int64), v, v * kl))
         if not out:
             empty = np.zeros(0)
@@ -156,6 +168,13 @@ class CarDrives:
         omega = np.where(np.isinf(tgt), vel, held)
         self.angle[live, k, :n] = ang + omega * dt
         return omega
+
+    def _roll_free(self, copies: np.ndarray, k: int, v: np.ndarray, kl: np.ndarray, dt: float) -> None:
+        """AckermannDrive.roll_free of car k in these copies (its moving ones), the same operations."""
+        for j, (x, y, r, steer) in enumerate(self.free_place[k]):
+            delta = self.sign[k] * self.angle[copies, k, steer] if steer >= 0 else np.zeros(len(copies))
+            along = (1.0 - kl * y) * libm_each(math.cos, delta) - kl * x * libm_each(math.sin, delta)
+            self.free_turned[copies, k, j] = self.free_turned[copies, k, j] + v * dt * along / r
 
     def _curvature(self, copies: np.ndarray, k: int) -> np.ndarray:
         """AckermannDrive.curvature of car k in these copies (1/R, positive turning right)."""
@@ -182,4 +201,18 @@ class CarDrives:
         mine = (car[:, 0] >= 0).nonzero()[0]
         if len(mine):
             values[mine] = self.angle[copies[mine], car[mine, 0], car[mine, 1]]
+        if self._free_encoders is None:      # a free wheel's encoder: its world-file angle plus the rolled one
+            enc = np.full((len(positions), 2), -1, dtype=np.int64)
+            for i, d in enumerate(positions):
+                k = self.car_of.get(int(d.robot_index))
+                wheel = getattr(d.config, "free_wheel", None)
+                if k is not None and wheel is not None:
+                    enc[i] = (k, self.free[k][wheel])
+            self._free_encoders = enc
+        free = self._free_encoders[cols]
+        mine = (free[:, 0] >= 0).nonzero()[0]
+        for i in mine.tolist():
+            cfg = positions[int(cols[i])].config
+            values[i] = float(cfg.position) + cfg.free_wheel_sign * float(self.free_turned[copies[i], free[i, 0],
+                                                                                            free[i, 1]])
 

@@ -424,6 +424,13 @@ class AckermannDrive(PlanarState):
         place = wheel_places(config)
         # each driven wheel: its motor, its (x, y) on the car, its radius
         self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
+        # the wheels without a motor (Webots' Car: a propulsion car's front ones, a traction car's rear
+        # ones): each rolls with the car; key -> (x, y, radius, steering index: 0 right, 1 left, -1 none)
+        driven = {field for field, _ in config.driven}
+        self.free: dict[str, tuple[float, float, float, int]] = {
+            field[:-6]: (*place[field], steer) for field, steer in FREE_WHEELS if field not in driven}
+        self.free_turned = dict.fromkeys(self.free, 0.0)
+        """Each free wheel's rolled angle (rad, forward positive) since the start."""
         self.rear_axle = float(getattr(config, "rear_axle_offset", 0.0))
         super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
 
@@ -453,6 +460,8 @@ class AckermannDrive(PlanarState):
             return None
         kl = -self.curvature()          # to the left, as yaw grows
         v = sum(u for u, _, _ in rolled) / sum(math.hypot(1.0 - kl * y, kl * x) for _, x, y in rolled)
+        if self.free:
+            self.roll_free(v, kl, dt)
         a = self.rear_axle
         if a == 0.0:
             self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, v * kl, dt)
@@ -464,6 +473,21 @@ class AckermannDrive(PlanarState):
             c, s = math.cos(self.yaw), math.sin(self.yaw)
             self.linear = (v * c + a * (v * kl) * s, v * s - a * (v * kl) * c)
         return self.pose()
+
+
+    def roll_free(self, v: float, kl: float, dt: float) -> None:
+        """Turn the free wheels by the step's move: each wheel's contact point moves at v·(1 - κ y, κ x)
+        (κ the curvature to the left), its rolled angle grows by that velocity along the wheel's own
+        heading (its steering angle δ, positive right: (cos δ, -sin δ)) times dt over its radius."""
+        steering = self.steering()
+        for key, (x, y, r, steer) in self.free.items():
+            delta = steering[steer] if steer >= 0 else 0.0
+            along = (1.0 - kl * y) * math.cos(delta) - kl * x * math.sin(delta)
+            self.free_turned[key] += v * dt * along / r
+
+
+FREE_WHEELS = (("right_front_wheel", 0), ("left_front_wheel", 1), ("right_rear_wheel", -1), ("left_rear_wheel", -1))
+"""A car's wheels by drive field, with the steering motor that turns each (0 right, 1 left, -1 none)."""
 
 
 def offset_arc_step(x: float, y: float, yaw: float, v: float, w: float, dt: float,

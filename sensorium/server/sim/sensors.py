@@ -551,12 +551,17 @@ class PositionSensor(Device):
         super().__post_init__()
         self.value = math.nan
         self.wheel: object | None = None          # the WheelMotor whose ``position`` is read
+        self.car: Any = None                      # a free wheel's car (AckermannDrive), whose free_turned is read
 
     def bind(self, robot: Any) -> None:
         self.wheel = robot.motors.get(self.config.motor) if self.config.motor is not None else None
+        self.car = robot.drive if getattr(self.config, "free_wheel", None) is not None else None
 
     def measure(self, now_ms: int) -> None:
-        v = float(self.wheel.position) if self.wheel is not None else float(self.config.position)  # type: ignore[attr-defined]
+        if self.car is not None:      # a car's free wheel: its world-file angle plus what it has rolled
+            v = float(self.config.position) + self.config.free_wheel_sign * self.car.free_turned[self.config.free_wheel]
+        else:
+            v = float(self.wheel.position) if self.wheel is not None else float(self.config.position)  # type: ignore[attr-defined]
         noise = float(self.config.noise)
         if noise > 0.0:
             v += float(self.rng.normal(0.0, noise))

@@ -385,6 +385,8 @@ class Simulation:
             if robot.drive is not None:
                 for m in robot.drive.motors.values():
                     m.target_position, m.velocity, m.position = 0.0, m.max_velocity, 0.0
+                if isinstance(robot.drive, AckermannDrive):     # free wheels back at their world-file angles
+                    robot.drive.free_turned = dict.fromkeys(robot.drive.free, 0.0)
                 robot.drive.reset(pose)
                 pose = robot.drive.placed(pose)
             for joint in robot.joints.values():

@@ -93,6 +93,7 @@ class Owner:
     parts: list[dict] = field(default_factory=list)
     keys: dict[tuple, dict] = field(default_factory=dict)      # visual parts by (geometry, frame)
     wheels: list[dict] = field(default_factory=list)           # motorised hinges (robots)
+    free: list[dict] = field(default_factory=list)             # a robot's wheel axes with encoders, no motor
     placed: Frame = field(default_factory=Frame.identity)      # the owner's frame in the world
 
 
@@ -1439,8 +1440,20 @@ class Converter:
             self.warn(node, f"{node.type} motor(s) outside a robot: not simulated")
         # (a robot's Hinge2Joint: hinge2() said which of its axes has sensors but no motor)
         if sensors and not motors and node.type != "Hinge2Joint":
-            self.warn(node, f"PositionSensor on a joint without a motor: reads the joint's position, "
-                            f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)")
+            line = (f"PositionSensor on a joint without a motor: reads the joint's position, "
+                    f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)")
+            if wheeled and node.type == "HingeJoint":     # perhaps a car's free rear wheel (said after the drive)
+                pf = self.fields(f.node_("jointParameters")) if f.node_("jointParameters") is not None else None
+                axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
+                centre = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
+                wheel = self.slotted(end)
+                if wheel is not None and wheel.type == "Solid":
+                    centre = self.fields(wheel).vec("translation", (0.0, 0.0, 0.0))
+                owner.free.append({"node": node, "sensors": sensors, "line": line, "steer": None,
+                                   "axis": frame.rotation @ np.asarray(axis),
+                                   "centre": np.asarray(frame.apply(centre)), "end": end})
+            else:
+                self.warn(node, line)
         if end is not None:
             if end.type == "SolidReference":
                 return
@@ -1561,9 +1574,15 @@ class Converter:
                 if found_sensors:       # joint_devices gave it the axis's position: it reads that, still
                     still = float(found_sensors[0].get("position", 0.0))
                     what = "a free wheel, which Webots' physics rolls" if not steers else "a free steering axis"
-                    self.warn(node, f"PositionSensor on a Hinge2Joint axis without a motor ({params_field}, "
-                                    f"{what}): listed, reads the axis's position in the world file ({still:g}) "
-                                    "and keeps it (nothing turns it here)")
+                    line = (f"PositionSensor on a Hinge2Joint axis without a motor ({params_field}, {what}): listed, "
+                            f"reads the axis's position in the world file ({still:g}) and keeps it (nothing turns "
+                            "it here)")
+                    if steers or not motors:
+                        self.warn(node, line)
+                    else:               # a car's free front wheel rolls (said after the drive if it is none)
+                        owner.free.append({"node": node, "sensors": found_sensors, "line": line,
+                                           "steer": self.fields(motors[0]).string("name", "rotational motor"),
+                                           "axis": frame.rotation @ np.asarray(axis), "centre": centre, "end": end})
                 continue
             m = self.fields(found[0])
             turn = frame.rotation @ np.asarray(axis)
@@ -1597,6 +1616,12 @@ class Converter:
             self._drive(node, robot, nowheel)
         finally:
             self._say_no_wheels(node, robot, nowheel)
+            from sensorium.server.world.wbt.drive import free_car_wheels
+
+            rolling = free_car_wheels(robot.data.get("ackermann_drive"), robot.free, self)
+            for free in robot.free:     # an encoder on a wheel axis no motor turns and no car rolls: still
+                if id(free) not in rolling:
+                    self.warn(free["node"], free["line"])
 
     def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         if len(nowheel) <= MANY_JOINTS:

@@ -378,6 +378,49 @@ def _ackermann(wheels: list[dict], conv) -> tuple[dict | None, str]:
     return out, ""
 
 
+def free_car_wheels(car: dict | None, free: list[dict], conv) -> set[int]:
+    """A car's wheels without a motor (Webots' Car: a propulsion car's front wheels, the second axis of
+    its steering Hinge2Joints; a traction car's rear ones, HingeJoints on the rear axle under its
+    origin) become the drive's free wheels: each encoder on them gets ``free_wheel`` (and
+    ``free_wheel_sign`` -1 when its axis is the car's right), a traction car the rear wheels' track
+    and radius. ``free``: the robot's wheel axes with encoders and no motor; the ids of those that
+    roll now (the others keep their line)."""
+    if car is None or car["type"] == "4x4" or not free:
+        return set()
+    fwd = car.get("forward")
+    frame = np.eye(3) if fwd is None else np.array([[fwd[0], fwd[1], 0.0], [-fwd[1], fwd[0], 0.0], [0.0, 0.0, 1.0]])
+    found: dict[str, tuple[dict, np.ndarray]] = {}      # right_front, ... -> (the axis, its centre in the drive's frame)
+    for f in free:
+        axis = frame @ (f["axis"] / np.linalg.norm(f["axis"]))
+        if abs(abs(axis[1]) - 1.0) > AXIS_TOL:         # no wheel rolling along the car
+            continue
+        centre = frame @ f["centre"]
+        if car["type"] == "propulsion" and f["steer"] in (car["right_steer"], car["left_steer"]):
+            found["right_front" if f["steer"] == car["right_steer"] else "left_front"] = (f, axis)
+        elif car["type"] == "traction" and f["steer"] is None and abs(centre[0]) <= TOL and abs(centre[1]) > TOL:
+            key = "right_rear" if centre[1] < 0 else "left_rear"
+            if key in found:            # two on one side: neither is the car's wheel
+                return set()
+            found[key] = (f, centre)
+    if car["type"] == "traction":
+        if set(found) != {"right_rear", "left_rear"}:
+            return set()
+        right, left = found["right_rear"], found["left_rear"]
+        if abs(right[1][1] + left[1][1]) > TOL:
+            return set()
+        radius, _ = _radius([right[0], left[0]], conv)
+        if radius is None:
+            return set()
+        car["track_rear"], car["rear_wheel_radius"] = float(left[1][1] - right[1][1]), radius
+        found = {k: (f, frame @ (f["axis"] / np.linalg.norm(f["axis"]))) for k, (f, _) in found.items()}
+    for key, (f, axis) in found.items():
+        for sensor in f["sensors"]:
+            sensor["free_wheel"] = key
+            if axis[1] < 0:
+                sensor["free_wheel_sign"] = -1
+    return {id(f) for f, _ in found.values()}
+
+
 # ---------------------------------------------------------------- mecanum wheels (a KUKA youBot)
 
 MECANUM_ANGLE = math.pi / 4
