@@ -36,13 +36,14 @@ ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
 CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
-               "wire_vectors", "every_device", "headers", "car_driver", "supervisor_scene",
+               "wire_vectors", "every_device", "headers", "car_driver", "car_lights", "supervisor_scene",
                "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos",
                "nested_nodes"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
 CAR_WORLD = REPO / "tests" / "worlds" / "car.yaml"
+CAR_LIGHTS_WORLD = REPO / "tests" / "worlds" / "car_lights.yaml"
 SCENE_WORLD = REPO / "tests" / "worlds" / "supervisor_scene.yaml"
 REMOVE_WORLD = REPO / "tests" / "worlds" / "supervisor_remove.yaml"
 ROOT_WORLD = REPO / "tests" / "worlds" / "root_children.wbt"
@@ -269,6 +270,20 @@ def test_a_webots_style_c_driver_controller_drives_the_closed_form_circle(cbin, 
     phi = 20 / 3.6 * time_ms / 1000 / radius
     x, y, _ = pose["translation"]
     assert (x, y) == pytest.approx((radius * math.sin(phi), -radius + radius * math.cos(phi)), abs=1e-9)
+
+
+def test_the_c_vehicle_library_keeps_the_lights_indicators_and_brake_as_the_python_one(cbin, servers):
+    """tests/c/car_lights.c prints the lines tests/controllers/car_lights.py prints: the engine type
+    from the world, the brake and brake lights, reverse and the backwards lights, the indicators
+    blinking by the simulated time and switching themselves off, the hazard flashers, the lights and
+    their LEDs, a free wheel's encoder (tests/test_vehicle_driver.py checks both)."""
+    from test_vehicle_driver import BRAKE_LINE, check_car_lights
+
+    server = servers(CAR_LIGHTS_WORLD, "--heartbeat-ms", "500")
+    code, out, err = finish(start([cbin["car_lights"]], server.url("car")))
+    assert code == 0, err
+    check_car_lights(out)
+    assert err.splitlines() == [BRAKE_LINE], err       # nothing said to be unsimulated
 
 
 def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_functions(cbin, servers):

@@ -126,3 +126,46 @@ def test_car_read_outs_and_a_robot_that_is_not_a_car(tmp_path: Path) -> None:
         "Error: Driver(): robot 'bot' has no ackermann_drive: Sensorium's vehicle library drives a car-like robot "
         "whose world entry has one (README \"World files\"; a .wbt car is mapped when its steering and wheel joints "
         "are a car's).")
+
+
+LIGHTS_WORLD = Path(__file__).resolve().parent / "worlds" / "car_lights.yaml"
+LIGHTS_PY = Path(__file__).resolve().parent / "controllers" / "car_lights.py"
+BRAKE_LINE = "Warning: wbu_driver_set_brake_intensity(): intensity 1.5 is outside [0, 1]: 1 used."
+
+
+def check_car_lights(lines: list[str]) -> None:
+    """What tests/controllers/car_lights.py and tests/c/car_lights.c print on a fresh
+    tests/worlds/car_lights.yaml: the world's engine type, the controller's commands kept and
+    answered as Webots' library keeps them, the car's LEDs of Webots' names switched for them."""
+    by = {line.split()[0]: line.split()[1:] for line in lines}
+    assert by["start"] == ["1", "0.34000000000000002", "0", "0", "0", "0"]    # electric; Webots' default period
+    # 50 steps straight at 36 km/h: the free front wheels (radius 0.3) roll 8 m; the left's axis is the car's right
+    right, left = (float(v) for v in by["rolled"])
+    assert right == pytest.approx(8 / 0.3, rel=1e-12) and left == pytest.approx(-8 / 0.3, rel=1e-12)
+    assert by["brake"] == ["1", "1", "1"] and by["released"] == ["0", "0", "0"]       # intensity, lights, LED
+    assert by["reverse"] == ["0"] and by["reversing"] == ["1", "1"] and by["stopped"] == ["0", "0"]
+    assert by["blink"][0] == "0.064000000000000001"
+
+    def lit(tokens: list[str], on_pattern: str) -> list[bool]:
+        # Webots' driver: on while int(t / period) is even, t the time before the step
+        ons = []
+        for token in tokens:
+            t, leds = token.split(":")
+            on = int(round(float(t) * 1000) / 1000.0 / 0.064) % 2 == 0
+            assert leds == (on_pattern if on else "00"), tokens
+            ons.append(on)
+        return ons
+    blinks = lit(by["blink"][1:], "10")
+    assert len(blinks) == 8 and any(blinks) and not all(blinks)
+    assert by["auto"] == ["1", "0", "2"]      # right kept at 0.25, off at 0.19 (0.3 - 0.1); left kept without auto-off
+    assert by["hazard"][0] == "1" and len(lit(by["hazard"][1:], "11")) == 4
+    assert by["lights"] == ["1", "1", "1", "1", "1"]
+
+
+def test_the_lights_indicators_brake_and_engine_as_webots_library_keeps_them(tmp_path: Path) -> None:
+    with serve(LIGHTS_WORLD, "--mode", "fast", "--heartbeat-ms", "500") as server:
+        proc = Proc(sensorium("controller", str(LIGHTS_PY), "--url", server.url("car")))
+        assert proc.wait(120) is not None
+    assert proc.returncode == 0, proc.stderr()
+    check_car_lights(proc.stdout().splitlines())
+    assert proc.stderr().strip().splitlines() == [BRAKE_LINE]     # nothing said to be unsimulated

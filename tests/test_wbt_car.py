@@ -236,3 +236,21 @@ def test_an_unmotorised_axis_on_no_car_keeps_its_line(tmp_path: Path) -> None:
     w = load_world(write(tmp_path, car(free_front("right", -T / 2, 0.7), rear="")))
     said = [x for x in w.warnings if "Hinge2Joint axis without a motor" in x]
     assert len(said) == 1 and "and keeps it (nothing turns it here)" in said[0] and "(0.7)" in said[0]
+
+
+@pytest.mark.parametrize("letter, engine", [("E", "electric"), ("P", "parallel hybrid"), ("S", "power-split hybrid"),
+                                            ("C", "combustion")])
+def test_a_webots_cars_custom_data_gives_the_drive_its_engine_type(tmp_path: Path, letter: str, engine: str) -> None:
+    # the customData Webots' Car PROTO writes for its vehicle library: geometry, brake, damping, the
+    # engineType's letter, the engine's figures, the gear count, the sound's length, the gears, the sound
+    data = f"2.6 1.5 1.5 0.35 0.35 700 5 {letter} 250 50000 1000 4500 150 0.1 0 0.25 3000 1000 6 17 -12 10 6.5 4.5 " \
+           "3.5 2.75 sounds/engine.wav "
+    body = HINGE2_CAR.replace('controller "<extern>"', f'controller "<extern>" customData "{data}"')
+    d = load_world(write(tmp_path, body)).world.robots[0].ackermann_drive
+    assert d is not None and d.engine_type == engine
+
+
+def test_custom_data_that_is_no_cars_leaves_the_engine_combustion(tmp_path: Path) -> None:
+    body = HINGE2_CAR.replace('controller "<extern>"', 'controller "<extern>" customData "2.6 1.5 E"')
+    d = load_world(write(tmp_path, body)).world.robots[0].ackermann_drive
+    assert d is not None and d.engine_type == "combustion"

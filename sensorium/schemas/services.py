@@ -720,6 +720,8 @@ class AckermannDescription(Result):
                                          "in the robot's frame; the geometry above is in the drive's axes")
     rear_axle_offset: float = Field(default=0.0, description="m, the rear axle's centre along forward from the "
                                     "robot's origin (0: the origin is on it, as in Webots' cars)")
+    engine_type: Literal["combustion", "electric", "parallel hybrid", "power-split hybrid"] = Field(
+        default="combustion", description="Webots' Car engineType (the vehicle library's getEngineType)")
 
     @field_validator("forward", mode="before")
     @classmethod

@@ -1176,6 +1176,9 @@ class AckermannDrive(Strict):
     rear_axle_offset: float = Field(default=0.0, description="m, where the rear axle's centre is along forward from "
                                     "the robot's origin (negative: behind it); 0, the origin on the rear axle, as "
                                     "Webots' car PROTOs have it")
+    engine_type: Literal["combustion", "electric", "parallel hybrid", "power-split hybrid"] = Field(
+        default="combustion", description="Webots' Car engineType: what the vehicle library's getEngineType answers "
+        "(no engine is simulated)")
 
     _forward_nonzero = field_validator("forward")(_nonzero_forward)
 

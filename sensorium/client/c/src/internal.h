@@ -223,6 +223,7 @@ typedef struct {
   double wheelbase, track_front, track_rear, front_wheel_radius, rear_wheel_radius;
   int type;    /* WBU_CAR_TRACTION, WBU_CAR_PROPULSION or WBU_CAR_FOUR_BY_FOUR */
   double sign; /* 1: a positive steering motor position steers right (Webots' Driver), -1: left */
+  int engine;  /* WBU_CAR_COMBUSTION_ENGINE, ...: a Webots Car's engineType */
   char *motors[6]; /* right_steer, left_steer, right_front_wheel, left_front_wheel, right_rear_wheel, left_rear_wheel */
 } sn_car;
 

@@ -306,8 +306,15 @@ static void parse_car(sn_car *car, const msgpack_object *o) {
   car->type = type == NULL ? -1 : strcmp(type, "traction") == 0 ? 0 : strcmp(type, "propulsion") == 0 ? 1
                                 : strcmp(type, "4x4") == 0        ? 2 : -1;
   car->sign = steers != NULL && strcmp(steers, "left") == 0 ? -1.0 : 1.0;
+  char *engine = sn_strdup_obj(sn_get(o, "engine_type")); /* absent (an older server): combustion */
+  car->engine = engine == NULL                           ? 0
+                : strcmp(engine, "electric") == 0           ? 1
+                : strcmp(engine, "parallel hybrid") == 0    ? 2
+                : strcmp(engine, "power-split hybrid") == 0 ? 3
+                                                            : 0;
   free(type);
   free(steers);
+  free(engine);
   bool ok = car->type >= 0 && car->wheelbase > 0 && car->front_wheel_radius > 0 && car->rear_wheel_radius > 0;
   for (int i = 0; i < 6; i++) {
     car->motors[i] = sn_strdup_obj(sn_get(o, motors[i]));

@@ -2,15 +2,19 @@
  * over a car-like robot's ordinary motors. The car's geometry comes with the attach reply (the
  * world's ackermann_drive; Webots reads a Car's customData). wbu_driver_set_steering_angle() turns
  * the two steering motors to Webots' Ackermann angles, wbu_driver_set_cruising_speed() sets the
- * driven wheels' velocities by Webots' geometric differentials; the car is kinematic (no engine,
- * gearbox, brakes, lights or wipers): those functions print one line the first time and answer
- * Webots' "no value". wbu_car_init()/wbu_driver_init() on a robot without an ackermann_drive print
- * one line and end the controller with status 1. Before init every function answers "no value". */
+ * driven wheels' velocities by Webots' geometric differentials. The brake intensity, indicators,
+ * hazard flashers, lights and the car's flags are the controller's commands, kept and answered as
+ * Webots' library keeps them (the car's LEDs of Webots' names switched for them); the engine type
+ * is the world's. The car is kinematic (no engine, gearbox, torque control or wipers): those
+ * functions print one line the first time and answer Webots' "no value". wbu_car_init()/
+ * wbu_driver_init() on a robot without an ackermann_drive print one line and end the controller with
+ * status 1. Before init every function answers "no value". */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <webots/led.h>
 #include <webots/motor.h>
 #include <webots/position_sensor.h>
 #include <webots/robot.h>
@@ -28,7 +32,33 @@ static struct {
   WbDeviceTag wheel_sensor[4]; /* right_front_sensor, ... (Webots' names); 0: none */
   double angle, right_angle, left_angle, cruising;
   WbuDriverControlMode mode;
+  /* the controller's own commands Webots' library keeps, and the LEDs it switches for them */
+  double brake, indicator_angle, indicator_period;
+  WbuDriverIndicatorState indicator;
+  bool hazard, dipped, antifog, backwards, limited_slip, auto_disabling;
+  WbDeviceTag lights[9]; /* LIGHTS' order; 0: the car has none */
+  int lit[9];            /* what each was last set to (-1: never) */
 } g_car;
+
+/* The LEDs Webots' car library switches when the car has them (Webots' VehicleLights names). */
+enum { FRONT, ANTIFOG, RIGHT_IND, LEFT_IND, REAR, BACKWARDS, BRAKE, IN_RIGHT_IND, IN_LEFT_IND };
+static const char *const LIGHTS[9] = {"front_lights",     "antifog_lights", "right_indicators",
+                                      "left_indicators",  "rear_lights",    "backwards_lights",
+                                      "brake_lights",     "interior_right_indicators", "interior_left_indicators"};
+#define INDICATOR_PERIOD 0.34          /* s: Webots' default */
+#define AUTO_DISABLING_THRESHOLD 0.1   /* rad: Webots' driver library's */
+
+/* Switch the car's LED (and an indicator's interior one), if it has it. */
+static void light(int which, bool on) {
+  int both[2] = {which, which == RIGHT_IND ? IN_RIGHT_IND : which == LEFT_IND ? IN_LEFT_IND : -1};
+  for (int k = 0; k < 2; k++) {
+    int i = both[k];
+    if (i < 0 || !g_car.lights[i] || g_car.lit[i] == (int)on)
+      continue;
+    wb_led_set(g_car.lights[i], on);
+    g_car.lit[i] = on;
+  }
+}
 
 static void unmodelled(const char *func, bool *said) {
   if (*said)
@@ -36,7 +66,7 @@ static void unmodelled(const char *func, bool *said) {
   *said = true;
   fprintf(stderr,
           "Warning: %s(): not simulated (Sensorium's car is kinematic, a bicycle model of its steering and wheel "
-          "motors: no engine, gearbox, brakes, lights or wipers); it answers Webots' \"no value\".\n",
+          "motors: no engine, gearbox, torque control or wipers); it answers Webots' \"no value\".\n",
           func);
   fflush(stderr);
 }
@@ -105,6 +135,12 @@ static void car_init(const char *func) {
       wb_motor_set_velocity(g_car.wheel[i], 0.0);
     }
   }
+  for (int i = 0; i < 9; i++) {
+    g_car.lights[i] = quiet_device(rb, LIGHTS[i], SN_LED);
+    g_car.lit[i] = -1;
+  }
+  g_car.indicator_period = INDICATOR_PERIOD;
+  g_car.limited_slip = g_car.auto_disabling = true;
   g_car.mode = UNDEFINED_CONTROL_MODE;
   g_car.ready = true;
 }
@@ -121,29 +157,28 @@ WbuCarType wbu_car_get_type(void) {
   return g_car.ready ? (WbuCarType)g_car.geo->type : WBU_CAR_TRACTION;
 }
 
+/* The world's engine type (a Webots Car's engineType); no engine runs here. */
 WbuCarEngineType wbu_car_get_engine_type(void) {
-  UNMODELLED();
-  return WBU_CAR_COMBUSTION_ENGINE;
+  return g_car.ready ? (WbuCarEngineType)g_car.geo->engine : WBU_CAR_COMBUSTION_ENGINE;
 }
 
 void wbu_car_set_indicator_period(double period) {
-  (void)period;
-  UNMODELLED();
+  if (g_car.ready)
+    g_car.indicator_period = period;
 }
 
 double wbu_car_get_indicator_period(void) {
-  UNMODELLED();
-  return NAN;
+  return g_car.ready ? g_car.indicator_period : NAN;
 }
 
+/* As Webots' driver decides it at each step: on while a negative cruising speed is set (reverse). */
 bool wbu_car_get_backwards_lights(void) {
-  UNMODELLED();
-  return false;
+  return g_car.ready && g_car.backwards;
 }
 
+/* On while the brake intensity is above 0. */
 bool wbu_car_get_brake_lights(void) {
-  UNMODELLED();
-  return false;
+  return g_car.ready && g_car.brake > 0.0;
 }
 
 double wbu_car_get_track_front(void) {
@@ -201,14 +236,15 @@ double wbu_car_get_left_steering_angle(void) {
   return g_car.ready ? g_car.left_angle : NAN;
 }
 
+/* Kept (Webots' library uses it in torque control only, which a kinematic car has not). */
 void wbu_car_enable_limited_slip_differential(bool enable) {
-  (void)enable;
-  UNMODELLED();
+  if (g_car.ready)
+    g_car.limited_slip = enable;
 }
 
 void wbu_car_enable_indicator_auto_disabling(bool enable) {
-  (void)enable;
-  UNMODELLED();
+  if (g_car.ready)
+    g_car.auto_disabling = enable;
 }
 
 /* ------------------------------------------------------------------ driver */
@@ -224,9 +260,16 @@ void wbu_driver_cleanup(void) {
   wbu_car_cleanup();
 }
 
+/* Before the step, as Webots' library: the indicators' LEDs blink (on for the first half of each
+ * period, by the simulated time) and the backwards lights are on while a negative cruising speed is set. */
 int wbu_driver_step(void) {
   if (!g_car.ready)
     return -1;
+  bool on = ((int)(wb_robot_get_time() / g_car.indicator_period) % 2) == 0;
+  light(RIGHT_IND, on && (g_car.hazard || g_car.indicator == RIGHT));
+  light(LEFT_IND, on && (g_car.hazard || g_car.indicator == LEFT));
+  g_car.backwards = g_car.mode == SPEED && g_car.cruising < 0.0;
+  light(BACKWARDS, g_car.backwards);
   return wb_robot_step((int)wb_robot_get_basic_time_step());
 }
 
@@ -243,6 +286,15 @@ void wbu_driver_set_steering_angle(double steering_angle) {
   wb_motor_set_position(g_car.steer[1], g_car.geo->sign * g_car.left_angle);
   if (g_car.mode == SPEED) /* the differential speeds follow the new angles */
     wbu_driver_set_cruising_speed(g_car.cruising);
+  if (g_car.auto_disabling && g_car.indicator != OFF) {
+    /* Webots' driver: an indicator follows the steering to its furthest turn its way, and goes off
+     * once the steering has come back from there by the threshold */
+    double toward = g_car.indicator == RIGHT ? 1.0 : -1.0, moved = toward * (steering_angle - g_car.indicator_angle);
+    if (moved > 0.0)
+      g_car.indicator_angle = steering_angle;
+    else if (moved <= -AUTO_DISABLING_THRESHOLD)
+      g_car.indicator = OFF;
+  }
 }
 
 /* The mean of the steering encoders (Webots), of the motors' targets where a steering motor has none. */
@@ -331,54 +383,68 @@ double wbu_driver_get_throttle(void) {
   return NAN;
 }
 
+/* Kept and answered (clamped to [0, 1], one line when it is not), the brake lights on while it is
+ * above 0; it does not slow the car here (the wheels follow their speed control). */
 void wbu_driver_set_brake_intensity(double intensity) {
-  (void)intensity;
-  UNMODELLED();
+  if (!g_car.ready)
+    return;
+  if (!(intensity >= 0.0 && intensity <= 1.0)) {
+    double used = intensity > 1.0 ? 1.0 : 0.0;
+    fprintf(stderr, "Warning: wbu_driver_set_brake_intensity(): intensity %g is outside [0, 1]: %g used.\n", intensity,
+            used);
+    fflush(stderr);
+    intensity = used;
+  }
+  g_car.brake = intensity;
+  light(BRAKE, intensity > 0.0);
 }
 
 double wbu_driver_get_brake_intensity(void) {
-  UNMODELLED();
-  return NAN;
+  return g_car.ready ? g_car.brake : NAN;
 }
 
 void wbu_driver_set_indicator(WbuDriverIndicatorState state) {
-  (void)state;
-  UNMODELLED();
+  if (!g_car.ready)
+    return;
+  g_car.indicator = state;
+  g_car.indicator_angle = g_car.angle;
 }
 
 void wbu_driver_set_hazard_flashers(bool state) {
-  (void)state;
-  UNMODELLED();
+  if (g_car.ready)
+    g_car.hazard = state;
 }
 
 WbuDriverIndicatorState wbu_driver_get_indicator(void) {
-  UNMODELLED();
-  return OFF;
+  return g_car.ready ? g_car.indicator : OFF;
 }
 
 bool wbu_driver_get_hazard_flashers(void) {
-  UNMODELLED();
-  return false;
+  return g_car.ready && g_car.hazard;
 }
 
+/* Kept, and the front and rear lights' LEDs switched (if the car has them). */
 void wbu_driver_set_dipped_beams(bool state) {
-  (void)state;
-  UNMODELLED();
+  if (!g_car.ready)
+    return;
+  g_car.dipped = state;
+  light(FRONT, state);
+  light(REAR, state);
 }
 
 void wbu_driver_set_antifog_lights(bool state) {
-  (void)state;
-  UNMODELLED();
+  if (!g_car.ready)
+    return;
+  g_car.antifog = state;
+  light(ANTIFOG, state);
 }
 
 bool wbu_driver_get_dipped_beams(void) {
-  UNMODELLED();
-  return false;
+  return g_car.ready && g_car.dipped;
 }
 
 bool wbu_driver_get_antifog_lights(void) {
-  UNMODELLED();
-  return false;
+  return g_car.ready && g_car.antifog;
 }
 
 double wbu_driver_get_rpm(void) {
@@ -415,14 +481,13 @@ WbuDriverWiperMode wbu_driver_get_wiper_mode(void) {
   return DOWN;
 }
 
+/* Webots' deprecated names of the brake intensity's functions. */
 void wbu_driver_set_brake(double brake) {
-  (void)brake;
-  UNMODELLED();
+  wbu_driver_set_brake_intensity(brake);
 }
 
 double wbu_driver_get_brake(void) {
-  UNMODELLED();
-  return NAN;
+  return wbu_driver_get_brake_intensity();
 }
 
 void wbu_driver_set_wipers_mode(wbu_wipers_mode mode) {

@@ -3,9 +3,11 @@
 A car-like robot (its world entry's ``ackermann_drive``, or a .wbt car mapped to one) is driven
 through its ordinary motors: ``Driver.setSteeringAngle`` sets the two steering motors to Webots'
 Ackermann angles, ``setCruisingSpeed`` the driven wheels' velocities by Webots' geometric
-differentials. There is no engine, gearbox, brake, light or wiper model: those functions print one
-line the first time and answer Webots' "no value". On a robot without an ``ackermann_drive`` the
-constructor prints one line and exits with status 1."""
+differentials. The brake intensity, indicators, lights and the car's flags are kept and answered as
+Webots' library keeps them (the car's LEDs of Webots' names switched for them). There is no engine,
+gearbox, torque control or wiper model: those functions print one line the first time and answer
+Webots' "no value". On a robot without an ``ackermann_drive`` the constructor prints one line and
+exits with status 1."""
 
 from .car import Car
 from .driver import Driver

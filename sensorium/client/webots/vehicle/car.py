@@ -1,12 +1,13 @@
-"""Webots' ``Car`` class: the ``Driver`` plus the car's read-outs (type, geometry, each front
-wheel's angle, the wheels' encoders and speeds). Engine type, indicator period and the lights are
-not simulated (one line the first time, then Webots' "no value")."""
+"""Webots' ``Car`` class: the ``Driver`` plus the car's read-outs (type, engine type, geometry, each
+front wheel's angle, the wheels' encoders and speeds) and what Webots' library keeps of the
+controller's commands (indicator period, brake and backwards lights, the limited-slip and indicator
+auto-disabling flags)."""
 
 from __future__ import annotations
 
 import math
 
-from .driver import Driver, unmodelled
+from .driver import Driver
 
 # Webots' wheel indices → (the car's wheel key, the encoder name Webots' car library looks up)
 _WHEELS = (("right_front", "right_front_sensor"), ("left_front", "left_front_sensor"),
@@ -75,13 +76,33 @@ class Car(Driver):
             return math.nan
         return float(self._wheels[_WHEELS[wheel_index][0]][0].getVelocity())
 
-    getEngineType = unmodelled("wbu_car_get_engine_type", COMBUSTION_ENGINE)
-    setIndicatorPeriod = unmodelled("wbu_car_set_indicator_period", None, "period")
-    getIndicatorPeriod = unmodelled("wbu_car_get_indicator_period", 0.0)
-    getBackwardsLights = unmodelled("wbu_car_get_backwards_lights", False)
-    getBrakeLights = unmodelled("wbu_car_get_brake_lights", False)
-    enableLimitedSlipDifferential = unmodelled("wbu_car_enable_limited_slip_differential", None, "enable")
-    enableIndicatorAutoDisabling = unmodelled("wbu_car_enable_indicator_auto_disabling", None, "enable")
+    def getEngineType(self) -> int:
+        """The car's engine type from its world entry (a Webots Car's engineType); no engine runs here."""
+        return self._engine
+
+    def setIndicatorPeriod(self, period: float) -> None:
+        """The indicators' blinking period (s; Webots' default 0.34)."""
+        self._indicator_period = float(period)
+
+    def getIndicatorPeriod(self) -> float:
+        return self._indicator_period
+
+    def getBackwardsLights(self) -> bool:
+        """Whether the backwards lights are on: as Webots' driver decides it at each step, while a
+        negative cruising speed is set (reverse)."""
+        return self._backwards
+
+    def getBrakeLights(self) -> bool:
+        """Whether the brake lights are on: while the brake intensity is above 0."""
+        return self._brake > 0.0
+
+    def enableLimitedSlipDifferential(self, enable: bool) -> None:
+        """Kept (Webots' library uses it in torque control only, which a kinematic car has not)."""
+        self._limited_slip = bool(enable)
+
+    def enableIndicatorAutoDisabling(self, enable: bool) -> None:
+        """Whether an indicator switches itself off once the steering comes back (Webots: on by default)."""
+        self._auto_disabling = bool(enable)
 
     wheelbase = property(getWheelbase)
     track_front = property(getTrackFront)

@@ -1,8 +1,11 @@
 """Webots' ``Driver`` class over a car-like robot's ordinary motors (its world entry's
 ``ackermann_drive``): ``setSteeringAngle`` turns the two steering motors to Webots' Ackermann
 angles, ``setCruisingSpeed`` sets the driven wheels' velocities by Webots' geometric differentials,
-``getCurrentSpeed`` reads them back. Sensorium's car is kinematic (no engine, gearbox, brakes,
-lights or wipers): those functions answer Webots' "no value" after one line the first time."""
+``getCurrentSpeed`` reads them back. The brake intensity, indicators, hazard flashers, dipped beams
+and antifog lights are the controller's commands, kept and answered as Webots' library keeps them
+(and the car's LEDs of Webots' names switched for them); Sensorium's car is kinematic (no engine,
+gearbox, torque control or wipers): those functions answer Webots' "no value" after one line the
+first time."""
 
 from __future__ import annotations
 
@@ -16,7 +19,16 @@ from sensorium.client.webots.controller.supervisor import Supervisor
 from sensorium.client.webots.controller.unsimulated import signed
 
 _UNMODELLED = ("Sensorium's car is kinematic (a bicycle model of its steering and wheel motors): no engine, "
-               "gearbox, brakes, lights or wipers")
+               "gearbox, torque control or wipers")
+
+LIGHTS = ("front_lights", "antifog_lights", "right_indicators", "left_indicators", "rear_lights", "backwards_lights",
+          "brake_lights", "interior_right_indicators", "interior_left_indicators")
+"""The LEDs Webots' car library switches when the car has them (Webots' VehicleLights names)."""
+INDICATOR_PERIOD = 0.34
+"""s: Webots' car library's indicator period until setIndicatorPeriod."""
+AUTO_DISABLING_THRESHOLD = 0.1
+"""rad: how far the steering comes back from its furthest turn towards the indicator's side before
+the indicator switches itself off (Webots' driver library)."""
 
 
 def refuse(cls: str, robot: str) -> SystemExit:
@@ -89,6 +101,32 @@ class Driver(Supervisor):
         self._angles = (0.0, 0.0)
         self._cruising = 0.0
         self._mode: int | None = None
+        # the controller's own commands Webots' library keeps (lights, indicators, brake) and the LEDs it
+        # switches for them when the car has them (looked up quietly, as Webots does)
+        self._lights: dict[str, Any] = {name: dev for name in LIGHTS
+                                        if (dev := self.devices.get(name)) is not None and type(dev).__name__ == "LED"}
+        self._lit: dict[str, int] = {}
+        self._brake = 0.0
+        self._indicator = self.INDICATOR_OFF
+        self._indicator_angle = 0.0
+        self._hazard = False
+        self._dipped = False
+        self._antifog = False
+        self._backwards = False
+        self._indicator_period = INDICATOR_PERIOD
+        self._limited_slip = True
+        self._auto_disabling = True
+        engine = geo.get("engine_type", "combustion")
+        self._engine = ("combustion", "electric", "parallel hybrid", "power-split hybrid").index(engine)
+
+    def _light(self, name: str, on: bool) -> None:
+        """Switch the car's LED ``name`` (and the interior indicator with an indicator), if it has it."""
+        names = (name, f"interior_{name}") if name.endswith("_indicators") else (name,)
+        for n in names:
+            led = self._lights.get(n)
+            if led is not None and self._lit.get(n) != int(on):
+                led.set(int(on))
+                self._lit[n] = int(on)
 
     def _motor(self, name: str) -> Any:
         motor = self.devices.get(name)
@@ -110,6 +148,14 @@ class Driver(Supervisor):
             motor.setPosition(self._sign * angle)
         if self._mode == self.SPEED:
             self.setCruisingSpeed(self._cruising)
+        if self._auto_disabling and self._indicator != self.INDICATOR_OFF:
+            # Webots' driver: an indicator follows the steering to its furthest turn its way, and goes off
+            # once the steering has come back from there by the threshold
+            toward = 1.0 if self._indicator == self.INDICATOR_RIGHT else -1.0
+            if toward * (self._angle - self._indicator_angle) > 0.0:
+                self._indicator_angle = self._angle
+            elif toward * (self._angle - self._indicator_angle) <= -AUTO_DISABLING_THRESHOLD:
+                self._indicator = self.INDICATOR_OFF
 
     def getSteeringAngle(self) -> float:
         """The mean of the two front wheels' angles (Webots: of the steering encoders; here the
@@ -176,8 +222,61 @@ class Driver(Supervisor):
         return self._mode
 
     def step(self, time_step: int | None = None) -> int:
-        """One basic time step (Webots' ``wbu_driver_step``); -1 when the simulation ends."""
+        """One basic time step (Webots' ``wbu_driver_step``); -1 when the simulation ends. Before it,
+        as Webots' library: the indicators' LEDs blink (on for the first half of each period, by the
+        simulated time), and the backwards lights are on while a negative cruising speed is set."""
+        on = int(self.getTime() / self._indicator_period) % 2 == 0
+        self._light("right_indicators", on and (self._hazard or self._indicator == self.INDICATOR_RIGHT))
+        self._light("left_indicators", on and (self._hazard or self._indicator == self.INDICATOR_LEFT))
+        self._backwards = self._mode == self.SPEED and self._cruising < 0.0
+        self._light("backwards_lights", self._backwards)
         return super().step(time_step)
+
+    # -- the controller's own commands: brake, indicators, lights (kept and answered, as Webots' library)
+    def setBrakeIntensity(self, brakeIntensity: float) -> None:
+        """Kept and answered (clamped to [0, 1], one line when it is not) and the brake lights on while it
+        is above 0; it does not slow the car here (the wheels follow their speed control)."""
+        value = float(brakeIntensity)
+        if not 0.0 <= value <= 1.0:
+            print(f"Warning: wbu_driver_set_brake_intensity(): intensity {value:g} is outside [0, 1]: "
+                  f"{min(max(value, 0.0), 1.0):g} used.", file=sys.stderr)
+            value = min(max(value, 0.0), 1.0)
+        self._brake = value
+        self._light("brake_lights", value > 0.0)
+
+    def getBrakeIntensity(self) -> float:
+        return self._brake
+
+    def setIndicator(self, indicator: int) -> None:
+        """``INDICATOR_OFF``, ``INDICATOR_RIGHT`` or ``INDICATOR_LEFT``; the indicator's LEDs blink with
+        the steps (if the car has them), and it switches itself off as Webots' (``enableIndicatorAutoDisabling``)."""
+        self._indicator = int(indicator)
+        self._indicator_angle = self._angle
+
+    def getIndicator(self) -> int:
+        return self._indicator
+
+    def setHazardFlashers(self, hazardFlasher: bool) -> None:
+        self._hazard = bool(hazardFlasher)
+
+    def getHazardFlashers(self) -> bool:
+        return self._hazard
+
+    def setDippedBeams(self, state: bool) -> None:
+        """Kept, and the front and rear lights' LEDs switched (if the car has them)."""
+        self._dipped = bool(state)
+        self._light("front_lights", self._dipped)
+        self._light("rear_lights", self._dipped)
+
+    def getDippedBeams(self) -> bool:
+        return self._dipped
+
+    def setAntifogLights(self, state: bool) -> None:
+        self._antifog = bool(state)
+        self._light("antifog_lights", self._antifog)
+
+    def getAntifogLights(self) -> bool:
+        return self._antifog
 
     @staticmethod
     def isInitialisationPossible() -> bool:
@@ -186,23 +285,13 @@ class Driver(Supervisor):
         wb.wb_robot_init()
         return wb.current().ackermann_drive is not None
 
-    # -- no engine, gearbox, brakes, lights or wipers here
+    # -- no engine, gearbox, torque control or wipers here
     setThrottle = unmodelled("wbu_driver_set_throttle", None, "throttle")
     getThrottle = unmodelled("wbu_driver_get_throttle", 0.0)
-    setBrakeIntensity = unmodelled("wbu_driver_set_brake_intensity", None, "brakeIntensity")
-    getBrakeIntensity = unmodelled("wbu_driver_get_brake_intensity", 0.0)
     setGear = unmodelled("wbu_driver_set_gear", None, "gear")
     getGear = unmodelled("wbu_driver_get_gear", 0)
     getGearNumber = unmodelled("wbu_driver_get_gear_number", 0)
     getRpm = unmodelled("wbu_driver_get_rpm", 0.0)
-    setIndicator = unmodelled("wbu_driver_set_indicator", None, "indicator")
-    getIndicator = unmodelled("wbu_driver_get_indicator", INDICATOR_OFF)
-    setHazardFlashers = unmodelled("wbu_driver_set_hazard_flashers", None, "hazardFlasher")
-    getHazardFlashers = unmodelled("wbu_driver_get_hazard_flashers", False)
-    setDippedBeams = unmodelled("wbu_driver_set_dipped_beams", None, "state")
-    getDippedBeams = unmodelled("wbu_driver_get_dipped_beams", False)
-    setAntifogLights = unmodelled("wbu_driver_set_antifog_lights", None, "state")
-    getAntifogLights = unmodelled("wbu_driver_get_antifog_lights", False)
     setWiperMode = unmodelled("wbu_driver_set_wiper_mode", None, "mode")
     getWiperMode = unmodelled("wbu_driver_get_wiper_mode", DOWN)
 

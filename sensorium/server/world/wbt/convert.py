@@ -1642,6 +1642,7 @@ class Converter:
     def _drive(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         from sensorium.server.world.wbt.drive import (
             ackermann_drive,
+            car_engine,
             differential_drive,
             holds_wheel,
             mecanum_drive,
@@ -1722,6 +1723,9 @@ class Converter:
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no Ackermann drive ({why}); the robot will not move")
                 return
+            engine = car_engine(robot.data.get("custom_data", ""))      # a Webots Car's engineType
+            if engine is not None and engine != "combustion":
+                drive["engine_type"] = engine
             robot.data["ackermann_drive"] = drive
         elif turns is not None:                   # rollers: friction turned on the wheels
             drive, why = mecanum_drive(wheels, turns, self)

@@ -378,6 +378,26 @@ def _ackermann(wheels: list[dict], conv) -> tuple[dict | None, str]:
     return out, ""
 
 
+ENGINES = {"C": "combustion", "E": "electric", "P": "parallel hybrid", "S": "power-split hybrid"}
+"""Webots' Car customData engine letters (its engineType field's values)."""
+
+
+def car_engine(custom_data: str) -> str | None:
+    """The engine type a Webots ``Car`` writes into its customData (its PROTO's engineType field, the
+    eighth of the twenty values Webots' car library reads: wheelbase, tracks, radii, brake
+    coefficient, damping, the engine letter, ...), or None when the data is no Car's (fewer than 20
+    values, as the car library judges it)."""
+    words = custom_data.split()
+    if len(words) < 20 or not words[7]:
+        return None
+    try:
+        [float(w) for w in words[:7] + words[8:18]]
+        [int(w) for w in words[18:20]]
+    except ValueError:
+        return None
+    return ENGINES.get(words[7][0], "combustion")
+
+
 def free_car_wheels(car: dict | None, free: list[dict], conv) -> set[int]:
     """A car's wheels without a motor (Webots' Car: a propulsion car's front wheels, the second axis of
     its steering Hinge2Joints; a traction car's rear ones, HingeJoints on the rear axle under its

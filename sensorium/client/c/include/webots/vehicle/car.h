@@ -1,8 +1,8 @@
 /* Sensorium C controller library: Webots' car library (vehicle/car.h, for the Car PROTO and its
  * descendants) over a car-like robot's ackermann_drive (see vehicle/driver.h): its type, geometry,
- * front wheels' angles, wheel encoders and speeds. Engine type, indicator period and lights print one
- * line the first time and answer Webots' "no value"; wbu_car_init() on a robot that is not a car
- * prints one line and exits with status 1. */
+ * engine type, front wheels' angles, wheel encoders and speeds; the indicator period, brake and
+ * backwards lights and the car's flags as Webots' library keeps them; wbu_car_init() on a robot that
+ * is not a car prints one line and exits with status 1. */
 #ifndef WBU_CAR_H
 #define WBU_CAR_H
 

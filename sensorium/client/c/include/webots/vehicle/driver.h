@@ -1,7 +1,8 @@
 /* Sensorium C controller library: Webots' driver library (vehicle/driver.h, for the Car PROTO and its
  * descendants) over a car-like robot's motors (the world's ackermann_drive; src/vehicle.c): steering
- * angle and cruising speed as Webots computes them. No engine, gearbox, brakes, lights or wipers:
- * those functions print one line the first time and answer Webots' "no value". wbu_driver_init() on
+ * angle and cruising speed as Webots computes them; the brake intensity, indicators and lights kept
+ * and answered as Webots' library keeps them. No engine, gearbox, torque control or wipers: those
+ * functions print one line the first time and answer Webots' "no value". wbu_driver_init() on
  * a robot without an ackermann_drive prints one line and exits with status 1. Before init every
  * function answers "no value" (NaN, 0, false, the first enumerator; wbu_driver_step(): -1). */
 #ifndef WBU_DRIVER_H
