@@ -140,8 +140,10 @@ def check_car_lights(lines: list[str]) -> None:
     by = {line.split()[0]: line.split()[1:] for line in lines}
     assert by["start"] == ["1", "0.34000000000000002", "0", "0", "0", "0"]    # electric; Webots' default period
     # 50 steps straight at 36 km/h: the free front wheels (radius 0.3) roll 8 m; the left's axis is the car's right
-    right, left = (float(v) for v in by["rolled"])
+    right, left, right_speed, left_speed = (float(v) for v in by["rolled"])
     assert right == pytest.approx(8 / 0.3, rel=1e-12) and left == pytest.approx(-8 / 0.3, rel=1e-12)
+    # their speeds as Webots' driver works every wheel's out: the encoder's change over the last step, v / r
+    assert right_speed == pytest.approx(10 / 0.3, rel=1e-9) and left_speed == pytest.approx(-10 / 0.3, rel=1e-9)
     assert by["brake"] == ["1", "1", "1"] and by["released"] == ["0", "0", "0"]       # intensity, lights, LED
     assert by["reverse"] == ["0"] and by["reversing"] == ["1", "1"] and by["stopped"] == ["0", "0"]
     assert by["blink"][0] == "0.064000000000000001"

@@ -23,8 +23,9 @@ int main(void) {
   wbu_driver_set_cruising_speed(36);
   for (int i = 0; i < 50; i++)
     wbu_driver_step();
-  printf("rolled %.17g %.17g\n", wbu_car_get_wheel_encoder(WBU_CAR_WHEEL_FRONT_RIGHT),
-         wbu_car_get_wheel_encoder(WBU_CAR_WHEEL_FRONT_LEFT));
+  printf("rolled %.17g %.17g %.17g %.17g\n", wbu_car_get_wheel_encoder(WBU_CAR_WHEEL_FRONT_RIGHT),
+         wbu_car_get_wheel_encoder(WBU_CAR_WHEEL_FRONT_LEFT), wbu_car_get_wheel_speed(WBU_CAR_WHEEL_FRONT_RIGHT),
+         wbu_car_get_wheel_speed(WBU_CAR_WHEEL_FRONT_LEFT));
   /* the brake: clamped (one line), the brake lights while it is above 0 */
   wbu_driver_set_brake_intensity(1.5);
   printf("brake %.17g %d %d\n", wbu_driver_get_brake_intensity(), (int)wbu_car_get_brake_lights(), led("brake_lights"));

@@ -18,7 +18,8 @@ print("start", car.getEngineType(), g(car.getIndicatorPeriod()), int(car.getBrak
 car.setCruisingSpeed(36)
 for _ in range(50):
     car.step()
-print("rolled", g(car.getWheelEncoder(Car.WHEEL_FRONT_RIGHT)), g(car.getWheelEncoder(Car.WHEEL_FRONT_LEFT)))
+print("rolled", g(car.getWheelEncoder(Car.WHEEL_FRONT_RIGHT)), g(car.getWheelEncoder(Car.WHEEL_FRONT_LEFT)),
+      g(car.getWheelSpeed(Car.WHEEL_FRONT_RIGHT)), g(car.getWheelSpeed(Car.WHEEL_FRONT_LEFT)))
 car.setBrakeIntensity(1.5)
 print("brake", g(car.getBrakeIntensity()), int(car.getBrakeLights()), led("brake_lights"))
 car.setBrakeIntensity(0.0)

@@ -36,6 +36,7 @@ static struct {
   double brake, indicator_angle, indicator_period;
   WbuDriverIndicatorState indicator;
   bool hazard, dipped, antifog, backwards, limited_slip, auto_disabling;
+  double free_last[4], free_speed[4]; /* a free wheel's encoder at the last driver step (NaN: none yet), its speed */
   WbDeviceTag lights[9]; /* LIGHTS' order; 0: the car has none */
   int lit[9];            /* what each was last set to (-1: never) */
 } g_car;
@@ -135,6 +136,10 @@ static void car_init(const char *func) {
       wb_motor_set_velocity(g_car.wheel[i], 0.0);
     }
   }
+  for (int i = 0; i < 4; i++) {
+    g_car.free_last[i] = NAN;
+    g_car.free_speed[i] = 0.0;
+  }
   for (int i = 0; i < 9; i++) {
     g_car.lights[i] = quiet_device(rb, LIGHTS[i], SN_LED);
     g_car.lit[i] = -1;
@@ -207,10 +212,14 @@ double wbu_car_get_wheel_encoder(WbuCarWheelIndex wheel_index) {
   return wb_position_sensor_get_value(g_car.wheel_sensor[wheel_index]);
 }
 
-/* A driven wheel's speed (rad/s): its commanded velocity, which a kinematic wheel keeps; NaN without a motor. */
+/* A driven wheel's speed (rad/s): its commanded velocity, which a kinematic wheel keeps; a free wheel's,
+ * as Webots' driver works it out at each step: its encoder's change over the last step (0 until it
+ * has read twice); NaN with neither motor nor encoder. */
 double wbu_car_get_wheel_speed(WbuCarWheelIndex wheel_index) {
-  if (!g_car.ready || (int)wheel_index < 0 || (int)wheel_index >= 4 || !g_car.wheel[wheel_index])
+  if (!g_car.ready || (int)wheel_index < 0 || (int)wheel_index >= 4)
     return NAN;
+  if (!g_car.wheel[wheel_index])
+    return g_car.wheel_sensor[wheel_index] ? g_car.free_speed[wheel_index] : NAN;
   return wb_motor_get_velocity(g_car.wheel[wheel_index]);
 }
 
@@ -270,7 +279,15 @@ int wbu_driver_step(void) {
   light(LEFT_IND, on && (g_car.hazard || g_car.indicator == LEFT));
   g_car.backwards = g_car.mode == SPEED && g_car.cruising < 0.0;
   light(BACKWARDS, g_car.backwards);
-  return wb_robot_step((int)wb_robot_get_basic_time_step());
+  int ms = (int)wb_robot_get_basic_time_step();
+  for (int i = 0; i < 4; i++) { /* a free wheel's speed: its encoder's change since the last step */
+    if (g_car.wheel[i] || !g_car.wheel_sensor[i])
+      continue;
+    double now = wb_position_sensor_get_value(g_car.wheel_sensor[i]), last = g_car.free_last[i];
+    g_car.free_speed[i] = isnan(now) || isnan(last) ? 0.0 : 1000.0 * (now - last) / ms;
+    g_car.free_last[i] = now;
+  }
+  return wb_robot_step(ms);
 }
 
 void wbu_driver_set_steering_angle(double steering_angle) {

@@ -70,9 +70,14 @@ class Car(Driver):
         return sensor.getValue() if sensor is not None and hasattr(sensor, "getValue") else math.nan
 
     def getWheelSpeed(self, wheel_index: int) -> float:
-        """A driven wheel's speed (rad/s: its commanded velocity, which a kinematic wheel keeps);
-        NaN for a wheel without a motor."""
-        if not 0 <= wheel_index < self.WHEEL_NB or _WHEELS[wheel_index][0] not in self._wheels:
+        """A driven wheel's speed (rad/s: its commanded velocity, which a kinematic wheel keeps); a free
+        wheel's, as Webots' driver works it out at each step: its encoder's change over the last step
+        (0 until it has read twice); NaN for a wheel with neither motor nor encoder."""
+        if not 0 <= wheel_index < self.WHEEL_NB:
+            return math.nan
+        if wheel_index in self._free_speed:
+            return self._free_speed[wheel_index]
+        if _WHEELS[wheel_index][0] not in self._wheels:
             return math.nan
         return float(self._wheels[_WHEELS[wheel_index][0]][0].getVelocity())
 

@@ -91,6 +91,12 @@ class Driver(Supervisor):
                 self._wheels[f"{side}_{axle}"] = (self._motor(geo[f"{side}_{axle}_wheel"]), geo[f"{axle}_wheel_radius"])
         wheel_sensors = [self.devices.get(f"{side}_{axle}_sensor") for axle in ("front", "rear")
                          for side in ("right", "left")]
+        # the encoders of the wheels without a motor (Webots' order): their speeds from each step's change
+        self._free_sensors = {i: sensor for i, (sensor, key) in enumerate(zip(wheel_sensors, (
+            "right_front", "left_front", "right_rear", "left_rear")))
+            if key not in self._wheels and sensor is not None and type(sensor).__name__ == "PositionSensor"}
+        self._free_last: dict[int, float] = {}
+        self._free_speed = dict.fromkeys(self._free_sensors, 0.0)
         for sensor in (*self._steer_sensors, *wheel_sensors):   # as Webots' car library: its encoders on
             if sensor is not None and type(sensor).__name__ == "PositionSensor":
                 sensor.enable(step)
@@ -230,6 +236,14 @@ class Driver(Supervisor):
         self._light("left_indicators", on and (self._hazard or self._indicator == self.INDICATOR_LEFT))
         self._backwards = self._mode == self.SPEED and self._cruising < 0.0
         self._light("backwards_lights", self._backwards)
+        # a free wheel's speed, as Webots' driver works out every wheel's: its encoder's change since the
+        # last step over the basic time step (0 until the encoder has read twice)
+        ms = self.getBasicTimeStep()
+        for i, sensor in self._free_sensors.items():
+            now = sensor.getValue()
+            last = self._free_last.get(i, math.nan)
+            self._free_speed[i] = 1000.0 * (now - last) / ms if now == now and last == last else 0.0
+            self._free_last[i] = now
         return super().step(time_step)
 
     # -- the controller's own commands: brake, indicators, lights (kept and answered, as Webots' library)
