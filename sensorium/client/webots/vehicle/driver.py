@@ -92,7 +92,7 @@ class Driver(Supervisor):
         wheel_sensors = [self.devices.get(f"{side}_{axle}_sensor") for axle in ("front", "rear")
                          for side in ("right", "left")]
         # the encoders of the wheels without a motor (Webots' order): their speeds from each step's change
-        self._free_sensors = {i: sensor for i, (sensor, key) in enumerate(zip(wheel_sensors, (
+        self._free_sensors: dict[int, Any] = {i: sensor for i, (sensor, key) in enumerate(zip(wheel_sensors, (
             "right_front", "left_front", "right_rear", "left_rear")))
             if key not in self._wheels and sensor is not None and type(sensor).__name__ == "PositionSensor"}
         self._free_last: dict[int, float] = {}
