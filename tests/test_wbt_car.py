@@ -254,3 +254,47 @@ def test_custom_data_that_is_no_cars_leaves_the_engine_combustion(tmp_path: Path
     body = HINGE2_CAR.replace('controller "<extern>"', 'controller "<extern>" customData "2.6 1.5 E"')
     d = load_world(write(tmp_path, body)).world.robots[0].ackermann_drive
     assert d is not None and d.engine_type == "combustion"
+
+
+def test_free_wheels_in_turned_joint_frames_and_slots_as_webots_cars_hold_them(tmp_path: Path) -> None:
+    # Webots' AckermannVehicle layout, a traction car: each joint in a Transform turned about z, its
+    # wheel (a Solid with no translation) in nested Slots; the rear HingeJoints have an encoder and a
+    # brake, no motor; the front Hinge2Joints' second axes drive
+    wheel = (f'Slot {{ endPoint Slot {{ endPoint Solid {{ children [ DEF S Shape {{ geometry Cylinder {{ radius 0.4 '
+             f'height 0.2 }} }} ] boundingObject USE S }} }} }}')
+
+    def front(side: str, y: float, turn: float, axis2: str) -> str:
+        return (f'Transform {{ translation {L} {y} 0 rotation 0 0 1 {turn} children [ Hinge2Joint {{ '
+                f'jointParameters HingeJointParameters {{ axis 0 0 -1 }} jointParameters2 JointParameters {{ axis {axis2} }} '
+                f'device [ RotationalMotor {{ name "{side}_steer" minPosition -0.5 maxPosition 0.5 }} '
+                f'PositionSensor {{ name "{side}_steer_sensor" }} ] '
+                f'device2 [ RotationalMotor {{ name "{side}_front_wheel" }} PositionSensor {{ name "{side}_front_sensor" }} ] '
+                f'endPoint {wheel} }} ] }}\n')
+
+    def rear(side: str, y: float, turn: float, axis: str) -> str:
+        return (f'Transform {{ translation 0 {y} 0 rotation 0 0 1 {turn} children [ HingeJoint {{ '
+                f'jointParameters HingeJointParameters {{ axis {axis} position 0.25 }} '
+                f'device [ PositionSensor {{ name "{side}_rear_sensor" }} Brake {{ name "{side}_rear_brake" }} ] '
+                f'endPoint {wheel} }} ] }}\n')
+    track = 1.7
+    body = car(front("left", T / 2, -1.5708, "-1 0 0") + front("right", -T / 2, 1.5708, "1 0 0"),
+               rear("left", track / 2, -1.5708, "-1 0 0") + rear("right", -track / 2, 1.5708, "1 0 0"))
+    w = load_world(write(tmp_path, body))
+    assert not [x for x in w.warnings if "without a motor" in x or "drive" in x], w.warnings
+    d = w.world.robots[0].ackermann_drive
+    assert d is not None and d.type == "traction"
+    assert d.track_rear == pytest.approx(track) and d.rear_wheel_radius == 0.4
+    sensors = {d.name: (d.free_wheel, d.free_wheel_sign, d.position) for d in w.world.robots[0].devices
+               if d.device == "PositionSensor" and d.motor is None}
+    assert sensors == {"left_rear_sensor": ("left_rear", 1, 0.25), "right_rear_sensor": ("right_rear", 1, 0.25)}
+    sim = Simulation(w)
+    r = sim.robot("car")
+    sensor = r.device("left_rear_sensor")
+    sensor.enable(16)
+    for name in ("right_front_wheel", "left_front_wheel"):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(5.0)
+    sim.run(100)
+    travel = 0.4 * 5.0 * 100 * 0.016                # straight: the front wheels' v t; the rear ones turn v t / r
+    assert r.pose.translation[0] == pytest.approx(travel, rel=1e-12)
+    assert sensor.value == pytest.approx(0.25 + travel / 0.4, rel=1e-12)
