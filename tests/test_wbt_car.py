@@ -260,8 +260,8 @@ def test_free_wheels_in_turned_joint_frames_and_slots_as_webots_cars_hold_them(t
     # Webots' AckermannVehicle layout, a traction car: each joint in a Transform turned about z, its
     # wheel (a Solid with no translation) in nested Slots; the rear HingeJoints have an encoder and a
     # brake, no motor; the front Hinge2Joints' second axes drive
-    wheel = (f'Slot {{ endPoint Slot {{ endPoint Solid {{ children [ DEF S Shape {{ geometry Cylinder {{ radius 0.4 '
-             f'height 0.2 }} }} ] boundingObject USE S }} }} }}')
+    wheel = ('Slot { endPoint Slot { endPoint Solid { children [ DEF S Shape { geometry Cylinder { radius 0.4 '
+             'height 0.2 } } ] boundingObject USE S } } }')
 
     def front(side: str, y: float, turn: float, axis2: str) -> str:
         return (f'Transform {{ translation {L} {y} 0 rotation 0 0 1 {turn} children [ Hinge2Joint {{ '
