@@ -11,6 +11,7 @@ import math
 import pytest
 
 from sensorium.client.webots.vehicle.driver import ackermann_angles
+from sensorium.server.sim import states
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import WorldError, parse_world
@@ -159,3 +160,24 @@ def test_a_free_wheel_needs_a_car() -> None:
     with pytest.raises(WorldError) as e:
         parse_world(w)
     assert "free_wheel 'right_front' needs the robot's ackermann_drive" in str(e.value)
+
+
+def test_a_saved_state_keeps_the_free_wheels_angles_and_init_puts_them_back() -> None:
+    sim = Simulation(parse_world(world("propulsion")))
+    for side in ("right", "left"):
+        sim.robot("car").device(f"{side}_front_sensor").enable(STEP)
+    robot = sim.robot("car")
+    scope = states.Scope("robot 'car'", robot="car", own_pose=True, motors=tuple(robot.motors))
+    saved = states.States()
+    drive(sim, "propulsion", 0.2, 10.0)
+    sim.run(40)
+    mid = encoders(sim, "front")
+    saved.save(sim, 1, scope, "mid")
+    sim.run(40)
+    assert encoders(sim, "front") != mid
+    saved.load(sim, 1, scope, "mid")
+    sim.run(1)
+    assert encoders(sim, "front") == mid             # the wheels hold: the car stands where it was saved
+    saved.load(sim, 1, scope, states.INIT)
+    sim.run(1)
+    assert encoders(sim, "front") == (0.7, 0.0)

@@ -3,7 +3,7 @@
 A node's state is what Webots' ``WbNode::save(id)`` keeps of the node and everything inside it, as
 far as Sensorium has it: the pose of a robot or top-level solid (a node inside one moves only with
 its joints), and the position of each joint in it (the joint motors' and a drive's wheels' and
-steering's). Loading a state puts each back: the pose bit for bit (a driven robot stops there, its
+steering's, a car's free wheels' too). Loading a state puts each back: the pose bit for bit (a driven robot stops there, its
 GPS and radar speeds start over as after a jump), each joint at its saved position with its motor
 holding it there at ``maxVelocity`` with its full torque/force (WbMotor::reset, then
 WbJoint::setPosition), and the LEDs inside off (WbLed::reset). The clock keeps running.
@@ -41,6 +41,7 @@ class Scope:
 class State:
     pose: Pose | None             # the robot's or solid's (None: the node has none of its own)
     positions: tuple[float, ...]  # the joints' positions, in the scope's motor order
+    free_wheels: dict[str, float] | None = None  # a car's free wheels' rolled angles (the robot's state)
 
 
 class States:
@@ -81,7 +82,9 @@ def _now(sim: Any, scope: Scope) -> State:
         # a driven robot on a slope: its own pose (the ground's attitude is applied again on loading)
         pose = drive.own_pose() if drive is not None and drive.slope is not None else robot.pose
     motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
-    return State(pose, tuple(float(motors[m].position) for m in scope.motors))
+    turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
+    return State(pose, tuple(float(motors[m].position) for m in scope.motors),
+                 dict(turned) if turned is not None else None)
 
 
 def _initial(sim: Any, scope: Scope) -> State:
@@ -91,8 +94,10 @@ def _initial(sim: Any, scope: Scope) -> State:
     elif scope.own_pose:
         pose = sim.robots[scope.robot].initial_pose
     motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
+    turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
     # a joint motor's initial position is the world file's; a wheel's angle starts at 0
-    return State(pose, tuple(float(getattr(motors[m], "initial_position", 0.0)) for m in scope.motors))
+    return State(pose, tuple(float(getattr(motors[m], "initial_position", 0.0)) for m in scope.motors),
+                 dict.fromkeys(turned, 0.0) if turned is not None else None)
 
 
 def _restore(sim: Any, scope: Scope, state: State) -> None:
@@ -104,6 +109,8 @@ def _restore(sim: Any, scope: Scope, state: State) -> None:
     for name, position in zip(scope.motors, state.positions):
         robot.motors[name].restore(position)
     sim.joints_moved(robot)
+    if state.free_wheels is not None:
+        robot.drive.free_turned = dict(state.free_wheels)
     if scope.own_pose and state.pose is not None:
         pose = state.pose
         if robot.drive is not None:
