@@ -615,9 +615,13 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
         raise ValueError(f"{what} has no {kind_of}field {field!r} here (fields: {', '.join(fields) or 'none'})")
     kind, _, setter = entry
     if setter is None and level == 1:
+        declared = next(f for f in node.interface[0].fields if f.name == field)
+        why = (f"it passes to the base node's {declared.base!r}, which is read-only here" if declared.base
+               and declared.base in _base_fields(sim, node) else "Webots regenerates the node when such a PROTO field "
+               "is set; Sensorium sets only the PROTO fields that pass straight through IS to a field it sets (a "
+               "top-level robot's or solid's translation and rotation, a light's fields)")
         raise ValueError(f"field {field!r} ({kind}) of PROTO {node.interface[0].name} ({what}) is read-only here: "
-                         "Webots regenerates the node when a PROTO field is set; Sensorium sets only the PROTO fields "
-                         "that pass straight to a base-node field it sets (translation, rotation, a light's fields)")
+                         f"{why}; nothing changed")
     if setter is None and node.nested:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
                          "top-level robots, solids and lights only, not the nodes inside them")
