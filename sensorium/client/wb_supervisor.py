@@ -586,7 +586,16 @@ def _field_value(field: Field | None, want: int | None, func: str) -> Any:
         return None
     assert field is not None
     got = _answer(r, "get_field", _field_args(field), func)
-    return None if got is None else got["value"]
+    return None if got is None else _noted(got, func)
+
+
+def _noted(got: dict, func: str) -> Any:
+    """A get_field reply's value; None after the server's line for a value it does not serve (a PROTO's
+    node-typed field, a value over its bound)."""
+    if got.get("note"):
+        print(f"Error: {func}(): {got['note']}.", file=sys.stderr)
+        return None
+    return got["value"]
 
 
 def wb_supervisor_field_get_count(field: Field | None) -> int:
@@ -601,7 +610,8 @@ def wb_supervisor_field_get_count(field: Field | None) -> int:
     if not field[2] & WB_MF:
         return -1
     got = _answer(r, "get_field", _field_args(field), func)
-    return -1 if got is None else len(got["value"])
+    value = None if got is None else _noted(got, func)
+    return -1 if value is None else len(value)
 
 
 def wb_supervisor_field_get_sf_bool(field: Field | None) -> bool:

@@ -923,6 +923,10 @@ class FieldValueResult(Result):
     absent: bool = Field(default=False, description="with type '': Webots' node of this type has no such field "
                                                      "either (a Solid's endPoint, a motor's children): the clients "
                                                      "answer NULL silently, as libController does")
+    note: str = Field(default="", description="a field whose value is not served (a PROTO's node-typed field that "
+                                               "does not pass straight to a base-node field, a value over 4096 items): "
+                                               "why, in one line; value is then [] and the clients print the line "
+                                               "and answer Webots' no value when it is read")
 
 
 class ProtoResult(Result):

@@ -538,12 +538,16 @@ def _interface_fields(sim: Any, node: Node, level: int) -> dict[str, tuple[str, 
     return out
 
 
+class NotKept(ValueError):
+    """A PROTO field whose value Sensorium does not keep: get_field answers its type and this line."""
+
+
 def _kept_value(proto: str, f: Any) -> Getter:
     def get(sim: Any, node: Node) -> Any:
         if f.value is None:
-            why = "a node-typed PROTO field is not served here unless it passes straight to the base node's " \
-                  "field of that name" if f.type.endswith("Node") else "its value is over 4096 items, not kept here"
-            raise ValueError(f"field {f.name!r} ({f.type}) of PROTO {proto} ({_what(node)}): {why}")
+            why = "a node-typed PROTO field is not served here unless it passes straight through IS to the base " \
+                  "node's field" if f.type.endswith("Node") else "its value is over 4096 items, not kept here"
+            raise NotKept(f"field {f.name!r} ({f.type}) of PROTO {proto} ({_what(node)}): {why}")
         return f.value
     return get
 
@@ -587,14 +591,17 @@ def get_field(sim: Any, node: Node, field: str, level: int = -1) -> dict:
         if level > 0:         # a PROTO has no such interface field: Webots' NULL, no line (as libController)
             return {"type": "", "value": [], "absent": True}
         return {"type": "", "value": [], "absent": True} if webots_lacks(node.type, field) else {"type": "", "value": []}
-    return {"type": entry[0], "value": entry[1](sim, node)}
+    try:
+        return {"type": entry[0], "value": entry[1](sim, node)}
+    except NotKept as exc:
+        return {"type": entry[0], "value": [], "note": str(exc)}
 
 
 def get_proto(sim: Any, node: Node, level: int) -> dict:
     """Webots' ``getProto()`` (level 1) and ``getParent()`` (level + 1): the PROTO's name, whether it is
     built on another PROTO, its interface fields' names; type_name '' for none."""
     if not 1 <= level <= len(node.interface):
-        return {"type_name": ""}
+        return {"type_name": "", "derived": False, "fields": []}
     proto = node.interface[level - 1]
     return {"type_name": proto.name, "derived": level < len(node.interface), "fields": [f.name for f in proto.fields]}
 

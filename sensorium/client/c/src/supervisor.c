@@ -898,6 +898,12 @@ static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_
   field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, field->level >= 0, field->level};
   if (sn_robot_call(rb, "robot/get_field", 2 + (field->level >= 0), args_field, &a, func, rep) != 0)
     return -1;
+  const msgpack_object *note = sn_get(rep->result, "note"); /* a value the server does not serve: its line */
+  if (note != NULL && note->type == MSGPACK_OBJECT_STR && note->via.str.size > 0) {
+    fprintf(stderr, "Error: %s(): %.*s.\n", func, (int)note->via.str.size, note->via.str.ptr);
+    sn_reply_free(rep);
+    return -1;
+  }
   *value = sn_get(rep->result, "value");
   return 0;
 }
