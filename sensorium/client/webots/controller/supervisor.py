@@ -435,8 +435,8 @@ class Proto:
         ref = wb.wb_supervisor_proto_get_parent(self._ref)
         return None if ref is None else Proto(ref)
 
-    def getField(self, fieldName: str) -> Field | None:  # noqa: N803
-        ref = wb.wb_supervisor_proto_get_field(self._ref, fieldName)
+    def getField(self, name: str) -> Field | None:
+        ref = wb.wb_supervisor_proto_get_field(self._ref, name)
         return None if ref is None else Field(ref)
 
     def getFieldByIndex(self, index: int) -> Field | None:
