@@ -159,6 +159,17 @@ def test_the_interface_of_the_robot_proto_follows_the_robot():
     assert field(lv, boss, "name") == {"type": "SFString", "value": "boss"}
 
 
+def test_an_imported_proto_instance_answers_its_interface():
+    lv = _live()
+    (crate,) = call(lv, "import_node_from_string", {"node": 0, "field": "children", "position": -1,
+                                                    "node_string": 'Crate { translation 0 2 0.1 size 0.1 0.3 0.1 }'})["value"]
+    assert call(lv, "get_proto", {"node": crate})["fields"] == ["translation", "name", "size"]
+    assert field(lv, crate, "size") == {"type": "SFVec3f", "value": [0.1, 0.3, 0.1]}
+    assert field(lv, crate, "name") == {"type": "SFString", "value": "crate(1)"}      # renamed, as Webots does
+    call(lv, "set_field", {"node": crate, "field": "translation", "value": [0.0, 2.5, 0.1]})
+    assert call(lv, "get_node_pose", {"node": crate})["position"] == [0.0, 2.5, 0.1]
+
+
 def test_a_long_value_is_not_kept_and_its_field_says_so(tmp_path):
     (tmp_path / "Long.proto").write_text(HEADER + "PROTO Long [\n  field MFFloat samples [ ]\n  field SFFloat k 2\n]\n"
                                          "{\n  Solid { name \"long\" }\n}\n")

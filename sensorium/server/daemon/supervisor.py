@@ -111,14 +111,16 @@ def _all_nodes(sim: Any) -> list[Node]:
     out += [Node(first + x, s.type, "", s.def_name, x, scenery=True, proto=s.proto, interface=s.interface)
             for x, s in enumerate(_scenery(sim))]
     imported_protos = getattr(sim, "imported_protos", {})
+    imported_faces = getattr(sim, "imported_interfaces", {})
     for kind, key in imported:
-        proto = imported_protos.get(key, "")
+        proto, face = imported_protos.get(key, ""), imported_faces.get(key, ())
         if kind == "Solid":
             j = names.index(key)
-            out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key, proto=proto))
+            out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key, proto=proto, interface=face))
         else:
             lt = top[int(key)]
-            out.append(Node(len(out) + 1, lt.type, lt.name or "", def_of(top, int(key)), key, proto=proto))
+            out.append(Node(len(out) + 1, lt.type, lt.name or "", def_of(top, int(key)), key, proto=proto,
+                            interface=face))
     return out
 
 
