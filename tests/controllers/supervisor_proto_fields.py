@@ -8,7 +8,7 @@ from controller import Supervisor
 
 
 def g(x: float) -> str:
-    return "%.17g" % x
+    return f"{x:.17g}"
 
 
 def gs(xs) -> str:

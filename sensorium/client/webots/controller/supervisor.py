@@ -43,7 +43,7 @@ class Field:
     MF_STRING = 0x18
     MF_NODE = wb.WB_MF_NODE
 
-    def __init__(self, ref: tuple[int, str, int]):
+    def __init__(self, ref: tuple[int, str, int] | tuple[int, str, int, int]):
         self._ref = ref
 
     def getName(self) -> str:

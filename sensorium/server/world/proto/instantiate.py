@@ -401,11 +401,11 @@ class _Expander:
         # PROTO its body is an instance of (a derived PROTO's parent), each field's base-node field when
         # the value passes there through IS unchanged
         parent = out.__dict__.get("interface") if out.proto is not None else None
-        inner = parent[2] if parent is not None else None
-        base = {}
+        parent_base: dict[str, str] | None = parent[2] if parent is not None else None
+        base: dict[str, str | None] = {}
         for fname, value in body.fields.items():
             if isinstance(value, IsRef) and value.name not in base:
-                base[value.name] = fname if inner is None else inner.get(fname)
+                base[value.name] = fname if parent_base is None else parent_base.get(fname)
         interface = (proto, values, {k: v for k, v in base.items() if v is not None}, parent)
         return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col), uses=uses,
                      interface=interface)
@@ -687,9 +687,9 @@ def _plain(ftype: str, value: Any) -> Any:
         if kind == "string" and len(value) > INTERFACE_ITEMS:
             return _NOT_KEPT
         return value
-    items = list(value)
-    if len(items) > INTERFACE_ITEMS * width:
+    if len(value) > INTERFACE_ITEMS * width:
         return _NOT_KEPT
+    items = list(value)
     if kind == "vec":
         return [[float(x) for x in items[i:i + width]] for i in range(0, len(items), width)]
     if kind == "int":
