@@ -1,6 +1,7 @@
 """Webots' ``Supervisor``, ``Node`` and ``Field`` classes — what Sensorium serves: the root and its
 ``children`` (robots, top-level solids and lights, WorldInfo, Viewpoint, ...), nodes by DEF, id or
-name, their identity (type and PROTO name, DEF, parent), fields (``translation``/``rotation`` read
+name, their identity (type and PROTO name, DEF, parent), a PROTO instance's interface fields
+(``getProto``, ``getParent``, ``getBaseNodeField``), fields (``translation``/``rotation`` read
 and set, ``name``, ``model``, ``customData``, lights' ``on``/``intensity``/``color``/... read and
 set, WorldInfo's, Viewpoint's and Background's values read), world poses and velocities; reset the
 simulation and change its mode. The robot's world entry needs ``supervisor: true``.
