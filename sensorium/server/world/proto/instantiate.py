@@ -658,8 +658,10 @@ def interface_levels(node: Node) -> list[dict[str, Any]]:
         proto, values, base, level = level[0], level[1], level[2], level[3]
         fields = []
         for name, decl in proto.fields.items():
-            if decl.kind == "hidden":        # Webots' saved state (translation_1, ...), not a parameter
+            if decl.kind == "hidden" or len(name) > 256:   # Webots' saved state (translation_1, ...), not a parameter
                 continue
+            if len(fields) == INTERFACE_FIELDS:
+                break
             entry: dict[str, Any] = {"name": name, "type": decl.type}
             value = _plain(decl.type, values.get(name, decl.default))
             if value is not _NOT_KEPT:
@@ -670,6 +672,9 @@ def interface_levels(node: Node) -> list[dict[str, Any]]:
         out.append({"name": proto.name, "fields": fields})
     return out
 
+
+INTERFACE_FIELDS = 1024
+"""Interface fields kept per PROTO (the world model's bound; a PROTO declares tens)."""
 
 _NOT_KEPT = object()
 
