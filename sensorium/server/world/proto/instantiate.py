@@ -656,7 +656,7 @@ def interface_levels(node: Node) -> list[dict[str, Any]]:
     level = node.__dict__.get("interface")
     while level is not None and len(out) < 16:
         proto, values, base, level = level[0], level[1], level[2], level[3]
-        fields = []
+        fields: list[dict[str, Any]] = []
         for name, decl in proto.fields.items():
             if decl.kind == "hidden" or len(name) > 256:   # Webots' saved state (translation_1, ...), not a parameter
                 continue
