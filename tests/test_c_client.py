@@ -306,9 +306,12 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
     assert len(warned) == 2 and "Microphone 'mic'" in warned[0] and "Radio 'radio'" in warned[1], err
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
     unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
-    assert unserved == ["Error: wb_supervisor_" + f for f in ("field_get_mf_int32", "movie_is_ready",
-                                                              "node_export_string", "node_get_center_of_mass",
-                                                              "node_get_number_of_fields", "node_get_selected")], err
+    assert unserved == ["Error: wb_supervisor_" + f for f in ("movie_is_ready", "node_export_string",
+                                                              "node_get_center_of_mass", "node_get_number_of_fields",
+                                                              "node_get_selected")], err
+    # served for a PROTO's interface fields: Webots' line for the robot's SFRotation, 0; the robot is no PROTO
+    assert "Error: wb_supervisor_field_get_mf_int32() called with wrong field type: SFRotation." in err
+    assert "wb_supervisor_node_get_number_of_fields(): not served by Sensorium on a node that is no PROTO" in err
     assert "simulation_quit" not in err
 
 

@@ -47,13 +47,14 @@ def run(sim: Simulation, steps: int = 50) -> list:
 
 def test_the_proto_robot_reads_bit_for_bit_like_its_base_node_twin() -> None:
     proto, twin = load_world(PROTO_WORLD), load_world(TWIN)
-    # the same world but for the robot's Supervisor type name (its PROTO's, the twin's base type)
-    named = [n.model_copy(update={"proto": None}) if n.proto == "MiniPuck" else n for n in proto.world.top_nodes]
+    # the same world but for the robot's Supervisor type name and interface (its PROTO's; the twin's base type)
+    named = [n.model_copy(update={"proto": None, "interface": []}) if n.proto == "MiniPuck" else n
+             for n in proto.world.top_nodes]
     assert [n.proto for n in proto.world.top_nodes if n.robots] == ["MiniPuck"]
     # and for the DEF names and PROTOs inside it: the PROTO's DEFs are internal (not found by DEF), the
     # twin's written in the world; its sensors are instances of the PROTO's own PROTOs
     def undefined(world):
-        return [r.model_copy(update={"nodes": [n.model_copy(update={"def_name": None, "proto": None})
+        return [r.model_copy(update={"nodes": [n.model_copy(update={"def_name": None, "proto": None, "interface": []})
                                                for n in r.nodes]}) for r in world.robots]
 
     assert proto.world.model_copy(update={"top_nodes": named, "robots": undefined(proto.world)}) == \

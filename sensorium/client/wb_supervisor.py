@@ -35,12 +35,21 @@ WB_SF_COLOR = 7
 WB_SF_STRING = 8
 WB_SF_NODE = 9
 WB_MF = 0x10
+WB_MF_BOOL = 0x11
+WB_MF_INT32 = 0x12
+WB_MF_FLOAT = 0x13
+WB_MF_VEC2F = 0x14
+WB_MF_VEC3F = 0x15
+WB_MF_ROTATION = 0x16
 WB_MF_COLOR = 0x17
+WB_MF_STRING = 0x18
 WB_MF_NODE = 0x19
 
 FIELD_TYPES = {"SFBool": WB_SF_BOOL, "SFInt32": WB_SF_INT32, "SFFloat": WB_SF_FLOAT, "SFVec2f": WB_SF_VEC2F,
                "SFVec3f": WB_SF_VEC3F, "SFRotation": WB_SF_ROTATION, "SFColor": WB_SF_COLOR,
-               "SFString": WB_SF_STRING, "SFNode": WB_SF_NODE, "MFColor": WB_MF_COLOR, "MFNode": WB_MF_NODE}
+               "SFString": WB_SF_STRING, "SFNode": WB_SF_NODE, "MFBool": WB_MF_BOOL, "MFInt32": WB_MF_INT32,
+               "MFFloat": WB_MF_FLOAT, "MFVec2f": WB_MF_VEC2F, "MFVec3f": WB_MF_VEC3F, "MFRotation": WB_MF_ROTATION,
+               "MFColor": WB_MF_COLOR, "MFString": WB_MF_STRING, "MFNode": WB_MF_NODE}
 _TYPE_NAMES = {v: k for k, v in FIELD_TYPES.items()}
 # Webots' node type constants by type name (any other type, a device's, a Pose's, a HingeJoint's:
 # nodes.node_type, which spells the constant from the name; Hinge2Joint's does not spell it)
@@ -48,7 +57,11 @@ NODE_TYPES = {"Group": "WB_NODE_GROUP", "Robot": "WB_NODE_ROBOT", "Solid": "WB_N
               "PointLight": "WB_NODE_POINT_LIGHT", "SpotLight": "WB_NODE_SPOT_LIGHT",
               "DirectionalLight": "WB_NODE_DIRECTIONAL_LIGHT", "Hinge2Joint": "WB_NODE_HINGE_2_JOINT"}
 
-Field = tuple[int, str, int]
+Field = tuple[int, str, int] | tuple[int, str, int, int]
+"""(node, name, type) — and, for a PROTO's field, the PROTO level: 0 the base node's (getBaseNodeField), k the
+k-th PROTO of the node's chain (1 its own: getProto().getField; a PROTO node's getField is level 1 too)."""
+Proto = tuple[int, int]
+"""Webots' WbProtoRef here: (node, level), level 1 the node's own PROTO, 2 the one it is built on, ..."""
 _NAN3 = [math.nan] * 3
 
 
@@ -391,16 +404,25 @@ def wb_supervisor_simulation_reset_physics() -> None:
 
 # ---------------------------------------------------------------------- fields
 
-def wb_supervisor_node_get_field(node: int | None, field_name: str) -> Field | None:
-    """The node's field of that name, None (with one line) when the node has no such field here."""
-    func = "wb_supervisor_node_get_field"
+def _field_args(field: Field) -> dict:
+    """A field's request arguments (a PROTO level only when the field names one)."""
+    args: dict[str, Any] = {"node": field[0], "field": field[1]}
+    if len(field) > 3:
+        args["level"] = field[3]       # type: ignore[misc]
+    return args
+
+
+def _get_field(node: Any, field_name: Any, level: int, func: str) -> Field | None:
     r = _checked_node(node, func)
     if r is None:
         return None
     if not isinstance(field_name, str) or not field_name or len(field_name) > 64:
         print(f"Error: {func}() called with a NULL, empty or invalid 'field_name' argument.", file=sys.stderr)
         return None
-    got = _answer(r, "get_field", {"node": int(node), "field": field_name}, func)  # type: ignore[arg-type]
+    args: dict[str, Any] = {"node": int(node), "field": field_name}
+    if level >= 0:
+        args["level"] = level
+    got = _answer(r, "get_field", args, func)
     if got is None:
         return None
     if not got["type"]:
@@ -408,7 +430,126 @@ def wb_supervisor_node_get_field(node: int | None, field_name: str) -> Field | N
             print(f"Error: {func}(): node {node} has no field {field_name!r} in Sensorium (README \"Supervisor\" "
                   f"lists the fields of each node kind).", file=sys.stderr)
         return None
-    return (int(node), field_name, FIELD_TYPES[got["type"]])  # type: ignore[arg-type]
+    if level >= 0:
+        return (int(node), field_name, FIELD_TYPES[got["type"]], level)
+    return (int(node), field_name, FIELD_TYPES[got["type"]])
+
+
+def wb_supervisor_node_get_field(node: int | None, field_name: str) -> Field | None:
+    """The node's field of that name (a PROTO instance's: its PROTO's interface field, as Webots), None
+    (with one line) when the node has no such field here."""
+    return _get_field(node, field_name, -1, "wb_supervisor_node_get_field")
+
+
+def wb_supervisor_node_get_base_node_field(node: int | None, field_name: str) -> Field | None:
+    """The field of the node's base node (a PROTO instance's Robot, Solid, ...): read-only on a PROTO
+    instance, as in Webots."""
+    return _get_field(node, field_name, 0, "wb_supervisor_node_get_base_node_field")
+
+
+def _proto_info(r: RobotClient, node: int, level: int, func: str) -> dict | None:
+    got = _answer(r, "get_proto", {"node": node, "level": level}, func)
+    return got if got is not None and got.get("type_name") else None
+
+
+def wb_supervisor_node_get_proto(node: int | None) -> Proto | None:
+    """The node's PROTO (Webots' WbProtoRef): None for a base node (or a PROTO Sensorium builds in)."""
+    func = "wb_supervisor_node_get_proto"
+    r = _checked_node(node, func)
+    if r is None:
+        return None
+    return None if _proto_info(r, int(node), 1, func) is None else (int(node), 1)  # type: ignore[arg-type]
+
+
+def _proto_checked(proto: Any, func: str) -> tuple[RobotClient, dict] | None:
+    r = _supervisor(func)
+    if r is None:
+        return None
+    info = None
+    if isinstance(proto, tuple) and len(proto) == 2:
+        info = _proto_info(r, proto[0], proto[1], func)
+    if info is None:
+        print(f"Error: {func}() called with a NULL or invalid 'proto' argument.", file=sys.stderr)
+        return None
+    return r, info
+
+
+def wb_supervisor_proto_get_type_name(proto: Proto | None) -> str:
+    got = _proto_checked(proto, "wb_supervisor_proto_get_type_name")
+    return "" if got is None else str(got[1]["type_name"])
+
+
+def wb_supervisor_proto_is_derived(proto: Proto | None) -> bool:
+    got = _proto_checked(proto, "wb_supervisor_proto_is_derived")
+    return got is not None and bool(got[1].get("derived"))
+
+
+def wb_supervisor_proto_get_parent(proto: Proto | None) -> Proto | None:
+    """The PROTO this one is built on (its body is an instance of it), None when it is built on a base node."""
+    got = _proto_checked(proto, "wb_supervisor_proto_get_parent")
+    if got is None or not got[1].get("derived"):
+        return None
+    assert proto is not None
+    return (proto[0], proto[1] + 1)
+
+
+def wb_supervisor_proto_get_number_of_fields(proto: Proto | None) -> int:
+    got = _proto_checked(proto, "wb_supervisor_proto_get_number_of_fields")
+    return -1 if got is None else len(got[1].get("fields", []))
+
+
+def wb_supervisor_proto_get_field(proto: Proto | None, field_name: str) -> Field | None:
+    """The PROTO's interface field of that name (on a parent PROTO: read-only, as in Webots)."""
+    func = "wb_supervisor_proto_get_field"
+    if _proto_checked(proto, func) is None:
+        return None
+    assert proto is not None
+    return _get_field(proto[0], field_name, proto[1], func)
+
+
+def _field_by_index(names: list, index: Any, func: str) -> str | None:
+    if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(names):
+        print(f"Error: {func}() called with an invalid 'index' argument: {index!r} (the PROTO has {len(names)} "
+              "fields).", file=sys.stderr)
+        return None
+    return str(names[index])
+
+
+def wb_supervisor_proto_get_field_by_index(proto: Proto | None, index: int) -> Field | None:
+    func = "wb_supervisor_proto_get_field_by_index"
+    got = _proto_checked(proto, func)
+    if got is None:
+        return None
+    assert proto is not None
+    name = _field_by_index(got[1].get("fields", []), index, func)
+    return None if name is None else _get_field(proto[0], name, proto[1], func)
+
+
+def _node_proto(node: Any, func: str) -> dict | None:
+    """A PROTO instance's own PROTO; None after one line for a base node (Sensorium counts and lists a
+    PROTO's interface fields only)."""
+    r = _checked_node(node, func)
+    if r is None:
+        return None
+    info = _proto_info(r, int(node), 1, func)
+    if info is None:
+        supervisor_unserved(func, "on a node that is no PROTO instance (Sensorium lists the fields of PROTO "
+                                  "instances only)")
+    return info
+
+
+def wb_supervisor_node_get_number_of_fields(node: int | None) -> int:
+    """A PROTO instance's interface fields, as Webots counts them (a base node: not served, -1)."""
+    info = _node_proto(node, "wb_supervisor_node_get_number_of_fields")
+    return -1 if info is None else len(info.get("fields", []))
+
+
+def wb_supervisor_node_get_field_by_index(node: int | None, index: int) -> Field | None:
+    """A PROTO instance's interface field ``index`` (declaration order)."""
+    func = "wb_supervisor_node_get_field_by_index"
+    info = _node_proto(node, func)
+    name = None if info is None else _field_by_index(info.get("fields", []), index, func)
+    return None if name is None else _get_field(node, name, -1, func)
 
 
 def wb_supervisor_field_get_type(field: Field | None) -> int:
@@ -444,8 +585,17 @@ def _field_value(field: Field | None, want: int | None, func: str) -> Any:
     if r is None:
         return None
     assert field is not None
-    got = _answer(r, "get_field", {"node": field[0], "field": field[1]}, func)
-    return None if got is None else got["value"]
+    got = _answer(r, "get_field", _field_args(field), func)
+    return None if got is None else _noted(got, func)
+
+
+def _noted(got: dict, func: str) -> Any:
+    """A get_field reply's value; None after the server's line for a value it does not serve (a PROTO's
+    node-typed field, a value over its bound)."""
+    if got.get("note"):
+        print(f"Error: {func}(): {got['note']}.", file=sys.stderr)
+        return None
+    return got["value"]
 
 
 def wb_supervisor_field_get_count(field: Field | None) -> int:
@@ -459,8 +609,9 @@ def wb_supervisor_field_get_count(field: Field | None) -> int:
         return -1
     if not field[2] & WB_MF:
         return -1
-    got = _answer(r, "get_field", {"node": field[0], "field": field[1]}, func)
-    return -1 if got is None else len(got["value"])
+    got = _answer(r, "get_field", _field_args(field), func)
+    value = None if got is None else _noted(got, func)
+    return -1 if value is None else len(value)
 
 
 def wb_supervisor_field_get_sf_bool(field: Field | None) -> bool:
@@ -485,6 +636,10 @@ def wb_supervisor_field_get_sf_string(field: Field | None) -> str:
 
 def _floats(v: Any, n: int) -> list[float] | None:
     return None if v is None else [float(x) for x in v][:n]
+
+
+def wb_supervisor_field_get_sf_vec2f(field: Field | None) -> list[float] | None:
+    return _floats(_field_value(field, WB_SF_VEC2F, "wb_supervisor_field_get_sf_vec2f"), 2)
 
 
 def wb_supervisor_field_get_sf_vec3f(field: Field | None) -> list[float] | None:
@@ -532,6 +687,37 @@ def wb_supervisor_field_get_mf_color(field: Field | None, index: int) -> list[fl
     return _floats(_mf_item(field, WB_MF_COLOR, index, "wb_supervisor_field_get_mf_color"), 3)
 
 
+# the other MF types: a PROTO's interface fields (negative indices count from the end, as Webots)
+def wb_supervisor_field_get_mf_bool(field: Field | None, index: int) -> bool:
+    return bool(_mf_item(field, WB_MF_BOOL, index, "wb_supervisor_field_get_mf_bool") or False)
+
+
+def wb_supervisor_field_get_mf_int32(field: Field | None, index: int) -> int:
+    return int(_mf_item(field, WB_MF_INT32, index, "wb_supervisor_field_get_mf_int32") or 0)
+
+
+def wb_supervisor_field_get_mf_float(field: Field | None, index: int) -> float:
+    v = _mf_item(field, WB_MF_FLOAT, index, "wb_supervisor_field_get_mf_float")
+    return math.nan if v is None else float(v)
+
+
+def wb_supervisor_field_get_mf_vec2f(field: Field | None, index: int) -> list[float] | None:
+    return _floats(_mf_item(field, WB_MF_VEC2F, index, "wb_supervisor_field_get_mf_vec2f"), 2)
+
+
+def wb_supervisor_field_get_mf_vec3f(field: Field | None, index: int) -> list[float] | None:
+    return _floats(_mf_item(field, WB_MF_VEC3F, index, "wb_supervisor_field_get_mf_vec3f"), 3)
+
+
+def wb_supervisor_field_get_mf_rotation(field: Field | None, index: int) -> list[float] | None:
+    return _floats(_mf_item(field, WB_MF_ROTATION, index, "wb_supervisor_field_get_mf_rotation"), 4)
+
+
+def wb_supervisor_field_get_mf_string(field: Field | None, index: int) -> str:
+    v = _mf_item(field, WB_MF_STRING, index, "wb_supervisor_field_get_mf_string")
+    return "" if v is None else str(v)
+
+
 def wb_supervisor_field_enable_sf_tracking(field: Field | None, sampling_period: int) -> None:
     """Webots sends a tracked field's value every sampling period so that its getters need no round
     trip; here every getter asks the server and answers the value of now, which is what tracking
@@ -573,7 +759,7 @@ def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
             not all(math.isfinite(v) for v in wire):
         print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
         return
-    _answer(r, "set_field", {"node": field[0], "field": field[1], "value": wire}, func)
+    _answer(r, "set_field", {**_field_args(field), "value": wire}, func)
 
 
 def wb_supervisor_field_set_sf_bool(field: Field | None, value: bool) -> None:
@@ -704,12 +890,16 @@ def wb_supervisor_world_reload() -> None:
 _unserved_warned: set[str] = set()
 
 
-def supervisor_unserved(func: str) -> None:
-    """A Supervisor function Sensorium does not serve: Webots' error in a Robot controller, else one
-    line the first time it is called (the same words as the C library's)."""
+def supervisor_unserved(func: str, what: str = "") -> None:
+    """A Supervisor function Sensorium does not serve (``what``: in which case): Webots' error in a Robot
+    controller, else one line the first time it is called (the same words as the C library's)."""
     if _supervisor(func) is None or func in _unserved_warned:
         return
     _unserved_warned.add(func)
+    if what:
+        print(f"Error: {func}(): not served by Sensorium {what}: ignored, Webots' \"no value\" returned.",
+              file=sys.stderr)
+        return
     print(f"Error: {func}(): not served by Sensorium (its Supervisor walks the root's children, reads nodes' "
           "identity, poses, velocities and fields (translation, rotation, name, lights' fields, ...), sets poses "
           "and lights, resets and sets the run mode): ignored, Webots' \"no value\" returned.", file=sys.stderr)

@@ -312,16 +312,29 @@ class NodeArgs(Args):
     node: NodeId
 
 
+_LEVEL = ("whose fields: -1 the node's (a PROTO instance's: its PROTO's interface fields, Webots' getField), 0 its "
+          "base node's (getBaseNodeField), k >= 1 the k-th PROTO of its chain (1 its own PROTO, 2 the PROTO that one "
+          "is built on, ...: getProto().getField, getParent())")
+
+
 class FieldArgs(Args):
     node: NodeId
     field: FieldName
+    level: int = Field(default=-1, ge=-1, le=16, description=_LEVEL)
 
 
 class SetFieldArgs(Args):
     node: NodeId
     field: FieldName
+    level: int = Field(default=-1, ge=-1, le=16, description=_LEVEL)
     value: bool | float | Annotated[list[float], Field(min_length=2, max_length=4)] = Field(
         description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis x, y, z, angle")
+
+
+class ProtoArgs(Args):
+    node: NodeId
+    level: int = Field(default=1, ge=1, le=16, description="the k-th PROTO of the node's chain: 1 its own PROTO "
+                       "(Webots' getProto()), 2 the PROTO that one is built on (getParent()), ...")
 
 
 class SetJointPositionArgs(Args):
@@ -904,12 +917,26 @@ class FieldValueResult(Result):
     type: str = Field(description="Webots' field type name (SFVec3f, SFRotation, SFColor, SFFloat, SFInt32, SFBool, "
                                   "SFString, SFNode, MFNode, MFColor); '' = the node has no such field here (the value "
                                   "is then [])")
-    value: bool | int | float | str | list[float] | list[int] | list[list[float]] = Field(
-        description="SFBool bool; SFFloat/SFInt32 number; SFString str; SFVec3f/SFColor/SFRotation numbers; SFNode "
-                    "the node's id; MFNode node ids; MFColor one list of 3 numbers per colour")
+    value: bool | int | float | str | list[float] | list[int] | list[bool] | list[str] | list[list[float]] = Field(
+        description="SFBool bool; SFFloat/SFInt32 number; SFString str; SFVec2f/SFVec3f/SFColor/SFRotation numbers; "
+                    "SFNode the node's id; MFNode node ids; MFBool/MFInt32/MFFloat/MFString one item each; "
+                    "MFVec2f/MFVec3f/MFColor/MFRotation one list of numbers per item (a PROTO's interface fields "
+                    "have any of these types)")
     absent: bool = Field(default=False, description="with type '': Webots' node of this type has no such field "
                                                      "either (a Solid's endPoint, a motor's children): the clients "
                                                      "answer NULL silently, as libController does")
+    note: str = Field(default="", description="a field whose value is not served (a PROTO's node-typed field that "
+                                               "does not pass straight to a base-node field, a value over 4096 items): "
+                                               "why, in one line; value is then [] and the clients print the line "
+                                               "and answer Webots' no value when it is read")
+
+
+class ProtoResult(Result):
+    type_name: str = Field(description="the PROTO's name; '' = no such PROTO (a base node, a level past the chain: "
+                                       "Webots' NULL)")
+    derived: bool = Field(default=False, description="its body is an instance of another PROTO (getParent is that one)")
+    fields: list[str] = Field(default=[], description="its interface fields' names in declaration order "
+                                                      "(getNumberOfFields, getFieldByIndex)")
 
 
 class NodePoseResult(Result):
@@ -1021,6 +1048,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_from_id", "robot", NodeIdArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_field", "robot", FieldArgs, FieldValueResult, attached=True, supervisor=True),
     ServiceSpec("set_field", "robot", SetFieldArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("get_proto", "robot", ProtoArgs, ProtoResult, attached=True, supervisor=True),
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("remove_node", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),

@@ -1257,6 +1257,31 @@ class MecanumDrive(Strict):
 
 # ---------------------------------------------------------------- robots and world
 
+class ProtoField(Strict):
+    """One interface field of a PROTO instance as the Supervisor reads it (README "Supervisor")."""
+
+    name: str = Field(min_length=1, max_length=256)
+    type: Literal["SFBool", "SFInt32", "SFFloat", "SFVec2f", "SFVec3f", "SFRotation", "SFColor", "SFString", "SFNode",
+                  "MFBool", "MFInt32", "MFFloat", "MFVec2f", "MFVec3f", "MFRotation", "MFColor", "MFString", "MFNode"]
+    value: bool | int | float | str | list[bool] | list[int] | list[float] | list[str] | list[list[float]] | None = Field(
+        default=None, description="the instance's value or the PROTO's default; none: not kept (a node-typed "
+        "field, or more than 4096 items)")
+    base: str | None = Field(default=None, min_length=1, description="the base node's field the value passes to "
+                             "through IS unchanged (a Supervisor sets the interface field through it)")
+
+
+class ProtoLevel(Strict):
+    """One PROTO of an instance's chain: the instance's own PROTO, then the one its body instantiates
+    (a derived PROTO's parent), ... (Webots' getProto(), getParent())."""
+
+    name: str = Field(min_length=1, max_length=256)
+    fields: list[ProtoField] = Field(default=[], max_length=1024)
+
+
+_INTERFACE = ("a PROTO instance's interface: its PROTO's fields with the instance's values, then each PROTO it is "
+              "built on (Supervisor getField, getProto)")
+
+
 class NestedNode(Strict):
     """A node inside a robot as the Supervisor walks it (README "Supervisor"): a ``.wbt`` robot's
     Solids, devices, Poses, Transforms, Groups, Slots and joints below it, depth first in file order
@@ -1266,6 +1291,7 @@ class NestedNode(Strict):
     type: str = Field(min_length=1, max_length=64, description="Webots' base node type (Solid, Pose, Camera, "
                       "HingeJoint, ...)")
     proto: str | None = Field(default=None, min_length=1, description="a PROTO instance: the PROTO's name")
+    interface: list[ProtoLevel] = Field(default=[], max_length=16, description=_INTERFACE)
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef; "
                                  "a PROTO's internal nodes have none: Webots does not find them by DEF)")
     name: str | None = Field(default=None, description="a Solid's or device's name field")
@@ -1455,6 +1481,7 @@ class TopNode(Strict):
     type: str = Field(min_length=1, description="Webots node type (a PROTO instance: its base type)")
     proto: str | None = Field(default=None, min_length=1, description="a PROTO instance: the PROTO's name "
                               "(Supervisor getTypeName; getBaseTypeName is type)")
+    interface: list[ProtoLevel] = Field(default=[], max_length=16, description=_INTERFACE)
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
     fields: dict[str, float | str | list[float] | list[list[float]]] = Field(
         default={}, description="a node not simulated (Viewpoint, Background): the world file's values of the fields "

@@ -74,6 +74,7 @@ class Nested:
     joint: str = ""       # the robot's joint motor whose link carries it (the innermost moving joint it is past)
     frame: int = -1       # the id of the nested node whose frame its ``own`` is in (-1: the owner's)
     motor: str = ""       # a joint's JointParameters node: the joint motor whose position it holds
+    interface: tuple = () # a PROTO instance's interface (wm.ProtoLevel each: supervisor.py serves its fields)
 
 
 @dataclass(frozen=True, slots=True)
@@ -195,7 +196,8 @@ def build(sim: Any, loaded_solids: int) -> Table:
             framed.append(first + k if local is not None else above_id)
             out.append(Nested(first + k, e.type, e.proto or "", e.def_name or "", e.name or "",
                               owner if e.parent < 0 else first + e.parent, e.field, local, _own(local, above),
-                              e.device or "", owner, "Robot", name, joints[k], above_id))
+                              e.device or "", owner, "Robot", name, joints[k], above_id,
+                              interface=tuple(e.interface)))
     for j in range(loaded_solids):
         owner = len(robots) + 1 + j
         solid = sim.world.solids[j]

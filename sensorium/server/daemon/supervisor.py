@@ -50,6 +50,7 @@ class Node:
     scenery: bool = False   # a top-level node Sensorium does not simulate (WorldInfo, Viewpoint, Background, ...)
     proto: str = ""         # the PROTO it is an instance of (Webots' getTypeName; ``type`` is its base type)
     nested: bool = False    # inside a robot or top-level solid (nested.py; key: its id)
+    interface: tuple = ()   # a PROTO instance's interface: wm.ProtoLevel each, its own PROTO first (getProto)
 
 
 ROOT = Node(0, "Group", "", "", "")
@@ -65,7 +66,7 @@ def _table(sim: Any) -> nested.Table:
 
 
 def _nested_node(n: nested.Nested) -> Node:
-    return Node(n.id, n.type, n.name, n.def_name, n.id, proto=n.proto, nested=True)
+    return Node(n.id, n.type, n.name, n.def_name, n.id, proto=n.proto, nested=True, interface=n.interface)
 
 
 def _nested_of(sim: Any, node: Node) -> nested.Nested:
@@ -97,25 +98,29 @@ def _all_nodes(sim: Any) -> list[Node]:
     loaded_solids, loaded_lights = _loaded_counts(sim)
     layout = getattr(sim, "top_level", None)
     protos = layout.protos if layout is not None else {}
-    out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name, proto=protos.get(("robots", i), ""))
-           for i, name in enumerate(sim.robots)]
+    faces = getattr(layout, "interfaces", {})
+    out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name, proto=protos.get(("robots", i), ""),
+                interface=faces.get(("robots", i), ())) for i, name in enumerate(sim.robots)]
     first = len(out) + 1
-    out += [Node(first + j, "Solid", names[j], def_of(solids_m, j), names[j], proto=protos.get(("solids", j), ""))
-            for j in range(loaded_solids)]
+    out += [Node(first + j, "Solid", names[j], def_of(solids_m, j), names[j], proto=protos.get(("solids", j), ""),
+                 interface=faces.get(("solids", j), ())) for j in range(loaded_solids)]
     first = len(out) + 1
-    out += [Node(first + k, top[k].type, top[k].name or "", def_of(top, k), k, proto=protos.get(("lights", k), ""))
-            for k in range(loaded_lights)]
+    out += [Node(first + k, top[k].type, top[k].name or "", def_of(top, k), k, proto=protos.get(("lights", k), ""),
+                 interface=faces.get(("lights", k), ())) for k in range(loaded_lights)]
     first = len(out) + 1
-    out += [Node(first + x, s.type, "", s.def_name, x, scenery=True, proto=s.proto) for x, s in enumerate(_scenery(sim))]
+    out += [Node(first + x, s.type, "", s.def_name, x, scenery=True, proto=s.proto, interface=s.interface)
+            for x, s in enumerate(_scenery(sim))]
     imported_protos = getattr(sim, "imported_protos", {})
+    imported_faces = getattr(sim, "imported_interfaces", {})
     for kind, key in imported:
-        proto = imported_protos.get(key, "")
+        proto, face = imported_protos.get(key, ""), imported_faces.get(key, ())
         if kind == "Solid":
             j = names.index(key)
-            out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key, proto=proto))
+            out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key, proto=proto, interface=face))
         else:
             lt = top[int(key)]
-            out.append(Node(len(out) + 1, lt.type, lt.name or "", def_of(top, int(key)), key, proto=proto))
+            out.append(Node(len(out) + 1, lt.type, lt.name or "", def_of(top, int(key)), key, proto=proto,
+                            interface=face))
     return out
 
 
@@ -502,10 +507,56 @@ def _set_parameter_position(sim: Any, node: Node, value: float) -> None:
     sim.joints_moved(robot)
 
 
-def _fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
+def _base_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
     if node.nested:
         return _nested_fields(sim, node)
     return SCENERY_FIELDS.get(node.type, {}) if node.scenery else FIELDS[node.type]
+
+
+def _level(node: Node, level: int) -> int:
+    """The fields a request names: -1 is the node's own (a PROTO instance's: its PROTO's, 1; else its base
+    node's, 0)."""
+    return (1 if node.interface else 0) if level < 0 else level
+
+
+def _interface_fields(sim: Any, node: Node, level: int) -> dict[str, tuple[str, Getter, Setter]]:
+    """The interface fields of PROTO ``level`` (1: the instance's own PROTO) of a PROTO instance. A field
+    whose value passes through IS unchanged to a base-node field served here reads that field now (a
+    robot's ``translation`` as it drives) and, on the instance's own PROTO, sets it as that field does;
+    any other field answers the instance's value (or the PROTO's default) and is read-only here: Webots
+    regenerates the node when one is set."""
+    if not 1 <= level <= len(node.interface):
+        raise ValueError(f"{_what(node)} has no PROTO at level {level} (its PROTO chain: "
+                         f"{' > '.join(p.name for p in node.interface) or 'none, it is no PROTO instance'})")
+    proto = node.interface[level - 1]
+    base = _base_fields(sim, node)
+    out: dict[str, tuple[str, Getter, Setter]] = {}
+    for f in proto.fields:
+        through = base.get(f.base) if f.base else None
+        if through is not None and through[0] == f.type:
+            out[f.name] = (f.type, through[1], through[2] if level == 1 else None)
+        else:
+            out[f.name] = (f.type, _kept_value(proto.name, f), None)
+    return out
+
+
+class NotKept(ValueError):
+    """A PROTO field whose value Sensorium does not keep: get_field answers its type and this line."""
+
+
+def _kept_value(proto: str, f: Any) -> Getter:
+    def get(sim: Any, node: Node) -> Any:
+        if f.value is None:
+            why = "a node-typed PROTO field is not served here unless it passes straight through IS to the base " \
+                  "node's field" if f.type.endswith("Node") else "its value is over 4096 items, not kept here"
+            raise NotKept(f"field {f.name!r} ({f.type}) of PROTO {proto} ({_what(node)}): {why}")
+        return f.value
+    return get
+
+
+def _fields(sim: Any, node: Node, level: int = -1) -> dict[str, tuple[str, Getter, Setter]]:
+    level = _level(node, level)
+    return _base_fields(sim, node) if level == 0 else _interface_fields(sim, node, level)
 
 
 _VECTOR_SIZES = {"SFVec3f": 3, "SFColor": 3, "SFRotation": 4}
@@ -532,21 +583,54 @@ def webots_lacks(node_type: str, field: str) -> bool:
     return node_type in _WEBOTS_LACKS.get(field, ())
 
 
-def get_field(sim: Any, node: Node, field: str) -> dict:
+def get_field(sim: Any, node: Node, field: str, level: int = -1) -> dict:
     """``{"type", "value"}``; type '' (and value []) when the node has no such field here, plus
-    ``absent: true`` when Webots' node has none either (``webots_lacks``)."""
-    entry = _fields(sim, node).get(field)
+    ``absent: true`` when Webots' node has none either (``webots_lacks``). ``level``: whose fields
+    (-1 the node's: a PROTO instance's interface; 0 its base node's; k its k-th PROTO's)."""
+    level = _level(node, level)
+    entry = _fields(sim, node, level).get(field)
     if entry is None:
+        if level > 0:         # a PROTO has no such interface field: Webots' NULL, no line (as libController)
+            return {"type": "", "value": [], "absent": True}
         return {"type": "", "value": [], "absent": True} if webots_lacks(node.type, field) else {"type": "", "value": []}
-    return {"type": entry[0], "value": entry[1](sim, node)}
+    try:
+        return {"type": entry[0], "value": entry[1](sim, node)}
+    except NotKept as exc:
+        return {"type": entry[0], "value": [], "note": str(exc)}
 
 
-def set_field(sim: Any, node: Node, field: str, value: Any) -> None:
-    entry = _fields(sim, node).get(field)
+def get_proto(sim: Any, node: Node, level: int) -> dict:
+    """Webots' ``getProto()`` (level 1) and ``getParent()`` (level + 1): the PROTO's name, whether it is
+    built on another PROTO, its interface fields' names; type_name '' for none."""
+    if not 1 <= level <= len(node.interface):
+        return {"type_name": "", "derived": False, "fields": []}
+    proto = node.interface[level - 1]
+    return {"type_name": proto.name, "derived": level < len(node.interface), "fields": [f.name for f in proto.fields]}
+
+
+def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> None:
+    level = _level(node, level)
     what = f"{node.type} {node.name or node.id!r}"
+    if level == 0 and node.interface:
+        raise ValueError(f"field {field!r} of {what} is a PROTO internal field (getBaseNodeField), read-only as in "
+                         f"Webots: set the field of PROTO {node.interface[0].name} instead")
+    if level > 1:
+        raise ValueError(f"field {field!r} of {what} belongs to PROTO {node.interface[level - 1].name}, which PROTO "
+                         f"{node.interface[0].name} is built on: read-only, as in Webots")
+    fields = _fields(sim, node, level)
+    entry = fields.get(field)
     if entry is None:
-        raise ValueError(f"{what} has no field {field!r} here (fields: {', '.join(_fields(sim, node)) or 'none'})")
+        kind_of = f"PROTO {node.interface[0].name} " if level == 1 else ""
+        raise ValueError(f"{what} has no {kind_of}field {field!r} here (fields: {', '.join(fields) or 'none'})")
     kind, _, setter = entry
+    if setter is None and level == 1:
+        declared = next(f for f in node.interface[0].fields if f.name == field)
+        why = (f"it passes to the base node's {declared.base!r}, which is read-only here" if declared.base
+               and declared.base in _base_fields(sim, node) else "Webots regenerates the node when such a PROTO field "
+               "is set; Sensorium sets only the PROTO fields that pass straight through IS to a field it sets (a "
+               "top-level robot's or solid's translation and rotation, a light's fields)")
+        raise ValueError(f"field {field!r} ({kind}) of PROTO {node.interface[0].name} ({what}) is read-only here: "
+                         f"{why}; nothing changed")
     if setter is None and node.nested:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
                          "top-level robots, solids and lights only, not the nodes inside them")
@@ -592,7 +676,7 @@ def node_velocity(sim: Any, node: Node) -> list[float]:
 # handler(sim, lockstep, calling robot, validated args) -> result; ValueError = INVALID_ARGUMENT
 
 def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
-    set_field(sim, node_by_id(sim, a.node), a.field, a.value)
+    set_field(sim, node_by_id(sim, a.node), a.field, a.value, a.level)
     return {"success": True}
 
 
@@ -799,7 +883,8 @@ HANDLERS = {
     "get_from_device": lambda sim, ls, robot, a: node_ref(sim, device_node(sim, robot, a.device)),
     "get_root": lambda sim, ls, robot, a: node_ref(sim, ROOT),
     "get_from_id": lambda sim, ls, robot, a: node_ref(sim, node_from_id(sim, a.id)),
-    "get_field": lambda sim, ls, robot, a: get_field(sim, node_by_id(sim, a.node), a.field),
+    "get_field": lambda sim, ls, robot, a: get_field(sim, node_by_id(sim, a.node), a.field, a.level),
+    "get_proto": lambda sim, ls, robot, a: get_proto(sim, node_by_id(sim, a.node), a.level),
     "set_field": _set_field,
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},

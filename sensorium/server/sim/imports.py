@@ -50,6 +50,7 @@ class ImportedNode:
     type: str           # "Solid" or the light's type (PointLight, SpotLight, DirectionalLight)
     model: Any          # wm.Solid or the light model, validated and sanitised
     proto: str = ""     # the PROTO the string's node is an instance of (Supervisor getTypeName), "" for a base node
+    interface: tuple = ()   # that PROTO instance's interface (wm.ProtoLevel each: Supervisor getField, getProto)
 
 
 @dataclass
@@ -153,6 +154,7 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     top = Owner("world", {})
     kinds: list[str] = []
     protos: list[str] = []
+    faces: list[tuple] = []
     for written, node in zip(wbt.nodes, expansion.nodes):
         solids, lights = len(conv.world["solids"]), len(conv.world["lights"])
         what = written.type if written.type == node.type else f"{written.type} (a {node.type})"
@@ -181,6 +183,8 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
         kinds.append(made[0][0])
         entry = conv.top_node(node, {})          # the PROTO's name as a world file's top-level node keeps it
         protos.append(entry.get("proto", "") if entry["type"] == made[0][0] else "")
+        faces.append(tuple(wm.ProtoLevel.model_validate(x) for x in entry.get("interface", []))
+                     if entry["type"] == made[0][0] else ())
     origin: dict[str, tuple[int, int, str]] = {}
     data = strip_origins({"solids": conv.world["solids"], "lights": conv.world["lights"]}, "", origin)
     data["world_info"] = {"coordinate_system": world.world_info.coordinate_system}
@@ -200,10 +204,10 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     warnings += [_wbt_warning(w, origin, LABEL) for w in parsed.warnings]
     queue: Counter[str] = Counter()
     out = []
-    for kind, proto in zip(kinds, protos):
+    for kind, proto, face in zip(kinds, protos, faces):
         group = "Solid" if kind == "Solid" else "light"
         models = fragment.solids if group == "Solid" else fragment.lights
-        out.append(ImportedNode(kind, models[queue[group]], proto))
+        out.append(ImportedNode(kind, models[queue[group]], proto, face))
         queue[group] += 1
     return out
 

@@ -36,6 +36,7 @@ class Scenery:
     def_name: str      # "" without one
     proto: str = ""    # the PROTO it is an instance of ("" for a base node)
     fields: dict = field(default_factory=dict)   # a Viewpoint's or Background's written values (TopNode.fields)
+    interface: tuple = ()   # a PROTO instance's interface (TopNode.interface: wm.ProtoLevel each)
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,6 +45,7 @@ class TopLevel:
     scenery: tuple[Scenery, ...]         # by index: file order, then the defaults Webots adds
     protos: dict = field(default_factory=dict)   # (kind, index) -> the PROTO a robot, solid or light is an
                                                  # instance of (the top-level node it alone became)
+    interfaces: dict = field(default_factory=dict)   # (kind, index) -> that instance's interface (wm.ProtoLevel each)
 
 
 def top_level(world: wm.World) -> TopLevel:
@@ -52,16 +54,19 @@ def top_level(world: wm.World) -> TopLevel:
     order: list[tuple[str, int]] = []
     scenery: list[Scenery] = []
     protos: dict[tuple[str, int], str] = {}
+    interfaces: dict[tuple[str, int], tuple] = {}
     for node in world.top_nodes:
         counts = {"robots": node.robots, "solids": node.solids, "lights": node.lights}
         if not any(counts.values()):
             order.append(("scenery", len(scenery)))
-            scenery.append(Scenery(node.type, node.def_name or "", node.proto or "", dict(node.fields)))
+            scenery.append(Scenery(node.type, node.def_name or "", node.proto or "", dict(node.fields),
+                                   tuple(node.interface)))
             continue
         alone = [kind for kind in KINDS if counts[kind]]
         if node.proto and sum(counts.values()) == 1 and node.type in BASES[alone[0]] \
                 and used[alone[0]] < sizes[alone[0]]:
             protos[(alone[0], used[alone[0]])] = node.proto
+            interfaces[(alone[0], used[alone[0]])] = tuple(node.interface)
         for kind in KINDS:
             for _ in range(counts[kind]):
                 if used[kind] < sizes[kind]:
@@ -73,4 +78,4 @@ def top_level(world: wm.World) -> TopLevel:
         if not any(s.type == kind for s in scenery):
             order.insert(min(place, len(order)), ("scenery", len(scenery)))
             scenery.append(Scenery(kind, ""))
-    return TopLevel(tuple(order), tuple(scenery), protos)
+    return TopLevel(tuple(order), tuple(scenery), protos, interfaces)

@@ -242,7 +242,7 @@ typedef struct {
   bool quit_returned; /* a step answered -1 for the termination: the next one ends the process */
   bool warned_duration;
   int keyboard_period;
-  void *nodes, *fields; /* supervisor handles handed out (supervisor.c) */
+  void *nodes, *fields, *protos; /* supervisor handles handed out (supervisor.c) */
   uint64_t pending; /* id of the pending step, 0 if none */
   int n_devices;
   sn_device *devices;

@@ -32,10 +32,30 @@ struct WbFieldStructPrivate {
   int64_t node;
   WbFieldType type;
   char *name;
+  int level; /* -1 the node's field (a PROTO instance's: its PROTO's), 0 its base node's, k its k-th PROTO's */
   double value[4]; /* an SF vector's or an MFColor item's last value */
   char *string; /* an SFString's last value */
   struct WbFieldStructPrivate *next;
 };
+
+/* Webots' WbProtoRef: the k-th PROTO (level) of a PROTO instance's chain, 1 its own PROTO */
+struct WbProtoInfoStructPrivate {
+  int64_t node;
+  int level;
+  char *type_name;
+  bool derived;
+  int n_fields;
+  char **fields; /* its interface fields' names, in declaration order */
+  struct WbProtoInfoStructPrivate *next;
+};
+
+static void proto_free(struct WbProtoInfoStructPrivate *p) {
+  for (int i = 0; i < p->n_fields; i++)
+    free(p->fields[i]);
+  free(p->fields);
+  free(p->type_name);
+  free(p);
+}
 
 void sn_supervisor_free(sn_robot *rb) {
   for (struct WbNodeStructPrivate *n = rb->nodes, *next; n != NULL; n = next) {
@@ -50,7 +70,11 @@ void sn_supervisor_free(sn_robot *rb) {
     free(f->string);
     free(f);
   }
-  rb->nodes = rb->fields = NULL;
+  for (struct WbProtoInfoStructPrivate *p = rb->protos, *next; p != NULL; p = next) {
+    next = p->next;
+    proto_free(p);
+  }
+  rb->nodes = rb->fields = rb->protos = NULL;
 }
 
 static sn_robot *supervisor(const char *func) {
@@ -589,9 +613,11 @@ static const struct {
   const char *name;
   WbFieldType type;
 } FIELD_TYPES[] = {{"SFBool", WB_SF_BOOL},     {"SFInt32", WB_SF_INT32},   {"SFFloat", WB_SF_FLOAT},
-                   {"SFVec3f", WB_SF_VEC3F},     {"SFRotation", WB_SF_ROTATION}, {"SFColor", WB_SF_COLOR},
-                   {"SFString", WB_SF_STRING},   {"SFNode", WB_SF_NODE},     {"MFColor", WB_MF_COLOR},
-                   {"MFNode", WB_MF_NODE}};
+                   {"SFVec2f", WB_SF_VEC2F},     {"SFVec3f", WB_SF_VEC3F},   {"SFRotation", WB_SF_ROTATION},
+                   {"SFColor", WB_SF_COLOR},     {"SFString", WB_SF_STRING}, {"SFNode", WB_SF_NODE},
+                   {"MFBool", WB_MF_BOOL},       {"MFInt32", WB_MF_INT32},   {"MFFloat", WB_MF_FLOAT},
+                   {"MFVec2f", WB_MF_VEC2F},     {"MFVec3f", WB_MF_VEC3F},   {"MFRotation", WB_MF_ROTATION},
+                   {"MFColor", WB_MF_COLOR},     {"MFString", WB_MF_STRING}, {"MFNode", WB_MF_NODE}};
 
 typedef struct {
   int64_t node;
@@ -601,6 +627,8 @@ typedef struct {
   double number;
   const double *values;
   int n;
+  bool has_level; /* a PROTO level (FieldArgs.level) is sent */
+  int level;
 } field_args;
 
 static void args_field(sn_req *r, const void *arg) {
@@ -609,6 +637,10 @@ static void args_field(sn_req *r, const void *arg) {
   msgpack_pack_int64(&r->pk, a->node);
   sn_req_key(r, "field");
   sn_req_str(r, a->name);
+  if (a->has_level) {
+    sn_req_key(r, "level");
+    msgpack_pack_int(&r->pk, a->level);
+  }
   if (a->kind == 0)
     return;
   sn_req_key(r, "value");
@@ -623,8 +655,8 @@ static void args_field(sn_req *r, const void *arg) {
   }
 }
 
-WbFieldRef wb_supervisor_node_get_field(WbNodeRef node, const char *field_name) {
-  const char *func = "wb_supervisor_node_get_field";
+/* The field `field_name` of the node (level -1), of its base node (0) or of the k-th PROTO of its chain (k) */
+static WbFieldRef field_at(WbNodeRef node, const char *field_name, int level, const char *func) {
   sn_robot *rb = supervisor_node(node, func);
   if (rb == NULL)
     return NULL;
@@ -633,11 +665,11 @@ WbFieldRef wb_supervisor_node_get_field(WbNodeRef node, const char *field_name) 
     return NULL;
   }
   for (struct WbFieldStructPrivate *f = rb->fields; f != NULL; f = f->next)
-    if (f->node == node->id && strcmp(f->name, field_name) == 0)
+    if (f->node == node->id && f->level == level && strcmp(f->name, field_name) == 0)
       return f;
-  field_args a = {node->id, field_name, 0, false, 0.0, NULL, 0};
+  field_args a = {node->id, field_name, 0, false, 0.0, NULL, 0, level >= 0, level};
   sn_reply rep;
-  if (sn_robot_call(rb, "robot/get_field", 2, args_field, &a, func, &rep) != 0)
+  if (sn_robot_call(rb, "robot/get_field", 2 + (level >= 0), args_field, &a, func, &rep) != 0)
     return NULL;
   const msgpack_object *type = sn_get(rep.result, "type");
   WbFieldType t = WB_NO_FIELD;
@@ -665,9 +697,166 @@ WbFieldRef wb_supervisor_node_get_field(WbNodeRef node, const char *field_name) 
   f->node = node->id;
   f->type = t;
   f->name = name;
+  f->level = level;
   f->next = rb->fields;
   rb->fields = f;
   return f;
+}
+
+/* a PROTO instance's: its PROTO's interface field, as Webots */
+WbFieldRef wb_supervisor_node_get_field(WbNodeRef node, const char *field_name) {
+  return field_at(node, field_name, -1, "wb_supervisor_node_get_field");
+}
+
+/* the base node's field (a PROTO instance's Robot, Solid, ...): read-only on a PROTO instance, as in Webots */
+WbFieldRef wb_supervisor_node_get_base_node_field(WbNodeRef node, const char *field_name) {
+  return field_at(node, field_name, 0, "wb_supervisor_node_get_base_node_field");
+}
+
+typedef struct {
+  int64_t node;
+  int level;
+} proto_args;
+
+static void args_proto(sn_req *r, const void *arg) {
+  const proto_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "level");
+  msgpack_pack_int(&r->pk, a->level);
+}
+
+/* PROTO `level` of the node's chain (kept until wb_robot_cleanup: a PROTO instance's interface never changes
+   here); NULL when there is none (a base node, a level past the chain) */
+static WbProtoRef proto_at(sn_robot *rb, int64_t node, int level, const char *func) {
+  for (struct WbProtoInfoStructPrivate *p = rb->protos; p != NULL; p = p->next)
+    if (p->node == node && p->level == level)
+      return p;
+  proto_args a = {node, level};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/get_proto", 2, args_proto, &a, func, &rep) != 0)
+    return NULL;
+  const msgpack_object *name = sn_get(rep.result, "type_name");
+  const msgpack_object *derived = sn_get(rep.result, "derived");
+  const msgpack_object *fields = sn_get(rep.result, "fields");
+  struct WbProtoInfoStructPrivate *p = NULL;
+  if (name != NULL && name->type == MSGPACK_OBJECT_STR && name->via.str.size > 0)
+    p = calloc(1, sizeof *p);
+  if (p != NULL) {
+    p->node = node;
+    p->level = level;
+    p->type_name = sn_strdup_obj(name);
+    p->derived = derived != NULL && derived->type == MSGPACK_OBJECT_BOOLEAN && derived->via.boolean;
+    uint32_t n = fields != NULL && fields->type == MSGPACK_OBJECT_ARRAY ? fields->via.array.size : 0;
+    p->fields = n ? calloc(n, sizeof *p->fields) : NULL;
+    for (uint32_t i = 0; p->fields != NULL && i < n; i++) {
+      p->fields[i] = sn_strdup_obj(&fields->via.array.ptr[i]);
+      if (p->fields[i] == NULL)
+        break;
+      p->n_fields = (int)i + 1;
+    }
+    if (p->type_name == NULL || (n && p->n_fields != (int)n)) {
+      proto_free(p);
+      p = NULL;
+    } else {
+      p->next = rb->protos;
+      rb->protos = p;
+    }
+  }
+  sn_reply_free(&rep);
+  return p;
+}
+
+/* the node's PROTO; NULL for a base node (or a PROTO Sensorium builds in: RectangleArena, ...) */
+WbProtoRef wb_supervisor_node_get_proto(WbNodeRef node) {
+  const char *func = "wb_supervisor_node_get_proto";
+  sn_robot *rb = supervisor_node(node, func);
+  return rb == NULL ? NULL : proto_at(rb, node->id, 1, func);
+}
+
+/* the supervisor robot for a call on `proto`, or NULL after Webots' line */
+static sn_robot *proto_robot(WbProtoRef proto, const char *func) {
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return NULL;
+  for (struct WbProtoInfoStructPrivate *p = rb->protos; proto != NULL && p != NULL; p = p->next)
+    if (p == proto)
+      return rb;
+  fprintf(stderr, "Error: %s() called with a NULL or invalid 'proto' argument.\n", func);
+  return NULL;
+}
+
+const char *wb_supervisor_proto_get_type_name(WbProtoRef proto) {
+  return proto_robot(proto, "wb_supervisor_proto_get_type_name") ? proto->type_name : "";
+}
+
+bool wb_supervisor_proto_is_derived(WbProtoRef proto) {
+  return proto_robot(proto, "wb_supervisor_proto_is_derived") ? proto->derived : false;
+}
+
+/* the PROTO this one is built on (its body is an instance of it); NULL when it is built on a base node */
+WbProtoRef wb_supervisor_proto_get_parent(WbProtoRef proto) {
+  const char *func = "wb_supervisor_proto_get_parent";
+  sn_robot *rb = proto_robot(proto, func);
+  if (rb == NULL || !proto->derived)
+    return NULL;
+  return proto_at(rb, proto->node, proto->level + 1, func);
+}
+
+int wb_supervisor_proto_get_number_of_fields(WbProtoRef proto) {
+  return proto_robot(proto, "wb_supervisor_proto_get_number_of_fields") ? proto->n_fields : -1;
+}
+
+/* a parent PROTO's fields are read-only, as in Webots */
+WbFieldRef wb_supervisor_proto_get_field(WbProtoRef proto, const char *field_name) {
+  const char *func = "wb_supervisor_proto_get_field";
+  sn_robot *rb = proto_robot(proto, func);
+  return rb == NULL ? NULL : field_at(node_ref(rb, proto->node), field_name, proto->level, func);
+}
+
+static const char *field_name_at(WbProtoRef proto, int index, const char *func) {
+  if (index < 0 || index >= proto->n_fields) {
+    fprintf(stderr, "Error: %s() called with an invalid 'index' argument: %d (the PROTO has %d fields).\n", func, index,
+            proto->n_fields);
+    return NULL;
+  }
+  return proto->fields[index];
+}
+
+WbFieldRef wb_supervisor_proto_get_field_by_index(WbProtoRef proto, int index) {
+  const char *func = "wb_supervisor_proto_get_field_by_index";
+  sn_robot *rb = proto_robot(proto, func);
+  const char *name = rb == NULL ? NULL : field_name_at(proto, index, func);
+  return name == NULL ? NULL : field_at(node_ref(rb, proto->node), name, proto->level, func);
+}
+
+/* Sensorium counts and lists the fields of PROTO instances only (their interface, as Webots): a base node
+   gets the not-served line */
+static WbProtoRef node_proto(WbNodeRef node, const char *func, bool *warned) {
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb == NULL)
+    return NULL;
+  WbProtoRef p = proto_at(rb, node->id, 1, func);
+  if (p == NULL && !*warned) {
+    *warned = true;
+    fprintf(stderr, "Error: %s(): not served by Sensorium on a node that is no PROTO instance (Sensorium lists the "
+                    "fields of PROTO instances only): ignored, Webots' \"no value\" returned.\n", func);
+  }
+  return p;
+}
+
+int wb_supervisor_node_get_number_of_fields(WbNodeRef node) {
+  static bool warned = false;
+  WbProtoRef p = node_proto(node, "wb_supervisor_node_get_number_of_fields", &warned);
+  return p == NULL ? -1 : p->n_fields;
+}
+
+WbFieldRef wb_supervisor_node_get_field_by_index(WbNodeRef node, int index) {
+  static bool warned = false;
+  const char *func = "wb_supervisor_node_get_field_by_index";
+  WbProtoRef p = node_proto(node, func, &warned);
+  const char *name = p == NULL ? NULL : field_name_at(p, index, func);
+  return name == NULL ? NULL : field_at(node, name, -1, func);
 }
 
 WbFieldType wb_supervisor_field_get_type(WbFieldRef field) { return field ? field->type : WB_NO_FIELD; }
@@ -706,9 +895,15 @@ static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_
   sn_robot *rb = field_robot(field, type, func);
   if (rb == NULL)
     return -1;
-  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0};
-  if (sn_robot_call(rb, "robot/get_field", 2, args_field, &a, func, rep) != 0)
+  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, field->level >= 0, field->level};
+  if (sn_robot_call(rb, "robot/get_field", 2 + (field->level >= 0), args_field, &a, func, rep) != 0)
     return -1;
+  const msgpack_object *note = sn_get(rep->result, "note"); /* a value the server does not serve: its line */
+  if (note != NULL && note->type == MSGPACK_OBJECT_STR && note->via.str.size > 0) {
+    fprintf(stderr, "Error: %s(): %.*s.\n", func, (int)note->via.str.size, note->via.str.ptr);
+    sn_reply_free(rep);
+    return -1;
+  }
   *value = sn_get(rep->result, "value");
   return 0;
 }
@@ -790,11 +985,15 @@ static const double *field_numbers(WbFieldRef field, WbFieldType type, const cha
   const msgpack_object *v;
   if (field_value(field, type, func, &rep, &v) != 0)
     return NULL;
-  bool ok = copy_numbers(v, field->value, type == WB_SF_ROTATION ? 4 : 3);
+  bool ok = copy_numbers(v, field->value, type == WB_SF_ROTATION ? 4 : type == WB_SF_VEC2F ? 2 : 3);
   sn_reply_free(&rep);
   if (!ok)
     fprintf(stderr, "Error: %s(): malformed reply\n", func);
   return ok ? field->value : NULL;
+}
+
+const double *wb_supervisor_field_get_sf_vec2f(WbFieldRef field) {
+  return field_numbers(field, WB_SF_VEC2F, "wb_supervisor_field_get_sf_vec2f");
 }
 
 const double *wb_supervisor_field_get_sf_vec3f(WbFieldRef field) {
@@ -865,6 +1064,70 @@ const double *wb_supervisor_field_get_mf_color(WbFieldRef field, int index) {
   return ok ? field->value : NULL;
 }
 
+/* item `index` of an MF field of `type` into *out (numbers: `width` of them into field->value; a string:
+   into field->string); false after Webots' line */
+static bool mf_get(WbFieldRef field, WbFieldType type, int index, int width, const char *func, double *number) {
+  sn_reply rep;
+  const msgpack_object *v;
+  if (field_value(field, type, func, &rep, &v) != 0)
+    return false;
+  const msgpack_object *item = mf_item(v, index, func);
+  bool ok = item != NULL;
+  if (ok && type == WB_MF_STRING) {
+    char *copy = sn_strdup_obj(item);
+    ok = copy != NULL;
+    if (ok) {
+      free(field->string);
+      field->string = copy;
+    }
+  } else if (ok && type == WB_MF_BOOL) {
+    ok = item->type == MSGPACK_OBJECT_BOOLEAN;
+    *number = ok && item->via.boolean ? 1.0 : 0.0;
+  } else if (ok && width == 1)
+    ok = sn_as_double(item, number);
+  else if (ok)
+    ok = copy_numbers(item, field->value, (uint32_t)width);
+  if (item != NULL && !ok)
+    fprintf(stderr, "Error: %s(): malformed reply\n", func);
+  sn_reply_free(&rep);
+  return ok;
+}
+
+bool wb_supervisor_field_get_mf_bool(WbFieldRef field, int index) {
+  double v = 0.0;
+  return mf_get(field, WB_MF_BOOL, index, 1, "wb_supervisor_field_get_mf_bool", &v) && v != 0.0;
+}
+
+int wb_supervisor_field_get_mf_int32(WbFieldRef field, int index) {
+  double v = 0.0;
+  return mf_get(field, WB_MF_INT32, index, 1, "wb_supervisor_field_get_mf_int32", &v) ? (int)v : 0;
+}
+
+double wb_supervisor_field_get_mf_float(WbFieldRef field, int index) {
+  double v = NAN;
+  return mf_get(field, WB_MF_FLOAT, index, 1, "wb_supervisor_field_get_mf_float", &v) ? v : NAN;
+}
+
+const double *wb_supervisor_field_get_mf_vec2f(WbFieldRef field, int index) {
+  double unused;
+  return mf_get(field, WB_MF_VEC2F, index, 2, "wb_supervisor_field_get_mf_vec2f", &unused) ? field->value : NULL;
+}
+
+const double *wb_supervisor_field_get_mf_vec3f(WbFieldRef field, int index) {
+  double unused;
+  return mf_get(field, WB_MF_VEC3F, index, 3, "wb_supervisor_field_get_mf_vec3f", &unused) ? field->value : NULL;
+}
+
+const double *wb_supervisor_field_get_mf_rotation(WbFieldRef field, int index) {
+  double unused;
+  return mf_get(field, WB_MF_ROTATION, index, 4, "wb_supervisor_field_get_mf_rotation", &unused) ? field->value : NULL;
+}
+
+const char *wb_supervisor_field_get_mf_string(WbFieldRef field, int index) {
+  double unused;
+  return mf_get(field, WB_MF_STRING, index, 1, "wb_supervisor_field_get_mf_string", &unused) ? field->string : "";
+}
+
 static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const char *func) {
   sn_robot *rb = field_robot(field, type, func);
   if (rb == NULL)
@@ -882,33 +1145,35 @@ static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const c
   }
   a->node = field->node;
   a->name = field->name;
+  a->has_level = field->level >= 0;
+  a->level = field->level;
   sn_reply rep;
-  if (sn_robot_call(rb, "robot/set_field", 3, args_field, a, func, &rep) == 0)
+  if (sn_robot_call(rb, "robot/set_field", 3 + a->has_level, args_field, a, func, &rep) == 0)
     sn_reply_free(&rep);
 }
 
 void wb_supervisor_field_set_sf_bool(WbFieldRef field, bool value) {
-  field_args a = {0, NULL, 1, value, 0.0, NULL, 0};
+  field_args a = {0, NULL, 1, value, 0.0, NULL, 0, false, 0};
   field_set(field, WB_SF_BOOL, &a, "wb_supervisor_field_set_sf_bool");
 }
 
 void wb_supervisor_field_set_sf_float(WbFieldRef field, double value) {
-  field_args a = {0, NULL, 2, false, value, NULL, 0};
+  field_args a = {0, NULL, 2, false, value, NULL, 0, false, 0};
   field_set(field, WB_SF_FLOAT, &a, "wb_supervisor_field_set_sf_float");
 }
 
 void wb_supervisor_field_set_sf_vec3f(WbFieldRef field, const double values[3]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 3};
+  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0};
   field_set(field, WB_SF_VEC3F, &a, "wb_supervisor_field_set_sf_vec3f");
 }
 
 void wb_supervisor_field_set_sf_rotation(WbFieldRef field, const double values[4]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 4};
+  field_args a = {0, NULL, 3, false, 0.0, values, 4, false, 0};
   field_set(field, WB_SF_ROTATION, &a, "wb_supervisor_field_set_sf_rotation");
 }
 
 void wb_supervisor_field_set_sf_color(WbFieldRef field, const double values[3]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 3};
+  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0};
   field_set(field, WB_SF_COLOR, &a, "wb_supervisor_field_set_sf_color");
 }
 

@@ -22,7 +22,6 @@ bool wb_supervisor_world_save(const char *filename) {
 }
 
 
-
 void wb_supervisor_movie_start_recording(const char *filename, int width, int height, int codec, int quality, int acceleration, bool caption) {
   SN_UNSUPPORTED();
 }
@@ -52,7 +51,6 @@ bool wb_supervisor_animation_stop_recording(void) {
 }
 
 
-
 WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def) {
   SN_UNSUPPORTED();
   return NULL;
@@ -65,21 +63,6 @@ WbNodeRef wb_supervisor_node_get_selected(void) {
 }
 
 
-WbFieldRef wb_supervisor_node_get_field_by_index(WbNodeRef node, int index) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
-int wb_supervisor_node_get_number_of_fields(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return -1;
-}
-
-WbFieldRef wb_supervisor_node_get_base_node_field(WbNodeRef node, const char *field_name) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
 WbFieldRef wb_supervisor_node_get_base_node_field_by_index(WbNodeRef node, int index) {
   SN_UNSUPPORTED();
   return NULL;
@@ -89,14 +72,6 @@ int wb_supervisor_node_get_number_of_base_node_fields(WbNodeRef node) {
   SN_UNSUPPORTED();
   return -1;
 }
-
-WbProtoRef wb_supervisor_node_get_proto(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
-
-
 
 
 const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
@@ -108,9 +83,6 @@ bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
   SN_UNSUPPORTED();
   return false;
 }
-
-
-
 
 
 const char *wb_supervisor_node_export_string(WbNodeRef node) {
@@ -142,53 +114,6 @@ WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
   SN_UNSUPPORTED();
   return NULL;
 }
-
-
-
-
-
-const double *wb_supervisor_field_get_sf_vec2f(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
-
-
-
-bool wb_supervisor_field_get_mf_bool(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return false;
-}
-
-int wb_supervisor_field_get_mf_int32(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return 0;
-}
-
-double wb_supervisor_field_get_mf_float(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return NAN;
-}
-
-const double *wb_supervisor_field_get_mf_vec2f(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
-
-const double *wb_supervisor_field_get_mf_vec3f(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
-
-const double *wb_supervisor_field_get_mf_rotation(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
-
-const char *wb_supervisor_field_get_mf_string(WbFieldRef field, int index) {
-  SN_UNSUPPORTED();
-  return "";
-}
-
 
 
 void wb_supervisor_field_set_sf_int32(WbFieldRef field, int value) {
@@ -281,35 +206,6 @@ void wb_supervisor_field_import_sf_node_from_string(WbFieldRef field, const char
   SN_UNSUPPORTED();
 }
 
-const char *wb_supervisor_proto_get_type_name(WbProtoRef proto) {
-  SN_UNSUPPORTED();
-  return "";
-}
-
-bool wb_supervisor_proto_is_derived(WbProtoRef proto) {
-  SN_UNSUPPORTED();
-  return false;
-}
-
-WbProtoRef wb_supervisor_proto_get_parent(WbProtoRef proto) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
-WbFieldRef wb_supervisor_proto_get_field(WbProtoRef proto, const char *field_name) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
-WbFieldRef wb_supervisor_proto_get_field_by_index(WbProtoRef proto, int index) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
-int wb_supervisor_proto_get_number_of_fields(WbProtoRef proto) {
-  SN_UNSUPPORTED();
-  return -1;
-}
 
 bool wb_supervisor_virtual_reality_headset_is_used(void) {
   SN_UNSUPPORTED();

@@ -1,6 +1,7 @@
 """Webots' ``Supervisor``, ``Node`` and ``Field`` classes — what Sensorium serves: the root and its
 ``children`` (robots, top-level solids and lights, WorldInfo, Viewpoint, ...), nodes by DEF, id or
-name, their identity (type and PROTO name, DEF, parent), fields (``translation``/``rotation`` read
+name, their identity (type and PROTO name, DEF, parent), a PROTO instance's interface fields
+(``getProto``, ``getParent``, ``getBaseNodeField``), fields (``translation``/``rotation`` read
 and set, ``name``, ``model``, ``customData``, lights' ``on``/``intensity``/``color``/... read and
 set, WorldInfo's, Viewpoint's and Background's values read), world poses and velocities; reset the
 simulation and change its mode. The robot's world entry needs ``supervisor: true``.
@@ -43,7 +44,7 @@ class Field:
     MF_STRING = 0x18
     MF_NODE = wb.WB_MF_NODE
 
-    def __init__(self, ref: tuple[int, str, int]):
+    def __init__(self, ref: tuple[int, str, int] | tuple[int, str, int, int]):
         self._ref = ref
 
     def getName(self) -> str:
@@ -88,6 +89,31 @@ class Field:
     def getMFColor(self, index: int) -> list[float] | None:
         return wb.wb_supervisor_field_get_mf_color(self._ref, index)
 
+    # a PROTO's interface fields have any VRML type
+    def getSFVec2f(self) -> list[float] | None:
+        return wb.wb_supervisor_field_get_sf_vec2f(self._ref)
+
+    def getMFBool(self, index: int) -> bool:
+        return wb.wb_supervisor_field_get_mf_bool(self._ref, index)
+
+    def getMFInt32(self, index: int) -> int:
+        return wb.wb_supervisor_field_get_mf_int32(self._ref, index)
+
+    def getMFFloat(self, index: int) -> float:
+        return wb.wb_supervisor_field_get_mf_float(self._ref, index)
+
+    def getMFVec2f(self, index: int) -> list[float] | None:
+        return wb.wb_supervisor_field_get_mf_vec2f(self._ref, index)
+
+    def getMFVec3f(self, index: int) -> list[float] | None:
+        return wb.wb_supervisor_field_get_mf_vec3f(self._ref, index)
+
+    def getMFRotation(self, index: int) -> list[float] | None:
+        return wb.wb_supervisor_field_get_mf_rotation(self._ref, index)
+
+    def getMFString(self, index: int) -> str:
+        return wb.wb_supervisor_field_get_mf_string(self._ref, index)
+
     def enableSFTracking(self, samplingPeriod: int) -> None:  # noqa: N803 - Webots' parameter name
         """Accepted: the getters ask the server at each call here (Webots streams tracked values)."""
         wb.wb_supervisor_field_enable_sf_tracking(self._ref, samplingPeriod)
@@ -114,9 +140,13 @@ class Field:
         wb.wb_supervisor_field_import_mf_node_from_string(self._ref, position, nodeString)
 
     _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_INT32: getSFInt32, wb.WB_SF_FLOAT: getSFFloat,
-                wb.WB_SF_STRING: getSFString,
+                wb.WB_SF_STRING: getSFString, wb.WB_SF_VEC2F: getSFVec2f,
                 wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor,
                 wb.WB_SF_NODE: getSFNode}
+
+    _MF_GETTERS = {wb.WB_MF_NODE: getMFNode, wb.WB_MF_COLOR: getMFColor, wb.WB_MF_BOOL: getMFBool,
+                   wb.WB_MF_INT32: getMFInt32, wb.WB_MF_FLOAT: getMFFloat, wb.WB_MF_VEC2F: getMFVec2f,
+                   wb.WB_MF_VEC3F: getMFVec3f, wb.WB_MF_ROTATION: getMFRotation, wb.WB_MF_STRING: getMFString}
 
     name = property(getName)
     type = property(getType)
@@ -129,10 +159,9 @@ class Field:
     @property
     def value(self) -> Any:
         """Webots' ``Field.value``: an SF field's value; an MF field's items as a list."""
-        if self._ref[2] == wb.WB_MF_NODE:
-            return [self.getMFNode(i) for i in range(self.getCount())]
-        if self._ref[2] == wb.WB_MF_COLOR:
-            return [self.getMFColor(i) for i in range(self.getCount())]
+        mf = Field._MF_GETTERS.get(self._ref[2])
+        if mf is not None:
+            return [mf(self, i) for i in range(self.getCount())]
         return Field._GETTERS[self._ref[2]](self)
 
     @value.setter
@@ -190,7 +219,26 @@ class Node:
         return _node_of(wb.wb_supervisor_node_get_parent_node(self._ref))
 
     def getField(self, fieldName: str) -> Field | None:  # noqa: N803 - Webots' parameter name
+        """The field of that name: a PROTO instance's PROTO field (its interface), else the node's own."""
         ref = wb.wb_supervisor_node_get_field(self._ref, fieldName)
+        return None if ref is None else Field(ref)
+
+    def getBaseNodeField(self, fieldName: str) -> Field | None:  # noqa: N803
+        """The base node's field (a PROTO instance's Robot, Solid, ...): read-only on a PROTO instance."""
+        ref = wb.wb_supervisor_node_get_base_node_field(self._ref, fieldName)
+        return None if ref is None else Field(ref)
+
+    def getProto(self) -> Proto | None:
+        """The node's PROTO (None for a base node)."""
+        ref = wb.wb_supervisor_node_get_proto(self._ref)
+        return None if ref is None else Proto(ref)
+
+    def getNumberOfFields(self) -> int:
+        """A PROTO instance's interface fields (a base node: not served here, -1 with one line)."""
+        return wb.wb_supervisor_node_get_number_of_fields(self._ref)
+
+    def getFieldByIndex(self, index: int) -> Field | None:
+        ref = wb.wb_supervisor_node_get_field_by_index(self._ref, index)
         return None if ref is None else Field(ref)
 
     def getPosition(self) -> list[float]:
@@ -372,11 +420,41 @@ class Supervisor(Robot):
 
 
 class Proto:
-    """Webots' PROTO of a node (``Node.getProto``): Sensorium does not serve PROTO queries, so none is
-    ever handed out; its methods answer Webots' "no value" with one error line each."""
+    """Webots' PROTO of a node (``Node.getProto``): its name, its interface fields (the instance's values,
+    or the PROTO's defaults), the PROTO it is built on (``getParent``)."""
 
-    def __init__(self, ref: int = 0):
+    def __init__(self, ref: tuple[int, int] = (0, 0)):
         self._ref = ref
+
+    def getTypeName(self) -> str:
+        return wb.wb_supervisor_proto_get_type_name(self._ref)
+
+    def isDerived(self) -> bool:
+        return wb.wb_supervisor_proto_is_derived(self._ref)
+
+    def getParent(self) -> Proto | None:
+        ref = wb.wb_supervisor_proto_get_parent(self._ref)
+        return None if ref is None else Proto(ref)
+
+    def getField(self, name: str) -> Field | None:
+        ref = wb.wb_supervisor_proto_get_field(self._ref, name)
+        return None if ref is None else Field(ref)
+
+    def getFieldByIndex(self, index: int) -> Field | None:
+        ref = wb.wb_supervisor_proto_get_field_by_index(self._ref, index)
+        return None if ref is None else Field(ref)
+
+    def getNumberOfFields(self) -> int:
+        return wb.wb_supervisor_proto_get_number_of_fields(self._ref)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Proto) and other._ref == self._ref
+
+    def __hash__(self) -> int:
+        return hash(self._ref)
+
+    def __repr__(self) -> str:
+        return f"Proto(level {self._ref[1]} of node {self._ref[0]})"
 
 
 def _unserved(method: str, func: str, value: Any, params: str) -> Callable[..., Any]:
@@ -405,11 +483,8 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3, ""),
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9, "")},
     Node: {
-        "getProto": ("node_get_proto", None, ""), "getFromProtoDef": ("node_get_from_proto_def", None, "DEF"),
-        "getNumberOfFields": ("node_get_number_of_fields", -1, ""),
+        "getFromProtoDef": ("node_get_from_proto_def", None, "DEF"),
         "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1, ""),
-        "getFieldByIndex": ("node_get_field_by_index", None, "index"),
-        "getBaseNodeField": ("node_get_base_node_field", None, "fieldName"),
         "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None, "index"),
         "exportString": ("node_export_string", "", ""),
         "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3, ""),
@@ -419,11 +494,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "addForce": ("node_add_force", None, "force, relative"),
         "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),
         "addTorque": ("node_add_torque", None, "torque, relative")},
-    Proto: {
-        "getTypeName": ("proto_get_type_name", "", ""), "isDerived": ("proto_is_derived", False, ""),
-        "getParent": ("proto_get_parent", None, ""), "getField": ("proto_get_field", None, "name"),
-        "getFieldByIndex": ("proto_get_field_by_index", None, "index"),
-        "getNumberOfFields": ("proto_get_number_of_fields", -1, "")},
     Field: {
         "getActualField": ("field_get_actual_field", None, ""), "removeMF": ("field_remove_mf", None, "index"),
         "removeSF": ("field_remove_sf", None, ""),
@@ -434,13 +504,9 @@ _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 
                     "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
 for _kind, _none in _FIELD_NO_VALUES.items():
     _c = _kind.lower()
-    if _kind not in ("Node", "Color"):         # getMFNode (the root's children), getMFColor (skyColor) are served
-        _UNSERVED[Field][f"getMF{_kind}"] = (f"field_get_mf_{_c}", _none, "index")
     if _kind != "Node":                        # setMFNode and insertMFNode are not Webots' (importMFNodeFromString)
         _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None, "index, value")
         _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None, "index, value")
-    if _kind == "Vec2f":             # the SF field type no node here has
-        _UNSERVED[Field][f"getSF{_kind}"] = (f"field_get_sf_{_c}", _none, "")
     if _kind in ("Int32", "Vec2f", "String"):  # SFString fields are read-only here
         _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None, "value")
 for _cls, _methods in _UNSERVED.items():

@@ -10,7 +10,7 @@ serve asset urls (meshes, textures) the same way.
 """
 
 from sensorium.server.world.proto.errors import ProtoError
-from sensorium.server.world.proto.instantiate import Expansion, ProtoUse, expand, protos_used
+from sensorium.server.world.proto.instantiate import Expansion, ProtoUse, expand, interface_levels, protos_used
 from sensorium.server.world.proto.resolve import ProtoSearch, asset_roots, resolve_url
 
-__all__ = ["ProtoError", "ProtoSearch", "Expansion", "ProtoUse", "expand", "protos_used", "resolve_url", "asset_roots"]
+__all__ = ["ProtoError", "ProtoSearch", "Expansion", "ProtoUse", "expand", "interface_levels", "protos_used", "resolve_url", "asset_roots"]

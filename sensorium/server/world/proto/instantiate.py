@@ -397,7 +397,18 @@ class _Expander:
         # the PROTOs this node stands for (a derived PROTO's base too), counted where it sits in the
         # expanded tree (check_size): an expansion shared by several places is several instances
         uses = (f"{proto.source}\0{proto.name}", *out.__dict__.get("uses", ()))
-        return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col), uses=uses)
+        # its interface as the Supervisor reads it (interface_levels): this PROTO's values, then the
+        # PROTO its body is an instance of (a derived PROTO's parent), each field's base-node field when
+        # the value passes there through IS unchanged
+        parent = out.__dict__.get("interface") if out.proto is not None else None
+        parent_base: dict[str, str] | None = parent[2] if parent is not None else None
+        base: dict[str, str | None] = {}
+        for fname, value in body.fields.items():
+            if isinstance(value, IsRef) and value.name not in base:
+                base[value.name] = fname if parent_base is None else parent_base.get(fname)
+        interface = (proto, values, {k: v for k, v in base.items() if v is not None}, parent)
+        return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col), uses=uses,
+                     interface=interface)
 
     def values(self, node: Node, proto: ProtoDef, chain: tuple[str, ...]) -> tuple[dict[str, Any], set[str]]:
         """The instance's value of every field of ``proto``, checked."""
@@ -628,6 +639,73 @@ class _Expander:
 _VALUE_TYPES = {float, int, str, bool}     # list items that are neither nodes nor None (types gathered at C speed)
 
 
+INTERFACE_ITEMS = 4096
+"""Items of one interface field the Supervisor gets (an MF field's elements, a string's characters):
+a longer value is not kept (its field answers one line), so a PROTO fed a mesh's points costs nothing."""
+
+
+def interface_levels(node: Node) -> list[dict[str, Any]]:
+    """A PROTO instance's interface as the Supervisor serves it (Webots' ``getProto()`` chain): one
+    ``{"name", "fields"}`` per PROTO, the instance's own first, then the PROTO its body instantiates (a
+    derived PROTO's parent), …; each field ``{"name", "type", "value"}`` in declaration order, the value
+    the instance gives or the PROTO's default (SFVec3f → 3 numbers, MFFloat → a list, MFVec3f → lists of
+    3), ``"base"``: the base node's field the value passes to through IS unchanged. A node-typed field,
+    or a value over :data:`INTERFACE_ITEMS` items, is kept without its value (``"value"`` absent).
+    [] for a base node or a built-in stand-in."""
+    out: list[dict[str, Any]] = []
+    level = node.__dict__.get("interface")
+    while level is not None and len(out) < 16:
+        proto, values, base, level = level[0], level[1], level[2], level[3]
+        fields: list[dict[str, Any]] = []
+        for name, decl in proto.fields.items():
+            if decl.kind == "hidden" or len(name) > 256:   # Webots' saved state (translation_1, ...), not a parameter
+                continue
+            if len(fields) == INTERFACE_FIELDS:
+                break
+            entry: dict[str, Any] = {"name": name, "type": decl.type}
+            value = _plain(decl.type, values.get(name, decl.default))
+            if value is not _NOT_KEPT:
+                entry["value"] = value
+            if name in base:
+                entry["base"] = base[name]
+            fields.append(entry)
+        out.append({"name": proto.name, "fields": fields})
+    return out
+
+
+INTERFACE_FIELDS = 1024
+"""Interface fields kept per PROTO (the world model's bound; a PROTO declares tens)."""
+
+_NOT_KEPT = object()
+
+
+def _plain(ftype: str, value: Any) -> Any:
+    """An interface value as plain data (lists, numbers, strings), or _NOT_KEPT."""
+    kind, width = FIELD_TYPES[ftype]
+    if kind == "node" or isinstance(value, IsRef):
+        return _NOT_KEPT
+    if ftype.startswith("SF"):
+        if kind == "vec":
+            return [float(x) for x in value]
+        if kind == "int":
+            return int(value)
+        if kind == "string" and len(value) > INTERFACE_ITEMS:
+            return _NOT_KEPT
+        return value
+    if len(value) > INTERFACE_ITEMS * width:
+        return _NOT_KEPT
+    items = list(value)
+    if kind == "vec":
+        return [[float(x) for x in items[i:i + width]] for i in range(0, len(items), width)]
+    if kind == "int":
+        return [int(x) for x in items]
+    if kind == "float":
+        return [float(x) for x in items]
+    if kind == "string" and sum(len(x) for x in items) > INTERFACE_ITEMS * 16:
+        return _NOT_KEPT
+    return items
+
+
 def _copy(node: Node, **changes: Any) -> Node:
     """A shallow copy of ``node`` with some attributes changed (dataclasses.replace, without its cost)."""
     new = object.__new__(Node)
@@ -681,4 +759,4 @@ def protos_used(path: str | Path, webots_home: str | Path | None = None,
     return expand(read_wbt(path), ProtoSearch.create(path.resolve().parent, webots_home, proto_path)).protos
 
 
-__all__ = ["expand", "protos_used", "Expansion", "ProtoUse", "FIELD_TYPES", "WbtSyntaxError"]
+__all__ = ["expand", "protos_used", "interface_levels", "Expansion", "ProtoUse", "FIELD_TYPES", "WbtSyntaxError"]

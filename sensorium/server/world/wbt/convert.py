@@ -246,6 +246,7 @@ class Converter:
         proto = node.proto or (node.type if node.type in KNOWN_PROTO_BASES else None)
         if proto:
             entry["proto"] = proto
+        self.interface(node, entry)
         if node.def_name:
             entry["def_name"] = node.def_name
         if base in SCENERY_VALUES:
@@ -376,6 +377,14 @@ class Converter:
         self.tree_stack.append((node, len(self.tree) - 1))
         return True
 
+    @staticmethod
+    def interface(node: Node, entry: dict) -> None:
+        """A PROTO instance's interface fields, for the Supervisor (proto.interface_levels)."""
+        if node.proto is not None and "interface" in node.__dict__:
+            from sensorium.server.world.proto import interface_levels
+
+            entry["interface"] = interface_levels(node)
+
     def tree_entry(self, node: Node, entry: dict, field: str, builtin: str | None = None) -> None:
         """Add ``entry`` (type, pose) for ``node`` under the node being walked: its PROTO, its DEF
         (one the world file writes: a PROTO's internal nodes are not found by DEF, as in Webots) and
@@ -384,6 +393,7 @@ class Converter:
         proto = node.proto or builtin
         if proto:
             entry["proto"] = proto
+        self.interface(node, entry)
         if self.nested_def(node):
             entry["def_name"] = node.def_name
         if node.type == "Solid" or node.type in SENSORS or node.type in OTHER_DEVICES or node.type in MOTORS:

@@ -1,0 +1,236 @@
+"""A PROTO instance's own fields through the Supervisor, as in Webots (README "Supervisor"): on a PROTO
+instance ``getField`` answers its PROTO's interface fields (the values written in the instance, else
+the PROTO's defaults), ``getBaseNodeField`` its base node's (read-only), ``getProto()`` its PROTO (name,
+``isDerived``, ``getParent`` for a PROTO built on a PROTO, its fields by name and index), and the node's
+``getNumberOfFields``/``getFieldByIndex`` count the interface fields. An interface field whose value passes
+straight through IS to a base-node field Sensorium sets (a top-level solid's ``translation``) reads that
+field now and sets it; any other is read-only here (Webots regenerates the node), refused with one line
+naming node and field, nothing changed.
+
+Sensorium's own PROTOs (tests/protos/supervisor: Crate, BigCrate on Crate, Boss, Keeper with most field
+types and a slot holding a Tag) on tests/worlds/proto/supervisor_protos.wbt and
+supervisor_proto_fields.wbt; the last tests run a Webots-style Python controller and the same sequence
+from C (the library built with AddressSanitizer and UBSan) through ``sensorium serve``."""
+
+from __future__ import annotations
+
+import sys
+
+import pytest
+from _protos import HEADER
+from test_multiprocess import REPO, run_paused
+from test_supervisor import A, Live
+
+from sensorium.schemas.wire import ErrorCode
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_proto_fields.wbt"
+PROTOS = REPO / "tests" / "worlds" / "proto" / "supervisor_protos.wbt"
+KEEPER, CRATE, BIG, BOX = range(1, 5)                  # the robot, then the top-level solids in file order
+SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
+
+
+def _live(world=WORLD, robot: str = "keeper") -> tuple[Live, str]:
+    lv = Live(Simulation(load_world(world)))
+    lv.ok(A, "attach", {"robot": robot})
+    return lv, robot
+
+
+def call(lv_robot: tuple[Live, str], item: str, args: dict) -> dict:
+    lv, robot = lv_robot
+    return lv.ok(A, f"/{robot}/robot/{item}", args)
+
+
+def refused(lv_robot: tuple[Live, str], item: str, args: dict) -> str:
+    lv, robot = lv_robot
+    return lv.err(A, f"/{robot}/robot/{item}", args, ErrorCode.INVALID_ARGUMENT)
+
+
+def field(lv_robot, node: int, name: str, level: int | None = None) -> dict:
+    return call(lv_robot, "get_field", {"node": node, "field": name, **({} if level is None else {"level": level})})
+
+
+def test_a_proto_instance_answers_its_interface_fields_as_written_else_the_protos_defaults():
+    lv = _live()
+    got = {name: field(lv, KEEPER, name) for name in
+           ("translation", "reach", "level", "active", "footprint", "color", "gains", "waypoints", "tags", "ids",
+            "flags")}
+    assert got == {
+        "translation": {"type": "SFVec3f", "value": [0.5, 0.0, 0.0]},       # written in the instance
+        "reach": {"type": "SFFloat", "value": 0.75},
+        "level": {"type": "SFInt32", "value": 3},                          # the PROTO's defaults
+        "active": {"type": "SFBool", "value": True},
+        "footprint": {"type": "SFVec2f", "value": [0.1, 0.2]},
+        "color": {"type": "SFColor", "value": [1.0, 0.5, 0.0]},
+        "gains": {"type": "MFFloat", "value": [4.0, 5.0]},                  # written
+        "waypoints": {"type": "MFVec3f", "value": [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]},
+        "tags": {"type": "MFString", "value": ["x"]},
+        "ids": {"type": "MFInt32", "value": [7, -2]},
+        "flags": {"type": "MFBool", "value": [True, False]}}
+    assert field(lv, CRATE, "size") == {"type": "SFVec3f", "value": [0.2, 0.2, 0.2]}        # Crate's default
+    # a slot (a node-typed field that does not pass straight to a base-node field): typed, its value not served
+    slot = field(lv, KEEPER, "bodySlot")
+    assert slot["type"] == "MFNode" and slot["value"] == []
+    assert slot["note"] == ("field 'bodySlot' (MFNode) of PROTO Keeper (Robot 'KEEPER' (node 1)): a node-typed PROTO "
+                            "field is not served here unless it passes straight through IS to the base node's field")
+
+
+def test_getfield_on_a_proto_instance_knows_only_its_interface_and_getbasenodefield_its_base_node():
+    lv = _live()
+    # the Robot's controller is no field of Keeper's interface: Webots' NULL, without a line
+    assert field(lv, KEEPER, "controller") == {"type": "", "value": [], "absent": True}
+    assert field(lv, KEEPER, "controller", level=0) == {"type": "SFString", "value": "<extern>"}
+    assert field(lv, KEEPER, "supervisor", level=0) == {"type": "SFBool", "value": True}
+    assert field(lv, KEEPER, "reach", level=0) == {"type": "", "value": []}      # the Robot has no reach
+    # a base node: getField is its own field, as before; it has no PROTO
+    assert field(lv, BOX, "translation") == field(lv, BOX, "translation", level=0) == \
+        {"type": "SFVec3f", "value": [-1.0, 0.0, 0.1]}
+    assert call(lv, "get_proto", {"node": BOX}) == {"type_name": "", "derived": False, "fields": []}
+    assert call(lv, "get_proto", {"node": 0}) == {"type_name": "", "derived": False, "fields": []}
+
+
+def test_getproto_names_the_proto_its_fields_and_the_proto_it_is_built_on():
+    lv = _live()
+    assert call(lv, "get_proto", {"node": KEEPER}) == {"type_name": "Keeper", "derived": False, "fields": [
+        "translation", "rotation", "name", "reach", "level", "active", "footprint", "color", "gains", "waypoints",
+        "tags", "ids", "flags", "bodySlot"]}
+    # BigCrate's body is a Crate: BigCrate is derived, its parent is Crate with the values BigCrate gives it
+    assert call(lv, "get_proto", {"node": BIG}) == {"type_name": "BigCrate", "derived": True,
+                                                    "fields": ["translation", "name"]}
+    assert call(lv, "get_proto", {"node": BIG, "level": 2}) == {"type_name": "Crate", "derived": False,
+                                                                "fields": ["translation", "name", "size"]}
+    assert call(lv, "get_proto", {"node": BIG, "level": 3})["type_name"] == ""
+    assert field(lv, BIG, "size", level=2) == {"type": "SFVec3f", "value": [0.4, 0.4, 0.4]}   # BigCrate's body
+    assert field(lv, BIG, "name", level=2) == {"type": "SFString", "value": "big crate"}       # BigCrate's default
+    assert field(lv, BIG, "size") == {"type": "", "value": [], "absent": True}    # not BigCrate's field
+    assert field(lv, BIG, "translation", level=2) == {"type": "SFVec3f", "value": [2.0, 0.0, 0.2]}
+
+
+def test_a_proto_field_passing_through_is_to_the_base_translation_moves_the_solid():
+    lv = _live()
+    call(lv, "set_field", {"node": CRATE, "field": "translation", "value": [1.5, -0.25, 0.1]})
+    assert call(lv, "get_node_pose", {"node": CRATE})["position"] == [1.5, -0.25, 0.1]
+    assert field(lv, CRATE, "translation")["value"] == [1.5, -0.25, 0.1]
+    assert field(lv, CRATE, "translation", level=0)["value"] == [1.5, -0.25, 0.1]
+    # BigCrate's translation reaches the Solid through Crate's: both levels read the solid now
+    call(lv, "set_field", {"node": BIG, "field": "translation", "value": [3.0, 0.0, 0.2]})
+    assert field(lv, BIG, "translation", level=2)["value"] == [3.0, 0.0, 0.2]
+    assert call(lv, "get_node_pose", {"node": BIG})["position"] == [3.0, 0.0, 0.2]
+
+
+def test_a_proto_field_sensorium_cannot_apply_is_refused_with_one_line_and_nothing_changes():
+    lv = _live()
+    msg = refused(lv, "set_field", {"node": CRATE, "field": "size", "value": [1.0, 1.0, 1.0]})
+    assert msg == ("set_field: field 'size' (SFVec3f) of PROTO Crate (Solid 'crate') is read-only here: Webots "
+                   "regenerates the node when such a PROTO field is set; Sensorium sets only the PROTO fields that "
+                   "pass straight through IS to a field it sets (a top-level robot's or solid's translation and "
+                   "rotation, a light's fields); nothing changed")
+    assert field(lv, CRATE, "size")["value"] == [0.2, 0.2, 0.2]
+    assert refused(lv, "set_field", {"node": CRATE, "field": "translation", "value": [0, 0, 1], "level": 0}) == (
+        "set_field: field 'translation' of Solid 'crate' is a PROTO internal field (getBaseNodeField), read-only as "
+        "in Webots: set the field of PROTO Crate instead")
+    assert refused(lv, "set_field", {"node": BIG, "field": "translation", "value": [0, 0, 1], "level": 2}) == (
+        "set_field: field 'translation' of Solid 'big crate' belongs to PROTO Crate, which PROTO BigCrate is built "
+        "on: read-only, as in Webots")
+    assert call(lv, "get_node_pose", {"node": CRATE})["position"] == [1.0, 0.0, 0.1]
+    assert call(lv, "get_node_pose", {"node": BIG})["position"] == [2.0, 0.0, 0.2]
+
+
+def test_a_proto_instance_inside_a_robot_answers_its_interface():
+    lv = _live()
+    tag = call(lv, "get_from_def", {"name": "TAG"})          # written in the world, passed into Keeper's slot
+    assert (tag["type"], tag["proto"], tag["name"]) == ("Solid", "Tag", "front tag")
+    assert call(lv, "get_proto", {"node": tag["node"]}) == {"type_name": "Tag", "derived": False,
+                                                            "fields": ["translation", "name", "weight"]}
+    assert field(lv, tag["node"], "weight") == {"type": "SFFloat", "value": 0.25}
+    assert field(lv, tag["node"], "translation") == {"type": "SFVec3f", "value": [0.0, 0.0, 0.1]}
+    assert refused(lv, "set_field", {"node": tag["node"], "field": "translation", "value": [0, 0, 0.2]}) == (
+        "set_field: field 'translation' (SFVec3f) of PROTO Tag (Solid 'front tag') is read-only here: it passes to "
+        "the base node's 'translation', which is read-only here; nothing changed")
+
+
+def test_the_interface_of_the_robot_proto_follows_the_robot():
+    lv = _live(PROTOS, "boss")
+    boss = 1
+    call(lv, "set_field", {"node": boss, "field": "translation", "value": [0.3, 0.2, 0.0]})
+    assert field(lv, boss, "translation")["value"] == [0.3, 0.2, 0.0]
+    assert call(lv, "get_node_pose", {"node": boss})["position"] == [0.3, 0.2, 0.0]
+    assert field(lv, boss, "name") == {"type": "SFString", "value": "boss"}
+
+
+def test_an_imported_proto_instance_answers_its_interface():
+    lv = _live()
+    (crate,) = call(lv, "import_node_from_string", {"node": 0, "field": "children", "position": -1,
+                                                    "node_string": 'Crate { translation 0 2 0.1 size 0.1 0.3 0.1 }'})["value"]
+    assert call(lv, "get_proto", {"node": crate})["fields"] == ["translation", "name", "size"]
+    assert field(lv, crate, "size") == {"type": "SFVec3f", "value": [0.1, 0.3, 0.1]}
+    assert field(lv, crate, "name") == {"type": "SFString", "value": "crate(1)"}      # renamed, as Webots does
+    call(lv, "set_field", {"node": crate, "field": "translation", "value": [0.0, 2.5, 0.1]})
+    assert call(lv, "get_node_pose", {"node": crate})["position"] == [0.0, 2.5, 0.1]
+
+
+def test_a_long_value_is_not_kept_and_its_field_says_so(tmp_path):
+    (tmp_path / "Long.proto").write_text(HEADER + "PROTO Long [\n  field MFFloat samples [ ]\n  field SFFloat k 2\n]\n"
+                                         "{\n  Solid { name \"long\" }\n}\n")
+    world = tmp_path / "long.wbt"
+    world.write_text(HEADER + 'EXTERNPROTO "Long.proto"\n'
+                     f"Long {{ samples [ {' '.join(['0.5'] * 4097)} ] }}\n"
+                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    lv = _live(world, "boss")
+    long_ = 2
+    got = field(lv, long_, "samples")
+    assert (got["type"], got["value"]) == ("MFFloat", [])
+    assert got["note"] == "field 'samples' (MFFloat) of PROTO Long (Solid 'long' (node 2)): its value is over 4096 " \
+                          "items, not kept here"
+    assert field(lv, long_, "k") == {"type": "SFFloat", "value": 2.0}
+
+
+EXPECTED = """proto Keeper 0 14
+node_count 14
+reach SFFloat 0.75
+level 3
+active 1
+footprint 0.10000000000000001 0.20000000000000001
+color 1 0.5 0
+gains 2 4 5
+waypoints 2 1 0 0
+tags 1 x
+ids 2 7 -2
+flags 2 1 0
+slot MFNode -1
+byindex reach MFNode
+base <extern> 1
+none null
+big BigCrate 1 2
+parent Crate 0 3 0.40000000000000002 0.40000000000000002 0.40000000000000002
+grand null
+crate 0.20000000000000001 0.20000000000000001 0.20000000000000001
+box null
+tag Tag 0.25 0 0 0.10000000000000001
+set 1.5 0 0.10000000000000001 0.20000000000000001 0.20000000000000001 0.20000000000000001""".splitlines()
+
+
+def _check_lines(err: str) -> None:
+    assert "field 'bodySlot' (MFNode) of PROTO Keeper" in err and "field 'size' (SFVec3f) of PROTO Crate" in err, err
+    assert "not served by Sensorium" not in err and "Sanitizer" not in err and "runtime error" not in err, err
+    assert err.count("Error:") == 2, err
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_webots_python_supervisor_reads_proto_fields(tmp_path):
+    """tests/controllers/supervisor_proto_fields.py through ``sensorium serve``."""
+    ctl = run_paused(WORLD, tmp_path, "supervisor_proto_fields.py", "keeper")
+    assert ctl.out == EXPECTED
+    _check_lines(ctl.stderr())
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_c_supervisor_reads_the_same_proto_fields(tmp_path, tmp_path_factory):
+    """tests/c/supervisor_proto_fields.c (the library with AddressSanitizer and UBSan)."""
+    from test_c_client import sanitized_controller
+
+    exe = sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "supervisor_proto_fields.c")
+    ctl = run_paused(WORLD, tmp_path, exe, "keeper", env=SAN_ENV)
+    assert ctl.out == EXPECTED
+    _check_lines(ctl.stderr())
