@@ -697,13 +697,13 @@ def test_a_concave_polygon_is_cut_into_ears_not_fanned(tmp_path: Path) -> None:
 def test_a_comb_shaped_face_is_cut_into_ears_that_cover_it_exactly(reverse: bool) -> None:
     """A comb of 16 teeth (corners on the diagonals' lines, the case a naive ear test gets wrong): its
     n − 2 ears cover exactly its area, 2·16 − 0.5 + 9·16 m², in the face's own winding."""
-    from sensorium.server.world.cad import _ear_clip
+    from sensorium.server.world.cad import ear_clip
 
     top = [c for i in range(16) for c in [(2 * i, 1), (2 * i, 10), (2 * i + 1, 10), (2 * i + 1, 1)]]
     points = np.array([(x, y, 0.0) for x, y in [(0, 0), (32, 0), *top[::-1]]])
     if reverse:
         points = points[::-1].copy()
-    ears = _ear_clip(points)
+    ears = ear_clip(points)
     assert ears is not None and len(ears) == len(points) - 2
     a = points[ears]
     turns = np.cross(a[:, 1] - a[:, 0], a[:, 2] - a[:, 0])[:, 2]

@@ -16,7 +16,7 @@ from sensorium.server.world.limits import ProtoLimits, WorldLimits
 from sensorium.server.world.loader import WorldError, load_world, parse_world
 from sensorium.server.world.wbt import parser as wp
 from sensorium.server.world.wbt import wbt_convert
-from sensorium.server.world.wbt.convert import fan_corners
+from sensorium.server.world.wbt.convert import EAR_CLIP_WORLD, fan_corners, polygon_corners
 from sensorium.server.world.wbt.parser import Tokens, WbtSyntaxError, parse_wbt
 
 HEADER = "#VRML_SIM R2023b utf8\n"
@@ -172,9 +172,10 @@ def test_fan_corners_match_the_fan_triangulation() -> None:
         assert [[index[c] for c in tri] for tri in corners] == fan(index)
 
 
-def test_a_big_mesh_converts_to_its_points_and_fan_triangles(tmp_path: Path) -> None:
+def test_a_big_mesh_converts_to_its_points_and_triangles(tmp_path: Path) -> None:
     """Quads, pentagons and triangles, under a uniform scale of 2: each vertex exactly twice its
-    point, each face the fan triangulation."""
+    point, each face its triangulation (the fan, concave polygons cut along their diagonals:
+    test_wbt_polygons.py)."""
     rng = random.Random(5)
     n = 20_000
     pts = numbers(3 * n)
@@ -188,7 +189,9 @@ def test_a_big_mesh_converts_to_its_points_and_fan_triangles(tmp_path: Path) -> 
     assert geom["type"] == "triangles"
     assert geom["vertices"] == [[float(pts[i]) * 2.0, float(pts[i + 1]) * 2.0, float(pts[i + 2]) * 2.0]
                                 for i in range(0, 3 * n, 3)]
-    assert geom["faces"] == fan(index)
+    corners, _ = polygon_corners(index, [float(x) for x in pts], [EAR_CLIP_WORLD])
+    assert geom["faces"] == [[index[c] for c in tri] for tri in corners.tolist()]
+    assert len(geom["faces"]) == len(fan(index)) and geom["faces"] != fan(index)   # random polygons: some concave
     assert all(type(x) is int for f in geom["faces"][:100] for x in f)
     loaded = load_world(p)
     tri = loaded.world.robots[0].shapes[0].geometry

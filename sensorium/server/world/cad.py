@@ -235,7 +235,7 @@ def _triangulated(p, budget: list[int]):
     tris = np.stack([first, first + k, first + k + 1], axis=1)
     positions = np.asarray(p.vertex, dtype=np.float64).reshape(-1, 3)
     if (vcounts > 3).any() and corners_index.max(initial=0) < len(positions):
-        concave = _concave(positions[corners_index], vcounts, starts)
+        concave = concave_polygons(positions[corners_index], vcounts, starts)
         if concave.any():
             tri_start = np.cumsum(n_tri) - n_tri
             for poly in np.flatnonzero(concave & (vcounts <= EAR_CLIP_CORNERS)):
@@ -243,7 +243,7 @@ def _triangulated(p, budget: list[int]):
                 if budget[0] < n * n:
                     break
                 budget[0] -= n * n
-                ears = _ear_clip(positions[corners_index[s:s + n]])
+                ears = ear_clip(positions[corners_index[s:s + n]])
                 if ears is not None:
                     tris[tri_start[poly]:tri_start[poly] + n - 2] = ears + s
     return SimpleNamespace(vertex=p.vertex, vertex_index=corners_index[tris], material=p.material,
@@ -252,9 +252,17 @@ def _triangulated(p, budget: list[int]):
                                                    for t in p.texcoord_indexset))
 
 
-def _concave(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) -> np.ndarray:
+def concave_polygons(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) -> np.ndarray:
     """Per polygon (corner positions ``points``, grouped by ``vcounts``): whether a corner turns
     against the polygon's normal (Newell's)."""
+    out = np.zeros(len(vcounts), dtype=bool)
+    np.logical_or.at(out, np.repeat(np.arange(len(vcounts)), vcounts), reflex_corners(points, vcounts, starts))
+    return out & (vcounts > 3)
+
+
+def reflex_corners(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """Per corner of polygons (corner positions ``points``, grouped by ``vcounts``, each starting
+    at ``starts``): whether it turns against its polygon's normal (Newell's)."""
     n = len(points)
     poly = np.repeat(np.arange(len(vcounts)), vcounts)
     local = np.arange(n) - np.repeat(starts, vcounts)
@@ -267,13 +275,10 @@ def _concave(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) -> np.
     turn = np.cross(points - points[prv], points[nxt] - points)
     along = np.einsum("ij,ij->i", turn, normal[poly])
     size = np.linalg.norm(turn, axis=1) * np.linalg.norm(normal[poly], axis=1)
-    reflex = along < -1e-9 * size
-    out = np.zeros(len(vcounts), dtype=bool)
-    np.logical_or.at(out, poly, reflex)
-    return out & (vcounts > 3)
+    return along < -1e-9 * size
 
 
-def _ear_clip(points: np.ndarray) -> np.ndarray | None:
+def ear_clip(points: np.ndarray) -> np.ndarray | None:
     """Ears of a simple polygon (n, 3) as (n − 2, 3) local corner triples, in the polygon's own
     winding; None when it has none to cut (self-crossing): then it stays fanned."""
     n = len(points)

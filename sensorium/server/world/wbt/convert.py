@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.world.cad import EAR_CLIP_CORNERS, ear_clip, reflex_corners
 from sensorium.server.world.poses import axis_angle_matrix
 from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
@@ -102,6 +103,7 @@ class Converter:
         self.wbt = wbt
         self.max_grid_points = max_grid_points
         self.grid_points = 0               # ElevationGrid points converted so far (each use of a DEF counts)
+        self.ear_budget = [EAR_CLIP_WORLD]  # corners² left for cutting concave IndexedFaceSet polygons into ears
         self.source = source
         self.search = search               # proto.ProtoSearch: where asset urls resolve (resolve_url)
         self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
@@ -900,14 +902,19 @@ class Converter:
                 if f.string("name", ""):
                     out["name"] = f.string("name", "")
             return out, ""
-        # IndexedFaceSet: polygons separated by -1, fan-triangulated (texCoordIndex alongside)
+        # IndexedFaceSet: polygons separated by -1, triangulated as Webots' tessellator covers them
+        # (convex ones fanned, concave ones cut into ears; texCoordIndex alongside)
         coord = f.node_("coord")
         points = self.fields(coord).flat_rows("point", 3) if coord is not None else []    # x y z x y z ...
         index = f.integers("coordIndex")
         if index and min(index) < -1:
             raise f.error("coordIndex", f"{min(index)} is not a vertex index (-1 ends a face)")
         tex, tex_index = fx.tex_coords(node, f, len(index), self.warn)
-        corners = fan_corners(index)
+        corners, fanned = polygon_corners(index, points, self.ear_budget)
+        if fanned:
+            self.warn_once(node, f"IndexedFaceSet: {fanned} concave polygon(s) left fanned from their first corner "
+                                 f"(over {EAR_CLIP_CORNERS} corners, or past the world's {EAR_CLIP_WORLD:,} "
+                                 "corners² for cutting them into ears): they may cover space outside their outline")
         faces = _pick(index, corners)
         tex_faces = _pick(tex_index, corners) if tex_index is not None else []
         if not faces:
@@ -1832,6 +1839,10 @@ def _clean_part(p: dict) -> dict:
     return out
 
 
+EAR_CLIP_WORLD = 400_000     # corners² a world's concave IndexedFaceSet polygons of 5 or more corners may take
+                             # (ear clipping is quadratic: about a second's work at most; quads are cut at once)
+
+
 def fan_corners(index: list[int]) -> np.ndarray:
     """An IndexedFaceSet's polygons (``index`` positions between -1s) fan-triangulated, as Webots
     does: per triangle, the positions in ``index`` of its three corners (first, k, k + 1), shape
@@ -1843,6 +1854,57 @@ def fan_corners(index: list[int]) -> np.ndarray:
     first = np.repeat(starts, per)
     k = np.arange(int(per.sum())) - np.repeat(np.cumsum(per) - per, per) + 1
     return np.stack([first, first + k, first + k + 1], axis=1)
+
+
+def polygon_corners(index: list[int], points: list[float], budget: list[int]) -> tuple[np.ndarray, int]:
+    """An IndexedFaceSet's triangles as Webots' GLU tessellator covers its polygons: :func:`fan_corners`,
+    with each concave polygon (a corner turning against its normal) cut along its diagonals instead,
+    so no triangle covers what lies outside it (an arena wall's top face drawn as one polygon, the
+    outer square and the inner one joined by a slit, covers the ring only, not the arena). A quad
+    with one reflex corner is cut along the diagonal from that corner (all such quads at once);
+    a larger polygon into ears, while ``budget[0]`` (the corners² left for ear clipping, which is
+    quadratic) lasts and it has at most ``EAR_CLIP_CORNERS`` corners, else it stays fanned. A quad
+    turning against itself twice (crossed, or folded out of its plane) keeps its fan. ``points``
+    are the coordinates (x y z ...): convexity and cuts are the same under any scale. Returns the
+    corners and how many concave polygons stayed fanned for size or budget."""
+    corners = fan_corners(index)
+    idx = np.asarray([*index, -1], dtype=np.int64)
+    ends = np.flatnonzero(idx < 0)
+    starts = np.concatenate(([0], ends[:-1] + 1))
+    counts = ends - starts
+    big = counts >= 4                                   # a triangle is convex
+    if not big.any():
+        return corners, 0
+    xyz = np.asarray(points, dtype=np.float64)
+    xyz = xyz[:len(xyz) - len(xyz) % 3].reshape(-1, 3)
+    bs, bc = starts[big], counts[big]
+    at = np.repeat(bs, bc) + np.arange(int(bc.sum())) - np.repeat(np.cumsum(bc) - bc, bc)   # their corners
+    vertex = idx[at]
+    if vertex.max(initial=0) >= len(xyz):              # an index past the points: refused later, by value
+        return corners, 0
+    reflex = reflex_corners(xyz[vertex], bc, np.cumsum(bc) - bc)
+    per = np.add.reduceat(reflex.astype(np.int64), np.cumsum(bc) - bc)
+    if not per.any():
+        return corners, 0
+    n_tri = np.maximum(counts - 2, 0)
+    tri_start = (np.cumsum(n_tri) - n_tri)[big]
+    quads = np.flatnonzero((bc == 4) & (per == 1))
+    if len(quads):                                      # the diagonal from the reflex corner r: (r, r+1, r+2), (r, r+2, r+3)
+        r = reflex.reshape(-1)[(np.cumsum(bc) - bc)[quads][:, None] + np.arange(4)].argmax(axis=1)
+        cut = bs[quads][:, None, None] + (r[:, None, None] + np.array([[[0, 1, 2], [0, 2, 3]]])) % 4
+        corners[(tri_start[quads][:, None] + np.arange(2)).reshape(-1)] = cut.reshape(-1, 3)
+    fanned = 0
+    for k in np.flatnonzero((bc > 4) & (per > 0)):
+        s, n = int(bs[k]), int(bc[k])
+        if n > EAR_CLIP_CORNERS or budget[0] < n * n:
+            fanned += 1
+            continue
+        budget[0] -= n * n
+        ears = ear_clip(xyz[idx[s:s + n]])
+        if ears is None:                                # self-crossing: no ear to cut, fanned as before
+            continue
+        corners[tri_start[k]:tri_start[k] + n - 2] = ears + s
+    return corners, fanned
 
 
 def _pick(values: list[int], corners: np.ndarray) -> list[list[int]]:
