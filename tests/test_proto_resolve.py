@@ -190,7 +190,7 @@ def test_builtin_stand_ins_when_the_file_is_missing_and_the_real_one_when_found(
     assert loaded.world.solids[0].name == "rectangle arena"
     notes = [x for x in loaded.warnings if "PROTO files not found" in x]
     assert notes == [f"{w}:2:1: PROTO files not found: Sensorium's built-in stand-ins used for RectangleArena; "
-                     "TexturedBackground skipped (no effect on these sensors) (give --webots-home or WEBOTS_HOME to "
+                     "TexturedBackground skipped (cameras see the flat sky colour, not its sky box) (give --webots-home or WEBOTS_HOME to "
                      "use Webots' own)"]
     uses = {u.name: u for u in expanded(w).protos}
     assert uses["RectangleArena"].builtin and uses["RectangleArena"].license.startswith("Sensorium's built-in stand-in")
@@ -204,7 +204,7 @@ def test_builtin_stand_ins_when_the_file_is_missing_and_the_real_one_when_found(
     # an installation was given but does not hold TexturedBackground: the note says where it looked
     # (it used to ask for the --webots-home the user had just given)
     notes = [x for x in loaded.warnings if "PROTO files not found" in x]
-    assert notes == [f"{w}:3:1: PROTO files not found: TexturedBackground skipped (no effect on these sensors) (not in "
+    assert notes == [f"{w}:3:1: PROTO files not found: TexturedBackground skipped (cameras see the flat sky colour, not its sky box) (not in "
                      f"the Webots installation {home} nor the --proto-path folders: a complete installation (or "
                      "--proto-path) gives Webots' own)"]
 

@@ -302,7 +302,7 @@ class _Expander:
         if decl.name not in self.stand_ins:
             self.stand_ins[decl.name] = (scope.source, decl.line, decl.col)
             what = ("Sensorium's built-in stand-in (no Webots file used)" if decl.name in BUILTIN_PROTOS
-                    else "not read (skipped: no effect on these sensors)")
+                    else f"not read (skipped: {_skipped_why(decl.name)})")
             self.uses[f"\0{decl.name}"] = ProtoUse(decl.name, "", decl.url, what, None, builtin=True)
 
     def stand_in_note(self) -> None:
@@ -313,7 +313,7 @@ class _Expander:
         built = sorted(n for n in self.stand_ins if n in BUILTIN_PROTOS)
         skipped = sorted(n for n in self.stand_ins if n not in BUILTIN_PROTOS)
         parts = ([f"Sensorium's built-in stand-ins used for {', '.join(built)}"] if built else []) + \
-                ([f"{', '.join(skipped)} skipped (no effect on these sensors)"] if skipped else [])
+                [f"{name} skipped ({_skipped_why(name)})" for name in skipped]
         home = self.search.home
         hint = ("give --webots-home or WEBOTS_HOME to use Webots' own" if home is None else
                 f"not in the Webots installation {home} nor the --proto-path folders: a complete installation "
@@ -634,6 +634,13 @@ class _Expander:
         """Nodes marked by id must stay alive while the expansion runs (ids are reused)."""
         self._kept = getattr(self, "_kept", [])
         self._kept.append(node)
+
+
+def _skipped_why(name: str) -> str:
+    """Why a PROTO Sensorium skips costs a user nothing, or what it costs."""
+    if name == "TexturedBackground":     # its sky box is seen by Webots' cameras
+        return "cameras see the flat sky colour, not its sky box"
+    return "no effect on these sensors"
 
 
 _VALUE_TYPES = {float, int, str, bool}     # list items that are neither nodes nor None (types gathered at C speed)

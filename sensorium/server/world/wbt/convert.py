@@ -534,6 +534,10 @@ class Converter:
             if end is not None:
                 self.tree_field = "endPoint"
                 self.visit(end, frame, owner)
+        elif t in ("Pose", "Transform") and top and node.def_name and self.marker(node, frame):
+            # a top-level DEF Pose holding only shapes (a target a Supervisor moves, as Webots' curriculum
+            # ball): a solid of its own without boundingObject, so its translation and rotation are served
+            self.solid(node, frame, owner, node.def_name, bounding=False)
         elif t in ("Pose", "Transform"):
             inner = self.child_frame(node, frame)
             for child in f.nodes("children"):
@@ -1075,6 +1079,19 @@ class Converter:
         else:
             owner.data.setdefault("children", []).append(out)
         return out
+
+    def marker(self, node: Node, frame: Frame) -> bool:
+        """A Pose or Transform (not scaled) with only shapes inside it, through Poses, Transforms and Groups."""
+        if not self.child_frame(node, frame).rigid:
+            return False
+        stack = list(self.fields(node).nodes("children"))
+        while stack:
+            child = stack.pop()
+            if child.type in ("Pose", "Transform", "Group"):
+                stack += self.fields(child).nodes("children")
+            elif child.type not in ("Shape", "CadShape"):
+                return False
+        return True
 
     def radar_cross_section(self, node: Node, data: dict) -> None:
         """A solid's or robot's radarCrossSection: > 0 makes it a Radar target (0 or less:
