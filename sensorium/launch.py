@@ -23,11 +23,13 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import IO, Any
 from urllib.parse import quote
 
-__all__ = ["ControllerSpec", "LaunchError", "Launcher", "WebotsProjects", "find_controller", "plan", "robot_protos"]
+__all__ = ["ControllerSpec", "LaunchError", "Launcher", "ProjectRun", "RunOptions", "WebotsProjects", "WorldPlan",
+           "after_run", "exit_status", "find_controller", "plan", "plan_world", "robot_protos", "run_project"]
 
 WEBOTS_DEPTH = 6         # folders under a Webots installation's projects/ where controllers/ folders are looked for
 WEBOTS_MAX_DIRS = 20000  # folders of that tree indexed at most
@@ -208,6 +210,53 @@ def plan(robots: list[Any], dirs: list[Path], webots: WebotsProjects | None = No
         except LaunchError as exc:
             problems.append(str(exc))
     return specs, problems
+
+
+@dataclass(frozen=True)
+class WorldPlan:
+    """What ``run`` does with one load of a world: the controllers to start, the problems (one line
+    each), the lines to say when it starts, and which robots the world waits for without a
+    controller of ours (as Webots waits for a synchronous ``<extern>`` one)."""
+
+    specs: tuple[ControllerSpec, ...]
+    problems: tuple[str, ...]
+    notes: tuple[str, ...]
+    extern_waited: frozenset[str]          # synchronous <extern> robots: waited for until attached
+    extern_synchronous: tuple[str, ...]    # robots waited for while none of them is attached
+
+
+def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: WebotsProjects | None = None,
+               protos: dict[str, str] | None = None) -> WorldPlan:
+    """The plan for ``robots`` (a loaded world's: ``name``, ``controller``, ``controller_args``,
+    ``synchronization``) served at ``rpc_url``; no process is started."""
+    specs, problems = plan(robots, dirs, webots, protos)
+    notes = [f"robot '{s.robot}': controller '{s.name}' found in Webots' projects: {s.program}" for s in specs if s.webots]
+    for r in robots:
+        if r.controller == "<generic>":
+            notes.append(f"robot '{r.name}': Webots' <generic> controller is not here: the robot waits for an "
+                         "<extern> controller")
+        elif r.controller == "<extern>":
+            notes.append(f"robot '{r.name}' is <extern>: attach its controller with `sensorium controller SCRIPT "
+                         f"--robot {r.name} --url {rpc_url}`")
+    # as Webots, the world waits for every synchronous <extern> robot's controller too, but a robot
+    # whose started controller has ended is uncontrolled: the world goes on without it, as Webots'
+    # does (only robots left to an <extern> controller are waited for while none is attached:
+    # <extern> and, here, <generic> ones)
+    return WorldPlan(tuple(specs), tuple(problems), tuple(notes),
+                     frozenset(r.name for r in robots if r.controller == "<extern>" and r.synchronization),
+                     tuple(r.name for r in robots if r.controller in ("<extern>", "<generic>") and r.synchronization))
+
+
+def after_run(reload_requested: bool, interrupted: bool, quit_status: int | None) -> bool:
+    """Whether the world is loaded again once its server stopped: only for a ``worldReload``, not
+    when the run was interrupted (Ctrl-C, SIGTERM, :meth:`ProjectRun.stop`) or quit
+    (``simulationQuit``) meanwhile; ``--until`` stops without a reload request."""
+    return reload_requested and not interrupted and quit_status is None
+
+
+def exit_status(quit_status: int | None) -> int:
+    """``run``'s exit status: ``simulationQuit(status)``'s low 8 bits, as Webots exits, else 0."""
+    return 0 if quit_status is None else quit_status & 0xFF
 
 
 def _describe(code: int) -> str:
@@ -444,3 +493,142 @@ class Launcher:
         self._wake.set()
         self._worker.join()
         self.end_all()
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What ``sensorium run`` takes besides the world file. ``serve`` is the server's
+    :class:`~sensorium.server.daemon.serve.ServeOptions`; ``webots_home`` the installation whose
+    projects hold stock controllers (None: not looked at)."""
+
+    serve: Any = None
+    controllers_dirs: tuple[Path, ...] = ()
+    webots_home: Path | None = None
+    grace_s: float = GRACE_S
+
+    def check(self, world: Path) -> None:
+        """Raise ValueError naming the first bad option (one line)."""
+        if not Path(world).is_file():
+            raise ValueError(f"no world file {world}")
+        if not 0 <= self.grace_s < float("inf"):
+            raise ValueError(f"--grace must be a finite number >= 0, got {self.grace_s}")
+        for d in self.controllers_dirs:
+            if not Path(d).is_dir():
+                raise ValueError(f"--controllers-dir {d}: no such folder")
+        if self.serve is not None:
+            self.serve.check()
+
+
+class ProjectRun:
+    """One ``sensorium run``: serve ``world``, start its controllers (:class:`Launcher`), reload on
+    ``worldReload``, end everything at the end. :meth:`run` blocks and returns the exit status;
+    :meth:`stop` (any thread, a signal handler) ends it as Ctrl-C does. Lines go to ``out`` (the
+    ready line, the controllers' stdout) and ``err`` (everything else)."""
+
+    def __init__(self, world: str | Path, options: RunOptions, *, out: IO[str] | None = None,
+                 err: IO[str] | None = None):
+        self.world = Path(world)
+        self.options = options
+        self.out = out or sys.stdout
+        self.err = err or sys.stderr
+        self.dirs = controller_dirs(self.world, list(options.controllers_dirs))
+        home = options.webots_home
+        self.webots = WebotsProjects(home) if home is not None and Path(home).is_dir() else None
+        self.interrupted = False
+        self._server: Any = None
+
+    def stop(self) -> None:
+        self.interrupted = True
+        if self._server is not None:
+            self._server.stop()
+
+    def _say(self, text: str) -> None:
+        print(text, file=self.err, flush=True)
+
+    def _open(self, serve: Any) -> Any:
+        """The world's server, or None (its problem said)."""
+        import zmq
+
+        from sensorium.cli.serve import bind_problem
+        from sensorium.server.daemon.serve import Server
+        from sensorium.server.world.loader import WorldError
+        try:
+            return Server.open(self.world, serve)
+        except WorldError as exc:
+            self._say(str(exc))
+        except (OSError, zmq.ZMQError) as exc:
+            self._say(f"sensorium run: {bind_problem(exc)}")
+        return None
+
+    def _plan(self, server: Any) -> WorldPlan | None:
+        """The plan for ``server``'s world, or None (server closed, every problem said)."""
+        loaded = server.core.sim.loaded.world
+        world_plan = plan_world(loaded.robots, self.dirs, server.transport.rpc_endpoint, self.webots,
+                                robot_protos(loaded))
+        if not world_plan.problems:
+            return world_plan
+        server.close()
+        for line in world_plan.problems:
+            self._say(f"sensorium run: {line}")
+        return None
+
+    def run(self, *, signals: bool = True) -> int:
+        """Run to the end; ``signals``: SIGINT/SIGTERM end it (main thread only)."""
+        server = self._open(self.options.serve)
+        if server is None:
+            return 1
+        world_plan = self._plan(server)
+        if world_plan is None:
+            return 1
+        report = server.core.sim.loaded.report
+        if report:
+            print(report.text(), file=self.err, flush=True)
+        launcher = Launcher(list(world_plan.specs), server.transport.rpc_endpoint, out=self.out, err=self.err,
+                            grace_s=self.options.grace_s)
+        self._server = server
+        old_handlers = {}
+        if signals:
+            old_handlers = {sig: signal.signal(sig, lambda signum, frame: self.stop())
+                            for sig in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            while True:
+                for line in world_plan.notes:
+                    launcher.log(line)
+                if self.interrupted:       # stopped while the world (re)loaded
+                    break
+                server.core.launcher = launcher
+                lockstep = server.core.lockstep
+                launcher.bind(lockstep.starting, server.transport.wake, partial(getattr, lockstep, "shutting_down"))
+                lockstep.starting.update(world_plan.extern_waited)
+                lockstep.extern_synchronous = list(world_plan.extern_synchronous)
+                launcher.on_reload = server.stop
+                print(server.ready_line, file=self.out, flush=True)
+                launcher.start_all()
+                server.run(signals=False)
+                launcher.end_all()
+                if not after_run(launcher.reload_requested, self.interrupted, server.core.quit_status):
+                    break
+                launcher.reload_requested = False          # worldReload: the same file, time 0, the same endpoints
+                again = dataclasses.replace(self.options.serve, rpc=server.transport.rpc_endpoint,
+                                            pub=server.transport.pub_endpoint)
+                reopened = self._open(again)
+                if reopened is None:
+                    return 1
+                world_plan = self._plan(reopened)          # the file may have changed
+                if world_plan is None:
+                    return 1
+                launcher.replan(list(world_plan.specs))
+                launcher.log(f"world reloaded from {self.world}")
+                server = self._server = reopened
+        finally:
+            launcher.close()
+            for sig, handler in old_handlers.items():
+                signal.signal(sig, handler)
+        core = server.core
+        self._say(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps")
+        return exit_status(core.quit_status)
+
+
+def run_project(world: str | Path, options: RunOptions, *, signals: bool = True) -> int:
+    """``sensorium run WORLD``: run the project to its end (see :class:`ProjectRun`); the exit status."""
+    return ProjectRun(world, options).run(signals=signals)

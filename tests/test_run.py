@@ -11,6 +11,7 @@ import signal
 import stat
 import subprocess
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 from _serve import REPO, Proc, run_controller, sensorium, wait_until
@@ -97,6 +98,47 @@ def test_controllers_are_found_in_webots_order_and_others_are_refused(tmp_path: 
         find_controller("r", "gone", [], [base, other])
     assert str(info.value) == (f"robot 'r': controller 'gone' not found (looked for the folder {base / 'gone'}, "
                                f"{other / 'gone'}; --webots-home DIR also looks in Webots' own projects)")
+
+
+def robot(name: str, controller: str, *args: str, synchronization: bool = True) -> SimpleNamespace:
+    """A loaded world's robot as the planner reads it."""
+    return SimpleNamespace(name=name, controller=controller, controller_args=list(args), synchronization=synchronization)
+
+
+def test_a_world_is_planned_without_a_process(tmp_path: Path) -> None:
+    """What run does with a world is data: the controllers to start, the problems, the lines to say
+    and the robots waited for, decided before anything starts."""
+    base = tmp_path / "controllers"
+    (base / "a").mkdir(parents=True)
+    (base / "a" / "a.py").write_text("")
+    robots = [robot("alpha", "a", "--fast"), robot("ext", "<extern>"), robot("free", "<extern>", synchronization=False),
+              robot("gen", "<generic>"), robot("off", "<none>"), robot("lost", "nowhere")]
+    got = launch.plan_world(robots, [base], "tcp://127.0.0.1:5555")
+    assert [(s.robot, s.program, s.args) for s in got.specs] == [("alpha", base / "a" / "a.py", ("--fast",))]
+    assert got.problems == (f"robot 'lost': controller 'nowhere' not found (looked for the folder {base / 'nowhere'}; "
+                            "--webots-home DIR also looks in Webots' own projects)",)
+    assert got.notes == (
+        "robot 'ext' is <extern>: attach its controller with `sensorium controller SCRIPT --robot ext --url "
+        "tcp://127.0.0.1:5555`",
+        "robot 'free' is <extern>: attach its controller with `sensorium controller SCRIPT --robot free --url "
+        "tcp://127.0.0.1:5555`",
+        "robot 'gen': Webots' <generic> controller is not here: the robot waits for an <extern> controller")
+    assert got.extern_waited == {"ext"}
+    assert got.extern_synchronous == ("ext", "gen")
+
+
+@pytest.mark.parametrize(("reload", "interrupted", "quit_status", "again", "status"), [
+    (False, False, None, False, 0),        # --until, or the server stopped
+    (True, False, None, True, 0),          # worldReload
+    (True, True, None, False, 0),          # a reload asked, then Ctrl-C: no reload
+    (True, False, 3, False, 3),            # a reload and a simulationQuit(3): the quit wins
+    (False, False, 259, False, 3),         # simulationQuit's low 8 bits, as a process's status
+])
+def test_after_a_server_stops_the_run_reloads_or_ends_with_a_status(reload: bool, interrupted: bool,
+                                                                     quit_status: int | None, again: bool,
+                                                                     status: int) -> None:
+    assert launch.after_run(reload, interrupted, quit_status) is again
+    assert launch.exit_status(quit_status) == status
 
 
 # ---------------------------------------------------------------------- running a project
