@@ -3,13 +3,13 @@ every robot's controller named in it, print their output with the robot's name, 
 ``restartController``, reload the world on ``worldReload``, end them all at the end.
 
 Where a controller is found, as Webots' WbController does for a project: ``controllers/NAME/`` next to
-the world's ``worlds/`` folder (then each ``--controllers-dir``); in that folder the first of
+the world's ``worlds/`` folder (then each ``--controllers-dir``, then each extra project's
+``controllers/NAME/``: ``$WEBOTS_EXTRA_PROJECT_PATH``, ``--extra-project-path``); in that folder the first of
 ``Dockerfile``, ``NAME`` (an executable), ``build/release/NAME``, ``NAME.class``, ``NAME.jar``,
 ``NAME.py``, ``NAME.m``, ``NAME.bsg``. Python and executables run (as ``sensorium controller`` runs
 them: the controller's folder as working directory, ``controllerArgs`` as arguments, the URL in the
 environment); the others are refused with one line. With ``--webots-home`` (or ``$WEBOTS_HOME``) a
-controller not found there is looked for in Webots' own projects (:class:`WebotsProjects`); extra
-project paths are not searched.
+controller not found there is looked for in Webots' own projects (:class:`WebotsProjects`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
@@ -33,6 +33,8 @@ __all__ = ["ControllerSpec", "LaunchError", "Launcher", "ProjectRun", "RunOption
 
 WEBOTS_DEPTH = 6         # folders under a Webots installation's projects/ where controllers/ folders are looked for
 WEBOTS_MAX_DIRS = 20000  # folders of that tree indexed at most
+EXTRA_ENV = "WEBOTS_EXTRA_PROJECT_PATH"   # Webots' extra project folders (each with controllers/, protos/)
+EXTRA_MAX = 64           # extra project folders read at most (each costs one look-up per controller)
 WEBOTS_SKIP = frozenset({"protos", "worlds", "plugins", "libraries", "textures", "meshes", "icons", "docs", "build"})
 # Webots' WbController: a controller gets the quit packet (-1), then 1 s to end before it is terminated
 GRACE_S = 1.0
@@ -59,10 +61,18 @@ class ControllerSpec:
     webots: bool = False       # found in Webots' own projects (--webots-home)
 
 
-def controller_dirs(world: Path, extra: list[Path]) -> list[Path]:
+def controller_dirs(world: Path, extra: list[Path], projects: Sequence[Path] = ()) -> list[Path]:
     """Where controllers are looked for: the project's ``controllers/`` (the world's folder's parent),
-    then ``--controllers-dir`` folders in their order."""
-    return [world.resolve().parent.parent / "controllers", *(Path(d).resolve() for d in extra)]
+    then ``--controllers-dir`` folders in their order, then each extra project's ``controllers/``."""
+    return [world.resolve().parent.parent / "controllers", *(Path(d).resolve() for d in extra),
+            *(Path(p).resolve() / "controllers" for p in projects)]
+
+
+def extra_project_paths(value: str | None) -> list[Path]:
+    """Webots' extra project paths from ``value`` (``$WEBOTS_EXTRA_PROJECT_PATH``: folders separated
+    like ``PATH``), in their order, each once, at most :data:`EXTRA_MAX`."""
+    paths = [Path(p).expanduser().absolute() for p in (value or "").split(os.pathsep) if p]
+    return list(dict.fromkeys(paths))[:EXTRA_MAX]
 
 
 class WebotsProjects:
@@ -503,6 +513,7 @@ class RunOptions:
 
     serve: Any = None
     controllers_dirs: tuple[Path, ...] = ()
+    extra_projects: tuple[Path, ...] = ()     # Webots' extra project paths (a folder that is none is said, skipped)
     webots_home: Path | None = None
     grace_s: float = GRACE_S
 
@@ -531,7 +542,8 @@ class ProjectRun:
         self.options = options
         self.out = out or sys.stdout
         self.err = err or sys.stderr
-        self.dirs = controller_dirs(self.world, list(options.controllers_dirs))
+        self.projects = [p for p in options.extra_projects if p.is_dir()]
+        self.dirs = controller_dirs(self.world, list(options.controllers_dirs), self.projects)
         home = options.webots_home
         self.webots = WebotsProjects(home) if home is not None and Path(home).is_dir() else None
         self.interrupted = False
@@ -583,6 +595,9 @@ class ProjectRun:
         report = server.core.sim.loaded.report
         if report:
             print(report.text(), file=self.err, flush=True)
+        for p in self.options.extra_projects:
+            if p not in self.projects:
+                self._say(f"sensorium run: extra project path {p} is not a folder: not looked in")
         launcher = Launcher(list(world_plan.specs), server.transport.rpc_endpoint, out=self.out, err=self.err,
                             grace_s=self.options.grace_s)
         self._server = server

@@ -570,3 +570,83 @@ def test_run_with_webots_home_starts_a_stock_controller_of_a_proto_robot(tmp_pat
     assert f"sensorium run: robot 'bee': controller 'bee_wander' found in Webots' projects: {folder / 'bee_wander.py'}" \
         in proc.stderr().splitlines()
     assert "[bee] bee stepped 10 until 320" in proc.stdout().splitlines()
+
+
+# ---------------------------------------------------------------------- extra project paths (WEBOTS_EXTRA_PROJECT_PATH)
+
+BEE_PROTO = ('#VRML_SIM R2023b utf8\nPROTO Bee [\n  field SFString name "bee"\n  field SFString controller "bee_ctl"\n]\n'
+             '{\n  Robot {\n    name IS name\n    controller IS controller\n  }\n}\n')
+
+
+def extra_project(root: Path) -> Path:
+    """A project of its own elsewhere: protos/Bee.proto (a robot) and controllers/bee_ctl/bee_ctl.py."""
+    (root / "protos").mkdir(parents=True)
+    (root / "protos" / "Bee.proto").write_text(BEE_PROTO)
+    (root / "controllers" / "bee_ctl").mkdir(parents=True)
+    (root / "controllers" / "bee_ctl" / "bee_ctl.py").write_text(COUNTER.replace("{step}", "32"))
+    return root
+
+
+def test_extra_projects_are_looked_in_after_the_project_and_controllers_dirs(tmp_path: Path) -> None:
+    """As Webots' WbRobot: the project's controllers/, (here: each --controllers-dir), then each
+    extra project's controllers/ in the order given, each folder once."""
+    extra = [extra_project(tmp_path / "one"), extra_project(tmp_path / "two")]
+    value = os.pathsep.join([str(extra[0]), "", str(extra[1]), str(extra[0])])
+    assert launch.extra_project_paths(value) == extra
+    (tmp_path / "proj").mkdir()
+    world = project(tmp_path / "proj", "", {})
+    dirs = launch.controller_dirs(world, [tmp_path / "mine"], extra)
+    assert dirs == [tmp_path / "proj" / "controllers", tmp_path / "mine", extra[0] / "controllers",
+                    extra[1] / "controllers"]
+    assert find_controller("r", "bee_ctl", [], dirs).folder == extra[0] / "controllers" / "bee_ctl"
+    (tmp_path / "mine" / "bee_ctl").mkdir(parents=True)
+    (tmp_path / "mine" / "bee_ctl" / "bee_ctl.py").write_text("")
+    assert find_controller("r", "bee_ctl", [], dirs).folder == tmp_path / "mine" / "bee_ctl"
+    with pytest.raises(LaunchError) as info:
+        find_controller("r", "gone", [], dirs)
+    assert f"{extra[1] / 'controllers' / 'gone'};" in str(info.value)
+    relative = launch.extra_project_paths("rel")[0]
+    assert relative.is_absolute() and relative.name == "rel"          # the controllers' folders differ from ours
+    many = os.pathsep.join(str(tmp_path / f"p{i}") for i in range(launch.EXTRA_MAX + 5))
+    assert len(launch.extra_project_paths(many)) == launch.EXTRA_MAX
+
+
+@pytest.mark.parametrize("how", ["env", "option"])
+def test_a_robot_proto_and_its_controller_come_from_an_extra_project(tmp_path: Path, how: str) -> None:
+    """The world names a PROTO and the PROTO a controller that only another project holds: with
+    that project as an extra project path both are found, as Webots finds them there."""
+    extra = extra_project(tmp_path / "shared")
+    (tmp_path / "proj" / "worlds").mkdir(parents=True)
+    world = tmp_path / "proj" / "worlds" / "w.wbt"
+    world.write_text('#VRML_SIM R2023b utf8\nEXTERNPROTO "../protos/Bee.proto"\nWorldInfo { basicTimeStep 16 }\n'
+                     'Bee { }\n')
+    nowhere = tmp_path / "nowhere"
+    if how == "env":
+        proc = run(world, "--until", "320", env={"WEBOTS_EXTRA_PROJECT_PATH": f"{nowhere}{os.pathsep}{extra}",
+                                                 "WEBOTS_HOME": None, "SENSORIUM_PROTO_PATH": None})
+    else:
+        proc = run(world, "--until", "320", "--extra-project-path", str(nowhere), "--extra-project-path", str(extra),
+                   env={"WEBOTS_EXTRA_PROJECT_PATH": None, "WEBOTS_HOME": None, "SENSORIUM_PROTO_PATH": None})
+    assert proc.wait() == 0, proc.stderr()
+    assert "[bee] bee args [] in bee_ctl" in proc.stdout().splitlines()
+    assert "[bee] bee stepped 10 until 320" in proc.stdout().splitlines()
+    assert f"sensorium run: extra project path {nowhere} is not a folder: not looked in" in proc.stderr().splitlines()
+    # without it neither is found: the PROTO's file is the load's one line
+    proc = run(world, env={"WEBOTS_EXTRA_PROJECT_PATH": None, "WEBOTS_HOME": None, "SENSORIUM_PROTO_PATH": None})
+    assert proc.wait() == 1
+    assert "Bee.proto" in proc.stderr()
+
+
+def test_a_world_saved_before_r2022b_finds_a_proto_of_an_extra_project_by_name(tmp_path: Path) -> None:
+    """R2022a worlds name PROTOs without EXTERNPROTO: Webots found them in extra projects too."""
+    extra = extra_project(tmp_path / "shared")
+    (tmp_path / "proj" / "worlds").mkdir(parents=True)
+    world = tmp_path / "proj" / "worlds" / "w.wbt"
+    world.write_text('#VRML_SIM R2022a utf8\nWorldInfo { basicTimeStep 16 }\nBee { }\n')
+    clean = {"WEBOTS_EXTRA_PROJECT_PATH": None, "WEBOTS_HOME": None, "SENSORIUM_PROTO_PATH": None}
+    with Proc(sensorium("validate", str(world), "--extra-project-path", str(extra)), env=clean) as proc:
+        assert proc.wait() == 0, proc.stderr()
+        assert proc.stdout().splitlines() == [f"{world}: OK"]
+    with Proc(sensorium("validate", str(world)), env=clean) as proc:
+        assert proc.wait() == 1
+        assert "unknown node 'Bee'" in proc.stderr()

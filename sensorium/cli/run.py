@@ -18,8 +18,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("world", help="world file of a Webots project (worlds/NAME.wbt; YAML or JSON too): its robots' "
                    "controllers are found in the project's controllers/NAME/")
     p.add_argument("--controllers-dir", action="append", default=[], metavar="DIR",
-                   help="also look for controllers/NAME/ folders here, after the project's (repeatable); then, "
-                   "with --webots-home, in Webots' own projects")
+                   help="also look for controllers/NAME/ folders here, after the project's (repeatable); then in "
+                   "each extra project's controllers/ (--extra-project-path, $WEBOTS_EXTRA_PROJECT_PATH); then, with "
+                   "--webots-home, in Webots' own projects")
     p.add_argument("--until", type=int, metavar="MS",
                    help="quit when the simulated time reaches MS milliseconds (controllers get -1, then end)")
     p.add_argument("--mode", choices=["fast", "realtime", "pause"], default="fast",
@@ -40,7 +41,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from sensorium.launch import RunOptions, run_project
+    from sensorium.launch import EXTRA_ENV, RunOptions, extra_project_paths, run_project
     from sensorium.server.daemon.serve import ServeOptions
 
     home = os.environ.get("WEBOTS_HOME")            # --webots-home sets it (cli/__init__.py)
@@ -50,6 +51,7 @@ def main(args: argparse.Namespace) -> int:
                            allow_outside_meshes=args.allow_outside_meshes,
                            contact=False if args.no_contact else None),
         controllers_dirs=tuple(Path(d) for d in args.controllers_dir),
+        extra_projects=tuple(extra_project_paths(os.environ.get(EXTRA_ENV))),   # --extra-project-path too
         webots_home=Path(home) if home else None, grace_s=args.grace)
     try:
         options.check(Path(args.world))
