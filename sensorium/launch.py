@@ -225,14 +225,16 @@ def plan(robots: list[Any], dirs: list[Path], webots: WebotsProjects | None = No
 @dataclass(frozen=True)
 class WorldPlan:
     """What ``run`` does with one load of a world: the controllers to start, the problems (one line
-    each), the lines to say when it starts, and which robots the world waits for without a
-    controller of ours (as Webots waits for a synchronous ``<extern>`` one)."""
+    each) and the robots they leave without a controller, the lines to say when it starts, and
+    which robots the world waits for without a controller of ours (as Webots waits for a
+    synchronous ``<extern>`` one)."""
 
     specs: tuple[ControllerSpec, ...]
     problems: tuple[str, ...]
     notes: tuple[str, ...]
     extern_waited: frozenset[str]          # synchronous <extern> robots: waited for until attached
     extern_synchronous: tuple[str, ...]    # robots waited for while none of them is attached
+    missing: tuple[tuple[str, str], ...] = ()   # (robot, controller) of each problem: it runs without one
 
 
 def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: WebotsProjects | None = None,
@@ -240,21 +242,22 @@ def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: Webots
     """The plan for ``robots`` (a loaded world's: ``name``, ``controller``, ``controller_args``,
     ``synchronization``) served at ``rpc_url``; no process is started."""
     specs, problems = plan(robots, dirs, webots, protos)
+    started = {s.robot for s in specs}
+    missing = tuple((r.name, r.controller) for r in robots if r.controller not in SPECIAL and r.name not in started)
     notes = [f"robot '{s.robot}': controller '{s.name}' found in Webots' projects: {s.program}" for s in specs if s.webots]
     for r in robots:
         if r.controller == "<generic>":
-            notes.append(f"robot '{r.name}': Webots' <generic> controller is not here: the robot waits for an "
-                         "<extern> controller")
+            notes.append(f"robot '{r.name}': controller '<generic>' (Webots' one only steps): the robot runs without "
+                         "a controller")
         elif r.controller == "<extern>":
             notes.append(f"robot '{r.name}' is <extern>: attach its controller with `sensorium controller SCRIPT "
                          f"--robot {r.name} --url {rpc_url}`")
-    # as Webots, the world waits for every synchronous <extern> robot's controller too, but a robot
-    # whose started controller has ended is uncontrolled: the world goes on without it, as Webots'
-    # does (only robots left to an <extern> controller are waited for while none is attached:
-    # <extern> and, here, <generic> ones)
+    # as Webots, the world waits for every synchronous <extern> robot's controller too (while none is
+    # attached); a robot whose controller ended, could not be found, or is <generic> is uncontrolled:
+    # the world goes on without it, as Webots' goes on with its generic controller stepping
     return WorldPlan(tuple(specs), tuple(problems), tuple(notes),
                      frozenset(r.name for r in robots if r.controller == "<extern>" and r.synchronization),
-                     tuple(r.name for r in robots if r.controller in ("<extern>", "<generic>") and r.synchronization))
+                     tuple(r.name for r in robots if r.controller == "<extern>" and r.synchronization), missing)
 
 
 def after_run(reload_requested: bool, interrupted: bool, quit_status: int | None) -> bool:
@@ -264,9 +267,12 @@ def after_run(reload_requested: bool, interrupted: bool, quit_status: int | None
     return reload_requested and not interrupted and quit_status is None
 
 
-def exit_status(quit_status: int | None) -> int:
-    """``run``'s exit status: ``simulationQuit(status)``'s low 8 bits, as Webots exits, else 0."""
-    return 0 if quit_status is None else quit_status & 0xFF
+def exit_status(quit_status: int | None, missing: bool = False) -> int:
+    """``run``'s exit status: ``simulationQuit(status)``'s low 8 bits, as Webots exits, when not 0;
+    else 1 when a robot ran without the controller its world names (``missing``: a CI job must not
+    pass by a run that was not the one its world describes); else 0."""
+    status = 0 if quit_status is None else quit_status & 0xFF
+    return status or (1 if missing else 0)
 
 
 def _describe(code: int) -> str:
@@ -315,6 +321,7 @@ class Launcher:
         self.reload_requested = False
         self.on_reload: Callable[[], None] | None = None     # stops the server (run's loop reloads)
         self._starting: set[str] = set()         # the lockstep's: the world waits until these attach
+        self.failed: dict[str, str] = {}          # robot -> controller whose process could not be started
         self._wake_server: Callable[[], None] = lambda: None
         self._quitting: Callable[[], bool] = lambda: False
         self._worker = threading.Thread(target=self._work, name="sensorium-launcher", daemon=True)
@@ -376,7 +383,9 @@ class Launcher:
                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                     start_new_session=True)    # its own group: ended by us, with its children
         except OSError as exc:
-            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {exc.strerror or exc}")
+            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {exc.strerror or exc}: the robot "
+                     "runs without a controller")
+            self.failed[robot] = spec.name
             self._starting.discard(robot)
             self._wake_server()
             return
@@ -516,6 +525,7 @@ class RunOptions:
     extra_projects: tuple[Path, ...] = ()     # Webots' extra project paths (a folder that is none is said, skipped)
     webots_home: Path | None = None
     grace_s: float = GRACE_S
+    require_controllers: bool = False          # a controller that cannot be started: exit 1 before the world runs
 
     def check(self, world: Path) -> None:
         """Raise ValueError naming the first bad option (one line)."""
@@ -547,6 +557,7 @@ class ProjectRun:
         home = options.webots_home
         self.webots = WebotsProjects(home) if home is not None and Path(home).is_dir() else None
         self.interrupted = False
+        self.missing: dict[str, str] = {}      # robot -> controller it ran without (every load of the world)
         self._server: Any = None
 
     def stop(self) -> None:
@@ -577,12 +588,15 @@ class ProjectRun:
         loaded = server.core.sim.loaded.world
         world_plan = plan_world(loaded.robots, self.dirs, server.transport.rpc_endpoint, self.webots,
                                 robot_protos(loaded))
-        if not world_plan.problems:
-            return world_plan
-        server.close()
-        for line in world_plan.problems:
-            self._say(f"sensorium run: {line}")
-        return None
+        if world_plan.problems and self.options.require_controllers:
+            server.close()
+            for line in world_plan.problems:
+                self._say(f"sensorium run: {line}")
+            return None
+        for line in world_plan.problems:      # as Webots (which starts its <generic> controller instead)
+            self._say(f"sensorium run: {line}: the robot runs without a controller")
+        self.missing.update(world_plan.missing)
+        return world_plan
 
     def run(self, *, signals: bool = True) -> int:
         """Run to the end; ``signals``: SIGINT/SIGTERM end it (main thread only)."""
@@ -641,7 +655,14 @@ class ProjectRun:
                 signal.signal(sig, handler)
         core = server.core
         self._say(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps")
-        return exit_status(core.quit_status)
+        missing = {**self.missing, **launcher.failed}
+        status = exit_status(core.quit_status, bool(missing))
+        if missing:
+            names = ", ".join(f"'{robot}' ('{name}')" for robot, name in missing.items())
+            self._say(f"sensorium run: {len(missing)} robot{'s' if len(missing) > 1 else ''} ran without the "
+                      f"controller the world names: {names} (exit status {status}; --require-controllers "
+                      "refuses to start instead)")
+        return status
 
 
 def run_project(world: str | Path, options: RunOptions, *, signals: bool = True) -> int:

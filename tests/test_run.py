@@ -122,23 +122,27 @@ def test_a_world_is_planned_without_a_process(tmp_path: Path) -> None:
         "tcp://127.0.0.1:5555`",
         "robot 'free' is <extern>: attach its controller with `sensorium controller SCRIPT --robot free --url "
         "tcp://127.0.0.1:5555`",
-        "robot 'gen': Webots' <generic> controller is not here: the robot waits for an <extern> controller")
+        "robot 'gen': controller '<generic>' (Webots' one only steps): the robot runs without a controller")
     assert got.extern_waited == {"ext"}
-    assert got.extern_synchronous == ("ext", "gen")
+    assert got.extern_synchronous == ("ext",)          # not <generic>, not 'lost': the world goes on without them
+    assert got.missing == (("lost", "nowhere"),)
 
 
-@pytest.mark.parametrize(("reload", "interrupted", "quit_status", "again", "status"), [
-    (False, False, None, False, 0),        # --until, or the server stopped
-    (True, False, None, True, 0),          # worldReload
-    (True, True, None, False, 0),          # a reload asked, then Ctrl-C: no reload
-    (True, False, 3, False, 3),            # a reload and a simulationQuit(3): the quit wins
-    (False, False, 259, False, 3),         # simulationQuit's low 8 bits, as a process's status
+@pytest.mark.parametrize(("reload", "interrupted", "quit_status", "again", "status", "status_missing"), [
+    (False, False, None, False, 0, 1),        # --until, or the server stopped
+    (True, False, None, True, 0, 1),          # worldReload
+    (True, True, None, False, 0, 1),          # a reload asked, then Ctrl-C: no reload
+    (True, False, 3, False, 3, 3),            # a reload and a simulationQuit(3): the quit wins
+    (False, False, 259, False, 3, 3),         # simulationQuit's low 8 bits, as a process's status
+    (False, False, 0, False, 0, 1),           # a supervisor's pass does not hide a robot that ran without its controller
+    (False, False, 256, False, 0, 1),
 ])
 def test_after_a_server_stops_the_run_reloads_or_ends_with_a_status(reload: bool, interrupted: bool,
                                                                      quit_status: int | None, again: bool,
-                                                                     status: int) -> None:
+                                                                     status: int, status_missing: int) -> None:
     assert launch.after_run(reload, interrupted, quit_status) is again
     assert launch.exit_status(quit_status) == status
+    assert launch.exit_status(quit_status, missing=True) == status_missing
 
 
 # ---------------------------------------------------------------------- running a project
@@ -162,14 +166,48 @@ def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: P
         assert not alive(pid)
 
 
-def test_a_missing_controller_is_one_line_and_nothing_runs(tmp_path: Path) -> None:
-    world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }', {})
-    proc = run(world, env={"WEBOTS_HOME": None})
+def test_with_require_controllers_a_missing_controller_is_one_line_and_nothing_runs(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }\nRobot { name "beta" controller "b" }',
+                    {"b.py": COUNTER.replace("{step}", "16")})
+    proc = run(world, "--require-controllers", env={"WEBOTS_HOME": None, "WEBOTS_EXTRA_PROJECT_PATH": None})
     assert proc.wait() == 1
     assert proc.stderr().strip() == (f"sensorium run: robot 'alpha': controller 'nowhere' not found (looked for the "
                                      f"folder {tmp_path / 'controllers' / 'nowhere'}; --webots-home DIR also looks "
                                      "in Webots' own projects)")
-    assert proc.stdout() == ""
+    assert proc.stdout() == "" and not pids(tmp_path / "controllers" / "b", "beta")
+
+
+def test_a_robot_whose_controller_cannot_start_runs_without_it_and_the_run_exits_1(tmp_path: Path) -> None:
+    """As Webots (which warns and starts its <generic> controller): one line naming the robot and
+    the controller, the world and the other controllers go on, and the run's status says it."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }\nRobot { name "beta" controller "b" }\n'
+                              'Robot { name "java" controller "jv" }',
+                    {"b.py": COUNTER.replace("{step}", "16"), "jv.jar": ""})
+    proc = run(world, "--until", "800", env={"WEBOTS_HOME": None, "WEBOTS_EXTRA_PROJECT_PATH": None})
+    assert proc.wait() == 1, proc.stderr()
+    assert "[beta] beta stepped 50 until 800" in proc.stdout().splitlines()
+    err = proc.stderr().splitlines()
+    assert (f"sensorium run: robot 'alpha': controller 'nowhere' not found (looked for the folder "
+            f"{tmp_path / 'controllers' / 'nowhere'}; --webots-home DIR also looks in Webots' own projects): the robot "
+            "runs without a controller") in err
+    assert (f"sensorium run: robot 'java': controller {tmp_path / 'controllers' / 'jv' / 'jv.jar'} is a Java controller, "
+            "which Sensorium does not run (Python controllers and executables run; start it as an <extern> "
+            "controller): the robot runs without a controller") in err
+    assert err[-2:] == ["sensorium: stopped at 800 ms after 50 steps",
+                        "sensorium run: 2 robots ran without the controller the world names: 'alpha' ('nowhere'), "
+                        "'java' ('jv') (exit status 1; --require-controllers refuses to start instead)"]
+
+
+def test_a_generic_robot_runs_without_a_controller_and_is_not_waited_for(tmp_path: Path) -> None:
+    """Webots' <generic> controller only steps: here the robot runs without one, and a world of
+    <generic> robots alone steps by itself to --until (exit 0: the world asked for it)."""
+    world = project(tmp_path, 'Robot { name "gen" controller "<generic>" }', {})
+    proc = run(world, "--until", "320")
+    assert proc.wait() == 0, proc.stderr()
+    err = proc.stderr().splitlines()
+    assert ("sensorium run: robot 'gen': controller '<generic>' (Webots' one only steps): the robot runs without a "
+            "controller") in err
+    assert err[-1] == "sensorium: stopped at 320 ms after 20 steps"
 
 
 def test_a_controller_that_crashes_is_said_and_the_world_goes_on(tmp_path: Path) -> None:
