@@ -363,12 +363,16 @@ class Launcher:
         env = dict(os.environ)
         env["SENSORIUM_CONTROLLER_URL"] = f"{self.url.rstrip('/')}/{quote(spec.robot, safe='')}"   # both clients decode it
         env.pop("WEBOTS_CONTROLLER_URL", None)
+        env["WEBOTS_ROBOT_NAME"] = spec.robot     # as Webots sets it for every controller it starts
         env["PYTHONUNBUFFERED"] = "1"            # lines reach the console as they are printed
         env["PYTHONIOENCODING"] = "UTF-8"        # as Webots sets it
         package_root = str(Path(__file__).resolve().parent.parent)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH", "")) if p)
-        if not spec.python and C_LIBRARY.is_dir():   # Webots puts its libController on the path likewise
-            env["LD_LIBRARY_PATH"] = os.pathsep.join(p for p in (str(C_LIBRARY), env.get("LD_LIBRARY_PATH", "")) if p)
+        # as Webots: the controller's folder first on the library path (a shared library shipped next to
+        # the controller loads), and our libController where Webots puts its own
+        libraries = [str(spec.folder), *([str(C_LIBRARY)] if not spec.python and C_LIBRARY.is_dir() else []),
+                     env.get("LD_LIBRARY_PATH", "")]
+        env["LD_LIBRARY_PATH"] = os.pathsep.join(dict.fromkeys(p for p in libraries if p))
         return env
 
     def start(self, robot: str) -> None:

@@ -148,14 +148,17 @@ def test_after_a_server_stops_the_run_reloads_or_ends_with_a_status(reload: bool
 # ---------------------------------------------------------------------- running a project
 
 def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: Path) -> None:
-    world = project(tmp_path, 'Robot { name "alpha" controller "a" controllerArgs [ "--say" "hello world" ] }\n'
+    # controllerArgs are the program's arguments one by one, as Webots passes them (no shell: quotes,
+    # backslashes, spaces and empty strings arrive as written in the world)
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" controllerArgs [ "--say" "hello world" '
+                              '"say \\"hi\\" \\\\ $HOME" "" ] }\n'
                               'Robot { name "beta %41" controller "b" }',     # a name a URL must encode
                     {"a.py": COUNTER.replace("{step}", "16"), "b.py": COUNTER.replace("{step}", "32")})
     proc = run(world, "--until", "1600")
     assert proc.wait() == 0, proc.stderr()
     out = proc.stdout().splitlines()
     assert out[0].startswith("sensorium: serving world 'w' rpc=tcp://127.0.0.1:")
-    assert "[alpha] alpha args ['--say', 'hello world'] in a" in out
+    assert """[alpha] alpha args ['--say', 'hello world', 'say "hi" \\\\ $HOME', ''] in a""" in out
     assert "[beta %41] beta %41 args [] in b" in out
     # the world waited for both before it stepped: every step of both, from 0 to --until
     assert "[alpha] alpha stepped 100 until 1600" in out
@@ -395,6 +398,51 @@ def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path, cli
     assert [line for line in proc.stdout().splitlines() if line.startswith("[boss]")] == [
         "[boss] boss starts (in C) at 0", "[boss] boss ends at 960", "[boss] boss starts (in C) at 0 after the reload",
         "[boss] boss ends at 1200"]
+
+
+C_NAMER = r'''#include <stdio.h>
+#include <stdlib.h>
+#include <webots/robot.h>
+
+int main(void) {
+  const char *env = getenv("WEBOTS_ROBOT_NAME");
+  wb_robot_init();
+  printf("WEBOTS_ROBOT_NAME %s, attached to %s\n", env ? env : "(unset)", wb_robot_get_name());
+  while (wb_robot_step(16) != -1) {
+  }
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+def test_webots_robot_name_is_set_for_a_controller_and_chooses_the_robot_of_a_url_without_one(
+        tmp_path: Path, clib: tuple[Path, list[str]]) -> None:
+    """As Webots, run sets WEBOTS_ROBOT_NAME for each controller it starts; a C controller started by
+    hand with a URL naming no robot attaches to WEBOTS_ROBOT_NAME's (two robots: "the only robot"
+    would be ambiguous)."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "namer" }\nRobot { name "ext" controller "<extern>" }',
+                    {})
+    compile_controller(clib, tmp_path / "controllers" / "namer", "namer", C_NAMER)
+    proc = run(world, "--until", "320")
+    url = proc.wait_line("sensorium: serving world").split("rpc=")[1].split()[0]
+    hand = {"WEBOTS_CONTROLLER_URL": url, "WEBOTS_ROBOT_NAME": "ext", "SENSORIUM_CONTROLLER_URL": None}
+    with Proc([str(tmp_path / "controllers" / "namer" / "namer")], env=hand) as manual:
+        assert manual.wait() == 0, manual.stderr()
+        assert manual.stdout().splitlines() == ["WEBOTS_ROBOT_NAME ext, attached to ext"]
+    assert proc.wait() == 0, proc.stderr()
+    assert "[alpha] WEBOTS_ROBOT_NAME alpha, attached to alpha" in proc.stdout().splitlines()
+
+
+def test_a_controller_gets_webots_variables_and_its_folder_on_the_library_path(tmp_path: Path) -> None:
+    """WEBOTS_ROBOT_NAME, and the controller's folder first on LD_LIBRARY_PATH (a shared library
+    shipped next to a controller loads), as Webots starts a controller."""
+    script = ('import os\nfrom controller import Robot\nrobot = Robot()\n'
+              'print(os.environ["WEBOTS_ROBOT_NAME"], os.environ["LD_LIBRARY_PATH"].split(os.pathsep)[0])\n')
+    world = project(tmp_path, 'Robot { name "alpha beta" controller "env" }', {"env.py": script})
+    proc = run(world, "--until", "160", env={"WEBOTS_ROBOT_NAME": "stale", "LD_LIBRARY_PATH": "/nowhere"})
+    assert proc.wait() == 0, proc.stderr()
+    assert f"[alpha beta] alpha beta {tmp_path / 'controllers' / 'env'}" in proc.stdout().splitlines()
 
 
 UNDER_SERVE = '''from controller import Supervisor
