@@ -237,18 +237,40 @@ class WorldPlan:
     missing: tuple[tuple[str, str], ...] = ()   # (robot, controller) of each problem: it runs without one
 
 
+@dataclass(frozen=True)
+class _Robot:
+    """A robot as ``run`` sees it: its controller as Webots reads the world."""
+
+    name: str
+    controller: str
+    controller_args: tuple[str, ...]
+    synchronization: bool
+    default: bool = False          # no controller field in the .wbt: Webots' default, <generic>
+
+
+def _as_webots(robot: Any, wbt: bool) -> _Robot:
+    """``robot`` with Webots' default controller when a ``.wbt`` world gives it none: ``<generic>``
+    (Sensorium's loader makes such a robot ``<extern>``, what ``serve`` waits for)."""
+    given = getattr(robot, "model_fields_set", None)
+    default = wbt and given is not None and "controller" not in given
+    return _Robot(robot.name, "<generic>" if default else robot.controller, tuple(robot.controller_args),
+                  bool(robot.synchronization), default)
+
+
 def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: WebotsProjects | None = None,
-               protos: dict[str, str] | None = None) -> WorldPlan:
+               protos: dict[str, str] | None = None, wbt: bool = False) -> WorldPlan:
     """The plan for ``robots`` (a loaded world's: ``name``, ``controller``, ``controller_args``,
-    ``synchronization``) served at ``rpc_url``; no process is started."""
+    ``synchronization``) served at ``rpc_url``; no process is started. ``wbt``: the world is a
+    ``.wbt`` file, where a robot without a ``controller`` field has Webots' ``<generic>``."""
+    robots = [_as_webots(r, wbt) for r in robots]
     specs, problems = plan(robots, dirs, webots, protos)
     started = {s.robot for s in specs}
     missing = tuple((r.name, r.controller) for r in robots if r.controller not in SPECIAL and r.name not in started)
     notes = [f"robot '{s.robot}': controller '{s.name}' found in Webots' projects: {s.program}" for s in specs if s.webots]
     for r in robots:
         if r.controller == "<generic>":
-            notes.append(f"robot '{r.name}': controller '<generic>' (Webots' one only steps): the robot runs without "
-                         "a controller")
+            which = "no controller field, so Webots' default '<generic>'" if r.default else "controller '<generic>'"
+            notes.append(f"robot '{r.name}': {which} (Webots' one only steps): the robot runs without a controller")
         elif r.controller == "<extern>":
             notes.append(f"robot '{r.name}' is <extern>: attach its controller with `sensorium controller SCRIPT "
                          f"--robot {r.name} --url {rpc_url}`")
@@ -591,7 +613,7 @@ class ProjectRun:
         """The plan for ``server``'s world, or None (server closed, every problem said)."""
         loaded = server.core.sim.loaded.world
         world_plan = plan_world(loaded.robots, self.dirs, server.transport.rpc_endpoint, self.webots,
-                                robot_protos(loaded))
+                                robot_protos(loaded), wbt=self.world.suffix.lower() == ".wbt")
         if world_plan.problems and self.options.require_controllers:
             server.close()
             for line in world_plan.problems:

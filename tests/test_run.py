@@ -18,6 +18,7 @@ from _serve import REPO, Proc, run_controller, sensorium, wait_until
 
 from sensorium import launch
 from sensorium.launch import LaunchError, WebotsProjects, find_controller
+from sensorium.schemas.world import Robot as WorldRobot
 
 WORLD = '''#VRML_SIM R2023b utf8
 WorldInfo { basicTimeStep 16 }
@@ -112,8 +113,9 @@ def test_a_world_is_planned_without_a_process(tmp_path: Path) -> None:
     (base / "a").mkdir(parents=True)
     (base / "a" / "a.py").write_text("")
     robots = [robot("alpha", "a", "--fast"), robot("ext", "<extern>"), robot("free", "<extern>", synchronization=False),
-              robot("gen", "<generic>"), robot("off", "<none>"), robot("lost", "nowhere")]
-    got = launch.plan_world(robots, [base], "tcp://127.0.0.1:5555")
+              robot("gen", "<generic>"), robot("off", "<none>"), robot("lost", "nowhere"),
+              WorldRobot(name="bare"), WorldRobot(name="said", controller="<extern>")]
+    got = launch.plan_world(robots, [base], "tcp://127.0.0.1:5555", wbt=True)
     assert [(s.robot, s.program, s.args) for s in got.specs] == [("alpha", base / "a" / "a.py", ("--fast",))]
     assert got.problems == (f"robot 'lost': controller 'nowhere' not found (looked for the folder {base / 'nowhere'}; "
                             "--webots-home DIR also looks in Webots' own projects)",)
@@ -122,10 +124,17 @@ def test_a_world_is_planned_without_a_process(tmp_path: Path) -> None:
         "tcp://127.0.0.1:5555`",
         "robot 'free' is <extern>: attach its controller with `sensorium controller SCRIPT --robot free --url "
         "tcp://127.0.0.1:5555`",
-        "robot 'gen': controller '<generic>' (Webots' one only steps): the robot runs without a controller")
-    assert got.extern_waited == {"ext"}
-    assert got.extern_synchronous == ("ext",)          # not <generic>, not 'lost': the world goes on without them
+        "robot 'gen': controller '<generic>' (Webots' one only steps): the robot runs without a controller",
+        "robot 'bare': no controller field, so Webots' default '<generic>' (Webots' one only steps): the robot runs "
+        "without a controller",
+        "robot 'said' is <extern>: attach its controller with `sensorium controller SCRIPT --robot said --url "
+        "tcp://127.0.0.1:5555`")
+    assert got.extern_waited == {"ext", "said"}
+    # not <generic>, not 'lost', not 'bare' (a .wbt robot without a controller field): the world goes on without them
+    assert got.extern_synchronous == ("ext", "said")
     assert got.missing == (("lost", "nowhere"),)
+    # in a YAML world a robot without a controller is Sensorium's default, <extern>: waited for
+    assert launch.plan_world([WorldRobot(name="bare")], [base], "tcp://127.0.0.1:5555").extern_synchronous == ("bare",)
 
 
 @pytest.mark.parametrize(("reload", "interrupted", "quit_status", "again", "status", "status_missing"), [
@@ -203,13 +212,16 @@ def test_a_robot_whose_controller_cannot_start_runs_without_it_and_the_run_exits
 
 def test_a_generic_robot_runs_without_a_controller_and_is_not_waited_for(tmp_path: Path) -> None:
     """Webots' <generic> controller only steps: here the robot runs without one, and a world of
-    <generic> robots alone steps by itself to --until (exit 0: the world asked for it)."""
-    world = project(tmp_path, 'Robot { name "gen" controller "<generic>" }', {})
+    <generic> robots alone steps by itself to --until (exit 0: the world asked for it). A robot of a
+    .wbt world without a controller field has Webots' default, <generic>, under run."""
+    world = project(tmp_path, 'Robot { name "gen" controller "<generic>" }\nRobot { name "bare" }', {})
     proc = run(world, "--until", "320")
     assert proc.wait() == 0, proc.stderr()
     err = proc.stderr().splitlines()
     assert ("sensorium run: robot 'gen': controller '<generic>' (Webots' one only steps): the robot runs without a "
             "controller") in err
+    assert ("sensorium run: robot 'bare': no controller field, so Webots' default '<generic>' (Webots' one only "
+            "steps): the robot runs without a controller") in err
     assert err[-1] == "sensorium: stopped at 320 ms after 20 steps"
 
 
