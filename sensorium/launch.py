@@ -625,7 +625,8 @@ class ProjectRun:
         return world_plan
 
     def run(self, *, signals: bool = True) -> int:
-        """Run to the end; ``signals``: SIGINT/SIGTERM end it (main thread only)."""
+        """Run to the end; ``signals``: SIGINT/SIGTERM end it (when called in the main thread; from
+        another thread, end it with :meth:`stop`)."""
         server = self._open(self.options.serve)
         if server is None:
             return 1
@@ -642,7 +643,7 @@ class ProjectRun:
                             grace_s=self.options.grace_s)
         self._server = server
         old_handlers = {}
-        if signals:
+        if signals and threading.current_thread() is threading.main_thread():    # Python's signals: main thread only
             old_handlers = {sig: signal.signal(sig, lambda signum, frame: self.stop())
                             for sig in (signal.SIGINT, signal.SIGTERM)}
         try:

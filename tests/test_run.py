@@ -748,3 +748,35 @@ def test_a_world_saved_before_r2022b_finds_a_proto_of_an_extra_project_by_name(t
     with Proc(sensorium("validate", str(world)), env=clean) as proc:
         assert proc.wait() == 1
         assert "unknown node 'Bee'" in proc.stderr()
+
+
+def test_a_project_runs_in_process_and_stop_ends_it(tmp_path: Path) -> None:
+    """The library's run (what `sensorium run` calls): in a thread of ours, its lines to our streams;
+    stop() ends it as Ctrl-C does (every controller gone, status 0)."""
+    import io
+    import threading
+
+    from sensorium.server.daemon.serve import ServeOptions
+
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }', {"a.py": COUNTER.replace("{step}", "16")})
+    out, err = io.StringIO(), io.StringIO()
+    options = launch.RunOptions(serve=ServeOptions(rpc="tcp://127.0.0.1:0", pub="tcp://127.0.0.1:0"), grace_s=5.0)
+    options.check(world)
+    project_run = launch.ProjectRun(world, options, out=out, err=err)
+    status: list[int] = []
+    thread = threading.Thread(target=lambda: status.append(project_run.run()))
+    thread.start()
+    try:
+        wait_until(lambda: "[alpha] alpha args [] in a" in out.getvalue(), what="the controller's first line")
+    finally:
+        project_run.stop()
+        thread.join(120)
+    assert not thread.is_alive() and status == [0], err.getvalue()
+    assert out.getvalue().startswith("sensorium: serving world 'w' rpc=tcp://127.0.0.1:")
+    assert any(line.startswith("[alpha] alpha stepped ") for line in out.getvalue().splitlines())
+    (pid,) = pids(tmp_path / "controllers" / "a", "alpha")
+    assert not alive(pid)
+    with pytest.raises(ValueError, match="--grace must be a finite number >= 0, got -1"):
+        launch.RunOptions(grace_s=-1).check(world)
+    with pytest.raises(ValueError, match=f"--controllers-dir {tmp_path / 'none'}: no such folder"):
+        launch.RunOptions(controllers_dirs=(tmp_path / "none",)).check(world)
