@@ -3,7 +3,8 @@ every robot's controller named in it, print their output with the robot's name, 
 ``restartController``, reload the world on ``worldReload``, end them all at the end.
 
 Where a controller is found, as Webots' WbController does for a project: ``controllers/NAME/`` next to
-the world's ``worlds/`` folder (then each ``--controllers-dir``, then each extra project's
+the world's ``worlds/`` folder (then the robot's PROTO's project, for a PROTO the world declares by
+a file path; then each ``--controllers-dir``, then each extra project's
 ``controllers/NAME/``: ``$WEBOTS_EXTRA_PROJECT_PATH``, ``--extra-project-path``); in that folder the first of
 ``Dockerfile``, ``NAME`` (an executable), ``build/release/NAME``, ``NAME.class``, ``NAME.jar``,
 ``NAME.py``, ``NAME.m``, ``NAME.bsg``. Python and executables run (as ``sensorium controller`` runs
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -29,7 +31,8 @@ from typing import IO, Any
 from urllib.parse import quote
 
 __all__ = ["ControllerSpec", "LaunchError", "Launcher", "ProjectRun", "RunOptions", "WebotsProjects", "WorldPlan",
-           "after_run", "exit_status", "find_controller", "plan", "plan_world", "robot_protos", "run_project"]
+           "after_run", "exit_status", "find_controller", "plan", "plan_world", "proto_projects", "robot_protos",
+           "run_project"]
 
 WEBOTS_DEPTH = 6         # folders under a Webots installation's projects/ where controllers/ folders are looked for
 WEBOTS_MAX_DIRS = 20000  # folders of that tree indexed at most
@@ -207,15 +210,46 @@ def robot_protos(world: Any) -> dict[str, str]:
     return out
 
 
+_EXTERNPROTO = re.compile(r'^[ \t]*(?:IMPORTABLE[ \t]+)?EXTERNPROTO[ \t]+"([^"\n]+)"', re.MULTILINE)
+
+
+def proto_projects(world: Path, text: str, protos: dict[str, str]) -> dict[str, Path]:
+    """Each robot whose PROTO (``protos``: robot -> PROTO name) the ``.wbt`` world ``text`` declares
+    by a file path (relative to the world's folder, or absolute; not ``webots://`` nor ``https://``)
+    -> that PROTO's project: the folder above the nearest ``protos`` folder holding the file, where
+    Webots looks for the robot's controller right after the world's own project."""
+    files: dict[str, Path] = {}
+    for url in _EXTERNPROTO.findall(text):
+        if "://" in url or not url.endswith(".proto"):
+            continue
+        path = Path(os.path.normpath(world.resolve().parent / url))      # the url's own "..", as Webots reads it
+        files.setdefault(path.stem, path)
+    out: dict[str, Path] = {}
+    for robot, proto in protos.items():
+        path = files.get(proto)
+        if path is None:
+            continue
+        for folder in path.parents:
+            if folder.name == "protos":
+                out[robot] = folder.parent
+                break
+    return out
+
+
 def plan(robots: list[Any], dirs: list[Path], webots: WebotsProjects | None = None,
-         protos: dict[str, str] | None = None) -> tuple[list[ControllerSpec], list[str]]:
-    """The controllers to start for the world's robots, and every problem (one line each)."""
+         protos: dict[str, str] | None = None,
+         projects: dict[str, Path] | None = None) -> tuple[list[ControllerSpec], list[str]]:
+    """The controllers to start for the world's robots, and every problem (one line each).
+    ``projects``: a robot's PROTO's project (:func:`proto_projects`), looked in right after the
+    world's own (``dirs[0]``), as Webots does."""
     specs, problems = [], []
     for r in robots:
         if r.controller in SPECIAL:
             continue
+        own = (projects or {}).get(r.name)
+        robot_dirs = list(dict.fromkeys([dirs[0], own / "controllers", *dirs[1:]])) if own is not None and dirs else dirs
         try:
-            specs.append(find_controller(r.name, r.controller, list(r.controller_args), dirs, webots,
+            specs.append(find_controller(r.name, r.controller, list(r.controller_args), robot_dirs, webots,
                                          (protos or {}).get(r.name)))
         except LaunchError as exc:
             problems.append(str(exc))
@@ -258,12 +292,14 @@ def _as_webots(robot: Any, wbt: bool) -> _Robot:
 
 
 def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: WebotsProjects | None = None,
-               protos: dict[str, str] | None = None, wbt: bool = False) -> WorldPlan:
+               protos: dict[str, str] | None = None, wbt: bool = False,
+               projects: dict[str, Path] | None = None) -> WorldPlan:
     """The plan for ``robots`` (a loaded world's: ``name``, ``controller``, ``controller_args``,
     ``synchronization``) served at ``rpc_url``; no process is started. ``wbt``: the world is a
-    ``.wbt`` file, where a robot without a ``controller`` field has Webots' ``<generic>``."""
+    ``.wbt`` file, where a robot without a ``controller`` field has Webots' ``<generic>``;
+    ``projects``: robots' PROTO projects (:func:`proto_projects`)."""
     robots = [_as_webots(r, wbt) for r in robots]
-    specs, problems = plan(robots, dirs, webots, protos)
+    specs, problems = plan(robots, dirs, webots, protos, projects)
     started = {s.robot for s in specs}
     missing = tuple((r.name, r.controller) for r in robots if r.controller not in SPECIAL and r.name not in started)
     notes = [f"robot '{s.robot}': controller '{s.name}' found in Webots' projects: {s.program}" for s in specs if s.webots]
@@ -612,8 +648,16 @@ class ProjectRun:
     def _plan(self, server: Any) -> WorldPlan | None:
         """The plan for ``server``'s world, or None (server closed, every problem said)."""
         loaded = server.core.sim.loaded.world
-        world_plan = plan_world(loaded.robots, self.dirs, server.transport.rpc_endpoint, self.webots,
-                                robot_protos(loaded), wbt=self.world.suffix.lower() == ".wbt")
+        protos = robot_protos(loaded)
+        wbt = self.world.suffix.lower() == ".wbt"
+        projects = {}
+        if wbt and protos:
+            try:
+                projects = proto_projects(self.world, self.world.read_text(encoding="utf-8", errors="replace"), protos)
+            except OSError:              # it was read a moment ago: gone since, nothing more to learn from it
+                pass
+        world_plan = plan_world(loaded.robots, self.dirs, server.transport.rpc_endpoint, self.webots, protos, wbt,
+                                projects)
         if world_plan.problems and self.options.require_controllers:
             server.close()
             for line in world_plan.problems:

@@ -780,3 +780,35 @@ def test_a_project_runs_in_process_and_stop_ends_it(tmp_path: Path) -> None:
         launch.RunOptions(grace_s=-1).check(world)
     with pytest.raises(ValueError, match=f"--controllers-dir {tmp_path / 'none'}: no such folder"):
         launch.RunOptions(controllers_dirs=(tmp_path / "none",)).check(world)
+
+
+def test_a_proto_robots_controller_is_found_in_the_protos_project(tmp_path: Path) -> None:
+    """Webots looks for a robot's controller in its PROTO's project right after the world's own: a
+    world declaring a PROTO of another project by its path runs that project's controller."""
+    shared = extra_project(tmp_path / "robots" / "shared")
+    (tmp_path / "proj" / "worlds").mkdir(parents=True)
+    world = tmp_path / "proj" / "worlds" / "w.wbt"
+    text = ('#VRML_SIM R2023b utf8\nEXTERNPROTO "../../robots/shared/protos/Bee.proto"\n'
+            'IMPORTABLE EXTERNPROTO "webots://projects/objects/Other.proto"\nWorldInfo { basicTimeStep 16 }\n'
+            'Bee { }\nBee { name "own" controller "mine" }\n')
+    world.write_text(text)
+    assert launch.proto_projects(world, text, {"bee": "Bee", "x": "Other", "y": "Nowhere"}) == {"bee": shared}
+    (tmp_path / "proj" / "controllers" / "mine").mkdir(parents=True)
+    (tmp_path / "proj" / "controllers" / "mine" / "mine.py").write_text(COUNTER.replace("{step}", "32"))
+    proc = run(world, "--until", "320", env={"WEBOTS_EXTRA_PROJECT_PATH": None, "WEBOTS_HOME": None})
+    assert proc.wait() == 0, proc.stderr()
+    out = proc.stdout().splitlines()
+    assert "[bee] bee args [] in bee_ctl" in out and "[bee] bee stepped 10 until 320" in out
+    assert "[own] own stepped 10 until 320" in out
+    # the world's own project comes first
+    (tmp_path / "proj" / "controllers" / "bee_ctl").mkdir(parents=True)
+    (tmp_path / "proj" / "controllers" / "bee_ctl" / "bee_ctl.py").write_text('print("the project\'s own")\n')
+    dirs = launch.controller_dirs(world, [])
+    got = launch.plan_world([WorldRobot(name="bee", controller="bee_ctl")], dirs, "tcp://127.0.0.1:5555",
+                            projects={"bee": shared})
+    assert [s.folder for s in got.specs] == [tmp_path / "proj" / "controllers" / "bee_ctl"]
+    (tmp_path / "proj" / "controllers" / "bee_ctl" / "bee_ctl.py").unlink()
+    (tmp_path / "proj" / "controllers" / "bee_ctl").rmdir()
+    got = launch.plan_world([WorldRobot(name="bee", controller="bee_ctl")], dirs, "tcp://127.0.0.1:5555",
+                            projects={"bee": shared})
+    assert [s.folder for s in got.specs] == [shared / "controllers" / "bee_ctl"]
