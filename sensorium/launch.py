@@ -30,6 +30,9 @@ from pathlib import Path
 from typing import IO, Any
 from urllib.parse import quote
 
+from sensorium import runtime_ini
+from sensorium.runtime_ini import RuntimeIni
+
 __all__ = ["ControllerSpec", "LaunchError", "Launcher", "ProjectRun", "RunOptions", "WebotsProjects", "WorldPlan",
            "after_run", "exit_status", "find_controller", "plan", "plan_world", "proto_projects", "robot_protos",
            "run_project"]
@@ -62,6 +65,8 @@ class ControllerSpec:
     python: bool
     args: tuple[str, ...] = ()
     webots: bool = False       # found in Webots' own projects (--webots-home)
+    runtime: RuntimeIni | None = None      # its folder's runtime.ini (environment variables, [python] COMMAND)
+    notes: tuple[str, ...] = ()            # lines to say about it when the world starts
 
 
 def controller_dirs(world: Path, extra: list[Path], projects: Sequence[Path] = ()) -> list[Path]:
@@ -152,12 +157,11 @@ def _in_folder(robot: str, name: str, args: list[str], folder: Path) -> Controll
     for kind, path in candidates:
         if not path.is_file():
             continue
-        if kind == "py":
-            return ControllerSpec(robot, name, folder, path, True, tuple(args))
-        if kind == "exe":
-            if not os.access(path, os.X_OK):
-                raise LaunchError(f"robot {robot!r}: controller {path} is not executable (chmod +x)")
-            return ControllerSpec(robot, name, folder, path, False, tuple(args))
+        if kind == "exe" and not os.access(path, os.X_OK):
+            raise LaunchError(f"robot {robot!r}: controller {path} is not executable (chmod +x)")
+        if kind in ("py", "exe"):
+            ini, notes = _runtime_ini(robot, folder)
+            return ControllerSpec(robot, name, folder, path, kind == "py", tuple(args), runtime=ini, notes=notes)
         raise LaunchError(f"robot {robot!r}: controller {path} is {UNSUPPORTED[kind]}, which Sensorium does not "
                           "run (Python controllers and executables run; start it as an <extern> controller)")
     hint = ""
@@ -165,6 +169,18 @@ def _in_folder(robot: str, name: str, args: list[str], folder: Path) -> Controll
         hint = " (its C/C++ source is there: compile it against sensorium/client/c)"
     raise LaunchError(f"robot {robot!r}: controller {name!r}: {folder} has none of {name}, {name}.py "
                       f"(nor {name}.class, .jar, .m, .bsg, Dockerfile){hint}")
+
+
+def _runtime_ini(robot: str, folder: Path) -> tuple[RuntimeIni | None, tuple[str, ...]]:
+    """The folder's runtime.ini and the lines to say about it (a file Webots would not read is one
+    line, and the controller starts without it, as Webots' does)."""
+    try:
+        ini = runtime_ini.read(folder)
+    except runtime_ini.RuntimeIniError as exc:
+        return None, (f"robot '{robot}': {exc}; the controller starts without it",)
+    if ini is None:
+        return None, ()
+    return ini, tuple(f"robot '{robot}': {folder / runtime_ini.FILE}: {line}" for line in ini.notes())
 
 
 def find_controller(robot: str, name: str, args: list[str], dirs: list[Path], webots: WebotsProjects | None = None,
@@ -226,10 +242,10 @@ def proto_projects(world: Path, text: str, protos: dict[str, str]) -> dict[str, 
         files.setdefault(path.stem, path)
     out: dict[str, Path] = {}
     for robot, proto in protos.items():
-        path = files.get(proto)
-        if path is None:
+        file = files.get(proto)
+        if file is None:
             continue
-        for folder in path.parents:
+        for folder in file.parents:
             if folder.name == "protos":
                 out[robot] = folder.parent
                 break
@@ -303,6 +319,7 @@ def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: Webots
     started = {s.robot for s in specs}
     missing = tuple((r.name, r.controller) for r in robots if r.controller not in SPECIAL and r.name not in started)
     notes = [f"robot '{s.robot}': controller '{s.name}' found in Webots' projects: {s.program}" for s in specs if s.webots]
+    notes += [line for s in specs for line in s.notes]
     for r in robots:
         if r.controller == "<generic>":
             which = "no controller field, so Webots' default '<generic>'" if r.default else "controller '<generic>'"
@@ -412,13 +429,24 @@ class Launcher:
         stream.close()
 
     # ------------------------------------------------------------------ processes
-    def _command(self, spec: ControllerSpec) -> list[str]:
-        if spec.python:   # as `sensorium controller` runs it: `controller` importable, its folder as cwd
-            return [sys.executable, "-m", "sensorium", "controller", str(spec.program), "--", *spec.args]
+    @staticmethod
+    def command(spec: ControllerSpec) -> list[str]:
+        """The controller's command line: a Python one as `sensorium controller` runs it (`controller`
+        importable, its folder as cwd), with runtime.ini's [python] COMMAND and OPTIONS as Webots
+        takes them (else this interpreter); an executable as itself."""
+        if spec.python:
+            ini = spec.runtime
+            python = (ini.python("COMMAND") if ini else None) or sys.executable
+            options = ((ini.python("OPTIONS") if ini else None) or "").split()
+            return [python, *options, "-m", "sensorium", "controller", str(spec.program), "--", *spec.args]
         return [str(spec.program), *spec.args]
 
-    def _environment(self, spec: ControllerSpec) -> dict[str, str]:
-        env = dict(os.environ)
+    def environment(self, spec: ControllerSpec, base: dict[str, str] | None = None) -> dict[str, str]:
+        """The controller's environment: ``base`` (this process's), its runtime.ini's variables, then
+        what it needs here: the URL, Webots' variables, Sensorium on the Python and library paths."""
+        env = dict(os.environ if base is None else base)
+        if spec.runtime is not None:
+            env = runtime_ini.environment(spec.runtime, env)
         env["SENSORIUM_CONTROLLER_URL"] = f"{self.url.rstrip('/')}/{quote(spec.robot, safe='')}"   # both clients decode it
         env.pop("WEBOTS_CONTROLLER_URL", None)
         env["WEBOTS_ROBOT_NAME"] = spec.robot     # as Webots sets it for every controller it starts
@@ -428,8 +456,8 @@ class Launcher:
         env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH", "")) if p)
         # as Webots: the controller's folder first on the library path (a shared library shipped next to
         # the controller loads), and our libController where Webots puts its own
-        libraries = [str(spec.folder), *([str(C_LIBRARY)] if not spec.python and C_LIBRARY.is_dir() else []),
-                     env.get("LD_LIBRARY_PATH", "")]
+        libraries = [env.get("WEBOTS_LIBRARY_PATH", ""), str(spec.folder),
+                     *([str(C_LIBRARY)] if not spec.python and C_LIBRARY.is_dir() else []), env.get("LD_LIBRARY_PATH", "")]
         env["LD_LIBRARY_PATH"] = os.pathsep.join(dict.fromkeys(p for p in libraries if p))
         return env
 
@@ -441,7 +469,7 @@ class Launcher:
                 return
         self._starting.add(robot)
         try:
-            proc = subprocess.Popen(self._command(spec), cwd=spec.folder, env=self._environment(spec),
+            proc = subprocess.Popen(self.command(spec), cwd=spec.folder, env=self.environment(spec),
                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                     start_new_session=True)    # its own group: ended by us, with its children
         except OSError as exc:

@@ -10,6 +10,7 @@ import shutil
 import signal
 import stat
 import subprocess
+import sys
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -812,3 +813,23 @@ def test_a_proto_robots_controller_is_found_in_the_protos_project(tmp_path: Path
     got = launch.plan_world([WorldRobot(name="bee", controller="bee_ctl")], dirs, "tcp://127.0.0.1:5555",
                             projects={"bee": shared})
     assert [s.folder for s in got.specs] == [shared / "controllers" / "bee_ctl"]
+
+
+def test_a_controllers_runtime_ini_sets_its_environment_and_python(tmp_path: Path) -> None:
+    """As Webots: the controller folder's runtime.ini adds a shared library folder to PYTHONPATH
+    (relative to the controller's folder), sets variables, and names the Python to run it with."""
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "shared_mod.py").write_text('WORD = "shared"\n')
+    wrapper = tmp_path / "python-wrapper"
+    wrapper.write_text(f'#!/bin/sh\necho "wrapped python" >&2\nexec "{sys.executable}" "$@"\n')
+    wrapper.chmod(0o755)
+    script = ('import os, sys\nimport shared_mod\nfrom controller import Robot\nrobot = Robot()\n'
+              'print(shared_mod.WORD, os.environ["GREETING"], sys.flags.dont_write_bytecode)\n')
+    world = project(tmp_path, 'Robot { name "alpha" controller "c" }', {"c.py": script})
+    (tmp_path / "controllers" / "c" / "runtime.ini").write_text(
+        '[environment variables with paths]\nPYTHONPATH = $(PYTHONPATH):../../lib\n'
+        f'[environment variables]\nGREETING = "hello; world" ; a comment\n[python]\nCOMMAND = {wrapper}\nOPTIONS = -B\n')
+    proc = run(world, "--until", "160")
+    assert proc.wait() == 0, proc.stderr()
+    assert "[alpha] shared hello; world 1" in proc.stdout().splitlines()
+    assert "[alpha] wrapped python" in proc.stderr().splitlines()
