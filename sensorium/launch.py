@@ -40,6 +40,7 @@ __all__ = ["ControllerSpec", "LaunchError", "Launcher", "ProjectRun", "RunOption
 WEBOTS_DEPTH = 6         # folders under a Webots installation's projects/ where controllers/ folders are looked for
 WEBOTS_MAX_DIRS = 20000  # folders of that tree indexed at most
 EXTRA_ENV = "WEBOTS_EXTRA_PROJECT_PATH"   # Webots' extra project folders (each with controllers/, protos/)
+LIBRARIES_MAX = 256      # folders of a project's libraries/ put on a controller's library path at most
 EXTRA_MAX = 64           # extra project folders read at most (each costs one look-up per controller)
 WEBOTS_SKIP = frozenset({"protos", "worlds", "plugins", "libraries", "textures", "meshes", "icons", "docs", "build"})
 # Webots' WbController: a controller gets the quit packet (-1), then 1 s to end before it is terminated
@@ -67,6 +68,7 @@ class ControllerSpec:
     webots: bool = False       # found in Webots' own projects (--webots-home)
     runtime: RuntimeIni | None = None      # its folder's runtime.ini (environment variables, [python] COMMAND)
     notes: tuple[str, ...] = ()            # lines to say about it when the world starts
+    libraries: tuple[Path, ...] = ()       # the projects' libraries/ folders, for its library path
 
 
 def controller_dirs(world: Path, extra: list[Path], projects: Sequence[Path] = ()) -> list[Path]:
@@ -265,11 +267,28 @@ def plan(robots: list[Any], dirs: list[Path], webots: WebotsProjects | None = No
         own = (projects or {}).get(r.name)
         robot_dirs = list(dict.fromkeys([dirs[0], own / "controllers", *dirs[1:]])) if own is not None and dirs else dirs
         try:
-            specs.append(find_controller(r.name, r.controller, list(r.controller_args), robot_dirs, webots,
-                                         (protos or {}).get(r.name)))
+            spec = find_controller(r.name, r.controller, list(r.controller_args), robot_dirs, webots,
+                                   (protos or {}).get(r.name))
         except LaunchError as exc:
             problems.append(str(exc))
+            continue
+        roots = [dirs[0].parent] if dirs else []
+        specs.append(dataclasses.replace(spec, libraries=library_folders([*roots, *([own] if own else [])])))
     return specs, problems
+
+
+def library_folders(projects: list[Path]) -> tuple[Path, ...]:
+    """The folders of each project's ``libraries/`` (at most :data:`LIBRARIES_MAX` of each, by name),
+    which Webots puts on a controller's library path: the world's project, then the robot's
+    PROTO's."""
+    out: list[Path] = []
+    for project in projects:
+        try:
+            names = sorted(e.name for e in os.scandir(project / "libraries") if e.is_dir())
+        except OSError:
+            continue
+        out.extend(project / "libraries" / n for n in names[:LIBRARIES_MAX])
+    return tuple(dict.fromkeys(out))
 
 
 @dataclass(frozen=True)
@@ -454,9 +473,9 @@ class Launcher:
         env["PYTHONIOENCODING"] = "UTF-8"        # as Webots sets it
         package_root = str(Path(__file__).resolve().parent.parent)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH", "")) if p)
-        # as Webots: the controller's folder first on the library path (a shared library shipped next to
-        # the controller loads), and our libController where Webots puts its own
-        libraries = [env.get("WEBOTS_LIBRARY_PATH", ""), str(spec.folder),
+        # as Webots: the project's libraries/ folders, WEBOTS_LIBRARY_PATH, the controller's folder (a shared
+        # library shipped next to the controller loads) first on the library path, then our libController
+        libraries = [*(str(p) for p in spec.libraries), env.get("WEBOTS_LIBRARY_PATH", ""), str(spec.folder),
                      *([str(C_LIBRARY)] if not spec.python and C_LIBRARY.is_dir() else []), env.get("LD_LIBRARY_PATH", "")]
         env["LD_LIBRARY_PATH"] = os.pathsep.join(dict.fromkeys(p for p in libraries if p))
         return env

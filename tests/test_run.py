@@ -448,14 +448,20 @@ def test_webots_robot_name_is_set_for_a_controller_and_chooses_the_robot_of_a_ur
 
 
 def test_a_controller_gets_webots_variables_and_its_folder_on_the_library_path(tmp_path: Path) -> None:
-    """WEBOTS_ROBOT_NAME, and the controller's folder first on LD_LIBRARY_PATH (a shared library
-    shipped next to a controller loads), as Webots starts a controller."""
+    """WEBOTS_ROBOT_NAME; on LD_LIBRARY_PATH the project's libraries/ folders, WEBOTS_LIBRARY_PATH
+    and the controller's folder (a shared library shipped next to a controller loads) before the
+    rest, as Webots starts a controller."""
     script = ('import os\nfrom controller import Robot\nrobot = Robot()\n'
-              'print(os.environ["WEBOTS_ROBOT_NAME"], os.environ["LD_LIBRARY_PATH"].split(os.pathsep)[0])\n')
+              'print(os.environ["WEBOTS_ROBOT_NAME"], *os.environ["LD_LIBRARY_PATH"].split(os.pathsep))\n')
     world = project(tmp_path, 'Robot { name "alpha beta" controller "env" }', {"env.py": script})
-    proc = run(world, "--until", "160", env={"WEBOTS_ROBOT_NAME": "stale", "LD_LIBRARY_PATH": "/nowhere"})
+    for name in ("b_lib", "a_lib"):
+        (tmp_path / "libraries" / name).mkdir(parents=True)
+    (tmp_path / "libraries" / "not_a_folder").write_text("")
+    proc = run(world, "--until", "160", env={"WEBOTS_ROBOT_NAME": "stale", "LD_LIBRARY_PATH": "/nowhere",
+                                             "WEBOTS_LIBRARY_PATH": "/mine"})
     assert proc.wait() == 0, proc.stderr()
-    assert f"[alpha beta] alpha beta {tmp_path / 'controllers' / 'env'}" in proc.stdout().splitlines()
+    assert (f"[alpha beta] alpha beta {tmp_path / 'libraries' / 'a_lib'} {tmp_path / 'libraries' / 'b_lib'} /mine "
+            f"{tmp_path / 'controllers' / 'env'} /nowhere") in proc.stdout().splitlines()
 
 
 UNDER_SERVE = '''from controller import Supervisor
