@@ -626,7 +626,7 @@ class Launcher:
 @dataclass(frozen=True)
 class RunOptions:
     """What ``sensorium run`` takes besides the world file. ``serve`` is the server's
-    :class:`~sensorium.server.daemon.serve.ServeOptions`; ``webots_home`` the installation whose
+    :class:`~sensorium.server.daemon.serve.ServeOptions` (None: its defaults); ``webots_home`` the installation whose
     projects hold stock controllers (None: not looked at)."""
 
     serve: Any = None
@@ -718,6 +718,9 @@ class ProjectRun:
     def run(self, *, signals: bool = True) -> int:
         """Run to the end; ``signals``: SIGINT/SIGTERM end it (when called in the main thread; from
         another thread, end it with :meth:`stop`)."""
+        if self.options.serve is None:              # serve's defaults
+            from sensorium.server.daemon.serve import ServeOptions
+            self.options = dataclasses.replace(self.options, serve=ServeOptions())
         server = self._open(self.options.serve)
         if server is None:
             return 1
