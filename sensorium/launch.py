@@ -3,34 +3,45 @@ every robot's controller named in it, print their output with the robot's name, 
 ``restartController``, reload the world on ``worldReload``, end them all at the end.
 
 Where a controller is found, as Webots' WbController does for a project: ``controllers/NAME/`` next to
-the world's ``worlds/`` folder (then each ``--controllers-dir``); in that folder the first of
+the world's ``worlds/`` folder (then the robot's PROTO's project, for a PROTO the world declares by
+a file path; then each ``--controllers-dir``, then each extra project's
+``controllers/NAME/``: ``$WEBOTS_EXTRA_PROJECT_PATH``, ``--extra-project-path``); in that folder the first of
 ``Dockerfile``, ``NAME`` (an executable), ``build/release/NAME``, ``NAME.class``, ``NAME.jar``,
 ``NAME.py``, ``NAME.m``, ``NAME.bsg``. Python and executables run (as ``sensorium controller`` runs
 them: the controller's folder as working directory, ``controllerArgs`` as arguments, the URL in the
 environment); the others are refused with one line. With ``--webots-home`` (or ``$WEBOTS_HOME``) a
-controller not found there is looked for in Webots' own projects (:class:`WebotsProjects`); extra
-project paths are not searched.
+controller not found there is looked for in Webots' own projects (:class:`WebotsProjects`).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import os
+import re
 import signal
 import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import IO, Any
 from urllib.parse import quote
 
-__all__ = ["ControllerSpec", "LaunchError", "Launcher", "WebotsProjects", "find_controller", "plan", "robot_protos"]
+from sensorium import runtime_ini
+from sensorium.runtime_ini import RuntimeIni
+
+__all__ = ["ControllerSpec", "LaunchError", "Launcher", "ProjectRun", "RunOptions", "WebotsProjects", "WorldPlan",
+           "after_run", "exit_status", "find_controller", "plan", "plan_world", "proto_projects", "robot_protos",
+           "run_project"]
 
 WEBOTS_DEPTH = 6         # folders under a Webots installation's projects/ where controllers/ folders are looked for
 WEBOTS_MAX_DIRS = 20000  # folders of that tree indexed at most
+EXTRA_ENV = "WEBOTS_EXTRA_PROJECT_PATH"   # Webots' extra project folders (each with controllers/, protos/)
+LIBRARIES_MAX = 256      # folders of a project's libraries/ put on a controller's library path at most
+EXTRA_MAX = 64           # extra project folders read at most (each costs one look-up per controller)
 WEBOTS_SKIP = frozenset({"protos", "worlds", "plugins", "libraries", "textures", "meshes", "icons", "docs", "build"})
 # Webots' WbController: a controller gets the quit packet (-1), then 1 s to end before it is terminated
 GRACE_S = 1.0
@@ -55,12 +66,23 @@ class ControllerSpec:
     python: bool
     args: tuple[str, ...] = ()
     webots: bool = False       # found in Webots' own projects (--webots-home)
+    runtime: RuntimeIni | None = None      # its folder's runtime.ini (environment variables, [python] COMMAND)
+    notes: tuple[str, ...] = ()            # lines to say about it when the world starts
+    libraries: tuple[Path, ...] = ()       # the projects' libraries/ folders, for its library path
 
 
-def controller_dirs(world: Path, extra: list[Path]) -> list[Path]:
+def controller_dirs(world: Path, extra: list[Path], projects: Sequence[Path] = ()) -> list[Path]:
     """Where controllers are looked for: the project's ``controllers/`` (the world's folder's parent),
-    then ``--controllers-dir`` folders in their order."""
-    return [world.resolve().parent.parent / "controllers", *(Path(d).resolve() for d in extra)]
+    then ``--controllers-dir`` folders in their order, then each extra project's ``controllers/``."""
+    return [world.resolve().parent.parent / "controllers", *(Path(d).resolve() for d in extra),
+            *(Path(p).resolve() / "controllers" for p in projects)]
+
+
+def extra_project_paths(value: str | None) -> list[Path]:
+    """Webots' extra project paths from ``value`` (``$WEBOTS_EXTRA_PROJECT_PATH``: folders separated
+    like ``PATH``), in their order, each once, at most :data:`EXTRA_MAX`."""
+    paths = [Path(p).expanduser().absolute() for p in (value or "").split(os.pathsep) if p]
+    return list(dict.fromkeys(paths))[:EXTRA_MAX]
 
 
 class WebotsProjects:
@@ -137,12 +159,11 @@ def _in_folder(robot: str, name: str, args: list[str], folder: Path) -> Controll
     for kind, path in candidates:
         if not path.is_file():
             continue
-        if kind == "py":
-            return ControllerSpec(robot, name, folder, path, True, tuple(args))
-        if kind == "exe":
-            if not os.access(path, os.X_OK):
-                raise LaunchError(f"robot {robot!r}: controller {path} is not executable (chmod +x)")
-            return ControllerSpec(robot, name, folder, path, False, tuple(args))
+        if kind == "exe" and not os.access(path, os.X_OK):
+            raise LaunchError(f"robot {robot!r}: controller {path} is not executable (chmod +x)")
+        if kind in ("py", "exe"):
+            ini, notes = _runtime_ini(robot, folder)
+            return ControllerSpec(robot, name, folder, path, kind == "py", tuple(args), runtime=ini, notes=notes)
         raise LaunchError(f"robot {robot!r}: controller {path} is {UNSUPPORTED[kind]}, which Sensorium does not "
                           "run (Python controllers and executables run; start it as an <extern> controller)")
     hint = ""
@@ -150,6 +171,18 @@ def _in_folder(robot: str, name: str, args: list[str], folder: Path) -> Controll
         hint = " (its C/C++ source is there: compile it against sensorium/client/c)"
     raise LaunchError(f"robot {robot!r}: controller {name!r}: {folder} has none of {name}, {name}.py "
                       f"(nor {name}.class, .jar, .m, .bsg, Dockerfile){hint}")
+
+
+def _runtime_ini(robot: str, folder: Path) -> tuple[RuntimeIni | None, tuple[str, ...]]:
+    """The folder's runtime.ini and the lines to say about it (a file Webots would not read is one
+    line, and the controller starts without it, as Webots' does)."""
+    try:
+        ini = runtime_ini.read(folder)
+    except runtime_ini.RuntimeIniError as exc:
+        return None, (f"robot '{robot}': {exc}; the controller starts without it",)
+    if ini is None:
+        return None, ()
+    return ini, tuple(f"robot '{robot}': {folder / runtime_ini.FILE}: {line}" for line in ini.notes())
 
 
 def find_controller(robot: str, name: str, args: list[str], dirs: list[Path], webots: WebotsProjects | None = None,
@@ -195,19 +228,145 @@ def robot_protos(world: Any) -> dict[str, str]:
     return out
 
 
+_EXTERNPROTO = re.compile(r'^[ \t]*(?:IMPORTABLE[ \t]+)?EXTERNPROTO[ \t]+"([^"\n]+)"', re.MULTILINE)
+
+
+def proto_projects(world: Path, text: str, protos: dict[str, str]) -> dict[str, Path]:
+    """Each robot whose PROTO (``protos``: robot -> PROTO name) the ``.wbt`` world ``text`` declares
+    by a file path (relative to the world's folder, or absolute; not ``webots://`` nor ``https://``)
+    -> that PROTO's project: the folder above the nearest ``protos`` folder holding the file, where
+    Webots looks for the robot's controller right after the world's own project."""
+    files: dict[str, Path] = {}
+    for url in _EXTERNPROTO.findall(text):
+        if "://" in url or not url.endswith(".proto"):
+            continue
+        path = Path(os.path.normpath(world.resolve().parent / url))      # the url's own "..", as Webots reads it
+        files.setdefault(path.stem, path)
+    out: dict[str, Path] = {}
+    for robot, proto in protos.items():
+        file = files.get(proto)
+        if file is None:
+            continue
+        for folder in file.parents:
+            if folder.name == "protos":
+                out[robot] = folder.parent
+                break
+    return out
+
+
 def plan(robots: list[Any], dirs: list[Path], webots: WebotsProjects | None = None,
-         protos: dict[str, str] | None = None) -> tuple[list[ControllerSpec], list[str]]:
-    """The controllers to start for the world's robots, and every problem (one line each)."""
+         protos: dict[str, str] | None = None,
+         projects: dict[str, Path] | None = None) -> tuple[list[ControllerSpec], list[str]]:
+    """The controllers to start for the world's robots, and every problem (one line each).
+    ``projects``: a robot's PROTO's project (:func:`proto_projects`), looked in right after the
+    world's own (``dirs[0]``), as Webots does."""
     specs, problems = [], []
     for r in robots:
         if r.controller in SPECIAL:
             continue
+        own = (projects or {}).get(r.name)
+        robot_dirs = list(dict.fromkeys([dirs[0], own / "controllers", *dirs[1:]])) if own is not None and dirs else dirs
         try:
-            specs.append(find_controller(r.name, r.controller, list(r.controller_args), dirs, webots,
-                                         (protos or {}).get(r.name)))
+            spec = find_controller(r.name, r.controller, list(r.controller_args), robot_dirs, webots,
+                                   (protos or {}).get(r.name))
         except LaunchError as exc:
             problems.append(str(exc))
+            continue
+        roots = [dirs[0].parent] if dirs else []
+        specs.append(dataclasses.replace(spec, libraries=library_folders([*roots, *([own] if own else [])])))
     return specs, problems
+
+
+def library_folders(projects: list[Path]) -> tuple[Path, ...]:
+    """The folders of each project's ``libraries/`` (at most :data:`LIBRARIES_MAX` of each, by name),
+    which Webots puts on a controller's library path: the world's project, then the robot's
+    PROTO's."""
+    out: list[Path] = []
+    for project in projects:
+        try:
+            names = sorted(e.name for e in os.scandir(project / "libraries") if e.is_dir())
+        except OSError:
+            continue
+        out.extend(project / "libraries" / n for n in names[:LIBRARIES_MAX])
+    return tuple(dict.fromkeys(out))
+
+
+@dataclass(frozen=True)
+class WorldPlan:
+    """What ``run`` does with one load of a world: the controllers to start, the problems (one line
+    each) and the robots they leave without a controller, the lines to say when it starts, and
+    which robots the world waits for without a controller of ours (as Webots waits for a
+    synchronous ``<extern>`` one)."""
+
+    specs: tuple[ControllerSpec, ...]
+    problems: tuple[str, ...]
+    notes: tuple[str, ...]
+    extern_waited: frozenset[str]          # synchronous <extern> robots: waited for until attached
+    extern_synchronous: tuple[str, ...]    # robots waited for while none of them is attached
+    missing: tuple[tuple[str, str], ...] = ()   # (robot, controller) of each problem: it runs without one
+
+
+@dataclass(frozen=True)
+class _Robot:
+    """A robot as ``run`` sees it: its controller as Webots reads the world."""
+
+    name: str
+    controller: str
+    controller_args: tuple[str, ...]
+    synchronization: bool
+    default: bool = False          # no controller field in the .wbt: Webots' default, <generic>
+
+
+def _as_webots(robot: Any, wbt: bool) -> _Robot:
+    """``robot`` with Webots' default controller when a ``.wbt`` world gives it none: ``<generic>``
+    (Sensorium's loader makes such a robot ``<extern>``, what ``serve`` waits for)."""
+    given = getattr(robot, "model_fields_set", None)
+    default = wbt and given is not None and "controller" not in given
+    return _Robot(robot.name, "<generic>" if default else robot.controller, tuple(robot.controller_args),
+                  bool(robot.synchronization), default)
+
+
+def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: WebotsProjects | None = None,
+               protos: dict[str, str] | None = None, wbt: bool = False,
+               projects: dict[str, Path] | None = None) -> WorldPlan:
+    """The plan for ``robots`` (a loaded world's: ``name``, ``controller``, ``controller_args``,
+    ``synchronization``) served at ``rpc_url``; no process is started. ``wbt``: the world is a
+    ``.wbt`` file, where a robot without a ``controller`` field has Webots' ``<generic>``;
+    ``projects``: robots' PROTO projects (:func:`proto_projects`)."""
+    robots = [_as_webots(r, wbt) for r in robots]
+    specs, problems = plan(robots, dirs, webots, protos, projects)
+    started = {s.robot for s in specs}
+    missing = tuple((r.name, r.controller) for r in robots if r.controller not in SPECIAL and r.name not in started)
+    notes = [f"robot '{s.robot}': controller '{s.name}' found in Webots' projects: {s.program}" for s in specs if s.webots]
+    notes += [line for s in specs for line in s.notes]
+    for r in robots:
+        if r.controller == "<generic>":
+            which = "no controller field, so Webots' default '<generic>'" if r.default else "controller '<generic>'"
+            notes.append(f"robot '{r.name}': {which} (Webots' one only steps): the robot runs without a controller")
+        elif r.controller == "<extern>":
+            notes.append(f"robot '{r.name}' is <extern>: attach its controller with `sensorium controller SCRIPT "
+                         f"--robot {r.name} --url {rpc_url}`")
+    # as Webots, the world waits for every synchronous <extern> robot's controller too (while none is
+    # attached); a robot whose controller ended, could not be found, or is <generic> is uncontrolled:
+    # the world goes on without it, as Webots' goes on with its generic controller stepping
+    return WorldPlan(tuple(specs), tuple(problems), tuple(notes),
+                     frozenset(r.name for r in robots if r.controller == "<extern>" and r.synchronization),
+                     tuple(r.name for r in robots if r.controller == "<extern>" and r.synchronization), missing)
+
+
+def after_run(reload_requested: bool, interrupted: bool, quit_status: int | None) -> bool:
+    """Whether the world is loaded again once its server stopped: only for a ``worldReload``, not
+    when the run was interrupted (Ctrl-C, SIGTERM, :meth:`ProjectRun.stop`) or quit
+    (``simulationQuit``) meanwhile; ``--until`` stops without a reload request."""
+    return reload_requested and not interrupted and quit_status is None
+
+
+def exit_status(quit_status: int | None, missing: bool = False) -> int:
+    """``run``'s exit status: ``simulationQuit(status)``'s low 8 bits, as Webots exits, when not 0;
+    else 1 when a robot ran without the controller its world names (``missing``: a CI job must not
+    pass by a run that was not the one its world describes); else 0."""
+    status = 0 if quit_status is None else quit_status & 0xFF
+    return status or (1 if missing else 0)
 
 
 def _describe(code: int) -> str:
@@ -256,6 +415,7 @@ class Launcher:
         self.reload_requested = False
         self.on_reload: Callable[[], None] | None = None     # stops the server (run's loop reloads)
         self._starting: set[str] = set()         # the lockstep's: the world waits until these attach
+        self.failed: dict[str, str] = {}          # robot -> controller whose process could not be started
         self._wake_server: Callable[[], None] = lambda: None
         self._quitting: Callable[[], bool] = lambda: False
         self._worker = threading.Thread(target=self._work, name="sensorium-launcher", daemon=True)
@@ -288,21 +448,36 @@ class Launcher:
         stream.close()
 
     # ------------------------------------------------------------------ processes
-    def _command(self, spec: ControllerSpec) -> list[str]:
-        if spec.python:   # as `sensorium controller` runs it: `controller` importable, its folder as cwd
-            return [sys.executable, "-m", "sensorium", "controller", str(spec.program), "--", *spec.args]
+    @staticmethod
+    def command(spec: ControllerSpec) -> list[str]:
+        """The controller's command line: a Python one as `sensorium controller` runs it (`controller`
+        importable, its folder as cwd), with runtime.ini's [python] COMMAND and OPTIONS as Webots
+        takes them (else this interpreter); an executable as itself."""
+        if spec.python:
+            ini = spec.runtime
+            python = (ini.python("COMMAND") if ini else None) or sys.executable
+            options = ((ini.python("OPTIONS") if ini else None) or "").split()
+            return [python, *options, "-m", "sensorium", "controller", str(spec.program), "--", *spec.args]
         return [str(spec.program), *spec.args]
 
-    def _environment(self, spec: ControllerSpec) -> dict[str, str]:
-        env = dict(os.environ)
+    def environment(self, spec: ControllerSpec, base: dict[str, str] | None = None) -> dict[str, str]:
+        """The controller's environment: ``base`` (this process's), its runtime.ini's variables, then
+        what it needs here: the URL, Webots' variables, Sensorium on the Python and library paths."""
+        env = dict(os.environ if base is None else base)
+        if spec.runtime is not None:
+            env = runtime_ini.environment(spec.runtime, env)
         env["SENSORIUM_CONTROLLER_URL"] = f"{self.url.rstrip('/')}/{quote(spec.robot, safe='')}"   # both clients decode it
         env.pop("WEBOTS_CONTROLLER_URL", None)
+        env["WEBOTS_ROBOT_NAME"] = spec.robot     # as Webots sets it for every controller it starts
         env["PYTHONUNBUFFERED"] = "1"            # lines reach the console as they are printed
         env["PYTHONIOENCODING"] = "UTF-8"        # as Webots sets it
         package_root = str(Path(__file__).resolve().parent.parent)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH", "")) if p)
-        if not spec.python and C_LIBRARY.is_dir():   # Webots puts its libController on the path likewise
-            env["LD_LIBRARY_PATH"] = os.pathsep.join(p for p in (str(C_LIBRARY), env.get("LD_LIBRARY_PATH", "")) if p)
+        # as Webots: the project's libraries/ folders, WEBOTS_LIBRARY_PATH, the controller's folder (a shared
+        # library shipped next to the controller loads) first on the library path, then our libController
+        libraries = [*(str(p) for p in spec.libraries), env.get("WEBOTS_LIBRARY_PATH", ""), str(spec.folder),
+                     *([str(C_LIBRARY)] if not spec.python and C_LIBRARY.is_dir() else []), env.get("LD_LIBRARY_PATH", "")]
+        env["LD_LIBRARY_PATH"] = os.pathsep.join(dict.fromkeys(p for p in libraries if p))
         return env
 
     def start(self, robot: str) -> None:
@@ -313,11 +488,13 @@ class Launcher:
                 return
         self._starting.add(robot)
         try:
-            proc = subprocess.Popen(self._command(spec), cwd=spec.folder, env=self._environment(spec),
+            proc = subprocess.Popen(self.command(spec), cwd=spec.folder, env=self.environment(spec),
                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                     start_new_session=True)    # its own group: ended by us, with its children
         except OSError as exc:
-            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {exc.strerror or exc}")
+            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {exc.strerror or exc}: the robot "
+                     "runs without a controller")
+            self.failed[robot] = spec.name
             self._starting.discard(robot)
             self._wake_server()
             return
@@ -444,3 +621,171 @@ class Launcher:
         self._wake.set()
         self._worker.join()
         self.end_all()
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What ``sensorium run`` takes besides the world file. ``serve`` is the server's
+    :class:`~sensorium.server.daemon.serve.ServeOptions` (None: its defaults); ``webots_home`` the installation whose
+    projects hold stock controllers (None: not looked at)."""
+
+    serve: Any = None
+    controllers_dirs: tuple[Path, ...] = ()
+    extra_projects: tuple[Path, ...] = ()     # Webots' extra project paths (a folder that is none is said, skipped)
+    webots_home: Path | None = None
+    grace_s: float = GRACE_S
+    require_controllers: bool = False          # a controller that cannot be started: exit 1 before the world runs
+
+    def check(self, world: Path) -> None:
+        """Raise ValueError naming the first bad option (one line)."""
+        if not Path(world).is_file():
+            raise ValueError(f"no world file {world}")
+        if not 0 <= self.grace_s < float("inf"):
+            raise ValueError(f"--grace must be a finite number >= 0, got {self.grace_s}")
+        for d in self.controllers_dirs:
+            if not Path(d).is_dir():
+                raise ValueError(f"--controllers-dir {d}: no such folder")
+        if self.serve is not None:
+            self.serve.check()
+
+
+class ProjectRun:
+    """One ``sensorium run``: serve ``world``, start its controllers (:class:`Launcher`), reload on
+    ``worldReload``, end everything at the end. :meth:`run` blocks and returns the exit status;
+    :meth:`stop` (any thread, a signal handler) ends it as Ctrl-C does. Lines go to ``out`` (the
+    ready line, the controllers' stdout) and ``err`` (everything else)."""
+
+    def __init__(self, world: str | Path, options: RunOptions, *, out: IO[str] | None = None,
+                 err: IO[str] | None = None):
+        self.world = Path(world)
+        self.options = options
+        self.out = out or sys.stdout
+        self.err = err or sys.stderr
+        self.projects = [p for p in options.extra_projects if p.is_dir()]
+        self.dirs = controller_dirs(self.world, list(options.controllers_dirs), self.projects)
+        home = options.webots_home
+        self.webots = WebotsProjects(home) if home is not None and Path(home).is_dir() else None
+        self.interrupted = False
+        self.missing: dict[str, str] = {}      # robot -> controller it ran without (every load of the world)
+        self._server: Any = None
+
+    def stop(self) -> None:
+        self.interrupted = True
+        if self._server is not None:
+            self._server.stop()
+
+    def _say(self, text: str) -> None:
+        print(text, file=self.err, flush=True)
+
+    def _open(self, serve: Any) -> Any:
+        """The world's server, or None (its problem said)."""
+        import zmq
+
+        from sensorium.cli.serve import bind_problem
+        from sensorium.server.daemon.serve import Server
+        from sensorium.server.world.loader import WorldError
+        try:
+            return Server.open(self.world, serve)
+        except WorldError as exc:
+            self._say(str(exc))
+        except (OSError, zmq.ZMQError) as exc:
+            self._say(f"sensorium run: {bind_problem(exc)}")
+        return None
+
+    def _plan(self, server: Any) -> WorldPlan | None:
+        """The plan for ``server``'s world, or None (server closed, every problem said)."""
+        loaded = server.core.sim.loaded.world
+        protos = robot_protos(loaded)
+        wbt = self.world.suffix.lower() == ".wbt"
+        projects = {}
+        if wbt and protos:
+            try:
+                projects = proto_projects(self.world, self.world.read_text(encoding="utf-8", errors="replace"), protos)
+            except OSError:              # it was read a moment ago: gone since, nothing more to learn from it
+                pass
+        world_plan = plan_world(loaded.robots, self.dirs, server.transport.rpc_endpoint, self.webots, protos, wbt,
+                                projects)
+        if world_plan.problems and self.options.require_controllers:
+            server.close()
+            for line in world_plan.problems:
+                self._say(f"sensorium run: {line}")
+            return None
+        for line in world_plan.problems:      # as Webots (which starts its <generic> controller instead)
+            self._say(f"sensorium run: {line}: the robot runs without a controller")
+        self.missing.update(world_plan.missing)
+        return world_plan
+
+    def run(self, *, signals: bool = True) -> int:
+        """Run to the end; ``signals``: SIGINT/SIGTERM end it (when called in the main thread; from
+        another thread, end it with :meth:`stop`)."""
+        if self.options.serve is None:              # serve's defaults
+            from sensorium.server.daemon.serve import ServeOptions
+            self.options = dataclasses.replace(self.options, serve=ServeOptions())
+        server = self._open(self.options.serve)
+        if server is None:
+            return 1
+        world_plan = self._plan(server)
+        if world_plan is None:
+            return 1
+        report = server.core.sim.loaded.report
+        if report:
+            print(report.text(), file=self.err, flush=True)
+        for p in self.options.extra_projects:
+            if p not in self.projects:
+                self._say(f"sensorium run: extra project path {p} is not a folder: not looked in")
+        launcher = Launcher(list(world_plan.specs), server.transport.rpc_endpoint, out=self.out, err=self.err,
+                            grace_s=self.options.grace_s)
+        self._server = server
+        old_handlers = {}
+        if signals and threading.current_thread() is threading.main_thread():    # Python's signals: main thread only
+            old_handlers = {sig: signal.signal(sig, lambda signum, frame: self.stop())
+                            for sig in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            while True:
+                for line in world_plan.notes:
+                    launcher.log(line)
+                if self.interrupted:       # stopped while the world (re)loaded
+                    break
+                server.core.launcher = launcher
+                lockstep = server.core.lockstep
+                launcher.bind(lockstep.starting, server.transport.wake, partial(getattr, lockstep, "shutting_down"))
+                lockstep.starting.update(world_plan.extern_waited)
+                lockstep.extern_synchronous = list(world_plan.extern_synchronous)
+                launcher.on_reload = server.stop
+                print(server.ready_line, file=self.out, flush=True)
+                launcher.start_all()
+                server.run(signals=False)
+                launcher.end_all()
+                if not after_run(launcher.reload_requested, self.interrupted, server.core.quit_status):
+                    break
+                launcher.reload_requested = False          # worldReload: the same file, time 0, the same endpoints
+                again = dataclasses.replace(self.options.serve, rpc=server.transport.rpc_endpoint,
+                                            pub=server.transport.pub_endpoint)
+                reopened = self._open(again)
+                if reopened is None:
+                    return 1
+                world_plan = self._plan(reopened)          # the file may have changed
+                if world_plan is None:
+                    return 1
+                launcher.replan(list(world_plan.specs))
+                launcher.log(f"world reloaded from {self.world}")
+                server = self._server = reopened
+        finally:
+            launcher.close()
+            for sig, handler in old_handlers.items():
+                signal.signal(sig, handler)
+        core = server.core
+        self._say(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps")
+        missing = {**self.missing, **launcher.failed}
+        status = exit_status(core.quit_status, bool(missing))
+        if missing:
+            names = ", ".join(f"'{robot}' ('{name}')" for robot, name in missing.items())
+            self._say(f"sensorium run: {len(missing)} robot{'s' if len(missing) > 1 else ''} ran without the "
+                      f"controller the world names: {names} (exit status {status}; --require-controllers "
+                      "refuses to start instead)")
+        return status
+
+
+def run_project(world: str | Path, options: RunOptions, *, signals: bool = True) -> int:
+    """``sensorium run WORLD``: run the project to its end (see :class:`ProjectRun`); the exit status."""
+    return ProjectRun(world, options).run(signals=signals)

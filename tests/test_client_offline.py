@@ -129,6 +129,14 @@ def test_controller_url_round_trips_and_env_precedence():
     del env["SENSORIUM_CONTROLLER_URL"]
     assert controller_url_from_env(env) == ControllerURL("tcp://w:1", "webots")
     assert controller_url_from_env({}) == ControllerURL("tcp://127.0.0.1:5560", None)
+    # WEBOTS_ROBOT_NAME names the robot of a URL that names none (Webots sets it for the controllers it
+    # starts; extern controllers before R2022b chose their robot with it), as it is: no percent-decoding
+    assert controller_url_from_env({"WEBOTS_ROBOT_NAME": "beta %41"}) == ControllerURL("tcp://127.0.0.1:5560", "beta %41")
+    assert controller_url_from_env({"WEBOTS_ROBOT_NAME": "b", "WEBOTS_CONTROLLER_URL": "tcp://w:1"}) == \
+        ControllerURL("tcp://w:1", "b")
+    assert controller_url_from_env({"WEBOTS_ROBOT_NAME": "b", "WEBOTS_CONTROLLER_URL": "tcp://w:1/a"}) == \
+        ControllerURL("tcp://w:1", "a")                     # the URL's robot wins
+    assert controller_url_from_env({"WEBOTS_ROBOT_NAME": ""}) == ControllerURL("tcp://127.0.0.1:5560", None)
 
 
 # ====================================================================== connection

@@ -10,13 +10,16 @@ import shutil
 import signal
 import stat
 import subprocess
+import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import pytest
 from _serve import REPO, Proc, run_controller, sensorium, wait_until
 
 from sensorium import launch
 from sensorium.launch import LaunchError, WebotsProjects, find_controller
+from sensorium.schemas.world import Robot as WorldRobot
 
 WORLD = '''#VRML_SIM R2023b utf8
 WorldInfo { basicTimeStep 16 }
@@ -99,17 +102,73 @@ def test_controllers_are_found_in_webots_order_and_others_are_refused(tmp_path: 
                                f"{other / 'gone'}; --webots-home DIR also looks in Webots' own projects)")
 
 
+def robot(name: str, controller: str, *args: str, synchronization: bool = True) -> SimpleNamespace:
+    """A loaded world's robot as the planner reads it."""
+    return SimpleNamespace(name=name, controller=controller, controller_args=list(args), synchronization=synchronization)
+
+
+def test_a_world_is_planned_without_a_process(tmp_path: Path) -> None:
+    """What run does with a world is data: the controllers to start, the problems, the lines to say
+    and the robots waited for, decided before anything starts."""
+    base = tmp_path / "controllers"
+    (base / "a").mkdir(parents=True)
+    (base / "a" / "a.py").write_text("")
+    robots = [robot("alpha", "a", "--fast"), robot("ext", "<extern>"), robot("free", "<extern>", synchronization=False),
+              robot("gen", "<generic>"), robot("off", "<none>"), robot("lost", "nowhere"),
+              WorldRobot(name="bare"), WorldRobot(name="said", controller="<extern>")]
+    got = launch.plan_world(robots, [base], "tcp://127.0.0.1:5555", wbt=True)
+    assert [(s.robot, s.program, s.args) for s in got.specs] == [("alpha", base / "a" / "a.py", ("--fast",))]
+    assert got.problems == (f"robot 'lost': controller 'nowhere' not found (looked for the folder {base / 'nowhere'}; "
+                            "--webots-home DIR also looks in Webots' own projects)",)
+    assert got.notes == (
+        "robot 'ext' is <extern>: attach its controller with `sensorium controller SCRIPT --robot ext --url "
+        "tcp://127.0.0.1:5555`",
+        "robot 'free' is <extern>: attach its controller with `sensorium controller SCRIPT --robot free --url "
+        "tcp://127.0.0.1:5555`",
+        "robot 'gen': controller '<generic>' (Webots' one only steps): the robot runs without a controller",
+        "robot 'bare': no controller field, so Webots' default '<generic>' (Webots' one only steps): the robot runs "
+        "without a controller",
+        "robot 'said' is <extern>: attach its controller with `sensorium controller SCRIPT --robot said --url "
+        "tcp://127.0.0.1:5555`")
+    assert got.extern_waited == {"ext", "said"}
+    # not <generic>, not 'lost', not 'bare' (a .wbt robot without a controller field): the world goes on without them
+    assert got.extern_synchronous == ("ext", "said")
+    assert got.missing == (("lost", "nowhere"),)
+    # in a YAML world a robot without a controller is Sensorium's default, <extern>: waited for
+    assert launch.plan_world([WorldRobot(name="bare")], [base], "tcp://127.0.0.1:5555").extern_synchronous == ("bare",)
+
+
+@pytest.mark.parametrize(("reload", "interrupted", "quit_status", "again", "status", "status_missing"), [
+    (False, False, None, False, 0, 1),        # --until, or the server stopped
+    (True, False, None, True, 0, 1),          # worldReload
+    (True, True, None, False, 0, 1),          # a reload asked, then Ctrl-C: no reload
+    (True, False, 3, False, 3, 3),            # a reload and a simulationQuit(3): the quit wins
+    (False, False, 259, False, 3, 3),         # simulationQuit's low 8 bits, as a process's status
+    (False, False, 0, False, 0, 1),           # a supervisor's pass does not hide a robot that ran without its controller
+    (False, False, 256, False, 0, 1),
+])
+def test_after_a_server_stops_the_run_reloads_or_ends_with_a_status(reload: bool, interrupted: bool,
+                                                                     quit_status: int | None, again: bool,
+                                                                     status: int, status_missing: int) -> None:
+    assert launch.after_run(reload, interrupted, quit_status) is again
+    assert launch.exit_status(quit_status) == status
+    assert launch.exit_status(quit_status, missing=True) == status_missing
+
+
 # ---------------------------------------------------------------------- running a project
 
 def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: Path) -> None:
-    world = project(tmp_path, 'Robot { name "alpha" controller "a" controllerArgs [ "--say" "hello world" ] }\n'
+    # controllerArgs are the program's arguments one by one, as Webots passes them (no shell: quotes,
+    # backslashes, spaces and empty strings arrive as written in the world)
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" controllerArgs [ "--say" "hello world" '
+                              '"say \\"hi\\" \\\\ $HOME" "" ] }\n'
                               'Robot { name "beta %41" controller "b" }',     # a name a URL must encode
                     {"a.py": COUNTER.replace("{step}", "16"), "b.py": COUNTER.replace("{step}", "32")})
     proc = run(world, "--until", "1600")
     assert proc.wait() == 0, proc.stderr()
     out = proc.stdout().splitlines()
     assert out[0].startswith("sensorium: serving world 'w' rpc=tcp://127.0.0.1:")
-    assert "[alpha] alpha args ['--say', 'hello world'] in a" in out
+    assert """[alpha] alpha args ['--say', 'hello world', 'say "hi" \\\\ $HOME', ''] in a""" in out
     assert "[beta %41] beta %41 args [] in b" in out
     # the world waited for both before it stepped: every step of both, from 0 to --until
     assert "[alpha] alpha stepped 100 until 1600" in out
@@ -120,14 +179,51 @@ def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: P
         assert not alive(pid)
 
 
-def test_a_missing_controller_is_one_line_and_nothing_runs(tmp_path: Path) -> None:
-    world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }', {})
-    proc = run(world, env={"WEBOTS_HOME": None})
+def test_with_require_controllers_a_missing_controller_is_one_line_and_nothing_runs(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }\nRobot { name "beta" controller "b" }',
+                    {"b.py": COUNTER.replace("{step}", "16")})
+    proc = run(world, "--require-controllers", env={"WEBOTS_HOME": None, "WEBOTS_EXTRA_PROJECT_PATH": None})
     assert proc.wait() == 1
     assert proc.stderr().strip() == (f"sensorium run: robot 'alpha': controller 'nowhere' not found (looked for the "
                                      f"folder {tmp_path / 'controllers' / 'nowhere'}; --webots-home DIR also looks "
                                      "in Webots' own projects)")
-    assert proc.stdout() == ""
+    assert proc.stdout() == "" and not pids(tmp_path / "controllers" / "b", "beta")
+
+
+def test_a_robot_whose_controller_cannot_start_runs_without_it_and_the_run_exits_1(tmp_path: Path) -> None:
+    """As Webots (which warns and starts its <generic> controller): one line naming the robot and
+    the controller, the world and the other controllers go on, and the run's status says it."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }\nRobot { name "beta" controller "b" }\n'
+                              'Robot { name "java" controller "jv" }',
+                    {"b.py": COUNTER.replace("{step}", "16"), "jv.jar": ""})
+    proc = run(world, "--until", "800", env={"WEBOTS_HOME": None, "WEBOTS_EXTRA_PROJECT_PATH": None})
+    assert proc.wait() == 1, proc.stderr()
+    assert "[beta] beta stepped 50 until 800" in proc.stdout().splitlines()
+    err = proc.stderr().splitlines()
+    assert (f"sensorium run: robot 'alpha': controller 'nowhere' not found (looked for the folder "
+            f"{tmp_path / 'controllers' / 'nowhere'}; --webots-home DIR also looks in Webots' own projects): the robot "
+            "runs without a controller") in err
+    assert (f"sensorium run: robot 'java': controller {tmp_path / 'controllers' / 'jv' / 'jv.jar'} is a Java controller, "
+            "which Sensorium does not run (Python controllers and executables run; start it as an <extern> "
+            "controller): the robot runs without a controller") in err
+    assert err[-2:] == ["sensorium: stopped at 800 ms after 50 steps",
+                        "sensorium run: 2 robots ran without the controller the world names: 'alpha' ('nowhere'), "
+                        "'java' ('jv') (exit status 1; --require-controllers refuses to start instead)"]
+
+
+def test_a_generic_robot_runs_without_a_controller_and_is_not_waited_for(tmp_path: Path) -> None:
+    """Webots' <generic> controller only steps: here the robot runs without one, and a world of
+    <generic> robots alone steps by itself to --until (exit 0: the world asked for it). A robot of a
+    .wbt world without a controller field has Webots' default, <generic>, under run."""
+    world = project(tmp_path, 'Robot { name "gen" controller "<generic>" }\nRobot { name "bare" }', {})
+    proc = run(world, "--until", "320")
+    assert proc.wait() == 0, proc.stderr()
+    err = proc.stderr().splitlines()
+    assert ("sensorium run: robot 'gen': controller '<generic>' (Webots' one only steps): the robot runs without a "
+            "controller") in err
+    assert ("sensorium run: robot 'bare': no controller field, so Webots' default '<generic>' (Webots' one only "
+            "steps): the robot runs without a controller") in err
+    assert err[-1] == "sensorium: stopped at 320 ms after 20 steps"
 
 
 def test_a_controller_that_crashes_is_said_and_the_world_goes_on(tmp_path: Path) -> None:
@@ -315,6 +411,57 @@ def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path, cli
     assert [line for line in proc.stdout().splitlines() if line.startswith("[boss]")] == [
         "[boss] boss starts (in C) at 0", "[boss] boss ends at 960", "[boss] boss starts (in C) at 0 after the reload",
         "[boss] boss ends at 1200"]
+
+
+C_NAMER = r'''#include <stdio.h>
+#include <stdlib.h>
+#include <webots/robot.h>
+
+int main(void) {
+  const char *env = getenv("WEBOTS_ROBOT_NAME");
+  wb_robot_init();
+  printf("WEBOTS_ROBOT_NAME %s, attached to %s\n", env ? env : "(unset)", wb_robot_get_name());
+  while (wb_robot_step(16) != -1) {
+  }
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+def test_webots_robot_name_is_set_for_a_controller_and_chooses_the_robot_of_a_url_without_one(
+        tmp_path: Path, clib: tuple[Path, list[str]]) -> None:
+    """As Webots, run sets WEBOTS_ROBOT_NAME for each controller it starts; a C controller started by
+    hand with a URL naming no robot attaches to WEBOTS_ROBOT_NAME's (two robots: "the only robot"
+    would be ambiguous)."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "namer" }\nRobot { name "ext" controller "<extern>" }',
+                    {})
+    compile_controller(clib, tmp_path / "controllers" / "namer", "namer", C_NAMER)
+    proc = run(world, "--until", "320")
+    url = proc.wait_line("sensorium: serving world").split("rpc=")[1].split()[0]
+    hand = {"WEBOTS_CONTROLLER_URL": url, "WEBOTS_ROBOT_NAME": "ext", "SENSORIUM_CONTROLLER_URL": None}
+    with Proc([str(tmp_path / "controllers" / "namer" / "namer")], env=hand) as manual:
+        assert manual.wait() == 0, manual.stderr()
+        assert manual.stdout().splitlines() == ["WEBOTS_ROBOT_NAME ext, attached to ext"]
+    assert proc.wait() == 0, proc.stderr()
+    assert "[alpha] WEBOTS_ROBOT_NAME alpha, attached to alpha" in proc.stdout().splitlines()
+
+
+def test_a_controller_gets_webots_variables_and_its_folder_on_the_library_path(tmp_path: Path) -> None:
+    """WEBOTS_ROBOT_NAME; on LD_LIBRARY_PATH the project's libraries/ folders, WEBOTS_LIBRARY_PATH
+    and the controller's folder (a shared library shipped next to a controller loads) before the
+    rest, as Webots starts a controller."""
+    script = ('import os\nfrom controller import Robot\nrobot = Robot()\n'
+              'print(os.environ["WEBOTS_ROBOT_NAME"], *os.environ["LD_LIBRARY_PATH"].split(os.pathsep))\n')
+    world = project(tmp_path, 'Robot { name "alpha beta" controller "env" }', {"env.py": script})
+    for name in ("b_lib", "a_lib"):
+        (tmp_path / "libraries" / name).mkdir(parents=True)
+    (tmp_path / "libraries" / "not_a_folder").write_text("")
+    proc = run(world, "--until", "160", env={"WEBOTS_ROBOT_NAME": "stale", "LD_LIBRARY_PATH": "/nowhere",
+                                             "WEBOTS_LIBRARY_PATH": "/mine"})
+    assert proc.wait() == 0, proc.stderr()
+    assert (f"[alpha beta] alpha beta {tmp_path / 'libraries' / 'a_lib'} {tmp_path / 'libraries' / 'b_lib'} /mine "
+            f"{tmp_path / 'controllers' / 'env'} /nowhere") in proc.stdout().splitlines()
 
 
 UNDER_SERVE = '''from controller import Supervisor
@@ -528,3 +675,167 @@ def test_run_with_webots_home_starts_a_stock_controller_of_a_proto_robot(tmp_pat
     assert f"sensorium run: robot 'bee': controller 'bee_wander' found in Webots' projects: {folder / 'bee_wander.py'}" \
         in proc.stderr().splitlines()
     assert "[bee] bee stepped 10 until 320" in proc.stdout().splitlines()
+
+
+# ---------------------------------------------------------------------- extra project paths (WEBOTS_EXTRA_PROJECT_PATH)
+
+BEE_PROTO = ('#VRML_SIM R2023b utf8\nPROTO Bee [\n  field SFString name "bee"\n  field SFString controller "bee_ctl"\n]\n'
+             '{\n  Robot {\n    name IS name\n    controller IS controller\n  }\n}\n')
+
+
+def extra_project(root: Path) -> Path:
+    """A project of its own elsewhere: protos/Bee.proto (a robot) and controllers/bee_ctl/bee_ctl.py."""
+    (root / "protos").mkdir(parents=True)
+    (root / "protos" / "Bee.proto").write_text(BEE_PROTO)
+    (root / "controllers" / "bee_ctl").mkdir(parents=True)
+    (root / "controllers" / "bee_ctl" / "bee_ctl.py").write_text(COUNTER.replace("{step}", "32"))
+    return root
+
+
+def test_extra_projects_are_looked_in_after_the_project_and_controllers_dirs(tmp_path: Path) -> None:
+    """As Webots' WbRobot: the project's controllers/, (here: each --controllers-dir), then each
+    extra project's controllers/ in the order given, each folder once."""
+    extra = [extra_project(tmp_path / "one"), extra_project(tmp_path / "two")]
+    value = os.pathsep.join([str(extra[0]), "", str(extra[1]), str(extra[0])])
+    assert launch.extra_project_paths(value) == extra
+    (tmp_path / "proj").mkdir()
+    world = project(tmp_path / "proj", "", {})
+    dirs = launch.controller_dirs(world, [tmp_path / "mine"], extra)
+    assert dirs == [tmp_path / "proj" / "controllers", tmp_path / "mine", extra[0] / "controllers",
+                    extra[1] / "controllers"]
+    assert find_controller("r", "bee_ctl", [], dirs).folder == extra[0] / "controllers" / "bee_ctl"
+    (tmp_path / "mine" / "bee_ctl").mkdir(parents=True)
+    (tmp_path / "mine" / "bee_ctl" / "bee_ctl.py").write_text("")
+    assert find_controller("r", "bee_ctl", [], dirs).folder == tmp_path / "mine" / "bee_ctl"
+    with pytest.raises(LaunchError) as info:
+        find_controller("r", "gone", [], dirs)
+    assert f"{extra[1] / 'controllers' / 'gone'};" in str(info.value)
+    relative = launch.extra_project_paths("rel")[0]
+    assert relative.is_absolute() and relative.name == "rel"          # the controllers' folders differ from ours
+    many = os.pathsep.join(str(tmp_path / f"p{i}") for i in range(launch.EXTRA_MAX + 5))
+    assert len(launch.extra_project_paths(many)) == launch.EXTRA_MAX
+
+
+@pytest.mark.parametrize("how", ["env", "option"])
+def test_a_robot_proto_and_its_controller_come_from_an_extra_project(tmp_path: Path, how: str) -> None:
+    """The world names a PROTO and the PROTO a controller that only another project holds: with
+    that project as an extra project path both are found, as Webots finds them there."""
+    extra = extra_project(tmp_path / "shared")
+    (tmp_path / "proj" / "worlds").mkdir(parents=True)
+    world = tmp_path / "proj" / "worlds" / "w.wbt"
+    world.write_text('#VRML_SIM R2023b utf8\nEXTERNPROTO "../protos/Bee.proto"\nWorldInfo { basicTimeStep 16 }\n'
+                     'Bee { }\n')
+    nowhere = tmp_path / "nowhere"
+    if how == "env":
+        proc = run(world, "--until", "320", env={"WEBOTS_EXTRA_PROJECT_PATH": f"{nowhere}{os.pathsep}{extra}",
+                                                 "WEBOTS_HOME": None, "SENSORIUM_PROTO_PATH": None})
+    else:
+        proc = run(world, "--until", "320", "--extra-project-path", str(nowhere), "--extra-project-path", str(extra),
+                   env={"WEBOTS_EXTRA_PROJECT_PATH": None, "WEBOTS_HOME": None, "SENSORIUM_PROTO_PATH": None})
+    assert proc.wait() == 0, proc.stderr()
+    assert "[bee] bee args [] in bee_ctl" in proc.stdout().splitlines()
+    assert "[bee] bee stepped 10 until 320" in proc.stdout().splitlines()
+    assert f"sensorium run: extra project path {nowhere} is not a folder: not looked in" in proc.stderr().splitlines()
+    # without it neither is found: the PROTO's file is the load's one line
+    proc = run(world, env={"WEBOTS_EXTRA_PROJECT_PATH": None, "WEBOTS_HOME": None, "SENSORIUM_PROTO_PATH": None})
+    assert proc.wait() == 1
+    assert "Bee.proto" in proc.stderr()
+
+
+def test_a_world_saved_before_r2022b_finds_a_proto_of_an_extra_project_by_name(tmp_path: Path) -> None:
+    """R2022a worlds name PROTOs without EXTERNPROTO: Webots found them in extra projects too."""
+    extra = extra_project(tmp_path / "shared")
+    (tmp_path / "proj" / "worlds").mkdir(parents=True)
+    world = tmp_path / "proj" / "worlds" / "w.wbt"
+    world.write_text('#VRML_SIM R2022a utf8\nWorldInfo { basicTimeStep 16 }\nBee { }\n')
+    clean = {"WEBOTS_EXTRA_PROJECT_PATH": None, "WEBOTS_HOME": None, "SENSORIUM_PROTO_PATH": None}
+    with Proc(sensorium("validate", str(world), "--extra-project-path", str(extra)), env=clean) as proc:
+        assert proc.wait() == 0, proc.stderr()
+        assert proc.stdout().splitlines() == [f"{world}: OK"]
+    with Proc(sensorium("validate", str(world)), env=clean) as proc:
+        assert proc.wait() == 1
+        assert "unknown node 'Bee'" in proc.stderr()
+
+
+def test_a_project_runs_in_process_and_stop_ends_it(tmp_path: Path) -> None:
+    """The library's run (what `sensorium run` calls): in a thread of ours, its lines to our streams;
+    stop() ends it as Ctrl-C does (every controller gone, status 0)."""
+    import io
+    import threading
+
+    from sensorium.server.daemon.serve import ServeOptions
+
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }', {"a.py": COUNTER.replace("{step}", "16")})
+    out, err = io.StringIO(), io.StringIO()
+    options = launch.RunOptions(serve=ServeOptions(rpc="tcp://127.0.0.1:0", pub="tcp://127.0.0.1:0"), grace_s=5.0)
+    options.check(world)
+    project_run = launch.ProjectRun(world, options, out=out, err=err)
+    status: list[int] = []
+    thread = threading.Thread(target=lambda: status.append(project_run.run()))
+    thread.start()
+    try:
+        wait_until(lambda: "[alpha] alpha args [] in a" in out.getvalue(), what="the controller's first line")
+    finally:
+        project_run.stop()
+        thread.join(120)
+    assert not thread.is_alive() and status == [0], err.getvalue()
+    assert out.getvalue().startswith("sensorium: serving world 'w' rpc=tcp://127.0.0.1:")
+    assert any(line.startswith("[alpha] alpha stepped ") for line in out.getvalue().splitlines())
+    (pid,) = pids(tmp_path / "controllers" / "a", "alpha")
+    assert not alive(pid)
+    with pytest.raises(ValueError, match="--grace must be a finite number >= 0, got -1"):
+        launch.RunOptions(grace_s=-1).check(world)
+    with pytest.raises(ValueError, match=f"--controllers-dir {tmp_path / 'none'}: no such folder"):
+        launch.RunOptions(controllers_dirs=(tmp_path / "none",)).check(world)
+
+
+def test_a_proto_robots_controller_is_found_in_the_protos_project(tmp_path: Path) -> None:
+    """Webots looks for a robot's controller in its PROTO's project right after the world's own: a
+    world declaring a PROTO of another project by its path runs that project's controller."""
+    shared = extra_project(tmp_path / "robots" / "shared")
+    (tmp_path / "proj" / "worlds").mkdir(parents=True)
+    world = tmp_path / "proj" / "worlds" / "w.wbt"
+    text = ('#VRML_SIM R2023b utf8\nEXTERNPROTO "../../robots/shared/protos/Bee.proto"\n'
+            'IMPORTABLE EXTERNPROTO "webots://projects/objects/Other.proto"\nWorldInfo { basicTimeStep 16 }\n'
+            'Bee { }\nBee { name "own" controller "mine" }\n')
+    world.write_text(text)
+    assert launch.proto_projects(world, text, {"bee": "Bee", "x": "Other", "y": "Nowhere"}) == {"bee": shared}
+    (tmp_path / "proj" / "controllers" / "mine").mkdir(parents=True)
+    (tmp_path / "proj" / "controllers" / "mine" / "mine.py").write_text(COUNTER.replace("{step}", "32"))
+    proc = run(world, "--until", "320", env={"WEBOTS_EXTRA_PROJECT_PATH": None, "WEBOTS_HOME": None})
+    assert proc.wait() == 0, proc.stderr()
+    out = proc.stdout().splitlines()
+    assert "[bee] bee args [] in bee_ctl" in out and "[bee] bee stepped 10 until 320" in out
+    assert "[own] own stepped 10 until 320" in out
+    # the world's own project comes first
+    (tmp_path / "proj" / "controllers" / "bee_ctl").mkdir(parents=True)
+    (tmp_path / "proj" / "controllers" / "bee_ctl" / "bee_ctl.py").write_text('print("the project\'s own")\n')
+    dirs = launch.controller_dirs(world, [])
+    got = launch.plan_world([WorldRobot(name="bee", controller="bee_ctl")], dirs, "tcp://127.0.0.1:5555",
+                            projects={"bee": shared})
+    assert [s.folder for s in got.specs] == [tmp_path / "proj" / "controllers" / "bee_ctl"]
+    (tmp_path / "proj" / "controllers" / "bee_ctl" / "bee_ctl.py").unlink()
+    (tmp_path / "proj" / "controllers" / "bee_ctl").rmdir()
+    got = launch.plan_world([WorldRobot(name="bee", controller="bee_ctl")], dirs, "tcp://127.0.0.1:5555",
+                            projects={"bee": shared})
+    assert [s.folder for s in got.specs] == [shared / "controllers" / "bee_ctl"]
+
+
+def test_a_controllers_runtime_ini_sets_its_environment_and_python(tmp_path: Path) -> None:
+    """As Webots: the controller folder's runtime.ini adds a shared library folder to PYTHONPATH
+    (relative to the controller's folder), sets variables, and names the Python to run it with."""
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "shared_mod.py").write_text('WORD = "shared"\n')
+    wrapper = tmp_path / "python-wrapper"
+    wrapper.write_text(f'#!/bin/sh\necho "wrapped python" >&2\nexec "{sys.executable}" "$@"\n')
+    wrapper.chmod(0o755)
+    script = ('import os, sys\nimport shared_mod\nfrom controller import Robot\nrobot = Robot()\n'
+              'print(shared_mod.WORD, os.environ["GREETING"], sys.flags.dont_write_bytecode)\n')
+    world = project(tmp_path, 'Robot { name "alpha" controller "c" }', {"c.py": script})
+    (tmp_path / "controllers" / "c" / "runtime.ini").write_text(
+        '[environment variables with paths]\nPYTHONPATH = $(PYTHONPATH):../../lib\n'
+        f'[environment variables]\nGREETING = "hello; world" ; a comment\n[python]\nCOMMAND = {wrapper}\nOPTIONS = -B\n')
+    proc = run(world, "--until", "160")
+    assert proc.wait() == 0, proc.stderr()
+    assert "[alpha] shared hello; world 1" in proc.stdout().splitlines()
+    assert "[alpha] wrapped python" in proc.stderr().splitlines()

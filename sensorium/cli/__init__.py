@@ -341,11 +341,15 @@ def _add_proto_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--proto-path", action="append", default=[], metavar="DIR",
                    help="more folders to find PROTO files in (repeatable): a project's protos/, a copy of Webots' "
                    "tree, an unpacked assets-RELEASE.zip (also $SENSORIUM_PROTO_PATH)")
+    p.add_argument("--extra-project-path", action="append", default=[], metavar="DIR",
+                   help="a Webots project folder whose protos/ (and, for `run`, controllers/) are looked in after "
+                   "the world's own, as Webots' extra project paths (repeatable; also $WEBOTS_EXTRA_PROJECT_PATH)")
 
 
 def _export_proto_args(args: argparse.Namespace) -> None:
-    """--webots-home/--proto-path become WEBOTS_HOME/SENSORIUM_PROTO_PATH, so every load of a world
-    in this command (and the processes it starts) finds the same PROTOs."""
+    """--webots-home/--proto-path/--extra-project-path become WEBOTS_HOME/SENSORIUM_PROTO_PATH/
+    WEBOTS_EXTRA_PROJECT_PATH, so every load of a world in this command (and the processes it starts)
+    finds the same PROTOs."""
     import os
 
     if getattr(args, "webots_home", None):
@@ -353,6 +357,17 @@ def _export_proto_args(args: argparse.Namespace) -> None:
     if getattr(args, "proto_path", None):
         before = [p for p in os.environ.get("SENSORIUM_PROTO_PATH", "").split(os.pathsep) if p]
         os.environ["SENSORIUM_PROTO_PATH"] = os.pathsep.join([*args.proto_path, *before])
+    # Webots' extra project paths: the option's first, then $WEBOTS_EXTRA_PROJECT_PATH's; their protos/
+    # folders are looked in by PROTO file name after every other proto path folder, as Webots looks there
+    from sensorium.launch import EXTRA_ENV, extra_project_paths
+
+    given = os.pathsep.join([*(getattr(args, "extra_project_path", None) or []), os.environ.get(EXTRA_ENV, "")])
+    projects = extra_project_paths(given)
+    if projects:
+        os.environ[EXTRA_ENV] = os.pathsep.join(str(p) for p in projects)
+        before = [p for p in os.environ.get("SENSORIUM_PROTO_PATH", "").split(os.pathsep) if p]
+        protos = [str(p / "protos") for p in projects if (p / "protos").is_dir()]
+        os.environ["SENSORIUM_PROTO_PATH"] = os.pathsep.join(dict.fromkeys([*before, *protos]))
 
 
 def compiled_paths() -> list[str]:

@@ -22,6 +22,7 @@ import socket
 import stat
 import threading
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any
@@ -36,6 +37,7 @@ DEFAULT_PUB_ENDPOINT = "tcp://127.0.0.1:5561"
 DEFAULT_PORT = 5560
 ENV_URL = "SENSORIUM_CONTROLLER_URL"
 WEBOTS_ENV_URL = "WEBOTS_CONTROLLER_URL"
+WEBOTS_ENV_ROBOT = "WEBOTS_ROBOT_NAME"
 ENV_CURVE_SERVERKEY = "SENSORIUM_CURVE_SERVERKEY"   # the server's CURVE public key: encrypt, authenticate it
 ENV_CURVE_PUBLICKEY = "SENSORIUM_CURVE_PUBLICKEY"   # this client's key pair (default: a fresh one per socket)
 ENV_CURVE_SECRETKEY = "SENSORIUM_CURVE_SECRETKEY"
@@ -196,10 +198,15 @@ def parse_controller_url(url: str | None, default_endpoint: str = DEFAULT_RPC_EN
     raise _bad_url(url, f"unsupported scheme {scheme!r} (use tcp://, ipc:// or a robot name)")
 
 
-def controller_url_from_env(environ: dict[str, str] | None = None) -> ControllerURL:
-    """The controller URL from ``SENSORIUM_CONTROLLER_URL``, else Webots' ``WEBOTS_CONTROLLER_URL``."""
+def controller_url_from_env(environ: Mapping[str, str] | None = None) -> ControllerURL:
+    """The controller URL from ``SENSORIUM_CONTROLLER_URL``, else Webots' ``WEBOTS_CONTROLLER_URL``;
+    a URL that names no robot takes ``WEBOTS_ROBOT_NAME``'s (Webots sets it for each controller it
+    starts, and extern controllers before R2022b chose their robot with it), literally (no
+    percent-decoding: it is a name, not a URL)."""
     env = os.environ if environ is None else environ
-    return parse_controller_url(env.get(ENV_URL) or env.get(WEBOTS_ENV_URL) or None)
+    url = parse_controller_url(env.get(ENV_URL) or env.get(WEBOTS_ENV_URL) or None)
+    name = env.get(WEBOTS_ENV_ROBOT)
+    return url.with_robot(name) if url.robot is None and name else url
 
 
 # ---------------------------------------------------------------------- CURVE (encryption)

@@ -388,7 +388,10 @@ int wb_robot_init(void) {
   sn_conn *c = sn_conn_open(url.endpoint, err, sizeof err);
   if (c == NULL)
     fatal("wb_robot_init", SN_BAD_URL, err);
-  char *name = url.robot ? strdup(url.robot) : only_robot(c);
+  /* a URL without a robot: WEBOTS_ROBOT_NAME's (Webots sets it for the controllers it starts; extern
+     controllers before R2022b chose their robot with it), taken as it is; else the world's only robot */
+  const char *named = getenv("WEBOTS_ROBOT_NAME");
+  char *name = url.robot ? strdup(url.robot) : (named != NULL && *named != '\0') ? strdup(named) : only_robot(c);
   sn_url_free(&url);
   sn_req r;
   uint64_t id = sn_conn_next_id(c);

@@ -2,7 +2,8 @@
  *
  * wb_robot_init() attaches this process to its robot; the controller URL comes from
  * SENSORIUM_CONTROLLER_URL, else WEBOTS_CONTROLLER_URL (forms: "NAME", "tcp://HOST[:PORT][/NAME]",
- * "ipc://PATH/NAME"; default tcp://127.0.0.1:5560 and the world's only robot). A URL that cannot be
+ * "ipc://PATH/NAME"; default tcp://127.0.0.1:5560; a URL without a robot takes WEBOTS_ROBOT_NAME's
+ * robot, else the world's only robot). A URL that cannot be
  * parsed, a robot that does not exist or a server that does not answer within
  * SENSORIUM_CONTROLLER_TIMEOUT seconds (default 10) print one line and exit the process with
  * status 1. */
