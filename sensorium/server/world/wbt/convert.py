@@ -463,7 +463,8 @@ class Converter:
         elif t == "Viewpoint":           # its values are kept (top_node): the Supervisor's and snapshots' view
             pass
         elif t in SKIPPED:
-            self.skipped[t] += 1
+            if t != "TexturedBackground":     # a PROTO not read: the PROTO note says what cameras lose
+                self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
             self.scaled_solid(node, owner)
         elif t == "Fluid":               # a Solid of water or air that immersed solids float in (physics only)
