@@ -234,3 +234,13 @@ def test_a_c_supervisor_reads_the_same_proto_fields(tmp_path, tmp_path_factory):
     ctl = run_paused(WORLD, tmp_path, exe, "keeper", env=SAN_ENV)
     assert ctl.out == EXPECTED
     _check_lines(ctl.stderr())
+
+
+def test_a_set_at_a_level_past_the_proto_chain_is_one_line_and_nothing_changes():
+    lv = _live()
+    for node, chain in ((BOX, "none, it is no PROTO instance"), (CRATE, "Crate"), (BIG, "BigCrate > Crate")):
+        what = {BOX: "Solid 'BOX' (node 4)", CRATE: "Solid 'CRATE' (node 2)", BIG: "Solid 'BIG' (node 3)"}[node]
+        assert refused(lv, "set_field", {"node": node, "field": "translation", "value": [0, 0, 1], "level": 3}) == (
+            f"set_field: {what} has no PROTO at level 3 (its PROTO chain: {chain})")
+    assert call(lv, "get_node_pose", {"node": CRATE})["position"] == [1.0, 0.0, 0.1]
+    assert call(lv, "get_node_pose", {"node": BOX})["position"] == [-1.0, 0.0, 0.1]
