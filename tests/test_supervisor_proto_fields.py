@@ -23,7 +23,7 @@ from test_supervisor import A, Live
 
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import load_world
+from sensorium.server.world.loader import WorldError, load_world
 
 WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_proto_fields.wbt"
 PROTOS = REPO / "tests" / "worlds" / "proto" / "supervisor_protos.wbt"
@@ -244,3 +244,20 @@ def test_a_set_at_a_level_past_the_proto_chain_is_one_line_and_nothing_changes()
             f"set_field: {what} has no PROTO at level 3 (its PROTO chain: {chain})")
     assert call(lv, "get_node_pose", {"node": CRATE})["position"] == [1.0, 0.0, 0.1]
     assert call(lv, "get_node_pose", {"node": BOX})["position"] == [-1.0, 0.0, 0.1]
+
+
+def test_a_proto_parameter_beyond_the_worlds_number_bounds_loads_when_nothing_simulates_it(tmp_path):
+    """A PROTO parameter of 1e12 or 1e-40 that no simulated field takes is read back as written; one that
+    reaches a simulated field through IS is still refused, naming that field."""
+    (tmp_path / "Wide.proto").write_text(HEADER + "PROTO Wide [\n  field SFFloat big 1e12\n  field MFFloat tiny [ 1e-40 ]\n"
+                                         "  field SFVec3f translation 0 0 0\n]\n"
+                                         "{\n  Solid { translation IS translation name \"wide\" }\n}\n")
+    world = tmp_path / "wide.wbt"
+    world.write_text(HEADER + 'EXTERNPROTO "Wide.proto"\nWide { big -1.5e300 }\n'
+                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    lv = _live(world, "boss")
+    assert field(lv, 2, "big") == {"type": "SFFloat", "value": -1.5e300}
+    assert field(lv, 2, "tiny") == {"type": "MFFloat", "value": [1e-40]}
+    world.write_text(HEADER + 'EXTERNPROTO "Wide.proto"\nWide { translation 1e12 0 0 }\n')
+    with pytest.raises(WorldError, match=r"translation.*the magnitude of 1e\+12 exceeds the limit"):
+        load_world(world)
