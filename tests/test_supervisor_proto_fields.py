@@ -261,3 +261,24 @@ def test_a_proto_parameter_beyond_the_worlds_number_bounds_loads_when_nothing_si
     world.write_text(HEADER + 'EXTERNPROTO "Wide.proto"\nWide { translation 1e12 0 0 }\n')
     with pytest.raises(WorldError, match=r"translation.*the magnitude of 1e\+12 exceeds the limit"):
         load_world(world)
+
+
+def test_a_chain_longer_than_the_16_protos_kept_still_says_its_last_kept_proto_is_derived(tmp_path):
+    """P17 built on P16 ... on P0: getProto() and 15 getParent() reach P2, which is derived (built on P1,
+    past the 16 PROTOs kept); the translation passes through all of them to the Solid."""
+    (tmp_path / "P0.proto").write_text(HEADER + "PROTO P0 [ field SFVec3f translation 0 0 0 ] "
+                                       "{ Solid { translation IS translation name \"deep\" } }\n")
+    for k in range(1, 18):
+        (tmp_path / f"P{k}.proto").write_text(HEADER + f'EXTERNPROTO "P{k - 1}.proto"\nPROTO P{k} [ field SFVec3f '
+                                              f"translation 0 0 0 ] {{ P{k - 1} {{ translation IS translation }} }}\n")
+    world = tmp_path / "deep.wbt"
+    world.write_text(HEADER + 'EXTERNPROTO "P17.proto"\nP17 { translation 1 2 3 }\n'
+                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    lv = _live(world, "boss")
+    deep = 2
+    for level in range(1, 17):
+        assert call(lv, "get_proto", {"node": deep, "level": level}) == {
+            "type_name": f"P{18 - level}", "derived": True, "fields": ["translation"]}
+        assert field(lv, deep, "translation", level=level)["value"] == [1.0, 2.0, 3.0]
+    call(lv, "set_field", {"node": deep, "field": "translation", "value": [0.5, 0.0, 0.0]})
+    assert field(lv, deep, "translation", level=16)["value"] == [0.5, 0.0, 0.0]

@@ -486,11 +486,12 @@ def wb_supervisor_proto_is_derived(proto: Proto | None) -> bool:
 
 def wb_supervisor_proto_get_parent(proto: Proto | None) -> Proto | None:
     """The PROTO this one is built on (its body is an instance of it), None when it is built on a base node."""
-    got = _proto_checked(proto, "wb_supervisor_proto_get_parent")
+    func = "wb_supervisor_proto_get_parent"
+    got = _proto_checked(proto, func)
     if got is None or not got[1].get("derived"):
         return None
-    assert proto is not None
-    return (proto[0], proto[1] + 1)
+    assert proto is not None             # asked now, as the C library does: past the chain kept, one line and None
+    return None if _proto_info(got[0], proto[0], proto[1] + 1, func) is None else (proto[0], proto[1] + 1)
 
 
 def wb_supervisor_proto_get_number_of_fields(proto: Proto | None) -> int:

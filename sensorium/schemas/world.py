@@ -1279,6 +1279,8 @@ class ProtoLevel(Strict):
 
     name: str = Field(min_length=1, max_length=256)
     fields: list[ProtoField] = Field(default=[], max_length=1024)
+    derived: bool = Field(default=False, description="its body is an instance of another PROTO (isDerived), the "
+                          "next level, or one past the 16 kept (getParent then answers NULL)")
 
 
 _INTERFACE = ("a PROTO instance's interface: its PROTO's fields with the instance's values, then each PROTO it is "

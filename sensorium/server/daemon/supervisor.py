@@ -605,7 +605,7 @@ def get_proto(sim: Any, node: Node, level: int) -> dict:
     if not 1 <= level <= len(node.interface):
         return {"type_name": "", "derived": False, "fields": []}
     proto = node.interface[level - 1]
-    return {"type_name": proto.name, "derived": level < len(node.interface), "fields": [f.name for f in proto.fields]}
+    return {"type_name": proto.name, "derived": proto.derived, "fields": [f.name for f in proto.fields]}
 
 
 def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> None:
