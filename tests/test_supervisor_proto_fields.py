@@ -282,3 +282,75 @@ def test_a_chain_longer_than_the_16_protos_kept_still_says_its_last_kept_proto_i
         assert field(lv, deep, "translation", level=level)["value"] == [1.0, 2.0, 3.0]
     call(lv, "set_field", {"node": deep, "field": "translation", "value": [0.5, 0.0, 0.0]})
     assert field(lv, deep, "translation", level=16)["value"] == [0.5, 0.0, 0.0]
+
+
+HARDEN = REPO / "tests" / "worlds" / "proto" / "supervisor_proto_harden.wbt"
+EXPECTED_HARDEN = """nullnode 1
+nullproto [] 0 -1 1 1 1
+foreign [] -1 1
+nullfield -1 0 nan 1
+foreignfield -1 nan 1
+basenull 1 -1
+proto Lengthy 7
+index -1 1 1
+index 7 1 1
+index 2147483647 1 1
+index -2147483648 1 1
+last label
+names 1 1 1 1
+long SFFloat 0.125 0.125
+unknown 1
+none 0 nan
+corner0 1 2
+corner-1 -0 4.9406564584124654e-324
+corner-2 1 2
+corner-3 -999 -999 null
+corner2 -999 -999 null
+cornermin -999 -999 null
+turn 0 0 1 -3.5
+size2 -1.0000000000000001e+300 1e-300
+label [a "quoted" back\\slash é中] -1
+wrong nan 0 0 1 1 1 1 [] 1
+moved 1 1 0.10000000000000001
+moved 0.25 -0.5 0.10000000000000001
+kept 0.125
+parent Crate 1
+box 1 -1 1
+me 14""".splitlines()
+FOREIGN_FIELD = "foreignfield -1 nan 1"       # C only: a WbFieldRef the library never gave
+
+
+def _check_harden_lines(err: str) -> None:
+    assert "Sanitizer" not in err and "runtime error" not in err and "Traceback" not in err, err
+    for line in ("Error: wb_supervisor_proto_get_parent() called with a NULL or invalid 'proto' argument.",
+                 "Error: wb_supervisor_field_get_count() called with NULL 'field' argument.",
+                 "Error: wb_supervisor_proto_get_field_by_index() called with an invalid 'index' argument: -2147483648 "
+                 "(the PROTO has 7 fields).",
+                 "Error: wb_supervisor_field_get_mf_vec2f() called with an out-of-bound index: -3 (should be between -2 "
+                 "and 1).",
+                 "Error: wb_supervisor_field_get_mf_float() called on an empty list.",
+                 "Error: wb_supervisor_field_get_mf_rotation() called with wrong field type: SFVec2f.",
+                 "Error: wb_supervisor_field_set_sf_vec3f() called with a NaN or infinite value."):
+        assert line in err.splitlines(), (line, err)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_careless_python_supervisor_gets_one_line_and_no_value_for_each_bad_call(tmp_path):
+    """tests/controllers/supervisor_proto_harden.py: None refs, indexes both ways out of range, the wrong
+    getter, names empty, of 84 and 100000 characters, NaN and infinite values set through IS."""
+    ctl = run_paused(HARDEN, tmp_path, "supervisor_proto_harden.py", "keeper")
+    assert ctl.out == [line for line in EXPECTED_HARDEN if line != FOREIGN_FIELD]
+    _check_harden_lines(ctl.stderr())
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_careless_c_supervisor_gets_webots_lines_and_no_sanitizer_report(tmp_path, tmp_path_factory):
+    """tests/c/supervisor_proto_harden.c under ASan and UBSan: the same, and refs the library never gave."""
+    from test_c_client import sanitized_controller
+
+    exe = sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "supervisor_proto_harden.c")
+    ctl = run_paused(HARDEN, tmp_path, exe, "keeper", env=SAN_ENV)
+    assert ctl.out == EXPECTED_HARDEN
+    err = ctl.stderr()
+    _check_harden_lines(err)
+    assert "Error: wb_supervisor_field_get_count() called with invalid 'field' argument." in err.splitlines(), err

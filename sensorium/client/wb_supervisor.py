@@ -416,7 +416,7 @@ def _get_field(node: Any, field_name: Any, level: int, func: str) -> Field | Non
     r = _checked_node(node, func)
     if r is None:
         return None
-    if not isinstance(field_name, str) or not field_name or len(field_name) > 64:
+    if not isinstance(field_name, str) or not field_name or len(field_name) > 256:
         print(f"Error: {func}() called with a NULL, empty or invalid 'field_name' argument.", file=sys.stderr)
         return None
     args: dict[str, Any] = {"node": int(node), "field": field_name}
