@@ -130,7 +130,7 @@ def test_car_read_outs_and_a_robot_that_is_not_a_car(tmp_path: Path) -> None:
 
 LIGHTS_WORLD = Path(__file__).resolve().parent / "worlds" / "car_lights.yaml"
 LIGHTS_PY = Path(__file__).resolve().parent / "controllers" / "car_lights.py"
-BRAKE_LINE = "Warning: wbu_driver_set_brake_intensity(): intensity 1.5 is outside [0, 1]: 1 used."
+BRAKE_LINE = "Warning: 'intensity' should be smaller or equal to 1, used 1 instead."   # Webots' line
 
 
 def check_car_lights(lines: list[str]) -> None:
@@ -171,3 +171,43 @@ def test_the_lights_indicators_brake_and_engine_as_webots_library_keeps_them(tmp
     assert proc.returncode == 0, proc.stderr()
     check_car_lights(proc.stdout().splitlines())
     assert proc.stderr().strip().splitlines() == [BRAKE_LINE]     # nothing said to be unsimulated
+
+
+HOSTILE_PY = Path(__file__).resolve().parent / "controllers" / "car_hostile.py"
+HOSTILE_LINES = [                      # what a careless controller is told, in order (C prints the same)
+    "Warning: wbu_driver_set_brake_intensity() called with an invalid 'intensity' argument (NaN): ignored.",
+    "Warning: 'intensity' should be bigger or equal to 0, used 0 instead.",
+    "Warning: 'intensity' should be smaller or equal to 1, used 1 instead.",
+    *(f"Warning: wbu_car_set_indicator_period() called with an invalid 'period' argument ({p}): it must be a "
+      "positive number of seconds; ignored." for p in ("0", "-1", "NaN", "inf", "-inf")),
+    *(f"Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument ({a})"
+      for a in ("NaN", "inf", "-inf")),
+    *(f"Warning: wbu_driver_set_cruising_speed() called with an invalid 'speed' argument ({s}): ignored."
+      for s in ("NaN", "-inf"))]
+
+
+def check_car_hostile(lines: list[str]) -> None:
+    """What tests/controllers/car_hostile.py and tests/c/car_hostile.c print: a bad value changes nothing,
+    an out-of-range brake is clamped as Webots clamps it, and the car keeps rolling straight and finite."""
+    by = {line.split()[0]: line.split()[1:] for line in lines}
+    assert by["brake_nan"] == ["0.25", "1"]
+    assert by["brake_negative"] == ["0", "0", "0"] and by["brake_inf"] == ["1", "1", "1"]
+    assert by["period"] == ["0.34000000000000002"]
+    assert by["tiny"] == ["1e-300", "1", "0"]        # on: the quotient is past a double's integers
+    # the bad commands changed nothing: 36 km/h at 0.2 rad, the rear wheels' differential speeds
+    speed, steer, right, left = (float(v) for v in by["kept"])
+    assert speed == 36.0 and steer != 0.0
+    assert right < left and (right + left) / 2 * 0.35 == pytest.approx(10.0, rel=1e-12)
+    # 5e-324 rad: front angles 0, the rear wheels both at 10 m/s / 0.35 m
+    assert by["denormal"] == ["0", "0", format(10 / 0.35, ".17g"), format(10 / 0.35, ".17g")]
+    right_enc, left_enc, finite = by["rolled"]
+    assert math.isfinite(float(right_enc)) and math.isfinite(float(left_enc)) and finite == "1"
+
+
+def test_a_careless_driver_gets_one_line_per_bad_value_and_nothing_changes(tmp_path: Path) -> None:
+    with serve(LIGHTS_WORLD, "--mode", "fast", "--heartbeat-ms", "500") as server:
+        proc = Proc(sensorium("controller", str(HOSTILE_PY), "--url", server.url("car")))
+        assert proc.wait(120) is not None
+    assert proc.returncode == 0, proc.stderr()
+    check_car_hostile(proc.stdout().splitlines())
+    assert proc.stderr().strip().splitlines() == HOSTILE_LINES
