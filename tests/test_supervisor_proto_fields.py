@@ -263,17 +263,44 @@ def test_a_proto_parameter_beyond_the_worlds_number_bounds_loads_when_nothing_si
         load_world(world)
 
 
+def _deep_chain(folder, n: int = 18):
+    """P{n-1} built on P{n-2} ... on P0, a Solid; the world: one P{n-1} (DEF DEEP) and a supervisor robot."""
+    (folder / "P0.proto").write_text(HEADER + "PROTO P0 [ field SFVec3f translation 0 0 0 ] "
+                                     "{ Solid { translation IS translation name \"deep\" } }\n")
+    for k in range(1, n):
+        (folder / f"P{k}.proto").write_text(HEADER + f'EXTERNPROTO "P{k - 1}.proto"\nPROTO P{k} [ field SFVec3f '
+                                            f"translation 0 0 0 ] {{ P{k - 1} {{ translation IS translation }} }}\n")
+    world = folder / "deep.wbt"
+    world.write_text(HEADER + f'EXTERNPROTO "P{n - 1}.proto"\nDEF DEEP P{n - 1} {{ translation 1 2 3 }}\n'
+                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    return world
+
+
+CHAIN = [f"P{k} 1 1" for k in range(17, 1, -1)] + ["end"]
+CHAIN_REFUSAL = "/boss/robot/get_proto: argument 'level': Input should be less than or equal to 16 (got 17)"
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_walking_a_chain_longer_than_16_protos_ends_with_one_line_in_python_and_c(tmp_path, tmp_path_factory):
+    """getParent() from P17 down: 16 PROTOs, each derived, then one line and NULL (the chain is kept to 16)."""
+    from test_c_client import sanitized_controller
+
+    world = _deep_chain(tmp_path)
+    (tmp_path / "py").mkdir()
+    (tmp_path / "c").mkdir()
+    py = run_paused(world, tmp_path / "py", "supervisor_proto_chain.py", "boss")
+    exe = sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "supervisor_proto_chain.c")
+    c = run_paused(world, tmp_path / "c", exe, "boss", env=SAN_ENV)
+    func = "Error: wb_supervisor_proto_get_parent(): "      # each client relays a refusal as it does any other
+    for ctl, line in ((py, f"{func}{CHAIN_REFUSAL}."), (c, f"{func}INVALID_ARGUMENT: {CHAIN_REFUSAL}")):
+        assert ctl.out == CHAIN
+        assert [x for x in ctl.stderr().splitlines() if x.startswith("Error")] == [line], ctl.stderr()
+
+
 def test_a_chain_longer_than_the_16_protos_kept_still_says_its_last_kept_proto_is_derived(tmp_path):
     """P17 built on P16 ... on P0: getProto() and 15 getParent() reach P2, which is derived (built on P1,
     past the 16 PROTOs kept); the translation passes through all of them to the Solid."""
-    (tmp_path / "P0.proto").write_text(HEADER + "PROTO P0 [ field SFVec3f translation 0 0 0 ] "
-                                       "{ Solid { translation IS translation name \"deep\" } }\n")
-    for k in range(1, 18):
-        (tmp_path / f"P{k}.proto").write_text(HEADER + f'EXTERNPROTO "P{k - 1}.proto"\nPROTO P{k} [ field SFVec3f '
-                                              f"translation 0 0 0 ] {{ P{k - 1} {{ translation IS translation }} }}\n")
-    world = tmp_path / "deep.wbt"
-    world.write_text(HEADER + 'EXTERNPROTO "P17.proto"\nP17 { translation 1 2 3 }\n'
-                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    world = _deep_chain(tmp_path)
     lv = _live(world, "boss")
     deep = 2
     for level in range(1, 17):
