@@ -353,8 +353,8 @@ def _check_harden_lines(err: str) -> None:
                  "Error: wb_supervisor_field_get_count() called with NULL 'field' argument.",
                  "Error: wb_supervisor_proto_get_field_by_index() called with an invalid 'index' argument: -2147483648 "
                  "(the PROTO has 7 fields).",
-                 "Error: wb_supervisor_field_get_mf_vec2f() called with an out-of-bound index: -3 (should be between -2 "
-                 "and 1).",
+                 "Error: wb_supervisor_field_get_mf_vec2f() called with an out-of-bound index: -3 (should be "
+                 "between -2 and 1).",
                  "Error: wb_supervisor_field_get_mf_float() called on an empty list.",
                  "Error: wb_supervisor_field_get_mf_rotation() called with wrong field type: SFVec2f.",
                  "Error: wb_supervisor_field_set_sf_vec3f() called with a NaN or infinite value."):
@@ -368,6 +368,9 @@ def test_a_careless_python_supervisor_gets_one_line_and_no_value_for_each_bad_ca
     ctl = run_paused(HARDEN, tmp_path, "supervisor_proto_harden.py", "keeper")
     assert ctl.out == [line for line in EXPECTED_HARDEN if line != FOREIGN_FIELD]
     _check_harden_lines(ctl.stderr())
+    # a NULL proto twice (type name, number of fields, ...), the foreign one and six bogus tuples: one line each
+    named = [x for x in ctl.stderr().splitlines() if x.startswith("Error: wb_supervisor_proto_get_type_name()")]
+    assert named == ["Error: wb_supervisor_proto_get_type_name() called with a NULL or invalid 'proto' argument."] * 8
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")

@@ -466,7 +466,8 @@ def _proto_checked(proto: Any, func: str) -> tuple[RobotClient, dict] | None:
     if r is None:
         return None
     info = None
-    if isinstance(proto, tuple) and len(proto) == 2:
+    if isinstance(proto, tuple) and len(proto) == 2 and all(type(x) is int for x in proto) and 0 <= proto[0] < 1 << 63 \
+            and 1 <= proto[1] <= 16:              # (a ref the library could have given: else asked for nothing)
         info = _proto_info(r, proto[0], proto[1], func)
     if info is None:
         print(f"Error: {func}() called with a NULL or invalid 'proto' argument.", file=sys.stderr)

@@ -20,7 +20,8 @@ def g(x: float) -> str:
 
 
 def numbers(what: str, v, n: int) -> None:
-    print(" ".join([what, *(g(x) for x in (v if v is not None else [-999.0] * n))]) + ("" if v is not None else " null"))
+    shown = [g(x) for x in (v if v is not None else [-999.0] * n)]
+    print(" ".join([what, *shown]) + ("" if v is not None else " null"))
 
 
 def null(x) -> int:
@@ -41,6 +42,8 @@ nothing = Proto(None)
 print(f"nullproto [{nothing.getTypeName()}] {int(nothing.isDerived())} {nothing.getNumberOfFields()} "
       f"{null(nothing.getParent())} {null(nothing.getField('translation'))} {null(nothing.getFieldByIndex(0))}")
 print(f"foreign [{foreign.getTypeName()}] {foreign.getNumberOfFields()} {null(foreign.getField('translation'))}")
+for bogus in ((lengthy._ref, 0), (lengthy._ref, 17), (lengthy._ref, -1), ("x", 1), (1 << 70, 1), (lengthy._ref,)):
+    Proto(bogus).getTypeName()                    # one line each, nothing asked (the test counts them)
 nofield = Field(None)
 print("nullfield", nofield.getCount(), nofield.getMFInt32(0), g(nofield.getMFFloat(0)), null(nofield.getSFVec2f()))
 print("basenull", null(wb.wb_supervisor_node_get_base_node_field(None, "name")),
