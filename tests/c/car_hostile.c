@@ -54,6 +54,10 @@ int main(void) {
   wbu_driver_set_steering_angle(5e-324);
   printf("denormal %.17g %.17g %.17g %.17g\n", wbu_car_get_right_steering_angle(), wbu_car_get_left_steering_angle(),
          rear("right_rear_wheel"), rear("left_rear_wheel"));
+  wbu_driver_set_steering_angle(1.5707963267948966); /* the front wheels' radii cancel: the shares stay finite */
+  printf("right_angle %.17g %.17g %.17g %.17g\n", wbu_car_get_right_steering_angle(), wbu_car_get_left_steering_angle(),
+         rear("right_rear_wheel"), rear("left_rear_wheel"));
+  wbu_driver_set_steering_angle(5e-324);
   for (int i = 0; i < 20; i++)
     wbu_driver_step();
   printf("rolled %.17g %.17g %d\n", wbu_car_get_wheel_encoder(WBU_CAR_WHEEL_FRONT_RIGHT),

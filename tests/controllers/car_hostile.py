@@ -48,6 +48,10 @@ print("kept", g(car.getTargetCruisingSpeed()), g(car.getDevice("right_steer").ge
 car.setSteeringAngle(5e-324)
 print("denormal", g(car.getRightSteeringAngle()), g(car.getLeftSteeringAngle()), rear("right_rear_wheel"),
       rear("left_rear_wheel"))
+car.setSteeringAngle(math.pi / 2)                 # the front wheels' radii cancel: a differential's shares stay finite
+print("right_angle", g(car.getRightSteeringAngle()), g(car.getLeftSteeringAngle()), rear("right_rear_wheel"),
+      rear("left_rear_wheel"))
+car.setSteeringAngle(5e-324)
 for _ in range(20):
     car.step()
 print("rolled", g(car.getWheelEncoder(Car.WHEEL_FRONT_RIGHT)), g(car.getWheelEncoder(Car.WHEEL_FRONT_LEFT)),

@@ -61,8 +61,9 @@ def _shown(x: float) -> str:
 
 def _ratio(r_right: float, r_left: float) -> float:
     """A differential's share of the right wheel from its wheels' turn radii; 0.5 (straight on) where an
-    angle too small for a float makes them infinite."""
-    ratio = r_right / (r_left + r_right) if math.isfinite(r_right) and math.isfinite(r_left) else math.nan
+    angle too small for a float makes them infinite, or one past a right angle makes them cancel (C's
+    division by 0 is not finite either)."""
+    ratio = _div(r_right, r_left + r_right) if math.isfinite(r_right) and math.isfinite(r_left) else math.nan
     return ratio if math.isfinite(ratio) else 0.5
 
 
@@ -223,7 +224,7 @@ class Driver(Supervisor):
             return 0.5
         wheelbase = self._geo["wheelbase"]
         front, rear = _div(wheelbase, math.sin(self._angle)), _div(wheelbase, math.tan(self._angle))
-        share = front / (front + rear) if math.isfinite(front) and math.isfinite(rear) else math.nan
+        share = _div(front, front + rear) if math.isfinite(front) and math.isfinite(rear) else math.nan
         share = share if math.isfinite(share) else 0.5
         return self._geo["rear_wheel_radius"] / self._geo["front_wheel_radius"] * share
 
