@@ -36,7 +36,7 @@ ENV = {**os.environ, "PYTHONUNBUFFERED": "1", **SAN_ENV}
 CDEVICES = REPO / "tests" / "worlds" / "cdevices.yaml"
 ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
-               "wire_vectors", "every_device", "headers", "car_driver", "car_lights", "supervisor_scene",
+               "wire_vectors", "every_device", "headers", "car_driver", "car_lights", "car_hostile", "supervisor_scene",
                "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos",
                "nested_nodes"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
@@ -1066,3 +1066,15 @@ def test_webots_style_api_tests(cbin, servers):
     assert server.conn.call("set_mode", {"mode": "fast"})["mode"] == "fast"
     for robot, p in pair.items():
         _succeeded(p, f"emitter_receiver as {robot}")
+
+
+def test_a_careless_c_driver_gets_the_python_librarys_lines_and_no_sanitizer_report(cbin, servers):
+    """tests/c/car_hostile.c prints what tests/controllers/car_hostile.py prints: NaN, infinite and
+    out-of-range brake, indicator period, steering and speed (tests/test_vehicle_driver.py)."""
+    from test_vehicle_driver import HOSTILE_LINES, check_car_hostile
+
+    server = servers(CAR_LIGHTS_WORLD, "--heartbeat-ms", "500")
+    code, out, err = finish(start([cbin["car_hostile"]], server.url("car")))
+    assert code == 0, err
+    check_car_hostile(out)
+    assert err.splitlines() == HOSTILE_LINES, err

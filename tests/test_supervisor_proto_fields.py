@@ -23,7 +23,7 @@ from test_supervisor import A, Live
 
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import load_world
+from sensorium.server.world.loader import WorldError, load_world
 
 WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_proto_fields.wbt"
 PROTOS = REPO / "tests" / "worlds" / "proto" / "supervisor_protos.wbt"
@@ -234,3 +234,153 @@ def test_a_c_supervisor_reads_the_same_proto_fields(tmp_path, tmp_path_factory):
     ctl = run_paused(WORLD, tmp_path, exe, "keeper", env=SAN_ENV)
     assert ctl.out == EXPECTED
     _check_lines(ctl.stderr())
+
+
+def test_a_set_at_a_level_past_the_proto_chain_is_one_line_and_nothing_changes():
+    lv = _live()
+    for node, chain in ((BOX, "none, it is no PROTO instance"), (CRATE, "Crate"), (BIG, "BigCrate > Crate")):
+        what = {BOX: "Solid 'BOX' (node 4)", CRATE: "Solid 'CRATE' (node 2)", BIG: "Solid 'BIG' (node 3)"}[node]
+        assert refused(lv, "set_field", {"node": node, "field": "translation", "value": [0, 0, 1], "level": 3}) == (
+            f"set_field: {what} has no PROTO at level 3 (its PROTO chain: {chain})")
+    assert call(lv, "get_node_pose", {"node": CRATE})["position"] == [1.0, 0.0, 0.1]
+    assert call(lv, "get_node_pose", {"node": BOX})["position"] == [-1.0, 0.0, 0.1]
+
+
+def test_a_proto_parameter_beyond_the_worlds_number_bounds_loads_when_nothing_simulates_it(tmp_path):
+    """A PROTO parameter of 1e12 or 1e-40 that no simulated field takes is read back as written; one that
+    reaches a simulated field through IS is still refused, naming that field."""
+    (tmp_path / "Wide.proto").write_text(HEADER + "PROTO Wide [\n  field SFFloat big 1e12\n  field MFFloat tiny [ 1e-40 ]\n"
+                                         "  field SFVec3f translation 0 0 0\n]\n"
+                                         "{\n  Solid { translation IS translation name \"wide\" }\n}\n")
+    world = tmp_path / "wide.wbt"
+    world.write_text(HEADER + 'EXTERNPROTO "Wide.proto"\nWide { big -1.5e300 }\n'
+                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    lv = _live(world, "boss")
+    assert field(lv, 2, "big") == {"type": "SFFloat", "value": -1.5e300}
+    assert field(lv, 2, "tiny") == {"type": "MFFloat", "value": [1e-40]}
+    world.write_text(HEADER + 'EXTERNPROTO "Wide.proto"\nWide { translation 1e12 0 0 }\n')
+    with pytest.raises(WorldError, match=r"translation.*the magnitude of 1e\+12 exceeds the limit"):
+        load_world(world)
+
+
+def _deep_chain(folder, n: int = 18):
+    """P{n-1} built on P{n-2} ... on P0, a Solid; the world: one P{n-1} (DEF DEEP) and a supervisor robot."""
+    (folder / "P0.proto").write_text(HEADER + "PROTO P0 [ field SFVec3f translation 0 0 0 ] "
+                                     "{ Solid { translation IS translation name \"deep\" } }\n")
+    for k in range(1, n):
+        (folder / f"P{k}.proto").write_text(HEADER + f'EXTERNPROTO "P{k - 1}.proto"\nPROTO P{k} [ field SFVec3f '
+                                            f"translation 0 0 0 ] {{ P{k - 1} {{ translation IS translation }} }}\n")
+    world = folder / "deep.wbt"
+    world.write_text(HEADER + f'EXTERNPROTO "P{n - 1}.proto"\nDEF DEEP P{n - 1} {{ translation 1 2 3 }}\n'
+                     'Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    return world
+
+
+CHAIN = [f"P{k} 1 1" for k in range(17, 1, -1)] + ["end"]
+CHAIN_REFUSAL = "/boss/robot/get_proto: argument 'level': Input should be less than or equal to 16 (got 17)"
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_walking_a_chain_longer_than_16_protos_ends_with_one_line_in_python_and_c(tmp_path, tmp_path_factory):
+    """getParent() from P17 down: 16 PROTOs, each derived, then one line and NULL (the chain is kept to 16)."""
+    from test_c_client import sanitized_controller
+
+    world = _deep_chain(tmp_path)
+    (tmp_path / "py").mkdir()
+    (tmp_path / "c").mkdir()
+    py = run_paused(world, tmp_path / "py", "supervisor_proto_chain.py", "boss")
+    exe = sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "supervisor_proto_chain.c")
+    c = run_paused(world, tmp_path / "c", exe, "boss", env=SAN_ENV)
+    func = "Error: wb_supervisor_proto_get_parent(): "      # each client relays a refusal as it does any other
+    for ctl, line in ((py, f"{func}{CHAIN_REFUSAL}."), (c, f"{func}INVALID_ARGUMENT: {CHAIN_REFUSAL}")):
+        assert ctl.out == CHAIN
+        assert [x for x in ctl.stderr().splitlines() if x.startswith("Error")] == [line], ctl.stderr()
+
+
+def test_a_chain_longer_than_the_16_protos_kept_still_says_its_last_kept_proto_is_derived(tmp_path):
+    """P17 built on P16 ... on P0: getProto() and 15 getParent() reach P2, which is derived (built on P1,
+    past the 16 PROTOs kept); the translation passes through all of them to the Solid."""
+    world = _deep_chain(tmp_path)
+    lv = _live(world, "boss")
+    deep = 2
+    for level in range(1, 17):
+        assert call(lv, "get_proto", {"node": deep, "level": level}) == {
+            "type_name": f"P{18 - level}", "derived": True, "fields": ["translation"]}
+        assert field(lv, deep, "translation", level=level)["value"] == [1.0, 2.0, 3.0]
+    call(lv, "set_field", {"node": deep, "field": "translation", "value": [0.5, 0.0, 0.0]})
+    assert field(lv, deep, "translation", level=16)["value"] == [0.5, 0.0, 0.0]
+
+
+HARDEN = REPO / "tests" / "worlds" / "proto" / "supervisor_proto_harden.wbt"
+EXPECTED_HARDEN = """nullnode 1
+nullproto [] 0 -1 1 1 1
+foreign [] -1 1
+nullfield -1 0 nan 1
+foreignfield -1 nan 1
+basenull 1 -1
+proto Lengthy 7
+index -1 1 1
+index 7 1 1
+index 2147483647 1 1
+index -2147483648 1 1
+last label
+names 1 1 1 1
+long SFFloat 0.125 0.125
+unknown 1
+none 0 nan
+corner0 1 2
+corner-1 -0 4.9406564584124654e-324
+corner-2 1 2
+corner-3 -999 -999 null
+corner2 -999 -999 null
+cornermin -999 -999 null
+turn 0 0 1 -3.5
+size2 -1.0000000000000001e+300 1e-300
+label [a "quoted" back\\slash é中] -1
+wrong nan 0 0 1 1 1 1 [] 1
+moved 1 1 0.10000000000000001
+moved 0.25 -0.5 0.10000000000000001
+kept 0.125
+parent Crate 1
+box 1 -1 1
+me 14""".splitlines()
+FOREIGN_FIELD = "foreignfield -1 nan 1"       # C only: a WbFieldRef the library never gave
+
+
+def _check_harden_lines(err: str) -> None:
+    assert "Sanitizer" not in err and "runtime error" not in err and "Traceback" not in err, err
+    for line in ("Error: wb_supervisor_proto_get_parent() called with a NULL or invalid 'proto' argument.",
+                 "Error: wb_supervisor_field_get_count() called with NULL 'field' argument.",
+                 "Error: wb_supervisor_proto_get_field_by_index() called with an invalid 'index' argument: -2147483648 "
+                 "(the PROTO has 7 fields).",
+                 "Error: wb_supervisor_field_get_mf_vec2f() called with an out-of-bound index: -3 (should be "
+                 "between -2 and 1).",
+                 "Error: wb_supervisor_field_get_mf_float() called on an empty list.",
+                 "Error: wb_supervisor_field_get_mf_rotation() called with wrong field type: SFVec2f.",
+                 "Error: wb_supervisor_field_set_sf_vec3f() called with a NaN or infinite value."):
+        assert line in err.splitlines(), (line, err)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_careless_python_supervisor_gets_one_line_and_no_value_for_each_bad_call(tmp_path):
+    """tests/controllers/supervisor_proto_harden.py: None refs, indexes both ways out of range, the wrong
+    getter, names empty, of 84 and 100000 characters, NaN and infinite values set through IS."""
+    ctl = run_paused(HARDEN, tmp_path, "supervisor_proto_harden.py", "keeper")
+    assert ctl.out == [line for line in EXPECTED_HARDEN if line != FOREIGN_FIELD]
+    _check_harden_lines(ctl.stderr())
+    # a NULL proto twice (type name, number of fields, ...), the foreign one and six bogus tuples: one line each
+    named = [x for x in ctl.stderr().splitlines() if x.startswith("Error: wb_supervisor_proto_get_type_name()")]
+    assert named == ["Error: wb_supervisor_proto_get_type_name() called with a NULL or invalid 'proto' argument."] * 8
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_careless_c_supervisor_gets_webots_lines_and_no_sanitizer_report(tmp_path, tmp_path_factory):
+    """tests/c/supervisor_proto_harden.c under ASan and UBSan: the same, and refs the library never gave."""
+    from test_c_client import sanitized_controller
+
+    exe = sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "supervisor_proto_harden.c")
+    ctl = run_paused(HARDEN, tmp_path, exe, "keeper", env=SAN_ENV)
+    assert ctl.out == EXPECTED_HARDEN
+    err = ctl.stderr()
+    _check_harden_lines(err)
+    assert "Error: wb_supervisor_field_get_count() called with invalid 'field' argument." in err.splitlines(), err

@@ -130,7 +130,7 @@ def test_car_read_outs_and_a_robot_that_is_not_a_car(tmp_path: Path) -> None:
 
 LIGHTS_WORLD = Path(__file__).resolve().parent / "worlds" / "car_lights.yaml"
 LIGHTS_PY = Path(__file__).resolve().parent / "controllers" / "car_lights.py"
-BRAKE_LINE = "Warning: wbu_driver_set_brake_intensity(): intensity 1.5 is outside [0, 1]: 1 used."
+BRAKE_LINE = "Warning: 'intensity' should be smaller or equal to 1, used 1 instead."   # Webots' line
 
 
 def check_car_lights(lines: list[str]) -> None:
@@ -171,3 +171,77 @@ def test_the_lights_indicators_brake_and_engine_as_webots_library_keeps_them(tmp
     assert proc.returncode == 0, proc.stderr()
     check_car_lights(proc.stdout().splitlines())
     assert proc.stderr().strip().splitlines() == [BRAKE_LINE]     # nothing said to be unsimulated
+
+
+HOSTILE_PY = Path(__file__).resolve().parent / "controllers" / "car_hostile.py"
+HOSTILE_LINES = [                      # what a careless controller is told, in order (C prints the same)
+    "Warning: wbu_driver_set_brake_intensity() called with an invalid 'intensity' argument (NaN): ignored.",
+    "Warning: 'intensity' should be bigger or equal to 0, used 0 instead.",
+    "Warning: 'intensity' should be smaller or equal to 1, used 1 instead.",
+    *(f"Warning: wbu_car_set_indicator_period() called with an invalid 'period' argument ({p}): it must be a "
+      "positive number of seconds; ignored." for p in ("0", "-1", "NaN", "inf", "-inf")),
+    *(f"Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument ({a})"
+      for a in ("NaN", "inf", "-inf")),
+    *(f"Warning: wbu_driver_set_cruising_speed() called with an invalid 'speed' argument ({s}): ignored."
+      for s in ("NaN", "-inf")),
+    # a right angle's differential asks the rear wheels for more than their motors give: Webots' motor lines
+    "WARNING: RotationalMotor \"right_rear_wheel\": The requested velocity -1.93011e+17 exceeds 'maxVelocity' = 100.",
+    "WARNING: RotationalMotor \"left_rear_wheel\": The requested velocity 1.93011e+17 exceeds 'maxVelocity' = 100."]
+
+
+def check_car_hostile(lines: list[str]) -> None:
+    """What tests/controllers/car_hostile.py and tests/c/car_hostile.c print: a bad value changes nothing,
+    an out-of-range brake is clamped as Webots clamps it, and the car keeps rolling straight and finite."""
+    by = {line.split()[0]: line.split()[1:] for line in lines}
+    assert by["brake_nan"] == ["0.25", "1"]
+    assert by["brake_negative"] == ["0", "0", "0"] and by["brake_inf"] == ["1", "1", "1"]
+    assert by["period"] == ["0.34000000000000002"]
+    assert by["tiny"] == ["1e-300", "1", "0"]        # on: the quotient is past a double's integers
+    # the bad commands changed nothing: 36 km/h at 0.2 rad, the rear wheels' differential speeds
+    speed, steer, right, left = (float(v) for v in by["kept"])
+    assert speed == 36.0 and steer != 0.0
+    assert right < left and (right + left) / 2 * 0.35 == pytest.approx(10.0, rel=1e-12)
+    # 5e-324 rad: front angles 0, the rear wheels both at 10 m/s / 0.35 m
+    assert by["denormal"] == ["0", "0", format(10 / 0.35, ".17g"), format(10 / 0.35, ".17g")]
+    # π/2: the front wheels at ±1.29 rad, their turn radii cancel; the rear shares stay finite, clamped by the motors
+    assert by["right_angle"] == ["-1.2899586021736937", "1.2899586021736937", "-100", "100"]
+    right_enc, left_enc, finite = by["rolled"]
+    assert math.isfinite(float(right_enc)) and math.isfinite(float(left_enc)) and finite == "1"
+
+
+def test_a_careless_driver_gets_one_line_per_bad_value_and_nothing_changes(tmp_path: Path) -> None:
+    with serve(LIGHTS_WORLD, "--mode", "fast", "--heartbeat-ms", "500") as server:
+        proc = Proc(sensorium("controller", str(HOSTILE_PY), "--url", server.url("car")))
+        assert proc.wait(120) is not None
+    assert proc.returncode == 0, proc.stderr()
+    check_car_hostile(proc.stdout().splitlines())
+    assert proc.stderr().strip().splitlines() == HOSTILE_LINES
+
+
+def test_the_differentials_and_blinking_stay_finite_for_any_finite_command() -> None:
+    """Hypothesis: for any finite steering angle (denormals, ±π/2, huge) the Ackermann angles and the
+    three differentials' shares are finite numbers and the indicators' blinking is decided, for any
+    positive period and any time of the simulation, without an exception."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    from sensorium.client.webots.vehicle.driver import Driver, ackermann_angles, blink_on
+
+    geo = {"wheelbase": 2.6, "track_front": 1.5, "track_rear": 1.5, "front_wheel_radius": 0.3,
+           "rear_wheel_radius": 0.35}
+    angles = st.floats(allow_nan=False, allow_infinity=False) | st.sampled_from(
+        [5e-324, -5e-324, 2.2250738585072014e-308, math.pi / 2, -math.pi / 2, math.pi, 1e300, 1e-160])
+
+    @settings(max_examples=400, deadline=None, derandomize=True)
+    @given(angles, st.floats(0.0, 1e12) | st.sampled_from([0.0, 0.016, 1e308]),
+           st.floats(5e-324, 1e308) | st.sampled_from([5e-324, 1e-300, 0.34, 1e308]))
+    def run(angle: float, t: float, period: float) -> None:
+        car = object.__new__(Driver)              # its geometry and commands only, no server
+        car._geo, car._angle = geo, angle
+        car._angles = ackermann_angles(angle, geo["wheelbase"], geo["track_front"])
+        assert all(math.isfinite(a) and abs(a) <= math.pi / 2 for a in car._angles), car._angles
+        for share in (car._ratio_front(), car._ratio_rear(), car._ratio_central()):
+            assert math.isfinite(share), (angle, share)
+        assert blink_on(t, period) in (True, False)
+
+    run()

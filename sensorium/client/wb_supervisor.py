@@ -416,7 +416,7 @@ def _get_field(node: Any, field_name: Any, level: int, func: str) -> Field | Non
     r = _checked_node(node, func)
     if r is None:
         return None
-    if not isinstance(field_name, str) or not field_name or len(field_name) > 64:
+    if not isinstance(field_name, str) or not field_name or len(field_name) > 256:
         print(f"Error: {func}() called with a NULL, empty or invalid 'field_name' argument.", file=sys.stderr)
         return None
     args: dict[str, Any] = {"node": int(node), "field": field_name}
@@ -466,7 +466,8 @@ def _proto_checked(proto: Any, func: str) -> tuple[RobotClient, dict] | None:
     if r is None:
         return None
     info = None
-    if isinstance(proto, tuple) and len(proto) == 2:
+    if isinstance(proto, tuple) and len(proto) == 2 and all(type(x) is int for x in proto) and 0 <= proto[0] < 1 << 63 \
+            and 1 <= proto[1] <= 16:              # (a ref the library could have given: else asked for nothing)
         info = _proto_info(r, proto[0], proto[1], func)
     if info is None:
         print(f"Error: {func}() called with a NULL or invalid 'proto' argument.", file=sys.stderr)
@@ -486,11 +487,12 @@ def wb_supervisor_proto_is_derived(proto: Proto | None) -> bool:
 
 def wb_supervisor_proto_get_parent(proto: Proto | None) -> Proto | None:
     """The PROTO this one is built on (its body is an instance of it), None when it is built on a base node."""
-    got = _proto_checked(proto, "wb_supervisor_proto_get_parent")
+    func = "wb_supervisor_proto_get_parent"
+    got = _proto_checked(proto, func)
     if got is None or not got[1].get("derived"):
         return None
-    assert proto is not None
-    return (proto[0], proto[1] + 1)
+    assert proto is not None             # asked now, as the C library does: past the chain kept, one line and None
+    return None if _proto_info(got[0], proto[0], proto[1] + 1, func) is None else (proto[0], proto[1] + 1)
 
 
 def wb_supervisor_proto_get_number_of_fields(proto: Proto | None) -> int:

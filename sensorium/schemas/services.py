@@ -27,9 +27,9 @@ MAX_MOTOR_COMMANDS = 256        # per step request (a robot has a handful of mot
 MAX_EMITTERS = 256              # emitters named in one step request
 MAX_DISPLAYS = 64               # displays named in one step request
 Mode = Literal["fast", "realtime", "pause"]
-FieldName = Annotated[str, Field(min_length=1, max_length=64, description=(
+FieldName = Annotated[str, Field(min_length=1, max_length=256, description=(
     "a Webots field name (translation, rotation, name, children, on, intensity, color, ...: README "
-    "'Supervisor' lists which node kind has which)"))]
+    "'Supervisor' lists which node kind has which; a PROTO's interface field's, up to 256 characters)"))]
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Vec4 = Annotated[list[float], Field(min_length=4, max_length=4)]
 

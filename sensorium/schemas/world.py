@@ -1260,6 +1260,9 @@ class MecanumDrive(Strict):
 class ProtoField(Strict):
     """One interface field of a PROTO instance as the Supervisor reads it (README "Supervisor")."""
 
+    # its numbers are read back, never simulated: the world's number bounds (limits.check_work) leave
+    # them out, so a PROTO parameter of 1e12 or 1e-40 that nothing here uses loads as in Webots
+    not_simulated: ClassVar[bool] = True
     name: str = Field(min_length=1, max_length=256)
     type: Literal["SFBool", "SFInt32", "SFFloat", "SFVec2f", "SFVec3f", "SFRotation", "SFColor", "SFString", "SFNode",
                   "MFBool", "MFInt32", "MFFloat", "MFVec2f", "MFVec3f", "MFRotation", "MFColor", "MFString", "MFNode"]
@@ -1276,6 +1279,8 @@ class ProtoLevel(Strict):
 
     name: str = Field(min_length=1, max_length=256)
     fields: list[ProtoField] = Field(default=[], max_length=1024)
+    derived: bool = Field(default=False, description="its body is an instance of another PROTO (isDerived), the "
+                          "next level, or one past the 16 kept (getParent then answers NULL)")
 
 
 _INTERFACE = ("a PROTO instance's interface: its PROTO's fields with the instance's values, then each PROTO it is "

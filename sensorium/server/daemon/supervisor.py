@@ -605,19 +605,19 @@ def get_proto(sim: Any, node: Node, level: int) -> dict:
     if not 1 <= level <= len(node.interface):
         return {"type_name": "", "derived": False, "fields": []}
     proto = node.interface[level - 1]
-    return {"type_name": proto.name, "derived": level < len(node.interface), "fields": [f.name for f in proto.fields]}
+    return {"type_name": proto.name, "derived": proto.derived, "fields": [f.name for f in proto.fields]}
 
 
 def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> None:
     level = _level(node, level)
     what = f"{node.type} {node.name or node.id!r}"
+    fields = _fields(sim, node, level)      # a level past the node's PROTO chain: one line
     if level == 0 and node.interface:
         raise ValueError(f"field {field!r} of {what} is a PROTO internal field (getBaseNodeField), read-only as in "
                          f"Webots: set the field of PROTO {node.interface[0].name} instead")
     if level > 1:
         raise ValueError(f"field {field!r} of {what} belongs to PROTO {node.interface[level - 1].name}, which PROTO "
                          f"{node.interface[0].name} is built on: read-only, as in Webots")
-    fields = _fields(sim, node, level)
     entry = fields.get(field)
     if entry is None:
         kind_of = f"PROTO {node.interface[0].name} " if level == 1 else ""

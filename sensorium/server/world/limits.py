@@ -234,6 +234,8 @@ def _walk_typed(model: Any, path: str = "", *, numbers: bool = False) -> Iterato
     while todo:
         p, v, block = todo.pop()
         yield p, v, block
+        if isinstance(v, BaseModel) and getattr(v, "not_simulated", False):   # (a PROTO's interface values)
+            continue
         if isinstance(v, BaseModel):       # pushed in reverse: yielded in file order
             kinds = _number_fields(type(v))
             for name in reversed(type(v).model_fields):
@@ -353,6 +355,8 @@ def _scan_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
             if not mag <= cap or 0.0 < mag < 1e-30:      # (NaN fails the first test)
                 return None
         elif isinstance(v, BaseModel):
+            if getattr(v, "not_simulated", False):       # (a PROTO's interface values: never simulated)
+                continue
             kind = getattr(v, "type", None)
             if kind in _GEOMETRY_TYPES and geometry_field:
                 triangles += triangle_count(v, mesh_triangles)

@@ -660,7 +660,7 @@ static WbFieldRef field_at(WbNodeRef node, const char *field_name, int level, co
   sn_robot *rb = supervisor_node(node, func);
   if (rb == NULL)
     return NULL;
-  if (field_name == NULL || *field_name == '\0' || strlen(field_name) > 64) {
+  if (field_name == NULL || *field_name == '\0' || strlen(field_name) > 256) {
     fprintf(stderr, "Error: %s() called with a NULL, empty or invalid 'field_name' argument.\n", func);
     return NULL;
   }
@@ -881,6 +881,13 @@ static sn_robot *field_robot(WbFieldRef field, WbFieldType type, const char *fun
     fprintf(stderr, "Error: %s() called with NULL 'field' argument.\n", func);
     return NULL;
   }
+  bool known = false; /* a ref of this library's (compared, never read before), as Webots checks it */
+  for (struct WbFieldStructPrivate *f = rb->fields; f != NULL && !known; f = f->next)
+    known = f == field;
+  if (!known) {
+    fprintf(stderr, "Error: %s() called with invalid 'field' argument.\n", func);
+    return NULL;
+  }
   if (type != WB_NO_FIELD && field->type != type) {
     fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
     return NULL;
@@ -911,9 +918,10 @@ static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_
 int wb_supervisor_field_get_count(WbFieldRef field) {
   sn_reply rep;
   const msgpack_object *v;
-  if (field == NULL || !(field->type & WB_MF) ||
-      field_value(field, WB_NO_FIELD, "wb_supervisor_field_get_count", &rep, &v) != 0)
-    return -1; /* Webots' count of a single (SF) field */
+  const char *func = "wb_supervisor_field_get_count";
+  if (field_robot(field, WB_NO_FIELD, func) == NULL || !(field->type & WB_MF) ||
+      field_value(field, WB_NO_FIELD, func, &rep, &v) != 0)
+    return -1; /* Webots' line for a NULL field; its count of a single (SF) field */
   int n = v != NULL && v->type == MSGPACK_OBJECT_ARRAY ? (int)v->via.array.size : -1;
   sn_reply_free(&rep);
   return n;

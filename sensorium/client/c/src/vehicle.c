@@ -87,6 +87,21 @@ static WbDeviceTag quiet_device(const sn_robot *rb, const char *name, sn_kind ki
   return 0;
 }
 
+/* A number in a warning line (NaN of either sign as NaN, as the Python library prints it). */
+static void shown(char *out, size_t size, double x) {
+  if (isnan(x))
+    snprintf(out, size, "NaN");
+  else
+    snprintf(out, size, "%g", x);
+}
+
+/* A differential's share of the right wheel from its wheels' turn radii; 0.5 (straight on) where an
+ * angle too small for a double makes them infinite. */
+static double share_of(double r, double l) {
+  double ratio = isfinite(r) && isfinite(l) ? r / (l + r) : NAN;
+  return isfinite(ratio) ? ratio : 0.5;
+}
+
 static void ackermann(double angle, double *right, double *left) {
   if (angle == 0.0) {
     *right = *left = 0.0;
@@ -168,8 +183,17 @@ WbuCarEngineType wbu_car_get_engine_type(void) {
 }
 
 void wbu_car_set_indicator_period(double period) {
-  if (g_car.ready)
-    g_car.indicator_period = period;
+  if (!g_car.ready)
+    return;
+  if (!(isfinite(period) && period > 0.0)) {
+    char text[32];
+    shown(text, sizeof text, period);
+    fprintf(stderr, "Warning: wbu_car_set_indicator_period() called with an invalid 'period' argument (%s): it must be "
+                    "a positive number of seconds; ignored.\n", text);
+    fflush(stderr);
+    return;
+  }
+  g_car.indicator_period = period;
 }
 
 double wbu_car_get_indicator_period(void) {
@@ -274,7 +298,9 @@ void wbu_driver_cleanup(void) {
 int wbu_driver_step(void) {
   if (!g_car.ready)
     return -1;
-  bool on = ((int)(wb_robot_get_time() / g_car.indicator_period) % 2) == 0;
+  /* Webots': on while int(t / period) is even; a quotient past a double's integers is even */
+  double q = wb_robot_get_time() / g_car.indicator_period;
+  bool on = isfinite(q) ? fmod(floor(q), 2.0) == 0.0 : true;
   light(RIGHT_IND, on && (g_car.hazard || g_car.indicator == RIGHT));
   light(LEFT_IND, on && (g_car.hazard || g_car.indicator == LEFT));
   g_car.backwards = g_car.mode == SPEED && g_car.cruising < 0.0;
@@ -293,8 +319,12 @@ int wbu_driver_step(void) {
 void wbu_driver_set_steering_angle(double steering_angle) {
   if (!g_car.ready)
     return;
-  if (isnan(steering_angle)) {
-    fprintf(stderr, "Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument (NaN)\n");
+  if (!isfinite(steering_angle)) {
+    char text[32];
+    shown(text, sizeof text, steering_angle);
+    fprintf(stderr, "Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument (%s)\n",
+            text);
+    fflush(stderr);
     return;
   }
   g_car.angle = steering_angle;
@@ -329,23 +359,22 @@ double wbu_driver_get_steering_angle(void) {
 static double ratio_front(void) {
   if (g_car.angle == 0.0)
     return 0.5;
-  double r = g_car.geo->wheelbase / sin(g_car.right_angle), l = g_car.geo->wheelbase / sin(g_car.left_angle);
-  return r / (l + r);
+  return share_of(g_car.geo->wheelbase / sin(g_car.right_angle), g_car.geo->wheelbase / sin(g_car.left_angle));
 }
 
 static double ratio_rear(void) {
   if (g_car.angle == 0.0)
     return 0.5;
   double c = g_car.geo->wheelbase / tan(g_car.angle);
-  double r = c - g_car.geo->track_rear / 2, l = c + g_car.geo->track_rear / 2;
-  return r / (l + r);
+  return share_of(c - g_car.geo->track_rear / 2, c + g_car.geo->track_rear / 2);
 }
 
 static double ratio_central(void) {
   if (g_car.angle == 0.0)
     return 0.5;
   double front = g_car.geo->wheelbase / sin(g_car.angle), rear = g_car.geo->wheelbase / tan(g_car.angle);
-  return g_car.geo->rear_wheel_radius / g_car.geo->front_wheel_radius * front / (front + rear);
+  double share = isfinite(front) && isfinite(rear) ? front / (front + rear) : NAN;
+  return g_car.geo->rear_wheel_radius / g_car.geo->front_wheel_radius * (isfinite(share) ? share : 0.5);
 }
 
 /* Webots' geometric differentials: each driven pair shares 2 * speed by its wheels' turn radii (a
@@ -353,6 +382,14 @@ static double ratio_central(void) {
 void wbu_driver_set_cruising_speed(double speed) {
   if (!g_car.ready)
     return;
+  if (!isfinite(speed)) {
+    char text[32];
+    shown(text, sizeof text, speed);
+    fprintf(stderr, "Warning: wbu_driver_set_cruising_speed() called with an invalid 'speed' argument (%s): ignored.\n",
+            text);
+    fflush(stderr);
+    return;
+  }
   double central = g_car.geo->type == WBU_CAR_FOUR_BY_FOUR ? ratio_central() : 0.5;
   double ratios[2] = {ratio_front(), ratio_rear()};
   double shares[2] = {2 * central, 2 * (1 - central)};
@@ -400,17 +437,22 @@ double wbu_driver_get_throttle(void) {
   return NAN;
 }
 
-/* Kept and answered (clamped to [0, 1], one line when it is not), the brake lights on while it is
+/* Kept and answered (clamped to [0, 1] with Webots' line; NaN: one line, ignored), the brake lights on while it is
  * above 0; it does not slow the car here (the wheels follow their speed control). */
 void wbu_driver_set_brake_intensity(double intensity) {
   if (!g_car.ready)
     return;
-  if (!(intensity >= 0.0 && intensity <= 1.0)) {
-    double used = intensity > 1.0 ? 1.0 : 0.0;
-    fprintf(stderr, "Warning: wbu_driver_set_brake_intensity(): intensity %g is outside [0, 1]: %g used.\n", intensity,
-            used);
+  if (isnan(intensity)) {
+    fprintf(stderr, "Warning: wbu_driver_set_brake_intensity() called with an invalid 'intensity' argument (NaN): "
+                    "ignored.\n");
     fflush(stderr);
-    intensity = used;
+    return;
+  }
+  if (intensity < 0.0 || intensity > 1.0) { /* Webots' lines */
+    fprintf(stderr, intensity < 0.0 ? "Warning: 'intensity' should be bigger or equal to 0, used 0 instead.\n"
+                                    : "Warning: 'intensity' should be smaller or equal to 1, used 1 instead.\n");
+    fflush(stderr);
+    intensity = intensity < 0.0 ? 0.0 : 1.0;
   }
   g_car.brake = intensity;
   light(BRAKE, intensity > 0.0);

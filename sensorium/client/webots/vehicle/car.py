@@ -6,8 +6,9 @@ auto-disabling flags)."""
 from __future__ import annotations
 
 import math
+import sys
 
-from .driver import Driver
+from .driver import Driver, _shown
 
 # Webots' wheel indices → (the car's wheel key, the encoder name Webots' car library looks up)
 _WHEELS = (("right_front", "right_front_sensor"), ("left_front", "left_front_sensor"),
@@ -86,8 +87,13 @@ class Car(Driver):
         return self._engine
 
     def setIndicatorPeriod(self, period: float) -> None:
-        """The indicators' blinking period (s; Webots' default 0.34)."""
-        self._indicator_period = float(period)
+        """The indicators' blinking period (s; Webots' default 0.34); not a positive number: one line, ignored."""
+        value = float(period)
+        if not (math.isfinite(value) and value > 0.0):
+            print("Warning: wbu_car_set_indicator_period() called with an invalid 'period' argument "
+                  f"({_shown(value)}): it must be a positive number of seconds; ignored.", file=sys.stderr)
+            return
+        self._indicator_period = value
 
     def getIndicatorPeriod(self) -> float:
         return self._indicator_period

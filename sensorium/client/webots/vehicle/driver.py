@@ -40,11 +40,44 @@ def refuse(cls: str, robot: str) -> SystemExit:
 
 def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float) -> tuple[float, float]:
     """(right, left) front wheel angles for the bicycle-model angle (positive: right), as Webots'
-    Driver computes them: cot δ_right = cot δ - t/2L, cot δ_left = cot δ + t/2L."""
+    Driver computes them: cot δ_right = cot δ - t/2L, cot δ_left = cot δ + t/2L (a cotangent of 0 is a
+    right angle, as C's atan(1/0) answers)."""
     if steering_angle == 0.0:
         return 0.0, 0.0
-    cot, half = 1.0 / math.tan(steering_angle), track_front / (2.0 * wheelbase)
-    return math.atan(1.0 / (cot - half)), math.atan(1.0 / (cot + half))
+    tan, half = math.tan(steering_angle), track_front / (2.0 * wheelbase)
+    cot = 1.0 / tan if tan != 0.0 else math.copysign(math.inf, tan)
+    return _atan_inv(cot - half), _atan_inv(cot + half)
+
+
+def _atan_inv(x: float) -> float:
+    """atan(1 / x) as C computes it (1 / ±0 = ±inf)."""
+    return math.atan(1.0 / x) if x != 0.0 else math.copysign(math.pi / 2, x)
+
+
+def _shown(x: float) -> str:
+    """A number in a warning line, as the C library prints it (NaN of either sign as NaN)."""
+    return "NaN" if math.isnan(x) else f"{x:g}"
+
+
+def _ratio(r_right: float, r_left: float) -> float:
+    """A differential's share of the right wheel from its wheels' turn radii; 0.5 (straight on) where an
+    angle too small for a float makes them infinite, or one past a right angle makes them cancel (C's
+    division by 0 is not finite either)."""
+    ratio = _div(r_right, r_left + r_right) if math.isfinite(r_right) and math.isfinite(r_left) else math.nan
+    return ratio if math.isfinite(ratio) else 0.5
+
+
+def _div(a: float, b: float) -> float:
+    """a / b as C computes it (b == 0: an infinity, or NaN for 0 / 0)."""
+    if b != 0.0:
+        return a / b
+    return math.nan if a == 0.0 else math.copysign(math.inf, a) * math.copysign(1.0, b)
+
+
+def blink_on(time: float, period: float) -> bool:
+    """Webots' indicators: on while int(t / period) is even; a quotient past a float's integers is even."""
+    q = time / period
+    return math.fmod(math.floor(q), 2.0) == 0.0 if math.isfinite(q) else True
 
 
 def unmodelled(func: str, answer: Any, params: str = "") -> Callable[..., Any]:
@@ -144,9 +177,10 @@ class Driver(Supervisor):
     def setSteeringAngle(self, steeringAngle: float) -> None:
         """Turn the front wheels to Webots' Ackermann angles for ``steeringAngle`` (rad, positive:
         right); the steering motors clamp to their limits. In speed control the wheel speeds follow."""
-        if not isinstance(steeringAngle, (int, float)) or math.isnan(steeringAngle):
-            print("Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument (NaN)",
-                  file=sys.stderr)
+        if not isinstance(steeringAngle, (int, float)) or not math.isfinite(steeringAngle):
+            shown = _shown(steeringAngle) if isinstance(steeringAngle, (int, float)) else repr(steeringAngle)
+            print("Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument "
+                  f"({shown})", file=sys.stderr)
             return
         self._angle = float(steeringAngle)
         self._angles = ackermann_angles(self._angle, self._geo["wheelbase"], self._geo["track_front"])
@@ -177,27 +211,32 @@ class Driver(Supervisor):
         right, left = self._angles
         if self._angle == 0.0:
             return 0.5
-        r_right, r_left = self._geo["wheelbase"] / math.sin(right), self._geo["wheelbase"] / math.sin(left)
-        return r_right / (r_left + r_right)
+        return _ratio(_div(self._geo["wheelbase"], math.sin(right)), _div(self._geo["wheelbase"], math.sin(left)))
 
     def _ratio_rear(self) -> float:
         if self._angle == 0.0:
             return 0.5
-        r = self._geo["wheelbase"] / math.tan(self._angle)
-        r_right, r_left = r - self._geo["track_rear"] / 2, r + self._geo["track_rear"] / 2
-        return r_right / (r_left + r_right)
+        r = _div(self._geo["wheelbase"], math.tan(self._angle))
+        return _ratio(r - self._geo["track_rear"] / 2, r + self._geo["track_rear"] / 2)
 
     def _ratio_central(self) -> float:
         if self._angle == 0.0:
             return 0.5
-        front, rear = self._geo["wheelbase"] / math.sin(self._angle), self._geo["wheelbase"] / math.tan(self._angle)
-        return self._geo["rear_wheel_radius"] / self._geo["front_wheel_radius"] * front / (front + rear)
+        wheelbase = self._geo["wheelbase"]
+        front, rear = _div(wheelbase, math.sin(self._angle)), _div(wheelbase, math.tan(self._angle))
+        share = _div(front, front + rear) if math.isfinite(front) and math.isfinite(rear) else math.nan
+        share = share if math.isfinite(share) else 0.5
+        return self._geo["rear_wheel_radius"] / self._geo["front_wheel_radius"] * share
 
     def setCruisingSpeed(self, cruisingSpeed: float) -> None:
         """Speed control (km/h): each driven wheel's velocity by Webots' geometric differentials
         (each axle's pair shares 2·speed in proportion to its wheels' turn radii; a 4x4's central
         differential splits front and rear)."""
         speed = float(cruisingSpeed)
+        if not math.isfinite(speed):
+            print("Warning: wbu_driver_set_cruising_speed() called with an invalid 'speed' argument "
+                  f"({_shown(speed)}): ignored.", file=sys.stderr)
+            return
         central = self._ratio_central() if self._geo["type"] == "4x4" else 0.5
         for axle, ratio, share in (("front", self._ratio_front(), 2 * central), ("rear", self._ratio_rear(),
                                                                                   2 * (1 - central))):
@@ -231,7 +270,7 @@ class Driver(Supervisor):
         """One basic time step (Webots' ``wbu_driver_step``); -1 when the simulation ends. Before it,
         as Webots' library: the indicators' LEDs blink (on for the first half of each period, by the
         simulated time), and the backwards lights are on while a negative cruising speed is set."""
-        on = int(self.getTime() / self._indicator_period) % 2 == 0
+        on = blink_on(self.getTime(), self._indicator_period)
         self._light("right_indicators", on and (self._hazard or self._indicator == self.INDICATOR_RIGHT))
         self._light("left_indicators", on and (self._hazard or self._indicator == self.INDICATOR_LEFT))
         self._backwards = self._mode == self.SPEED and self._cruising < 0.0
@@ -248,13 +287,20 @@ class Driver(Supervisor):
 
     # -- the controller's own commands: brake, indicators, lights (kept and answered, as Webots' library)
     def setBrakeIntensity(self, brakeIntensity: float) -> None:
-        """Kept and answered (clamped to [0, 1], one line when it is not) and the brake lights on while it
-        is above 0; it does not slow the car here (the wheels follow their speed control)."""
+        """Kept and answered (clamped to [0, 1] with Webots' line; NaN: one line, ignored) and the brake
+        lights on while it is above 0; it does not slow the car here (the wheels follow their speed
+        control)."""
         value = float(brakeIntensity)
-        if not 0.0 <= value <= 1.0:
-            print(f"Warning: wbu_driver_set_brake_intensity(): intensity {value:g} is outside [0, 1]: "
-                  f"{min(max(value, 0.0), 1.0):g} used.", file=sys.stderr)
-            value = min(max(value, 0.0), 1.0)
+        if math.isnan(value):
+            print("Warning: wbu_driver_set_brake_intensity() called with an invalid 'intensity' argument (NaN): "
+                  "ignored.", file=sys.stderr)
+            return
+        if value < 0.0:       # Webots' lines
+            print("Warning: 'intensity' should be bigger or equal to 0, used 0 instead.", file=sys.stderr)
+            value = 0.0
+        elif value > 1.0:
+            print("Warning: 'intensity' should be smaller or equal to 1, used 1 instead.", file=sys.stderr)
+            value = 1.0
         self._brake = value
         self._light("brake_lights", value > 0.0)
 

@@ -676,7 +676,7 @@ def interface_levels(node: Node) -> list[dict[str, Any]]:
             if name in base:
                 entry["base"] = base[name]
             fields.append(entry)
-        out.append({"name": proto.name, "fields": fields})
+        out.append({"name": proto.name, "fields": fields, "derived": level is not None})
     return out
 
 
