@@ -88,11 +88,15 @@ static WbDeviceTag quiet_device(const sn_robot *rb, const char *name, sn_kind ki
 }
 
 /* A number in a warning line (NaN of either sign as NaN, as the Python library prints it). */
-static void shown(char *out, size_t size, double x) {
+/* One warning line for a number a function refuses ("NaN" as Python spells it); ``then`` ends the line. */
+static void refused(const char *function, const char *argument, double x, const char *then) {
+  char text[32];
   if (isnan(x))
-    snprintf(out, size, "NaN");
+    snprintf(text, sizeof text, "NaN");
   else
-    snprintf(out, size, "%g", x);
+    snprintf(text, sizeof text, "%g", x);
+  fprintf(stderr, "Warning: %s() called with an invalid '%s' argument (%s)%s\n", function, argument, text, then);
+  fflush(stderr);
 }
 
 /* A differential's share of the right wheel from its wheels' turn radii; 0.5 (straight on) where an
@@ -186,11 +190,7 @@ void wbu_car_set_indicator_period(double period) {
   if (!g_car.ready)
     return;
   if (!(isfinite(period) && period > 0.0)) {
-    char text[32];
-    shown(text, sizeof text, period);
-    fprintf(stderr, "Warning: wbu_car_set_indicator_period() called with an invalid 'period' argument (%s): it must be "
-                    "a positive number of seconds; ignored.\n", text);
-    fflush(stderr);
+    refused("wbu_car_set_indicator_period", "period", period, ": it must be a positive number of seconds; ignored.");
     return;
   }
   g_car.indicator_period = period;
@@ -320,11 +320,7 @@ void wbu_driver_set_steering_angle(double steering_angle) {
   if (!g_car.ready)
     return;
   if (!isfinite(steering_angle)) {
-    char text[32];
-    shown(text, sizeof text, steering_angle);
-    fprintf(stderr, "Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument (%s)\n",
-            text);
-    fflush(stderr);
+    refused("wbu_driver_set_steering_angle", "steering_angle", steering_angle, "");
     return;
   }
   g_car.angle = steering_angle;
@@ -383,11 +379,7 @@ void wbu_driver_set_cruising_speed(double speed) {
   if (!g_car.ready)
     return;
   if (!isfinite(speed)) {
-    char text[32];
-    shown(text, sizeof text, speed);
-    fprintf(stderr, "Warning: wbu_driver_set_cruising_speed() called with an invalid 'speed' argument (%s): ignored.\n",
-            text);
-    fflush(stderr);
+    refused("wbu_driver_set_cruising_speed", "speed", speed, ": ignored.");
     return;
   }
   double central = g_car.geo->type == WBU_CAR_FOUR_BY_FOUR ? ratio_central() : 0.5;
