@@ -679,16 +679,14 @@ class ProjectRun:
 
     def _open(self, serve: Any) -> Any:
         """The world's server, or None (its problem said)."""
-        import zmq
-
-        from sensorium.cli.serve import bind_problem
         from sensorium.server.daemon.serve import Server
+        from sensorium.server.daemon.transport import BIND_ERRORS, bind_problem
         from sensorium.server.world.loader import WorldError
         try:
             return Server.open(self.world, serve)
         except WorldError as exc:
             self._say(str(exc))
-        except (OSError, zmq.ZMQError) as exc:
+        except BIND_ERRORS as exc:
             self._say(f"sensorium run: {bind_problem(exc)}")
         return None
 

@@ -10,7 +10,6 @@ port), so scripts can wait for it::
 from __future__ import annotations
 
 import argparse
-import errno
 import os
 import shlex
 import sys
@@ -114,21 +113,9 @@ def options(args: argparse.Namespace):
                         cpu=getattr(args, "cpu", None))
 
 
-def bind_problem(exc: BaseException) -> str:
-    """One line for a socket that could not be bound, with what to do about it."""
-    text = str(exc)
-    addr = text.split("addr=", 1)[1].strip("')") if "addr=" in text else ""
-    what = text.split(" (addr=")[0]
-    hint = ""
-    if getattr(exc, "errno", None) == errno.EADDRINUSE or "in use" in text:
-        hint = " (another server? choose other --rpc/--pub ports, or port 0 for free ones)"
-    return f"cannot bind {addr or 'the endpoint'}: {what}{hint}"
-
-
 def main(args: argparse.Namespace) -> int:
-    import zmq
-
     from sensorium.server.daemon.serve import Server
+    from sensorium.server.daemon.transport import BIND_ERRORS, bind_problem
     from sensorium.server.world.loader import WorldError
 
     try:
@@ -153,7 +140,7 @@ def main(args: argparse.Namespace) -> int:
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1
-    except (OSError, zmq.ZMQError) as exc:          # address in use, bad endpoint
+    except BIND_ERRORS as exc:          # address in use, bad endpoint
         print(f"sensorium serve: {bind_problem(exc)}", file=sys.stderr)
         return 1
     report = server.core.sim.loaded.report

@@ -19,6 +19,7 @@ A thin adapter around :class:`sensorium.server.daemon.services.Core` (sans-IO): 
 
 from __future__ import annotations
 
+import errno
 import os
 import signal
 import socket
@@ -42,6 +43,20 @@ DEFAULT_RPC = "tcp://127.0.0.1:5560"
 DEFAULT_PUB = "tcp://127.0.0.1:5561"
 STEP_BUDGET_S = 0.005          # at most this long stepping before looking at the sockets again
 MAX_IDLE_WAIT_S = 1.0
+BIND_ERRORS: tuple[type[Exception], ...] = (OSError, zmq.ZMQError)
+"""What opening a server's sockets raises for an address in use or a bad endpoint (callers that do not
+import zmq catch these)."""
+
+
+def bind_problem(exc: BaseException) -> str:
+    """One line for a socket that could not be bound, with what to do about it."""
+    text = str(exc)
+    addr = text.split("addr=", 1)[1].strip("')") if "addr=" in text else ""
+    what = text.split(" (addr=")[0]
+    hint = ""
+    if getattr(exc, "errno", None) == errno.EADDRINUSE or "in use" in text:
+        hint = " (another server? choose other --rpc/--pub ports, or port 0 for free ones)"
+    return f"cannot bind {addr or 'the endpoint'}: {what}{hint}"
 MAX_IDLE_WAIT_MS = int(MAX_IDLE_WAIT_S * 1000)
 EXPIRE_EVERY_S = 0.01           # session expiry scan (and, while busy, a look at XPUB + wake) this often
 HOT_S = 0.01                    # busy: a request arrived this recently; wait in the ROUTER's recv alone
