@@ -7,7 +7,8 @@ solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``neste
 are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dotted path ``A.B`` walks
 direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
 a removed solid or light keeps its id, which then answers NULL and is never given to another node.
-Shapes, geometries and lights carried by a solid or robot are not nodes here: Webots' NULL.
+Shapes with their appearances and geometries are nested nodes too (:mod:`.appearance`); lights
+carried by a solid or robot are not nodes here: Webots' NULL.
 
 Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame. Setting one field
 keeps the others (Webots). A field change applies at once; the next measurement sees it. A nested
@@ -27,7 +28,7 @@ import numpy as np
 from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
-from sensorium.server.daemon import nested
+from sensorium.server.daemon import appearance, nested
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import states, viewshot
 from sensorium.server.world.poses import matrix_quaternion
@@ -476,6 +477,8 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
     """A nested node's fields, all read-only here: its pose in its parent's frame, its name, its
     children; a moving joint's ``jointParameters`` and their ``position``."""
     n = _nested_of(sim, node)
+    if n.shape is not None:            # a Shape or a node inside it (appearance.py)
+        return appearance.fields(n.shape, lambda field: _sf_child(sim, n.id, field))
     out = dict(_NESTED_POSE) if n.own is not None else {}
     if n.name:
         out["name"] = ("SFString", lambda sim, node: node.name, None)
@@ -492,6 +495,11 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
         out["position"] = ("SFFloat", lambda sim, node: nested.joint_position(sim, _nested_of(sim, node)),
                            _set_parameter_position)
     return out
+
+
+def _sf_child(sim: Any, parent: int, field: str) -> int:
+    """The id of the node in a nested node's SFNode ``field`` (0: NULL)."""
+    return next((c.id for c in _table(sim).by_parent.get(parent, ()) if c.field == field), 0)
 
 
 def _set_parameter_position(sim: Any, node: Node, value: float) -> None:
@@ -568,9 +576,10 @@ _JOINT_FIELDS = {"endPoint": frozenset(nested.JOINT_DEVICES), "device": frozense
                  "device3": frozenset({"BallJoint"}), "jointParameters3": frozenset({"BallJoint"})}
 _PARAMETERS = frozenset({"HingeJointParameters", "JointParameters", "BallJointParameters"})
 _SCENERY = frozenset({"WorldInfo", "Viewpoint", "Background", "Fog", "PointLight", "SpotLight", "DirectionalLight"})
-_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS | _SCENERY
+_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS | _SCENERY | appearance.TYPES
 _WEBOTS_LACKS = {"children": _NO_POSE, "translation": _NO_POSE | {"Group"}, "rotation": _NO_POSE | {"Group"},
-                 "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | _SCENERY | {"Pose", "Transform", "Group"}}
+                 "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | _SCENERY | {"Pose", "Transform", "Group"}
+                 | (appearance.TYPES - {"Appearance", "PBRAppearance"})}
 
 
 def webots_lacks(node_type: str, field: str) -> bool:
@@ -631,6 +640,10 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
                "top-level robot's or solid's translation and rotation, a light's fields)")
         raise ValueError(f"field {field!r} ({kind}) of PROTO {node.interface[0].name} ({what}) is read-only here: "
                          f"{why}; nothing changed")
+    if setter is None and node.nested and node.type in appearance.TYPES:
+        raise ValueError(f"field {field!r} ({kind}) of {_what(node)} is read-only here: of a shape's nodes a "
+                         "Supervisor sets a Material's diffuseColor, emissiveColor and transparency and a "
+                         "PBRAppearance's baseColor, roughness, metalness, transparency and emissiveColor only")
     if setter is None and node.nested:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
                          "top-level robots, solids and lights only, not the nodes inside them")

@@ -1,0 +1,155 @@
+"""A Supervisor changing what shapes look like (tests/worlds/appearance_change.wbt): a solid's and a
+robot's Shape nodes with their appearance, material and geometry, found by DEF and through
+``children``; their fields read as the world file wrote them (Webots' defaults for the rest); a
+colour, roughness or transparency set is what cameras and infra-red sensors see from the next step,
+bit for bit as a world file saying it (closed form: an ambient-only light of 0.5 on a flat face, a
+pixel is ``round(255 (1 - e^(-0.5 albedo))^(1/2.2))``). The same from Python and C controllers."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from test_multiprocess import REPO, run_paused
+
+from sensorium.server.daemon import supervisor as sv
+from sensorium.server.daemon.nested import FIRST_ID
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+WORLD = REPO / "tests" / "worlds" / "appearance_change.wbt"
+AMBIENT = 0.5
+
+
+def expected_bytes(albedo) -> list[int]:
+    """Webots' HDR resolve of an ambient-lit face, RGB bytes."""
+    L = AMBIENT * np.asarray(albedo, dtype=np.float64)
+    return np.floor(255.0 * (1.0 - np.exp(-L)) ** (1.0 / 2.2) + 0.5).astype(np.int64).tolist()
+
+
+def _sim(path=WORLD) -> Simulation:
+    sim = Simulation(load_world(path))
+    sim.device("looker/cam").enable(16)
+    sim.device("looker/ir").enable(16)
+    return sim
+
+
+def _shot(sim: Simulation) -> tuple[np.ndarray, float]:
+    sim.run(1)
+    return sim.device("looker/cam").image.copy(), float(sim.device("looker/ir").value)
+
+
+def _variant(tmp_path, old: str, new: str):
+    text = WORLD.read_text()
+    assert old in text
+    path = tmp_path / "variant.wbt"
+    path.write_text(text.replace(old, new))
+    return path
+
+
+def field(sim, node, name):
+    return sv.get_field(sim, node, name)["value"]
+
+
+def test_shapes_and_their_nodes_are_served_after_the_other_nested_nodes():
+    sim = _sim()
+    wall, panel, looker = (sv.find_node(sim, d) for d in ("WALL", "PANEL", "LOOKER"))
+    shape = sv.find_node(sim, "WALL_SHAPE")
+    assert field(sim, wall, "children") == [shape.id]
+    assert (shape.type, sv.node_ref(sim, shape)["parent"]) == ("Shape", wall.id)
+    app = sv.node_by_id(sim, field(sim, shape, "appearance"))
+    assert (app.type, app.def_name) == ("PBRAppearance", "WALL_APP") and app == sv.find_node(sim, "WALL_APP")
+    box = sv.node_by_id(sim, field(sim, shape, "geometry"))
+    assert (box.type, box.def_name, field(sim, box, "size")) == ("Box", "WALL_BOX", [0.1, 20.0, 20.0])
+    # written values, Webots' defaults for the others
+    assert field(sim, app, "baseColor") == [0.8, 0.5, 0.2]
+    assert (field(sim, app, "roughness"), field(sim, app, "metalness"), field(sim, app, "transparency")) == (0.3, 0.0, 0.0)
+    assert (field(sim, app, "emissiveColor"), field(sim, app, "IBLStrength")) == ([0.0, 0.0, 0.0], 1.0)
+    assert field(sim, shape, "castShadows") is True
+    # a solid's children in file order: the nested solid LEG, then the Shape; the Material inside its Appearance
+    leg, ball = field(sim, panel, "children")
+    assert sv.node_by_id(sim, leg).def_name == "LEG"
+    appearance = sv.node_by_id(sim, field(sim, sv.node_by_id(sim, ball), "appearance"))
+    assert appearance.type == "Appearance" and field(sim, appearance, "texture") == 0
+    material = sv.node_by_id(sim, field(sim, appearance, "material"))
+    assert material == sv.find_node(sim, "PANEL_MATERIAL") and material.type == "Material"
+    assert field(sim, material, "diffuseColor") == [0.1, 0.9, 0.2] and field(sim, material, "transparency") == 0.25
+    assert (field(sim, material, "shininess"), field(sim, material, "specularColor")) == (0.2, [0.0, 0.0, 0.0])
+    sphere = sv.node_by_id(sim, field(sim, sv.node_by_id(sim, ball), "geometry"))
+    assert (sphere.type, field(sim, sphere, "radius")) == ("Sphere", 0.3)
+    # a robot's shape between its devices, as the file writes it; an empty PBRAppearance: Webots' defaults
+    cam, body, ir = (sv.node_by_id(sim, i) for i in field(sim, looker, "children"))
+    assert (cam.type, body.def_name, ir.type) == ("Camera", "BODY", "DistanceSensor")
+    body_app = sv.node_by_id(sim, field(sim, body, "appearance"))
+    assert (field(sim, body_app, "baseColor"), field(sim, body_app, "metalness")) == ([1.0, 1.0, 1.0], 1.0)
+    # appended after every other nested node: the earlier ids do not move
+    assert (cam.id, ir.id, leg) == (FIRST_ID, FIRST_ID + 1, FIRST_ID + 2) and body.id > leg
+    # Webots' node has no pose or children: NULL without a line
+    assert sv.get_field(sim, shape, "translation").get("absent") and sv.get_field(sim, material, "children").get("absent")
+
+
+def test_a_base_colour_set_is_seen_as_if_the_world_file_said_it(tmp_path):
+    sim = _sim()
+    img, ir = _shot(sim)
+    assert img[2, 2, [2, 1, 0]].tolist() == expected_bytes([0.8, 0.5, 0.2])
+    sv.set_field(sim, sv.find_node(sim, "WALL_APP"), "baseColor", [0.3, 0.6, 0.9])
+    assert field(sim, sv.find_node(sim, "WALL_APP"), "baseColor") == [0.3, 0.6, 0.9]
+    img2, ir2 = _shot(sim)
+    assert np.all(img2[:, :, [2, 1, 0]] == expected_bytes([0.3, 0.6, 0.9]))
+    ref_img, ref_ir = _shot(_sim(_variant(tmp_path, "baseColor 0.8 0.5 0.2", "baseColor 0.3 0.6 0.9")))
+    assert np.array_equal(img2, ref_img) and ir2 == ref_ir and ir2 != ir      # infra-red reads the red 0.3
+
+
+def test_roughness_and_a_materials_colour_and_transparency(tmp_path):
+    sim = _sim()
+    sv.set_field(sim, sv.find_node(sim, "WALL_APP"), "roughness", 0.9)
+    img, ir = _shot(sim)
+    ref = _shot(_sim(_variant(tmp_path, "roughness 0.3", "roughness 0.9")))
+    assert np.array_equal(img, ref[0]) and ir == ref[1]
+    assert ir != _shot(_sim())[1]                      # the infra-red reflection depends on roughness
+    # the wall as an Appearance with a Material: its diffuseColor and transparency
+    mat = "appearance Appearance { material DEF WALL_MAT Material { diffuseColor 0.8 0.5 0.2 transparency 0.2 } }"
+    pbr = "appearance DEF WALL_APP PBRAppearance {\n        baseColor 0.8 0.5 0.2\n        roughness 0.3\n        metalness 0\n      }"
+    sim = _sim(_variant(tmp_path, pbr, mat))
+    material = sv.find_node(sim, "WALL_MAT")
+    sv.set_field(sim, material, "diffuseColor", [0.1, 0.2, 0.7])
+    sv.set_field(sim, material, "transparency", 0.6)
+    img, ir = _shot(sim)
+    path = tmp_path / "ref.wbt"
+    _variant(tmp_path, pbr, mat.replace("0.8 0.5 0.2 transparency 0.2", "0.1 0.2 0.7 transparency 0.6")).rename(path)
+    ref = _shot(_sim(path))
+    assert np.array_equal(img, ref[0]) and ir == ref[1]
+
+
+def test_refusals_name_the_field_and_change_nothing():
+    sim = _sim()
+    app, box = sv.find_node(sim, "WALL_APP"), sv.find_node(sim, "WALL_BOX")
+    before = _shot(sim)
+    with pytest.raises(ValueError, match=r"'baseColor' .* must be in \[0, 1\]"):
+        sv.set_field(sim, app, "baseColor", [0.1, 1.5, 0.2])
+    with pytest.raises(ValueError, match="stays on its side of 0 and 1"):
+        sv.set_field(sim, app, "transparency", 0.5)
+    with pytest.raises(ValueError, match="'size' .* read-only here: of a shape's nodes"):
+        sv.set_field(sim, box, "size", [1.0, 1.0, 1.0])
+    with pytest.raises(ValueError, match="'IBLStrength' .* read-only"):
+        sv.set_field(sim, app, "IBLStrength", 0.5)
+    assert np.array_equal(_shot(sim)[0], before[0])
+    # metalness and emissive colours are kept and read back (cameras here render neither, as for the world file)
+    sv.set_field(sim, app, "metalness", 0.7)
+    sv.set_field(sim, app, "emissiveColor", [0.2, 0.0, 0.0])
+    assert (field(sim, app, "metalness"), field(sim, app, "emissiveColor")) == (0.7, [0.2, 0.0, 0.0])
+    assert np.array_equal(_shot(sim)[0], before[0])
+
+
+def test_a_simulation_reset_brings_the_loaded_colours_back():
+    sim = _sim()
+    first = _shot(sim)
+    app = sv.find_node(sim, "WALL_APP")
+    sv.set_field(sim, app, "baseColor", [0.0, 1.0, 0.0])
+    assert not np.array_equal(_shot(sim)[0], first[0])
+    sim.reset()
+    assert field(sim, app, "baseColor") == [0.8, 0.5, 0.2]
+    assert np.array_equal(_shot(sim)[0], first[0])
