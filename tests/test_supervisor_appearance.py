@@ -7,13 +7,9 @@ pixel is ``round(255 (1 - e^(-0.5 albedo))^(1/2.2))``). The same from Python and
 
 from __future__ import annotations
 
-import math
-import subprocess
-import sys
-
 import numpy as np
 import pytest
-from test_multiprocess import REPO, run_paused
+from test_multiprocess import REPO
 
 from sensorium.server.daemon import supervisor as sv
 from sensorium.server.daemon.nested import FIRST_ID
