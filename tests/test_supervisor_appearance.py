@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from _serve import run_controller, sensorium
+from test_c_client import sanitized_controller
 from test_multiprocess import REPO
 
 from sensorium.server.daemon import supervisor as sv
@@ -18,6 +20,7 @@ from sensorium.server.world.loader import load_world
 
 WORLD = REPO / "tests" / "worlds" / "appearance_change.wbt"
 AMBIENT = 0.5
+SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
 
 
 def expected_bytes(albedo) -> list[int]:
@@ -149,3 +152,32 @@ def test_a_simulation_reset_brings_the_loaded_colours_back():
     sim.reset()
     assert field(sim, app, "baseColor") == [0.8, 0.5, 0.2]
     assert np.array_equal(_shot(sim)[0], first[0])
+
+
+# ---------------------------------------------------------------------- Python and C controllers
+def _expected_lines() -> list[str]:
+    before, after = expected_bytes([0.8, 0.5, 0.2]), expected_bytes([0.3, 0.6, 0.9])
+    return [f"before {before[0]} {before[1]} {before[2]}",
+            "nodes Shape PBRAppearance WALL_APP Box 1 1 1",
+            "size 0.1 20 20",
+            "color 0.8 0.5 0.2 0",
+            f"after {after[0]} {after[1]} {after[2]} 0.3 0.6 0.9",
+            "material Material 0.1 0.9 0.2 0.25",
+            "material 0.5 0.25 0.125"]
+
+
+@pytest.fixture(scope="module")
+def c_controller(tmp_path_factory) -> str:
+    return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "appearance_change.c")
+
+
+def test_a_python_controller_sets_a_colour_its_camera_sees() -> None:
+    lines, err = run_controller(WORLD, lambda url: sensorium(
+        "controller", "--url", url, str(REPO / "tests" / "controllers" / "appearance_change.py")), robot="looker")
+    assert lines == _expected_lines(), err
+
+
+def test_a_c_controller_does_the_same(c_controller: str) -> None:
+    lines, err = run_controller(WORLD, lambda url: [c_controller], env=SAN_ENV, robot="looker")
+    assert "Sanitizer" not in err and "runtime error" not in err, err
+    assert lines == _expected_lines(), err
