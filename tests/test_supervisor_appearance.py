@@ -13,6 +13,7 @@ from _serve import run_controller, sensorium
 from test_c_client import sanitized_controller
 from test_multiprocess import REPO
 
+from sensorium.schemas import world as wm
 from sensorium.server.daemon import supervisor as sv
 from sensorium.server.daemon.nested import FIRST_ID
 from sensorium.server.sim.simulation import Simulation
@@ -152,6 +153,48 @@ def test_a_simulation_reset_brings_the_loaded_colours_back():
     sim.reset()
     assert field(sim, app, "baseColor") == [0.8, 0.5, 0.2]
     assert np.array_equal(_shot(sim)[0], first[0])
+
+
+def _yaml_world(base_color) -> wm.World:
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16},
+        "lights": [{"type": "DirectionalLight", "direction": [1, 0, 0], "intensity": 0.0, "ambient_intensity": AMBIENT}],
+        "solids": [{"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
+                    "appearance": {"base_color": base_color}},
+                   {"name": "post", "geometry": {"type": "box", "size": [1, 1, 1]}, "seen_by": "bounding"}],
+        "robots": [{"name": "r", "supervisor": True, "devices": [{"device": "Camera", "name": "cam", "width": 3,
+                                                                   "height": 3, "field_of_view": 0.5}]}]})
+
+
+def test_a_yaml_shape_is_served_with_a_pbr_appearance_of_its_model():
+    sim = Simulation(_yaml_world([0.8, 0.5, 0.2]))
+    sim.device("r/cam").enable(16)
+    wall, post = sv.find_node(sim, "wall"), sv.find_node(sim, "post")
+    (shape,) = field(sim, wall, "children")
+    assert field(sim, post, "children") == []             # a bounding-only shape is Webots' boundingObject
+    app = sv.node_by_id(sim, field(sim, sv.node_by_id(sim, shape), "appearance"))
+    box = sv.node_by_id(sim, field(sim, sv.node_by_id(sim, shape), "geometry"))
+    assert (app.type, field(sim, app, "baseColor"), box.type, field(sim, box, "size")) == \
+        ("PBRAppearance", [0.8, 0.5, 0.2], "Box", [0.1, 20.0, 20.0])
+    sv.set_field(sim, app, "baseColor", [0.25, 0.5, 1.0])
+    sim.run(1)
+    ref = Simulation(_yaml_world([0.25, 0.5, 1.0]))
+    ref.device("r/cam").enable(16)
+    ref.run(1)
+    assert np.array_equal(sim.device("r/cam").image, ref.device("r/cam").image)
+    assert sim.device("r/cam").image[1, 1, [2, 1, 0]].tolist() == expected_bytes([0.25, 0.5, 1.0])
+
+
+def test_a_robots_own_shape_takes_its_new_colour():
+    sim = _sim()
+    body = sv.find_node(sim, "BODY")
+    app = sv.node_by_id(sim, field(sim, body, "appearance"))
+    k = sv._table(sim).get(body.id).shape.index
+    assert sim.scene.colors[k].tolist() == [1.0, 1.0, 1.0]
+    sv.set_field(sim, app, "baseColor", [0.5, 0.0, 0.25])
+    assert sim.scene.colors[k].tolist() == [0.5, 0.0, 0.25] and sim.scene.red[k] == 0.5
+    assert sim.scene.colors[:k].tolist() + sim.scene.colors[k + 1:].tolist() == \
+        _sim().scene.colors[:k].tolist() + _sim().scene.colors[k + 1:].tolist()     # only its entries changed
 
 
 # ---------------------------------------------------------------------- Python and C controllers
