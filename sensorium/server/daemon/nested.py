@@ -2,7 +2,9 @@
 
 A robot's nodes are its world entry's ``nodes`` (the ``.wbt`` import keeps its Solids, devices,
 Poses, Transforms, Groups, Slots and joints, schemas.world.NestedNode), or one node per device of
-its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth. They are
+its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth.
+Both hold their Shapes too, numbered after every other nested node (:func:`_shape_nodes`; their
+fields: appearance.py). They are
 numbered once per simulation, in scene order (robots, then solids, each depth first), from
 :data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
 imports) are never shifted by them. A nested node is found by DEF (first in scene order, as
