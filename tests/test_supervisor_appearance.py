@@ -197,6 +197,39 @@ def test_a_robots_own_shape_takes_its_new_colour():
         _sim().scene.colors[:k].tolist() + _sim().scene.colors[k + 1:].tolist()     # only its entries changed
 
 
+PAINT = """#VRML_SIM R2023b utf8
+PROTO Paint [
+  field SFColor colorOverride 0.2 0.4 0.6
+  field SFFloat gloss 0.5
+]
+{
+  PBRAppearance {
+    baseColor IS colorOverride
+    roughness 0.5
+  }
+}
+"""
+
+
+def test_an_appearance_proto_is_named_by_its_proto_and_its_fields_pass_through(tmp_path):
+    (tmp_path / "protos").mkdir()
+    (tmp_path / "protos" / "Paint.proto").write_text(PAINT)
+    text = WORLD.read_text()
+    pbr = "appearance DEF WALL_APP PBRAppearance {\n        baseColor 0.8 0.5 0.2\n        roughness 0.3\n        metalness 0\n      }"
+    text = text.replace("WorldInfo {", 'EXTERNPROTO "protos/Paint.proto"\nWorldInfo {', 1)
+    (tmp_path / "paint.wbt").write_text(text.replace(pbr, "appearance DEF WALL_APP Paint { colorOverride 0.8 0.5 0.2 }"))
+    sim = _sim(tmp_path / "paint.wbt")
+    app = sv.find_node(sim, "WALL_APP")
+    assert (app.proto, app.type) == ("Paint", "PBRAppearance")
+    assert field(sim, app, "colorOverride") == [0.8, 0.5, 0.2] and field(sim, app, "gloss") == 0.5
+    assert sv.get_field(sim, app, "baseColor").get("absent")                 # no interface field (Webots' NULL)
+    assert sv.get_field(sim, app, "roughness", level=0)["value"] == 0.5      # getBaseNodeField
+    sv.set_field(sim, app, "colorOverride", [0.3, 0.6, 0.9])                # IS baseColor: passes through
+    assert _shot(sim)[0][2, 2, [2, 1, 0]].tolist() == expected_bytes([0.3, 0.6, 0.9])
+    with pytest.raises(ValueError, match="'gloss' .* read-only here"):
+        sv.set_field(sim, app, "gloss", 0.1)
+
+
 # ---------------------------------------------------------------------- Python and C controllers
 def _expected_lines() -> list[str]:
     before, after = expected_bytes([0.8, 0.5, 0.2]), expected_bytes([0.3, 0.6, 0.9])

@@ -300,6 +300,10 @@ class ShapeNode(Strict):
                        "children solids come before it, minus one")
     appearance: Literal["Appearance", "PBRAppearance"] | None = None
     appearance_def: str | None = Field(default=None, min_length=1)
+    appearance_proto: str | None = Field(default=None, min_length=1, description="an appearance PROTO instance "
+                                         "(PaintedWood, ...): the PROTO's name")
+    appearance_interface: list[ProtoLevel] = Field(default=[], max_length=16, description="its PROTO's interface, as a "
+                                                   "nested node's `interface`")
     material: bool = Field(default=False, description="an Appearance with a Material node")
     material_def: str | None = Field(default=None, min_length=1)
     texture_def: str | None = Field(default=None, min_length=1)

@@ -213,8 +213,11 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
         above = {"appearance": me, "geometry": me}
         for role, type_, def_name, field in appearance.inside(shape, k):
             nid = FIRST_ID + len(out) + len(added)
-            added.append(Nested(nid, type_, "", def_name, "", above[role if role in above else "appearance"], field,
-                                None, None, "", owner, kind, key, shape=appearance.ShapeRef(k, node, role, type_)))
+            proto, face = ((node.appearance_proto or "", tuple(node.appearance_interface))
+                           if node is not None and role == "appearance" else ("", ()))
+            added.append(Nested(nid, type_, proto, def_name, "", above[role if role in above else "appearance"], field,
+                                None, None, "", owner, kind, key, interface=face,
+                                shape=appearance.ShapeRef(k, node, role, type_)))
             if role == "appearance":
                 above["appearance"] = nid
 

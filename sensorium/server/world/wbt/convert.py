@@ -700,6 +700,13 @@ class Converter:
         where it sits among its parent's children (a robot's: after the last tree node written before
         it; a solid's: after its children solids so far)."""
         out = fx.shape_node(node, self.source, self.nested_def)
+        app = self.fields(node).node_("appearance")
+        if app is not None and app.proto and "appearance" in out:     # an appearance PROTO (PaintedWood, ...)
+            out["appearance_proto"] = app.proto
+            face: dict[str, Any] = {}
+            self.interface(app, face)
+            if face.get("interface"):
+                out["appearance_interface"] = face["interface"]
         if owner.kind == "robot" and self.tree is not None:
             if self.tree_stack:
                 out["parent"] = self.tree_stack[-1][1]
