@@ -169,15 +169,17 @@ def root_children(sim: Any) -> list[Node]:
     return [by_id[i] for i in order if i in by_id]
 
 
-def _scene_order(sim: Any) -> list[Node]:
-    """Every node in the world in Webots' scene order: the root's children, each followed by the nodes
-    inside it depth first."""
+def _first_def(sim: Any, name: str) -> Node | None:
+    """The first node in Webots' scene order (the root's children, each followed by the nodes inside
+    it) with DEF ``name``; only that one is made a Node."""
     table = _table(sim)
-    out = []
     for top in root_children(sim):
-        out.append(top)
-        out += [_nested_node(n) for n in table.by_owner.get(top.id, ())]
-    return out
+        if top.def_name == name:
+            return top
+        hit = next((n for n in table.by_owner.get(top.id, ()) if n.def_name == name), None)
+        if hit is not None:
+            return _nested_node(hit)
+    return None
 
 
 def find_node(sim: Any, name: str) -> Node | None:
@@ -189,7 +191,7 @@ def find_node(sim: Any, name: str) -> Node | None:
         path.pop()
     if not first or "" in path:          # a node without a DEF is never found by one
         return None
-    found = next((n for n in _scene_order(sim) if n.def_name == first), None)
+    found = _first_def(sim, first)
     if found is None and not path:
         found = next((n for n in _nodes(sim) if n.name == name), None)
     table = _table(sim)
