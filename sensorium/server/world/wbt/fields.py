@@ -5,6 +5,7 @@ the wrong shape is an error naming file, line and column."""
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -504,7 +505,7 @@ def _written(f: Fields, table: dict[str, tuple[str, Any]], prefix: str, out: dic
     for name, (kind, default) in table.items():
         if f.has(name):
             try:
-                _write(f, name, kind, default, f"{prefix}.{name}", out)
+                _write(f, name, kind, default, sys.intern(f"{prefix}.{name}"), out)
             except WbtSyntaxError:      # a value the conversion does not read and Webots would refuse: its default
                 pass
 
@@ -541,15 +542,19 @@ def shape_node(node: Node, source: str, keep_def) -> dict:
             out["appearance_def"] = app.def_name
         a = f.sub(app)
         texture = a.node_("texture" if app.type == "Appearance" else "baseColorMap")
+        # what the appearance model holds (as the loader sanitised it) is read there, not kept twice
         if app.type == "PBRAppearance":
-            _written(a, PBR_FIELDS, "appearance", values)
+            _written(a, {k: v for k, v in PBR_FIELDS.items() if k not in ("baseColor", "transparency", "roughness")},
+                     "appearance", values)
         else:
             material = a.node_("material")
             if material is not None and material.type == "Material":
                 out["material"] = True
                 if keep_def(material):
                     out["material_def"] = material.def_name
-                _written(a.sub(material), MATERIAL_FIELDS, "material", values)
+                held = ("transparency",) if texture is not None else ("transparency", "diffuseColor")
+                _written(a.sub(material), {k: v for k, v in MATERIAL_FIELDS.items() if k not in held}, "material",
+                         values)
         if texture is not None and texture.type == "ImageTexture":
             if keep_def(texture):
                 out["texture_def"] = texture.def_name
