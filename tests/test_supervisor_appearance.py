@@ -111,7 +111,7 @@ def test_roughness_and_a_materials_colour_and_transparency(tmp_path):
     assert np.array_equal(img, ref[0]) and ir == ref[1]
     assert ir != _shot(_sim())[1]                      # the infra-red reflection depends on roughness
     # the wall as an Appearance with a Material: its diffuseColor and transparency
-    mat = "appearance Appearance { material DEF WALL_MAT Material { diffuseColor 0.8 0.5 0.2 transparency 0.2 } }"
+    mat = "appearance DEF WALL_APP Appearance { material DEF WALL_MAT Material { diffuseColor 0.8 0.5 0.2 transparency 0.2 } }"
     pbr = "appearance DEF WALL_APP PBRAppearance {\n        baseColor 0.8 0.5 0.2\n        roughness 0.3\n        metalness 0\n      }"
     sim = _sim(_variant(tmp_path, pbr, mat))
     material = sv.find_node(sim, "WALL_MAT")
@@ -122,6 +122,25 @@ def test_roughness_and_a_materials_colour_and_transparency(tmp_path):
     _variant(tmp_path, pbr, mat.replace("0.8 0.5 0.2 transparency 0.2", "0.1 0.2 0.7 transparency 0.6")).rename(path)
     ref = _shot(_sim(path))
     assert np.array_equal(img, ref[0]) and ir == ref[1]
+
+
+def test_a_change_to_a_defd_node_reaches_the_shapes_that_use_it():
+    sim = _sim()
+    twin = sv.find_node(sim, "twin")
+    used_app, used_material_shape = (sv.node_by_id(sim, i) for i in field(sim, twin, "children"))
+    app = sv.node_by_id(sim, field(sim, used_app, "appearance"))
+    material = sv.node_by_id(sim, field(sim, sv.node_by_id(sim, field(sim, used_material_shape, "appearance")),
+                                         "material"))
+    assert (app.def_name, material.def_name) == ("", "")      # a USE is a node of its own, without the DEF
+    assert field(sim, app, "baseColor") == [0.8, 0.5, 0.2] and field(sim, material, "diffuseColor") == [0.1, 0.9, 0.2]
+    sv.set_field(sim, sv.find_node(sim, "WALL_APP"), "baseColor", [0.3, 0.6, 0.9])
+    sv.set_field(sim, sv.find_node(sim, "PANEL_MATERIAL"), "diffuseColor", [0.5, 0.25, 0.125])
+    assert field(sim, app, "baseColor") == [0.3, 0.6, 0.9] and field(sim, material, "diffuseColor") == [0.5, 0.25, 0.125]
+    table = sv._table(sim)
+    k_app, k_material = (table.get(n.id).shape.index for n in (app, material))
+    assert sim.scene.colors[k_app].tolist() == [0.3, 0.6, 0.9] and sim.scene.colors[k_material].tolist() == [0.5, 0.25, 0.125]
+    sv.set_field(sim, app, "roughness", 0.7)            # and from a USE to its DEF
+    assert field(sim, sv.find_node(sim, "WALL_APP"), "roughness") == 0.7
 
 
 def test_refusals_name_the_field_and_change_nothing():

@@ -304,7 +304,10 @@ class ShapeNode(Strict):
                                          "(PaintedWood, ...): the PROTO's name")
     appearance_interface: list[ProtoLevel] = Field(default=[], max_length=16, description="its PROTO's interface, as a "
                                                    "nested node's `interface`")
+    appearance_key: int = Field(default=-1, ge=-1, description="shapes whose appearance is one world-file node "
+                                "(its DEF and USEs) share this number; a Supervisor's change reaches them all")
     material: bool = Field(default=False, description="an Appearance with a Material node")
+    material_key: int = Field(default=-1, ge=-1, description="the same for its Material node")
     material_def: str | None = Field(default=None, min_length=1)
     texture_def: str | None = Field(default=None, min_length=1)
     geometry: str = Field(default="", max_length=64, description="the geometry node's type (Box, Mesh, ...)")

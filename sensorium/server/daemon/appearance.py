@@ -50,6 +50,7 @@ class ShapeRef:
     node: wm.ShapeNode | None
     role: str            # "Shape", "appearance", "material", "texture", "geometry"
     type: str            # its Webots type (PBRAppearance, Box, ...)
+    peers: tuple[int, ...] = ()   # the shapes whose node this is too (a DEF and its USEs), itself included
 
 
 def served(shape: Any, wbt: bool) -> bool:
@@ -137,25 +138,31 @@ def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
             raise ValueError(f"{where}: {'each component' if kind == 'SFColor' else 'the value'} must be in [0, 1], "
                              f"got {value!r} (Webots resets it with a warning); nothing changed")
         scene = sim.scene
-        loaded = scene.loaded_model(ref.index).appearance
-        current = scene.shape_model(ref.index).appearance
-        update: dict[str, Any] = {}
+        shapes = ref.peers or (ref.index,)
         if name == "transparency":
-            if loaded is not None and _class(float(value)) != _class(loaded.transparency):
-                sides = ("0 (opaque)", "between 0 and 1 (translucent)", "1 (invisible)")
-                raise ValueError(f"{where}: the world file's {loaded.transparency:g} is {sides[_class(loaded.transparency)]}"
-                                 f" and {float(value):g} is {sides[_class(float(value))]}: which rays see a shape and "
-                                 "its shadows is fixed when the scene is built here, so a transparency stays on its "
-                                 "side of 0 and 1; nothing changed")
-            update["transparency"] = float(value)
-        elif name == "baseColor" or (name == "diffuseColor" and loaded is not None and loaded.texture is None):
-            update["base_color"] = tuple(float(v) for v in values)
-        elif name == "roughness":
-            update["roughness"] = float(value)
-        if update and current is not None:      # (metalness, emissive colours: not rendered here, kept)
-            scene.set_appearance(ref.index, current.model_copy(update=update))
-        scene.appearance_values.setdefault(ref.index, {})[f"{ref.role}.{name}"] = \
-            [float(v) for v in values] if kind == "SFColor" else float(value)
+            for k in shapes:
+                loaded = scene.loaded_model(k).appearance
+                if loaded is not None and _class(float(value)) != _class(loaded.transparency):
+                    sides = ("0 (opaque)", "between 0 and 1 (translucent)", "1 (invisible)")
+                    raise ValueError(
+                        f"{where}: the world file's {loaded.transparency:g} is {sides[_class(loaded.transparency)]} and "
+                        f"{float(value):g} is {sides[_class(float(value))]}: which rays see a shape and its shadows is "
+                        "fixed when the scene is built here, so a transparency stays on its side of 0 and 1; nothing "
+                        "changed")
+        for k in shapes:        # the shape, and those that USE the same node
+            loaded = scene.loaded_model(k).appearance
+            current = scene.shape_model(k).appearance
+            update: dict[str, Any] = {}
+            if name == "transparency":
+                update["transparency"] = float(value)
+            elif name == "baseColor" or (name == "diffuseColor" and loaded is not None and loaded.texture is None):
+                update["base_color"] = tuple(float(v) for v in values)
+            elif name == "roughness":
+                update["roughness"] = float(value)
+            if update and current is not None:      # (metalness, emissive colours: not rendered here, kept)
+                scene.set_appearance(k, current.model_copy(update=update))
+            scene.appearance_values.setdefault(k, {})[f"{ref.role}.{name}"] = \
+                [float(v) for v in values] if kind == "SFColor" else float(value)
 
     return set_value
 

@@ -193,6 +193,13 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
     index = {id(scene.loaded_model(k)): k for k in range(len(scene.shapes))}
     loaded = getattr(sim, "loaded", None)
     wbt = str(getattr(loaded, "source", "")).lower().endswith(".wbt")
+    shared: dict[tuple[str, int], list[int]] = {}     # (role, the node's number) -> the shapes holding it
+    for k in range(len(scene.shapes)):
+        held = getattr(scene.loaded_model(k), "node", None)
+        if held is not None:
+            for role, number in (("appearance", held.appearance_key), ("material", held.material_key)):
+                if number >= 0:
+                    shared.setdefault((role, number), []).append(k)
     added: list[Nested] = []
     starts: dict[int, int] = {}       # a robot's node id -> the id of its first world entry
     for n in out:
@@ -215,9 +222,12 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
             nid = FIRST_ID + len(out) + len(added)
             proto, face = ((node.appearance_proto or "", tuple(node.appearance_interface))
                            if node is not None and role == "appearance" else ("", ()))
+            number = -1 if node is None else node.appearance_key if role == "appearance" else \
+                node.material_key if role == "material" else -1
+            peers = tuple(shared.get((role, number), (k,)))
             added.append(Nested(nid, type_, proto, def_name, "", above[role if role in above else "appearance"], field,
                                 None, None, "", owner, kind, key, interface=face,
-                                shape=appearance.ShapeRef(k, node, role, type_)))
+                                shape=appearance.ShapeRef(k, node, role, type_, peers)))
             if role == "appearance":
                 above["appearance"] = nid
 

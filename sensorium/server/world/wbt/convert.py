@@ -139,6 +139,7 @@ class Converter:
         self.tree_field = "children"       # the field the next node walked sits in (a joint's endPoint, ...)
         self.builtin_proto: str | None = None   # a built-in PROTO being expanded (the expansion's node names it)
         self.nested_defs: set[int] = set()      # nested nodes whose DEF is kept (a USE of one is a copy without it)
+        self.shared_nodes: dict[int, int] = {}  # id(appearance or material node) -> its number (its USEs share it)
 
     # ------------------------------------------------------------ messages
     def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
@@ -699,7 +700,8 @@ class Converter:
         """The Supervisor's view of a Shape (schemas.world.ShapeNode): its DEFs and written fields, and
         where it sits among its parent's children (a robot's: after the last tree node written before
         it; a solid's: after its children solids so far)."""
-        out = fx.shape_node(node, self.source, self.nested_def)
+        out = fx.shape_node(node, self.source, self.nested_def,
+                            lambda n: self.shared_nodes.setdefault(id(n), len(self.shared_nodes)))
         app = self.fields(node).node_("appearance")
         if app is not None and app.proto and "appearance" in out:     # an appearance PROTO (PaintedWood, ...)
             out["appearance_proto"] = app.proto

@@ -526,10 +526,11 @@ def _write(f: Fields, name: str, kind: str, default: Any, key: str, out: dict[st
         out[key] = tuple(f.strings(name))
 
 
-def shape_node(node: Node, source: str, keep_def) -> dict:
+def shape_node(node: Node, source: str, keep_def, key) -> dict:
     """A Shape as a Supervisor serves it (schemas.world.ShapeNode): DEFs (``keep_def(node)``: whether
     the world file's DEF is served), its appearance node's type and the written values of its
-    appearance's, material's, texture's and geometry's fields."""
+    appearance's, material's, texture's and geometry's fields; ``key(node)``: the number of its
+    appearance and material nodes (the same for a USE of one as for its DEF)."""
     f = Fields(node, source)
     out: dict[str, Any] = {}
     values: dict[str, Any] = {}
@@ -538,6 +539,7 @@ def shape_node(node: Node, source: str, keep_def) -> dict:
     app = f.node_("appearance")
     if app is not None and app.type in ("Appearance", "PBRAppearance"):
         out["appearance"] = app.type
+        out["appearance_key"] = key(app)
         if keep_def(app):
             out["appearance_def"] = app.def_name
         a = f.sub(app)
@@ -550,6 +552,7 @@ def shape_node(node: Node, source: str, keep_def) -> dict:
             material = a.node_("material")
             if material is not None and material.type == "Material":
                 out["material"] = True
+                out["material_key"] = key(material)
                 if keep_def(material):
                     out["material_def"] = material.def_name
                 held = ("transparency",) if texture is not None else ("transparency", "diffuseColor")
