@@ -12,7 +12,8 @@ carried by a solid or robot are not nodes here: Webots' NULL.
 
 Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame. Setting one field
 keeps the others (Webots). A field change applies at once; the next measurement sees it. A nested
-node's fields are read-only here, but a joint's parameters' ``position``. A joint is set with
+node's fields are read-only here, but a joint's parameters' ``position`` and a shape's colours,
+roughness and transparency (:mod:`.appearance`). A joint is set with
 ``set_joint_position``; a node's state is saved and loaded by name (sim/states.py).
 """
 
