@@ -257,6 +257,7 @@ def _expected_lines() -> list[str]:
             "size 0.1 20 20",
             "color 0.8 0.5 0.2 0",
             f"after {after[0]} {after[1]} {after[2]} 0.3 0.6 0.9",
+            "reached 1 1 Material",
             "material Material 0.1 0.9 0.2 0.25",
             "material 0.5 0.25 0.125"]
 

@@ -54,6 +54,12 @@ int main(void) {
   numbers(wb_supervisor_field_get_sf_color(color), 3);
   printf("\n");
   WbNodeRef material = wb_supervisor_node_get_from_def("PANEL_MATERIAL");
+  WbNodeRef ball =
+    wb_supervisor_field_get_mf_node(wb_supervisor_node_get_field(wb_supervisor_node_get_from_def("PANEL"), "children"), 1);
+  WbNodeRef panel_appearance = wb_supervisor_field_get_sf_node(wb_supervisor_node_get_field(ball, "appearance"));
+  WbNodeRef reached = wb_supervisor_field_get_sf_node(wb_supervisor_node_get_field(panel_appearance, "material"));
+  printf("reached %d %d %s\n", wb_supervisor_node_get_id(reached) == wb_supervisor_node_get_id(material),
+         wb_supervisor_node_get_type(material) == WB_NODE_MATERIAL, wb_supervisor_node_get_base_type_name(reached));
   WbFieldRef diffuse = wb_supervisor_node_get_field(material, "diffuseColor");
   printf("material %s", wb_supervisor_node_get_type_name(material));
   numbers(wb_supervisor_field_get_sf_color(diffuse), 3);

@@ -36,6 +36,10 @@ color.setSFColor([0.3, 0.6, 0.9])
 robot.step(timestep)
 print("after", centre(), numbers(color.getSFColor()))
 material = robot.getFromDef("PANEL_MATERIAL")
+ball = robot.getFromDef("PANEL").getField("children").getMFNode(1)
+reached = ball.getField("appearance").getSFNode().getField("material").getSFNode()
+print("reached", int(reached.getId() == material.getId()), int(material.getType() == Node.MATERIAL),
+      reached.getBaseTypeName())
 diffuse = material.getField("diffuseColor")
 print("material", material.getTypeName(), numbers(diffuse.getSFColor()),
       f"{material.getField('transparency').getSFFloat():g}")
