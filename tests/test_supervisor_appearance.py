@@ -204,6 +204,19 @@ def test_a_yaml_shape_is_served_with_a_pbr_appearance_of_its_model():
     assert sim.device("r/cam").image[1, 1, [2, 1, 0]].tolist() == expected_bytes([0.25, 0.5, 1.0])
 
 
+def test_a_yaml_texture_reads_its_model(tmp_path):
+    from PIL import Image
+    Image.new("RGB", (2, 2), (200, 100, 30)).save(tmp_path / "t.png")
+    w = _yaml_world([1.0, 1.0, 1.0]).model_dump()
+    w["solids"][0]["appearance"]["texture"] = {"url": "t.png", "repeat_s": False}
+    sim = Simulation(wm.World.model_validate(w), base_dir=tmp_path)
+    (shape,) = field(sim, sv.find_node(sim, "wall"), "children")
+    app = sv.node_by_id(sim, field(sim, sv.node_by_id(sim, shape), "appearance"))
+    texture = sv.node_by_id(sim, field(sim, app, "baseColorMap"))
+    assert (texture.type, field(sim, texture, "url"), field(sim, texture, "repeatS"), field(sim, texture, "filtering")) \
+        == ("ImageTexture", ["t.png"], False, 4)
+
+
 def test_a_robots_own_shape_takes_its_new_colour():
     sim = _sim()
     body = sv.find_node(sim, "BODY")

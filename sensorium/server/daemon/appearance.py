@@ -110,10 +110,13 @@ def _value(sim: Any, ref: ShapeRef, name: str, default: Any) -> Any:
     if seen is not None:
         return seen
     written: Any = ref.node.values.get(key, default) if ref.node is not None else default
-    if ref.node is None and ref.role == "geometry":
+    if ref.node is None and ref.role == "geometry":       # a YAML shape: its model's
         model = sim.scene.loaded_model(ref.index).geometry
         written = getattr(model, _MODEL_GEOMETRY.get(name, ""), None)
         written = default if written is None else written
+    elif ref.node is None and ref.role == "texture":
+        t = sim.scene.loaded_model(ref.index).appearance.texture
+        written = {"url": [t.url], "repeatS": t.repeat_s, "repeatT": t.repeat_t, "filtering": t.filtering}[name]
     if ref.role == "geometry" and name == "subdivision" or ref.role == "texture" and name == "filtering":
         return int(written)
     return list(written) if isinstance(written, tuple) else written
