@@ -83,11 +83,14 @@ def test_supervisor_services_need_a_supervisor_robot_and_its_controller(live):
     assert live.ok(A, "/pioneer/robot/get_from_def", {"name": "nothing"}) == {
         "node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
     live.err(A, "/pioneer/robot/get_field", {"node": 99, "field": "translation"}, ErrorCode.INVALID_ARGUMENT)
-    # a robot written without nested nodes (a YAML world) holds one node per device, in device order
+    # a robot written without nested nodes (a YAML world) holds one node per device, in device order, then
+    # its shapes that visual rays see (Shape nodes)
     kids = live.ok(A, "/pioneer/robot/get_field", {"node": 1, "field": "children"})
     devices = live.ok(A, "/pioneer/robot/get_device_list")["list"]
-    assert kids["type"] == "MFNode" and len(kids["value"]) == len(devices)
-    assert [live.ok(A, "/pioneer/robot/get_from_id", {"id": k})["name"] for k in kids["value"]] == devices
+    assert kids["type"] == "MFNode" and len(kids["value"]) > len(devices)
+    named = [live.ok(A, "/pioneer/robot/get_from_id", {"id": k}) for k in kids["value"]]
+    assert [n["name"] for n in named[:len(devices)]] == devices
+    assert {n["type"] for n in named[len(devices):]} == {"Shape"}
     assert live.ok(A, "/pioneer/robot/get_field", {"node": 1, "field": "parent"}) == {"type": "", "value": []}
     live.err(A, "/pioneer/robot/set_field", {"node": 1, "field": "rotation", "value": [0, 0, 1]},
              ErrorCode.INVALID_ARGUMENT)

@@ -80,7 +80,9 @@ def test_nested_defs_are_found_anywhere_and_by_dotted_paths():
     assert node(lv, "ROVER.") == ROVER          # nothing after the dot (Webots)
     for missing in ("ROVER.CAM", "ROVER.TIP", "ARM.CAM", "ROVER..ds", ".CAM", "NOPE.TIP", "ROVER.ARM.TIP.X"):
         assert rover(lv, "get_from_def", {"name": missing})["type"] == "", missing
-    assert node(lv, "WHEEL") == 0               # a DEF'd Shape is no node here (Webots' NULL)
+    wheel = rover(lv, "get_from_def", {"name": "WHEEL"})      # a DEF'd Shape: a node after all the others
+    assert (wheel["type"], wheel["parent"]) == ("Shape", LEFT_WHEEL) and wheel["node"] > LEFT_PARAMETERS
+    assert node(lv, "ROVER.LEFT_JOINT.LEFT_WHEEL.WHEEL") == wheel["node"]
     assert node(lv, "rover") == ROVER           # a top-level node's name still finds it
 
 
@@ -145,10 +147,14 @@ def test_fields_are_read_in_the_parents_frame_and_refused_when_set():
     assert get(LEFT_PARAMETERS, "position") == {"type": "SFFloat", "value": 0.0}
     drive(lv, W, W, 10)
     assert get(LEFT_PARAMETERS, "position")["value"] == pytest.approx(W * 10 * DT, abs=1e-12)
-    assert rover(lv, "get_from_id", {"id": FIRST_ID + 15})["type"] == ""         # past the last nested node
+    assert rover(lv, "get_from_id", {"id": FIRST_ID + 15})["type"] == "Shape"    # the shapes come last
+    assert rover(lv, "get_from_id", {"id": FIRST_ID + 10**6})["type"] == ""      # past the last nested node
     # a node id that is none says which ids there are, the nested ones too
-    msg = lv.err(A, "/rover/robot/get_node_pose", {"node": FIRST_ID + 15}, ErrorCode.INVALID_ARGUMENT)
-    assert msg.endswith(f"no node with id {FIRST_ID + 15} (ids 0..4: 0 the root, nested {FIRST_ID}..{FIRST_ID + 14})"), msg
+    end = FIRST_ID + 15
+    while rover(lv, "get_from_id", {"id": end})["type"]:       # past the shapes and the nodes inside them
+        end += 1
+    msg = lv.err(A, "/rover/robot/get_node_pose", {"node": end}, ErrorCode.INVALID_ARGUMENT)
+    assert msg.endswith(f"no node with id {end} (ids 0..4: 0 the root, nested {FIRST_ID}..{end - 1})"), msg
 
 
 def test_world_poses_follow_the_robot_as_it_drives():

@@ -52,10 +52,11 @@ FIELD_TYPES = {"SFBool": WB_SF_BOOL, "SFInt32": WB_SF_INT32, "SFFloat": WB_SF_FL
                "MFColor": WB_MF_COLOR, "MFString": WB_MF_STRING, "MFNode": WB_MF_NODE}
 _TYPE_NAMES = {v: k for k, v in FIELD_TYPES.items()}
 # Webots' node type constants by type name (any other type, a device's, a Pose's, a HingeJoint's:
-# nodes.node_type, which spells the constant from the name; Hinge2Joint's does not spell it)
+# nodes.node_type, which spells the constant from the name; Hinge2Joint's and PBRAppearance's do not spell it)
 NODE_TYPES = {"Group": "WB_NODE_GROUP", "Robot": "WB_NODE_ROBOT", "Solid": "WB_NODE_SOLID",
               "PointLight": "WB_NODE_POINT_LIGHT", "SpotLight": "WB_NODE_SPOT_LIGHT",
-              "DirectionalLight": "WB_NODE_DIRECTIONAL_LIGHT", "Hinge2Joint": "WB_NODE_HINGE_2_JOINT"}
+              "DirectionalLight": "WB_NODE_DIRECTIONAL_LIGHT", "Hinge2Joint": "WB_NODE_HINGE_2_JOINT",
+              "PBRAppearance": "WB_NODE_PBR_APPEARANCE"}
 
 Field = tuple[int, str, int] | tuple[int, str, int, int]
 """(node, name, type) — and, for a PROTO's field, the PROTO level: 0 the base node's (getBaseNodeField), k the

@@ -283,6 +283,38 @@ class Appearance(Strict):
 
 SeenBy = Literal["both", "bounding", "visual"]
 
+NodeValue = float | tuple[float, float, float] | tuple[float, float] | tuple[str, ...] | bool
+
+
+class ShapeNode(Strict):
+    """A ``.wbt`` Shape as a Supervisor serves it (README "Supervisor"): its DEFs, its appearance
+    node's type, and the written values of its appearance's, material's, texture's and geometry's
+    fields (Webots' defaults for the ones left out). What sensors see is the shape's ``appearance``;
+    these are what a Supervisor reads back."""
+
+    def_name: str | None = Field(default=None, min_length=1)
+    parent: int = Field(default=-1, ge=-1, description="on a robot: the index in the robot's `nodes` of the node "
+                        "holding it (-1: the robot); on a solid: -1 (the solid holding it)")
+    after: int = Field(default=-1, ge=-1, description="its place among its parent's children: on a robot, the "
+                       "index of the last `nodes` entry written before it; on a solid, how many of the solid's "
+                       "children solids come before it, minus one")
+    appearance: Literal["Appearance", "PBRAppearance"] | None = None
+    appearance_def: str | None = Field(default=None, min_length=1)
+    appearance_proto: str | None = Field(default=None, min_length=1, description="an appearance PROTO instance "
+                                         "(PaintedWood, ...): the PROTO's name")
+    appearance_interface: list[ProtoLevel] = Field(default=[], max_length=16, description="its PROTO's interface, as a "
+                                                   "nested node's `interface`")
+    appearance_key: int = Field(default=-1, ge=-1, description="shapes whose appearance is one world-file node "
+                                "(its DEF and USEs) share this number; a Supervisor's change reaches them all")
+    material: bool = Field(default=False, description="an Appearance with a Material node")
+    material_key: int = Field(default=-1, ge=-1, description="the same for its Material node")
+    material_def: str | None = Field(default=None, min_length=1)
+    texture_def: str | None = Field(default=None, min_length=1)
+    geometry: str = Field(default="", max_length=64, description="the geometry node's type (Box, Mesh, ...)")
+    geometry_def: str | None = Field(default=None, min_length=1)
+    values: dict[str, NodeValue] = Field(default={}, max_length=64, description="the written values: "
+                                         "'<node>.<field>' (node: appearance, material, texture, geometry)")
+
 _CAST_SHADOWS = ("Webots' Shape.castShadows: false lets cameras' shadow rays through this shape (it still hides "
                  "what is behind it, and other rays see it)")
 
@@ -295,6 +327,8 @@ class Shape(Strict):
     appearance: Appearance | None = None
     seen_by: SeenBy = "both"
     cast_shadows: bool = Field(default=True, description=_CAST_SHADOWS)
+    node: ShapeNode | None = Field(default=None, description="the .wbt Shape node a Supervisor serves (its DEF, "
+                                   "its appearance's fields as written); none: served from `appearance`")
 
     @model_validator(mode="after")
     def _cone_seen(self) -> Shape:

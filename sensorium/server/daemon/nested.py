@@ -2,7 +2,9 @@
 
 A robot's nodes are its world entry's ``nodes`` (the ``.wbt`` import keeps its Solids, devices,
 Poses, Transforms, Groups, Slots and joints, schemas.world.NestedNode), or one node per device of
-its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth. They are
+its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth.
+Both hold their Shapes too, numbered after every other nested node (:func:`_shape_nodes`; their
+fields: appearance.py). They are
 numbered once per simulation, in scene order (robots, then solids, each depth first), from
 :data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
 imports) are never shifted by them. A nested node is found by DEF (first in scene order, as
@@ -27,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.daemon import appearance
 from sensorium.server.sim.joints import Links
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
@@ -75,6 +78,8 @@ class Nested:
     frame: int = -1       # the id of the nested node whose frame its ``own`` is in (-1: the owner's)
     motor: str = ""       # a joint's JointParameters node: the joint motor whose position it holds
     interface: tuple = () # a PROTO instance's interface (wm.ProtoLevel each: supervisor.py serves its fields)
+    order: float = 0.0    # its place among its parent's children (file order: Shapes between the others)
+    shape: Any = None     # a Shape or a node inside it: its appearance.ShapeRef (appearance.py serves its fields)
 
 
 @dataclass(frozen=True, slots=True)
@@ -178,6 +183,71 @@ def _joint_parameters(sim: Any, robots: list[str], out: list[Nested]) -> tuple[l
     return added, frozenset(bare)
 
 
+def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nested],
+                 solid_ids: dict[int, int]) -> list[Nested]:
+    """The robots' and top-level solids' Shape nodes (appearance.py), each followed by the nodes inside
+    it, numbered after every other nested node: robots in world order, then solids (each solid's
+    shapes, then those of the solids inside it). A robot's shape sits under the node its world entry
+    names (``ShapeNode.parent``), a solid's under the solid holding it."""
+    scene = sim.scene
+    index = {id(scene.loaded_model(k)): k for k in range(len(scene.shapes))}
+    loaded = getattr(sim, "loaded", None)
+    wbt = str(getattr(loaded, "source", "")).lower().endswith(".wbt")
+    shared: dict[tuple[str, int], list[int]] = {}     # (role, the node's number) -> the shapes holding it
+    for k in range(len(scene.shapes)):
+        held = getattr(scene.loaded_model(k), "node", None)
+        if held is not None:
+            for role, number in (("appearance", held.appearance_key), ("material", held.material_key)):
+                if number >= 0:
+                    shared.setdefault((role, number), []).append(k)
+    added: list[Nested] = []
+    starts: dict[int, int] = {}       # a robot's node id -> the id of its first world entry
+    for n in out:
+        if n.owner_kind == "Robot" and n.field != "jointParameters":
+            starts.setdefault(n.owner, n.id)
+
+    def add(shape: Any, parent: int, owner: int, kind: str, key: str) -> None:
+        k = index.get(id(shape))
+        if k is None or not appearance.served(shape, wbt):
+            return
+        node = getattr(shape, "node", None)
+        if node is not None and kind == "Robot" and node.parent >= 0 and owner in starts:
+            parent = starts[owner] + node.parent
+        order = float("inf") if node is None else node.after + 0.5
+        me = FIRST_ID + len(out) + len(added)
+        added.append(Nested(me, "Shape", "", (node.def_name if node else None) or "", "", parent, "children", None,
+                            None, "", owner, kind, key, order=order, shape=appearance.ShapeRef(k, node, "Shape", "Shape")))
+        above = {"appearance": me, "geometry": me}
+        for role, type_, def_name, field in appearance.inside(shape, k):
+            nid = FIRST_ID + len(out) + len(added)
+            proto, face = ((node.appearance_proto or "", tuple(node.appearance_interface))
+                           if node is not None and role == "appearance" else ("", ()))
+            number = -1 if node is None else node.appearance_key if role == "appearance" else \
+                node.material_key if role == "material" else -1
+            peers = tuple(shared.get((role, number), (k,)))
+            added.append(Nested(nid, type_, proto, def_name, "", above[role if role in above else "appearance"], field,
+                                None, None, "", owner, kind, key, interface=face,
+                                shape=appearance.ShapeRef(k, node, role, type_, peers)))
+            if role == "appearance":
+                above["appearance"] = nid
+
+    for i, name in enumerate(robots):
+        model = sim.robots[name].model
+        for shape in ([model.body] if model.body is not None else []) + list(model.shapes):
+            add(shape, i + 1, i + 1, "Robot", name)
+    for j in range(loaded_solids):
+        owner, key = len(robots) + 1 + j, sim.scene.solid_names[j]
+
+        def walk(s: wm.Solid, holder: int, owner: int = owner, key: str = key) -> None:
+            for shape in ([s] if s.geometry is not None else []) + list(s.shapes):
+                add(shape, holder, owner, "Solid", key)
+            for child in s.children:
+                walk(child, solid_ids[id(child)])
+
+        walk(sim.world.solids[j], owner)
+    return added
+
+
 def build(sim: Any, loaded_solids: int) -> Table:
     out: list[Nested] = []
     robots = list(sim.robots)
@@ -197,24 +267,27 @@ def build(sim: Any, loaded_solids: int) -> Table:
             out.append(Nested(first + k, e.type, e.proto or "", e.def_name or "", e.name or "",
                               owner if e.parent < 0 else first + e.parent, e.field, local, _own(local, above),
                               e.device or "", owner, "Robot", name, joints[k], above_id,
-                              interface=tuple(e.interface)))
+                              interface=tuple(e.interface), order=float(k)))
+    solid_ids: dict[int, int] = {}          # id(nested solid model) -> its node id
     for j in range(loaded_solids):
         owner = len(robots) + 1 + j
         solid = sim.world.solids[j]
 
         def walk(s: wm.Solid, parent: int, at: Pose | None, solid_name: str = sim.scene.solid_names[j],
                  owner: int = owner) -> None:
-            for child in s.children:
+            for k, child in enumerate(s.children):
                 own = pose_from_model(child.pose)
                 local = own if at is None else at.compose(own)
                 node = Nested(FIRST_ID + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
-                              local, own, "", owner, "Solid", solid_name)
+                              local, own, "", owner, "Solid", solid_name, order=float(k))
                 out.append(node)
+                solid_ids[id(child)] = node.id
                 walk(child, node.id, local)
 
         walk(solid, owner, None)
     parameters, bare = _joint_parameters(sim, robots, out)
     out += parameters
+    out += _shape_nodes(sim, robots, loaded_solids, out, solid_ids)     # after all others: no other id moves
     by_owner: dict[int, list[Nested]] = {}
     by_parent: dict[int, list[Nested]] = {}
     for n in out:
@@ -313,7 +386,7 @@ def has_children(n: Nested) -> bool:
 
 def children(table: Table, parent: int) -> list[int]:
     """The ids of a node's ``children`` (not a joint's end point nor its devices)."""
-    return [c.id for c in table.by_parent.get(parent, ()) if c.field == "children"]
+    return [c.id for c in sorted(table.by_parent.get(parent, ()), key=lambda c: c.order) if c.field == "children"]
 
 
 def end_point(table: Table, joint: int) -> int:

@@ -7,11 +7,13 @@ solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``neste
 are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dotted path ``A.B`` walks
 direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
 a removed solid or light keeps its id, which then answers NULL and is never given to another node.
-Shapes, geometries and lights carried by a solid or robot are not nodes here: Webots' NULL.
+Shapes with their appearances and geometries are nested nodes too (:mod:`.appearance`); lights
+carried by a solid or robot are not nodes here: Webots' NULL.
 
 Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame. Setting one field
 keeps the others (Webots). A field change applies at once; the next measurement sees it. A nested
-node's fields are read-only here, but a joint's parameters' ``position``. A joint is set with
+node's fields are read-only here, but a joint's parameters' ``position`` and a shape's colours,
+roughness and transparency (:mod:`.appearance`). A joint is set with
 ``set_joint_position``; a node's state is saved and loaded by name (sim/states.py).
 """
 
@@ -27,7 +29,7 @@ import numpy as np
 from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
-from sensorium.server.daemon import nested
+from sensorium.server.daemon import appearance, nested
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import states, viewshot
 from sensorium.server.world.poses import matrix_quaternion
@@ -168,15 +170,17 @@ def root_children(sim: Any) -> list[Node]:
     return [by_id[i] for i in order if i in by_id]
 
 
-def _scene_order(sim: Any) -> list[Node]:
-    """Every node in the world in Webots' scene order: the root's children, each followed by the nodes
-    inside it depth first."""
+def _first_def(sim: Any, name: str) -> Node | None:
+    """The first node in Webots' scene order (the root's children, each followed by the nodes inside
+    it) with DEF ``name``; only that one is made a Node."""
     table = _table(sim)
-    out = []
     for top in root_children(sim):
-        out.append(top)
-        out += [_nested_node(n) for n in table.by_owner.get(top.id, ())]
-    return out
+        if top.def_name == name:
+            return top
+        hit = next((n for n in table.by_owner.get(top.id, ()) if n.def_name == name), None)
+        if hit is not None:
+            return _nested_node(hit)
+    return None
 
 
 def find_node(sim: Any, name: str) -> Node | None:
@@ -188,7 +192,7 @@ def find_node(sim: Any, name: str) -> Node | None:
         path.pop()
     if not first or "" in path:          # a node without a DEF is never found by one
         return None
-    found = next((n for n in _scene_order(sim) if n.def_name == first), None)
+    found = _first_def(sim, first)
     if found is None and not path:
         found = next((n for n in _nodes(sim) if n.name == name), None)
     table = _table(sim)
@@ -476,6 +480,8 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
     """A nested node's fields, all read-only here: its pose in its parent's frame, its name, its
     children; a moving joint's ``jointParameters`` and their ``position``."""
     n = _nested_of(sim, node)
+    if n.shape is not None:            # a Shape or a node inside it (appearance.py)
+        return appearance.fields(n.shape, lambda field: _sf_child(sim, n.id, field))
     out = dict(_NESTED_POSE) if n.own is not None else {}
     if n.name:
         out["name"] = ("SFString", lambda sim, node: node.name, None)
@@ -492,6 +498,11 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
         out["position"] = ("SFFloat", lambda sim, node: nested.joint_position(sim, _nested_of(sim, node)),
                            _set_parameter_position)
     return out
+
+
+def _sf_child(sim: Any, parent: int, field: str) -> int:
+    """The id of the node in a nested node's SFNode ``field`` (0: NULL)."""
+    return next((c.id for c in _table(sim).by_parent.get(parent, ()) if c.field == field), 0)
 
 
 def _set_parameter_position(sim: Any, node: Node, value: float) -> None:
@@ -568,9 +579,10 @@ _JOINT_FIELDS = {"endPoint": frozenset(nested.JOINT_DEVICES), "device": frozense
                  "device3": frozenset({"BallJoint"}), "jointParameters3": frozenset({"BallJoint"})}
 _PARAMETERS = frozenset({"HingeJointParameters", "JointParameters", "BallJointParameters"})
 _SCENERY = frozenset({"WorldInfo", "Viewpoint", "Background", "Fog", "PointLight", "SpotLight", "DirectionalLight"})
-_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS | _SCENERY
+_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS | _SCENERY | appearance.TYPES
 _WEBOTS_LACKS = {"children": _NO_POSE, "translation": _NO_POSE | {"Group"}, "rotation": _NO_POSE | {"Group"},
-                 "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | _SCENERY | {"Pose", "Transform", "Group"}}
+                 "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | _SCENERY | {"Pose", "Transform", "Group"}
+                 | (appearance.TYPES - {"Appearance", "PBRAppearance"})}
 
 
 def webots_lacks(node_type: str, field: str) -> bool:
@@ -631,6 +643,10 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
                "top-level robot's or solid's translation and rotation, a light's fields)")
         raise ValueError(f"field {field!r} ({kind}) of PROTO {node.interface[0].name} ({what}) is read-only here: "
                          f"{why}; nothing changed")
+    if setter is None and node.nested and node.type in appearance.TYPES:
+        raise ValueError(f"field {field!r} ({kind}) of {_what(node)} is read-only here: of a shape's nodes a "
+                         "Supervisor sets a Material's diffuseColor, emissiveColor and transparency and a "
+                         "PBRAppearance's baseColor, roughness, metalness, transparency and emissiveColor only")
     if setter is None and node.nested:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
                          "top-level robots, solids and lights only, not the nodes inside them")

@@ -458,6 +458,9 @@ class Scene:
                                  ink_evaporation=self._ink_evaporation)
         self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
+        # a Supervisor's appearance changes: shape -> its model as loaded, and the field values it set
+        self._loaded_models: dict[int, wm.Shape | wm.Solid] = {}
+        self.appearance_values: dict[int, dict[str, Any]] = {}
         self._link_frames: dict[tuple[int, str], tuple[Pose, Pose, Pose]] = {}   # link -> (robot, link, world)
         self.lights_version = 0        # changes whenever a light moves with its owner
         self.solids_version = 0        # changes whenever a top-level solid moves, is added or removed (gym's TopDown)
@@ -491,6 +494,36 @@ class Scene:
         # cameras read these (sim/cameras.py): base colour (white without appearance) and transparency
         self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
         self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
+
+    def set_appearance(self, shape: int, appearance: wm.Appearance) -> None:
+        """A Supervisor's new colour, roughness or transparency for one shape (Webots' Material and
+        PBRAppearance fields): from the next measurement cameras and infra-red sensors read it as if the
+        world file had said it. Only that shape's entries change (no rebuild); a transparency keeps its
+        side of 0 and 1 (the caller's check: which rays see the shape and its shadows is fixed)."""
+        key, local, model = self._parts[shape]
+        self._loaded_models.setdefault(shape, model)
+        model = model.model_copy(update={"appearance": appearance})
+        self._parts[shape] = (key, local, model)
+        info = _shape_info(self.shapes[shape].name, self.shapes[shape].owner, model)
+        self.shapes[shape] = info
+        self.red[shape], self.roughness[shape], self.transparency[shape] = info.red, info.roughness, info.transparency
+        self.colors[shape] = _base_color(model)
+
+    def shape_model(self, shape: int) -> wm.Shape | wm.Solid:
+        """A shape's model now (its appearance as a Supervisor last set it)."""
+        return self._parts[shape][2]
+
+    def loaded_model(self, shape: int) -> wm.Shape | wm.Solid:
+        """A shape's model as the world loaded it (before any Supervisor change)."""
+        return self._loaded_models.get(shape, self._parts[shape][2])
+
+    def restore_appearances(self) -> None:
+        """Every shape's appearance as loaded (``simulationReset``)."""
+        for shape, model in self._loaded_models.items():
+            if model.appearance is not None:
+                self.set_appearance(shape, model.appearance)
+        self._loaded_models.clear()
+        self.appearance_values.clear()
 
     def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool,
                   key: str | int | None = None, entries: list[ShapeEntry] | None = None) -> int:

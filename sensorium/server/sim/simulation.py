@@ -422,6 +422,7 @@ class Simulation:
             if self.scene.top_lights()[k] is not light:
                 self.scene.set_top_light(k, light)
         self.scene.clear_ink()          # WbPen::reset clears every paint texture
+        self.scene.restore_appearances()     # colours a Supervisor set: as loaded
         # radar cross sections a Supervisor set: back to the loaded ones (of the robots and solids still there)
         owners = {k: k[0] if isinstance(k, tuple) else k for k in self._initial["radar_targets"]}
         self.scene.radar_targets = {k: v for k, v in self._initial["radar_targets"].items()

@@ -139,6 +139,7 @@ class Converter:
         self.tree_field = "children"       # the field the next node walked sits in (a joint's endPoint, ...)
         self.builtin_proto: str | None = None   # a built-in PROTO being expanded (the expansion's node names it)
         self.nested_defs: set[int] = set()      # nested nodes whose DEF is kept (a USE of one is a copy without it)
+        self.shared_nodes: dict[int, int] = {}  # id(appearance or material node) -> its number (its USEs share it)
 
     # ------------------------------------------------------------ messages
     def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
@@ -689,10 +690,33 @@ class Converter:
                 part["appearance"] = app
             if node.type == "Shape" and not f.flag("castShadows", True):
                 part["cast_shadows"] = False
+            if node.type == "Shape":       # a node a Supervisor serves
+                part["node"] = self.shape_node(node, owner)
             owner.keys[key] = part
         part["_at"] = self.at(gnode)
         self.ride(part)
         owner.parts.append(part)
+
+    def shape_node(self, node: Node, owner: Owner) -> dict:
+        """The Supervisor's view of a Shape (schemas.world.ShapeNode): its DEFs and written fields, and
+        where it sits among its parent's children (a robot's: after the last tree node written before
+        it; a solid's: after its children solids so far)."""
+        out = fx.shape_node(node, self.source, self.nested_def,
+                            lambda n: self.shared_nodes.setdefault(id(n), len(self.shared_nodes)))
+        app = self.fields(node).node_("appearance")
+        if app is not None and app.proto and "appearance" in out:     # an appearance PROTO (PaintedWood, ...)
+            out["appearance_proto"] = app.proto
+            face: dict[str, Any] = {}
+            self.interface(app, face)
+            if face.get("interface"):
+                out["appearance_interface"] = face["interface"]
+        if owner.kind == "robot" and self.tree is not None:
+            if self.tree_stack:
+                out["parent"] = self.tree_stack[-1][1]
+            out["after"] = len(self.tree) - 1
+        elif owner.kind != "robot":
+            out["after"] = len(owner.data.get("children", ())) - 1
+        return out
 
     def cad_shape(self, node: Node, frame: Frame, owner: Owner) -> None:
         """A CadShape: its file as a visual mesh. A COLLADA file, or an OBJ file with .mtl materials,

@@ -5,6 +5,7 @@ the wrong shape is an error naming file, line and column."""
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable
 from typing import Any
 
@@ -465,6 +466,111 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
         return out
     warn(node, f"appearance {node.type}: not built in (a PROTO?); taken as white")
     return None
+
+
+MATERIAL_FIELDS: dict[str, tuple[str, Any]] = {
+    "ambientIntensity": ("SFFloat", 0.2), "diffuseColor": ("SFColor", (0.8, 0.8, 0.8)),
+    "emissiveColor": ("SFColor", (0.0, 0.0, 0.0)), "shininess": ("SFFloat", 0.2),
+    "specularColor": ("SFColor", (0.0, 0.0, 0.0)), "transparency": ("SFFloat", 0.0)}
+"""Webots' Material fields a Supervisor reads: type, Webots' default."""
+
+PBR_FIELDS: dict[str, tuple[str, Any]] = {
+    "baseColor": ("SFColor", (1.0, 1.0, 1.0)), "transparency": ("SFFloat", 0.0), "roughness": ("SFFloat", 0.0),
+    "metalness": ("SFFloat", 1.0), "IBLStrength": ("SFFloat", 1.0), "normalMapFactor": ("SFFloat", 1.0),
+    "occlusionMapStrength": ("SFFloat", 1.0), "emissiveColor": ("SFColor", (0.0, 0.0, 0.0)),
+    "emissiveIntensity": ("SFFloat", 1.0)}
+"""Webots' PBRAppearance fields a Supervisor reads (its maps are SFNode fields): type, Webots' default."""
+
+TEXTURE_FIELDS: dict[str, tuple[str, Any]] = {
+    "url": ("MFString", ()), "repeatS": ("SFBool", True), "repeatT": ("SFBool", True), "filtering": ("SFInt32", 4)}
+"""Webots' ImageTexture fields a Supervisor reads."""
+
+GEOMETRY_FIELDS: dict[str, dict[str, tuple[str, Any]]] = {
+    "Box": {"size": ("SFVec3f", (0.1, 0.1, 0.1))},
+    "Sphere": {"radius": ("SFFloat", 0.1), "subdivision": ("SFInt32", 1), "ico": ("SFBool", True)},
+    "Cylinder": {"radius": ("SFFloat", 0.05), "height": ("SFFloat", 0.1), "subdivision": ("SFInt32", 36),
+                 "bottom": ("SFBool", True), "side": ("SFBool", True), "top": ("SFBool", True)},
+    "Capsule": {"radius": ("SFFloat", 0.05), "height": ("SFFloat", 0.1), "subdivision": ("SFInt32", 12),
+                "bottom": ("SFBool", True), "side": ("SFBool", True), "top": ("SFBool", True)},
+    "Cone": {"bottomRadius": ("SFFloat", 0.05), "height": ("SFFloat", 0.1), "subdivision": ("SFInt32", 12),
+             "bottom": ("SFBool", True), "side": ("SFBool", True)},
+    "Plane": {"size": ("SFVec2f", (1.0, 1.0))},
+}
+"""The geometry fields a Supervisor reads (the cheap ones: sizes, not a mesh's points)."""
+
+
+def _written(f: Fields, table: dict[str, tuple[str, Any]], prefix: str, out: dict[str, Any]) -> None:
+    """The fields of ``table`` that the node writes, as ``prefix.field`` in ``out`` (the others are
+    Webots' defaults, which the reader supplies)."""
+    for name, (kind, default) in table.items():
+        if f.has(name):
+            try:
+                _write(f, name, kind, default, sys.intern(f"{prefix}.{name}"), out)
+            except WbtSyntaxError:      # a value the conversion does not read and Webots would refuse: its default
+                pass
+
+
+def _write(f: Fields, name: str, kind: str, default: Any, key: str, out: dict[str, Any]) -> None:
+    """One written field's value into ``out[key]`` (WbtSyntaxError: not of its type)."""
+    if kind == "SFColor":
+        out[key] = tuple(float(v) for v in f.color(name, default))
+    elif kind in ("SFVec3f", "SFVec2f"):
+        out[key] = tuple(float(v) for v in f.vec(name, default))
+    elif kind == "SFFloat":
+        out[key] = float(f.num(name, default))
+    elif kind == "SFInt32":
+        out[key] = float(f.integer(name, default))
+    elif kind == "SFBool":
+        out[key] = bool(f.flag(name, default))
+    elif kind == "MFString":
+        out[key] = tuple(f.strings(name))
+
+
+def shape_node(node: Node, source: str, keep_def, key) -> dict:
+    """A Shape as a Supervisor serves it (schemas.world.ShapeNode): DEFs (``keep_def(node)``: whether
+    the world file's DEF is served), its appearance node's type and the written values of its
+    appearance's, material's, texture's and geometry's fields; ``key(node)``: the number of its
+    appearance and material nodes (the same for a USE of one as for its DEF)."""
+    f = Fields(node, source)
+    out: dict[str, Any] = {}
+    values: dict[str, Any] = {}
+    if keep_def(node):
+        out["def_name"] = node.def_name
+    app = f.node_("appearance")
+    if app is not None and app.type in ("Appearance", "PBRAppearance"):
+        out["appearance"] = app.type
+        out["appearance_key"] = key(app)
+        if keep_def(app):
+            out["appearance_def"] = app.def_name
+        a = f.sub(app)
+        texture = a.node_("texture" if app.type == "Appearance" else "baseColorMap")
+        # what the appearance model holds (as the loader sanitised it) is read there, not kept twice
+        if app.type == "PBRAppearance":
+            _written(a, {k: v for k, v in PBR_FIELDS.items() if k not in ("baseColor", "transparency", "roughness")},
+                     "appearance", values)
+        else:
+            material = a.node_("material")
+            if material is not None and material.type == "Material":
+                out["material"] = True
+                out["material_key"] = key(material)
+                if keep_def(material):
+                    out["material_def"] = material.def_name
+                held = ("transparency",) if texture is not None else ("transparency", "diffuseColor")
+                _written(a.sub(material), {k: v for k, v in MATERIAL_FIELDS.items() if k not in held}, "material",
+                         values)
+        if texture is not None and texture.type == "ImageTexture":
+            if keep_def(texture):
+                out["texture_def"] = texture.def_name
+            _written(a.sub(texture), TEXTURE_FIELDS, "texture", values)
+    geometry = f.node_("geometry")
+    if geometry is not None:
+        out["geometry"] = geometry.type
+        if keep_def(geometry):
+            out["geometry_def"] = geometry.def_name
+        _written(f.sub(geometry), GEOMETRY_FIELDS.get(geometry.type, {}), "geometry", values)
+    if values:
+        out["values"] = values
+    return out
 
 
 def image_texture(node: Node | None, source: str, warn, resolve=None) -> dict | None:

@@ -1,0 +1,193 @@
+"""The Supervisor's Shape nodes and what is inside them (sans-IO): a shape's ``appearance``
+(``Appearance`` with its ``material`` Material and ``texture`` ImageTexture, or ``PBRAppearance``
+with its ``baseColorMap``) and its ``geometry``.
+
+Numbered by nested.py after every other nested node (so no other id moves). Their fields read what
+the world file wrote (``schemas.world.ShapeNode``; Webots' defaults for what it leaves out), the
+values sensors see where the world's model has them (a colour, transparency and roughness as the
+loader sanitised them), or what a Supervisor set since. A Supervisor sets a Material's
+``diffuseColor``, ``emissiveColor`` and ``transparency``, a PBRAppearance's ``baseColor``,
+``roughness``, ``metalness``, ``transparency`` and ``emissiveColor``: the scene takes the new
+appearance for that one shape (``Scene.set_appearance``), so cameras and infra-red sensors see it
+at their next measurement as if the world file had said it. Everything else is read-only.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from sensorium.schemas import world as wm
+from sensorium.server.world.wbt.fields import GEOMETRY_FIELDS, MATERIAL_FIELDS, PBR_FIELDS, TEXTURE_FIELDS
+
+TYPES = frozenset({"Shape", "Appearance", "PBRAppearance", "Material", "ImageTexture", "Box", "Sphere", "Cylinder",
+                   "Capsule", "Cone", "Plane", "Mesh", "IndexedFaceSet", "ElevationGrid"})
+"""The node types served here (what Webots' node of each type lacks: no pose, no children)."""
+
+GEOMETRY_TYPES = {wm.Box: "Box", wm.Sphere: "Sphere", wm.Cylinder: "Cylinder", wm.Capsule: "Capsule", wm.Cone: "Cone",
+                  wm.Plane: "Plane", wm.Mesh: "Mesh", wm.Triangles: "IndexedFaceSet",
+                  wm.ElevationGrid: "ElevationGrid"}
+
+SETTABLE = {"Material": frozenset({"diffuseColor", "emissiveColor", "transparency"}),
+            "PBRAppearance": frozenset({"baseColor", "roughness", "metalness", "transparency", "emissiveColor"})}
+"""The fields a Supervisor sets here; the rest of these nodes is read-only."""
+
+# the written field names of a YAML geometry model (no .wbt node): Webots' field -> the model's attribute
+_MODEL_GEOMETRY = {"size": "size", "radius": "radius", "height": "height", "bottomRadius": "bottom_radius",
+                   "subdivision": "subdivision"}
+
+Getter = Callable[[Any, Any], Any]
+Setter = Callable[[Any, Any, Any], None] | None
+
+
+@dataclass(frozen=True, slots=True)
+class ShapeRef:
+    """A served Shape, or a node inside it: the scene's shape index, the ``.wbt`` node's DEFs and
+    written values (None: a YAML shape, served from its ``appearance``), and which node it is."""
+
+    index: int
+    node: wm.ShapeNode | None
+    role: str            # "Shape", "appearance", "material", "texture", "geometry"
+    type: str            # its Webots type (PBRAppearance, Box, ...)
+    peers: tuple[int, ...] = ()   # the shapes whose node this is too (a DEF and its USEs), itself included
+
+
+def served(shape: Any, wbt: bool) -> bool:
+    """Whether a shape of a robot or solid is a Shape node here: one the ``.wbt`` import describes
+    (``node``), or in a YAML world one that visual rays see (a bounding-only shape is Webots'
+    boundingObject, no child)."""
+    if getattr(shape, "node", None) is not None:
+        return True
+    return not wbt and shape.seen_by != "bounding"
+
+
+def inside(shape: Any, index: int) -> list[tuple[str, str, str, str]]:
+    """The nodes inside a served Shape, parents first: (role, type, DEF, the field of its parent
+    holding it); the appearance's children follow it, then the geometry."""
+    node: wm.ShapeNode | None = getattr(shape, "node", None)
+    out: list[tuple[str, str, str, str]] = []
+    app = shape.appearance
+    kind = node.appearance if node is not None else ("PBRAppearance" if app is not None else None)
+    if kind is not None:
+        out.append(("appearance", kind, (node.appearance_def if node else None) or "", "appearance"))
+        if node is not None and node.material:
+            out.append(("material", "Material", node.material_def or "", "material"))
+        textured = (app is not None and app.texture is not None) or (node is not None and (
+            node.texture_def is not None or any(k.startswith("texture.") for k in node.values)))
+        if textured:
+            out.append(("texture", "ImageTexture", (node.texture_def if node else None) or "",
+                        "texture" if kind == "Appearance" else "baseColorMap"))
+    geometry = node.geometry if node is not None and node.geometry else GEOMETRY_TYPES.get(type(shape.geometry), "")
+    if geometry:
+        out.append(("geometry", geometry, (node.geometry_def if node else None) or "", "geometry"))
+    return out
+
+
+def _seen(ref: ShapeRef, loaded: wm.Appearance | None, name: str) -> Any:
+    """A field's value as the world's model has it (what sensors see, as the loader sanitised it);
+    None where the model does not hold that field."""
+    if loaded is None:
+        return None
+    if ref.type == "PBRAppearance":
+        held = {"baseColor": loaded.base_color, "transparency": loaded.transparency, "roughness": loaded.roughness}
+    else:      # a Material: its transparency; its diffuse colour unless a texture replaces it by white
+        held = {"transparency": loaded.transparency}
+        if loaded.texture is None:
+            held["diffuseColor"] = loaded.base_color
+    v = held.get(name)
+    return [float(x) for x in v] if isinstance(v, tuple | list) else v
+
+
+def _value(sim: Any, ref: ShapeRef, name: str, default: Any) -> Any:
+    """A field's value now: as a Supervisor set it, else as the world loaded it, else Webots' default."""
+    key = f"{ref.role}.{name}"
+    changed = sim.scene.appearance_values.get(ref.index, {})
+    if key in changed:
+        return changed[key]
+    seen = _seen(ref, sim.scene.loaded_model(ref.index).appearance, name) if ref.role in ("appearance", "material") \
+        else None
+    if seen is not None:
+        return seen
+    written: Any = ref.node.values.get(key, default) if ref.node is not None else default
+    if ref.node is None and ref.role == "geometry":       # a YAML shape: its model's
+        model = sim.scene.loaded_model(ref.index).geometry
+        written = getattr(model, _MODEL_GEOMETRY.get(name, ""), None)
+        written = default if written is None else written
+    elif ref.node is None and ref.role == "texture":
+        t = sim.scene.loaded_model(ref.index).appearance.texture
+        written = {"url": [t.url], "repeatS": t.repeat_s, "repeatT": t.repeat_t, "filtering": t.filtering}[name]
+    if ref.role == "geometry" and name == "subdivision" or ref.role == "texture" and name == "filtering":
+        return int(written)
+    return list(written) if isinstance(written, tuple) else written
+
+
+def _what(ref: ShapeRef, def_name: str, node_id: int) -> str:
+    return f"{ref.type} {def_name!r} (node {node_id})" if def_name else f"{ref.type} (node {node_id})"
+
+
+def _class(t: float) -> int:
+    return 0 if t <= 0.0 else 2 if t >= 1.0 else 1
+
+
+def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
+    if name not in SETTABLE.get(ref.type, ()):
+        return None
+
+    def set_value(sim: Any, node: Any, value: Any) -> None:
+        where = f"field {name!r} ({kind}) of {_what(ref, node.def_name, node.id)}"
+        values = value if isinstance(value, list) else [value]
+        if not all(0.0 <= float(v) <= 1.0 for v in values):
+            raise ValueError(f"{where}: {'each component' if kind == 'SFColor' else 'the value'} must be in [0, 1], "
+                             f"got {value!r} (Webots resets it with a warning); nothing changed")
+        scene = sim.scene
+        shapes = ref.peers or (ref.index,)
+        if name == "transparency":
+            for k in shapes:
+                loaded = scene.loaded_model(k).appearance
+                if loaded is not None and _class(float(value)) != _class(loaded.transparency):
+                    sides = ("0 (opaque)", "between 0 and 1 (translucent)", "1 (invisible)")
+                    raise ValueError(
+                        f"{where}: the world file's {loaded.transparency:g} is {sides[_class(loaded.transparency)]} and "
+                        f"{float(value):g} is {sides[_class(float(value))]}: which rays see a shape and its shadows is "
+                        "fixed when the scene is built here, so a transparency stays on its side of 0 and 1; nothing "
+                        "changed")
+        for k in shapes:        # the shape, and those that USE the same node
+            loaded = scene.loaded_model(k).appearance
+            current = scene.shape_model(k).appearance
+            update: dict[str, Any] = {}
+            if name == "transparency":
+                update["transparency"] = float(value)
+            elif name == "baseColor" or (name == "diffuseColor" and loaded is not None and loaded.texture is None):
+                update["base_color"] = tuple(float(v) for v in values)
+            elif name == "roughness":
+                update["roughness"] = float(value)
+            if update and current is not None:      # (metalness, emissive colours: not rendered here, kept)
+                scene.set_appearance(k, current.model_copy(update=update))
+            scene.appearance_values.setdefault(k, {})[f"{ref.role}.{name}"] = \
+                [float(v) for v in values] if kind == "SFColor" else float(value)
+
+    return set_value
+
+
+def fields(ref: ShapeRef, child: Callable[[str], int]) -> dict[str, tuple[str, Getter, Setter]]:
+    """A served node's fields: (type, getter, setter or None). ``child(field)``: the id of the node
+    in its SFNode field (0: NULL)."""
+    def node_field(name: str) -> tuple[str, Getter, Setter]:
+        return ("SFNode", lambda sim, node: child(name), None)
+
+    if ref.role == "Shape":
+        return {"appearance": node_field("appearance"), "geometry": node_field("geometry"),
+                "castShadows": ("SFBool", lambda sim, node: bool(sim.scene.loaded_model(ref.index).cast_shadows), None)}
+    table = {"material": MATERIAL_FIELDS, "texture": TEXTURE_FIELDS}.get(ref.role) or (
+        PBR_FIELDS if ref.type == "PBRAppearance" else {} if ref.role == "appearance"
+        else GEOMETRY_FIELDS.get(ref.type, {}))
+    out: dict[str, tuple[str, Getter, Setter]] = {}
+    for name, (kind, default) in table.items():
+        out[name] = (kind, lambda sim, node, name=name, default=default: _value(sim, ref, name, default),
+                     _setter(ref, name, kind))
+    if ref.type == "Appearance":
+        out.update(material=node_field("material"), texture=node_field("texture"))
+    elif ref.type == "PBRAppearance":
+        out["baseColorMap"] = node_field("baseColorMap")
+    return out
