@@ -423,21 +423,38 @@ def _run_worker(path: str, scale: tuple[float, ...], memory: int, max_triangles:
 
 def triangles_mesh(vertices, faces):
     """Inline triangles (a world's ``triangles`` geometry) → ``geometry.Mesh``; indices are checked
-    by the loader. Cached on the exact values, like files."""
-    key = (tuple(tuple(float(c) for c in v) for v in vertices), tuple(tuple(int(i) for i in f) for f in faces))
-    return _triangles(key)
+    by the loader. Cached on the exact values (their bytes as float64 and int64 arrays), like files:
+    the robots of a swarm that carry the same inline mesh share one Mesh (and the ray engine one
+    tier for them), and the scene, recognition and the viewer ask for it again. The cache keeps the
+    Mesh and a digest of its bytes, never a second copy of the numbers."""
+    import hashlib
 
-
-@lru_cache(maxsize=64)
-def _triangles(key):
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)      # (one pass at C speed over the lists)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    digest = hashlib.blake2b(v.data, digest_size=16)
+    digest.update(f.data)
+    key = (v.shape, f.shape, digest.digest())
+    mesh = _TRIANGLES.get(key)
+    if mesh is not None and np.array_equal(mesh.vertices.view(np.int64), v.view(np.int64)) \
+            and np.array_equal(mesh.faces, f):       # (the bytes, as the digest: -0.0 is not 0.0)
+        _TRIANGLES.move_to_end(key)
+        return mesh
     import trimesh
 
     from sensorium.server.world.geometry import Mesh
 
-    vertices = np.asarray(key[0], dtype=np.float64).reshape(-1, 3)
-    faces = np.asarray(key[1], dtype=np.int64).reshape(-1, 3)
-    merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
-    return Mesh(vertices=vertices, faces=faces, closed=bool(merged.is_watertight))
+    merged = trimesh.Trimesh(vertices=v, faces=f, process=True, validate=False)
+    mesh = Mesh(vertices=v, faces=f, closed=bool(merged.is_watertight))
+    del merged
+    _TRIANGLES[key] = mesh
+    while len(_TRIANGLES) > CACHED_TRIANGLES:
+        _TRIANGLES.popitem(last=False)
+    return mesh
+
+
+# inline meshes made, by (shapes, digest of the bytes), the CACHED_TRIANGLES most recently used
+_TRIANGLES: OrderedDict[tuple, Any] = OrderedDict()
+CACHED_TRIANGLES = 64
 
 
 def elevation_grid_mesh(height: tuple[float, ...], x_dimension: int, x_spacing: float, y_dimension: int,

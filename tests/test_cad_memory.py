@@ -1,0 +1,79 @@
+"""What a robot of many meshes holds once its scene is built (``sensorium/benchmarks/cad.py`` measures
+it): each mesh's triangles once in the ray engine whatever kinds of rays see them, and no cache
+holding a second copy of an inline mesh's numbers. Counted (objects, tracemalloc's allocations),
+never timed."""
+
+from __future__ import annotations
+
+import gc
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+from sensorium.benchmarks.cad import cad_robot_world, part_mesh, swarm_world
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.limits import WorldLimits
+from sensorium.server.world.loader import load_world
+from sensorium.server.world.meshes import triangles_mesh
+
+
+def _tiers(sim: Simulation) -> list:
+    eng = sim.scene.engine
+    return list({id(t): t for t in (*eng._static.values(), *eng._shared.values()) if t is not None}.values())
+
+
+def _stepped(path: Path) -> Simulation:
+    sim = Simulation(load_world(path, limits=WorldLimits.large()), "fast")
+    for robot in sim.world.robots:
+        for d in robot.devices:
+            sim.device(f"{robot.name}/{d.name}").enable(32)
+    sim.step()
+    return sim
+
+
+def test_a_cad_robots_meshes_are_held_once_for_bounding_and_visual_rays(tmp_path: Path) -> None:
+    """Three inline meshes seen by both kinds of rays (the default), a lidar (visual rays) and laser
+    distance sensors (bounding rays): two tiers in all, the room's and the robot's, the robot's
+    holding each of its triangles once (before: a bounding and a visual copy of each, BVH included)."""
+    sim = _stepped(cad_robot_world(tmp_path, "triangles", parts=3, scale=0.05))
+    expected = sum(len(part_mesh(k, n)[1]) for k, n in enumerate([1000, 1500, 2000]))
+    tiers = _tiers(sim)
+    assert len(tiers) == 2
+    assert sorted(len(t.F) for t in tiers) == [12 * 4, expected]      # four walls of 12 triangles; the parts
+    assert np.isfinite(sim.device("cad/lidar").range_image).any()
+
+
+def test_a_swarms_inline_meshes_are_one_mesh_and_one_tier(tmp_path: Path) -> None:
+    """Twelve robots carrying the same three inline meshes (a PROTO's IndexedFaceSets, converted):
+    one Mesh per part, and one body-frame tier for all of them."""
+    sim = _stepped(swarm_world(tmp_path, 12, "triangles", triangles=300))
+    robot_tiers = [t for t in _tiers(sim) if t is not sim.scene.engine._static_tier("visual")]
+    assert len(robot_tiers) == 1 and len(robot_tiers[0].F) == 3 * len(part_mesh(100, 300)[1])
+    meshes = {id(e.primitive) for e in sim.scene.engine._entries if type(e.primitive).__name__ == "Mesh"}
+    assert len(meshes) == 3
+
+
+def test_inline_triangles_are_cached_without_a_second_copy_of_their_numbers() -> None:
+    """triangles_mesh keeps the Mesh (float64 vertices, int64 faces: 24 bytes a row) and a digest;
+    before, its cache key was the numbers again as tuples of Python floats and ints (~64 bytes a
+    row more, kept as long as the cached Mesh). The same numbers in other lists: the same Mesh."""
+    v, f = part_mesh(7, 6000)
+    vertices, faces = [tuple(r) for r in v.tolist()], [tuple(r) for r in f.tolist()]
+    arrays = 24 * (len(v) + len(f))
+    triangles_mesh(*part_mesh(8, 200))      # (trimesh's watertightness judge imports what it needs on first use)
+    gc.collect()
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        mesh = triangles_mesh(vertices, faces)
+        gc.collect()
+        kept = tracemalloc.get_traced_memory()[0] - before
+    finally:
+        tracemalloc.stop()
+    assert arrays <= kept < arrays + 64_000, (kept, arrays)
+    assert np.array_equal(mesh.vertices, v) and np.array_equal(mesh.faces, f) and mesh.closed
+    again = triangles_mesh([list(r) for r in vertices], [list(r) for r in faces])
+    assert again is mesh
+    moved = triangles_mesh([(x + 1.0, y, z) for x, y, z in vertices], faces)
+    assert moved is not mesh and np.array_equal(moved.vertices[:, 0], v[:, 0] + 1.0)
