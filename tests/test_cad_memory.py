@@ -77,3 +77,33 @@ def test_inline_triangles_are_cached_without_a_second_copy_of_their_numbers() ->
     assert again is mesh
     moved = triangles_mesh([(x + 1.0, y, z) for x, y, z in vertices], faces)
     assert moved is not mesh and np.array_equal(moved.vertices[:, 0], v[:, 0] + 1.0)
+
+
+def test_a_mesh_files_vertices_are_held_once_per_position(tmp_path: Path) -> None:
+    """A binary STL file gives three vertices per triangle; its Mesh holds each position once (the
+    tier's welding, done once when read: the tier's arrays are unchanged), in process and from the
+    reading worker (a file over 1 MiB). A file with an unused vertex is kept as read."""
+    from sensorium.benchmarks.cad import write_stl
+    from sensorium.server.raycast import packets, tiers
+    from sensorium.server.world.geometry import Pose
+    from sensorium.server.world.meshes import IN_PROCESS_BYTES, load_mesh, welded
+
+    for k, n in ((3, 3000), (4, 25_000)):
+        v, f = part_mesh(k, n)
+        path = tmp_path / f"part{k}.stl"
+        write_stl(path, v, f)
+        assert (path.stat().st_size > IN_PROCESS_BYTES) == (n > 20_000)
+        mesh = load_mesh(path)
+        assert len(mesh.vertices) == len(v) and len(mesh.faces) == len(f) and mesh.closed
+        corners = v.astype(np.float32).astype(np.float64)[f]               # (STL stores float32)
+        assert np.array_equal(mesh.vertices[mesh.faces], corners)
+        again = welded(mesh.vertices, mesh.faces)
+        assert np.array_equal(again[0], mesh.vertices) and np.array_equal(again[1], mesh.faces)
+        tier = tiers._Tier(packets.Device(), [(0, mesh, Pose.identity())], np.array([-1]))
+        soup = welded(corners.reshape(-1, 3), np.arange(3 * len(f)).reshape(-1, 3))   # what the tier welded before
+        assert np.array_equal(tier.V, soup[0]) and np.array_equal(tier.F[:len(f)], soup[1])
+    ply = tmp_path / "spare.ply"          # (a repeated position and an unused vertex: as read)
+    ply.write_text("ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+                   "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                   "0 0 0\n1 0 0\n0 1 0\n1 0 0\n5 5 5\n3 0 1 2\n3 2 3 0\n")
+    assert len(load_mesh(ply).vertices) == 5
