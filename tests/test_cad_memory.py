@@ -107,3 +107,43 @@ def test_a_mesh_files_vertices_are_held_once_per_position(tmp_path: Path) -> Non
                    "element face 2\nproperty list uchar int vertex_indices\nend_header\n"
                    "0 0 0\n1 0 0\n0 1 0\n1 0 0\n5 5 5\n3 0 1 2\n3 2 3 0\n")
     assert len(load_mesh(ply).vertices) == 5
+
+
+def test_a_meshs_valid_faces_are_found_once_and_are_its_own_faces_when_all_are_valid() -> None:
+    """tessellate(Mesh) is asked for by the scene (triangle counts, robot after robot of a swarm
+    sharing the Mesh) and the ray engine: its valid faces are found once, and are the Mesh's own
+    array (no copy) when none is degenerate."""
+    from sensorium.server.world.geometry import Mesh, tessellate
+
+    v, f = part_mesh(2, 500)
+    whole = Mesh(v, f, True)
+    assert tessellate(whole)[1] is whole.faces and tessellate(whole)[1] is whole.faces
+    spoiled = Mesh(v, np.r_[f, [[0, 0, 1]]], False)               # one degenerate face more
+    kept = tessellate(spoiled)[1]
+    assert np.array_equal(kept, f) and tessellate(spoiled)[1] is kept and not kept.flags.writeable
+
+
+def test_a_face_indexing_outside_the_vertices_is_named_first_bad_face_first() -> None:
+    """The loader's index check is one numpy pass over a mesh's faces: the same one problem, at the
+    first face out of range (a negative index or one past the vertices), its indices quoted."""
+    import pytest
+
+    from sensorium.server.world.loader import WorldError, parse_world
+
+    v, f = part_mesh(1, 400)
+    for bad_at, bad in ((150, [3, -1, 4]), (7, [2, len(v), 5]), (len(f) - 1, [len(v) + 9, 0, 1])):
+        faces = f.tolist()
+        faces[bad_at] = bad
+        world = {"robots": [{"name": "r", "shapes": [{"geometry": {"type": "triangles", "vertices": v.tolist(),
+                                                                   "faces": faces}}]}]}
+        with pytest.raises(WorldError) as info:
+            parse_world(world)
+        assert [(p.path, p.message) for p in info.value.problems] == [
+            (f"robots[0].shapes[0].geometry.faces[{bad_at}]", f"vertex index outside 0..{len(v) - 1}: {bad}")]
+    big = f.tolist()
+    big[3] = [2**70, 0, 1]        # (beyond 64 bits: checked face by face, the same line)
+    with pytest.raises(WorldError) as info:
+        parse_world({"robots": [{"name": "r", "shapes": [{"geometry": {"type": "triangles", "vertices": v.tolist(),
+                                                                       "faces": big}}]}]})
+    assert [(p.path, p.message) for p in info.value.problems] == [
+        ("robots[0].shapes[0].geometry.faces[3]", f"vertex index outside 0..{len(v) - 1}: [{2**70}, 0, 1]")]
