@@ -7,8 +7,8 @@ our own shapes, no Webots file): one robot of ``parts`` distinct closed meshes (
 the YAML's inline ``triangles``, a ``.wbt`` of inline ``IndexedFaceSet`` nodes -- and a swarm of
 small robots of three shared mesh files each. Each world is measured in a fresh interpreter, stage by
 stage: the resident memory (``VmRSS``, after glibc's ``malloc_trim``) and the process's peak so far
-(``ru_maxrss``) after loading the world, building the scene (``Simulation``), the first step (the
-BVHs built, the first cast) and a second step; the mesh workers' peak (``RUSAGE_CHILDREN``) beside.
+(``VmHWM``) after loading the world, building the scene (``Simulation``), the first step (the BVHs
+built, the first cast) and a second step.
 
 ``python -m sensorium.benchmarks.cad`` prints the table (``--quick``: smaller worlds);
 ``sensorium bench --only cad`` puts it in the report.
@@ -179,20 +179,23 @@ def swarm_world(folder: Path, robots: int, form: str = "stl", triangles: int = 2
 # One child per measurement, run with a source tree of its own on PYTHONPATH (``--compare`` runs
 # another tree's child with the same code): load the world, build its simulation (FAST), enable every
 # device and step twice; per stage the wall time, the resident memory after it (VmRSS after glibc's
-# malloc_trim, so freed temporaries do not count) and the process's peak so far (ru_maxrss).
+# malloc_trim, so freed temporaries do not count) and the process's peak so far (VmHWM).
 _CHILD = r"""
-import ctypes, json, resource, sys, time
+import ctypes, json, sys, time
 try:
     _trim = ctypes.CDLL("libc.so.6").malloc_trim
 except (OSError, AttributeError):
     _trim = lambda pad: 0
 
-def rss():
-    _trim(0)
+def status(key):
     for line in open("/proc/self/status"):
-        if line.startswith("VmRSS:"):
+        if line.startswith(key):
             return int(line.split()[1]) * 1024
     return 0
+
+def rss():
+    _trim(0)
+    return status("VmRSS:")
 
 import numpy as np
 import trimesh
@@ -208,7 +211,7 @@ out = {"rss": {}, "peak": {}, "ms": {}, "base": rss()}
 def stage(name, t0):
     out["ms"][name] = (time.perf_counter() - t0) * 1e3
     out["rss"][name] = rss()
-    out["peak"][name] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    out["peak"][name] = status("VmHWM:")     # (this process's own: ru_maxrss starts from its parent's at exec)
 
 t0 = time.perf_counter()
 loaded = load_world(sys.argv[1], limits=WorldLimits.large())
@@ -228,7 +231,6 @@ sim.step()
 stage("step", t0)
 eng = sim.scene.engine
 tiers = {id(t): t for t in (*eng._static.values(), *eng._shared.values()) if t is not None}
-out["children_peak"] = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * 1024
 out["triangles"] = sum(len(t.F) for t in tiers.values())      # (each tier's, a shared tier once)
 out["robots"] = len(sim.world.robots)
 print(json.dumps(out))
@@ -291,12 +293,12 @@ def rows_of(samples: dict[str, list]) -> list[list[str]]:
         best = min(got, key=lambda s: s["peak"]["step"])
         ms = {k: float(np.median([s["ms"][k] for s in got])) for k in STAGES}
         rows.append([name, f"{best['triangles']:,}", *(f"{best['rss'][k] / 1e6:.0f}" for k in STAGES),
-                     f"{best['peak']['step'] / 1e6:.0f}", f"{best['children_peak'] / 1e6:.0f}",
+                     f"{best['peak']['step'] / 1e6:.0f}",
                      f"{ms['load']:.0f}", f"{ms['scene']:.0f}", f"{ms['first step']:.0f}"])
     return rows
 
 
-COLUMNS = ["world", "triangles in tiers", *(f"RSS MB after {k}" for k in STAGES), "peak MB", "mesh workers' peak MB",
+COLUMNS = ["world", "triangles in tiers", *(f"RSS MB after {k}" for k in STAGES), "peak MB",
            "load ms", "scene ms", "first step ms"]
 
 
@@ -312,7 +314,7 @@ def run(cfg: Config) -> Section:
                             f"({rounds} interleaved rounds, fresh interpreters)", COLUMNS, rows_of(runs), notes=[
                                 "RSS after malloc_trim, the interpreter's own "
                                 f"{runs[next(iter(runs))][0]['base'] / 1e6:.0f} MB included; peak: the process's "
-                                "ru_maxrss; mesh workers: the largest child's (files over 1 MiB are read in one)",
+                                "VmHWM (the mesh workers reading files over 1 MiB are processes of their own)",
                                 f"swarm: {per['stl']:.1f} ms (three shared STL files) and {per['triangles']:.1f} ms "
                                 "(three inline meshes) per added robot, loading and the scene",
                                 "Reproduce: `python -m sensorium.benchmarks.cad` (sensorium/benchmarks/cad.py)"]))
