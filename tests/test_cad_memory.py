@@ -147,20 +147,3 @@ def test_a_face_indexing_outside_the_vertices_is_named_first_bad_face_first() ->
                                                                        "faces": big}}]}]})
     assert [(p.path, p.message) for p in info.value.problems] == [
         ("robots[0].shapes[0].geometry.faces[3]", f"vertex index outside 0..{len(v) - 1}: [{2**70}, 0, 1]")]
-
-
-def test_a_converted_meshs_rows_are_kept_not_copied_when_the_bookkeeping_is_stripped() -> None:
-    """A .wbt world's converted dict loses its ``_at`` keys in one walk; a mesh's rows of numbers
-    pass through it as they are (their lists were copied: a million face rows cost ~150 MB more at
-    the load's peak), the lists holding them new, and the numbers equal."""
-    from sensorium.server.world.wbt.convert import strip_origins
-
-    rows = [[0.0, 1.0, 2.0] for _ in range(40)]
-    raw = {"_at": (1, 1, "Robot"), "shapes": [{"_at": (2, 3, "Shape"), "vertices": rows, "faces": [[0, 1, 2]] * 40,
-                                              "size": [1.0, 2.0, 3.0]}]}
-    origin: dict = {}
-    out = strip_origins(raw, "", origin)
-    shape = out["shapes"][0]
-    assert shape["vertices"] == rows and shape["vertices"] is not rows and shape["vertices"][7] is rows[7]
-    assert shape["size"] == [1.0, 2.0, 3.0] and shape["size"] is not raw["shapes"][0]["size"]
-    assert origin == {"": (1, 1, "Robot"), "shapes[0]": (2, 3, "Shape")} and "_at" not in shape

@@ -1823,11 +1823,11 @@ def strip_origins(data: Any, path: str, origin: dict[str, tuple[int, int, str]])
             origin[path] = data["_at"]
         return {k: strip_origins(v, f"{path}.{k}" if path else k, origin) for k, v in data.items() if k != "_at"}
     if isinstance(data, list):
-        kinds = set(map(type, data))            # a mesh's numbers (no dict inside): the list copied at C
-        if _flat(kinds):                        # speed, its rows kept (the converted dict was their only
-            return list(data)                   # holder; copying a million face rows was ~150 MB more at
-        if kinds == {list} and _flat(set(map(type, itertools.chain.from_iterable(data)))):    # the load's peak)
+        kinds = set(map(type, data))            # a mesh's numbers: copied at C speed (no dict inside)
+        if _flat(kinds):
             return list(data)
+        if kinds == {list} and _flat(set(map(type, itertools.chain.from_iterable(data)))):
+            return list(map(list, data))
         return [strip_origins(v, f"{path}[{i}]", origin) for i, v in enumerate(data)]
     return data
 
