@@ -1,17 +1,18 @@
 """CAD robots: the memory and load time of a robot built of many meshes, and of a swarm.
 
-A CAD export gives a robot of tens of parts, each a mesh file or an inline ``IndexedFaceSet`` of
-tens of thousands of triangles. The worlds here are generated (``cad_robot_world``, ``swarm_world``:
-our own shapes, no Webots file): one robot of ``parts`` distinct closed meshes (a bumpy torus each,
-20 000-50 000 triangles), a lidar and four distance sensors, written three ways -- binary STL files,
-the YAML's inline ``triangles``, a ``.wbt`` of inline ``IndexedFaceSet`` nodes -- and a swarm of
-small robots of three shared mesh files each. Each world is measured in a fresh interpreter, stage by
-stage: the resident memory (``VmRSS``, after glibc's ``malloc_trim``) and the process's peak so far
-(``VmHWM``) after loading the world, building the scene (``Simulation``), the first step (the BVHs
-built, the first cast) and a second step.
+A CAD export gives a robot of tens of parts, each a mesh file or an inline `IndexedFaceSet` of
+tens of thousands of triangles. The worlds here are generated (`cad_robot_world`, `swarm_world`: our
+own shapes, no Webots file): one robot of 30 distinct closed meshes (a bumpy torus each, 20,000-50,000
+triangles), a lidar and four laser distance sensors, written three ways -- binary STL files, inline
+`triangles` in a JSON world file, a `.wbt` of `IndexedFaceSet` nodes -- and swarms of small robots of
+one model, three meshes each (three shared STL files, or the same three inline meshes in every robot).
+Each world is measured in a fresh interpreter, stage by stage: the resident memory (`VmRSS`, after
+glibc's `malloc_trim`) and the process's peak so far (`VmHWM`) after loading the world, building the
+scene (`Simulation`), the first step (the BVHs built, the first cast) and a second step.
 
-``python -m sensorium.benchmarks.cad`` prints the table (``--quick``: smaller worlds);
-``sensorium bench --only cad`` puts it in the report.
+``python -m sensorium.benchmarks.cad`` prints the table (``--quick``: a quarter of the triangles;
+``--compare TREE``: the same worlds measured with another source tree too, say the base checkout,
+interleaved); ``sensorium bench --only cad`` puts it in the report.
 """
 
 from __future__ import annotations
