@@ -134,3 +134,52 @@ def test_rays_at_a_high_valence_vertex_get_the_same_bits_in_c_and_numpy():
         hit = np.isfinite(h.distance)
     assert out[True] == out[False]
     assert hit.mean() > 0.7
+
+
+def _torus(k: int = 24) -> Mesh:
+    """A closed torus of 2 k² triangles (radii 0.5 and 0.2) about z."""
+    u = np.arange(k) * (2.0 * np.pi / k)
+    uu, vv = np.meshgrid(u, u, indexing="ij")
+    v = np.stack([(0.5 + 0.2 * np.cos(vv)) * np.cos(uu), (0.5 + 0.2 * np.cos(vv)) * np.sin(uu), 0.2 * np.sin(vv)], -1)
+    i, j = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+    a, b = (i * k + j).ravel(), (((i + 1) % k) * k + j).ravel()
+    c, d = (((i + 1) % k) * k + (j + 1) % k).ravel(), (i * k + (j + 1) % k).ravel()
+    return Mesh(v.reshape(-1, 3), np.r_[np.c_[a, b, c], np.c_[a, c, d]], True)
+
+
+@pytest.mark.parametrize("prec", ["fast", "exact"])
+def test_bounding_and_visual_rays_share_one_tier_where_they_see_the_same_shapes(prec):
+    """A mesh seen by both kinds of rays (a world's default) is held once, its BVH built once: the
+    bounding and the visual tiers of a robot and of the static bodies are one object, and each kind
+    still sees exactly what it sees alone; a shape only one kind sees gives each kind its own tier."""
+    from sensorium.server.raycast.engine import RayEngine, RayKind, ShapeEntry
+
+    def world(seen_by_both: bool) -> RayEngine:
+        eng = RayEngine(prec)
+        extra = [] if seen_by_both else [ShapeEntry(Box((0.1, 0.1, 0.1)), Pose(np.eye(3), np.array([0.0, 0, 1])),
+                                                    bounding=False, visual=True)]
+        eng.add_body([ShapeEntry(_torus(), Pose.identity(), True, True)], Pose(np.eye(3), np.array([3.0, 0, 0])))
+        eng.add_body([ShapeEntry(_torus(), Pose.identity(), True, True), *extra], Pose.identity(), owner=0,
+                     movable=True)
+        return eng
+
+    rng = np.random.default_rng(5)
+    a = rng.uniform(-0.4, 0.4, 400) + np.pi * (np.arange(400) % 2)      # towards either torus
+    D = np.c_[np.cos(a), np.sin(a), rng.uniform(-0.1, 0.1, 400)]
+    D /= np.linalg.norm(D, axis=1)[:, None]
+    O = np.broadcast_to([1.5, 0.0, 0.1], D.shape)
+    shared = world(True)
+    hits = {kind: shared.cast(O, D, 0.0, 10.0, kind=kind) for kind in (RayKind.BOUNDING, RayKind.VISUAL)}
+    assert shared.counters["bvh_builds"] == 2            # the static tier and the robot's: once for both kinds
+    robot = shared._bodies[1]
+    assert robot.tiers["visual"] is robot.tiers["bounding"]
+    assert shared._static_tier("visual") is shared._static_tier("bounding")
+    for kind, h in hits.items():          # the same bits as an engine casting that kind alone
+        alone = world(True).cast(O, D, 0.0, 10.0, kind=kind)
+        assert np.isfinite(h.distance).sum() > 300
+        assert np.array_equal(h.distance, alone.distance) and np.array_equal(h.shape, alone.shape)
+        assert np.array_equal(h.normal, alone.normal)
+    apart = world(False)
+    for kind in (RayKind.BOUNDING, RayKind.VISUAL):
+        apart.cast(O, D, 0.0, 10.0, kind=kind)
+    assert apart._bodies[1].tiers["visual"] is not apart._bodies[1].tiers["bounding"]

@@ -9,7 +9,7 @@ import math
 from pathlib import Path
 
 SCHEMA = 1
-ORDER = ("peers", "accuracy", "scaling", "memory", "limits", "transport", "scaleout", "loading", "images", "training", "radio")
+ORDER = ("peers", "accuracy", "scaling", "memory", "limits", "transport", "scaleout", "loading", "cad", "images", "training", "radio")
 
 
 def load(out: Path) -> dict:

@@ -190,6 +190,11 @@ def _sees(e: ShapeEntry, variant: str) -> bool:
     return e.bounding and not e.transparent
 
 
+def _items_key(items) -> tuple:
+    """What a tier is built of (``_Tier``'s items: shape number, primitive, pose), as a dict key."""
+    return tuple((i, prim, pose.rotation.tobytes(), pose.translation.tobytes()) for i, prim, pose in items)
+
+
 class RayEngine(TierTracer):
     """Nearest-hit ray queries against bodies of shapes (see module docstring)."""
 
@@ -206,7 +211,8 @@ class RayEngine(TierTracer):
         self._static: dict[str, _Tier | None] = {}
         self._planes: dict[str, _Planes | None] = {}
         self._mover_tables: dict[str, _Movers | None] = {}
-        self._shared: dict[tuple, _Tier | None] = {}   # body-frame tiers by (variant, shapes)
+        self._static_items: dict[tuple, _Tier | None] = {}   # the static tiers by their shapes (_items_key)
+        self._shared: dict[tuple, _Tier | None] = {}   # body-frame tiers by their shapes (_items_key)
         self._epoch = 0                                 # bumped by every set_body_pose, add and removal
         self.threads = available()   # threads a large cast may use (see .blocks; 1: the calling thread only)
         self.native = True   # judge and refine hits in packets.c where the packet path is on (the same answers)
@@ -244,7 +250,7 @@ class RayEngine(TierTracer):
             self._movers.append(self._bodies[-1])
             self._mover_tables.clear()
         else:
-            self._static.clear()
+            self._drop_static()
         return body
 
     def set_body_pose(self, body: int, pose: Pose) -> None:
@@ -258,7 +264,7 @@ class RayEngine(TierTracer):
         if not b.mover:  # first move of a static body: it leaves the static tier for good
             b.mover = True
             self._movers.append(b)
-            self._static.clear()
+            self._drop_static()
             self._mover_tables.clear()
 
     def remove_body(self, body: int) -> None:
@@ -276,7 +282,7 @@ class RayEngine(TierTracer):
             self._movers.remove(b)
             self._mover_tables.clear()
         else:
-            self._static.clear()
+            self._drop_static()
 
     def shape_owner(self, shape: int) -> int:
         return int(self._owner_of[shape])
@@ -324,26 +330,36 @@ class RayEngine(TierTracer):
                    for b in bodies for e in map(self._entries.__getitem__, b.shapes))
 
     def _static_tier(self, variant: str) -> _Tier | None:
+        """The world-frame tier of the static bodies' shapes seen by ``variant``: one tier for
+        every variant that sees the same shapes (bounding and visual rays, where each shape is seen
+        by both: a tier is made of its items alone, so the two would hold the same arrays and BVH)."""
         if variant not in self._static:
             statics = [b for b in self._bodies if not b.mover and not b.removed]
             if variant in _NARROWS and not self._narrows(variant, statics):
                 self._static[variant] = self._static_tier(_NARROWS[variant])
             else:
-                self._static[variant] = self._build([i for b in statics for i in self._items(b, variant, True)],
-                                                    self._owner_of)
+                items = [i for b in statics for i in self._items(b, variant, True)]
+                key = _items_key(items)
+                if key not in self._static_items:
+                    self._static_items[key] = self._build(items, self._owner_of)
+                self._static[variant] = self._static_items[key]
         return self._static[variant]
+
+    def _drop_static(self) -> None:
+        """Forget the static tiers (a body added, moved for the first time or removed): rebuilt on use."""
+        self._static.clear()
+        self._static_items.clear()
 
     def _mover_tier(self, body: _Body, variant: str) -> _Tier | None:
         """The body-frame tier of a mover, shared by all bodies with the same shapes (primitive and
-        local pose) seen by the variant.  Shared tiers carry no owner: exclusion is decided per
+        local pose) seen by the variant, and by the variants that see the same shapes.  Shared tiers carry no owner: exclusion is decided per
         (ray, mover) pair in the broad phase."""
         if variant not in body.tiers:
             if variant in _NARROWS and not self._narrows(variant, [body]):
                 body.tiers[variant] = self._mover_tier(body, _NARROWS[variant])
             else:
                 items = self._items(body, variant, False)
-                key = (variant, tuple((i, prim, pose.rotation.tobytes(), pose.translation.tobytes())
-                                      for i, prim, pose in items))
+                key = _items_key(items)        # (a variant seeing the same shapes shares the tier)
                 if key not in self._shared:
                     self._shared[key] = self._build(items, np.full(len(body.shapes), -1, dtype=np.int64))
                 body.tiers[variant] = self._shared[key]

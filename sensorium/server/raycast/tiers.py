@@ -30,6 +30,7 @@ from sensorium.server.raycast.guards import (
     risky_edges,
 )
 from sensorium.server.world.geometry import Capsule, Cone, Cylinder, Mesh, Pose, Primitive, Sphere, tessellate
+from sensorium.server.world.meshes import welded as _welded  # (a mesh file's Mesh is welded already: then unchanged)
 
 
 def new_device():
@@ -37,43 +38,6 @@ def new_device():
     if packets.library() is not None:
         return packets.Device()
     return _rtc.EmbreeDevice()
-
-
-def _welded(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The referenced vertices of a mesh, one per distinct position (in order of first use), and
-    its faces on them. (Positions are grouped by their bytes, as np.unique of 24-byte rows would,
-    through a stable sort of the three coordinates' int64 views: ~40 B per vertex at the peak
-    instead of ~100; a binary STL file gives three vertices per triangle.)"""
-    f = np.asarray(f).reshape(-1, 3)
-    present = np.zeros(len(v), dtype=bool)
-    present[f.ravel()] = True
-    used = present.nonzero()[0]                  # np.unique(f) and its inverse, without sorting f
-    if len(used) < len(v):
-        rank = np.cumsum(present) - 1
-        f = rank[f]
-        del rank
-    del present
-    v = np.ascontiguousarray(v[used], dtype=np.float64)
-    del used
-    bits = v.view(np.int64)
-    order = np.lexsort((bits[:, 2], bits[:, 1], bits[:, 0]))   # stable: each group's first is its first use
-    new = np.zeros(len(v), dtype=bool)
-    new[:1] = True
-    for k in range(3):
-        col = bits[order, k]
-        new[1:] |= col[1:] != col[:-1]
-        del col
-    first = order[new]                            # per distinct position (sorted by bytes): its first use
-    if len(first) == len(v):
-        return v, np.asarray(f, dtype=np.int64).reshape(-1, 3)
-    group = np.empty(len(v), dtype=np.int64)
-    group[order] = np.cumsum(new) - 1
-    del order, new
-    keep = np.sort(first)                        # distinct positions, in their order in v
-    rank = np.empty(len(v), dtype=np.int64)
-    rank[keep] = np.arange(len(keep))
-    to = rank[first[group]]                      # every vertex -> its position's first occurrence
-    return v[keep], to[f]
 
 
 def _cone_shell(cone: Cone, a: float) -> np.ndarray:

@@ -431,10 +431,24 @@ def tessellate(p: Primitive) -> tuple[np.ndarray, np.ndarray]:
     if isinstance(p, Plane):
         raise ValueError("planes are intersected analytically and have no tessellation")
     if isinstance(p, Mesh):
-        return p.vertices, valid_faces(p.vertices, p.faces)
+        return p.vertices, _mesh_faces(p)
     if isinstance(p, (Box, Sphere, Cylinder, Capsule, Cone)):
         return _tessellate_cached(p)
     raise TypeError(f"not a primitive: {p!r}")
+
+
+def _mesh_faces(p: Mesh) -> np.ndarray:
+    """A Mesh's valid faces (``valid_faces``), found once per Mesh -- the scene counts them, the
+    ray engine builds them, and a swarm's robots share one Mesh --: its own faces array when every
+    face is valid (no copy), else a read-only array of those kept."""
+    got = p.__dict__.get("_valid_faces")
+    if got is None:
+        got = valid_faces(p.vertices, p.faces)
+        if len(got) == len(p.faces):
+            got = p.faces
+        got.flags.writeable = False
+        object.__setattr__(p, "_valid_faces", got)
+    return got
 
 
 def triangle_count(p: Primitive) -> int:

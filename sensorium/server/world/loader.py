@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 from pydantic import ValidationError
 
@@ -649,10 +650,13 @@ def _check_geometry(geom: Any, path: str, base_dir: Path) -> list[Problem]:
         n = len(geom.vertices)
         if n == 0 and geom.faces:          # (a .wbt IndexedFaceSet without its coord)
             return [Problem(f"{path}.vertices", f"no vertices for its {len(geom.faces)} face(s) to index")]
-        for i, face in enumerate(geom.faces):
-            if min(face) < 0 or max(face) >= n:
-                return [Problem(f"{path}.faces[{i}]", f"vertex index outside 0..{n - 1}: {list(face)}")]
-        return []
+        try:                        # the first face indexing outside the vertices, found in one numpy pass
+            f = np.asarray(geom.faces, dtype=np.int64).reshape(-1, 3)
+            bad = ((f < 0) | (f >= n)).any(axis=1)
+            first = [int(bad.argmax())] if bad.any() else []
+        except OverflowError:       # (an index beyond 64 bits: face by face)
+            first = [i for i, face in enumerate(geom.faces) if min(face) < 0 or max(face) >= n][:1]
+        return [Problem(f"{path}.faces[{i}]", f"vertex index outside 0..{n - 1}: {list(geom.faces[i])}") for i in first]
     return []      # mesh files: _check_meshes_and_work (url confined to the world's folder, size, triangles)
 
 

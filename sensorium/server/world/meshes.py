@@ -1,5 +1,5 @@
 """Mesh files (STL, OBJ, PLY, GLB via trimesh; COLLADA, and an OBJ file's faces of one material, via
-:mod:`.cad`) → float64 triangle arrays.
+:mod:`.cad`) → float64 triangle arrays, each position once (welded, as the ray engine holds them).
 
 Loaded meshes are cached by (resolved path, modification time, scale): validating a world and then
 building its scene reads each file once. A file larger than ``IN_PROCESS_BYTES`` is read in a
@@ -120,7 +120,7 @@ def _load_materials(key: tuple, memory: int, max_triangles: int | None, kind: st
         if len(faces) == 0:
             continue
         vertices *= np.asarray(scale, dtype=np.float64)
-        mesh = Mesh(vertices=vertices, faces=faces, closed=closed)
+        mesh = Mesh(*_compact(vertices, faces), closed=closed)
         _remember((path, mtime, scale, m, ""), mesh)
         if m == material:
             wanted = mesh
@@ -191,7 +191,7 @@ def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: i
     if size > IN_PROCESS_BYTES:
         vertices, faces, closed = _read_in_worker(path, scale, memory, max_triangles, kind, select)
         vertices *= np.asarray(scale, dtype=np.float64)
-        return Mesh(vertices=vertices, faces=faces, closed=closed)
+        return Mesh(*_compact(vertices, faces), closed=closed)
     import trimesh
 
     if by_cad(kind, select):
@@ -223,7 +223,8 @@ def _load(path: str, _mtime: int, scale: tuple[float, ...], memory: int, size: i
     # merge coincident vertices so that watertightness can be judged on the topology
     merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
     closed = bool(merged.is_watertight)
-    return Mesh(vertices=np.ascontiguousarray(vertices), faces=np.ascontiguousarray(faces), closed=closed)
+    del merged
+    return Mesh(*_compact(vertices, np.asarray(faces, dtype=np.int64)), closed=closed)
 
 
 _FORMAT_NAMES = {"dae": "COLLADA", "obj": "OBJ"}
@@ -423,21 +424,91 @@ def _run_worker(path: str, scale: tuple[float, ...], memory: int, max_triangles:
 
 def triangles_mesh(vertices, faces):
     """Inline triangles (a world's ``triangles`` geometry) → ``geometry.Mesh``; indices are checked
-    by the loader. Cached on the exact values, like files."""
-    key = (tuple(tuple(float(c) for c in v) for v in vertices), tuple(tuple(int(i) for i in f) for f in faces))
-    return _triangles(key)
+    by the loader. Cached on the exact values (their bytes as float64 and int64 arrays), like files:
+    the robots of a swarm that carry the same inline mesh share one Mesh (and the ray engine one
+    tier for them), and the scene, recognition and the viewer ask for it again. The cache keeps the
+    Mesh and a digest of its bytes, never a second copy of the numbers."""
+    import hashlib
 
-
-@lru_cache(maxsize=64)
-def _triangles(key):
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)      # (one pass at C speed over the lists)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    digest = hashlib.blake2b(v.data, digest_size=16)
+    digest.update(f.data)
+    key = (v.shape, f.shape, digest.digest())
+    mesh = _TRIANGLES.get(key)
+    if mesh is not None and np.array_equal(mesh.vertices.view(np.int64), v.view(np.int64)) \
+            and np.array_equal(mesh.faces, f):       # (the bytes, as the digest: -0.0 is not 0.0)
+        _TRIANGLES.move_to_end(key)
+        return mesh
     import trimesh
 
     from sensorium.server.world.geometry import Mesh
 
-    vertices = np.asarray(key[0], dtype=np.float64).reshape(-1, 3)
-    faces = np.asarray(key[1], dtype=np.int64).reshape(-1, 3)
-    merged = trimesh.Trimesh(vertices=vertices, faces=faces, process=True, validate=False)
-    return Mesh(vertices=vertices, faces=faces, closed=bool(merged.is_watertight))
+    merged = trimesh.Trimesh(vertices=v, faces=f, process=True, validate=False)
+    mesh = Mesh(vertices=v, faces=f, closed=bool(merged.is_watertight))
+    del merged
+    _TRIANGLES[key] = mesh
+    while len(_TRIANGLES) > CACHED_TRIANGLES:
+        _TRIANGLES.popitem(last=False)
+    return mesh
+
+
+# inline meshes made, by (shapes, digest of the bytes), the CACHED_TRIANGLES most recently used
+_TRIANGLES: OrderedDict[tuple, Any] = OrderedDict()
+CACHED_TRIANGLES = 64
+
+
+def welded(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The referenced vertices of a mesh, one per distinct position (in order of first use), and
+    its faces on them: the ray engine's tiers hold a mesh this way (vertex rings, edges shared by
+    two faces), and a mesh read from a file is kept this way (:func:`_compact`); on such a mesh it
+    returns the same values. (Positions are grouped by their bytes, as np.unique of 24-byte rows would,
+    through a stable sort of the three coordinates' int64 views: ~40 B per vertex at the peak
+    instead of ~100; a binary STL file gives three vertices per triangle.)"""
+    f = np.asarray(f).reshape(-1, 3)
+    present = np.zeros(len(v), dtype=bool)
+    present[f.ravel()] = True
+    used = present.nonzero()[0]                  # np.unique(f) and its inverse, without sorting f
+    if len(used) < len(v):
+        rank = np.cumsum(present) - 1
+        f = rank[f]
+        del rank
+    del present
+    v = np.ascontiguousarray(v[used], dtype=np.float64)
+    del used
+    bits = v.view(np.int64)
+    order = np.lexsort((bits[:, 2], bits[:, 1], bits[:, 0]))   # stable: each group's first is its first use
+    new = np.zeros(len(v), dtype=bool)
+    new[:1] = True
+    for k in range(3):
+        col = bits[order, k]
+        new[1:] |= col[1:] != col[:-1]
+        del col
+    first = order[new]                            # per distinct position (sorted by bytes): its first use
+    if len(first) == len(v):
+        return v, np.asarray(f, dtype=np.int64).reshape(-1, 3)
+    group = np.empty(len(v), dtype=np.int64)
+    group[order] = np.cumsum(new) - 1
+    del order, new
+    keep = np.sort(first)                        # distinct positions, in their order in v
+    rank = np.empty(len(v), dtype=np.int64)
+    rank[keep] = np.arange(len(keep))
+    to = rank[first[group]]                      # every vertex -> its position's first occurrence
+    return v[keep], to[f]
+
+
+def _compact(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh file's (vertices, faces) with each position once (:func:`welded`) when every vertex is
+    used: a binary STL file gives three vertices per triangle, about six times the vertices of the
+    surface, which the Mesh would hold for as long as the world is loaded. The positions are the same
+    set (what contact and recognition read of a Mesh); the ray engine's tier welds them so anyway.
+    A mesh with unused vertices (their positions count for its extent) is kept as read."""
+    used = np.zeros(len(vertices), dtype=bool)
+    used[faces.ravel()] = True
+    if not used.all():
+        return vertices, faces
+    del used
+    return welded(vertices, faces)
 
 
 def elevation_grid_mesh(height: tuple[float, ...], x_dimension: int, x_spacing: float, y_dimension: int,

@@ -1,0 +1,360 @@
+"""CAD robots: the memory and load time of a robot built of many meshes, and of a swarm.
+
+A CAD export gives a robot of tens of parts, each a mesh file or an inline `IndexedFaceSet` of
+tens of thousands of triangles. The worlds here are generated (`cad_robot_world`, `swarm_world`: our
+own shapes, no Webots file): one robot of 30 distinct closed meshes (a bumpy torus each, 20,000-50,000
+triangles), a lidar and four laser distance sensors, written three ways -- binary STL files, inline
+`triangles` in a JSON world file, a `.wbt` of `IndexedFaceSet` nodes -- and swarms of small robots of
+one model, three meshes each (three shared STL files, or the same three inline meshes in every robot).
+Each world is measured in a fresh interpreter, stage by stage: the resident memory (`VmRSS`, after
+glibc's `malloc_trim`) and the process's peak so far (`VmHWM`) after loading the world, building the
+scene (`Simulation`), the first step (the BVHs built, the first cast) and a second step.
+
+``python -m sensorium.benchmarks.cad`` prints the table (``--quick``: a quarter of the triangles;
+``--compare TREE``: the same worlds measured with another source tree too, say the base checkout,
+interleaved); ``sensorium bench --only cad`` puts it in the report.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from .common import Config, Section, Table
+
+PARTS = 30
+STAGES = ("load", "scene", "first step", "step")
+
+
+# ----------------------------------------------------------------------------- the worlds
+def part_mesh(k: int, triangles: int) -> tuple[np.ndarray, np.ndarray]:
+    """Part ``k``: a closed bumpy torus of about ``triangles`` triangles (float64 vertices, int64
+    faces, outward), ~0.1 m across, distinct for each ``k``."""
+    nv = max(3, int(round(np.sqrt(triangles / 2.0 / 3.0))))     # around the tube
+    nu = max(3, triangles // (2 * nv))                            # around the ring
+    u = np.arange(nu) * (2.0 * np.pi / nu)
+    v = np.arange(nv) * (2.0 * np.pi / nv)
+    uu, vv = np.meshgrid(u, v, indexing="ij")
+    big, small = 0.05 + 0.001 * (k % 7), 0.015 * (1.0 + 0.1 * np.sin((k + 3) * uu) * np.cos(2 * vv))
+    ring = big + small * np.cos(vv)
+    verts = np.stack([ring * np.cos(uu), ring * np.sin(uu), small * np.sin(vv)], axis=-1).reshape(-1, 3)
+    i, j = np.meshgrid(np.arange(nu), np.arange(nv), indexing="ij")
+    a = (i * nv + j).ravel()
+    b = (((i + 1) % nu) * nv + j).ravel()
+    c = (((i + 1) % nu) * nv + (j + 1) % nv).ravel()
+    d = (i * nv + (j + 1) % nv).ravel()
+    faces = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    return verts, faces
+
+
+def write_stl(path: Path, verts: np.ndarray, faces: np.ndarray) -> None:
+    """A binary STL of the triangles (each corner written out, as STL does; zero normals)."""
+    rec = np.zeros(len(faces), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    rec["v"] = verts[faces]
+    with open(path, "wb") as f:
+        f.write(b"sensorium cad benchmark".ljust(80, b" "))
+        f.write(np.uint32(len(faces)).tobytes())
+        f.write(rec.tobytes())
+
+
+def _triangle_counts(parts: int, scale: float) -> list[int]:
+    return [int((20_000 + 10_000 * (k % 4)) * scale) for k in range(parts)]     # 20k, 30k, 40k, 50k, ...
+
+
+_DEVICES = [
+    {"device": "Lidar", "name": "lidar", "pose": {"translation": [0.0, 0.0, 0.25]}, "horizontal_resolution": 512,
+     "field_of_view": 6.283185307179586, "number_of_layers": 4, "vertical_field_of_view": 0.4,
+     "min_range": 0.05, "max_range": 8.0},
+    *({"device": "DistanceSensor", "name": f"ds{i}", "type": "laser",
+       "pose": {"translation": [0.2 * np.cos(a), 0.2 * np.sin(a), 0.05], "rotation": [0, 0, 1, float(a)]},
+       "lookup_table": [[0.0, 0.0, 0.0], [2.0, 2000.0, 0.0]]} for i, a in enumerate(np.arange(4) * np.pi / 2)),
+]
+
+
+def _part_pose(k: int) -> dict:
+    return {"translation": [0.12 * (k % 5 - 2), 0.12 * ((k // 5) % 3 - 1), 0.04 + 0.05 * (k // 15)]}
+
+
+def _room() -> list[dict]:
+    walls = [("n", [0, 3, 0.5], [6.2, 0.1, 1]), ("s", [0, -3, 0.5], [6.2, 0.1, 1]),
+             ("e", [3, 0, 0.5], [0.1, 6, 1]), ("w", [-3, 0, 0.5], [0.1, 6, 1])]
+    return [{"name": "floor", "geometry": {"type": "plane", "size": [6.0, 6.0]}},
+            *({"name": f"wall_{n}", "pose": {"translation": t}, "geometry": {"type": "box", "size": s}}
+              for n, t, s in walls)]
+
+
+def cad_robot_world(folder: Path, form: str = "stl", parts: int = PARTS, scale: float = 1.0) -> Path:
+    """A world of one robot of ``parts`` distinct mesh parts (20k-50k triangles each, times
+    ``scale``) with a lidar and four distance sensors, in a room, written under ``folder``.
+    ``form``: "stl" (binary STL files), "triangles" (YAML, inline), "wbt" (inline IndexedFaceSets)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    counts = _triangle_counts(parts, scale)
+    if form == "wbt":
+        return _wbt_world(folder, counts)
+    shapes = []
+    for k, n in enumerate(counts):
+        v, f = part_mesh(k, n)
+        if form == "stl":
+            (folder / "parts").mkdir(exist_ok=True)
+            write_stl(folder / "parts" / f"part{k:02d}.stl", v, f)
+            geometry: dict = {"type": "mesh", "url": f"parts/part{k:02d}.stl"}
+        elif form == "triangles":
+            geometry = {"type": "triangles", "vertices": np.round(v, 6).tolist(), "faces": f.tolist()}
+        else:
+            raise ValueError(f"unknown form {form!r}")
+        shapes.append({"name": f"part{k}", "pose": _part_pose(k), "geometry": geometry})
+    world = {"world_info": {"name": f"cad_{form}", "basic_time_step": 32}, "solids": _room(),
+             "robots": [{"name": "cad", "controller": "<none>", "pose": {"translation": [0.0, 0.0, 0.0]},
+                         "shapes": shapes, "devices": _DEVICES}]}
+    path = folder / f"cad_{form}.json"          # JSON: written and read fast, the same model as YAML
+    path.write_text(json.dumps(world))
+    return path
+
+
+def _wbt_world(folder: Path, counts: list[int]) -> Path:
+    parts = []
+    for k, n in enumerate(counts):
+        v, f = part_mesh(k, n)
+        point = " ".join(f"{x:.6f}" for x in v.ravel())
+        index = " ".join(f"{a} {b} {c} -1" for a, b, c in f.tolist())
+        t = _part_pose(k)["translation"]
+        parts.append(f"Solid {{ translation {t[0]} {t[1]} {t[2]} name \"part{k}\" children [ Shape {{ geometry "
+                     f"IndexedFaceSet {{ coord Coordinate {{ point [ {point} ] }} coordIndex [ {index} ] }} }} ] }}")
+    lidar = ("Lidar { translation 0 0 0.25 name \"lidar\" horizontalResolution 512 fieldOfView 6.283185 "
+             "numberOfLayers 4 verticalFieldOfView 0.4 minRange 0.05 maxRange 8 }")
+    sensors = " ".join(f"DistanceSensor {{ translation {0.2 * np.cos(a):.6f} {0.2 * np.sin(a):.6f} 0.05 "
+                       f"rotation 0 0 1 {a:.6f} name \"ds{i}\" type \"laser\" lookupTable [ 0 0 0 2 2000 0 ] }}"
+                       for i, a in enumerate(np.arange(4) * np.pi / 2))
+    walls = " ".join(f"Solid {{ translation {t} children [ Shape {{ geometry Box {{ size {s} }} }} ] "
+                     f"name \"wall_{n}\" boundingObject Box {{ size {s} }} }}"
+                     for n, t, s in (("n", "0 3 0.5", "6.2 0.1 1"), ("s", "0 -3 0.5", "6.2 0.1 1"),
+                                     ("e", "3 0 0.5", "0.1 6 1"), ("w", "-3 0 0.5", "0.1 6 1")))
+    path = folder / "cad_wbt.wbt"
+    path.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 32 }\n"
+                    "Solid { name \"floor\" children [ Shape { geometry Plane { size 6 6 } } ] "
+                    "boundingObject Plane { size 6 6 } }\n" + walls + "\n"
+                    f"Robot {{ name \"cad\" controller \"<none>\" children [ {' '.join(parts)} {lidar} {sensors} ] }}\n")
+    return path
+
+
+def swarm_world(folder: Path, robots: int, form: str = "stl", triangles: int = 2_000) -> Path:
+    """A world of ``robots`` small robots in a grid, one robot model: three parts of ``triangles``
+    triangles each, read from the same three STL files (``form`` "stl") or written inline in each
+    robot (``form`` "triangles", as a PROTO's IndexedFaceSets are converted), with two distance sensors."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "parts").mkdir(exist_ok=True)
+    geometries: list[dict] = []
+    for k in range(3):
+        v, f = part_mesh(100 + k, triangles)
+        if form == "stl":
+            write_stl(folder / "parts" / f"small{k}.stl", v * 0.5, f)
+            geometries.append({"type": "mesh", "url": f"parts/small{k}.stl"})
+        elif form == "triangles":
+            geometries.append({"type": "triangles", "vertices": np.round(v * 0.5, 6).tolist(), "faces": f.tolist()})
+        else:
+            raise ValueError(f"unknown form {form!r}")
+    side = int(np.ceil(np.sqrt(robots)))
+    bots = []
+    for r in range(robots):
+        bots.append({"name": f"bot{r}", "controller": "<none>",
+                     "pose": {"translation": [0.5 * (r % side) - 2.5, 0.5 * (r // side) - 2.5, 0.0]},
+                     "shapes": [{"name": f"p{k}", "pose": {"translation": [0.0, 0.0, 0.02 + 0.03 * k]},
+                                 "geometry": g} for k, g in enumerate(geometries)],
+                     "devices": [{"device": "DistanceSensor", "name": f"ds{i}", "type": "laser",
+                                  "pose": {"translation": [0.06 * (1 - 2 * i), 0.0, 0.03],
+                                           "rotation": [0, 0, 1, np.pi * i]},
+                                  "lookup_table": [[0.0, 0.0, 0.0], [2.0, 2000.0, 0.0]]} for i in range(2)]})
+    world = {"world_info": {"name": "swarm", "basic_time_step": 32}, "solids": _room(), "robots": bots}
+    path = folder / f"swarm_{form}_{robots}.json"
+    path.write_text(json.dumps(world))
+    return path
+
+
+# ----------------------------------------------------------------------------- one measurement
+# One child per measurement, run with a source tree of its own on PYTHONPATH (``--compare`` runs
+# another tree's child with the same code): load the world, build its simulation (FAST), enable every
+# device and step twice; per stage the wall time, the resident memory after it (VmRSS after glibc's
+# malloc_trim, so freed temporaries do not count) and the process's peak so far (VmHWM).
+_CHILD = r"""
+import ctypes, json, sys, time
+try:
+    _trim = ctypes.CDLL("libc.so.6").malloc_trim
+except (OSError, AttributeError):
+    _trim = lambda pad: 0
+
+def status(key):
+    for line in open("/proc/self/status"):
+        if line.startswith(key):
+            return int(line.split()[1]) * 1024
+    return 0
+
+def rss():
+    _trim(0)
+    return status("VmRSS:")
+
+import numpy as np
+import trimesh
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.limits import WorldLimits
+from sensorium.server.world.loader import load_world
+
+# warm up what loads lazily (trimesh's watertightness judge), so that no stage times an import
+trimesh.Trimesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]),
+                [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], process=True, validate=False).is_watertight
+out = {"rss": {}, "peak": {}, "ms": {}, "base": rss()}
+
+def stage(name, t0):
+    out["ms"][name] = (time.perf_counter() - t0) * 1e3
+    out["rss"][name] = rss()
+    out["peak"][name] = status("VmHWM:")     # (this process's own: ru_maxrss starts from its parent's at exec)
+
+t0 = time.perf_counter()
+loaded = load_world(sys.argv[1], limits=WorldLimits.large())
+stage("load", t0)
+t0 = time.perf_counter()
+sim = Simulation(loaded, "fast")
+del loaded
+stage("scene", t0)
+for robot in sim.world.robots:
+    for d in robot.devices:
+        sim.device(robot.name + "/" + d.name).enable(32)
+t0 = time.perf_counter()
+sim.step()
+stage("first step", t0)
+t0 = time.perf_counter()
+sim.step()
+stage("step", t0)
+eng = sim.scene.engine
+tiers = {id(t): t for t in (*eng._static.values(), *eng._shared.values()) if t is not None}
+out["triangles"] = sum(len(t.F) for t in tiers.values())      # (each tier's, a shared tier once)
+out["robots"] = len(sim.world.robots)
+print(json.dumps(out))
+"""
+
+
+def _child(path: Path, tree: str | None = None) -> dict:
+    """One measurement of the world ``path`` in a fresh interpreter, with ``tree`` (a source tree)
+    first on its path (default: this one's)."""
+    env = dict(os.environ)
+    if tree is not None:
+        env["PYTHONPATH"] = tree
+    out = subprocess.run([sys.executable, "-c", _CHILD, str(path)], capture_output=True, text=True, timeout=1800,
+                         check=False, env=env)
+    if out.returncode != 0:
+        raise RuntimeError(f"cad child failed on {path.name}: {out.stderr.strip().splitlines()[-3:]}")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+# ----------------------------------------------------------------------------- the section
+def worlds(tmp: Path, quick: bool) -> dict[str, Path]:
+    """The measured worlds, written under ``tmp``, by row name."""
+    scale = 0.25 if quick else 1.0
+    n = SWARM_QUICK if quick else SWARM
+    return {f"STL files ({PARTS} parts)": cad_robot_world(tmp / "stl", "stl", scale=scale),
+            f"inline triangles, JSON ({PARTS} parts)": cad_robot_world(tmp / "tri", "triangles", scale=scale),
+            f"inline IndexedFaceSet, .wbt ({PARTS} parts)": cad_robot_world(tmp / "wbt", "wbt", scale=scale),
+            **{f"swarm of {k}, {form}": swarm_world(tmp / "swarm", k, form)
+               for form in ("stl", "triangles") for k in (1, n)}}
+
+
+SWARM, SWARM_QUICK = 50, 20
+
+
+def measure_all(paths: dict[str, Path], trees: dict[str, str | None], rounds: int, log) -> dict[str, dict[str, list]]:
+    """{tree: {world: [samples]}}: every world with every tree, ``rounds`` times, interleaved
+    (A B A B ...: the machine's load hits both alike)."""
+    runs: dict[str, dict[str, list]] = {t: {w: [] for w in paths} for t in trees}
+    for _ in range(rounds):
+        for w, path in paths.items():
+            for t, tree in trees.items():
+                runs[t][w].append(_child(path, tree))
+                log(f"  cad: {t}: {w}: peak {runs[t][w][-1]['peak']['step'] / 1e6:.0f} MB")
+    return runs
+
+
+def per_robot_ms(samples: dict[str, list], form: str) -> float:
+    """Load and scene ms per added robot of a swarm: (swarm of n - swarm of 1) / (n - 1), median over rounds."""
+    big = [k for k in samples if k.startswith("swarm of ") and k.endswith(form) and not k.startswith("swarm of 1,")][0]
+    n = samples[big][0]["robots"]
+    one = samples[f"swarm of 1, {form}"]
+    per = [(a["ms"]["load"] + a["ms"]["scene"] - b["ms"]["load"] - b["ms"]["scene"]) / (n - 1)
+           for a, b in zip(samples[big], one, strict=True)]
+    return float(np.median(per))
+
+
+def rows_of(samples: dict[str, list]) -> list[list[str]]:
+    rows = []
+    for name, got in samples.items():
+        best = min(got, key=lambda s: s["peak"]["step"])
+        ms = {k: float(np.median([s["ms"][k] for s in got])) for k in STAGES}
+        rows.append([name, f"{best['triangles']:,}", *(f"{best['rss'][k] / 1e6:.0f}" for k in STAGES),
+                     f"{best['peak']['step'] / 1e6:.0f}",
+                     f"{ms['load']:.0f}", f"{ms['scene']:.0f}", f"{ms['first step']:.0f}"])
+    return rows
+
+
+COLUMNS = ["world", "triangles in tiers", *(f"RSS MB after {k}" for k in STAGES), "peak MB",
+           "load ms", "scene ms", "first step ms"]
+
+
+def run(cfg: Config) -> Section:
+    sec = Section("cad", "CAD robots: memory and load time of a robot of many meshes, and of a swarm",
+                  intro=" ".join(__doc__.split("\n\n")[1].split()))
+    rounds = cfg.pick(3, 1)
+    with tempfile.TemporaryDirectory() as tmp:
+        runs = measure_all(worlds(Path(tmp), cfg.quick), {"this": None}, rounds, cfg.log)["this"]
+    per = {form: per_robot_ms(runs, form) for form in ("stl", "triangles")}
+    sec.data.update(samples=runs, swarm_ms_per_robot=per)
+    sec.tables.append(Table("cad", f"A CAD robot and a swarm: resident memory after each stage, peak, load time "
+                            f"({rounds} interleaved rounds, fresh interpreters)", COLUMNS, rows_of(runs), notes=[
+                                "RSS after malloc_trim, the interpreter's own "
+                                f"{runs[next(iter(runs))][0]['base'] / 1e6:.0f} MB included; peak: the process's "
+                                "VmHWM (the mesh workers reading files over 1 MiB are processes of their own)",
+                                f"swarm: {per['stl']:.1f} ms (three shared STL files) and {per['triangles']:.1f} ms "
+                                "(three inline meshes) per added robot, loading and the scene",
+                                "Reproduce: `python -m sensorium.benchmarks.cad` (sensorium/benchmarks/cad.py)"]))
+    stl = runs[f"STL files ({PARTS} parts)"][0]
+    sec.findings.append(f"A robot of {PARTS} mesh parts ({stl['triangles']:,} triangles in the ray engine) peaks at "
+                        f"{stl['peak']['step'] / 1e6:.0f} MB and holds {stl['rss']['step'] / 1e6:.0f} MB once stepping; "
+                        f"a swarm robot costs {per['stl']:.1f} ms (shared mesh files) or {per['triangles']:.1f} ms "
+                        "(inline meshes) to load.")
+    return sec
+
+
+def _print(title: str, rows: list[list[str]]) -> None:
+    print(title)
+    widths = [max(len(str(c)), *(len(str(r[i])) for r in rows)) for i, c in enumerate(COLUMNS)]
+    for row in [COLUMNS, *rows]:
+        print("  ".join(str(c).rjust(w) for c, w in zip(row, widths)))
+
+
+def main(argv: list[str]) -> int:
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m sensorium.benchmarks.cad", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--quick", action="store_true", help="a quarter of the triangles, a swarm of 20")
+    parser.add_argument("--rounds", type=int, default=1, help="interleaved rounds (default 1)")
+    parser.add_argument("--compare", metavar="TREE", help="also measure another source tree (say the base "
+                        "checkout), interleaved with this one")
+    args = parser.parse_args(argv)
+    here = str(Path(__file__).resolve().parents[2])
+    trees: dict[str, str | None] = {"this": here}
+    if args.compare:
+        trees = {args.compare: str(Path(args.compare).resolve()), "this": here}
+    with tempfile.TemporaryDirectory() as tmp:
+        runs = measure_all(worlds(Path(tmp), args.quick), trees, args.rounds, lambda s: print(s, file=sys.stderr))
+    for name, samples in runs.items():
+        _print(f"{name} ({here if name == 'this' else name}): best of {args.rounds}", rows_of(samples))
+        print(f"swarm, ms per added robot: {per_robot_ms(samples, 'stl'):.1f} (shared STL files), "
+              f"{per_robot_ms(samples, 'triangles'):.1f} (inline meshes)\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
