@@ -500,9 +500,12 @@ class Scene:
         PBRAppearance fields): from the next measurement cameras and infra-red sensors read it as if the
         world file had said it. Only that shape's entries change (no rebuild); a transparency keeps its
         side of 0 and 1 (the caller's check: which rays see the shape and its shadows is fixed)."""
-        key, local, model = self._parts[shape]
+        model = self._parts[shape][2]
         self._loaded_models.setdefault(shape, model)
-        model = model.model_copy(update={"appearance": appearance})
+        self._use_model(shape, model.model_copy(update={"appearance": appearance}))
+
+    def _use_model(self, shape: int, model: wm.Shape | wm.Solid) -> None:
+        key, local, _ = self._parts[shape]
         self._parts[shape] = (key, local, model)
         info = _shape_info(self.shapes[shape].name, self.shapes[shape].owner, model)
         self.shapes[shape] = info
@@ -520,8 +523,7 @@ class Scene:
     def restore_appearances(self) -> None:
         """Every shape's appearance as loaded (``simulationReset``)."""
         for shape, model in self._loaded_models.items():
-            if model.appearance is not None:
-                self.set_appearance(shape, model.appearance)
+            self._use_model(shape, model)       # a shape loaded without an appearance gets none back
         self._loaded_models.clear()
         self.appearance_values.clear()
 
