@@ -31,12 +31,14 @@ from sensorium.server.world.wbt.convert import Converter, Owner, strip_origins
 from sensorium.server.world.wbt.frames import Frame
 from sensorium.server.world.wbt.parser import (
     ExternProto,
-    Node as ParsedNode,
     Parser,
     Tokens,
     WbtFile,
     WbtSyntaxError,
     parse_header,
+)
+from sensorium.server.world.wbt.parser import (
+    Node as ParsedNode,
 )
 
 LABEL = "node string"           # how errors name the string (file:line:col style)
