@@ -234,3 +234,40 @@ def test_a_c_supervisor_draws_the_same_trail(c_controller: str) -> None:
     assert "Sanitizer" not in err and "runtime error" not in err, err
     _expected_lines(lines)
     assert err.count("Error:") == 2, err
+
+
+def test_a_simulation_reset_removes_an_imported_trail_with_the_nodes_inside_it():
+    sim = _sim()
+    _import(sim, TRAIL)
+    inner = sv.find_node(sim, "TRAIL_LINE_SET").id
+    sim.reset()
+    assert sv.find_node(sim, "TRAIL") is None and sv.find_node(sim, "TRAIL_LINE_SET") is None
+    assert sv.node_from_id(sim, inner) is None
+    again = _import(sim, TRAIL)                            # new ids, never the removed ones
+    assert sv.find_node(sim, "TRAIL").id == again and sv.find_node(sim, "TRAIL_LINE_SET").id > inner
+
+
+def test_an_imported_shapes_colour_is_set_as_the_world_files_shapes_are(tmp_path):
+    """Through the appearance path: the PBRAppearance's baseColor set, the camera sees the box as if the
+    string had said the new colour (bit for bit against the world file with it)."""
+    sim = _sim()
+    sim.device("drawer/cam").enable(16)
+    node = _import(sim, BOX)
+    sim.run(1)
+    red = sim.device("drawer/cam").image.copy()
+    pbr = field(sim, node, "appearance")
+    assert field(sim, pbr, "baseColor") == [1.0, 0.0, 0.0]
+    sv.set_field(sim, sv.node_by_id(sim, pbr), "baseColor", [0.2, 0.4, 0.6])
+    assert field(sim, pbr, "baseColor") == [0.2, 0.4, 0.6]
+    sim.run(1)
+    got = sim.device("drawer/cam").image.copy()
+    written = tmp_path / "written.wbt"
+    written.write_text(WORLD.read_text() + BOX.replace("baseColor 1 0 0", "baseColor 0.2 0.4 0.6") + "\n")
+    ref = _sim(written)
+    ref.device("drawer/cam").enable(16)
+    ref.run(1)
+    want = ref.device("drawer/cam").image
+    assert not np.array_equal(got, red) and np.array_equal(got, want)
+    with pytest.raises(ValueError, match=r"must be in \[0, 1\]"):
+        sv.set_field(sim, sv.node_by_id(sim, pbr), "baseColor", [2.0, 0.0, 0.0])
+    assert field(sim, pbr, "baseColor") == [0.2, 0.4, 0.6]

@@ -572,7 +572,32 @@ def _visual_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
             return [list(x) if isinstance(x, list) else x for x in value] if isinstance(value, list) else value
         return get
 
-    return {name: (kind, getter(name), None) for name, kind in visuals.fields(v).items()}
+    out: dict[str, tuple[str, Getter, Setter]] = {name: (kind, getter(name), None)
+                                                  for name, kind in visuals.fields(v).items()}
+    ref = _visual_shape(sim, v)
+    if ref is not None and v.type in appearance.SETTABLE:      # an area shape's colours: the appearance path
+        served = appearance.fields(ref, lambda field: 0)
+        for name in appearance.SETTABLE[v.type]:
+            if name in served and name in out:
+                out[name] = served[name]
+    return out
+
+
+def _visual_shape(sim: Any, v: visuals.VNode) -> appearance.ShapeRef | None:
+    """The appearance path's reference for a node of an imported area shape (its scene shape, found as
+    the import's solid's shapes in order), None for any other node."""
+    if v.shape < 0 or v.role not in ("appearance", "material"):
+        return None
+    solid = next((s for s in reversed(sim.world.solids) if s.name == v.key), None)
+    shapes = [] if solid is None else list(solid.shapes)
+    if v.shape >= len(shapes):
+        return None
+    model = shapes[v.shape]
+    node = getattr(model, "node", None)
+    k = next((k for k in range(len(sim.scene.shapes)) if sim.scene.loaded_model(k) is model), None)
+    if node is None or k is None or (v.role == "material" and not node.material):
+        return None
+    return appearance.ShapeRef(k, node, v.role, v.type)
 
 
 def _base_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:

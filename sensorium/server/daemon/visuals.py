@@ -36,6 +36,8 @@ INSIDE = frozenset({"Shape", "Group", "Pose", "Transform"})
 """What a visual root may hold (through its children)."""
 
 LINES = frozenset({"IndexedLineSet", "PointSet"})
+AREAS = frozenset({"Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane", "IndexedFaceSet", "ElevationGrid", "Mesh"})
+"""Geometries sensors see: their Shape is one of the import's solid's shapes (its colours set as a world file's)."""
 """Geometries no sensor sees here: their MF fields are set freely."""
 
 _POSE = {"translation": ("SFVec3f", (0.0, 0.0, 0.0)), "rotation": ("SFRotation", (0.0, 0.0, 1.0, 0.0))}
@@ -81,6 +83,8 @@ class VNode:
     key: str                      # the backing solid's name (the import's)
     values: dict[str, Any] = field(default_factory=dict)    # field -> value (SFNode: id; MFNode: ids)
     inert: bool = False           # inside a line or point set: no sensor sees it
+    shape: int = -1               # its area Shape's place among the import's (the solid's shapes), -1: none
+    role: str = ""                # in that Shape: "Shape", "appearance", "material", "texture", "geometry"
 
 
 @dataclass
@@ -88,6 +92,7 @@ class Store:
     """Every imported visual node, by id (roots keep their top-level id)."""
 
     nodes: dict[int, VNode] = field(default_factory=dict)
+    _areas: int = 0
     roots: dict[str, int] = field(default_factory=dict)     # backing solid name -> the root's id
     next_id: int = FIRST_ID
 
@@ -96,11 +101,21 @@ class Store:
         if key in self.roots:
             return
         self.roots[key] = root_id
-        self._node(written, root_id, 0, "children", key, False)
+        self._areas = 0
+        self._node(written, root_id, 0, "children", key, False, -1)
 
-    def _node(self, w: Any, node_id: int, parent: int, held: str, key: str, inert: bool) -> None:
+    def _node(self, w: Any, node_id: int, parent: int, held: str, key: str, inert: bool, shape: int) -> None:
         inert = inert or w.type in LINES
-        me = VNode(node_id, w.type, w.def_name or "", parent, held, key, inert=inert)
+        role = ""
+        if w.type == "Shape":
+            geometry = w.fields.get("geometry")
+            shape, role = -1, "Shape"
+            if hasattr(geometry, "type") and geometry.type in AREAS:    # the solid's next shape (the converter's order)
+                shape, self._areas = self._areas, self._areas + 1
+        elif shape >= 0:
+            role = {"appearance": "appearance", "material": "material", "texture": "texture",
+                    "baseColorMap": "texture", "geometry": "geometry"}.get(held, "")
+        me = VNode(node_id, w.type, w.def_name or "", parent, held, key, inert=inert, shape=shape, role=role)
         self.nodes[node_id] = me
         for name, (kind, default) in TABLES.get(w.type, {}).items():
             value = w.fields.get(name)
@@ -108,7 +123,7 @@ class Store:
                 if value is not None and hasattr(value, "type") and value.type in TABLES:
                     child = self.next_id
                     self.next_id += 1
-                    self._node(value, child, node_id, name, key, inert)
+                    self._node(value, child, node_id, name, key, inert, shape)
                     me.values[name] = child
                 else:
                     me.values[name] = 0
@@ -118,7 +133,7 @@ class Store:
                     if hasattr(c, "type") and c.type in TABLES:
                         child = self.next_id
                         self.next_id += 1
-                        self._node(c, child, node_id, name, key, inert)
+                        self._node(c, child, node_id, name, key, inert, -1)
                         ids.append(child)
                 me.values[name] = ids
             else:
