@@ -595,7 +595,13 @@ def _visual_shape(sim: Any, v: visuals.VNode) -> appearance.ShapeRef | None:
     model = shapes[v.shape]
     node = getattr(model, "node", None)
     k = next((k for k in range(len(sim.scene.shapes)) if sim.scene.loaded_model(k) is model), None)
-    if node is None or k is None or (v.role == "material" and not node.material):
+    holder = v
+    store = _visuals(sim)
+    while holder.role != "Shape" and holder.parent in store.nodes:
+        holder = store.nodes[holder.parent]
+    geometry = store.nodes.get(holder.values.get("geometry", 0))
+    if node is None or k is None or (v.role == "material" and not node.material) or \
+            geometry is None or node.geometry != geometry.type:      # (the converter's order, checked)
         return None
     return appearance.ShapeRef(k, node, v.role, v.type)
 
