@@ -168,7 +168,7 @@ def _unchanged(lv: Live) -> tuple:
     ("Crate { }", "node string:1:1: Crate: not a built-in node or PROTO here."),
     ("Transform { scale 2 2 2 children [ Shape { geometry Box { } } ] }",
      "node string:1:1: Transform: not importable here"),
-    ("Group { children [ Shape { geometry Box { } } ] }", "node string:1:1: Group: not importable here"),
+    ("Group { children [ Shape { geometry Box { } } PointLight { } ] }", "node string:1:1: Group: not importable here"),
     ("WorldInfo { }", "node string:1:1: WorldInfo: not importable here"),
     ("Solid {\n children [ PointLight { attenuation 0 0 0 } ] }",
      "node string:2:13 (PointLight, converted as solids[0].lights[0].attenuation): attenuation 0 0 0 would give"),

@@ -785,6 +785,71 @@ def wb_supervisor_field_set_sf_color(field: Field | None, values: Any) -> None:
     _field_set(field, WB_SF_COLOR, values, "wb_supervisor_field_set_sf_color")
 
 
+def _mf_change(field: Field | None, want: int | None, op: str, index: Any, value: Any, func: str) -> None:
+    """An MF field's item set, inserted or removed (``want`` None: any MF type, removeMF); the server
+    checks the index (negative from the end, as Webots) and the value, and says what is wrong in one
+    line. Served on an imported line or point set's fields (README "Supervisor")."""
+    r = _field_robot(field, want, func)
+    if r is None:
+        return
+    assert field is not None
+    if want is None and not field[2] & WB_MF:
+        print(f"Error: {func}() called with wrong field type: {_TYPE_NAMES[field[2]]}.", file=sys.stderr)
+        return
+    if isinstance(index, bool) or not isinstance(index, int) or not -(1 << 31) <= index < 1 << 31:
+        print(f"Error: {func}() called with an invalid 'index' argument: {index!r}.", file=sys.stderr)
+        return
+    args: dict[str, Any] = {**_field_args(field), "index": index, "op": op}
+    if op != "remove" and want == WB_MF_INT32:
+        if isinstance(value, bool) or not isinstance(value, int) or not -(1 << 31) <= value < 1 << 31:
+            print(f"Error: {func}(): expected a 32-bit whole number, got {value!r}.", file=sys.stderr)
+            return
+        args["value"] = value
+    elif op != "remove":
+        n = 4 if want == WB_MF_ROTATION else 2 if want == WB_MF_VEC2F else 3
+        try:
+            wire = [float(v) for v in value]
+        except (TypeError, ValueError):
+            print(f"Error: {func}(): expected {n} numbers, got {value!r}.", file=sys.stderr)
+            return
+        if len(wire) != n:
+            print(f"Error: {func}(): expected {n} numbers, got {len(wire)}.", file=sys.stderr)
+            return
+        if not all(math.isfinite(v) for v in wire):
+            print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
+            return
+        args["value"] = wire
+    _answer(r, "set_field", args, func)
+
+
+def wb_supervisor_field_set_mf_int32(field: Field | None, index: int, value: int) -> None:
+    _mf_change(field, WB_MF_INT32, "set", index, value, "wb_supervisor_field_set_mf_int32")
+
+
+def wb_supervisor_field_set_mf_vec3f(field: Field | None, index: int, values: Any) -> None:
+    _mf_change(field, WB_MF_VEC3F, "set", index, values, "wb_supervisor_field_set_mf_vec3f")
+
+
+def wb_supervisor_field_set_mf_color(field: Field | None, index: int, values: Any) -> None:
+    _mf_change(field, WB_MF_COLOR, "set", index, values, "wb_supervisor_field_set_mf_color")
+
+
+def wb_supervisor_field_insert_mf_int32(field: Field | None, index: int, value: int) -> None:
+    _mf_change(field, WB_MF_INT32, "insert", index, value, "wb_supervisor_field_insert_mf_int32")
+
+
+def wb_supervisor_field_insert_mf_vec3f(field: Field | None, index: int, values: Any) -> None:
+    _mf_change(field, WB_MF_VEC3F, "insert", index, values, "wb_supervisor_field_insert_mf_vec3f")
+
+
+def wb_supervisor_field_insert_mf_color(field: Field | None, index: int, values: Any) -> None:
+    _mf_change(field, WB_MF_COLOR, "insert", index, values, "wb_supervisor_field_insert_mf_color")
+
+
+def wb_supervisor_field_remove_mf(field: Field | None, index: int) -> None:
+    _mf_change(field, None, "remove", index, None, "wb_supervisor_field_remove_mf")
+
+
 def wb_supervisor_field_import_mf_node_from_string(field: Field | None, position: int, node_string: str) -> None:
     """Webots' ``importMFNodeFromString`` into the root's ``children``: the string's solids (or PROTO
     instances that are solids, of PROTOs the world file declares) and lights join the world from the

@@ -327,8 +327,14 @@ class SetFieldArgs(Args):
     node: NodeId
     field: FieldName
     level: int = Field(default=-1, ge=-1, le=16, description=_LEVEL)
-    value: bool | float | Annotated[list[float], Field(min_length=2, max_length=4)] = Field(
-        description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis x, y, z, angle")
+    value: bool | int | float | Annotated[list[float], Field(min_length=2, max_length=4)] | None = Field(
+        default=None, description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis "
+        "x, y, z, angle; an MF field's item (with index): MFInt32 a whole number, MFVec3f/MFColor 3 numbers; none to "
+        "remove")
+    index: int | None = Field(default=None, ge=-(1 << 31), lt=1 << 31, description=(
+        "an MF field's item (negative from the end, as Webots): setMF*, insertMF* (0 first, -1 after the last), "
+        "removeMF; absent: the field as a whole"))
+    op: Literal["set", "insert", "remove"] = Field(default="set", description="with index: what is done to the item")
 
 
 class ProtoArgs(Args):

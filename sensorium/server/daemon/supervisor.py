@@ -29,7 +29,7 @@ import numpy as np
 from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
-from sensorium.server.daemon import appearance, nested
+from sensorium.server.daemon import appearance, nested, visuals
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import states, viewshot
 from sensorium.server.world.poses import matrix_quaternion
@@ -53,6 +53,7 @@ class Node:
     proto: str = ""         # the PROTO it is an instance of (Webots' getTypeName; ``type`` is its base type)
     nested: bool = False    # inside a robot or top-level solid (nested.py; key: its id)
     interface: tuple = ()   # a PROTO instance's interface: wm.ProtoLevel each, its own PROTO first (getProto)
+    visual: bool = False    # an imported Shape or Group, or a node inside one (visuals.py; key: its solid's name)
 
 
 ROOT = Node(0, "Group", "", "", "")
@@ -69,6 +70,22 @@ def _table(sim: Any) -> nested.Table:
 
 def _nested_node(n: nested.Nested) -> Node:
     return Node(n.id, n.type, n.name, n.def_name, n.id, proto=n.proto, nested=True, interface=n.interface)
+
+
+def _visuals(sim: Any) -> visuals.Store:
+    """The imported visual nodes (filled by :func:`_all_nodes` as it numbers the imports)."""
+    store = getattr(sim, "_supervisor_visuals", None)
+    if store is None:
+        store = sim._supervisor_visuals = visuals.Store()
+    return store
+
+
+def _visual_node(v: visuals.VNode) -> Node:
+    return Node(v.id, v.type, "", v.def_name, v.key, visual=True)
+
+
+def _vnode(sim: Any, node: Node) -> visuals.VNode:
+    return _visuals(sim).nodes[node.id]
 
 
 def _nested_of(sim: Any, node: Node) -> nested.Nested:
@@ -114,9 +131,14 @@ def _all_nodes(sim: Any) -> list[Node]:
             for x, s in enumerate(_scenery(sim))]
     imported_protos = getattr(sim, "imported_protos", {})
     imported_faces = getattr(sim, "imported_interfaces", {})
+    imported_visuals = getattr(sim, "imported_visuals", {})
     for kind, key in imported:
         proto, face = imported_protos.get(key, ""), imported_faces.get(key, ())
-        if kind == "Solid":
+        written = imported_visuals.get(key)
+        if written is not None:           # a Shape or Group (visuals.py), held by a solid named key
+            _visuals(sim).add(str(key), len(out) + 1, written)
+            out.append(Node(len(out) + 1, written.type, "", written.def_name or "", key, visual=True))
+        elif kind == "Solid":
             j = names.index(key)
             out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key, proto=proto, interface=face))
         else:
@@ -129,6 +151,8 @@ def _all_nodes(sim: Any) -> list[Node]:
 def _removed(sim: Any, node: Node) -> bool:
     if node.scenery:
         return False
+    if node.visual:                  # with the solid holding it
+        return node.key not in sim.scene.solid_poses
     if node.nested:                  # with its top-level solid
         n = _nested_of(sim, node)
         return n.owner_kind == "Solid" and n.owner_key not in sim.scene.solid_poses
@@ -177,6 +201,11 @@ def _first_def(sim: Any, name: str) -> Node | None:
     for top in root_children(sim):
         if top.def_name == name:
             return top
+        if top.visual:
+            inner = next((v for v in _visuals(sim).inside(top.id) if v.def_name == name), None)
+            if inner is not None:
+                return _visual_node(inner)
+            continue
         hit = next((n for n in table.by_owner.get(top.id, ()) if n.def_name == name), None)
         if hit is not None:
             return _nested_node(hit)
@@ -199,6 +228,11 @@ def find_node(sim: Any, name: str) -> Node | None:
     for part in path:
         if found is None:
             return None
+        if found.visual:
+            store = _visuals(sim)
+            v = next((v for v in store.nodes.values() if v.parent == found.id and v.def_name == part), None)
+            found = None if v is None else _visual_node(v)
+            continue
         sub = next((c for c in table.by_parent.get(found.id, ()) if c.def_name == part), None)
         found = None if sub is None else _nested_node(sub)
     return found
@@ -226,6 +260,15 @@ def _known_ids(sim: Any) -> str:
 def node_by_id(sim: Any, node: int) -> Node:
     if node == 0:
         return ROOT
+    if node >= visuals.FIRST_ID:
+        _all_nodes(sim)                  # (numbers the imports' visual nodes)
+        v = _visuals(sim).nodes.get(node)
+        if v is None:
+            raise ValueError(f"no node with id {node} ({_known_ids(sim)})")
+        found = _visual_node(v)
+        if _removed(sim, found):
+            raise ValueError(f"node {node} ({found.type}) was removed with the imported node holding it")
+        return found
     if node >= nested.FIRST_ID:
         inner = _table(sim).get(node)
         if inner is None:
@@ -262,7 +305,8 @@ def node_from_id(sim: Any, node: int) -> Node | None:
 def node_ref(sim: Any, node: Node | None) -> dict:
     if node is None:
         return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
-    parent = _nested_of(sim, node).parent if node.nested else -1 if node.id == 0 else 0
+    parent = _nested_of(sim, node).parent if node.nested else _vnode(sim, node).parent \
+        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else 0
     return {"node": node.id, "type": node.type, "name": node.name, "def_name": node.def_name,
             "parent": parent, "proto": node.proto}
 
@@ -518,7 +562,53 @@ def _set_parameter_position(sim: Any, node: Node, value: float) -> None:
     sim.joints_moved(robot)
 
 
+def _visual_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
+    """An imported visual node's fields: what the string wrote, Webots' defaults otherwise (visuals.py)."""
+    v = _vnode(sim, node)
+
+    def getter(name: str) -> Getter:
+        def get(sim: Any, n: Node) -> Any:
+            value = v.values[name]
+            return [list(x) if isinstance(x, list) else x for x in value] if isinstance(value, list) else value
+        return get
+
+    out: dict[str, tuple[str, Getter, Setter]] = {name: (kind, getter(name), None)
+                                                  for name, kind in visuals.fields(v).items()}
+    ref = _visual_shape(sim, v)
+    if ref is not None and v.type in appearance.SETTABLE:      # an area shape's colours: the appearance path
+        served = appearance.fields(ref, lambda field: 0)
+        for name in appearance.SETTABLE[v.type]:
+            if name in served and name in out:
+                out[name] = served[name]
+    return out
+
+
+def _visual_shape(sim: Any, v: visuals.VNode) -> appearance.ShapeRef | None:
+    """The appearance path's reference for a node of an imported area shape (its scene shape, found as
+    the import's solid's shapes in order), None for any other node."""
+    if v.shape < 0 or v.role not in ("appearance", "material"):
+        return None
+    solid = next((s for s in reversed(sim.world.solids) if s.name == v.key), None)
+    shapes = [] if solid is None else list(solid.shapes)
+    if v.shape >= len(shapes):
+        return None
+    model = shapes[v.shape]
+    node = getattr(model, "node", None)
+    k = next((k for k in range(len(sim.scene.shapes)) if sim.scene.loaded_model(k) is model), None)
+    holder = v
+    store = _visuals(sim)
+    while holder.role != "Shape" and holder.parent in store.nodes:
+        holder = store.nodes[holder.parent]
+    geometry = store.nodes.get(holder.values.get("geometry", 0))
+    if node is None or k is None or (v.role == "material" and not node.material) or \
+            geometry is None or node.geometry != geometry.type:      # (the converter's order, checked)
+        return None
+    return appearance.ShapeRef(k, node, v.role, v.type)
+
+
 def _base_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
+    if node.visual and node.id >= visuals.FIRST_ID or node.visual and node.type in visuals.ROOTS:
+        return _visual_fields(sim, node)
     if node.nested:
         return _nested_fields(sim, node)
     return SCENERY_FIELDS.get(node.type, {}) if node.scenery else FIELDS[node.type]
@@ -579,7 +669,8 @@ _JOINT_FIELDS = {"endPoint": frozenset(nested.JOINT_DEVICES), "device": frozense
                  "device3": frozenset({"BallJoint"}), "jointParameters3": frozenset({"BallJoint"})}
 _PARAMETERS = frozenset({"HingeJointParameters", "JointParameters", "BallJointParameters"})
 _SCENERY = frozenset({"WorldInfo", "Viewpoint", "Background", "Fog", "PointLight", "SpotLight", "DirectionalLight"})
-_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS | _SCENERY | appearance.TYPES
+_NO_POSE = frozenset(nested.JOINT_DEVICES) | nested.NOT_POSES | _PARAMETERS | _SCENERY | appearance.TYPES | \
+    (visuals.TABLES.keys() - {"Pose", "Transform", "Group"})
 _WEBOTS_LACKS = {"children": _NO_POSE, "translation": _NO_POSE | {"Group"}, "rotation": _NO_POSE | {"Group"},
                  "name": frozenset(nested.JOINT_DEVICES) | _PARAMETERS | _SCENERY | {"Pose", "Transform", "Group"}
                  | (appearance.TYPES - {"Appearance", "PBRAppearance"})}
@@ -620,6 +711,25 @@ def get_proto(sim: Any, node: Node, level: int) -> dict:
     return {"type_name": proto.name, "derived": proto.derived, "fields": [f.name for f in proto.fields]}
 
 
+def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: Any) -> None:
+    """Webots' ``setMF*``/``insertMF*``/``removeMF``: on an imported line or point set's MF fields
+    (visuals.py); any other MF field is read-only here (one line, nothing changed)."""
+    fields = _fields(sim, node)
+    entry = fields.get(field)
+    what = visuals.what(_vnode(sim, node)) if node.visual and node.id >= visuals.FIRST_ID else _what(node)
+    if entry is None:
+        raise ValueError(f"{what} has no field {field!r} here (fields: {', '.join(fields) or 'none'})")
+    kind = entry[0]
+    if not kind.startswith("MF"):
+        raise ValueError(f"field {field!r} of {what} is an {kind}, not a list: set it as a whole")
+    if not (node.visual and node.id >= visuals.FIRST_ID and visuals.settable(_vnode(sim, node), field)):
+        if node.visual and node.id >= visuals.FIRST_ID:
+            raise ValueError(visuals.read_only_line(_vnode(sim, node), field, kind))
+        raise ValueError(f"field {field!r} ({kind}) of {what}: its items are read-only here (a Supervisor changes "
+                         "the items of an imported line or point set's fields only); nothing changed")
+    visuals.change(_vnode(sim, node), field, op, index, value)
+
+
 def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> None:
     level = _level(node, level)
     what = f"{node.type} {node.name or node.id!r}"
@@ -643,6 +753,8 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
                "top-level robot's or solid's translation and rotation, a light's fields)")
         raise ValueError(f"field {field!r} ({kind}) of PROTO {node.interface[0].name} ({what}) is read-only here: "
                          f"{why}; nothing changed")
+    if setter is None and node.visual and node.id >= visuals.FIRST_ID:
+        raise ValueError(visuals.read_only_line(_vnode(sim, node), field, kind))
     if setter is None and node.nested and node.type in appearance.TYPES:
         raise ValueError(f"field {field!r} ({kind}) of {_what(node)} is read-only here: of a shape's nodes a "
                          "Supervisor sets a Material's diffuseColor, emissiveColor and transparency and a "
@@ -657,7 +769,9 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
     elif kind == "SFFloat":
         ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
     else:
-        ok = isinstance(value, list) and len(value) == _VECTOR_SIZES[kind]
+        ok = isinstance(value, list) and len(value) == _VECTOR_SIZES.get(kind, -1)
+    if not ok and kind not in _VECTOR_SIZES and kind not in ("SFBool", "SFFloat"):
+        raise ValueError(f"field {field!r} of {what} is an {kind}: not set as a whole here")
     if not ok:
         want = {"SFBool": "true or false", "SFFloat": "a finite number"}.get(kind, f"{_VECTOR_SIZES.get(kind)} numbers")
         raise ValueError(f"field {field!r} is an {kind}: takes {want}, got {value!r}")
@@ -692,6 +806,9 @@ def node_velocity(sim: Any, node: Node) -> list[float]:
 # handler(sim, lockstep, calling robot, validated args) -> result; ValueError = INVALID_ARGUMENT
 
 def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    if a.index is not None:          # an MF field's item: set, inserted or removed
+        change_item(sim, node_by_id(sim, a.node), a.field, a.op, a.index, a.value)
+        return {"success": True}
     set_field(sim, node_by_id(sim, a.node), a.field, a.value, a.level)
     return {"success": True}
 
@@ -703,6 +820,12 @@ def remove_node(sim: Any, node: Node) -> None:
     if node.scenery:
         raise ValueError(f"{node.type} (node {node.id}) cannot be removed here: only top-level solids and lights "
                          "can (Sensorium does not simulate it)")
+    if node.visual and node.id >= visuals.FIRST_ID:
+        raise ValueError(f"{visuals.what(_vnode(sim, node))} cannot be removed here: of an imported Shape or Group "
+                         "only the node at the root can be (remove it and import it again)")
+    if node.visual:
+        sim.remove_solid(node.key)
+        return
     if node.nested:
         raise ValueError(f"{node.type} {node.name or node.def_name or node.id!r} (node {node.id}) cannot be removed "
                          "here: only top-level solids and lights can, not the nodes inside a robot or solid")

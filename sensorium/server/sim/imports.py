@@ -9,9 +9,11 @@ running simulation changes here; :meth:`Simulation.import_nodes` adds what this 
 As Webots, a PROTO instance must be of a PROTO the world file declares (``EXTERNPROTO`` or
 ``IMPORTABLE EXTERNPROTO``; Sensorium's built-in stand-ins need none), a solid whose name is taken
 is renamed ``name(1)``, ``name(2)``, ... (Webots' name clash rule), and every node of the string is
-imported in order. Departures: a robot (a ``Robot`` or a PROTO that is one, or a solid holding
-one) is refused, as are nodes that are neither a solid nor a light (``Group``, ``Shape`` at the
-top, ``WorldInfo``, a scaled ``Transform``, ...); a ``Pose`` (or a ``Transform`` of scale 1) is
+imported in order. A ``Shape`` (or a ``Group`` of shapes) is imported as a solid without
+boundingObject holding it, as a world file holds its top-level shapes (``ImportedNode.visual`` keeps
+the parsed node: the Supervisor serves it, daemon/visuals.py). Departures: a robot (a ``Robot`` or a
+PROTO that is one, or a solid holding one) is refused, as are nodes that are neither a solid, a light
+nor shapes (``WorldInfo``, a scaled ``Transform``, ...); a ``Pose`` (or a ``Transform`` of scale 1) is
 imported as a ``Solid`` of its shapes, with one warning; a ``USE`` names a ``DEF`` of the string
 only.
 """
@@ -35,6 +37,9 @@ from sensorium.server.world.wbt.parser import (
     WbtSyntaxError,
     parse_header,
 )
+from sensorium.server.world.wbt.parser import (
+    Node as ParsedNode,
+)
 
 LABEL = "node string"           # how errors name the string (file:line:col style)
 _NAME = "<importMFNodeFromString>"   # its pseudo file, in the world's folder: relative urls resolve there
@@ -51,6 +56,7 @@ class ImportedNode:
     model: Any          # wm.Solid or the light model, validated and sanitised
     proto: str = ""     # the PROTO the string's node is an instance of (Supervisor getTypeName), "" for a base node
     interface: tuple = ()   # that PROTO instance's interface (wm.ProtoLevel each: Supervisor getField, getProto)
+    visual: Any = None      # a Shape or Group of shapes imported at the root: its parsed node (the solid holds it)
 
 
 @dataclass
@@ -155,6 +161,7 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     kinds: list[str] = []
     protos: list[str] = []
     faces: list[tuple] = []
+    visuals: list[Any] = []
     for written, node in zip(wbt.nodes, expansion.nodes):
         solids, lights = len(conv.world["solids"]), len(conv.world["lights"])
         what = written.type if written.type == node.type else f"{written.type} (a {node.type})"
@@ -165,6 +172,13 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
             node = replace(node, type="Solid")
             warnings.append(f"{at}: {written.type} imported as a Solid of its shapes (getTypeName() answers "
                             "'Solid'): Sensorium imports solids and lights")
+        visual = None
+        if node.type in ("Shape", "Group") and node.proto is None and _only_shapes(node):
+            # a visual node at the root (Webots' draw-trail sample): a solid without boundingObject holds it,
+            # as a world file's top-level shapes are held (its area shapes seen by every sensor; lines by none)
+            visual = node
+            node = ParsedNode("Solid", {"children": [node], "name": "shapes"}, node.line, node.col, source=node.source)
+        visuals.append(visual)
         conv.visit(node, Frame.identity(), top, top=True)
         if conv.world["robots"]:
             held = "" if node.type == "Robot" else f" (it holds robot {conv.world['robots'][0]['name']!r})"
@@ -179,7 +193,8 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
                [(lt["type"], lt) for lt in conv.world["lights"][lights:]]
         if len(made) != 1 or top.parts or conv.world["world_info"].keys() - {"coordinate_system"}:
             raise ImportRefused(f"{at}: {what}: not importable here: a node string holds solids (Solid, or a PROTO "
-                                "that is one) and lights (PointLight, SpotLight, DirectionalLight) only")
+                                "that is one), lights (PointLight, SpotLight, DirectionalLight) and shapes (Shape, "
+                                "or a Group, Pose or Transform of shapes) only")
         kinds.append(made[0][0])
         entry = conv.top_node(node, {})          # the PROTO's name as a world file's top-level node keeps it
         protos.append(entry.get("proto", "") if entry["type"] == made[0][0] else "")
@@ -204,12 +219,25 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     warnings += [_wbt_warning(w, origin, LABEL) for w in parsed.warnings]
     queue: Counter[str] = Counter()
     out = []
-    for kind, proto, face in zip(kinds, protos, faces):
+    for kind, proto, face, visual in zip(kinds, protos, faces, visuals):
         group = "Solid" if kind == "Solid" else "light"
         models = fragment.solids if group == "Solid" else fragment.lights
-        out.append(ImportedNode(kind, models[queue[group]], proto, face))
+        out.append(ImportedNode(kind, models[queue[group]], proto, face, visual))
         queue[group] += 1
     return out
+
+
+def _only_shapes(node: Any) -> bool:
+    """A Shape, or a Group holding only shapes (through Groups, Poses and Transforms)."""
+    stack = [node]
+    while stack:
+        n = stack.pop()
+        if not isinstance(n, ParsedNode) or n.type not in ("Shape", "Group", "Pose", "Transform") or n.proto is not None:
+            return False
+        if n.type != "Shape":
+            children = n.fields.get("children", [])
+            stack += children if isinstance(children, list) else [children]
+    return True
 
 
 def _unscaled(node: Any) -> bool:

@@ -289,6 +289,7 @@ class Simulation:
         self.allow_outside_meshes = allow_outside_meshes
         self.imported: list[tuple[str, str | int]] = []     # (node type, key) of each node a Supervisor imported
         self.imported_protos: dict[str | int, str] = {}       # key -> the PROTO an imported node is an instance of
+        self.imported_visuals: dict[str | int, Any] = {}      # key -> an imported Shape or Group (parsed; its solid's key)
         self.imported_interfaces: dict[str | int, tuple] = {}  # key -> that PROTO instance's interface fields
         self.top_level = top_level(self.world)     # the root's children as loaded (world/top_nodes.py)
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
@@ -558,6 +559,8 @@ class Simulation:
             self.imported.append((node.type, key))
             self.imported_protos[key] = node.proto
             self.imported_interfaces[key] = node.interface
+            if node.visual is not None:
+                self.imported_visuals[key] = node.visual
             out.append((node.type, key, node_id))
         return out
 

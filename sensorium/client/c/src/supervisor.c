@@ -1199,6 +1199,108 @@ void wb_supervisor_field_set_sf_color(WbFieldRef field, const double values[3]) 
   field_set(field, WB_SF_COLOR, &a, "wb_supervisor_field_set_sf_color");
 }
 
+/* an MF field's item set, inserted or removed (Webots' setMF*, insertMF*, removeMF): served on an imported
+   line or point set's fields; the server checks the index (negative from the end) and the value */
+typedef struct {
+  int64_t node;
+  const char *name;
+  bool has_level;
+  int level;
+  int index;
+  const char *op;
+  int kind; /* 0: no value (remove), 1: an int32, 3: numbers */
+  int number;
+  const double *values;
+  int n;
+} mf_args;
+
+static void args_mf(sn_req *r, const void *arg) {
+  const mf_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "field");
+  sn_req_str(r, a->name);
+  if (a->has_level) {
+    sn_req_key(r, "level");
+    msgpack_pack_int(&r->pk, a->level);
+  }
+  sn_req_key(r, "index");
+  msgpack_pack_int(&r->pk, a->index);
+  sn_req_key(r, "op");
+  sn_req_str(r, a->op);
+  if (a->kind == 0)
+    return;
+  sn_req_key(r, "value");
+  if (a->kind == 1)
+    msgpack_pack_int(&r->pk, a->number);
+  else {
+    msgpack_pack_array(&r->pk, (size_t)a->n);
+    for (int i = 0; i < a->n; i++)
+      msgpack_pack_double(&r->pk, a->values[i]);
+  }
+}
+
+static void mf_change(WbFieldRef field, WbFieldType type, mf_args *a, const char *func) {
+  sn_robot *rb = field_robot(field, type, func);
+  if (rb == NULL)
+    return;
+  if (type == WB_NO_FIELD && !(field->type & WB_MF)) {
+    fprintf(stderr, "Error: %s() called with wrong field type: %s.\n", func, wb_supervisor_field_get_type_name(field));
+    return;
+  }
+  if (a->kind == 3 && a->values == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL 'values' argument.\n", func);
+    return;
+  }
+  for (int i = 0; a->kind == 3 && i < a->n; i++)
+    if (!isfinite(a->values[i])) {
+      fprintf(stderr, "Error: %s() called with a NaN or infinite value.\n", func);
+      return;
+    }
+  a->node = field->node;
+  a->name = field->name;
+  a->has_level = field->level >= 0;
+  a->level = field->level;
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/set_field", 4 + a->has_level + (a->kind != 0), args_mf, a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
+void wb_supervisor_field_set_mf_int32(WbFieldRef field, int index, int value) {
+  mf_args a = {0, NULL, false, 0, index, "set", 1, value, NULL, 0};
+  mf_change(field, WB_MF_INT32, &a, "wb_supervisor_field_set_mf_int32");
+}
+
+void wb_supervisor_field_set_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
+  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3};
+  mf_change(field, WB_MF_VEC3F, &a, "wb_supervisor_field_set_mf_vec3f");
+}
+
+void wb_supervisor_field_set_mf_color(WbFieldRef field, int index, const double values[3]) {
+  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3};
+  mf_change(field, WB_MF_COLOR, &a, "wb_supervisor_field_set_mf_color");
+}
+
+void wb_supervisor_field_insert_mf_int32(WbFieldRef field, int index, int value) {
+  mf_args a = {0, NULL, false, 0, index, "insert", 1, value, NULL, 0};
+  mf_change(field, WB_MF_INT32, &a, "wb_supervisor_field_insert_mf_int32");
+}
+
+void wb_supervisor_field_insert_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
+  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3};
+  mf_change(field, WB_MF_VEC3F, &a, "wb_supervisor_field_insert_mf_vec3f");
+}
+
+void wb_supervisor_field_insert_mf_color(WbFieldRef field, int index, const double values[3]) {
+  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3};
+  mf_change(field, WB_MF_COLOR, &a, "wb_supervisor_field_insert_mf_color");
+}
+
+void wb_supervisor_field_remove_mf(WbFieldRef field, int index) {
+  mf_args a = {0, NULL, false, 0, index, "remove", 0, 0, NULL, 0};
+  mf_change(field, WB_NO_FIELD, &a, "wb_supervisor_field_remove_mf");
+}
+
 typedef struct {
   int64_t node;
   const char *field;

@@ -134,10 +134,6 @@ void wb_supervisor_field_set_mf_bool(WbFieldRef field, int index, bool value) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_set_mf_int32(WbFieldRef field, int index, int value) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_field_set_mf_float(WbFieldRef field, int index, double value) {
   SN_UNSUPPORTED();
 }
@@ -146,15 +142,7 @@ void wb_supervisor_field_set_mf_vec2f(WbFieldRef field, int index, const double 
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_set_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_field_set_mf_rotation(WbFieldRef field, int index, const double values[4]) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_set_mf_color(WbFieldRef field, int index, const double values[3]) {
   SN_UNSUPPORTED();
 }
 
@@ -166,10 +154,6 @@ void wb_supervisor_field_insert_mf_bool(WbFieldRef field, int index, bool value)
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_insert_mf_int32(WbFieldRef field, int index, int value) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_field_insert_mf_float(WbFieldRef field, int index, double value) {
   SN_UNSUPPORTED();
 }
@@ -178,23 +162,11 @@ void wb_supervisor_field_insert_mf_vec2f(WbFieldRef field, int index, const doub
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_insert_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_field_insert_mf_rotation(WbFieldRef field, int index, const double values[4]) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_insert_mf_color(WbFieldRef field, int index, const double values[3]) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_field_insert_mf_string(WbFieldRef field, int index, const char *value) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_remove_mf(WbFieldRef field, int index) {
   SN_UNSUPPORTED();
 }
 

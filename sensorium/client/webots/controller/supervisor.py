@@ -136,6 +136,28 @@ class Field:
     def setSFColor(self, value: list[float]) -> None:
         wb.wb_supervisor_field_set_sf_color(self._ref, value)
 
+    # an imported line or point set's lists (README "Supervisor": the draw-trail pattern)
+    def setMFInt32(self, index: int, value: int) -> None:
+        wb.wb_supervisor_field_set_mf_int32(self._ref, index, value)
+
+    def setMFVec3f(self, index: int, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_mf_vec3f(self._ref, index, value)
+
+    def setMFColor(self, index: int, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_mf_color(self._ref, index, value)
+
+    def insertMFInt32(self, index: int, value: int) -> None:
+        wb.wb_supervisor_field_insert_mf_int32(self._ref, index, value)
+
+    def insertMFVec3f(self, index: int, value: list[float]) -> None:
+        wb.wb_supervisor_field_insert_mf_vec3f(self._ref, index, value)
+
+    def insertMFColor(self, index: int, value: list[float]) -> None:
+        wb.wb_supervisor_field_insert_mf_color(self._ref, index, value)
+
+    def removeMF(self, index: int) -> None:
+        wb.wb_supervisor_field_remove_mf(self._ref, index)
+
     def importMFNodeFromString(self, position: int, nodeString: str) -> None:  # noqa: N803 - Webots' name
         wb.wb_supervisor_field_import_mf_node_from_string(self._ref, position, nodeString)
 
@@ -495,7 +517,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),
         "addTorque": ("node_add_torque", None, "torque, relative")},
     Field: {
-        "getActualField": ("field_get_actual_field", None, ""), "removeMF": ("field_remove_mf", None, "index"),
+        "getActualField": ("field_get_actual_field", None, ""),
         "removeSF": ("field_remove_sf", None, ""),
         # no SFNode field here takes an import (a joint's jointParameters and endPoint are read-only)
         "importSFNodeFromString": ("field_import_sf_node_from_string", None, "nodeString")},
@@ -504,7 +526,7 @@ _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 
                     "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
 for _kind, _none in _FIELD_NO_VALUES.items():
     _c = _kind.lower()
-    if _kind != "Node":                        # setMFNode and insertMFNode are not Webots' (importMFNodeFromString)
+    if _kind not in ("Node", "Int32", "Vec3f", "Color"):   # those served above; no setMFNode (Webots has none)
         _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None, "index, value")
         _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None, "index, value")
     if _kind in ("Int32", "Vec2f", "String"):  # SFString fields are read-only here
