@@ -1,0 +1,225 @@
+"""Numerical hardness of IndexedFaceSet polygon tessellation (``polygon_corners``: convex polygons
+fanned, concave ones cut along diagonals). Simple polygons built so by construction (star-shaped,
+combs, spirals, slit rings as Webots' curriculum arenas draw a wall's top face) are placed in any
+plane, far from the origin, tiny or huge, with nearly collinear, duplicate and repeated corners, and
+clockwise or counter-clockwise. The triangles are checked exactly (rational arithmetic on the
+polygon as the float64 points place it, projected into its plane): every triangle turns as the
+polygon turns, their signed areas add up to the polygon's (so, none turning backwards, they cover it
+once), and every triangle's centroid lies inside the polygon."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from sensorium.server.world.wbt.convert import fan_corners, polygon_corners
+
+FAST = settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+# ---------------------------------------------------------------- simple polygons, by construction
+
+
+def star(n: int, radii: list[float], jitter: list[float]) -> list[tuple[float, float]]:
+    """Corners at increasing angles (gaps below π) around the origin: simple and star-shaped."""
+    return [(r * math.cos(2 * math.pi * (k + 0.45 * j) / n), r * math.sin(2 * math.pi * (k + 0.45 * j) / n))
+            for k, (r, j) in enumerate(zip(radii, jitter))]
+
+
+def comb(heights: list[float]) -> list[tuple[float, float]]:
+    """A base bar 0 ≤ y ≤ 1 with a tooth per height (width 1, gaps 1) on top, counter-clockwise."""
+    m = len(heights)
+    out = [(0.0, 0.0), (2.0 * m - 1, 0.0)]
+    for i in reversed(range(m)):
+        x = 2.0 * i
+        out += [(x + 1, 1.0 + heights[i]), (x, 1.0 + heights[i])]
+        if i:
+            out += [(x, 1.0), (x - 1, 1.0)]
+    return out
+
+
+def spiral(turns: float, n: int) -> list[tuple[float, float]]:
+    """A spiral band: out along r = 1 + θ/π, back along r = 1 + θ/π − 1 (a band 1 wide, its
+    turns 2 apart): simple, with long runs of reflex corners."""
+    theta = [turns * 2 * math.pi * k / (n - 1) for k in range(n)]
+    outer = [((1.5 + t / math.pi) * math.cos(t), (1.5 + t / math.pi) * math.sin(t)) for t in theta]
+    inner = [((0.5 + t / math.pi) * math.cos(t), (0.5 + t / math.pi) * math.sin(t)) for t in reversed(theta)]
+    return outer + inner
+
+
+def slit_ring(outer_ccw: bool, inner: float) -> list[tuple[float, float]]:
+    """A square wall's top face as Webots' curriculum arenas draw it: the outer square, a slit to the
+    inner square, the inner square the other way round, back along the slit (corners repeated)."""
+    o = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+    i = [(-inner, -inner), (-inner, inner), (inner, inner), (inner, -inner)]
+    if not outer_ccw:
+        o = [o[0]] + o[1:][::-1]
+        i = [i[0]] + i[1:][::-1]
+    return o + [o[0]] + i + [i[0]]
+
+
+# ---------------------------------------------------------------- placing and checking
+
+
+def frame(a: float, b: float, c: float) -> np.ndarray:
+    """An orthonormal frame (rows u, v, n) from three angles."""
+    ca, sa, cb, sb, cc, sc = math.cos(a), math.sin(a), math.cos(b), math.sin(b), math.cos(c), math.sin(c)
+    rz = np.array([[ca, -sa, 0], [sa, ca, 0], [0, 0, 1]])
+    ry = np.array([[cb, 0, sb], [0, 1, 0], [-sb, 0, cb]])
+    rx = np.array([[1, 0, 0], [0, cc, -sc], [0, sc, cc]])
+    return (rz @ ry @ rx).T
+
+
+def place(xy: list[tuple[float, float]], f: np.ndarray, scale: float, offset: float) -> list[float]:
+    p = np.asarray(xy, dtype=np.float64) * scale
+    xyz = p[:, :1] * f[0] + p[:, 1:] * f[1] + offset
+    return xyz.reshape(-1).tolist()
+
+
+def projected(points: list[float], f: np.ndarray, offset: float) -> list[tuple[Fraction, Fraction]]:
+    """The float64 points exactly, less the offset, on the frame's u and v (rationals)."""
+    u, v = [Fraction(float(c)) for c in f[0]], [Fraction(float(c)) for c in f[1]]
+    o = Fraction(offset)
+    out = []
+    for k in range(0, len(points), 3):
+        q = [Fraction(c) - o for c in points[k:k + 3]]
+        out.append((sum(a * b for a, b in zip(q, u)), sum(a * b for a, b in zip(q, v))))
+    return out
+
+
+def twice_area(a, b, c) -> Fraction:
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+
+def winding(p, poly) -> int:
+    """Winding number of ``poly`` around ``p`` (exact; p on no edge)."""
+    w = 0
+    for a, b in zip(poly, poly[1:] + poly[:1]):
+        if a[1] <= p[1] < b[1] and twice_area(a, b, p) > 0:
+            w += 1
+        elif b[1] <= p[1] < a[1] and twice_area(a, b, p) < 0:
+            w -= 1
+    return w
+
+
+def check_cover(xy: list[tuple[float, float]], f: np.ndarray, scale: float, offset: float) -> np.ndarray:
+    """Tessellate the placed polygon and check its triangles exactly. Returns the triangles."""
+    n = len(xy)
+    points = place(xy, f, scale, offset)
+    index = list(range(n))
+    corners, fanned = polygon_corners(index, points, [10 ** 9])
+    assert fanned == 0
+    again, _ = polygon_corners(index, points, [10 ** 9])
+    assert np.array_equal(corners, again)                       # deterministic
+    assert corners.shape == (n - 2, 3) and corners.min() >= 0 and corners.max() < n
+    assert sorted(set(corners.reshape(-1).tolist())) == list(range(n))   # every corner used
+    poly = projected(points, f, offset)
+    total = sum(twice_area(poly[0], poly[k], poly[k + 1]) for k in range(1, n - 1))   # shoelace, exact
+    assert total != 0
+    sign = 1 if total > 0 else -1
+    got = Fraction(0)
+    for a, b, c in corners.tolist():
+        t = twice_area(poly[a], poly[b], poly[c])
+        assert t * sign >= 0, f"triangle {(a, b, c)} turns against the polygon"
+        got += t
+        if t != 0:
+            centroid = ((poly[a][0] + poly[b][0] + poly[c][0]) / 3, (poly[a][1] + poly[b][1] + poly[c][1]) / 3)
+            assert winding(centroid, poly) == sign, f"triangle {(a, b, c)} lies outside the polygon"
+    assert got == total                                          # covered once: the areas agree exactly
+    assert np.isfinite(np.asarray(points)).all()
+    return corners
+
+
+ANGLES = st.tuples(*[st.floats(0, 2 * math.pi, allow_nan=False)] * 3)
+AXIS = st.sampled_from([np.eye(3)[list(p)] * s for p in ((0, 1, 2), (1, 2, 0), (2, 0, 1)) for s in (1.0, -1.0)])
+SCALE = st.sampled_from([1e-6, 1e-3, 1.0, 37.5, 1e4])
+OFFSET = st.sampled_from([0.0, -3.25, 1e5, -1e5, 1e7])
+
+
+def fits(scale: float, offset: float) -> bool:
+    """A rotated polygon far out keeps its shape to ~1e-9 of its size (float64 rounds the offset)."""
+    return abs(offset) * 1e-16 <= scale * 1e-5
+
+
+@st.composite
+def star_polygons(draw):
+    n = draw(st.integers(4, 40))
+    radii = draw(st.lists(st.floats(0.05, 1.0), min_size=n, max_size=n))
+    jitter = draw(st.lists(st.floats(-1.0, 1.0), min_size=n, max_size=n))
+    xy = star(n, radii, jitter)
+    return xy if draw(st.booleans()) else xy[::-1]
+
+
+@settings(FAST)
+@given(star_polygons(), ANGLES, SCALE, OFFSET)
+def test_star_shaped_polygons_in_any_plane_and_place_are_covered_exactly(xy, angles, scale, offset) -> None:
+    if fits(scale, offset):
+        check_cover(xy, frame(*angles), scale, offset)
+
+
+@settings(FAST)
+@given(star_polygons(), AXIS, st.integers(-20, 13), OFFSET)
+def test_star_shaped_polygons_on_a_grid_far_out_and_tiny_are_covered_exactly(xy, axes, e, offset) -> None:
+    """In an axis plane with corners on a binary grid, even a micrometre polygon 1e7 m out is placed
+    exactly: the check holds with no rounding at all."""
+    grid = [(round(x * 4096) / 4096, round(y * 4096) / 4096) for x, y in xy]
+    if len(set(grid)) < len(grid) or abs(sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(grid, grid[1:] + grid[:1]))) == 0:
+        return
+    check_cover(grid, axes, 2.0 ** e, offset)
+
+
+@settings(FAST)
+@given(st.lists(st.floats(0.01, 5.0), min_size=2, max_size=12), ANGLES, SCALE, OFFSET, st.booleans())
+def test_combs_are_covered_exactly(heights, angles, scale, offset, cw) -> None:
+    xy = comb(heights)
+    if fits(scale, offset):
+        check_cover(xy[::-1] if cw else xy, frame(*angles), scale, offset)
+
+
+@settings(FAST)
+@given(st.floats(0.6, 2.5), st.integers(8, 40), ANGLES, SCALE, OFFSET, st.booleans())
+def test_spirals_are_covered_exactly(turns, n, angles, scale, offset, cw) -> None:
+    xy = spiral(turns, max(n, math.ceil(10 * turns) + 1))      # ≥ 10 corners a turn: chords stay in the band
+    if fits(scale, offset):
+        check_cover(xy[::-1] if cw else xy, frame(*angles), scale, offset)
+
+
+@settings(FAST)
+@given(st.booleans(), st.floats(0.05, 0.99), ANGLES, SCALE, OFFSET, st.integers(0, 9))
+def test_slit_rings_either_way_round_cover_the_ring_only(outer_ccw, inner, angles, scale, offset, roll) -> None:
+    xy = slit_ring(outer_ccw, inner)
+    xy = xy[roll:] + xy[:roll]
+    if fits(scale, offset):
+        check_cover(xy, frame(*angles), scale, offset)
+
+
+@settings(FAST)
+@given(star_polygons(), ANGLES, SCALE, st.data())
+def test_duplicate_consecutive_corners_and_nearly_collinear_ones_are_covered_exactly(xy, angles, scale, data) -> None:
+    """A corner written twice in a row, and a corner added on an edge, pushed in or out by 1e-9 to
+    1e-3 of the polygon's size, anywhere."""
+    xy = list(xy)
+    for _ in range(data.draw(st.integers(1, 4))):
+        k = data.draw(st.integers(0, len(xy) - 1))
+        if data.draw(st.booleans()):
+            xy.insert(k, xy[k])
+        else:
+            (x0, y0), (x1, y1) = xy[k], xy[(k + 1) % len(xy)]
+            t = data.draw(st.floats(0.1, 0.9))
+            d = data.draw(st.sampled_from([1e-9, -1e-9, 1e-6, -1e-6, 1e-3, -1e-3]))
+            xy.insert(k + 1, (x0 + t * (x1 - x0) - d * (y1 - y0), y0 + t * (y1 - y0) + d * (x1 - x0)))
+    check_cover(xy, frame(*angles), scale, 0.0)
+
+
+def test_zero_area_slivers_inside_a_polygon_are_covered() -> None:
+    """A spike out and straight back (a zero-area sliver) on a concave polygon, and a polygon of
+    all-collinear corners: a defined set of triangles, no NaN, nothing thrown."""
+    xy = [(0, 0), (3, 0), (3, 1), (1, 1), (1, 3), (0.5, 5), (1, 3), (0, 3)]     # an L with a spike
+    corners = check_cover([(float(x), float(y)) for x, y in xy], np.eye(3), 1.0, 0.0)
+    assert len(corners) == 6
+    flat = [0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 1.5, 0, 0]
+    corners, fanned = polygon_corners([0, 1, 2, 3, 4, -1], flat, [10 ** 6])
+    assert fanned == 0 and corners.tolist() == fan_corners([0, 1, 2, 3, 4, -1]).tolist()
