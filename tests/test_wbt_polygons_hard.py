@@ -223,3 +223,46 @@ def test_zero_area_slivers_inside_a_polygon_are_covered() -> None:
     flat = [0, 0, 0, 1, 0, 0, 2, 0, 0, 3, 0, 0, 1.5, 0, 0]
     corners, fanned = polygon_corners([0, 1, 2, 3, 4, -1], flat, [10 ** 6])
     assert fanned == 0 and corners.tolist() == fan_corners([0, 1, 2, 3, 4, -1]).tolist()
+
+
+def test_a_world_of_many_256_corner_spirals_cuts_within_the_budget_and_fans_the_rest(tmp_path) -> None:
+    """Ear clipping is bounded per world: 400,000 corners², so of twenty 256-corner concave spirals
+    (65,536 each) six are cut and fourteen stay fanned, said in one line (it was a line per
+    IndexedFaceSet: a hostile world's thousands of nodes gave thousands of lines)."""
+    from sensorium.server.world.wbt import wbt_convert
+    from sensorium.server.world.wbt.convert import EAR_CLIP_WORLD
+
+    xy = spiral(6.0, 128)
+    assert len(xy) == 256 and EAR_CLIP_WORLD == 400_000
+    shapes = []
+    for k in range(20):
+        points = ", ".join(f"{x + 20 * k} {y} 0" for x, y in xy)
+        shapes.append(f"Shape {{ geometry IndexedFaceSet {{ coord Coordinate {{ point [ {points} ] }} "
+                      f"coordIndex [ {' '.join(map(str, range(256)))} -1 ] }} }}")
+    p = tmp_path / "spirals.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { }\nSolid { children [ " + "\n".join(shapes) + " ] }\n")
+    conv = wbt_convert(p)
+    said = [w for w in conv.warnings if "left fanned" in w]
+    assert len(said) == 1 and "14 concave polygon(s)" in said[0] and "(14 IndexedFaceSets, the first here)" in said[0]
+    assert "spirals.wbt:9:" in said[0], said          # the first one fanned: the 7th shape, on line 9
+    fan = [[0, k, k + 1] for k in range(1, 255)]
+    geoms = [s["geometry"] for s in conv.data["solids"][0]["shapes"]]
+    assert [g["faces"] != fan for g in geoms] == [True] * 6 + [False] * 14
+
+
+@settings(FAST)
+@given(st.lists(st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-0.3, 0.3)), min_size=4, max_size=40),
+       SCALE, OFFSET)
+def test_self_crossing_and_non_planar_polygons_get_a_defined_cover_never_a_crash(pts, scale, offset) -> None:
+    """Random corners (a polygon crossing itself, folded out of its plane): n − 2 triangles of its own
+    corners, the same every time, finite; a quad keeps its fan or is cut along one of its diagonals."""
+    n = len(pts)
+    flat = [c * scale + offset for p in pts for c in p]
+    index = list(range(n)) + [-1]
+    corners, fanned = polygon_corners(index, flat, [10 ** 6])
+    assert fanned == 0 and corners.shape == (n - 2, 3) and 0 <= corners.min() and corners.max() < n
+    assert np.array_equal(corners, polygon_corners(index, flat, [10 ** 6])[0])
+    assert (corners[:, 0] != corners[:, 1]).all() and (corners[:, 1] != corners[:, 2]).all()
+    if n == 4:
+        assert corners.tolist() in ([[0, 1, 2], [0, 2, 3]], [[1, 2, 3], [1, 3, 0]], [[2, 3, 0], [2, 0, 1]],
+                                    [[3, 0, 1], [3, 1, 2]])

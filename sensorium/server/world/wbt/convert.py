@@ -104,6 +104,7 @@ class Converter:
         self.max_grid_points = max_grid_points
         self.grid_points = 0               # ElevationGrid points converted so far (each use of a DEF counts)
         self.ear_budget = [EAR_CLIP_WORLD]  # corners² left for cutting concave IndexedFaceSet polygons into ears
+        self.left_fanned: dict[str, int] = {}  # where an IndexedFaceSet kept concave polygons fanned: how many
         self.source = source
         self.search = search               # proto.ProtoSearch: where asset urls resolve (resolve_url)
         self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
@@ -234,6 +235,13 @@ class Converter:
             self.warnings.append(f"{where}: {n} texture{'s' if n > 1 else ''} not loaded (first: {why}); "
                                  "read as Webots reads a texture it cannot load: an Appearance as its material's "
                                  "diffuseColor, a PBRAppearance as its baseColor")
+        if self.left_fanned:
+            where, n = next(iter(self.left_fanned.items())), len(self.left_fanned)
+            self.warnings.append(
+                f"{where[0]}: IndexedFaceSet: {sum(self.left_fanned.values())} concave polygon(s) left fanned from their "
+                f"first corner (over {EAR_CLIP_CORNERS} corners, or past the world's {EAR_CLIP_WORLD:,} corners² for "
+                "cutting them into ears): they may cover space outside their outline"
+                + (f" ({n} IndexedFaceSets, the first here)" if n > 1 else ""))
         if self.skipped:
             listed = ", ".join(f"{k} x{v}" if v > 1 else k for k, v in sorted(self.skipped.items()))
             self.warnings.append(f"{self.source}: skipped nodes that do not matter to these sensors: {listed}")
@@ -916,10 +924,8 @@ class Converter:
             raise f.error("coordIndex", f"{min(index)} is not a vertex index (-1 ends a face)")
         tex, tex_index = fx.tex_coords(node, f, len(index), self.warn)
         corners, fanned = polygon_corners(index, points, self.ear_budget)
-        if fanned:
-            self.warn_once(node, f"IndexedFaceSet: {fanned} concave polygon(s) left fanned from their first corner "
-                                 f"(over {EAR_CLIP_CORNERS} corners, or past the world's {EAR_CLIP_WORLD:,} "
-                                 "corners² for cutting them into ears): they may cover space outside their outline")
+        if fanned:     # said once for the world, at its end (a hostile world has thousands of these nodes)
+            self.left_fanned.setdefault(self.where(node), fanned)
         faces = _pick(index, corners)
         tex_faces = _pick(tex_index, corners) if tex_index is not None else []
         if not faces:
