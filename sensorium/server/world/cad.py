@@ -262,12 +262,21 @@ def concave_polygons(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray
 
 def reflex_corners(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) -> np.ndarray:
     """Per corner of polygons (corner positions ``points``, grouped by ``vcounts``, each starting
-    at ``starts``): whether it turns against its polygon's normal (Newell's)."""
+    at ``starts``): whether it turns against its polygon's normal (Newell's). A corner at the same
+    place as the one before it turns nowhere: the turns are read between distinct corners (a
+    reflex corner written twice in a row is still reflex, at its first copy)."""
     n = len(points)
     poly = np.repeat(np.arange(len(vcounts)), vcounts)
     local = np.arange(n) - np.repeat(starts, vcounts)
     nxt = np.repeat(starts, vcounts) + (local + 1) % np.repeat(vcounts, vcounts)
     prv = np.repeat(starts, vcounts) + (local - 1) % np.repeat(vcounts, vcounts)
+    keep = (points != points[prv]).any(axis=1)
+    if not keep.all():                  # once: what is kept has no corner repeating the one before it
+        counts = np.bincount(poly[keep], minlength=len(vcounts))
+        counts = counts[counts > 0]
+        out = np.zeros(n, dtype=bool)
+        out[keep] = reflex_corners(points[keep], counts, np.cumsum(counts) - counts)
+        return out
     a, b = points, points[nxt]
     newell = np.stack([(a[:, 1] - b[:, 1]) * (a[:, 2] + b[:, 2]), (a[:, 2] - b[:, 2]) * (a[:, 0] + b[:, 0]),
                        (a[:, 0] - b[:, 0]) * (a[:, 1] + b[:, 1])], axis=1)
