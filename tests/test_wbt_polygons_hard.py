@@ -281,3 +281,42 @@ def test_a_reflex_corner_written_twice_still_makes_the_polygon_concave() -> None
           (-0.5, 0.8660254037844387), (0.125, 0.21650635094610965), (0.25, 0.0), (0.25, 0.0)]
     for roll in range(len(xy)):
         check_cover(xy[roll:] + xy[:roll], np.eye(3), 1.0, 0.0, exact=True)
+
+
+@st.composite
+def touching_polygons(draw):
+    """A polygon touching itself at one corner P = (1, 0), written once per visit: two star-shaped
+    lobes either side of P (a figure eight, both turning the same way), or a star-shaped hole inside
+    a square, its corner at P on the square's side (turning the other way)."""
+    def lobe(centre_x, start, r_max):
+        n = draw(st.integers(3, 16))
+        radii = draw(st.lists(st.floats(0.2 * r_max, r_max), min_size=n - 1, max_size=n - 1))
+        return [(1.0, 0.0)] + [(centre_x + r * math.cos(start + 2 * math.pi * k / n), r * math.sin(start + 2 * math.pi * k / n))
+                               for k, r in zip(range(1, n), radii)]
+    if draw(st.booleans()):
+        xy = lobe(0.0, 0.0, 0.95) + lobe(2.0, math.pi, 0.95)
+    else:
+        hole = lobe(0.5, 0.0, 0.45)            # P at 0.5 from its centre, the others within 0.45
+        xy = [(1.0, 0.0), (1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)] + [(1.0, 0.0)] + hole[:0:-1]
+    roll = draw(st.integers(0, len(xy) - 1))
+    xy = xy[roll:] + xy[:roll]
+    return xy[::-1] if draw(st.booleans()) else xy
+
+
+@settings(FAST)
+@given(touching_polygons(), ANGLES, SCALE, OFFSET)
+def test_polygons_touching_themselves_at_a_corner_are_covered_exactly(xy, angles, scale, offset) -> None:
+    if fits(scale, offset):
+        check_cover(xy, frame(*angles), scale, offset)
+
+
+def test_a_figure_eight_is_not_cut_across_its_waist() -> None:
+    """Two lobes touching at P = (1, 0), P written once per visit: an ear from the second lobe's
+    last corner through P to the first lobe's was taken (no corner inside it, the second P being
+    the ear's own corner again) though the outline, leaving the second P, runs into it."""
+    xy = [(1.0, 0.0), (0.15450849718747373, 0.47552825814757677), (-0.40450849718747367, 0.2938926261462366),
+          (-0.4045084971874738, -0.2938926261462365), (0.15450849718747361, -0.4755282581475768), (1.0, 0.0),
+          (2.2499999999999996, -0.4330127018922195), (2.125, 0.2165063509461096)]
+    for roll in range(len(xy)):
+        for way in (1, -1):
+            check_cover((xy[roll:] + xy[:roll])[::way], np.eye(3), 1.0, 0.0, exact=True)

@@ -336,7 +336,7 @@ def ear_clip(points: np.ndarray) -> np.ndarray | None:
                         (cross(c, a, others) >= -eps)
                     for q in (a, b, c):
                         inside &= ((others - q) ** 2).sum(axis=1) > eps
-                    if not inside.any():
+                    if not inside.any() and not _enters(p, keep, ((a, b, c), (b, c, a), (c, a, b)), eps, cross):
                         cut = u
                         break
                 if cut is not None:
@@ -348,6 +348,20 @@ def ear_clip(points: np.ndarray) -> np.ndarray | None:
         t = (cut - 1) % (m - 1)
     out.append((left[0], left[1], left[2]))
     return np.asarray(out, dtype=np.int64)
+
+
+def _enters(p: np.ndarray, keep: np.ndarray, corners, eps: float, cross) -> bool:
+    """Whether the outline, where it passes again through one of an ear's corners (a polygon
+    touching itself there: a figure eight's waist, a hole's corner on the outline), leaves that
+    corner into the ear (``corners``: each ear corner with the next and the previous, counter-
+    clockwise): the ear would cover what lies between the two visits."""
+    m = len(p)
+    for x, y, z in corners:
+        for j in np.flatnonzero(keep & (((p - x) ** 2).sum(axis=1) <= eps)).tolist():
+            for w in (p[j - 1], p[(j + 1) % m]):
+                if cross(x, y, w) > eps and cross(x, w, z) > eps:
+                    return True
+    return False
 
 
 def _first_uv_set(p) -> int:
