@@ -320,3 +320,25 @@ def test_a_figure_eight_is_not_cut_across_its_waist() -> None:
     for roll in range(len(xy)):
         for way in (1, -1):
             check_cover((xy[roll:] + xy[:roll])[::way], np.eye(3), 1.0, 0.0, exact=True)
+
+
+def test_corners_too_large_to_square_are_refused_by_value_without_numpy_warnings(tmp_path) -> None:
+    """A concave face with a corner at 1e308 m: the world limits refuse it in one line; the
+    tessellation before them printed four numpy overflow warnings first (its products overflow).
+    Read before the limits, that polygon is fanned, silently; ear clipping it says nothing either."""
+    import warnings
+
+    from sensorium.server.world.cad import ear_clip
+    from sensorium.server.world.wbt import wbt_convert
+
+    p = tmp_path / "far.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { }\nSolid { children [ Shape { geometry IndexedFaceSet { "
+                 "coord Coordinate { point [ 0 0 0, 3 0 0, 3 1 0, 1e308 1 0, 1 3 0, 0 3 0 ] } "
+                 "coordIndex [ 0 1 2 3 4 5 -1 ] } } ] }\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        faces = wbt_convert(p).data["solids"][0]["shapes"][0]["geometry"]["faces"]
+    assert faces == [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ear_clip(np.array([(0, 0, 0), (3, 0, 0), (3, 1, 0), (1e308, 1, 0), (1, 3, 0), (0, 3, 0)], dtype=np.float64))

@@ -260,6 +260,7 @@ def concave_polygons(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray
     return out & (vcounts > 3)
 
 
+@np.errstate(over="ignore", invalid="ignore")    # corners past 1e154 m: refused later, by value
 def reflex_corners(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) -> np.ndarray:
     """Per corner of polygons (corner positions ``points``, grouped by ``vcounts``, each starting
     at ``starts``): whether it turns against its polygon's normal (Newell's). A corner at the same
@@ -287,6 +288,7 @@ def reflex_corners(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) 
     return along < -1e-9 * size
 
 
+@np.errstate(over="ignore", invalid="ignore")
 def ear_clip(points: np.ndarray) -> np.ndarray | None:
     """Ears of a simple polygon (n, 3) as (n − 2, 3) local corner triples, in the polygon's own
     winding; None when it has none to cut (self-crossing): then it stays fanned. A corner written
