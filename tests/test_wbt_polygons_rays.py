@@ -1,8 +1,8 @@
 """Rays through a concave IndexedFaceSet face's cut diagonals and at its reflex corners (EXACT):
 no gap and no stray hit. Each face (a slit ring as Webots' curriculum arenas draw a wall's top, a
 comb, a star) lies flat at z = h; rays come down onto points of every diagonal the tessellation cut
-(shared edges of two triangles inside the face), nudged sideways by 0 to 1e-6 m, straight and
-slanted, and onto points just inside and just outside each reflex corner. A point inside the
+(shared edges of two triangles inside the face), nudged sideways by 0 to 1e-6 m, straight down,
+slanted and grazing (1.6° and 0.2° from the face), and onto points just inside and just outside each reflex corner. A point inside the
 polygon is hit at the closed-form distance, one outside is not hit (the fan's roof over the
 notches is gone), near the origin and 1e5 m from it."""
 
@@ -104,7 +104,7 @@ def test_rays_through_cut_diagonals_and_at_reflex_corners_neither_leak_nor_hit_o
                     expect.append(inside(tuple(q), xy))
     t = np.asarray(targets) + base
     got = {}
-    for slant in ((0.0, 0.0), (0.3, -0.2)):
+    for slant in ((0.0, 0.0), (0.3, -0.2), (30.0, -20.0), (-300.0, 7.0)):     # down, slanted, grazing (1.6° and 0.2°)
         d = np.array([slant[0], slant[1], -1.0])
         d /= np.linalg.norm(d)
         o = np.column_stack([t, np.full(len(t), H)]) - d * 1.0
