@@ -342,3 +342,35 @@ def test_corners_too_large_to_square_are_refused_by_value_without_numpy_warnings
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         ear_clip(np.array([(0, 0, 0), (3, 0, 0), (3, 1, 0), (1e308, 1, 0), (1, 3, 0), (0, 3, 0)], dtype=np.float64))
+
+
+@settings(settings(FAST, max_examples=25))
+@given(st.lists(st.floats(0.05, 3.0), min_size=2, max_size=8), st.integers(0, 30), st.booleans())
+def test_a_read_worlds_texture_corners_follow_its_cut_triangles(heights, roll, cw) -> None:
+    """Through the .wbt reader: a comb face with a texCoordIndex (the texture points listed after
+    seven unused ones): each triangle's texture corners are its coordinate corners' own, and the
+    faces cover the comb exactly."""
+    import tempfile
+    from pathlib import Path
+
+    from sensorium.server.world.wbt import wbt_convert
+
+    xy = comb(heights)
+    xy = xy[::-1] if cw else xy
+    roll %= len(xy)
+    xy = xy[roll:] + xy[:roll]
+    n = len(xy)
+    with tempfile.TemporaryDirectory() as d:
+        p = Path(d) / "comb.wbt"
+        p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { }\nSolid { children [ Shape { geometry IndexedFaceSet {\n"
+                     f"  coord Coordinate {{ point [ {', '.join(f'{x!r} {y!r} 0' for x, y in xy)} ] }}\n"
+                     f"  texCoord TextureCoordinate {{ point [ {', '.join(['9 9'] * 7 + [f'{x / 20!r} {y / 9!r}' for x, y in xy])} ] }}\n"
+                     f"  coordIndex [ {' '.join(map(str, range(n)))} -1 ]\n"
+                     f"  texCoordIndex [ {' '.join(str(k + 7) for k in range(n))} -1 ] }} }} ] }}\n")
+        geom = wbt_convert(p).data["solids"][0]["shapes"][0]["geometry"]
+    faces = geom["faces"]
+    assert geom["tex_coord_faces"] == [[c + 7 for c in f] for f in faces]
+    poly = [(Fraction(x), Fraction(y)) for x, y in xy]
+    total = sum(twice_area(poly[0], poly[k], poly[k + 1]) for k in range(1, n - 1))
+    tris = [twice_area(poly[a], poly[b], poly[c]) for a, b, c in faces]
+    assert all(t * total > 0 for t in tris) and sum(tris) == total

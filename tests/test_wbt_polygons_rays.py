@@ -2,9 +2,9 @@
 no gap and no stray hit. Each face (a slit ring as Webots' curriculum arenas draw a wall's top, a
 comb, a star) lies flat at z = h; rays come down onto points of every diagonal the tessellation cut
 (shared edges of two triangles inside the face), nudged sideways by 0 to 1e-6 m, straight down,
-slanted and grazing (1.6° and 0.2° from the face), and onto points just inside and just outside each reflex corner. A point inside the
-polygon is hit at the closed-form distance, one outside is not hit (the fan's roof over the
-notches is gone), near the origin and 1e5 m from it."""
+slanted and grazing (1.6° and 0.2° from the face), and onto points just inside and just outside
+each reflex corner. A point inside the polygon is hit at the closed-form distance, one outside is
+not hit (the fan's roof over the notches is gone), near the origin and 1e5 m from it."""
 
 from __future__ import annotations
 
