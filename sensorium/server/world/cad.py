@@ -311,6 +311,8 @@ def ear_clip(points: np.ndarray) -> np.ndarray | None:
     left = np.arange(n)
     out = []
     t = 0                                      # where the search for an ear starts
+    # the corners another corner is written at again (a polygon touching itself, a slit's ends)
+    twin = (((xy[:, None] - xy[None]) ** 2).sum(axis=2) <= eps).sum(axis=1) > 1 if n <= 4096 else np.ones(n, dtype=bool)
 
     def cross(o, p, q):
         return (p[..., 0] - o[..., 0]) * (q[..., 1] - o[..., 1]) - (p[..., 1] - o[..., 1]) * (q[..., 0] - o[..., 0])
@@ -336,9 +338,11 @@ def ear_clip(points: np.ndarray) -> np.ndarray | None:
                     # corner may leave the polygon), unless it is one of the ear's own corners again
                     inside = (cross(a, b, others) >= -eps) & (cross(b, c, others) >= -eps) & \
                         (cross(c, a, others) >= -eps)
-                    for q in (a, b, c):
-                        inside &= ((others - q) ** 2).sum(axis=1) > eps
-                    if not inside.any() and not _enters(p, keep, ((a, b, c), (b, c, a), (c, a, b)), eps, cross):
+                    twins = twin[left[u - 1]] or twin[left[u]] or twin[left[(u + 1) % m]]
+                    if twins:
+                        for q in (a, b, c):
+                            inside &= ((others - q) ** 2).sum(axis=1) > eps
+                    if not inside.any() and not (twins and _enters(p, keep, ((a, b, c), (b, c, a), (c, a, b)), eps, cross)):
                         cut = u
                         break
                 if cut is not None:
