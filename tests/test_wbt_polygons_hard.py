@@ -42,7 +42,7 @@ def comb(heights: list[float]) -> list[tuple[float, float]]:
 
 
 def spiral(turns: float, n: int) -> list[tuple[float, float]]:
-    """A spiral band: out along r = 1 + θ/π, back along r = 1 + θ/π − 1 (a band 1 wide, its
+    """A spiral band: out along r = 1.5 + θ/π, back along r = 0.5 + θ/π (a band 1 wide, its
     turns 2 apart): simple, with long runs of reflex corners."""
     theta = [turns * 2 * math.pi * k / (n - 1) for k in range(n)]
     outer = [((1.5 + t / math.pi) * math.cos(t), (1.5 + t / math.pi) * math.sin(t)) for t in theta]
@@ -145,7 +145,8 @@ OFFSET = st.sampled_from([0.0, -3.25, 1e5, -1e5, 1e7])
 
 
 def fits(scale: float, offset: float) -> bool:
-    """A rotated polygon far out keeps its shape to ~1e-9 of its size (float64 rounds the offset)."""
+    """A rotated polygon far out keeps its shape to ~1e-5 of its size (float64 rounds its corners
+    to ~1e-16 of the offset): simple polygons stay simple."""
     return abs(offset) * 1e-16 <= scale * 1e-5
 
 
