@@ -375,3 +375,24 @@ def test_a_read_worlds_texture_corners_follow_its_cut_triangles(heights, roll, c
     total = sum(twice_area(poly[0], poly[k], poly[k + 1]) for k in range(1, n - 1))
     tris = [twice_area(poly[a], poly[b], poly[c]) for a, b, c in faces]
     assert all(t * total > 0 for t in tris) and sum(tris) == total
+
+
+def test_a_def_face_used_many_times_is_cut_the_same_at_every_use(tmp_path) -> None:
+    """A DEF IndexedFaceSet (a 200-corner concave star) USEd twenty times: every use gets the same
+    triangles, and the world's ear-clipping budget is spent on it once (each use was cut again and
+    charged again, so past the tenth use the same face was fanned over its notches)."""
+    from sensorium.server.world.wbt import wbt_convert
+
+    n = 200
+    xy = star(n, [1.0 if k % 2 else 0.6 for k in range(n)], [0.0] * n)
+    face = ("DEF STAR IndexedFaceSet { coord Coordinate { point [ " + ", ".join(f"{x!r} {y!r} 0" for x, y in xy)
+            + f" ] }} coordIndex [ {' '.join(map(str, range(n)))} -1 ] }}")
+    solids = [f'Solid {{ name "s0" children [ Shape {{ geometry {face} }} ] }}'] + \
+        [f'Solid {{ name "s{k}" translation {3 * k} 0 0 children [ Shape {{ geometry USE STAR }} ] }}' for k in range(1, 20)]
+    p = tmp_path / "stars.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { }\n" + "\n".join(solids) + "\n")
+    conv = wbt_convert(p)
+    faces = [s["shapes"][0]["geometry"]["faces"] for s in conv.data["solids"]]
+    assert len(faces) == 20 and all(f == faces[0] for f in faces[1:])
+    assert faces[0] != [[0, k, k + 1] for k in range(1, n - 1)]
+    assert not [w for w in conv.warnings if "left fanned" in w]

@@ -105,6 +105,7 @@ class Converter:
         self.grid_points = 0               # ElevationGrid points converted so far (each use of a DEF counts)
         self.ear_budget = [EAR_CLIP_WORLD]  # corners² left for cutting concave IndexedFaceSet polygons into ears
         self.left_fanned: dict[str, int] = {}  # where an IndexedFaceSet kept concave polygons fanned: how many
+        self.ear_cut: dict[int, tuple] = {}    # per IndexedFaceSet node cut into ears: (coordIndex, points, corners, fanned)
         self.source = source
         self.search = search               # proto.ProtoSearch: where asset urls resolve (resolve_url)
         self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
@@ -923,7 +924,14 @@ class Converter:
         if index and min(index) < -1:
             raise f.error("coordIndex", f"{min(index)} is not a vertex index (-1 ends a face)")
         tex, tex_index = fx.tex_coords(node, f, len(index), self.warn)
-        corners, fanned = polygon_corners(index, points, self.ear_budget)
+        cut = self.ear_cut.get(id(node))
+        if cut is not None and cut[0] == index and (cut[1] is points or cut[1] == points):
+            corners, fanned = cut[2], cut[3]        # a DEF face USEd again: the same triangles, charged once
+        else:
+            spent = self.ear_budget[0]
+            corners, fanned = polygon_corners(index, points, self.ear_budget)
+            if fanned or self.ear_budget[0] != spent:   # what the budget decided is kept for the next use
+                self.ear_cut[id(node)] = (index, points, corners, fanned)
         if fanned:     # said once for the world, at its end (a hostile world has thousands of these nodes)
             self.left_fanned.setdefault(self.where(node), fanned)
         faces = _pick(index, corners)
