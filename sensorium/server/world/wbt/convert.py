@@ -1872,7 +1872,7 @@ def _clean_part(p: dict) -> dict:
 
 
 EAR_CLIP_WORLD = 400_000     # corners² a world's concave IndexedFaceSet polygons of 5 or more corners may take
-                             # (ear clipping is quadratic: about a second's work at most; quads are cut at once)
+                             # (ear clipping is quadratic: six 256-corner polygons, ~0.15 s; quads are cut at once)
 
 
 def fan_corners(index: list[int]) -> np.ndarray:
