@@ -260,14 +260,24 @@ def concave_polygons(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray
     return out & (vcounts > 3)
 
 
+@np.errstate(over="ignore", invalid="ignore")    # corners past 1e154 m: refused later, by value
 def reflex_corners(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) -> np.ndarray:
     """Per corner of polygons (corner positions ``points``, grouped by ``vcounts``, each starting
-    at ``starts``): whether it turns against its polygon's normal (Newell's)."""
+    at ``starts``): whether it turns against its polygon's normal (Newell's). A corner at the same
+    place as the one before it turns nowhere: the turns are read between distinct corners (a
+    reflex corner written twice in a row is still reflex, at its first copy)."""
     n = len(points)
     poly = np.repeat(np.arange(len(vcounts)), vcounts)
     local = np.arange(n) - np.repeat(starts, vcounts)
     nxt = np.repeat(starts, vcounts) + (local + 1) % np.repeat(vcounts, vcounts)
     prv = np.repeat(starts, vcounts) + (local - 1) % np.repeat(vcounts, vcounts)
+    keep = (points != points[prv]).any(axis=1)
+    if not keep.all():                  # once: what is kept has no corner repeating the one before it
+        counts = np.bincount(poly[keep], minlength=len(vcounts))
+        counts = counts[counts > 0]
+        out = np.zeros(n, dtype=bool)
+        out[keep] = reflex_corners(points[keep], counts, np.cumsum(counts) - counts)
+        return out
     a, b = points, points[nxt]
     newell = np.stack([(a[:, 1] - b[:, 1]) * (a[:, 2] + b[:, 2]), (a[:, 2] - b[:, 2]) * (a[:, 0] + b[:, 0]),
                        (a[:, 0] - b[:, 0]) * (a[:, 1] + b[:, 1])], axis=1)
@@ -278,9 +288,13 @@ def reflex_corners(points: np.ndarray, vcounts: np.ndarray, starts: np.ndarray) 
     return along < -1e-9 * size
 
 
+@np.errstate(over="ignore", invalid="ignore")
 def ear_clip(points: np.ndarray) -> np.ndarray | None:
     """Ears of a simple polygon (n, 3) as (n − 2, 3) local corner triples, in the polygon's own
-    winding; None when it has none to cut (self-crossing): then it stays fanned."""
+    winding; None when it has none to cut (self-crossing): then it stays fanned. A corner written
+    twice in a row, or the tip of a spike out and straight back (its neighbours at one place), is
+    cut first as a zero-area triangle; the search for the next ear starts where the last was cut,
+    so a polygon whose ears all lie at one end (a spiral) takes quadratic, not cubic, work."""
     n = len(points)
     normal = np.zeros(3)
     for i in range(n):
@@ -294,39 +308,66 @@ def ear_clip(points: np.ndarray) -> np.ndarray | None:
         xy = xy[:, ::-1]
     scale = float(np.ptp(xy, axis=0).max()) or 1.0
     eps = 1e-12 * scale * scale
-    left = list(range(n))
+    left = np.arange(n)
     out = []
+    t = 0                                      # where the search for an ear starts
+    # the corners another corner is written at again (a polygon touching itself, a slit's ends)
+    twin = (((xy[:, None] - xy[None]) ** 2).sum(axis=2) <= eps).sum(axis=1) > 1 if n <= 4096 else np.ones(n, dtype=bool)
 
     def cross(o, p, q):
         return (p[..., 0] - o[..., 0]) * (q[..., 1] - o[..., 1]) - (p[..., 1] - o[..., 1]) * (q[..., 0] - o[..., 0])
 
     while len(left) > 3:
         m = len(left)
+        p = xy[left]
+        prv, nxt = np.roll(p, 1, axis=0), np.roll(p, -1, axis=0)
+        same = (p == nxt).all(axis=1) | (prv == nxt).all(axis=1) | (p == prv).all(axis=1)
         cut = None
-        for strict in (True, False):
-            for t in range(m):
-                a, b, c = left[t - 1], left[t], left[(t + 1) % m]
-                turn = cross(xy[a], xy[b], xy[c])
-                if turn <= eps if strict else turn < -eps:
-                    continue
-                others = xy[[left[u] for u in range(m) if u not in ((t - 1) % m, t, (t + 1) % m)]]
-                # another corner inside the ear or on its edges blocks it (a diagonal through a corner
-                # may leave the polygon), unless it is one of the ear's own corners again
-                inside = (cross(xy[a], xy[b], others) >= -eps) & (cross(xy[b], xy[c], others) >= -eps) & \
-                    (cross(xy[c], xy[a], others) >= -eps)
-                for q in (a, b, c):
-                    inside &= ((others - xy[q]) ** 2).sum(axis=1) > eps
-                if not inside.any():
-                    cut = t
+        if same.any():                         # zero area, and what is left is the same outline
+            cut = int(np.flatnonzero(same)[0])
+        else:
+            turn = cross(prv, p, nxt)
+            order = (np.arange(m) + t) % m
+            for ok in (turn > eps, turn >= -eps):
+                for u in order[ok[order]].tolist():
+                    a, b, c = p[u - 1], p[u], p[(u + 1) % m]
+                    keep = np.ones(m, dtype=bool)
+                    keep[[u - 1, u, (u + 1) % m]] = False
+                    others = p[keep]
+                    # another corner inside the ear or on its edges blocks it (a diagonal through a
+                    # corner may leave the polygon), unless it is one of the ear's own corners again
+                    inside = (cross(a, b, others) >= -eps) & (cross(b, c, others) >= -eps) & \
+                        (cross(c, a, others) >= -eps)
+                    twins = twin[left[u - 1]] or twin[left[u]] or twin[left[(u + 1) % m]]
+                    if twins:
+                        for q in (a, b, c):
+                            inside &= ((others - q) ** 2).sum(axis=1) > eps
+                    if not inside.any() and not (twins and _enters(p, keep, ((a, b, c), (b, c, a), (c, a, b)), eps, cross)):
+                        cut = u
+                        break
+                if cut is not None:
                     break
-            if cut is not None:
-                break
         if cut is None:
             return None
         out.append((left[cut - 1], left[cut], left[(cut + 1) % m]))
-        del left[cut]
+        left = np.delete(left, cut)
+        t = (cut - 1) % (m - 1)
     out.append((left[0], left[1], left[2]))
     return np.asarray(out, dtype=np.int64)
+
+
+def _enters(p: np.ndarray, keep: np.ndarray, corners, eps: float, cross) -> bool:
+    """Whether the outline, where it passes again through one of an ear's corners (a polygon
+    touching itself there: a figure eight's waist, a hole's corner on the outline), leaves that
+    corner into the ear (``corners``: each ear corner with the next and the previous, counter-
+    clockwise): the ear would cover what lies between the two visits."""
+    m = len(p)
+    for x, y, z in corners:
+        for j in np.flatnonzero(keep & (((p - x) ** 2).sum(axis=1) <= eps)).tolist():
+            for w in (p[j - 1], p[(j + 1) % m]):
+                if cross(x, y, w) > eps and cross(x, w, z) > eps:
+                    return True
+    return False
 
 
 def _first_uv_set(p) -> int:
