@@ -436,8 +436,10 @@ class Launcher:
     the server's loop thread and only queue work."""
 
     def __init__(self, specs: list[ControllerSpec], url: str, *, out: IO[str] | None = None,
-                 err: IO[str] | None = None, grace_s: float = GRACE_S, serverkey: str | None = None):
+                 err: IO[str] | None = None, grace_s: float = GRACE_S, serverkey: str | None = None,
+                 attach_timeout_s: float | None = None):
         self.specs = {s.robot: s for s in specs}
+        self.attach_timeout_s = attach_timeout_s   # None: wait for a started controller to attach, as Webots
         self.url = url
         self.serverkey = serverkey        # the server's CURVE public key (Z85), None for a plain one
         self.out = out or sys.stdout
@@ -557,6 +559,32 @@ class Launcher:
             self.running[robot] = run
             self.starts[robot] += 1
         threading.Thread(target=self._watch, args=(run,), daemon=True, name=f"sensorium-wait-{robot}").start()
+        if self.attach_timeout_s is not None:
+            threading.Thread(target=self._attach_watch, args=(run, self.attach_timeout_s), daemon=True,
+                             name=f"sensorium-attach-{robot}").start()
+
+    def _attach_watch(self, run: _Running, timeout_s: float) -> None:
+        """``--attach-timeout``: a controller still running and not attached ``timeout_s`` seconds
+        after it started is ended; its robot runs without a controller (said, and in the exit status)."""
+        try:
+            run.proc.wait(timeout_s)
+            return                                 # it ended by itself (said by _watch)
+        except subprocess.TimeoutExpired:
+            pass
+        robot = run.spec.robot
+        with self._lock:
+            if run.ending or self.running.get(robot) is not run or robot not in self._starting:
+                return                             # attached, or ended by us meanwhile
+            run.ending = True
+        self.log(f"'{run.spec.name}' controller of robot '{robot}' did not attach within {timeout_s:g} s "
+                 "(--attach-timeout): ended; the robot runs without a controller")
+        self.failed[robot] = run.spec.name
+        self._starting.discard(robot)
+        self._wake_server()
+        try:
+            os.killpg(run.proc.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
 
     def replan(self, specs: list[ControllerSpec]) -> None:
         """The controllers of a reloaded world (its file may name others now)."""
@@ -693,6 +721,7 @@ class RunOptions:
     webots_home: Path | None = None
     grace_s: float = GRACE_S
     require_controllers: bool = False          # a controller that cannot be started: exit 1 before the world runs
+    attach_timeout_s: float | None = None      # a started controller not attached after this: ended (None: waited for)
 
     def check(self, world: Path) -> None:
         """Raise ValueError naming the first bad option (one line)."""
@@ -700,6 +729,8 @@ class RunOptions:
             raise ValueError(f"no world file {world}")
         if not 0 <= self.grace_s < float("inf"):
             raise ValueError(f"--grace must be a finite number >= 0, got {self.grace_s}")
+        if self.attach_timeout_s is not None and not 0 < self.attach_timeout_s < float("inf"):
+            raise ValueError(f"--attach-timeout must be a finite number of seconds > 0, got {self.attach_timeout_s}")
         for d in self.controllers_dirs:
             if not Path(d).is_dir():
                 raise ValueError(f"--controllers-dir {d}: no such folder")
@@ -800,7 +831,8 @@ class ProjectRun:
             if p not in self.projects:
                 self._say(f"sensorium run: extra project path {p} is not a folder: not looked in")
         launcher = Launcher(list(world_plan.specs), server.transport.rpc_endpoint, out=self.out, err=self.err,
-                            grace_s=self.options.grace_s, serverkey=self._serverkey())
+                            grace_s=self.options.grace_s, serverkey=self._serverkey(),
+                            attach_timeout_s=self.options.attach_timeout_s)
         self._server = server
         old_handlers = {}
         if signals and threading.current_thread() is threading.main_thread():    # Python's signals: main thread only

@@ -198,3 +198,27 @@ def test_a_controller_that_exits_leaving_a_child_is_said_at_once(tmp_path: Path)
         wait_until(lambda: not alive(pid), what="the child to end with the run")
     finally:
         proc.stop()
+
+
+def test_a_controller_that_never_attaches_is_waited_for_or_ended_at_attach_timeout(tmp_path: Path) -> None:
+    """As Webots, the world waits for a started controller to attach (no bound by default: a
+    controller may import for long); --attach-timeout S ends one that has not attached after S
+    seconds: one line, its robot runs without a controller, the world goes on, run exits 1."""
+    world = project(tmp_path, 'Robot { name "stuck" controller "hang" }\nRobot { name "beta" controller "b" }',
+                    {"hang": "#!/bin/sh\necho $$ > pid\nexec sleep 600\n", "b.py": STEPPER})
+    proc = run(world, 48708, "--until", "320", "--attach-timeout", "1.5")
+    assert proc.wait() == 1, proc.stderr()
+    err = proc.stderr().splitlines()
+    assert ("sensorium run: 'hang' controller of robot 'stuck' did not attach within 1.5 s (--attach-timeout): "
+            "ended; the robot runs without a controller") in err
+    assert err[-1] == ("sensorium run: 1 robot ran without the controller the world names: 'stuck' ('hang') (exit "
+                       "status 1; --require-controllers refuses to start instead)")
+    assert "[beta] beta stepped 20" in proc.stdout().splitlines()
+    assert not alive(int((tmp_path / "controllers" / "hang" / "pid").read_text()))
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("inf"), float("nan")])
+def test_a_bad_attach_timeout_is_one_line(tmp_path: Path, bad: float) -> None:
+    (tmp_path / "w.yaml").write_text("")
+    with pytest.raises(ValueError, match=r"^--attach-timeout must be a finite number of seconds > 0, got "):
+        launch.RunOptions(attach_timeout_s=bad).check(tmp_path / "w.yaml")
