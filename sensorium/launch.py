@@ -83,11 +83,12 @@ def controller_dirs(world: Path, extra: list[Path], projects: Sequence[Path] = (
             *(Path(p).resolve() / "controllers" for p in projects)]
 
 
-def extra_project_paths(value: str | None) -> list[Path]:
+def extra_project_paths(value: str | None, limit: int | None = EXTRA_MAX) -> list[Path]:
     """Webots' extra project paths from ``value`` (``$WEBOTS_EXTRA_PROJECT_PATH``: folders separated
-    like ``PATH``), in their order, each once, at most :data:`EXTRA_MAX`."""
-    paths = [Path(p).expanduser().absolute() for p in (value or "").split(os.pathsep) if p]
-    return list(dict.fromkeys(paths))[:EXTRA_MAX]
+    like ``PATH``, so a folder with ``:`` in its name cannot be one, as in Webots; empty entries are
+    none), in their order, each once, at most ``limit`` (None: all)."""
+    paths = list(dict.fromkeys(Path(p).expanduser().absolute() for p in (value or "").split(os.pathsep) if p))
+    return paths if limit is None else paths[:limit]
 
 
 class WebotsProjects:

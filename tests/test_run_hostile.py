@@ -33,7 +33,7 @@ print(robot.getName(), "stepped", steps)
 
 
 def project(tmp_path: Path, robots: str, controllers: dict[str, str]) -> Path:
-    (tmp_path / "worlds").mkdir()
+    (tmp_path / "worlds").mkdir(parents=True)
     world = tmp_path / "worlds" / "w.wbt"
     world.write_text(WORLD.replace("{robots}", robots))
     for name, text in controllers.items():     # NAME.py, NAME (an executable) or FOLDER/FILE
@@ -222,3 +222,57 @@ def test_a_bad_attach_timeout_is_one_line(tmp_path: Path, bad: float) -> None:
     (tmp_path / "w.yaml").write_text("")
     with pytest.raises(ValueError, match=r"^--attach-timeout must be a finite number of seconds > 0, got "):
         launch.RunOptions(attach_timeout_s=bad).check(tmp_path / "w.yaml")
+
+
+# ---------------------------------------------------------------------- extra project paths (no process)
+
+def test_extra_project_paths_split_like_path_each_once_at_most_64(tmp_path: Path) -> None:
+    value = ":".join(["", "a", "a", "b::c", "", *(f"p{i}" for i in range(100)), ""])
+    got = launch.extra_project_paths(value)
+    cwd = Path.cwd()
+    assert got[:3] == [cwd / "a", cwd / "b", cwd / "c"] and len(got) == launch.EXTRA_MAX
+    assert len(launch.extra_project_paths(value, None)) == 103
+    assert launch.extra_project_paths("") == launch.extra_project_paths(":::") == []
+
+
+def test_more_than_64_extra_project_paths_is_one_line(monkeypatch: pytest.MonkeyPatch,
+                                                      capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    from argparse import Namespace
+
+    from sensorium.cli import _export_proto_args
+    monkeypatch.setenv("WEBOTS_EXTRA_PROJECT_PATH", ":".join(str(tmp_path / f"p{i}") for i in range(70)))
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    _export_proto_args(Namespace(extra_project_path=[str(tmp_path / "first")]))
+    assert capsys.readouterr().err == (
+        f"sensorium: 71 extra project paths (--extra-project-path, $WEBOTS_EXTRA_PROJECT_PATH): the first 64 are "
+        f"read, not {tmp_path / 'p63'} and the 6 after it\n")
+    assert os.environ["WEBOTS_EXTRA_PROJECT_PATH"].split(":")[:2] == [str(tmp_path / "first"), str(tmp_path / "p0")]
+
+
+def test_extra_projects_that_are_no_folder_or_a_symlink_loop_are_passed_over(tmp_path: Path) -> None:
+    world = project(tmp_path / "proj", 'Robot { name "r" controller "c" }', {})
+    (tmp_path / "file").write_text("")
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    (tmp_path / "x" / "controllers" / "c").mkdir(parents=True)
+    (tmp_path / "x" / "controllers" / "c" / "c.py").write_text("")
+    extra = (tmp_path / "file", tmp_path / "loop", tmp_path / "missing", tmp_path / "x")
+    runner = launch.ProjectRun(world, launch.RunOptions(extra_projects=extra))
+    assert runner.projects == [tmp_path / "x"]
+    spec = find_controller("r", "c", [], runner.dirs)
+    assert spec.folder == tmp_path / "x" / "controllers" / "c"
+
+
+def test_the_proto_index_of_a_huge_tree_of_folders_is_bounded(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Folders count in the bound as files do: a tree of empty folders (or a deep one) is not
+    walked to its end (before, only files counted)."""
+    from sensorium.server.world.proto import resolve
+    monkeypatch.setattr(resolve, "_INDEX_ENTRIES", 20)
+    deep = tmp_path / "protos"
+    for i in range(40):
+        deep = deep / f"d{i:02}"
+    deep.mkdir(parents=True)
+    (deep / "Far.proto").write_text("")
+    (tmp_path / "protos" / "Near.proto").write_text("")
+    (tmp_path / "protos" / "loop").symlink_to(tmp_path / "protos")
+    index = resolve.proto_index(tmp_path / "protos")
+    assert "Near.proto" in index and "Far.proto" not in index
