@@ -51,6 +51,8 @@ LINE_MAX = 1 << 16       # bytes of a controller's line printed at once
 # seconds a controller's output is read on after its process ended: what it wrote is in the pipe by then; a
 # process it started that holds the pipe and is out of its process group (a daemon) is not waited for
 DRAIN_S = 2.0
+# seconds after which a started controller that has not attached is said to be waited for (without --attach-timeout)
+ATTACH_NOTE_S = 10.0
 C_LIBRARY = Path(__file__).resolve().parent / "client" / "c" / "build"
 SPECIAL = ("<extern>", "<none>", "<generic>")
 # the kinds Webots runs that Sensorium does not (file in the controller's folder -> what it is)
@@ -537,13 +539,14 @@ class Launcher:
             if now is not None and now.proc.poll() is None:      # a restart and a reload at once: one process
                 return
         self._starting.add(robot)
+        argv = self.command(spec)
         try:
-            proc = subprocess.Popen(self.command(spec), cwd=spec.folder, env=self.environment(spec),
+            proc = subprocess.Popen(argv, cwd=spec.folder, env=self.environment(spec),
                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                     start_new_session=True)    # its own group: ended by us, with its children
         except (OSError, ValueError) as exc:     # ValueError: a NUL byte in an argument or the environment
             why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {why}: the robot "
+            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {why} ({argv[0]!r}): the robot "
                      "runs without a controller")
             self.failed[robot] = spec.name
             self._starting.discard(robot)
@@ -560,15 +563,16 @@ class Launcher:
             self.running[robot] = run
             self.starts[robot] += 1
         threading.Thread(target=self._watch, args=(run,), daemon=True, name=f"sensorium-wait-{robot}").start()
-        if self.attach_timeout_s is not None:
-            threading.Thread(target=self._attach_watch, args=(run, self.attach_timeout_s), daemon=True,
-                             name=f"sensorium-attach-{robot}").start()
+        threading.Thread(target=self._attach_watch, args=(run, self.attach_timeout_s), daemon=True,
+                         name=f"sensorium-attach-{robot}").start()
 
-    def _attach_watch(self, run: _Running, timeout_s: float) -> None:
+    def _attach_watch(self, run: _Running, timeout_s: float | None) -> None:
         """``--attach-timeout``: a controller still running and not attached ``timeout_s`` seconds
-        after it started is ended; its robot runs without a controller (said, and in the exit status)."""
+        after it started is ended; its robot runs without a controller (said, and in the exit status).
+        Without it (None, as Webots waits), one line after :data:`ATTACH_NOTE_S` says what the world
+        waits for."""
         try:
-            run.proc.wait(timeout_s)
+            run.proc.wait(ATTACH_NOTE_S if timeout_s is None else timeout_s)
             return                                 # it ended by itself (said by _watch)
         except subprocess.TimeoutExpired:
             pass
@@ -576,6 +580,10 @@ class Launcher:
         with self._lock:
             if run.ending or self.running.get(robot) is not run or robot not in self._starting:
                 return                             # attached, or ended by us meanwhile
+            if timeout_s is None:
+                self.log(f"the world waits for the '{run.spec.name}' controller of robot '{robot}', started "
+                         f"{ATTACH_NOTE_S:g} s ago, to attach (as Webots waits; --attach-timeout S ends it instead)")
+                return
             run.ending = True
         self.log(f"'{run.spec.name}' controller of robot '{robot}' did not attach within {timeout_s:g} s "
                  "(--attach-timeout): ended; the robot runs without a controller")

@@ -92,8 +92,8 @@ def test_a_nul_byte_in_controller_args_is_one_line_not_a_traceback(tmp_path: Pat
     finally:
         launcher.close()
     assert launcher.failed == {"r": "c"} and not launcher.running
-    assert err.getvalue() == ("sensorium run: 'c' controller of robot 'r' failed to start: embedded null byte: the "
-                              "robot runs without a controller\n")
+    assert err.getvalue() == ("sensorium run: 'c' controller of robot 'r' failed to start: embedded null byte "
+                              f"({str(folder / 'c')!r}): the robot runs without a controller\n")
 
 
 def pump(data: bytes, sink: io.TextIOBase) -> None:
@@ -276,3 +276,49 @@ def test_the_proto_index_of_a_huge_tree_of_folders_is_bounded(tmp_path: Path, mo
     (tmp_path / "protos" / "loop").symlink_to(tmp_path / "protos")
     index = resolve.proto_index(tmp_path / "protos")
     assert "Near.proto" in index and "Far.proto" not in index
+
+
+def test_without_attach_timeout_the_world_waits_and_says_so(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """In process (the library's run; the controller is a subprocess): a controller that never
+    attaches is waited for, as Webots waits, with one line after ATTACH_NOTE_S; stop() ends it."""
+    import threading
+
+    from sensorium.server.daemon.serve import ServeOptions
+    monkeypatch.setattr(launch, "ATTACH_NOTE_S", 0.5)
+    world = project(tmp_path, 'Robot { name "stuck" controller "hang" }',
+                    {"hang": "#!/bin/sh\necho $$ > pid\nexec sleep 600\n"})
+    out, err = io.StringIO(), io.StringIO()
+    options = launch.RunOptions(serve=ServeOptions(rpc="tcp://127.0.0.1:48710", pub="tcp://127.0.0.1:48711"))
+    project_run = launch.ProjectRun(world, options, out=out, err=err)
+    status: list[int] = []
+    thread = threading.Thread(target=lambda: status.append(project_run.run(signals=False)))
+    thread.start()
+    note = ("sensorium run: the world waits for the 'hang' controller of robot 'stuck', started 0.5 s ago, to attach "
+            "(as Webots waits; --attach-timeout S ends it instead)")
+    try:
+        wait_until(lambda: note in err.getvalue(), what="the waiting line")
+    finally:
+        project_run.stop()
+        thread.join(120)
+    assert not thread.is_alive() and status == [0], err.getvalue()
+    assert "sensorium: stopped at 0 ms after 0 steps" in err.getvalue().splitlines()
+    assert not alive(int((tmp_path / "controllers" / "hang" / "pid").read_text()))
+
+
+def test_a_python_command_with_spaces_and_quotes_is_one_program(tmp_path: Path) -> None:
+    """[python] COMMAND names one program, as Webots starts it (no shell): a quoted path with a space
+    runs; "python3 -u" is no program: one line naming it, the robot runs without a controller."""
+    spaced = tmp_path / "my python" / "py"
+    spaced.parent.mkdir()
+    spaced.write_text(f'#!/bin/sh\necho "wrapped $1" >&2\nexec "{sys.executable}" "$@"\n')
+    spaced.chmod(0o755)
+    world = project(tmp_path / "p", 'Robot { name "good" controller "g" }\nRobot { name "bad" controller "b" }',
+                    {"g.py": STEPPER, "b.py": STEPPER,
+                     "g/runtime.ini": f'[python]\nCOMMAND = "{spaced}" ; a comment\nOPTIONS = -B\n',
+                     "b/runtime.ini": '[python]\nCOMMAND = "python3 -u"\n'})
+    proc = run(world, 48712, "--until", "160")
+    assert proc.wait() == 1, proc.stderr()
+    err = proc.stderr().splitlines()
+    assert "[good] wrapped -B" in err and "[good] good stepped 10" in proc.stdout().splitlines()
+    assert ("sensorium run: 'b' controller of robot 'bad' failed to start: No such file or directory ('python3 -u'): "
+            "the robot runs without a controller") in err
