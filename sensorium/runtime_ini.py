@@ -31,6 +31,7 @@ MAX_BYTES = 1 << 20          # a runtime.ini larger than this is refused (one li
 # Linux's default limit for a program's arguments and environment together (no controller could start with more),
 # so a file of references to references (A = $(A)$(A), again and again) cannot fill the memory
 MAX_SET = 1 << 22
+NOTES_MAX = 8                # unknown [python] keys named, at most (then one line counts the others)
 PATH_SECTIONS = ("environment variables with paths", "environment variables with relative paths")
 _REFERENCE = re.compile(r"\$\(([^)]*)\)")
 # what Qt's trimmed() takes off a line, a key and a value: Python's whitespace less \x1c-\x1f (Qt keeps those)
@@ -59,15 +60,19 @@ class RuntimeIni:
         return found
 
     def notes(self) -> list[str]:
-        """Lines Webots would say about this file (unknown ``python`` keys, the deprecated section)."""
-        out = []
-        for section, key, _ in self.entries:
-            if section == "python" and key not in ("COMMAND", "OPTIONS"):
-                out.append(f"unknown key {key} in its [python] section (COMMAND and OPTIONS are read)")
-            if section == "environment variables with relative paths":
-                out.append("[environment variables with relative paths] is deprecated: use [environment variables "
-                           "with paths]")
-        return list(dict.fromkeys(out))
+        """Lines Webots would say about this file (unknown ``python`` keys, the deprecated section):
+        at most :data:`NOTES_MAX` unknown keys by name, then one line counting the others."""
+        unknown = list(dict.fromkeys(key for section, key, _ in self.entries
+                                     if section == "python" and key not in ("COMMAND", "OPTIONS")))
+        out = [f"unknown key {key if key.isprintable() and len(key) <= 80 else repr(key[:80])} in its [python] "
+               "section (COMMAND and OPTIONS are read)"
+               for key in unknown[:NOTES_MAX]]
+        if len(unknown) > NOTES_MAX:
+            out.append(f"{len(unknown) - NOTES_MAX} more unknown keys in its [python] section")
+        if any(section == "environment variables with relative paths" for section, _, _ in self.entries):
+            out.append("[environment variables with relative paths] is deprecated: use [environment variables "
+                       "with paths]")
+        return out
 
 
 def parse(text: str, where: str = FILE) -> RuntimeIni:
@@ -165,15 +170,17 @@ def environment(ini: RuntimeIni, env: Mapping[str, str], platform: str = sys.pla
     characters."""
     out = dict(env)
     applied = ("environment variables", *PATH_SECTIONS, *_sections(platform))
-    sizes: dict[str, int] = {}        # the values the file has set, as they are now
+    sizes: dict[str, int] = {}        # the values the file has set, as they are now, and their total
+    total = 0
     for i, (section, key, value) in enumerate(ini.entries):
         if section in applied and key:
-            budget = MAX_SET - (sum(sizes.values()) - sizes.get(key, 0))
+            budget = MAX_SET - (total - sizes.get(key, 0))
             resolved = _resolve(value, out, section in PATH_SECTIONS, budget)
             if resolved is None:
                 line = f"line {ini.lines[i]}: " if i < len(ini.lines) else ""
                 raise RuntimeIniError(f"{ini.where}: {line}{key}'s value with its $(...) references replaced makes "
                                       f"the file's values longer than the {MAX_SET} characters set at most")
+            total += len(resolved) - sizes.get(key, 0)
             sizes[key] = len(resolved)
             out[key] = resolved
     return out

@@ -181,3 +181,20 @@ def test_a_curve_server_key_is_the_servers_own() -> None:
 
 def test_an_empty_ini_changes_nothing() -> None:
     assert environment(RuntimeIni(), {"A": "1"}, "linux") == {"A": "1"}
+
+
+def test_a_megabyte_of_entries_is_read_and_said_in_bounded_lines(tmp_path: Path) -> None:
+    """The largest file read: 55,000 distinct variables (the bound's running total, not a sum per
+    entry: that was quadratic) and 55,000 unknown [python] keys (8 named, one line for the others)."""
+    text = "[environment variables]\n" + "".join(f"V{i}=1\n" for i in range(55_000)) + "[python]\n" + "".join(
+        f"K{i}=1\n" for i in range(55_000)) + "K\x1b[2J=1\n"
+    assert len(text.encode()) <= runtime_ini.MAX_BYTES
+    (tmp_path / "runtime.ini").write_text(text)
+    ini = runtime_ini.read(tmp_path)
+    assert ini is not None and len(environment(ini, {}, "linux")) == 55_000
+    notes = ini.notes()
+    assert notes[:2] == ["unknown key K0 in its [python] section (COMMAND and OPTIONS are read)",
+                         "unknown key K1 in its [python] section (COMMAND and OPTIONS are read)"]
+    assert notes[8:] == ["54993 more unknown keys in its [python] section"]
+    assert parse("[python]\nK\x1b[2J = 1\n").notes() == [
+        "unknown key 'K\\x1b[2J' in its [python] section (COMMAND and OPTIONS are read)"]
