@@ -198,3 +198,13 @@ def test_a_megabyte_of_entries_is_read_and_said_in_bounded_lines(tmp_path: Path)
     assert notes[8:] == ["54993 more unknown keys in its [python] section"]
     assert parse("[python]\nK\x1b[2J = 1\n").notes() == [
         "unknown key 'K\\x1b[2J' in its [python] section (COMMAND and OPTIONS are read)"]
+
+
+def test_long_lines_and_duplicates_are_read_in_order_and_said_short() -> None:
+    ini = parse("[environment variables]\nA = 1\n[python]\nCOMMAND = a\n[environment variables]\nA = $(A)2\n"
+                "[python]\nCOMMAND = b\nB = " + "v" * 1_000_000 + "\n")
+    assert environment(ini, {}, "linux")["A"] == "12" and ini.python("COMMAND") == "b"
+    assert ini.entries[-1] == ("python", "B", "v" * 1_000_000)
+    with pytest.raises(RuntimeIniError) as info:
+        parse("[environment variables]\n" + "k;" * 500_000 + "= 1\n", "f")
+    assert len(one_line(info.value, "f")) < 200
