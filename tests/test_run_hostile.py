@@ -322,3 +322,18 @@ def test_a_python_command_with_spaces_and_quotes_is_one_program(tmp_path: Path) 
     assert "[good] wrapped -B" in err and "[good] good stepped 10" in proc.stdout().splitlines()
     assert ("sensorium run: 'b' controller of robot 'bad' failed to start: No such file or directory ('python3 -u'): "
             "the robot runs without a controller") in err
+
+
+def test_a_wbt_world_naming_a_controller_outside_its_project_runs_without_it(tmp_path: Path) -> None:
+    """The .wbt reader makes such a robot Webots' <generic> (one warning): run starts nothing
+    for it and does not wait for it (it was <extern>: run waited forever for a controller)."""
+    world = project(tmp_path, 'Robot { name "r" controller "../../../bin/sh" }\nRobot { name "s" controller "x/y" }\n'
+                              'Robot { name "beta" controller "b" }', {"b.py": STEPPER})
+    proc = run(world, 48714, "--until", "160")
+    assert proc.wait() == 0, proc.stderr()
+    err = proc.stderr()
+    assert ("Robot 'r': controller '../../../bin/sh' is no controller's name (a folder under controllers/): the robot "
+            "has Webots' <generic> controller (none under sensorium run, an <extern> one under serve)") in err
+    assert ("sensorium run: robot 's': controller '<generic>' (Webots' one only steps): the robot runs without a "
+            "controller") in err.splitlines()
+    assert "[beta] beta stepped 10" in proc.stdout().splitlines()
