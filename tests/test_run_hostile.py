@@ -328,7 +328,8 @@ def test_a_wbt_world_naming_a_controller_outside_its_project_runs_without_it(tmp
     """The .wbt reader makes such a robot Webots' <generic> (one warning): run starts nothing
     for it and does not wait for it (it was <extern>: run waited forever for a controller)."""
     world = project(tmp_path, 'Robot { name "r" controller "../../../bin/sh" }\nRobot { name "s" controller "x/y" }\n'
-                              'Robot { name "beta" controller "b" }', {"b.py": STEPPER})
+                              'Robot { name "u" controller "<unknown>" }\nRobot { name "beta" controller "b" }',
+                    {"b.py": STEPPER})
     proc = run(world, 48714, "--until", "160")
     assert proc.wait() == 0, proc.stderr()
     err = proc.stderr()
@@ -337,3 +338,5 @@ def test_a_wbt_world_naming_a_controller_outside_its_project_runs_without_it(tmp
     assert ("sensorium run: robot 's': controller '<generic>' (Webots' one only steps): the robot runs without a "
             "controller") in err.splitlines()
     assert "[beta] beta stepped 10" in proc.stdout().splitlines()
+    assert ("Robot 'u': controller '<unknown>' is unknown: the robot has Webots' <generic> controller (none under "
+            "sensorium run, an <extern> one under serve)") in err

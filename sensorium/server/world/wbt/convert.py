@@ -1152,8 +1152,9 @@ class Converter:
                             "an <extern> one under serve)")
             controller = "<generic>"
         elif controller.startswith("<") and controller not in ("<extern>", "<none>", "<generic>"):
-            self.warn(node, f"Robot {unique!r}: controller {controller!r} is unknown: the robot is an <extern> robot")
-            controller = "<extern>"
+            self.warn(node, f"Robot {unique!r}: controller {controller!r} is unknown: the robot has Webots' <generic> "
+                            "controller (none under sensorium run, an <extern> one under serve)")
+            controller = "<generic>"
         # a named controller is kept: `sensorium run` starts it, `sensorium serve` waits for it as <extern>
         extras = {"controller": controller, "controller_args": f.strings("controllerArgs"),
                   "supervisor": f.flag("supervisor", False),
