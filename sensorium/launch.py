@@ -15,6 +15,7 @@ controller not found there is looked for in Webots' own projects (:class:`Webots
 
 from __future__ import annotations
 
+import codecs
 import dataclasses
 import os
 import re
@@ -45,7 +46,13 @@ EXTRA_MAX = 64           # extra project folders read at most (each costs one lo
 WEBOTS_SKIP = frozenset({"protos", "worlds", "plugins", "libraries", "textures", "meshes", "icons", "docs", "build"})
 # Webots' WbController: a controller gets the quit packet (-1), then 1 s to end before it is terminated
 GRACE_S = 1.0
+CURVE_ENV = "SENSORIUM_CURVE_SERVERKEY"    # the clients' CURVE server key (sensorium.client.connection)
 LINE_MAX = 1 << 16       # bytes of a controller's line printed at once
+# seconds a controller's output is read on after its process ended: what it wrote is in the pipe by then; a
+# process it started that holds the pipe and is out of its process group (a daemon) is not waited for
+DRAIN_S = 2.0
+# seconds after which a started controller that has not attached is said to be waited for (without --attach-timeout)
+ATTACH_NOTE_S = 10.0
 C_LIBRARY = Path(__file__).resolve().parent / "client" / "c" / "build"
 SPECIAL = ("<extern>", "<none>", "<generic>")
 # the kinds Webots runs that Sensorium does not (file in the controller's folder -> what it is)
@@ -78,11 +85,12 @@ def controller_dirs(world: Path, extra: list[Path], projects: Sequence[Path] = (
             *(Path(p).resolve() / "controllers" for p in projects)]
 
 
-def extra_project_paths(value: str | None) -> list[Path]:
+def extra_project_paths(value: str | None, limit: int | None = EXTRA_MAX) -> list[Path]:
     """Webots' extra project paths from ``value`` (``$WEBOTS_EXTRA_PROJECT_PATH``: folders separated
-    like ``PATH``), in their order, each once, at most :data:`EXTRA_MAX`."""
-    paths = [Path(p).expanduser().absolute() for p in (value or "").split(os.pathsep) if p]
-    return list(dict.fromkeys(paths))[:EXTRA_MAX]
+    like ``PATH``, so a folder with ``:`` in its name cannot be one, as in Webots; empty entries are
+    none), in their order, each once, at most ``limit`` (None: all)."""
+    paths = list(dict.fromkeys(Path(p).expanduser().absolute() for p in (value or "").split(os.pathsep) if p))
+    return paths if limit is None else paths[:limit]
 
 
 class WebotsProjects:
@@ -182,6 +190,10 @@ def _runtime_ini(robot: str, folder: Path) -> tuple[RuntimeIni | None, tuple[str
         return None, (f"robot '{robot}': {exc}; the controller starts without it",)
     if ini is None:
         return None, ()
+    try:          # its $(...) references replaced against this environment: too long is said now
+        runtime_ini.environment(ini, os.environ)
+    except runtime_ini.RuntimeIniError as exc:
+        return None, (f"robot '{robot}': {exc}; the controller starts without it",)
     return ini, tuple(f"robot '{robot}': {folder / runtime_ini.FILE}: {line}" for line in ini.notes())
 
 
@@ -190,7 +202,12 @@ def find_controller(robot: str, name: str, args: list[str], dirs: list[Path], we
     """The controller ``name`` of ``robot`` in the first of ``dirs`` that has a ``NAME/`` folder, else
     in Webots' own projects (``webots``; where several have it, the one that defines the robot's
     PROTO ``proto``, as Webots looks in the PROTO's project), by Webots' order of files. Raises
-    LaunchError naming where it looked or what is not supported."""
+    LaunchError naming where it looked or what is not supported, or a ``name`` that is not one
+    folder's name (so a world cannot make ``run`` start a program outside the folders it looks in)."""
+    problem = name_problem(name)
+    if problem:
+        raise LaunchError(f"robot {robot!r}: controller {name!r} {problem}: not looked for (a controller is named "
+                          "by its folder in a controllers/ folder)")
     for base in dirs:
         folder = base / name
         if folder.is_dir():
@@ -213,6 +230,17 @@ def find_controller(robot: str, name: str, args: list[str], dirs: list[Path], we
                           f"in Webots' projects under {webots.where()})")
     spec = _in_folder(robot, name, args, found[0])
     return dataclasses.replace(spec, webots=True)
+
+
+def name_problem(name: str) -> str | None:
+    """What makes ``name`` no controller folder's name (None when it is one): empty, ``.``/``..``,
+    a path separator or a NUL byte in it."""
+    if name in ("", ".", ".."):
+        return "is no folder name" if name else "is empty"
+    for bad in dict.fromkeys(("/", os.sep, *([os.altsep] if os.altsep else []))):
+        if bad in name:
+            return f"has a {bad!r} in it"
+    return "has a NUL byte in it" if "\0" in name else None
 
 
 def robot_protos(world: Any) -> dict[str, str]:
@@ -382,26 +410,41 @@ def _describe(code: int) -> str:
     return f"exited with status: {code}."
 
 
+def _print_line(text: str, sink: IO[str]) -> None:
+    """``text`` on ``sink``; what its encoding cannot write (a controller's bytes on a terminal that is
+    not UTF-8) as ``?``, not an error that would end the robot's output."""
+    try:
+        print(text, file=sink, flush=True)
+    except UnicodeEncodeError:
+        encoding = getattr(sink, "encoding", None) or "ascii"
+        print(text.encode(encoding, errors="replace").decode(encoding, errors="replace"), file=sink, flush=True)
+
+
 @dataclass
 class _Running:
     spec: ControllerSpec
     proc: subprocess.Popen
     readers: list[threading.Thread] = field(default_factory=list)
     ending: bool = False       # ended by us (restart, reload, quit): no "exited" line of its own
+    said_held: bool = False    # its pipes outlived its process group: said once
 
 
 class Launcher:
     """Start, watch, restart and end the controller processes of one ``sensorium run``.
 
     ``url`` is the server's RPC endpoint; each controller gets ``url/ROBOT`` in
-    ``SENSORIUM_CONTROLLER_URL``. ``out``/``err`` receive the controllers' lines, ``[ROBOT] line``,
+    ``SENSORIUM_CONTROLLER_URL`` (and ``serverkey``, the server's CURVE public key, in
+    ``SENSORIUM_CURVE_SERVERKEY``). ``out``/``err`` receive the controllers' lines, ``[ROBOT] line``,
     and the launcher's own lines (``log``). Thread-safe: ``restart`` and ``reload`` are called from
     the server's loop thread and only queue work."""
 
     def __init__(self, specs: list[ControllerSpec], url: str, *, out: IO[str] | None = None,
-                 err: IO[str] | None = None, grace_s: float = GRACE_S):
+                 err: IO[str] | None = None, grace_s: float = GRACE_S, serverkey: str | None = None,
+                 attach_timeout_s: float | None = None):
         self.specs = {s.robot: s for s in specs}
+        self.attach_timeout_s = attach_timeout_s   # None: wait for a started controller to attach, as Webots
         self.url = url
+        self.serverkey = serverkey        # the server's CURVE public key (Z85), None for a plain one
         self.out = out or sys.stdout
         self.err = err or sys.stderr
         self.grace_s = grace_s
@@ -436,13 +479,14 @@ class Launcher:
         """Each line of a controller's stream as ``[ROBOT] line`` (Webots' console names the robot);
         a last line without a newline is printed too."""
         sink_open = True
+        decoder = codecs.getincrementaldecoder("utf-8")(errors="replace")    # a character cut between pieces
         for raw in iter(lambda: stream.readline(LINE_MAX), b""):      # a longer line comes in pieces
             if not sink_open:
                 continue            # read on all the same: a controller blocked on a full pipe would stall the world
-            line = raw.decode("utf-8", errors="replace").rstrip("\r\n")
+            line = decoder.decode(raw, final=raw.endswith(b"\n")).rstrip("\r\n")
             try:
                 with self._print_lock:
-                    print(f"[{robot}] {line}", file=sink, flush=True)
+                    _print_line(f"[{robot}] {line}", sink)
             except (BrokenPipeError, ValueError, OSError):        # `sensorium run | head`: the reader left
                 sink_open = False
         stream.close()
@@ -465,9 +509,17 @@ class Launcher:
         what it needs here: the URL, Webots' variables, Sensorium on the Python and library paths."""
         env = dict(os.environ if base is None else base)
         if spec.runtime is not None:
-            env = runtime_ini.environment(spec.runtime, env)
+            try:
+                env = runtime_ini.environment(spec.runtime, env)
+            except runtime_ini.RuntimeIniError as exc:       # checked when planned; the environment changed since
+                self.log(f"robot '{spec.robot}': {exc}; the controller starts without it")
         env["SENSORIUM_CONTROLLER_URL"] = f"{self.url.rstrip('/')}/{quote(spec.robot, safe='')}"   # both clients decode it
         env.pop("WEBOTS_CONTROLLER_URL", None)
+        # the server's CURVE key, or none: a key from this shell or a runtime.ini would make it fail to attach
+        if self.serverkey:
+            env[CURVE_ENV] = self.serverkey
+        else:
+            env.pop(CURVE_ENV, None)
         env["WEBOTS_ROBOT_NAME"] = spec.robot     # as Webots sets it for every controller it starts
         env["PYTHONUNBUFFERED"] = "1"            # lines reach the console as they are printed
         env["PYTHONIOENCODING"] = "UTF-8"        # as Webots sets it
@@ -487,12 +539,14 @@ class Launcher:
             if now is not None and now.proc.poll() is None:      # a restart and a reload at once: one process
                 return
         self._starting.add(robot)
+        argv = self.command(spec)
         try:
-            proc = subprocess.Popen(self.command(spec), cwd=spec.folder, env=self.environment(spec),
+            proc = subprocess.Popen(argv, cwd=spec.folder, env=self.environment(spec),
                                     stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                     start_new_session=True)    # its own group: ended by us, with its children
-        except OSError as exc:
-            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {exc.strerror or exc}: the robot "
+        except (OSError, ValueError) as exc:     # ValueError: a NUL byte in an argument or the environment
+            why = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+            self.log(f"'{spec.name}' controller of robot '{robot}' failed to start: {why} ({argv[0]!r}): the robot "
                      "runs without a controller")
             self.failed[robot] = spec.name
             self._starting.discard(robot)
@@ -509,6 +563,37 @@ class Launcher:
             self.running[robot] = run
             self.starts[robot] += 1
         threading.Thread(target=self._watch, args=(run,), daemon=True, name=f"sensorium-wait-{robot}").start()
+        threading.Thread(target=self._attach_watch, args=(run, self.attach_timeout_s), daemon=True,
+                         name=f"sensorium-attach-{robot}").start()
+
+    def _attach_watch(self, run: _Running, timeout_s: float | None) -> None:
+        """``--attach-timeout``: a controller still running and not attached ``timeout_s`` seconds
+        after it started is ended; its robot runs without a controller (said, and in the exit status).
+        Without it (None, as Webots waits), one line after :data:`ATTACH_NOTE_S` says what the world
+        waits for."""
+        try:
+            run.proc.wait(ATTACH_NOTE_S if timeout_s is None else timeout_s)
+            return                                 # it ended by itself (said by _watch)
+        except subprocess.TimeoutExpired:
+            pass
+        robot = run.spec.robot
+        with self._lock:
+            if run.ending or self.running.get(robot) is not run or robot not in self._starting:
+                return                             # attached, or ended by us meanwhile
+            if timeout_s is None:
+                self.log(f"the world waits for the '{run.spec.name}' controller of robot '{robot}', started "
+                         f"{ATTACH_NOTE_S:g} s ago, to attach (as Webots waits; --attach-timeout S ends it instead)")
+                return
+            run.ending = True
+        self.log(f"'{run.spec.name}' controller of robot '{robot}' did not attach within {timeout_s:g} s "
+                 "(--attach-timeout): ended; the robot runs without a controller")
+        self.failed[robot] = run.spec.name
+        self._starting.discard(robot)
+        self._wake_server()
+        try:
+            os.killpg(run.proc.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
 
     def replan(self, specs: list[ControllerSpec]) -> None:
         """The controllers of a reloaded world (its file may name others now)."""
@@ -527,8 +612,7 @@ class Launcher:
         if not run.ending:          # it may never have attached (a crash at start): not waited for any more
             self._starting.discard(run.spec.robot)
             self._wake_server()
-        for t in run.readers:
-            t.join()
+        self._drain(run)
         if not run.ending and not quitting:      # it ended by itself: the robot stays uncontrolled, the world goes on
             self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}' {_describe(code)}")
 
@@ -556,8 +640,19 @@ class Launcher:
             os.killpg(proc.pid, signal.SIGKILL)
         except (ProcessLookupError, PermissionError):
             pass
+        if not self._drain(run) and not run.said_held:
+            run.said_held = True
+            self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}': a process it started outside its "
+                     "process group still holds its output: not read further, not ended")
+
+    @staticmethod
+    def _drain(run: _Running) -> bool:
+        """Read ``run``'s output to its end, at most :data:`DRAIN_S` seconds after its process
+        ended; False when something else still holds its pipes (the readers go on by themselves)."""
+        deadline = time.monotonic() + DRAIN_S
         for t in run.readers:
-            t.join()
+            t.join(max(0.0, deadline - time.monotonic()))
+        return not any(t.is_alive() for t in run.readers)
 
     def end_all(self, grace_s: float | None = None) -> None:
         """End every controller (the server already answered their steps with -1)."""
@@ -635,6 +730,7 @@ class RunOptions:
     webots_home: Path | None = None
     grace_s: float = GRACE_S
     require_controllers: bool = False          # a controller that cannot be started: exit 1 before the world runs
+    attach_timeout_s: float | None = None      # a started controller not attached after this: ended (None: waited for)
 
     def check(self, world: Path) -> None:
         """Raise ValueError naming the first bad option (one line)."""
@@ -642,6 +738,8 @@ class RunOptions:
             raise ValueError(f"no world file {world}")
         if not 0 <= self.grace_s < float("inf"):
             raise ValueError(f"--grace must be a finite number >= 0, got {self.grace_s}")
+        if self.attach_timeout_s is not None and not 0 < self.attach_timeout_s < float("inf"):
+            raise ValueError(f"--attach-timeout must be a finite number of seconds > 0, got {self.attach_timeout_s}")
         for d in self.controllers_dirs:
             if not Path(d).is_dir():
                 raise ValueError(f"--controllers-dir {d}: no such folder")
@@ -673,6 +771,14 @@ class ProjectRun:
         self.interrupted = True
         if self._server is not None:
             self._server.stop()
+
+    def _serverkey(self) -> str | None:
+        """The server's CURVE public key when it encrypts (``curve_keys``), for its controllers."""
+        keys = getattr(self.options.serve, "curve_keys", None)
+        if not keys:
+            return None
+        from sensorium.server.daemon.transport import load_curve_keys
+        return load_curve_keys(keys)[0].decode("ascii")
 
     def _say(self, text: str) -> None:
         print(text, file=self.err, flush=True)
@@ -732,7 +838,8 @@ class ProjectRun:
             if p not in self.projects:
                 self._say(f"sensorium run: extra project path {p} is not a folder: not looked in")
         launcher = Launcher(list(world_plan.specs), server.transport.rpc_endpoint, out=self.out, err=self.err,
-                            grace_s=self.options.grace_s)
+                            grace_s=self.options.grace_s, serverkey=self._serverkey(),
+                            attach_timeout_s=self.options.attach_timeout_s)
         self._server = server
         old_handlers = {}
         if signals and threading.current_thread() is threading.main_thread():    # Python's signals: main thread only

@@ -624,17 +624,18 @@ def test_devices_are_listed_in_webots_tree_order(tmp_path: Path) -> None:
 
 def test_named_controllers_are_kept_with_their_args(tmp_path: Path) -> None:
     """A controller's name and controllerArgs are kept (`sensorium run` starts it; `serve` waits for it
-    as an <extern> one); a name that is no folder name is an <extern> robot, with one warning."""
+    as an <extern> one); a name that is no folder name is Webots' <generic> (a controller it cannot
+    run), with one warning: under `run` the robot is not waited for (it was <extern>: run waited forever)."""
     p = write(tmp_path, 'Robot { name "r" controller "e-puck_avoid_collision" controllerArgs [ "-v" "2" ] }\n'
                         'Robot { name "s" controller "../up" }\nRobot { name "t" controller "" }\n')
     w = load_world(p)
     r, s, t = w.world.robots
     assert (r.name, r.controller, r.controller_args) == ("r", "e-puck_avoid_collision", ["-v", "2"])
-    assert (s.controller, s.controller_args) == ("<extern>", [])
+    assert (s.controller, s.controller_args) == ("<generic>", [])
     assert t.controller == "<none>"
     assert [x for x in w.warnings if "controller" in x] == [
         f"{p}:3:1: Robot 's': controller '../up' is no controller's name (a folder under controllers/): the robot "
-        "is an <extern> robot"]
+        "has Webots' <generic> controller (none under sensorium run, an <extern> one under serve)"]
 
 
 def test_mesh_losses_load_and_name_their_lines(tmp_path: Path) -> None:

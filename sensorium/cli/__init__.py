@@ -359,10 +359,15 @@ def _export_proto_args(args: argparse.Namespace) -> None:
         os.environ["SENSORIUM_PROTO_PATH"] = os.pathsep.join([*args.proto_path, *before])
     # Webots' extra project paths: the option's first, then $WEBOTS_EXTRA_PROJECT_PATH's; their protos/
     # folders are looked in by PROTO file name after every other proto path folder, as Webots looks there
-    from sensorium.launch import EXTRA_ENV, extra_project_paths
+    from sensorium.launch import EXTRA_ENV, EXTRA_MAX, extra_project_paths
 
     given = os.pathsep.join([*(getattr(args, "extra_project_path", None) or []), os.environ.get(EXTRA_ENV, "")])
-    projects = extra_project_paths(given)
+    every = extra_project_paths(given, None)
+    projects = every[:EXTRA_MAX]
+    if len(every) > EXTRA_MAX:
+        print(f"sensorium: {len(every)} extra project paths (--extra-project-path, ${EXTRA_ENV}): the first "
+              f"{EXTRA_MAX} are read, not {every[EXTRA_MAX]} and the {len(every) - EXTRA_MAX - 1} after it",
+              file=sys.stderr)
     if projects:
         os.environ[EXTRA_ENV] = os.pathsep.join(str(p) for p in projects)
         before = [p for p in os.environ.get("SENSORIUM_PROTO_PATH", "").split(os.pathsep) if p]

@@ -37,6 +37,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--grace", type=float, default=1.0, metavar="S",
                    help="seconds a controller has to end after its last step (-1) before it is terminated "
                    "(default 1, as Webots)")
+    p.add_argument("--attach-timeout", type=float, metavar="S",
+                   help="a started controller that has not attached after S seconds is ended and its robot runs "
+                   "without one (run exits 1 at the end); default: the world waits for it, as Webots")
     p.add_argument("--require-controllers", action="store_true",
                    help="a controller that cannot be found or started is an error: exit 1 before the world runs "
                    "(default: as Webots, the robot runs without it and the world goes on; run exits 1 at the end)")
@@ -55,7 +58,8 @@ def main(args: argparse.Namespace) -> int:
                            contact=False if args.no_contact else None),
         controllers_dirs=tuple(Path(d) for d in args.controllers_dir),
         extra_projects=tuple(extra_project_paths(os.environ.get(EXTRA_ENV))),   # --extra-project-path too
-        webots_home=Path(home) if home else None, grace_s=args.grace, require_controllers=args.require_controllers)
+        webots_home=Path(home) if home else None, grace_s=args.grace, require_controllers=args.require_controllers,
+        attach_timeout_s=args.attach_timeout)
     try:
         options.check(Path(args.world))
     except ValueError as exc:

@@ -34,7 +34,7 @@ from sensorium.server.world.proto.errors import ProtoError
 RAW_PREFIX = "https://raw.githubusercontent.com/cyberbotics/webots/"
 _RAW = re.compile(r"^https?://raw\.githubusercontent\.com/cyberbotics/webots/([A-Za-z0-9_\-+.]+)/(.+)$")
 PROTO_PATH_ENV = "SENSORIUM_PROTO_PATH"
-_INDEX_ENTRIES = 200_000          # files walked when indexing a proto_path folder by PROTO file name
+_INDEX_ENTRIES = 200_000          # files and folders walked when indexing a proto_path folder by PROTO file name
 
 # files found in an asset-cache folder (named by a hash) → the url they stand for, so that relative
 # urls inside them resolve against that url (the folder's log.txt says the same when present)
@@ -153,8 +153,9 @@ def proto_index(folder: Path) -> dict[str, Path]:
     if key not in _INDEXES:
         index: dict[str, Path] = {}
         seen = 0
-        for root, dirs, files in os.walk(folder):
+        for root, dirs, files in os.walk(folder):        # symbolic links to folders are not entered
             dirs.sort()
+            seen += 1                                      # a folder counts: a tree of empty folders is bounded too
             for name in sorted(files):
                 seen += 1
                 if name.lower().endswith(".proto"):

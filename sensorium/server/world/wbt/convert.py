@@ -1186,11 +1186,13 @@ class Converter:
             controller = "<none>"
         if not controller.startswith("<") and (controller in (".", "..") or any(c in controller for c in "/\\\0")):
             self.warn(node, f"Robot {unique!r}: controller {controller!r} is no controller's name (a folder under "
-                            "controllers/): the robot is an <extern> robot")
-            controller = "<extern>"
+                            "controllers/): the robot has Webots' <generic> controller (none under sensorium run, "
+                            "an <extern> one under serve)")
+            controller = "<generic>"
         elif controller.startswith("<") and controller not in ("<extern>", "<none>", "<generic>"):
-            self.warn(node, f"Robot {unique!r}: controller {controller!r} is unknown: the robot is an <extern> robot")
-            controller = "<extern>"
+            self.warn(node, f"Robot {unique!r}: controller {controller!r} is unknown: the robot has Webots' <generic> "
+                            "controller (none under sensorium run, an <extern> one under serve)")
+            controller = "<generic>"
         # a named controller is kept: `sensorium run` starts it, `sensorium serve` waits for it as <extern>
         extras = {"controller": controller, "controller_args": f.strings("controllerArgs"),
                   "supervisor": f.flag("supervisor", False),
