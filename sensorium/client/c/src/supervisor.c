@@ -830,8 +830,8 @@ WbFieldRef wb_supervisor_proto_get_field(WbProtoRef proto, const char *field_nam
 
 static const char *field_name_at(WbProtoRef proto, int index, const char *func) {
   if (index < 0 || index >= proto->n_fields) {
-    fprintf(stderr, "Error: %s() called with an invalid 'index' argument: %d (the PROTO has %d fields).\n", func, index,
-            proto->n_fields);
+    fprintf(stderr, "Error: %s() called with an invalid 'index' argument: %d (the %s has %d fields).\n", func, index,
+            proto->level == 0 ? "node" : "PROTO", proto->n_fields);
     return NULL;
   }
   return proto->fields[index];
@@ -844,33 +844,40 @@ WbFieldRef wb_supervisor_proto_get_field_by_index(WbProtoRef proto, int index) {
   return name == NULL ? NULL : field_at(node_ref(rb, proto->node), name, proto->level, func);
 }
 
-/* Sensorium counts and lists the fields of PROTO instances only (their interface, as Webots): a base node
-   gets the not-served line */
-static WbProtoRef node_proto(WbNodeRef node, const char *func, bool *warned) {
+/* The field names getNumberOfFields counts (`base` false: a PROTO instance's interface, else its base node's)
+   or getNumberOfBaseNodeFields does (`base` true): the server's get_proto at level 1, or at level 0 (the base
+   node's fields served here, in Webots' declaration order), kept as a level-0 entry of the PROTO list */
+static WbProtoRef node_fields(WbNodeRef node, bool base, const char *func) {
   sn_robot *rb = supervisor_node(node, func);
   if (rb == NULL)
     return NULL;
-  WbProtoRef p = proto_at(rb, node->id, 1, func);
-  if (p == NULL && !*warned) {
-    *warned = true;
-    fprintf(stderr, "Error: %s(): not served by Sensorium on a node that is no PROTO instance (Sensorium lists the "
-                    "fields of PROTO instances only): ignored, Webots' \"no value\" returned.\n", func);
-  }
-  return p;
+  WbProtoRef p = base ? NULL : proto_at(rb, node->id, 1, func);
+  return p != NULL ? p : proto_at(rb, node->id, 0, func);
 }
 
 int wb_supervisor_node_get_number_of_fields(WbNodeRef node) {
-  static bool warned = false;
-  WbProtoRef p = node_proto(node, "wb_supervisor_node_get_number_of_fields", &warned);
+  WbProtoRef p = node_fields(node, false, "wb_supervisor_node_get_number_of_fields");
   return p == NULL ? -1 : p->n_fields;
 }
 
 WbFieldRef wb_supervisor_node_get_field_by_index(WbNodeRef node, int index) {
-  static bool warned = false;
   const char *func = "wb_supervisor_node_get_field_by_index";
-  WbProtoRef p = node_proto(node, func, &warned);
+  WbProtoRef p = node_fields(node, false, func);
   const char *name = p == NULL ? NULL : field_name_at(p, index, func);
   return name == NULL ? NULL : field_at(node, name, -1, func);
+}
+
+int wb_supervisor_node_get_number_of_base_node_fields(WbNodeRef node) {
+  WbProtoRef p = node_fields(node, true, "wb_supervisor_node_get_number_of_base_node_fields");
+  return p == NULL ? -1 : p->n_fields;
+}
+
+/* on a PROTO instance read-only, as wb_supervisor_node_get_base_node_field */
+WbFieldRef wb_supervisor_node_get_base_node_field_by_index(WbNodeRef node, int index) {
+  const char *func = "wb_supervisor_node_get_base_node_field_by_index";
+  WbProtoRef p = node_fields(node, true, func);
+  const char *name = p == NULL ? NULL : field_name_at(p, index, func);
+  return name == NULL ? NULL : field_at(node, name, 0, func);
 }
 
 WbFieldType wb_supervisor_field_get_type(WbFieldRef field) { return field ? field->type : WB_NO_FIELD; }
@@ -1208,11 +1215,17 @@ typedef struct {
   int level;
   int index;
   const char *op;
-  int kind; /* 0: no value (remove), 1: an int32, 3: numbers */
+  int kind; /* 0: no value (remove), 1: an int32, 2: a bool, 3: numbers, 4: a double, 5: a string */
   int number;
   const double *values;
   int n;
+  bool flag;
+  double real;
+  const char *string;
 } mf_args;
+
+/* the longest MFString item sent (the server's bound) */
+#define SN_MAX_MF_STRING 4096
 
 static void args_mf(sn_req *r, const void *arg) {
   const mf_args *a = arg;
@@ -1233,6 +1246,12 @@ static void args_mf(sn_req *r, const void *arg) {
   sn_req_key(r, "value");
   if (a->kind == 1)
     msgpack_pack_int(&r->pk, a->number);
+  else if (a->kind == 2)
+    a->flag ? msgpack_pack_true(&r->pk) : msgpack_pack_false(&r->pk);
+  else if (a->kind == 4)
+    msgpack_pack_double(&r->pk, a->real);
+  else if (a->kind == 5)
+    sn_req_str(r, a->string);
   else {
     msgpack_pack_array(&r->pk, (size_t)a->n);
     for (int i = 0; i < a->n; i++)
@@ -1252,11 +1271,26 @@ static void mf_change(WbFieldRef field, WbFieldType type, mf_args *a, const char
     fprintf(stderr, "Error: %s() called with a NULL 'values' argument.\n", func);
     return;
   }
+  bool finite = a->kind != 4 || isfinite(a->real);
   for (int i = 0; a->kind == 3 && i < a->n; i++)
-    if (!isfinite(a->values[i])) {
-      fprintf(stderr, "Error: %s() called with a NaN or infinite value.\n", func);
-      return;
-    }
+    finite = finite && isfinite(a->values[i]);
+  if (!finite) {
+    fprintf(stderr, "Error: %s() called with a NaN or infinite value.\n", func);
+    return;
+  }
+  if (type == WB_MF_ROTATION && a->values[0] == 0.0 && a->values[1] == 0.0 && a->values[2] == 0.0) {
+    fprintf(stderr, "Error: %s() called with invalid values for the [x y z] axis (a zero vector).\n", func);
+    return;
+  }
+  if (a->kind == 5 && a->string == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL 'value' argument.\n", func);
+    return;
+  }
+  if (a->kind == 5 && strlen(a->string) > SN_MAX_MF_STRING) {
+    fprintf(stderr, "Error: %s(): a string of %zu characters is longer than the %d a field item takes here.\n", func,
+            strlen(a->string), SN_MAX_MF_STRING);
+    return;
+  }
   a->node = field->node;
   a->name = field->name;
   a->has_level = field->level >= 0;
@@ -1267,37 +1301,87 @@ static void mf_change(WbFieldRef field, WbFieldType type, mf_args *a, const char
 }
 
 void wb_supervisor_field_set_mf_int32(WbFieldRef field, int index, int value) {
-  mf_args a = {0, NULL, false, 0, index, "set", 1, value, NULL, 0};
+  mf_args a = {0, NULL, false, 0, index, "set", 1, value, NULL, 0, false, 0.0, NULL};
   mf_change(field, WB_MF_INT32, &a, "wb_supervisor_field_set_mf_int32");
 }
 
 void wb_supervisor_field_set_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3};
+  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3, false, 0.0, NULL};
   mf_change(field, WB_MF_VEC3F, &a, "wb_supervisor_field_set_mf_vec3f");
 }
 
 void wb_supervisor_field_set_mf_color(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3};
+  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3, false, 0.0, NULL};
   mf_change(field, WB_MF_COLOR, &a, "wb_supervisor_field_set_mf_color");
 }
 
 void wb_supervisor_field_insert_mf_int32(WbFieldRef field, int index, int value) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 1, value, NULL, 0};
+  mf_args a = {0, NULL, false, 0, index, "insert", 1, value, NULL, 0, false, 0.0, NULL};
   mf_change(field, WB_MF_INT32, &a, "wb_supervisor_field_insert_mf_int32");
 }
 
 void wb_supervisor_field_insert_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3};
+  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3, false, 0.0, NULL};
   mf_change(field, WB_MF_VEC3F, &a, "wb_supervisor_field_insert_mf_vec3f");
 }
 
 void wb_supervisor_field_insert_mf_color(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3};
+  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3, false, 0.0, NULL};
   mf_change(field, WB_MF_COLOR, &a, "wb_supervisor_field_insert_mf_color");
 }
 
+void wb_supervisor_field_set_mf_bool(WbFieldRef field, int index, bool value) {
+  mf_args a = {.index = index, .op = "set", .kind = 2, .flag = value};
+  mf_change(field, WB_MF_BOOL, &a, "wb_supervisor_field_set_mf_bool");
+}
+
+void wb_supervisor_field_insert_mf_bool(WbFieldRef field, int index, bool value) {
+  mf_args a = {.index = index, .op = "insert", .kind = 2, .flag = value};
+  mf_change(field, WB_MF_BOOL, &a, "wb_supervisor_field_insert_mf_bool");
+}
+
+void wb_supervisor_field_set_mf_float(WbFieldRef field, int index, double value) {
+  mf_args a = {.index = index, .op = "set", .kind = 4, .real = value};
+  mf_change(field, WB_MF_FLOAT, &a, "wb_supervisor_field_set_mf_float");
+}
+
+void wb_supervisor_field_insert_mf_float(WbFieldRef field, int index, double value) {
+  mf_args a = {.index = index, .op = "insert", .kind = 4, .real = value};
+  mf_change(field, WB_MF_FLOAT, &a, "wb_supervisor_field_insert_mf_float");
+}
+
+void wb_supervisor_field_set_mf_vec2f(WbFieldRef field, int index, const double values[2]) {
+  mf_args a = {.index = index, .op = "set", .kind = 3, .values = values, .n = 2};
+  mf_change(field, WB_MF_VEC2F, &a, "wb_supervisor_field_set_mf_vec2f");
+}
+
+void wb_supervisor_field_insert_mf_vec2f(WbFieldRef field, int index, const double values[2]) {
+  mf_args a = {.index = index, .op = "insert", .kind = 3, .values = values, .n = 2};
+  mf_change(field, WB_MF_VEC2F, &a, "wb_supervisor_field_insert_mf_vec2f");
+}
+
+void wb_supervisor_field_set_mf_rotation(WbFieldRef field, int index, const double values[4]) {
+  mf_args a = {.index = index, .op = "set", .kind = 3, .values = values, .n = 4};
+  mf_change(field, WB_MF_ROTATION, &a, "wb_supervisor_field_set_mf_rotation");
+}
+
+void wb_supervisor_field_insert_mf_rotation(WbFieldRef field, int index, const double values[4]) {
+  mf_args a = {.index = index, .op = "insert", .kind = 3, .values = values, .n = 4};
+  mf_change(field, WB_MF_ROTATION, &a, "wb_supervisor_field_insert_mf_rotation");
+}
+
+void wb_supervisor_field_set_mf_string(WbFieldRef field, int index, const char *value) {
+  mf_args a = {.index = index, .op = "set", .kind = 5, .string = value};
+  mf_change(field, WB_MF_STRING, &a, "wb_supervisor_field_set_mf_string");
+}
+
+void wb_supervisor_field_insert_mf_string(WbFieldRef field, int index, const char *value) {
+  mf_args a = {.index = index, .op = "insert", .kind = 5, .string = value};
+  mf_change(field, WB_MF_STRING, &a, "wb_supervisor_field_insert_mf_string");
+}
+
 void wb_supervisor_field_remove_mf(WbFieldRef field, int index) {
-  mf_args a = {0, NULL, false, 0, index, "remove", 0, 0, NULL, 0};
+  mf_args a = {0, NULL, false, 0, index, "remove", 0, 0, NULL, 0, false, 0.0, NULL};
   mf_change(field, WB_NO_FIELD, &a, "wb_supervisor_field_remove_mf");
 }
 
