@@ -973,6 +973,27 @@ def wb_supervisor_field_import_mf_node_from_string(field: Field | None, position
         print(f"Error: {func}(): {err.message}.", file=sys.stderr)
 
 
+def wb_supervisor_field_import_sf_node_from_string(field: Field | None, node_string: str) -> None:
+    """Webots' ``importSFNodeFromString``: served into the empty ``coord`` (a ``Coordinate``) or ``color`` (a
+    ``Color``) of an imported line or point set; any other SFNode field, a full one or a string that does not
+    read is refused with the server's one line, nothing changed."""
+    func = "wb_supervisor_field_import_sf_node_from_string"
+    r = _field_robot(field, WB_SF_NODE, func)
+    if r is None:
+        return
+    assert field is not None
+    if not isinstance(node_string, str) or not node_string:
+        print(f"Error: {func}() called with a NULL or empty 'node_string' argument.", file=sys.stderr)
+        return
+    try:
+        _call(r, "import_node_from_string", {"node": field[0], "field": field[1], "position": 0,
+                                             "node_string": node_string})
+    except SensoriumError as err:      # not a slot served here, a full one, a bad string: the server's line
+        if err.code != ErrorCode.INVALID_ARGUMENT:
+            raise
+        print(f"Error: {func}(): {err.message}.", file=sys.stderr)
+
+
 # ---------------------------------------------------------------------- the simulation
 
 def wb_supervisor_simulation_reset() -> None:

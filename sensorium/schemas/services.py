@@ -358,8 +358,10 @@ class NodeStateArgs(Args):
 
 
 class ImportNodeArgs(Args):
-    node: NodeId = Field(description="the node whose field takes the nodes: the root (0) here")
-    field: FieldName = Field(description="its MFNode field: 'children'")
+    node: NodeId = Field(description="the node whose field takes the nodes: the root (0), or an imported line or "
+                         "point set (importSFNodeFromString)")
+    field: FieldName = Field(description="its MFNode field: 'children'; or the set's empty SFNode 'coord' (a "
+                             "Coordinate) or 'color' (a Color): one node, position ignored")
     position: int = Field(ge=-(1 << 31), lt=1 << 31, description=(
         "where in the list: 0 first, -1 after the last, -2 before the last (Webots); past an end: that end"))
     node_string: str = Field(max_length=1 << 24, description=(

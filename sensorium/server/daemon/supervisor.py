@@ -1009,6 +1009,8 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
     :func:`insert_index`); returns their new ids. Any other field is refused (Sensorium's nodes
     have no other MFNode field); a string that cannot be imported changes nothing (one line).
     ``warnings`` gets the values corrected as Webots corrects them (Webots prints them in its console)."""
+    if node.visual and node.id >= visuals.FIRST_ID or node.nested or node.visual and field != "children":
+        return [import_sf_node(sim, node, field, text)]
     if node.id != 0 or field != "children":
         what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
         raise ValueError(f"field {field!r} of {what}: nodes are imported into the root's 'children' only here")
@@ -1017,6 +1019,27 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
     added = [node_id for _, _, node_id in sim.import_nodes(text, warnings)]
     sim.root_order = current[:index] + added + current[index:]
     return added
+
+
+def import_sf_node(sim: Any, node: Node, field: str, text: str) -> int:
+    """Webots' ``importSFNodeFromString``: into an empty ``coord`` or ``color`` of an imported line or point
+    set (visuals.py: a ``Coordinate`` or ``Color`` as written, seen by no sensor, its items then set as the
+    others'); returns its id. Any other SFNode field is read-only here, a full one refused as in Webots
+    (one line, nothing changed)."""
+    from sensorium.server.sim.imports import parse_sf_node_string
+
+    fields = _fields(sim, node)
+    entry = fields.get(field)
+    if entry is None or entry[0] != "SFNode":
+        kind = f" ({entry[0]})" if entry else ""
+        raise ValueError(f"field {field!r}{kind} of {_what(node)}: a node string is imported into an SFNode field only")
+    if not (node.visual and node.id >= visuals.FIRST_ID):
+        raise ValueError(f"field {field!r} (SFNode) of {_what(node)} is read-only here: a node string is imported into "
+                         "the empty coord or color of an imported line or point set only; nothing changed")
+    parent = _vnode(sim, node)
+    if parent.values.get(field, 0) or not (parent.inert and field in visuals.SF_SLOTS.get(parent.type, {})):
+        return _visuals(sim).attach(parent, field, None)       # its line: full, or not a slot served here
+    return _visuals(sim).attach(parent, field, parse_sf_node_string(text, sim.limits))
 
 
 def _import(sim: Any, ls: Any, robot: str, a: Any) -> dict:

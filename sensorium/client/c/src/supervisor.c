@@ -1422,6 +1422,24 @@ void wb_supervisor_field_import_mf_node_from_string(WbFieldRef field, int positi
     sn_reply_free(&rep);
 }
 
+/* Webots' import into an SFNode field: served into the empty coord (a Coordinate) or color (a Color) of an
+   imported line or point set; any other SFNode field, a full one or a string that does not read is refused
+   with the server's one line, nothing changed. */
+void wb_supervisor_field_import_sf_node_from_string(WbFieldRef field, const char *node_string) {
+  const char *func = "wb_supervisor_field_import_sf_node_from_string";
+  sn_robot *rb = field_robot(field, WB_SF_NODE, func);
+  if (rb == NULL)
+    return;
+  if (node_string == NULL || *node_string == '\0') {
+    fprintf(stderr, "Error: %s() called with a NULL or empty 'node_string' argument.\n", func);
+    return;
+  }
+  import_args a = {field->node, field->name, 0, node_string};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/import_node_from_string", 4, args_import, &a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
 /* ------------------------------------------------------------------ the simulation */
 static void args_status(sn_req *r, const void *arg) {
   sn_req_key(r, "status");

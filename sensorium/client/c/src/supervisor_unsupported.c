@@ -124,10 +124,6 @@ void wb_supervisor_field_remove_sf(WbFieldRef field) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_field_import_sf_node_from_string(WbFieldRef field, const char *node_string) {
-  SN_UNSUPPORTED();
-}
-
 
 bool wb_supervisor_virtual_reality_headset_is_used(void) {
   SN_UNSUPPORTED();

@@ -185,6 +185,9 @@ class Field:
     def insertMFString(self, index: int, value: str) -> None:
         wb.wb_supervisor_field_insert_mf_string(self._ref, index, value)
 
+    def importSFNodeFromString(self, nodeString: str) -> None:  # noqa: N803 - Webots' name
+        wb.wb_supervisor_field_import_sf_node_from_string(self._ref, nodeString)
+
     def removeMF(self, index: int) -> None:
         wb.wb_supervisor_field_remove_mf(self._ref, index)
 
@@ -554,9 +557,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "addTorque": ("node_add_torque", None, "torque, relative")},
     Field: {
         "getActualField": ("field_get_actual_field", None, ""),
-        "removeSF": ("field_remove_sf", None, ""),
-        # no SFNode field here takes an import (a joint's jointParameters and endPoint are read-only)
-        "importSFNodeFromString": ("field_import_sf_node_from_string", None, "nodeString")},
+        "removeSF": ("field_remove_sf", None, "")},
 }
 _FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 2, "Vec3f": [_NAN] * 3,
                     "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
