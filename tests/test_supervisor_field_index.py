@@ -2,7 +2,8 @@
 ``getNumberOfBaseNodeFields``/``getBaseNodeFieldByIndex`` (C ``wb_supervisor_node_get_number_of_fields``, ...)
 count and list the fields Sensorium serves for the node, in Webots' declaration order (its nodes' .wrl files:
 a Solid's translation, rotation, children, name, model, radarCrossSection; a Robot's then controller,
-customData, supervisor, synchronization; ...). Python and C (AddressSanitizer, UBSan) print the same on
+customData, supervisor, synchronization; ...); ``getFromProtoDef`` answers NULL with one line (a PROTO's internal
+DEF names are not kept here). Python and C (AddressSanitizer, UBSan) print the same on
 tests/worlds/proto/supervisor_proto_harden.wbt."""
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ ROBOT = SOLID + ["controller", "customData", "supervisor", "synchronization"]
 INFO = ["title", "gravity", "basicTimeStep", "inkEvaporation", "coordinateSystem", "gpsCoordinateSystem",
         "gpsReference", "randomSeed"]
 EXPECTED = [" ".join(["box", "6", *SOLID]), " ".join(["boxbase", "6", *SOLID]), " ".join(["info", "8", *INFO]),
-            " ".join(["keeper", "14", "10", *ROBOT]), "controller SFString <extern>", "translation -1 0 0.1", "bad 1 1"]
+            " ".join(["keeper", "14", "10", *ROBOT]), "controller SFString <extern>", "translation -1 0 0.1", "bad 1 1", "protodef 1 1 1 1"]
 
 
 def _live(world=HARDEN) -> Live:
@@ -72,7 +73,8 @@ def test_a_python_supervisor_lists_fields_by_index(tmp_path):
     ctl = run_paused(HARDEN, tmp_path, "supervisor_field_index.py", "keeper")
     assert ctl.out == EXPECTED
     err = ctl.stderr()
-    assert "not served" not in err and err.count("Error:") == 2, err
+    assert "not served" not in err and err.count("Error:") == 4, err
+    _check_proto_def(err, "None")
     assert "Error: wb_supervisor_node_get_field_by_index() called with an invalid 'index' argument: 6 (the node has " \
            "6 fields)." in err.splitlines(), err
 
@@ -86,4 +88,13 @@ def test_a_c_supervisor_lists_the_same_fields(tmp_path, tmp_path_factory):
     assert ctl.out == EXPECTED
     err = ctl.stderr()
     assert "not served" not in err and "Sanitizer" not in err and "runtime error" not in err, err
-    assert err.count("Error:") == 2, err
+    assert err.count("Error:") == 4, err
+    _check_proto_def(err, "NULL")
+
+
+def _check_proto_def(err: str, none: str) -> None:
+    func = "wb_supervisor_node_get_from_proto_def"
+    lines = err.splitlines()
+    kept = [x for x in lines if x.startswith(f"Error: {func}(): Sensorium does not keep the DEF names")]
+    assert len(kept) == 1 and kept[0].endswith(f"{none} returned."), err
+    assert f"Error: {func}() called with a NULL or empty 'def' argument." in lines, err

@@ -542,6 +542,27 @@ def _node_fields(node: Any, func: str, base: bool) -> tuple[list, int, str] | No
     return None if got is None else (list(got.get("fields", [])), 0 if base else -1, "the node")
 
 
+_proto_def_warned: list[bool] = []
+
+
+def wb_supervisor_node_get_from_proto_def(node: int | None, def_name: str) -> int | None:
+    """Webots' DEF lookup inside a PROTO instance's body: Sensorium does not keep the DEF names of a PROTO's
+    internal nodes (Webots' getFromDef does not find them either), so after Webots' checks a PROTO instance
+    gets one line (the first time) and None; a node that is no PROTO instance has no internal DEF: None."""
+    func = "wb_supervisor_node_get_from_proto_def"
+    r = _checked_node(node, func)
+    if r is None:
+        return None
+    if not isinstance(def_name, str) or not def_name:
+        print(f"Error: {func}() called with a NULL or empty 'def' argument.", file=sys.stderr)
+        return None
+    if _proto_info(r, int(node), 1, func) is not None and not _proto_def_warned:  # type: ignore[arg-type]
+        _proto_def_warned.append(True)
+        print(f"Error: {func}(): Sensorium does not keep the DEF names inside a PROTO's body (reach those nodes "
+              "through 'children', getFromDevice, ...): None returned.", file=sys.stderr)
+    return None
+
+
 def wb_supervisor_node_get_number_of_fields(node: int | None) -> int:
     """A PROTO instance's interface fields, as Webots counts them; a base node's fields served here
     (Webots counts all its node type's fields; README "Supervisor" says which are left out)."""

@@ -35,6 +35,10 @@ int main(void) {
   printf("translation %g %g %g\n", t[0], t[1], t[2]);
   printf("bad %d %d\n", wb_supervisor_node_get_field_by_index(box, 6) == NULL,
          wb_supervisor_node_get_base_node_field_by_index(box, -1) == NULL);
+  /* a PROTO's internal DEFs are not kept here (one line, the first time), a base node has none */
+  printf("protodef %d %d %d %d\n", wb_supervisor_node_get_from_proto_def(keeper, "BODY") == NULL,
+         wb_supervisor_node_get_from_proto_def(keeper, "BODY") == NULL, wb_supervisor_node_get_from_proto_def(box, "BODY") == NULL,
+         wb_supervisor_node_get_from_proto_def(keeper, "") == NULL);
   wb_robot_cleanup();
   return 0;
 }

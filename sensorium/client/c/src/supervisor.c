@@ -855,6 +855,27 @@ static WbProtoRef node_fields(WbNodeRef node, bool base, const char *func) {
   return p != NULL ? p : proto_at(rb, node->id, 0, func);
 }
 
+/* Webots' DEF lookup inside a PROTO instance's body: Sensorium does not keep the DEF names of a PROTO's
+   internal nodes (Webots' getFromDef does not find them either), so after Webots' checks a PROTO instance
+   gets one line (the first time) and NULL; a node that is no PROTO instance has no internal DEF: NULL. */
+WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def) {
+  static bool warned = false;
+  const char *func = "wb_supervisor_node_get_from_proto_def";
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb == NULL)
+    return NULL;
+  if (def == NULL || *def == '\0') {
+    fprintf(stderr, "Error: %s() called with a NULL or empty 'def' argument.\n", func);
+    return NULL;
+  }
+  if (proto_at(rb, node->id, 1, func) != NULL && !warned) {
+    warned = true;
+    fprintf(stderr, "Error: %s(): Sensorium does not keep the DEF names inside a PROTO's body (reach those nodes through "
+                    "'children', wb_supervisor_node_get_from_device, ...): NULL returned.\n", func);
+  }
+  return NULL;
+}
+
 int wb_supervisor_node_get_number_of_fields(WbNodeRef node) {
   WbProtoRef p = node_fields(node, false, "wb_supervisor_node_get_number_of_fields");
   return p == NULL ? -1 : p->n_fields;

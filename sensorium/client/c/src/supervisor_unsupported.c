@@ -51,11 +51,6 @@ bool wb_supervisor_animation_stop_recording(void) {
 }
 
 
-WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
 
 WbNodeRef wb_supervisor_node_get_selected(void) {
   SN_UNSUPPORTED();

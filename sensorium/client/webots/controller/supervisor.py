@@ -296,6 +296,10 @@ class Node:
         ref = wb.wb_supervisor_node_get_field_by_index(self._ref, index)
         return None if ref is None else Field(ref)
 
+    def getFromProtoDef(self, DEF: str) -> Node | None:  # noqa: N803 - Webots' name
+        """A DEF inside this PROTO instance's body: not kept here (one line the first time), None."""
+        return _node_of(wb.wb_supervisor_node_get_from_proto_def(self._ref, DEF))
+
     def getNumberOfBaseNodeFields(self) -> int:
         """The base node's fields served here (a PROTO instance's Robot, Solid, ...), in Webots' order."""
         return wb.wb_supervisor_node_get_number_of_base_node_fields(self._ref)
@@ -546,7 +550,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3, ""),
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9, "")},
     Node: {
-        "getFromProtoDef": ("node_get_from_proto_def", None, "DEF"),
         "exportString": ("node_export_string", "", ""),
         "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3, ""),
         "getStaticBalance": ("node_get_static_balance", False, ""),
