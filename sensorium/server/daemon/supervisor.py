@@ -1006,10 +1006,15 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
                  warnings: list[str] | None = None) -> list[int]:
     """Webots' ``importMFNodeFromString`` on the root's ``children``: the string's solids and
     lights join the world from the next measurement, inserted at ``position`` (Webots' rule,
-    :func:`insert_index`); returns their new ids. Any other field is refused (Sensorium's nodes
-    have no other MFNode field); a string that cannot be imported changes nothing (one line).
-    ``warnings`` gets the values corrected as Webots corrects them (Webots prints them in its console)."""
-    if node.visual and node.id >= visuals.FIRST_ID or node.nested or node.visual and field != "children":
+    :func:`insert_index`); returns their new ids. An SFNode field is Webots' ``importSFNodeFromString``
+    (:func:`import_sf_node`); any other field is refused (Sensorium's nodes have no other MFNode field
+    taking imports); a string that cannot be imported changes nothing (one line). ``warnings`` gets the
+    values corrected as Webots corrects them (Webots prints them in its console)."""
+    try:
+        entry = _fields(sim, node).get(field) if node.id != 0 else None
+    except (KeyError, ValueError):
+        entry = None
+    if entry is not None and entry[0] == "SFNode":        # importSFNodeFromString
         return [import_sf_node(sim, node, field, text)]
     if node.id != 0 or field != "children":
         what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
