@@ -2,8 +2,9 @@
 setMFString and their insertMF*) through the one set_field path the line and point sets' items take: on a
 field of that type that is not settable here (a PROTO's interface fields, on
 tests/worlds/proto/supervisor_proto_harden.wbt) the server answers the field's read-only line, nothing changed;
-the clients' own checks (a zero rotation axis, NaN, the wrong type) are Webots' lines without a request. Python
-and C (AddressSanitizer, UBSan) print the same."""
+the clients' own checks (a zero rotation axis, NaN, the wrong type) are Webots' lines without a request; so are
+setSFInt32, setSFVec2f and setSFString (no field of those types is settable here). Python and C
+(AddressSanitizer, UBSan) print the same."""
 
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ from sensorium.server.world.loader import load_world
 HARDEN = REPO / "tests" / "worlds" / "proto" / "supervisor_proto_harden.wbt"
 SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
 KEEPER = 1
-EXPECTED = ["counts 2 2 2 2 1", "values 4 5 a 1 0 1 2 0 0 1 -3.5"]
+EXPECTED = ["counts 2 2 2 2 1", "values 4 5 a 1 0 1 2 0 0 1 -3.5", "sf 3 -1e+300 1e-300 keeper"]
 
 
 def _live() -> Live:
@@ -76,15 +77,16 @@ def _check(err: str, func_prefix: str = "wb_supervisor_field_") -> None:
     lines = err.splitlines()
     assert "not served" not in err and "Sanitizer" not in err and "runtime error" not in err, err
     read_only = [x for x in lines if "read-only here" in x]
-    assert len(read_only) == 10, err
+    assert len(read_only) == 13, err
     for f in ("set_mf_float", "insert_mf_float", "set_mf_string", "insert_mf_string", "set_mf_bool", "insert_mf_bool",
-              "set_mf_vec2f", "insert_mf_vec2f", "set_mf_rotation", "insert_mf_rotation"):
+              "set_mf_vec2f", "insert_mf_vec2f", "set_mf_rotation", "insert_mf_rotation", "set_sf_int32", "set_sf_vec2f",
+              "set_sf_string"):
         assert any(x.startswith(f"Error: {func_prefix}{f}(): ") for x in read_only), (f, err)
     assert f"Error: {func_prefix}set_mf_rotation() called with invalid values for the [x y z] axis (a zero " \
            "vector)." in lines, err
     assert f"Error: {func_prefix}set_mf_float() called with a NaN or infinite value." in lines, err
     assert any(x.startswith(f"Error: {func_prefix}set_mf_bool() called with wrong field type") for x in lines), err
-    assert err.count("Error:") == 13, err
+    assert err.count("Error:") == 16, err
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")

@@ -781,6 +781,10 @@ def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
     # a value of the wrong shape is printed and ignored, as Webots' Python Field does (no exception)
     if want == WB_SF_BOOL:
         wire: Any = bool(value)
+    elif want in (WB_SF_INT32, WB_SF_STRING):     # read-only here: the server's line
+        wire = _mf_value(WB_MF_INT32 if want == WB_SF_INT32 else WB_MF_STRING, value, func)
+        if wire is None:
+            return
     elif want == WB_SF_FLOAT:
         try:
             wire = float(value)
@@ -788,7 +792,7 @@ def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
             print(f"Error: {func}(): expected a number, got {value!r}.", file=sys.stderr)
             return
     else:
-        n = 4 if want == WB_SF_ROTATION else 3
+        n = 4 if want == WB_SF_ROTATION else 2 if want == WB_SF_VEC2F else 3
         try:
             wire = [float(v) for v in value]
         except (TypeError, ValueError):
@@ -822,6 +826,18 @@ def wb_supervisor_field_set_sf_rotation(field: Field | None, values: Any) -> Non
 
 def wb_supervisor_field_set_sf_color(field: Field | None, values: Any) -> None:
     _field_set(field, WB_SF_COLOR, values, "wb_supervisor_field_set_sf_color")
+
+
+def wb_supervisor_field_set_sf_int32(field: Field | None, value: int) -> None:
+    _field_set(field, WB_SF_INT32, value, "wb_supervisor_field_set_sf_int32")
+
+
+def wb_supervisor_field_set_sf_vec2f(field: Field | None, values: Any) -> None:
+    _field_set(field, WB_SF_VEC2F, values, "wb_supervisor_field_set_sf_vec2f")
+
+
+def wb_supervisor_field_set_sf_string(field: Field | None, value: str) -> None:
+    _field_set(field, WB_SF_STRING, value, "wb_supervisor_field_set_sf_string")
 
 
 MAX_MF_STRING = 4096

@@ -43,6 +43,15 @@ int main(void) {
          wb_supervisor_field_get_mf_string(tags, 0), wb_supervisor_field_get_mf_bool(flags, 0),
          wb_supervisor_field_get_mf_bool(flags, 1), c0, c1);
   printf(" %g %g %g %g\n", t[0], t[1], t[2], t[3]);
+  /* the SF setters of those types: read-only here too */
+  const double size2[2] = {1, 2};
+  wb_supervisor_field_set_sf_int32(wb_supervisor_node_get_field(keeper, "level"), 4);
+  wb_supervisor_field_set_sf_vec2f(wb_supervisor_node_get_field(lengthy, "size2"), size2);
+  wb_supervisor_field_set_sf_string(wb_supervisor_node_get_field(keeper, "name"), "other");
+  const double *s2 = wb_supervisor_field_get_sf_vec2f(wb_supervisor_node_get_field(lengthy, "size2"));
+  const double s20 = s2[0], s21 = s2[1];
+  printf("sf %d %g %g %s\n", wb_supervisor_field_get_sf_int32(wb_supervisor_node_get_field(keeper, "level")), s20, s21,
+         wb_supervisor_field_get_sf_string(wb_supervisor_node_get_field(keeper, "name")));
   wb_robot_cleanup();
   return 0;
 }

@@ -32,3 +32,8 @@ print("counts", gains.getCount(), tags.getCount(), flags.getCount(), corners.get
 print("values", " ".join(f"{v:g}" for v in (gains.getMFFloat(0), gains.getMFFloat(1))), tags.getMFString(0),
       int(flags.getMFBool(0)), int(flags.getMFBool(1)), " ".join(f"{v:g}" for v in corners.getMFVec2f(0)),
       " ".join(f"{v:g}" for v in turns.getMFRotation(0)))
+keeper.getField("level").setSFInt32(4)                  # the SF setters of those types: read-only here too
+lengthy.getField("size2").setSFVec2f([1.0, 2.0])
+keeper.getField("name").setSFString("other")
+print("sf", keeper.getField("level").getSFInt32(), " ".join(f"{v:g}" for v in lengthy.getField("size2").getSFVec2f()),
+      keeper.getField("name").getSFString())

@@ -633,16 +633,21 @@ static const struct {
                    {"MFVec2f", WB_MF_VEC2F},     {"MFVec3f", WB_MF_VEC3F},   {"MFRotation", WB_MF_ROTATION},
                    {"MFColor", WB_MF_COLOR},     {"MFString", WB_MF_STRING}, {"MFNode", WB_MF_NODE}};
 
+/* the longest string a set or an MFString item sends (the server's bound) */
+#define SN_MAX_MF_STRING 4096
+
 typedef struct {
   int64_t node;
   const char *name;
-  int kind; /* 0: no value, 1: bool, 2: double, 3: numbers */
+  int kind; /* 0: no value, 1: bool, 2: double, 3: numbers, 4: an int32, 5: a string */
   bool flag;
   double number;
   const double *values;
   int n;
   bool has_level; /* a PROTO level (FieldArgs.level) is sent */
   int level;
+  int integer;
+  const char *string;
 } field_args;
 
 static void args_field(sn_req *r, const void *arg) {
@@ -662,6 +667,10 @@ static void args_field(sn_req *r, const void *arg) {
     sn_arg_bool(r, &a->flag);
   else if (a->kind == 2)
     msgpack_pack_double(&r->pk, a->number);
+  else if (a->kind == 4)
+    msgpack_pack_int(&r->pk, a->integer);
+  else if (a->kind == 5)
+    sn_req_str(r, a->string);
   else {
     msgpack_pack_array(&r->pk, (size_t)a->n);
     for (int i = 0; i < a->n; i++)
@@ -681,7 +690,7 @@ static WbFieldRef field_at(WbNodeRef node, const char *field_name, int level, co
   for (struct WbFieldStructPrivate *f = rb->fields; f != NULL; f = f->next)
     if (f->node == node->id && f->level == level && strcmp(f->name, field_name) == 0)
       return f;
-  field_args a = {node->id, field_name, 0, false, 0.0, NULL, 0, level >= 0, level};
+  field_args a = {node->id, field_name, 0, false, 0.0, NULL, 0, level >= 0, level, 0, NULL};
   sn_reply rep;
   if (sn_robot_call(rb, "robot/get_field", 2 + (level >= 0), args_field, &a, func, &rep) != 0)
     return NULL;
@@ -944,7 +953,7 @@ static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_
   sn_robot *rb = field_robot(field, type, func);
   if (rb == NULL)
     return -1;
-  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, field->level >= 0, field->level};
+  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, field->level >= 0, field->level, 0, NULL};
   if (sn_robot_call(rb, "robot/get_field", 2 + (field->level >= 0), args_field, &a, func, rep) != 0)
     return -1;
   const msgpack_object *note = sn_get(rep->result, "note"); /* a value the server does not serve: its line */
@@ -1186,6 +1195,15 @@ static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const c
     fprintf(stderr, "Error: %s() called with a NULL 'values' argument.\n", func);
     return;
   }
+  if (a->kind == 5 && a->string == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL 'value' argument.\n", func);
+    return;
+  }
+  if (a->kind == 5 && strlen(a->string) > SN_MAX_MF_STRING) {
+    fprintf(stderr, "Error: %s(): a string of %zu characters is longer than the %d a field takes here.\n", func,
+            strlen(a->string), SN_MAX_MF_STRING);
+    return;
+  }
   bool finite = a->kind != 2 || isfinite(a->number);
   for (int i = 0; a->kind == 3 && i < a->n; i++)
     finite = finite && isfinite(a->values[i]);
@@ -1203,28 +1221,44 @@ static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const c
 }
 
 void wb_supervisor_field_set_sf_bool(WbFieldRef field, bool value) {
-  field_args a = {0, NULL, 1, value, 0.0, NULL, 0, false, 0};
+  field_args a = {0, NULL, 1, value, 0.0, NULL, 0, false, 0, 0, NULL};
   field_set(field, WB_SF_BOOL, &a, "wb_supervisor_field_set_sf_bool");
 }
 
 void wb_supervisor_field_set_sf_float(WbFieldRef field, double value) {
-  field_args a = {0, NULL, 2, false, value, NULL, 0, false, 0};
+  field_args a = {0, NULL, 2, false, value, NULL, 0, false, 0, 0, NULL};
   field_set(field, WB_SF_FLOAT, &a, "wb_supervisor_field_set_sf_float");
 }
 
 void wb_supervisor_field_set_sf_vec3f(WbFieldRef field, const double values[3]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0};
+  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0, 0, NULL};
   field_set(field, WB_SF_VEC3F, &a, "wb_supervisor_field_set_sf_vec3f");
 }
 
 void wb_supervisor_field_set_sf_rotation(WbFieldRef field, const double values[4]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 4, false, 0};
+  field_args a = {0, NULL, 3, false, 0.0, values, 4, false, 0, 0, NULL};
   field_set(field, WB_SF_ROTATION, &a, "wb_supervisor_field_set_sf_rotation");
 }
 
 void wb_supervisor_field_set_sf_color(WbFieldRef field, const double values[3]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0};
+  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0, 0, NULL};
   field_set(field, WB_SF_COLOR, &a, "wb_supervisor_field_set_sf_color");
+}
+
+/* read-only here (a robot's name, WorldInfo's randomSeed, a PROTO's fields, ...): the server's line */
+void wb_supervisor_field_set_sf_int32(WbFieldRef field, int value) {
+  field_args a = {.kind = 4, .integer = value};
+  field_set(field, WB_SF_INT32, &a, "wb_supervisor_field_set_sf_int32");
+}
+
+void wb_supervisor_field_set_sf_vec2f(WbFieldRef field, const double values[2]) {
+  field_args a = {.kind = 3, .values = values, .n = 2};
+  field_set(field, WB_SF_VEC2F, &a, "wb_supervisor_field_set_sf_vec2f");
+}
+
+void wb_supervisor_field_set_sf_string(WbFieldRef field, const char *value) {
+  field_args a = {.kind = 5, .string = value};
+  field_set(field, WB_SF_STRING, &a, "wb_supervisor_field_set_sf_string");
 }
 
 /* an MF field's item set, inserted or removed (Webots' setMF*, insertMF*, removeMF): served on an imported
@@ -1245,8 +1279,6 @@ typedef struct {
   const char *string;
 } mf_args;
 
-/* the longest MFString item sent (the server's bound) */
-#define SN_MAX_MF_STRING 4096
 
 static void args_mf(sn_req *r, const void *arg) {
   const mf_args *a = arg;

@@ -101,19 +101,8 @@ WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
 }
 
 
-void wb_supervisor_field_set_sf_int32(WbFieldRef field, int value) {
-  SN_UNSUPPORTED();
-}
 
 
-void wb_supervisor_field_set_sf_vec2f(WbFieldRef field, const double values[2]) {
-  SN_UNSUPPORTED();
-}
-
-
-void wb_supervisor_field_set_sf_string(WbFieldRef field, const char *value) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_field_remove_sf(WbFieldRef field) {
   SN_UNSUPPORTED();

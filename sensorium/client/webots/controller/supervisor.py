@@ -188,6 +188,15 @@ class Field:
     def importSFNodeFromString(self, nodeString: str) -> None:  # noqa: N803 - Webots' name
         wb.wb_supervisor_field_import_sf_node_from_string(self._ref, nodeString)
 
+    def setSFInt32(self, value: int) -> None:
+        wb.wb_supervisor_field_set_sf_int32(self._ref, value)
+
+    def setSFVec2f(self, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_sf_vec2f(self._ref, value)
+
+    def setSFString(self, value: str) -> None:
+        wb.wb_supervisor_field_set_sf_string(self._ref, value)
+
     def removeMF(self, index: int) -> None:
         wb.wb_supervisor_field_remove_mf(self._ref, index)
 
@@ -209,7 +218,7 @@ class Field:
     count = property(getCount)
 
     _SETTERS = {wb.WB_SF_BOOL: "setSFBool", wb.WB_SF_FLOAT: "setSFFloat", wb.WB_SF_STRING: "setSFString",
-                wb.WB_SF_VEC3F: "setSFVec3f", wb.WB_SF_ROTATION: "setSFRotation", wb.WB_SF_COLOR: "setSFColor"}
+                wb.WB_SF_INT32: "setSFInt32", wb.WB_SF_VEC2F: "setSFVec2f", wb.WB_SF_VEC3F: "setSFVec3f", wb.WB_SF_ROTATION: "setSFRotation", wb.WB_SF_COLOR: "setSFColor"}
 
     @property
     def value(self) -> Any:
@@ -562,12 +571,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "getActualField": ("field_get_actual_field", None, ""),
         "removeSF": ("field_remove_sf", None, "")},
 }
-_FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 2, "Vec3f": [_NAN] * 3,
-                    "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
-for _kind, _none in _FIELD_NO_VALUES.items():
-    _c = _kind.lower()
-    if _kind in ("Int32", "Vec2f", "String"):  # SFString fields are read-only here
-        _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None, "value")
 for _cls, _methods in _UNSERVED.items():
     for _method, (_func, _value, _params) in _methods.items():
         assert not hasattr(_cls, _method), _method        # never hides a served method
