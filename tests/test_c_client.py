@@ -299,7 +299,7 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
                       "wwi (null) (null) 0",                 # no robot window
                       "default window (null)",               # its default window's functions: compile, run, no effect
                       "step 0",
-                      "supervisor NULL 1 SFRotation -1 -1 nan  1 0",   # beyond the subset: "no value"
+                      "supervisor NULL 1 SFRotation -1 10 nan  1 0",   # beyond the subset: "no value"; 10 fields
                       "after quit -1"]     # the simulation ended for this controller: the next step ends it
     warned = [line for line in err.splitlines() if "does not simulate" in line]
     assert "wbu_default_robot_window" not in err, err
@@ -307,11 +307,10 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
     unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
     assert unserved == ["Error: wb_supervisor_" + f for f in ("movie_is_ready", "node_export_string",
-                                                              "node_get_center_of_mass", "node_get_number_of_fields",
-                                                              "node_get_selected")], err
-    # served for a PROTO's interface fields: Webots' line for the robot's SFRotation, 0; the robot is no PROTO
+                                                              "node_get_center_of_mass", "node_get_selected")], err
+    # served for a PROTO's interface fields: Webots' line for the robot's SFRotation, 0; the robot (no PROTO)
+    # counts the 10 fields served for a Robot
     assert "Error: wb_supervisor_field_get_mf_int32() called with wrong field type: SFRotation." in err
-    assert "wb_supervisor_node_get_number_of_fields(): not served by Sensorium on a node that is no PROTO" in err
     assert "simulation_quit" not in err
 
 

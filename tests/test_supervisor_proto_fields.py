@@ -342,7 +342,7 @@ moved 1 1 0.10000000000000001
 moved 0.25 -0.5 0.10000000000000001
 kept 0.125
 parent Crate 1
-box 1 -1 1
+box 1 6 0
 me 14""".splitlines()
 FOREIGN_FIELD = "foreignfield -1 nan 1"       # C only: a WbFieldRef the library never gave
 

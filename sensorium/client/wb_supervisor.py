@@ -510,9 +510,9 @@ def wb_supervisor_proto_get_field(proto: Proto | None, field_name: str) -> Field
     return _get_field(proto[0], field_name, proto[1], func)
 
 
-def _field_by_index(names: list, index: Any, func: str) -> str | None:
+def _field_by_index(names: list, index: Any, func: str, whose: str = "the PROTO") -> str | None:
     if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(names):
-        print(f"Error: {func}() called with an invalid 'index' argument: {index!r} (the PROTO has {len(names)} "
+        print(f"Error: {func}() called with an invalid 'index' argument: {index!r} ({whose} has {len(names)} "
               "fields).", file=sys.stderr)
         return None
     return str(names[index])
@@ -528,31 +528,70 @@ def wb_supervisor_proto_get_field_by_index(proto: Proto | None, index: int) -> F
     return None if name is None else _get_field(proto[0], name, proto[1], func)
 
 
-def _node_proto(node: Any, func: str) -> dict | None:
-    """A PROTO instance's own PROTO; None after one line for a base node (Sensorium counts and lists a
-    PROTO's interface fields only)."""
+def _node_fields(node: Any, func: str, base: bool) -> tuple[list, int, str] | None:
+    """The field names ``getNumberOfFields`` (``base`` False: a PROTO instance's interface, else its base
+    node's) or ``getNumberOfBaseNodeFields`` (``base`` True) count, with the level a field is asked at and
+    whose fields they are (for a line); None after one line (a NULL or removed node)."""
     r = _checked_node(node, func)
     if r is None:
         return None
-    info = _proto_info(r, int(node), 1, func)
-    if info is None:
-        supervisor_unserved(func, "on a node that is no PROTO instance (Sensorium lists the fields of PROTO "
-                                  "instances only)")
-    return info
+    info = None if base else _proto_info(r, int(node), 1, func)
+    if info is not None:
+        return list(info.get("fields", [])), -1, "the PROTO"
+    got = _answer(r, "get_proto", {"node": int(node), "level": 0}, func)    # the base node's served fields
+    return None if got is None else (list(got.get("fields", [])), 0 if base else -1, "the node")
+
+
+_proto_def_warned: list[bool] = []
+
+
+def wb_supervisor_node_get_from_proto_def(node: int | None, def_name: str) -> int | None:
+    """Webots' DEF lookup inside a PROTO instance's body: Sensorium does not keep the DEF names of a PROTO's
+    internal nodes (Webots' getFromDef does not find them either), so after Webots' checks a PROTO instance
+    gets one line (the first time) and None; a node that is no PROTO instance has no internal DEF: None."""
+    func = "wb_supervisor_node_get_from_proto_def"
+    r = _checked_node(node, func)
+    if r is None:
+        return None
+    if not isinstance(def_name, str) or not def_name:
+        print(f"Error: {func}() called with a NULL or empty 'def' argument.", file=sys.stderr)
+        return None
+    if _proto_info(r, int(node), 1, func) is not None and not _proto_def_warned:  # type: ignore[arg-type]
+        _proto_def_warned.append(True)
+        print(f"Error: {func}(): Sensorium does not keep the DEF names inside a PROTO's body (reach those nodes "
+              "through 'children', getFromDevice, ...): None returned.", file=sys.stderr)
+    return None
 
 
 def wb_supervisor_node_get_number_of_fields(node: int | None) -> int:
-    """A PROTO instance's interface fields, as Webots counts them (a base node: not served, -1)."""
-    info = _node_proto(node, "wb_supervisor_node_get_number_of_fields")
-    return -1 if info is None else len(info.get("fields", []))
+    """A PROTO instance's interface fields, as Webots counts them; a base node's fields served here
+    (Webots counts all its node type's fields; README "Supervisor" says which are left out)."""
+    got = _node_fields(node, "wb_supervisor_node_get_number_of_fields", False)
+    return -1 if got is None else len(got[0])
 
 
 def wb_supervisor_node_get_field_by_index(node: int | None, index: int) -> Field | None:
-    """A PROTO instance's interface field ``index`` (declaration order)."""
+    """A PROTO instance's interface field ``index`` (declaration order); a base node's served field ``index``
+    (Webots' declaration order)."""
     func = "wb_supervisor_node_get_field_by_index"
-    info = _node_proto(node, func)
-    name = None if info is None else _field_by_index(info.get("fields", []), index, func)
-    return None if name is None else _get_field(node, name, -1, func)
+    got = _node_fields(node, func, False)
+    name = None if got is None else _field_by_index(got[0], index, func, got[2])
+    return None if name is None or got is None else _get_field(node, name, got[1], func)
+
+
+def wb_supervisor_node_get_number_of_base_node_fields(node: int | None) -> int:
+    """The base node's fields served here (a PROTO instance's Robot, Solid, ...; a base node's own)."""
+    got = _node_fields(node, "wb_supervisor_node_get_number_of_base_node_fields", True)
+    return -1 if got is None else len(got[0])
+
+
+def wb_supervisor_node_get_base_node_field_by_index(node: int | None, index: int) -> Field | None:
+    """The base node's served field ``index``, in Webots' declaration order (on a PROTO instance read-only,
+    as ``getBaseNodeField``)."""
+    func = "wb_supervisor_node_get_base_node_field_by_index"
+    got = _node_fields(node, func, True)
+    name = None if got is None else _field_by_index(got[0], index, func, got[2])
+    return None if name is None or got is None else _get_field(node, name, got[1], func)
 
 
 def wb_supervisor_field_get_type(field: Field | None) -> int:
@@ -742,6 +781,10 @@ def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
     # a value of the wrong shape is printed and ignored, as Webots' Python Field does (no exception)
     if want == WB_SF_BOOL:
         wire: Any = bool(value)
+    elif want in (WB_SF_INT32, WB_SF_STRING):     # read-only here: the server's line
+        wire = _mf_value(WB_MF_INT32 if want == WB_SF_INT32 else WB_MF_STRING, value, func)
+        if wire is None:
+            return
     elif want == WB_SF_FLOAT:
         try:
             wire = float(value)
@@ -749,7 +792,7 @@ def _field_set(field: Field | None, want: int, value: Any, func: str) -> None:
             print(f"Error: {func}(): expected a number, got {value!r}.", file=sys.stderr)
             return
     else:
-        n = 4 if want == WB_SF_ROTATION else 3
+        n = 4 if want == WB_SF_ROTATION else 2 if want == WB_SF_VEC2F else 3
         try:
             wire = [float(v) for v in value]
         except (TypeError, ValueError):
@@ -785,6 +828,22 @@ def wb_supervisor_field_set_sf_color(field: Field | None, values: Any) -> None:
     _field_set(field, WB_SF_COLOR, values, "wb_supervisor_field_set_sf_color")
 
 
+def wb_supervisor_field_set_sf_int32(field: Field | None, value: int) -> None:
+    _field_set(field, WB_SF_INT32, value, "wb_supervisor_field_set_sf_int32")
+
+
+def wb_supervisor_field_set_sf_vec2f(field: Field | None, values: Any) -> None:
+    _field_set(field, WB_SF_VEC2F, values, "wb_supervisor_field_set_sf_vec2f")
+
+
+def wb_supervisor_field_set_sf_string(field: Field | None, value: str) -> None:
+    _field_set(field, WB_SF_STRING, value, "wb_supervisor_field_set_sf_string")
+
+
+MAX_MF_STRING = 4096
+"""The longest MFString item a set or insert sends (the server's bound)."""
+
+
 def _mf_change(field: Field | None, want: int | None, op: str, index: Any, value: Any, func: str) -> None:
     """An MF field's item set, inserted or removed (``want`` None: any MF type, removeMF); the server
     checks the index (negative from the end, as Webots) and the value, and says what is wrong in one
@@ -800,26 +859,59 @@ def _mf_change(field: Field | None, want: int | None, op: str, index: Any, value
         print(f"Error: {func}() called with an invalid 'index' argument: {index!r}.", file=sys.stderr)
         return
     args: dict[str, Any] = {**_field_args(field), "index": index, "op": op}
-    if op != "remove" and want == WB_MF_INT32:
-        if isinstance(value, bool) or not isinstance(value, int) or not -(1 << 31) <= value < 1 << 31:
-            print(f"Error: {func}(): expected a 32-bit whole number, got {value!r}.", file=sys.stderr)
-            return
-        args["value"] = value
-    elif op != "remove":
-        n = 4 if want == WB_MF_ROTATION else 2 if want == WB_MF_VEC2F else 3
-        try:
-            wire = [float(v) for v in value]
-        except (TypeError, ValueError):
-            print(f"Error: {func}(): expected {n} numbers, got {value!r}.", file=sys.stderr)
-            return
-        if len(wire) != n:
-            print(f"Error: {func}(): expected {n} numbers, got {len(wire)}.", file=sys.stderr)
-            return
-        if not all(math.isfinite(v) for v in wire):
-            print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
+    if op != "remove":
+        wire = _mf_value(want, value, func)
+        if wire is None:
             return
         args["value"] = wire
     _answer(r, "set_field", args, func)
+
+
+def _mf_value(want: int | None, value: Any, func: str) -> Any:
+    """An item's value as sent, after the client's checks (Webots': a NULL string, NaN, a zero rotation
+    axis); None after one line."""
+    if want == WB_MF_BOOL:
+        return bool(value)
+    if want == WB_MF_INT32:
+        if isinstance(value, bool) or not isinstance(value, int) or not -(1 << 31) <= value < 1 << 31:
+            print(f"Error: {func}(): expected a 32-bit whole number, got {value!r}.", file=sys.stderr)
+            return None
+        return value
+    if want == WB_MF_STRING:
+        if not isinstance(value, str):
+            print(f"Error: {func}() called with a NULL or non-string 'value' argument: {value!r}.", file=sys.stderr)
+            return None
+        if len(value) > MAX_MF_STRING:
+            print(f"Error: {func}(): a string of {len(value)} characters is longer than the {MAX_MF_STRING} "
+                  "a field item takes here.", file=sys.stderr)
+            return None
+        return value
+    if want == WB_MF_FLOAT:
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            print(f"Error: {func}(): expected a number, got {value!r}.", file=sys.stderr)
+            return None
+        if not math.isfinite(number):
+            print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
+            return None
+        return number
+    n = 4 if want == WB_MF_ROTATION else 2 if want == WB_MF_VEC2F else 3
+    try:
+        wire = [float(v) for v in value]
+    except (TypeError, ValueError):
+        print(f"Error: {func}(): expected {n} numbers, got {value!r}.", file=sys.stderr)
+        return None
+    if len(wire) != n:
+        print(f"Error: {func}(): expected {n} numbers, got {len(wire)}.", file=sys.stderr)
+        return None
+    if not all(math.isfinite(v) for v in wire):
+        print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
+        return None
+    if want == WB_MF_ROTATION and wire[0] == wire[1] == wire[2] == 0.0:
+        print(f"Error: {func}() called with invalid values for the [x y z] axis (a zero vector).", file=sys.stderr)
+        return None
+    return wire
 
 
 def wb_supervisor_field_set_mf_int32(field: Field | None, index: int, value: int) -> None:
@@ -844,6 +936,46 @@ def wb_supervisor_field_insert_mf_vec3f(field: Field | None, index: int, values:
 
 def wb_supervisor_field_insert_mf_color(field: Field | None, index: int, values: Any) -> None:
     _mf_change(field, WB_MF_COLOR, "insert", index, values, "wb_supervisor_field_insert_mf_color")
+
+
+def wb_supervisor_field_set_mf_bool(field: Field | None, index: int, value: bool) -> None:
+    _mf_change(field, WB_MF_BOOL, "set", index, value, "wb_supervisor_field_set_mf_bool")
+
+
+def wb_supervisor_field_insert_mf_bool(field: Field | None, index: int, value: bool) -> None:
+    _mf_change(field, WB_MF_BOOL, "insert", index, value, "wb_supervisor_field_insert_mf_bool")
+
+
+def wb_supervisor_field_set_mf_float(field: Field | None, index: int, value: float) -> None:
+    _mf_change(field, WB_MF_FLOAT, "set", index, value, "wb_supervisor_field_set_mf_float")
+
+
+def wb_supervisor_field_insert_mf_float(field: Field | None, index: int, value: float) -> None:
+    _mf_change(field, WB_MF_FLOAT, "insert", index, value, "wb_supervisor_field_insert_mf_float")
+
+
+def wb_supervisor_field_set_mf_vec2f(field: Field | None, index: int, values: Any) -> None:
+    _mf_change(field, WB_MF_VEC2F, "set", index, values, "wb_supervisor_field_set_mf_vec2f")
+
+
+def wb_supervisor_field_insert_mf_vec2f(field: Field | None, index: int, values: Any) -> None:
+    _mf_change(field, WB_MF_VEC2F, "insert", index, values, "wb_supervisor_field_insert_mf_vec2f")
+
+
+def wb_supervisor_field_set_mf_rotation(field: Field | None, index: int, values: Any) -> None:
+    _mf_change(field, WB_MF_ROTATION, "set", index, values, "wb_supervisor_field_set_mf_rotation")
+
+
+def wb_supervisor_field_insert_mf_rotation(field: Field | None, index: int, values: Any) -> None:
+    _mf_change(field, WB_MF_ROTATION, "insert", index, values, "wb_supervisor_field_insert_mf_rotation")
+
+
+def wb_supervisor_field_set_mf_string(field: Field | None, index: int, value: str) -> None:
+    _mf_change(field, WB_MF_STRING, "set", index, value, "wb_supervisor_field_set_mf_string")
+
+
+def wb_supervisor_field_insert_mf_string(field: Field | None, index: int, value: str) -> None:
+    _mf_change(field, WB_MF_STRING, "insert", index, value, "wb_supervisor_field_insert_mf_string")
 
 
 def wb_supervisor_field_remove_mf(field: Field | None, index: int) -> None:
@@ -873,6 +1005,27 @@ def wb_supervisor_field_import_mf_node_from_string(field: Field | None, position
         _call(r, "import_node_from_string", {"node": field[0], "field": field[1], "position": position,
                                              "node_string": node_string})
     except SensoriumError as err:      # a robot, a bad string, limits: the server's line
+        if err.code != ErrorCode.INVALID_ARGUMENT:
+            raise
+        print(f"Error: {func}(): {err.message}.", file=sys.stderr)
+
+
+def wb_supervisor_field_import_sf_node_from_string(field: Field | None, node_string: str) -> None:
+    """Webots' ``importSFNodeFromString``: served into the empty ``coord`` (a ``Coordinate``) or ``color`` (a
+    ``Color``) of an imported line or point set; any other SFNode field, a full one or a string that does not
+    read is refused with the server's one line, nothing changed."""
+    func = "wb_supervisor_field_import_sf_node_from_string"
+    r = _field_robot(field, WB_SF_NODE, func)
+    if r is None:
+        return
+    assert field is not None
+    if not isinstance(node_string, str) or not node_string:
+        print(f"Error: {func}() called with a NULL or empty 'node_string' argument.", file=sys.stderr)
+        return
+    try:
+        _call(r, "import_node_from_string", {"node": field[0], "field": field[1], "position": 0,
+                                             "node_string": node_string})
+    except SensoriumError as err:      # not a slot served here, a full one, a bad string: the server's line
         if err.code != ErrorCode.INVALID_ARGUMENT:
             raise
         print(f"Error: {func}(): {err.message}.", file=sys.stderr)

@@ -327,10 +327,11 @@ class SetFieldArgs(Args):
     node: NodeId
     field: FieldName
     level: int = Field(default=-1, ge=-1, le=16, description=_LEVEL)
-    value: bool | int | float | Annotated[list[float], Field(min_length=2, max_length=4)] | None = Field(
+    value: bool | int | float | Annotated[list[float], Field(min_length=2, max_length=4)] | \
+        Annotated[str, Field(max_length=4096)] | None = Field(
         default=None, description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis "
-        "x, y, z, angle; an MF field's item (with index): MFInt32 a whole number, MFVec3f/MFColor 3 numbers; none to "
-        "remove")
+        "x, y, z, angle; SFInt32 a whole number, SFVec2f 2 numbers, SFString a string (read-only here); an MF field's item (with index): MFBool true/false, MFInt32 a whole number, MFFloat a "
+        "number, MFVec2f 2 numbers, MFVec3f/MFColor 3 numbers, MFRotation 4, MFString a string; none to remove")
     index: int | None = Field(default=None, ge=-(1 << 31), lt=1 << 31, description=(
         "an MF field's item (negative from the end, as Webots): setMF*, insertMF* (0 first, -1 after the last), "
         "removeMF; absent: the field as a whole"))
@@ -339,8 +340,9 @@ class SetFieldArgs(Args):
 
 class ProtoArgs(Args):
     node: NodeId
-    level: int = Field(default=1, ge=1, le=16, description="the k-th PROTO of the node's chain: 1 its own PROTO "
-                       "(Webots' getProto()), 2 the PROTO that one is built on (getParent()), ...")
+    level: int = Field(default=1, ge=0, le=16, description="the k-th PROTO of the node's chain: 1 its own PROTO "
+                       "(Webots' getProto()), 2 the PROTO that one is built on (getParent()), ...; 0 the base node "
+                       "(its base type name and the fields served here, in Webots' declaration order)")
 
 
 class SetJointPositionArgs(Args):
@@ -356,8 +358,10 @@ class NodeStateArgs(Args):
 
 
 class ImportNodeArgs(Args):
-    node: NodeId = Field(description="the node whose field takes the nodes: the root (0) here")
-    field: FieldName = Field(description="its MFNode field: 'children'")
+    node: NodeId = Field(description="the node whose field takes the nodes: the root (0), or an imported line or "
+                         "point set (importSFNodeFromString)")
+    field: FieldName = Field(description="its MFNode field: 'children'; or the set's empty SFNode 'coord' (a "
+                             "Coordinate) or 'color' (a Color): one node, position ignored")
     position: int = Field(ge=-(1 << 31), lt=1 << 31, description=(
         "where in the list: 0 first, -1 after the last, -2 before the last (Webots); past an end: that end"))
     node_string: str = Field(max_length=1 << 24, description=(

@@ -702,26 +702,70 @@ def get_field(sim: Any, node: Node, field: str, level: int = -1) -> dict:
         return {"type": entry[0], "value": [], "note": str(exc)}
 
 
+_SOLID_ORDER = ("translation", "rotation", "scale", "children", "name", "model", "radarCrossSection", "controller",
+                "customData", "supervisor", "synchronization")
+_JOINT_ORDER = ("jointParameters", "jointParameters2", "jointParameters3", "device", "device2", "device3", "endPoint")
+_LIGHT_ORDER = ("ambientIntensity", "attenuation", "beamWidth", "color", "cutOffAngle", "direction", "intensity",
+                "location", "on", "radius", "castShadows")
+DECLARATION_ORDER: dict[str, tuple[str, ...]] = {
+    "WorldInfo": ("title", "gravity", "basicTimeStep", "inkEvaporation", "coordinateSystem", "gpsCoordinateSystem",
+                  "gpsReference", "randomSeed"),
+    "Viewpoint": ("fieldOfView", "orientation", "position", "description", "near", "far", "exposure", "follow"),
+    **{kind: _LIGHT_ORDER for kind in LIGHTS},
+    **{kind: _JOINT_ORDER for kind in nested.JOINT_DEVICES},
+}
+"""Webots' declaration order of the fields served here (its nodes' .wrl files), for the node types whose
+served fields are not built in that order; any other type's (a Solid, a device, a Pose: ``_SOLID_ORDER``;
+a Shape's nodes, visual nodes: their tables, written in Webots' order) keep it."""
+
+
+def field_names(sim: Any, node: Node, level: int = 0) -> list[str]:
+    """The fields Sensorium serves of the node's base node (level 0) or of its PROTO ``level``, in Webots'
+    declaration order: what ``getNumberOfFields``/``getFieldByIndex`` of a base node and
+    ``getNumberOfBaseNodeFields``/``getBaseNodeFieldByIndex`` count and list. Webots' other fields
+    (``description``, ``boundingObject``, ``physics``, ...) are left out: they are not served here."""
+    names = list(_fields(sim, node, level))
+    if level >= 1:
+        return names
+    order = DECLARATION_ORDER.get(node.type, _SOLID_ORDER)
+    rank = {name: k for k, name in enumerate(order)}
+    return sorted(names, key=lambda name: (rank.get(name, len(order)), names.index(name)))
+
+
 def get_proto(sim: Any, node: Node, level: int) -> dict:
     """Webots' ``getProto()`` (level 1) and ``getParent()`` (level + 1): the PROTO's name, whether it is
-    built on another PROTO, its interface fields' names; type_name '' for none."""
+    built on another PROTO, its interface fields' names; type_name '' for none. Level 0: the base node,
+    its type name and the fields served here (:func:`field_names`)."""
+    if level == 0:
+        return {"type_name": node.type, "derived": False, "fields": field_names(sim, node, 0)}
     if not 1 <= level <= len(node.interface):
         return {"type_name": "", "derived": False, "fields": []}
     proto = node.interface[level - 1]
     return {"type_name": proto.name, "derived": proto.derived, "fields": [f.name for f in proto.fields]}
 
 
-def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: Any) -> None:
-    """Webots' ``setMF*``/``insertMF*``/``removeMF``: on an imported line or point set's MF fields
-    (visuals.py); any other MF field is read-only here (one line, nothing changed)."""
-    fields = _fields(sim, node)
+def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: Any, level: int = -1) -> None:
+    """Webots' ``setMF*``/``insertMF*``/``removeMF`` of every MF type: on an imported line or point set's MF
+    fields (visuals.py); any other MF field (a PROTO's interface field of any type too) is read-only here
+    (one line, nothing changed)."""
+    level = _level(node, level)
+    fields = _fields(sim, node, level)
     entry = fields.get(field)
     what = visuals.what(_vnode(sim, node)) if node.visual and node.id >= visuals.FIRST_ID else _what(node)
+    if level >= 1:
+        what = f"PROTO {node.interface[level - 1].name} ({what})"
     if entry is None:
         raise ValueError(f"{what} has no field {field!r} here (fields: {', '.join(fields) or 'none'})")
     kind = entry[0]
     if not kind.startswith("MF"):
         raise ValueError(f"field {field!r} of {what} is an {kind}, not a list: set it as a whole")
+    if level >= 1:
+        raise ValueError(f"field {field!r} ({kind}) of {what}: its items are read-only here (Webots regenerates the "
+                         "node when a PROTO field is changed; a Supervisor changes the items of an imported line or "
+                         "point set's fields only); nothing changed")
+    if level == 0 and node.interface:
+        raise ValueError(f"field {field!r} ({kind}) of {what} is a PROTO internal field (getBaseNodeField): its "
+                         "items are read-only, as in Webots; nothing changed")
     if not (node.visual and node.id >= visuals.FIRST_ID and visuals.settable(_vnode(sim, node), field)):
         if node.visual and node.id >= visuals.FIRST_ID:
             raise ValueError(visuals.read_only_line(_vnode(sim, node), field, kind))
@@ -807,7 +851,7 @@ def node_velocity(sim: Any, node: Node) -> list[float]:
 
 def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     if a.index is not None:          # an MF field's item: set, inserted or removed
-        change_item(sim, node_by_id(sim, a.node), a.field, a.op, a.index, a.value)
+        change_item(sim, node_by_id(sim, a.node), a.field, a.op, a.index, a.value, a.level)
         return {"success": True}
     set_field(sim, node_by_id(sim, a.node), a.field, a.value, a.level)
     return {"success": True}
@@ -962,9 +1006,16 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
                  warnings: list[str] | None = None) -> list[int]:
     """Webots' ``importMFNodeFromString`` on the root's ``children``: the string's solids and
     lights join the world from the next measurement, inserted at ``position`` (Webots' rule,
-    :func:`insert_index`); returns their new ids. Any other field is refused (Sensorium's nodes
-    have no other MFNode field); a string that cannot be imported changes nothing (one line).
-    ``warnings`` gets the values corrected as Webots corrects them (Webots prints them in its console)."""
+    :func:`insert_index`); returns their new ids. An SFNode field is Webots' ``importSFNodeFromString``
+    (:func:`import_sf_node`); any other field is refused (Sensorium's nodes have no other MFNode field
+    taking imports); a string that cannot be imported changes nothing (one line). ``warnings`` gets the
+    values corrected as Webots corrects them (Webots prints them in its console)."""
+    try:
+        entry = _fields(sim, node).get(field) if node.id != 0 else None
+    except (KeyError, ValueError):
+        entry = None
+    if entry is not None and entry[0] == "SFNode":        # importSFNodeFromString
+        return [import_sf_node(sim, node, field, text)]
     if node.id != 0 or field != "children":
         what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
         raise ValueError(f"field {field!r} of {what}: nodes are imported into the root's 'children' only here")
@@ -973,6 +1024,27 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
     added = [node_id for _, _, node_id in sim.import_nodes(text, warnings)]
     sim.root_order = current[:index] + added + current[index:]
     return added
+
+
+def import_sf_node(sim: Any, node: Node, field: str, text: str) -> int:
+    """Webots' ``importSFNodeFromString``: into an empty ``coord`` or ``color`` of an imported line or point
+    set (visuals.py: a ``Coordinate`` or ``Color`` as written, seen by no sensor, its items then set as the
+    others'); returns its id. Any other SFNode field is read-only here, a full one refused as in Webots
+    (one line, nothing changed)."""
+    from sensorium.server.sim.imports import parse_sf_node_string
+
+    fields = _fields(sim, node)
+    entry = fields.get(field)
+    if entry is None or entry[0] != "SFNode":
+        kind = f" ({entry[0]})" if entry else ""
+        raise ValueError(f"field {field!r}{kind} of {_what(node)}: a node string is imported into an SFNode field only")
+    if not (node.visual and node.id >= visuals.FIRST_ID):
+        raise ValueError(f"field {field!r} (SFNode) of {_what(node)} is read-only here: a node string is imported into "
+                         "the empty coord or color of an imported line or point set only; nothing changed")
+    parent = _vnode(sim, node)
+    if parent.values.get(field, 0) or not (parent.inert and field in visuals.SF_SLOTS.get(parent.type, {})):
+        return _visuals(sim).attach(parent, field, None)       # its line: full, or not a slot served here
+    return _visuals(sim).attach(parent, field, parse_sf_node_string(text, sim.limits))
 
 
 def _import(sim: Any, ls: Any, robot: str, a: Any) -> dict:

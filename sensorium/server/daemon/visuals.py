@@ -69,6 +69,9 @@ TABLES: dict[str, dict[str, tuple[str, Any]]] = {
 
 _WIDTH = {"MFVec3f": 3, "MFColor": 3, "MFVec2f": 2, "MFRotation": 4, "SFVec3f": 3, "SFColor": 3, "SFVec2f": 2,
           "SFRotation": 4}
+SF_SLOTS = {"IndexedLineSet": {"coord": "Coordinate", "color": "Color"}, "PointSet": {"coord": "Coordinate",
+                                                                                        "color": "Color"}}
+"""The SFNode fields a node string is imported into (when empty), with the node type each takes."""
 SETTABLE = {"IndexedLineSet": ("coordIndex", "colorIndex"), "Coordinate": ("point",), "Color": ("color",)}
 """The MF fields set here, on nodes of a line or point set only."""
 
@@ -138,6 +141,42 @@ class Store:
                 me.values[name] = ids
             else:
                 me.values[name] = _read(kind, value, default)
+
+    def attach(self, parent: VNode, name: str, written: Any) -> int:
+        """Webots' ``importSFNodeFromString`` into an empty slot of an imported line or point set (its
+        ``coord`` takes a ``Coordinate``, its ``color`` a ``Color``): the node joins with the next id, as
+        written; ValueError (one line, nothing changed) for any other field, a full slot or another node type."""
+        kind = fields(parent).get(name)
+        where = f"field {name!r} ({kind}) of {what(parent)}"
+        want = SF_SLOTS.get(parent.type, {}).get(name) if parent.inert else None
+        if want is None:
+            raise ValueError(f"{where} is read-only here: a node string is imported into the empty coord or color of "
+                             "an imported line or point set only; nothing changed")
+        if parent.values.get(name, 0):
+            raise ValueError(f"{where} is not empty (Webots imports into an empty SFNode field only: remove its "
+                             "node first, or import the whole shape again); nothing changed")
+        if getattr(written, "type", None) != want:
+            raise ValueError(f"{where} takes a {want} node here, got {getattr(written, 'type', written)!r}; nothing "
+                             "changed")
+        child = first = self.next_id
+        self.next_id += 1
+        self._node(written, child, parent.id, name, parent.key, True, -1)
+        me = self.nodes[child]
+        try:             # its lists as the item setters check them: at most MAX_ITEMS, each item in range
+            for field_name in SETTABLE.get(me.type, ()):
+                items = me.values[field_name]
+                if len(items) > MAX_ITEMS:
+                    raise ValueError(f"field {field_name!r} of {what(me)}: {len(items):,} items, more than the "
+                                     f"{MAX_ITEMS:,} an imported line or point set's field holds here; nothing changed")
+                for item in items:
+                    _item(me, field_name, fields(me)[field_name], item)
+        except ValueError:
+            for i in range(first, self.next_id):
+                self.nodes.pop(i, None)
+            self.next_id = first
+            raise
+        parent.values[name] = child
+        return child
 
     def inside(self, root_id: int) -> list[VNode]:
         """The nodes inside a root, depth first (its own fields' order)."""
@@ -258,4 +297,4 @@ def change(n: VNode, name: str, op: str, index: int, value: Any) -> None:
 
 
 __all__ = ["FIRST_ID", "MAX_ITEMS", "ROOTS", "INSIDE", "LINES", "TABLES", "VNode", "Store", "fields", "settable",
-           "change", "what", "read_only_line"]
+           "change", "what", "read_only_line", "SF_SLOTS"]

@@ -117,6 +117,27 @@ def _syntax(exc: WbtSyntaxError, source: str) -> ImportRefused:
     return ImportRefused(f"{at}: {_shown(exc.message, source)}")
 
 
+def parse_sf_node_string(text: Any, limits: WorldLimits) -> Any:
+    """A Supervisor's ``importSFNodeFromString`` string read as one node with the world file's parser and
+    bounds (no PROTO, no conversion: the caller serves the node as written); ImportRefused (one line) for
+    anything else."""
+    if not isinstance(text, str):
+        raise ImportRefused(f"the node string must be a string, got {type(text).__name__}")
+    size = len(text.encode("utf-8", errors="surrogatepass"))
+    if size > limits.file_bytes:
+        raise ImportRefused(f"a node string of {size:,} bytes, more than the world file limit of "
+                            f"{limits.file_bytes:,} (raise the limits with --allow-large)")
+    source = "<importSFNodeFromString>"
+    try:
+        wbt = Parser(Tokens(text, source), source, limits=ProtoLimits.matching(limits)).file(DEFAULT_VERSION, text)
+    except WbtSyntaxError as exc:
+        raise _syntax(exc, source) from None
+    if wbt.declarations or wbt.protos or len(wbt.nodes) != 1:
+        raise ImportRefused(f"{LABEL}: an SFNode field takes exactly one node, declaring no PROTO "
+                            f"(got {len(wbt.nodes)} nodes)")
+    return wbt.nodes[0]
+
+
 def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: set[str], limits: WorldLimits,
                      allow_outside_meshes: bool = False, protos: _WorldProtos | None = None,
                      warnings: list[str] | None = None) -> list[ImportedNode]:
@@ -270,4 +291,4 @@ def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles
     over("triangles", triangles_now, triangles_added, limits.triangles)
 
 
-__all__ = ["ImportRefused", "ImportedNode", "read_node_string", "check_additions", "world_protos"]
+__all__ = ["parse_sf_node_string", "ImportRefused", "ImportedNode", "read_node_string", "check_additions", "world_protos"]

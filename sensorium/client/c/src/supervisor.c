@@ -633,16 +633,21 @@ static const struct {
                    {"MFVec2f", WB_MF_VEC2F},     {"MFVec3f", WB_MF_VEC3F},   {"MFRotation", WB_MF_ROTATION},
                    {"MFColor", WB_MF_COLOR},     {"MFString", WB_MF_STRING}, {"MFNode", WB_MF_NODE}};
 
+/* the longest string a set or an MFString item sends (the server's bound) */
+#define SN_MAX_MF_STRING 4096
+
 typedef struct {
   int64_t node;
   const char *name;
-  int kind; /* 0: no value, 1: bool, 2: double, 3: numbers */
+  int kind; /* 0: no value, 1: bool, 2: double, 3: numbers, 4: an int32, 5: a string */
   bool flag;
   double number;
   const double *values;
   int n;
   bool has_level; /* a PROTO level (FieldArgs.level) is sent */
   int level;
+  int integer;
+  const char *string;
 } field_args;
 
 static void args_field(sn_req *r, const void *arg) {
@@ -662,6 +667,10 @@ static void args_field(sn_req *r, const void *arg) {
     sn_arg_bool(r, &a->flag);
   else if (a->kind == 2)
     msgpack_pack_double(&r->pk, a->number);
+  else if (a->kind == 4)
+    msgpack_pack_int(&r->pk, a->integer);
+  else if (a->kind == 5)
+    sn_req_str(r, a->string);
   else {
     msgpack_pack_array(&r->pk, (size_t)a->n);
     for (int i = 0; i < a->n; i++)
@@ -681,7 +690,7 @@ static WbFieldRef field_at(WbNodeRef node, const char *field_name, int level, co
   for (struct WbFieldStructPrivate *f = rb->fields; f != NULL; f = f->next)
     if (f->node == node->id && f->level == level && strcmp(f->name, field_name) == 0)
       return f;
-  field_args a = {node->id, field_name, 0, false, 0.0, NULL, 0, level >= 0, level};
+  field_args a = {node->id, field_name, 0, false, 0.0, NULL, 0, level >= 0, level, 0, NULL};
   sn_reply rep;
   if (sn_robot_call(rb, "robot/get_field", 2 + (level >= 0), args_field, &a, func, &rep) != 0)
     return NULL;
@@ -830,8 +839,8 @@ WbFieldRef wb_supervisor_proto_get_field(WbProtoRef proto, const char *field_nam
 
 static const char *field_name_at(WbProtoRef proto, int index, const char *func) {
   if (index < 0 || index >= proto->n_fields) {
-    fprintf(stderr, "Error: %s() called with an invalid 'index' argument: %d (the PROTO has %d fields).\n", func, index,
-            proto->n_fields);
+    fprintf(stderr, "Error: %s() called with an invalid 'index' argument: %d (the %s has %d fields).\n", func, index,
+            proto->level == 0 ? "node" : "PROTO", proto->n_fields);
     return NULL;
   }
   return proto->fields[index];
@@ -844,33 +853,61 @@ WbFieldRef wb_supervisor_proto_get_field_by_index(WbProtoRef proto, int index) {
   return name == NULL ? NULL : field_at(node_ref(rb, proto->node), name, proto->level, func);
 }
 
-/* Sensorium counts and lists the fields of PROTO instances only (their interface, as Webots): a base node
-   gets the not-served line */
-static WbProtoRef node_proto(WbNodeRef node, const char *func, bool *warned) {
+/* The field names getNumberOfFields counts (`base` false: a PROTO instance's interface, else its base node's)
+   or getNumberOfBaseNodeFields does (`base` true): the server's get_proto at level 1, or at level 0 (the base
+   node's fields served here, in Webots' declaration order), kept as a level-0 entry of the PROTO list */
+static WbProtoRef node_fields(WbNodeRef node, bool base, const char *func) {
   sn_robot *rb = supervisor_node(node, func);
   if (rb == NULL)
     return NULL;
-  WbProtoRef p = proto_at(rb, node->id, 1, func);
-  if (p == NULL && !*warned) {
-    *warned = true;
-    fprintf(stderr, "Error: %s(): not served by Sensorium on a node that is no PROTO instance (Sensorium lists the "
-                    "fields of PROTO instances only): ignored, Webots' \"no value\" returned.\n", func);
+  WbProtoRef p = base ? NULL : proto_at(rb, node->id, 1, func);
+  return p != NULL ? p : proto_at(rb, node->id, 0, func);
+}
+
+/* Webots' DEF lookup inside a PROTO instance's body: Sensorium does not keep the DEF names of a PROTO's
+   internal nodes (Webots' getFromDef does not find them either), so after Webots' checks a PROTO instance
+   gets one line (the first time) and NULL; a node that is no PROTO instance has no internal DEF: NULL. */
+WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def) {
+  static bool warned = false;
+  const char *func = "wb_supervisor_node_get_from_proto_def";
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb == NULL)
+    return NULL;
+  if (def == NULL || *def == '\0') {
+    fprintf(stderr, "Error: %s() called with a NULL or empty 'def' argument.\n", func);
+    return NULL;
   }
-  return p;
+  if (proto_at(rb, node->id, 1, func) != NULL && !warned) {
+    warned = true;
+    fprintf(stderr, "Error: %s(): Sensorium does not keep the DEF names inside a PROTO's body (reach those nodes through "
+                    "'children', wb_supervisor_node_get_from_device, ...): NULL returned.\n", func);
+  }
+  return NULL;
 }
 
 int wb_supervisor_node_get_number_of_fields(WbNodeRef node) {
-  static bool warned = false;
-  WbProtoRef p = node_proto(node, "wb_supervisor_node_get_number_of_fields", &warned);
+  WbProtoRef p = node_fields(node, false, "wb_supervisor_node_get_number_of_fields");
   return p == NULL ? -1 : p->n_fields;
 }
 
 WbFieldRef wb_supervisor_node_get_field_by_index(WbNodeRef node, int index) {
-  static bool warned = false;
   const char *func = "wb_supervisor_node_get_field_by_index";
-  WbProtoRef p = node_proto(node, func, &warned);
+  WbProtoRef p = node_fields(node, false, func);
   const char *name = p == NULL ? NULL : field_name_at(p, index, func);
   return name == NULL ? NULL : field_at(node, name, -1, func);
+}
+
+int wb_supervisor_node_get_number_of_base_node_fields(WbNodeRef node) {
+  WbProtoRef p = node_fields(node, true, "wb_supervisor_node_get_number_of_base_node_fields");
+  return p == NULL ? -1 : p->n_fields;
+}
+
+/* on a PROTO instance read-only, as wb_supervisor_node_get_base_node_field */
+WbFieldRef wb_supervisor_node_get_base_node_field_by_index(WbNodeRef node, int index) {
+  const char *func = "wb_supervisor_node_get_base_node_field_by_index";
+  WbProtoRef p = node_fields(node, true, func);
+  const char *name = p == NULL ? NULL : field_name_at(p, index, func);
+  return name == NULL ? NULL : field_at(node, name, 0, func);
 }
 
 WbFieldType wb_supervisor_field_get_type(WbFieldRef field) { return field ? field->type : WB_NO_FIELD; }
@@ -916,7 +953,7 @@ static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_
   sn_robot *rb = field_robot(field, type, func);
   if (rb == NULL)
     return -1;
-  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, field->level >= 0, field->level};
+  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, field->level >= 0, field->level, 0, NULL};
   if (sn_robot_call(rb, "robot/get_field", 2 + (field->level >= 0), args_field, &a, func, rep) != 0)
     return -1;
   const msgpack_object *note = sn_get(rep->result, "note"); /* a value the server does not serve: its line */
@@ -1158,6 +1195,15 @@ static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const c
     fprintf(stderr, "Error: %s() called with a NULL 'values' argument.\n", func);
     return;
   }
+  if (a->kind == 5 && a->string == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL 'value' argument.\n", func);
+    return;
+  }
+  if (a->kind == 5 && strlen(a->string) > SN_MAX_MF_STRING) {
+    fprintf(stderr, "Error: %s(): a string of %zu characters is longer than the %d a field takes here.\n", func,
+            strlen(a->string), SN_MAX_MF_STRING);
+    return;
+  }
   bool finite = a->kind != 2 || isfinite(a->number);
   for (int i = 0; a->kind == 3 && i < a->n; i++)
     finite = finite && isfinite(a->values[i]);
@@ -1175,28 +1221,44 @@ static void field_set(WbFieldRef field, WbFieldType type, field_args *a, const c
 }
 
 void wb_supervisor_field_set_sf_bool(WbFieldRef field, bool value) {
-  field_args a = {0, NULL, 1, value, 0.0, NULL, 0, false, 0};
+  field_args a = {0, NULL, 1, value, 0.0, NULL, 0, false, 0, 0, NULL};
   field_set(field, WB_SF_BOOL, &a, "wb_supervisor_field_set_sf_bool");
 }
 
 void wb_supervisor_field_set_sf_float(WbFieldRef field, double value) {
-  field_args a = {0, NULL, 2, false, value, NULL, 0, false, 0};
+  field_args a = {0, NULL, 2, false, value, NULL, 0, false, 0, 0, NULL};
   field_set(field, WB_SF_FLOAT, &a, "wb_supervisor_field_set_sf_float");
 }
 
 void wb_supervisor_field_set_sf_vec3f(WbFieldRef field, const double values[3]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0};
+  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0, 0, NULL};
   field_set(field, WB_SF_VEC3F, &a, "wb_supervisor_field_set_sf_vec3f");
 }
 
 void wb_supervisor_field_set_sf_rotation(WbFieldRef field, const double values[4]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 4, false, 0};
+  field_args a = {0, NULL, 3, false, 0.0, values, 4, false, 0, 0, NULL};
   field_set(field, WB_SF_ROTATION, &a, "wb_supervisor_field_set_sf_rotation");
 }
 
 void wb_supervisor_field_set_sf_color(WbFieldRef field, const double values[3]) {
-  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0};
+  field_args a = {0, NULL, 3, false, 0.0, values, 3, false, 0, 0, NULL};
   field_set(field, WB_SF_COLOR, &a, "wb_supervisor_field_set_sf_color");
+}
+
+/* read-only here (a robot's name, WorldInfo's randomSeed, a PROTO's fields, ...): the server's line */
+void wb_supervisor_field_set_sf_int32(WbFieldRef field, int value) {
+  field_args a = {.kind = 4, .integer = value};
+  field_set(field, WB_SF_INT32, &a, "wb_supervisor_field_set_sf_int32");
+}
+
+void wb_supervisor_field_set_sf_vec2f(WbFieldRef field, const double values[2]) {
+  field_args a = {.kind = 3, .values = values, .n = 2};
+  field_set(field, WB_SF_VEC2F, &a, "wb_supervisor_field_set_sf_vec2f");
+}
+
+void wb_supervisor_field_set_sf_string(WbFieldRef field, const char *value) {
+  field_args a = {.kind = 5, .string = value};
+  field_set(field, WB_SF_STRING, &a, "wb_supervisor_field_set_sf_string");
 }
 
 /* an MF field's item set, inserted or removed (Webots' setMF*, insertMF*, removeMF): served on an imported
@@ -1208,11 +1270,15 @@ typedef struct {
   int level;
   int index;
   const char *op;
-  int kind; /* 0: no value (remove), 1: an int32, 3: numbers */
+  int kind; /* 0: no value (remove), 1: an int32, 2: a bool, 3: numbers, 4: a double, 5: a string */
   int number;
   const double *values;
   int n;
+  bool flag;
+  double real;
+  const char *string;
 } mf_args;
+
 
 static void args_mf(sn_req *r, const void *arg) {
   const mf_args *a = arg;
@@ -1233,6 +1299,12 @@ static void args_mf(sn_req *r, const void *arg) {
   sn_req_key(r, "value");
   if (a->kind == 1)
     msgpack_pack_int(&r->pk, a->number);
+  else if (a->kind == 2)
+    a->flag ? msgpack_pack_true(&r->pk) : msgpack_pack_false(&r->pk);
+  else if (a->kind == 4)
+    msgpack_pack_double(&r->pk, a->real);
+  else if (a->kind == 5)
+    sn_req_str(r, a->string);
   else {
     msgpack_pack_array(&r->pk, (size_t)a->n);
     for (int i = 0; i < a->n; i++)
@@ -1252,11 +1324,26 @@ static void mf_change(WbFieldRef field, WbFieldType type, mf_args *a, const char
     fprintf(stderr, "Error: %s() called with a NULL 'values' argument.\n", func);
     return;
   }
+  bool finite = a->kind != 4 || isfinite(a->real);
   for (int i = 0; a->kind == 3 && i < a->n; i++)
-    if (!isfinite(a->values[i])) {
-      fprintf(stderr, "Error: %s() called with a NaN or infinite value.\n", func);
-      return;
-    }
+    finite = finite && isfinite(a->values[i]);
+  if (!finite) {
+    fprintf(stderr, "Error: %s() called with a NaN or infinite value.\n", func);
+    return;
+  }
+  if (type == WB_MF_ROTATION && a->values[0] == 0.0 && a->values[1] == 0.0 && a->values[2] == 0.0) {
+    fprintf(stderr, "Error: %s() called with invalid values for the [x y z] axis (a zero vector).\n", func);
+    return;
+  }
+  if (a->kind == 5 && a->string == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL 'value' argument.\n", func);
+    return;
+  }
+  if (a->kind == 5 && strlen(a->string) > SN_MAX_MF_STRING) {
+    fprintf(stderr, "Error: %s(): a string of %zu characters is longer than the %d a field item takes here.\n", func,
+            strlen(a->string), SN_MAX_MF_STRING);
+    return;
+  }
   a->node = field->node;
   a->name = field->name;
   a->has_level = field->level >= 0;
@@ -1267,37 +1354,87 @@ static void mf_change(WbFieldRef field, WbFieldType type, mf_args *a, const char
 }
 
 void wb_supervisor_field_set_mf_int32(WbFieldRef field, int index, int value) {
-  mf_args a = {0, NULL, false, 0, index, "set", 1, value, NULL, 0};
+  mf_args a = {0, NULL, false, 0, index, "set", 1, value, NULL, 0, false, 0.0, NULL};
   mf_change(field, WB_MF_INT32, &a, "wb_supervisor_field_set_mf_int32");
 }
 
 void wb_supervisor_field_set_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3};
+  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3, false, 0.0, NULL};
   mf_change(field, WB_MF_VEC3F, &a, "wb_supervisor_field_set_mf_vec3f");
 }
 
 void wb_supervisor_field_set_mf_color(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3};
+  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3, false, 0.0, NULL};
   mf_change(field, WB_MF_COLOR, &a, "wb_supervisor_field_set_mf_color");
 }
 
 void wb_supervisor_field_insert_mf_int32(WbFieldRef field, int index, int value) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 1, value, NULL, 0};
+  mf_args a = {0, NULL, false, 0, index, "insert", 1, value, NULL, 0, false, 0.0, NULL};
   mf_change(field, WB_MF_INT32, &a, "wb_supervisor_field_insert_mf_int32");
 }
 
 void wb_supervisor_field_insert_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3};
+  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3, false, 0.0, NULL};
   mf_change(field, WB_MF_VEC3F, &a, "wb_supervisor_field_insert_mf_vec3f");
 }
 
 void wb_supervisor_field_insert_mf_color(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3};
+  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3, false, 0.0, NULL};
   mf_change(field, WB_MF_COLOR, &a, "wb_supervisor_field_insert_mf_color");
 }
 
+void wb_supervisor_field_set_mf_bool(WbFieldRef field, int index, bool value) {
+  mf_args a = {.index = index, .op = "set", .kind = 2, .flag = value};
+  mf_change(field, WB_MF_BOOL, &a, "wb_supervisor_field_set_mf_bool");
+}
+
+void wb_supervisor_field_insert_mf_bool(WbFieldRef field, int index, bool value) {
+  mf_args a = {.index = index, .op = "insert", .kind = 2, .flag = value};
+  mf_change(field, WB_MF_BOOL, &a, "wb_supervisor_field_insert_mf_bool");
+}
+
+void wb_supervisor_field_set_mf_float(WbFieldRef field, int index, double value) {
+  mf_args a = {.index = index, .op = "set", .kind = 4, .real = value};
+  mf_change(field, WB_MF_FLOAT, &a, "wb_supervisor_field_set_mf_float");
+}
+
+void wb_supervisor_field_insert_mf_float(WbFieldRef field, int index, double value) {
+  mf_args a = {.index = index, .op = "insert", .kind = 4, .real = value};
+  mf_change(field, WB_MF_FLOAT, &a, "wb_supervisor_field_insert_mf_float");
+}
+
+void wb_supervisor_field_set_mf_vec2f(WbFieldRef field, int index, const double values[2]) {
+  mf_args a = {.index = index, .op = "set", .kind = 3, .values = values, .n = 2};
+  mf_change(field, WB_MF_VEC2F, &a, "wb_supervisor_field_set_mf_vec2f");
+}
+
+void wb_supervisor_field_insert_mf_vec2f(WbFieldRef field, int index, const double values[2]) {
+  mf_args a = {.index = index, .op = "insert", .kind = 3, .values = values, .n = 2};
+  mf_change(field, WB_MF_VEC2F, &a, "wb_supervisor_field_insert_mf_vec2f");
+}
+
+void wb_supervisor_field_set_mf_rotation(WbFieldRef field, int index, const double values[4]) {
+  mf_args a = {.index = index, .op = "set", .kind = 3, .values = values, .n = 4};
+  mf_change(field, WB_MF_ROTATION, &a, "wb_supervisor_field_set_mf_rotation");
+}
+
+void wb_supervisor_field_insert_mf_rotation(WbFieldRef field, int index, const double values[4]) {
+  mf_args a = {.index = index, .op = "insert", .kind = 3, .values = values, .n = 4};
+  mf_change(field, WB_MF_ROTATION, &a, "wb_supervisor_field_insert_mf_rotation");
+}
+
+void wb_supervisor_field_set_mf_string(WbFieldRef field, int index, const char *value) {
+  mf_args a = {.index = index, .op = "set", .kind = 5, .string = value};
+  mf_change(field, WB_MF_STRING, &a, "wb_supervisor_field_set_mf_string");
+}
+
+void wb_supervisor_field_insert_mf_string(WbFieldRef field, int index, const char *value) {
+  mf_args a = {.index = index, .op = "insert", .kind = 5, .string = value};
+  mf_change(field, WB_MF_STRING, &a, "wb_supervisor_field_insert_mf_string");
+}
+
 void wb_supervisor_field_remove_mf(WbFieldRef field, int index) {
-  mf_args a = {0, NULL, false, 0, index, "remove", 0, 0, NULL, 0};
+  mf_args a = {0, NULL, false, 0, index, "remove", 0, 0, NULL, 0, false, 0.0, NULL};
   mf_change(field, WB_NO_FIELD, &a, "wb_supervisor_field_remove_mf");
 }
 
@@ -1333,6 +1470,24 @@ void wb_supervisor_field_import_mf_node_from_string(WbFieldRef field, int positi
     return;
   }
   import_args a = {field->node, field->name, position, node_string};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/import_node_from_string", 4, args_import, &a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
+/* Webots' import into an SFNode field: served into the empty coord (a Coordinate) or color (a Color) of an
+   imported line or point set; any other SFNode field, a full one or a string that does not read is refused
+   with the server's one line, nothing changed. */
+void wb_supervisor_field_import_sf_node_from_string(WbFieldRef field, const char *node_string) {
+  const char *func = "wb_supervisor_field_import_sf_node_from_string";
+  sn_robot *rb = field_robot(field, WB_SF_NODE, func);
+  if (rb == NULL)
+    return;
+  if (node_string == NULL || *node_string == '\0') {
+    fprintf(stderr, "Error: %s() called with a NULL or empty 'node_string' argument.\n", func);
+    return;
+  }
+  import_args a = {field->node, field->name, 0, node_string};
   sn_reply rep;
   if (sn_robot_call(rb, "robot/import_node_from_string", 4, args_import, &a, func, &rep) == 0)
     sn_reply_free(&rep);

@@ -51,27 +51,12 @@ bool wb_supervisor_animation_stop_recording(void) {
 }
 
 
-WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
 
 WbNodeRef wb_supervisor_node_get_selected(void) {
   SN_UNSUPPORTED();
   return NULL;
 }
 
-
-WbFieldRef wb_supervisor_node_get_base_node_field_by_index(WbNodeRef node, int index) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
-
-int wb_supervisor_node_get_number_of_base_node_fields(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return -1;
-}
 
 
 const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
@@ -116,65 +101,10 @@ WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
 }
 
 
-void wb_supervisor_field_set_sf_int32(WbFieldRef field, int value) {
-  SN_UNSUPPORTED();
-}
 
 
-void wb_supervisor_field_set_sf_vec2f(WbFieldRef field, const double values[2]) {
-  SN_UNSUPPORTED();
-}
-
-
-void wb_supervisor_field_set_sf_string(WbFieldRef field, const char *value) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_set_mf_bool(WbFieldRef field, int index, bool value) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_set_mf_float(WbFieldRef field, int index, double value) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_set_mf_vec2f(WbFieldRef field, int index, const double values[2]) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_set_mf_rotation(WbFieldRef field, int index, const double values[4]) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_set_mf_string(WbFieldRef field, int index, const char *value) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_insert_mf_bool(WbFieldRef field, int index, bool value) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_insert_mf_float(WbFieldRef field, int index, double value) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_insert_mf_vec2f(WbFieldRef field, int index, const double values[2]) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_insert_mf_rotation(WbFieldRef field, int index, const double values[4]) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_insert_mf_string(WbFieldRef field, int index, const char *value) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_field_remove_sf(WbFieldRef field) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_field_import_sf_node_from_string(WbFieldRef field, const char *node_string) {
   SN_UNSUPPORTED();
 }
 

@@ -155,6 +155,48 @@ class Field:
     def insertMFColor(self, index: int, value: list[float]) -> None:
         wb.wb_supervisor_field_insert_mf_color(self._ref, index, value)
 
+    def setMFBool(self, index: int, value: bool) -> None:
+        wb.wb_supervisor_field_set_mf_bool(self._ref, index, value)
+
+    def insertMFBool(self, index: int, value: bool) -> None:
+        wb.wb_supervisor_field_insert_mf_bool(self._ref, index, value)
+
+    def setMFFloat(self, index: int, value: float) -> None:
+        wb.wb_supervisor_field_set_mf_float(self._ref, index, value)
+
+    def insertMFFloat(self, index: int, value: float) -> None:
+        wb.wb_supervisor_field_insert_mf_float(self._ref, index, value)
+
+    def setMFVec2f(self, index: int, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_mf_vec2f(self._ref, index, value)
+
+    def insertMFVec2f(self, index: int, value: list[float]) -> None:
+        wb.wb_supervisor_field_insert_mf_vec2f(self._ref, index, value)
+
+    def setMFRotation(self, index: int, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_mf_rotation(self._ref, index, value)
+
+    def insertMFRotation(self, index: int, value: list[float]) -> None:
+        wb.wb_supervisor_field_insert_mf_rotation(self._ref, index, value)
+
+    def setMFString(self, index: int, value: str) -> None:
+        wb.wb_supervisor_field_set_mf_string(self._ref, index, value)
+
+    def insertMFString(self, index: int, value: str) -> None:
+        wb.wb_supervisor_field_insert_mf_string(self._ref, index, value)
+
+    def importSFNodeFromString(self, nodeString: str) -> None:  # noqa: N803 - Webots' name
+        wb.wb_supervisor_field_import_sf_node_from_string(self._ref, nodeString)
+
+    def setSFInt32(self, value: int) -> None:
+        wb.wb_supervisor_field_set_sf_int32(self._ref, value)
+
+    def setSFVec2f(self, value: list[float]) -> None:
+        wb.wb_supervisor_field_set_sf_vec2f(self._ref, value)
+
+    def setSFString(self, value: str) -> None:
+        wb.wb_supervisor_field_set_sf_string(self._ref, value)
+
     def removeMF(self, index: int) -> None:
         wb.wb_supervisor_field_remove_mf(self._ref, index)
 
@@ -176,7 +218,7 @@ class Field:
     count = property(getCount)
 
     _SETTERS = {wb.WB_SF_BOOL: "setSFBool", wb.WB_SF_FLOAT: "setSFFloat", wb.WB_SF_STRING: "setSFString",
-                wb.WB_SF_VEC3F: "setSFVec3f", wb.WB_SF_ROTATION: "setSFRotation", wb.WB_SF_COLOR: "setSFColor"}
+                wb.WB_SF_INT32: "setSFInt32", wb.WB_SF_VEC2F: "setSFVec2f", wb.WB_SF_VEC3F: "setSFVec3f", wb.WB_SF_ROTATION: "setSFRotation", wb.WB_SF_COLOR: "setSFColor"}
 
     @property
     def value(self) -> Any:
@@ -256,11 +298,23 @@ class Node:
         return None if ref is None else Proto(ref)
 
     def getNumberOfFields(self) -> int:
-        """A PROTO instance's interface fields (a base node: not served here, -1 with one line)."""
+        """A PROTO instance's interface fields; a base node's fields served here (Webots' order)."""
         return wb.wb_supervisor_node_get_number_of_fields(self._ref)
 
     def getFieldByIndex(self, index: int) -> Field | None:
         ref = wb.wb_supervisor_node_get_field_by_index(self._ref, index)
+        return None if ref is None else Field(ref)
+
+    def getFromProtoDef(self, DEF: str) -> Node | None:  # noqa: N803 - Webots' name
+        """A DEF inside this PROTO instance's body: not kept here (one line the first time), None."""
+        return _node_of(wb.wb_supervisor_node_get_from_proto_def(self._ref, DEF))
+
+    def getNumberOfBaseNodeFields(self) -> int:
+        """The base node's fields served here (a PROTO instance's Robot, Solid, ...), in Webots' order."""
+        return wb.wb_supervisor_node_get_number_of_base_node_fields(self._ref)
+
+    def getBaseNodeFieldByIndex(self, index: int) -> Field | None:
+        ref = wb.wb_supervisor_node_get_base_node_field_by_index(self._ref, index)
         return None if ref is None else Field(ref)
 
     def getPosition(self) -> list[float]:
@@ -505,9 +559,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3, ""),
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9, "")},
     Node: {
-        "getFromProtoDef": ("node_get_from_proto_def", None, "DEF"),
-        "getNumberOfBaseNodeFields": ("node_get_number_of_base_node_fields", -1, ""),
-        "getBaseNodeFieldByIndex": ("node_get_base_node_field_by_index", None, "index"),
         "exportString": ("node_export_string", "", ""),
         "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3, ""),
         "getStaticBalance": ("node_get_static_balance", False, ""),
@@ -518,19 +569,8 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "addTorque": ("node_add_torque", None, "torque, relative")},
     Field: {
         "getActualField": ("field_get_actual_field", None, ""),
-        "removeSF": ("field_remove_sf", None, ""),
-        # no SFNode field here takes an import (a joint's jointParameters and endPoint are read-only)
-        "importSFNodeFromString": ("field_import_sf_node_from_string", None, "nodeString")},
+        "removeSF": ("field_remove_sf", None, "")},
 }
-_FIELD_NO_VALUES = {"Bool": False, "Int32": 0, "Float": _NAN, "Vec2f": [_NAN] * 2, "Vec3f": [_NAN] * 3,
-                    "Rotation": [_NAN] * 4, "Color": [_NAN] * 3, "String": "", "Node": None}
-for _kind, _none in _FIELD_NO_VALUES.items():
-    _c = _kind.lower()
-    if _kind not in ("Node", "Int32", "Vec3f", "Color"):   # those served above; no setMFNode (Webots has none)
-        _UNSERVED[Field][f"setMF{_kind}"] = (f"field_set_mf_{_c}", None, "index, value")
-        _UNSERVED[Field][f"insertMF{_kind}"] = (f"field_insert_mf_{_c}", None, "index, value")
-    if _kind in ("Int32", "Vec2f", "String"):  # SFString fields are read-only here
-        _UNSERVED[Field][f"setSF{_kind}"] = (f"field_set_sf_{_c}", None, "value")
 for _cls, _methods in _UNSERVED.items():
     for _method, (_func, _value, _params) in _methods.items():
         assert not hasattr(_cls, _method), _method        # never hides a served method
