@@ -1354,32 +1354,32 @@ static void mf_change(WbFieldRef field, WbFieldType type, mf_args *a, const char
 }
 
 void wb_supervisor_field_set_mf_int32(WbFieldRef field, int index, int value) {
-  mf_args a = {0, NULL, false, 0, index, "set", 1, value, NULL, 0, false, 0.0, NULL};
+  mf_args a = {.index = index, .op = "set", .kind = 1, .number = value};
   mf_change(field, WB_MF_INT32, &a, "wb_supervisor_field_set_mf_int32");
 }
 
 void wb_supervisor_field_set_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3, false, 0.0, NULL};
+  mf_args a = {.index = index, .op = "set", .kind = 3, .values = values, .n = 3};
   mf_change(field, WB_MF_VEC3F, &a, "wb_supervisor_field_set_mf_vec3f");
 }
 
 void wb_supervisor_field_set_mf_color(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "set", 3, 0, values, 3, false, 0.0, NULL};
+  mf_args a = {.index = index, .op = "set", .kind = 3, .values = values, .n = 3};
   mf_change(field, WB_MF_COLOR, &a, "wb_supervisor_field_set_mf_color");
 }
 
 void wb_supervisor_field_insert_mf_int32(WbFieldRef field, int index, int value) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 1, value, NULL, 0, false, 0.0, NULL};
+  mf_args a = {.index = index, .op = "insert", .kind = 1, .number = value};
   mf_change(field, WB_MF_INT32, &a, "wb_supervisor_field_insert_mf_int32");
 }
 
 void wb_supervisor_field_insert_mf_vec3f(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3, false, 0.0, NULL};
+  mf_args a = {.index = index, .op = "insert", .kind = 3, .values = values, .n = 3};
   mf_change(field, WB_MF_VEC3F, &a, "wb_supervisor_field_insert_mf_vec3f");
 }
 
 void wb_supervisor_field_insert_mf_color(WbFieldRef field, int index, const double values[3]) {
-  mf_args a = {0, NULL, false, 0, index, "insert", 3, 0, values, 3, false, 0.0, NULL};
+  mf_args a = {.index = index, .op = "insert", .kind = 3, .values = values, .n = 3};
   mf_change(field, WB_MF_COLOR, &a, "wb_supervisor_field_insert_mf_color");
 }
 
@@ -1434,7 +1434,7 @@ void wb_supervisor_field_insert_mf_string(WbFieldRef field, int index, const cha
 }
 
 void wb_supervisor_field_remove_mf(WbFieldRef field, int index) {
-  mf_args a = {0, NULL, false, 0, index, "remove", 0, 0, NULL, 0, false, 0.0, NULL};
+  mf_args a = {.index = index, .op = "remove"};
   mf_change(field, WB_NO_FIELD, &a, "wb_supervisor_field_remove_mf");
 }
 
