@@ -84,7 +84,7 @@ def test_a_mesh_files_vertices_are_held_once_per_position(tmp_path: Path) -> Non
     tier's welding, done once when read: the tier's arrays are unchanged), in process and from the
     reading worker (a file over 1 MiB). A file with an unused vertex is kept as read."""
     from sensorium.benchmarks.cad import write_stl
-    from sensorium.server.raycast import packets, tiers
+    from sensorium.server.raycast import tiers
     from sensorium.server.world.geometry import Pose
     from sensorium.server.world.meshes import IN_PROCESS_BYTES, load_mesh, welded
 
@@ -99,7 +99,7 @@ def test_a_mesh_files_vertices_are_held_once_per_position(tmp_path: Path) -> Non
         assert np.array_equal(mesh.vertices[mesh.faces], corners)
         again = welded(mesh.vertices, mesh.faces)
         assert np.array_equal(again[0], mesh.vertices) and np.array_equal(again[1], mesh.faces)
-        tier = tiers._Tier(packets.Device(), [(0, mesh, Pose.identity())], np.array([-1]))
+        tier = tiers._Tier(tiers.new_device(), [(0, mesh, Pose.identity())], np.array([-1]))
         soup = welded(corners.reshape(-1, 3), np.arange(3 * len(f)).reshape(-1, 3))   # what the tier welded before
         assert np.array_equal(tier.V, soup[0]) and np.array_equal(tier.F[:len(f)], soup[1])
     ply = tmp_path / "spare.ply"          # (a repeated position and an unused vertex: as read)
