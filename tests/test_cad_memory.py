@@ -6,6 +6,7 @@ never timed."""
 from __future__ import annotations
 
 import gc
+import os
 import tracemalloc
 from pathlib import Path
 
@@ -88,7 +89,10 @@ def test_a_mesh_files_vertices_are_held_once_per_position(tmp_path: Path) -> Non
     from sensorium.server.world.geometry import Pose
     from sensorium.server.world.meshes import IN_PROCESS_BYTES, load_mesh, welded
 
-    for k, n in ((3, 3000), (4, 25_000)):
+    # the worker cannot start under the sanitizers' LD_PRELOAD (CI's sanitizer pass: their shadow memory
+    # is over its address-space limit, as tests/test_build_memory.py says): the in-process read only
+    sizes = ((3, 3000),) if "libasan" in os.environ.get("LD_PRELOAD", "") else ((3, 3000), (4, 25_000))
+    for k, n in sizes:
         v, f = part_mesh(k, n)
         path = tmp_path / f"part{k}.stl"
         write_stl(path, v, f)
