@@ -117,16 +117,21 @@ def _syntax(exc: WbtSyntaxError, source: str) -> ImportRefused:
     return ImportRefused(f"{at}: {_shown(exc.message, source)}")
 
 
-def parse_sf_node_string(text: Any, limits: WorldLimits) -> Any:
-    """A Supervisor's ``importSFNodeFromString`` string read as one node with the world file's parser and
-    bounds (no PROTO, no conversion: the caller serves the node as written); ImportRefused (one line) for
-    anything else."""
+def _check_string(text: Any, limits: WorldLimits) -> None:
+    """A node string a Supervisor sends: a string within the world file's size limit (ImportRefused)."""
     if not isinstance(text, str):
         raise ImportRefused(f"the node string must be a string, got {type(text).__name__}")
     size = len(text.encode("utf-8", errors="surrogatepass"))
     if size > limits.file_bytes:
         raise ImportRefused(f"a node string of {size:,} bytes, more than the world file limit of "
                             f"{limits.file_bytes:,} (raise the limits with --allow-large)")
+
+
+def parse_sf_node_string(text: Any, limits: WorldLimits) -> Any:
+    """A Supervisor's ``importSFNodeFromString`` string read as one node with the world file's parser and
+    bounds (no PROTO, no conversion: the caller serves the node as written); ImportRefused (one line) for
+    anything else."""
+    _check_string(text, limits)
     source = "<importSFNodeFromString>"
     try:
         wbt = Parser(Tokens(text, source), source, limits=ProtoLimits.matching(limits)).file(DEFAULT_VERSION, text)
@@ -147,12 +152,7 @@ def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: 
     the world is checked by the caller). ``warnings``: given, it gets one line per value corrected
     as Webots corrects it (a ``Sphere { radius 0 }`` gets radius 1, as in a world file), placed in
     the string."""
-    if not isinstance(text, str):
-        raise ImportRefused(f"the node string must be a string, got {type(text).__name__}")
-    size = len(text.encode("utf-8", errors="surrogatepass"))
-    if size > limits.file_bytes:
-        raise ImportRefused(f"a node string of {size:,} bytes, more than the world file limit of "
-                            f"{limits.file_bytes:,} (raise the limits with --allow-large)")
+    _check_string(text, limits)
     proto_limits = ProtoLimits.matching(limits)
     source = str(loaded.base_dir / _NAME)
     try:
