@@ -310,6 +310,7 @@ class ShapeNode(Strict):
     material_key: int = Field(default=-1, ge=-1, description="the same for its Material node")
     material_def: str | None = Field(default=None, min_length=1)
     texture_def: str | None = Field(default=None, min_length=1)
+    texture_key: int = Field(default=-1, ge=-1, description="the same for its ImageTexture node")
     geometry: str = Field(default="", max_length=64, description="the geometry node's type (Box, Mesh, ...)")
     geometry_def: str | None = Field(default=None, min_length=1)
     values: dict[str, NodeValue] = Field(default={}, max_length=64, description="the written values: "

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sensorium.schemas import world as wm
+from sensorium.server.world.textures import TextureFileError, checked_image
 from sensorium.server.world.wbt.fields import GEOMETRY_FIELDS, MATERIAL_FIELDS, PBR_FIELDS, TEXTURE_FIELDS
 
 TYPES = frozenset({"Shape", "Appearance", "PBRAppearance", "Material", "ImageTexture", "Box", "Sphere", "Cylinder",
@@ -30,8 +31,13 @@ GEOMETRY_TYPES = {wm.Box: "Box", wm.Sphere: "Sphere", wm.Cylinder: "Cylinder", w
                   wm.ElevationGrid: "ElevationGrid"}
 
 SETTABLE = {"Material": frozenset({"diffuseColor", "emissiveColor", "transparency"}),
-            "PBRAppearance": frozenset({"baseColor", "roughness", "metalness", "transparency", "emissiveColor"})}
-"""The fields a Supervisor sets here; the rest of these nodes is read-only."""
+            "PBRAppearance": frozenset({"baseColor", "roughness", "metalness", "transparency", "emissiveColor"}),
+            "ImageTexture": frozenset({"repeatS", "repeatT", "filtering"})}
+"""The SF fields a Supervisor sets here (an ImageTexture's ``url`` is an MF field: :func:`change_url`);
+the rest of these nodes is read-only."""
+
+MAX_URLS = 64
+"""The most items an ImageTexture's ``url`` holds after a Supervisor's change (Webots reads the first)."""
 
 # the written field names of a YAML geometry model (no .wbt node): Webots' field -> the model's attribute
 _MODEL_GEOMETRY = {"size": "size", "radius": "radius", "height": "height", "bottomRadius": "bottom_radius",
@@ -133,6 +139,8 @@ def _class(t: float) -> int:
 def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
     if name not in SETTABLE.get(ref.type, ()):
         return None
+    if ref.type == "ImageTexture":
+        return _texture_setter(ref, name, kind)
 
     def set_value(sim: Any, node: Any, value: Any) -> None:
         where = f"field {name!r} ({kind}) of {_what(ref, node.def_name, node.id)}"
@@ -158,7 +166,7 @@ def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
             update: dict[str, Any] = {}
             if name == "transparency":
                 update["transparency"] = float(value)
-            elif name == "baseColor" or (name == "diffuseColor" and loaded is not None and loaded.texture is None):
+            elif name == "baseColor" or (name == "diffuseColor" and current is not None and current.texture is None):
                 update["base_color"] = tuple(float(v) for v in values)
             elif name == "roughness":
                 update["roughness"] = float(value)
@@ -166,6 +174,160 @@ def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
                 scene.set_appearance(k, current.model_copy(update=update))
             scene.appearance_values.setdefault(k, {})[f"{ref.role}.{name}"] = \
                 [float(v) for v in values] if kind == "SFColor" else float(value)
+
+    return set_value
+
+
+# ------------------------------------------------------------------------------ an ImageTexture's fields
+
+def _texture_value(scene: Any, k: int, name: str, default: Any) -> Any:
+    """Shape ``k``'s ImageTexture field now: as a Supervisor set it, else as the world file wrote it."""
+    changed = scene.appearance_values.get(k, {})
+    if f"texture.{name}" in changed:
+        return changed[f"texture.{name}"]
+    node = getattr(scene.loaded_model(k), "node", None)
+    if node is not None:
+        return node.values.get(f"texture.{name}", default)
+    t = scene.loaded_model(k).appearance.texture
+    return {"url": [t.url], "repeatS": t.repeat_s, "repeatT": t.repeat_t, "filtering": t.filtering}.get(name, default)
+
+
+def _retextured(scene: Any, k: int, url: str | None) -> wm.Appearance | None:
+    """Shape ``k``'s appearance with its base map naming ``url`` (None: no texture, as Webots draws an
+    ImageTexture it has no image for: an Appearance shows its Material's diffuseColor, a
+    PBRAppearance its baseColor), as the world file's loader would have made it."""
+    current = scene.shape_model(k).appearance
+    if current is None:
+        return None
+    loaded = scene.loaded_model(k).appearance
+    node = getattr(scene.loaded_model(k), "node", None)
+    kind = node.appearance if node is not None else "PBRAppearance"
+    update: dict[str, Any] = {}
+    if url is None:
+        update.update(texture=None, roughness_map=None, occlusion_map=None)
+        if kind == "Appearance" and node is not None and node.material:
+            changed = scene.appearance_values.get(k, {})
+            diffuse = changed.get("material.diffuseColor") or (
+                loaded.base_color if loaded.texture is None else node.values.get("material.diffuseColor", (0.8, 0.8, 0.8)))
+            update["base_color"] = tuple(float(v) for v in diffuse)
+    else:
+        update["texture"] = wm.Texture(url=url, repeat_s=bool(_texture_value(scene, k, "repeatS", True)),
+                                       repeat_t=bool(_texture_value(scene, k, "repeatT", True)),
+                                       filtering=int(_texture_value(scene, k, "filtering", 4)))
+        if current.texture is None:     # the PBR maps read with the base map: the world file's
+            update.update(roughness_map=loaded.roughness_map, occlusion_map=loaded.occlusion_map)
+        if kind == "Appearance":
+            update["base_color"] = (1.0, 1.0, 1.0)        # a texture replaces the diffuse colour by white
+    return current.model_copy(update=update)
+
+
+def _world_url(scene: Any, url: str) -> str | None:
+    """The file a texture url the world file itself writes (a ``webots://`` url, one in a PROTO file)
+    was read from, so that such a url reads as at load; None for any other url."""
+    for k in range(len(scene.shapes)):
+        model = scene.loaded_model(k)
+        node, app = getattr(model, "node", None), model.appearance
+        if node is not None and app is not None and app.texture is not None:
+            written = node.values.get("texture.url")
+            if written and str(written[0]).replace("\\", "/") == url:
+                return app.texture.url
+    return None
+
+
+def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> None:
+    """Every shape holding the texture takes ``url`` (checked as a world file's textures are), or
+    none of them does (ValueError: one line)."""
+    scene = sim.scene
+    shapes = ref.peers or (ref.index,)
+    name = url
+    if url is not None:
+        known = _world_url(scene, url)
+        if known is None and "://" in url:
+            raise ValueError(f"{where}: {url!r}: only local image files are read here, named relative to the world "
+                             "file's folder (no downloads; a webots:// url only where the world file writes it); "
+                             "nothing changed")
+        name = known or url
+        before = scene.textures.pixels(without=shapes) if scene.textures is not None else 0
+        try:
+            checked_image(name, scene.base_dir, sim.limits, pixels_before=before,
+                          allow_outside=known is not None or bool(getattr(sim, "allow_outside_meshes", False)))
+        except TextureFileError as exc:
+            raise ValueError(f"{where}: {exc}; nothing changed") from None
+    plans = []
+    for k in shapes:
+        new = _retextured(scene, k, name)
+        current = scene.shape_model(k).appearance
+        if new is None:
+            continue
+        if scene.casts_shadow(k, new) != scene.casts_shadow(k, current):
+            alpha = not scene.casts_shadow(k, new)
+            raise ValueError(
+                f"{where}: the shape casts shadows {'and' if alpha else 'but'} the pixel format of {url!r} "
+                f"{'has' if alpha else 'has no'} alpha (Webots then draws the shape translucent, without shadows, "
+                f"{'un' if not alpha else ''}like its image now); which shapes cast shadows is fixed when the scene is "
+                "built here; nothing changed")
+        plans.append((k, new))
+    for k, new in plans:
+        scene.set_texture(k, new)
+
+
+def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: Any) -> None:
+    """Webots' ``setMFString``/``insertMFString``/``removeMF`` on an ImageTexture's ``url``: when its
+    first item changes, the image it names is read (relative to the world file's folder, within the
+    world's texture limits) and every shape holding the texture shows it from the next step, as if the
+    world file had named it; an empty url (or none) leaves the shapes untextured, as Webots. A url that
+    cannot be read: ValueError (one line naming the node, the field and the problem), nothing changed."""
+    where = f"field 'url' (MFString) of {_what(ref, node.def_name, node.id)}"
+    items = [str(v) for v in _value(sim, ref, "url", ())]
+    count = len(items)
+    if isinstance(index, bool) or not isinstance(index, int):
+        raise ValueError(f"{where}: the index must be a whole number, got {index!r}; nothing changed")
+    if op != "remove" and not isinstance(value, str):
+        raise ValueError(f"{where}: takes a string, got {value!r}; nothing changed")
+    if op == "insert":
+        at = index + count + 1 if index < 0 else index
+        if not 0 <= at <= count:
+            raise ValueError(f"{where}: out-of-bound index {index} (should be between {-count - 1} and {count}); "
+                             "nothing changed")
+        if count >= MAX_URLS:
+            raise ValueError(f"{where}: it holds {count} urls, the most kept here; nothing changed")
+        new = [*items[:at], value.replace("\\", "/"), *items[at:]]
+    elif op in ("set", "remove"):
+        if not -count <= index < count:
+            raise ValueError(f"{where}: out-of-bound index {index} (should be between {-count} and {count - 1}); "
+                             "nothing changed" if count else f"{where}: the list is empty; nothing changed")
+        at = index + count if index < 0 else index
+        new = list(items)
+        if op == "remove":
+            del new[at]
+        else:
+            new[at] = value.replace("\\", "/")
+    else:
+        raise ValueError(f"{where}: unknown change {op!r}")
+    first, was = (new[0] if new else ""), (items[0] if items else "")
+    if first != was:
+        _retexture(sim, ref, where, first if first.strip() else None)
+    for k in ref.peers or (ref.index,):
+        sim.scene.appearance_values.setdefault(k, {})["texture.url"] = list(new)
+
+
+def _texture_setter(ref: ShapeRef, name: str, kind: str) -> Setter:
+    """``repeatS``/``repeatT`` (the wrap infra-red sensors and cameras read) and ``filtering`` (kept and
+    read back; it changes Webots' rendering only, never a texel read)."""
+    def set_value(sim: Any, node: Any, value: Any) -> None:
+        where = f"field {name!r} ({kind}) of {_what(ref, node.def_name, node.id)}"
+        if name == "filtering" and (isinstance(value, bool) or not isinstance(value, int) or not 0 <= value <= 5):
+            raise ValueError(f"{where}: must be a whole number from 0 to 5, got {value!r} (Webots resets it to 4 "
+                             "with a warning); nothing changed")
+        scene = sim.scene
+        for k in ref.peers or (ref.index,):
+            current = scene.shape_model(k).appearance
+            if name != "filtering" and current is not None and current.texture is not None:
+                attr = "repeat_s" if name == "repeatS" else "repeat_t"
+                scene.set_texture(k, current.model_copy(update={
+                    "texture": current.texture.model_copy(update={attr: bool(value)})}))
+            scene.appearance_values.setdefault(k, {})[f"texture.{name}"] = int(value) if name == "filtering" \
+                else bool(value)
 
     return set_value
 

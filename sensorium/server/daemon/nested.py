@@ -197,7 +197,8 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
     for k in range(len(scene.shapes)):
         held = getattr(scene.loaded_model(k), "node", None)
         if held is not None:
-            for role, number in (("appearance", held.appearance_key), ("material", held.material_key)):
+            for role, number in (("appearance", held.appearance_key), ("material", held.material_key),
+                                 ("texture", held.texture_key)):
                 if number >= 0:
                     shared.setdefault((role, number), []).append(k)
     added: list[Nested] = []
@@ -223,7 +224,7 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
             proto, face = ((node.appearance_proto or "", tuple(node.appearance_interface))
                            if node is not None and role == "appearance" else ("", ()))
             number = -1 if node is None else node.appearance_key if role == "appearance" else \
-                node.material_key if role == "material" else -1
+                node.material_key if role == "material" else node.texture_key if role == "texture" else -1
             peers = tuple(shared.get((role, number), (k,)))
             added.append(Nested(nid, type_, proto, def_name, "", above[role if role in above else "appearance"], field,
                                 None, None, "", owner, kind, key, interface=face,

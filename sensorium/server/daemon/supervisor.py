@@ -766,6 +766,10 @@ def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: An
     if level == 0 and node.interface:
         raise ValueError(f"field {field!r} ({kind}) of {what} is a PROTO internal field (getBaseNodeField): its "
                          "items are read-only, as in Webots; nothing changed")
+    ref = _nested_of(sim, node).shape if node.nested else None
+    if ref is not None and ref.type == "ImageTexture" and field == "url":      # a texture's image (appearance.py)
+        appearance.change_url(sim, ref, node, op, index, value)
+        return
     if not (node.visual and node.id >= visuals.FIRST_ID and visuals.settable(_vnode(sim, node), field)):
         if node.visual and node.id >= visuals.FIRST_ID:
             raise ValueError(visuals.read_only_line(_vnode(sim, node), field, kind))
@@ -799,10 +803,14 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
                          f"{why}; nothing changed")
     if setter is None and node.visual and node.id >= visuals.FIRST_ID:
         raise ValueError(visuals.read_only_line(_vnode(sim, node), field, kind))
+    if setter is None and node.nested and node.type == "ImageTexture" and field == "url":
+        raise ValueError(f"field 'url' ({kind}) of {_what(node)} is changed item by item (setMFString, "
+                         "insertMFString, removeMF), not set as a whole; nothing changed")
     if setter is None and node.nested and node.type in appearance.TYPES:
         raise ValueError(f"field {field!r} ({kind}) of {_what(node)} is read-only here: of a shape's nodes a "
-                         "Supervisor sets a Material's diffuseColor, emissiveColor and transparency and a "
-                         "PBRAppearance's baseColor, roughness, metalness, transparency and emissiveColor only")
+                         "Supervisor sets a Material's diffuseColor, emissiveColor and transparency, a "
+                         "PBRAppearance's baseColor, roughness, metalness, transparency and emissiveColor and an "
+                         "ImageTexture's url, repeatS, repeatT and filtering only")
     if setter is None and node.nested:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
                          "top-level robots, solids and lights only, not the nodes inside them")
@@ -810,14 +818,16 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here")
     if kind == "SFBool":
         ok = isinstance(value, bool)
+    elif kind == "SFInt32":
+        ok = isinstance(value, int) and not isinstance(value, bool)
     elif kind == "SFFloat":
         ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
     else:
         ok = isinstance(value, list) and len(value) == _VECTOR_SIZES.get(kind, -1)
-    if not ok and kind not in _VECTOR_SIZES and kind not in ("SFBool", "SFFloat"):
+    if not ok and kind not in _VECTOR_SIZES and kind not in ("SFBool", "SFInt32", "SFFloat"):
         raise ValueError(f"field {field!r} of {what} is an {kind}: not set as a whole here")
     if not ok:
-        want = {"SFBool": "true or false", "SFFloat": "a finite number"}.get(kind, f"{_VECTOR_SIZES.get(kind)} numbers")
+        want = {"SFBool": "true or false", "SFInt32": "a whole number", "SFFloat": "a finite number"}.get(kind, f"{_VECTOR_SIZES.get(kind)} numbers")
         raise ValueError(f"field {field!r} is an {kind}: takes {want}, got {value!r}")
     if isinstance(value, list) and not all(math.isfinite(v) for v in value):
         raise ValueError(f"field {field!r}: values must be finite")

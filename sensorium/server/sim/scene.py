@@ -78,6 +78,11 @@ def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
     return (1.0, 1.0, 1.0) if a is None else tuple(float(v) for v in a.base_color)  # type: ignore[return-value]
 
 
+def _maps(a: wm.Appearance) -> tuple:
+    """What of an appearance the texture sampler reads."""
+    return a.texture, a.roughness_map, a.occlusion_map, a.texture_transform
+
+
 def translucent(appearance: wm.Appearance | None, base_dir: Path) -> bool:
     """Whether WREN draws a shape of this appearance as translucent: a transparency above 0 or a
     base image whose pixel format has alpha (an RGBA PNG even where every alpha is 255: Webots'
@@ -504,6 +509,23 @@ class Scene:
         self._loaded_models.setdefault(shape, model)
         self._use_model(shape, model.model_copy(update={"appearance": appearance}))
 
+    def set_texture(self, shape: int, appearance: wm.Appearance) -> None:
+        """:meth:`set_appearance` with new images (an ImageTexture's url or wrap a Supervisor set, or
+        its texture gone): the texture sampler reads them for that shape (the caller checked the files,
+        the limits and that the shape's shadow casting stays), so cameras and infra-red sensors see them
+        from the next measurement as if the world file had named them."""
+        self.set_appearance(shape, appearance)
+        if self.textures is not None:
+            self.textures.set_shape(shape, appearance)
+        elif appearance.texture is not None:
+            self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
+                                           ink_evaporation=self._ink_evaporation)
+
+    def casts_shadow(self, shape: int, appearance: wm.Appearance | None) -> bool:
+        """Whether the shape would cast shadows with that appearance (fixed in the ray scene when it
+        is built: see :func:`translucent`)."""
+        return bool(self._parts[shape][2].cast_shadows) and not translucent(appearance, self._base_dir)
+
     def _use_model(self, shape: int, model: wm.Shape | wm.Solid) -> None:
         key, local, _ = self._parts[shape]
         self._parts[shape] = (key, local, model)
@@ -523,7 +545,11 @@ class Scene:
     def restore_appearances(self) -> None:
         """Every shape's appearance as loaded (``simulationReset``)."""
         for shape, model in self._loaded_models.items():
+            retextured = self._parts[shape][2].appearance
             self._use_model(shape, model)       # a shape loaded without an appearance gets none back
+            if self.textures is not None and retextured is not None and model.appearance is not None and \
+                    _maps(retextured) != _maps(model.appearance):
+                self.textures.set_shape(shape, model.appearance)
         self._loaded_models.clear()
         self.appearance_values.clear()
 

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Collection, Iterator
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -45,7 +45,7 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.world import texcoords as tc
 
-__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "load_image", "load_alpha", "uses_alpha", "check_textures",
+__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "checked_image", "load_image", "load_alpha", "uses_alpha", "check_textures",
            "TextureImage", "transform_uv", "TextureSampler", "TriangleLocator", "texture_urls"]
 
 FORMATS = {"PNG": "PNG", "JPEG": "JPEG", "MPO": "JPEG"}     # Pillow's format → what Webots calls it
@@ -215,6 +215,25 @@ def _appearances(world: wm.World) -> Iterator[tuple[str, Any]]:
             yield f"robots[{r_i}].shapes[{i}]", part
 
 
+def checked_image(url: str, base_dir: Path, limits: Any, *, allow_outside: bool = False,
+                  allowed: frozenset[Path] = frozenset(), pixels_before: int = 0) -> tuple[Path, int]:
+    """A texture url → (its file, its pixels), checked as a world's textures are: confined (see
+    :func:`resolve_texture_url`), a PNG or JPEG no larger than ``limits.texture_file_bytes`` with at
+    most ``limits.texture_pixels`` pixels, ``pixels_before`` (the other images' pixels) plus its own
+    within ``limits.texture_pixels_total``, and decoded (a broken file raises here, once)."""
+    file = resolve_texture_url(url, base_dir, allow_outside=allow_outside, max_bytes=limits.texture_file_bytes,
+                               allowed=allowed)
+    _, w, h = image_header(file, url)
+    if w * h > limits.texture_pixels:
+        raise TextureFileError(f"texture {url!r} has {w}x{h} = {w * h:,} pixels, more than the "
+                               f"limit of {limits.texture_pixels:,} (raise the limits with --allow-large)")
+    if pixels_before + w * h > limits.texture_pixels_total:
+        raise TextureFileError(f"the world's textures have more than {limits.texture_pixels_total:,} "
+                               "pixels together (raise the limits with --allow-large)")
+    load_image(file, url)
+    return file, w * h
+
+
 def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False,
                    allowed: frozenset[Path] = frozenset()) -> list[tuple[str, str]]:
     """Every texture of a world: url confined (``allowed``: files outside the world's folder it may
@@ -235,16 +254,10 @@ def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: 
                                            max_bytes=limits.texture_file_bytes, allowed=allowed)
                 if file in seen:
                     continue
-                _, w, h = image_header(file, tex.url)
-                if w * h > limits.texture_pixels:
-                    raise TextureFileError(f"texture {tex.url!r} has {w}x{h} = {w * h:,} pixels, more than the "
-                                           f"limit of {limits.texture_pixels:,} (raise the limits with --allow-large)")
-                total += w * h
-                if total > limits.texture_pixels_total:
-                    raise TextureFileError(f"the world's textures have more than {limits.texture_pixels_total:,} "
-                                           "pixels together (raise the limits with --allow-large)")
-                load_image(file, tex.url)
-                seen[file] = w * h
+                file, pixels = checked_image(tex.url, base_dir, limits, allow_outside=allow_outside, allowed=allowed,
+                                             pixels_before=total)
+                total += pixels
+                seen[file] = pixels
             except TextureFileError as exc:
                 problems.append((where, str(exc)))
     return problems
@@ -722,6 +735,7 @@ class TextureSampler:
         self._locators: dict[int, TriangleLocator] = {}
         self._meshes: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         self._images: dict[Path, tuple[np.ndarray, np.ndarray | None, bool]] = {}
+        self._kept: set[Path] = set()              # the world's own images (see _image)
         self.models: list[tuple[Any, wm.Appearance | None]] = []
         self.textured = np.zeros(1, dtype=bool)
         self.alpha = np.zeros(1, dtype=bool)
@@ -731,10 +745,14 @@ class TextureSampler:
         self.extend(shapes)
         self.lookups = 0
 
-    def _image(self, t: wm.Texture | None) -> TextureImage | None:
+    def _image(self, t: wm.Texture | None, keep: bool = True) -> TextureImage | None:
+        """The image a texture names (read once); ``keep``: one of the world's own, kept for good (a
+        reset brings them back), else (a Supervisor's) let go when no shape uses it any more."""
         if t is None:
             return None
         path = resolve_texture_url(t.url, self.base_dir, allow_outside=True)
+        if keep:
+            self._kept.add(path)
         if path not in self._images:
             self._images[path] = (load_image(path, t.url), load_alpha(path, t.url), uses_alpha(path, t.url))
         rgb, alpha, translucent = self._images[path]
@@ -767,6 +785,37 @@ class TextureSampler:
         translucent[[s for s, st in self.shapes.items() if st.base.translucent]] = True
         self.translucent = translucent
         self.has_translucent = bool(translucent.any())
+
+    def set_shape(self, shape: int, appearance: wm.Appearance | None) -> None:
+        """A Supervisor's new images for one shape (an ImageTexture's url or wrap changed, or the
+        texture gone): its maps are read as :meth:`extend` reads them (the caller checked the files
+        and the limits), its flags change in place (callers hold these arrays), ink stays, and an
+        image no shape uses any more is let go."""
+        geometry = self.models[shape][0]
+        self.models[shape] = (geometry, appearance)
+        if appearance is not None and appearance.texture is not None:
+            base = self._image(appearance.texture, keep=False)
+            assert base is not None
+            self.shapes[shape] = ShapeTexture(base, self._image(appearance.roughness_map, keep=False),
+                                              self._image(appearance.occlusion_map, keep=False),
+                                              appearance.texture_transform)
+        else:
+            self.shapes.pop(shape, None)
+        st = self.shapes.get(shape)
+        self.textured[shape] = st is not None or shape in self.ink
+        self.alpha[shape] = st is not None and st.base.alpha is not None
+        self.has_alpha = bool(self.alpha.any())
+        self.translucent[shape] = st is not None and st.base.translucent
+        self.has_translucent = bool(self.translucent.any())
+        used = {id(img.rgb) for st in self.shapes.values() for img in (st.base, st.roughness, st.occlusion)
+                if img is not None}
+        self._images = {p: v for p, v in self._images.items() if p in self._kept or id(v[0]) in used}
+
+    def pixels(self, without: Collection[int] = ()) -> int:
+        """The pixels of the distinct images the shapes use (but those of the shapes ``without``)."""
+        seen = {id(img.rgb): img.rgb.shape[0] * img.rgb.shape[1] for k, st in self.shapes.items() if k not in without
+                for img in (st.base, st.roughness, st.occlusion) if img is not None}
+        return sum(seen.values())
 
     def __bool__(self) -> bool:
         return bool(self.shapes) or bool(self.ink)

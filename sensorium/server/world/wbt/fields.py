@@ -448,6 +448,7 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
                 extra = image_texture(f.node_(field), source, warn, resolve)
                 if extra is not None:
                     out[key] = extra
+        if f.node_("baseColorMap") is not None:      # (kept for a url a Supervisor sets)
             _texture_transform(f, source, out)
         return out
     if node.type == "Appearance":
@@ -462,6 +463,7 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
             out["transparency"] = m.within("transparency", 0.0, 0.0, 1.0, 0.5)
         if texture is not None:
             out["texture"] = texture
+        if f.node_("texture") is not None:           # (kept for a url a Supervisor sets)
             _texture_transform(f, source, out)
         return out
     warn(node, f"appearance {node.type}: not built in (a PROTO?); taken as white")
@@ -559,6 +561,7 @@ def shape_node(node: Node, source: str, keep_def, key) -> dict:
                 _written(a.sub(material), {k: v for k, v in MATERIAL_FIELDS.items() if k not in held}, "material",
                          values)
         if texture is not None and texture.type == "ImageTexture":
+            out["texture_key"] = key(texture)
             if keep_def(texture):
                 out["texture_def"] = texture.def_name
             _written(a.sub(texture), TEXTURE_FIELDS, "texture", values)
