@@ -847,7 +847,8 @@ MAX_MF_STRING = 4096
 def _mf_change(field: Field | None, want: int | None, op: str, index: Any, value: Any, func: str) -> None:
     """An MF field's item set, inserted or removed (``want`` None: any MF type, removeMF); the server
     checks the index (negative from the end, as Webots) and the value, and says what is wrong in one
-    line. Served on an imported line or point set's fields (README "Supervisor")."""
+    line. Served on an imported line or point set's fields and on a shape's ImageTexture's ``url``
+    (README "Supervisor")."""
     r = _field_robot(field, want, func)
     if r is None:
         return

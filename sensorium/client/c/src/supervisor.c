@@ -1262,7 +1262,8 @@ void wb_supervisor_field_set_sf_string(WbFieldRef field, const char *value) {
 }
 
 /* an MF field's item set, inserted or removed (Webots' setMF*, insertMF*, removeMF): served on an imported
-   line or point set's fields; the server checks the index (negative from the end) and the value */
+   line or point set's fields and on a shape's ImageTexture url; the server checks the index (negative from
+   the end) and the value */
 typedef struct {
   int64_t node;
   const char *name;
