@@ -246,6 +246,23 @@ def test_a_texture_the_world_file_could_not_load_takes_a_url_set_later(folder):
     assert np.array_equal(got[0], ref[0]) and got[1] == ref[1]
 
 
+def test_an_image_texture_without_url_takes_one(folder):
+    path = folder / "bare.wbt"
+    path.write_text(WORLD.replace('DEF TEX ImageTexture {\n          url [\n            "a.png"\n          ]', "ImageTexture {")
+                    .replace("texture USE TEX", ""))
+    assert "a.png" not in path.read_text() and "TEX" not in path.read_text()
+    sim = _sim(path)
+    assert _centre(_shot(sim)[0]) == expected_bytes(DIFFUSE)
+    shape = sv.node_by_id(sim, field(sim, sv.find_node(sim, "WALL"), "children")[0])
+    tex = sv.node_by_id(sim, field(sim, sv.node_by_id(sim, field(sim, shape, "appearance")), "texture"))
+    assert tex.type == "ImageTexture"
+    assert field(sim, tex, "url") == []
+    sv.change_item(sim, tex, "url", "insert", -1, "b.png")
+    got = _shot(sim)
+    ref = _written(folder, '"b.png"')
+    assert np.array_equal(got[0], ref[0]) and got[1] == ref[1]
+
+
 def test_repeat_and_filtering(folder):
     sim = _sim(folder / "world.wbt")
     tex = sv.find_node(sim, "TEX")

@@ -80,7 +80,7 @@ def inside(shape: Any, index: int) -> list[tuple[str, str, str, str]]:
         if node is not None and node.material:
             out.append(("material", "Material", node.material_def or "", "material"))
         textured = (app is not None and app.texture is not None) or (node is not None and (
-            node.texture_def is not None or any(k.startswith("texture.") for k in node.values)))
+            node.texture_def is not None or node.texture_key >= 0 or any(k.startswith("texture.") for k in node.values)))
         if textured:
             out.append(("texture", "ImageTexture", (node.texture_def if node else None) or "",
                         "texture" if kind == "Appearance" else "baseColorMap"))
