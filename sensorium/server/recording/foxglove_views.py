@@ -83,11 +83,12 @@ class FoxgloveViews:
         self._tf_schema = FrameTransforms.get_schema()
         self._scene_schema = SceneUpdate.get_schema()
 
-    def scene(self) -> tuple[str, str, str, bytes, str, bytes] | None:
-        """The ``/scene`` record (at time 0), or ``None`` without a world."""
+    def scene(self, drawn: dict[int, Any] | None = None) -> tuple[str, str, str, bytes, str, bytes] | None:
+        """The ``/scene`` record, or ``None`` without a world. ``drawn``: the shapes a Supervisor
+        recoloured (``Scene.drawn_models``), drawn as they look now."""
         if self.world is None:
             return None
-        data = self._scene.scene_update(self.world, self.base_dir, 0).encode()
+        data = self._scene.scene_update(self.world, self.base_dir, 0, drawn=drawn).encode()
         s = self._scene_schema
         return ("/scene", s.name, s.encoding, bytes(s.data), "protobuf", data)
 

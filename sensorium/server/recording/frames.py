@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -17,7 +17,7 @@ from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 
 __all__ = ["WORLD_FRAME", "INFINITE_PLANE_SIZE", "Mount", "mounts", "link_frame", "JointFrames", "quat_from_x", "Body", "bodies", "lights",
-           "shape_rgba", "GHOST_ALPHA"]
+           "shape_rgba", "GHOST_ALPHA", "Appearances"]
 
 WORLD_FRAME = "world"
 INFINITE_PLANE_SIZE = 50.0      # metres: an infinite plane is drawn as a square of this side
@@ -26,6 +26,17 @@ NO_APPEARANCE = (0.85, 0.85, 0.85)  # a shape without appearance (Webots draws i
 GHOST_ALPHA = 0.25               # bounding-only shapes (invisible in Webots) are drawn this translucent
 
 Mount = tuple[str, tuple[float, float, float], tuple[float, float, float, float]]
+
+
+class Appearances(Protocol):
+    """Where the scene's drawers read what a Supervisor changed in shapes' appearances (the
+    simulation's ``Scene``): ``appearance_version`` changes with every change and reset, so a
+    drawer compares one number per step; ``drawn_models()`` gives the changed shapes' models now
+    (``id()`` of the world's model -> the model to draw)."""
+
+    appearance_version: int
+
+    def drawn_models(self) -> dict[int, Any]: ...
 
 
 def shape_rgba(shape: Any, ghost: bool = False) -> tuple[float, float, float, float]:

@@ -15,7 +15,10 @@ direction, in the light's colour). Boxes, spheres and cylinders are Foxglove pri
 mesh files are triangle lists; a finite plane is a flat cube, an infinite plane is drawn as a
 ``INFINITE_PLANE_SIZE`` square (Foxglove has no infinite primitive). Colours are the appearance's
 ``base_color`` with alpha ``1 - transparency``; a shape without appearance is drawn light grey
-(Webots draws it white).
+(Webots draws it white). A textured shape keeps that rule: an ``Appearance`` with an image is white
+(the loader's base colour: the image replaces the diffuse colour), a ``PBRAppearance`` its
+``baseColor``. ``drawn`` gives the models of the shapes whose appearance a Supervisor changed
+(``Scene.drawn_models``): those are drawn as they look now, by the same rule.
 
 Everything here is pure: world model in, ``foxglove.messages`` objects out (encode with
 ``.encode()``; the schema is ``SceneUpdate.get_schema()`` / ``FrameTransforms.get_schema()``).
@@ -23,7 +26,7 @@ Everything here is pure: world model in, ``foxglove.messages`` objects out (enco
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from collections.abc import Set as AbstractSet
 from pathlib import Path
 from typing import Any
@@ -159,17 +162,22 @@ def _light_entity(entity_id: str, frame_id: str, frame_locked: bool, light: Any,
 
 
 def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
-                 solid_poses: dict[str, Any] | None = None, removed_lights: AbstractSet[int] = frozenset()) -> SceneUpdate:
+                 solid_poses: dict[str, Any] | None = None, removed_lights: AbstractSet[int] = frozenset(),
+                 drawn: Mapping[int, Any] | None = None) -> SceneUpdate:
     """The whole world as one ``SceneUpdate``. ``solid_poses`` (name → geometry ``Pose``) overrides
     the file's pose of a solid that was moved since loading (its children and lights move with it);
     a solid it leaves out was removed (a Supervisor's ``node.remove()``): not drawn, and deleted, as
-    the world's top-level lights of ``removed_lights`` (indices in ``world.lights``)."""
+    the world's top-level lights of ``removed_lights`` (indices in ``world.lights``). ``drawn``
+    (``id()`` of a shape model ``world`` holds → the model to draw in its place) gives the shapes
+    whose appearance a Supervisor changed (``Scene.drawn_models``)."""
     base = Path(base_dir)
     budget = [MAX_SCENE_TRIANGLES]
     entities: list[SceneEntity] = []
     for body in bodies(world, solid_poses):
         merged: dict[str, list[Any]] = {}
         for shape, pose, ghost in body.parts:
+            if drawn:
+                shape = drawn.get(id(shape), shape)
             fx_pose = _pose(pose.translation, matrix_quaternion(pose.rotation))
             for key, prims in shape_primitives(shape, fx_pose, base, budget, ghost).items():
                 merged.setdefault(key, []).extend(prims)

@@ -18,7 +18,9 @@ publishes, with the bytes it published: nothing is dropped and nothing is re-enc
 Foxglove-ready recordings (format 2, the default when the ``foxglove`` extra is installed): the
 msgpack bodies go to ``/sensorium/wire<topic>`` channels wrapped as a CDR ``uint8[]`` (still byte
 for byte), next to per-topic ROS 2 CDR views, ``/tf`` and ``/scene`` that Foxglove displays; see
-:mod:`.foxglove_views`. Readers use only the lossless channels.
+:mod:`.foxglove_views`. Readers use only the lossless channels. ``/scene`` is written at time 0 and,
+when the recorder is given the simulation's scene (``appearances``: ``serve --record``), again at the
+stamp of the first message after a Supervisor changed a shape's appearance or a reset restored them.
 
 Reading is :mod:`.reader`; constants, the envelope and topic filters are :mod:`.envelope`.
 """
@@ -32,7 +34,7 @@ import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import IO, Any, cast
+from typing import IO, TYPE_CHECKING, Any, cast
 
 import msgpack
 from mcap.writer import CompressionType, IndexType, Writer
@@ -47,6 +49,9 @@ from sensorium.server.recording.envelope import (
     media_type,
     topic_matcher,
 )
+
+if TYPE_CHECKING:
+    from sensorium.server.recording.frames import Appearances
 
 __all__ = ["McapRecorder", "recorder_for_server", "DEFAULT_CHUNK_SIZE"]
 
@@ -114,7 +119,8 @@ class McapRecorder:
                  compression: str = "zstd", flush_interval: float | None = 1.0,
                  session: dict[str, str] | None = None, demand: bool = True,
                  background_flush: bool = True, foxglove: bool = True, world: Any = None,
-                 base_dir: str | os.PathLike = ".", on_error: Callable[[str], None] | None = None):
+                 base_dir: str | os.PathLike = ".", on_error: Callable[[str], None] | None = None,
+                 appearances: Appearances | None = None):
         self.path = Path(path)
         # a write error (disk full, file size limit) stops the recording, never the caller: one line
         # through on_error, ``failed`` says why, record() and close() return quietly from then on
@@ -126,6 +132,9 @@ class McapRecorder:
         self._view_schemas: dict[str, int] = {}
         self._view_channels: dict[str, int] = {}
         self._view_seq: dict[str, int] = {}
+        # the shapes a Supervisor recoloured: /scene is written again when the version moves
+        self._appearances = appearances if self._views is not None and world is not None else None
+        self._scene_version = self._appearances.appearance_version if self._appearances is not None else 0
         self.topics = list(topics) if topics else None
         self.demand = demand
         self._wants = topic_matcher(self.topics)
@@ -170,7 +179,8 @@ class McapRecorder:
                     "started_at_ns": str(time.time_ns()), "pid": str(os.getpid())}
             sess.update({str(k): str(v) for k, v in (session or {}).items()})
             self._writer.add_metadata("session", sess)
-            scene = self._views.scene() if self._views is not None else None
+            drawn = self._appearances.drawn_models() if self._appearances is not None else None
+            scene = self._views.scene(drawn) if self._views is not None else None
             if scene is not None:
                 self._add_view(scene, 0)
         except BaseException:
@@ -247,6 +257,12 @@ class McapRecorder:
                                      data=fxv.wire_wrap(bytes(body)), sequence=int(seq) % SEQ_MODULUS)
             for view in self._views.views(topic, ros_type, bytes(body), stamp):
                 self._add_view(view, stamp, int(seq) if view[0] == topic else None)
+            looks = self._appearances
+            if looks is not None and looks.appearance_version != self._scene_version:
+                self._scene_version = looks.appearance_version
+                scene = self._views.scene(looks.drawn_models())
+                if scene is not None:
+                    self._add_view(scene, stamp)
         self.counts[topic] = self.counts.get(topic, 0) + 1
         self.message_count += 1
         self._dirty = True
@@ -390,7 +406,7 @@ def recorder_for_server(path: str | os.PathLike, core: Any, topics: list[str] | 
     rec = McapRecorder(path, text, Path(source).name if source and source != "<memory>" else "world.yaml", meta,
                        topics, chunk_size, session={"mode": "server", "world_path": source},
                        world=getattr(sim, "world", None), base_dir=getattr(loaded, "base_dir", "."),
-                       foxglove=foxglove)
+                       foxglove=foxglove, appearances=getattr(sim, "scene", None))
     try:
         base = Path(getattr(loaded, "base_dir", "") or ".")
         seen: set[str] = set()

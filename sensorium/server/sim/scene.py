@@ -471,6 +471,7 @@ class Scene:
         self.solids_version = 0        # changes whenever a top-level solid moves, is added or removed (gym's TopDown)
         self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
         self.shapes_version = 0        # changes whenever a Supervisor adds shapes (cameras' recognition rebuilds)
+        self.appearance_version = 0    # changes whenever a shape's appearance changes or a reset restores it (Foxglove's scene)
         self._shape_arrays()
         # what cameras see past everything: the HDR radiance Webots clears with (shows as the sky colour)
         self.background = background_radiance(world.background.sky_color)
@@ -504,10 +505,15 @@ class Scene:
         """A Supervisor's new colour, roughness or transparency for one shape (Webots' Material and
         PBRAppearance fields): from the next measurement cameras and infra-red sensors read it as if the
         world file had said it. Only that shape's entries change (no rebuild); a transparency keeps its
-        side of 0 and 1 (the caller's check: which rays see the shape and its shadows is fixed)."""
+        side of 0 and 1 (the caller's check: which rays see the shape and its shadows is fixed).
+        ``appearance_version`` moves unless the appearance is the same as now (the Foxglove scene
+        draws it again)."""
         model = self._parts[shape][2]
+        if appearance == model.appearance:      # the same values again: nothing to redraw
+            return
         self._loaded_models.setdefault(shape, model)
         self._use_model(shape, model.model_copy(update={"appearance": appearance}))
+        self.appearance_version += 1
 
     def set_texture(self, shape: int, appearance: wm.Appearance) -> None:
         """:meth:`set_appearance` with new images (an ImageTexture's url or wrap a Supervisor set, or
@@ -550,8 +556,16 @@ class Scene:
             if self.textures is not None and retextured is not None and model.appearance is not None and \
                     _maps(retextured) != _maps(model.appearance):
                 self.textures.set_shape(shape, model.appearance)
+        if self._loaded_models:
+            self.appearance_version += 1
         self._loaded_models.clear()
         self.appearance_values.clear()
+
+    def drawn_models(self) -> dict[int, wm.Shape | wm.Solid]:
+        """The shapes whose appearance a Supervisor changed, for drawing them as they look now (the
+        Foxglove scene, which walks the world's own models): ``id()`` of the model the world holds ->
+        the model now. Empty while nothing changed (or after a reset)."""
+        return {id(model): self._parts[shape][2] for shape, model in self._loaded_models.items()}
 
     def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool,
                   key: str | int | None = None, entries: list[ShapeEntry] | None = None) -> int:

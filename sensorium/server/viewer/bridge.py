@@ -31,7 +31,9 @@ Never slowing the step loop: :meth:`record` (called by ``Topics`` in the step th
 the msgpack bytes to a bounded queue (the oldest is dropped when full, ``dropped`` counts it); a
 worker thread encodes CDR/protobuf and hands the bytes to the SDK, whose per-client backlog drops
 the oldest messages of a slow client. Simulated time is broadcast as the server time. When a
-supervisor moves a solid, the scene is sent again to every ``/scene`` subscriber.
+supervisor moves, removes or imports a solid or a light, or changes a shape's appearance (a colour,
+a transparency, a texture given or taken: ``Scene.appearance_version``), or a reset brings the
+loaded appearances back, the scene is sent again to every ``/scene`` subscriber.
 """
 
 from __future__ import annotations
@@ -46,13 +48,16 @@ from collections.abc import Callable, Iterable
 from collections.abc import Set as AbstractSet
 from contextlib import ExitStack
 from pathlib import Path
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import msgpack
 
 from sensorium.schemas import world as wm
 from sensorium.server.recording.export import CdrEncoder, ExportError
 from sensorium.server.recording.ros_views import joint_positions, joint_states_robot, pose_robot
+
+if TYPE_CHECKING:
+    from sensorium.server.recording.frames import Appearances
 
 __all__ = ["FoxgloveBridge", "ViewerError", "parse_address", "exposure_warning", "TF_TOPIC", "SCENE_TOPIC", "POSE_TYPE"]
 
@@ -225,7 +230,9 @@ class FoxgloveBridge:
     """One Foxglove WebSocket server. ``topic_types``: topic → ROS type of its msgpack body;
     ``world``/``base_dir``: for ``/scene`` and the mounts in ``/tf`` (``None``: no scene);
     ``on_demand(topics)``: called by :meth:`pump` with the topics viewers demand now;
-    ``wake()``: called from the SDK's thread when :meth:`pump` has something to apply."""
+    ``wake()``: called from the SDK's thread when :meth:`pump` has something to apply;
+    ``appearances``: the simulation's scene, whose shapes are drawn as a Supervisor last set their
+    appearance (``None``: as loaded)."""
 
     def __init__(self, topic_types: dict[str, str], world: wm.World | None = None, base_dir: str | Path = ".", *,
                  host: str = "127.0.0.1", port: int = DEFAULT_PORT, name: str = "sensorium",
@@ -233,7 +240,7 @@ class FoxgloveBridge:
                  solid_poses: Callable[[], dict[str, Any]] | None = None,
                  removed_lights: Callable[[], AbstractSet[int]] | None = None, queue_size: int | None = None,
                  backlog: int | None = None, distro: str = "jazzy", status: Callable[[], str | None] | None = None,
-                 largest_message: int = 0):
+                 largest_message: int = 0, appearances: Appearances | None = None):
         try:
             import foxglove
             from foxglove.messages import FrameTransforms, SceneUpdate
@@ -252,6 +259,11 @@ class FoxgloveBridge:
         self.wake = wake or (lambda: None)
         self.solid_poses = solid_poses
         self.removed_lights = removed_lights          # the world's top-level lights a Supervisor removed
+        # the shapes a Supervisor recoloured: (the scene's appearance_version, its drawn_models()), taken
+        # by the step thread (pump) when the version moves, read whole by the worker (scene_bytes)
+        self.appearances = appearances
+        self._drawn: tuple[int, dict[int, Any]] = (
+            (appearances.appearance_version, appearances.drawn_models()) if appearances is not None else (0, {}))
         self.ctx = foxglove.Context()
         self.types: dict[str, str] = {}            # topic -> channel schema name
         self.unsupported: dict[str, str] = {}      # topic -> its type the distro lacks
@@ -342,7 +354,7 @@ class FoxgloveBridge:
                      on_demand=topics.set_viewer_demand, wake=transport.wake,
                      solid_poses=lambda: dict(sim.scene.solid_poses),
                      removed_lights=lambda: frozenset(sim.scene.removed_lights), status=lambda: waiting_message(core),
-                     largest_message=largest_message(sim.world), **kw)
+                     largest_message=largest_message(sim.world), appearances=sim.scene, **kw)
         topics.set_viewer(bridge.record)
         transport.hooks.append(lambda: bridge.pump(sim.time_ms * 1_000_000))
         return bridge
@@ -439,7 +451,8 @@ class FoxgloveBridge:
     # ------------------------------------------------------------------ step-loop thread
     def pump(self, time_ns: int | None = None) -> None:
         """Apply subscription changes (``on_demand``), note the simulated time, and resend the scene
-        when a solid was moved (supervisor). Cheap when idle."""
+        when a Supervisor moved, removed or imported something or changed an appearance (or a reset
+        restored them). Cheap when idle: a version number and the solids' pose objects compared."""
         if time_ns is not None and time_ns != self._time_ns:
             self._time_ns = int(time_ns)
             self._event.set()
@@ -451,18 +464,25 @@ class FoxgloveBridge:
                 if status != self._status:
                     self._status = status
                     self._event.set()
-        if self.solid_poses is not None and self._subs.get(SCENE_TOPIC, 0) > 0:
+        resend = False
+        appearances = self.appearances
+        if appearances is not None and appearances.appearance_version != self._drawn[0]:
+            self._drawn = (appearances.appearance_version, appearances.drawn_models())
+            resend = True
+        watching = self._subs.get(SCENE_TOPIC, 0) > 0
+        if self.solid_poses is not None and watching:
             poses = list(self.solid_poses().values())
             # lights removed or imported (a Supervisor's) change the scene too
             removed = (len(self.removed_lights()) if self.removed_lights is not None else 0,
                        len(self.world.lights) if self.world is not None else 0)
             if len(poses) != len(self._seen_poses) or any(a is not b for a, b in zip(poses, self._seen_poses)) \
                     or removed != self._seen_removed_lights:
-                if self._seen_poses:
-                    self._scene_for.append(None)
-                    self._event.set()
+                resend = resend or bool(self._seen_poses)
                 self._seen_poses = poses
                 self._seen_removed_lights = removed
+        if resend and watching:
+            self._scene_for.append(None)
+            self._event.set()
         if self._dirty:
             with self._lock:
                 self._dirty = False
@@ -571,15 +591,18 @@ class FoxgloveBridge:
         return self._scene_mod.frame_transforms(robot, ns, t, q, self.mounts.get(robot, [])).encode()
 
     def scene_bytes(self) -> bytes:
-        """The encoded ``SceneUpdate`` of the world (solids at their current poses)."""
+        """The encoded ``SceneUpdate`` of the world (solids at their current poses, shapes in their
+        current appearances); encoded again only when one of those changed."""
         if self.world is None:
             return b""
         poses = self.solid_poses() if self.solid_poses is not None else None
         removed = frozenset(self.removed_lights()) if self.removed_lights is not None else frozenset()
+        version, drawn = self._drawn
         key = (tuple((n, p.translation.tobytes(), p.rotation.tobytes()) for n, p in (poses or {}).items()),
-               tuple(sorted(removed)), len(self.world.lights))
+               tuple(sorted(removed)), len(self.world.lights), version)
         if self._scene_bytes is None or key != self._scene_key:
-            self._scene_bytes = self._scene_mod.scene_update(self.world, self.base_dir, 0, poses, removed).encode()
+            self._scene_bytes = self._scene_mod.scene_update(self.world, self.base_dir, 0, poses, removed,
+                                                             drawn).encode()
             self._scene_key = key
         return self._scene_bytes
 
