@@ -279,3 +279,58 @@ def test_a_server_recording_writes_the_scene_again_when_an_appearance_changes(wo
     wall = {e["id"]: e for e in got["last"]["/scene"]["msg"]["entities"]}["solid/wall"]
     c = wall["cubes"][0]["color"]
     assert (c["r"], c["g"], c["b"], c["a"]) == (0.25, 0.5, 0.75, 1.0)
+
+
+def _rgba(entity: dict, kind: str) -> tuple[float, float, float, float]:
+    c = entity[kind][0]["color"]
+    return (c["r"], c["g"], c["b"], c["a"])
+
+
+def test_a_viewer_we_did_not_write_sees_a_supervisors_colour_and_the_reset(world):
+    """serve --foxglove end to end: Foxglove's own client (Node) subscribed to /scene gets the scene
+    again after a supervisor's set_field over the wire, and again after simulation_reset."""
+    import signal
+
+    import zmq
+    from _node import NodeProcess
+    from _serve import serve
+    from test_foxglove_live import Rpc
+
+    srv = serve(world, "--precision", "fast", "--heartbeat-ms", "2000", "--foxglove", "127.0.0.1:0")
+    ctx = zmq.Context()
+    node = None
+    try:
+        node = NodeProcess("live_client.js", srv.fields["foxglove"])
+        node.wait_for(lambda e: e["event"] == "advertise", what="advertise")
+        node.send(cmd="subscribe", topic="/scene")
+
+        def scene(k: int) -> dict:
+            """The k-th /scene message (0: the subscriber's own copy), entities by id."""
+            node.find(lambda e: sum(x["event"] == "message" and x["topic"] == "/scene" for x in node.seen) > k,
+                      what=f"/scene #{k}")
+            msgs = [e for e in node.seen if e["event"] == "message" and e["topic"] == "/scene"]
+            return {e["id"]: e for e in msgs[k]["msg"]["entities"]}
+
+        assert _rgba(scene(0)["solid/ball"], "spheres") == (0.75, 0.5, 0.25, 1.0)
+        rpc = Rpc(ctx, srv.fields["rpc"])
+        rpc.session = rpc.ok("attach", {"robot": "boss"})["session"]
+        app = rpc.ok("/boss/robot/get_from_def", {"name": "BALL_APP"})["node"]
+        rpc.ok("/boss/robot/set_field", {"node": app, "field": "baseColor", "value": [0.25, 0.5, 1.0]})
+        rpc.ok("/boss/robot/step")
+        changed = scene(1)
+        assert _rgba(changed["solid/ball"], "spheres") == _rgba(changed["solid/twin"], "cubes") == (0.25, 0.5, 1.0, 1.0)
+        assert _rgba(changed["solid/pane"], "cylinders") == (0.125, 0.875, 0.25, 0.75)
+        rpc.ok("/boss/robot/simulation_reset")
+        rpc.ok("/boss/robot/step")
+        assert _rgba(scene(2)["solid/ball"], "spheres") == (0.75, 0.5, 0.25, 1.0)
+        for _ in range(3):
+            rpc.ok("/boss/robot/step")
+        node.drain()                                # (kept in node.seen)
+        assert sum(e["event"] == "message" and e["topic"] == "/scene" for e in node.seen) == 3
+        assert not [e for e in node.seen if e["event"] == "error"]
+    finally:
+        if node is not None:
+            node.close()
+        code = srv.stop(signal.SIGTERM)
+        ctx.destroy(0)
+        assert code == 0, srv.stderr()
