@@ -13,6 +13,7 @@ import pytest
 from test_multiprocess import REPO, run_paused
 from test_supervisor import A, Live
 
+from sensorium.schemas.wire import ErrorCode
 from sensorium.server.daemon import nested
 from sensorium.server.daemon import supervisor as sv
 from sensorium.server.sim.simulation import Simulation
@@ -110,6 +111,18 @@ def test_the_service_answers_a_node_ref_and_its_note():
     assert (eye["type"], eye["name"], eye["def_name"], eye["note"]) == ("DistanceSensor", "eye", "", "")
     mass = lv.ok(A, "/rover/robot/get_from_proto_def", {"node": 1, "name": "MASS"})
     assert mass["type"] == "" and "physics only" in mass["note"]
+
+
+def test_bad_requests_get_one_line():
+    lv = Live(_sim())
+    lv.ok(A, "attach", {"robot": "rover"})
+    for args in ({"node": 1, "name": "X" * 4097}, {"node": 1, "name": ""}, {"node": 999, "name": "EYE"},
+                 {"node": 1}, {"name": "EYE"}):
+        lv.err(A, "/rover/robot/get_from_proto_def", args, ErrorCode.INVALID_ARGUMENT)
+    dotted = lv.ok(A, "/rover/robot/get_from_proto_def", {"node": 1, "name": "CHASSIS.HULL_SHAPE"})
+    assert (dotted["type"], dotted["note"]) == ("", "")       # a DEF name has no dot: none (Webots)
+    root = lv.ok(A, "/rover/robot/get_from_proto_def", {"node": 0, "name": "EYE"})
+    assert (root["type"], root["note"]) == ("", "'node' is not a PROTO node")
 
 
 def _check_lines(err: str) -> None:

@@ -9,7 +9,9 @@ numbered once per simulation, in scene order (robots, then solids, each depth fi
 :data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
 imports) are never shifted by them. A nested node is found by DEF (first in scene order, as
 Webots' DEF dictionary) or by a dotted path ``A.B.C`` (each name after the first a direct child's
-DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``).
+DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``). A PROTO instance's body nodes are
+found by their DEF in that instance's scope (``getFromProtoDef``: :func:`inner_def`, from the import's
+``inner_defs``), never by ``getFromDef``.
 
 Its world pose is its owner's pose now (the robot as it drives, the solid as a Supervisor set it)
 composed with the node's frame in the owner as the world loaded, moved by the joints it is past: a
@@ -190,7 +192,8 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
     """The robots' and top-level solids' Shape nodes (appearance.py), each followed by the nodes inside
     it, numbered after every other nested node: robots in world order, then solids (each solid's
     shapes, then those of the solids inside it). A robot's shape sits under the node its world entry
-    names (``ShapeNode.parent``), a solid's under the solid holding it."""
+    names (``ShapeNode.parent``), a solid's under the solid holding it. ``shape_tags`` gets the PROTO-body
+    DEFs of the shapes and their nodes: (owner id, InnerDef, the node's id)."""
     scene = sim.scene
     index = {id(scene.loaded_model(k)): k for k in range(len(scene.shapes))}
     loaded = getattr(sim, "loaded", None)
