@@ -265,6 +265,7 @@ def build(sim: Any, loaded_solids: int) -> Table:
     robots = list(sim.robots)
     tags: list[tuple[int, wm.InnerDef, int | str]] = []     # (owner, tag, the node it names or why it is none)
     firsts: dict[int, int] = {}            # a robot's id -> the id of its first entry (InnerDef.scope 0)
+    counts: dict[int, int] = {}            # a robot's id -> how many entries it has
     serials: dict[int, dict[int, int]] = {}     # a top-level solid's id -> its PROTO instances' ids by number
     for i, name in enumerate(robots):
         owner = i + 1
@@ -272,6 +273,7 @@ def build(sim: Any, loaded_solids: int) -> Table:
         joints = _riding(sim.robots[name], entries)
         first = FIRST_ID + len(out)
         firsts[owner] = first
+        counts[owner] = len(entries)
         tags.extend((owner, t, t.why) for t in sim.robots[name].model.inner_defs)
         tags.extend((owner, t, first + k) for k, e in enumerate(entries) for t in e.inner_defs)
         frames: list[Pose | None] = []       # each entry's nearest Pose frame in the robot (None: the robot's)
@@ -314,8 +316,10 @@ def build(sim: Any, loaded_solids: int) -> Table:
     tags.extend(shape_tags)
     inner: dict[int, dict[str, int | str]] = {}
     for owner, tag, target in tags:
-        instance = owner if tag.scope < 0 else firsts[owner] + tag.scope if owner in firsts \
-            else serials.get(owner, {}).get(tag.scope)
+        if owner in firsts:                # a robot: the instance's entry (a world file's scope past them: none)
+            instance = owner if tag.scope < 0 else firsts[owner] + tag.scope if tag.scope < counts[owner] else None
+        else:                              # a top-level solid: the nested solid of that number
+            instance = owner if tag.scope < 0 else serials.get(owner, {}).get(tag.scope)
         if instance is not None:
             inner.setdefault(instance, {}).setdefault(tag.name, target)
     by_owner: dict[int, list[Nested]] = {}
