@@ -1,9 +1,10 @@
-"""getFromProtoDef (C ``wb_supervisor_node_get_from_proto_def``) on Sensorium's own PROTOs
+"""getFromProtoDef (C ``wb_supervisor_node_get_from_proto_def``, C++ ``Node::getFromProtoDef``) on Sensorium's own PROTOs
 (tests/protos/protodef, tests/worlds/proto/supervisor_proto_def.wbt): a PROTO instance's body nodes found by
 their DEF and read as any node (fields, parent, world position), Webots' scope (the instance's own body and
 what it holds; a nested PROTO instance's body is that instance's), a DEF used twice (the DEF'd node, not its
 USE), and the NULLs: no such DEF, a DEF naming a node Sensorium serves none for (a line saying why), a node
-that is no PROTO instance, a NULL or empty DEF. Python and C (AddressSanitizer, UBSan) print the same."""
+that is no PROTO instance, a NULL or empty DEF. Python and C (AddressSanitizer, UBSan) print the same; the C++
+classes find them too."""
 
 from __future__ import annotations
 
@@ -150,3 +151,29 @@ def test_a_c_supervisor_finds_the_same(tmp_path, tmp_path_factory):
     err = ctl.stderr()
     assert "Sanitizer" not in err and "runtime error" not in err, err
     _check_lines(err)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_the_cpp_classes_find_them_too(tmp_path, tmp_path_factory):
+    import shutil
+    import subprocess
+
+    from test_c_client import CLIB, _make
+
+    if shutil.which("c++") is None:
+        pytest.skip("needs a C++ toolchain")
+    build = tmp_path_factory.mktemp("cppbuild")
+    _make(f"BUILD={build}", "SANITIZE=1")
+    exe = build / "supervisor_proto_def_cpp"
+    done = subprocess.run(["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+                           f"-I{CLIB / 'include'}", str(REPO / "tests" / "c" / "supervisor_proto_def_cpp.cpp"), "-o",
+                           str(exe), str(build / "libController.a"), *_make("libs").split()],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    ctl = run_paused(WORLD, tmp_path, str(exe), "rover", env=SAN_ENV)
+    assert ctl.out == ["DistanceSensor eye 1.1 0 0.05", "Arm Pose 1 1 1"]
+    err = ctl.stderr()
+    assert "Sanitizer" not in err and "runtime error" not in err, err
+    assert [x for x in err.splitlines() if x.startswith("Error:")] == [
+        f"Error: {FUNC}(): DEF MASS of PROTO Rover's body (Robot 'ROVER' (node 1)) names a Physics node: physics only, "
+        "which Sensorium does not simulate (no Supervisor node here)."], err
