@@ -1,10 +1,10 @@
-"""getFromProtoDef (C ``wb_supervisor_node_get_from_proto_def``, C++ ``Node::getFromProtoDef``) on Sensorium's own PROTOs
-(tests/protos/protodef, tests/worlds/proto/supervisor_proto_def.wbt): a PROTO instance's body nodes found by
-their DEF and read as any node (fields, parent, world position), Webots' scope (the instance's own body and
-what it holds; a nested PROTO instance's body is that instance's), a DEF used twice (the DEF'd node, not its
-USE), and the NULLs: no such DEF, a DEF naming a node Sensorium serves none for (a line saying why), a node
-that is no PROTO instance, a NULL or empty DEF. Python and C (AddressSanitizer, UBSan) print the same; the C++
-classes find them too."""
+"""getFromProtoDef (C ``wb_supervisor_node_get_from_proto_def``, C++ ``Node::getFromProtoDef``) on Sensorium's
+own PROTOs (tests/protos/protodef, tests/worlds/proto/supervisor_proto_def.wbt): a PROTO instance's body nodes
+found by their DEF and read as any node (fields, parent, world position), Webots' scope (the instance's own body
+and what it holds; a nested PROTO instance's body is that instance's), a DEF used twice (the DEF'd node, not its
+USE), and the NULLs: no such DEF, a DEF naming a node Sensorium serves none for (a line saying why), a node that
+is no PROTO instance, a NULL or empty DEF. Python and C (AddressSanitizer, UBSan) print the same; the C++ classes
+find them too."""
 
 from __future__ import annotations
 
