@@ -101,6 +101,9 @@ class Owner:
 MAX_INNER_DEFS = 1024
 """DEF names of PROTO bodies kept per robot or top-level solid (getFromProtoDef); a body declares tens."""
 
+MAX_DEF = 4096
+"""The longest DEF name getFromProtoDef is asked for (a longer one is never found)."""
+
 SCOPE_NODES = 20_000
 """Nodes read per PROTO instance for its body's DEF names (the rest of a huge body is not searched)."""
 
@@ -145,7 +148,7 @@ def _scope_defs(root: Node) -> dict[str, tuple[int, str]]:
     found: dict[str, tuple[int, str]] = {}
     level = _sub_nodes(root)
     for child in level:
-        if child.def_name and child.def_name not in found:
+        if child.def_name and child.def_name not in found and len(child.def_name) <= MAX_DEF:
             found[child.def_name] = (id(child), child.type)
     budget = SCOPE_NODES
     seen: set[int] = set()
@@ -157,7 +160,8 @@ def _scope_defs(root: Node) -> dict[str, tuple[int, str]]:
                 continue
             seen.add(id(node))
             budget -= 1
-            if node.def_name and node.def_name not in found and body_of(node) not in hidden:
+            if node.def_name and node.def_name not in found and len(node.def_name) <= MAX_DEF \
+                    and body_of(node) not in hidden:
                 found[node.def_name] = (id(node), node.type)
             if node.proto is not None and node.instance_at is not None:
                 hidden = hidden | _chain_keys(node)     # a nested instance: its body is its own scope
@@ -500,7 +504,7 @@ class Converter:
         notes = scope.owner.setdefault("inner_defs", [])
         for name, (_, kind) in scope.first.items():
             if name not in scope.tagged and len(notes) < MAX_INNER_DEFS:
-                notes.append({"scope": scope.scope, "name": name, "why": _unserved_why(kind)})
+                notes.append({"scope": scope.scope, "name": name, "why": _unserved_why(kind[:64])})
         if not notes:
             del scope.owner["inner_defs"]
 
