@@ -53,13 +53,16 @@ def test_the_proto_robot_reads_bit_for_bit_like_its_base_node_twin() -> None:
     assert [n.proto for n in proto.world.top_nodes if n.robots] == ["MiniPuck"]
     # and for the DEF names and PROTOs inside it: the PROTO's DEFs are internal (not found by DEF), the
     # twin's written in the world; its sensors are instances of the PROTO's own PROTOs
-    no_defs = dict.fromkeys(("def_name", "appearance_def", "material_def", "texture_def", "geometry_def"))
+    # (inner_defs: the body's DEFs as getFromProtoDef finds them)
+    no_defs = dict.fromkeys(("def_name", "appearance_def", "material_def", "texture_def", "geometry_def")) | \
+        {"inner_defs": []}
 
     def undefined(world):
-        return [r.model_copy(update={"nodes": [n.model_copy(update={"def_name": None, "proto": None, "interface": []})
+        return [r.model_copy(update={"nodes": [n.model_copy(update={"def_name": None, "proto": None, "interface": [],
+                                                                    "inner_defs": []})
                                                for n in r.nodes],
                                      "shapes": [p.model_copy(update={"node": p.node and p.node.model_copy(update=no_defs)})
-                                                for p in r.shapes]}) for r in world.robots]
+                                                for p in r.shapes], "inner_defs": []}) for r in world.robots]
 
     assert proto.world.model_copy(update={"top_nodes": named, "robots": undefined(proto.world)}) == \
         twin.world.model_copy(update={"robots": undefined(twin.world)})

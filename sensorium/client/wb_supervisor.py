@@ -542,25 +542,30 @@ def _node_fields(node: Any, func: str, base: bool) -> tuple[list, int, str] | No
     return None if got is None else (list(got.get("fields", [])), 0 if base else -1, "the node")
 
 
-_proto_def_warned: list[bool] = []
-
-
 def wb_supervisor_node_get_from_proto_def(node: int | None, def_name: str) -> int | None:
-    """Webots' DEF lookup inside a PROTO instance's body: Sensorium does not keep the DEF names of a PROTO's
-    internal nodes (Webots' getFromDef does not find them either), so after Webots' checks a PROTO instance
-    gets one line (the first time) and None; a node that is no PROTO instance has no internal DEF: None."""
+    """Webots' DEF lookup inside a PROTO instance's body: the node of the instance's own body (and of what
+    its nested PROTO instances hold in their fields, not their own bodies) with that DEF, usable as any
+    node; None when there is none. Webots' lines for a NULL or empty ``def``, a NULL node, a node that is
+    no PROTO instance; Sensorium's line when the DEF names a node it serves no Supervisor node for."""
     func = "wb_supervisor_node_get_from_proto_def"
-    r = _checked_node(node, func)
+    r = _supervisor(func)
     if r is None:
         return None
     if not isinstance(def_name, str) or not def_name:
-        print(f"Error: {func}() called with a NULL or empty 'def' argument.", file=sys.stderr)
+        print(f"Error: {func}() called with NULL or empty 'def' argument.", file=sys.stderr)
         return None
-    if _proto_info(r, int(node), 1, func) is not None and not _proto_def_warned:  # type: ignore[arg-type]
-        _proto_def_warned.append(True)
-        print(f"Error: {func}(): Sensorium does not keep the DEF names inside a PROTO's body (reach those nodes "
-              "through 'children', getFromDevice, ...): None returned.", file=sys.stderr)
-    return None
+    info = _live_node_info(node, func)
+    if info is None:
+        return None
+    if not info.get("proto"):
+        print(f"Error: {func}(): 'node' is not a PROTO node.", file=sys.stderr)
+        return None
+    got = _answer(r, "get_from_proto_def", {"node": int(node), "name": def_name}, func)  # type: ignore[arg-type]
+    if got is None:
+        return None
+    if got.get("note"):
+        print(f"Error: {func}(): {got['note']}.", file=sys.stderr)
+    return _node_id(got)
 
 
 def wb_supervisor_node_get_number_of_fields(node: int | None) -> int:

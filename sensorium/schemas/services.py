@@ -295,6 +295,11 @@ class NodeNameArgs(Args):
                       "(A.B: B a direct child of A); else a robot's, solid's or light's name")
 
 
+class ProtoDefArgs(Args):
+    node: NodeId = Field(description="a PROTO instance (Webots wb_supervisor_node_get_from_proto_def's node)")
+    name: str = Field(min_length=1, max_length=4096, description="a DEF name written in the instance's PROTO body")
+
+
 class NodeDeviceArgs(Args):
     device: str = Field(min_length=1, max_length=4096, description="the calling robot's device name (Webots "
                         "wb_supervisor_node_get_from_device)")
@@ -923,6 +928,12 @@ class NodeResult(Result):
                                     "nested node's) for a nested node; -1 for the root and NULL)")
 
 
+class ProtoDefResult(NodeResult):
+    note: str = Field(default="", description="why there is no node to give, when Webots would print it or Sensorium "
+                                              "departs from Webots ('node' is no PROTO instance, the DEF names a "
+                                              "node Sensorium does not serve, ...); '' otherwise")
+
+
 class FieldValueResult(Result):
     type: str = Field(description="Webots' field type name (SFVec3f, SFRotation, SFColor, SFFloat, SFInt32, SFBool, "
                                   "SFString, SFNode, MFNode, MFColor); '' = the node has no such field here (the value "
@@ -1052,6 +1063,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("set_custom_data", "robot", StringArgs, SuccessResult, attached=True),
     ServiceSpec("get_model", "robot", NoArgs, StringValue),
     ServiceSpec("get_from_def", "robot", NodeNameArgs, NodeResult, attached=True, supervisor=True),
+    ServiceSpec("get_from_proto_def", "robot", ProtoDefArgs, ProtoDefResult, attached=True, supervisor=True),
     ServiceSpec("get_self", "robot", NoArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_from_device", "robot", NodeDeviceArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_root", "robot", NoArgs, NodeResult, attached=True, supervisor=True),

@@ -286,6 +286,25 @@ SeenBy = Literal["both", "bounding", "visual"]
 NodeValue = float | tuple[float, float, float] | tuple[float, float] | tuple[str, ...] | bool
 
 
+class InnerDef(Strict):
+    """A DEF name written in a PROTO's body, for the Supervisor's getFromProtoDef (README "Supervisor"). On
+    the node it names (a robot's `nodes` entry, a solid inside a top-level solid, a shape or one of its
+    nodes: ``role``): which PROTO instance's scope finds it; on a robot or top-level solid, with ``why``, a
+    DEF of an instance inside it that names a node Sensorium does not serve (a Physics node, ...)."""
+
+    scope: int = Field(ge=-1, description="the PROTO instance: -1 the robot or top-level solid holding the node, "
+                       "else (in a robot) the index of the instance's entry in the robot's `nodes`, (in a top-level "
+                       "solid) the `proto_scope` of the nested solid that is the instance")
+    name: str = Field(min_length=1, max_length=4096, description="the DEF name")
+    role: Literal["", "appearance", "material", "texture", "geometry"] = Field(
+        default="", description="on a shape: which of its nodes ('' the Shape itself)")
+    why: str = Field(default="", max_length=512, description="on the robot or top-level solid: why the DEF'd node is "
+                     "no Supervisor node here ('' on the node itself)")
+
+
+_INNER_DEFS = "the DEF names of PROTO bodies this node answers getFromProtoDef for (see InnerDef)"
+
+
 class ShapeNode(Strict):
     """A ``.wbt`` Shape as a Supervisor serves it (README "Supervisor"): its DEFs, its appearance
     node's type, and the written values of its appearance's, material's, texture's and geometry's
@@ -315,6 +334,7 @@ class ShapeNode(Strict):
     geometry_def: str | None = Field(default=None, min_length=1)
     values: dict[str, NodeValue] = Field(default={}, max_length=64, description="the written values: "
                                          "'<node>.<field>' (node: appearance, material, texture, geometry)")
+    inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
 
 _CAST_SHADOWS = ("Webots' Shape.castShadows: false lets cameras' shadow rays through this shape (it still hides "
                  "what is behind it, and other rays see it)")
@@ -501,6 +521,10 @@ class Solid(Strict):
     connectors: list[Connector] = Field(
         default=[], max_length=1024, description="Webots Connectors on this solid (a passive object a robot's "
         "connector docks with), each pose in the solid's frame: robots' connectors see them; they read nothing")
+    inner_defs: list[InnerDef] = Field(default=[], max_length=1024, description=_INNER_DEFS + "; on a top-level "
+                                       "solid, those of its PROTO instances' DEFs that name no node here (`why`)")
+    proto_scope: int | None = Field(default=None, ge=0, description="a PROTO instance inside a top-level solid: its "
+                                    "number there (InnerDef.scope)")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 
@@ -1345,6 +1369,7 @@ class NestedNode(Strict):
                                "(Supervisor getFromDevice)")
     joint_parameters: bool = Field(default=False, description="a HingeJoint or SliderJoint whose world file gives "
                                    "its jointParameters node (a Supervisor reads its position there)")
+    inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
 
 
 class CarriedTarget(Strict):
@@ -1424,6 +1449,8 @@ class Robot(Strict):
     nodes: list[NestedNode] = Field(
         default=[], max_length=200_000, description="the nodes inside the robot a Supervisor walks (getFromDef, "
         "getFromDevice, children, parents, world poses); written by the .wbt import; empty: one per device")
+    inner_defs: list[InnerDef] = Field(default=[], max_length=1024, description="the DEF names of its PROTO "
+                                       "instances' bodies that name no node here, with why (InnerDef)")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 

@@ -35,7 +35,7 @@ int main(void) {
   printf("translation %g %g %g\n", t[0], t[1], t[2]);
   printf("bad %d %d\n", wb_supervisor_node_get_field_by_index(box, 6) == NULL,
          wb_supervisor_node_get_base_node_field_by_index(box, -1) == NULL);
-  /* a PROTO's internal DEFs are not kept here (one line, the first time), a base node has none */
+  /* Keeper's body has no DEF BODY (NULL, no line); a base node is no PROTO; an empty DEF (lines) */
   printf("protodef %d %d %d %d\n", wb_supervisor_node_get_from_proto_def(keeper, "BODY") == NULL,
          wb_supervisor_node_get_from_proto_def(keeper, "BODY") == NULL, wb_supervisor_node_get_from_proto_def(box, "BODY") == NULL,
          wb_supervisor_node_get_from_proto_def(keeper, "") == NULL);

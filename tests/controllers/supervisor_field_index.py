@@ -26,6 +26,6 @@ controller = keeper.getBaseNodeFieldByIndex(6)
 print("controller", controller.getTypeName(), controller.getSFString())
 print("translation", " ".join(f"{v:g}" for v in box.getFieldByIndex(0).getSFVec3f()))
 print("bad", int(box.getFieldByIndex(6) is None), int(box.getBaseNodeFieldByIndex(-1) is None))
-# getFromProtoDef: a PROTO's internal DEFs are not kept here (one line, the first time), a base node has none
+# getFromProtoDef: Keeper's body has no DEF BODY (NULL, no line); a base node is no PROTO; an empty DEF (lines)
 print("protodef", int(keeper.getFromProtoDef("BODY") is None), int(keeper.getFromProtoDef("BODY") is None),
       int(box.getFromProtoDef("BODY") is None), int(keeper.getFromProtoDef("") is None))

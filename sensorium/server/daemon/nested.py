@@ -9,7 +9,9 @@ numbered once per simulation, in scene order (robots, then solids, each depth fi
 :data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
 imports) are never shifted by them. A nested node is found by DEF (first in scene order, as
 Webots' DEF dictionary) or by a dotted path ``A.B.C`` (each name after the first a direct child's
-DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``).
+DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``). A PROTO instance's body nodes are
+found by their DEF in that instance's scope (``getFromProtoDef``: :func:`inner_def`, from the import's
+``inner_defs``), never by ``getFromDef``.
 
 Its world pose is its owner's pose now (the robot as it drives, the solid as a Supervisor set it)
 composed with the node's frame in the owner as the world loaded, moved by the joints it is past: a
@@ -88,6 +90,8 @@ class Table:
     by_owner: dict[int, tuple[Nested, ...]]     # owner id -> its nodes, depth first
     by_parent: dict[int, tuple[Nested, ...]]    # parent id -> its direct subnodes
     bare_joints: frozenset[int] = frozenset()   # motorised joints without jointParameters (NULL)
+    inner: dict[int, dict[str, int | str]] | None = None   # PROTO instance id -> DEF of its body -> node id, or why
+                                                # it is no node here (getFromProtoDef: :func:`inner_defs`)
 
     def get(self, node_id: int) -> Nested | None:
         k = node_id - FIRST_ID
@@ -184,11 +188,12 @@ def _joint_parameters(sim: Any, robots: list[str], out: list[Nested]) -> tuple[l
 
 
 def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nested],
-                 solid_ids: dict[int, int]) -> list[Nested]:
+                 solid_ids: dict[int, int], shape_tags: list[tuple[int, wm.InnerDef, int]]) -> list[Nested]:
     """The robots' and top-level solids' Shape nodes (appearance.py), each followed by the nodes inside
     it, numbered after every other nested node: robots in world order, then solids (each solid's
     shapes, then those of the solids inside it). A robot's shape sits under the node its world entry
-    names (``ShapeNode.parent``), a solid's under the solid holding it."""
+    names (``ShapeNode.parent``), a solid's under the solid holding it. ``shape_tags`` gets the PROTO-body
+    DEFs of the shapes and their nodes: (owner id, InnerDef, the node's id)."""
     scene = sim.scene
     index = {id(scene.loaded_model(k)): k for k in range(len(scene.shapes))}
     loaded = getattr(sim, "loaded", None)
@@ -206,6 +211,7 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
     for n in out:
         if n.owner_kind == "Robot" and n.field != "jointParameters":
             starts.setdefault(n.owner, n.id)
+    inner_tags: list[tuple[int, wm.InnerDef, int]] = []     # (owner, tag, the id of the node it names)
 
     def add(shape: Any, parent: int, owner: int, kind: str, key: str) -> None:
         k = index.get(id(shape))
@@ -219,6 +225,7 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
         added.append(Nested(me, "Shape", "", (node.def_name if node else None) or "", "", parent, "children", None,
                             None, "", owner, kind, key, order=order, shape=appearance.ShapeRef(k, node, "Shape", "Shape")))
         above = {"appearance": me, "geometry": me}
+        ids = {"": me}
         for role, type_, def_name, field in appearance.inside(shape, k):
             nid = FIRST_ID + len(out) + len(added)
             proto, face = ((node.appearance_proto or "", tuple(node.appearance_interface))
@@ -231,6 +238,10 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
                                 shape=appearance.ShapeRef(k, node, role, type_, peers)))
             if role == "appearance":
                 above["appearance"] = nid
+            ids[role] = nid
+        for tag in (node.inner_defs if node is not None else ()):
+            if tag.role in ids:
+                inner_tags.append((owner, tag, ids[tag.role]))
 
     for i, name in enumerate(robots):
         model = sim.robots[name].model
@@ -246,17 +257,26 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
                 walk(child, solid_ids[id(child)])
 
         walk(sim.world.solids[j], owner)
+    shape_tags.extend(inner_tags)
     return added
 
 
 def build(sim: Any, loaded_solids: int) -> Table:
     out: list[Nested] = []
     robots = list(sim.robots)
+    tags: list[tuple[int, wm.InnerDef, int | str]] = []     # (owner, tag, the node it names or why it is none)
+    firsts: dict[int, int] = {}            # a robot's id -> the id of its first entry (InnerDef.scope 0)
+    counts: dict[int, int] = {}            # a robot's id -> how many entries it has
+    serials: dict[int, dict[int, int]] = {}     # a top-level solid's id -> its PROTO instances' ids by number
     for i, name in enumerate(robots):
         owner = i + 1
         entries = _robot_entries(sim.robots[name])
         joints = _riding(sim.robots[name], entries)
         first = FIRST_ID + len(out)
+        firsts[owner] = first
+        counts[owner] = len(entries)
+        tags.extend((owner, t, t.why) for t in sim.robots[name].model.inner_defs)
+        tags.extend((owner, t, first + k) for k, e in enumerate(entries) for t in e.inner_defs)
         frames: list[Pose | None] = []       # each entry's nearest Pose frame in the robot (None: the robot's)
         framed: list[int] = []               # its id (-1: the robot's)
         for k, e in enumerate(entries):
@@ -283,19 +303,41 @@ def build(sim: Any, loaded_solids: int) -> Table:
                               local, own, "", owner, "Solid", solid_name, order=float(k))
                 out.append(node)
                 solid_ids[id(child)] = node.id
+                if child.proto_scope is not None:
+                    serials.setdefault(owner, {})[child.proto_scope] = node.id
+                tags.extend((owner, t, node.id) for t in child.inner_defs)
                 walk(child, node.id, local)
 
         walk(solid, owner, None)
+        tags.extend((owner, t, t.why) for t in solid.inner_defs if t.why)
     parameters, bare = _joint_parameters(sim, robots, out)
     out += parameters
-    out += _shape_nodes(sim, robots, loaded_solids, out, solid_ids)     # after all others: no other id moves
+    shape_tags: list[tuple[int, wm.InnerDef, int]] = []
+    out += _shape_nodes(sim, robots, loaded_solids, out, solid_ids, shape_tags)     # after all others: no other id moves
+    tags.extend(shape_tags)
+    inner: dict[int, dict[str, int | str]] = {}
+    for owner, tag, target in tags:
+        if owner in firsts:                # a robot: the instance's entry (a world file's scope past them: none)
+            instance = owner if tag.scope < 0 else firsts[owner] + tag.scope if tag.scope < counts[owner] else None
+        else:                              # a top-level solid: the nested solid of that number
+            instance = owner if tag.scope < 0 else serials.get(owner, {}).get(tag.scope)
+        if instance is not None:
+            inner.setdefault(instance, {}).setdefault(tag.name, target)
     by_owner: dict[int, list[Nested]] = {}
     by_parent: dict[int, list[Nested]] = {}
     for n in out:
         by_owner.setdefault(n.owner, []).append(n)
         by_parent.setdefault(n.parent, []).append(n)
     return Table(tuple(out), {k: tuple(v) for k, v in by_owner.items()}, {k: tuple(v) for k, v in by_parent.items()},
-                 bare)
+                 bare, inner)
+
+
+def inner_def(table: Table, instance: int, name: str) -> int | str | None:
+    """getFromProtoDef: the node of PROTO instance ``instance``'s body with DEF ``name`` (its id), why the
+    DEF'd node is no node here (a line), or None when the body has no such DEF. The scope is Webots':
+    the instance's own body (a derived PROTO's bodies too) with the nodes it holds in its fields; a
+    nested PROTO instance's body is its own (the nodes written here that it holds are in)."""
+    return (table.inner or {}).get(instance, {}).get(name)
 
 
 def owner_pose(sim: Any, n: Nested) -> Pose:

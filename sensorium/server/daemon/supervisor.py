@@ -744,6 +744,33 @@ def get_proto(sim: Any, node: Node, level: int) -> dict:
     return {"type_name": proto.name, "derived": proto.derived, "fields": [f.name for f in proto.fields]}
 
 
+def from_proto_def(sim: Any, node: Node, name: str) -> tuple[Node | None, str]:
+    """Webots' ``getFromProtoDef``: the node of PROTO instance ``node``'s body with DEF ``name`` (Webots'
+    scope: :func:`nested.inner_def`), or None with a line when there is none to give: ``node`` is no PROTO
+    instance, one Sensorium builds in (its body is not read), one whose body is not searched here (a light,
+    an appearance, a Background PROTO), or the DEF names a node Sensorium does not serve (a Physics node,
+    ...: why); None without a line when the body has no such DEF (Webots' NULL)."""
+    if not node.proto:
+        return None, "'node' is not a PROTO node"
+    if not node.interface:
+        return None, (f"PROTO {node.proto} is built into Sensorium here (its file was not read): the DEF names of its "
+                      "body are not known")
+    if node.scenery or node.visual or node.type in LIGHTS or (node.nested and _nested_of(sim, node).shape is not None):
+        return None, (f"the body of PROTO {node.proto} ({_what(node)}) is not searched here: DEF names are found in "
+                      "the bodies of robots, solids and the PROTO instances inside them")
+    found = nested.inner_def(_table(sim), node.id, name)
+    if isinstance(found, str):
+        return None, f"DEF {name} of PROTO {node.proto}'s body ({_what(node)}) names {found}"
+    if found is None:
+        return None, ""
+    return node_by_id(sim, found), ""
+
+
+def _from_proto_def(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    found, note = from_proto_def(sim, node_by_id(sim, a.node), a.name)
+    return {**node_ref(sim, found), "note": note}
+
+
 def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: Any, level: int = -1) -> None:
     """Webots' ``setMF*``/``insertMF*``/``removeMF`` of every MF type: on an imported line or point set's MF
     fields (visuals.py); any other MF field (a PROTO's interface field of any type too) is read-only here
@@ -1100,6 +1127,7 @@ def _export_image(sim: Any, ls: Any, robot: str, a: Any) -> dict:
 
 HANDLERS = {
     "get_from_def": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, a.name)),
+    "get_from_proto_def": _from_proto_def,
     "get_self": lambda sim, ls, robot, a: node_ref(sim, robot_node(sim, robot)),
     "get_from_device": lambda sim, ls, robot, a: node_ref(sim, device_node(sim, robot, a.device)),
     "get_root": lambda sim, ls, robot, a: node_ref(sim, ROOT),

@@ -864,25 +864,46 @@ static WbProtoRef node_fields(WbNodeRef node, bool base, const char *func) {
   return p != NULL ? p : proto_at(rb, node->id, 0, func);
 }
 
-/* Webots' DEF lookup inside a PROTO instance's body: Sensorium does not keep the DEF names of a PROTO's
-   internal nodes (Webots' getFromDef does not find them either), so after Webots' checks a PROTO instance
-   gets one line (the first time) and NULL; a node that is no PROTO instance has no internal DEF: NULL. */
+typedef struct {
+  int64_t node;
+  const char *name;
+} proto_def_args;
+
+static void args_proto_def(sn_req *r, const void *arg) {
+  const proto_def_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "name");
+  sn_req_str(r, a->name);
+}
+
+/* Webots' DEF lookup inside a PROTO instance's body: the node of the instance's own body (and of what its
+   nested PROTO instances hold in their fields, not their own bodies) with that DEF, usable as any node; NULL
+   when there is none. Webots' checks and lines first (a NULL or empty def, a NULL node, a node that is no
+   PROTO instance); the server's line when the DEF names a node Sensorium serves no Supervisor node for. */
 WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def) {
-  static bool warned = false;
   const char *func = "wb_supervisor_node_get_from_proto_def";
-  sn_robot *rb = supervisor_node(node, func);
+  sn_robot *rb = supervisor(func);
   if (rb == NULL)
     return NULL;
   if (def == NULL || *def == '\0') {
-    fprintf(stderr, "Error: %s() called with a NULL or empty 'def' argument.\n", func);
+    fprintf(stderr, "Error: %s() called with NULL or empty 'def' argument.\n", func);
     return NULL;
   }
-  if (proto_at(rb, node->id, 1, func) != NULL && !warned) {
-    warned = true;
-    fprintf(stderr, "Error: %s(): Sensorium does not keep the DEF names inside a PROTO's body (reach those nodes through "
-                    "'children', wb_supervisor_node_get_from_device, ...): NULL returned.\n", func);
+  if (live_node(node, func) == NULL)
+    return NULL;
+  if (node->proto == NULL || *node->proto == '\0') {
+    fprintf(stderr, "Error: %s(): 'node' is not a PROTO node.\n", func);
+    return NULL;
   }
-  return NULL;
+  proto_def_args a = {node->id, def};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/get_from_proto_def", 2, args_proto_def, &a, func, &rep) != 0)
+    return NULL;
+  const msgpack_object *note = sn_get(rep.result, "note");
+  if (note != NULL && note->type == MSGPACK_OBJECT_STR && note->via.str.size > 0)
+    fprintf(stderr, "Error: %s(): %.*s.\n", func, (int)note->via.str.size, note->via.str.ptr);
+  return node_from_reply(rb, &rep);
 }
 
 int wb_supervisor_node_get_number_of_fields(WbNodeRef node) {

@@ -306,7 +306,7 @@ class Node:
         return None if ref is None else Field(ref)
 
     def getFromProtoDef(self, DEF: str) -> Node | None:  # noqa: N803 - Webots' name
-        """A DEF inside this PROTO instance's body: not kept here (one line the first time), None."""
+        """The node of this PROTO instance's body with that DEF (Webots' scope), None if there is none."""
         return _node_of(wb.wb_supervisor_node_get_from_proto_def(self._ref, DEF))
 
     def getNumberOfBaseNodeFields(self) -> int:

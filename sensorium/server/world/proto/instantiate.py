@@ -407,8 +407,9 @@ class _Expander:
             if isinstance(value, IsRef) and value.name not in base:
                 base[value.name] = fname if parent_base is None else parent_base.get(fname)
         interface = (proto, values, {k: v for k, v in base.items() if v is not None}, parent)
+        # body_of: the body the instance is written in (its root stands where the instance is written)
         return _copy(out, def_name=node.def_name, proto=proto.name, instance_at=(where, node.line, node.col), uses=uses,
-                     interface=interface)
+                     interface=interface, body_of=node.__dict__.get("body_of"))
 
     def values(self, node: Node, proto: ProtoDef, chain: tuple[str, ...]) -> tuple[dict[str, Any], set[str]]:
         """The instance's value of every field of ``proto``, checked."""
@@ -499,6 +500,7 @@ class _Expander:
         if extra.kind != "eof":
             raise parser.error(extra, f"PROTO {proto.name}: the body holds more than one node (found {extra.text!r} "
                                       "after its first node)")
+        _mark_body(root, proto_key(proto))
         return root
 
     def context(self, proto: ProtoDef) -> str:
@@ -636,6 +638,46 @@ class _Expander:
         self._kept.append(node)
 
 
+def proto_key(proto: ProtoDef) -> str:
+    """A PROTO definition's name among the bodies (its file and name: a world file may define several)."""
+    return f"{proto.source}\0{proto.name}"
+
+
+def _mark_body(root: Node, key: str) -> None:
+    """Mark every node written in a PROTO's body (``body_of``: :func:`proto_key`), so the Supervisor tells
+    the nodes of an instance's own body from those a nested instance's body holds (getFromProtoDef's
+    scope: :func:`body_of`, :func:`chain_keys`). A parsed body is shared by the instances using it."""
+    stack, seen = [root], set()
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        node.__dict__["body_of"] = key
+        for value in node.fields.values():
+            if isinstance(value, Node):
+                stack.append(value)
+            elif isinstance(value, list) and not set(map(type, value)) <= _VALUE_TYPES:
+                stack += [x for x in value if isinstance(x, Node)]
+
+
+def body_of(node: Node) -> str | None:
+    """The PROTO body ``node`` is written in (:func:`proto_key`), None for a node the world file writes."""
+    key: str | None = node.__dict__.get("body_of")
+    return key
+
+
+def chain_keys(node: Node) -> frozenset[str]:
+    """The bodies an expanded PROTO instance is made of: its PROTO's, and for a derived PROTO the bodies
+    of the PROTOs it is built on (one node in Webots: their DEFs are the instance's own)."""
+    keys: list[str] = []
+    level = node.__dict__.get("interface")
+    while level is not None and len(keys) < 16:
+        keys.append(proto_key(level[0]))
+        level = level[3]
+    return frozenset(keys)
+
+
 def _skipped_why(name: str) -> str:
     """Why a PROTO Sensorium skips costs a user nothing, or what it costs."""
     if name == "TexturedBackground":     # its sky box is seen by Webots' cameras
@@ -766,4 +808,5 @@ def protos_used(path: str | Path, webots_home: str | Path | None = None,
     return expand(read_wbt(path), ProtoSearch.create(path.resolve().parent, webots_home, proto_path)).protos
 
 
-__all__ = ["expand", "protos_used", "interface_levels", "Expansion", "ProtoUse", "FIELD_TYPES", "WbtSyntaxError"]
+__all__ = ["expand", "protos_used", "interface_levels", "body_of", "chain_keys", "proto_key", "Expansion", "ProtoUse",
+           "FIELD_TYPES", "WbtSyntaxError"]

@@ -98,6 +98,95 @@ class Owner:
     placed: Frame = field(default_factory=Frame.identity)      # the owner's frame in the world
 
 
+MAX_INNER_DEFS = 1024
+"""DEF names of PROTO bodies kept per robot or top-level solid (getFromProtoDef); a body declares tens."""
+
+MAX_DEF = 4096
+"""The longest DEF name getFromProtoDef is asked for (a longer one is never found)."""
+
+SCOPE_NODES = 20_000
+"""Nodes read per PROTO instance for its body's DEF names (the rest of a huge body is not searched)."""
+
+
+@dataclass(eq=False)
+class _Scope:
+    """A PROTO instance being walked: the bodies it is made of (``keys``), and, when a Supervisor is served
+    it (``scope`` set: see ``Converter.open_scope``), its body's DEF names (``first``: name -> (id of the
+    DEF'd node, its type)), those a served node took (``tagged``) and the entry that keeps the others."""
+
+    node: Node
+    keys: frozenset[str]
+    scope: int | None = None
+    owner: dict | None = None
+    first: dict[str, tuple[int, str]] = field(default_factory=dict)
+    tagged: set[str] = field(default_factory=set)
+
+
+def _chain_keys(node: Node) -> frozenset[str]:
+    from sensorium.server.world.proto.instantiate import chain_keys
+
+    return chain_keys(node)
+
+
+def _sub_nodes(node: Node) -> list[Node]:
+    out: list[Node] = []
+    for value in node.fields.values():
+        if isinstance(value, Node):
+            out.append(value)
+        elif isinstance(value, list) and value and not isinstance(value[0], float | int | str | bool):
+            out += [x for x in value if isinstance(x, Node)]
+    return out
+
+
+def _scope_defs(root: Node) -> dict[str, tuple[int, str]]:
+    """The DEF names a PROTO instance's getFromProtoDef finds, as Webots' WbSupervisorUtilities searches:
+    the nodes of its fields first, then depth first below each; a nested PROTO instance's own body is
+    out of scope (its DEFs are its own), the nodes written here that it holds (its fields' values) are
+    in. The first node of each name, with its type, at most :data:`SCOPE_NODES` nodes read."""
+    from sensorium.server.world.proto.instantiate import body_of
+
+    found: dict[str, tuple[int, str]] = {}
+    level = _sub_nodes(root)
+    for child in level:
+        if child.def_name and child.def_name not in found and len(child.def_name) <= MAX_DEF:
+            found[child.def_name] = (id(child), child.type)
+    budget = SCOPE_NODES
+    seen: set[int] = set()
+    for child in level:
+        stack: list[tuple[Node, frozenset[str]]] = [(child, frozenset())]
+        while stack and budget > 0:
+            node, hidden = stack.pop()
+            if id(node) in seen:
+                continue
+            seen.add(id(node))
+            budget -= 1
+            if node.def_name and node.def_name not in found and len(node.def_name) <= MAX_DEF \
+                    and body_of(node) not in hidden:
+                found[node.def_name] = (id(node), node.type)
+            if node.proto is not None and node.instance_at is not None:
+                hidden = hidden | _chain_keys(node)     # a nested instance: its body is its own scope
+            stack += [(x, hidden) for x in reversed(_sub_nodes(node))]
+    return found
+
+
+_PHYSICS_ONLY = frozenset({"Physics", "Damping", "ContactProperties", "ImmersionProperties", "Fluid", "Muscle"})
+
+
+def _unserved_why(kind: str) -> str:
+    """Why a DEF'd node of a PROTO's body is no Supervisor node here (getFromProtoDef's line)."""
+    if kind in _PHYSICS_ONLY:
+        return f"a {kind} node: physics only, which Sensorium does not simulate (no Supervisor node here)"
+    if kind in LIGHTS:
+        return f"a {kind} carried by a solid or robot: lights inside them are no Supervisor nodes here"
+    if kind in GEOMETRIES:
+        return (f"a {kind} geometry of no visible Shape (a boundingObject's: Sensorium serves the geometries of "
+                "visible shapes only)")
+    if kind in ("JointParameters", "HingeJointParameters"):
+        return f"a {kind} node: read through its joint's 'jointParameters' field here"
+    return (f"a {kind} node, which Sensorium does not serve as a Supervisor node there (it serves the solids, "
+            "devices, joints, Poses and Groups of robots, the solids inside top-level solids and visible shapes)")
+
+
 class Converter:
     def __init__(self, wbt: WbtFile, source: str, search: Any = None, max_grid_points: int = MAX_GRID_POINTS):
         self.wbt = wbt
@@ -142,6 +231,11 @@ class Converter:
         self.builtin_proto: str | None = None   # a built-in PROTO being expanded (the expansion's node names it)
         self.nested_defs: set[int] = set()      # nested nodes whose DEF is kept (a USE of one is a copy without it)
         self.shared_nodes: dict[int, int] = {}  # id(appearance or material node) -> its number (its USEs share it)
+        # getFromProtoDef: the PROTO instances being walked (innermost last), the robot or top-level solid whose
+        # entries are being made, and the number the next PROTO instance nested in a top-level solid gets
+        self.scopes: list[_Scope] = []
+        self.inner_owner: dict | None = None
+        self.scope_serial = 0
 
     # ------------------------------------------------------------ messages
     def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
@@ -358,15 +452,61 @@ class Converter:
         try:
             if node.proto is not None and node.instance_at is not None:
                 self.instances.append((node.proto, node.instance_at))
+                scope = _Scope(node, _chain_keys(node))
+                self.scopes.append(scope)
+                if pushed and self.tree is not None:       # a PROTO instance inside a robot: its entry's index
+                    self.open_scope(node, len(self.tree) - 1 if self.tree_stack[-1][0] is node else None)
                 try:
                     self.visit_node(node, frame, owner, top)
                 finally:
                     self.instances.pop()
+                    self.scopes.pop()
+                    self.close_scope(scope)
             else:
                 self.visit_node(node, frame, owner, top)
         finally:
             if pushed:
                 self.tree_stack.pop()
+
+    # ------------------------------------------------------------ getFromProtoDef: the DEFs of a PROTO's body
+    def open_scope(self, node: Node, scope: int | None) -> None:
+        """Make the innermost PROTO instance being walked, ``node``, a Supervisor node whose body's DEFs
+        are found (``scope``: -1 the robot or top-level solid being made, else its entry's index in the
+        robot's ``nodes`` or its number in the top-level solid); its DEFs are read now (:func:`_scope_defs`)."""
+        top = self.scopes[-1] if self.scopes else None
+        if top is None or top.node is not node or top.scope is not None or scope is None or self.inner_owner is None:
+            return
+        top.scope, top.owner = scope, self.inner_owner
+        top.first = _scope_defs(node)
+
+    def inner_defs(self, node: Node | None, role: str = "") -> list[dict]:
+        """The DEFs ``node`` (a node a Supervisor is served) answers getFromProtoDef for: the DEF'd node of
+        each enclosing PROTO instance's scope (its first place: a USE of it is a copy without the DEF)."""
+        out: list[dict] = []
+        name = None if node is None else node.def_name
+        if not name:
+            return out
+        for scope in self.scopes:
+            if scope.scope is None or scope.node is node or scope.owner is not self.inner_owner:
+                continue
+            hit = scope.first.get(name)
+            if hit is None or hit[0] != id(node) or name in scope.tagged:
+                continue
+            scope.tagged.add(name)
+            out.append({"scope": scope.scope, "name": name} | ({"role": role} if role else {}))
+        return out
+
+    @staticmethod
+    def close_scope(scope: _Scope) -> None:
+        """The DEFs of the scope no served node took: each with why it is no node here (getFromProtoDef's line)."""
+        if scope.owner is None:
+            return
+        notes = scope.owner.setdefault("inner_defs", [])
+        for name, (_, kind) in scope.first.items():
+            if name not in scope.tagged and len(notes) < MAX_INNER_DEFS:
+                notes.append({"scope": scope.scope, "name": name, "why": _unserved_why(kind[:64])})
+        if not notes:
+            del scope.owner["inner_defs"]
 
     # ------------------------------------------------------------ the nodes a Supervisor walks in a robot
     def tree_node(self, node: Node, frame: Frame, owner: Owner) -> bool:
@@ -416,6 +556,9 @@ class Converter:
             entry["parent"] = self.tree_stack[-1][1]
         if field != "children":
             entry["field"] = field
+        tags = self.inner_defs(node)
+        if tags:
+            entry["inner_defs"] = tags[:64]
         self.tree.append(entry)
 
     def nested_def(self, node: Node) -> bool:
@@ -712,6 +855,20 @@ class Converter:
         it; a solid's: after its children solids so far)."""
         out = fx.shape_node(node, self.source, self.nested_def,
                             lambda n: self.shared_nodes.setdefault(id(n), len(self.shared_nodes)))
+        tags = self.inner_defs(node)
+        app = self.fields(node).node_("appearance") if "appearance" in out else None
+        if app is not None:
+            tags += self.inner_defs(app, "appearance")
+            a = self.fields(app)
+            if out.get("material"):
+                tags += self.inner_defs(a.node_("material"), "material")
+            texture = a.node_("texture" if app.type == "Appearance" else "baseColorMap")
+            if texture is not None and texture.type == "ImageTexture":
+                tags += self.inner_defs(texture, "texture")
+        if out.get("geometry"):
+            tags += self.inner_defs(self.fields(node).node_("geometry"), "geometry")
+        if tags:
+            out["inner_defs"] = tags[:64]
         app = self.fields(node).node_("appearance")
         if app is not None and app.proto and "appearance" in out:     # an appearance PROTO (PaintedWood, ...)
             out["appearance_proto"] = app.proto
@@ -1093,6 +1250,10 @@ class Converter:
             self.def_name(node, data)
         elif self.nested_def(node):     # a nested solid: found by DEF (a Supervisor walks it)
             data["def_name"] = node.def_name
+        if owner.kind == "solid":       # inside a top-level solid: a node a Supervisor walks
+            tags = self.inner_defs(node)
+            if tags:
+                data["inner_defs"] = tags[:64]
         if owner.kind == "world":
             colors = f.colors("recognitionColors", [])        # what cameras with a Recognition node report
             if colors:
@@ -1110,7 +1271,18 @@ class Converter:
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
         # a nested solid's spot lights: a LightSensor turns them by this solid's own rotation (not the Poses above)
         own = Frame.identity() if owner.kind == "world" else Frame(np.eye(3), np.zeros(3), own_rotation=inner.own_rotation)
-        self.solid_contents(node, own, mine, bounding)
+        saved_owner = self.inner_owner
+        if owner.kind == "world":
+            self.inner_owner = data
+            self.open_scope(node, -1)
+        elif owner.kind == "solid" and self.scopes and self.scopes[-1].node is node:
+            data["proto_scope"] = self.scope_serial
+            self.open_scope(node, self.scope_serial)
+            self.scope_serial += 1
+        try:
+            self.solid_contents(node, own, mine, bounding)
+        finally:
+            self.inner_owner = saved_owner
         out = self.solid_dict(mine, data)
         out["_at"] = self.at(node)
         if owner.kind == "world":
@@ -1218,13 +1390,14 @@ class Converter:
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.riding = []
-        saved = self.tree, self.tree_stack
-        self.tree, self.tree_stack = [], []
+        saved = self.tree, self.tree_stack, self.inner_owner
+        self.tree, self.tree_stack, self.inner_owner = [], [], data
+        self.open_scope(node, -1)
         try:
             self.solid_contents(node, Frame.identity(), mine)
             tree = self.tree
         finally:
-            self.tree, self.tree_stack = saved
+            self.tree, self.tree_stack, self.inner_owner = saved
         self.drive(node, mine)
         if mine.parts:
             data["shapes"] = [_clean_part(p) for p in mine.parts]
