@@ -14,6 +14,7 @@ import pytest
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
+from sensorium.server.sim.summary import drive_line
 from sensorium.server.world.loader import load_world
 
 R = 0.03                                   # wheel radius
@@ -56,6 +57,7 @@ def test_the_drive_turns_about_the_wheels_centre(tmp_path: Path) -> None:
     assert dd.axle_center == pytest.approx((CX, CY), abs=1e-15)
     assert dd.axle_length == pytest.approx(TRACK, abs=1e-15)
     assert (dd.left_motor, dd.right_motor, dd.wheel_radius) == ("left wheel motor", "right wheel motor", R)
+    assert drive_line(w.world.robots[0]).endswith(f"{TRACK:g} m apart, turning about ({CX:g}, {CY:g}) m from its origin")
 
     # turning in place: the wheels' centre stays where it was, the origin circles it at |c|
     sim = Simulation(w)
