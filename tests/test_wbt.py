@@ -383,7 +383,6 @@ def test_a_propeller_lists_its_motor_and_shows_its_slow_helix(tmp_path: Path) ->
 
 @pytest.mark.parametrize("kwargs, why", [
     (dict(axis_left="0 -1 0"), "wheel axis of motor 'left wheel motor' is [0.0, -1.0, 0.0], not the robot's +y"),
-    (dict(anchor_x=0.02), "the axle midpoint is at x=0.02, y=0 in the robot frame, not under the robot's origin"),
     # a third motorised hinge that is a wheel (its end point has a cylinder to roll on): a hinge
     # with nothing round at its end is no wheel and leaves the other two their drive (test_wbt_drives.py)
     (dict(extra=f'HingeJoint {{ device [ RotationalMotor {{ name "third" }} ] endPoint {_ROLLER} }}\n'),

@@ -174,13 +174,20 @@ def test_wheels_it_cannot_drive_get_one_line(tmp_path: Path, axes: dict, why: st
     assert len(said) == 1 and said[0].startswith(f"{p}:2:1: robot 'r': no differential drive ({why}"), w.warnings
 
 
-def test_a_wheel_line_off_the_origin_is_said_in_the_drives_frame(tmp_path: Path) -> None:
+def test_a_wheel_line_off_the_origin_is_the_drives_centre_in_its_frame(tmp_path: Path) -> None:
+    # the wheels 0.05 m ahead along the robot's +y (the drive's forward): the robot turns about them
+    # (tests/test_wbt_axle_center.py has the closed forms of a robot driving along its x)
     shifted = {n: (x, y + 0.05) for n, (x, y) in WHEELS.items()}
     w = load_world(write(tmp_path, rover(wheels=shifted)))
-    assert w.world.robots[0].differential_drive is None
-    assert any("the wheels' centre is at x=0.05 in the robot frame, not under the robot's origin" in x
-               and "in the drive's frame: x forward along [0.0, 1.0] in the robot's, y its left" in x
-               for x in w.warnings), w.warnings
+    dd = w.world.robots[0].differential_drive
+    assert dd is not None and dd.forward == (0.0, 1.0)
+    assert dd.axle_center == pytest.approx((0.05, 0.0), abs=1e-15)
+    sim = Simulation(w)
+    go(sim, "rover", -1.0, 1.0)            # in place: the centre (robot y = 0.05) stays where it was
+    sim.run(50)
+    pose = sim.robot("rover").pose
+    assert pose.translation[:2] + pose.rotation[:2, :2] @ np.array([0.0, 0.05]) == pytest.approx([0.0, 0.05], abs=1e-12)
+    assert not np.allclose(pose.translation[:2], 0.0)
 
 
 def test_copies_drive_it_as_the_single_simulation_bit_for_bit(tmp_path: Path) -> None:

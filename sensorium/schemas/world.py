@@ -1179,6 +1179,11 @@ class DifferentialDrive(Strict):
     right_motor: str = Field(default="right wheel motor", min_length=1)
     skid_steer: SkidSteer | None = Field(default=None, description="more wheels per side (skid steer)")
     forward: tuple[float, float] = _forward_field()
+    axle_center: tuple[float, float] = Field(
+        default=(0.0, 0.0), description="m, where the robot turns: the point midway between the wheel lines (the "
+        "wheels' centre) from the robot's origin, along forward and its left; (0, 0): under the origin. Elsewhere "
+        "(a Boe-Bot's axle 2.5 cm ahead of its origin) the centre follows the drive's arc and the origin, rigidly "
+        "attached to it, turns about it")
 
     @property
     def motor_names(self) -> tuple[list[str], list[str]]:

@@ -352,6 +352,10 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
         for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
+            if r.differential_drive is not None and tuple(r.differential_drive.axle_center) != (0.0, 0.0):
+                raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: its wheels' centre is not under its origin "
+                                   "(differential_drive.axle_center); the batched simulation turns two-wheel and "
+                                   "skid-steer robots about their origin only (use Simulation)")
             drive = {m for _, m in r.drive_motors}
             joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]
             if joints:

@@ -276,11 +276,18 @@ class DifferentialDrive(PlanarState):
     rotation that is not a turn about the up axis, so a tilted robot keeps its tilt while driving.
     The state is kept in ENU axes; in a NUE world poses are converted on the way in and out, so the
     robot drives on the ground plane (normal +y) there.
+
+    The wheels' centre (``config.axle_center``, (cx, cy) along forward and its left) is where the
+    robot turns: it moves at v along the heading while the robot turns at w, so the origin, at
+    -(cx, cy) from it, moves with the body twist (v + w·cy, -w·cx), taken exactly over a step by
+    :func:`twist_step`; a centre under the origin is the arc of the origin itself (:func:`arc_step`).
     """
 
     def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
         self.wheel_radius = float(config.wheel_radius)
         self.axle_length = float(config.axle_length)
+        cx, cy = getattr(config, "axle_center", (0.0, 0.0))
+        self.center: tuple[float, float] | None = (float(cx), float(cy)) if (cx or cy) else None
         speed = float(config.max_wheel_speed)
         skid = getattr(config, "skid_steer", None)
         self.left = WheelMotor(config.left_motor, speed)
@@ -306,8 +313,16 @@ class DifferentialDrive(PlanarState):
             return None
         v = self.wheel_radius * (wl + wr) / 2.0
         w = self.wheel_radius * (wr - wl) / self.axle_length
-        self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
-        self.moved(v, w)
+        if self.center is None:
+            self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
+            self.moved(v, w)
+            return self.pose()
+        cx, cy = self.center           # the origin's body twist, the wheels' centre moving at v
+        vx, vy = v + w * cy, -w * cx
+        self.x, self.y, self.yaw = twist_step(self.x, self.y, self.yaw, vx, vy, w, dt)
+        self.moved(vx, w)
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        self.linear = (vx * c - vy * s, vx * s + vy * c)     # the origin's velocity at the step's end
         return self.pose()
 
 

@@ -45,7 +45,9 @@ def drive_line(r: wm.Robot) -> str:
         skid = d.skid_steer
         kind = (f"skid-steer, {1 + len(skid.left)} + {1 + len(skid.right)} wheels" if skid is not None
                 else f"two-wheel ({d.left_motor}, {d.right_motor})")
-        return f"{kind}: wheels of radius {d.wheel_radius:g} m, {d.axle_length:g} m apart"
+        cx, cy = d.axle_center
+        centre = f", turning about ({cx:g}, {cy:g}) m from its origin" if (cx or cy) else ""
+        return f"{kind}: wheels of radius {d.wheel_radius:g} m, {d.axle_length:g} m apart{centre}"
     return "none (the robot does not move itself)"
 
 

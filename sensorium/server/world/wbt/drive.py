@@ -1,13 +1,17 @@
 """Motorised HingeJoint wheels → the world format's kinematic ``differential_drive``.
 
-The kinematic drive turns the robot about its origin, x forward, wheels on the robot's y axis, and
+The kinematic drive turns the robot about its wheels' centre, x forward, wheels along the robot's y axis, and
 a positive wheel speed drives forward. A Webots robot maps onto it when it clearly is such a robot:
 every motorised hinge's axis along the robot's +y and wheels of one radius, and either
 
-* two wheels: both anchors on one line parallel to y, the wheels (their end points' origins) on
-  either side of the robot's origin (their midpoint under it); or
+* two wheels: both anchors on one line parallel to y, the wheels (their end points' origins) at
+  two places along it; or
 * several wheels per side (skid steer, a Pioneer 3-AT): each side's wheels on one line parallel to
-  x, the two lines at the same distance either side of the origin, the wheels' centre under it.
+  x, one line on either side of the robot's x axis.
+
+The robot turns about its wheels' centre (the midpoint of the two wheels, or of the wheel lines at
+the wheels' mean x), as Webots' physics turns it: a centre that is not under the robot's origin (a
+Boe-Bot's axle is 2.5 cm ahead of it) is the drive's ``axle_center``.
 
 A robot with steered wheels (a motorised hinge with a vertical axis, a Hinge2Joint's first axis: a
 car) maps onto the kinematic ``ackermann_drive`` when its geometry is a car's as the world format
@@ -249,21 +253,28 @@ def _two_wheels(wheels: list[dict], conv) -> tuple[dict | None, str]:
     if abs(a0[1] - a1[1]) <= TOL:
         return None, "both wheels are at the same place on the axle"
     mid = (a0 + a1) / 2.0
-    if abs(mid[0]) > TOL or abs(mid[1]) > TOL:
-        return None, (f"the axle midpoint is at x={mid[0]:g}, y={mid[1]:g} in the robot frame, not under the robot's "
-                      "origin (the kinematic drive turns about the origin)")
     r0, why = _radius(wheels, conv)
     if r0 is None:
         return None, why
     left, right = (wheels[0], wheels[1]) if a0[1] > a1[1] else (wheels[1], wheels[0])
-    return {"wheel_radius": r0, "axle_length": float(abs(a0[1] - a1[1])), "max_wheel_speed": _max_speed(wheels, conv),
-            "left_motor": left["motor"], "right_motor": right["motor"]}, ""
+    return _centred({"wheel_radius": r0, "axle_length": float(abs(a0[1] - a1[1])),
+                     "max_wheel_speed": _max_speed(wheels, conv), "left_motor": left["motor"],
+                     "right_motor": right["motor"]}, mid[0], mid[1]), ""
+
+
+def _centred(drive: dict, cx: float, cy: float) -> dict:
+    """The drive with its ``axle_center`` when the wheels' centre is not under the robot's origin
+    (Webots' robot turns about its wheels' centre wherever its origin is: a Boe-Bot's axle is
+    2.5 cm ahead of it); a centre within TOL of the origin is the origin (the field left out)."""
+    if abs(cx) > TOL or abs(cy) > TOL:
+        drive["axle_center"] = [float(cx), float(cy)]
+    return drive
 
 
 def _skid_steer(wheels: list[dict], conv) -> tuple[dict | None, str]:
     """Several wheels per side on parallel axes (a Pioneer 3-AT): each side's wheels on one line
-    parallel to x, the two lines either side of the origin at the same distance, the wheels'
-    centroid under the origin (the kinematic drive turns about it)."""
+    parallel to x, one line either side of the robot's x axis; the robot turns about the middle of
+    the two lines at the wheels' mean x (``axle_center`` when that is not the origin)."""
     centres = np.array([w["centre"] for w in wheels])
     left = [w for w, c in zip(wheels, centres) if c[1] > TOL]
     right = [w for w, c in zip(wheels, centres) if c[1] < -TOL]
@@ -273,19 +284,13 @@ def _skid_steer(wheels: list[dict], conv) -> tuple[dict | None, str]:
     yl, yr = (np.array([w["centre"][1] for w in side]) for side in (left, right))
     if np.ptp(yl) > TOL or np.ptp(yr) > TOL:
         return None, "the wheels of one side are not on one line parallel to the robot's x axis"
-    if abs(yl[0] + yr[0]) > TOL:
-        return None, (f"the wheel lines are at y={yl[0]:g} and y={yr[0]:g}, not symmetric about the robot's origin "
-                      "(the kinematic drive turns about the origin)")
-    mid_x = float(centres[:, 0].mean())
-    if abs(mid_x) > TOL:
-        return None, (f"the wheels' centre is at x={mid_x:g} in the robot frame, not under the robot's origin "
-                      "(the kinematic drive turns about the origin)")
     r0, why = _radius(wheels, conv)
     if r0 is None:
         return None, why
-    return {"wheel_radius": r0, "axle_length": float(yl[0] - yr[0]), "max_wheel_speed": _max_speed(wheels, conv),
-            "left_motor": left[0]["motor"], "right_motor": right[0]["motor"],
-            "skid_steer": {"left": [w["motor"] for w in left[1:]], "right": [w["motor"] for w in right[1:]]}}, ""
+    return _centred({"wheel_radius": r0, "axle_length": float(yl[0] - yr[0]), "max_wheel_speed": _max_speed(wheels, conv),
+                     "left_motor": left[0]["motor"], "right_motor": right[0]["motor"],
+                     "skid_steer": {"left": [w["motor"] for w in left[1:]], "right": [w["motor"] for w in right[1:]]}},
+                    float(centres[:, 0].mean()), float(yl[0] + yr[0]) / 2.0), ""
 
 
 STEERING_UNLIMITED = 1.5
