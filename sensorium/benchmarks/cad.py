@@ -461,7 +461,7 @@ def load_split(path: Path, tree: str | None = None) -> dict:
     if tree is not None:
         env["PYTHONPATH"] = tree
     out = subprocess.run([sys.executable, "-c", _LOAD_CHILD, str(path)], capture_output=True, text=True, timeout=1800,
-                         check=False, env=env)
+                         check=False, env=env, cwd=path.parent)     # (-c puts the working folder first on the path)
     if out.returncode != 0:
         raise RuntimeError(f"load child failed on {path.name}: {out.stderr.strip().splitlines()[-3:]}")
     got = json.loads(out.stdout.strip().splitlines()[-1])
