@@ -2,13 +2,15 @@
 :mod:`.cad`) → float64 triangle arrays, each position once (welded, as the ray engine holds them).
 
 Loaded meshes are cached by (resolved path, modification time, scale): validating a world and then
-building its scene reads each file once. A file larger than ``IN_PROCESS_BYTES`` is read in a
-worker process with a memory limit (:mod:`.mesh_worker`): mesh readers need up to hundreds of
-times a file's size (3.4 GB for a 16 MB OBJ), and a world file names its meshes.
+building its scene reads each file once. A file larger than ``IN_PROCESS_BYTES`` is read by a
+worker process under a memory limit (:mod:`.mesh_worker`): mesh readers need up to hundreds of
+times a file's size (3.4 GB for a 16 MB OBJ), and a world file names its meshes. One worker reads
+files in turn, each under its own limit (its start costs more than reading a 1.5 MB file).
 """
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
@@ -339,7 +341,6 @@ class _Worker:
         self.proc = subprocess.Popen([sys.executable, "-I", str(worker), repr(float(idle))], stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, close_fds=True)
         self.owner = os.getpid()
-        self.requests = 0
 
     def end(self, wait: bool = True) -> int | None:
         """Close its pipes: it ends at the end of its input (or, writing, on the closed pipe); its exit
@@ -410,8 +411,8 @@ def _take_worker() -> tuple[_Worker, bool]:
 def _exchange(request: dict, read_reply) -> tuple[Any, int | None]:
     """Send ``request`` to a worker and read its reply with ``read_reply(stream)`` → (result, whether
     the worker may read another file): (the result, the worker's exit status when it was not kept).
-    A worker that had ended before it took the request (idle, or retired after its last file) is
-    replaced by a new one, once."""
+    A worker that had ended before it took the request (left idle, or retired after its last file)
+    is passed over for the next; a new worker that does not take it is the reader stopping."""
     import json
 
     line = (json.dumps(request) + "\n").encode("utf-8")
@@ -429,18 +430,19 @@ def _exchange(request: dict, read_reply) -> tuple[Any, int | None]:
             if new:
                 return None, code
             continue
-        keep = False
         try:
             result, keep = read_reply(w.proc.stdout)
-        finally:
-            w.requests += 1
-            if keep:
-                with _WORKERS_LOCK:
-                    _IDLE.append(w)
-        return result, None if keep else w.end()
+        except BaseException:
+            w.end(wait=False)           # (its pipes closed: it ends)
+            raise
+        if keep:
+            with _WORKERS_LOCK:
+                _IDLE.append(w)
+            return result, None
+        return result, w.end()
 
 
-_WORKERS_LOCK = __import__("threading").Lock()
+_WORKERS_LOCK = threading.Lock()
 _AT_EXIT = False
 
 
