@@ -153,3 +153,26 @@ def test_a_worker_that_ended_while_waiting_is_replaced_and_a_bad_file_leaves_it_
     with pytest.raises(meshes.MeshFileError, match=f"has {n:,} triangles, more than the world's limit of {n - 1:,}"):
         meshes.load_mesh(tmp_path / "link0.stl", max_triangles=n - 1)
     assert len(meshes.load_mesh(tmp_path / "link0.stl").faces) == n and starts[0] == 3
+
+
+def test_a_wbt_worlds_cad_shapes_and_meshes_are_read_by_one_worker(tmp_path: Path, starts: list[int]) -> None:
+    """A .wbt's CadShapes (their materials read while converting, then their triangles) and Mesh
+    nodes: one worker reads them all, the same triangles as a worker per file."""
+    write_dae(tmp_path / "a.dae", *part_mesh(0, 2_000))
+    write_dae(tmp_path / "b.dae", *part_mesh(1, 2_500))
+    write_stl(tmp_path / "c.stl", *part_mesh(2, 3_000))
+    (tmp_path / "w.wbt").write_text(
+        '#VRML_SIM R2023b utf8\nSolid { children [ CadShape { url [ "a.dae" ] } CadShape { url [ "b.dae" ] } '
+        'Shape { geometry Mesh { url [ "c.stl" ] } } ] }\n')
+    shapes = load_world(tmp_path / "w.wbt").world.solids[0].shapes
+    assert starts[0] == 1
+    assert [(s.geometry.url, s.appearance.base_color if s.appearance else None) for s in shapes][:2] == [
+        ("a.dae", (0.6, 0.6, 0.7)), ("b.dae", (0.6, 0.6, 0.7))]
+    together = _read(tmp_path, [("a.dae", {"material": 0}), ("b.dae", {"material": 0}), ("c.stl", {})])
+    meshes._CACHE.clear()
+    alone = []
+    for ask in [("a.dae", {"material": 0}), ("b.dae", {"material": 0}), ("c.stl", {})]:
+        meshes.close_workers()
+        meshes._CACHE.clear()
+        alone += _read(tmp_path, [ask])
+    assert together == alone and starts[0] == 4
