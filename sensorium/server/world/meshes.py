@@ -378,14 +378,15 @@ def worker_starts() -> int:
 
 
 def close_workers() -> None:
-    """End the idle mesh workers (at exit; a worker also ends by itself when left idle)."""
+    """End the idle mesh workers (at exit; a worker also ends by itself when left idle): each ends at
+    the end of its input, at once (waiting for the next request)."""
     import os
 
     with _WORKERS_LOCK:
         idle, _IDLE[:] = list(_IDLE), []
     for w in idle:
         if w.owner == os.getpid():          # (a forked child leaves its parent's workers alone)
-            w.end(wait=False)
+            w.end()
 
 
 def _take_worker() -> tuple[_Worker, bool]:
