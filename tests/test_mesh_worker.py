@@ -176,3 +176,23 @@ def test_a_wbt_worlds_cad_shapes_and_meshes_are_read_by_one_worker(tmp_path: Pat
         meshes._CACHE.clear()
         alone += _read(tmp_path, [ask])
     assert together == alone and starts[0] == 4
+
+
+def test_a_worker_that_dies_reading_is_said_in_one_line_and_the_next_file_loads(
+        tmp_path: Path, starts: list[int], monkeypatch) -> None:
+    """A worker that takes a file and dies before its reply (as one killed at the CPU limit, or by the
+    system at the memory limit): today's line with its exit status; a new worker reads the next file."""
+    for k in (0, 1):
+        write_stl(tmp_path / f"link{k}.stl", *part_mesh(k, 2_000))
+    dies = "import sys\nsys.stdin.buffer.readline()\nsys.stdout.buffer.write(b'\\x01')\nsys.stdout.flush()\nsys.exit(3)\n"
+
+    def first_dies() -> meshes._Worker:
+        starts[0] += 1
+        return meshes._Worker(600.0, dies if starts[0] == 1 else None)
+
+    monkeypatch.setattr(meshes, "_start_worker", first_dies)
+    with pytest.raises(meshes.MeshFileError) as err:
+        meshes.load_mesh(tmp_path / "link0.stl", display="link0.stl")
+    assert str(err.value) == ("cannot read mesh link0.stl: its reader stopped (exit status 3), most likely at the "
+                              "limits for reading a mesh (2 GiB of memory, 300 s) (raise the limits with --allow-large)")
+    assert len(meshes.load_mesh(tmp_path / "link1.stl").faces) == len(part_mesh(1, 2_000)[1]) and starts[0] == 2

@@ -330,7 +330,8 @@ WORKER_IDLE_S = 5.0
 class _Worker:
     """One mesh_worker.py process, with pipes to it."""
 
-    def __init__(self, idle: float) -> None:
+    def __init__(self, idle: float, script: str | None = None) -> None:
+        """``script``: Python source run instead of mesh_worker.py (tests: a worker that dies)."""
         import os
         import subprocess
         import sys
@@ -338,7 +339,8 @@ class _Worker:
         worker = Path(__file__).with_name("mesh_worker.py")
         env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
         env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
-        self.proc = subprocess.Popen([sys.executable, "-I", str(worker), repr(float(idle))], stdin=subprocess.PIPE,
+        run = [str(worker)] if script is None else ["-c", script]
+        self.proc = subprocess.Popen([sys.executable, "-I", *run, repr(float(idle))], stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, close_fds=True)
         self.owner = os.getpid()
 
