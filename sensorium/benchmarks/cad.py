@@ -324,6 +324,7 @@ def run(cfg: Config) -> Section:
                         f"{stl['peak']['step'] / 1e6:.0f} MB and holds {stl['rss']['step'] / 1e6:.0f} MB once stepping; "
                         f"a swarm robot costs {per['stl']:.1f} ms (shared mesh files) or {per['triangles']:.1f} ms "
                         "(inline meshes) to load.")
+    load_split_section(sec, cfg)
     return sec
 
 
@@ -342,11 +343,16 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--rounds", type=int, default=1, help="interleaved rounds (default 1)")
     parser.add_argument("--compare", metavar="TREE", help="also measure another source tree (say the base "
                         "checkout), interleaved with this one")
+    parser.add_argument("--load-split", action="store_true", help="only load a robot of 24 mesh files and split "
+                        "its load time: mesh worker starts, their reading, the rest")
     args = parser.parse_args(argv)
     here = str(Path(__file__).resolve().parents[2])
     trees: dict[str, str | None] = {"this": here}
     if args.compare:
         trees = {args.compare: str(Path(args.compare).resolve()), "this": here}
+    if args.load_split:
+        load_split_main(trees, args.rounds)
+        return 0
     with tempfile.TemporaryDirectory() as tmp:
         runs = measure_all(worlds(Path(tmp), args.quick), trees, args.rounds, lambda s: print(s, file=sys.stderr))
     for name, samples in runs.items():
@@ -354,6 +360,151 @@ def main(argv: list[str]) -> int:
         print(f"swarm, ms per added robot: {per_robot_ms(samples, 'stl'):.1f} (shared STL files), "
               f"{per_robot_ms(samples, 'triangles'):.1f} (inline meshes)\n")
     return 0
+
+
+
+# ----------------------------------------------------------------------------- mesh files: where the load goes
+# A URDF robot converted for Webots: ~20 STL links of ~1.5 MB each, and a few OBJ and COLLADA parts,
+# every file over meshes.IN_PROCESS_BYTES (read by the bounded mesh worker). ``--load-split`` loads
+# it in a fresh interpreter per tree and splits the load: the worker processes' starts (each timed
+# alone: an interpreter importing numpy and trimesh, as the worker does first), their reading (the
+# time spent waiting on workers, less those starts) and the rest (the loader: validation, welding).
+URDF_STL, URDF_OBJ, URDF_DAE = 20, 2, 2
+
+
+def write_obj(path: Path, verts: np.ndarray, faces: np.ndarray) -> None:
+    """A Wavefront OBJ of the triangles (1-based indices)."""
+    with open(path, "w") as f:
+        f.write("".join(f"v {x:.6f} {y:.6f} {z:.6f}\n" for x, y, z in verts.tolist()))
+        f.write("".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in faces.tolist()))
+
+
+def write_dae(path: Path, verts: np.ndarray, faces: np.ndarray) -> None:
+    """A COLLADA file of one geometry and one material, Z up, in metres."""
+    points = " ".join(f"{x:.6f}" for x in verts.ravel())
+    index = " ".join(str(i) for i in faces.ravel())
+    path.write_text(
+        '<?xml version="1.0" encoding="utf-8"?>\n<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" '
+        'version="1.4.1"><asset><unit meter="1"/><up_axis>Z_UP</up_axis></asset>'
+        '<library_effects><effect id="e"><profile_COMMON><technique sid="t"><lambert><diffuse><color>0.6 0.6 0.7 1'
+        '</color></diffuse></lambert></technique></profile_COMMON></effect></library_effects>'
+        '<library_materials><material id="m" name="m"><instance_effect url="#e"/></material></library_materials>'
+        f'<library_geometries><geometry id="g" name="g"><mesh><source id="p"><float_array id="pa" count="{verts.size}">'
+        f'{points}</float_array><technique_common><accessor source="#pa" count="{len(verts)}" stride="3">'
+        '<param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/></accessor>'
+        '</technique_common></source><vertices id="v"><input semantic="POSITION" source="#p"/></vertices>'
+        f'<triangles count="{len(faces)}" material="s"><input semantic="VERTEX" source="#v" offset="0"/><p>{index}</p>'
+        '</triangles></mesh></geometry></library_geometries><library_visual_scenes><visual_scene id="vs"><node id="n">'
+        '<instance_geometry url="#g"><bind_material><technique_common><instance_material symbol="s" target="#m"/>'
+        '</technique_common></bind_material></instance_geometry></node></visual_scene></library_visual_scenes>'
+        '<scene><instance_visual_scene url="#vs"/></scene></COLLADA>\n')
+
+
+def urdf_robot_world(folder: Path) -> Path:
+    """A robot of URDF_STL binary STL links of 30,000 triangles (1.5 MB each), URDF_OBJ OBJ parts and
+    URDF_DAE COLLADA parts of 40,000 triangles (~2 MB each), as mesh files, written under ``folder``."""
+    (folder / "meshes").mkdir(parents=True, exist_ok=True)
+    shapes = []
+    for k in range(URDF_STL + URDF_OBJ + URDF_DAE):
+        form = "stl" if k < URDF_STL else "obj" if k < URDF_STL + URDF_OBJ else "dae"
+        v, f = part_mesh(200 + k, 30_000 if form == "stl" else 40_000)
+        name = f"meshes/link{k:02d}.{form}"
+        {"stl": write_stl, "obj": write_obj, "dae": write_dae}[form](folder / name, v, f)
+        shapes.append({"name": f"link{k}", "pose": _part_pose(k), "geometry": {"type": "mesh", "url": name}})
+    world = {"world_info": {"name": "urdf_meshes", "basic_time_step": 32}, "solids": _room(),
+             "robots": [{"name": "arm", "controller": "<none>", "shapes": shapes}]}
+    path = folder / "urdf_meshes.json"
+    path.write_text(json.dumps(world))
+    return path
+
+
+_LOAD_CHILD = r"""
+import json, os, statistics, subprocess, sys, time
+import numpy as np
+import trimesh
+from sensorium.server.world import meshes
+from sensorium.server.world.limits import WorldLimits
+from sensorium.server.world.loader import load_world
+
+trimesh.Trimesh(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]]),
+                [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], process=True, validate=False).is_watertight
+waited = {"ms": 0.0, "runs": 0}
+for name in ("_run_worker", "_worker_header"):          # every wait on a mesh worker goes through these
+    def timed(*a, _f=getattr(meshes, name), **k):
+        t = time.perf_counter()
+        try:
+            return _f(*a, **k)
+        finally:
+            waited["ms"] += (time.perf_counter() - t) * 1e3
+            waited["runs"] += 1
+    setattr(meshes, name, timed)
+t0 = time.perf_counter()
+load_world(sys.argv[1], limits=WorldLimits.large())
+total = (time.perf_counter() - t0) * 1e3
+starts = getattr(meshes, "worker_starts", lambda: waited["runs"])()
+env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+one = []
+for _ in range(3):
+    t = time.perf_counter()
+    subprocess.run([sys.executable, "-I", "-c", "import numpy, trimesh"], env=env, check=True)
+    one.append((time.perf_counter() - t) * 1e3)
+start = statistics.median(one)
+print(json.dumps({"total": total, "starts": starts, "start_ms": start, "workers_ms": waited["ms"],
+                  "files": waited["runs"]}))
+"""
+
+
+def load_split(path: Path, tree: str | None = None) -> dict:
+    """The load of ``path`` in a fresh interpreter (``tree`` first on its path), split: ms in worker
+    starts, in their reading, in the rest."""
+    env = dict(os.environ)
+    if tree is not None:
+        env["PYTHONPATH"] = tree
+    out = subprocess.run([sys.executable, "-c", _LOAD_CHILD, str(path)], capture_output=True, text=True, timeout=1800,
+                         check=False, env=env, cwd=path.parent)     # (-c puts the working folder first on the path)
+    if out.returncode != 0:
+        raise RuntimeError(f"load child failed on {path.name}: {out.stderr.strip().splitlines()[-3:]}")
+    got = json.loads(out.stdout.strip().splitlines()[-1])
+    started = got["starts"] * got["start_ms"]
+    return {"total ms": got["total"], "worker starts": got["starts"], "start ms": started,
+            "reading ms": got["workers_ms"] - started, "rest ms": got["total"] - got["workers_ms"],
+            "files": got["files"]}
+
+
+def load_split_section(sec: Section, cfg: Config) -> None:
+    """The mesh-file robot's load, split (``--load-split``), as a table and a finding of ``sec``."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = urdf_robot_world(Path(tmp))
+        got = [load_split(path) for _ in range(cfg.pick(2, 1))]
+    med = {k: float(np.median([g[k] for g in got])) for k in got[0]}
+    sec.data.update(load_split=got)
+    sec.tables.append(Table("cad_load_split", f"A robot of {URDF_STL + URDF_OBJ + URDF_DAE} mesh files over 1 MiB "
+                            f"({URDF_STL} STL links of 1.5 MB, {URDF_OBJ} OBJ and {URDF_DAE} COLLADA parts of ~2 MB): "
+                            "its load, split", ["load ms", "worker starts", "starts ms", "reading ms", "rest ms"],
+                            [[f"{med['total ms']:.0f}", f"{med['worker starts']:.0f}", f"{med['start ms']:.0f}",
+                              f"{med['reading ms']:.0f}", f"{med['rest ms']:.0f}"]], notes=[
+                                "starts ms: the starts counted times one start timed alone (an interpreter importing "
+                                "numpy and trimesh); reading ms: the time waiting on mesh workers less the starts",
+                                "Reproduce: `python -m sensorium.benchmarks.cad --load-split`"]))
+    sec.findings.append(f"A robot of {URDF_STL + URDF_OBJ + URDF_DAE} mesh files over 1 MiB loads in "
+                        f"{med['total ms'] / 1e3:.1f} s with {med['worker starts']:.0f} mesh worker start(s).")
+
+
+def load_split_main(trees: dict[str, str | None], rounds: int) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = urdf_robot_world(Path(tmp))
+        runs: dict[str, list[dict]] = {t: [] for t in trees}
+        for _ in range(rounds):
+            for t, tree in trees.items():
+                runs[t].append(load_split(path, tree))
+                print(f"  load split: {t}: {runs[t][-1]['total ms']:.0f} ms", file=sys.stderr)
+    print(f"a robot of {URDF_STL} STL links (1.5 MB each), {URDF_OBJ} OBJ and {URDF_DAE} COLLADA parts (~2 MB), "
+          f"loaded; median of {rounds}:")
+    for t, got in runs.items():
+        med = {k: float(np.median([g[k] for g in got])) for k in got[0]}
+        print(f"  {t}: load {med['total ms']:.0f} ms = worker starts {med['start ms']:.0f} ms "
+              f"({med['worker starts']:.0f} starts) + reading {med['reading ms']:.0f} ms + rest {med['rest ms']:.0f} ms")
 
 
 if __name__ == "__main__":

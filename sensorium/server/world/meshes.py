@@ -2,13 +2,15 @@
 :mod:`.cad`) → float64 triangle arrays, each position once (welded, as the ray engine holds them).
 
 Loaded meshes are cached by (resolved path, modification time, scale): validating a world and then
-building its scene reads each file once. A file larger than ``IN_PROCESS_BYTES`` is read in a
-worker process with a memory limit (:mod:`.mesh_worker`): mesh readers need up to hundreds of
-times a file's size (3.4 GB for a 16 MB OBJ), and a world file names its meshes.
+building its scene reads each file once. A file larger than ``IN_PROCESS_BYTES`` is read by a
+worker process under a memory limit (:mod:`.mesh_worker`): mesh readers need up to hundreds of
+times a file's size (3.4 GB for a 16 MB OBJ), and a world file names its meshes. One worker reads
+files in turn, each under its own limit (its start costs more than reading a 1.5 MB file).
 """
 
 from __future__ import annotations
 
+import threading
 from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
@@ -292,30 +294,159 @@ MATERIALS_ONLY = -2       # (mesh_worker.MATERIALS_ONLY)
 
 
 def _worker_header(path: str, memory: int, kind: str, extra: list[str]) -> dict | None:
-    """Run :mod:`.mesh_worker` on ``path`` for a reply without arrays: its JSON header (None: it
-    stopped without one)."""
-    import json
-    import os
-    import struct
-    import subprocess
-    import sys
+    """Ask a :mod:`.mesh_worker` about ``path`` for a reply without arrays (``extra``: [MATERIAL]):
+    its JSON header (None: it stopped without one)."""
+    def header_only(stream) -> tuple[dict | None, bool]:
+        header = _read_header(stream)
+        return header, header is not None and header.get("kind") != "memory"
 
-    worker = Path(__file__).with_name("mesh_worker.py")
-    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
-    env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
-    proc = subprocess.Popen([sys.executable, "-I", str(worker), path, "1.0", "1.0", "1.0", str(memory), kind, *extra],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=env,
-                            close_fds=True)
-    assert proc.stdout is not None
+    header, _ = _exchange({"path": path, "scale": [1.0, 1.0, 1.0], "memory": memory, "format": kind,
+                           "material": int(extra[0]) if extra else -1, "name": "", "cap": None}, header_only)
+    return header
+
+
+def _read_header(stream) -> dict | None:
+    """A worker reply's JSON header (None: no header, or not a JSON object)."""
+    import json
+    import struct
+
     try:
-        head = proc.stdout.read(4)
-        header = json.loads(proc.stdout.read(struct.unpack(">I", head)[0])) if len(head) == 4 else None
+        head = stream.read(4)
+        header = json.loads(stream.read(struct.unpack(">I", head)[0])) if len(head) == 4 else None
     except ValueError:       # (a reply that is not JSON)
-        header = None
-    finally:
-        proc.stdout.close()
-        proc.wait()
+        return None
     return header if isinstance(header, dict) else None
+
+
+# ----------------------------------------------------------------------------- the mesh workers
+# A worker process reads files one after another (mesh_worker.py: each under its own memory limit):
+# starting one (an interpreter importing numpy and trimesh) costs ~0.4 s, more than reading a
+# 1.5 MB STL file, and a robot converted from URDF has tens of such files. Idle workers wait here for
+# the next file; one ends by itself after WORKER_IDLE_S seconds without a request, after a file that
+# hit its memory limit, or when this process ends. A worker is used by one read at a time.
+WORKER_IDLE_S = 5.0
+
+
+class _Worker:
+    """One mesh_worker.py process, with pipes to it."""
+
+    def __init__(self, idle: float, script: str | None = None) -> None:
+        """``script``: Python source run instead of mesh_worker.py (tests: a worker that dies)."""
+        import os
+        import subprocess
+        import sys
+
+        worker = Path(__file__).with_name("mesh_worker.py")
+        env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
+        env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
+        run = [str(worker)] if script is None else ["-c", script]
+        self.proc = subprocess.Popen([sys.executable, "-I", *run, repr(float(idle))], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, close_fds=True)
+        self.owner = os.getpid()
+
+    def end(self, wait: bool = True) -> int | None:
+        """Close its pipes: it ends at the end of its input (or, writing, on the closed pipe); its exit
+        status (``wait``: once it has ended, killed if it has not within 30 s)."""
+        import subprocess
+
+        for pipe in (self.proc.stdin, self.proc.stdout):
+            try:
+                if pipe is not None:
+                    pipe.close()
+            except OSError:
+                pass
+        if not wait:
+            return self.proc.poll()
+        try:
+            return self.proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            return self.proc.wait()
+
+
+_IDLE: list[_Worker] = []
+_STARTS = [0]
+
+
+def _start_worker() -> _Worker:
+    """A new worker process (a seam: tests count the starts)."""
+    _STARTS[0] += 1
+    return _Worker(WORKER_IDLE_S)
+
+
+def worker_starts() -> int:
+    """How many mesh worker processes this process has started."""
+    return _STARTS[0]
+
+
+def close_workers() -> None:
+    """End the idle mesh workers (at exit; a worker also ends by itself when left idle): each ends at
+    the end of its input, at once (waiting for the next request)."""
+    import os
+
+    with _WORKERS_LOCK:
+        idle, _IDLE[:] = list(_IDLE), []
+    for w in idle:
+        if w.owner == os.getpid():          # (a forked child leaves its parent's workers alone)
+            w.end()
+
+
+def _take_worker() -> tuple[_Worker, bool]:
+    """(an idle worker of this process, else a new one; whether it is new)."""
+    import os
+
+    with _WORKERS_LOCK:
+        while _IDLE:
+            w = _IDLE.pop()
+            if w.owner == os.getpid() and w.proc.poll() is None:
+                return w, False
+            if w.owner == os.getpid():
+                w.end()
+    global _AT_EXIT
+    if not _AT_EXIT:
+        import atexit
+
+        atexit.register(close_workers)
+        _AT_EXIT = True
+    return _start_worker(), True
+
+
+def _exchange(request: dict, read_reply) -> tuple[Any, int | None]:
+    """Send ``request`` to a worker and read its reply with ``read_reply(stream)`` → (result, whether
+    the worker may read another file): (the result, the worker's exit status when it was not kept).
+    A worker that had ended before it took the request (left idle, or retired after its last file)
+    is passed over for the next; a new worker that does not take it is the reader stopping."""
+    import json
+
+    line = (json.dumps(request) + "\n").encode("utf-8")
+    while True:
+        w, new = _take_worker()
+        assert w.proc.stdin is not None and w.proc.stdout is not None
+        try:
+            w.proc.stdin.write(line)
+            w.proc.stdin.flush()
+            taken = w.proc.stdout.read(1) == b"\x01"
+        except OSError:         # (a broken pipe: it had ended)
+            taken = False
+        if not taken:
+            code = w.end()
+            if new:
+                return None, code
+            continue
+        try:
+            result, keep = read_reply(w.proc.stdout)
+        except BaseException:
+            w.end(wait=False)           # (its pipes closed: it ends)
+            raise
+        if keep:
+            with _WORKERS_LOCK:
+                _IDLE.append(w)
+            return result, None
+        return result, w.end()
+
+
+_WORKERS_LOCK = threading.Lock()
+_AT_EXIT = False
 
 
 ALL_MATERIALS = -3        # (mesh_worker.ALL_MATERIALS)
@@ -352,58 +483,44 @@ def _check_arrays(path: str, vertices: np.ndarray, faces: np.ndarray) -> None:
 
 def _run_worker(path: str, scale: tuple[float, ...], memory: int, max_triangles: int | None, kind: str | None,
                 select: tuple[int, str]) -> tuple[dict, list[tuple[np.ndarray, np.ndarray]]]:
-    """Run :mod:`.mesh_worker` for triangles: (its JSON header, the (vertices, faces) arrays it sent:
-    one pair, or one per group when ``select`` asks for every material). MeshFileError: it failed."""
-    import json
-    import os
-    import struct
-    import subprocess
-    import sys
-
-    worker = Path(__file__).with_name("mesh_worker.py")
-    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTHON")}
-    env.update(OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")   # little address space
-    proc = subprocess.Popen([sys.executable, "-I", str(worker), path, *map(repr, scale), str(memory),
-                             kind or Path(path).suffix.lower()[1:], str(select[0]), select[1],
-                             str(max_triangles) if max_triangles is not None else ""],
-                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, env=env,
-                            close_fds=True)
-    assert proc.stdout is not None
+    """Have a :mod:`.mesh_worker` read a file's triangles: (its JSON header, the (vertices, faces)
+    arrays it sent: one pair, or one per group when ``select`` asks for every material).
+    MeshFileError: it failed."""
     arrays: list[tuple[np.ndarray, np.ndarray]] = []
-    try:
-        head = proc.stdout.read(4)
-        header = json.loads(proc.stdout.read(struct.unpack(">I", head)[0])) if len(head) == 4 else None
-        if not isinstance(header, dict):
-            header = None
-        if header is not None and header.get("ok"):
+    too_many: list[int] = []
+
+    def triangles(stream) -> tuple[dict | None, bool]:
+        header = _read_header(stream)
+        if header is None or not header.get("ok"):
+            return header, header is not None and header.get("kind") != "memory"
+        try:
             sizes = [(int(g[1]), int(g[2])) for g in header["groups"]] if "groups" in header \
                 else [(int(header["vertices"]), int(header["faces"]))]
-            for _, nf in sizes:
-                if max_triangles is not None and nf > max_triangles:
-                    proc.kill()
-                    raise MeshFileError(f"mesh {path} has {nf:,} triangles, more than the world's limit of "
-                                        f"{max_triangles:,} (raise the limits with --allow-large)")
-            for nv, nf in sizes:
-                pair = (np.empty((nv, 3), dtype=np.float64), np.empty((nf, 3), dtype=np.int64))
-                for a in pair:
-                    view = memoryview(a).cast("B")
-                    got = 0
-                    while got < len(view):
-                        n = proc.stdout.readinto(view[got:])
-                        if not n:
-                            header = None
-                            break
-                        got += n
-                    if header is None:
-                        break
-                if header is None:
-                    break
-                arrays.append(pair)
-    except (ValueError, KeyError, TypeError, IndexError):       # (a reply that is not what was asked)
-        header = None
-    finally:
-        proc.stdout.close()
-        code = proc.wait()
+        except (ValueError, KeyError, TypeError, IndexError):       # (a reply that is not what was asked)
+            return None, False
+        for _, nf in sizes:
+            if max_triangles is not None and nf > max_triangles:
+                too_many.append(nf)
+                return header, False             # (its arrays are not read: the worker is ended)
+        for nv, nf in sizes:
+            pair = (np.empty((nv, 3), dtype=np.float64), np.empty((nf, 3), dtype=np.int64))
+            for a in pair:
+                view = memoryview(a).cast("B")
+                got = 0
+                while got < len(view):
+                    n = stream.readinto(view[got:])
+                    if not n:
+                        return None, False
+                    got += n
+            arrays.append(pair)
+        return header, True
+
+    header, code = _exchange({"path": path, "scale": [float(s) for s in scale], "memory": int(memory),
+                              "format": kind or Path(path).suffix.lower()[1:], "material": int(select[0]),
+                              "name": select[1], "cap": max_triangles}, triangles)
+    if too_many:
+        raise MeshFileError(f"mesh {path} has {too_many[0]:,} triangles, more than the world's limit of "
+                            f"{max_triangles:,} (raise the limits with --allow-large)")
     limit = f"{memory / (1 << 30):g} GiB"
     if header is None:
         raise MeshFileError(f"cannot read mesh {path}: its reader stopped (exit status {code}), most likely at the "
