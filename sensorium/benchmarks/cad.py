@@ -240,11 +240,11 @@ print(json.dumps(out))
 
 def _child(path: Path, tree: str | None = None) -> dict:
     """One measurement of the world ``path`` in a fresh interpreter, with ``tree`` (a source tree)
-    first on its path (default: this one's)."""
+    first on its path (default: this one's). (``-P``: the working directory is not put before it, so
+    a run started inside one tree measures the other tree's code, not its own twice.)"""
     env = dict(os.environ)
-    if tree is not None:
-        env["PYTHONPATH"] = tree
-    out = subprocess.run([sys.executable, "-c", _CHILD, str(path)], capture_output=True, text=True, timeout=1800,
+    env["PYTHONPATH"] = tree if tree is not None else str(Path(__file__).resolve().parents[2])
+    out = subprocess.run([sys.executable, "-P", "-c", _CHILD, str(path)], capture_output=True, text=True, timeout=1800,
                          check=False, env=env)
     if out.returncode != 0:
         raise RuntimeError(f"cad child failed on {path.name}: {out.stderr.strip().splitlines()[-3:]}")
