@@ -296,3 +296,8 @@ def test_an_inline_mesh_is_held_as_arrays_in_the_model(tmp_path: Path) -> None:
     h = parse_world(data).world.robots[0].shapes[0].geometry
     assert isinstance(h.vertices, wm.Rows) and h.vertices == g.vertices and h.faces == g.faces
     assert h == g and hash(h) == hash(g)
+    uv = [[k / 40, 1 - k / 40] for k in range(40)]
+    data["robots"][0]["shapes"][0]["geometry"].update(tex_coords=uv, tex_coord_faces=f.tolist())
+    t = parse_world(data).world.robots[0].shapes[0].geometry
+    assert isinstance(t.tex_coords, wm.Rows) and isinstance(t.tex_coord_faces, wm.Rows)
+    assert t.tex_coords.array.dtype == np.float64 and t.tex_coords.tolist() == uv and t.tex_coord_faces == t.faces

@@ -89,7 +89,7 @@ Solid {{ children [ Shape {{ geometry IndexedFaceSet {{
     for a, b, c in faces:
         (xa, ya, _), (xb, yb, _), (xc, yc, _) = verts[a], verts[b], verts[c]
         assert ((xb - xa) * (yc - ya) - (yb - ya) * (xc - xa)) * shoelace > 0
-    assert geom["tex_coord_faces"] == [[i + 10 for i in f] for f in faces]
+    assert geom["tex_coord_faces"].tolist() == [[i + 10 for i in f] for f in faces.tolist()]
 
 
 def test_convex_polygons_and_triangles_keep_their_fan_bit_for_bit(tmp_path: Path) -> None:

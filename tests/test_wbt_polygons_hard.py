@@ -370,7 +370,7 @@ def test_a_read_worlds_texture_corners_follow_its_cut_triangles(heights, roll, c
                      f"  texCoordIndex [ {' '.join(str(k + 7) for k in range(n))} -1 ] }} }} ] }}\n")
         geom = wbt_convert(p).data["solids"][0]["shapes"][0]["geometry"]
     faces = geom["faces"]
-    assert geom["tex_coord_faces"] == [[c + 7 for c in f] for f in faces]
+    assert geom["tex_coord_faces"].tolist() == [[c + 7 for c in f] for f in faces.tolist()]
     poly = [(Fraction(x), Fraction(y)) for x, y in xy]
     total = sum(twice_area(poly[0], poly[k], poly[k + 1]) for k in range(1, n - 1))
     tris = [twice_area(poly[a], poly[b], poly[c]) for a, b, c in faces]

@@ -239,12 +239,13 @@ class Rows:
         return (Rows, (self.array,))
 
 
-def _as_rows(width: int, kind: type) -> typing.Callable[[Any, ValidatorFunctionWrapHandler, ValidationInfo], Any]:
+def _as_rows(width: int, kind: type, min_length: int, max_length: int
+             ) -> typing.Callable[[Any, ValidatorFunctionWrapHandler], Any]:
     """A field of rows of ``width`` numbers of ``kind`` (float or int) validated into ``Rows``. Rows
     given as a numpy array of that dtype and shape (a .wbt IndexedFaceSet's, as converted), or as
-    lists of plain numbers (a YAML/JSON world), are checked in one numpy pass (finite, the field's
-    length bounds) and kept as one array; anything else goes through pydantic's own validation of
-    the list type, whose errors (path, message) are the field's errors as before."""
+    lists of plain numbers (a YAML/JSON world), are checked in one numpy pass (finite, within the
+    field's length bounds) and kept as one array; anything else goes through pydantic's own
+    validation of the list type, whose errors (path, message) are the field's errors as before."""
     dtype = np.float64 if kind is float else np.int64
     scalars = {float, int} if kind is float else {int}
 
@@ -271,15 +272,12 @@ def _as_rows(width: int, kind: type) -> typing.Callable[[Any, ValidatorFunctionW
             return None
         return arr
 
-    def validate(value: Any, handler: ValidatorFunctionWrapHandler, info: ValidationInfo) -> Any:
+    def validate(value: Any, handler: ValidatorFunctionWrapHandler) -> Any:
         arr = fast(value)
-        if arr is not None:
-            field = Triangles.model_fields[info.field_name or ""]
-            lo = next((m.min_length for m in field.metadata if getattr(m, "min_length", None) is not None), 0)
-            hi = next((m.max_length for m in field.metadata if getattr(m, "max_length", None) is not None), None)
-            if lo <= len(arr) and (hi is None or len(arr) <= hi):
-                return Rows(arr)
-            value = arr.tolist()            # out of bounds: pydantic says so, as for a list
+        if arr is not None and min_length <= len(arr) <= max_length:
+            return Rows(arr)
+        if isinstance(value, Rows):         # (out of bounds: pydantic says so, as for a list)
+            value = value.array
         if isinstance(value, np.ndarray):
             value = value.tolist()
         out = handler(value)
@@ -298,8 +296,15 @@ def _rows_out(value: Any, info: SerializationInfo) -> Any:
     return value
 
 
-Vec3Rows = Annotated[list[Vec3], WrapValidator(_as_rows(3, float)), PlainSerializer(_rows_out)]
-IndexRows = Annotated[list[tuple[int, int, int]], WrapValidator(_as_rows(3, int)), PlainSerializer(_rows_out)]
+# each a list type (its JSON schema, its errors) held as Rows; the bounds are the list's, given to both
+Vertices = Annotated[list[Vec3], Field(max_length=1_000_000), WrapValidator(_as_rows(3, float, 0, 1_000_000)),
+                     PlainSerializer(_rows_out)]
+Faces = Annotated[list[tuple[int, int, int]], Field(min_length=1, max_length=2_000_000),
+                  WrapValidator(_as_rows(3, int, 1, 2_000_000)), PlainSerializer(_rows_out)]
+TexCoords = Annotated[list[tuple[float, float]], Field(max_length=1_000_000),
+                      WrapValidator(_as_rows(2, float, 0, 1_000_000)), PlainSerializer(_rows_out)]
+TexFaces = Annotated[list[tuple[int, int, int]], Field(max_length=2_000_000),
+                     WrapValidator(_as_rows(3, int, 0, 2_000_000)), PlainSerializer(_rows_out)]
 
 
 class Triangles(Strict):
@@ -307,14 +312,14 @@ class Triangles(Strict):
     triples into them, in the shape's frame."""
 
     type: Literal["triangles"]
-    vertices: Vec3Rows = Field(max_length=1_000_000)
-    faces: IndexRows = Field(min_length=1, max_length=2_000_000)
-    tex_coords: list[tuple[float, float]] | None = Field(
-        default=None, max_length=1_000_000,
+    vertices: Vertices
+    faces: Faces
+    tex_coords: TexCoords | None = Field(
+        default=None,
         description="texture coordinates (s, t), t up as in Webots' TextureCoordinate; none: Webots' default "
                     "mapping from the bounding box")
-    tex_coord_faces: list[tuple[int, int, int]] | None = Field(
-        default=None, max_length=2_000_000,
+    tex_coord_faces: TexFaces | None = Field(
+        default=None,
         description="per face, the tex_coords index of each corner (Webots' texCoordIndex); none: the faces' indices")
 
 

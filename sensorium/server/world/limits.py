@@ -269,6 +269,8 @@ def _number_fields(cls: type[BaseModel]) -> dict[str, Block]:
         if typing.get_origin(tp) in (typing.Union, types.UnionType):
             kinds = [a for a in typing.get_args(tp) if a is not type(None)]
             tp = kinds[0] if len(kinds) == 1 else None
+        if typing.get_origin(tp) is typing.Annotated:     # (a model's Rows: the list type it stands for)
+            tp = typing.get_args(tp)[0]
         origin, args = typing.get_origin(tp), typing.get_args(tp)
         if not (origin is list and len(args) == 1) and not (origin is tuple and len(args) == 2 and args[1] is Ellipsis):
             continue

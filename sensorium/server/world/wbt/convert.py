@@ -964,7 +964,6 @@ class Converter:
         tex_faces = _pick(tex_index, corners) if tex_index is not None else []
         if not len(faces):
             raise f.error("coordIndex", "an IndexedFaceSet needs at least one polygon")
-        tex_faces = tex_faces.tolist() if isinstance(tex_faces, np.ndarray) else tex_faces
         vertices = points * float(s)        # the same products as one at a time (s is a float: the frame's scale)
         out = {"type": "triangles", "vertices": vertices, "faces": faces}
         if tex is not None:

@@ -268,7 +268,8 @@ def _triangles_by(g: dict, lin: np.ndarray) -> dict:
         f = g["faces"]
         out["faces"] = f[:, [0, 2, 1]] if isinstance(f, np.ndarray) else [[a, c, b] for a, b, c in f]
         if "tex_coord_faces" in g:
-            out["tex_coord_faces"] = [[a, c, b] for a, b, c in g["tex_coord_faces"]]
+            t = g["tex_coord_faces"]
+            out["tex_coord_faces"] = t[:, [0, 2, 1]] if isinstance(t, np.ndarray) else [[a, c, b] for a, b, c in t]
     return out
 
 
