@@ -8,6 +8,7 @@ from __future__ import annotations
 import random
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
@@ -187,6 +188,8 @@ def test_a_big_mesh_converts_to_its_points_and_triangles(tmp_path: Path) -> None
     conv = wbt_convert(p)
     geom = conv.data["robots"][0]["shapes"][0]["geometry"]
     assert geom["type"] == "triangles"
+    assert isinstance(geom["vertices"], np.ndarray) and isinstance(geom["faces"], np.ndarray)    # compact, as converted
+    geom = {**geom, "vertices": geom["vertices"].tolist(), "faces": geom["faces"].tolist()}
     assert geom["vertices"] == [[float(pts[i]) * 2.0, float(pts[i + 1]) * 2.0, float(pts[i + 2]) * 2.0]
                                 for i in range(0, 3 * n, 3)]
     corners, _ = polygon_corners(index, [float(x) for x in pts], [EAR_CLIP_WORLD])
@@ -263,3 +266,38 @@ def test_the_work_checks_skip_a_meshs_numbers_without_walking_them() -> None:
     world = parse_world(world_with(big_triangles())).world
     assert sum(1 for _ in lim._walk(world)) < 100
     assert sum(1 for _ in lim._walk(world, numbers=True)) > 160_000
+
+
+def test_an_inline_mesh_is_held_as_arrays_in_the_model(tmp_path: Path) -> None:
+    """A .wbt IndexedFaceSet's points and faces, and a JSON world's inline triangles, are held by the
+    validated model as one read-only float64 / int64 array each (``wm.Rows``), not lists of Python
+    numbers; the scene's mesh takes those arrays without a copy; the model still reads as the lists
+    of tuples it stands for and writes numbers."""
+    pts = numbers(3 * 40, seed=11)
+    index = [str(i) for k in range(38) for i in (0, k + 1, k + 2, -1)]
+    p = tmp_path / "w.wbt"
+    p.write_text(mesh_world(pts, index))
+    g = load_world(p).world.robots[0].shapes[0].geometry
+    assert isinstance(g, wm.Triangles) and isinstance(g.vertices, wm.Rows) and isinstance(g.faces, wm.Rows)
+    v, f = g.vertices.array, g.faces.array
+    assert (v.dtype, v.shape, f.dtype, f.shape) == (np.float64, (40, 3), np.int64, (38, 3))
+    assert not v.flags.writeable and not f.flags.writeable
+    assert v.tolist() == [[float(x) for x in pts[i:i + 3]] for i in range(0, len(pts), 3)]
+    assert f.tolist() == [[0, k + 1, k + 2] for k in range(38)]
+    assert np.asarray(g.vertices) is v and np.asarray(g.faces, dtype=np.int64) is f     # no copy
+    assert g.vertices[1] == tuple(float(x) for x in pts[3:6]) and list(g.faces)[0] == (0, 1, 2)
+    assert g.model_dump(mode="json")["faces"][:2] == [[0, 1, 2], [0, 2, 3]]
+    from sensorium.server.world.geometry import Mesh
+
+    mesh = Mesh(vertices=g.vertices, faces=g.faces, closed=False)
+    assert np.shares_memory(mesh.vertices, v) and np.shares_memory(mesh.faces, f)
+    data = {"robots": [{"name": "r", "shapes": [{"geometry": {"type": "triangles", "vertices": v.tolist(),
+                                                              "faces": f.tolist()}}]}]}
+    h = parse_world(data).world.robots[0].shapes[0].geometry
+    assert isinstance(h.vertices, wm.Rows) and h.vertices == g.vertices and h.faces == g.faces
+    assert h == g and hash(h) == hash(g)
+    uv = [[k / 40, 1 - k / 40] for k in range(40)]
+    data["robots"][0]["shapes"][0]["geometry"].update(tex_coords=uv, tex_coord_faces=f.tolist())
+    t = parse_world(data).world.robots[0].shapes[0].geometry
+    assert isinstance(t.tex_coords, wm.Rows) and isinstance(t.tex_coord_faces, wm.Rows)
+    assert t.tex_coords.array.dtype == np.float64 and t.tex_coords.tolist() == uv and t.tex_coord_faces == t.faces

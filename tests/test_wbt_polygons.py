@@ -89,7 +89,7 @@ Solid {{ children [ Shape {{ geometry IndexedFaceSet {{
     for a, b, c in faces:
         (xa, ya, _), (xb, yb, _), (xc, yc, _) = verts[a], verts[b], verts[c]
         assert ((xb - xa) * (yc - ya) - (yb - ya) * (xc - xa)) * shoelace > 0
-    assert geom["tex_coord_faces"] == [[i + 10 for i in f] for f in faces]
+    assert geom["tex_coord_faces"].tolist() == [[i + 10 for i in f] for f in faces.tolist()]
 
 
 def test_convex_polygons_and_triangles_keep_their_fan_bit_for_bit(tmp_path: Path) -> None:
@@ -104,7 +104,7 @@ def test_convex_polygons_and_triangles_keep_their_fan_bit_for_bit(tmp_path: Path
                  + ", ".join(" ".join(map(str, q)) for q in pts) + " ] } coordIndex [ "
                  + " ".join(map(str, index)) + " ] } } ] }\n")
     conv = wbt_convert(p)
-    faces = conv.data["solids"][0]["shapes"][0]["geometry"]["faces"]
+    faces = conv.data["solids"][0]["shapes"][0]["geometry"]["faces"].tolist()
     assert faces == [[index[c] for c in tri] for tri in fan_corners(index).tolist()]
     assert not [w for w in conv.warnings if "fanned" in w]
 
@@ -119,7 +119,7 @@ def test_a_huge_concave_polygon_stays_fanned_and_says_so(tmp_path: Path) -> None
                  + ", ".join(f"{x} {y} 0" for x, y in star) + " ] } coordIndex [ "
                  + " ".join(map(str, range(n))) + " -1 ] } } ] }\n")
     conv = wbt_convert(p)
-    assert conv.data["solids"][0]["shapes"][0]["geometry"]["faces"] == [[0, k, k + 1] for k in range(1, n - 1)]
+    assert conv.data["solids"][0]["shapes"][0]["geometry"]["faces"].tolist() == [[0, k, k + 1] for k in range(1, n - 1)]
     said = [w for w in conv.warnings if "left fanned" in w]
     assert len(said) == 1 and "1 concave polygon(s)" in said[0] and "star.wbt:3:" in said[0]
 

@@ -253,7 +253,7 @@ def test_a_world_of_many_256_corner_spirals_cuts_within_the_budget_and_fans_the_
     assert "spirals.wbt:9:" in said[0], said          # the first one fanned: the 7th shape, on line 9
     fan = [[0, k, k + 1] for k in range(1, 255)]
     geoms = [s["geometry"] for s in conv.data["solids"][0]["shapes"]]
-    assert [g["faces"] != fan for g in geoms] == [True] * 6 + [False] * 14
+    assert [g["faces"].tolist() != fan for g in geoms] == [True] * 6 + [False] * 14
 
 
 @settings(FAST)
@@ -338,7 +338,7 @@ def test_corners_too_large_to_square_are_refused_by_value_without_numpy_warnings
                  "coordIndex [ 0 1 2 3 4 5 -1 ] } } ] }\n")
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        faces = wbt_convert(p).data["solids"][0]["shapes"][0]["geometry"]["faces"]
+        faces = wbt_convert(p).data["solids"][0]["shapes"][0]["geometry"]["faces"].tolist()
     assert faces == [[0, 1, 2], [0, 2, 3], [0, 3, 4], [0, 4, 5]]
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -370,7 +370,7 @@ def test_a_read_worlds_texture_corners_follow_its_cut_triangles(heights, roll, c
                      f"  texCoordIndex [ {' '.join(str(k + 7) for k in range(n))} -1 ] }} }} ] }}\n")
         geom = wbt_convert(p).data["solids"][0]["shapes"][0]["geometry"]
     faces = geom["faces"]
-    assert geom["tex_coord_faces"] == [[c + 7 for c in f] for f in faces]
+    assert geom["tex_coord_faces"].tolist() == [[c + 7 for c in f] for f in faces.tolist()]
     poly = [(Fraction(x), Fraction(y)) for x, y in xy]
     total = sum(twice_area(poly[0], poly[k], poly[k + 1]) for k in range(1, n - 1))
     tris = [twice_area(poly[a], poly[b], poly[c]) for a, b, c in faces]
@@ -392,7 +392,7 @@ def test_a_def_face_used_many_times_is_cut_the_same_at_every_use(tmp_path) -> No
     p = tmp_path / "stars.wbt"
     p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { }\n" + "\n".join(solids) + "\n")
     conv = wbt_convert(p)
-    faces = [s["shapes"][0]["geometry"]["faces"] for s in conv.data["solids"]]
+    faces = [s["shapes"][0]["geometry"]["faces"].tolist() for s in conv.data["solids"]]
     assert len(faces) == 20 and all(f == faces[0] for f in faces[1:])
     assert faces[0] != [[0, k, k + 1] for k in range(1, n - 1)]
     assert not [w for w in conv.warnings if "left fanned" in w]

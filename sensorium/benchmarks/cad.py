@@ -240,11 +240,11 @@ print(json.dumps(out))
 
 def _child(path: Path, tree: str | None = None) -> dict:
     """One measurement of the world ``path`` in a fresh interpreter, with ``tree`` (a source tree)
-    first on its path (default: this one's)."""
+    first on its path (default: this one's). (``-P``: the working directory is not put before it, so
+    a run started inside one tree measures the other tree's code, not its own twice.)"""
     env = dict(os.environ)
-    if tree is not None:
-        env["PYTHONPATH"] = tree
-    out = subprocess.run([sys.executable, "-c", _CHILD, str(path)], capture_output=True, text=True, timeout=1800,
+    env["PYTHONPATH"] = tree if tree is not None else str(Path(__file__).resolve().parents[2])
+    out = subprocess.run([sys.executable, "-P", "-c", _CHILD, str(path)], capture_output=True, text=True, timeout=1800,
                          check=False, env=env)
     if out.returncode != 0:
         raise RuntimeError(f"cad child failed on {path.name}: {out.stderr.strip().splitlines()[-3:]}")
@@ -459,10 +459,9 @@ def load_split(path: Path, tree: str | None = None) -> dict:
     """The load of ``path`` in a fresh interpreter (``tree`` first on its path), split: ms in worker
     starts, in their reading, in the rest."""
     env = dict(os.environ)
-    if tree is not None:
-        env["PYTHONPATH"] = tree
-    out = subprocess.run([sys.executable, "-c", _LOAD_CHILD, str(path)], capture_output=True, text=True, timeout=1800,
-                         check=False, env=env, cwd=path.parent)     # (-c puts the working folder first on the path)
+    env["PYTHONPATH"] = tree if tree is not None else str(Path(__file__).resolve().parents[2])
+    out = subprocess.run([sys.executable, "-P", "-c", _LOAD_CHILD, str(path)], capture_output=True, text=True,
+                         timeout=1800, check=False, env=env)        # (-P: as _child)
     if out.returncode != 0:
         raise RuntimeError(f"load child failed on {path.name}: {out.stderr.strip().splitlines()[-3:]}")
     got = json.loads(out.stdout.strip().splitlines()[-1])

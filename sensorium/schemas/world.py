@@ -17,7 +17,20 @@ import types
 import typing
 from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationInfo, field_validator, model_validator
+import numpy as np
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Field,
+    PlainSerializer,
+    SerializationInfo,
+    ValidationInfo,
+    ValidatorFunctionWrapHandler,
+    WrapValidator,
+    field_validator,
+    model_validator,
+)
 
 Vec3 = tuple[float, float, float]
 
@@ -172,19 +185,141 @@ class Plane(Strict):
         return v
 
 
+class Rows:
+    """Rows of numbers (a mesh's vertices or faces) held as one read-only numpy array of shape
+    (n, width): 8 bytes a number instead of a Python object and a list slot each. It reads as the
+    list of tuples it stands for (``len``, indexing and iteration give tuples of Python numbers,
+    ``==`` compares values), and ``np.asarray`` gives the array itself, without a copy. Float rows
+    are float64, index rows int64 (object only for an index beyond 64 bits, which the loader refuses
+    by value)."""
+
+    __slots__ = ("array",)
+
+    def __init__(self, array: np.ndarray):
+        array = np.asarray(array)
+        array.flags.writeable = False       # (the caller's array itself: handed over, never copied)
+        self.array = array
+
+    def __len__(self) -> int:
+        return len(self.array)
+
+    def __bool__(self) -> bool:
+        return len(self.array) > 0
+
+    def __getitem__(self, i: Any) -> Any:
+        if isinstance(i, slice):
+            return Rows(self.array[i])
+        return tuple(self.array[i].tolist())
+
+    def __iter__(self) -> typing.Iterator[tuple[Any, ...]]:
+        return map(tuple, self.array.tolist())
+
+    def __array__(self, dtype: Any = None, copy: bool | None = None) -> np.ndarray:
+        if dtype is None or np.dtype(dtype) == self.array.dtype:
+            return self.array.copy() if copy else self.array
+        return self.array.astype(dtype)
+
+    def tolist(self) -> list[list[Any]]:
+        return self.array.tolist()
+
+    def __eq__(self, other: object) -> bool:
+        if isinstance(other, Rows):
+            return self.array.shape == other.array.shape and bool(np.array_equal(self.array, other.array))
+        if isinstance(other, list | tuple):
+            return len(other) == len(self) and all(a == tuple(b) for a, b in zip(self, other, strict=True))
+        return NotImplemented
+
+    def __hash__(self) -> int:
+        return hash((self.array.shape, self.array.dtype.str, self.array.tobytes()))
+
+    def __repr__(self) -> str:
+        return f"Rows({self.array.shape[0]} x {self.array.shape[1] if self.array.ndim == 2 else 0}, {self.array.dtype})"
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (Rows, (self.array,))
+
+
+def _as_rows(width: int, kind: type, min_length: int, max_length: int
+             ) -> typing.Callable[[Any, ValidatorFunctionWrapHandler], Any]:
+    """A field of rows of ``width`` numbers of ``kind`` (float or int) validated into ``Rows``. Rows
+    given as a numpy array of that dtype and shape (a .wbt IndexedFaceSet's, as converted), or as
+    lists of plain numbers (a YAML/JSON world), are checked in one numpy pass (finite, within the
+    field's length bounds) and kept as one array; anything else goes through pydantic's own
+    validation of the list type, whose errors (path, message) are the field's errors as before."""
+    dtype = np.float64 if kind is float else np.int64
+    scalars = {float, int} if kind is float else {int}
+
+    def fast(value: Any) -> np.ndarray | None:
+        if isinstance(value, Rows):
+            return value.array
+        if isinstance(value, np.ndarray):
+            if value.dtype != dtype or value.ndim != 2 or value.shape[1] != width:
+                return None
+            arr = value
+        elif isinstance(value, list):
+            if value and not (set(map(type, value)) <= {list, tuple} and set(map(len, value)) == {width}
+                              and set(map(type, itertools.chain.from_iterable(value))) <= scalars):
+                return None
+            try:
+                arr = np.array(value, dtype=dtype)
+            except (OverflowError, ValueError):
+                return None
+            if arr.ndim != 2:
+                arr = arr.reshape(-1, width)    # (no rows)
+        else:
+            return None
+        if kind is float and not np.isfinite(arr).all():
+            return None
+        return arr
+
+    def validate(value: Any, handler: ValidatorFunctionWrapHandler) -> Any:
+        arr = fast(value)
+        if arr is not None and min_length <= len(arr) <= max_length:
+            return Rows(arr)
+        if isinstance(value, Rows):         # (out of bounds: pydantic says so, as for a list)
+            value = value.array
+        if isinstance(value, np.ndarray):
+            value = value.tolist()
+        out = handler(value)
+        try:
+            return Rows(np.array(out, dtype=dtype).reshape(-1, width))
+        except OverflowError:               # an index beyond 64 bits: kept, refused by value later
+            return Rows(np.array(out, dtype=object).reshape(-1, width))
+
+    return validate
+
+
+def _rows_out(value: Any, info: SerializationInfo) -> Any:
+    """``Rows`` written back as lists of numbers (``model_dump``: tuples, as the list type's own)."""
+    if isinstance(value, Rows):
+        return value.tolist() if info.mode_is_json() else list(value)
+    return value
+
+
+# each a list type (its JSON schema, its errors) held as Rows; the bounds are the list's, given to both
+Vertices = Annotated[list[Vec3], Field(max_length=1_000_000), WrapValidator(_as_rows(3, float, 0, 1_000_000)),
+                     PlainSerializer(_rows_out)]
+Faces = Annotated[list[tuple[int, int, int]], Field(min_length=1, max_length=2_000_000),
+                  WrapValidator(_as_rows(3, int, 1, 2_000_000)), PlainSerializer(_rows_out)]
+TexCoords = Annotated[list[tuple[float, float]], Field(max_length=1_000_000),
+                      WrapValidator(_as_rows(2, float, 0, 1_000_000)), PlainSerializer(_rows_out)]
+TexFaces = Annotated[list[tuple[int, int, int]], Field(max_length=2_000_000),
+                     WrapValidator(_as_rows(3, int, 0, 2_000_000)), PlainSerializer(_rows_out)]
+
+
 class Triangles(Strict):
     """Triangles given inline (Webots' IndexedFaceSet, triangulated): vertex coordinates and index
     triples into them, in the shape's frame."""
 
     type: Literal["triangles"]
-    vertices: list[Vec3] = Field(max_length=1_000_000)
-    faces: list[tuple[int, int, int]] = Field(min_length=1, max_length=2_000_000)
-    tex_coords: list[tuple[float, float]] | None = Field(
-        default=None, max_length=1_000_000,
+    vertices: Vertices
+    faces: Faces
+    tex_coords: TexCoords | None = Field(
+        default=None,
         description="texture coordinates (s, t), t up as in Webots' TextureCoordinate; none: Webots' default "
                     "mapping from the bounding box")
-    tex_coord_faces: list[tuple[int, int, int]] | None = Field(
-        default=None, max_length=2_000_000,
+    tex_coord_faces: TexFaces | None = Field(
+        default=None,
         description="per face, the tex_coords index of each corner (Webots' texCoordIndex); none: the faces' indices")
 
 

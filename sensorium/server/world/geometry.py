@@ -124,6 +124,15 @@ class Plane:
             object.__setattr__(self, "size", tuple(_positive("Plane.size", s) for s in self.size))
 
 
+def _own(values: object, dtype: type) -> np.ndarray:
+    """``values`` as an (n, 3) array of ``dtype`` no one can write: a read-only array of that dtype
+    as it is (a world model's mesh arrays, ``Rows``: no second copy), anything else copied."""
+    a = np.asarray(values, dtype=dtype)
+    if a.flags.writeable and isinstance(values, np.ndarray):     # (from a list: already a fresh array)
+        a = a.copy()
+    return a.reshape(-1, 3)
+
+
 @dataclass(frozen=True, eq=False)
 class Mesh:
     """Indexed triangle mesh in its local frame.  ``closed`` = watertight (as trimesh.is_watertight)."""
@@ -133,8 +142,8 @@ class Mesh:
     closed: bool
 
     def __post_init__(self) -> None:
-        v = np.array(self.vertices, dtype=np.float64, copy=True).reshape(-1, 3)
-        f = np.array(self.faces, dtype=np.int64, copy=True).reshape(-1, 3)
+        v = _own(self.vertices, np.float64)
+        f = _own(self.faces, np.int64)
         if not np.all(np.isfinite(v)):
             raise ValueError("Mesh.vertices must be finite")
         if f.size and (f.min() < 0 or f.max() >= len(v)):

@@ -30,6 +30,7 @@ import numpy as np
 from pydantic import BaseModel
 
 from sensorium.schemas.devices import KINDS
+from sensorium.schemas.world import Rows
 
 __all__ = ["BYTES_PER_RAY", "BYTES_PER_TRIANGLE", "MAX_COORDINATE_M", "check_pose", "WorldLimits", "LimitError", "check_counts", "check_data", "check_work", "quote", "triangle_count"]
 
@@ -174,6 +175,12 @@ def check_data(data: Any, limits: WorldLimits) -> None:
                 continue
             for i in reversed(range(len(value))):
                 todo.append((value[i], f"{path}[{i}]", key, depth + 1))
+        elif isinstance(value, np.ndarray):        # a converted .wbt mesh's rows: counted as the lists they stand for
+            if depth + value.ndim > limits.nesting_depth:
+                raise LimitError(path + "[0]" * value.ndim, f"nested deeper than {limits.nesting_depth} levels {RAISE}")
+            count += value.size + (len(value) if value.ndim == 2 else 0)
+            if count > limits.values:
+                raise LimitError("", f"more than {limits.values} values {RAISE}")
         elif isinstance(value, str):
             cap = _string_limit(key, limits)
             if len(value) > cap:
@@ -241,10 +248,15 @@ def _walk_typed(model: Any, path: str = "", *, numbers: bool = False) -> Iterato
             for name in reversed(type(v).model_fields):
                 x = getattr(v, name)
                 b = kinds.get(name)
-                todo.append((f"{p}.{name}" if p else name, x,
-                             b if b is not None and isinstance(x, (list, tuple)) and len(x) >= BLOCK_MIN else None))
-        elif isinstance(v, (list, tuple)) and (numbers or block is None):
+                todo.append((f"{p}.{name}" if p else name, x, b if b is not None and _is_block(x) else None))
+        elif isinstance(v, (list, tuple, Rows)) and (numbers or block is None):
             todo.extend((f"{p}[{i}]", v[i], None) for i in reversed(range(len(v))))
+
+
+def _is_block(x: Any) -> bool:
+    """A field's value checked as one block of numbers: a long list or tuple, or ``Rows`` of any
+    length (an array, never walked number by number unless one is out of bounds)."""
+    return isinstance(x, Rows) or (isinstance(x, (list, tuple)) and len(x) >= BLOCK_MIN)
 
 
 @functools.cache
@@ -257,6 +269,8 @@ def _number_fields(cls: type[BaseModel]) -> dict[str, Block]:
         if typing.get_origin(tp) in (typing.Union, types.UnionType):
             kinds = [a for a in typing.get_args(tp) if a is not type(None)]
             tp = kinds[0] if len(kinds) == 1 else None
+        if typing.get_origin(tp) is typing.Annotated:     # (a model's Rows: the list type it stands for)
+            tp = typing.get_args(tp)[0]
         origin, args = typing.get_origin(tp), typing.get_args(tp)
         if not (origin is list and len(args) == 1) and not (origin is tuple and len(args) == 2 and args[1] is Ellipsis):
             continue
@@ -299,7 +313,10 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
 def _numbers_fine(v: Any, levels: int, cap: float) -> bool:
     """Every number of a list of floats (``levels`` 1) or of rows of floats (2) finite, at most
     ``cap`` in magnitude, and 0 or at least 1e-30; one numpy pass."""
-    mag = np.abs(np.fromiter(itertools.chain.from_iterable(v) if levels == 2 else v, dtype=np.float64))
+    if isinstance(v, Rows):             # (a model's array of rows: read as it is)
+        mag = np.abs(np.asarray(v, dtype=np.float64))
+    else:
+        mag = np.abs(np.fromiter(itertools.chain.from_iterable(v) if levels == 2 else v, dtype=np.float64))
     return bool(np.all(np.isfinite(mag)) and not np.any(mag > cap) and not np.any((mag > 0.0) & (mag < 1e-30)))
 
 
@@ -366,7 +383,7 @@ def _scan_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
             for name in type(v).model_fields:
                 x = getattr(v, name)
                 block = blocks.get(name)
-                if block is not None and isinstance(x, (list, tuple)) and len(x) >= BLOCK_MIN:   # a mesh's numbers
+                if block is not None and _is_block(x):   # a mesh's numbers
                     if block[1] is float and not _numbers_fine(x, block[0], cap):
                         return None
                     continue

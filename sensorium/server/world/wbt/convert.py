@@ -1099,30 +1099,29 @@ class Converter:
             return out, ""
         # IndexedFaceSet: polygons separated by -1, triangulated as Webots' tessellator covers them
         # (convex ones fanned, concave ones cut into ears; texCoordIndex alongside)
+        # (points and indices as numpy arrays all the way to the model: 8 bytes a number, no Python object each)
         coord = f.node_("coord")
-        points = self.fields(coord).flat_rows("point", 3) if coord is not None else []    # x y z x y z ...
-        index = f.integers("coordIndex")
-        if index and min(index) < -1:
-            raise f.error("coordIndex", f"{min(index)} is not a vertex index (-1 ends a face)")
+        points = self.fields(coord).row_array("point", 3) if coord is not None else np.empty((0, 3))
+        index = f.index_array("coordIndex")
+        lowest = (int(index.min()) if isinstance(index, np.ndarray) else min(index)) if len(index) else 0
+        if lowest < -1:
+            raise f.error("coordIndex", f"{lowest} is not a vertex index (-1 ends a face)")
         tex, tex_index = fx.tex_coords(node, f, len(index), self.warn)
         cut = self.ear_cut.get(id(node))
-        if cut is not None and cut[0] == index and (cut[1] is points or cut[1] == points):
+        if cut is not None and _same(cut[0], index) and (cut[1] is points or np.array_equal(cut[1], points)):
             corners, fanned = cut[2], cut[3]        # a DEF face USEd again: the same triangles, charged once
         else:
             spent = self.ear_budget[0]
-            corners, fanned = polygon_corners(index, points, self.ear_budget)
+            corners, fanned = polygon_corners(index, points.reshape(-1), self.ear_budget)
             if fanned or self.ear_budget[0] != spent:   # what the budget decided is kept for the next use
                 self.ear_cut[id(node)] = (index, points, corners, fanned)
         if fanned:     # said once for the world, at its end (a hostile world has thousands of these nodes)
             self.left_fanned.setdefault(self.where(node), fanned)
         faces = _pick(index, corners)
         tex_faces = _pick(tex_index, corners) if tex_index is not None else []
-        if not faces:
+        if not len(faces):
             raise f.error("coordIndex", "an IndexedFaceSet needs at least one polygon")
-        if type(s) is float:                # the same products as one at a time, at C speed
-            vertices = (np.asarray(points, dtype=np.float64).reshape(-1, 3) * s).tolist()
-        else:
-            vertices = [[v * s for v in points[i:i + 3]] for i in range(0, len(points), 3)]
+        vertices = points * float(s)        # the same products as one at a time (s is a float: the frame's scale)
         out = {"type": "triangles", "vertices": vertices, "faces": faces}
         if tex is not None:
             out["tex_coords"], out["tex_coord_faces"] = tex, tex_faces
@@ -2078,7 +2077,7 @@ def fan_corners(index: list[int]) -> np.ndarray:
     """An IndexedFaceSet's polygons (``index`` positions between -1s) fan-triangulated, as Webots
     does: per triangle, the positions in ``index`` of its three corners (first, k, k + 1), shape
     (n, 3); polygons of fewer than three corners give none."""
-    idx = np.asarray([*index, -1], dtype=np.int64)
+    idx = np.append(np.asarray(index, dtype=np.int64), -1)
     ends = np.flatnonzero(idx < 0)
     starts = np.concatenate(([0], ends[:-1] + 1))
     per = np.maximum(ends - starts - 2, 0)              # triangles per polygon
@@ -2099,7 +2098,7 @@ def polygon_corners(index: list[int], points: list[float], budget: list[int]) ->
     are the coordinates (x y z ...): convexity and cuts are the same under any scale. Returns the
     corners and how many concave polygons stayed fanned for size or budget."""
     corners = fan_corners(index)
-    idx = np.asarray([*index, -1], dtype=np.int64)
+    idx = np.append(np.asarray(index, dtype=np.int64), -1)
     ends = np.flatnonzero(idx < 0)
     starts = np.concatenate(([0], ends[:-1] + 1))
     counts = ends - starts
@@ -2138,14 +2137,22 @@ def polygon_corners(index: list[int], points: list[float], budget: list[int]) ->
     return corners, fanned
 
 
-def _pick(values: list[int], corners: np.ndarray) -> list[list[int]]:
-    """``values`` at each triangle's corner positions: lists of Python ints."""
+def _pick(values: np.ndarray | list[int], corners: np.ndarray) -> np.ndarray | list[list[int]]:
+    """``values`` at each triangle's corner positions: an int64 array (n, 3) (lists of Python ints
+    for an index beyond 64 bits, which the loader refuses by value)."""
     if not len(corners):
         return []
     try:
-        return np.asarray(values, dtype=np.int64)[corners].tolist()
+        return np.asarray(values, dtype=np.int64)[corners]
     except OverflowError:       # an index beyond 64 bits: refused later, by value
         return [[values[a], values[b], values[c]] for a, b, c in corners.tolist()]
+
+
+def _same(a: np.ndarray | list[int], b: np.ndarray | list[int]) -> bool:
+    """Two coordIndex values equal (arrays or, beyond 64 bits, lists)."""
+    if isinstance(a, np.ndarray) and isinstance(b, np.ndarray):
+        return a.shape == b.shape and bool(np.array_equal(a, b))
+    return list(a) == list(b)
 
 
 def strip_origins(data: Any, path: str, origin: dict[str, tuple[int, int, str]]) -> Any:

@@ -6,6 +6,7 @@ import os
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from sensorium.server.world.wbt import wbt_to_dict
@@ -39,6 +40,8 @@ def _rebase(data: Any, src_dir: Path, out_dir: Path) -> Any:
                 for k, v in data.items()}
     if isinstance(data, list):
         return [_rebase(v, src_dir, out_dir) for v in data]
+    if isinstance(data, np.ndarray):        # an IndexedFaceSet's points or faces: written as numbers
+        return data.tolist()
     return data
 
 

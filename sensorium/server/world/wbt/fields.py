@@ -9,6 +9,8 @@ import sys
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from sensorium.server.world.wbt import resets
 from sensorium.server.world.wbt.parser import Node, WbtSyntaxError
 
@@ -112,6 +114,29 @@ class Fields:
                 raise self.error(name, f"expected integers, got {v}")
             out.append(int(v))
         return out
+
+    def index_array(self, name: str) -> np.ndarray | list[int]:
+        """``integers`` as one int64 array (a mesh's ``coordIndex``: no Python int per entry); the list
+        ``integers`` gives, with its error, when some value is not whole or beyond 64 bits."""
+        a = self.number_array(name)
+        if a.size == 0 or (np.abs(a).max() < 2.0 ** 63 and np.array_equal(a, np.trunc(a))):
+            return a.astype(np.int64)
+        return self.integers(name)
+
+    def number_array(self, name: str) -> np.ndarray:
+        """``numbers`` as one float64 array, the same values (a long run as parsed: read at C speed,
+        without the list copy)."""
+        v = self.node.fields.get(name, [])
+        if isinstance(v, list) and set(map(type, v)) == {float}:
+            return np.array(v, dtype=np.float64)
+        return np.array(self.numbers(name), dtype=np.float64)
+
+    def row_array(self, name: str, width: int) -> np.ndarray:
+        """``flat_rows`` as a float64 array of shape (n, width) (an absent field: none), the same error."""
+        flat = self.number_array(name)
+        if len(flat) % width:
+            raise self.error(name, f"expected groups of {width} numbers, got {len(flat)} numbers")
+        return flat.reshape(-1, width)
 
     def vec(self, name: str, default: tuple[float, ...]) -> tuple[float, ...]:
         v = self.node.fields.get(name, default)

@@ -261,11 +261,15 @@ def _triangles_by(g: dict, lin: np.ndarray) -> dict:
     """Triangles (or an IndexedFaceSet's) with every vertex mapped by ``lin``; a mirroring map keeps
     the faces wound as before seen from outside."""
     out = dict(g)
-    out["vertices"] = (np.asarray(g["vertices"], dtype=np.float64) @ lin.T).tolist()
+    mapped = np.asarray(g["vertices"], dtype=np.float64) @ lin.T
+    compact = isinstance(g["vertices"], np.ndarray)      # (an IndexedFaceSet's arrays stay arrays)
+    out["vertices"] = mapped if compact else mapped.tolist()
     if np.linalg.det(lin) < 0:
-        out["faces"] = [[a, c, b] for a, b, c in g["faces"]]
+        f = g["faces"]
+        out["faces"] = f[:, [0, 2, 1]] if isinstance(f, np.ndarray) else [[a, c, b] for a, b, c in f]
         if "tex_coord_faces" in g:
-            out["tex_coord_faces"] = [[a, c, b] for a, b, c in g["tex_coord_faces"]]
+            t = g["tex_coord_faces"]
+            out["tex_coord_faces"] = t[:, [0, 2, 1]] if isinstance(t, np.ndarray) else [[a, c, b] for a, b, c in t]
     return out
 
 

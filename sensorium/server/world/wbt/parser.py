@@ -87,7 +87,8 @@ class Token:
     """One token: kind ("num", "str", "name", "tmpl", "{", "}", "[", "]", "eof", or "nums": a run of
     numbers), text, offset; its line and column are computed when asked (errors and node positions
     only). A "nums" token's text and offset are its first number's (an error quoting it reads as one
-    about that number); ``values`` are its numbers (floats, every one finite) and ``end`` where the run ends."""
+    about that number); ``values`` are its numbers (floats, every one finite; once the parser has
+    put them in a list value, a ``range`` of as many) and ``end`` where the run ends."""
 
     __slots__ = ("kind", "text", "pos", "lines", "values", "end")
 
@@ -237,7 +238,7 @@ class Tokens:
             if len(parts) < RUN_MIN or "x" in text or "X" in text:
                 self._plain = end
                 return None
-            values = list(map(float, parts))
+            values = floats(parts)
         if len(parts) < RUN_MIN or not all(map(math.isfinite, values)):     # short, or beyond ±1.8e308
             self._plain = end
             return None
@@ -264,7 +265,7 @@ class Tokens:
                 return None
         parts = body.replace(",", " ").split()
         try:
-            return end, parts, list(map(float, parts))
+            return end, parts, floats(parts)
         except ValueError:
             return None
 
@@ -274,6 +275,16 @@ class Tokens:
         run = self.items[j]
         self.items[j:j + 1] = [Token("num", m.group(), m.start(), self.lines)
                                for m in _NUM_AT.finditer(self.text, run.pos, run.end)]
+
+
+def floats(parts: list[str]) -> list[float]:
+    """``float`` of each text, one float object for each distinct text: a mesh's coordIndex repeats
+    each vertex index about six times, and a float is 24 bytes (the values are those of
+    ``map(float, parts)``; ValueError as it raises)."""
+    if len(parts) < RUN_MIN:
+        return list(map(float, parts))
+    memo = {p: float(p) for p in set(parts)}
+    return list(map(memo.__getitem__, parts))
 
 
 def tokenize(text: str, source: str, lines: Lines | None = None) -> list[Token]:
@@ -425,7 +436,11 @@ class Parser:
                 if self.peek().kind == "eof":
                     raise self.error(self.peek(), f"end of file inside the list opened at line {tok.line}, column {tok.col}")
                 if self.peek().kind == "nums":
-                    items += self.run(self.take())
+                    run = self.run(self.take())
+                    if items:
+                        items += run
+                    else:
+                        items = run         # (the token's list, handed over: no second list of the numbers)
                 else:
                     items.append(self.item(depth))
             self.take()
@@ -450,6 +465,7 @@ class Parser:
         """A "nums" token's numbers, each counted as a value (the error names the number that passes
         the bound, as one read alone would)."""
         values = tok.values
+        tok.values = range(len(values))     # (its count kept for the bound's error; the list goes to the node)
         self.values += len(values)
         if self.values > self.limits.values:
             self.values -= len(values)
