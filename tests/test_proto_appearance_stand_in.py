@@ -195,3 +195,16 @@ def test_webots_path() -> None:
     assert webots_path("protos/B.proto", "/w/w.wbt") is None
     assert webots_path("https://example.com/projects/appearances/protos/B.proto", "/w/w.wbt") is None
     assert webots_path("webots://../../etc/B.proto", "/w/w.wbt") is None
+
+
+def test_a_supervisor_sees_the_plain_pbr_appearance_named_by_its_proto(tmp_path: Path) -> None:
+    from sensorium.server.daemon import supervisor as sv
+
+    w = write(tmp_path, world_text("DEF LOOK " + FLOOR_LOOK, [SANDY]))
+    sim = Simulation(load_world(w))
+    look = sv.find_node(sim, "LOOK")
+    assert (look.proto, look.type) == ("SandyGround", "PBRAppearance")
+    assert sv.get_field(sim, look, "baseColor")["value"] == [0.25, 0.5, 0.5]     # its fields are the PBRAppearance's
+    assert sv.get_field(sim, look, "roughness")["value"] == 0.5
+    with pytest.raises(ValueError, match="has no field 'colorOverride' here"):
+        sv.set_field(sim, look, "colorOverride", [1.0, 0.0, 0.0])
