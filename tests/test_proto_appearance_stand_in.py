@@ -89,7 +89,7 @@ def test_a_missing_appearance_proto_stands_in_as_a_plain_pbr_appearance(tmp_path
     assert robot.name == "bot" and sorted(d.name for d in robot.devices) == ["cam", "ir"]
     assert notes(loaded) == [
         f"{w}:2:1: PROTO files not found: plain PBRAppearances stand in for the appearances SandyGround (0.5 grey × "
-        "colorOverride, other fields ignored: cameras and infra-red distance sensors see that colour, not the texture; "
+        "its colorOverride or baseColor, other fields ignored: cameras and infra-red distance sensors see that colour, not the texture; "
         "lidars, range finders and other distance sensors are unaffected) (give --webots-home or WEBOTS_HOME to use "
         "Webots' own)"]
     assert [x for x in loaded.warnings if "SandyGround" in x] == notes(loaded)     # its other fields: no word
@@ -161,6 +161,10 @@ def test_stand_in_colours_and_bad_values(tmp_path: Path) -> None:
     look = [n for n in exp.nodes if n.type == "Solid"][0].fields["children"][0].fields["appearance"]
     assert look.fields["baseColor"] == (0.5, 0.25, 0.0)
     assert f"{w}:8:32: SandyGround.colorOverride: 2 0.5 -1 is outside [0, 1]; using 1 0.5 0 (as Webots does)" in exp.warnings
+    # a paint's colour is its baseColor (MattePaint, GlossyCarPaint, ...)
+    w = write(tmp_path, world_text("MattePaint { baseColor 0.2 0.4 1 }", ["webots://projects/appearances/protos/MattePaint.proto"]))
+    look = [n for n in expanded(w).nodes if n.type == "Solid"][0].fields["children"][0].fields["appearance"]
+    assert (look.proto, look.fields["baseColor"]) == ("MattePaint", (0.1, 0.2, 0.5))
     # a colorOverride that is no colour: one line naming it
     w = write(tmp_path, world_text('SandyGround { colorOverride "red" }', [SANDY]))
     with pytest.raises(ProtoError, match=r':8:32: SandyGround.colorOverride: SFColor expects'):

@@ -53,8 +53,8 @@ from sensorium.server.world.wbt.resets import shown
 STAND_INS = frozenset(BUILTIN_PROTOS) | SKIPPED
 
 # Webots' appearance PROTOs (SandyGround, Parquetry, ...: a PBRAppearance with textures, whose
-# colorOverride multiplies the texture) stand in, when their file is not found, as a plain
-# PBRAppearance: this grey × colorOverride, and the roughness and metalness below (SolidBox's
+# colorOverride, or a paint's baseColor, multiplies the texture) stand in, when their file is not
+# found, as a plain PBRAppearance: this grey × that colour, and the roughness and metalness below (SolidBox's
 # stand-in takes the same for its textured default)
 APPEARANCE_GREY = 0.5
 APPEARANCE_ROUGHNESS = 0.5
@@ -331,7 +331,7 @@ class _Expander:
         looks = sorted(n for n in self.stand_ins if n not in STAND_INS)
         parts = ([f"Sensorium's built-in stand-ins used for {', '.join(built)}"] if built else []) + \
                 ([f"plain PBRAppearances stand in for the appearances {', '.join(looks)} ({APPEARANCE_GREY:g} grey × "
-                  "colorOverride, other fields ignored: cameras and infra-red distance sensors see that colour, not "
+                  "its colorOverride or baseColor, other fields ignored: cameras and infra-red distance sensors see that colour, not "
                   "the texture; lidars, range finders and other distance sensors are unaffected)"] if looks else []) + \
                 [f"{name} skipped ({_skipped_why(name)})" for name in skipped]
         home = self.search.home
@@ -377,22 +377,24 @@ class _Expander:
 
     def plain_appearance(self, node: Node) -> Node:
         """The PBRAppearance an appearance PROTO whose file is not found stands in as: grey × its
-        ``colorOverride`` (clamped to [0, 1] as Webots clamps a baseColor); its other fields (a
-        textureTransform, IBLStrength, ...) are not used, whatever they are."""
+        ``colorOverride`` (a paint's ``baseColor``: MattePaint, GlossyCarPaint, ...), clamped to [0, 1] as
+        Webots clamps a baseColor; its other fields (a textureTransform, IBLStrength, ...) are not used,
+        whatever they are."""
         where = node.source or self.world
         color: tuple[float, ...] = (1.0, 1.0, 1.0)
-        if "colorOverride" in node.fields:
-            raw = node.fields["colorOverride"]
-            line, col = node.field_pos.get("colorOverride", (node.line, node.col))
+        name = "colorOverride" if "colorOverride" in node.fields else "baseColor"
+        if name in node.fields:
+            raw = node.fields[name]
+            line, col = node.field_pos.get(name, (node.line, node.col))
             if isinstance(raw, IsRef):
                 raise ProtoError(where, raw.line, raw.col, f"IS {raw.name}: outside a PROTO body")
             try:
                 color = tuple(check_value("SFColor", raw))
             except ValueError as exc:
-                raise ProtoError(where, line, col, f"{node.type}.colorOverride: {exc}") from None
+                raise ProtoError(where, line, col, f"{node.type}.{name}: {exc}") from None
             fixed, why = clamped_color(color)
             if why:
-                self.warnings.append(f"{where}:{line}:{col}: {node.type}.colorOverride: {shown(color)} {why}; using "
+                self.warnings.append(f"{where}:{line}:{col}: {node.type}.{name}: {shown(color)} {why}; using "
                                      f"{shown(fixed)} (as Webots does)")
             color = fixed
         self.instances += 1
