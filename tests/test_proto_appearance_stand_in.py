@@ -212,3 +212,15 @@ def test_a_supervisor_sees_the_plain_pbr_appearance_named_by_its_proto(tmp_path:
     assert sv.get_field(sim, look, "roughness")["value"] == 0.5
     with pytest.raises(ValueError, match="has no field 'colorOverride' here"):
         sv.set_field(sim, look, "colorOverride", [1.0, 0.0, 0.0])
+
+
+def test_validate_accepts_the_world_and_info_lists_the_stand_in(tmp_path: Path, capsys) -> None:
+    from sensorium.cli import main as cli
+
+    w = write(tmp_path, world_text(FLOOR_LOOK, [SANDY]))
+    assert cli(["validate", str(w)]) == 0
+    captured = capsys.readouterr()
+    assert f"{w}: OK" in captured.out and "stand in for the appearances SandyGround" in captured.err
+    assert cli(["info", str(w)]) == 0
+    assert (f"proto     SandyGround x1: Sensorium's built-in stand-in: a plain PBRAppearance (no Webots file used) "
+            f"({SANDY})") in capsys.readouterr().out
