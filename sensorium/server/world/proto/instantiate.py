@@ -41,14 +41,25 @@ from sensorium.server.world.proto.interface import (
     refused,
     show,
 )
-from sensorium.server.world.proto.resolve import ProtoSearch, logical_location, proto_index, resolve_url
+from sensorium.server.world.proto.resolve import ProtoSearch, logical_location, proto_index, resolve_url, webots_path
 from sensorium.server.world.wbt.convert import SKIPPED
 from sensorium.server.world.wbt.parser import ExternProto, IsRef, Node, Parser, Tokens, WbtFile, WbtSyntaxError, short
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
+from sensorium.server.world.wbt.resets import color as clamped_color
+from sensorium.server.world.wbt.resets import shown
 
 # PROTOs Sensorium stands in for when their file is not found: built-in expansions, and the
 # visual-only nodes the converter skips anyway (backgrounds)
 STAND_INS = frozenset(BUILTIN_PROTOS) | SKIPPED
+
+# Webots' appearance PROTOs (SandyGround, Parquetry, ...: a PBRAppearance with textures, whose
+# colorOverride, or a paint's baseColor, multiplies the texture) stand in, when their file is not
+# found, as a plain PBRAppearance: this grey × that colour, and the roughness and metalness below (SolidBox's
+# stand-in takes the same for its textured default)
+APPEARANCE_GREY = 0.5
+APPEARANCE_ROUGHNESS = 0.5
+APPEARANCE_METALNESS = 0.0
+_APPEARANCES = re.compile(r"projects/appearances/protos/[^/]+\.proto", re.IGNORECASE)
 
 TREE_DEPTH = 150            # nodes nested inside one another in the expanded tree (the converter recurses)
 
@@ -127,6 +138,7 @@ class _Expander:
         self.warnings: list[str] = []
         self.noted: set[str] = set()
         self.stand_ins: dict[str, tuple[str, int, int]] = {}
+        self.appearances: dict[str, set[str]] = {}          # file → the appearance PROTOs standing in there
         self.memo: dict[int, tuple[Node, Node]] = {}       # id(node) → (node, its expansion)
         self.outer: dict[int, tuple[str, ...]] = {}        # nodes an instance passed in → the chain they were written in
         self.bodies: dict[tuple[str, int, str], Node] = {}  # (PROTO file, body offset, generated text) → parsed root
@@ -270,7 +282,7 @@ class _Expander:
         try:
             path = resolve_url(decl.url, scope.source, self.search)
         except ProtoError as exc:
-            if decl.name in STAND_INS:
+            if decl.name in STAND_INS or _is_appearance(decl.url, scope.source, self.search):
                 self.note_builtin(scope, decl, exc.message)
                 return None
             raise ProtoError(scope.source, decl.line, decl.col, f"EXTERNPROTO {short(decl.name)}: {exc.message}") from None
@@ -299,9 +311,13 @@ class _Expander:
             self.uses[key] = ProtoUse(proto.name, path, url or path, proto.license, proto.license_url)
 
     def note_builtin(self, scope: _Scope, decl: ExternProto, why: str) -> None:
+        appearance = decl.name not in STAND_INS
+        if appearance:
+            self.appearances.setdefault(scope.source, set()).add(decl.name)
         if decl.name not in self.stand_ins:
             self.stand_ins[decl.name] = (scope.source, decl.line, decl.col)
             what = ("Sensorium's built-in stand-in (no Webots file used)" if decl.name in BUILTIN_PROTOS
+                    else "Sensorium's built-in stand-in: a plain PBRAppearance (no Webots file used)" if appearance
                     else f"not read (skipped: {_skipped_why(decl.name)})")
             self.uses[f"\0{decl.name}"] = ProtoUse(decl.name, "", decl.url, what, None, builtin=True)
 
@@ -311,8 +327,12 @@ class _Expander:
             return
         source, line, col = min(self.stand_ins.values(), key=lambda at: (at[0] != self.world, at))
         built = sorted(n for n in self.stand_ins if n in BUILTIN_PROTOS)
-        skipped = sorted(n for n in self.stand_ins if n not in BUILTIN_PROTOS)
+        skipped = sorted(n for n in self.stand_ins if n in SKIPPED and n not in BUILTIN_PROTOS)
+        looks = sorted(n for n in self.stand_ins if n not in STAND_INS)
         parts = ([f"Sensorium's built-in stand-ins used for {', '.join(built)}"] if built else []) + \
+                ([f"plain PBRAppearances stand in for the appearances {', '.join(looks)} ({APPEARANCE_GREY:g} grey × "
+                  "its colorOverride or baseColor, other fields ignored: cameras and infra-red distance sensors see that colour, not "
+                  "the texture; lidars, range finders and other distance sensors are unaffected)"] if looks else []) + \
                 [f"{name} skipped ({_skipped_why(name)})" for name in skipped]
         home = self.search.home
         hint = ("give --webots-home or WEBOTS_HOME to use Webots' own" if home is None else
@@ -346,9 +366,43 @@ class _Expander:
                              f"nodes nested deeper than {TREE_DEPTH} levels once PROTOs are expanded")
         chain = self.outer.get(key, chain)
         proto = self.lookup(node)
-        result = self.instance(node, proto, chain, depth) if proto is not None else self.fields(node, chain, depth)
+        if proto is not None:
+            result = self.instance(node, proto, chain, depth)
+        elif self.appearances and node.type in self.appearances.get(node.source or self.world, ()):
+            result = self.plain_appearance(node)
+        else:
+            result = self.fields(node, chain, depth)
         self.memo[key] = (node, result)
         return result
+
+    def plain_appearance(self, node: Node) -> Node:
+        """The PBRAppearance an appearance PROTO whose file is not found stands in as: grey × its
+        ``colorOverride`` (a paint's ``baseColor``: MattePaint, GlossyCarPaint, ...), clamped to [0, 1] as
+        Webots clamps a baseColor; its other fields (a textureTransform, IBLStrength, ...) are not used,
+        whatever they are."""
+        where = node.source or self.world
+        color: tuple[float, ...] = (1.0, 1.0, 1.0)
+        name = "colorOverride" if "colorOverride" in node.fields else "baseColor"
+        if name in node.fields:
+            raw = node.fields[name]
+            line, col = node.field_pos.get(name, (node.line, node.col))
+            if isinstance(raw, IsRef):
+                raise ProtoError(where, raw.line, raw.col, f"IS {raw.name}: outside a PROTO body")
+            try:
+                color = tuple(check_value("SFColor", raw))
+            except ValueError as exc:
+                raise ProtoError(where, line, col, f"{node.type}.{name}: {exc}") from None
+            fixed, why = clamped_color(color)
+            if why:
+                self.warnings.append(f"{where}:{line}:{col}: {node.type}.{name}: {shown(color)} {why}; using "
+                                     f"{shown(fixed)} (as Webots does)")
+            color = fixed
+        self.instances += 1
+        base = tuple(APPEARANCE_GREY * c for c in color)
+        plain = Node("PBRAppearance", {"baseColor": base, "roughness": APPEARANCE_ROUGHNESS,
+                                       "metalness": APPEARANCE_METALNESS}, node.line, node.col, def_name=node.def_name,
+                     source=where, proto=node.type, instance_at=(where, node.line, node.col))
+        return _copy(plain, uses=(f"\0{node.type}",), body_of=node.__dict__.get("body_of"))
 
     def fields(self, node: Node, chain: tuple[str, ...], depth: int) -> Node:
         changed: dict[str, Any] | None = None
@@ -441,6 +495,8 @@ class _Expander:
         """A node's type and, for a PROTO instance, the base node type it expands to."""
         names = {node.type}
         proto = self.lookup(node)
+        if proto is None and node.type in self.appearances.get(node.source or self.world, ()):
+            names.add("PBRAppearance")       # a plain PBRAppearance stands in for it
         while proto is not None and len(names) < 16:
             base = _body_type(proto)
             if base is None or base in names:
@@ -676,6 +732,14 @@ def chain_keys(node: Node) -> frozenset[str]:
         keys.append(proto_key(level[0]))
         level = level[3]
     return frozenset(keys)
+
+
+def _is_appearance(url: str, source: str, search: ProtoSearch) -> bool:
+    """Whether an EXTERNPROTO url names one of Webots' appearance PROTOs (its
+    ``projects/appearances/protos/`` folder holds appearances only, all PBRAppearances)."""
+    trees = [p for p in (search.home, *search.proto_path) if p is not None]
+    rel = webots_path(url, source, trees)
+    return rel is not None and _APPEARANCES.fullmatch(rel) is not None
 
 
 def _skipped_why(name: str) -> str:

@@ -25,6 +25,7 @@ import hashlib
 import os
 import posixpath
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from urllib.parse import urljoin
@@ -118,6 +119,38 @@ def url_tag(location: str) -> str | None:
     """The version tag of a raw.githubusercontent.com/cyberbotics/webots url, else None."""
     m = _RAW.match(location)
     return m.group(1) if m else None
+
+
+def webots_path(url: str, base_file: str | Path, trees: Sequence[Path] = ()) -> str | None:
+    """The path inside Webots' own tree (``projects/…``) that ``url`` names: a ``webots://`` or
+    raw.githubusercontent.com/cyberbotics/webots url (any tag), or a relative url written in a file
+    that stands for one (a file of ``trees``' ``projects/`` stands for its ``webots://`` url: an
+    installation, a --proto-path tree); None for any other url (a local file, another site)."""
+    u = url.strip().replace("\\", "/")
+    if not re.match(r"^[A-Za-z][A-Za-z0-9+.\-]*://", u) and not u.startswith("/"):
+        base = logical_location(base_file)
+        for root in trees:
+            try:
+                inside = Path(base).relative_to(root).as_posix()
+            except ValueError:
+                continue
+            if inside.startswith("projects/"):
+                base = "webots://" + inside
+                break
+        if base.startswith("webots://"):
+            u = "webots://" + posixpath.join(posixpath.dirname(base[len("webots://"):]), u)
+        elif _RAW.match(base):
+            u = urljoin(base, u)
+        else:
+            return None
+    if u.startswith("webots://"):
+        rel = u[len("webots://"):].lstrip("/")
+    elif (m := _RAW.match(u)) is not None:
+        rel = m.group(2)
+    else:
+        return None
+    rel = posixpath.normpath(rel)
+    return None if rel.startswith("..") else rel
 
 
 def _archive_log(folder: Path) -> dict[str, str]:
