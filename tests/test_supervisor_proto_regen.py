@@ -162,6 +162,15 @@ def test_a_value_that_does_not_build_is_one_line_and_nothing_changes():
         assert text.startswith(line) and "\n" not in text, text
     assert "exceeds the limit of 1e+09" in str(pytest.raises(ValueError, sv.set_field, sim, node, "size",
                                                              [0.6, 0.6, 2e9]).value)
+    # a value the PROTO's declaration does not accept; one its template refuses
+    with pytest.raises(ValueError) as exc:
+        sv.set_field(sim, node, "material", "glass")
+    assert str(exc.value).endswith("supervisor_proto_regen.wbt:17:10: Obstacle.material: 'glass' is not an accepted "
+                                   'value (one of: "wood", "stone"); nothing changed'), exc.value
+    with pytest.raises(ValueError) as exc:
+        sv.set_field(sim, node, "size", [60.0, 1.0, 1.0])
+    assert "an obstacle is at most 50 m wide" in str(exc.value) and "\n" not in str(exc.value), exc.value
+    assert str(exc.value).startswith("field 'size' (SFVec3f) of PROTO Obstacle (Solid 'OBST' (node 2)) not set: ")
     with pytest.raises(ValueError, match="index 3 out of range"):
         sv.change_item(sim, node, "posts", "set", 3, 1.0)
     assert field(sim, "size") == [0.2, 0.2, 0.2] and field(sim, "round") is False
