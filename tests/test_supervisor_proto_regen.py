@@ -4,7 +4,8 @@ passing through IS to a node inside (``color``) is seen by every sensor from the
 file written with that value; the solid keeps its node id, DEF, name, place among the root's children and the
 pose a Supervisor gave it; the nodes of its old body read as removed; ``simulationReset`` puts it back where the
 file put it and keeps the values set (Webots' reset resets no field); a value that does not build is one line
-and nothing changes. An imported instance is rebuilt the same way. The same from Python and C controllers.
+and nothing changes. An imported instance is rebuilt the same way; kinematic contact and the ground robots ride
+see the new solid. The same from Python and C controllers.
 
 Sensorium's own PROTO (tests/protos/regen/Obstacle.proto) on tests/worlds/proto/supervisor_proto_regen.wbt;
 each variant world is that file with a value written in, in the test's folder."""
@@ -232,3 +233,67 @@ def _check_lines(err: str) -> None:
     assert "Sanitizer" not in err and "runtime error" not in err and "Traceback" not in err, err
     errors = [x for x in err.splitlines() if x.startswith("Error")]
     assert len(errors) == 1 and "not set: the solid does not build with that value" in errors[0], err
+
+
+ROVER_WORLD = """#VRML_SIM R2023b utf8
+EXTERNPROTO "Obstacle.proto"
+WorldInfo {
+  basicTimeStep 16
+}
+DEF OBST Obstacle {
+  translation 1 0 0.1
+  size 0.2 2 0.2
+}
+Robot {
+  name "rover"
+  children [
+    HingeJoint {
+      jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0.05 0.03 }
+      device [ RotationalMotor { name "left" } ]
+      endPoint Solid { translation 0 0.05 0.03 children [ Shape { geometry Cylinder { radius 0.03 height 0.01 } } ] }
+    }
+    HingeJoint {
+      jointParameters HingeJointParameters { axis 0 1 0 anchor 0 -0.05 0.03 }
+      device [ RotationalMotor { name "right" } ]
+      endPoint Solid { translation 0 -0.05 0.03 children [ Shape { geometry Cylinder { radius 0.03 height 0.01 } } ] }
+    }
+  ]
+  boundingObject Pose { translation 0 0 0.06 children [ Box { size 0.2 0.2 0.06 } ] }
+}
+"""
+
+
+def _rover_run(sim: Simulation) -> float:
+    rover = sim.robot("rover")
+    for m in rover.motors.values():
+        m.target_position, m.velocity = float("inf"), 10.0
+    for _ in range(200):                                  # 3.2 s at 0.3 m/s: stopped at the obstacle
+        sim.step()
+    return float(rover.pose.translation[0])
+
+
+def test_kinematic_contact_stops_a_robot_at_the_rebuilt_obstacle(tmp_path):
+    shutil.copy(PROTO, tmp_path / "Obstacle.proto")
+    (tmp_path / "rover.wbt").write_text(ROVER_WORLD)
+    (tmp_path / "wide.wbt").write_text(ROVER_WORLD.replace("size 0.2 2 0.2", "size 0.6 2 0.2"))
+    sim = Simulation(load_world(tmp_path / "rover.wbt"), contact=True)
+    assert sim.contact is not None
+    sv.set_field(sim, obst(sim), "size", [0.6, 2.0, 0.2])      # its face from x = 0.9 to x = 0.7
+    got = _rover_run(sim)
+    assert got == _rover_run(Simulation(load_world(tmp_path / "wide.wbt"), contact=True))
+    assert got == pytest.approx(0.6, abs=1e-6)                   # the rover's half length 0.1 before the face
+
+
+def test_the_rebuilt_obstacle_is_ground_as_the_world_files_box_tops_are(tmp_path):
+    """In a world with a terrain, a box top is ground: the rebuilt obstacle's new top, as the world file's."""
+    shutil.copy(PROTO, tmp_path / "Obstacle.proto")
+    terrain = ('Solid { translation -5 -5 0 name "field" children [ Shape { geometry ElevationGrid { xDimension 2 '
+               'yDimension 2 xSpacing 10 ySpacing 10 height [ 0 0 0 0 ] } } ] boundingObject ElevationGrid { '
+               'xDimension 2 yDimension 2 xSpacing 10 ySpacing 10 height [ 0 0 0 0 ] } }\n')
+    (tmp_path / "rover.wbt").write_text(ROVER_WORLD + terrain)
+    (tmp_path / "tall.wbt").write_text(ROVER_WORLD.replace("size 0.2 2 0.2", "size 0.2 2 0.4") + terrain)
+    sim = Simulation(load_world(tmp_path / "rover.wbt"))
+    assert sim.ground is not None and sim.ground.at(1.0, 0.0) == (0.2, 0.0, 0.0)      # 0.1 + 0.2 / 2
+    sv.set_field(sim, obst(sim), "size", [0.2, 2.0, 0.4])
+    tall = Simulation(load_world(tmp_path / "tall.wbt"))
+    assert sim.ground.at(1.0, 0.0) == tall.ground.at(1.0, 0.0) == pytest.approx((0.3, 0.0, 0.0), abs=1e-12)

@@ -626,8 +626,8 @@ def _interface_fields(sim: Any, node: Node, level: int) -> dict[str, tuple[str, 
     """The interface fields of PROTO ``level`` (1: the instance's own PROTO) of a PROTO instance. A field
     whose value passes through IS unchanged to a base-node field served here reads that field now (a
     robot's ``translation`` as it drives) and, on the instance's own PROTO, sets it as that field does;
-    any other field answers the instance's value (or the PROTO's default) and is read-only here: Webots
-    regenerates the node when one is set."""
+    any other field answers the instance's value (or the PROTO's default); setting one builds a top-level
+    solid again (:func:`_regenerate`, Webots' regeneration) and is refused on any other node."""
     if not 1 <= level <= len(node.interface):
         raise ValueError(f"{_what(node)} has no PROTO at level {level} (its PROTO chain: "
                          f"{' > '.join(p.name for p in node.interface) or 'none, it is no PROTO instance'})")
