@@ -33,17 +33,19 @@ def _sim(path=WORLD) -> Simulation:
     sim = Simulation(load_world(path))
     for name in DEVICES:
         sim.device(f"eye/{name}").enable(16)
+    sim.device("eye/cam").recognition_enable(16)
     return sim
 
 
 def _readings(sim: Simulation) -> dict:
     sim.step()
     return {"cam": sim.device("eye/cam").image.copy(), "depth": np.array(sim.device("eye/depth").range_image),
-            "lidar": np.array(sim.device("eye/lidar").range_image), "ds": float(sim.device("eye/ds").value)}
+            "lidar": np.array(sim.device("eye/lidar").range_image), "ds": float(sim.device("eye/ds").value),
+            "objects": repr(sim.device("eye/cam").objects)}
 
 
 def _same(a: dict, b: dict) -> bool:
-    return all(np.array_equal(a[k], b[k]) for k in DEVICES)
+    return all(np.array_equal(a[k], b[k]) for k in DEVICES) and a["objects"] == b["objects"]
 
 
 def _variant(folder, *changes: tuple[str, str]) -> Simulation:
@@ -75,6 +77,7 @@ def test_each_proto_field_set_is_seen_as_the_world_file_written_with_that_value(
     sim = _sim()
     before = _readings(sim)
     assert float(before["lidar"][0, 16]) == pytest.approx(0.8, abs=1e-6)      # 1 - 0.2 / 2 - 0.1 (the lidar's x)
+    assert "id=2," in before["objects"]            # recognised as node 2, before and after (the same node)
     changes: list[tuple[str, str]] = []
     steps = [("size", [0.6, 0.4, 0.3], ("size 0.2 0.2 0.2", "size 0.6 0.4 0.3")),      # the template's box
              ("color", [0.9, 0.1, 0.2], ("color 0.5 0.5 0.5", "color 0.9 0.1 0.2")),   # IS to its PBRAppearance
@@ -196,7 +199,9 @@ def test_an_imported_instance_is_rebuilt_the_same_way(tmp_path):
     again = obst(sim)
     assert (again.id, again.proto) == (added, "Obstacle")
     assert sv.get_field(sim, again, "size")["value"] == [0.6, 0.4, 0.3]
-    assert _same(_readings(sim), _written(tmp_path, ("size 0.2 0.2 0.2", "size 0.6 0.4 0.3")))
+    got, ref = _readings(sim), _written(tmp_path, ("size 0.2 0.2 0.2", "size 0.6 0.4 0.3"))
+    assert all(np.array_equal(got[k], ref[k]) for k in DEVICES)
+    assert got["objects"] == ref["objects"].replace("id=2,", f"id={added},")     # recognised as the imported node
     sim.reset()                                   # Webots' reset removes what a Supervisor imported
     assert obst(sim) is None
 
