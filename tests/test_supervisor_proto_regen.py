@@ -25,7 +25,7 @@ from sensorium.server.world.loader import load_world
 
 WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_proto_regen.wbt"
 PROTO = REPO / "tests" / "protos" / "regen" / "Obstacle.proto"
-DEVICES = ("cam", "depth", "lidar", "ds")
+DEVICES = ("cam", "depth", "lidar", "ds", "ir")
 SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
 
 
@@ -41,6 +41,7 @@ def _readings(sim: Simulation) -> dict:
     sim.step()
     return {"cam": sim.device("eye/cam").image.copy(), "depth": np.array(sim.device("eye/depth").range_image),
             "lidar": np.array(sim.device("eye/lidar").range_image), "ds": float(sim.device("eye/ds").value),
+            "ir": float(sim.device("eye/ir").value),
             "objects": repr(sim.device("eye/cam").objects)}
 
 
@@ -81,6 +82,7 @@ def test_each_proto_field_set_is_seen_as_the_world_file_written_with_that_value(
     changes: list[tuple[str, str]] = []
     steps = [("size", [0.6, 0.4, 0.3], ("size 0.2 0.2 0.2", "size 0.6 0.4 0.3")),      # the template's box
              ("color", [0.9, 0.1, 0.2], ("color 0.5 0.5 0.5", "color 0.9 0.1 0.2")),   # IS to its PBRAppearance
+             ("material", "stone", ("round FALSE", 'round FALSE\n  material "stone"')),      # the template's roughness
              ("round", True, ("round FALSE", "round TRUE"))]                             # the template's sphere
     for name, value, change in steps:
         assert sv.set_field(sim, obst(sim), name, value) == []
@@ -100,7 +102,7 @@ def test_each_proto_field_set_is_seen_as_the_world_file_written_with_that_value(
     sv.change_item(sim, obst(sim), "posts", "remove", 0, None)
     assert field(sim, "posts") == [2.0]
     assert _same(_readings(sim), _written(tmp_path, *changes, ("posts [ ]", "posts [ 2 ]")))
-    assert sim.counters["regenerations"] == 7
+    assert sim.counters["regenerations"] == 8
 
 
 def test_the_rebuilt_solid_keeps_its_id_def_name_place_and_the_pose_a_supervisor_gave_it(tmp_path):
