@@ -48,6 +48,10 @@ int main(void) {
   wb_robot_step(step);
   printf("round %d %.17g\n", wb_supervisor_field_get_sf_bool(wb_supervisor_node_get_field(obst, "round")),
          wb_supervisor_field_get_mf_float(posts, 0));
+  WbFieldRef material = wb_supervisor_node_get_field(obst, "material");
+  wb_supervisor_field_set_sf_string(material, "stone");
+  wb_robot_step(step);
+  printf("material %s\n", wb_supervisor_field_get_sf_string(material));
   wb_supervisor_field_set_sf_vec3f(size, huge); /* beyond the world's limits: one line, nothing changed */
   wb_robot_step(step);
   printf("refused");

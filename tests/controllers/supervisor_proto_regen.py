@@ -1,7 +1,7 @@
 """A Webots-style supervisor randomising a PROTO obstacle (tests/test_supervisor_proto_regen.py on
 tests/worlds/proto/supervisor_proto_regen.wbt): it sets the obstacle's size, moves it, sets its colour, adds a
-post, makes it round, tries a size the world's limits refuse and resets the simulation, reading its lidar's
-centre beam and the fields as it goes. Written as for Webots; prints one line per reading, as
+post, makes it round and of stone, tries a size the world's limits refuse and resets the simulation, reading its
+lidar's centre beam and the fields as it goes. Written as for Webots; prints one line per reading, as
 tests/c/supervisor_proto_regen.c does."""
 
 from controller import Supervisor
@@ -40,6 +40,10 @@ print("posts", posts.getCount(), g(posts.getMFFloat(0)))
 obst.getField("round").setSFBool(True)
 robot.step(timestep)
 print("round", int(obst.getField("round").getSFBool()), g(posts.getMFFloat(0)))
+material = obst.getField("material")
+material.setSFString("stone")
+robot.step(timestep)
+print("material", material.getSFString())
 size.setSFVec3f([4e9, 0.6, 0.6])              # beyond the world's limits: one line, nothing changed
 robot.step(timestep)
 print("refused", gs(size.getSFVec3f()))
