@@ -778,8 +778,9 @@ def _from_proto_def(sim: Any, ls: Any, robot: str, a: Any) -> dict:
 
 def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: Any, level: int = -1) -> list[str]:
     """Webots' ``setMF*``/``insertMF*``/``removeMF`` of every MF type: on an imported line or point set's MF
-    fields (visuals.py); any other MF field (a PROTO's interface field of any type too) is read-only here
-    (one line, nothing changed)."""
+    fields (visuals.py) and a shape's texture url; on a top-level solid's PROTO interface field, which builds
+    the solid again (:func:`_regenerate`: returns the lines of the values corrected); any other MF field (a
+    robot's PROTO interface field too) is read-only here (one line, nothing changed)."""
     level = _level(node, level)
     fields = _fields(sim, node, level)
     entry = fields.get(field)
@@ -884,11 +885,11 @@ def _check_value(field: str, kind: str, value: Any) -> None:
 
 def _regenerate(sim: Any, node: Node, field: str, kind: str, value: Any) -> list[str]:
     """Webots' regeneration of PROTO instance ``node`` (a top-level solid) with ``field`` set to ``value``
-    (sim/regenerate.py): it keeps its id, DEF, name, pose now and place among the root's children (built at the
-    instance's written pose, as loaded, then moved where a Supervisor put it: its template reads the written
-    ``translation`` and ``rotation``); the nodes
-    inside it were Webots' internal nodes of the old body: they read as removed, and those of the new body
-    are not served (as an imported solid's). One line and nothing changed when it does not build."""
+    (sim/regenerate.py): it keeps its id, DEF, name, pose now and place among the root's children (built at
+    the instance's written pose, as loaded, then moved where a Supervisor put it: its template reads the
+    written ``translation`` and ``rotation``); the nodes inside it were Webots' internal nodes of the old
+    body: they read as removed, and those of the new body are not served (as an imported solid's). One line
+    and nothing changed when it does not build; returns the lines of the values corrected as in a world file."""
     from sensorium.server.sim.imports import ImportRefused
     from sensorium.server.sim.regenerate import regenerate
 
