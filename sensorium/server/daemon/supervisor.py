@@ -6,7 +6,8 @@ whose ``children`` lists the others), the robots (ids 1..R in world order), the 
 solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``nested.FIRST_ID``). They
 are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dotted path ``A.B`` walks
 direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
-a removed solid or light keeps its id, which then answers NULL and is never given to another node.
+a removed solid or light keeps its id, which then answers NULL and is never given to another node; a
+top-level solid built again by a PROTO field set keeps its own (Webots keeps a regenerated node's).
 Shapes with their appearances and geometries are nested nodes too (:mod:`.appearance`); lights
 carried by a solid or robot are not nodes here: Webots' NULL.
 
