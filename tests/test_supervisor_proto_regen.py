@@ -306,3 +306,29 @@ def test_the_rebuilt_obstacle_is_ground_as_the_world_files_box_tops_are(tmp_path
     sv.set_field(sim, obst(sim), "size", [0.2, 2.0, 0.4])
     tall = Simulation(load_world(tmp_path / "tall.wbt"))
     assert sim.ground.at(1.0, 0.0) == tall.ground.at(1.0, 0.0) == pytest.approx((0.3, 0.0, 0.0), abs=1e-12)
+
+
+def test_the_live_viewer_draws_the_rebuilt_obstacle_each_time():
+    """The Foxglove scene is encoded again after each set, the obstacle keeping its name and pose (loopback
+    ports of this test's own)."""
+    pytest.importorskip("foxglove")
+    from sensorium.server.daemon.services import Core
+    from sensorium.server.daemon.transport import Transport
+    from sensorium.server.recording.scene3d import scene_update
+    from sensorium.server.viewer.bridge import FoxgloveBridge
+
+    sim = Simulation(load_world(WORLD), precision="fast")
+    transport = Transport(Core(sim), "tcp://127.0.0.1:49521", "tcp://127.0.0.1:49522")
+    bridge = FoxgloveBridge.for_core(transport.core, transport, "127.0.0.1", 49523)
+    try:
+        drawn = [bridge.scene_bytes()]
+        for size in ([0.6, 0.4, 0.3], [1.0, 0.4, 0.3]):        # the second time the obstacle is already last
+            sv.set_field(sim, obst(sim), "size", size)
+            transport.hooks[0]()
+            drawn.append(bridge.scene_bytes())
+            assert drawn[-1] == scene_update(sim.world, sim.loaded.base_dir, 0, dict(sim.scene.solid_poses),
+                                             sim.scene.removed_lights).encode()
+        assert len(set(drawn)) == 3
+    finally:
+        bridge.close()
+        transport.close()
