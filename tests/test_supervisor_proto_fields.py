@@ -4,8 +4,9 @@ the PROTO's defaults), ``getBaseNodeField`` its base node's (read-only), ``getPr
 ``isDerived``, ``getParent`` for a PROTO built on a PROTO, its fields by name and index), and the node's
 ``getNumberOfFields``/``getFieldByIndex`` count the interface fields. An interface field whose value passes
 straight through IS to a base-node field Sensorium sets (a top-level solid's ``translation``) reads that
-field now and sets it; any other is read-only here (Webots regenerates the node), refused with one line
-naming node and field, nothing changed.
+field now and sets it; another field of a top-level solid builds it again (tests/test_supervisor_proto_regen.py);
+any other is read-only here (a robot's: Webots regenerates the node), refused with one line naming node and
+field, nothing changed.
 
 Sensorium's own PROTOs (tests/protos/supervisor: Crate, BigCrate on Crate, Boss, Keeper with most field
 types and a slot holding a Tag) on tests/worlds/proto/supervisor_protos.wbt and
@@ -121,12 +122,16 @@ def test_a_proto_field_passing_through_is_to_the_base_translation_moves_the_soli
 
 def test_a_proto_field_sensorium_cannot_apply_is_refused_with_one_line_and_nothing_changes():
     lv = _live()
-    msg = refused(lv, "set_field", {"node": CRATE, "field": "size", "value": [1.0, 1.0, 1.0]})
-    assert msg == ("set_field: field 'size' (SFVec3f) of PROTO Crate (Solid 'crate') is read-only here: Webots "
-                   "regenerates the node when such a PROTO field is set; Sensorium sets only the PROTO fields that "
-                   "pass straight through IS to a field it sets (a top-level robot's or solid's translation and "
-                   "rotation, a light's fields); nothing changed")
-    assert field(lv, CRATE, "size")["value"] == [0.2, 0.2, 0.2]
+    msg = refused(lv, "set_field", {"node": KEEPER, "field": "reach", "value": 0.5})
+    assert msg == ("set_field: field 'reach' (SFFloat) of PROTO Keeper (Robot 'keeper') is read-only here: Webots "
+                   "regenerates the node when such a PROTO field is set; Sensorium builds again only a top-level "
+                   "solid (a robot's controller, devices and lockstep slot are built once here: a robot is not "
+                   "rebuilt) and otherwise sets only the PROTO fields that pass straight through IS to a field it "
+                   "sets (a top-level robot's or solid's translation and rotation, a light's fields); nothing changed")
+    assert field(lv, KEEPER, "reach")["value"] == 0.75
+    assert refused(lv, "set_field", {"node": CRATE, "field": "name", "value": "box"}) == (
+        "set_field: field 'name' (SFString) of PROTO Crate (Solid 'crate') is read-only here: it passes to the base "
+        "node's 'name', which is read-only here; nothing changed")
     assert refused(lv, "set_field", {"node": CRATE, "field": "translation", "value": [0, 0, 1], "level": 0}) == (
         "set_field: field 'translation' of Solid 'crate' is a PROTO internal field (getBaseNodeField), read-only as "
         "in Webots: set the field of PROTO Crate instead")
@@ -208,13 +213,13 @@ grand null
 crate 0.20000000000000001 0.20000000000000001 0.20000000000000001
 box null
 tag Tag 0.25 0 0 0.10000000000000001
-set 1.5 0 0.10000000000000001 0.20000000000000001 0.20000000000000001 0.20000000000000001""".splitlines()
+set 1.5 0 0.10000000000000001 1 1 1""".splitlines()
 
 
 def _check_lines(err: str) -> None:
-    assert "field 'bodySlot' (MFNode) of PROTO Keeper" in err and "field 'size' (SFVec3f) of PROTO Crate" in err, err
+    assert "field 'bodySlot' (MFNode) of PROTO Keeper" in err and "of PROTO Crate" not in err, err
     assert "not served by Sensorium" not in err and "Sanitizer" not in err and "runtime error" not in err, err
-    assert err.count("Error:") == 2, err
+    assert err.count("Error:") == 1, err
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
@@ -340,7 +345,7 @@ label [a "quoted" back\\slash é中] -1
 wrong nan 0 0 1 1 1 1 [] 1
 moved 1 1 0.10000000000000001
 moved 0.25 -0.5 0.10000000000000001
-kept 0.125
+kept 2
 parent Crate 1
 box 1 6 0
 me 14""".splitlines()

@@ -335,7 +335,7 @@ class SetFieldArgs(Args):
     value: bool | int | float | Annotated[list[float], Field(min_length=2, max_length=4)] | \
         Annotated[str, Field(max_length=4096)] | None = Field(
         default=None, description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis "
-        "x, y, z, angle; SFInt32 a whole number, SFVec2f 2 numbers, SFString a string (read-only here); an MF field's item (with index): MFBool true/false, MFInt32 a whole number, MFFloat a "
+        "x, y, z, angle; SFInt32 a whole number, SFVec2f 2 numbers, SFString a string (a top-level solid's PROTO fields only); an MF field's item (with index): MFBool true/false, MFInt32 a whole number, MFFloat a "
         "number, MFVec2f 2 numbers, MFVec3f/MFColor 3 numbers, MFRotation 4, MFString a string; none to remove")
     index: int | None = Field(default=None, ge=-(1 << 31), lt=1 << 31, description=(
         "an MF field's item (negative from the end, as Webots): setMF*, insertMF* (0 first, -1 after the last), "

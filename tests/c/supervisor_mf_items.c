@@ -1,6 +1,6 @@
 /* Webots' item setters and inserters of every MF type from C (tests/worlds/proto/supervisor_proto_harden.wbt):
- * on the PROTO fields of those types (read-only here) each call gets the server's read-only line and nothing
- * changes; the library's own checks (a zero rotation axis, NaN, the wrong type, a NULL string) answer Webots'
+ * on the robot's PROTO fields (read-only here) each call gets the server's read-only line and nothing changes; on
+ * the top-level solid Lengthy's the items change (it is built again); the library's own checks (a zero rotation axis, NaN, the wrong type, a NULL string) answer Webots'
  * lines without a request. The same stdout as tests/controllers/supervisor_mf_items.py. */
 #include <math.h>
 #include <stdio.h>
@@ -43,7 +43,7 @@ int main(void) {
          wb_supervisor_field_get_mf_string(tags, 0), wb_supervisor_field_get_mf_bool(flags, 0),
          wb_supervisor_field_get_mf_bool(flags, 1), c0, c1);
   printf(" %g %g %g %g\n", t[0], t[1], t[2], t[3]);
-  /* the SF setters of those types: read-only here too */
+  /* the SF setters: the robot's read-only here, Lengthy's built again */
   const double size2[2] = {1, 2};
   wb_supervisor_field_set_sf_int32(wb_supervisor_node_get_field(keeper, "level"), 4);
   wb_supervisor_field_set_sf_vec2f(wb_supervisor_node_get_field(lengthy, "size2"), size2);

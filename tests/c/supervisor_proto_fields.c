@@ -66,7 +66,7 @@ int main(void) {
   numbers(wb_supervisor_field_get_sf_vec3f(wb_supervisor_node_get_field(tag, "translation")), 3);
   const double moved[3] = {1.5, 0.0, 0.1}, bigger[3] = {1.0, 1.0, 1.0};
   wb_supervisor_field_set_sf_vec3f(wb_supervisor_node_get_field(crate, "translation"), moved);
-  wb_supervisor_field_set_sf_vec3f(wb_supervisor_node_get_field(crate, "size"), bigger); /* refused: one line */
+  wb_supervisor_field_set_sf_vec3f(wb_supervisor_node_get_field(crate, "size"), bigger); /* built again, where it was moved */
   wb_robot_step(step);
   printf("\nset");
   numbers(wb_supervisor_field_get_sf_vec3f(wb_supervisor_node_get_base_node_field(crate, "translation")), 3);

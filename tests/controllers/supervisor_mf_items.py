@@ -1,7 +1,8 @@
 """Webots' item setters and inserters of every MF type a Supervisor may call (tests/test_supervisor_mf_items.py on
-tests/worlds/proto/supervisor_proto_harden.wbt): on the PROTO fields of those types (read-only here) each call
-gets the server's read-only line and nothing changes; the clients' own checks (a zero rotation axis, NaN, the
-wrong type) answer Webots' lines without a request. The same stdout as tests/c/supervisor_mf_items.c."""
+tests/worlds/proto/supervisor_proto_harden.wbt): on the robot's PROTO fields (read-only here) each call gets the
+server's read-only line and nothing changes; on the top-level solid Lengthy's the items change (it is built
+again); the clients' own checks (a zero rotation axis, NaN, the wrong type) answer Webots' lines without a
+request. The same stdout as tests/c/supervisor_mf_items.c."""
 
 import math
 
@@ -32,7 +33,7 @@ print("counts", gains.getCount(), tags.getCount(), flags.getCount(), corners.get
 print("values", " ".join(f"{v:g}" for v in (gains.getMFFloat(0), gains.getMFFloat(1))), tags.getMFString(0),
       int(flags.getMFBool(0)), int(flags.getMFBool(1)), " ".join(f"{v:g}" for v in corners.getMFVec2f(0)),
       " ".join(f"{v:g}" for v in turns.getMFRotation(0)))
-keeper.getField("level").setSFInt32(4)                  # the SF setters of those types: read-only here too
+keeper.getField("level").setSFInt32(4)                  # the robot's: read-only here (Lengthy's: built again)
 lengthy.getField("size2").setSFVec2f([1.0, 2.0])
 keeper.getField("name").setSFString("other")
 print("sf", keeper.getField("level").getSFInt32(), " ".join(f"{v:g}" for v in lengthy.getField("size2").getSFVec2f()),

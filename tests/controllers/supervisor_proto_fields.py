@@ -1,7 +1,7 @@
 """A Webots-style supervisor reading PROTO instances' own fields (tests/test_supervisor_proto_fields.py on
 tests/worlds/proto/supervisor_proto_fields.wbt): its own PROTO's interface through getField, getProto and
 getFieldByIndex, its base node's fields, a PROTO built on another (getParent), a PROTO inside it, and a
-PROTO field set through IS. Written as for Webots; prints one line per reading, as
+PROTO field set through IS, and one that builds the crate again. Written as for Webots; prints one line per reading, as
 tests/c/supervisor_proto_fields.c does."""
 
 from controller import Supervisor
@@ -54,6 +54,6 @@ tag = robot.getFromDef("TAG")
 print("tag", tag.getTypeName(), g(tag.getField("weight").getSFFloat()), gs(tag.getField("translation").getSFVec3f()))
 crate = robot.getFromDef("CRATE")
 crate.getField("translation").setSFVec3f([1.5, 0.0, 0.1])
-crate.getField("size").setSFVec3f([1.0, 1.0, 1.0])          # refused: one line, nothing changed
+crate.getField("size").setSFVec3f([1.0, 1.0, 1.0])          # the crate is built again, where it was moved
 robot.step(timestep)
 print("set", gs(crate.getBaseNodeField("translation").getSFVec3f()), gs(crate.getField("size").getSFVec3f()))

@@ -6,7 +6,8 @@ whose ``children`` lists the others), the robots (ids 1..R in world order), the 
 solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``nested.FIRST_ID``). They
 are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dotted path ``A.B`` walks
 direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
-a removed solid or light keeps its id, which then answers NULL and is never given to another node.
+a removed solid or light keeps its id, which then answers NULL and is never given to another node; a
+top-level solid built again by a PROTO field set keeps its own (Webots keeps a regenerated node's).
 Shapes with their appearances and geometries are nested nodes too (:mod:`.appearance`); lights
 carried by a solid or robot are not nodes here: Webots' NULL.
 
@@ -32,7 +33,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.daemon import appearance, nested, visuals
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import states, viewshot
-from sensorium.server.world.poses import matrix_quaternion
+from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 from sensorium.server.world.top_nodes import Scenery
 
 T = TypeVar("T")
@@ -153,9 +154,10 @@ def _removed(sim: Any, node: Node) -> bool:
         return False
     if node.visual:                  # with the solid holding it
         return node.key not in sim.scene.solid_poses
-    if node.nested:                  # with its top-level solid
+    if node.nested:                  # with its top-level solid, or when that solid was built again
         n = _nested_of(sim, node)
-        return n.owner_kind == "Solid" and n.owner_key not in sim.scene.solid_poses
+        return n.owner_kind == "Solid" and (n.owner_key not in sim.scene.solid_poses
+                                            or n.owner in getattr(sim, "_supervisor_rebuilt", ()))
     if node.type == "Solid":
         return node.key not in sim.scene.solid_poses
     return node.type in LIGHTS and node.key in sim.scene.removed_lights
@@ -275,7 +277,8 @@ def node_by_id(sim: Any, node: int) -> Node:
             raise ValueError(f"no node with id {node} ({_known_ids(sim)})")
         found = _nested_node(inner)
         if _removed(sim, found):
-            raise ValueError(f"node {node} ({found.type} {found.name!r}) was removed with {inner.owner_key!r}")
+            how = " when a PROTO field set built it again" if inner.owner_key in sim.scene.solid_poses else ""
+            raise ValueError(f"node {node} ({found.type} {found.name!r}) was removed with {inner.owner_key!r}{how}")
         return found
     nodes = _all_nodes(sim)
     if not 0 <= node <= len(nodes):
@@ -624,8 +627,8 @@ def _interface_fields(sim: Any, node: Node, level: int) -> dict[str, tuple[str, 
     """The interface fields of PROTO ``level`` (1: the instance's own PROTO) of a PROTO instance. A field
     whose value passes through IS unchanged to a base-node field served here reads that field now (a
     robot's ``translation`` as it drives) and, on the instance's own PROTO, sets it as that field does;
-    any other field answers the instance's value (or the PROTO's default) and is read-only here: Webots
-    regenerates the node when one is set."""
+    any other field answers the instance's value (or the PROTO's default); setting one builds a top-level
+    solid again (:func:`_regenerate`, Webots' regeneration) and is refused on any other node."""
     if not 1 <= level <= len(node.interface):
         raise ValueError(f"{_what(node)} has no PROTO at level {level} (its PROTO chain: "
                          f"{' > '.join(p.name for p in node.interface) or 'none, it is no PROTO instance'})")
@@ -758,6 +761,9 @@ def from_proto_def(sim: Any, node: Node, name: str) -> tuple[Node | None, str]:
     if node.scenery or node.visual or node.type in LIGHTS or (node.nested and _nested_of(sim, node).shape is not None):
         return None, (f"the body of PROTO {node.proto} ({_what(node)}) is not searched here: DEF names are found in "
                       "the bodies of robots, solids and the PROTO instances inside them")
+    if node.id in getattr(sim, "_supervisor_rebuilt", ()):
+        return None, (f"PROTO {node.proto} ({_what(node)}) was built again by a PROTO field set: the DEF names of its "
+                      "new body are not served here (as an imported solid's)")
     found = nested.inner_def(_table(sim), node.id, name)
     if isinstance(found, str):
         return None, f"DEF {name} of PROTO {node.proto}'s body ({_what(node)}) names {found}"
@@ -771,10 +777,11 @@ def _from_proto_def(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     return {**node_ref(sim, found), "note": note}
 
 
-def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: Any, level: int = -1) -> None:
+def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: Any, level: int = -1) -> list[str]:
     """Webots' ``setMF*``/``insertMF*``/``removeMF`` of every MF type: on an imported line or point set's MF
-    fields (visuals.py); any other MF field (a PROTO's interface field of any type too) is read-only here
-    (one line, nothing changed)."""
+    fields (visuals.py) and a shape's texture url; on a top-level solid's PROTO interface field, which builds
+    the solid again (:func:`_regenerate`: returns the lines of the values corrected); any other MF field (a
+    robot's PROTO interface field too) is read-only here (one line, nothing changed)."""
     level = _level(node, level)
     fields = _fields(sim, node, level)
     entry = fields.get(field)
@@ -786,26 +793,140 @@ def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: An
     kind = entry[0]
     if not kind.startswith("MF"):
         raise ValueError(f"field {field!r} of {what} is an {kind}, not a list: set it as a whole")
+    if level == 1 and _rebuilds(node):
+        return _regenerate(sim, node, field, kind, _changed_items(sim, node, field, kind, entry, op, index, value))
     if level >= 1:
         raise ValueError(f"field {field!r} ({kind}) of {what}: its items are read-only here (Webots regenerates the "
-                         "node when a PROTO field is changed; a Supervisor changes the items of an imported line or "
-                         "point set's fields only); nothing changed")
+                         "node when a PROTO field is changed; Sensorium builds again only a top-level solid, not a "
+                         "robot, and a Supervisor changes the items of an imported line or point set's fields); "
+                         "nothing changed")
     if level == 0 and node.interface:
         raise ValueError(f"field {field!r} ({kind}) of {what} is a PROTO internal field (getBaseNodeField): its "
                          "items are read-only, as in Webots; nothing changed")
     ref = _nested_of(sim, node).shape if node.nested else None
     if ref is not None and ref.type == "ImageTexture" and field == "url":      # a texture's image (appearance.py)
         appearance.change_url(sim, ref, node, op, index, value)
-        return
+        return []
     if not (node.visual and node.id >= visuals.FIRST_ID and visuals.settable(_vnode(sim, node), field)):
         if node.visual and node.id >= visuals.FIRST_ID:
             raise ValueError(visuals.read_only_line(_vnode(sim, node), field, kind))
         raise ValueError(f"field {field!r} ({kind}) of {what}: its items are read-only here (a Supervisor changes "
                          "the items of an imported line or point set's fields only); nothing changed")
     visuals.change(_vnode(sim, node), field, op, index, value)
+    return []
 
 
-def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> None:
+_ITEM_SIZES = {"MFVec2f": 2, "MFVec3f": 3, "MFColor": 3, "MFRotation": 4}
+
+
+def _changed_items(sim: Any, node: Node, field: str, kind: str, entry: tuple, op: str, index: int,
+                   value: Any) -> list:
+    """A PROTO field's list with one item set, inserted or removed (Webots' index rules: negative from the end;
+    an insert at -1 is after the last), each item of the field's type (one line otherwise)."""
+    try:
+        items = list(entry[1](sim, node))
+    except NotKept as exc:
+        raise ValueError(f"{exc}: its items cannot be changed here; nothing changed") from None
+    count = len(items) + (1 if op == "insert" else 0)
+    at = index + count if index < 0 else index
+    if not 0 <= at < count:
+        raise ValueError(f"field {field!r} ({kind}): index {index} out of range (it has {len(items)} items)")
+    if op == "remove":
+        del items[at]
+        return items
+    size = _ITEM_SIZES.get(kind)
+    item_kind = {"MFBool": "SFBool", "MFInt32": "SFInt32", "MFFloat": "SFFloat", "MFString": "SFString"}.get(
+        kind, {2: "SFVec2f", 3: "SFVec3f", 4: "SFRotation"}.get(size or 0, kind))
+    _check_value(field, item_kind, value)
+    item = [float(v) for v in value] if size else value
+    if op == "insert":
+        items.insert(at, item)
+    else:
+        items[at] = item
+    return items
+
+
+_NOT_REBUILT = ("Webots regenerates the node when such a PROTO field is set; Sensorium builds again only a top-level "
+                "solid (a robot's controller, devices and lockstep slot are built once here: a robot is not "
+                "rebuilt) and otherwise sets only the PROTO fields that pass straight through IS to a field it sets "
+                "(a top-level robot's or solid's translation and rotation, a light's fields)")
+
+
+def _rebuilds(node: Node) -> bool:
+    """Whether a set of one of the node's own PROTO fields builds it again (Webots' regeneration): a
+    top-level solid that is a PROTO instance (a .wbt world's or an imported one)."""
+    return node.type == "Solid" and bool(node.interface) and not (node.nested or node.scenery or node.visual)
+
+
+_INT32 = (-(1 << 31), (1 << 31) - 1)
+
+
+def _check_value(field: str, kind: str, value: Any) -> None:
+    """A value a Supervisor sets into a PROTO field that rebuilds the node: of the field's type (one line)."""
+    if kind == "SFBool":
+        ok = isinstance(value, bool)
+    elif kind == "SFInt32":
+        ok = isinstance(value, int) and not isinstance(value, bool) and _INT32[0] <= value <= _INT32[1]
+    elif kind == "SFFloat":
+        ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    elif kind == "SFString":
+        ok = isinstance(value, str)
+    elif kind in _VECTOR_SIZES or kind == "SFVec2f":
+        size = _VECTOR_SIZES.get(kind, 2)
+        ok = isinstance(value, list) and len(value) == size and all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+    else:
+        raise ValueError(f"field {field!r} is an {kind}: set it item by item (setMF*, insertMF*, removeMF)" if
+                         kind.startswith("MF") else f"field {field!r} is an {kind}: not set as a whole here")
+    if not ok:
+        want = {"SFBool": "true or false", "SFInt32": "a whole number within 32 bits", "SFFloat": "a finite number",
+                "SFString": "a string"}.get(kind, f"{_VECTOR_SIZES.get(kind, 2)} finite numbers")
+        raise ValueError(f"field {field!r} is an {kind}: takes {want}, got {value!r}")
+
+
+def _regenerate(sim: Any, node: Node, field: str, kind: str, value: Any) -> list[str]:
+    """Webots' regeneration of PROTO instance ``node`` (a top-level solid) with ``field`` set to ``value``
+    (sim/regenerate.py): it keeps its id, DEF, name, pose now and place among the root's children (built at
+    the instance's written pose, as loaded, then moved where a Supervisor put it: its template reads the
+    written ``translation`` and ``rotation``); the nodes inside it were Webots' internal nodes of the old
+    body: they read as removed, and those of the new body are not served (as an imported solid's). One line
+    and nothing changed when it does not build; returns the lines of the values corrected as in a world file."""
+    from sensorium.server.sim.imports import ImportRefused
+    from sensorium.server.sim.regenerate import regenerate
+
+    table = _table(sim)              # numbered before the solid changes (its old nodes keep their ids)
+    proto = node.interface[0]
+    key = str(node.key)
+    now = sim.scene.solid_poses[key]
+    built = pose_from_model(next(s for s in reversed(sim.world.solids) if s.name == key).pose)
+    moved = not (np.array_equal(now.translation, built.translation) and np.array_equal(now.rotation, built.rotation))
+    corrected: list[str] = []
+    try:
+        regenerate(sim, key, node.id, {field: (kind, value)}, corrected)
+    except (ImportRefused, KeyError, OSError, RecursionError) as exc:
+        text = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        raise ValueError(f"field {field!r} ({kind}) of PROTO {proto.name} ({_what(node)}) not set: the solid does "
+                         f"not build with that value: {text}; nothing changed") from None
+    if moved:                        # built where the instance says, as loaded (a reset puts it back there bit for
+        sim.place_solid(key, now)    # bit), then moved where the Supervisor had put it
+    _forget(sim, table, node.id)
+    return corrected
+
+
+def _forget(sim: Any, table: nested.Table, owner: int) -> None:
+    """The nodes inside top-level node ``owner`` leave the tree (its body was built again): they keep their
+    ids, which read as removed nodes, and no walk, DEF or getFromProtoDef finds them."""
+    gone = {n.id for n in table.by_owner.get(owner, ())}
+    by_owner = {k: v for k, v in table.by_owner.items() if k != owner}
+    by_parent = {k: tuple(n for n in v if n.id not in gone) for k, v in table.by_parent.items() if k not in gone}
+    inner = {k: v for k, v in (table.inner or {}).items() if k != owner and k not in gone}
+    sim._supervisor_nested = nested.Table(table.nodes, by_owner, by_parent, table.bare_joints, inner)
+    sim._supervisor_rebuilt = {*getattr(sim, "_supervisor_rebuilt", ()), owner}
+
+
+def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> list[str]:
+    """Webots' ``setSF*``: the field's value changes at once. Returns the lines Webots would print in its
+    console (the values corrected when a PROTO field set builds a solid again)."""
     level = _level(node, level)
     what = f"{node.type} {node.name or node.id!r}"
     fields = _fields(sim, node, level)      # a level past the node's PROTO chain: one line
@@ -822,10 +943,11 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
     kind, _, setter = entry
     if setter is None and level == 1:
         declared = next(f for f in node.interface[0].fields if f.name == field)
+        if _rebuilds(node) and declared.base != "name":
+            _check_value(field, kind, value)
+            return _regenerate(sim, node, field, kind, value)
         why = (f"it passes to the base node's {declared.base!r}, which is read-only here" if declared.base
-               and declared.base in _base_fields(sim, node) else "Webots regenerates the node when such a PROTO field "
-               "is set; Sensorium sets only the PROTO fields that pass straight through IS to a field it sets (a "
-               "top-level robot's or solid's translation and rotation, a light's fields)")
+               and declared.base in _base_fields(sim, node) else _NOT_REBUILT)
         raise ValueError(f"field {field!r} ({kind}) of PROTO {node.interface[0].name} ({what}) is read-only here: "
                          f"{why}; nothing changed")
     if setter is None and node.visual and node.id >= visuals.FIRST_ID:
@@ -859,6 +981,7 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
     if isinstance(value, list) and not all(math.isfinite(v) for v in value):
         raise ValueError(f"field {field!r}: values must be finite")
     setter(sim, node, value)
+    return []
 
 
 def node_pose(sim: Any, node: Node) -> dict:
@@ -888,10 +1011,10 @@ def node_velocity(sim: Any, node: Node) -> list[float]:
 
 def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     if a.index is not None:          # an MF field's item: set, inserted or removed
-        change_item(sim, node_by_id(sim, a.node), a.field, a.op, a.index, a.value, a.level)
-        return {"success": True}
-    set_field(sim, node_by_id(sim, a.node), a.field, a.value, a.level)
-    return {"success": True}
+        corrected = change_item(sim, node_by_id(sim, a.node), a.field, a.op, a.index, a.value, a.level)
+    else:
+        corrected = set_field(sim, node_by_id(sim, a.node), a.field, a.value, a.level)
+    return {"success": True, LOG: corrected} if corrected else {"success": True}
 
 
 def remove_node(sim: Any, node: Node) -> None:

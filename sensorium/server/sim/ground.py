@@ -115,6 +115,31 @@ def _is_upright(r: np.ndarray) -> bool:
             and abs(r[2, 1]) <= UPRIGHT_TOL and r[2, 2] > 0.0)
 
 
+def _surfaces(s: wm.Solid) -> list[_Surface]:
+    """The ground a top-level solid holds: its shapes seen by bounding rays that are terrains, planes, boxes
+    or cylinders."""
+    from sensorium.server.sim.scene import solid_parts
+
+    surfaces: list[_Surface] = []
+    for _, local, shape in solid_parts(s, Pose.identity()):
+        if shape.seen_by not in ("both", "bounding"):
+            continue
+        g = shape.geometry
+        if isinstance(g, wm.ElevationGrid):
+            xs = np.arange(g.x_dimension, dtype=np.float64) * float(g.x_spacing)
+            ys = np.arange(g.y_dimension, dtype=np.float64) * float(g.y_spacing)
+            h = np.asarray(g.height, dtype=np.float64).reshape(g.y_dimension, g.x_dimension)
+            surfaces.append(_Surface(s.name, local, _Grid(xs, ys, h)))
+        elif isinstance(g, wm.Plane):
+            surfaces.append(_Surface(s.name, local, None))
+        elif isinstance(g, wm.Box):
+            sx, sy, sz = (float(v) / 2.0 for v in g.size)
+            surfaces.append(_Surface(s.name, local, None, (sx, sy, sz)))
+        elif isinstance(g, wm.Cylinder):
+            surfaces.append(_Surface(s.name, local, None, disc=(float(g.radius), float(g.height) / 2.0)))
+    return surfaces
+
+
 class Ground:
     """The world's ground (see the module docstring); :meth:`under` samples it at points."""
 
@@ -132,29 +157,20 @@ class Ground:
         """The ground of a world with at least one terrain seen by bounding rays (None otherwise:
         robots then keep their heights, as they always did). ``solid_poses``: the top-level solids'
         world poses; ``to_enu``: world axes to ENU (None in an ENU world)."""
-        from sensorium.server.sim.scene import solid_parts
-
-        surfaces: list[_Surface] = []
-        for s in world.solids:
-            for _, local, shape in solid_parts(s, Pose.identity()):
-                if shape.seen_by not in ("both", "bounding"):
-                    continue
-                g = shape.geometry
-                if isinstance(g, wm.ElevationGrid):
-                    xs = np.arange(g.x_dimension, dtype=np.float64) * float(g.x_spacing)
-                    ys = np.arange(g.y_dimension, dtype=np.float64) * float(g.y_spacing)
-                    h = np.asarray(g.height, dtype=np.float64).reshape(g.y_dimension, g.x_dimension)
-                    surfaces.append(_Surface(s.name, local, _Grid(xs, ys, h)))
-                elif isinstance(g, wm.Plane):
-                    surfaces.append(_Surface(s.name, local, None))
-                elif isinstance(g, wm.Box):
-                    sx, sy, sz = (float(v) / 2.0 for v in g.size)
-                    surfaces.append(_Surface(s.name, local, None, (sx, sy, sz)))
-                elif isinstance(g, wm.Cylinder):
-                    surfaces.append(_Surface(s.name, local, None, disc=(float(g.radius), float(g.height) / 2.0)))
+        surfaces = [surface for s in world.solids for surface in _surfaces(s)]
         if not any(s.grid is not None for s in surfaces):
             return None
         return cls(surfaces, solid_poses, to_enu)
+
+    def add_solid(self, solid: wm.Solid, pose: Pose) -> None:
+        """A top-level solid built again (a Supervisor set a PROTO field of it): its terrains, floors and
+        box tops are ground as the world file's are."""
+        added = _surfaces(solid)
+        self._poses[solid.name] = pose
+        self._surfaces += added
+        self._boxes_stale = True
+        for s in added:
+            self._place(s)
 
     def tilted_terrains(self) -> list[str]:
         """The solids holding a grid that is not upright (not ground: robots keep their height over it)."""

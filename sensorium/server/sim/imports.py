@@ -57,6 +57,8 @@ class ImportedNode:
     proto: str = ""     # the PROTO the string's node is an instance of (Supervisor getTypeName), "" for a base node
     interface: tuple = ()   # that PROTO instance's interface (wm.ProtoLevel each: Supervisor getField, getProto)
     visual: Any = None      # a Shape or Group of shapes imported at the root: its parsed node (the solid holds it)
+    written: Any = None     # the node as written (parsed): a PROTO instance is built again from it when a
+                            # Supervisor sets one of its fields (sim/regenerate.py)
 
 
 @dataclass
@@ -107,8 +109,8 @@ class _Converter(Converter):
         return unique
 
 
-def _shown(message: str, source: str) -> str:
-    return message.replace(source, LABEL)
+def _shown(message: str, source: str, label: str = LABEL) -> str:
+    return message.replace(source, label)
 
 
 def _syntax(exc: WbtSyntaxError, source: str) -> ImportRefused:
@@ -171,8 +173,36 @@ def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: 
         raise _syntax(exc, source) from None
 
 
+def string_file(loaded: LoadedWorld, protos: _WorldProtos) -> WbtFile:
+    """What a node string is read as part of (no node): the world's version and declarations, the string's
+    pseudo file in the world's folder (``rebuild_node`` of an imported instance)."""
+    return WbtFile(protos.version, [], [], str(loaded.base_dir / _NAME), list(protos.declarations))
+
+
+def rebuild_node(written: ParsedNode, wbt: WbtFile, loaded: LoadedWorld, world: wm.World, *, taken: set[str],
+                 limits: WorldLimits, allow_outside_meshes: bool = False,
+                 warnings: list[str] | None = None) -> ImportedNode:
+    """A top-level PROTO instance built again from ``written`` (its node as written, a field's value
+    changed: a Supervisor's set, daemon/supervisor.py): the same PROTO expansion (its template run within
+    the world's PROTO limits), conversion and validation as a load or an import, the PROTOs of ``wbt``
+    (the file it was written in: its declarations and the PROTOs it defines). Errors are
+    ``ImportRefused`` lines placed in that file (``wbt.source``, a world's path or the import's string)."""
+    label = LABEL if wbt.source.endswith(_NAME) else wbt.source
+    proto_limits = ProtoLimits.matching(limits)
+    try:
+        one = WbtFile(wbt.version, [written], [], wbt.source, list(wbt.declarations), list(wbt.protos))
+        (node,) = _convert(one, wbt.source, loaded, world, taken, limits, proto_limits, allow_outside_meshes,
+                           [] if warnings is None else warnings, label)
+        return node
+    except WbtSyntaxError as exc:           # ProtoError too: in the instance or a PROTO file
+        where = label if exc.source == wbt.source else exc.source
+        at = f"{where}:{exc.line}:{exc.col}" if exc.line else where
+        raise ImportRefused(f"{at}: {_shown(exc.message, wbt.source, label)}") from None
+
+
 def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, taken: set[str], limits: WorldLimits,
-             proto_limits: ProtoLimits, allow_outside_meshes: bool, warnings: list[str]) -> list[ImportedNode]:
+             proto_limits: ProtoLimits, allow_outside_meshes: bool, warnings: list[str],
+             label: str = LABEL) -> list[ImportedNode]:
     from sensorium.server.world.proto import ProtoSearch, expand
 
     expansion = expand(wbt, ProtoSearch.create(loaded.base_dir), proto_limits)
@@ -186,7 +216,7 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     for written, node in zip(wbt.nodes, expansion.nodes):
         solids, lights = len(conv.world["solids"]), len(conv.world["lights"])
         what = written.type if written.type == node.type else f"{written.type} (a {node.type})"
-        at = f"{LABEL}:{written.line}:{written.col}"
+        at = f"{label}:{written.line}:{written.col}"
         if node.type in ("Pose", "Transform") and node.proto is None and _unscaled(node):
             # a grouping node of shapes (Webots' supervisor sample imports a Pose holding a Sphere, then
             # moves it by its translation): a Solid of the same frame and children, movable the same way
@@ -208,7 +238,7 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
         if conv.losses:
             hint = " (a PROTO must be declared in the world file: IMPORTABLE EXTERNPROTO)" \
                 if "not a built-in node or PROTO" in conv.losses[0].text else ""
-            raise ImportRefused(_shown(conv.losses[0].text, source).replace("; skipped (with everything inside it)", "")
+            raise ImportRefused(_shown(conv.losses[0].text, source, label).replace("; skipped (with everything inside it)", "")
                                 + hint)
         made = [("Solid", s) for s in conv.world["solids"][solids:]] + \
                [(lt["type"], lt) for lt in conv.world["lights"][lights:]]
@@ -225,25 +255,25 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
     data = strip_origins({"solids": conv.world["solids"], "lights": conv.world["lights"]}, "", origin)
     data["world_info"] = {"coordinate_system": world.world_info.coordinate_system}
     try:
-        parsed = parse_world(data, source=LABEL, base_dir=loaded.base_dir, limits=limits,
+        parsed = parse_world(data, source=label, base_dir=loaded.base_dir, limits=limits,
                              allow_outside_meshes=allow_outside_meshes, asset_files=conv.asset_files)
         fragment = parsed.world
     except WorldError as exc:
         first = _wbt_problem(exc.problems[0], origin)
         more = f" (and {len(exc.problems) - 1} more)" if len(exc.problems) > 1 else ""
         if first.path.startswith("line "):      # placed at the string's node it came from
-            where = first.path.replace("line ", f"{LABEL}:", 1).replace(", column ", ":", 1)
+            where = first.path.replace("line ", f"{label}:", 1).replace(", column ", ":", 1)
         else:
-            where = f"{LABEL}: {first.path}" if first.path else LABEL
-        raise ImportRefused(f"{where}: {_shown(first.message, source)}{more}") from None
-    warnings += [_shown(w, source) for w in conv.warnings]
-    warnings += [_wbt_warning(w, origin, LABEL) for w in parsed.warnings]
+            where = f"{label}: {first.path}" if first.path else label
+        raise ImportRefused(f"{where}: {_shown(first.message, source, label)}{more}") from None
+    warnings += [_shown(w, source, label) for w in conv.warnings]
+    warnings += [_wbt_warning(w, origin, label) for w in parsed.warnings]
     queue: Counter[str] = Counter()
     out = []
-    for kind, proto, face, visual in zip(kinds, protos, faces, visuals):
+    for kind, proto, face, visual, written in zip(kinds, protos, faces, visuals, wbt.nodes):
         group = "Solid" if kind == "Solid" else "light"
         models = fragment.solids if group == "Solid" else fragment.lights
-        out.append(ImportedNode(kind, models[queue[group]], proto, face, visual))
+        out.append(ImportedNode(kind, models[queue[group]], proto, face, visual, written))
         queue[group] += 1
     return out
 
@@ -291,4 +321,5 @@ def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles
     over("triangles", triangles_now, triangles_added, limits.triangles)
 
 
-__all__ = ["parse_sf_node_string", "ImportRefused", "ImportedNode", "read_node_string", "check_additions", "world_protos"]
+__all__ = ["parse_sf_node_string", "ImportRefused", "ImportedNode", "read_node_string", "rebuild_node", "check_additions",
+           "string_file", "world_protos"]

@@ -662,18 +662,25 @@ class Scene:
         parts = list(solid_parts(solid, Pose.identity()))
         return parts, [_entry(shape, self._base_dir, local) for _, local, shape in parts]
 
-    def add_solid(self, solid: wm.Solid, node_id: int, prepared: tuple[list, list[ShapeEntry]] | None = None) -> None:
+    def solid_triangles(self, name: str) -> int:
+        """The triangles of top-level solid ``name``'s body (0 for a removed one)."""
+        return self._solid_triangles.get(name, 0)
+
+    def add_solid(self, solid: wm.Solid, node_id: int, prepared: tuple[list, list[ShapeEntry]] | None = None,
+                  again: bool = False) -> None:
         """A top-level solid a Supervisor imported (``importMFNodeFromString``): its body joins the
         ray engine (every ray kind sees it from the next cast), its pose ``solid_poses``, its
         lights the light arrays, its recognition colours the cameras' objects (as Supervisor node
-        ``node_id``). Its shape ids follow every existing one (none is ever reused)."""
+        ``node_id``). Its shape ids follow every existing one (none is ever reused). ``again``: a
+        solid built again under the name of one just removed (a PROTO field set), keeping its place."""
         name = solid.name
-        if name in self.solid_poses or name in self.solid_names:
-            raise KeyError(f"a solid named {name!r} exists or existed")
+        if name in self.solid_poses or (name in self.solid_names) != again:
+            raise KeyError(f"a solid named {name!r} exists or existed" if not again else f"no removed solid {name!r}")
         parts, entries = prepared if prepared is not None else self.solid_entries(solid)
         pose = pose_from_model(solid.pose)
         self._nested_targets(solid)
-        self.solid_names.append(name)
+        if not again:
+            self.solid_names.append(name)
         self.solid_poses[name] = pose
         self.solids_version += 1
         if parts:

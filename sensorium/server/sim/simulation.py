@@ -41,7 +41,9 @@ from sensorium.server.sim.scene import (
     primitive_from_model,
     robot_bounding_parts,
     robot_parts,
+    solid_lights,
     solid_parts,
+    solid_radar_targets,
 )
 from sensorium.server.sim.sensors import (
     GPS,
@@ -291,6 +293,7 @@ class Simulation:
         self.imported_protos: dict[str | int, str] = {}       # key -> the PROTO an imported node is an instance of
         self.imported_visuals: dict[str | int, Any] = {}      # key -> an imported Shape or Group (parsed; its solid's key)
         self.imported_interfaces: dict[str | int, tuple] = {}  # key -> that PROTO instance's interface fields
+        self.imported_written: dict[str | int, Any] = {}      # key -> an imported PROTO instance as written (parsed)
         self.top_level = top_level(self.world)     # the root's children as loaded (world/top_nodes.py)
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
                                                             # a node was imported (None: the loaded order)
@@ -546,12 +549,8 @@ class Simulation:
             if prep is not None:
                 solid = node.model
                 self.world.solids.append(solid)
-                self.scene.add_solid(solid, node_id, prep)
+                self._join_solid(solid, node_id, prep)
                 self._imported_poses[solid.name] = self.scene.solid_poses[solid.name]
-                if self.contact is not None:
-                    pose = self.scene.solid_poses[solid.name]
-                    self.contact.add_solid(solid.name, [(e.primitive, local, shape.seen_by in ("both", "bounding"))
-                                                        for (_, local, shape), e in zip(*prep)], pose)
                 key: str | int = solid.name
             else:
                 self.world.lights.append(node.model)
@@ -561,8 +560,52 @@ class Simulation:
             self.imported_interfaces[key] = node.interface
             if node.visual is not None:
                 self.imported_visuals[key] = node.visual
+            if node.written is not None and node.proto:
+                self.imported_written[key] = node.written
             out.append((node.type, key, node_id))
         return out
+
+    def _join_solid(self, solid: wm.Solid, node_id: int, prepared: tuple[list, list], again: bool = False) -> None:
+        """A top-level solid joins the scene, kinematic contact and the terrains (an import, or a solid built
+        again: ``again``, under the name it had)."""
+        self.scene.add_solid(solid, node_id, prepared, again=again)
+        pose = self.scene.solid_poses[solid.name]
+        if self.contact is not None:
+            self.contact.add_solid(solid.name, [(e.primitive, local, shape.seen_by in ("both", "bounding"))
+                                                for (_, local, shape), e in zip(*prepared)], pose)
+        if self.ground is not None and again:
+            self.ground.add_solid(solid, pose)
+
+    def replace_solid(self, name: str, node: Any, node_id: int) -> None:
+        """Top-level solid ``name`` built again (a Supervisor set one of its PROTO fields, sim/regenerate.py):
+        ``node`` (an ``ImportedNode``, its solid named ``name``) takes its place from the next measurement,
+        as Supervisor node ``node_id``, through the removal and import paths (every ray kind, contact, terrains,
+        lights, recognition, radar). The world stays within its limits (else ``ImportRefused``, nothing
+        changed); its pose as loaded stays the one ``simulationReset`` puts it back at (Webots keeps the
+        translation and rotation from the file), and so do the world model's other solids."""
+        from sensorium.server.sim.imports import check_additions
+        from sensorium.server.world.geometry import triangle_count
+
+        solid = node.model
+        assert solid.name == name and name in self.scene.solid_poses
+        prepared = self.scene.solid_entries(solid)
+        added = sum(triangle_count(e.primitive) for e in prepared[1])
+        k = next(i for i in range(len(self.world.solids) - 1, -1, -1) if self.world.solids[i].name == name)
+        old = self.world.solids[k]
+        others = [s for i, s in enumerate(self.world.solids) if i != k]
+        lights_old = sum(1 for _ in solid_lights(old, Pose.identity()))
+        check_additions(self.world.model_copy(update={"solids": others}), set(self.scene.solid_poses) - {name},
+                        len(self.scene.world_lights()) - lights_old, self.scene.triangle_count
+                        - self.scene.solid_triangles(name), added, [node], self.limits)
+        self.remove_solid(name)
+        self.world.solids[k] = solid
+        self._join_solid(solid, node_id, prepared, again=True)
+        if name in self._initial["solids"]:       # a reset keeps the new values (Webots resets no field)
+            targets = self._initial["radar_targets"]
+            for key in [t for t in targets if t == name or (isinstance(t, tuple) and t[0] == name)]:
+                del targets[key]
+            targets.update(solid_radar_targets(solid))
+        self._counters["regenerations"] += 1
 
     @property
     def counters(self) -> dict[str, int]:

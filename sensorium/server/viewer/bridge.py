@@ -598,8 +598,9 @@ class FoxgloveBridge:
         poses = self.solid_poses() if self.solid_poses is not None else None
         removed = frozenset(self.removed_lights()) if self.removed_lights is not None else frozenset()
         version, drawn = self._drawn
+        # the scene's solids_version too: a solid built again (a PROTO field set) keeps its name and pose
         key = (tuple((n, p.translation.tobytes(), p.rotation.tobytes()) for n, p in (poses or {}).items()),
-               tuple(sorted(removed)), len(self.world.lights), version)
+               tuple(sorted(removed)), len(self.world.lights), version, getattr(self.appearances, "solids_version", 0))
         if self._scene_bytes is None or key != self._scene_key:
             self._scene_bytes = self._scene_mod.scene_update(self.world, self.base_dir, 0, poses, removed,
                                                              drawn).encode()

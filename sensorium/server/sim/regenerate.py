@@ -1,0 +1,107 @@
+"""A Supervisor's set of a PROTO field of a top-level solid: the instance built again with the new value,
+as Webots regenerates a PROTO node (WbTemplateManager).
+
+The instance as written (the ``.wbt`` world's top-level node, parsed once at the first set; an imported
+instance's node string as read) gets the new value in that field (the caller moves the new solid where a
+Supervisor had put the old one), then goes through
+the import's path (sim/imports.py ``rebuild_node``: PROTO expansion and template within the world's PROTO
+limits, conversion, validation) and takes the old solid's place (``Simulation.replace_solid``: the removal
+and import paths) under the same name. What fails changes nothing (``ImportRefused``, one line). The
+written node kept is then the one with the value, so successive sets add up."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+from sensorium.server.sim.imports import ImportedNode, ImportRefused, rebuild_node, string_file, world_protos
+from sensorium.server.world.limits import ProtoLimits
+from sensorium.server.world.wbt.parser import Node as ParsedNode
+from sensorium.server.world.wbt.parser import WbtFile, WbtSyntaxError, parse_wbt
+
+_VECTORS = frozenset({"SFVec2f", "SFVec3f", "SFColor", "SFRotation"})
+
+
+def written_value(kind: str, value: Any) -> Any:
+    """A Supervisor's value (checked by the caller) as the ``.wbt`` parser gives that field's value: numbers
+    as floats, a vector as a tuple, an MF vector field's items flattened into one list."""
+    if kind in ("SFBool", "SFString"):
+        return value
+    if kind in ("SFInt32", "SFFloat"):
+        return float(value)
+    if kind in _VECTORS:
+        return tuple(float(v) for v in value)
+    if kind in ("MFBool", "MFString"):
+        return list(value)
+    if kind in ("MFInt32", "MFFloat"):
+        return [float(v) for v in value]
+    return [float(v) for item in value for v in item]          # MFVec2f, MFVec3f, MFColor, MFRotation
+
+
+def _world_instances(sim: Any) -> tuple[WbtFile, dict[str, ParsedNode]]:
+    """The world file's declarations and PROTOs, and its top-level PROTO instances that became one top-level
+    solid each (by the solid's name): the file parsed again once, at the first set, the rest dropped."""
+    kept = getattr(sim, "_regen_world", None)
+    if kept is not None:
+        return kept
+    loaded = sim.loaded
+    if not loaded.source.lower().endswith(".wbt") or not loaded.text:
+        kept = (WbtFile("", [], [], loaded.source), {})
+    else:
+        text = loaded.text.removeprefix(b"\xef\xbb\xbf").decode("utf-8", errors="replace")
+        try:
+            wbt = parse_wbt(text, loaded.source, ProtoLimits.matching(sim.limits))
+        except WbtSyntaxError as exc:       # the file changed on disk since it loaded? it loaded from these bytes
+            raise ImportRefused(f"{loaded.source}: the world file does not parse again: {exc.message}") from None
+        instances: dict[str, ParsedNode] = {}
+        solids = 0
+        faces = sim.top_level.interfaces
+        for written, top in zip(wbt.nodes, sim.loaded.world.top_nodes):
+            if top.solids == 1 and not top.robots and not top.lights and ("solids", solids) in faces:
+                instances[sim.scene.solid_names[solids]] = written
+            solids += top.solids
+        kept = (replace(wbt, nodes=[]), instances)
+    sim._regen_world = kept
+    return kept
+
+
+def _instance(sim: Any, key: str) -> tuple[ParsedNode, WbtFile] | None:
+    """The instance top-level solid ``key`` was built from, as written, and the file it was written in."""
+    done = getattr(sim, "_regen_written", {})
+    if key in sim.imported_written:
+        if sim._import_protos is None:
+            sim._import_protos = world_protos(sim.loaded, ProtoLimits.matching(sim.limits))
+        return done.get(key, sim.imported_written[key]), string_file(sim.loaded, sim._import_protos)
+    wbt, instances = _world_instances(sim)
+    written = done.get(key, instances.get(key))
+    return None if written is None else (written, wbt)
+
+
+def regenerate(sim: Any, key: str, node_id: int, values: dict[str, tuple[str, Any]],
+               warnings: list[str] | None = None) -> ImportedNode:
+    """Top-level solid ``key`` (Supervisor node ``node_id``, a PROTO instance) built again with ``values``
+    (field name -> (its VRML type, the Supervisor's value)) in its instance; returns what it became.
+    ``ImportRefused`` (one line, nothing changed) when it is not built from an instance kept here or the
+    new instance does not load."""
+    found = _instance(sim, key)
+    if found is None:
+        raise ImportRefused(f"the PROTO instance solid {key!r} was built from is not at hand here")
+    written, file = found
+    fields = dict(written.fields)
+    for name, (kind, value) in values.items():
+        fields[name] = written_value(kind, value)
+    new = replace(written, fields=fields)
+    taken = set(sim.scene.solid_names) - {key}
+    node = rebuild_node(new, file, sim.loaded, sim.world, taken=taken, limits=sim.limits,
+                        allow_outside_meshes=sim.allow_outside_meshes, warnings=warnings)
+    if node.type != "Solid":
+        raise ImportRefused(f"it would become a {node.type}, no longer a solid")
+    if node.model.name != key:
+        raise ImportRefused(f"it would be named {node.model.name!r}: a top-level solid keeps its name here (its key)")
+    sim.replace_solid(key, node, node_id)
+    sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
+    if key in sim.imported_interfaces:
+        sim.imported_interfaces[key] = node.interface
+    else:
+        sim.top_level.interfaces[("solids", sim.scene.solid_names.index(key))] = node.interface
+    return node
