@@ -178,6 +178,55 @@ def test_speeds_that_agree_with_no_twist_move_it_by_their_least_squares_fit() ->
     assert (x, y, yaw) == pytest.approx((ca * vx - cb * vy, cb * vx + ca * vy, w * 1.6), abs=1e-12)
 
 
+def test_contact_stops_it_at_a_wall_it_slides_into_sideways(tmp_path: Path) -> None:
+    wall = ('Solid { translation 0 0.5 0.1 name "wall" children [ DEF WALL Shape { geometry Box { size 2 0.1 0.2 } } ] '
+            'boundingObject USE WALL }\n')
+    p = tmp_path / "walled.wbt"
+    p.write_text(three_wheeler_text().replace(HEADER, HEADER + wall))
+    sim = Simulation(load_world(p))
+    spin(sim, three_speeds(0.0, 0.3, 0.0))             # to its left (+y) at 0.3 m/s: 0.96 m in 3.2 s unless stopped
+    sim.run(200)
+    x, y, yaw = pose2d(sim)
+    assert (x, yaw) == pytest.approx((0.0, 0.0), abs=1e-12)
+    # wheel 3's rim reaches farthest to its left (beyond the body's 0.12): its disc (radius r, 0.02 thick) about
+    # the axis (cos 60°, sin 60°) at L·(cos 60°, sin 60°) reaches y = L·sin 60° + r·cos 60° + 0.01·sin 60°
+    reach = L3 * math.sin(math.pi / 3) + R3 * 0.5 + 0.01 * math.sin(math.pi / 3)
+    assert y == pytest.approx(0.45 - reach, abs=1e-9)
+    assert sim.robot("omni").pressing
+
+
+CONTROLLER = '''
+from controller import Robot
+robot = Robot()
+step = int(robot.getBasicTimeStep())
+gps = robot.getDevice("gps")
+gps.enable(step)
+enc = robot.getDevice("wheel1 sensor")
+enc.enable(step)
+for name, v in SPEEDS.items():
+    m = robot.getDevice(name)
+    m.setPosition(float("inf"))
+    m.setVelocity(v)
+for _ in range(100):
+    robot.step(step)
+print("gps %.9f %.9f wheel1 %.9f" % tuple(round(v, 9) + 0.0 for v in (*gps.getValues()[:2], enc.getValue())))
+'''
+
+
+@pytest.mark.slow
+def test_a_python_controller_drives_it_sideways(tmp_path: Path) -> None:
+    from _serve import run_controller, sensorium
+    world = three_wheeler(tmp_path)
+    speeds = three_speeds(0.0, 0.2, 0.0)
+    script = tmp_path / "slide.py"
+    script.write_text(CONTROLLER.replace("SPEEDS", repr(speeds)))
+    lines, err = run_controller(world, lambda url: sensorium("controller", str(script), "--url", url), robot="omni",
+                                cwd=tmp_path)
+    # 1.6 s at 0.2 m/s to its left; wheel1 (at θ = π, rolling along (0, 1)) at 0.2/r = 4 rad/s for 1.6 s
+    assert speeds["wheel1"] == pytest.approx(4.0, abs=1e-12)
+    assert lines[-1:] == ["gps 0.000000000 0.320000000 wheel1 6.400000000"], err
+
+
 # ---------------------------------------------------------------- the four-wheel robot (four axes)
 
 RS, HS = 0.08, 0.15
