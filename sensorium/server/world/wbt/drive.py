@@ -38,6 +38,13 @@ kinematic ``mecanum_drive`` when they sit at the corners (±lx, ±ly) of a recta
 the origin, of one radius; a wheel's roller sign is minus the sign of its friction's turn (the
 youBot's wheels turned by +0.785 are the ones its library's formulas give -1).
 
+Three or more wheels, none steering, about axes horizontal in the robot's frame that are not all
+along one line, each turning something round about its axis, their lowest points on one ground
+(:func:`omni_wheels`: Webots' ``omni_wheels`` how-to, the ``four_wheels`` how-to's omni robot, a
+Robotino) map onto the kinematic ``omni_drive``: each wheel where its round part meets its axis's
+line, its axis and radius. Rollers (passive hinges across the wheel's axis, or asymmetric friction:
+:func:`has_rollers`) do not decide it; wheels without them are said in one warning.
+
 Anything else gets one sentence saying which of these failed.
 """
 
