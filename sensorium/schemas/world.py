@@ -1454,6 +1454,60 @@ class MecanumDrive(Strict):
         return self
 
 
+class OmniWheel(Strict):
+    """One wheel of an omni drive: where it touches the ground, the axis it turns about, its radius
+    and motor (in the robot's frame: x forward, y left, z up)."""
+
+    motor: str = Field(min_length=1, description="its RotationalMotor's name")
+    position: tuple[float, float] = Field(description="m, (x, y) of the wheel in the robot's frame: where it rolls "
+                                          "on the ground")
+    axis: tuple[float, float] = Field(description="its hinge axis in the ground plane, (x, y) in the robot's frame "
+                                      "(any length but 0): a positive speed rolls the wheel along axis × up")
+    radius: float = Field(gt=0, description="m")
+
+    @field_validator("axis")
+    @classmethod
+    def _nonzero_axis(cls, v: tuple[float, float]) -> tuple[float, float]:
+        if v[0] == 0.0 and v[1] == 0.0:
+            raise ValueError("axis must not be the zero vector")
+        return v
+
+
+class OmniDrive(Strict):
+    """Kinematic omnidirectional drive on omni wheels (three 120° apart as in Webots' ``omni_wheels``
+    how-to or a Festo Robotino, four at a square's corners, ...; no physics): each wheel's rollers let
+    it slip freely along its axis a, and it rolls without slip along d = a × up, so a wheel at p turning
+    at ω drives the robot's twist (vx, vy, ωz) with d · (v + ωz × p) = r·ω. The twist over a step is the
+    least-squares solution for the wheels' speeds: exact when they agree with one twist, their best fit
+    when they do not (a real robot's wheels would slip). The wheels must fix the twist: their rows
+    (d, d · (up × p)) span three dimensions (not all axes parallel)."""
+
+    wheels: list[OmniWheel] = Field(min_length=3, max_length=16)
+    max_wheel_speed: float = Field(default=10.0, gt=0, description="rad/s, the wheel motors' maxVelocity")
+
+    @property
+    def motor_fields(self) -> list[tuple[str, str]]:
+        """(field, motor name) of the wheels, in their order."""
+        return [(f"wheels[{i}].motor", w.motor) for i, w in enumerate(self.wheels)]
+
+    @model_validator(mode="after")
+    def _valid(self) -> OmniDrive:
+        names = [w.motor for w in self.wheels]
+        if len(set(names)) != len(names):
+            raise ValueError(f"every wheel motor needs its own name, got {names}")
+        rows = []
+        for w in self.wheels:
+            n = math.hypot(*w.axis)
+            dx, dy = w.axis[1] / n, -w.axis[0] / n
+            rows.append((dx, dy, dx * -w.position[1] + dy * w.position[0]))
+        s = [float(x) for x in np.linalg.svd(np.array(rows), compute_uv=False)]
+        if s[2] <= 1e-9 * max(s[0], 1e-300):
+            raise ValueError("the wheels cannot move the robot in every direction (their axes are all parallel, or "
+                             "their rolling directions leave a twist free): an omni drive needs wheels whose "
+                             "rolling fixes vx, vy and the turn rate")
+        return self
+
+
 # ---------------------------------------------------------------- robots and world
 
 class ProtoField(Strict):
@@ -1575,6 +1629,8 @@ class Robot(Strict):
                                                    "a robot has one drive at most")
     mecanum_drive: MecanumDrive | None = Field(default=None, description="an omnidirectional robot on four mecanum "
                                                "wheels (a KUKA youBot); a robot has one drive at most")
+    omni_drive: OmniDrive | None = Field(default=None, description="an omnidirectional robot on three or more omni "
+                                         "wheels (Webots' omni_wheels how-to, a Robotino); a robot has one drive at most")
     devices: list[Device] = Field(default=[], description="in Webots' tree order (the order of the device "
                                   "indices); every Webots device type is accepted, those not simulated as present")
     recognition_colors: list[Color] = Field(
@@ -1596,10 +1652,11 @@ class Robot(Strict):
 
     @model_validator(mode="after")
     def _one_drive(self) -> Robot:
-        given = [k for k in ("differential_drive", "ackermann_drive", "mecanum_drive") if getattr(self, k) is not None]
+        given = [k for k in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive")
+                 if getattr(self, k) is not None]
         if len(given) > 1:
-            raise ValueError(f"a robot has one drive at most: give one of differential_drive, ackermann_drive and "
-                             f"mecanum_drive, not {' and '.join(given)}")
+            raise ValueError(f"a robot has one drive at most: give one of differential_drive, ackermann_drive, "
+                             f"mecanum_drive and omni_drive, not {' and '.join(given)}")
         for i, t in enumerate(self.radar_targets):
             bad = [k for k in t.shapes if k >= len(self.shapes)]
             if bad:
@@ -1634,6 +1691,8 @@ class Robot(Strict):
             return [(f"ackermann_drive.{f}", m) for f, m in self.ackermann_drive.motor_fields]
         if self.mecanum_drive is not None:
             return [(f"mecanum_drive.{f}", m) for f, m in self.mecanum_drive.motor_fields]
+        if self.omni_drive is not None:
+            return [(f"omni_drive.{f}", m) for f, m in self.omni_drive.motor_fields]
         return []
 
 

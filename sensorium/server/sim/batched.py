@@ -356,6 +356,10 @@ class BatchedSimulation:
                 raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: its wheels' centre is not under its origin "
                                    "(differential_drive.axle_center); the batched simulation turns two-wheel and "
                                    "skid-steer robots about their origin only (use Simulation)")
+            if r.omni_drive is not None:
+                raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: an omni-wheel robot (omni_drive); the "
+                                   "batched simulation drives two-wheel, skid-steer, car-like and mecanum robots only "
+                                   "(use Simulation)")
             drive = {m for _, m in r.drive_motors}
             joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]
             if joints:

@@ -1,5 +1,5 @@
 """Kinematic wheeled drives (two wheels, skid steer, car-like Ackermann steering, four mecanum
-wheels): Webots-style wheel motors and exact pose integration.
+wheels, three or more omni wheels): Webots-style wheel motors and exact pose integration.
 
 No physics: wheels never slip and nothing collides. Over a basic step the wheel speeds are
 constant, so the robot follows an exact circular arc (or a straight segment); integrating the arc
@@ -380,6 +380,54 @@ class MecanumDrive(PlanarState):
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
         dt = dt_ms / 1000.0
         speeds = [m.advance(dt) for m, _, _ in self.wheels]
+        if all(u == 0.0 for u in speeds):
+            self.moved(0.0, 0.0)
+            return None
+        vx, vy, w = self.twist(speeds)
+        self.x, self.y, self.yaw = twist_step(self.x, self.y, self.yaw, vx, vy, w, dt)
+        self.moved(vx, w)
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        self.linear = (vx * c - vy * s, vx * s + vy * c)     # the origin's velocity at the step's end
+        return self.pose()
+
+
+class OmniDrive(PlanarState):
+    """Three or more omni wheels (``omni_drive``): wheel i at p_i (x forward, y left) turning about
+    a_i in the ground plane, rollers letting it slip freely along a_i, rolling without slip along
+    d_i = a_i × up (where a positive speed rolls a wheel's centre: ω·r·(a × up)). A twist (vx, vy, ωz)
+    rolls it at r_i·ω_i = d_i · (v + ωz × p_i), one row (d_ix, d_iy, d_i · (up × p_i)) of a matrix A;
+    the body twist over a step is the least-squares solution of A·t = (r_i·ω_i), A's pseudo-inverse
+    applied to the wheels' rims' speeds: exact when they agree with one twist (three wheels always do
+    when A is invertible), their best fit when they do not (a real robot's wheels would slip). Over a
+    basic step the twist is constant and :func:`twist_step` moves the robot exactly."""
+
+    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
+        speed = float(config.max_wheel_speed)
+        rows = []
+        self.wheels: list[tuple[WheelMotor, float]] = []
+        for w in config.wheels:
+            n = math.hypot(float(w.axis[0]), float(w.axis[1]))
+            dx, dy = float(w.axis[1]) / n, -float(w.axis[0]) / n
+            px, py = float(w.position[0]), float(w.position[1])
+            rows.append((dx, dy, dx * -py + dy * px))
+            self.wheels.append((WheelMotor(w.motor, speed), float(w.radius)))
+        self.solve = np.linalg.pinv(np.array(rows, dtype=np.float64))
+        """3 × N: the wheels' rim speeds (r_i·ω_i) to the body twist (vx, vy, ωz)."""
+        super().__init__(pose, up, ground, band_low)
+
+    @property
+    def motors(self) -> dict[str, WheelMotor]:
+        return {m.name: m for m, _ in self.wheels}
+
+    def twist(self, speeds: list[float]) -> tuple[float, float, float]:
+        """(vx, vy, ωz) in the robot's frame for the wheels' speeds (rad/s, the wheels' order)."""
+        vx, vy, w = self.solve @ np.array([u * r for u, (_, r) in zip(speeds, self.wheels)], dtype=np.float64)
+        return float(vx), float(vy), float(w)
+
+    def step(self, dt_ms: int) -> Pose | None:
+        """Advance one basic step; the new pose, or None when the wheels did not turn."""
+        dt = dt_ms / 1000.0
+        speeds = [m.advance(dt) for m, _ in self.wheels]
         if all(u == 0.0 for u in speeds):
             self.moved(0.0, 0.0)
             return None

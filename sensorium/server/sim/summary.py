@@ -32,6 +32,10 @@ def device_line(d) -> str:
 
 def drive_line(r: wm.Robot) -> str:
     """How the robot moves: its drive, what the .wbt import made of its wheels (or none)."""
+    if r.omni_drive is not None:
+        wheels = ", ".join(f"{w.motor} at ({w.position[0]:g}, {w.position[1]:g}) m about ({w.axis[0]:g}, "
+                           f"{w.axis[1]:g}), radius {w.radius:g} m" for w in r.omni_drive.wheels)
+        return f"omni wheels, {len(r.omni_drive.wheels)}: {wheels}"
     if r.mecanum_drive is not None:
         m = r.mecanum_drive
         return (f"mecanum: wheels of radius {m.wheel_radius:g} m at (±{m.lx:g}, ±{m.ly:g}) m, rollers "

@@ -1891,9 +1891,12 @@ class Converter:
             ackermann_drive,
             car_engine,
             differential_drive,
+            has_rollers,
             holds_wheel,
             mecanum_drive,
             mecanum_turns,
+            omni_drive,
+            omni_wheels,
             rolls_about_its_axis,
             wheel_radius,
         )
@@ -1950,6 +1953,20 @@ class Converter:
                                 f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
                                 "turning about a vertical axis"))
             return
+        if omni_wheels(wheels, self):     # three or more wheels about horizontal axes not along one line (drive.py)
+            drive, why = omni_drive(wheels, self)
+            if drive is None:
+                self.warn(node, f"robot {robot.data['name']!r}: no omni drive ({why}); the robot will not move")
+                return
+            plain = [w["motor"] for w in wheels if not has_rollers(w, self)]
+            if plain:
+                self.warn(node, f"robot {robot.data['name']!r}: wheel(s) {', '.join(repr(m) for m in plain)} show no "
+                                "rollers (passive hinges across their axis) nor asymmetric friction: taken as omni "
+                                "wheels, which slip freely along their axes (Webots' physics makes plain wheels "
+                                "grip there, so such a robot moves only where no wheel would slide sideways)")
+            robot.data["omni_drive"] = drive
+            self._drive_wheels(robot, wheels)
+            return
         turns = None                              # mecanum rollers: the wheels' friction turned (wbt/drive.py)
         if any(w["steers"] for w in wheels):
             # a mecanum base carrying an arm whose first joint turns about the vertical (a youBot): the
@@ -2005,6 +2022,10 @@ class Converter:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return
             robot.data["differential_drive"] = drive
+        self._drive_wheels(robot, wheels)
+
+    def _drive_wheels(self, robot: Owner, wheels: list[dict]) -> None:
+        """The drive's wheels are its own: their encoders measure them, their motors' joint fields go."""
         for w in wheels:    # the wheels' encoders measure the drive's wheels
             for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]
@@ -2054,6 +2075,7 @@ def drive_motor_names(robot: dict) -> list[str]:
         *skid.get("left", ()), *skid.get("right", ())]
     motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
     motors += [v for k, v in (robot.get("mecanum_drive") or {}).items() if k.endswith("_motor")]
+    motors += [w["motor"] for w in (robot.get("omni_drive") or {}).get("wheels", ())]
     return [m for m in motors if isinstance(m, str)]
 
 

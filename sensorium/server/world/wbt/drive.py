@@ -38,6 +38,13 @@ kinematic ``mecanum_drive`` when they sit at the corners (±lx, ±ly) of a recta
 the origin, of one radius; a wheel's roller sign is minus the sign of its friction's turn (the
 youBot's wheels turned by +0.785 are the ones its library's formulas give -1).
 
+Three or more wheels, none steering, about axes horizontal in the robot's frame that are not all
+along one line, each turning something round about its axis, their lowest points on one ground
+(:func:`omni_wheels`: Webots' ``omni_wheels`` how-to, the ``four_wheels`` how-to's omni robot, a
+Robotino) map onto the kinematic ``omni_drive``: each wheel where its round part meets its axis's
+line, its axis and radius. Rollers (passive hinges across the wheel's axis, or asymmetric friction:
+:func:`has_rollers`) do not decide it; wheels without them are said in one warning.
+
 Anything else gets one sentence saying which of these failed.
 """
 
@@ -555,3 +562,153 @@ def _mecanum(wheels: list[dict], turns: list[float | None], conv) -> tuple[dict 
     for (end_, side), key in zip(order, ("front_left", "front_right", "rear_left", "rear_right")):
         out[f"{key}_motor"] = slots[(end_, side)][0]["motor"]
     return out, ""
+
+
+# ---------------------------------------------------------------- omni wheels (Webots' omni_wheels how-to, a Robotino)
+
+ROLLER_COS = 0.1
+"""|cos| between a passive hinge's axis and its wheel's below which the hinge is a roller (across the
+wheel's axis; Webots' omni_wheels how-to has its rollers exactly across, 0)."""
+
+
+GROUND_TOL = 1e-3
+"""m: how far apart the omni wheels' lowest points may be and still stand on one ground plane."""
+
+
+def omni_wheels(wheels: list[dict], conv) -> bool:
+    """Whether a robot's motorised hinges make an omni-wheel robot: three or more wheels, none
+    steering, every axis horizontal in the robot's frame (perpendicular to its z) and not all along
+    one line (parallel or opposite), each a wheel (something round at its end point turning about
+    its axis: :func:`rolls_about_its_axis`) and their lowest points at one height (within
+    GROUND_TOL): they stand on one ground. A two-wheel, skid-steer or mecanum robot has its axes
+    along one line and a car steers, so none of them is one; mirrored axes (one side's wheels about
+    -y) stay with the differential drive, which says why it cannot drive them; an arm's hinge beside
+    two wheels is no wheel (nothing round turns about its axis, or it is not on the ground), and the
+    differential drive takes the two."""
+    if len(wheels) < 3 or any(w["steers"] for w in wheels):
+        return False
+    axes = [np.asarray(w["axis"], dtype=np.float64) / np.linalg.norm(w["axis"]) for w in wheels]
+    if any(abs(a[2]) > AXIS_TOL for a in axes):
+        return False
+    if not any(abs(float(np.dot(a, axes[0]))) < 1.0 - TOL for a in axes[1:]):
+        return False
+    if not all(rolls_about_its_axis(w, conv) for w in wheels):
+        return False
+    bottoms = []
+    for w in wheels:
+        radius = wheel_radius(w["end"], conv)
+        if radius is None:
+            return False
+        bottoms.append(float(_on_axis(w, conv)[2]) - radius)
+    return max(bottoms) - min(bottoms) <= GROUND_TOL
+
+
+def _on_axis(w: dict, conv) -> np.ndarray:
+    """Where a wheel rolls on the ground (above it): the centre of its round part (:func:`round_centre`,
+    else its end point's origin) taken onto its axis's line, in the robot's frame."""
+    axis = np.asarray(w["axis"], dtype=np.float64) / np.linalg.norm(w["axis"])
+    anchor = np.asarray(w["anchor"], dtype=np.float64)
+    centre = round_centre(w, conv)
+    centre = np.asarray(w["centre"], dtype=np.float64) if centre is None else centre
+    return anchor + axis * float(np.dot(centre - anchor, axis))
+
+
+def round_centre(w: dict, conv) -> np.ndarray | None:
+    """The centre, in the robot's frame, of the first cylinder, capsule or sphere of a wheel's end
+    point (its boundingObject first, as :func:`wheel_radius` looks), or None."""
+    end = conv.slotted(w["end"])
+    if end is None:
+        return None
+
+    def find(node: Node | None, frame) -> np.ndarray | None:
+        if node is None:
+            return None
+        conv.walk(node)
+        nf = conv.fields(node)
+        if node.type in ("Cylinder", "Sphere", "Capsule"):
+            return np.asarray(frame.translation, dtype=np.float64)
+        if node.type == "Shape":
+            return find(nf.node_("geometry"), frame)
+        if node.type in ("Pose", "Transform", "Group", "Solid"):
+            inner = frame if node.type == "Group" else conv.child_frame(node, frame)
+            for child in nf.nodes("children"):
+                r = find(child, inner)
+                if r is not None:
+                    return r
+        return None
+
+    at = conv.child_frame(end, w["frame"])
+    found = find(conv.fields(end).node_("boundingObject"), at)
+    return found if found is not None else find(end, w["frame"])
+
+
+def has_rollers(w: dict, conv) -> bool:
+    """Whether a wheel shows its rollers: two or more HingeJoints without a motor in its end point
+    whose axes lie across the wheel's (Webots' omni_wheels how-to: passive rollers that only its
+    physics turns), or an asymmetric friction on its contact material (a ContactProperties'
+    two ``coulombFriction`` values for it, as a Robotino's or a youBot's wheels have)."""
+    end = conv.slotted(w["end"])
+    if end is None:
+        return False
+    axis = np.asarray(w["axis"], dtype=np.float64) / np.linalg.norm(w["axis"])
+    count = 0
+
+    def walk(node: Node | None, frame) -> None:
+        nonlocal count
+        if node is None:
+            return
+        conv.walk(node)
+        nf = conv.fields(node)
+        if node.type == "HingeJoint":
+            if not any(d.type == "RotationalMotor" for d in nf.nodes("device")):
+                params = nf.node_("jointParameters")
+                a = conv.fields(params).vec("axis", (1.0, 0.0, 0.0)) if params is not None else (1.0, 0.0, 0.0)
+                turned = np.asarray(frame.rotation, dtype=np.float64) @ np.asarray(a, dtype=np.float64)
+                n = float(np.linalg.norm(turned))
+                if n > 0.0 and abs(float(np.dot(turned, axis))) <= ROLLER_COS * n:
+                    count += 1
+            return
+        if node.type in ("Pose", "Transform", "Group", "Solid"):
+            inner = frame if node.type == "Group" else conv.child_frame(node, frame)
+            for child in nf.nodes("children"):
+                walk(child, inner)
+
+    walk(end, w["frame"])
+    if count >= 2:
+        return True
+    if end.type != "Solid":
+        return False
+    material = conv.fields(end).string("contactMaterial", "default")
+    for m1, m2, friction, _rotation in contact_properties(conv):
+        if material not in (m1, m2):
+            continue
+        pair = friction[:2] if material == m1 and len(friction) >= 2 else friction[-2:] if len(friction) in (2, 4) else ()
+        return len(pair) == 2 and pair[0] != pair[1]
+    return False
+
+
+def omni_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
+    """The kinematic omni drive of a robot's wheels (:func:`omni_wheels` said they make one), or
+    (None, the sentence why not). Each wheel rolls on the ground where its round part is: the centre
+    of its cylinder (or sphere) taken onto its axis's line, else the end point's origin; its radius
+    that cylinder's. The wheels' places and axes are the robot's x and y."""
+    out = []
+    for w in wheels:
+        radius = wheel_radius(w["end"], conv)
+        if radius is None:
+            return None, f"wheel {w['motor']!r}: its end point has no cylinder or sphere to take the wheel radius from"
+        axis = np.asarray(w["axis"], dtype=np.float64) / np.linalg.norm(w["axis"])
+        on_axis = _on_axis(w, conv)
+        out.append({"motor": w["motor"], "position": [float(on_axis[0]), float(on_axis[1])],
+                    "axis": [float(axis[0]), float(axis[1])], "radius": float(radius)})
+    rows = []
+    for o in out:
+        (ax, ay), (px, py) = o["axis"], o["position"]
+        rows.append((ay, -ax, ay * -py - ax * px))
+    s = np.linalg.svd(np.array(rows), compute_uv=False)
+    if s[2] <= 1e-9 * max(float(s[0]), 1e-300):
+        where = ", ".join(f"{o['motor']!r} at ({o['position'][0]:g}, {o['position'][1]:g}) about "
+                          f"({o['axis'][0]:g}, {o['axis'][1]:g})" for o in out)
+        return None, (f"the wheels ({where}) cannot move the robot in every direction: their rolling leaves a twist "
+                      "free")
+    return {"wheels": out, "max_wheel_speed": _max_speed(wheels, conv)}, ""
