@@ -8,7 +8,8 @@
 A :class:`Connection` owns one ``DEALER`` socket (not thread-safe: use it from one thread). A
 :class:`Heartbeat` thread owns a second socket and sends ``ping {session}`` every
 ``heartbeat_ms`` so that a controller computing for a long time between steps stays attached; it
-also tells the connection when the server stopped answering, so a blocked step raises
+also tells the connection when the server is gone (no answer and no live ZeroMQ connection: a
+server computing a long step keeps its connection up and is waited for), so a blocked step raises
 :class:`ConnectionLost` instead of hanging forever. Errors the server sends back raise
 :class:`SensoriumError` with the protocol's code (PROTOCOL.md §3.2).
 """
@@ -565,8 +566,13 @@ class Connection:
 class Heartbeat(threading.Thread):
     """Sends ``ping {session}`` every ``interval_ms`` on its own socket and watches the replies.
 
-    :meth:`problem` says why the connection is unusable: no reply for ``lost_after_s`` seconds
-    (default: 5 heartbeats, at least 2 s), or the server answered that the session is gone."""
+    :meth:`problem` says why the connection is unusable: the server answered that the session is
+    gone, or it is gone itself: no reply for ``lost_after_s`` seconds (default: 5 heartbeats, at
+    least 2 s) *and* no live ZeroMQ connection to it for :attr:`down_grace` seconds. A server that
+    computes a long step answers no ping, but its ZeroMQ I/O thread answers the ZMTP heartbeats this
+    socket sends (``ZMQ_HEARTBEAT_IVL``/``ZMQ_HEARTBEAT_TIMEOUT``) and keeps the connection up:
+    busy, not gone, so the wait goes on. A killed server closes the connection; a frozen one
+    (SIGSTOP: its I/O threads stop too) lets the ZMTP heartbeats time out, which closes it."""
 
     def __init__(self, endpoint: str, session: str, interval_ms: int, context: zmq.Context,
                  lost_after_s: float | None = None, serverkey: bytes | None = None):
@@ -576,6 +582,12 @@ class Heartbeat(threading.Thread):
         self.session = session
         self.interval = max(1, int(interval_ms)) / 1000.0
         self.lost_after = lost_after_s if lost_after_s is not None else max(2.0, 5 * self.interval)
+        # ZMTP heartbeats: a PING each interval; no traffic for zmtp_timeout closes the connection
+        self.zmtp_timeout = max(1.0, 3 * self.interval)
+        # a connection down this long (a reconnection takes ~0.1 s) counts as no connection
+        self.down_grace = max(0.5, 2 * self.interval)
+        self.connected = False     # a ZeroMQ connection has passed its handshake and not closed since
+        self.down_since = time.monotonic()
         self._context = context
         self._stop_event = threading.Event()
         # stop() wakes the thread through this pair: it sleeps until its next ping, not in short
@@ -591,10 +603,29 @@ class Heartbeat(threading.Thread):
     def problem(self) -> str | None:
         if self._problem is not None:
             return self._problem
-        silent = time.monotonic() - self.last_reply
-        if silent > self.lost_after:
-            return f"no answer from {self.endpoint} for {silent:.1f} s (server gone, or the network down)"
-        return None
+        now = time.monotonic()
+        silent = now - self.last_reply
+        if silent <= self.lost_after or self.connected:
+            return None                 # answering, or busy (a long step): its connection lives
+        down = now - self.down_since
+        if down <= self.down_grace:
+            return None
+        return (f"no answer from {self.endpoint} for {silent:.1f} s and no connection to it for {down:.1f} s "
+                "(server gone, or the network down)")
+
+    def _watch(self, monitor: zmq.Socket) -> None:
+        """Read the connection's events (non-blocking): up after a handshake, down when it closes."""
+        while True:
+            try:
+                frames = monitor.recv_multipart(zmq.NOBLOCK)
+            except zmq.Again:
+                return
+            event = int.from_bytes(frames[0][:2], "little")
+            if event == zmq.EVENT_HANDSHAKE_SUCCEEDED:
+                self.connected = True
+            elif event == zmq.EVENT_DISCONNECTED and self.connected:
+                self.connected = False
+                self.down_since = time.monotonic()
 
     def stop(self) -> None:
         self._stop_event.set()
@@ -608,8 +639,18 @@ class Heartbeat(threading.Thread):
     def run(self) -> None:
         sock = self._context.socket(zmq.DEALER)
         sock.setsockopt(zmq.LINGER, 0)
+        sock.setsockopt(zmq.HEARTBEAT_IVL, max(1, int(self.interval * 1000)))
+        sock.setsockopt(zmq.HEARTBEAT_TIMEOUT, int(self.zmtp_timeout * 1000))
+        # the connection's ups and downs (the unbounded pipe: see Connection.__init__)
+        addr = f"inproc://sensorium-heartbeat-{secrets.token_hex(8)}"
+        sock.monitor(addr, zmq.EVENT_HANDSHAKE_SUCCEEDED | zmq.EVENT_DISCONNECTED)
+        monitor = self._context.socket(zmq.PAIR)
+        monitor.setsockopt(zmq.RCVHWM, 0)
+        monitor.setsockopt(zmq.LINGER, 0)
+        monitor.connect(addr)
         poller = zmq.Poller()
         poller.register(sock, zmq.POLLIN)
+        poller.register(monitor, zmq.POLLIN)
         poller.register(self._wake_r.fileno(), zmq.POLLIN)
         try:
             curve_client(sock, self.serverkey)
@@ -624,6 +665,7 @@ class Heartbeat(threading.Thread):
                     # not a sign that it is gone; ask again before judging
                     self.paused_s = max(self.paused_s, now - last_turn)
                     self.last_reply = now
+                    self.down_since = max(self.down_since, now)
                     next_ping = now
                 last_turn = now
                 if now >= next_ping:
@@ -631,7 +673,10 @@ class Heartbeat(threading.Thread):
                     self.pings += 1
                     next_ping = now + self.interval
                 wait_ms = int((next_ping - time.monotonic()) * 1000) + 1
-                if dict(poller.poll(max(wait_ms, 1))).get(sock):
+                ready = dict(poller.poll(max(wait_ms, 1)))
+                if ready.get(monitor):
+                    self._watch(monitor)
+                if ready.get(sock):
                     while True:
                         try:
                             reply = unpack(sock.recv_multipart(zmq.NOBLOCK)[-1])
@@ -650,6 +695,11 @@ class Heartbeat(threading.Thread):
         except zmq.ContextTerminated:
             pass
         finally:
+            try:
+                sock.disable_monitor()
+            except zmq.ZMQError:
+                pass
+            monitor.close(linger=0)
             sock.close(linger=0)
             self._wake_r.close()
             self._wake_w.close()
