@@ -29,7 +29,7 @@ import pytest
 from _serve import Served, wait_until
 from test_c_client import ENV, finish, sanitized_controller
 
-from sensorium.client.connection import Connection, ConnectionLost
+from sensorium.client.connection import PING_BACKLOG, Connection, ConnectionLost
 from sensorium.server.daemon.transport import generate_curve_keys
 
 TESTS = Path(__file__).parent
@@ -82,16 +82,16 @@ def _attached(url: str) -> Connection:
     return conn
 
 
-def _long_step(conn: Connection, hold: Path) -> Step:
-    """A step the server computes for longer than twice the controller's five heartbeats; the
-    controller still waiting for it at the end."""
+def _long_step(conn: Connection, hold: Path, silent_s: float = 2 * LOST_S) -> Step:
+    """A step the server computes until the controller has heard nothing for ``silent_s`` (twice its
+    five heartbeats); the controller still waiting for it at the end."""
     hb = conn.heartbeat
     assert hb is not None
     hold.touch()
     step = Step(conn)
     wait_until(Path(f"{hold}.holding").exists, what="the server's long step")
-    wait_until(lambda: step.ended or time.monotonic() - hb.last_reply > 2 * LOST_S, timeout=120,
-               what="twice five heartbeats without an answer")
+    wait_until(lambda: step.ended or time.monotonic() - hb.last_reply > silent_s, timeout=120,
+               what="the controller's wait without an answer")
     assert step.error is None and step.result is None, f"the controller gave up on a busy server: {step.error}"
     return step
 
@@ -107,8 +107,14 @@ def test_a_python_controller_waits_out_a_step_longer_than_five_heartbeats(tmp_pa
     rpc = f"ipc://{tmp_path}/rpc" if kind == "ipc" else "tcp://127.0.0.1:0"
     with slow_server(tmp_path, rpc, keys) as (server, hold):
         conn = _attached(server.rpc + (f"?serverkey={public}" if keys else ""))
+        hb = conn.heartbeat
+        assert hb is not None
         try:
-            step = _long_step(conn, hold)
+            pings, retries = hb.pings, conn.retries
+            step = _long_step(conn, hold, 6.0)                  # 30 heartbeats
+            # what waits in the server's queue meanwhile stays short: pings stop at PING_BACKLOG
+            # unanswered, the step's copies (against a lost reply) come 1, 2, 4, 8 … s apart
+            assert hb.pings - pings <= PING_BACKLOG and conn.retries - retries <= 3
             hold.unlink()
             step.join(60)
             assert step.error is None and step.result is not None and step.result["time_ms"] == 32

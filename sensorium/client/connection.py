@@ -42,7 +42,9 @@ WEBOTS_ENV_ROBOT = "WEBOTS_ROBOT_NAME"
 ENV_CURVE_SERVERKEY = "SENSORIUM_CURVE_SERVERKEY"   # the server's CURVE public key: encrypt, authenticate it
 ENV_CURVE_PUBLICKEY = "SENSORIUM_CURVE_PUBLICKEY"   # this client's key pair (default: a fresh one per socket)
 ENV_CURVE_SECRETKEY = "SENSORIUM_CURVE_SECRETKEY"
-RETRY_S = 1.0                   # a step request unanswered this long is sent again (same id)
+RETRY_S = 1.0                   # a step request unanswered this long is sent again (same id) ...
+RETRY_MAX_S = 8.0               # ... then after twice as long each time, up to this (a long step)
+PING_BACKLOG = 16               # unanswered pings at most (a long step): the server's queue stays short
 RETRIED_SERVICES = ("/robot/step", "/robot/time_step")
 DEFAULT_TIMEOUT = 10.0          # seconds for a non-step request (the server may still be starting)
 
@@ -325,7 +327,7 @@ class Connection:
         self._packer = msgpack.Packer(use_bin_type=True)   # reused: one per connection (one thread)
         self._outstanding: dict[int, str] = {}      # id -> service, for messages
         self._replies: dict[int, dict] = {}
-        self._retry: dict[int, tuple[bytes, float]] = {}   # step requests: id -> (bytes, last sent)
+        self._retry: dict[int, tuple[bytes, float, float]] = {}   # step requests: id -> (bytes, last sent, wait)
         self.heartbeat: Heartbeat | None = None
         self.retries = 0                            # step requests sent again (see _resend_due)
         self.closed = False
@@ -351,7 +353,7 @@ class Connection:
                                  "or 1000 requests wait unsent") from None
         self._outstanding[rid] = service
         if service.endswith(RETRIED_SERVICES):
-            self._retry[rid] = (data, time.monotonic())
+            self._retry[rid] = (data, time.monotonic(), RETRY_S)
         return rid
 
     def wait(self, rid: int, timeout: Any = _NO_TIMEOUT) -> dict:
@@ -478,7 +480,7 @@ class Connection:
         """Re-send a step request not answered for :data:`RETRY_S`: its reply may have been lost
         with a dropped connection. The server answers a repeated id once (PROTOCOL.md)."""
         entry = self._retry.get(rid)
-        if entry is not None and time.monotonic() - entry[1] >= RETRY_S:
+        if entry is not None and time.monotonic() - entry[1] >= entry[2]:
             try:
                 self._socket.send(entry[0], _NOBLOCK)
             except zmq.Again:
@@ -488,7 +490,8 @@ class Connection:
                 self._retry.pop(rid, None)
                 raise ConnectionLost(f"ZeroMQ closed the connection to {self.endpoint} for good while the reply to "
                                      f"{service!r} was due (a message that is not ZeroMQ ends it)") from None
-            self._retry[rid] = (entry[0], time.monotonic())
+            # a step the server computes for long gets fewer copies: 1, 2, 4, 8, 8 … s apart
+            self._retry[rid] = (entry[0], time.monotonic(), min(2 * entry[2], RETRY_MAX_S))
             self.retries += 1
 
     def discard(self, rid: int) -> None:
@@ -598,6 +601,7 @@ class Heartbeat(threading.Thread):
         self.last_reply = time.monotonic()
         self.pings = 0
         self.replies = 0
+        self._unanswered = 0       # pings sent since the last reply (or connection)
         self.paused_s = 0.0        # longest time this thread did not run (SIGSTOP, a stalled VM)
 
     def problem(self) -> str | None:
@@ -623,6 +627,7 @@ class Heartbeat(threading.Thread):
             event = int.from_bytes(frames[0][:2], "little")
             if event == zmq.EVENT_HANDSHAKE_SUCCEEDED:
                 self.connected = True
+                self._unanswered = 0        # a new connection: pings sent before may be lost
             elif event == zmq.EVENT_DISCONNECTED and self.connected:
                 self.connected = False
                 self.down_since = time.monotonic()
@@ -669,8 +674,11 @@ class Heartbeat(threading.Thread):
                     next_ping = now
                 last_turn = now
                 if now >= next_ping:
-                    sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
-                    self.pings += 1
+                    # a server computing a long step reads none: a few wait for it, not one per beat
+                    if self._unanswered < PING_BACKLOG:
+                        sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
+                        self.pings += 1
+                        self._unanswered += 1
                     next_ping = now + self.interval
                 wait_ms = int((next_ping - time.monotonic()) * 1000) + 1
                 ready = dict(poller.poll(max(wait_ms, 1)))
@@ -686,6 +694,7 @@ class Heartbeat(threading.Thread):
                             continue
                         self.last_reply = time.monotonic()
                         self.replies += 1
+                        self._unanswered = 0
                         if isinstance(reply, dict) and reply.get("ok") is False:
                             err = _error_from(reply)
                             why = (f"after this process did not run for {self.paused_s:.1f} s"

@@ -300,6 +300,7 @@ struct sn_conn {
   size_t retry_size;
   uint64_t retry_id;
   int64_t retry_sent_ms;
+  int64_t retry_wait_ms; /* RETRY_MS, doubled at each re-send up to RETRY_MAX_MS (a long step) */
   /* handshake events (tcp only), so that a server that refuses this client's security handshake is
      said as such rather than as "is the server running?"; dropped after the first reply */
   void *monitor;
@@ -308,6 +309,8 @@ struct sn_conn {
 };
 
 #define RETRY_MS 1000
+#define RETRY_MAX_MS 8000
+#define PING_BACKLOG 16 /* unanswered pings at most (a long step): the server's queue stays short */
 
 /* CURVE (PROTOCOL.md, README "Security and limits"): with SENSORIUM_CURVE_SERVERKEY set (the
    server's public key, 64 hex or 40 Z85 characters) the socket encrypts and authenticates the
@@ -557,6 +560,7 @@ int sn_conn_send_retried(sn_conn *c, sn_req *r, uint64_t id) {
     memcpy(c->retry_data, r->buf.data, r->buf.size);
     c->retry_size = r->buf.size;
     c->retry_sent_ms = now_ms();
+    c->retry_wait_ms = RETRY_MS;
   }
   return 0;
 }
@@ -629,7 +633,7 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
       return -1;
     }
     if (n == 0) {
-      if (c->retry_id == id && now_ms() - c->retry_sent_ms >= RETRY_MS) {
+      if (c->retry_id == id && now_ms() - c->retry_sent_ms >= c->retry_wait_ms) {
         if (zmq_send(c->sock, c->retry_data, c->retry_size, ZMQ_DONTWAIT) < 0 && zmq_errno() == EAGAIN) {
           /* the socket has no connection left to queue on: ZeroMQ closed it for good, which it does
              (without reconnecting) when a message breaks the protocol, e.g. a reply larger than
@@ -649,6 +653,7 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
           return -1;
         }
         c->retry_sent_ms = now_ms();
+        c->retry_wait_ms = 2 * c->retry_wait_ms < RETRY_MAX_MS ? 2 * c->retry_wait_ms : RETRY_MAX_MS;
       }
       if (c->monitor != NULL)
         watch_handshakes(c);
@@ -744,7 +749,7 @@ int sn_conn_wait_any(sn_conn *c, int timeout_ms, sn_reply *out) {
 /* ------------------------------------------------------------------ heartbeat */
 
 /* The heartbeat connection's events (never blocks): up after a handshake, down when it closes. */
-static void watch_connection(sn_conn *c, void *mon) {
+static void watch_connection(sn_conn *c, void *mon, int *unanswered) {
   for (;;) {
     zmq_msg_t msg;
     zmq_msg_init(&msg);
@@ -764,9 +769,10 @@ static void watch_connection(sn_conn *c, void *mon) {
         break;
     }
     zmq_msg_close(&msg);
-    if (event == ZMQ_EVENT_HANDSHAKE_SUCCEEDED)
+    if (event == ZMQ_EVENT_HANDSHAKE_SUCCEEDED) {
       atomic_store(&c->hb_connected, true);
-    else if (event == ZMQ_EVENT_DISCONNECTED && atomic_load(&c->hb_connected)) {
+      *unanswered = 0; /* a new connection: pings sent before may be lost */
+    } else if (event == ZMQ_EVENT_DISCONNECTED && atomic_load(&c->hb_connected)) {
       atomic_store(&c->hb_connected, false);
       atomic_store(&c->hb_down_since, (long long)now_ms());
     }
@@ -811,16 +817,20 @@ static void *heartbeat_main(void *arg) {
     return NULL;
   }
   uint64_t ids = 1;
+  int unanswered = 0; /* pings sent since the last reply (or connection) */
   int64_t next_ping = now_ms();
   while (!atomic_load(&c->hb_stop)) {
     int64_t now = now_ms();
     if (now >= next_ping) {
-      sn_req r;
-      sn_req_begin(&r, ids++, "ping", 1);
-      sn_req_key(&r, "session");
-      sn_req_str(&r, c->hb_session);
-      zmq_send(sock, r.buf.data, r.buf.size, ZMQ_DONTWAIT);
-      sn_req_free(&r);
+      if (unanswered < PING_BACKLOG) { /* a server computing a long step reads none: a few wait for it */
+        sn_req r;
+        sn_req_begin(&r, ids++, "ping", 1);
+        sn_req_key(&r, "session");
+        sn_req_str(&r, c->hb_session);
+        zmq_send(sock, r.buf.data, r.buf.size, ZMQ_DONTWAIT);
+        sn_req_free(&r);
+        unanswered++;
+      }
       next_ping = now + c->hb_interval_ms;
     }
     int64_t wait = next_ping - now_ms();
@@ -830,7 +840,7 @@ static void *heartbeat_main(void *arg) {
       wait = 1;
     zmq_pollitem_t items[2] = {{sock, 0, ZMQ_POLLIN, 0}, {mon, 0, ZMQ_POLLIN, 0}};
     if (zmq_poll(items, mon != NULL ? 2 : 1, (long)wait) > 0 && (items[1].revents & ZMQ_POLLIN))
-      watch_connection(c, mon);
+      watch_connection(c, mon, &unanswered);
     if (items[0].revents & ZMQ_POLLIN) {
       zmq_msg_t msg;
       zmq_msg_init(&msg);
@@ -843,6 +853,7 @@ static void *heartbeat_main(void *arg) {
           uint64_t got;
           if (decode_reply(data, size, &rep, &got) == 0) {
             atomic_store(&c->hb_last_reply, (long long)now_ms());
+            unanswered = 0;
             if (!rep.ok) {
               pthread_mutex_lock(&c->hb_lock);
               snprintf(c->hb_problem, sizeof c->hb_problem, "the server dropped session '%s' (%s: %s)", c->hb_session,
