@@ -791,8 +791,9 @@ static void *heartbeat_main(void *arg) {
   zmq_setsockopt(sock, ZMQ_HEARTBEAT_TIMEOUT, &timeout, sizeof timeout);
   /* the connection's ups and downs, on an unbounded pipe (see start_monitor); without a monitor the
      connection counts as down: unanswered pings then mean gone, as before */
-  char addr[64];
-  snprintf(addr, sizeof addr, "inproc://sensorium-heartbeat-%p", (void *)c);
+  static atomic_uint monitors; /* a fresh address each time: a closed monitor's may linger */
+  char addr[80];
+  snprintf(addr, sizeof addr, "inproc://sensorium-heartbeat-%p-%u", (void *)c, atomic_fetch_add(&monitors, 1u));
   void *mon = NULL;
   if (zmq_socket_monitor(sock, addr, ZMQ_EVENT_HANDSHAKE_SUCCEEDED | ZMQ_EVENT_DISCONNECTED) == 0) {
     mon = zmq_socket(c->ctx, ZMQ_PAIR);
