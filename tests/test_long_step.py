@@ -144,9 +144,12 @@ def script(tmp_path_factory) -> str:
     return sanitized_controller(tmp_path_factory, TESTS / "c" / "script.c")
 
 
-def _c_controller(script: str, server: Served, steps: int) -> subprocess.Popen:
+def _c_controller(script: str, server: Served, steps: int, serverkey: str | None = None) -> subprocess.Popen:
+    env = {**ENV, "SENSORIUM_CONTROLLER_URL": server.url("bot2")}
+    if serverkey is not None:
+        env["SENSORIUM_CURVE_SERVERKEY"] = serverkey
     return subprocess.Popen([script, "step", "16", str(steps)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env={**ENV, "SENSORIUM_CONTROLLER_URL": server.url("bot2")})
+                            text=True, env=env)
 
 
 def _waits_through_a_long_step(p: subprocess.Popen, hold: Path) -> None:
@@ -158,10 +161,14 @@ def _waits_through_a_long_step(p: subprocess.Popen, hold: Path) -> None:
     assert p.poll() is None, f"the C controller gave up on a busy server: {p.communicate()[1]}"
 
 
-def test_a_c_controller_waits_out_a_step_longer_than_five_heartbeats(tmp_path, script) -> None:
-    with slow_server(tmp_path) as (server, hold):
+@pytest.mark.parametrize("kind", ["tcp", "ipc", "curve"])
+def test_a_c_controller_waits_out_a_step_longer_than_five_heartbeats(tmp_path, script, kind) -> None:
+    keys = tmp_path / "keys" if kind == "curve" else None
+    public = generate_curve_keys(keys).decode() if keys else None
+    rpc = f"ipc://{tmp_path}/rpc" if kind == "ipc" else "tcp://127.0.0.1:0"
+    with slow_server(tmp_path, rpc, keys) as (server, hold):
         hold.touch()
-        p = _c_controller(script, server, 3)
+        p = _c_controller(script, server, 3, public)
         _waits_through_a_long_step(p, hold)
         hold.unlink()
         code, lines, err = finish(p, 60)
