@@ -325,15 +325,26 @@ def test_heartbeat_pings_from_its_own_socket(robot, server):
     assert robot.conn.heartbeat.problem() is None
 
 
-def test_blocked_step_ends_when_server_goes_silent(server, capsys):
+def test_a_blocked_step_waits_for_a_silent_server_and_ends_when_it_is_gone(server, capsys):
+    """A server that answers nothing (a long step) but whose ZeroMQ connection lives is busy: the
+    step waits past lost_after_s. Once its socket closes (the server gone), the step ends with -1
+    at the heartbeat's next look, not after the 20 s timeout."""
     r1 = wb.RobotClient(server.endpoint, robot="r1", timeout=20.0, lost_after_s=0.4)
+    hb = r1.conn.heartbeat
     try:
         server.hold = True
         r1.step_begin()
         server.silent = True
+        status: list[int] = []
+        waiter = threading.Thread(target=lambda: status.append(r1.step_end()), daemon=True)
+        waiter.start()
+        _until(lambda: status or time.monotonic() - hb.last_reply > 2.0)      # five times lost_after_s
+        assert status == [], "the step gave up on a busy server"
         t0 = time.monotonic()
-        assert r1.step_end() == -1
-        assert time.monotonic() - t0 < 10.0           # lost_after_s, not the 20 s timeout
+        server.stop()                                  # its socket closes: gone
+        waiter.join(30)
+        assert status == [-1]
+        assert time.monotonic() - t0 < 10.0            # lost_after_s and the grace, not the 20 s timeout
         assert "no answer" in capsys.readouterr().err
         assert r1.step() == -1
     finally:

@@ -8,7 +8,8 @@
 A :class:`Connection` owns one ``DEALER`` socket (not thread-safe: use it from one thread). A
 :class:`Heartbeat` thread owns a second socket and sends ``ping {session}`` every
 ``heartbeat_ms`` so that a controller computing for a long time between steps stays attached; it
-also tells the connection when the server stopped answering, so a blocked step raises
+also tells the connection when the server is gone (no answer and no live ZeroMQ connection: a
+server computing a long step keeps its connection up and is waited for), so a blocked step raises
 :class:`ConnectionLost` instead of hanging forever. Errors the server sends back raise
 :class:`SensoriumError` with the protocol's code (PROTOCOL.md §3.2).
 """
@@ -41,7 +42,9 @@ WEBOTS_ENV_ROBOT = "WEBOTS_ROBOT_NAME"
 ENV_CURVE_SERVERKEY = "SENSORIUM_CURVE_SERVERKEY"   # the server's CURVE public key: encrypt, authenticate it
 ENV_CURVE_PUBLICKEY = "SENSORIUM_CURVE_PUBLICKEY"   # this client's key pair (default: a fresh one per socket)
 ENV_CURVE_SECRETKEY = "SENSORIUM_CURVE_SECRETKEY"
-RETRY_S = 1.0                   # a step request unanswered this long is sent again (same id)
+RETRY_S = 1.0                   # a step request unanswered this long is sent again (same id) ...
+RETRY_MAX_S = 8.0               # ... then after twice as long each time, up to this (a long step)
+PING_BACKLOG = 16               # unanswered pings at most (a long step): the server's queue stays short
 RETRIED_SERVICES = ("/robot/step", "/robot/time_step")
 DEFAULT_TIMEOUT = 10.0          # seconds for a non-step request (the server may still be starting)
 
@@ -324,7 +327,7 @@ class Connection:
         self._packer = msgpack.Packer(use_bin_type=True)   # reused: one per connection (one thread)
         self._outstanding: dict[int, str] = {}      # id -> service, for messages
         self._replies: dict[int, dict] = {}
-        self._retry: dict[int, tuple[bytes, float]] = {}   # step requests: id -> (bytes, last sent)
+        self._retry: dict[int, tuple[bytes, float, float]] = {}   # step requests: id -> (bytes, last sent, wait)
         self.heartbeat: Heartbeat | None = None
         self.retries = 0                            # step requests sent again (see _resend_due)
         self.closed = False
@@ -350,7 +353,7 @@ class Connection:
                                  "or 1000 requests wait unsent") from None
         self._outstanding[rid] = service
         if service.endswith(RETRIED_SERVICES):
-            self._retry[rid] = (data, time.monotonic())
+            self._retry[rid] = (data, time.monotonic(), RETRY_S)
         return rid
 
     def wait(self, rid: int, timeout: Any = _NO_TIMEOUT) -> dict:
@@ -477,7 +480,7 @@ class Connection:
         """Re-send a step request not answered for :data:`RETRY_S`: its reply may have been lost
         with a dropped connection. The server answers a repeated id once (PROTOCOL.md)."""
         entry = self._retry.get(rid)
-        if entry is not None and time.monotonic() - entry[1] >= RETRY_S:
+        if entry is not None and time.monotonic() - entry[1] >= entry[2]:
             try:
                 self._socket.send(entry[0], _NOBLOCK)
             except zmq.Again:
@@ -487,7 +490,8 @@ class Connection:
                 self._retry.pop(rid, None)
                 raise ConnectionLost(f"ZeroMQ closed the connection to {self.endpoint} for good while the reply to "
                                      f"{service!r} was due (a message that is not ZeroMQ ends it)") from None
-            self._retry[rid] = (entry[0], time.monotonic())
+            # a step the server computes for long gets fewer copies: 1, 2, 4, 8, 8 … s apart
+            self._retry[rid] = (entry[0], time.monotonic(), min(2 * entry[2], RETRY_MAX_S))
             self.retries += 1
 
     def discard(self, rid: int) -> None:
@@ -565,8 +569,13 @@ class Connection:
 class Heartbeat(threading.Thread):
     """Sends ``ping {session}`` every ``interval_ms`` on its own socket and watches the replies.
 
-    :meth:`problem` says why the connection is unusable: no reply for ``lost_after_s`` seconds
-    (default: 5 heartbeats, at least 2 s), or the server answered that the session is gone."""
+    :meth:`problem` says why the connection is unusable: the server answered that the session is
+    gone, or it is gone itself: no reply for ``lost_after_s`` seconds (default: 5 heartbeats, at
+    least 2 s) *and* no live ZeroMQ connection to it for :attr:`down_grace` seconds. A server that
+    computes a long step answers no ping, but its ZeroMQ I/O thread answers the ZMTP heartbeats this
+    socket sends (``ZMQ_HEARTBEAT_IVL``/``ZMQ_HEARTBEAT_TIMEOUT``) and keeps the connection up:
+    busy, not gone, so the wait goes on. A killed server closes the connection; a frozen one
+    (SIGSTOP: its I/O threads stop too) lets the ZMTP heartbeats time out, which closes it."""
 
     def __init__(self, endpoint: str, session: str, interval_ms: int, context: zmq.Context,
                  lost_after_s: float | None = None, serverkey: bytes | None = None):
@@ -576,6 +585,12 @@ class Heartbeat(threading.Thread):
         self.session = session
         self.interval = max(1, int(interval_ms)) / 1000.0
         self.lost_after = lost_after_s if lost_after_s is not None else max(2.0, 5 * self.interval)
+        # ZMTP heartbeats: a PING each interval; no traffic for zmtp_timeout closes the connection
+        self.zmtp_timeout = max(1.0, 3 * self.interval)
+        # a connection down this long (a reconnection takes ~0.1 s) counts as no connection
+        self.down_grace = max(0.5, 2 * self.interval)
+        self.connected = False     # a ZeroMQ connection has passed its handshake and not closed since
+        self.down_since = time.monotonic()
         self._context = context
         self._stop_event = threading.Event()
         # stop() wakes the thread through this pair: it sleeps until its next ping, not in short
@@ -586,15 +601,36 @@ class Heartbeat(threading.Thread):
         self.last_reply = time.monotonic()
         self.pings = 0
         self.replies = 0
+        self._unanswered = 0       # pings sent since the last reply (or connection)
         self.paused_s = 0.0        # longest time this thread did not run (SIGSTOP, a stalled VM)
 
     def problem(self) -> str | None:
         if self._problem is not None:
             return self._problem
-        silent = time.monotonic() - self.last_reply
-        if silent > self.lost_after:
-            return f"no answer from {self.endpoint} for {silent:.1f} s (server gone, or the network down)"
-        return None
+        now = time.monotonic()
+        silent = now - self.last_reply
+        if silent <= self.lost_after or self.connected:
+            return None                 # answering, or busy (a long step): its connection lives
+        down = now - self.down_since
+        if down <= self.down_grace:
+            return None
+        return (f"no answer from {self.endpoint} for {silent:.1f} s and no connection to it for {down:.1f} s "
+                "(server gone, or the network down)")
+
+    def _watch(self, monitor: zmq.Socket) -> None:
+        """Read the connection's events (non-blocking): up after a handshake, down when it closes."""
+        while True:
+            try:
+                frames = monitor.recv_multipart(zmq.NOBLOCK)
+            except zmq.Again:
+                return
+            event = int.from_bytes(frames[0][:2], "little")
+            if event == zmq.EVENT_HANDSHAKE_SUCCEEDED:
+                self.connected = True
+                self._unanswered = 0        # a new connection: pings sent before may be lost
+            elif event == zmq.EVENT_DISCONNECTED and self.connected:
+                self.connected = False
+                self.down_since = time.monotonic()
 
     def stop(self) -> None:
         self._stop_event.set()
@@ -608,8 +644,18 @@ class Heartbeat(threading.Thread):
     def run(self) -> None:
         sock = self._context.socket(zmq.DEALER)
         sock.setsockopt(zmq.LINGER, 0)
+        sock.setsockopt(zmq.HEARTBEAT_IVL, max(1, int(self.interval * 1000)))
+        sock.setsockopt(zmq.HEARTBEAT_TIMEOUT, int(self.zmtp_timeout * 1000))
+        # the connection's ups and downs (the unbounded pipe: see Connection.__init__)
+        addr = f"inproc://sensorium-heartbeat-{secrets.token_hex(8)}"
+        sock.monitor(addr, zmq.EVENT_HANDSHAKE_SUCCEEDED | zmq.EVENT_DISCONNECTED)
+        monitor = self._context.socket(zmq.PAIR)
+        monitor.setsockopt(zmq.RCVHWM, 0)
+        monitor.setsockopt(zmq.LINGER, 0)
+        monitor.connect(addr)
         poller = zmq.Poller()
         poller.register(sock, zmq.POLLIN)
+        poller.register(monitor, zmq.POLLIN)
         poller.register(self._wake_r.fileno(), zmq.POLLIN)
         try:
             curve_client(sock, self.serverkey)
@@ -624,14 +670,21 @@ class Heartbeat(threading.Thread):
                     # not a sign that it is gone; ask again before judging
                     self.paused_s = max(self.paused_s, now - last_turn)
                     self.last_reply = now
+                    self.down_since = max(self.down_since, now)
                     next_ping = now
                 last_turn = now
                 if now >= next_ping:
-                    sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
-                    self.pings += 1
+                    # a server computing a long step reads none: a few wait for it, not one per beat
+                    if self._unanswered < PING_BACKLOG:
+                        sock.send(pack({"id": next(ids), "service": "ping", "args": {"session": self.session}}))
+                        self.pings += 1
+                        self._unanswered += 1
                     next_ping = now + self.interval
                 wait_ms = int((next_ping - time.monotonic()) * 1000) + 1
-                if dict(poller.poll(max(wait_ms, 1))).get(sock):
+                ready = dict(poller.poll(max(wait_ms, 1)))
+                if ready.get(monitor):
+                    self._watch(monitor)
+                if ready.get(sock):
                     while True:
                         try:
                             reply = unpack(sock.recv_multipart(zmq.NOBLOCK)[-1])
@@ -641,6 +694,7 @@ class Heartbeat(threading.Thread):
                             continue
                         self.last_reply = time.monotonic()
                         self.replies += 1
+                        self._unanswered = 0
                         if isinstance(reply, dict) and reply.get("ok") is False:
                             err = _error_from(reply)
                             why = (f"after this process did not run for {self.paused_s:.1f} s"
@@ -650,6 +704,11 @@ class Heartbeat(threading.Thread):
         except zmq.ContextTerminated:
             pass
         finally:
+            try:
+                sock.disable_monitor()
+            except zmq.ZMQError:
+                pass
+            monitor.close(linger=0)
             sock.close(linger=0)
             self._wake_r.close()
             self._wake_w.close()

@@ -1,6 +1,8 @@
 /* Sensorium C controller library: the only ZeroMQ code. Controller URLs, one DEALER socket with
  * requests matched to replies by id, and a heartbeat thread (its own socket) that pings the
- * session every heartbeat_ms and notices when the server is gone. */
+ * session every heartbeat_ms and notices when the server is gone: no answer for 5 heartbeats and
+ * no live ZeroMQ connection either (a server computing a long step answers no ping, but its ZeroMQ
+ * I/O thread answers the ZMTP heartbeats this socket sends, so its connection stays up). */
 #define _POSIX_C_SOURCE 200809L
 #include <ctype.h>
 #include <errno.h>
@@ -288,12 +290,17 @@ struct sn_conn {
   pthread_mutex_t hb_lock;
   int hb_interval_ms;
   int64_t hb_lost_after_ms;
+  atomic_bool hb_connected;   /* a connection passed its handshake and has not closed since */
+  atomic_llong hb_down_since; /* when it closed (or the heartbeat started) */
+  int64_t hb_zmtp_timeout_ms; /* ZMTP heartbeats: no traffic this long closes the connection */
+  int64_t hb_down_grace_ms;   /* a connection down this long counts as none (a reconnection: ~0.1 s) */
   /* the step request in flight, re-sent (same id) while unanswered: its reply may have been lost
      with a dropped connection (PROTOCOL.md, "Connections that drop") */
   char *retry_data;
   size_t retry_size;
   uint64_t retry_id;
   int64_t retry_sent_ms;
+  int64_t retry_wait_ms; /* RETRY_MS, doubled at each re-send up to RETRY_MAX_MS (a long step) */
   /* handshake events (tcp only), so that a server that refuses this client's security handshake is
      said as such rather than as "is the server running?"; dropped after the first reply */
   void *monitor;
@@ -302,6 +309,8 @@ struct sn_conn {
 };
 
 #define RETRY_MS 1000
+#define RETRY_MAX_MS 8000
+#define PING_BACKLOG 16 /* unanswered pings at most (a long step): the server's queue stays short */
 
 /* CURVE (PROTOCOL.md, README "Security and limits"): with SENSORIUM_CURVE_SERVERKEY set (the
    server's public key, 64 hex or 40 Z85 characters) the socket encrypts and authenticates the
@@ -551,6 +560,7 @@ int sn_conn_send_retried(sn_conn *c, sn_req *r, uint64_t id) {
     memcpy(c->retry_data, r->buf.data, r->buf.size);
     c->retry_size = r->buf.size;
     c->retry_sent_ms = now_ms();
+    c->retry_wait_ms = RETRY_MS;
   }
   return 0;
 }
@@ -566,12 +576,16 @@ static char *heartbeat_problem(sn_conn *c, char *buf, size_t len) {
     pthread_mutex_unlock(&c->hb_lock);
     return buf;
   }
-  int64_t silent = now_ms() - (int64_t)atomic_load(&c->hb_last_reply);
-  if (silent > c->hb_lost_after_ms) {
-    snprintf(buf, len, "no answer from %s for %.1f s (server gone?)", c->endpoint, (double)silent / 1000.0);
-    return buf;
-  }
-  return NULL;
+  int64_t now = now_ms();
+  int64_t silent = now - (int64_t)atomic_load(&c->hb_last_reply);
+  if (silent <= c->hb_lost_after_ms || atomic_load(&c->hb_connected))
+    return NULL; /* answering, or busy (a long step): its connection lives */
+  int64_t down = now - (int64_t)atomic_load(&c->hb_down_since);
+  if (down <= c->hb_down_grace_ms)
+    return NULL;
+  snprintf(buf, len, "no answer from %s for %.1f s and no connection to it for %.1f s (server gone?)", c->endpoint,
+           (double)silent / 1000.0, (double)down / 1000.0);
+  return buf;
 }
 
 int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
@@ -619,7 +633,7 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
       return -1;
     }
     if (n == 0) {
-      if (c->retry_id == id && now_ms() - c->retry_sent_ms >= RETRY_MS) {
+      if (c->retry_id == id && now_ms() - c->retry_sent_ms >= c->retry_wait_ms) {
         if (zmq_send(c->sock, c->retry_data, c->retry_size, ZMQ_DONTWAIT) < 0 && zmq_errno() == EAGAIN) {
           /* the socket has no connection left to queue on: ZeroMQ closed it for good, which it does
              (without reconnecting) when a message breaks the protocol, e.g. a reply larger than
@@ -639,6 +653,7 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
           return -1;
         }
         c->retry_sent_ms = now_ms();
+        c->retry_wait_ms = 2 * c->retry_wait_ms < RETRY_MAX_MS ? 2 * c->retry_wait_ms : RETRY_MAX_MS;
       }
       if (c->monitor != NULL)
         watch_handshakes(c);
@@ -733,29 +748,90 @@ int sn_conn_wait_any(sn_conn *c, int timeout_ms, sn_reply *out) {
 
 /* ------------------------------------------------------------------ heartbeat */
 
+/* The heartbeat connection's events (never blocks): up after a handshake, down when it closes. */
+static void watch_connection(sn_conn *c, void *mon, int *unanswered) {
+  for (;;) {
+    zmq_msg_t msg;
+    zmq_msg_init(&msg);
+    if (zmq_msg_recv(&msg, mon, ZMQ_DONTWAIT) < 0) {
+      zmq_msg_close(&msg);
+      return;
+    }
+    int event = 0;
+    if (zmq_msg_size(&msg) >= 2) {
+      const unsigned char *d = zmq_msg_data(&msg);
+      event = d[0] | (d[1] << 8);
+    }
+    while (zmq_msg_more(&msg)) { /* the second frame: the endpoint */
+      zmq_msg_close(&msg);
+      zmq_msg_init(&msg);
+      if (zmq_msg_recv(&msg, mon, ZMQ_DONTWAIT) < 0)
+        break;
+    }
+    zmq_msg_close(&msg);
+    if (event == ZMQ_EVENT_HANDSHAKE_SUCCEEDED) {
+      atomic_store(&c->hb_connected, true);
+      *unanswered = 0; /* a new connection: pings sent before may be lost */
+    } else if (event == ZMQ_EVENT_DISCONNECTED && atomic_load(&c->hb_connected)) {
+      atomic_store(&c->hb_connected, false);
+      atomic_store(&c->hb_down_since, (long long)now_ms());
+    }
+  }
+}
+
 static void *heartbeat_main(void *arg) {
   sn_conn *c = arg;
   void *sock = zmq_socket(c->ctx, ZMQ_DEALER);
   if (sock == NULL)
     return NULL;
   int zero = 0;
+  int ivl = c->hb_interval_ms, timeout = (int)c->hb_zmtp_timeout_ms;
   zmq_setsockopt(sock, ZMQ_LINGER, &zero, sizeof zero);
+  zmq_setsockopt(sock, ZMQ_HEARTBEAT_IVL, &ivl, sizeof ivl);
+  zmq_setsockopt(sock, ZMQ_HEARTBEAT_TIMEOUT, &timeout, sizeof timeout);
+  /* the connection's ups and downs, on an unbounded pipe (see start_monitor); without a monitor the
+     connection counts as down: unanswered pings then mean gone, as before */
+  static atomic_uint monitors; /* a fresh address each time: a closed monitor's may linger */
+  char addr[80];
+  snprintf(addr, sizeof addr, "inproc://sensorium-heartbeat-%p-%u", (void *)c, atomic_fetch_add(&monitors, 1u));
+  void *mon = NULL;
+  if (zmq_socket_monitor(sock, addr, ZMQ_EVENT_HANDSHAKE_SUCCEEDED | ZMQ_EVENT_DISCONNECTED) == 0) {
+    mon = zmq_socket(c->ctx, ZMQ_PAIR);
+    if (mon != NULL) {
+      zmq_setsockopt(mon, ZMQ_RCVHWM, &zero, sizeof zero);
+      zmq_setsockopt(mon, ZMQ_LINGER, &zero, sizeof zero);
+      if (zmq_connect(mon, addr) != 0) {
+        zmq_close(mon);
+        mon = NULL;
+      }
+    }
+    if (mon == NULL)
+      zmq_socket_monitor(sock, NULL, 0);
+  }
   char curve_err[160];
   if (curve_client(sock, curve_err, sizeof curve_err) != 0 || zmq_connect(sock, c->endpoint) != 0) {
+    if (mon != NULL) {
+      zmq_socket_monitor(sock, NULL, 0);
+      zmq_close(mon);
+    }
     zmq_close(sock);
     return NULL;
   }
   uint64_t ids = 1;
+  int unanswered = 0; /* pings sent since the last reply (or connection) */
   int64_t next_ping = now_ms();
   while (!atomic_load(&c->hb_stop)) {
     int64_t now = now_ms();
     if (now >= next_ping) {
-      sn_req r;
-      sn_req_begin(&r, ids++, "ping", 1);
-      sn_req_key(&r, "session");
-      sn_req_str(&r, c->hb_session);
-      zmq_send(sock, r.buf.data, r.buf.size, ZMQ_DONTWAIT);
-      sn_req_free(&r);
+      if (unanswered < PING_BACKLOG) { /* a server computing a long step reads none: a few wait for it */
+        sn_req r;
+        sn_req_begin(&r, ids++, "ping", 1);
+        sn_req_key(&r, "session");
+        sn_req_str(&r, c->hb_session);
+        zmq_send(sock, r.buf.data, r.buf.size, ZMQ_DONTWAIT);
+        sn_req_free(&r);
+        unanswered++;
+      }
       next_ping = now + c->hb_interval_ms;
     }
     int64_t wait = next_ping - now_ms();
@@ -763,8 +839,10 @@ static void *heartbeat_main(void *arg) {
       wait = 50;
     if (wait < 1)
       wait = 1;
-    zmq_pollitem_t item = {sock, 0, ZMQ_POLLIN, 0};
-    if (zmq_poll(&item, 1, (long)wait) > 0) {
+    zmq_pollitem_t items[2] = {{sock, 0, ZMQ_POLLIN, 0}, {mon, 0, ZMQ_POLLIN, 0}};
+    if (zmq_poll(items, mon != NULL ? 2 : 1, (long)wait) > 0 && (items[1].revents & ZMQ_POLLIN))
+      watch_connection(c, mon, &unanswered);
+    if (items[0].revents & ZMQ_POLLIN) {
       zmq_msg_t msg;
       zmq_msg_init(&msg);
       while (zmq_msg_recv(&msg, sock, ZMQ_DONTWAIT) >= 0) {
@@ -776,6 +854,7 @@ static void *heartbeat_main(void *arg) {
           uint64_t got;
           if (decode_reply(data, size, &rep, &got) == 0) {
             atomic_store(&c->hb_last_reply, (long long)now_ms());
+            unanswered = 0;
             if (!rep.ok) {
               pthread_mutex_lock(&c->hb_lock);
               snprintf(c->hb_problem, sizeof c->hb_problem, "the server dropped session '%s' (%s: %s)", c->hb_session,
@@ -792,6 +871,10 @@ static void *heartbeat_main(void *arg) {
       zmq_msg_close(&msg);
     }
   }
+  if (mon != NULL) {
+    zmq_socket_monitor(sock, NULL, 0);
+    zmq_close(mon);
+  }
   zmq_close(sock);
   return NULL;
 }
@@ -803,6 +886,16 @@ int sn_conn_start_heartbeat(sn_conn *c, const char *session, int interval_ms) {
   c->hb_lost_after_ms = 5 * (int64_t)c->hb_interval_ms;
   if (c->hb_lost_after_ms < 2000)
     c->hb_lost_after_ms = 2000;
+  c->hb_zmtp_timeout_ms = 3 * (int64_t)c->hb_interval_ms;
+  if (c->hb_zmtp_timeout_ms < 1000)
+    c->hb_zmtp_timeout_ms = 1000;
+  if (c->hb_zmtp_timeout_ms > 0x7fffffff)
+    c->hb_zmtp_timeout_ms = 0x7fffffff;
+  c->hb_down_grace_ms = 2 * (int64_t)c->hb_interval_ms;
+  if (c->hb_down_grace_ms < 500)
+    c->hb_down_grace_ms = 500;
+  atomic_store(&c->hb_connected, false);
+  atomic_store(&c->hb_down_since, (long long)now_ms());
   atomic_store(&c->hb_stop, false);
   atomic_store(&c->hb_dropped, false);
   atomic_store(&c->hb_last_reply, (long long)now_ms());
