@@ -198,3 +198,46 @@ def test_a_world_image_deleted_after_load_still_comes_back_on_reset(tmp_path: Pa
     sv.change_item(sim, tex, "url", "set", 0, "c.jpg")      # and a shape holding it is checked without reading it
     with pytest.raises(ValueError, match="texture file 'a.png' not found"):     # a url set is read now: refused
         sv.change_item(sim, tex, "url", "set", 0, "a.png")
+
+
+def test_url_changes_through_the_core_answer_or_refuse_in_one_line(folder: Path) -> None:
+    """The same changes as a controller sends them (set_field with an index and an op), random
+    arguments included: one reply each, a refusal one line and never INTERNAL, the core healthy."""
+    from test_fuzz_core import Fuzzed
+    from test_fuzz_new_devices import send, values
+
+    f = Fuzzed(str(folder / "world.wbt"))
+    [reply] = send(f, "attach", {"robot": "looker"})
+    assert reply["ok"], reply
+    [reply] = send(f, "/looker/robot/get_from_def", {"name": "TEX"})
+    tex = reply["result"]["node"]
+    well_formed = st.fixed_dictionaries({"node": st.just(tex), "field": st.just("url"), "value": url,
+                                         "index": st.integers(-2, 1), "op": st.sampled_from(["set", "insert"])})
+    broken = st.fixed_dictionaries(
+        {"node": st.just(tex), "field": st.sampled_from(["url", "repeatS", "filtering"]),
+         "value": url | values, "index": st.integers(-3, 3) | values,
+         "op": st.sampled_from(["set", "insert", "remove"]) | values},
+        optional={"level": st.integers(-2, 2)})
+    request = well_formed | well_formed | broken
+
+    done = {True: 0, False: 0}
+
+    @SETTINGS
+    @given(st.lists(request | st.just("reset"), min_size=1, max_size=5))
+    def run(batch):
+        for args in batch:
+            if args == "reset":
+                [reply] = send(f, "/looker/robot/simulation_reset", {})
+                assert reply["ok"], reply
+                continue
+            [reply] = send(f, "/looker/robot/set_field", args)
+            done[reply["ok"]] += 1
+            if not reply["ok"]:
+                message = reply["error"]["message"]
+                assert "\n" not in message and len(message) < 1000, reply
+            f.assert_healthy()
+        f.steps()
+        f.assert_healthy()
+
+    run()
+    assert done[True] > 20, done         # (the changes that apply were exercised too)
