@@ -115,6 +115,7 @@ def test_random_proto_field_sets_rebuild_or_refuse_in_one_line(regen) -> None:
         st.tuples(st.just("set"), st.sampled_from(sorted(FIELDS) + ["posts", "nope", ""]), values),
         st.tuples(st.sampled_from(["insert", "set_item", "remove"]), st.integers(-3, 3) | values, number | values),
         st.tuples(st.just("reset"), st.none(), st.none()),
+        st.tuples(st.just("proto_def"), names | st.just("BODY"), st.none()),
         st.tuples(st.just("step"), st.none(), st.none()))
 
     def read(name: str):
@@ -139,6 +140,12 @@ def test_random_proto_field_sets_rebuild_or_refuse_in_one_line(regen) -> None:
                 continue
             if kind == "step":
                 f.steps()
+                continue
+            if kind == "proto_def":        # the body's DEFs (a rebuilt body's: NULL with one line, README)
+                [reply] = send(f, R + "get_from_proto_def", {"node": obst, "name": a})
+                got = reply.get("result") or reply["error"]
+                assert "\n" not in str(got) and len(str(got)) < 2000, reply
+                f.assert_healthy()
                 continue
             if kind == "set":
                 args = {"node": obst, "field": a, "value": b}
