@@ -1,9 +1,9 @@
 """Hardening of the one mesh worker that reads a world's mesh files in turn (sensorium/server/world/
 meshes.py, mesh_worker.py): hostile files (random bytes of every format) followed by good files, a file
-deleted or replaced while it is being loaded, two threads loading at once, and a fork (multiprocessing,
-as Ray's and gym's workers start) after a load. Each hostile file is one line or a mesh; the good files
-after it read the triangles a worker of their own reads; no worker is stuck, shared between threads or
-processes, or left running. Process starts are counted through ``meshes._start_worker``, never timed."""
+deleted or replaced while it is being loaded, two threads loading at once, and a fork (multiprocessing's
+fork start method) after a load. Each hostile file is one line or a mesh; the good files after it read
+the triangles a worker of their own reads; no worker is stuck, shared between threads or processes, or
+left running. Process starts are counted through ``meshes._start_worker``, never timed."""
 
 from __future__ import annotations
 
@@ -161,7 +161,7 @@ def test_a_fork_after_a_load_reads_with_its_own_worker_and_holds_none_of_the_par
     parent_starts = meshes.worker_starts()
     ctx = multiprocessing.get_context("fork")
     queue, gate = ctx.Queue(), ctx.Event()
-    holder = ctx.Process(target=gate.wait, args=(120,))       # a forked process that lives on (a pool worker)
+    holder = ctx.Process(target=gate.wait, args=(120,))       # a forked process that lives on (a pool's)
     holder.start()
     try:
         meshes._CACHE.clear()

@@ -454,7 +454,7 @@ _LIVE: weakref.WeakSet[_Worker] = weakref.WeakSet()     # every worker this proc
 
 
 def _after_fork_in_child() -> None:
-    """A forked process (multiprocessing, Ray, gym's vector workers) lets go of its parent's workers: their
+    """A forked process (``os.fork``, multiprocessing's fork start method) lets go of its parent's workers: their
     pipes' descriptors point at /dev/null in it (closed by its file objects in time, never flushed into a
     worker), so a parent's worker sees its input end when the parent closes it, not when every fork
     has ended; the lock starts afresh (another thread may have held it at the fork)."""
