@@ -82,10 +82,12 @@ TOKENS = ["0", "1", "2", "-1", "-0", "1e400", "-1e400", "0x10", "1,", ",", "1.5"
           "3", "nan", "inf", "1e", "--1", "0.0", "2e0", "07"]
 
 
-def _world(points: list[str], index: list[str]) -> str:
+def _world(points: list[str], index: list[str], tex: list[str] | None = None) -> str:
+    uv = "" if tex is None else ("  texCoord TextureCoordinate { point [ " + " ".join(tex[: len(tex) // 2 * 2])
+                                 + " ] }\n  texCoordIndex [ " + " ".join(index) + " ]\n")
     return ('#VRML_SIM R2023b utf8\nRobot { name "r" children [ Shape { geometry IndexedFaceSet {\n'
             "  coord Coordinate { point [ " + " ".join(points) + " ] }\n  coordIndex [ " + " ".join(index)
-            + " ]\n} } ] }\n")
+            + " ]\n" + uv + "} } ] }\n")
 
 
 def _read(text: str, folder: Path) -> tuple[str, Any]:
@@ -98,14 +100,17 @@ def _read(text: str, folder: Path) -> tuple[str, Any]:
         assert "Traceback" not in str(exc)
         return "error", str(exc)
     g = world.robots[0].shapes[0].geometry if world.robots[0].shapes else None
-    return "ok", None if g is None else ([tuple(r) for r in g.vertices], [tuple(r) for r in g.faces])
+    if g is None:
+        return "ok", None
+    return "ok", tuple(None if v is None else [tuple(r) for r in v]
+                       for v in (g.vertices, g.faces, g.tex_coords, g.tex_coord_faces))
 
 
 @SETTINGS
 @given(st.lists(st.sampled_from(TOKENS), min_size=0, max_size=40), st.lists(st.sampled_from(TOKENS), max_size=40),
-       st.integers(1, 3))
-def test_wbt_runs_read_as_one_number_at_a_time(points, index, run_min) -> None:
-    text = _world(points * 3, index * 2)
+       st.integers(1, 3), st.none() | st.lists(st.sampled_from(TOKENS), max_size=30))
+def test_wbt_runs_read_as_one_number_at_a_time(points, index, run_min, tex) -> None:
+    text = _world(points * 3, index * 2, None if tex is None else tex * 2)
     with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as mp:
         mp.setattr(wp, "RUN_MIN", run_min)
         runs = _read(text, Path(tmp))
