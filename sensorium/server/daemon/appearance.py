@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sensorium.schemas import world as wm
-from sensorium.server.world.textures import TextureFileError, checked_image
+from sensorium.server.world.textures import TextureFileError, read_checked_image
 from sensorium.server.world.wbt.fields import GEOMETRY_FIELDS, MATERIAL_FIELDS, PBR_FIELDS, TEXTURE_FIELDS
 
 TYPES = frozenset({"Shape", "Appearance", "PBRAppearance", "Material", "ImageTexture", "Box", "Sphere", "Cylinder",
@@ -38,6 +38,14 @@ the rest of these nodes is read-only."""
 
 MAX_URLS = 64
 """The most items an ImageTexture's ``url`` holds after a Supervisor's change (Webots reads the first)."""
+
+MAX_URL_CHARS = 4096
+"""The longest url item a Supervisor sets (a file path's most on Linux); a refusal quotes only its start."""
+
+
+def _quoted(url: str) -> str:
+    """A url as a refusal line quotes it: whole up to 80 characters, else its start and its length."""
+    return repr(url) if len(url) <= 80 else f"{url[:60]!r}... ({len(url):,} characters)"
 
 # the written field names of a YAML geometry model (no .wbt node): Webots' field -> the model's attribute
 _MODEL_GEOMETRY = {"size": "size", "radius": "radius", "height": "height", "bottomRadius": "bottom_radius",
@@ -243,32 +251,36 @@ def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> None:
     if url is not None:
         known = _world_url(scene, url)
         if known is None and "://" in url:
-            raise ValueError(f"{where}: {url!r}: only local image files are read here, named relative to the world "
+            raise ValueError(f"{where}: {_quoted(url)}: only local image files are read here, named relative to the world "
                              "file's folder (no downloads; a webots:// url only where the world file writes it); "
                              "nothing changed")
         name = known or url
         before = scene.textures.pixels(without=shapes) if scene.textures is not None else 0
-        try:
-            checked_image(name, scene.base_dir, sim.limits, pixels_before=before,
-                          allow_outside=known is not None or bool(getattr(sim, "allow_outside_meshes", False)))
+        try:      # (read once: the image checked is the image shown, whatever happens to the file after)
+            file, _, decoded = read_checked_image(
+                name, scene.base_dir, sim.limits, pixels_before=before,
+                allow_outside=known is not None or bool(getattr(sim, "allow_outside_meshes", False)))
         except TextureFileError as exc:
-            raise ValueError(f"{where}: {exc}; nothing changed") from None
+            raise ValueError(f"{where}: {str(exc).replace(repr(name), _quoted(name))}; nothing changed") from None
+        given = {name: (file, decoded)}
+    else:
+        given = {}
     plans = []
     for k in shapes:
         new = _retextured(scene, k, name)
         current = scene.shape_model(k).appearance
         if new is None:
             continue
-        if scene.casts_shadow(k, new) != scene.casts_shadow(k, current):
-            alpha = not scene.casts_shadow(k, new)
+        if scene.casts_shadow(k, new, given) != scene.casts_shadow(k, current):
+            alpha = not scene.casts_shadow(k, new, given)
             raise ValueError(
-                f"{where}: the shape casts shadows {'and' if alpha else 'but'} the pixel format of {url!r} "
+                f"{where}: the shape casts shadows {'and' if alpha else 'but'} the pixel format of {_quoted(url or '')} "
                 f"{'has' if alpha else 'has no'} alpha (Webots then draws the shape translucent, without shadows, "
                 f"{'un' if not alpha else ''}like its image now); which shapes cast shadows is fixed when the scene is "
                 "built here; nothing changed")
         plans.append((k, new))
     for k, new in plans:
-        scene.set_texture(k, new)
+        scene.set_texture(k, new, given)
 
 
 def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: Any) -> None:
@@ -284,6 +296,9 @@ def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: A
         raise ValueError(f"{where}: the index must be a whole number, got {index!r}; nothing changed")
     if op != "remove" and not isinstance(value, str):
         raise ValueError(f"{where}: takes a string, got {value!r}; nothing changed")
+    if op != "remove" and len(value) > MAX_URL_CHARS:
+        raise ValueError(f"{where}: takes a url of at most {MAX_URL_CHARS:,} characters, got {_quoted(value)}; "
+                         "nothing changed")
     if op == "insert":
         at = index + count + 1 if index < 0 else index
         if not 0 <= at <= count:

@@ -12,7 +12,7 @@ without textures): ``infra_red_terms`` turns hits into the colour terms of Webot
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -27,7 +27,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.meshes import elevation_grid_mesh, load_mesh, triangles_mesh
 from sensorium.server.world.poses import pose_from_model
-from sensorium.server.world.textures import TextureSampler, resolve_texture_url, uses_alpha
+from sensorium.server.world.textures import Decoded, TextureSampler, resolve_texture_url, uses_alpha
 
 _IDENTITY = Pose.identity()
 
@@ -515,22 +515,35 @@ class Scene:
         self._use_model(shape, model.model_copy(update={"appearance": appearance}))
         self.appearance_version += 1
 
-    def set_texture(self, shape: int, appearance: wm.Appearance) -> None:
+    def set_texture(self, shape: int, appearance: wm.Appearance,
+                    given: Mapping[str, tuple[Path, Decoded]] | None = None) -> None:
         """:meth:`set_appearance` with new images (an ImageTexture's url or wrap a Supervisor set, or
-        its texture gone): the texture sampler reads them for that shape (the caller checked the files,
-        the limits and that the shape's shadow casting stays), so cameras and infra-red sensors see them
-        from the next measurement as if the world file had named them."""
-        self.set_appearance(shape, appearance)
-        if self.textures is not None:
-            self.textures.set_shape(shape, appearance)
-        elif appearance.texture is not None:
+        its texture gone): the texture sampler takes them for that shape (``given``: url -> the file
+        and its image as the caller read and checked it, not read again; the caller also checked that
+        the shape's shadow casting stays), so cameras and infra-red sensors see them from the next
+        measurement as if the world file had named them."""
+        if self.textures is None and appearance.texture is not None:     # (no shape textured until now)
             self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
                                            ink_evaporation=self._ink_evaporation)
+        self.set_appearance(shape, appearance)
+        if self.textures is not None:
+            self.textures.set_shape(shape, appearance, given)
 
-    def casts_shadow(self, shape: int, appearance: wm.Appearance | None) -> bool:
+    def casts_shadow(self, shape: int, appearance: wm.Appearance | None,
+                     given: Mapping[str, tuple[Path, Decoded]] | None = None) -> bool:
         """Whether the shape would cast shadows with that appearance (fixed in the ray scene when it
-        is built: see :func:`translucent`)."""
-        return bool(self._parts[shape][2].cast_shadows) and not translucent(appearance, self._base_dir)
+        is built: see :func:`translucent`). Its image is the one ``given`` holds for its url, else the
+        one the shape shows now if it is the shape's appearance now, else read."""
+        if not self._parts[shape][2].cast_shadows:
+            return False
+        if appearance is not None and appearance.transparency <= 0.0 and appearance.texture is not None:
+            t = appearance.texture
+            if given is not None and t.url in given:
+                return not given[t.url][1][2]
+            held = self.textures.shapes.get(shape) if self.textures is not None else None
+            if held is not None and appearance is self._parts[shape][2].appearance:
+                return not held.base.translucent
+        return not translucent(appearance, self._base_dir)
 
     def _use_model(self, shape: int, model: wm.Shape | wm.Solid) -> None:
         key, local, _ = self._parts[shape]

@@ -10,7 +10,9 @@ files in turn, each under its own limit (its start costs more than reading a 1.5
 
 from __future__ import annotations
 
+import os
 import threading
+import weakref
 from collections import OrderedDict
 from functools import lru_cache
 from pathlib import Path
@@ -343,6 +345,7 @@ class _Worker:
         self.proc = subprocess.Popen([sys.executable, "-I", *run, repr(float(idle))], stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, close_fds=True)
         self.owner = os.getpid()
+        _LIVE.add(self)
 
     def end(self, wait: bool = True) -> int | None:
         """Close its pipes: it ends at the end of its input (or, writing, on the closed pipe); its exit
@@ -447,6 +450,36 @@ def _exchange(request: dict, read_reply) -> tuple[Any, int | None]:
 
 _WORKERS_LOCK = threading.Lock()
 _AT_EXIT = False
+_LIVE: weakref.WeakSet[_Worker] = weakref.WeakSet()     # every worker this process started (not yet collected)
+
+
+def _after_fork_in_child() -> None:
+    """A forked process (``os.fork``, multiprocessing's fork start method) lets go of its parent's workers: their
+    pipes' descriptors point at /dev/null in it (closed by its file objects in time, never flushed into a
+    worker), so a parent's worker sees its input end when the parent closes it, not when every fork
+    has ended; the lock starts afresh (another thread may have held it at the fork)."""
+    global _WORKERS_LOCK
+    _WORKERS_LOCK = threading.Lock()
+    _IDLE.clear()
+    try:
+        devnull = os.open(os.devnull, os.O_RDWR)
+    except OSError:
+        return
+    try:
+        for w in list(_LIVE):
+            for pipe in (w.proc.stdin, w.proc.stdout):
+                try:
+                    if pipe is not None and not pipe.closed:
+                        os.dup2(devnull, pipe.fileno())
+                except (OSError, ValueError):
+                    pass
+        _LIVE.clear()
+    finally:
+        os.close(devnull)
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_after_fork_in_child)
 
 
 ALL_MATERIALS = -3        # (mesh_worker.ALL_MATERIALS)

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Callable, Collection, Iterator
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -45,7 +45,7 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.world import texcoords as tc
 
-__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "checked_image", "load_image", "load_alpha", "uses_alpha", "check_textures",
+__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "checked_image", "read_checked_image", "load_image", "load_alpha", "uses_alpha", "check_textures",
            "TextureImage", "transform_uv", "TextureSampler", "TriangleLocator", "texture_urls"]
 
 FORMATS = {"PNG": "PNG", "JPEG": "JPEG", "MPO": "JPEG"}     # Pillow's format → what Webots calls it
@@ -147,8 +147,17 @@ def _decoded(path: Path, display: str | None) -> tuple[np.ndarray, np.ndarray | 
 _ALPHA_MODES = ("RGBA", "LA", "PA", "RGBa", "La")
 
 
+Decoded = tuple[np.ndarray, np.ndarray | None, bool]
+"""An image as read: (RGB, alpha or None, whether its pixel format has alpha)."""
+
+
 @lru_cache(maxsize=16)
-def _decode(path: str, _mtime: int, _size: int) -> tuple[np.ndarray, np.ndarray | None, bool]:
+def _decode(path: str, _mtime: int, _size: int) -> Decoded:
+    return _decode_from(path, path)
+
+
+def _decode_from(source: Any, path: str) -> Decoded:
+    """The image in ``source`` (a file name or a file object) decoded; ``path`` names it in errors."""
     from PIL import Image
 
     old = Image.MAX_IMAGE_PIXELS       # the world limits were checked on the header; Pillow's own
@@ -156,7 +165,7 @@ def _decode(path: str, _mtime: int, _size: int) -> tuple[np.ndarray, np.ndarray 
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            with Image.open(path) as im:
+            with Image.open(source) as im:
                 im.load()
                 alpha = None
                 has_alpha = False
@@ -232,6 +241,33 @@ def checked_image(url: str, base_dir: Path, limits: Any, *, allow_outside: bool 
                                "pixels together (raise the limits with --allow-large)")
     load_image(file, url)
     return file, w * h
+
+
+def read_checked_image(url: str, base_dir: Path, limits: Any, *, allow_outside: bool = False,
+                       pixels_before: int = 0) -> tuple[Path, int, Decoded]:
+    """:func:`checked_image` on the file's bytes read once: (its file, its pixels, the image decoded
+    from those very bytes), so a file replaced or grown after its check is never what is decoded
+    (a Supervisor's url: what was checked is what is shown). Not cached: an image no shape shows is
+    let go."""
+    import io
+
+    file = resolve_texture_url(url, base_dir, allow_outside=allow_outside, max_bytes=limits.texture_file_bytes)
+    try:
+        with open(file, "rb") as f:
+            data = f.read(limits.texture_file_bytes + 1)
+    except OSError as exc:
+        raise TextureFileError(f"texture file {url!r} cannot be read: {exc.strerror or exc}") from None
+    if len(data) > limits.texture_file_bytes:
+        raise TextureFileError(f"texture file {url!r} is larger than the limit of {limits.texture_file_bytes:,} "
+                               "bytes (raise the limits with --allow-large)")
+    _, w, h = image_header(io.BytesIO(data), url)    # type: ignore[arg-type]
+    if w * h > limits.texture_pixels:
+        raise TextureFileError(f"texture {url!r} has {w}x{h} = {w * h:,} pixels, more than the "
+                               f"limit of {limits.texture_pixels:,} (raise the limits with --allow-large)")
+    if pixels_before + w * h > limits.texture_pixels_total:
+        raise TextureFileError(f"the world's textures have more than {limits.texture_pixels_total:,} "
+                               "pixels together (raise the limits with --allow-large)")
+    return file, w * h, _decode_from(io.BytesIO(data), url)   # (the very bytes whose header was checked)
 
 
 def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False,
@@ -745,12 +781,25 @@ class TextureSampler:
         self.extend(shapes)
         self.lookups = 0
 
-    def _image(self, t: wm.Texture | None, keep: bool = True) -> TextureImage | None:
+    def _image(self, t: wm.Texture | None, keep: bool = True,
+               given: Mapping[str, tuple[Path, Decoded]] | None = None) -> TextureImage | None:
         """The image a texture names (read once); ``keep``: one of the world's own, kept for good (a
-        reset brings them back), else (a Supervisor's) let go when no shape uses it any more."""
+        reset brings them back), else (a Supervisor's) let go when no shape uses it any more.
+        ``given``: url -> (file, image) already read and checked (:func:`read_checked_image`), used
+        as it is: the file is not read again (a world's own image stays as loaded)."""
         if t is None:
             return None
-        path = resolve_texture_url(t.url, self.base_dir, allow_outside=True)
+        if given is not None and t.url in given:
+            path, decoded = given[t.url]
+            if path not in self._kept:
+                self._images[path] = decoded
+        else:
+            try:
+                path = (self.base_dir / t.url).resolve()
+            except (OSError, RuntimeError, ValueError):
+                path = None
+            if path is None or path not in self._images:     # (one read before is not looked for again)
+                path = resolve_texture_url(t.url, self.base_dir, allow_outside=True)
         if keep:
             self._kept.add(path)
         if path not in self._images:
@@ -786,7 +835,8 @@ class TextureSampler:
         self.translucent = translucent
         self.has_translucent = bool(translucent.any())
 
-    def set_shape(self, shape: int, appearance: wm.Appearance | None) -> None:
+    def set_shape(self, shape: int, appearance: wm.Appearance | None,
+                  given: Mapping[str, tuple[Path, Decoded]] | None = None) -> None:
         """A Supervisor's new images for one shape (an ImageTexture's url or wrap changed, or the
         texture gone): its maps are read as :meth:`extend` reads them (the caller checked the files
         and the limits), its flags change in place (callers hold these arrays), ink stays, and an
@@ -794,10 +844,10 @@ class TextureSampler:
         geometry = self.models[shape][0]
         self.models[shape] = (geometry, appearance)
         if appearance is not None and appearance.texture is not None:
-            base = self._image(appearance.texture, keep=False)
+            base = self._image(appearance.texture, keep=False, given=given)
             assert base is not None
-            self.shapes[shape] = ShapeTexture(base, self._image(appearance.roughness_map, keep=False),
-                                              self._image(appearance.occlusion_map, keep=False),
+            self.shapes[shape] = ShapeTexture(base, self._image(appearance.roughness_map, keep=False, given=given),
+                                              self._image(appearance.occlusion_map, keep=False, given=given),
                                               appearance.texture_transform)
         else:
             self.shapes.pop(shape, None)
