@@ -342,7 +342,27 @@ def twist_step(x: float, y: float, yaw: float, vx: float, vy: float, w: float,
     return x + c * dx - s * dy, y + s * dx + c * dy, _wrap(yaw + w * dt)
 
 
-class MecanumDrive(PlanarState):
+class HolonomicDrive(PlanarState):
+    """A drive whose wheels' speeds give a body twist (vx, vy, ω) of their own (:meth:`twist`)."""
+
+    def twist(self, speeds: list[float]) -> tuple[float, float, float]:
+        raise NotImplementedError
+
+    def roll(self, speeds: list[float], dt: float) -> Pose | None:
+        """Move by the twist of the wheels' ``speeds`` over ``dt`` s, exactly (:func:`twist_step`); the
+        new pose, or None when no wheel turned."""
+        if all(u == 0.0 for u in speeds):
+            self.moved(0.0, 0.0)
+            return None
+        vx, vy, w = self.twist(speeds)
+        self.x, self.y, self.yaw = twist_step(self.x, self.y, self.yaw, vx, vy, w, dt)
+        self.moved(vx, w)
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        self.linear = (vx * c - vy * s, vx * s + vy * c)     # the origin's velocity at the step's end
+        return self.pose()
+
+
+class MecanumDrive(HolonomicDrive):
     """Four mecanum wheels at (±lx, ±ly) (x forward, y left), rollers at 45°, no slip.
 
     A wheel at (x_i, y_i) with roller sign s_i turning at ω_i rolls the robot with r·ω_i = vx +
@@ -380,18 +400,10 @@ class MecanumDrive(PlanarState):
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
         dt = dt_ms / 1000.0
         speeds = [m.advance(dt) for m, _, _ in self.wheels]
-        if all(u == 0.0 for u in speeds):
-            self.moved(0.0, 0.0)
-            return None
-        vx, vy, w = self.twist(speeds)
-        self.x, self.y, self.yaw = twist_step(self.x, self.y, self.yaw, vx, vy, w, dt)
-        self.moved(vx, w)
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        self.linear = (vx * c - vy * s, vx * s + vy * c)     # the origin's velocity at the step's end
-        return self.pose()
+        return self.roll(speeds, dt)
 
 
-class OmniDrive(PlanarState):
+class OmniDrive(HolonomicDrive):
     """Three or more omni wheels (``omni_drive``): wheel i at p_i (x forward, y left) turning about
     a_i in the ground plane, rollers letting it slip freely along a_i, rolling without slip along
     d_i = a_i × up (where a positive speed rolls a wheel's centre: ω·r·(a × up)). A twist (vx, vy, ωz)
@@ -428,15 +440,7 @@ class OmniDrive(PlanarState):
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
         dt = dt_ms / 1000.0
         speeds = [m.advance(dt) for m, _ in self.wheels]
-        if all(u == 0.0 for u in speeds):
-            self.moved(0.0, 0.0)
-            return None
-        vx, vy, w = self.twist(speeds)
-        self.x, self.y, self.yaw = twist_step(self.x, self.y, self.yaw, vx, vy, w, dt)
-        self.moved(vx, w)
-        c, s = math.cos(self.yaw), math.sin(self.yaw)
-        self.linear = (vx * c - vy * s, vx * s + vy * c)     # the origin's velocity at the step's end
-        return self.pose()
+        return self.roll(speeds, dt)
 
 
 def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float) -> tuple[float, float]:

@@ -224,6 +224,16 @@ def _appearances(world: wm.World) -> Iterator[tuple[str, Any]]:
             yield f"robots[{r_i}].shapes[{i}]", part
 
 
+def _check_pixels(url: str, w: int, h: int, limits: Any, pixels_before: int) -> None:
+    """An image of w×h pixels within the texture limits, alone and with the others' ``pixels_before``."""
+    if w * h > limits.texture_pixels:
+        raise TextureFileError(f"texture {url!r} has {w}x{h} = {w * h:,} pixels, more than the "
+                               f"limit of {limits.texture_pixels:,} (raise the limits with --allow-large)")
+    if pixels_before + w * h > limits.texture_pixels_total:
+        raise TextureFileError(f"the world's textures have more than {limits.texture_pixels_total:,} "
+                               "pixels together (raise the limits with --allow-large)")
+
+
 def checked_image(url: str, base_dir: Path, limits: Any, *, allow_outside: bool = False,
                   allowed: frozenset[Path] = frozenset(), pixels_before: int = 0) -> tuple[Path, int]:
     """A texture url → (its file, its pixels), checked as a world's textures are: confined (see
@@ -233,12 +243,7 @@ def checked_image(url: str, base_dir: Path, limits: Any, *, allow_outside: bool 
     file = resolve_texture_url(url, base_dir, allow_outside=allow_outside, max_bytes=limits.texture_file_bytes,
                                allowed=allowed)
     _, w, h = image_header(file, url)
-    if w * h > limits.texture_pixels:
-        raise TextureFileError(f"texture {url!r} has {w}x{h} = {w * h:,} pixels, more than the "
-                               f"limit of {limits.texture_pixels:,} (raise the limits with --allow-large)")
-    if pixels_before + w * h > limits.texture_pixels_total:
-        raise TextureFileError(f"the world's textures have more than {limits.texture_pixels_total:,} "
-                               "pixels together (raise the limits with --allow-large)")
+    _check_pixels(url, w, h, limits, pixels_before)
     load_image(file, url)
     return file, w * h
 
@@ -261,12 +266,7 @@ def read_checked_image(url: str, base_dir: Path, limits: Any, *, allow_outside: 
         raise TextureFileError(f"texture file {url!r} is larger than the limit of {limits.texture_file_bytes:,} "
                                "bytes (raise the limits with --allow-large)")
     _, w, h = image_header(io.BytesIO(data), url)    # type: ignore[arg-type]
-    if w * h > limits.texture_pixels:
-        raise TextureFileError(f"texture {url!r} has {w}x{h} = {w * h:,} pixels, more than the "
-                               f"limit of {limits.texture_pixels:,} (raise the limits with --allow-large)")
-    if pixels_before + w * h > limits.texture_pixels_total:
-        raise TextureFileError(f"the world's textures have more than {limits.texture_pixels_total:,} "
-                               "pixels together (raise the limits with --allow-large)")
+    _check_pixels(url, w, h, limits, pixels_before)
     return file, w * h, _decode_from(io.BytesIO(data), url)   # (the very bytes whose header was checked)
 
 

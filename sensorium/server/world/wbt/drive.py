@@ -95,9 +95,7 @@ def rolls_about_its_axis(w: dict, conv) -> bool:
     axis with its centre on it, or its first sphere is centred on the axis (within a quarter of the
     radius, 5° of tilt). An arm's link of a plain cylinder, standing across the axis or off it, does
     not: a robot with such an arm beside its wheels keeps its drive."""
-    end = w["end"]
-    while end is not None and end.type == "Slot":
-        end = conv.fields(end).node_("endPoint")
+    end = conv.slotted(w["end"])
     if end is None:
         return False
     axis = np.asarray(w["axis"], dtype=np.float64)
@@ -114,26 +112,9 @@ def rolls_about_its_axis(w: dict, conv) -> bool:
         along = np.asarray(frame.rotation, dtype=np.float64) @ np.array([0.0, 0.0, 1.0])
         return abs(float(np.dot(along, axis))) >= math.cos(math.radians(5.0)) * float(np.linalg.norm(along))
 
-    def find(node: Node | None, frame) -> bool | None:
-        if node is None:
-            return None
-        conv.walk(node)
-        nf = conv.fields(node)
-        if node.type in ("Cylinder", "Sphere", "Capsule"):
-            return judge(node.type, nf.num("radius", 1.0) * frame.scale, frame)
-        if node.type == "Shape":
-            return find(nf.node_("geometry"), frame)
-        if node.type in ("Pose", "Transform", "Group", "Solid"):
-            inner = frame if node.type == "Group" else conv.child_frame(node, frame)
-            for child in nf.nodes("children"):
-                r = find(child, inner)
-                if r is not None:
-                    return r
-        return None
-
-    at = conv.child_frame(end, w["frame"])
-    found = find(conv.fields(end).node_("boundingObject"), at)
-    return bool(found if found is not None else find(end, w["frame"]))
+    found = _first_round_part(conv, end, w["frame"],
+                              lambda kind, nf, frame: judge(kind, nf.num("radius", 1.0) * frame.scale, frame))
+    return bool(found)
 
 
 def holds_wheel(end: Node | None, conv) -> bool:
@@ -620,13 +601,21 @@ def round_centre(w: dict, conv) -> np.ndarray | None:
     if end is None:
         return None
 
-    def find(node: Node | None, frame) -> np.ndarray | None:
+    return _first_round_part(conv, end, w["frame"],
+                             lambda kind, nf, frame: np.asarray(frame.translation, dtype=np.float64))
+
+
+def _first_round_part(conv, end: Node, frame, leaf):
+    """``leaf(type, its fields, its frame)`` of the first cylinder, capsule or sphere of a wheel's end
+    point (placed at ``frame``), its boundingObject first, else its children; None when it has none. A
+    leaf's answer ends the search, False included."""
+    def find(node: Node | None, frame):
         if node is None:
             return None
         conv.walk(node)
         nf = conv.fields(node)
         if node.type in ("Cylinder", "Sphere", "Capsule"):
-            return np.asarray(frame.translation, dtype=np.float64)
+            return leaf(node.type, nf, frame)
         if node.type == "Shape":
             return find(nf.node_("geometry"), frame)
         if node.type in ("Pose", "Transform", "Group", "Solid"):
@@ -637,9 +626,8 @@ def round_centre(w: dict, conv) -> np.ndarray | None:
                     return r
         return None
 
-    at = conv.child_frame(end, w["frame"])
-    found = find(conv.fields(end).node_("boundingObject"), at)
-    return found if found is not None else find(end, w["frame"])
+    found = find(conv.fields(end).node_("boundingObject"), conv.child_frame(end, frame))
+    return found if found is not None else find(end, frame)
 
 
 def has_rollers(w: dict, conv) -> bool:
