@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from sensorium.schemas import world as wm
+from sensorium.server.daemon.mf_items import item_position
 from sensorium.server.world.textures import TextureFileError, read_checked_image
 from sensorium.server.world.wbt.fields import GEOMETRY_FIELDS, MATERIAL_FIELDS, PBR_FIELDS, TEXTURE_FIELDS
 
@@ -292,33 +293,21 @@ def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: A
     where = f"field 'url' (MFString) of {_what(ref, node.def_name, node.id)}"
     items = [str(v) for v in _value(sim, ref, "url", ())]
     count = len(items)
-    if isinstance(index, bool) or not isinstance(index, int):
-        raise ValueError(f"{where}: the index must be a whole number, got {index!r}; nothing changed")
     if op != "remove" and not isinstance(value, str):
         raise ValueError(f"{where}: takes a string, got {value!r}; nothing changed")
     if op != "remove" and len(value) > MAX_URL_CHARS:
         raise ValueError(f"{where}: takes a url of at most {MAX_URL_CHARS:,} characters, got {_quoted(value)}; "
                          "nothing changed")
+    at = item_position(where, op, index, count)
+    new = list(items)
     if op == "insert":
-        at = index + count + 1 if index < 0 else index
-        if not 0 <= at <= count:
-            raise ValueError(f"{where}: out-of-bound index {index} (should be between {-count - 1} and {count}); "
-                             "nothing changed")
         if count >= MAX_URLS:
             raise ValueError(f"{where}: it holds {count} urls, the most kept here; nothing changed")
-        new = [*items[:at], value.replace("\\", "/"), *items[at:]]
-    elif op in ("set", "remove"):
-        if not -count <= index < count:
-            raise ValueError(f"{where}: out-of-bound index {index} (should be between {-count} and {count - 1}); "
-                             "nothing changed" if count else f"{where}: the list is empty; nothing changed")
-        at = index + count if index < 0 else index
-        new = list(items)
-        if op == "remove":
-            del new[at]
-        else:
-            new[at] = value.replace("\\", "/")
+        new.insert(at, value.replace("\\", "/"))
+    elif op == "remove":
+        del new[at]
     else:
-        raise ValueError(f"{where}: unknown change {op!r}")
+        new[at] = value.replace("\\", "/")
     first, was = (new[0] if new else ""), (items[0] if items else "")
     if first != was:
         _retexture(sim, ref, where, first if first.strip() else None)

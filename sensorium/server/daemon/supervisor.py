@@ -31,6 +31,7 @@ from pydantic import ValidationError
 
 from sensorium.schemas import world as wm
 from sensorium.server.daemon import appearance, nested, visuals
+from sensorium.server.daemon.mf_items import item_position
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import states, viewshot
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
@@ -827,10 +828,7 @@ def _changed_items(sim: Any, node: Node, field: str, kind: str, entry: tuple, op
         items = list(entry[1](sim, node))
     except NotKept as exc:
         raise ValueError(f"{exc}: its items cannot be changed here; nothing changed") from None
-    count = len(items) + (1 if op == "insert" else 0)
-    at = index + count if index < 0 else index
-    if not 0 <= at < count:
-        raise ValueError(f"field {field!r} ({kind}): index {index} out of range (it has {len(items)} items)")
+    at = item_position(f"field {field!r} ({kind}) of {_what(node)}", op, index, len(items))
     if op == "remove":
         del items[at]
         return items

@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+from sensorium.server.daemon.mf_items import item_position
 from sensorium.server.world.limits import MAX_COORDINATE_M
 from sensorium.server.world.wbt.fields import GEOMETRY_FIELDS, MATERIAL_FIELDS, PBR_FIELDS, TEXTURE_FIELDS
 
@@ -272,28 +273,16 @@ def change(n: VNode, name: str, op: str, index: int, value: Any) -> None:
     items: list = n.values[name]
     count = len(items)
     where = f"field {name!r} ({kind}) of {what(n)}"
-    if isinstance(index, bool) or not isinstance(index, int):
-        raise ValueError(f"{where}: the index must be a whole number, got {index!r}; nothing changed")
+    at = item_position(where, op, index, count)
     if op == "insert":
-        at = index + count + 1 if index < 0 else index
-        if not 0 <= at <= count:
-            raise ValueError(f"{where}: out-of-bound index {index} (should be between {-count - 1} and {count}); "
-                             "nothing changed")
         if count >= MAX_ITEMS:
             raise ValueError(f"{where}: it holds {count:,} items, the most an imported line or point set's field "
                              f"holds here ({MAX_ITEMS:,}); nothing changed")
         items.insert(at, _item(n, name, kind, value))
-        return
-    if not -count <= index < count:
-        raise ValueError(f"{where}: out-of-bound index {index} (should be between {-count} and {count - 1})"
-                         if count else f"{where}: the list is empty")
-    at = index + count if index < 0 else index
-    if op == "remove":
+    elif op == "remove":
         del items[at]
-    elif op == "set":
-        items[at] = _item(n, name, kind, value)
     else:
-        raise ValueError(f"{where}: unknown change {op!r}")
+        items[at] = _item(n, name, kind, value)
 
 
 __all__ = ["FIRST_ID", "MAX_ITEMS", "ROOTS", "INSIDE", "LINES", "TABLES", "VNode", "Store", "fields", "settable",
