@@ -580,20 +580,55 @@ class Camera(Device):
     def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
                  counters: Any) -> np.ndarray:
         """(S, n) False where a shadow-casting light is hidden from the point by a visible shape
-        (its segment to the light, 1000 m towards a directional one); only lit, facing pairs cast."""
-        att, direct = light_math.light_terms(P, N, lights)
-        lit = np.ones(direct.shape, dtype=bool)
-        unit, length = light_math.occlusion_segments_many(P, lights)
-        for j in shadows.nonzero()[0].tolist():
-            i = (direct[:, j] > 0.0).nonzero()[0]
-            near = shading.within_radius(P[i], lights, j)       # beyond the light's radius: unlit anyway
-            if near is not None:
-                i = i[near]
+        (its segment to the light, 1000 m towards a directional one); only lit, facing pairs cast.
+        Which pairs cast and their segments come from :func:`shadow_rays` (row blocks on the
+        engine's threads); each light's rays are then one cast, as one batch."""
+        lit = np.ones((len(P), len(lights)), dtype=bool)
+        engine = self._scene.engine
+        for j, (i, unit, length) in shadow_rays(P, N, lights, shadows, engine.threads).items():
             if len(i) == 0:
                 continue
-            hits = self._scene.engine.cast(P[i], unit[i, j], 0.0, length[i, j], kind=RayKind.SHADOW, exclude_owner=-1,
-                                           distance_only=True)
+            hits = engine.cast(P[i], unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1, distance_only=True)
             counters["rays_camera"] += len(i)
             counters["cast_calls"] += 1
-            lit[i, j] = ~(hits.distance <= length[i, j])
+            lit[i, j] = ~(hits.distance <= length)
         return lit
+
+
+def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
+                threads: int) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per shadow-casting light ``j``: the points (ascending indices into ``P``) whose direct term
+    from it is above 0 (``light.light_terms``) and which lie within its radius
+    (``shading.within_radius``), with their unit segments towards it and the segments' lengths
+    (``light.occlusion_segments_many``). Every value is elementwise, so it is worked out on row
+    blocks of ``shading.BLOCK`` points (each block's (S, n, 3) temporaries stay in the CPU's cache)
+    on up to ``threads`` threads: the same points and the same bits as one pass over all of them."""
+    js = shadows.nonzero()[0].tolist()
+    S = len(P)
+    parts = [slice(a, min(S, a + shading.BLOCK)) for a in range(0, S, shading.BLOCK)]
+
+    def part(sl: slice) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        Pb = P[sl]
+        direct = light_math.light_terms(Pb, N[sl], lights)[1]
+        unit, length = light_math.occlusion_segments_many(Pb, lights)
+        out = []
+        for j in js:
+            i = (direct[:, j] > 0.0).nonzero()[0]
+            near = shading.within_radius(Pb[i], lights, j)       # beyond the light's radius: unlit anyway
+            if near is not None:
+                i = i[near]
+            out.append((i + sl.start, unit[i, j], length[i, j]))
+        return out
+
+    done = blocks.run(part, parts, threads) if js and S else []
+    rays = {}
+    for k, j in enumerate(js):
+        got = [d[k] for d in done]
+        if len(got) == 1:
+            rays[j] = got[0]
+        elif got:
+            rays[j] = (np.concatenate([g[0] for g in got]), np.concatenate([g[1] for g in got]),
+                       np.concatenate([g[2] for g in got]))
+        else:
+            rays[j] = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0))
+    return rays
