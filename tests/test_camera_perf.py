@@ -71,3 +71,84 @@ def test_shadow_rays_of_no_points_and_no_shadow_lights():
     assert shadow_rays(P, N, lights, np.zeros(4, dtype=bool), 2) == {}
     got = shadow_rays(P[:0], N[:0], lights, np.array([True, False, False, False]), 2)
     assert list(got) == [0] and len(got[0][0]) == 0 and got[0][1].shape == (0, 3)
+
+
+# --------------------------------------------------------------------- the ray engine's part
+
+import math  # noqa: E402
+
+import pytest  # noqa: E402
+
+from sensorium.server.raycast.blocks import MIN_RAYS  # noqa: E402
+from sensorium.server.raycast.engine import Mount, Precision, RayEngine, RayKind, ShapeEntry  # noqa: E402
+from sensorium.server.world.geometry import Box, Cylinder, Plane, Pose, Sphere  # noqa: E402
+
+
+def _fan(n: int, seed: int) -> np.ndarray:
+    """n unit directions all around (a camera's pixel rays, in any frame)."""
+    d = np.random.default_rng(seed).normal(size=(n, 3))
+    return d / np.linalg.norm(d, axis=1)[:, None]
+
+
+def _robot_world(precision):
+    """A floor, a wall, a ball, a moving robot (a cylinder body and a box on it) and another robot."""
+    eng = RayEngine(precision)
+    eng.add_body([ShapeEntry(Plane(), Pose.identity(), True, True)], Pose.identity())
+    eng.add_body([ShapeEntry(Box((0.1, 2.0, 1.0)), Pose.identity(), True, True)],
+                 Pose(np.eye(3), np.array([1.5, 0.0, 0.5])))
+    eng.add_body([ShapeEntry(Sphere(0.15), Pose.identity(), True, True)], Pose(np.eye(3), np.array([0.8, 0.3, 0.15])))
+    body = eng.add_body([ShapeEntry(Cylinder(0.045, 0.08), Pose.identity(), True, True),
+                         ShapeEntry(Box((0.02, 0.02, 0.02)), Pose(np.eye(3), np.array([0.03, 0.0, 0.05])), True, True)],
+                        Pose(np.eye(3), np.array([0.0, 0.0, 0.04])), owner=0, movable=True)
+    eng.add_body([ShapeEntry(Cylinder(0.045, 0.08), Pose.identity(), True, True)],
+                 Pose(np.eye(3), np.array([0.4, -0.2, 0.04])), owner=1, movable=True)
+    return eng, body
+
+
+@pytest.mark.parametrize("precision", [Precision.FAST, Precision.EXACT])
+def test_a_large_local_cast_traces_only_the_rays_that_may_meet_the_body(precision):
+    eng, body = _robot_world(precision)
+    n = MIN_RAYS + 1000
+    D = _fan(n, 3)
+    O = np.ascontiguousarray(np.broadcast_to(np.array([0.04, 0.0, 0.06]), D.shape))   # above the box, in the body frame
+    big = eng.cast_local(body, O, D, 0.001, np.inf, kind=RayKind.VISUAL)
+    pruned = eng.counters["local_pruned"]
+    assert 0 < pruned < n                   # most rays pass the body by; some meet it
+    step = MIN_RAYS // 2                    # batches too small to be pruned: every ray traced
+    parts = [eng.cast_local(body, O[a:a + step], D[a:a + step], 0.001, np.inf, kind=RayKind.VISUAL)
+             for a in range(0, n, step)]
+    assert eng.counters["local_pruned"] == pruned
+    assert np.concatenate([p.distance for p in parts]).tobytes() == big.distance.tobytes()
+    assert np.concatenate([p.shape for p in parts]).tobytes() == big.shape.tobytes()
+    # a hit's normal bit for bit; a miss's is zero (FAST's sign of that zero already follows the
+    # batch's path -- mostly missing or mostly hitting -- and nothing reads it)
+    hit = np.isfinite(big.distance)
+    normals = np.concatenate([p.normal for p in parts])
+    assert normals[hit].tobytes() == big.normal[hit].tobytes()
+    assert not normals[~hit].any() and not big.normal[~hit].any()
+    assert np.isfinite(big.distance).any()
+
+
+@pytest.mark.parametrize("precision,n", [(Precision.FAST, (1 << 16) + 1000), (Precision.EXACT, MIN_RAYS + 1000)])
+def test_unbounded_rays_mounted_on_a_robot_skip_the_mount_tables(precision, n):
+    """A camera without a far plane on its robot, a cast in blocks (FAST's packet path takes up
+    to 65,536 rays in one C pass): the Mount's cast takes the general broad phase directly
+    (counted), with the hits of the same rays given a plain mount array."""
+    eng, body = _robot_world(precision)
+    eng.threads = 2
+    yaw = 0.3
+    R = np.array([[math.cos(yaw), -math.sin(yaw), 0.0], [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+    eng.set_body_pose(body, Pose(R, np.array([0.0, 0.0, 0.04])))
+    D = _fan(n, 4)
+    O = np.broadcast_to(np.array([0.03, 0.0, 0.1]), D.shape)       # one origin for every ray (a camera)
+    mount = Mount(np.full(n, body))
+    for _ in range(2):          # the same rays cast again, as an image's each step
+        before = eng.counters["unbounded_mounts"]
+        got = eng.cast(O, D, 0.01, np.inf, kind=RayKind.VISUAL, exclude_owner=-1, mount=mount)
+        assert eng.counters["unbounded_mounts"] > before
+        want = eng.cast(O, D, 0.01, np.inf, kind=RayKind.VISUAL, exclude_owner=-1, mount=np.full(n, body))
+        assert got.distance.tobytes() == want.distance.tobytes()
+        assert got.shape.tobytes() == want.shape.tobytes()
+        assert got.normal.tobytes() == want.normal.tobytes()
+        assert (got.shape == eng._bodies[body + 1].first).any()      # the other robot is seen, never its own body
+        assert not np.isin(got.shape, [eng._bodies[body].first, eng._bodies[body].first + 1]).any()
