@@ -152,3 +152,30 @@ def test_unbounded_rays_mounted_on_a_robot_skip_the_mount_tables(precision, n):
         assert got.normal.tobytes() == want.normal.tobytes()
         assert (got.shape == eng._bodies[body + 1].first).any()      # the other robot is seen, never its own body
         assert not np.isin(got.shape, [eng._bodies[body].first, eng._bodies[body].first + 1]).any()
+
+
+def test_direct_and_segments_are_light_terms_and_occlusion_segments():
+    lights = _lights()
+    P, N = _points(5000, 7)
+    direct, unit, length = light_math.direct_and_segments(P, N, lights)
+    assert direct.tobytes() == light_math.light_terms(P, N, lights)[1].tobytes()
+    want_unit, want_length = light_math.occlusion_segments_many(P, lights)
+    assert unit.tobytes() == want_unit.tobytes() and length.tobytes() == want_length.tobytes()
+
+
+def test_mounted_rays_turn_as_one_pass_on_any_threads():
+    from sensorium.server.sim.cameras import MountedRays
+
+    local = _fan(3 * shading.BLOCK + 77, 11)
+    yaw = 0.7
+    R = np.array([[math.cos(yaw), -math.sin(yaw), 0.0], [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+    x, y, z = (np.ascontiguousarray(local[:, k]) for k in range(3))
+    want = np.empty(local.shape)
+    for k in range(3):          # the one pass the rays were turned with before the blocks
+        want[:, k] = x * R[k, 0] + y * R[k, 1] + z * R[k, 2]
+    for threads in (1, 2):
+        world, world32 = MountedRays(local).at(R, threads)
+        assert world.tobytes() == want.tobytes()
+        assert world32.tobytes() == want.astype(np.float32).tobytes()
+    small = MountedRays(local[:10]).at(R, 2)[0]
+    assert small.tobytes() == want[:10].tobytes()

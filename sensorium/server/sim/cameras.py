@@ -46,15 +46,24 @@ class MountedRays:
     def __len__(self) -> int:
         return len(self.local)
 
-    def at(self, rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def at(self, rotation: np.ndarray, threads: int = 1) -> tuple[np.ndarray, np.ndarray]:
+        """The world directions (and their float32 copy) at ``rotation``: turned in row blocks on up
+        to ``threads`` threads, each row's value the same on any number of them."""
         key = rotation.tobytes()
         if key != self._key:
             x, y, z = self._cols
-            out = np.empty((len(x), 3))
-            for k in range(3):     # by columns: no BLAS call (threads stall on a busy machine)
-                out[:, k] = x * rotation[k, 0] + y * rotation[k, 1] + z * rotation[k, 2]
+            n = len(x)
+            out = np.empty((n, 3))
+            w32 = np.empty((n, 3), dtype=np.float32)
+
+            def turn(sl: slice) -> None:
+                for k in range(3):     # by columns: no BLAS call (threads stall on a busy machine)
+                    out[sl, k] = x[sl] * rotation[k, 0] + y[sl] * rotation[k, 1] + z[sl] * rotation[k, 2]
+                w32[sl] = out[sl]      # rounded to float32 as astype rounds
+
+            rows = shading.BLOCK if n >= blocks.MIN_RAYS else max(n, 1)
+            blocks.run(turn, [slice(a, min(n, a + rows)) for a in range(0, n, rows)], threads)
             out.flags.writeable = False
-            w32 = out.astype(np.float32)
             w32.flags.writeable = False
             self._key, self.world, self.world32 = key, out, w32
         return self.world, self.world32
@@ -72,9 +81,9 @@ def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, 
                  distance_only: bool = False) -> RayHits:
     """The nearest surface along each of a device's pixel rays from its world pose ``pose``: nothing
     excluded (its robot is in view), but blind to the device's own shapes."""
-    dirs, dirs32 = rays.at(pose.rotation)
-    origins = np.broadcast_to(pose.translation, dirs.shape)
     engine = device._scene.engine
+    dirs, dirs32 = rays.at(pose.rotation, engine.threads)
+    origins = np.broadcast_to(pose.translation, dirs.shape)
     if rays.own is not None:
         return rays.own.cast(engine, origins, dirs, device.carrier_rotation(device._robot.pose), dirs32,
                              distance_only)
@@ -600,7 +609,7 @@ def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, sh
     """Per shadow-casting light ``j``: the points (ascending indices into ``P``) whose direct term
     from it is above 0 (``light.light_terms``) and which lie within its radius
     (``shading.within_radius``), with their unit segments towards it and the segments' lengths
-    (``light.occlusion_segments_many``). Every value is elementwise, so it is worked out on row
+    (``light.occlusion_segments_many``; both from ``light.direct_and_segments``). Every value is elementwise, so it is worked out on row
     blocks of ``shading.BLOCK`` points (each block's (S, n, 3) temporaries stay in the CPU's cache)
     on up to ``threads`` threads: the same points and the same bits as one pass over all of them."""
     js = shadows.nonzero()[0].tolist()
@@ -609,8 +618,7 @@ def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, sh
 
     def part(sl: slice) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         Pb = P[sl]
-        direct = light_math.light_terms(Pb, N[sl], lights)[1]
-        unit, length = light_math.occlusion_segments_many(Pb, lights)
+        direct, unit, length = light_math.direct_and_segments(Pb, N[sl], lights)
         out = []
         for j in js:
             i = (direct[:, j] > 0.0).nonzero()[0]
