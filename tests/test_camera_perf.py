@@ -179,3 +179,18 @@ def test_mounted_rays_turn_as_one_pass_on_any_threads():
         assert world32.tobytes() == want.astype(np.float32).tobytes()
     small = MountedRays(local[:10]).at(R, 2)[0]
     assert small.tobytes() == want[:10].tobytes()
+
+
+def test_hits_move_into_a_shape_frame_in_blocks_as_in_one_product():
+    from sensorium.server.sim.scene import _POSE_ROWS, _in_blocks
+    from sensorium.server.world.geometry import Pose as GeoPose
+
+    rng = np.random.default_rng(12)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    pose = GeoPose(q, np.array([0.3, -1.2, 0.05]))
+    x = rng.normal(size=(2 * _POSE_ROWS + 999, 3)) * 3.0
+    rows = np.sort(rng.choice(len(x), 2 * _POSE_ROWS + 5, replace=False))
+    assert _in_blocks(pose, x, rows, True).tobytes() == pose.apply(x[rows]).tobytes()
+    assert _in_blocks(pose, x, rows, False).tobytes() == pose.apply_dirs(x[rows]).tobytes()
+    one = np.broadcast_to(np.array([0.1, 0.2, 0.3]), x.shape)       # a camera's origin, one row for all
+    assert _in_blocks(pose, one, rows, True).tobytes() == pose.apply(one[rows]).tobytes()

@@ -571,9 +571,12 @@ class Camera(Device):
             albedo = scene.surface_colors(s, np.broadcast_to(origin, (len(s), 3)), D, t)
             lit = None
             if shadows.any():    # shadows fall on opaque surfaces only (Webots' translucent ones take none)
-                lit = np.ones((len(s), len(shadows)), dtype=bool)
                 on = scene.receives_shadows(s).nonzero()[0]
-                lit[on] = self._shadows(P[on], N[on], lights, shadows, counters)
+                if len(on) == len(s):     # every surface seen (an opaque world): no gathered copies
+                    lit = self._shadows(P, N, lights, shadows, counters)
+                else:
+                    lit = np.ones((len(s), len(shadows)), dtype=bool)
+                    lit[on] = self._shadows(P[on], N[on], lights, shadows, counters)
             return _shade(P, N, albedo, lights, lit, engine.threads)
 
         alpha = None
