@@ -194,3 +194,13 @@ def test_hits_move_into_a_shape_frame_in_blocks_as_in_one_product():
     assert _in_blocks(pose, x, rows, False).tobytes() == pose.apply_dirs(x[rows]).tobytes()
     one = np.broadcast_to(np.array([0.1, 0.2, 0.3]), x.shape)       # a camera's origin, one row for all
     assert _in_blocks(pose, one, rows, True).tobytes() == pose.apply(one[rows]).tobytes()
+
+
+def test_an_image_s_rays_turn_into_its_body_frame_in_blocks_as_in_one_product():
+    from sensorium.server.sim.own_shapes import _ROWS, _turned
+
+    rng = np.random.default_rng(13)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    x = _fan(2 * _ROWS + 321, 14)
+    assert _turned(x, q.T).tobytes() == np.ascontiguousarray(x @ q.T).tobytes()
+    assert _turned(x[:100], q.T).tobytes() == np.ascontiguousarray(x[:100] @ q.T).tobytes()
