@@ -204,3 +204,27 @@ def test_an_image_s_rays_turn_into_its_body_frame_in_blocks_as_in_one_product():
     x = _fan(2 * _ROWS + 321, 14)
     assert _turned(x, q.T).tobytes() == np.ascontiguousarray(x @ q.T).tobytes()
     assert _turned(x[:100], q.T).tobytes() == np.ascontiguousarray(x[:100] @ q.T).tobytes()
+
+
+@pytest.mark.parametrize("casting", [[0], [1], [2], [0, 2], [1, 3]])
+def test_shadow_rays_of_some_lights_are_the_one_pass_choice(casting):
+    """Only the shadow-casting lights' terms are made (LightArrays.subset): the same values."""
+    lights = _lights()
+    shadows = np.isin(np.arange(4), casting)
+    P, N = _points(shading.BLOCK + 500, 5)
+    want = _one_pass(P, N, lights, shadows)
+    got = shadow_rays(P, N, lights, shadows, 2)
+    assert sorted(got) == sorted(want) == casting
+    for j in casting:
+        for a, b in zip(got[j], want[j]):
+            assert a.tobytes() == b.tobytes()
+
+
+def test_a_light_subset_keeps_every_value():
+    lights = _lights()
+    sub = lights.subset([2, 0])
+    assert len(sub) == 2
+    for name in ("kind", "position", "direction", "attenuation", "intensity", "ambient_intensity", "color",
+                 "beam_width", "cut_off_angle", "radius"):
+        assert getattr(sub, name).tobytes() == getattr(lights, name)[[2, 0]].tobytes()
+        assert not getattr(sub, name).flags.writeable

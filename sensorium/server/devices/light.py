@@ -35,8 +35,8 @@ Degenerate cases (decided here):
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from dataclasses import dataclass
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, fields
 from enum import IntEnum
 
 import numpy as np
@@ -154,6 +154,19 @@ class LightArrays:
     @classmethod
     def empty(cls) -> LightArrays:
         return cls.from_lights(())
+
+    def subset(self, index: Sequence[int]) -> LightArrays:
+        """These lights' arrays at ``index`` (in that order), their values as they are (not
+        normalised again: a unit direction keeps its bits)."""
+        idx = np.asarray(index, dtype=np.int64)
+        out = object.__new__(LightArrays)
+        for f in fields(self):
+            a = getattr(self, f.name)
+            if a is not None:
+                a = a[:, idx] if a.ndim == 3 else a[idx]       # (S, n, 3): per point (batched lights)
+                a.setflags(write=False)
+            object.__setattr__(out, f.name, a)
+        return out
 
 
 def _per_point(a: np.ndarray) -> np.ndarray:

@@ -618,14 +618,16 @@ def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, sh
     js = shadows.nonzero()[0].tolist()
     S = len(P)
     parts = [slice(a, min(S, a + shading.BLOCK)) for a in range(0, S, shading.BLOCK)]
+    # the shadow-casting lights only (each light's values are its own: the others change none of them)
+    casting = lights if len(js) == len(lights) else lights.subset(js)
 
     def part(sl: slice) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         Pb = P[sl]
-        direct, unit, length = light_math.direct_and_segments(Pb, N[sl], lights)
+        direct, unit, length = light_math.direct_and_segments(Pb, N[sl], casting)
         out = []
-        for j in js:
+        for j in range(len(js)):
             i = (direct[:, j] > 0.0).nonzero()[0]
-            near = shading.within_radius(Pb[i], lights, j)       # beyond the light's radius: unlit anyway
+            near = shading.within_radius(Pb[i], casting, j)       # beyond the light's radius: unlit anyway
             if near is not None:
                 i = i[near]
             out.append((i + sl.start, unit[i, j], length[i, j]))
