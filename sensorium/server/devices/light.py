@@ -35,8 +35,8 @@ Degenerate cases (decided here):
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from dataclasses import dataclass
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, fields
 from enum import IntEnum
 
 import numpy as np
@@ -155,6 +155,19 @@ class LightArrays:
     def empty(cls) -> LightArrays:
         return cls.from_lights(())
 
+    def subset(self, index: Sequence[int]) -> LightArrays:
+        """These lights' arrays at ``index`` (in that order), their values as they are (not
+        normalised again: a unit direction keeps its bits)."""
+        idx = np.asarray(index, dtype=np.int64)
+        out = object.__new__(LightArrays)
+        for f in fields(self):
+            a = getattr(self, f.name)
+            if a is not None:
+                a = a[:, idx] if a.ndim == 3 else a[idx]       # (S, n, 3): per point (batched lights)
+                a.setflags(write=False)
+            object.__setattr__(out, f.name, a)
+        return out
+
 
 def _per_point(a: np.ndarray) -> np.ndarray:
     """A light field (n, 3) shared by every point as (1, n, 3); (S, n, 3), one row per point (the
@@ -175,13 +188,18 @@ def _vectors(points: np.ndarray, lights: LightArrays):
     return v, length, unit, d
 
 
-def _terms(P: np.ndarray, N: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
-    """Attenuation ``att`` (S,n) and un-occluded direct term ``Id = I·c·spot`` (S,n)."""
-    v, length, unit, d = _vectors(P, lights)
-    local = lights.kind != LightKind.DIRECTIONAL
-    a = lights.attenuation
-    with np.errstate(divide="ignore"):
-        att = np.where(local[None, :], 1.0 / (a[:, 0] + a[:, 1] * d + a[:, 2] * d * d), 1.0)
+def _terms(P: np.ndarray, N: np.ndarray, lights: LightArrays, vectors: tuple | None = None,
+           attenuation: bool = True) -> tuple[np.ndarray | None, np.ndarray]:
+    """Attenuation ``att`` (S,n) and un-occluded direct term ``Id = I·c·spot`` (S,n).
+    ``vectors``: ``_vectors(P, lights)`` when the caller has them; ``attenuation`` False: ``att``
+    is not computed (None)."""
+    v, length, unit, d = _vectors(P, lights) if vectors is None else vectors
+    att = None
+    if attenuation:
+        local = lights.kind != LightKind.DIRECTIONAL
+        a = lights.attenuation
+        with np.errstate(divide="ignore"):
+            att = np.where(local[None, :], 1.0 / (a[:, 0] + a[:, 1] * d + a[:, 2] * d * d), 1.0)
 
     # c = N·(q - p)/d: exactly 0 when the light is exactly in the sensor plane (and when d = 0).
     c = np.einsum("sk,snk->sn", N, v) / np.where(length > 0.0, length, 1.0)
@@ -211,14 +229,29 @@ def irradiance_many(positions: np.ndarray, normals: np.ndarray, lights: LightArr
     if len(lights) == 0:
         return np.zeros(len(P))
     att, direct = _terms(P, N, lights)
+    assert att is not None
     return irradiance_from_terms(att, direct, lights, occluded, color_filters)
 
 
 def light_terms(positions: np.ndarray, normals: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
     """Attenuation (S,n) and un-occluded direct term (S,n) of S sensors, to compute once and use
     both for choosing occlusion rays and for :func:`irradiance_from_terms`."""
-    return _terms(np.asarray(positions, dtype=np.float64).reshape(-1, 3),
-                  np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights)
+    att, direct = _terms(np.asarray(positions, dtype=np.float64).reshape(-1, 3),
+                         np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights)
+    assert att is not None
+    return att, direct
+
+
+def direct_and_segments(positions: np.ndarray, normals: np.ndarray, lights: LightArrays
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The un-occluded direct term (S,n) of :func:`light_terms` and the occlusion segments (S,n,3),
+    (S,n) of :func:`occlusion_segments_many`, the same values, from one pass of the point-to-light
+    vectors (a camera choosing its shadow rays needs no attenuation)."""
+    P = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    vectors = _vectors(P, lights)
+    direct = _terms(P, np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights, vectors, attenuation=False)[1]
+    unit, d = _segments(vectors)
+    return direct, unit, d
 
 
 def irradiance_from_terms(att: np.ndarray, direct: np.ndarray, lights: LightArrays,
@@ -242,6 +275,10 @@ def occlusion_segments_many(positions: np.ndarray, lights: LightArrays) -> tuple
     (S,n,3) and lengths (S,n) (the sensor–light distance, 1000 for directional lights); a hit with
     ``0 <= t <= length`` means occluded. A sensor exactly at a light gets direction (1, 0, 0) and
     length 0: its direct term is 0 whatever the ray reports."""
-    _, _, unit, d = _vectors(np.asarray(positions, dtype=np.float64).reshape(-1, 3), lights)
+    return _segments(_vectors(np.asarray(positions, dtype=np.float64).reshape(-1, 3), lights))
+
+
+def _segments(vectors: tuple) -> tuple[np.ndarray, np.ndarray]:
+    _, _, unit, d = vectors
     unit = np.where((d > 0.0)[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
     return unit, d

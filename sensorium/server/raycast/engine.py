@@ -195,6 +195,9 @@ def _items_key(items) -> tuple:
     return tuple((i, prim, pose.rotation.tobytes(), pose.translation.tobytes()) for i, prim, pose in items)
 
 
+_BOUND_ROWS = 32768   # rows of a large cast_local's bound test at a time (its temporaries stay in the cache)
+
+
 class RayEngine(TierTracer):
     """Nearest-hit ray queries against bodies of shapes (see module docstring)."""
 
@@ -220,6 +223,7 @@ class RayEngine(TierTracer):
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
             "continued_rays": 0, "unresolved_rays": 0, "edge_guard_hits": 0, "neighbour_lists": 0, "ray_lists": 0,
+            "unbounded_mounts": 0, "local_pruned": 0,
         }
 
     # ---- configuration ----------------------------------------------------------------------
@@ -582,12 +586,40 @@ class RayEngine(TierTracer):
         t_near = _param(t_near, n, np.float64, float)
         t_far = _param(t_far, n, np.float64, float)
         big = max(float(O.max()), -float(O.min()))
+        far = np.array(_full(t_far, n), dtype=np.float64)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            res = self._trace(tier, O, D, t_near, np.array(_full(t_far, n), dtype=np.float64), -1,
-                              1e-9 + 1e-14 * big, self._precision is Precision.EXACT)
+            # a large batch (an image's pixel rays on their robot, cast once): only the rays whose
+            # segment may meet the tier's bound, grown well past the test's rounding, are traced
+            # (the others meet none of its shapes; no ray's answer depends on the rays beside it)
+            sel = None
+            if n >= MIN_RAYS:
+                grow = 1e-9 + 1e-12 * big
+                may = np.empty(n, dtype=bool)
+
+                def test(sl: slice) -> None:     # row blocks (each row's own test) in the cache
+                    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # per thread
+                        may[sl] = tier.may_hit(O[sl], D[sl], _take(t_near, sl), far[sl], grow=grow)
+
+                run_blocks(test, [slice(a, min(n, a + _BOUND_ROWS)) for a in range(0, n, _BOUND_ROWS)], self.threads)
+                if not may.all():
+                    sel = may.nonzero()[0]
+                    self.counters["local_pruned"] += n - len(sel)
+            if sel is None:
+                res = self._trace(tier, O, D, t_near, far, -1, 1e-9 + 1e-14 * big, self._precision is Precision.EXACT)
+            elif len(sel) == 0:
+                res = None
+            else:
+                res = self._trace(tier, O.take(sel, axis=0), D.take(sel, axis=0), _take(t_near, sel), far[sel], -1,
+                                  1e-9 + 1e-14 * big, self._precision is Precision.EXACT)
         if res is not None:
-            t, s, normal = res
-            shape = np.where(s >= 0, s + b.first, -1)
+            ts, s, nrm = res
+            if sel is None:
+                t, normal = ts, nrm
+                shape = np.where(s >= 0, s + b.first, -1)
+            else:
+                t[sel] = ts
+                shape[sel] = np.where(s >= 0, s + b.first, -1)
+                normal[sel] = nrm
         return RayHits(t, normal, shape)
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
@@ -716,6 +748,7 @@ class RayEngine(TierTracer):
             mt.C = mt.T + np.einsum("mij,mj->mi", mt.R, mt.anchor) if mt.anchored else mt.T
             mt.epoch = self._epoch
         C = mt.C
+        n = len(O)
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = own = None
         tight = -1   # a mover row whose pairs are only a Mount's own pairs (already tested against its bound)
@@ -724,6 +757,19 @@ class RayEngine(TierTracer):
                 mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
                 mt.row_of[mt.index] = np.arange(len(mt.index))
             kept = isinstance(mount, Mount)
+            row = int(mt.row_of[mount.lo]) if kept and mount.lo == mount.hi >= 0 else -1
+            if (row >= 0 and mount.own is None and not (len(C) > _FEW_MOVERS and n * len(C) > _DENSE_PAIRS)
+                    and not np.count_nonzero(lim < _INF)):
+                # every ray rides one mover and no segment is bounded (a camera without a far plane):
+                # mount_state and _mounted_pairs would build their per-ray tables only to find every
+                # ray unbounded and hand them all to the general broad phase, which this is, on the
+                # same values without their gathered copies (_sphere_pairs' test for rows of one
+                # origin, as it runs on such a copy), less the pairs with the mount itself
+                self.counters["unbounded_mounts"] += 1
+                pr, pm = _sphere_pairs(C, mt.r2, owner, O, D, t_near, lim, excl, cone=False)
+                keep = (pm != row).nonzero()[0]
+                order = np.argsort(pr[keep], kind="stable")
+                return pr[keep][order], pm[keep][order], -1, None
             st = mount_state(mount, mt, C, O, t_near, t_far, D, self._rot) if kept else None
             if st is None and kept and mount.own is not None:
                 pass   # unbounded rays that see their own mount: the general broad phase for all

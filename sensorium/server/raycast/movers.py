@@ -36,15 +36,17 @@ def _segment_near_sphere(rel_x, rel_y, rel_z, dx, dy, dz, t_lo, t_hi, r2):
     return e2 - tc * (b + b - tc) <= r2 + 1e-12 * e2
 
 
-def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=None):
+def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=None, cone: bool = True):
     """(ray, mover) index pairs whose segment [t_near, lim] passes within the mover's bounding
     sphere (centre C, squared radius r2) and whose owner is not excluded (``owner`` None: no
     check).  Small tables: one (rays, movers, 3) computation, pairs ordered by ray.  Large batches
     (a lidar): one mover at a time on contiguous columns, pairs ordered by mover (so the pairs of
     any one mover are always in ray order); ``among`` (ascending mover indices, a superset of those
-    any ray can pass near) then skips the others' tests (the same pairs, the same arithmetic)."""
+    any ray can pass near) then skips the others' tests (the same pairs, the same arithmetic).
+    ``cone`` False: rows of one origin given as a broadcast array take the test (and give the
+    pairs) they would as a gathered copy of those rows, without the broadcast origin's cone test."""
     n, M = len(O), len(C)
-    one = O.strides[0] == 0 and n > 1   # one origin for all rays (a lidar): the per-mover path below
+    one = cone and O.strides[0] == 0 and n > 1   # one origin for all rays (a lidar): the per-mover path below
     if n * M <= _TINY and not one:  # a few rays and movers: plain floats (same test)
         Cl, Ol, Dl, r2l, hil = C.tolist(), O.tolist(), D.tolist(), r2.tolist(), lim.tolist()
         lol = t_near.tolist() if isinstance(t_near, np.ndarray) else [t_near] * n
@@ -77,7 +79,7 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=None):
         if owner is not None:
             sel &= owner != (excl[:, None] if isinstance(excl, np.ndarray) else excl)
         return sel.nonzero()
-    shared = one or not np.count_nonzero(O != O[0])   # one origin (a lidar): rel = C - o is per mover
+    shared = one or O.strides[0] == 0 or not np.count_nonzero(O != O[0])   # one origin: rel = C - o is per mover
     if not shared:
         ox, oy, oz, dx, dy, dz = (np.ascontiguousarray(a[:, k]) for a in (O, D) for k in range(3))
     prs, pms = [], []

@@ -46,15 +46,24 @@ class MountedRays:
     def __len__(self) -> int:
         return len(self.local)
 
-    def at(self, rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def at(self, rotation: np.ndarray, threads: int = 1) -> tuple[np.ndarray, np.ndarray]:
+        """The world directions (and their float32 copy) at ``rotation``: turned in row blocks on up
+        to ``threads`` threads, each row's value the same on any number of them."""
         key = rotation.tobytes()
         if key != self._key:
             x, y, z = self._cols
-            out = np.empty((len(x), 3))
-            for k in range(3):     # by columns: no BLAS call (threads stall on a busy machine)
-                out[:, k] = x * rotation[k, 0] + y * rotation[k, 1] + z * rotation[k, 2]
+            n = len(x)
+            out = np.empty((n, 3))
+            w32 = np.empty((n, 3), dtype=np.float32)
+
+            def turn(sl: slice) -> None:
+                for k in range(3):     # by columns: no BLAS call (threads stall on a busy machine)
+                    out[sl, k] = x[sl] * rotation[k, 0] + y[sl] * rotation[k, 1] + z[sl] * rotation[k, 2]
+                w32[sl] = out[sl]      # rounded to float32 as astype rounds
+
+            rows = shading.BLOCK if n >= blocks.MIN_RAYS else max(n, 1)
+            blocks.run(turn, [slice(a, min(n, a + rows)) for a in range(0, n, rows)], threads)
             out.flags.writeable = False
-            w32 = out.astype(np.float32)
             w32.flags.writeable = False
             self._key, self.world, self.world32 = key, out, w32
         return self.world, self.world32
@@ -72,9 +81,9 @@ def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, 
                  distance_only: bool = False) -> RayHits:
     """The nearest surface along each of a device's pixel rays from its world pose ``pose``: nothing
     excluded (its robot is in view), but blind to the device's own shapes."""
-    dirs, dirs32 = rays.at(pose.rotation)
-    origins = np.broadcast_to(pose.translation, dirs.shape)
     engine = device._scene.engine
+    dirs, dirs32 = rays.at(pose.rotation, engine.threads)
+    origins = np.broadcast_to(pose.translation, dirs.shape)
     if rays.own is not None:
         return rays.own.cast(engine, origins, dirs, device.carrier_rotation(device._robot.pose), dirs32,
                              distance_only)
@@ -562,9 +571,12 @@ class Camera(Device):
             albedo = scene.surface_colors(s, np.broadcast_to(origin, (len(s), 3)), D, t)
             lit = None
             if shadows.any():    # shadows fall on opaque surfaces only (Webots' translucent ones take none)
-                lit = np.ones((len(s), len(shadows)), dtype=bool)
                 on = scene.receives_shadows(s).nonzero()[0]
-                lit[on] = self._shadows(P[on], N[on], lights, shadows, counters)
+                if len(on) == len(s):     # every surface seen (an opaque world): no gathered copies
+                    lit = self._shadows(P, N, lights, shadows, counters)
+                else:
+                    lit = np.ones((len(s), len(shadows)), dtype=bool)
+                    lit[on] = self._shadows(P[on], N[on], lights, shadows, counters)
             return _shade(P, N, albedo, lights, lit, engine.threads)
 
         alpha = None
@@ -580,20 +592,56 @@ class Camera(Device):
     def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
                  counters: Any) -> np.ndarray:
         """(S, n) False where a shadow-casting light is hidden from the point by a visible shape
-        (its segment to the light, 1000 m towards a directional one); only lit, facing pairs cast."""
-        att, direct = light_math.light_terms(P, N, lights)
-        lit = np.ones(direct.shape, dtype=bool)
-        unit, length = light_math.occlusion_segments_many(P, lights)
-        for j in shadows.nonzero()[0].tolist():
-            i = (direct[:, j] > 0.0).nonzero()[0]
-            near = shading.within_radius(P[i], lights, j)       # beyond the light's radius: unlit anyway
-            if near is not None:
-                i = i[near]
+        (its segment to the light, 1000 m towards a directional one); only lit, facing pairs cast.
+        Which pairs cast and their segments come from :func:`shadow_rays` (row blocks on the
+        engine's threads); each light's rays are then one cast, as one batch."""
+        lit = np.ones((len(P), len(lights)), dtype=bool)
+        engine = self._scene.engine
+        for j, (i, unit, length) in shadow_rays(P, N, lights, shadows, engine.threads).items():
             if len(i) == 0:
                 continue
-            hits = self._scene.engine.cast(P[i], unit[i, j], 0.0, length[i, j], kind=RayKind.SHADOW, exclude_owner=-1,
-                                           distance_only=True)
+            hits = engine.cast(P[i], unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1, distance_only=True)
             counters["rays_camera"] += len(i)
             counters["cast_calls"] += 1
-            lit[i, j] = ~(hits.distance <= length[i, j])
+            lit[i, j] = ~(hits.distance <= length)
         return lit
+
+
+def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
+                threads: int) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per shadow-casting light ``j``: the points (ascending indices into ``P``) whose direct term
+    from it is above 0 (``light.light_terms``) and which lie within its radius
+    (``shading.within_radius``), with their unit segments towards it and the segments' lengths
+    (``light.occlusion_segments_many``; both from ``light.direct_and_segments``). Every value is elementwise, so it is worked out on row
+    blocks of ``shading.BLOCK`` points (each block's (S, n, 3) temporaries stay in the CPU's cache)
+    on up to ``threads`` threads: the same points and the same bits as one pass over all of them."""
+    js = shadows.nonzero()[0].tolist()
+    S = len(P)
+    parts = [slice(a, min(S, a + shading.BLOCK)) for a in range(0, S, shading.BLOCK)]
+    # the shadow-casting lights only (each light's values are its own: the others change none of them)
+    casting = lights if len(js) == len(lights) else lights.subset(js)
+
+    def part(sl: slice) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        Pb = P[sl]
+        direct, unit, length = light_math.direct_and_segments(Pb, N[sl], casting)
+        out = []
+        for j in range(len(js)):
+            i = (direct[:, j] > 0.0).nonzero()[0]
+            near = shading.within_radius(Pb[i], casting, j)       # beyond the light's radius: unlit anyway
+            if near is not None:
+                i = i[near]
+            out.append((i + sl.start, unit[i, j], length[i, j]))
+        return out
+
+    done = blocks.run(part, parts, threads) if js and S else []
+    rays = {}
+    for k, j in enumerate(js):
+        got = [d[k] for d in done]
+        if len(got) == 1:
+            rays[j] = got[0]
+        elif got:
+            rays[j] = (np.concatenate([g[0] for g in got]), np.concatenate([g[1] for g in got]),
+                       np.concatenate([g[2] for g in got]))
+        else:
+            rays[j] = (np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0))
+    return rays

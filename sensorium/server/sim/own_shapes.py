@@ -38,18 +38,26 @@ def _skipping(cast: Callable[[bool, np.ndarray, np.ndarray, np.ndarray], RayHits
               mine: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> RayHits:
     """The loop: ``cast(first, rows, near, far)`` casts those rays (``first``: every ray, with the
     caller's own limits), ``mine(rows, shapes)`` says which hits are own shapes; those rays go
-    again from just past their hit."""
+    again from just past their hit. When no ray's first hit is an own shape (most casts), that
+    cast is the answer, with no per-ray tables made."""
+    rows = np.arange(n)
+    first = cast(True, rows, t_near, t_far)
+    own = mine(rows, first.shape)
+    if not own.any():
+        return RayHits(first.distance, first.normal, first.shape)
     near = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,)).copy()
     far = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))
     t = np.full(n, np.inf)
     shape = np.full(n, -1, dtype=np.int64)
     normal = np.zeros((n, 3))
-    rows = np.arange(n)
     for p in range(MAX_PASSES):
         if not len(rows):
             break
-        h = cast(p == 0, rows, near[rows], far[rows])
-        own = mine(rows, h.shape)
+        if p:
+            h = cast(False, rows, near[rows], far[rows])
+            own = mine(rows, h.shape)
+        else:
+            h = first
         done = ~own
         t[rows[done]], shape[rows[done]], normal[rows[done]] = h.distance[done], h.shape[done], h.normal[done]
         rows = rows[own]
@@ -63,7 +71,9 @@ def cast_local_skipping(engine, body: int, origins: np.ndarray, directions: np.n
     """``engine.cast_local`` on ``body``, each ray ``i`` blind to the shapes ``own[i]`` (global shape
     indices; one set for every ray: ``own``): the nearest hit on any other shape of the body, or no hit."""
 
-    def cast(first: bool, rows: np.ndarray, near: np.ndarray, far: np.ndarray) -> RayHits:
+    def cast(first: bool, rows: np.ndarray, near, far) -> RayHits:
+        if first:       # every ray, with the caller's limits: no gathered copies
+            return engine.cast_local(body, origins, directions, near, far, kind=kind, skip_transparent=skip_transparent)
         return engine.cast_local(body, origins[rows], directions[rows], near, far, kind=kind,
                                  skip_transparent=skip_transparent)
 
@@ -100,6 +110,20 @@ def cast_skipping(engine, origins: np.ndarray, directions: np.ndarray, t_near, t
     return _skipping(cast, len(origins), t_near, t_far, mine)
 
 
+_ROWS = 32768    # rows per product: a larger one goes to OpenBLAS's threads, which stall on a busy machine
+
+
+def _turned(x: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """``x @ M`` for (n, 3) rows (an image's pixel directions), ``_ROWS`` rows per product: each
+    row's values those of the one product."""
+    if len(x) <= _ROWS:
+        return np.ascontiguousarray(x @ M)
+    out = np.empty((len(x), 3))
+    for a in range(0, len(x), _ROWS):
+        out[a:a + _ROWS] = x[a:a + _ROWS] @ M
+    return out
+
+
 class OwnBodyRays:
     """An image device's pixel rays (directions in its frame) when it has shapes of its own: cast
     mounted on its robot's body, which the world cast then skips, and nearer hits on that body
@@ -112,7 +136,7 @@ class OwnBodyRays:
         self.mount = Mount(np.full(len(directions), body, dtype=np.int64))
         self.limits = (t_near, t_far)
         self._local = (np.ascontiguousarray(np.broadcast_to(local.translation, directions.shape)),
-                       np.ascontiguousarray(directions @ local.rotation.T))
+                       _turned(directions, local.rotation.T))
         self._own = own
         self._hits: tuple[object, RayHits] | None = None
 

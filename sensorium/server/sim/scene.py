@@ -278,9 +278,27 @@ def _texel_coords(sampler: TextureSampler, chosen: np.ndarray, world_to_shape: C
     for s in sorted(set(on.tolist())):
         rows = hit[on == s]
         inv = world_to_shape(s)
-        o, d = inv.apply(origins[rows]), inv.apply_dirs(directions[rows])
+        o, d = _in_blocks(inv, origins, rows, True), _in_blocks(inv, directions, rows, False)
         uv, picked = sampler.uv(s, o, d, distance[rows])
         yield s, rows, o, d, np.where(picked[:, None], uv, 0.0), picked
+
+
+_POSE_ROWS = 32768
+"""Rows of a camera's hits moved into a shape's frame per ``Pose.apply`` call: a larger product is
+multi-threaded by OpenBLAS, whose threads stall beside the engine's on a busy machine."""
+
+
+def _in_blocks(pose: Pose, x: np.ndarray, rows: np.ndarray, points: bool) -> np.ndarray:
+    """``pose.apply(x[rows])`` (``apply_dirs`` unless ``points``), ``_POSE_ROWS`` rows per product:
+    each row's values those of the one product."""
+    n = len(rows)
+    if n <= _POSE_ROWS:
+        return pose.apply(x[rows]) if points else pose.apply_dirs(x[rows])
+    out = np.empty((n, 3))
+    for a in range(0, n, _POSE_ROWS):
+        r = rows[a:a + _POSE_ROWS]
+        out[a:a + _POSE_ROWS] = pose.apply(x[r]) if points else pose.apply_dirs(x[r])
+    return out
 
 
 def infra_red_terms(red_of: np.ndarray, roughness_of: np.ndarray, sampler: TextureSampler | None,
