@@ -133,6 +133,7 @@ def _all_nodes(sim: Any) -> list[Node]:
     imported_protos = getattr(sim, "imported_protos", {})
     imported_faces = getattr(sim, "imported_interfaces", {})
     imported_visuals = getattr(sim, "imported_visuals", {})
+    place = {name: j for j, name in enumerate(names)} if imported else {}     # (one pass, not one per import)
     for kind, key in imported:
         proto, face = imported_protos.get(key, ""), imported_faces.get(key, ())
         written = imported_visuals.get(key)
@@ -140,7 +141,7 @@ def _all_nodes(sim: Any) -> list[Node]:
             _visuals(sim).add(str(key), len(out) + 1, written)
             out.append(Node(len(out) + 1, written.type, "", written.def_name or "", key, visual=True))
         elif kind == "Solid":
-            j = names.index(key)
+            j = place[key]
             out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key, proto=proto, interface=face))
         else:
             lt = top[int(key)]
