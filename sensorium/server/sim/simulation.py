@@ -502,6 +502,27 @@ class Simulation:
         """Take a top-level solid out of the world for good (Webots' ``node.remove()``): from the
         next measurement no sensor sees it, kinematic contact no longer stops robots at it, and
         ``simulationReset`` does not bring it back (Webots' reset adds no removed node)."""
+        self._take_out(name)
+        # what only a removed imported solid needed goes with it (a Supervisor importing and removing for days
+        # keeps a name, a node id and a few hundred bytes per removed solid): its model in ``world.solids``
+        # (where it keeps its place: the Supervisor numbers nodes by it) becomes its name and DEF alone (a
+        # world file's solid keeps its model: the Supervisor's nodes inside it are numbered from it)
+        if self._imported_poses.pop(name, None) is None:
+            return
+        self.imported_written.pop(name, None)
+        self.imported_interfaces.pop(name, None)
+        regen = getattr(self, "_regen_written", None)
+        if regen:
+            regen.pop(name, None)
+        for k in range(len(self.world.solids) - 1, -1, -1):
+            old = self.world.solids[k]
+            if old.name == name:
+                self.world.solids[k] = wm.Solid.model_construct(name=name, def_name=old.def_name)
+                break
+
+    def _take_out(self, name: str) -> None:
+        """A top-level solid out of the scene, kinematic contact and the terrains (a removal, or a solid
+        about to be built again under its name)."""
         if name not in self.scene.solid_poses:
             raise KeyError(f"no solid {name!r}")
         self.scene.remove_solid(name)
@@ -600,7 +621,7 @@ class Simulation:
         check_additions(self.world.model_copy(update={"solids": others}), set(self.scene.solid_poses) - {name},
                         len(self.scene.world_lights()) - lights_old, self.scene.triangle_count
                         - self.scene.solid_triangles(name), added, [node], self.limits)
-        self.remove_solid(name)
+        self._take_out(name)
         self.world.solids[k] = solid
         self._join_solid(solid, node_id, prepared, again=True)
         if name in self._initial["solids"]:       # a reset keeps the new values (Webots resets no field)
