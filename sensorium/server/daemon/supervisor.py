@@ -175,8 +175,10 @@ def _imported_nodes(sim: Any, first: int) -> _Imported:
     imported_faces = getattr(sim, "imported_interfaces", {})
     imported_visuals = getattr(sim, "imported_visuals", {})
     new = imported[len(kept.every):]
-    wanted = {key for kind, key in new if kind == "Solid"}
-    place = {name: j for j, name in enumerate(names) if name in wanted}     # (one pass, not one per import)
+
+    def place(key: str) -> int:          # an imported solid's name is among the last ones
+        return next(j for j in range(len(names) - 1, -1, -1) if names[j] == key)
+
     for kind, key in new:
         node_id = first + len(kept.every) + 1
         proto, face = imported_protos.get(key, ""), imported_faces.get(key, ())
@@ -185,7 +187,7 @@ def _imported_nodes(sim: Any, first: int) -> _Imported:
             store.add(str(key), node_id, written)
             node = Node(node_id, written.type, "", written.def_name or "", key, visual=True)
         elif kind == "Solid":
-            node = Node(node_id, "Solid", str(key), _def_of(solids_m, place[key]), key, proto=proto, interface=face)
+            node = Node(node_id, "Solid", str(key), _def_of(solids_m, place(key)), key, proto=proto, interface=face)
         else:
             lt = top[int(key)]
             node = Node(node_id, lt.type, lt.name or "", _def_of(top, int(key)), key, proto=proto, interface=face)

@@ -387,6 +387,7 @@ class Scene:
         self.engine = RayEngine(Precision(precision))
         self.shapes: list[ShapeInfo] = []
         self.solid_names = [s.name for s in world.solids]
+        self.solid_name_set = set(self.solid_names)     # (every name the world has had: never reused)
         self._solid_body: dict[str, int] = {}
         self.solid_poses: dict[str, Pose] = {}
         self.triangle_count = 0            # of the bodies in the world now (a removed solid's leave the count)
@@ -705,13 +706,14 @@ class Scene:
         ``node_id``). Its shape ids follow every existing one (none is ever reused). ``again``: a
         solid built again under the name of one just removed (a PROTO field set), keeping its place."""
         name = solid.name
-        if name in self.solid_poses or (name in self.solid_names) != again:
+        if name in self.solid_poses or (name in self.solid_name_set) != again:
             raise KeyError(f"a solid named {name!r} exists or existed" if not again else f"no removed solid {name!r}")
         parts, entries = prepared if prepared is not None else self.solid_entries(solid)
         pose = pose_from_model(solid.pose)
         self._nested_targets(solid)
         if not again:
             self.solid_names.append(name)
+            self.solid_name_set.add(name)
         self.solid_poses[name] = pose
         self.solids_version += 1
         if parts:

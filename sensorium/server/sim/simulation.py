@@ -301,6 +301,8 @@ class Simulation:
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
                                                             # a node was imported (None: the loaded order)
         self._import_protos: Any = None                     # the world's EXTERNPROTO declarations, read once
+        self._name_suffixes: dict[str, int] = {}            # imports' renames so far (imports.py _Converter)
+        self._sizes: dict[str, int] | None = None           # see _solid_sizes
         self.basic_time_step = self.world.world_info.basic_time_step
         self.seed = self.world.world_info.random_seed
         self.time_ms = 0
@@ -526,6 +528,8 @@ class Simulation:
         if name not in self.scene.solid_poses:
             raise KeyError(f"no solid {name!r}")
         self.scene.remove_solid(name)
+        if self._sizes is not None:
+            self._sizes.pop(name, None)
         if self.contact is not None:
             self.contact.remove_solid(name)
         if self.ground is not None:
@@ -560,13 +564,13 @@ class Simulation:
 
         if self._import_protos is None:
             self._import_protos = world_protos(self.loaded, ProtoLimits.matching(self.limits))
-        nodes = read_node_string(text, self.loaded, self.world, taken=set(self.scene.solid_names), limits=self.limits,
+        nodes = read_node_string(text, self.loaded, self.world, taken=self.scene.solid_name_set, limits=self.limits,
                                  allow_outside_meshes=self.allow_outside_meshes, protos=self._import_protos,
-                                 warnings=warnings)
+                                 warnings=warnings, suffixes=self._name_suffixes)
         prepared = [self.scene.solid_entries(n.model) if n.type == "Solid" else None for n in nodes]
         added = sum(triangle_count(e.primitive) for p in prepared if p is not None for e in p[1])
         check_additions(self.world, set(self.scene.solid_poses), len(self.scene.world_lights()),
-                        self.scene.triangle_count, added, nodes, self.limits)
+                        self.scene.triangle_count, added, nodes, self.limits, solids_now=sum(self._solid_sizes().values()))
         out: list[tuple[str, str | int, int]] = []
         for node, prep in zip(nodes, prepared):
             node_id = self.next_node_id()
@@ -589,10 +593,23 @@ class Simulation:
             out.append((node.type, key, node_id))
         return out
 
+    def _solid_sizes(self) -> dict[str, int]:
+        """Each top-level solid's solids (itself and its nested children), kept from the first import on."""
+        from sensorium.server.sim.imports import solid_count
+
+        if self._sizes is None:
+            alive = self.scene.solid_poses
+            self._sizes = {s.name: solid_count(s)[0] for s in self.world.solids if s.name in alive}
+        return self._sizes
+
     def _join_solid(self, solid: wm.Solid, node_id: int, prepared: tuple[list, list], again: bool = False) -> None:
         """A top-level solid joins the scene, kinematic contact and the terrains (an import, or a solid built
         again: ``again``, under the name it had)."""
+        from sensorium.server.sim.imports import solid_count
+
         self.scene.add_solid(solid, node_id, prepared, again=again)
+        if self._sizes is not None:
+            self._sizes[solid.name] = solid_count(solid)[0]
         pose = self.scene.solid_poses[solid.name]
         if self.contact is not None:
             self.contact.add_solid(solid.name, [(e.primitive, local, shape.seen_by in ("both", "bounding"))
@@ -618,9 +635,11 @@ class Simulation:
         old = self.world.solids[k]
         others = [s for i, s in enumerate(self.world.solids) if i != k]
         lights_old = sum(1 for _ in solid_lights(old, Pose.identity()))
+        sizes = self._solid_sizes()
         check_additions(self.world.model_copy(update={"solids": others}), set(self.scene.solid_poses) - {name},
                         len(self.scene.world_lights()) - lights_old, self.scene.triangle_count
-                        - self.scene.solid_triangles(name), added, [node], self.limits)
+                        - self.scene.solid_triangles(name), added, [node], self.limits,
+                        solids_now=sum(sizes.values()) - sizes.get(name, 0))
         self._take_out(name)
         self.world.solids[k] = solid
         self._join_solid(solid, node_id, prepared, again=True)
