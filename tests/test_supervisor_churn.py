@@ -122,3 +122,29 @@ def test_a_refused_import_does_not_take_a_name():
         assert sv.node_by_id(sim, node).key == "ball(3)"
         assert sorted(n for n in sim.scene.solid_poses if n.startswith("ball")) == \
             ["ball", "ball(1)", "ball(2)", "ball(3)"]
+
+
+def test_the_foxglove_scene_stays_the_size_of_the_world_after_many_removals(tmp_path):
+    """Each removal once was one deletion in every later scene update (10,000 removals: 10,000 deletions each
+    time the scene changes); past MAX_DELETIONS a scene update deletes everything drawn and draws the world."""
+    from test_supervisor_remove import _top_fields
+
+    from sensorium.server.recording.scene3d import MAX_DELETIONS, scene_update
+
+    sim = churn.simulation(churn.world_file(tmp_path))
+
+    def scene() -> tuple[list[bytes], list[bytes]]:
+        fields = _top_fields(scene_update(sim.world, sim.loaded.base_dir, 0, dict(sim.scene.solid_poses),
+                                          sim.scene.removed_lights).encode())
+        return [p for f, p in fields if f == 1], [p for f, p in fields if f == 2]
+
+    _, world_entities = scene()
+    for k in range(MAX_DELETIONS + 1):
+        (node,) = sv.import_nodes(sim, sv.ROOT, "children", -1, ball(1.0))
+        sv.remove_node(sim, sv.node_by_id(sim, node))
+        if k == MAX_DELETIONS - 1:
+            deletions, entities = scene()
+            assert len(deletions) == MAX_DELETIONS and b"solid/ball(63)" in deletions[-1]
+    deletions, entities = scene()
+    assert len(deletions) == 1 and b"solid/" not in deletions[0]      # one deletion of every entity
+    assert entities == world_entities
