@@ -66,6 +66,9 @@ from sensorium.server.world.report import warn_losses
 from sensorium.server.world.top_nodes import top_level
 
 
+_REMOVED = wm.Solid.model_construct(name="", def_name="")   # a removed imported solid's model: its name and DEF
+
+
 def lights_from_models(models: list) -> light_math.LightArrays:
     """The lights that are on, as arrays in world coordinates (lights that are off contribute nothing)."""
     return light_math.LightArrays.from_lights([light_from_model(m) for m in models if m.on])
@@ -519,7 +522,7 @@ class Simulation:
         for k in range(len(self.world.solids) - 1, -1, -1):
             old = self.world.solids[k]
             if old.name == name:
-                self.world.solids[k] = wm.Solid.model_construct(name=name, def_name=old.def_name)
+                self.world.solids[k] = _REMOVED.model_copy(update={"name": name, "def_name": old.def_name})
                 break
 
     def _take_out(self, name: str) -> None:
