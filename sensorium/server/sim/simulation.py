@@ -65,7 +65,6 @@ from sensorium.server.world.poses import moved_pose
 from sensorium.server.world.report import warn_losses
 from sensorium.server.world.top_nodes import top_level
 
-
 _REMOVED = wm.Solid.model_construct(name="", def_name="")   # a removed imported solid's model: its name and DEF
 
 
