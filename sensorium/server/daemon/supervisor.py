@@ -20,6 +20,7 @@ roughness and transparency (:mod:`.appearance`). A joint is set with
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import sys
 from collections.abc import Callable
@@ -106,12 +107,17 @@ def _all_nodes(sim: Any) -> list[Node]:
     loaded with, then its other top-level nodes — WorldInfo, Viewpoint, ... in file order, then
     the ones Webots adds —, then the nodes a Supervisor imported, in import order), removed ones
     included: a node's id is its place here, so it never changes and is never reused."""
+    loaded = _loaded_nodes(sim)
+    return loaded + _imported_nodes(sim, len(loaded)).every
+
+
+def _def_of(models: list | None, k: int) -> str:
+    return (getattr(models[k], "def_name", None) or "") if models is not None and k < len(models) else ""
+
+
+def _loaded_nodes(sim: Any) -> list[Node]:
+    """The nodes the world loaded with (robots, solids, lights, then the others), in id order."""
     world = getattr(sim, "world", None)
-
-    def def_of(models: list, k: int) -> str:
-        return (getattr(models[k], "def_name", None) or "") if models is not None and k < len(models) else ""
-
-    imported = getattr(sim, "imported", [])
     robots_m = world.robots if world is not None else None
     solids_m = world.solids if world is not None else None
     names = sim.scene.solid_names
@@ -120,34 +126,78 @@ def _all_nodes(sim: Any) -> list[Node]:
     layout = getattr(sim, "top_level", None)
     protos = layout.protos if layout is not None else {}
     faces = getattr(layout, "interfaces", {})
-    out = [Node(i + 1, "Robot", name, def_of(robots_m, i), name, proto=protos.get(("robots", i), ""),
+    out = [Node(i + 1, "Robot", name, _def_of(robots_m, i), name, proto=protos.get(("robots", i), ""),
                 interface=faces.get(("robots", i), ())) for i, name in enumerate(sim.robots)]
     first = len(out) + 1
-    out += [Node(first + j, "Solid", names[j], def_of(solids_m, j), names[j], proto=protos.get(("solids", j), ""),
+    out += [Node(first + j, "Solid", names[j], _def_of(solids_m, j), names[j], proto=protos.get(("solids", j), ""),
                  interface=faces.get(("solids", j), ())) for j in range(loaded_solids)]
     first = len(out) + 1
-    out += [Node(first + k, top[k].type, top[k].name or "", def_of(top, k), k, proto=protos.get(("lights", k), ""),
+    out += [Node(first + k, top[k].type, top[k].name or "", _def_of(top, k), k, proto=protos.get(("lights", k), ""),
                  interface=faces.get(("lights", k), ())) for k in range(loaded_lights)]
     first = len(out) + 1
     out += [Node(first + x, s.type, "", s.def_name, x, scenery=True, proto=s.proto, interface=s.interface)
             for x, s in enumerate(_scenery(sim))]
+    return out
+
+
+@dataclass
+class _Imported:
+    """The nodes a Supervisor imported, made once each (a Supervisor importing and removing for days asks
+    for nodes in time bounded by those there now, not by every node the world has had): ``every`` in
+    import order (ids), ``live`` those not yet seen removed (a removed node never comes back), the
+    import counts by kind; ``stamp``: what they were made from (a solid built again, a light changed)."""
+
+    stamp: tuple
+    every: list[Node] = dataclasses.field(default_factory=list)
+    live: list[Node] = dataclasses.field(default_factory=list)
+    solids: int = 0
+    lights: int = 0
+    lights_version: int = 0     # the scene's when they were made (an imported light's fields changed)
+
+
+def _imported_nodes(sim: Any, first: int) -> _Imported:
+    """The imported nodes (ids after the ``first`` loaded ones), the new imports numbered on the way."""
+    imported = getattr(sim, "imported", [])
+    scene = sim.scene
+    counters = getattr(sim, "_counters", {})
+    store = _visuals(sim)
+    stamp = (first, id(store), id(getattr(sim, "world", None)), counters.get("regenerations", 0))
+    kept = getattr(sim, "_supervisor_imported", None)
+    if kept is None or kept.stamp != stamp or len(kept.every) > len(imported) or \
+            (kept.lights and kept.lights_version != scene.lights_version):
+        kept = sim._supervisor_imported = _Imported(stamp, lights_version=scene.lights_version)
+    if len(kept.every) == len(imported):
+        return kept
+    world = getattr(sim, "world", None)
+    solids_m = world.solids if world is not None else None
+    names = scene.solid_names
+    top = scene.top_lights()
     imported_protos = getattr(sim, "imported_protos", {})
     imported_faces = getattr(sim, "imported_interfaces", {})
     imported_visuals = getattr(sim, "imported_visuals", {})
-    for kind, key in imported:
+    new = imported[len(kept.every):]
+
+    def place(key: str) -> int:          # an imported solid's name is among the last ones
+        return next(j for j in range(len(names) - 1, -1, -1) if names[j] == key)
+
+    for kind, key in new:
+        node_id = first + len(kept.every) + 1
         proto, face = imported_protos.get(key, ""), imported_faces.get(key, ())
         written = imported_visuals.get(key)
         if written is not None:           # a Shape or Group (visuals.py), held by a solid named key
-            _visuals(sim).add(str(key), len(out) + 1, written)
-            out.append(Node(len(out) + 1, written.type, "", written.def_name or "", key, visual=True))
+            store.add(str(key), node_id, written)
+            node = Node(node_id, written.type, "", written.def_name or "", key, visual=True)
         elif kind == "Solid":
-            j = names.index(key)
-            out.append(Node(len(out) + 1, "Solid", str(key), def_of(solids_m, j), key, proto=proto, interface=face))
+            node = Node(node_id, "Solid", str(key), _def_of(solids_m, place(key)), key, proto=proto, interface=face)
         else:
             lt = top[int(key)]
-            out.append(Node(len(out) + 1, lt.type, lt.name or "", def_of(top, int(key)), key, proto=proto,
-                            interface=face))
-    return out
+            node = Node(node_id, lt.type, lt.name or "", _def_of(top, int(key)), key, proto=proto, interface=face)
+        kept.every.append(node)
+        kept.live.append(node)
+        kept.solids += kind == "Solid"
+        kept.lights += kind != "Solid"
+    kept.lights_version = scene.lights_version
+    return kept
 
 
 def _removed(sim: Any, node: Node) -> bool:
@@ -166,7 +216,10 @@ def _removed(sim: Any, node: Node) -> bool:
 
 def _nodes(sim: Any) -> list[Node]:
     """The nodes in the world now, in id order."""
-    return [n for n in _all_nodes(sim) if not _removed(sim, n)]
+    loaded = _loaded_nodes(sim)
+    kept = _imported_nodes(sim, len(loaded))
+    kept.live = [n for n in kept.live if not _removed(sim, n)]     # (removed for good)
+    return [n for n in loaded if not _removed(sim, n)] + kept.live
 
 
 def _loaded_order(sim: Any, nodes: list[Node]) -> list[int]:
@@ -184,9 +237,16 @@ def _loaded_order(sim: Any, nodes: list[Node]) -> list[int]:
 
 def _loaded_counts(sim: Any) -> tuple[int, int]:
     """How many top-level solids and lights the world loaded with (those now, imported ones left out)."""
-    imported = getattr(sim, "imported", [])
-    return (len(sim.scene.solid_names) - sum(kind == "Solid" for kind, _ in imported),
-            len(sim.scene.top_lights()) - sum(kind != "Solid" for kind, _ in imported))
+    imported = getattr(sim, "imported", [])          # (appended to only: counted once each)
+    n, solids, lights = getattr(sim, "_supervisor_counted", (0, 0, 0))
+    if n > len(imported):
+        n, solids, lights = 0, 0, 0
+    for kind, _ in imported[n:]:
+        solids += kind == "Solid"
+        lights += kind != "Solid"
+    if n != len(imported):
+        sim._supervisor_counted = (len(imported), solids, lights)
+    return len(sim.scene.solid_names) - solids, len(sim.scene.top_lights()) - lights
 
 
 def root_children(sim: Any) -> list[Node]:

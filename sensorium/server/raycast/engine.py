@@ -178,6 +178,7 @@ __all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine", "Mount"
 _V_VISUAL, _V_BOUNDING, _V_OPAQUE, _V_SHADOW = "visual", "bounding", "bounding-opaque", "shadow"
 # a variant whose scenes are another's when no shape tells them apart (built once, shared)
 _NARROWS = {_V_OPAQUE: _V_BOUNDING, _V_SHADOW: _V_VISUAL}
+_NOWHERE = Pose.identity()   # a removed body's pose (its own let go)
 
 
 def _sees(e: ShapeEntry, variant: str) -> bool:
@@ -274,8 +275,11 @@ class RayEngine(TierTracer):
     def remove_body(self, body: int) -> None:
         """Take a body out of every ray query for good (a Supervisor's ``node.remove()``): a mover
         leaves the movers' tables, a static body the static tier (rebuilt on the next cast, as a
-        static body's first move does). Its index and shape ids stay (never reused), so every other
-        body's and shape's number is unchanged; casts in a world that never removes do no more work."""
+        static body's first move does). Every other body's and shape's number is unchanged; the last
+        bodies, once all removed, leave the tables and the next ones added take their numbers again
+        (a Supervisor importing and removing solids for days: bounded tables), while a removed body
+        followed by one still there keeps its number and an empty entry. Casts in a world that never
+        removes do no more work."""
         b = self._bodies[body]
         if b.removed:
             return
@@ -285,8 +289,33 @@ class RayEngine(TierTracer):
         if b.mover:
             self._movers.remove(b)
             self._mover_tables.clear()
+            # its body-frame tiers, when no body left uses them (a Supervisor randomising a moved solid's
+            # size between episodes would otherwise keep one Embree scene per size for good)
+            used = {id(t) for m in self._movers for t in m.tiers.values()}
+            gone = {id(t) for t in b.tiers.values() if t is not None and id(t) not in used}
+            if gone:
+                self._shared = {k: t for k, t in self._shared.items() if id(t) not in gone}
         else:
             self._drop_static()
+        b.tiers = {}
+        b.pose = _NOWHERE
+        while self._bodies and self._bodies[-1].removed:   # the last bodies removed: their slots are free again
+            last = self._bodies.pop()
+            del self._entries[last.first if last.shapes else len(self._entries):]
+            del self._shape_body[len(self._entries):]
+        if len(self._owner_of) != len(self._entries):
+            self._owner_of = self._owner_of[:len(self._entries)].copy()
+            self._rot, self._pos = self._rot[:len(self._bodies)].copy(), self._pos[:len(self._bodies)].copy()
+
+    @property
+    def shape_count(self) -> int:
+        """The shapes numbered now: every body's but those of the last bodies removed (whose numbers the
+        next bodies added take again)."""
+        return len(self._entries)
+
+    def body_shapes(self, body: int) -> list[int]:
+        """The shape numbers of ``body``."""
+        return list(self._bodies[body].shapes)
 
     def shape_owner(self, shape: int) -> int:
         return int(self._owner_of[shape])

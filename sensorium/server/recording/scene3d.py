@@ -161,6 +161,10 @@ def _light_entity(entity_id: str, frame_id: str, frame_locked: bool, light: Any,
     return _entity(frame_id, entity_id, stamp_ns, parts, f"light:{light.type}", frame_locked=frame_locked)
 
 
+MAX_DELETIONS = 64
+"""Past this many removed nodes, a scene update deletes everything drawn before it (then draws the world)."""
+
+
 def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
                  solid_poses: dict[str, Any] | None = None, removed_lights: AbstractSet[int] = frozenset(),
                  drawn: Mapping[int, Any] | None = None) -> SceneUpdate:
@@ -191,8 +195,14 @@ def scene_update(world: wm.World, base_dir: str | Path, stamp_ns: int = 0,
             gone.append(entity_id)
             continue
         entities.append(_light_entity(entity_id, frame_id, locked, light, stamp_ns))
-    deletions = [SceneEntityDeletion(timestamp=Timestamp(2**32 - 1, 0), type=SceneEntityDeletionType.MatchingId,
-                                     id=entity_id) for entity_id in gone]
+    if len(gone) > MAX_DELETIONS:
+        # a Supervisor that removed many nodes (importing and removing for days): one deletion of everything
+        # drawn before, then the whole world again (a viewer applies the deletions first), not one per node
+        # the world has ever lost, which would grow every scene update without bound
+        deletions = [SceneEntityDeletion(timestamp=Timestamp(2**32 - 1, 0), type=SceneEntityDeletionType.All, id="")]
+    else:
+        deletions = [SceneEntityDeletion(timestamp=Timestamp(2**32 - 1, 0), type=SceneEntityDeletionType.MatchingId,
+                                         id=entity_id) for entity_id in gone]
     return SceneUpdate(deletions=deletions, entities=entities)
 
 

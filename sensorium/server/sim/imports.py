@@ -21,6 +21,7 @@ only.
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Collection
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -96,16 +97,26 @@ def world_protos(loaded: LoadedWorld, limits: ProtoLimits) -> _WorldProtos:
 class _Converter(Converter):
     """The converter with Webots' name clash rule against every solid name the world has had."""
 
-    def __init__(self, *args: Any, taken: set[str], **kwargs: Any):
+    def __init__(self, *args: Any, taken: Collection[str], suffixes: dict[str, int] | None = None, **kwargs: Any):
         super().__init__(*args, **kwargs)
-        self.taken = set(taken)
+        self.taken = taken                  # (read only: a set the caller keeps)
+        self.added: set[str] = set()
+        # name -> a k such that name(1) ... name(k - 1) are all taken (names are never freed: a Supervisor
+        # importing "ball" for days finds the next free "ball(k)" at once)
+        self.suffixes = {} if suffixes is None else suffixes
 
     def unique_name(self, name: str) -> str:
-        unique, k = name, 0
-        while unique in self.taken:
+        k = self.suffixes.get(name, 0)
+        unique = name if k == 0 else f"{name}({k})"
+        free_from = None                    # the first one taken by this string only (free if it is not imported)
+        while unique in self.taken or unique in self.added:
+            if free_from is None and unique not in self.taken:
+                free_from = k
             k += 1
             unique = f"{name}({k})"
-        self.taken.add(unique)
+        if k > 0:
+            self.suffixes[name] = k if free_from is None else free_from
+        self.added.add(unique)
         return unique
 
 
@@ -145,9 +156,9 @@ def parse_sf_node_string(text: Any, limits: WorldLimits) -> Any:
     return wbt.nodes[0]
 
 
-def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: set[str], limits: WorldLimits,
+def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: Collection[str], limits: WorldLimits,
                      allow_outside_meshes: bool = False, protos: _WorldProtos | None = None,
-                     warnings: list[str] | None = None) -> list[ImportedNode]:
+                     warnings: list[str] | None = None, suffixes: dict[str, int] | None = None) -> list[ImportedNode]:
     """The nodes of ``text`` as world models, in order (``ImportRefused`` for anything that is not
     imported). ``taken``: every solid name the world has had (removed ones included: names are
     never reused); ``limits``: the world's (the string alone stays within them; what it adds to
@@ -168,7 +179,7 @@ def read_node_string(text: Any, loaded: LoadedWorld, world: wm.World, *, taken: 
             raise ImportRefused(f"{LABEL}: no node in it (e.g. 'Solid {{ ... }}')")
         wbt = WbtFile(protos.version, wbt.nodes, [], source, list(protos.declarations))
         return _convert(wbt, source, loaded, world, taken, limits, proto_limits, allow_outside_meshes,
-                        [] if warnings is None else warnings)
+                        [] if warnings is None else warnings, suffixes=suffixes)
     except WbtSyntaxError as exc:           # ProtoError too: in the string or a PROTO file
         raise _syntax(exc, source) from None
 
@@ -200,13 +211,14 @@ def rebuild_node(written: ParsedNode, wbt: WbtFile, loaded: LoadedWorld, world: 
         raise ImportRefused(f"{at}: {_shown(exc.message, wbt.source, label)}") from None
 
 
-def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, taken: set[str], limits: WorldLimits,
-             proto_limits: ProtoLimits, allow_outside_meshes: bool, warnings: list[str],
-             label: str = LABEL) -> list[ImportedNode]:
+def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, taken: Collection[str],
+             limits: WorldLimits, proto_limits: ProtoLimits, allow_outside_meshes: bool, warnings: list[str],
+             label: str = LABEL, suffixes: dict[str, int] | None = None) -> list[ImportedNode]:
     from sensorium.server.world.proto import ProtoSearch, expand
 
     expansion = expand(wbt, ProtoSearch.create(loaded.base_dir), proto_limits)
-    conv = _Converter(expansion.as_wbt(), source, expansion.search, max_grid_points=proto_limits.values, taken=taken)
+    conv = _Converter(expansion.as_wbt(), source, expansion.search, max_grid_points=proto_limits.values, taken=taken,
+                      suffixes=suffixes)
     conv.world["world_info"] = {"coordinate_system": world.world_info.coordinate_system}
     top = Owner("world", {})
     kinds: list[str] = []
@@ -297,24 +309,29 @@ def _unscaled(node: Any) -> bool:
     return scale is None or tuple(float(v) for v in scale) == (1.0, 1.0, 1.0)
 
 
-def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles_now: int, triangles_added: int,
-                    nodes: list[ImportedNode], limits: WorldLimits) -> None:
-    """The world with ``nodes`` added stays within its limits (solids with their nested children,
-    lights, triangles), else ``ImportRefused`` saying by how much."""
+def solid_count(solid: wm.Solid) -> tuple[int, int]:
+    """A solid's solids (itself and its nested children) and lights."""
+    n, lights = 1, len(solid.lights)
+    for child in solid.children:
+        dn, dl = solid_count(child)
+        n, lights = n + dn, lights + dl
+    return n, lights
 
-    def count(solid: wm.Solid) -> tuple[int, int]:
-        n, lights = 1, len(solid.lights)
-        for child in solid.children:
-            dn, dl = count(child)
-            n, lights = n + dn, lights + dl
-        return n, lights
+
+def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles_now: int, triangles_added: int,
+                    nodes: list[ImportedNode], limits: WorldLimits, solids_now: int | None = None) -> None:
+    """The world with ``nodes`` added stays within its limits (solids with their nested children,
+    lights, triangles), else ``ImportRefused`` saying by how much. ``solids_now``: the world's solids
+    (nested children included) when the caller keeps the count (else counted in ``world``'s ``alive`` ones)."""
+    count = solid_count
 
     def over(what: str, now: int, added: int, cap: int) -> None:
         if now + added > cap:
             raise ImportRefused(f"importing it would bring the world to {now + added:,} {what} ({now:,} now, "
                                 f"{added:,} added), more than the limit of {cap:,} (raise the limits with --allow-large)")
 
-    solids_now = sum(count(s)[0] for s in world.solids if s.name in alive)
+    if solids_now is None:
+        solids_now = sum(count(s)[0] for s in world.solids if s.name in alive)
     added = [count(n.model) if n.type == "Solid" else (0, 1) for n in nodes]
     over("solids (nested children included)", solids_now, sum(a[0] for a in added), limits.solids)
     over("lights", lights_now, sum(a[1] for a in added), limits.lights)
@@ -322,4 +339,5 @@ def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles
 
 
 __all__ = ["parse_sf_node_string", "ImportRefused", "ImportedNode", "read_node_string", "rebuild_node", "check_additions",
+           "solid_count",
            "string_file", "world_protos"]

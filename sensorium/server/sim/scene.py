@@ -30,6 +30,8 @@ from sensorium.server.world.poses import pose_from_model
 from sensorium.server.world.textures import Decoded, TextureSampler, resolve_texture_url, uses_alpha
 
 _IDENTITY = Pose.identity()
+# a removed shape's model while its number is kept (Scene._forget_shapes): no geometry, no appearance
+_NO_MODEL = wm.Shape.model_construct(geometry=None, appearance=None)
 
 
 @dataclass(frozen=True, slots=True)
@@ -403,6 +405,7 @@ class Scene:
         self.engine = RayEngine(Precision(precision))
         self.shapes: list[ShapeInfo] = []
         self.solid_names = [s.name for s in world.solids]
+        self.solid_name_set = set(self.solid_names)     # (every name the world has had: never reused)
         self._solid_body: dict[str, int] = {}
         self.solid_poses: dict[str, Pose] = {}
         self.triangle_count = 0            # of the bodies in the world now (a removed solid's leave the count)
@@ -677,15 +680,44 @@ class Scene:
         self.solids_version += 1
         body = self._solid_body.pop(name, None)
         if body is not None:
+            dead = self.engine.body_shapes(body)
             self.engine.remove_body(body)
+            self._forget_shapes(dead)
         self.triangle_count -= self._solid_triangles.pop(name, 0)
         self.recognisable.pop(name, None)
+        for key in [k for k in self.carried_targets if k[0] == name]:
+            del self.carried_targets[key]
         for key in [k for k in self.radar_targets if k == name or (isinstance(k, tuple) and k[0] == name)]:
             del self.radar_targets[key]
         if name in self._attached:
             self._lights = [entry for entry in self._lights if entry[1] != name]
             self._attached.discard(name)
             self.lights_version += 1
+
+    def _forget_shapes(self, dead: list[int]) -> None:
+        """The shapes of a removed body let go: what was kept per shape (a Supervisor's appearance changes,
+        the world-to-shape poses) dropped; when the engine freed the last shapes' numbers (every body after
+        them removed too), every per-shape list and array ends where the engine's shapes now end, so the
+        next import numbers its shapes there again (a fresh world's numbers); a shape followed by one still
+        there keeps its number, its entry pointing at no owner and no model (recognition, radar and the
+        texture sampler skip it; no ray reaches it)."""
+        for shape in dead:
+            self._inverse.pop(shape, None)
+            self._loaded_models.pop(shape, None)
+            self.appearance_values.pop(shape, None)
+        n = self.engine.shape_count
+        kept = [shape for shape in dead if shape < n]
+        for shape in kept:
+            self._parts[shape] = (None, _IDENTITY, _NO_MODEL)
+        if self.textures is not None:
+            self.textures.forget(kept, n)
+        if n < len(self.shapes):
+            del self.shapes[n:], self._parts[n:]
+            self.red = np.append(self.red[:n], self.red[-1])
+            self.roughness = np.append(self.roughness[:n], self.roughness[-1])
+            self.colors = np.concatenate([self.colors[:n], self.colors[-1:]])
+            self.transparency = np.append(self.transparency[:n], self.transparency[-1])
+            self.shapes_version += 1
 
     def solid_entries(self, solid: wm.Solid) -> tuple[list, list[ShapeEntry]]:
         """A top-level solid's parts (``solid_parts``) and their ray-engine entries, built before
@@ -705,13 +737,14 @@ class Scene:
         ``node_id``). Its shape ids follow every existing one (none is ever reused). ``again``: a
         solid built again under the name of one just removed (a PROTO field set), keeping its place."""
         name = solid.name
-        if name in self.solid_poses or (name in self.solid_names) != again:
+        if name in self.solid_poses or (name in self.solid_name_set) != again:
             raise KeyError(f"a solid named {name!r} exists or existed" if not again else f"no removed solid {name!r}")
         parts, entries = prepared if prepared is not None else self.solid_entries(solid)
         pose = pose_from_model(solid.pose)
         self._nested_targets(solid)
         if not again:
             self.solid_names.append(name)
+            self.solid_name_set.add(name)
         self.solid_poses[name] = pose
         self.solids_version += 1
         if parts:

@@ -65,6 +65,8 @@ from sensorium.server.world.poses import moved_pose
 from sensorium.server.world.report import warn_losses
 from sensorium.server.world.top_nodes import top_level
 
+_REMOVED = wm.Solid.model_construct(name="", def_name="")   # a removed imported solid's model: its name and DEF
+
 
 def lights_from_models(models: list) -> light_math.LightArrays:
     """The lights that are on, as arrays in world coordinates (lights that are off contribute nothing)."""
@@ -301,6 +303,8 @@ class Simulation:
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
                                                             # a node was imported (None: the loaded order)
         self._import_protos: Any = None                     # the world's EXTERNPROTO declarations, read once
+        self._name_suffixes: dict[str, int] = {}            # imports' renames so far (imports.py _Converter)
+        self._sizes: dict[str, int] | None = None           # see _solid_sizes
         self.basic_time_step = self.world.world_info.basic_time_step
         self.seed = self.world.world_info.random_seed
         self.time_ms = 0
@@ -502,9 +506,32 @@ class Simulation:
         """Take a top-level solid out of the world for good (Webots' ``node.remove()``): from the
         next measurement no sensor sees it, kinematic contact no longer stops robots at it, and
         ``simulationReset`` does not bring it back (Webots' reset adds no removed node)."""
+        self._take_out(name)
+        # what only a removed imported solid needed goes with it (a Supervisor importing and removing for days
+        # keeps a name, a node id and a few hundred bytes per removed solid): its model in ``world.solids``
+        # (where it keeps its place: the Supervisor numbers nodes by it) becomes its name and DEF alone (a
+        # world file's solid keeps its model: the Supervisor's nodes inside it are numbered from it)
+        if self._imported_poses.pop(name, None) is None:
+            return
+        self.imported_written.pop(name, None)
+        self.imported_interfaces.pop(name, None)
+        regen = getattr(self, "_regen_written", None)
+        if regen:
+            regen.pop(name, None)
+        for k in range(len(self.world.solids) - 1, -1, -1):
+            old = self.world.solids[k]
+            if old.name == name:
+                self.world.solids[k] = _REMOVED.model_copy(update={"name": name, "def_name": old.def_name})
+                break
+
+    def _take_out(self, name: str) -> None:
+        """A top-level solid out of the scene, kinematic contact and the terrains (a removal, or a solid
+        about to be built again under its name)."""
         if name not in self.scene.solid_poses:
             raise KeyError(f"no solid {name!r}")
         self.scene.remove_solid(name)
+        if self._sizes is not None:
+            self._sizes.pop(name, None)
         if self.contact is not None:
             self.contact.remove_solid(name)
         if self.ground is not None:
@@ -539,13 +566,13 @@ class Simulation:
 
         if self._import_protos is None:
             self._import_protos = world_protos(self.loaded, ProtoLimits.matching(self.limits))
-        nodes = read_node_string(text, self.loaded, self.world, taken=set(self.scene.solid_names), limits=self.limits,
+        nodes = read_node_string(text, self.loaded, self.world, taken=self.scene.solid_name_set, limits=self.limits,
                                  allow_outside_meshes=self.allow_outside_meshes, protos=self._import_protos,
-                                 warnings=warnings)
+                                 warnings=warnings, suffixes=self._name_suffixes)
         prepared = [self.scene.solid_entries(n.model) if n.type == "Solid" else None for n in nodes]
         added = sum(triangle_count(e.primitive) for p in prepared if p is not None for e in p[1])
         check_additions(self.world, set(self.scene.solid_poses), len(self.scene.world_lights()),
-                        self.scene.triangle_count, added, nodes, self.limits)
+                        self.scene.triangle_count, added, nodes, self.limits, solids_now=sum(self._solid_sizes().values()))
         out: list[tuple[str, str | int, int]] = []
         for node, prep in zip(nodes, prepared):
             node_id = self.next_node_id()
@@ -568,10 +595,23 @@ class Simulation:
             out.append((node.type, key, node_id))
         return out
 
+    def _solid_sizes(self) -> dict[str, int]:
+        """Each top-level solid's solids (itself and its nested children), kept from the first import on."""
+        from sensorium.server.sim.imports import solid_count
+
+        if self._sizes is None:
+            alive = self.scene.solid_poses
+            self._sizes = {s.name: solid_count(s)[0] for s in self.world.solids if s.name in alive}
+        return self._sizes
+
     def _join_solid(self, solid: wm.Solid, node_id: int, prepared: tuple[list, list], again: bool = False) -> None:
         """A top-level solid joins the scene, kinematic contact and the terrains (an import, or a solid built
         again: ``again``, under the name it had)."""
+        from sensorium.server.sim.imports import solid_count
+
         self.scene.add_solid(solid, node_id, prepared, again=again)
+        if self._sizes is not None:
+            self._sizes[solid.name] = solid_count(solid)[0]
         pose = self.scene.solid_poses[solid.name]
         if self.contact is not None:
             self.contact.add_solid(solid.name, [(e.primitive, local, shape.seen_by in ("both", "bounding"))
@@ -597,10 +637,12 @@ class Simulation:
         old = self.world.solids[k]
         others = [s for i, s in enumerate(self.world.solids) if i != k]
         lights_old = sum(1 for _ in solid_lights(old, Pose.identity()))
+        sizes = self._solid_sizes()
         check_additions(self.world.model_copy(update={"solids": others}), set(self.scene.solid_poses) - {name},
                         len(self.scene.world_lights()) - lights_old, self.scene.triangle_count
-                        - self.scene.solid_triangles(name), added, [node], self.limits)
-        self.remove_solid(name)
+                        - self.scene.solid_triangles(name), added, [node], self.limits,
+                        solids_now=sum(sizes.values()) - sizes.get(name, 0))
+        self._take_out(name)
         self.world.solids[k] = solid
         self._join_solid(solid, node_id, prepared, again=True)
         if name in self._initial["solids"]:       # a reset keeps the new values (Webots resets no field)

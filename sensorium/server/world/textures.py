@@ -835,6 +835,36 @@ class TextureSampler:
         self.translucent = translucent
         self.has_translucent = bool(translucent.any())
 
+    def forget(self, shapes: Collection[int], count: int) -> None:
+        """Shapes of a body a Supervisor removed let go: ``shapes`` (numbers kept) hold nothing any more
+        (no image, no ink), and every shape from ``count`` on is gone (the next shapes added take those
+        numbers again); images no shape uses any more are let go."""
+        gone = set(shapes) | set(range(count, len(self.models)))
+        if not gone:
+            return
+        layers = {id(self.ink[s]) for s in gone if s in self.ink}
+        for s in gone:
+            self.shapes.pop(s, None)
+            self.ink.pop(s, None)
+            self.ink_refused.discard(s)
+            self._locators.pop(s, None)
+            self._meshes.pop(s, None)
+            self._uv.pop((s, False), None)
+            self._uv.pop((s, True), None)
+        if layers:
+            self._evaporating = [layer for layer in self._evaporating if id(layer) not in layers]
+        shorter = count < len(self.models)
+        self.models = [m if i not in gone else (None, None) for i, m in enumerate(self.models[:count])]
+        for name in ("textured", "alpha", "translucent"):
+            flags = getattr(self, name)
+            if shorter:           # new arrays (the scene tells their holders: shapes_version)
+                flags = np.append(flags[:count], False)
+                setattr(self, name, flags)
+            flags[[s for s in shapes if s < count]] = False     # in place
+        self.has_alpha = bool(self.alpha.any())
+        self.has_translucent = bool(self.translucent.any())
+        self._let_go_unused()
+
     def set_shape(self, shape: int, appearance: wm.Appearance | None,
                   given: Mapping[str, tuple[Path, Decoded]] | None = None) -> None:
         """A Supervisor's new images for one shape (an ImageTexture's url or wrap changed, or the
@@ -857,6 +887,10 @@ class TextureSampler:
         self.has_alpha = bool(self.alpha.any())
         self.translucent[shape] = st is not None and st.base.translucent
         self.has_translucent = bool(self.translucent.any())
+        self._let_go_unused()
+
+    def _let_go_unused(self) -> None:
+        """Images no shape shows any more, but the world's own (a reset brings them back), let go."""
         used = {id(img.rgb) for st in self.shapes.values() for img in (st.base, st.roughness, st.occlusion)
                 if img is not None}
         self._images = {p: v for p, v in self._images.items() if p in self._kept or id(v[0]) in used}
