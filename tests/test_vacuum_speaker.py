@@ -292,3 +292,33 @@ def test_a_megabyte_of_unclosed_markup_is_counted_at_once() -> None:
                           env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])})
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["2", "2", str((1 << 20) // 3)]
+
+
+def test_a_gripper_touches_a_solid_as_a_supervisor_rebuilt_it(tmp_path: Path) -> None:
+    """A top-level PROTO solid rebuilt under its name (a Supervisor set its size) is what the gripper
+    touches from then on: the gripper kept each solid's shapes by name, so it went on touching the
+    old, bigger box. The Obstacle (tests/protos/regen) is a box centred on its origin, here at z = 0.2;
+    the gripper's bottom is 0.49 m above the robot's origin, lowered to z = -0.1."""
+    import shutil
+
+    from sensorium.server.daemon import supervisor as sv
+
+    shutil.copy(REPO / "tests" / "protos" / "regen" / "Obstacle.proto", tmp_path / "Obstacle.proto")
+    p = tmp_path / "w.wbt"
+    p.write_text('#VRML_SIM R2023b utf8\nEXTERNPROTO "Obstacle.proto"\n'
+                 'Robot { name "r" supervisor TRUE children [\n'
+                 'VacuumGripper { translation 0 0 0.5 name "cup" isOn TRUE '
+                 'boundingObject Cylinder { radius 0.05 height 0.02 } }\n] }\n'
+                 'DEF BOX Obstacle { translation 0 0 0.2 size 0.4 0.4 0.4 }\n')
+    sim = Simulation(load_world(p))
+    g = sim.device("r/cup")
+    g.enable(STEP)
+    sim.robot("r").set_pose(translation=[0.0, 0.0, -0.1])
+    sim.step()
+    assert g.value == 1.0                          # type: ignore[attr-defined]   top at 0.4: gap -0.01
+    assert sv.set_field(sim, sv.find_node(sim, "BOX"), "size", [0.2, 0.2, 0.2]) == []
+    sim.step()
+    assert g.value == 0.0                          # type: ignore[attr-defined]   top at 0.3: gap 0.09
+    assert sv.set_field(sim, sv.find_node(sim, "BOX"), "size", [0.6, 0.6, 0.6]) == []
+    sim.step()
+    assert g.value == 1.0                          # type: ignore[attr-defined]   top at 0.5: sunk in it

@@ -81,7 +81,11 @@ class VacuumGripper(Device):
         self._sim: Any = None
         self._robot: Any = None
         self._own: list[tuple[Any, Pose, str | None]] = []          # (primitive, pose in robot frame, on_joint)
-        self._solids: dict[str, list[tuple[Any, Pose]]] = {}        # solid name -> (primitive, pose in solid frame)
+        # solid name -> (its model, [(primitive, pose in solid frame)]); the models by name, taken again when
+        # the scene's solids change (a Supervisor's import, removal or rebuild under the same name)
+        self._solids: dict[str, tuple[Any, list[tuple[Any, Pose]]]] = {}
+        self._models: dict[str, Any] = {}
+        self._models_version = -1
         self._robots: dict[int, list[tuple[Any, Pose]]] = {}
 
     def bind(self, robot: Any) -> None:
@@ -104,14 +108,19 @@ class VacuumGripper(Device):
 
     # -- measuring
     def _solid_shapes(self, name: str) -> list[tuple[Any, Pose]]:
-        shapes = self._solids.get(name)
-        if shapes is None:
+        scene = self._sim.scene
+        if self._models_version != scene.solids_version:
+            self._models = {s.name: s for s in self._sim.world.solids if s.name in scene.solid_poses}
+            self._models_version = scene.solids_version
+            self._solids = {k: v for k, v in self._solids.items() if self._models.get(k) is v[0]}
+        model = self._models[name]
+        cached = self._solids.get(name)
+        if cached is None or cached[0] is not model:
             base = self._sim.loaded.base_dir
-            model = next(s for s in self._sim.world.solids if s.name == name)
-            shapes = self._solids[name] = [(primitive_from_model(shape.geometry, base), local)
-                                           for _, local, shape in solid_parts(model, Pose.identity())
-                                           if shape.seen_by in ("both", "bounding")]
-        return shapes
+            cached = self._solids[name] = (model, [(primitive_from_model(shape.geometry, base), local)
+                                                   for _, local, shape in solid_parts(model, Pose.identity())
+                                                   if shape.seen_by in ("both", "bounding")])
+        return cached[1]
 
     def _robot_shapes(self, index: int) -> list[tuple[Any, Pose]]:
         shapes = self._robots.get(index)
