@@ -146,10 +146,14 @@ def _scope_defs(root: Node) -> dict[str, tuple[int, str]]:
     from sensorium.server.world.proto.instantiate import body_of
 
     found: dict[str, tuple[int, str]] = {}
+
+    def take(node: Node) -> None:            # its DEF, unless an earlier node holds the name
+        if node.def_name and node.def_name not in found and len(node.def_name) <= MAX_DEF:
+            found[node.def_name] = (id(node), node.type)
+
     level = _sub_nodes(root)
     for child in level:
-        if child.def_name and child.def_name not in found and len(child.def_name) <= MAX_DEF:
-            found[child.def_name] = (id(child), child.type)
+        take(child)
     budget = SCOPE_NODES
     seen: set[int] = set()
     for child in level:
@@ -160,9 +164,8 @@ def _scope_defs(root: Node) -> dict[str, tuple[int, str]]:
                 continue
             seen.add(id(node))
             budget -= 1
-            if node.def_name and node.def_name not in found and len(node.def_name) <= MAX_DEF \
-                    and body_of(node) not in hidden:
-                found[node.def_name] = (id(node), node.type)
+            if body_of(node) not in hidden:
+                take(node)
             if node.proto is not None and node.instance_at is not None:
                 hidden = hidden | _chain_keys(node)     # a nested instance: its body is its own scope
             stack += [(x, hidden) for x in reversed(_sub_nodes(node))]
