@@ -197,13 +197,14 @@ def test_hits_move_into_a_shape_frame_in_blocks_as_in_one_product():
 
 
 def test_an_image_s_rays_turn_into_its_body_frame_in_blocks_as_in_one_product():
-    from sensorium.server.sim.own_shapes import _ROWS, _turned
+    # (own_shapes.OwnBodyRays turns them with the ray engine's row-block product)
+    from sensorium.server.raycast.exact import _MATMUL_ROWS, _mat
 
     rng = np.random.default_rng(13)
     q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    x = _fan(2 * _ROWS + 321, 14)
-    assert _turned(x, q.T).tobytes() == np.ascontiguousarray(x @ q.T).tobytes()
-    assert _turned(x[:100], q.T).tobytes() == np.ascontiguousarray(x[:100] @ q.T).tobytes()
+    x = _fan(2 * _MATMUL_ROWS + 321, 14)
+    assert _mat(x, q.T).tobytes() == np.ascontiguousarray(x @ q.T).tobytes()
+    assert _mat(x[:100], q.T).tobytes() == np.ascontiguousarray(x[:100] @ q.T).tobytes()
 
 
 @pytest.mark.parametrize("casting", [[0], [1], [2], [0, 2], [1, 3]])

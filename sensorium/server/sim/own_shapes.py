@@ -29,6 +29,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
+from sensorium.server.raycast.exact import _mat
 from sensorium.server.world.geometry import Pose
 
 MAX_PASSES = 64     # crossings of a device's own shapes one ray may pass (two per closed shape)
@@ -110,20 +111,6 @@ def cast_skipping(engine, origins: np.ndarray, directions: np.ndarray, t_near, t
     return _skipping(cast, len(origins), t_near, t_far, mine)
 
 
-_ROWS = 32768    # rows per product: a larger one goes to OpenBLAS's threads, which stall on a busy machine
-
-
-def _turned(x: np.ndarray, M: np.ndarray) -> np.ndarray:
-    """``x @ M`` for (n, 3) rows (an image's pixel directions), ``_ROWS`` rows per product: each
-    row's values those of the one product."""
-    if len(x) <= _ROWS:
-        return np.ascontiguousarray(x @ M)
-    out = np.empty((len(x), 3))
-    for a in range(0, len(x), _ROWS):
-        out[a:a + _ROWS] = x[a:a + _ROWS] @ M
-    return out
-
-
 class OwnBodyRays:
     """An image device's pixel rays (directions in its frame) when it has shapes of its own: cast
     mounted on its robot's body, which the world cast then skips, and nearer hits on that body
@@ -136,7 +123,7 @@ class OwnBodyRays:
         self.mount = Mount(np.full(len(directions), body, dtype=np.int64))
         self.limits = (t_near, t_far)
         self._local = (np.ascontiguousarray(np.broadcast_to(local.translation, directions.shape)),
-                       _turned(directions, local.rotation.T))
+                       _mat(directions, local.rotation.T))    # (row blocks)
         self._own = own
         self._hits: tuple[object, RayHits] | None = None
 
