@@ -734,7 +734,8 @@ class Scene:
         """A top-level solid a Supervisor imported (``importMFNodeFromString``): its body joins the
         ray engine (every ray kind sees it from the next cast), its pose ``solid_poses``, its
         lights the light arrays, its recognition colours the cameras' objects (as Supervisor node
-        ``node_id``). Its shape ids follow every existing one (none is ever reused). ``again``: a
+        ``node_id``). Its shape ids follow the shapes numbered now (the numbers of the last bodies removed
+        are taken again: :meth:`_forget_shapes`). ``again``: a
         solid built again under the name of one just removed (a PROTO field set), keeping its place."""
         name = solid.name
         if name in self.solid_poses or (name in self.solid_name_set) != again:
