@@ -188,19 +188,23 @@ def _vectors(points: np.ndarray, lights: LightArrays):
     return v, length, unit, d
 
 
-def _terms(P: np.ndarray, N: np.ndarray, lights: LightArrays, vectors: tuple | None = None,
-           attenuation: bool = True) -> tuple[np.ndarray | None, np.ndarray]:
-    """Attenuation ``att`` (S,n) and un-occluded direct term ``Id = I·c·spot`` (S,n).
-    ``vectors``: ``_vectors(P, lights)`` when the caller has them; ``attenuation`` False: ``att``
-    is not computed (None)."""
-    v, length, unit, d = _vectors(P, lights) if vectors is None else vectors
-    att = None
-    if attenuation:
-        local = lights.kind != LightKind.DIRECTIONAL
-        a = lights.attenuation
-        with np.errstate(divide="ignore"):
-            att = np.where(local[None, :], 1.0 / (a[:, 0] + a[:, 1] * d + a[:, 2] * d * d), 1.0)
+def _terms(P: np.ndarray, N: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
+    """Attenuation ``att`` (S,n) and un-occluded direct term ``Id = I·c·spot`` (S,n)."""
+    vectors = _vectors(P, lights)
+    return _attenuation(lights, vectors[3]), _direct(N, lights, vectors)
 
+
+def _attenuation(lights: LightArrays, d: np.ndarray) -> np.ndarray:
+    """``1 / (a0 + a1·d + a2·d²)`` (S,n) of each light at distance ``d``; 1 for a directional one."""
+    local = lights.kind != LightKind.DIRECTIONAL
+    a = lights.attenuation
+    with np.errstate(divide="ignore"):
+        return np.where(local[None, :], 1.0 / (a[:, 0] + a[:, 1] * d + a[:, 2] * d * d), 1.0)
+
+
+def _direct(N: np.ndarray, lights: LightArrays, vectors: tuple) -> np.ndarray:
+    """The un-occluded direct term ``Id = I·c·spot`` (S,n) from ``_vectors(P, lights)``."""
+    v, length, unit, _ = vectors
     # c = N·(q - p)/d: exactly 0 when the light is exactly in the sensor plane (and when d = 0).
     c = np.einsum("sk,snk->sn", N, v) / np.where(length > 0.0, length, 1.0)
 
@@ -215,8 +219,7 @@ def _terms(P: np.ndarray, N: np.ndarray, lights: LightArrays, vectors: tuple | N
         factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, linear))
         spot = np.where(is_spot[None, :], factor, 1.0)
 
-    direct = np.where(c > 0.0, lights.intensity[None, :] * c * spot, 0.0)
-    return att, direct
+    return np.where(c > 0.0, lights.intensity[None, :] * c * spot, 0.0)
 
 
 def irradiance_many(positions: np.ndarray, normals: np.ndarray, lights: LightArrays,
@@ -229,17 +232,14 @@ def irradiance_many(positions: np.ndarray, normals: np.ndarray, lights: LightArr
     if len(lights) == 0:
         return np.zeros(len(P))
     att, direct = _terms(P, N, lights)
-    assert att is not None
     return irradiance_from_terms(att, direct, lights, occluded, color_filters)
 
 
 def light_terms(positions: np.ndarray, normals: np.ndarray, lights: LightArrays) -> tuple[np.ndarray, np.ndarray]:
     """Attenuation (S,n) and un-occluded direct term (S,n) of S sensors, to compute once and use
     both for choosing occlusion rays and for :func:`irradiance_from_terms`."""
-    att, direct = _terms(np.asarray(positions, dtype=np.float64).reshape(-1, 3),
-                         np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights)
-    assert att is not None
-    return att, direct
+    return _terms(np.asarray(positions, dtype=np.float64).reshape(-1, 3),
+                  np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights)
 
 
 def direct_and_segments(positions: np.ndarray, normals: np.ndarray, lights: LightArrays
@@ -249,7 +249,7 @@ def direct_and_segments(positions: np.ndarray, normals: np.ndarray, lights: Ligh
     vectors (a camera choosing its shadow rays needs no attenuation)."""
     P = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
     vectors = _vectors(P, lights)
-    direct = _terms(P, np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights, vectors, attenuation=False)[1]
+    direct = _direct(np.asarray(normals, dtype=np.float64).reshape(-1, 3), lights, vectors)
     unit, d = _segments(vectors)
     return direct, unit, d
 
