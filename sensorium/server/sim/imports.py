@@ -323,7 +323,6 @@ def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles
     """The world with ``nodes`` added stays within its limits (solids with their nested children,
     lights, triangles), else ``ImportRefused`` saying by how much. ``solids_now``: the world's solids
     (nested children included) when the caller keeps the count (else counted in ``world``'s ``alive`` ones)."""
-    count = solid_count
 
     def over(what: str, now: int, added: int, cap: int) -> None:
         if now + added > cap:
@@ -331,13 +330,12 @@ def check_additions(world: wm.World, alive: set[str], lights_now: int, triangles
                                 f"{added:,} added), more than the limit of {cap:,} (raise the limits with --allow-large)")
 
     if solids_now is None:
-        solids_now = sum(count(s)[0] for s in world.solids if s.name in alive)
-    added = [count(n.model) if n.type == "Solid" else (0, 1) for n in nodes]
+        solids_now = sum(solid_count(s)[0] for s in world.solids if s.name in alive)
+    added = [solid_count(n.model) if n.type == "Solid" else (0, 1) for n in nodes]
     over("solids (nested children included)", solids_now, sum(a[0] for a in added), limits.solids)
     over("lights", lights_now, sum(a[1] for a in added), limits.lights)
     over("triangles", triangles_now, triangles_added, limits.triangles)
 
 
 __all__ = ["parse_sf_node_string", "ImportRefused", "ImportedNode", "read_node_string", "rebuild_node", "check_additions",
-           "solid_count",
-           "string_file", "world_protos"]
+           "solid_count", "string_file", "world_protos"]
