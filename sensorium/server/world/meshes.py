@@ -334,7 +334,6 @@ class _Worker:
 
     def __init__(self, idle: float, script: str | None = None) -> None:
         """``script``: Python source run instead of mesh_worker.py (tests: a worker that dies)."""
-        import os
         import subprocess
         import sys
 
@@ -385,8 +384,6 @@ def worker_starts() -> int:
 def close_workers() -> None:
     """End the idle mesh workers (at exit; a worker also ends by itself when left idle): each ends at
     the end of its input, at once (waiting for the next request)."""
-    import os
-
     with _WORKERS_LOCK:
         idle, _IDLE[:] = list(_IDLE), []
     for w in idle:
@@ -396,8 +393,6 @@ def close_workers() -> None:
 
 def _take_worker() -> tuple[_Worker, bool]:
     """(an idle worker of this process, else a new one; whether it is new)."""
-    import os
-
     with _WORKERS_LOCK:
         while _IDLE:
             w = _IDLE.pop()
