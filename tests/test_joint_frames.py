@@ -278,7 +278,7 @@ def test_live_viewer_tf_demands_joint_states_and_moves_the_riding_frames():
     sim.step()
     topics.publish(sim.time_ms)
     demands: list[set[str]] = []
-    b = FoxgloveBridge({t.name: t.type for t in topics.topics}, w, ".", port=46231, on_demand=demands.append)
+    b = FoxgloveBridge({t.name: t.type for t in topics.topics}, w, ".", port=0, on_demand=demands.append)
     try:
         b._subscribed(1, "/tf", +1)
         b.pump()

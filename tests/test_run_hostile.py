@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from _serve import Proc, sensorium, wait_until
+from _serve import ANY_PORT, Proc, sensorium, wait_until
 
 from sensorium import launch
 from sensorium.launch import ControllerSpec, Launcher, LaunchError, find_controller, name_problem
@@ -45,10 +45,10 @@ def project(tmp_path: Path, robots: str, controllers: dict[str, str]) -> Path:
     return world
 
 
-def run(world: Path, port: int, *extra: str) -> Proc:
-    """``sensorium run`` on two ports of this test's range (48700-48799)."""
-    return Proc(sensorium("run", str(world), "--rpc", f"tcp://127.0.0.1:{port}", "--pub",
-                          f"tcp://127.0.0.1:{port + 1}", *extra),
+def run(world: Path, *extra: str) -> Proc:
+    """``sensorium run`` on free loopback ports (a fixed one may be any process's ephemeral port:
+    that made CI fail with 'Address already in use')."""
+    return Proc(sensorium("run", str(world), "--rpc", ANY_PORT, "--pub", ANY_PORT, *extra),
                 env={"WEBOTS_HOME": None, "WEBOTS_EXTRA_PROJECT_PATH": None})
 
 
@@ -129,7 +129,7 @@ def test_a_broken_runtime_ini_is_one_line_and_every_controller_runs(tmp_path: Pa
                     {"a.py": STEPPER, "b.py": STEPPER,
                      "a/runtime.ini": "[environment variables]\nA;B = 1\n",
                      "b/runtime.ini": "[environment variables]\nX = y\n" + "X = $(X)$(X)\n" * 30})
-    proc = run(world, 48700, "--until", "320")
+    proc = run(world, "--until", "320")
     assert proc.wait() == 0, proc.stderr()
     out, err = proc.stdout().splitlines(), proc.stderr().splitlines()
     assert "[alpha] alpha stepped 20" in out and "[beta] beta stepped 20" in out
@@ -148,7 +148,7 @@ def test_a_controller_that_exits_at_once_and_one_that_floods_its_output(tmp_path
              'sys.stdout.flush()\n' + STEPPER.split("\n", 1)[1])
     world = project(tmp_path, 'Robot { name "quick" controller "q" }\nRobot { name "loud" controller "f" }',
                     {"q": "#!/bin/sh\nexit 0\n", "f.py": flood})
-    proc = run(world, 48702, "--until", "160")
+    proc = run(world, "--until", "160")
     assert proc.wait() == 0, proc.stderr()
     assert "sensorium run: 'q' controller of robot 'quick' exited successfully." in proc.stderr().splitlines()
     out = proc.stdout().splitlines()
@@ -167,7 +167,7 @@ def test_processes_a_controller_leaves_behind_are_ended_or_said(tmp_path: Path) 
            'open("pids", "w").write(f"{a.pid} {b.pid}")\n'
            'while robot.step(16) != -1:\n    pass\n')
     world = project(tmp_path, 'Robot { name "parent" controller "k" }', {"k.py": kid})
-    proc = run(world, 48704, "--until", "320")
+    proc = run(world, "--until", "320")
     try:
         assert proc.wait() == 0, proc.stderr()
         a, b = (int(x) for x in (tmp_path / "controllers" / "k" / "pids").read_text().split())
@@ -188,7 +188,7 @@ def test_a_controller_that_exits_leaving_a_child_is_said_at_once(tmp_path: Path)
     """Its 'exited' line does not wait for the child holding its output (it waited for the end)."""
     world = project(tmp_path, 'Robot { name "alpha" controller "s" }\nRobot { name "beta" controller "b" }',
                     {"s": "#!/bin/sh\nsleep 300 &\necho $! > pid\nexit 4\n", "b.py": STEPPER})
-    proc = run(world, 48706)
+    proc = run(world)
     try:
         wait_until(lambda: "sensorium run: 's' controller of robot 'alpha' exited with status: 4." in proc.stderr(),
                    timeout=60, what="the exited line while its child lives")
@@ -206,7 +206,7 @@ def test_a_controller_that_never_attaches_is_waited_for_or_ended_at_attach_timeo
     seconds: one line, its robot runs without a controller, the world goes on, run exits 1."""
     world = project(tmp_path, 'Robot { name "stuck" controller "hang" }\nRobot { name "beta" controller "b" }',
                     {"hang": "#!/bin/sh\necho $$ > pid\nexec sleep 600\n", "b.py": STEPPER})
-    proc = run(world, 48708, "--until", "320", "--attach-timeout", "1.5")
+    proc = run(world, "--until", "320", "--attach-timeout", "1.5")
     assert proc.wait() == 1, proc.stderr()
     err = proc.stderr().splitlines()
     assert ("sensorium run: 'hang' controller of robot 'stuck' did not attach within 1.5 s (--attach-timeout): "
@@ -288,7 +288,7 @@ def test_without_attach_timeout_the_world_waits_and_says_so(tmp_path: Path, monk
     world = project(tmp_path, 'Robot { name "stuck" controller "hang" }',
                     {"hang": "#!/bin/sh\necho $$ > pid\nexec sleep 600\n"})
     out, err = io.StringIO(), io.StringIO()
-    options = launch.RunOptions(serve=ServeOptions(rpc="tcp://127.0.0.1:48710", pub="tcp://127.0.0.1:48711"))
+    options = launch.RunOptions(serve=ServeOptions(rpc=ANY_PORT, pub=ANY_PORT))
     project_run = launch.ProjectRun(world, options, out=out, err=err)
     status: list[int] = []
     thread = threading.Thread(target=lambda: status.append(project_run.run(signals=False)))
@@ -316,7 +316,7 @@ def test_a_python_command_with_spaces_and_quotes_is_one_program(tmp_path: Path) 
                     {"g.py": STEPPER, "b.py": STEPPER,
                      "g/runtime.ini": f'[python]\nCOMMAND = "{spaced}" ; a comment\nOPTIONS = -B\n',
                      "b/runtime.ini": '[python]\nCOMMAND = "python3 -u"\n'})
-    proc = run(world, 48712, "--until", "160")
+    proc = run(world, "--until", "160")
     assert proc.wait() == 1, proc.stderr()
     err = proc.stderr().splitlines()
     assert "[good] wrapped -B" in err and "[good] good stepped 10" in proc.stdout().splitlines()
@@ -330,7 +330,7 @@ def test_a_wbt_world_naming_a_controller_outside_its_project_runs_without_it(tmp
     world = project(tmp_path, 'Robot { name "r" controller "../../../bin/sh" }\nRobot { name "s" controller "x/y" }\n'
                               'Robot { name "u" controller "<unknown>" }\nRobot { name "beta" controller "b" }',
                     {"b.py": STEPPER})
-    proc = run(world, 48714, "--until", "160")
+    proc = run(world, "--until", "160")
     assert proc.wait() == 0, proc.stderr()
     err = proc.stderr()
     assert ("Robot 'r': controller '../../../bin/sh' is no controller's name (a folder under controllers/): the robot "

@@ -309,8 +309,8 @@ def test_the_rebuilt_obstacle_is_ground_as_the_world_files_box_tops_are(tmp_path
 
 
 def test_the_live_viewer_draws_the_rebuilt_obstacle_each_time():
-    """The Foxglove scene is encoded again after each set, the obstacle keeping its name and pose (loopback
-    ports of this test's own)."""
+    """The Foxglove scene is encoded again after each set, the obstacle keeping its name and pose (free loopback
+    ports)."""
     pytest.importorskip("foxglove")
     from sensorium.server.daemon.services import Core
     from sensorium.server.daemon.transport import Transport
@@ -318,8 +318,8 @@ def test_the_live_viewer_draws_the_rebuilt_obstacle_each_time():
     from sensorium.server.viewer.bridge import FoxgloveBridge
 
     sim = Simulation(load_world(WORLD), precision="fast")
-    transport = Transport(Core(sim), "tcp://127.0.0.1:49521", "tcp://127.0.0.1:49522")
-    bridge = FoxgloveBridge.for_core(transport.core, transport, "127.0.0.1", 49523)
+    transport = Transport(Core(sim), "tcp://127.0.0.1:0", "tcp://127.0.0.1:0")
+    bridge = FoxgloveBridge.for_core(transport.core, transport, "127.0.0.1", 0)
     try:
         drawn = [bridge.scene_bytes()]
         for size in ([0.6, 0.4, 0.3], [1.0, 0.4, 0.3]):        # the second time the obstacle is already last

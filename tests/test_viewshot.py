@@ -12,7 +12,6 @@ in its colour's channel; the boxes' sides (normals ±y, ±z) get no light; the s
 
 from __future__ import annotations
 
-import itertools
 import math
 import re
 import subprocess
@@ -31,8 +30,6 @@ REPO = Path(__file__).resolve().parents[1]
 WORLD = REPO / "tests" / "worlds" / "viewshot.wbt"
 FOV = 0.785398
 FACE = math.floor(255.0 * (1.0 - math.exp(-1.0)) ** (1.0 / 2.2) + 0.5)     # 207
-# servers this file starts listen on 127.0.0.1 ports from this range (never an OS-picked one)
-PORTS = itertools.count(46700, 2)
 
 
 @pytest.fixture(scope="module")
@@ -177,8 +174,7 @@ def test_export_image_sends_the_pictures_pixels_with_the_labels_and_set_label_ch
 
 def _serve_and_run(argv, out: Path, env: dict[str, str] | None = None) -> tuple[list[str], str]:
     from _serve import Proc, serve
-    port = next(PORTS)
-    with serve(WORLD, "--mode", "fast", rpc=f"tcp://127.0.0.1:{port}", pub=f"tcp://127.0.0.1:{port + 1}") as server:
+    with serve(WORLD, "--mode", "fast") as server:
         url = server.url("boss")
         proc = Proc(argv(url), env={**(env or {}), "VIEWSHOT_OUT": str(out), "SENSORIUM_CONTROLLER_URL": url})
         try:
