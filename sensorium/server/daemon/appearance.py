@@ -8,8 +8,9 @@ values sensors see where the world's model has them (a colour, transparency and 
 loader sanitised them), or what a Supervisor set since. A Supervisor sets a Material's
 ``diffuseColor``, ``emissiveColor`` and ``transparency``, a PBRAppearance's ``baseColor``,
 ``roughness``, ``metalness``, ``transparency`` and ``emissiveColor``: the scene takes the new
-appearance for that one shape (``Scene.set_appearance``), so cameras and infra-red sensors see it
-at their next measurement as if the world file had said it. Everything else is read-only.
+appearance for that one shape (``Scene.set_appearance``), so every sensor sees it at its next
+measurement as if the world file had said it (a transparency crossing 0 or 1 too: which rays see
+the shape and its shadows follows). Everything else is read-only.
 """
 
 from __future__ import annotations
@@ -141,10 +142,6 @@ def _what(ref: ShapeRef, def_name: str, node_id: int) -> str:
     return f"{ref.type} {def_name!r} (node {node_id})" if def_name else f"{ref.type} (node {node_id})"
 
 
-def _class(t: float) -> int:
-    return 0 if t <= 0.0 else 2 if t >= 1.0 else 1
-
-
 def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
     if name not in SETTABLE.get(ref.type, ()):
         return None
@@ -159,18 +156,7 @@ def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
                              f"got {value!r} (Webots resets it with a warning); nothing changed")
         scene = sim.scene
         shapes = ref.peers or (ref.index,)
-        if name == "transparency":
-            for k in shapes:
-                loaded = scene.loaded_model(k).appearance
-                if loaded is not None and _class(float(value)) != _class(loaded.transparency):
-                    sides = ("0 (opaque)", "between 0 and 1 (translucent)", "1 (invisible)")
-                    raise ValueError(
-                        f"{where}: the world file's {loaded.transparency:g} is {sides[_class(loaded.transparency)]} and "
-                        f"{float(value):g} is {sides[_class(float(value))]}: which rays see a shape and its shadows is "
-                        "fixed when the scene is built here, so a transparency stays on its side of 0 and 1; nothing "
-                        "changed")
         for k in shapes:        # the shape, and those that USE the same node
-            loaded = scene.loaded_model(k).appearance
             current = scene.shape_model(k).appearance
             update: dict[str, Any] = {}
             if name == "transparency":

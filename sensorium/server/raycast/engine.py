@@ -126,6 +126,7 @@ Known limits (measure-zero in practice)
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 from collections.abc import Sequence
 
@@ -218,6 +219,8 @@ class RayEngine(TierTracer):
         self._static_items: dict[tuple, _Tier | None] = {}   # the static tiers by their shapes (_items_key)
         self._shared: dict[tuple, _Tier | None] = {}   # body-frame tiers by their shapes (_items_key)
         self._epoch = 0                                 # bumped by every set_body_pose, add and removal
+        # bumped whenever which rays see a shape changes (set_shape_seen): hits a caller kept are stale then
+        self.seen_version = 0
         self.threads = available()   # threads a large cast may use (see .blocks; 1: the calling thread only)
         self.native = True   # judge and refine hits in packets.c where the packet path is on (the same answers)
         self._counting = threading.Lock()
@@ -284,20 +287,9 @@ class RayEngine(TierTracer):
         if b.removed:
             return
         b.removed = True
-        self._epoch += 1
-        self._planes.clear()
         if b.mover:
             self._movers.remove(b)
-            self._mover_tables.clear()
-            # its body-frame tiers, when no body left uses them (a Supervisor randomising a moved solid's
-            # size between episodes would otherwise keep one Embree scene per size for good)
-            used = {id(t) for m in self._movers for t in m.tiers.values()}
-            gone = {id(t) for t in b.tiers.values() if t is not None and id(t) not in used}
-            if gone:
-                self._shared = {k: t for k, t in self._shared.items() if id(t) not in gone}
-        else:
-            self._drop_static()
-        b.tiers = {}
+        self._forget_tiers(b)
         b.pose = _NOWHERE
         while self._bodies and self._bodies[-1].removed:   # the last bodies removed: their slots are free again
             last = self._bodies.pop()
@@ -306,6 +298,44 @@ class RayEngine(TierTracer):
         if len(self._owner_of) != len(self._entries):
             self._owner_of = self._owner_of[:len(self._entries)].copy()
             self._rot, self._pos = self._rot[:len(self._bodies)].copy(), self._pos[:len(self._bodies)].copy()
+
+    def set_shape_seen(self, shape: int, transparent: bool, casts_shadow: bool) -> None:
+        """Which rays see a shape, changed (a Supervisor's ``transparency`` crossing 0 or 1: see
+        :class:`ShapeEntry`): its body's scenes are made again at the next cast, as after a removal --
+        the static tier for a static body, else the body's own tiers and the movers' table -- from
+        the same items a world loaded with these flags builds them of (the same answers, bit for bit).
+        Every body and shape keeps its number; a body-frame tier no body uses any more is let go (a
+        Supervisor hiding and showing a shape for days keeps bounded tables). Nothing happens when
+        the flags are the same."""
+        e = self._entries[shape]
+        if e.transparent == bool(transparent) and e.casts_shadow == bool(casts_shadow):
+            return
+        self._entries[shape] = dataclasses.replace(e, transparent=bool(transparent), casts_shadow=bool(casts_shadow))
+        self._forget_tiers(self._bodies[self._shape_body[shape]])
+        self.seen_version += 1
+
+    def _forget_tiers(self, b: _Body) -> None:
+        """The scenes holding body ``b``'s shapes forgotten (made again on use): the planes, the static
+        tier of a static body, a mover's own tiers and the movers' tables; body-frame tiers no mover
+        uses any more leave the shared table."""
+        self._epoch += 1
+        self._planes.clear()
+        if b.mover:
+            self._mover_tables.clear()
+        else:
+            self._drop_static()
+        old, b.tiers = b.tiers, {}
+        # its body-frame tiers, when no body left uses them (a Supervisor randomising a moved solid's
+        # size between episodes would otherwise keep one Embree scene per size for good)
+        used = {id(t) for m in self._bodies for t in m.tiers.values()}
+        gone = {id(t) for t in old.values() if t is not None and id(t) not in used}
+        if gone:
+            self._shared = {k: t for k, t in self._shared.items() if id(t) not in gone}
+
+    @property
+    def held_tiers(self) -> int:
+        """The Embree tiers held now (the static tiers and the body-frame tiers, each counted once)."""
+        return len({id(t) for t in (*self._static_items.values(), *self._shared.values()) if t is not None})
 
     @property
     def shape_count(self) -> int:

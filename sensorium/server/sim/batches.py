@@ -249,7 +249,7 @@ class _Group:
         """Each ray's hit on its own robot's body (body frame), cast once per engine precision."""
         if self.own_visible is None or not np.count_nonzero(self.own_visible):
             return None
-        if self.own is None or self.own[0] != engine.precision:
+        if self.own is None or self.own[0] != (engine.precision, engine.seen_version):
             S, n = len(self.idx), self.n
             O = np.repeat(local_pos[self.idx], n, axis=0)
             D = np.einsum("sij,snj->sni", local_rot[self.idx], self.local_dirs).reshape(-1, 3)
@@ -265,7 +265,7 @@ class _Group:
                     h = engine.cast_local(body, O[rows], D[rows], 0.0, self.t_far[rows], kind=self.kind,
                                           skip_transparent=self.skip)
                 t[rows], shape[rows], normal[rows] = h.distance, h.shape, h.normal
-            self.own = (engine.precision, RayHits(t, normal, shape))
+            self.own = ((engine.precision, engine.seen_version), RayHits(t, normal, shape))
         return self.own[1]
 
 

@@ -128,9 +128,9 @@ class OwnBodyRays:
         self._hits: tuple[object, RayHits] | None = None
 
     def body_hits(self, engine) -> RayHits:
-        if self._hits is None or self._hits[0] != engine.precision:
+        if self._hits is None or self._hits[0] != (engine.precision, engine.seen_version):
             O, D = self._local
-            self._hits = (engine.precision, cast_local_skipping(engine, self.body, O, D, *self.limits,
+            self._hits = ((engine.precision, engine.seen_version), cast_local_skipping(engine, self.body, O, D, *self.limits,
                                                                 RayKind.VISUAL, False, self._own))
         return self._hits[1]
 

@@ -524,17 +524,32 @@ class Scene:
 
     def set_appearance(self, shape: int, appearance: wm.Appearance) -> None:
         """A Supervisor's new colour, roughness or transparency for one shape (Webots' Material and
-        PBRAppearance fields): from the next measurement cameras and infra-red sensors read it as if the
-        world file had said it. Only that shape's entries change (no rebuild); a transparency keeps its
-        side of 0 and 1 (the caller's check: which rays see the shape and its shadows is fixed).
-        ``appearance_version`` moves unless the appearance is the same as now (the Foxglove scene
-        draws it again)."""
+        PBRAppearance fields): from the next measurement every sensor reads it as if the world file had
+        said it. Only that shape's entries change; a transparency crossing 0 or 1 also changes which
+        rays see the shape and its shadows (:meth:`_seen_again`: its body's ray scenes are made again
+        at the next cast). ``appearance_version`` moves unless the appearance is the same as now (the
+        Foxglove scene draws it again)."""
         model = self._parts[shape][2]
         if appearance == model.appearance:      # the same values again: nothing to redraw
             return
         self._loaded_models.setdefault(shape, model)
         self._use_model(shape, model.model_copy(update={"appearance": appearance}))
+        self._seen_again(shape)
         self.appearance_version += 1
+
+    def _seen_again(self, shape: int) -> None:
+        """The ray engine's flags of a shape as :func:`_entry` makes them from its model now (invisible
+        at a transparency of 1, no shadow from a translucent shape), its image's format read from the
+        image the sampler holds (no file read); the engine remakes its scenes only when they change."""
+        model = self._parts[shape][2]
+        a = model.appearance
+        held = self.textures.shapes.get(shape) if self.textures is not None else None
+        if a is None or a.transparency > 0.0 or a.texture is None or held is None:
+            lucent = translucent(a, self._base_dir)
+        else:
+            lucent = held.base.translucent
+        self.engine.set_shape_seen(shape, transparent=a is not None and a.transparency >= 1.0,
+                                   casts_shadow=model.cast_shadows and not lucent)
 
     def set_texture(self, shape: int, appearance: wm.Appearance,
                     given: Mapping[str, tuple[Path, Decoded]] | None = None) -> None:
@@ -549,6 +564,7 @@ class Scene:
         self.set_appearance(shape, appearance)
         if self.textures is not None:
             self.textures.set_shape(shape, appearance, given)
+            self._seen_again(shape)
 
     def casts_shadow(self, shape: int, appearance: wm.Appearance | None,
                      given: Mapping[str, tuple[Path, Decoded]] | None = None) -> bool:
@@ -590,6 +606,7 @@ class Scene:
             if self.textures is not None and retextured is not None and model.appearance is not None and \
                     _maps(retextured) != _maps(model.appearance):
                 self.textures.set_shape(shape, model.appearance)
+            self._seen_again(shape)
         if self._loaded_models:
             self.appearance_version += 1
         self._loaded_models.clear()

@@ -285,14 +285,14 @@ class Lidar(Device):
         assert self._own_body is not None
         scene, body, _ = self._own_body
         engine = scene.engine
-        if self._own_hits is None or self._own_hits[0] != engine.precision:
+        if self._own_hits is None or self._own_hits[0] != (engine.precision, engine.seen_version):
             L, W = self.config.number_of_layers, self.config.horizontal_resolution
             D = self._all_dirs.reshape(-1, 3) @ self.mount_pose.rotation.T
             O = np.broadcast_to(self.mount_pose.translation, D.shape)
             far = self._t_far.reshape(-1) if isinstance(self._t_far, np.ndarray) else self._t_far
             h = cast_local_skipping(engine, body, np.ascontiguousarray(O), D, self.params.near, far, RayKind.VISUAL,
                                     False, [self.own_shapes] * (L * W))
-            self._own_hits = (engine.precision, h.distance.reshape(L, W))
+            self._own_hits = ((engine.precision, engine.seen_version), h.distance.reshape(L, W))
         return self._own_hits[1]
 
     # -- controller API
