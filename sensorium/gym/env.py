@@ -457,7 +457,8 @@ def rebuild(loaded: LoadedWorld, world_seed: int, precision: str) -> Simulation:
     noise streams all as at the start."""
     w = loaded.world
     w = w.model_copy(update={"world_info": w.world_info.model_copy(update={"random_seed": world_seed})})
-    return Simulation(LoadedWorld(world=w, source=loaded.source, base_dir=loaded.base_dir, text=loaded.text),
+    return Simulation(LoadedWorld(world=w, source=loaded.source, base_dir=loaded.base_dir, text=loaded.text,
+                                  textures=loaded.textures),
                       precision=precision)
 
 

@@ -27,7 +27,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.meshes import elevation_grid_mesh, load_mesh, triangles_mesh
 from sensorium.server.world.poses import pose_from_model
-from sensorium.server.world.textures import Decoded, TextureSampler, resolve_texture_url, uses_alpha
+from sensorium.server.world.textures import Checked, Decoded, TextureSampler, resolve_texture_url, uses_alpha
 
 _IDENTITY = Pose.identity()
 # a removed shape's model while its number is kept (Scene._forget_shapes): no geometry, no appearance
@@ -85,16 +85,19 @@ def _maps(a: wm.Appearance) -> tuple:
     return a.texture, a.roughness_map, a.occlusion_map, a.texture_transform
 
 
-def translucent(appearance: wm.Appearance | None, base_dir: Path) -> bool:
+def translucent(appearance: wm.Appearance | None, base_dir: Path, images: Checked | None = None) -> bool:
     """Whether WREN draws a shape of this appearance as translucent: a transparency above 0 or a
     base image whose pixel format has alpha (an RGBA PNG even where every alpha is 255: Webots'
     ``WbImageTexture`` tests the format, not the pixels). Webots casts no shadow from such a shape
-    and shadows none on it."""
+    and shadows none on it. ``images``: the world's images as its check read them (the image is
+    read from its file only when they do not hold it)."""
     if appearance is None:
         return False
     if appearance.transparency > 0.0:
         return True
     t = appearance.texture
+    if t is not None and images is not None and t.url in images:
+        return images[t.url][1][2]
     return t is not None and uses_alpha(resolve_texture_url(t.url, base_dir, allow_outside=True), t.url)
 
 
@@ -106,7 +109,8 @@ def receives_shadows(transparency: np.ndarray, alpha: np.ndarray | None, shape: 
     return out if alpha is None else out & ~alpha[shape]
 
 
-def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None) -> ShapeEntry:
+def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None,
+           images: Checked | None = None) -> ShapeEntry:
     transparent = shape.appearance is not None and shape.appearance.transparency >= 1.0
     assert shape.geometry is not None
     return ShapeEntry(
@@ -115,7 +119,7 @@ def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None
         bounding=shape.seen_by in ("both", "bounding") and not isinstance(shape.geometry, wm.Cone),   # as Webots
         visual=shape.seen_by in ("both", "visual"),
         transparent=transparent,
-        casts_shadow=shape.cast_shadows and not translucent(shape.appearance, base_dir),
+        casts_shadow=shape.cast_shadows and not translucent(shape.appearance, base_dir, images),
     )
 
 
@@ -401,8 +405,12 @@ def solid_radar_targets(solid: wm.Solid) -> dict[TargetKey, float]:
 class Scene:
     """Geometry and poses of a world; the only owner of the ray engine."""
 
-    def __init__(self, world: wm.World, base_dir: Path, precision: Precision | str = Precision.EXACT):
+    def __init__(self, world: wm.World, base_dir: Path, precision: Precision | str = Precision.EXACT,
+                 images: Checked | None = None):
+        """``images``: the world's images as its check read them (``LoadedWorld.textures``): shown
+        as they are, their files not read again."""
         self.engine = RayEngine(Precision(precision))
+        self._images: Checked = images or {}
         self.shapes: list[ShapeInfo] = []
         self.solid_names = [s.name for s in world.solids]
         self.solid_name_set = set(self.solid_names)     # (every name the world has had: never reused)
@@ -481,7 +489,7 @@ class Scene:
         self._base_dir = base_dir
         self._ink_evaporation = world.world_info.ink_evaporation
         sampler = TextureSampler([(shape.geometry, shape.appearance) for _, _, shape in self._parts], base_dir,
-                                 ink_evaporation=self._ink_evaporation)
+                                 ink_evaporation=self._ink_evaporation, given=self._images)
         self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         # a Supervisor's appearance changes: shape -> its model as loaded, and the field values it set
@@ -545,7 +553,7 @@ class Scene:
         a = model.appearance
         held = self.textures.shapes.get(shape) if self.textures is not None else None
         if a is None or a.transparency > 0.0 or a.texture is None or held is None:
-            lucent = translucent(a, self._base_dir)
+            lucent = translucent(a, self._base_dir, self._images)
         else:
             lucent = held.base.translucent
         self.engine.set_shape_seen(shape, transparent=a is not None and a.transparency >= 1.0,
@@ -560,7 +568,7 @@ class Scene:
         measurement as if the world file had named them."""
         if self.textures is None and appearance.texture is not None:     # (no shape textured until now)
             self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
-                                           ink_evaporation=self._ink_evaporation)
+                                           ink_evaporation=self._ink_evaporation, given=self._images)
         self.set_appearance(shape, appearance)
         if self.textures is not None:
             self.textures.set_shape(shape, appearance, given)
@@ -580,7 +588,7 @@ class Scene:
             held = self.textures.shapes.get(shape) if self.textures is not None else None
             if held is not None and appearance is self._parts[shape][2].appearance:
                 return not held.base.translucent
-        return not translucent(appearance, self._base_dir)
+        return not translucent(appearance, self._base_dir, self._images)
 
     def _use_model(self, shape: int, model: wm.Shape | wm.Solid) -> None:
         key, local, _ = self._parts[shape]
@@ -621,7 +629,7 @@ class Scene:
     def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool,
                   key: str | int | None = None, entries: list[ShapeEntry] | None = None) -> int:
         if entries is None:
-            entries = [_entry(shape, base_dir, local) for _, local, shape in parts]
+            entries = [_entry(shape, base_dir, local, self._images) for _, local, shape in parts]
         self._parts += [(key, local, shape) for _, local, shape in parts]
         triangles = sum(geo.triangle_count(e.primitive) for e in entries)
         self.triangle_count += triangles
@@ -740,7 +748,7 @@ class Scene:
         """A top-level solid's parts (``solid_parts``) and their ray-engine entries, built before
         anything changes (a mesh that cannot be read raises here, the scene untouched)."""
         parts = list(solid_parts(solid, Pose.identity()))
-        return parts, [_entry(shape, self._base_dir, local) for _, local, shape in parts]
+        return parts, [_entry(shape, self._base_dir, local, self._images) for _, local, shape in parts]
 
     def solid_triangles(self, name: str) -> int:
         """The triangles of top-level solid ``name``'s body (0 for a removed one)."""
@@ -775,7 +783,7 @@ class Scene:
                 self.textures.extend(models)
             elif any(a is not None and a.texture is not None for _, a in models):
                 self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
-                                               ink_evaporation=self._ink_evaporation)
+                                               ink_evaporation=self._ink_evaporation, given=self._images)
             self.shapes_version += 1
         carried = [(lt, name, f) for lt, f in solid_lights(solid, Pose.identity())]
         if carried:
@@ -881,7 +889,7 @@ class Scene:
         shape's ink layer (textures.InkLayer), made on the first stroke; returns the texels inked."""
         if self.textures is None:
             self.textures = TextureSampler([(shape_.geometry, shape_.appearance) for _, _, shape_ in self._parts],
-                                           self._base_dir, ink_evaporation=self._ink_evaporation)
+                                           self._base_dir, ink_evaporation=self._ink_evaporation, given=self._images)
         inv = self._world_to_shape(shape)
         return self.textures.paint(shape, inv.apply(np.asarray(origin, dtype=np.float64)),
                                    inv.apply_dirs(np.asarray(direction, dtype=np.float64)), float(distance),

@@ -309,7 +309,7 @@ class Simulation:
         self.seed = self.world.world_info.random_seed
         self.time_ms = 0
         self.step_count = 0
-        self.scene = Scene(self.world, loaded.base_dir, precision)
+        self.scene = Scene(self.world, loaded.base_dir, precision, images=dict(loaded.textures))
         self.ground = Ground.from_world(self.world, self.scene.solid_poses, _TO_ENU[self.world.world_info.coordinate_system])
         self.lights = lights_from_models(self.scene.sensor_lights())
         self._lights_version = self.scene.lights_version

@@ -69,7 +69,7 @@ def _geometry_line(s: wm.Solid) -> str:
 def world_summary(path: str | Path) -> dict:
     loaded = load_world(path)
     w = loaded.world
-    scene = Scene(w, loaded.base_dir)
+    scene = Scene(w, loaded.base_dir, images=dict(loaded.textures))
     return {
         "world": w.world_info.name,
         "file": str(path),

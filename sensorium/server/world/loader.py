@@ -78,6 +78,8 @@ class LoadedWorld:
     losses: tuple[Loss, ...] = ()                        # what sensors would notice was left out (report.py)
     asset_files: frozenset[Path] = frozenset()          # files outside base_dir it may read (PROTO assets)
     timings: dict[str, float] = field(default_factory=dict)   # wall seconds per loading stage (sensorium bench)
+    # its texture images as the check read them, each file once (url -> file, image): the scene shows these
+    textures: Mapping[str, tuple[Path, Any]] = field(default_factory=dict)
 
     @property
     def report(self) -> LoadReport:
@@ -268,7 +270,7 @@ def load_wbt(path: Path, *, limits: WorldLimits | None = None, allow_outside_mes
     placed = [_wbt_warning(w, origin, source) for w in loaded.warnings]
     return LoadedWorld(world=loaded.world, source=source, base_dir=loaded.base_dir, text=text,
                        warnings=[*warnings, *placed], losses=conv.losses, asset_files=conv.asset_files,
-                       timings={**conv.timings, "validate": time.perf_counter() - t0})
+                       timings={**conv.timings, "validate": time.perf_counter() - t0}, textures=loaded.textures)
 
 
 def _origin_of(path: str, origin: dict[str, tuple[int, int, str]]) -> tuple[int, int, str] | None:
@@ -316,22 +318,24 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
     except ValidationError as exc:
         raise WorldError(source, _named(data, [_problem_from_pydantic(e) for e in exc.errors()])) from None
     base = base_dir or Path.cwd()
+    textures: dict = {}
     problems = check_world(world, base, limits=limits, allow_outside_meshes=allow_outside_meshes,
-                           asset_files=asset_files)
+                           asset_files=asset_files, textures=textures)
     if problems:
         raise WorldError(source, _named(data, problems))
     world, warnings = sanitize(world)
-    return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings)
+    return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings, textures=textures)
 
 
 def from_model(world: wm.World, base_dir: Path | None = None) -> LoadedWorld:
     """A world model built in memory (``<memory>``), checked against its files under ``base_dir``
     (default: the working directory) and sanitised as a world file is; ``WorldError`` if unusable."""
-    problems = check_world(world, base_dir or Path.cwd())
+    textures: dict = {}
+    problems = check_world(world, base_dir or Path.cwd(), textures=textures)
     if problems:
         raise WorldError("<memory>", problems)
     world, _ = sanitize(world)
-    return LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd())
+    return LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd(), textures=textures)
 
 
 _TAGS = {"box", "sphere", "cylinder", "capsule", "cone", "plane", "triangles", "mesh", "elevation_grid", "PointLight", "SpotLight",
@@ -402,9 +406,10 @@ _BOOL_FIELD = re.compile(r"(\w+): (expected a number, got (?:True|False))$")   #
 
 
 def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None = None,
-                allow_outside_meshes: bool = False, asset_files: frozenset[Path] = frozenset()) -> list[Problem]:
+                allow_outside_meshes: bool = False, asset_files: frozenset[Path] = frozenset(),
+                textures: dict | None = None) -> list[Problem]:
     """Checks that relate several fields or the file system, and the world's limits; one problem
-    per finding."""
+    per finding. ``textures`` receives the texture images as read (``check_textures``' ``images``)."""
     problems: list[Problem] = []
 
     def unique(items: Sequence[tuple[str, str | None]], what: str) -> None:
@@ -513,7 +518,7 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
         from sensorium.server.world.textures import check_textures
 
         problems += [Problem(*p) for p in check_textures(world, base_dir, limits or WorldLimits(), allow_outside_meshes,
-                                                         asset_files)]
+                                                         asset_files, textures)]
     return problems
 
 

@@ -19,10 +19,11 @@ float32), and an image whose sides are not powers of two is sampled as stored (W
 to the next powers of two first, keeping its aspect ratio, with Qt's nearest-pixel scaling): such
 an image reads the same texels except within about one texel of a texel boundary.
 
-Images are decoded once (when the world is checked; cached by file, modification time and size)
-and bounded by the world limits (``texture_file_bytes``, ``texture_pixels`` per image,
-``texture_pixels_total`` per world): a larger image is rejected with the limit it exceeds, never
-silently reduced (reduced texels would change readings).
+A world's images are read once, when the world is checked (:func:`check_textures`), and the scene
+shows those very images (the file is not read again); they are bounded by the world limits
+(``texture_file_bytes``, ``texture_pixels`` per image, ``texture_pixels_total`` per world): a larger
+image is rejected with the limit it exceeds, never silently reduced (reduced texels would change
+readings).
 
 The sampler (:class:`TextureSampler`) is per scene: for each shape, the mapping of its geometry and
 its images. Its API works on one shape's local-frame points at a time — ``uv`` (Webots'
@@ -45,7 +46,8 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.world import texcoords as tc
 
-__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "checked_image", "read_checked_image", "load_image", "load_alpha", "uses_alpha", "check_textures",
+__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "read_texture_file",
+           "read_checked_image", "load_image", "load_alpha", "uses_alpha", "check_textures", "Checked",
            "TextureImage", "transform_uv", "TextureSampler", "TriangleLocator", "texture_urls"]
 
 FORMATS = {"PNG": "PNG", "JPEG": "JPEG", "MPO": "JPEG"}     # Pillow's format → what Webots calls it
@@ -234,50 +236,54 @@ def _check_pixels(url: str, w: int, h: int, limits: Any, pixels_before: int) -> 
                                "pixels together (raise the limits with --allow-large)")
 
 
-def checked_image(url: str, base_dir: Path, limits: Any, *, allow_outside: bool = False,
-                  allowed: frozenset[Path] = frozenset(), pixels_before: int = 0) -> tuple[Path, int]:
-    """A texture url → (its file, its pixels), checked as a world's textures are: confined (see
-    :func:`resolve_texture_url`), a PNG or JPEG no larger than ``limits.texture_file_bytes`` with at
-    most ``limits.texture_pixels`` pixels, ``pixels_before`` (the other images' pixels) plus its own
-    within ``limits.texture_pixels_total``, and decoded (a broken file raises here, once)."""
-    file = resolve_texture_url(url, base_dir, allow_outside=allow_outside, max_bytes=limits.texture_file_bytes,
-                               allowed=allowed)
-    _, w, h = image_header(file, url)
-    _check_pixels(url, w, h, limits, pixels_before)
-    load_image(file, url)
-    return file, w * h
+def read_texture_file(file: Path, url: str, max_bytes: int) -> bytes:
+    """The bytes of a texture file, at most ``max_bytes`` of them (else ``TextureFileError``): the
+    one read of an image a world or a Supervisor names (:func:`read_checked_image`)."""
+    try:
+        with open(file, "rb") as f:
+            data = f.read(max_bytes + 1)
+    except OSError as exc:
+        raise TextureFileError(f"texture file {url!r} cannot be read: {exc.strerror or exc}") from None
+    if len(data) > max_bytes:
+        raise TextureFileError(f"texture file {url!r} is larger than the limit of {max_bytes:,} "
+                               "bytes (raise the limits with --allow-large)")
+    return data
 
 
 def read_checked_image(url: str, base_dir: Path, limits: Any, *, allow_outside: bool = False,
-                       pixels_before: int = 0) -> tuple[Path, int, Decoded]:
-    """:func:`checked_image` on the file's bytes read once: (its file, its pixels, the image decoded
-    from those very bytes), so a file replaced or grown after its check is never what is decoded
-    (a Supervisor's url: what was checked is what is shown). Not cached: an image no shape shows is
-    let go."""
+                       allowed: frozenset[Path] = frozenset(), pixels_before: int = 0) -> tuple[Path, int, Decoded]:
+    """A texture url checked as a world's textures are -- confined (see :func:`resolve_texture_url`), a
+    PNG or JPEG no larger than ``limits.texture_file_bytes`` with at most ``limits.texture_pixels``
+    pixels, ``pixels_before`` (the other images' pixels) plus its own within
+    ``limits.texture_pixels_total``, and decoded -- on the file's bytes read once: (its file, its
+    pixels, the image decoded from those very bytes), so a file replaced or grown after its check is
+    never what is decoded (a world's textures and a Supervisor's url: what was checked is what is
+    shown). Not cached: an image no shape shows is let go."""
     import io
 
-    file = resolve_texture_url(url, base_dir, allow_outside=allow_outside, max_bytes=limits.texture_file_bytes)
-    try:
-        with open(file, "rb") as f:
-            data = f.read(limits.texture_file_bytes + 1)
-    except OSError as exc:
-        raise TextureFileError(f"texture file {url!r} cannot be read: {exc.strerror or exc}") from None
-    if len(data) > limits.texture_file_bytes:
-        raise TextureFileError(f"texture file {url!r} is larger than the limit of {limits.texture_file_bytes:,} "
-                               "bytes (raise the limits with --allow-large)")
+    file = resolve_texture_url(url, base_dir, allow_outside=allow_outside, max_bytes=limits.texture_file_bytes,
+                               allowed=allowed)
+    data = read_texture_file(file, url, limits.texture_file_bytes)
     _, w, h = image_header(io.BytesIO(data), url)    # type: ignore[arg-type]
     _check_pixels(url, w, h, limits, pixels_before)
     return file, w * h, _decode_from(io.BytesIO(data), url)   # (the very bytes whose header was checked)
 
 
+Checked = dict[str, tuple[Path, Decoded]]
+"""A world's images as its check read them: url as the world names it -> (its file, its image)."""
+
+
 def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: bool = False,
-                   allowed: frozenset[Path] = frozenset()) -> list[tuple[str, str]]:
+                   allowed: frozenset[Path] = frozenset(), images: Checked | None = None) -> list[tuple[str, str]]:
     """Every texture of a world: url confined (``allowed``: files outside the world's folder it may
     read, a .wbt's PROTO assets) and readable, a PNG or JPEG within the limits, decoded (so a broken
-    file is found when the world is checked, and decoded once); the texture coordinates of inline
-    triangles consistent. ``(path, message)`` per problem."""
+    file is found when the world is checked); the texture coordinates of inline triangles consistent.
+    ``(path, message)`` per problem. Each file is read once (:func:`read_checked_image`), and
+    ``images`` (when given) receives each url's file and image as read: the scene shows those
+    (``TextureSampler``'s ``given``), never the file read again, so a file changed after the check is
+    not what sensors see."""
     problems: list[tuple[str, str]] = []
-    seen: dict[Path, int] = {}
+    seen: dict[Path, Decoded] = {}
     total = 0
     for path, shape in _appearances(world):
         g = shape.geometry
@@ -288,12 +294,12 @@ def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: 
             try:
                 file = resolve_texture_url(tex.url, base_dir, allow_outside=allow_outside,
                                            max_bytes=limits.texture_file_bytes, allowed=allowed)
-                if file in seen:
-                    continue
-                file, pixels = checked_image(tex.url, base_dir, limits, allow_outside=allow_outside, allowed=allowed,
-                                             pixels_before=total)
-                total += pixels
-                seen[file] = pixels
+                if file not in seen:
+                    file, pixels, seen[file] = read_checked_image(tex.url, base_dir, limits, allow_outside=allow_outside,
+                                                                  allowed=allowed, pixels_before=total)
+                    total += pixels
+                if images is not None:
+                    images[tex.url] = (file, seen[file])
             except TextureFileError as exc:
                 problems.append((where, str(exc)))
     return problems
@@ -759,8 +765,11 @@ class TextureSampler:
     such a shape)."""
 
     def __init__(self, shapes: list[tuple[Any, wm.Appearance | None]], base_dir: Path, *,
-                 ink_evaporation: float = 0.0, ink_texels_max: int = INK_TEXELS_MAX):
+                 ink_evaporation: float = 0.0, ink_texels_max: int = INK_TEXELS_MAX,
+                 given: Mapping[str, tuple[Path, Decoded]] | None = None):
         self.base_dir = Path(base_dir)
+        # the world's images as its check read them (check_textures' ``images``): shown as they are
+        self._given: Mapping[str, tuple[Path, Decoded]] = given or {}
         self.shapes: dict[int, ShapeTexture] = {}
         self.ink: dict[int, InkLayer] = {}
         self.ink_evaporation = float(ink_evaporation)
@@ -814,10 +823,10 @@ class TextureSampler:
         self.models = [*self.models, *shapes]
         for i, (_, app) in enumerate(shapes, start=first):
             if app is not None and app.texture is not None:
-                base = self._image(app.texture)
+                base = self._image(app.texture, given=self._given)
                 assert base is not None
-                self.shapes[i] = ShapeTexture(base, self._image(app.roughness_map), self._image(app.occlusion_map),
-                                              app.texture_transform)
+                self.shapes[i] = ShapeTexture(base, self._image(app.roughness_map, given=self._given),
+                                              self._image(app.occlusion_map, given=self._given), app.texture_transform)
         textured = np.zeros(len(self.models) + 1, dtype=bool)
         textured[:first] = self.textured[:first]        # the trailing "no hit" entry stays False
         textured[list(self.shapes)] = True
