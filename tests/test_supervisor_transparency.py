@@ -3,7 +3,8 @@ next step every sensor reads the shape exactly as a world file written with that
 (shadows included), range finders, lidars, infra-red, sonar and laser distance sensors, a light sensor
 behind it -- for a static solid's shape and for a robot's own shape (a moving body, seen by its own
 infra-red sensor and lidar); ``USE``d appearances follow; a reset brings the loaded value back; hiding
-and showing a shape again and again keeps the engine's tables bounded."""
+and showing a shape again and again keeps the engine's tables bounded. A texture url whose image's
+pixel format has alpha (or no longer has it) changes the shape's shadows the same way."""
 
 from __future__ import annotations
 
@@ -264,3 +265,33 @@ def test_a_defd_appearance_or_material_crosses_in_every_shape_that_uses_it(tmp_p
         assert np.array_equal(got[0], ref[0]) and got[1] == ref[1], (t_pbr, t_mat)
     hidden, shown = _use_readings(_use_world(tmp_path, 1.0, 1.0)), _use_readings(_use_world(tmp_path, 0.0, 0.0))
     assert not np.array_equal(hidden[0], shown[0]) and hidden[1] != shown[1]
+
+
+def _textured(image: str, base_dir) -> Simulation:
+    w = world(0.0, "block").model_dump()
+    w["solids"][1]["appearance"] = {"texture": {"url": image}}
+    sim = Simulation(wm.World.model_validate(w), base_dir=base_dir)
+    for d in DEVICES:
+        sim.device(f"r/{d}").enable(16)
+    return sim
+
+
+def test_a_url_whose_image_has_alpha_lets_the_light_through_as_the_world_file_naming_it(tmp_path):
+    from PIL import Image
+
+    Image.new("RGB", (2, 2), (200, 120, 40)).save(tmp_path / "rgb.png")
+    Image.new("RGBA", (2, 2), (200, 120, 40, 255)).save(tmp_path / "rgba.png")   # the same colours, alpha 255
+    sim = _textured("rgb.png", tmp_path)
+    (shape,) = sv.get_field(sim, sv.find_node(sim, "block"), "children")["value"]
+    app = sv.node_by_id(sim, sv.get_field(sim, sv.node_by_id(sim, shape), "appearance")["value"])
+    tex = sv.node_by_id(sim, sv.get_field(sim, app, "baseColorMap")["value"])
+    refs = {}
+    for steps, image in enumerate(("rgba.png", "rgb.png", "rgba.png"), start=1):
+        sv.change_item(sim, tex, "url", "set", 0, image)
+        sim.run(1)
+        ref = _textured(image, tmp_path)
+        ref.run(steps)
+        refs[image] = readings(ref)
+        assert same(readings(sim), refs[image]) == [], image
+    # the block's shadow on the wall is the only difference: an RGBA image makes it translucent (Webots)
+    assert same(refs["rgb.png"], refs["rgba.png"]) == ["cam"]

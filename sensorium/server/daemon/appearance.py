@@ -252,22 +252,10 @@ def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> None:
         given = {name: (file, decoded)}
     else:
         given = {}
-    plans = []
-    for k in shapes:
+    for k in shapes:        # (an image whose pixel format has alpha: the shape casts no shadow, as Webots draws it)
         new = _retextured(scene, k, name)
-        current = scene.shape_model(k).appearance
-        if new is None:
-            continue
-        if scene.casts_shadow(k, new, given) != scene.casts_shadow(k, current):
-            alpha = not scene.casts_shadow(k, new, given)
-            raise ValueError(
-                f"{where}: the shape casts shadows {'and' if alpha else 'but'} the pixel format of {_quoted(url or '')} "
-                f"{'has' if alpha else 'has no'} alpha (Webots then draws the shape translucent, without shadows, "
-                f"{'un' if not alpha else ''}like its image now); which shapes cast shadows is fixed when the scene is "
-                "built here; nothing changed")
-        plans.append((k, new))
-    for k, new in plans:
-        scene.set_texture(k, new, given)
+        if new is not None:
+            scene.set_texture(k, new, given)
 
 
 def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: Any) -> None:

@@ -537,13 +537,19 @@ class Scene:
         rays see the shape and its shadows (:meth:`_seen_again`: its body's ray scenes are made again
         at the next cast). ``appearance_version`` moves unless the appearance is the same as now (the
         Foxglove scene draws it again)."""
+        if self._take_appearance(shape, appearance):
+            self._seen_again(shape)
+
+    def _take_appearance(self, shape: int, appearance: wm.Appearance) -> bool:
+        """The shape's model takes ``appearance`` (its per-shape entries; the loaded model kept for a
+        reset); False when it is the same as now (nothing to redraw)."""
         model = self._parts[shape][2]
-        if appearance == model.appearance:      # the same values again: nothing to redraw
-            return
+        if appearance == model.appearance:
+            return False
         self._loaded_models.setdefault(shape, model)
         self._use_model(shape, model.model_copy(update={"appearance": appearance}))
-        self._seen_again(shape)
         self.appearance_version += 1
+        return True
 
     def _seen_again(self, shape: int) -> None:
         """The ray engine's flags of a shape as :func:`_entry` makes them from its model now (invisible
@@ -563,32 +569,16 @@ class Scene:
                     given: Mapping[str, tuple[Path, Decoded]] | None = None) -> None:
         """:meth:`set_appearance` with new images (an ImageTexture's url or wrap a Supervisor set, or
         its texture gone): the texture sampler takes them for that shape (``given``: url -> the file
-        and its image as the caller read and checked it, not read again; the caller also checked that
-        the shape's shadow casting stays), so cameras and infra-red sensors see them from the next
-        measurement as if the world file had named them."""
+        and its image as the caller read and checked it, not read again), so every sensor sees them
+        from the next measurement as if the world file had named them -- shadows too: a base image
+        whose pixel format has alpha makes the shape cast none (:meth:`_seen_again`)."""
         if self.textures is None and appearance.texture is not None:     # (no shape textured until now)
             self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
                                            ink_evaporation=self._ink_evaporation, given=self._images)
-        self.set_appearance(shape, appearance)
+        self._take_appearance(shape, appearance)
         if self.textures is not None:
             self.textures.set_shape(shape, appearance, given)
-            self._seen_again(shape)
-
-    def casts_shadow(self, shape: int, appearance: wm.Appearance | None,
-                     given: Mapping[str, tuple[Path, Decoded]] | None = None) -> bool:
-        """Whether the shape would cast shadows with that appearance (fixed in the ray scene when it
-        is built: see :func:`translucent`). Its image is the one ``given`` holds for its url, else the
-        one the shape shows now if it is the shape's appearance now, else read."""
-        if not self._parts[shape][2].cast_shadows:
-            return False
-        if appearance is not None and appearance.transparency <= 0.0 and appearance.texture is not None:
-            t = appearance.texture
-            if given is not None and t.url in given:
-                return not given[t.url][1][2]
-            held = self.textures.shapes.get(shape) if self.textures is not None else None
-            if held is not None and appearance is self._parts[shape][2].appearance:
-                return not held.base.translucent
-        return not translucent(appearance, self._base_dir, self._images)
+        self._seen_again(shape)
 
     def _use_model(self, shape: int, model: wm.Shape | wm.Solid) -> None:
         key, local, _ = self._parts[shape]
