@@ -79,7 +79,7 @@ class LoadedWorld:
     asset_files: frozenset[Path] = frozenset()          # files outside base_dir it may read (PROTO assets)
     timings: dict[str, float] = field(default_factory=dict)   # wall seconds per loading stage (sensorium bench)
     # its texture images as the check read them, each file once (url -> file, image): the scene shows these
-    textures: Mapping[str, tuple[Path, Any]] = field(default_factory=dict)
+    textures: Mapping[str, tuple[Path, Any]] = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def report(self) -> LoadReport:
