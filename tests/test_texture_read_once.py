@@ -93,3 +93,77 @@ def test_each_texture_file_is_read_once_and_the_checked_image_is_the_one_seen(tm
     assert set(loaded.textures) == {"wall.png", "./wall.png", "leaf.png"}
     assert loaded.textures["wall.png"][1] is loaded.textures["./wall.png"][1]          # one image per file
 
+
+
+WBT = """#VRML_SIM R2023b utf8
+WorldInfo {
+  basicTimeStep 16
+}
+DirectionalLight {
+  direction 1 0 0
+  intensity 0
+  ambientIntensity 0.5
+}
+Solid {
+  translation 1 0 0
+  name "wall"
+  children [
+    Shape {
+      appearance Appearance {
+        texture ImageTexture {
+          url [
+            "wall.png"
+          ]
+        }
+      }
+      geometry Box {
+        size 0.1 1 1
+      }
+    }
+  ]
+}
+Robot {
+  name "r"
+  controller "<extern>"
+  children [
+    Camera {
+      name "cam"
+      width 8
+      height 8
+      fieldOfView 0.6
+    }
+    DistanceSensor {
+      name "ir"
+      type "infra-red"
+      lookupTable [ 0 0 0, 10 1000 0 ]
+    }
+  ]
+}
+"""
+
+
+def test_a_wbt_worlds_textures_too(tmp_path, monkeypatch):
+    folders = {name: tmp_path / name for name in ("original", "world")}
+    for folder in folders.values():
+        folder.mkdir()
+        (folder / "world.wbt").write_text(WBT)
+        _images(folder, replaced=False)
+    original = _readings(load_world(folders["original"] / "world.wbt"))
+    reads: Counter[str] = Counter()
+    read, check = textures.read_texture_file, textures.check_textures
+
+    def counted(file, url, max_bytes):
+        reads[Path(file).name] += 1
+        return read(file, url, max_bytes)
+
+    def check_then_replace(*args, **kwargs):
+        problems = check(*args, **kwargs)
+        _images(folders["world"], replaced=True)
+        return problems
+
+    monkeypatch.setattr(textures, "read_texture_file", counted)
+    monkeypatch.setattr(textures, "check_textures", check_then_replace)
+    got = _readings(load_world(folders["world"] / "world.wbt"))
+    assert dict(reads) == {"wall.png": 1}
+    assert np.array_equal(got[0], original[0]) and got[1] == original[1]
+    assert not np.array_equal(got[0], _readings(load_world(folders["world"] / "world.wbt"))[0])   # now replaced
