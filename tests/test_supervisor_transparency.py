@@ -1,8 +1,8 @@
 """A Supervisor's ``transparency`` set across 0 and 1 (opaque ↔ translucent ↔ invisible): from the
 next step every sensor reads the shape exactly as a world file written with that value -- cameras
 (shadows included), range finders, lidars, infra-red, sonar and laser distance sensors, a light sensor
-behind it -- for a static solid's shape and for a robot's own shape (a moving body, seen by its own
-infra-red sensor and lidar); ``USE``d appearances follow; a reset brings the loaded value back; hiding
+behind it, a camera's recognition and segmentation -- for a static solid's shape and for a robot's
+own shape (a moving body, seen by its own infra-red sensor and lidar); ``USE``d appearances follow; a reset brings the loaded value back; hiding
 and showing a shape again and again keeps the engine's tables bounded. A texture url whose image's
 pixel format has alpha (or no longer has it) changes the shape's shadows the same way."""
 
@@ -17,6 +17,7 @@ from sensorium.server.sim.simulation import Simulation
 
 TABLE = [[0.0, 0.0, 0.0], [10.0, 1000.0, 0.0]]
 DEVICES = ("cam", "rf", "lidar", "ir", "sonar", "laser", "ls")
+READINGS = (*DEVICES, "objects", "segmentation")       # and the camera's recognition
 CHAIN = (0.0, 0.5, 1.0, 0.0, 1.0, 0.5, 0.0)      # every ordered crossing of 0 and 1 once: 0→½→1→0→1→½→0
 BLUE = [0.3, 0.6, 0.9]
 
@@ -35,8 +36,10 @@ def world(transparency: float, target: str) -> wm.World:
                     "cast_shadows": True}],
         "solids": [{"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
                     "appearance": {"base_color": [0.8, 0.5, 0.2]}},
-                   {"name": "block", "pose": {"translation": [1.0, 0.0, 0.0]},
-                    "geometry": {"type": "box", "size": [0.1, 0.4, 0.4]}, "appearance": app("block")}],
+                   {"name": "block", "pose": {"translation": [1.0, 0.0, 0.0]}, "recognition_colors": [[1, 0, 0]],
+                    "geometry": {"type": "box", "size": [0.1, 0.4, 0.4]}, "appearance": app("block")},
+                   {"name": "ball", "pose": {"translation": [1.8, 0.1, 0.0]}, "recognition_colors": [[0, 1, 0]],
+                    "geometry": {"type": "sphere", "radius": 0.05}}],
         "robots": [{"name": "r", "supervisor": True,
                     "shapes": [{"name": "visor", "pose": {"translation": [0.5, 0.1, 0.0]},
                                 "geometry": {"type": "box", "size": [0.02, 0.2, 0.3]}, "appearance": app("visor")},
@@ -45,7 +48,8 @@ def world(transparency: float, target: str) -> wm.World:
                                *({"name": f"{d}_housing", "of_device": d, "pose": {"translation": [-0.05, 0.0, 0.0]},
                                   "geometry": {"type": "box", "size": [0.02, 0.02, 0.02]}} for d in ("cam", "rf", "lidar"))],
                     "devices": [
-                        {"device": "Camera", "name": "cam", "width": 21, "height": 21, "field_of_view": 1.0},
+                        {"device": "Camera", "name": "cam", "width": 21, "height": 21, "field_of_view": 1.0,
+                         "recognition": {"occlusion": 1, "segmentation": True}},
                         {"device": "RangeFinder", "name": "rf", "width": 11, "height": 11, "field_of_view": 1.0,
                          "max_range": 10},
                         {"device": "Lidar", "name": "lidar", "horizontal_resolution": 32, "field_of_view": 1.0,
@@ -63,18 +67,22 @@ def _sim(w: wm.World, precision: str) -> Simulation:
     sim = Simulation(w, precision=precision)
     for d in DEVICES:
         sim.device(f"r/{d}").enable(16)
+    sim.device("r/cam").recognition_enable(16)
+    sim.device("r/cam").enable_segmentation(True)
     return sim
 
 
 def readings(sim: Simulation) -> dict[str, object]:
     dev = {d: sim.device(f"r/{d}") for d in DEVICES}
     return {"cam": dev["cam"].image.copy(), "rf": dev["rf"].range_image.copy(), "lidar": dev["lidar"].range_image.copy(),
-            **{d: float(dev[d].value) for d in ("ir", "sonar", "laser", "ls")}}
+            **{d: float(dev[d].value) for d in ("ir", "sonar", "laser", "ls")},
+            "objects": repr(dev["cam"].objects), "segmentation": dev["cam"].segmentation_image.copy()}
 
 
 def same(a: dict, b: dict) -> list[str]:
     """The devices whose readings differ (NaN equal to NaN; arrays bit for bit)."""
-    return [d for d in DEVICES if not np.array_equal(np.asarray(a[d]), np.asarray(b[d]), equal_nan=True)]
+    return [d for d in READINGS if not (a[d] == b[d] if isinstance(a[d], str) else
+                                        np.array_equal(np.asarray(a[d]), np.asarray(b[d]), equal_nan=True))]
 
 
 def _appearance(sim: Simulation, target: str):
@@ -105,7 +113,8 @@ def test_each_crossing_reads_as_the_world_file_with_that_transparency(target: st
     # the three worlds are told apart by these sensors (else the comparison above proves nothing):
     # hidden, the shape is no longer seen by visual rays; translucent, it casts no shadow
     opaque, clear, hidden = refs[0.0], refs[0.5], refs[1.0]
-    seen_by_visual_rays = {"cam", "rf", "lidar", "ir"} | ({"laser"} if target == "block" else set())
+    seen_by_visual_rays = {"cam", "rf", "lidar", "ir", "segmentation"} | (
+        {"laser", "objects"} if target == "block" else set())     # (hidden, the block no longer hides the ball)
     assert seen_by_visual_rays <= set(same(opaque, hidden))      # (a laser skips its own robot, as Webots' rays)
     assert "cam" in same(opaque, clear) and "ir" in same(opaque, clear)      # shadow and blending; red·(1 − t)
     assert opaque["rf"].tolist() == clear["rf"].tolist()                      # seen as opaque by depth rays
@@ -139,7 +148,7 @@ def test_hiding_and_showing_again_and_again_keeps_the_tables_bounded():
             sim.run(1)
         counts.append((engine.held_tiers, engine.shape_count, len(sim.scene.shapes), len(sim.scene.transparency)))
     assert counts[-1] == counts[1] and len(set(counts[1:])) == 1, counts[:3]
-    assert engine.shape_count == 6 and engine.seen_version == 40 * 3 * 2
+    assert engine.shape_count == 7 and engine.seen_version == 40 * 3 * 2
 
 
 USE_WORLD = """#VRML_SIM R2023b utf8
