@@ -95,6 +95,35 @@ def test_each_texture_file_is_read_once_and_the_checked_image_is_the_one_seen(tm
 
 
 
+def _batched_readings(loaded) -> tuple[np.ndarray, np.ndarray]:
+    from sensorium.server.sim.batched import BatchedSimulation
+
+    b = BatchedSimulation(loaded, 2)
+    cam, ir = b.device("r", "cam"), b.device("r", "ir")
+    b.enable(cam, 16)
+    b.enable(ir, 16)
+    b.step()
+    return b.image(cam).copy(), b.value(ir).copy()
+
+
+def test_the_batched_simulation_shows_the_checked_images_too(tmp_path, monkeypatch):
+    """Training's batched copies (and the gym's worker processes, which get the loaded world) take the
+    images the check read, as the single simulation does: no file is read again by its path."""
+    folder = _folder(tmp_path, "world", replaced=False)
+    single = _readings(load_world(_folder(tmp_path, "original", replaced=False) / "world.yaml"))
+    loaded = load_world(folder / "world.yaml")
+    _images(folder, replaced=True)                 # the files change after the world loaded
+
+    def by_path(*args, **kwargs):
+        raise AssertionError(f"a texture file read again by its path: {args}")
+
+    monkeypatch.setattr(textures, "_decoded", by_path)
+    image, ir = _batched_readings(loaded)
+    assert all(np.array_equal(image[c], single[0]) for c in range(2))
+    assert ir.tolist() == [single[1]] * 2
+
+
+
 WBT = """#VRML_SIM R2023b utf8
 WorldInfo {
   basicTimeStep 16

@@ -215,7 +215,7 @@ class BatchedSimulation:
         self.to_enu: np.ndarray | None = _TO_ENU[up]
         base = world.base_dir
         # -- what never moves, once: the solids' scene (static tier, planes), the lights
-        self.scene = Scene(w.model_copy(update={"robots": []}), base, precision)
+        self.scene = Scene(w.model_copy(update={"robots": []}), base, precision, images=dict(world.textures))
         self.lights = lights_from_models(self.scene.sensor_lights())
         # lights carried by robots: each copy's at its robots' poses (batched_lights.py); None without any
         self.carried = (CarriedLights(w, self.scene.world_lights(), C) if any(has_carried_lights(r) for r in w.robots)

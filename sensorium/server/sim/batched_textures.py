@@ -47,7 +47,7 @@ class RobotTextures:
         models = [(shape.geometry, shape.appearance) for _, _, shape in parts]
         if scene.textures is None:
             statics = [(m.geometry, m.appearance) for m in (scene.part(i)[2] for i in range(self.n_static))]
-            scene.textures = TextureSampler(statics + models, scene.base_dir)
+            scene.textures = TextureSampler(statics + models, scene.base_dir, given=scene.images)
         else:
             scene.textures.extend(models)
         self.sampler: TextureSampler = scene.textures

@@ -410,7 +410,7 @@ class Scene:
         """``images``: the world's images as its check read them (``LoadedWorld.textures``): shown
         as they are, their files not read again."""
         self.engine = RayEngine(Precision(precision))
-        self._images: Checked = images or {}
+        self.images: Checked = images or {}
         self.shapes: list[ShapeInfo] = []
         self.solid_names = [s.name for s in world.solids]
         self.solid_name_set = set(self.solid_names)     # (every name the world has had: never reused)
@@ -489,7 +489,7 @@ class Scene:
         self._base_dir = base_dir
         self._ink_evaporation = world.world_info.ink_evaporation
         sampler = TextureSampler([(shape.geometry, shape.appearance) for _, _, shape in self._parts], base_dir,
-                                 ink_evaporation=self._ink_evaporation, given=self._images)
+                                 ink_evaporation=self._ink_evaporation, given=self.images)
         self.textures: TextureSampler | None = sampler if sampler else None   # made on a first pen stroke
         self._inverse: dict[int, tuple[Pose, Pose]] = {}     # shape -> (owner pose, world-to-shape pose)
         # a Supervisor's appearance changes: shape -> its model as loaded, and the field values it set
@@ -559,7 +559,7 @@ class Scene:
         a = model.appearance
         held = self.textures.shapes.get(shape) if self.textures is not None else None
         if a is None or a.transparency > 0.0 or a.texture is None or held is None:
-            lucent = translucent(a, self._base_dir, self._images)
+            lucent = translucent(a, self._base_dir, self.images)
         else:
             lucent = held.base.translucent
         self.engine.set_shape_seen(shape, transparent=a is not None and a.transparency >= 1.0,
@@ -574,7 +574,7 @@ class Scene:
         whose pixel format has alpha makes the shape cast none (:meth:`_seen_again`)."""
         if self.textures is None and appearance.texture is not None:     # (no shape textured until now)
             self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
-                                           ink_evaporation=self._ink_evaporation, given=self._images)
+                                           ink_evaporation=self._ink_evaporation, given=self.images)
         self._take_appearance(shape, appearance)
         if self.textures is not None:
             self.textures.set_shape(shape, appearance, given)
@@ -619,7 +619,7 @@ class Scene:
     def _add_body(self, parts: list, base_dir: Path, pose: Pose, owner: int, movable: bool,
                   key: str | int | None = None, entries: list[ShapeEntry] | None = None) -> int:
         if entries is None:
-            entries = [_entry(shape, base_dir, local, self._images) for _, local, shape in parts]
+            entries = [_entry(shape, base_dir, local, self.images) for _, local, shape in parts]
         self._parts += [(key, local, shape) for _, local, shape in parts]
         triangles = sum(geo.triangle_count(e.primitive) for e in entries)
         self.triangle_count += triangles
@@ -738,7 +738,7 @@ class Scene:
         """A top-level solid's parts (``solid_parts``) and their ray-engine entries, built before
         anything changes (a mesh that cannot be read raises here, the scene untouched)."""
         parts = list(solid_parts(solid, Pose.identity()))
-        return parts, [_entry(shape, self._base_dir, local, self._images) for _, local, shape in parts]
+        return parts, [_entry(shape, self._base_dir, local, self.images) for _, local, shape in parts]
 
     def solid_triangles(self, name: str) -> int:
         """The triangles of top-level solid ``name``'s body (0 for a removed one)."""
@@ -773,7 +773,7 @@ class Scene:
                 self.textures.extend(models)
             elif any(a is not None and a.texture is not None for _, a in models):
                 self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
-                                               ink_evaporation=self._ink_evaporation, given=self._images)
+                                               ink_evaporation=self._ink_evaporation, given=self.images)
             self.shapes_version += 1
         carried = [(lt, name, f) for lt, f in solid_lights(solid, Pose.identity())]
         if carried:
@@ -879,7 +879,7 @@ class Scene:
         shape's ink layer (textures.InkLayer), made on the first stroke; returns the texels inked."""
         if self.textures is None:
             self.textures = TextureSampler([(shape_.geometry, shape_.appearance) for _, _, shape_ in self._parts],
-                                           self._base_dir, ink_evaporation=self._ink_evaporation, given=self._images)
+                                           self._base_dir, ink_evaporation=self._ink_evaporation, given=self.images)
         inv = self._world_to_shape(shape)
         return self.textures.paint(shape, inv.apply(np.asarray(origin, dtype=np.float64)),
                                    inv.apply_dirs(np.asarray(direction, dtype=np.float64)), float(distance),
