@@ -450,3 +450,28 @@ def test_pettingzoo_omni_and_off_centre_robots_are_agents_and_both_engines_agree
         ob, rb, tb, ub, _ = b.step(acts)
         assert (ra, ta, ua) == (rb, tb, ub)
     assert not a.agents
+
+
+@pytest.mark.slow           # starts worker processes
+def test_the_workers_env_carries_omni_wheel_actions_bit_for_bit():
+    """SensoriumWorkersEnv (two processes) shares (n, 3) actions: sub-env i equals the one-process
+    vector env's, autoresets included."""
+    from sensorium.gym.vector import SensoriumVectorEnv
+    from sensorium.gym.workers import SensoriumWorkersEnv
+    from tests.test_gym_workers import _same
+
+    w, n = world(True), 3
+    ref = SensoriumVectorEnv(w, agent_task(max_steps=5), n)
+    envs = SensoriumWorkersEnv(w, agent_task(max_steps=5), n, workers=2)
+    try:
+        assert envs.action_space == ref.action_space and envs.single_action_space.shape == (3,)
+        _same(envs.reset(seed=2), ref.reset(seed=2), "reset")
+        rng = np.random.default_rng(1)
+        for t in range(12):
+            a = rng.uniform(-1, 1, (n, 3)).astype(np.float32)
+            _same(envs.step(a), ref.step(a), f"step {t}")
+        with pytest.raises(ValueError, match=r"^actions must have shape \(3, 3\)"):
+            envs.step(np.zeros((n, 2), dtype=np.float32))
+    finally:
+        ref.close()
+        envs.close()

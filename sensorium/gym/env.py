@@ -223,8 +223,8 @@ class Agent:
 
     def commands(self, action) -> np.ndarray:
         """An action -> float64 (2,): (left, right) wheel velocities (rad/s), or a car's (steering
-        angle (rad, positive left), driven wheels' velocity (rad/s)); a mecanum robot's (4,) wheel
-        velocities (rad/s, the drive's order); clamped later by the motors."""
+        angle (rad, positive left), driven wheels' velocity (rad/s)); a mecanum robot's (4,) or an
+        omni-wheel robot's (n,) wheel velocities (rad/s, the drive's order); clamped later by the motors."""
         a = np.asarray(action, dtype=np.float64).reshape(-1)
         if a.shape != (self.n_actions,) or not np.all(np.isfinite(a)):
             what = ("values in [-1, 1]" if self.actions == "normalized"
