@@ -279,7 +279,7 @@ def test_bad_actions_are_refused_in_one_line(bad):
 
 def test_a_world_without_a_drive_has_no_agent():
     w = parse_world({"robots": [{"name": "pole"}]})
-    with pytest.raises(ValueError, match="no robot with a differential_drive, an ackermann_drive or a mecanum_drive to act as the agent"):
+    with pytest.raises(ValueError, match="no robot with a differential_drive, an ackermann_drive, a mecanum_drive or an omni_drive to act as the agent"):
         SensoriumEnv(w)
 
 

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import WorldError, load_world, parse_world
 
@@ -322,11 +322,23 @@ def test_world_file_checks_name_the_field(tmp_path: Path) -> None:
         parse_world({"robots": [{**robot, "differential_drive": {}}]})
 
 
-def test_the_batched_simulation_refuses_it_in_one_line(tmp_path: Path) -> None:
+def test_the_batched_simulation_drives_it_as_the_single_one(tmp_path: Path) -> None:
+    """The batched simulation refused an omni-wheel robot; now each copy of the imported three-wheeler
+    (its own twist) ends where its Simulation does, the same bits (tests/test_batched_omni.py has
+    the closed forms, contact and the gym)."""
     world = load_world(three_wheeler(tmp_path)).world
-    with pytest.raises(BatchedError, match=r"robot 'omni': an omni-wheel robot \(omni_drive\).*use Simulation") as e:
-        BatchedSimulation(world, 2)
-    assert "\n" not in str(e.value)
+    twists = [(0.2, 0.0, 0.0), (0.0, -0.1, 1.5), (0.05, 0.1, -2.0)]
+    batched = BatchedSimulation(world, len(twists))
+    batched.omni.command(0, [[three_speeds(*t)[f"wheel{i + 1}"] for i in range(3)] for t in twists])
+    batched.run(60)
+    for c, t in enumerate(twists):
+        sim = Simulation(world)
+        spin(sim, three_speeds(*t))
+        sim.run(60)
+        pose = sim.robot("omni").pose
+        assert pose.translation.tobytes() == batched.pos[c, 0].tobytes(), c
+        assert pose.rotation.tobytes() == batched.rot[c, 0].tobytes(), c
+    assert batched.pos[0, 0, :2] == pytest.approx([0.2 * 60 * DT, 0.0], abs=1e-12)
 
 
 # ---------------------------------------------------------------- helpers

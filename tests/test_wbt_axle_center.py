@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.sim.summary import drive_line
 from sensorium.server.world.loader import load_world
@@ -109,14 +109,28 @@ def test_a_skid_steer_robot_off_its_origin_drives_too(tmp_path: Path) -> None:
     assert pose.translation[:2] == pytest.approx([0.03 - 0.03 * math.cos(theta), -0.03 * math.sin(theta)], abs=1e-12)
 
 
-def test_a_centred_drive_leaves_the_field_out_and_the_batched_simulation_refuses_an_offset_one(tmp_path: Path) -> None:
+def test_a_centred_drive_leaves_the_field_out_and_the_batched_simulation_drives_an_offset_one(tmp_path: Path) -> None:
+    """The batched simulation refused an offset drive; now each copy (its own wheel speeds: a turn in
+    place, an arc, a straight line) ends where its Simulation does, the same bits
+    (tests/test_batched_omni.py has the closed forms and contact)."""
     centred = load_world(write(tmp_path, wheel("left wheel motor", 0, 0.05) + wheel("right wheel motor", 0, -0.05)))
     assert centred.world.robots[0].differential_drive.axle_center == (0.0, 0.0)
     assert "axle_center" not in centred.world.robots[0].differential_drive.model_dump(exclude_defaults=True)
-    offset = load_world(write(tmp_path, two_wheels())).world
-    with pytest.raises(BatchedError, match=r"robot 'bot': its wheels' centre is not under its origin "
-                                           r"\(differential_drive.axle_center\)"):
-        BatchedSimulation(offset, 2)
+    offset = load_world(write(tmp_path, two_wheels(), "translation 0.2 -0.1 0 rotation 0 0 1 0.4"))
+    plans = [(-3.0, 3.0), (2.0, 5.0), (4.0, 4.0)]
+    batched = BatchedSimulation(offset.world, len(plans))
+    batched.set_wheels(0, [p[0] for p in plans], [p[1] for p in plans])
+    batched.run(80)
+    for c, (wl, wr) in enumerate(plans):
+        sim = Simulation(offset)
+        drive(sim, {"left wheel motor": wl, "right wheel motor": wr}, 0.8)
+        pose = sim.robot("bot").pose
+        assert pose.translation.tobytes() == batched.pos[c, 0].tobytes(), c
+        assert pose.rotation.tobytes() == batched.rot[c, 0].tobytes(), c
+    # the turn in place kept the wheels' centre: the origin moved about it
+    centre = batched.pos[0, 0, :2] + batched.rot[0, 0, :2, :2] @ [CX, CY]
+    start = np.array([0.2, -0.1]) + np.array([[math.cos(0.4), -math.sin(0.4)], [math.sin(0.4), math.cos(0.4)]]) @ [CX, CY]
+    assert centre == pytest.approx(start, abs=1e-12)
 
 
 def test_the_world_format_takes_an_axle_center() -> None:

@@ -44,7 +44,10 @@ A mecanum robot (``mecanum_drive``, a youBot's base) acts with float32 ``(4,)`` 
 velocities in the drive's order (front left, front right, rear left, rear right): normalised, each in
 ``[-1, 1]`` times ``max_wheel_speed``; ``actions="wheel"``: rad/s, bounded by it. All four at +1 drive
 forward, and with the default (youBot) rollers (-1, +1, +1, -1) strafes left and (-1, +1, -1, +1)
-turns left on the spot (README "mecanum"); the body twist is the wheels' least-squares fit.
+turns left on the spot (README "mecanum"); the body twist is the wheels' least-squares fit. An
+omni-wheel robot (``omni_drive``, three or more omni wheels) acts alike with one velocity per wheel,
+float32 ``(n,)`` in the drive's ``wheels`` order: all at +1 turn it in place (clockwise for wheels
+whose axes point out from its centre).
 
 ``reset(seed=s)`` restarts the world with a world seed drawn from the environment's generator
 seeded with ``s``: every device noise stream, the start pose drawn by ``Task.start`` and the clock
@@ -116,15 +119,15 @@ class Agent:
         if name is None:
             driven = [r.name for r in w.robots if has_drive(r)]
             if not driven:
-                raise ValueError(f"{loaded.source}: no robot with a differential_drive, an ackermann_drive or a "
-                                 "mecanum_drive to act as the agent")
+                raise ValueError(f"{loaded.source}: no robot with a differential_drive, an ackermann_drive, a "
+                                 "mecanum_drive or an omni_drive to act as the agent")
             name = driven[0]
         if name not in robots:
             raise ValueError(f"{loaded.source}: task robot {name!r} not in the world (robots: {', '.join(robots)})")
         model = robots[name]
         if not has_drive(model):
-            raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive, ackermann_drive or "
-                             "mecanum_drive to act with")
+            raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive, ackermann_drive, "
+                             "mecanum_drive or omni_drive to act with")
         self.robot = name
         ctrl = basic if task.control_period_ms is None else task.control_period_ms
         if not whole(ctrl) or ctrl <= 0 or ctrl % basic:
@@ -165,13 +168,19 @@ class Agent:
         self.flatten = bool(flatten)
         self.observation_space: spaces.Space = (spaces.flatten_space(self.dict_space) if self.flatten
                                                 else self.dict_space)
-        # a car-like robot acts with (steering, speed), a mecanum one with its four wheels: see :meth:`commands`
+        # a car-like robot acts with (steering, speed), a mecanum or omni-wheel one with its wheels: see
+        # :meth:`commands`
         self.car: wm.AckermannDrive | None = model.ackermann_drive
         self.mecanum: wm.MecanumDrive | None = model.mecanum_drive
-        self.n_actions = 4 if self.mecanum is not None else 2
-        """The action's length: 2 (left, right or steering, speed), 4 for a mecanum robot's wheels."""
+        self.omni: wm.OmniDrive | None = model.omni_drive
+        holonomic = self.mecanum or self.omni
+        self.wheel_motors: list[str] | None = (None if holonomic is None
+                                               else [name for _, name in holonomic.motor_fields])
+        """A mecanum or omni-wheel robot's wheel motors, in the order of its action; None for the others."""
+        self.n_actions = 2 if self.wheel_motors is None else len(self.wheel_motors)
+        """The action's length: 2 (left, right or steering, speed), a mecanum or omni-wheel robot's wheels."""
         if self.car is None:
-            drive = model.differential_drive if self.mecanum is None else self.mecanum
+            drive = model.differential_drive or holonomic
             assert drive is not None
             self.vmax = vmax = float(drive.max_wheel_speed)
             raw = spaces.Box(-vmax, vmax, shape=(self.n_actions,), dtype=np.float32)
@@ -189,9 +198,9 @@ class Agent:
         if self.task.start is not None:
             self.task.start(sim, robot, rng)
         # (a car's steering motors stay as built: position control at 0, at max_steering_speed)
-        wheels = (robot.motors.values() if self.car is None and self.mecanum is None
-                  else [robot.motors[n] for _, n in (self.car.driven if self.car is not None
-                                                     else self.mecanum.motor_fields)])
+        wheels = (robot.motors.values() if self.car is None and self.wheel_motors is None
+                  else [robot.motors[n] for n in ([n for _, n in self.car.driven] if self.car is not None
+                                                  else self.wheel_motors or [])])
         for m in wheels:
             m.set_position(math.inf)
             m.set_velocity(0.0)
@@ -214,14 +223,15 @@ class Agent:
 
     def commands(self, action) -> np.ndarray:
         """An action -> float64 (2,): (left, right) wheel velocities (rad/s), or a car's (steering
-        angle (rad, positive left), driven wheels' velocity (rad/s)); a mecanum robot's (4,) wheel
-        velocities (rad/s, the drive's order); clamped later by the motors."""
+        angle (rad, positive left), driven wheels' velocity (rad/s)); a mecanum robot's (4,) or an
+        omni-wheel robot's (n,) wheel velocities (rad/s, the drive's order); clamped later by the motors."""
         a = np.asarray(action, dtype=np.float64).reshape(-1)
         if a.shape != (self.n_actions,) or not np.all(np.isfinite(a)):
             what = ("values in [-1, 1]" if self.actions == "normalized"
                     else "wheel velocities" if self.car is None else "values (rad, rad/s)")
             names = ("steering, speed" if self.car is not None
                      else "front left, front right, rear left, rear right" if self.mecanum is not None
+                     else ", ".join(self.wheel_motors) if self.wheel_motors is not None
                      else "left, right")
             # (the values as a list: an array's repr would break the line)
             raise ValueError(f"{self.robot}: action must be {self.n_actions} finite {what} ({names}), "
@@ -262,8 +272,8 @@ class Agent:
             for _, name in self.car.driven:
                 robot.motors[name].set_velocity(float(v[1]))
             return
-        if self.mecanum is not None:
-            for (_, name), u in zip(self.mecanum.motor_fields, v.tolist()):
+        if self.wheel_motors is not None:
+            for name, u in zip(self.wheel_motors, v.tolist()):
                 robot.motors[name].set_velocity(u)
             return
         drive = robot.drive
@@ -309,9 +319,10 @@ class Agent:
 
 
 def has_drive(model: wm.Robot) -> bool:
-    """Whether a robot can act as an agent: it has a two-wheel (or skid-steer), car-like or mecanum drive."""
+    """Whether a robot can act as an agent: it has a two-wheel (or skid-steer), car-like, mecanum or
+    omni-wheel drive."""
     return (model.differential_drive is not None or model.ackermann_drive is not None
-            or model.mecanum_drive is not None)
+            or model.mecanum_drive is not None or model.omni_drive is not None)
 
 
 OBSERVABLE = ("LightSensor", "DistanceSensor", "Lidar", "PositionSensor", "GPS", "Compass", "InertialUnit",

@@ -5,8 +5,8 @@
     obs, infos = env.reset(seed=0)
     obs, rewards, terms, truncs, infos = env.step({a: env.action_space(a).sample() for a in env.agents})
 
-Every agent is a robot with a differential drive, a car-like robot (an ackermann drive) or a mecanum
-robot (four wheel speeds) and its own :class:`~sensorium.gym.task.Task`
+Every agent is a robot with a differential drive, a car-like robot (an ackermann drive), a mecanum
+robot (four wheel speeds) or an omni-wheel robot (a speed per wheel) and its own :class:`~sensorium.gym.task.Task`
 (spaces as in :class:`~sensorium.gym.env.SensoriumEnv`); all act every control period, which must
 be the same for all. An agent that terminates or truncates leaves ``agents`` and its robot stops;
 the world keeps running for the others. Resets are exact as in the single-agent environment.
@@ -50,8 +50,8 @@ class SensoriumParallelEnv(TopDownRendering, ParallelEnv):
         if tasks is None:
             tasks = {r.name: Task(robot=r.name) for r in self.loaded.world.robots if has_drive(r)}
         if not tasks:
-            raise ValueError(f"{self.loaded.source}: no robot with a differential_drive, an ackermann_drive or a "
-                             "mecanum_drive to act as an agent")
+            raise ValueError(f"{self.loaded.source}: no robot with a differential_drive, an ackermann_drive, a "
+                             "mecanum_drive or an omni_drive to act as an agent")
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']} or None, got {render_mode!r}")
         self.render_mode = render_mode

@@ -267,7 +267,7 @@ class _ReachLightCopies(VectorGoal):
 
 
 _NO_WHEEL_PAIR = ("AvoidObstacles' reward reads a left and a right wheel speed: robot {!r} has no differential_drive "
-                  "(a car-like or mecanum robot: write a reward for it; AvoidObstacles().terminated works)")
+                  "(a car-like, mecanum or omni-wheel robot: write a reward for it; AvoidObstacles().terminated works)")
 
 
 class AvoidObstacles:

@@ -25,7 +25,7 @@ rewards and flags (tests compare them step by step, resets included).
 * ``sub_env(i)``: sub-environment *i* as a plain ``gymnasium.Env`` (reset and step it alone; for
   checkers and tests).
 * Options as ``SensoriumEnv``: ``actions`` (``"normalized"``: [-1, 1], the default; ``"wheel"``:
-  rad/s; a car-like agent's (steering, speed), a mecanum agent's four wheels as there), ``flatten`` (one Box), ``precision``; a task's reward and termination use their
+  rad/s; a car-like agent's (steering, speed), a mecanum or omni-wheel agent's wheels as there), ``flatten`` (one Box), ``precision``; a task's reward and termination use their
   vectorised form when they have one (``ReachLight``, ``AvoidObstacles``, :mod:`.task`), else
   they are called per copy with views of that copy.
 * ``threads``: the threads a cast of >= 16,384 rays (all copies' lidar beams) may be split over
@@ -52,6 +52,7 @@ from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.raycast import packets
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_observable
+from sensorium.server.sim.batched_holonomic import HolonomicDrives
 from sensorium.server.world.loader import LoadedWorld
 
 __all__ = ["SensoriumVectorEnv", "SubEnv"]
@@ -222,9 +223,8 @@ class SensoriumVectorEnv(VectorEnv):
             for c in copies.tolist():
                 view = self._view(c)
                 self.task.start(view, view.robot(self.agent.robot), self._rngs[c])
-        if self.agent.mecanum is not None:      # a mecanum robot: its four wheels at rest in velocity control
-            assert self.sim.mecanum is not None
-            self.sim.mecanum.command(self.slot, np.zeros((len(copies), 4)), copies)
+        if self.agent.wheel_motors is not None:      # a mecanum or omni-wheel robot: its wheels at rest, velocity control
+            self._wheels().command(self.slot, np.zeros((len(copies), self.agent.n_actions)), copies)
         elif self.agent.car is None:
             self.sim.set_wheels(self.slot, np.zeros(len(copies)), np.zeros(len(copies)), copies)
         else:       # a car: its driven wheels at rest in velocity control (its steering as built)
@@ -248,6 +248,12 @@ class SensoriumVectorEnv(VectorEnv):
             active = (stepping & (k < spa)) | (resetting & (k < warm))
             self.sim.step(active)
 
+    def _wheels(self) -> HolonomicDrives:
+        """The batched wheels of a mecanum or omni-wheel agent."""
+        drives = self.sim.mecanum if self.agent.mecanum is not None else self.sim.omni
+        assert drives is not None
+        return drives
+
     def _act(self, copies: np.ndarray, actions: np.ndarray) -> None:
         width = self.agent.n_actions
         a = np.asarray(actions, dtype=np.float64).reshape(len(copies), width)
@@ -257,9 +263,8 @@ class SensoriumVectorEnv(VectorEnv):
         cmd = self.agent.scaled(a)          # (the single env's commands, row by row)
         # (every copy in order: the simulation's own default, a slice rather than a gather)
         which = None if copies is self._every else copies
-        if self.agent.mecanum is not None:     # a mecanum robot: its four wheels (the drive's order)
-            assert self.sim.mecanum is not None
-            self.sim.mecanum.command(self.slot, cmd, which)
+        if self.agent.wheel_motors is not None:     # a mecanum or omni-wheel robot: its wheels (the drive's order)
+            self._wheels().command(self.slot, cmd, which)
         elif self.agent.car is None:
             self.sim.set_wheels(self.slot, cmd[:, 0], cmd[:, 1], which)
         elif len(copies):       # a car: its steering motors to the Ackermann angles, its driven wheels to the speed

@@ -19,8 +19,8 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   ``.objects``) and ``.segmentation_image``: this copy's, batched_recognition.py).
   The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
   side share one state, so commanding one of them commands its side. A car-like robot has
-  ``motors`` (its steering and driven wheels) and no ``drive``; so has a mecanum robot (its four
-  wheels, batched_mecanum.MecanumDrives).
+  ``motors`` (its steering and driven wheels) and no ``drive``; so have a mecanum robot (its four
+  wheels, batched_mecanum.MecanumDrives) and an omni-wheel robot (its wheels, batched_omni.OmniDrives).
 
 Anything else a callable reaches for raises AttributeError naming the view.
 """
@@ -34,6 +34,7 @@ import numpy as np
 
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.batched_holonomic import HolonomicDrives
 from sensorium.server.sim.batched_kinematic import READINGS
 from sensorium.server.sim.batched_lights import copy_world_lights
 from sensorium.server.sim.motion import velocity_accepted
@@ -44,8 +45,8 @@ __all__ = ["CopySim", "CopyRobot"]
 class _Motor:
     """A motor in one copy, over the batched state arrays that hold it (``target``, ``velocity``,
     ``angle`` at ``index``): a wheel of a drive, a car's steering or driven-wheel motor
-    (batched_car.CarDrives; a steering motor's target clamped to +-``limit``), or a mecanum wheel
-    (batched_mecanum.MecanumDrives)."""
+    (batched_car.CarDrives; a steering motor's target clamped to +-``limit``), or a mecanum or omni
+    wheel (batched_holonomic.HolonomicDrives)."""
 
     def __init__(self, name: str, max_velocity: float, arrays: tuple[np.ndarray, np.ndarray, np.ndarray],
                  index: tuple[int, int, int], limit: float = math.inf):
@@ -69,11 +70,9 @@ class _Motor:
                    float(cars.limit[k]) if j < 2 else math.inf)
 
     @classmethod
-    def mecanum(cls, sim: BatchedSimulation, copy: int, slot: int, name: str) -> _Motor:
-        mec = sim.mecanum
-        assert mec is not None
-        k, j = mec.column(slot, name)
-        return cls(name, float(mec.max_velocity[k, j]), (mec.target, mec.velocity, mec.angle), (copy, k, j))
+    def holonomic(cls, drives: HolonomicDrives, copy: int, slot: int, name: str) -> _Motor:
+        k, j = drives.column(slot, name)
+        return cls(name, float(drives.max_velocity[k, j]), (drives.target, drives.velocity, drives.angle), (copy, k, j))
 
     @property
     def velocity(self) -> float:
@@ -176,13 +175,13 @@ class CopyRobot:
         elif sim.cars is not None and slot in sim.cars.car_of:     # a car: its motors (no drive view)
             self.drive = None
             self.motors = {name: _Motor.car(sim, copy, slot, name) for name in sim.cars.columns[sim.cars.car_of[slot]]}
-        elif sim.mecanum is not None and slot in sim.mecanum.of:     # a mecanum robot: its four wheels
-            self.drive = None
-            self.motors = {name: _Motor.mecanum(sim, copy, slot, name)
-                           for name in sim.mecanum.columns[sim.mecanum.of[slot]]}
-        else:
+        else:           # a mecanum or omni-wheel robot: its wheels; any other robot: no motors
             self.drive = None
             self.motors = {}
+            for drives in (sim.mecanum, sim.omni):
+                if drives is not None and slot in drives.of:
+                    self.motors = {name: _Motor.holonomic(drives, copy, slot, name)
+                                   for name in drives.columns[drives.of[slot]]}
 
     @property
     def pose(self):

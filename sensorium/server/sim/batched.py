@@ -33,8 +33,13 @@ and an infra-red sensor or a camera to see its ink is refused. Textured robot bo
 Car-like robots (``ackermann_drive``) are driven by :mod:`~sensorium.server.sim.batched_car`
 (``sim.cars.command``; their encoders read its motors), their moves through the same arc, contact
 and placing as the other robots. Mecanum robots (``mecanum_drive``) are driven by
-:mod:`~sensorium.server.sim.batched_mecanum` (``sim.mecanum.command``, four wheel speeds), their
-moves through the single drive's exact twist step, then the same contact and placing.
+:mod:`~sensorium.server.sim.batched_mecanum` (``sim.mecanum.command``, four wheel speeds) and
+omni-wheel robots (``omni_drive``) by :mod:`~sensorium.server.sim.batched_omni` (``sim.omni.command``,
+a speed per wheel), both on :mod:`~sensorium.server.sim.batched_holonomic`'s wheels, their moves
+through the single drive's exact twist step (:func:`~sensorium.server.sim.batched_holonomic.twist_steps`),
+then the same contact and placing. A two-wheel or skid-steer robot whose wheels' centre is off its
+origin (``differential_drive.axle_center``) moves by the same twist step (its origin's body twist,
+as DifferentialDrive.step), the others by their arcs.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
@@ -65,8 +70,10 @@ from sensorium.server.sim import batched_kinematic as kin
 from sensorium.server.sim import batched_lidar
 from sensorium.server.sim import batched_recognition as recog
 from sensorium.server.sim.batched_car import CarDrives
+from sensorium.server.sim.batched_holonomic import twist_steps
 from sensorium.server.sim.batched_lights import CarriedLights, has_carried_lights
-from sensorium.server.sim.batched_mecanum import MecanumDrives, twist_steps
+from sensorium.server.sim.batched_mecanum import MecanumDrives
+from sensorium.server.sim.batched_omni import OmniDrives
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import (
@@ -81,7 +88,15 @@ from sensorium.server.sim.contact import (
     spin_reach,
 )
 from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, support_ceiling
-from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, MecanumDrive, PlanarState, _rz
+from sensorium.server.sim.motion import (
+    _TO_ENU,
+    AckermannDrive,
+    DifferentialDrive,
+    MecanumDrive,
+    OmniDrive,
+    PlanarState,
+    _rz,
+)
 from sensorium.server.sim.scene import (
     Scene,
     _entry,
@@ -277,6 +292,12 @@ class BatchedSimulation:
             if r.differential_drive else {} for r in w.robots]
         self.side_wheels = np.array([[len(n) for n in r.differential_drive.motor_names] if r.differential_drive
                                      else [1, 1] for r in w.robots], dtype=np.int64)
+        # a two-wheel robot's wheels' centre (axle_center, x forward and y left of its origin): where it
+        # is off the origin the robot moves by its origin's body twist (twist_steps), not the arc
+        self.axle_center = np.array([r.differential_drive.axle_center if r.differential_drive else (0.0, 0.0)
+                                     for r in w.robots], dtype=np.float64).reshape(-1, 2)
+        self.off_centre = (self.axle_center != 0.0).any(axis=1)
+        self._any_off_centre = bool(self.off_centre.any())
         # the terrains robots ride (sim/ground.py; None in a world without one: heights never change)
         self.ground = Ground.from_world(w, self.scene.solid_poses, self.to_enu)
         # each robot's band bottom below its origin (its support ceiling's, ground.band_low; 0 without a ground)
@@ -289,11 +310,18 @@ class BatchedSimulation:
                                 band_low=float(self.band_low[i])) if r.ackermann_drive
             else MecanumDrive(r.mecanum_drive, self.initial[i], up=up, ground=self.ground,
                               band_low=float(self.band_low[i])) if r.mecanum_drive
+            else OmniDrive(r.omni_drive, self.initial[i], up=up, ground=self.ground,
+                           band_low=float(self.band_low[i])) if r.omni_drive
             else None for i, r in enumerate(w.robots)]
         # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
         self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
         # mecanum robots: their four wheels and body twist (batched_mecanum.py), None in a world without one
         self.mecanum = (MecanumDrives(self._templates, C) if any(r.mecanum_drive for r in w.robots) else None)
+        # omni-wheel robots: their wheels and body twist (batched_omni.py), None in a world without one
+        self.omni = OmniDrives(self._templates, C) if any(r.omni_drive for r in w.robots) else None
+        # the drives the C drive pass does not step (it moves two-wheel robots about their origin by arcs)
+        self._numpy_drives = (self.cars is not None or self.mecanum is not None or self.omni is not None
+                              or self._any_off_centre or self.to_enu is not None)
         # -- per copy state
         self.time_ms = np.zeros(C, dtype=np.int64)
         self._every_copy = np.arange(C)             # (step's live copies when every copy steps; never written)
@@ -317,7 +345,8 @@ class BatchedSimulation:
         # -- kinematic contact: the solids' obstacles once, the robots' footprints (and headings) per copy
         use_contact = w.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = None
-        if use_contact and (self.has_drive.any() or self.cars is not None or self.mecanum is not None):
+        if use_contact and (self.has_drive.any() or self.cars is not None or self.mecanum is not None
+                            or self.omni is not None):
             solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
@@ -352,14 +381,6 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
         for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
-            if r.differential_drive is not None and tuple(r.differential_drive.axle_center) != (0.0, 0.0):
-                raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: its wheels' centre is not under its origin "
-                                   "(differential_drive.axle_center); the batched simulation turns two-wheel and "
-                                   "skid-steer robots about their origin only (use Simulation)")
-            if r.omni_drive is not None:
-                raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: an omni-wheel robot (omni_drive); the "
-                                   "batched simulation drives two-wheel, skid-steer, car-like and mecanum robots only "
-                                   "(use Simulation)")
             drive = {m for _, m in r.drive_motors}
             joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]
             if joints:
@@ -610,6 +631,8 @@ class BatchedSimulation:
             self.cars.reset(idx)
         if self.mecanum is not None:
             self.mecanum.reset(idx)
+        if self.omni is not None:
+            self.omni.reset(idx)
         self.pressing[idx] = False
         self.led_value[idx] = 0                 # LEDs off, their lights too (WbLed::reset)
         if self.carried is not None:
@@ -696,6 +719,10 @@ class BatchedSimulation:
         if self.mecanum is not None and slot in self.mecanum.of:
             raise ValueError(f"{self.robot_names[slot]}: a mecanum robot has no left and right wheels: "
                              "command it with mecanum.command(slot, speeds) (copies, 4)")
+        if self.omni is not None and slot in self.omni.of:
+            n = int(self.omni.count[self.omni.of[slot]])
+            raise ValueError(f"{self.robot_names[slot]}: an omni-wheel robot has no left and right wheels: "
+                             f"command it with omni.command(slot, speeds) (copies, {n})")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         vmax = self.max_wheel[slot]
         left = np.asarray(left, dtype=np.float64)
@@ -748,9 +775,10 @@ class BatchedSimulation:
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:
         driven = self._driven
-        if self.cars is not None or self.mecanum is not None or self.to_enu is not None:
-            # car-like and mecanum robots (batched_car.py, batched_mecanum.py): their moves join the
-            # numpy path's; a NUE world's poses are turned into its axes there (the C pass writes ENU poses)
+        if self._numpy_drives:
+            # car-like, mecanum and omni-wheel robots (batched_car.py, batched_holonomic.py) and two-wheel
+            # robots off their origin: their moves join the numpy path's; a NUE world's poses are turned
+            # into its axes there (the C pass writes ENU poses)
             self._drive_numpy(live, driven, dt_ms / 1000.0)
             return
         if not len(driven):
@@ -814,17 +842,27 @@ class BatchedSimulation:
     def _drive_numpy(self, live: np.ndarray, driven: np.ndarray, dt: float) -> None:
         """:meth:`_drive` without the C helper (the same values)."""
         self.pressing[live] = False
+        # the moves by body twists (copies, slots, vx, vy, ωz): mecanum and omni-wheel robots', two-wheel
+        # robots' off their origin; they join the arcs' arrays after them
+        twists = [d.step(live, dt) for d in (self.mecanum, self.omni) if d is not None]
         if len(driven):
             copies, slots, v, w = self._drive_wheels(live, driven, dt)
-        else:         # no two-wheel or skid-steer robot (cars, mecanum robots): nothing to gather
+            if self._any_off_centre:
+                off = self.off_centre[slots]
+                if off.any():     # DifferentialDrive.step: the origin's twist, the wheels' centre moving at v
+                    on = ~off
+                    oc, os_, ov, ow = copies[off], slots[off], v[off], w[off]
+                    cx, cy = self.axle_center[os_, 0], self.axle_center[os_, 1]
+                    twists.append((oc, os_, ov + ow * cy, -ow * cx, ow))
+                    copies, slots, v, w = copies[on], slots[on], v[on], w[on]
+        else:         # no two-wheel or skid-steer robot (cars, mecanum or omni-wheel robots): nothing to gather
             copies = slots = _NONE
             v = w = _EMPTY
         if self.cars is not None:     # the cars' moves too, sorted into slot order below where it matters (_narrow)
             cars = self.cars.step(live, dt)
             copies, slots, v, w = (np.concatenate(pair) for pair in zip((copies, slots, v, w), cars))
-        # mecanum robots' moves (MecanumDrive.step's twist step), after the arcs' in the same arrays
-        mec = self.mecanum.step(live, dt) if self.mecanum is not None else None
-        if not len(copies) and (mec is None or not len(mec[0])):
+        twists = [t for t in twists if len(t[0])]
+        if not len(copies) and not twists:
             return
         x0, y0 = self.x[copies, slots], self.y[copies, slots]
         yaw0 = self.yaw[copies, slots]
@@ -834,13 +872,13 @@ class BatchedSimulation:
             x, y, yaw = _offset_arc_steps(x0, y0, yaw0, v, w, dt, self.cars.rear_axle[slots])
         else:
             x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
-        if mec is not None and len(mec[0]):
-            mc, ms, vx, vy, mw = mec
-            mx0, my0, myaw0 = self.x[mc, ms], self.y[mc, ms], self.yaw[mc, ms]
-            mx, my, myaw = twist_steps(mx0, my0, myaw0, vx, vy, mw, dt)
-            copies, slots = np.concatenate([copies, mc]), np.concatenate([slots, ms])
-            x0, y0, yaw0 = np.concatenate([x0, mx0]), np.concatenate([y0, my0]), np.concatenate([yaw0, myaw0])
-            x, y, yaw = np.concatenate([x, mx]), np.concatenate([y, my]), np.concatenate([yaw, myaw])
+        if twists:        # every twist move in one twist_steps call
+            tc, ts, vx, vy, tw = (np.concatenate(col) if len(twists) > 1 else col[0] for col in zip(*twists))
+            tx0, ty0, tyaw0 = self.x[tc, ts], self.y[tc, ts], self.yaw[tc, ts]
+            tx, ty, tyaw = twist_steps(tx0, ty0, tyaw0, vx, vy, tw, dt)
+            copies, slots = np.concatenate([copies, tc]), np.concatenate([slots, ts])
+            x0, y0, yaw0 = np.concatenate([x0, tx0]), np.concatenate([y0, ty0]), np.concatenate([yaw0, tyaw0])
+            x, y, yaw = np.concatenate([x, tx]), np.concatenate([y, ty]), np.concatenate([yaw, tyaw])
         cos, sin = kin.libm_cos_sin(yaw)
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
@@ -1142,6 +1180,8 @@ class BatchedSimulation:
             self.cars.read_encoders(self.position, copies, cols, v)
         if self.mecanum is not None:  # a mecanum wheel's encoder
             self.mecanum.read_encoders(self.position, copies, cols, v)
+        if self.omni is not None:     # an omni wheel's encoder
+            self.omni.read_encoders(self.position, copies, cols, v)
         plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself
         for k in (~plain).nonzero()[0].tolist():
             col = int(cols[k])

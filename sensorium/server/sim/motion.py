@@ -425,6 +425,8 @@ class OmniDrive(HolonomicDrive):
             self.wheels.append((WheelMotor(w.motor, speed), float(w.radius)))
         self.solve = np.linalg.pinv(np.array(rows, dtype=np.float64))
         """3 × N: the wheels' rim speeds (r_i·ω_i) to the body twist (vx, vy, ωz)."""
+        self.columns = [(float(a), float(b), float(c)) for a, b, c in self.solve.T.tolist()]
+        """Each wheel's column of :attr:`solve`, the numbers :meth:`twist` sums."""
         super().__init__(pose, up, ground, band_low)
 
     @property
@@ -432,9 +434,14 @@ class OmniDrive(HolonomicDrive):
         return {m.name: m for m, _ in self.wheels}
 
     def twist(self, speeds: list[float]) -> tuple[float, float, float]:
-        """(vx, vy, ωz) in the robot's frame for the wheels' speeds (rad/s, the wheels' order)."""
-        vx, vy, w = self.solve @ np.array([u * r for u, (_, r) in zip(speeds, self.wheels)], dtype=np.float64)
-        return float(vx), float(vy), float(w)
+        """(vx, vy, ωz) in the robot's frame for the wheels' speeds (rad/s, the wheels' order): the
+        pseudo-inverse's columns times the rims' speeds, summed left to right in plain float64 (as the
+        batched simulation sums them, batched_omni.py; a BLAS product may fuse and reorder)."""
+        vx = vy = w = 0.0
+        for u, (_, r), (a, b, c) in zip(speeds, self.wheels, self.columns):
+            rim = u * r
+            vx, vy, w = vx + a * rim, vy + b * rim, w + c * rim
+        return vx, vy, w
 
     def step(self, dt_ms: int) -> Pose | None:
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
