@@ -877,6 +877,44 @@ def test_a_device_inside_its_robots_body_is_said(tmp_path: Path) -> None:
         "or make the shape part of the device's Solid"]
 
 
+def test_a_device_inside_its_robots_mesh_body_is_said(tmp_path: Path) -> None:
+    """The iRobot Create's shape: a disc-like body written as an IndexedFaceSet (Webots' picking
+    culls a mesh's triangles seen from behind, so its infra-red cliff sensors, mounted inside the
+    body and pointing down, see the floor) with the cliff sensors inside it. Here the mesh is seen
+    from inside: a sensor 5 cm above the floor reads the body's floor plate 3.5 cm below it. That
+    was said for a Box or a Sphere only, never for a mesh; now the load report names the
+    IndexedFaceSet at the sensor and at a camera inside it, and not at a sensor outside the body
+    nor under an open plate (one square, no inside)."""
+    ring = [(0.15 * math.cos(k * math.pi / 3), 0.15 * math.sin(k * math.pi / 3)) for k in range(6)]
+    points = " ".join(f"{x:.6f} {y:.6f} {z}" for z in (-0.035, 0.035) for x, y in ring)
+    faces = ("5 4 3 2 1 0 -1 6 7 8 9 10 11 -1 "                       # bottom (seen from below), top
+             + " ".join(f"{k} {(k + 1) % 6} {(k + 1) % 6 + 6} {k + 6} -1" for k in range(6)))
+    down = 'rotation 0 1 0 1.5708 lookupTable [ 0 1000 0 0.2 0 0 ] type "infra-red"'
+    p = write(tmp_path, 'Solid { children [ Shape { geometry Plane { size 10 10 } } ] }\n'
+              'Robot { name "r" translation 0 0 0.05 children [\n'
+              f'Shape {{ geometry IndexedFaceSet {{ coord Coordinate {{ point [ {points} ] }} coordIndex [ {faces} ] }} }}\n'
+              f'DistanceSensor {{ translation 0.1 0 0 name "cliff" {down} }}\n'
+              f'DistanceSensor {{ translation 0.2 0 0 name "outside" {down} }}\n'
+              'Camera { translation 0.05 0 0.01 }\n'
+              'Pose { translation 0 0.5 0.1 children [ Shape { geometry IndexedFaceSet { '
+              'coord Coordinate { point [ -0.1 -0.1 0, 0.1 -0.1 0, 0.1 0.1 0, -0.1 0.1 0 ] } coordIndex [ 0 1 2 3 -1 ] } } ] }\n'
+              f'DistanceSensor {{ translation 0 0.5 0.05 name "under plate" {down} }}\n'
+              '] }\n')
+    w = load_world(p)
+    assert w.warnings == [
+        f"{p}:{line}:1: {device} of robot 'r' is inside the robot's IndexedFaceSet (written at line 4, column 18): "
+        "its rays see that shape from inside, where Webots' never do (back faces culled); mount the device outside "
+        "it or make the shape part of the device's Solid"
+        for line, device in ((5, "DistanceSensor 'cliff'"), (7, "Camera 'camera'"))]
+    sim = Simulation(w)
+    for name in ("cliff", "outside"):
+        sim.device(f"r/{name}").enable(32)
+    sim.step()
+    # lookupTable 0 m -> 1000, 0.2 m -> 0: the plate 0.035 m below the inside sensor, the floor 0.05 m below the other
+    assert sim.device("r/cliff").value == pytest.approx(1000 * (1 - 0.035 / 0.2), abs=1e-6)
+    assert sim.device("r/outside").value == pytest.approx(1000 * (1 - 0.05 / 0.2), abs=1e-6)
+
+
 def test_a_camera_in_a_shape_closer_than_its_near_plane_is_not_said(tmp_path: Path) -> None:
     """Webots' binocular sample: each camera sits at the centre of its neighbouring distance sensor's
     small housing (a cylinder of radius 8 mm, 4 mm high: every point within 8.25 mm of the camera,
