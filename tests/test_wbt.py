@@ -877,42 +877,51 @@ def test_a_device_inside_its_robots_body_is_said(tmp_path: Path) -> None:
         "or make the shape part of the device's Solid"]
 
 
-def test_a_device_inside_its_robots_mesh_body_is_said(tmp_path: Path) -> None:
-    """The iRobot Create's shape: a disc-like body written as an IndexedFaceSet (Webots' picking
-    culls a mesh's triangles seen from behind, so its infra-red cliff sensors, mounted inside the
-    body and pointing down, see the floor) with the cliff sensors inside it. Here the mesh is seen
-    from inside: a sensor 5 cm above the floor reads the body's floor plate 3.5 cm below it. That
-    was said for a Box or a Sphere only, never for a mesh; now the load report names the
-    IndexedFaceSet at the sensor and at a camera inside it, and not at a sensor outside the body
-    nor under an open plate (one square, no inside)."""
+def test_a_device_inside_its_robots_mesh_body_sees_out(tmp_path: Path) -> None:
+    """The iRobot Create's shape: a disc-like body written as an IndexedFaceSet with infra-red cliff
+    sensors inside it, pointing down. Webots culls the triangles a ray meets from behind (its
+    infra-red picking and its renderer), so they see the floor; here the mesh was seen from inside
+    and a sensor 5 cm above the floor read the body's floor plate 3.5 cm below it, with no word.
+    Now the mesh is split so that each device inside it is blind to the triangles facing away from
+    it: the cliff sensor reads the floor (1000 at 0 m to 0 at 0.2 m: 750), a sensor over a plate
+    of the same mesh that faces up reads the plate (900) and one under it looking up sees nothing
+    (the plate's back, the body's top from inside: 0), as in Webots; nothing is said."""
     ring = [(0.15 * math.cos(k * math.pi / 3), 0.15 * math.sin(k * math.pi / 3)) for k in range(6)]
     points = " ".join(f"{x:.6f} {y:.6f} {z}" for z in (-0.035, 0.035) for x, y in ring)
-    faces = ("5 4 3 2 1 0 -1 6 7 8 9 10 11 -1 "                       # bottom (seen from below), top
-             + " ".join(f"{k} {(k + 1) % 6} {(k + 1) % 6 + 6} {k + 6} -1" for k in range(6)))
-    down = 'rotation 0 1 0 1.5708 lookupTable [ 0 1000 0 0.2 0 0 ] type "infra-red"'
+    points += " 0.05 -0.03 0, 0.13 -0.03 0, 0.13 0.03 0, 0.05 0.03 0"          # 12-15: a plate facing up
+    faces = ("5 4 3 2 1 0 -1 6 7 8 9 10 11 -1 "                               # bottom (seen from below), top
+             + " ".join(f"{k} {(k + 1) % 6} {(k + 1) % 6 + 6} {k + 6} -1" for k in range(6)) + " 12 13 14 15 -1")
+    table = 'lookupTable [ 0 1000 0 0.2 0 0 ] type "infra-red"'
     p = write(tmp_path, 'Solid { children [ Shape { geometry Plane { size 10 10 } } ] }\n'
               'Robot { name "r" translation 0 0 0.05 children [\n'
               f'Shape {{ geometry IndexedFaceSet {{ coord Coordinate {{ point [ {points} ] }} coordIndex [ {faces} ] }} }}\n'
-              f'DistanceSensor {{ translation 0.1 0 0 name "cliff" {down} }}\n'
-              f'DistanceSensor {{ translation 0.2 0 0 name "outside" {down} }}\n'
-              'Camera { translation 0.05 0 0.01 }\n'
-              'Pose { translation 0 0.5 0.1 children [ Shape { geometry IndexedFaceSet { '
-              'coord Coordinate { point [ -0.1 -0.1 0, 0.1 -0.1 0, 0.1 0.1 0, -0.1 0.1 0 ] } coordIndex [ 0 1 2 3 -1 ] } } ] }\n'
-              f'DistanceSensor {{ translation 0 0.5 0.05 name "under plate" {down} }}\n'
+              f'DistanceSensor {{ translation -0.1 0 0 rotation 0 1 0 1.5708 name "cliff" {table} }}\n'
+              f'DistanceSensor {{ translation 0.1 0 0.02 rotation 0 1 0 1.5708 name "over plate" {table} }}\n'
+              f'DistanceSensor {{ translation 0.1 0 -0.02 rotation 0 1 0 -1.5708 name "under plate" {table} }}\n'
+              'Camera { translation -0.05 0 0.01 }\n'
               '] }\n')
     w = load_world(p)
-    assert w.warnings == [
-        f"{p}:{line}:1: {device} of robot 'r' is inside the robot's IndexedFaceSet (written at line 4, column 18): "
-        "its rays see that shape from inside, where Webots' never do (back faces culled); mount the device outside "
-        "it or make the shape part of the device's Solid"
-        for line, device in ((5, "DistanceSensor 'cliff'"), (7, "Camera 'camera'"))]
+    assert w.warnings == []
     sim = Simulation(w)
-    for name in ("cliff", "outside"):
+    for name in ("cliff", "over plate", "under plate"):
         sim.device(f"r/{name}").enable(32)
     sim.step()
-    # lookupTable 0 m -> 1000, 0.2 m -> 0: the plate 0.035 m below the inside sensor, the floor 0.05 m below the other
-    assert sim.device("r/cliff").value == pytest.approx(1000 * (1 - 0.035 / 0.2), abs=1e-6)
-    assert sim.device("r/outside").value == pytest.approx(1000 * (1 - 0.05 / 0.2), abs=1e-6)
+    assert sim.device("r/cliff").value == pytest.approx(1000 * (1 - 0.05 / 0.2), abs=1e-6)
+    assert sim.device("r/over plate").value == pytest.approx(1000 * (1 - 0.02 / 0.2), abs=1e-6)
+    assert sim.device("r/under plate").value == 0.0
+    # the body's triangles, split by the devices they face away from (the camera's too)
+    split = {tuple(part.unseen_by): len(part.geometry.faces) for part in w.world.robots[0].shapes}
+    assert sum(split.values()) == 2 * 4 + 6 * 2 + 2 and ("camera", "cliff", "over plate", "under plate") in split
+
+
+def test_unseen_by_names_devices_of_its_robot(tmp_path: Path) -> None:
+    """A world file's ``unseen_by`` (what the .wbt import writes for a split mesh) must name devices
+    of the shape's robot, like ``of_device``."""
+    p = tmp_path / "w.yaml"
+    p.write_text("robots:\n  - name: r\n    devices: [{device: DistanceSensor, name: ds}]\n"
+                 "    shapes: [{geometry: {type: box, size: [0.1, 0.1, 0.1]}, seen_by: visual, unseen_by: [ds, dz]}]\n")
+    with pytest.raises(WorldError, match=r"robots\[0\] \(r\)\.shapes\[0\]\.unseen_by\[1\]: 'dz' is not a device of this robot \(devices: 'ds'\)"):
+        load_world(p)
 
 
 def test_a_camera_in_a_shape_closer_than_its_near_plane_is_not_said(tmp_path: Path) -> None:

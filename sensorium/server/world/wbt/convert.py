@@ -34,7 +34,7 @@ from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
 from sensorium.server.world.wbt.fields import Fields
 from sensorium.server.world.wbt.frames import Frame, bounding_constraint, bounding_geometry, visual_geometry
-from sensorium.server.world.wbt.inside import enclosing_shapes, shape_name, unread_image_fields
+from sensorium.server.world.wbt.inside import enclosing_shapes, turn_meshes_away, unread_image_fields
 from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
@@ -1410,6 +1410,7 @@ class Converter:
             if "_device" in part:
                 part["of_device"] = part.pop("_device")["name"]
         self.on_joints(data)
+        turn_meshes_away(data)
         self.devices_inside(data)
         if not data["devices"]:
             del data["devices"]
@@ -1417,18 +1418,18 @@ class Converter:
 
     def devices_inside(self, robot: dict) -> None:
         """One warning for each visual device whose origin is inside one of its robot's closed
-        shapes, which Webots never sees from there and rays here do (wbt/inside.py)."""
-        meshes: dict = {}        # the robot's meshes, prepared once for all its devices
+        primitives, which Webots never sees from there and rays here do (wbt/inside.py; a mesh is
+        split instead: turn_meshes_away)."""
         for dev in robot["devices"]:
             where = self.device_where.get(id(dev))
             if where is None:
                 continue
-            for part in enclosing_shapes(robot, dev, meshes):
+            for part in enclosing_shapes(robot, dev):
                 line, col, _ = part.get("_at", (0, 0, ""))
                 at = f" (written at line {line}, column {col})" if line else ""
                 self.warnings.append(
                     f"{where}: {dev['device']} {dev['name']!r} of robot {robot['name']!r} is inside the robot's "
-                    f"{shape_name(part['geometry'])}{at}: its rays see that shape from inside, where Webots' never do "
+                    f"{part['geometry']['type']}{at}: its rays see that shape from inside, where Webots' never do "
                     "(back faces culled); mount the device outside it or make the shape part of the device's Solid")
 
     def unique_devices(self, robot: dict) -> None:
