@@ -912,6 +912,13 @@ def test_a_device_inside_its_robots_mesh_body_sees_out(tmp_path: Path) -> None:
     # the body's triangles, split by the devices they face away from (the camera's too)
     split = {tuple(part.unseen_by): len(part.geometry.faces) for part in w.world.robots[0].shapes}
     assert sum(split.values()) == 2 * 4 + 6 * 2 + 2 and ("camera", "cliff", "over plate", "under plate") in split
+    # written ccw FALSE, its fronts are not judged: the mesh stays whole, seen from inside (the plate 3.5 cm below)
+    w = load_world(write(tmp_path, p.read_text().replace("IndexedFaceSet {", "IndexedFaceSet { ccw FALSE")))
+    assert [part.unseen_by for part in w.world.robots[0].shapes] == [[]]
+    sim = Simulation(w)
+    sim.device("r/cliff").enable(32)
+    sim.step()
+    assert sim.device("r/cliff").value == pytest.approx(1000 * (1 - 0.035 / 0.2), abs=1e-6)
 
 
 def test_unseen_by_names_devices_of_its_robot(tmp_path: Path) -> None:

@@ -198,6 +198,7 @@ class Converter:
         self.ear_budget = [EAR_CLIP_WORLD]  # corners² left for cutting concave IndexedFaceSet polygons into ears
         self.left_fanned: dict[str, int] = {}  # where an IndexedFaceSet kept concave polygons fanned: how many
         self.ear_cut: dict[int, tuple] = {}    # per IndexedFaceSet node cut into ears: (coordIndex, points, corners, fanned)
+        self.clockwise: set[int] = set()       # the geometries of IndexedFaceSets written ccw FALSE (front: clockwise)
         self.source = source
         self.search = search               # proto.ProtoSearch: where asset urls resolve (resolve_url)
         self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
@@ -838,6 +839,8 @@ class Converter:
             owner.keys[key]["seen_by"] = "both"     # the same geometry seen by both kinds of ray
             return
         part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
+        if gnode.type == "IndexedFaceSet" and not self.fields(gnode).flag("ccw", True):
+            self.clockwise.add(id(geometry))
         if seen_by == "visual":
             app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note,
                                 lambda n, u: self.asset(n, u, "texture"), self.field_reset)
@@ -1410,7 +1413,7 @@ class Converter:
             if "_device" in part:
                 part["of_device"] = part.pop("_device")["name"]
         self.on_joints(data)
-        turn_meshes_away(data)
+        turn_meshes_away(data, self.clockwise)
         self.devices_inside(data)
         if not data["devices"]:
             del data["devices"]

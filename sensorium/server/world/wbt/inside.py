@@ -154,7 +154,7 @@ def enclosing_shapes(robot: dict, device: dict) -> list[dict]:
     return out
 
 
-def turn_meshes_away(robot: dict) -> None:
+def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
     """Split each of the robot's visual meshes that has one of its visual devices (camera, range
     finder, lidar, infra-red distance sensor) within its box so that the device is blind to the
     triangles facing away from it, as Webots' back-face culling makes it (its renderer, its
@@ -162,8 +162,9 @@ def turn_meshes_away(robot: dict) -> None:
     turned from the device's origin can only be met from behind. A device inside its robot's body
     mesh (the iRobot Create's cliff sensors) so sees out. Triangles are grouped by the set of
     devices they face away from; each group is a shape of its own (same pose, appearance, node)
-    whose ``unseen_by`` lists them. Meshes with no device in their box stay whole, and so does a
-    mesh that is also a bounding object (contact sees it whole)."""
+    whose ``unseen_by`` lists them. Meshes with no device in their box stay whole, and so do a mesh
+    that is also a bounding object (contact sees it whole) and one written ``ccw FALSE``
+    (``clockwise``: the ids of those geometries), whose front side is not judged here."""
     shapes = robot.get("shapes")
     devices = [(d, np.asarray(d.get("pose", {}).get("translation", (0.0, 0.0, 0.0)), dtype=np.float64))
                for d in robot.get("devices", ())
@@ -173,7 +174,7 @@ def turn_meshes_away(robot: dict) -> None:
     out: list[dict] = []
     for part in shapes:
         geometry = part.get("geometry", {})
-        if part.get("seen_by") != "visual" or geometry.get("type") != "triangles":
+        if part.get("seen_by") != "visual" or geometry.get("type") != "triangles" or id(geometry) in clockwise:
             out.append(part)
             continue
         faces = MeshFaces(geometry["vertices"], geometry["faces"])
