@@ -921,6 +921,32 @@ def test_a_device_inside_its_robots_mesh_body_sees_out(tmp_path: Path) -> None:
     assert sim.device("r/cliff").value == pytest.approx(1000 * (1 - 0.035 / 0.2), abs=1e-6)
 
 
+def test_the_batched_simulation_hides_the_turned_away_faces_too(tmp_path: Path) -> None:
+    """The split mesh of the test above, two copies at different poses: each copy's cliff sensor
+    reads what the single simulation reads, the floor 5 cm below (750), bit for bit."""
+    from sensorium.server.sim.batched import BatchedSimulation
+
+    ring = [(0.15 * math.cos(k * math.pi / 3), 0.15 * math.sin(k * math.pi / 3)) for k in range(6)]
+    points = " ".join(f"{x:.6f} {y:.6f} {z}" for z in (-0.035, 0.035) for x, y in ring)
+    faces = "5 4 3 2 1 0 -1 6 7 8 9 10 11 -1 " + " ".join(f"{k} {(k + 1) % 6} {(k + 1) % 6 + 6} {k + 6} -1" for k in range(6))
+    p = write(tmp_path, 'Solid { children [ Shape { geometry Plane { size 10 10 } } ] }\n'
+              'Robot { name "r" translation 0 0 0.05 children [\n'
+              f'Shape {{ geometry IndexedFaceSet {{ coord Coordinate {{ point [ {points} ] }} coordIndex [ {faces} ] }} }}\n'
+              'DistanceSensor { translation -0.1 0 0 rotation 0 1 0 1.5708 name "cliff" '
+              'lookupTable [ 0 1000 0 0.2 0 0 ] type "infra-red" }\n] }\n')
+    bs = BatchedSimulation(load_world(p), 2)
+    sims = [Simulation(load_world(p)) for _ in range(2)]
+    bs.set_pose(1, 0, [0.5, 0.2, 0.05], rotation=[0, 0, 1, 0.3])
+    sims[1].robot("r").set_pose([0.5, 0.2, 0.05], rotation=[0, 0, 1, 0.3])
+    bs.enable(bs.device("r", "cliff"), 32)
+    for s in sims:
+        s.device("r/cliff").enable(32)
+    bs.run(2)
+    for c, s in enumerate(sims):
+        s.run(2)
+        assert s.device("r/cliff").value == float(bs.value(bs.device("r", "cliff"))[c]) == pytest.approx(750.0, abs=1e-6)
+
+
 def test_unseen_by_names_devices_of_its_robot(tmp_path: Path) -> None:
     """A world file's ``unseen_by`` (what the .wbt import writes for a split mesh) must name devices
     of the shape's robot, like ``of_device``."""
