@@ -877,6 +877,86 @@ def test_a_device_inside_its_robots_body_is_said(tmp_path: Path) -> None:
         "or make the shape part of the device's Solid"]
 
 
+def test_a_device_inside_its_robots_mesh_body_sees_out(tmp_path: Path) -> None:
+    """The iRobot Create's shape: a disc-like body written as an IndexedFaceSet with infra-red cliff
+    sensors inside it, pointing down. Webots culls the triangles a ray meets from behind (its
+    infra-red picking and its renderer), so they see the floor; here the mesh was seen from inside
+    and a sensor 5 cm above the floor read the body's floor plate 3.5 cm below it, with no word.
+    Now the mesh is split so that each device inside it is blind to the triangles facing away from
+    it: the cliff sensor reads the floor (1000 at 0 m to 0 at 0.2 m: 750), a sensor over a plate
+    of the same mesh that faces up reads the plate (900) and one under it looking up sees nothing
+    (the plate's back, the body's top from inside: 0), as in Webots; nothing is said."""
+    ring = [(0.15 * math.cos(k * math.pi / 3), 0.15 * math.sin(k * math.pi / 3)) for k in range(6)]
+    points = " ".join(f"{x:.6f} {y:.6f} {z}" for z in (-0.035, 0.035) for x, y in ring)
+    points += " 0.05 -0.03 0, 0.13 -0.03 0, 0.13 0.03 0, 0.05 0.03 0"          # 12-15: a plate facing up
+    faces = ("5 4 3 2 1 0 -1 6 7 8 9 10 11 -1 "                               # bottom (seen from below), top
+             + " ".join(f"{k} {(k + 1) % 6} {(k + 1) % 6 + 6} {k + 6} -1" for k in range(6)) + " 12 13 14 15 -1")
+    table = 'lookupTable [ 0 1000 0 0.2 0 0 ] type "infra-red"'
+    p = write(tmp_path, 'Solid { children [ Shape { geometry Plane { size 10 10 } } ] }\n'
+              'Robot { name "r" translation 0 0 0.05 children [\n'
+              f'Shape {{ geometry IndexedFaceSet {{ coord Coordinate {{ point [ {points} ] }} coordIndex [ {faces} ] }} }}\n'
+              f'DistanceSensor {{ translation -0.1 0 0 rotation 0 1 0 1.5708 name "cliff" {table} }}\n'
+              f'DistanceSensor {{ translation 0.1 0 0.02 rotation 0 1 0 1.5708 name "over plate" {table} }}\n'
+              f'DistanceSensor {{ translation 0.1 0 -0.02 rotation 0 1 0 -1.5708 name "under plate" {table} }}\n'
+              'Camera { translation -0.05 0 0.01 }\n'
+              '] }\n')
+    w = load_world(p)
+    assert w.warnings == []
+    sim = Simulation(w)
+    for name in ("cliff", "over plate", "under plate"):
+        sim.device(f"r/{name}").enable(32)
+    sim.step()
+    assert sim.device("r/cliff").value == pytest.approx(1000 * (1 - 0.05 / 0.2), abs=1e-6)
+    assert sim.device("r/over plate").value == pytest.approx(1000 * (1 - 0.02 / 0.2), abs=1e-6)
+    assert sim.device("r/under plate").value == 0.0
+    # the body's triangles, split by the devices they face away from (the camera's too)
+    split = {tuple(part.unseen_by): len(part.geometry.faces) for part in w.world.robots[0].shapes}
+    assert sum(split.values()) == 2 * 4 + 6 * 2 + 2 and ("camera", "cliff", "over plate", "under plate") in split
+    # written ccw FALSE, its fronts are not judged: the mesh stays whole, seen from inside (the plate 3.5 cm below)
+    w = load_world(write(tmp_path, p.read_text().replace("IndexedFaceSet {", "IndexedFaceSet { ccw FALSE")))
+    assert [part.unseen_by for part in w.world.robots[0].shapes] == [[]]
+    sim = Simulation(w)
+    sim.device("r/cliff").enable(32)
+    sim.step()
+    assert sim.device("r/cliff").value == pytest.approx(1000 * (1 - 0.035 / 0.2), abs=1e-6)
+
+
+def test_the_batched_simulation_hides_the_turned_away_faces_too(tmp_path: Path) -> None:
+    """The split mesh of the test above, two copies at different poses: each copy's cliff sensor
+    reads what the single simulation reads, the floor 5 cm below (750), bit for bit."""
+    from sensorium.server.sim.batched import BatchedSimulation
+
+    ring = [(0.15 * math.cos(k * math.pi / 3), 0.15 * math.sin(k * math.pi / 3)) for k in range(6)]
+    points = " ".join(f"{x:.6f} {y:.6f} {z}" for z in (-0.035, 0.035) for x, y in ring)
+    faces = "5 4 3 2 1 0 -1 6 7 8 9 10 11 -1 " + " ".join(f"{k} {(k + 1) % 6} {(k + 1) % 6 + 6} {k + 6} -1" for k in range(6))
+    p = write(tmp_path, 'Solid { children [ Shape { geometry Plane { size 10 10 } } ] }\n'
+              'Robot { name "r" translation 0 0 0.05 children [\n'
+              f'Shape {{ geometry IndexedFaceSet {{ coord Coordinate {{ point [ {points} ] }} coordIndex [ {faces} ] }} }}\n'
+              'DistanceSensor { translation -0.1 0 0 rotation 0 1 0 1.5708 name "cliff" '
+              'lookupTable [ 0 1000 0 0.2 0 0 ] type "infra-red" }\n] }\n')
+    bs = BatchedSimulation(load_world(p), 2)
+    sims = [Simulation(load_world(p)) for _ in range(2)]
+    bs.set_pose(1, 0, [0.5, 0.2, 0.05], rotation=[0, 0, 1, 0.3])
+    sims[1].robot("r").set_pose([0.5, 0.2, 0.05], rotation=[0, 0, 1, 0.3])
+    bs.enable(bs.device("r", "cliff"), 32)
+    for s in sims:
+        s.device("r/cliff").enable(32)
+    bs.run(2)
+    for c, s in enumerate(sims):
+        s.run(2)
+        assert s.device("r/cliff").value == float(bs.value(bs.device("r", "cliff"))[c]) == pytest.approx(750.0, abs=1e-6)
+
+
+def test_unseen_by_names_devices_of_its_robot(tmp_path: Path) -> None:
+    """A world file's ``unseen_by`` (what the .wbt import writes for a split mesh) must name devices
+    of the shape's robot, like ``of_device``."""
+    p = tmp_path / "w.yaml"
+    p.write_text("robots:\n  - name: r\n    devices: [{device: DistanceSensor, name: ds}]\n"
+                 "    shapes: [{geometry: {type: box, size: [0.1, 0.1, 0.1]}, seen_by: visual, unseen_by: [ds, dz]}]\n")
+    with pytest.raises(WorldError, match=r"robots\[0\] \(r\)\.shapes\[0\]\.unseen_by\[1\]: 'dz' is not a device of this robot \(devices: 'ds'\)"):
+        load_world(p)
+
+
 def test_a_camera_in_a_shape_closer_than_its_near_plane_is_not_said(tmp_path: Path) -> None:
     """Webots' binocular sample: each camera sits at the centre of its neighbouring distance sensor's
     small housing (a cylinder of radius 8 mm, 4 mm high: every point within 8.25 mm of the camera,

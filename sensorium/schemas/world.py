@@ -512,6 +512,11 @@ class Part(Shape):
         default=None, min_length=1,
         description="on a robot: the device whose own Solid this shape belongs to (a sensor's housing); that "
                     "device's infra-red rays and lidar beams do not see it, as in Webots")
+    unseen_by: list[str] = Field(
+        default=[], max_length=256,
+        description="on a robot: devices whose visual rays (infra-red, lidar, camera, range finder) do not see this "
+                    "shape although it is not theirs: the triangles of a mesh around a device that face away from it, "
+                    "which Webots culls (the .wbt import splits such a mesh)")
 
 
 # ---------------------------------------------------------------- lights

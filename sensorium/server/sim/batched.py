@@ -255,6 +255,8 @@ class BatchedSimulation:
                 for k, (_, _, shape) in enumerate(parts):
                     if getattr(shape, "of_device", None) is not None:
                         owned.setdefault(shape.of_device, set()).add(first + k)
+                    for unseen in getattr(shape, "unseen_by", ()):     # faces turned away from it
+                        owned.setdefault(unseen, set()).add(first + k)
                 self._own_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
                 first += len(parts)
                 for name, _, shape in parts:

@@ -477,6 +477,8 @@ class Scene:
                     device = getattr(shape, "of_device", None)
                     if device is not None:
                         owned.setdefault(device, set()).add(first + k)
+                    for unseen in getattr(shape, "unseen_by", ()):     # faces turned away from it
+                        owned.setdefault(unseen, set()).add(first + k)
             self._device_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
             for k, t in enumerate(r.radar_targets):          # solids it carries that radars detect apart
                 self.carried_targets[(i, k)] = (pose_from_model(t.pose), t.on_joint,
@@ -793,8 +795,8 @@ class Scene:
         return index
 
     def device_shapes(self, robot: int, device: str) -> frozenset[int]:
-        """The shapes (``Scene.shapes`` indices) of a device's own Solid (``of_device``), which its
-        visual rays do not see (sim/own_shapes.py)."""
+        """The shapes (``Scene.shapes`` indices) of a device's own Solid (``of_device``) and those
+        turned away from it (``unseen_by``), which its visual rays do not see (sim/own_shapes.py)."""
         return self._device_shapes.get((robot, device), frozenset())
 
     def robot_body(self, index: int) -> int | None:

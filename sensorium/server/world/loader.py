@@ -468,6 +468,8 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
             if part.of_device is not None:
                 problems.append(Problem(f"{path}.shapes[{s_i}].of_device",
                                         "only a robot's shapes belong to one of its devices"))
+            if part.unseen_by:
+                problems.append(Problem(f"{path}.shapes[{s_i}].unseen_by", "only a robot's devices see its shapes"))
     for p, geom in all_geometries(world):
         problems += _check_geometry(geom, p, base_dir)
     for r_i, robot in enumerate(world.robots):
@@ -483,6 +485,11 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                 problems.append(Problem(f"{rp}.shapes[{s_i}].of_device",
                                         f"{part.of_device!r} is not a device of this robot "
                                         f"(devices: {', '.join(repr(n) for n in device_names) or 'none'})"))
+            for u_i, name in enumerate(part.unseen_by):
+                if name not in device_names:
+                    problems.append(Problem(f"{rp}.shapes[{s_i}].unseen_by[{u_i}]",
+                                            f"{name!r} is not a device of this robot "
+                                            f"(devices: {', '.join(repr(n) for n in device_names) or 'none'})"))
         problems += _check_joints(robot, rp)
         for d_i, dev in enumerate(robot.devices):
             dp = f"{rp}.devices[{d_i}]"

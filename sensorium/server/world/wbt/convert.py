@@ -34,7 +34,7 @@ from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
 from sensorium.server.world.wbt.fields import Fields
 from sensorium.server.world.wbt.frames import Frame, bounding_constraint, bounding_geometry, visual_geometry
-from sensorium.server.world.wbt.inside import enclosing_shapes, unread_image_fields
+from sensorium.server.world.wbt.inside import enclosing_shapes, turn_meshes_away, unread_image_fields
 from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
 
@@ -198,6 +198,7 @@ class Converter:
         self.ear_budget = [EAR_CLIP_WORLD]  # corners² left for cutting concave IndexedFaceSet polygons into ears
         self.left_fanned: dict[str, int] = {}  # where an IndexedFaceSet kept concave polygons fanned: how many
         self.ear_cut: dict[int, tuple] = {}    # per IndexedFaceSet node cut into ears: (coordIndex, points, corners, fanned)
+        self.clockwise: set[int] = set()       # the geometries of IndexedFaceSets written ccw FALSE (front: clockwise)
         self.source = source
         self.search = search               # proto.ProtoSearch: where asset urls resolve (resolve_url)
         self.world: dict[str, Any] = {"world_info": {}, "solids": [], "lights": [], "robots": []}
@@ -838,6 +839,8 @@ class Converter:
             owner.keys[key]["seen_by"] = "both"     # the same geometry seen by both kinds of ray
             return
         part: dict[str, Any] = {"pose": frame.pose(), "geometry": geometry, "seen_by": seen_by}
+        if gnode.type == "IndexedFaceSet" and not self.fields(gnode).flag("ccw", True):
+            self.clockwise.add(id(geometry))
         if seen_by == "visual":
             app = fx.appearance(f.node_("appearance"), self.source, self.appearance_note,
                                 lambda n, u: self.asset(n, u, "texture"), self.field_reset)
@@ -1410,6 +1413,7 @@ class Converter:
             if "_device" in part:
                 part["of_device"] = part.pop("_device")["name"]
         self.on_joints(data)
+        turn_meshes_away(data, self.clockwise)
         self.devices_inside(data)
         if not data["devices"]:
             del data["devices"]
@@ -1417,7 +1421,8 @@ class Converter:
 
     def devices_inside(self, robot: dict) -> None:
         """One warning for each visual device whose origin is inside one of its robot's closed
-        shapes, which Webots never sees from there and rays here do (wbt/inside.py)."""
+        primitives, which Webots never sees from there and rays here do (wbt/inside.py; a mesh is
+        split instead: turn_meshes_away)."""
         for dev in robot["devices"]:
             where = self.device_where.get(id(dev))
             if where is None:

@@ -1,11 +1,16 @@
 """What a .wbt device's rays meet differently here, said at load time.
 
 * A visual device (camera, range finder, lidar, infra-red distance sensor) whose origin lies inside
-  one of its robot's closed shapes: Webots never sees that shape (its renderer culls back faces, its
-  infra-red picking finds no hit from inside a Box or Sphere), while here every shape that is not
-  the device's own (``of_device``) is seen from inside too (README, "a device inside a closed
+  one of its robot's closed primitives: Webots never sees that shape (its renderer culls back faces,
+  its infra-red picking finds no hit from inside a Box or Sphere), while here every shape that is
+  not the device's own (``of_device``) is seen from inside too (README, "a device inside a closed
   shape"). Webots' own range-finder sample mounts its device 1.5 mm under the top of the robot's
   body cylinder: its image was the cylinder's wall, 14 mm away, with no word why.
+* A mesh (IndexedFaceSet) around such a device is split instead, so that the device does not see
+  the triangles facing away from it, as Webots' culling (renderer and infra-red picking alike)
+  makes it: the iRobot Create's four cliff sensors sit within its body's IndexedFaceSet (z within
+  ±35 mm, radius under 162 mm) and read its floor plate, 35 mm below, whatever the ground, with no
+  word why.
 * The image fields of a Camera or RangeFinder that Webots' renderer uses and Sensorium does not
   (motion blur, depth of field, ...): the README lists them; the load report now names the ones a
   world writes.
@@ -58,6 +63,29 @@ def unread_image_fields(kind: str, written: dict) -> list[tuple[str, str]]:
 def _local(pose: dict, point: np.ndarray) -> np.ndarray:
     p = pose_from_values(pose["translation"], pose.get("rotation"), pose.get("quaternion"))
     return p.rotation.T @ (point - p.translation)
+
+
+class MeshFaces:
+    """A triangle mesh's box, its triangles' first corners and their normals."""
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray) -> None:
+        v = np.asarray(vertices, dtype=np.float64).reshape(-1, 3)
+        f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+        self.empty = not len(f)
+        if self.empty:
+            return
+        self.low, self.high = v[f].reshape(-1, 3).min(axis=0), v[f].reshape(-1, 3).max(axis=0)
+        self.a = v[f[:, 0]]
+        self.normals = np.cross(v[f[:, 1]] - self.a, v[f[:, 2]] - self.a)   # front: counter-clockwise
+
+    def around(self, p: np.ndarray) -> bool:
+        """Whether ``p`` lies strictly within the mesh's box."""
+        return not self.empty and bool(np.all(p > self.low) and np.all(p < self.high))
+
+    def turned_away(self, p: np.ndarray) -> np.ndarray:
+        """Each triangle's front turned away from ``p`` (p behind its plane): a ray from p can only
+        meet its back, which Webots culls."""
+        return np.einsum("ij,ij->i", p - self.a, self.normals) < 0.0
 
 
 def contains(geometry: dict, p: np.ndarray) -> bool:
@@ -124,3 +152,53 @@ def enclosing_shapes(robot: dict, device: dict) -> list[dict]:
                 continue
         out.append(part)
     return out
+
+
+def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
+    """Split each of the robot's visual meshes that has one of its visual devices (camera, range
+    finder, lidar, infra-red distance sensor) within its box so that the device is blind to the
+    triangles facing away from it, as Webots' back-face culling makes it (its renderer, its
+    infra-red picking): a triangle whose front side (counter-clockwise: its normal ``e1 x e2``) is
+    turned from the device's origin can only be met from behind. A device inside its robot's body
+    mesh (the iRobot Create's cliff sensors) so sees out. Triangles are grouped by the set of
+    devices they face away from; each group is a shape of its own (same pose, appearance, node)
+    whose ``unseen_by`` lists them. Meshes with no device in their box stay whole, and so do a mesh
+    that is also a bounding object (contact sees it whole) and one written ``ccw FALSE``
+    (``clockwise``: the ids of those geometries), whose front side is not judged here."""
+    shapes = robot.get("shapes")
+    devices = [(d, np.asarray(d.get("pose", {}).get("translation", (0.0, 0.0, 0.0)), dtype=np.float64))
+               for d in robot.get("devices", ())
+               if d["device"] in RENDERED or (d["device"] == "DistanceSensor" and d.get("type") == "infra-red")]
+    if not shapes or not devices:
+        return
+    out: list[dict] = []
+    for part in shapes:
+        geometry = part.get("geometry", {})
+        if part.get("seen_by") != "visual" or geometry.get("type") != "triangles" or id(geometry) in clockwise:
+            out.append(part)
+            continue
+        faces = MeshFaces(geometry["vertices"], geometry["faces"])
+        away: list[tuple[str, np.ndarray]] = []
+        for dev, origin in devices:
+            if part.get("of_device") == dev["name"]:
+                continue
+            local = _local(part["pose"], origin)
+            if faces.around(local):
+                away.append((dev["name"], faces.turned_away(local)))
+        if not away:
+            out.append(part)
+            continue
+        groups: dict[tuple[str, ...], list[int]] = {}
+        for t, key in enumerate(zip(*(behind.tolist() for _, behind in away))):
+            groups.setdefault(tuple(name for (name, _), b in zip(away, key) if b), []).append(t)
+        triangles = np.asarray(geometry["faces"]).reshape(-1, 3)
+        for names, rows in groups.items():
+            picked = np.asarray(rows, dtype=np.int64)
+            g = dict(geometry, faces=triangles[picked])
+            if len(g.get("tex_coord_faces", ())):
+                g["tex_coord_faces"] = np.asarray(g["tex_coord_faces"]).reshape(-1, 3)[picked]
+            piece = dict(part, geometry=g)
+            if names:
+                piece["unseen_by"] = sorted(names)
+            out.append(piece)
+    robot["shapes"] = out
