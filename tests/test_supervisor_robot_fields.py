@@ -137,3 +137,25 @@ def test_the_step_reply_schema_has_the_custom_data(live: Logged) -> None:
     reply = live.step(B, "rover", {"duration": 32})
     assert StepResult.model_validate(reply).custom_data == "abc"
     assert msgpack.packb(reply)
+
+
+def test_a_proto_robots_controller_field_passes_to_its_robot(tmp_path) -> None:
+    from test_webots_api import REPO
+
+    from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.loader import load_world
+
+    proto = (REPO / "tests" / "protos" / "minipuck" / "MiniPuck.proto").as_posix()
+    world = tmp_path / "puck.wbt"
+    world.write_text(f'#VRML_SIM R2023b utf8\nEXTERNPROTO "{proto}"\nWorldInfo {{ basicTimeStep 16 }}\n'
+                     'MiniPuck { name "puck" supervisor TRUE }\n')
+    lv = Logged()
+    lv.sim = Simulation(load_world(world))
+    lv.core = Core(lv.sim, new_token=lambda: "s", log=lv.lines.append)
+    lv.ok(A, "attach", {"robot": "puck"})
+    me = lv.ok(A, "/puck/robot/get_self")
+    assert me["proto"] == "MiniPuck"
+    lv.ok(A, "/puck/robot/set_field", {"node": me["node"], "field": "controller", "value": "roamer"})
+    assert lv.ok(A, "/puck/robot/get_field", {"node": me["node"], "field": "controller"})["value"] == "roamer"
+    assert lv.ok(A, "get_info")["robots"][0]["controller"] == "roamer"
+    assert lv.lines[-1].startswith("robot 'puck': set_field: robot 'puck''s controller is now 'roamer'")
