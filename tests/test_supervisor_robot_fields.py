@@ -159,3 +159,14 @@ def test_a_proto_robots_controller_field_passes_to_its_robot(tmp_path) -> None:
     assert lv.ok(A, "/puck/robot/get_field", {"node": me["node"], "field": "controller"})["value"] == "roamer"
     assert lv.ok(A, "get_info")["robots"][0]["controller"] == "roamer"
     assert lv.lines[-1].startswith("robot 'puck': set_field: robot 'puck''s controller is now 'roamer'")
+
+
+def test_none_refuses_a_controller_and_extern_lets_one_attach_again(live: Logged) -> None:
+    rover = rover_node(live)
+    live.ok(B, "detach", {"session": "s1"})
+    set_field(live, rover, "controller", "<none>")
+    msg = live.err(B, "attach", {"robot": "rover"}, ErrorCode.WRONG_STATE)
+    assert "has controller \"<none>\" (its world file's or a Supervisor's)" in msg
+    assert live.step(A, "pioneer", {"duration": 32})["time_ms"] == 32          # the world does not wait for it
+    set_field(live, rover, "controller", "<extern>")
+    assert live.ok(B, "attach", {"robot": "rover"})["robot"] == "rover"

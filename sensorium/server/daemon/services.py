@@ -827,6 +827,10 @@ class Core(DeviceServices):
         (``<extern>``: the robot waits for one to attach; ``""``/``<none>``: none). Under plain
         ``serve`` every controller is the user's: the value changes, nothing ends or starts (one line)."""
         name = self.sim.robots[robot].controller
+        ls = self.lockstep        # "<none>": no controller attaches (as one named so in the world file)
+        ls.uncontrolled = ls.uncontrolled | {robot} if name == "<none>" else ls.uncontrolled - {robot}
+        if name == "<none>" and robot in ls.extern_synchronous:
+            ls.extern_synchronous.remove(robot)
         if self.launcher is None:
             self.log_error(f"robot {c.robot!r}: set_field: robot {robot!r}'s controller is now {name!r}; nothing "
                            "is ended or started: only `sensorium run` starts controllers")
