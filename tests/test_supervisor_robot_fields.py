@@ -170,3 +170,14 @@ def test_none_refuses_a_controller_and_extern_lets_one_attach_again(live: Logged
     assert live.step(A, "pioneer", {"duration": 32})["time_ms"] == 32          # the world does not wait for it
     set_field(live, rover, "controller", "<extern>")
     assert live.ok(B, "attach", {"robot": "rover"})["robot"] == "rover"
+
+
+def test_a_controller_attaching_after_the_change_has_it_from_attach(live: Logged) -> None:
+    rover = rover_node(live)
+    live.ok(B, "detach", {"session": "s1"})
+    set_field(live, rover, "customData", "later")
+    assert live.ok(B, "attach", {"robot": "rover"})["custom_data"] == "later"
+    assert "custom_data" not in live.step(B, "rover", {"duration": 32})
+    live.ok(B, "/rover/robot/set_custom_data", {"value": "own"})        # a reset brings back the file's ""
+    live.ok(A, "/pioneer/robot/simulation_reset")
+    assert live.step(B, "rover", {"duration": 32})["custom_data"] == ""

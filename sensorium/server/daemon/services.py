@@ -133,6 +133,7 @@ class Core(DeviceServices):
         self.topics = Topics(sim)
         self._seen: dict[str, dict[str, int]] = {}          # session token -> device path -> measurements
         self._custom_sent: dict[str, str] = {}    # session token -> the robot's customData its controller has
+        self._custom_news: set[str] = set()       # robots whose customData a Supervisor's request changed
         self._controls_by_robot: dict[str, list[Control]] = {name: [] for name in sim.robots}
         for ctl in self.topics.controls.values():
             self._controls_by_robot[ctl.robot].append(ctl)
@@ -452,7 +453,9 @@ class Core(DeviceServices):
             values: dict[str, dict] = {}
             if d.status != -1 and d.session.alive and self._controls_by_robot[d.session.robot]:
                 values = self._new_values(d.session)
-            data = self._custom_data_news(d.session) if d.status != -1 and d.session.alive else None
+            data = None                           # (an empty set: one test a reply)
+            if self._custom_news and d.session.robot in self._custom_news and d.status != -1 and d.session.alive:
+                data = self._custom_data_news(d.session)
             if not values and data is None:       # most replies: no new value; the gate packs them
                 plain = (envelope, rid, d.status, d.time_ms)
                 d.session.last_step = (rid, plain)   # kept for a retry of a reply lost in transit
@@ -467,6 +470,7 @@ class Core(DeviceServices):
     def _custom_data_news(self, session: Session) -> str | None:
         """The robot's customData when a Supervisor (or a reset) changed it since its controller last
         had it, else None: Webots sends it with the step's answer (WbRobot::updateData)."""
+        self._custom_news.discard(session.robot)
         data = self.sim.robots[session.robot].custom_data
         if self._custom_sent.get(session.token) == data:
             return None
@@ -635,7 +639,7 @@ class Core(DeviceServices):
             self._queue_packets(packets)
             self._draw(drawings)
             now: dict[str, Any] = {"status": 0, "time_ms": self.sim.time_ms, "values": self._new_values(s)}
-            data = self._custom_data_news(s)
+            data = self._custom_data_news(s) if c.robot in self._custom_news else None
             if data is not None:
                 now["custom_data"] = data
             return now
@@ -809,15 +813,20 @@ class Core(DeviceServices):
 
     def _supervisor(self, item: str, c: Call) -> dict:
         """Every Supervisor service: :data:`supervisor.HANDLERS` (ValueError → INVALID_ARGUMENT)."""
-        controllers = {name: r.controller for name, r in self.sim.robots.items()} if item == "set_field" else {}
+        # what a set field, a reset or a loaded state may change: a robot's controller, its customData
+        fields = {name: (r.controller, r.custom_data) for name, r in self.sim.robots.items()} \
+            if item in ("set_field", "simulation_reset", "load_node_state") else {}
         try:
             out = supervisor.HANDLERS[item](self.sim, self.lockstep, c.robot, c.args)
         except ValueError as exc:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{item}: {exc}") from None
         for line in out.pop(supervisor.LOG, ()):
             self.log_error(f"robot {c.robot!r}: {item}: {line}")
-        for name, before in controllers.items():      # a robot's controller field set (through a PROTO's too)
-            if self.sim.robots[name].controller != before:
+        for name, (controller, data) in fields.items():     # (through a PROTO's field too)
+            robot = self.sim.robots[name]
+            if robot.custom_data != data:
+                self._custom_news.add(name)               # its controller gets it with its next step reply
+            if robot.controller != controller:
                 self._controller_changed(name, c)
         return out
 
