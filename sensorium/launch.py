@@ -292,17 +292,22 @@ def plan(robots: list[Any], dirs: list[Path], webots: WebotsProjects | None = No
     for r in robots:
         if r.controller in SPECIAL:
             continue
-        own = (projects or {}).get(r.name)
-        robot_dirs = list(dict.fromkeys([dirs[0], own / "controllers", *dirs[1:]])) if own is not None and dirs else dirs
         try:
-            spec = find_controller(r.name, r.controller, list(r.controller_args), robot_dirs, webots,
-                                   (protos or {}).get(r.name))
+            specs.append(robot_controller(r.name, r.controller, list(r.controller_args), dirs, webots, protos, projects))
         except LaunchError as exc:
             problems.append(str(exc))
-            continue
-        roots = [dirs[0].parent] if dirs else []
-        specs.append(dataclasses.replace(spec, libraries=library_folders([*roots, *([own] if own else [])])))
     return specs, problems
+
+
+def robot_controller(robot: str, name: str, args: list[str], dirs: list[Path], webots: WebotsProjects | None = None,
+                     protos: dict[str, str] | None = None, projects: dict[str, Path] | None = None) -> ControllerSpec:
+    """The controller ``name`` of ``robot`` as :func:`plan` finds it (the robot's PROTO's project right
+    after the world's own), with the projects' libraries; LaunchError (one line) when it is not found."""
+    own = (projects or {}).get(robot)
+    robot_dirs = list(dict.fromkeys([dirs[0], own / "controllers", *dirs[1:]])) if own is not None and dirs else dirs
+    spec = find_controller(robot, name, args, robot_dirs, webots, (protos or {}).get(robot))
+    roots = [dirs[0].parent] if dirs else []
+    return dataclasses.replace(spec, libraries=library_folders([*roots, *([own] if own else [])]))
 
 
 def library_folders(projects: list[Path]) -> tuple[Path, ...]:
@@ -452,11 +457,13 @@ class Launcher:
         self.starts: dict[str, int] = {s.robot: 0 for s in specs}
         self._lock = threading.Lock()            # running, starts
         self._print_lock = threading.Lock()
-        self._restarts: list[str] = []
+        self._restarts: list[tuple[str, bool]] = []     # (robot, its controller field changed)
         self._wake = threading.Event()
         self._closed = False
         self.reload_requested = False
         self.on_reload: Callable[[], None] | None = None     # stops the server (run's loop reloads)
+        # (robot, controller name) -> the controller to start (run's find_controller for this world), or LaunchError
+        self.find: Callable[[str, str], ControllerSpec] | None = None
         self._starting: set[str] = set()         # the lockstep's: the world waits until these attach
         self.failed: dict[str, str] = {}          # robot -> controller whose process could not be started
         self._wake_server: Callable[[], None] = lambda: None
@@ -670,10 +677,46 @@ class Launcher:
         if robot in self.specs:
             self._starting.add(robot)        # the world waits for the new process, as for the first one
         with self._lock:
-            self._restarts.append(robot)
+            self._restarts.append((robot, False))
             run = self.running.get(robot)
             if run is not None:
                 run.ending = True
+        self._wake.set()
+
+    def switch(self, robot: str, name: str, synchronous: bool) -> None:
+        """A Supervisor set the robot's ``controller`` field to ``name`` (the server has ended its
+        session): end its process and start the controller ``name`` names, found as the world's are;
+        ``<extern>`` waits for one to attach (a synchronous robot holds the world until then, as at
+        load), ``""``, ``<none>`` and ``<generic>`` leave the robot without one, as a name not found (one line)."""
+        spec = None
+        if name == "<extern>":
+            self.log(f"robot '{robot}' is <extern> now: attach its controller with `sensorium controller SCRIPT "
+                     f"--robot {robot} --url {self.url}`")
+        elif name in ("", "<none>", "<generic>"):
+            self.log(f"robot '{robot}': controller {name!r} now: the robot runs without a controller")
+        else:
+            try:
+                if self.find is None:
+                    raise LaunchError(f"robot {robot!r}: controller {name!r} not looked for (no world to look from)")
+                spec = self.find(robot, name)
+            except LaunchError as exc:
+                self.log(f"{exc}: the robot runs without a controller")
+                self.failed[robot] = name
+        with self._lock:
+            if spec is None:
+                self.specs.pop(robot, None)
+            else:
+                self.specs[robot] = spec
+                self.starts.setdefault(robot, 0)
+            self._restarts.append((robot, True))
+            run = self.running.get(robot)
+            if run is not None:
+                run.ending = True
+        if spec is not None or (name == "<extern>" and synchronous):
+            self._starting.add(robot)        # the world waits for the new controller, as at load
+        else:
+            self._starting.discard(robot)    # nor for the one it had started
+            self._wake_server()
         self._wake.set()
 
     def reload(self) -> None:
@@ -700,15 +743,15 @@ class Launcher:
                 with self._lock:
                     if not self._restarts:
                         break
-                    robot = self._restarts.pop(0)
+                    robot, switched = self._restarts.pop(0)
                     run = self.running.pop(robot, None)
-                if robot not in self.specs:
+                    spec = self.specs.get(robot)
+                if spec is None and not switched:
                     self.log(f"robot '{robot}' has no controller `sensorium run` started (an <extern> one?): "
                              "restartController ended its session only")
-                    continue
                 if run is not None:
                     self._end(run, self.grace_s)
-                if not self._closed:
+                if spec is not None and not self._closed:
                     self.start(robot)
 
     def close(self) -> None:
@@ -766,6 +809,7 @@ class ProjectRun:
         self.interrupted = False
         self.missing: dict[str, str] = {}      # robot -> controller it ran without (every load of the world)
         self._server: Any = None
+        self._find: Callable[[str, str], ControllerSpec] | None = None    # the loaded world's (_plan)
 
     def stop(self) -> None:
         self.interrupted = True
@@ -809,6 +853,10 @@ class ProjectRun:
                 pass
         world_plan = plan_world(loaded.robots, self.dirs, server.transport.rpc_endpoint, self.webots, protos, wbt,
                                 projects)
+        args = {r.name: list(r.controller_args) for r in loaded.robots}
+        # a Supervisor's controller field set: the named controller looked for as the world's are
+        self._find = lambda robot, name: robot_controller(robot, name, args.get(robot, []), self.dirs, self.webots,
+                                                          protos, projects)
         if world_plan.problems and self.options.require_controllers:
             server.close()
             for line in world_plan.problems:
@@ -857,6 +905,7 @@ class ProjectRun:
                 lockstep.starting.update(world_plan.extern_waited)
                 lockstep.extern_synchronous = list(world_plan.extern_synchronous)
                 launcher.on_reload = server.stop
+                launcher.find = self._find
                 print(server.ready_line, file=self.out, flush=True)
                 launcher.start_all()
                 server.run(signals=False)

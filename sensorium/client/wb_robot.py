@@ -385,6 +385,9 @@ class RobotClient:
         values = result.get("values")
         if values:
             self._apply(values)
+        data = result.get("custom_data")
+        if data is not None:            # a Supervisor set the robot's customData field (Webots sends it so too)
+            self.custom_data = str(data)
         if status == -1:
             self.terminated = True
         return status

@@ -335,7 +335,7 @@ class SetFieldArgs(Args):
     value: bool | int | float | Annotated[list[float], Field(min_length=2, max_length=4)] | \
         Annotated[str, Field(max_length=4096)] | None = Field(
         default=None, description="SFBool true/false; SFFloat a number; SFVec3f/SFColor 3 numbers; SFRotation axis "
-        "x, y, z, angle; SFInt32 a whole number, SFVec2f 2 numbers, SFString a string (a top-level solid's PROTO fields only); an MF field's item (with index): MFBool true/false, MFInt32 a whole number, MFFloat a "
+        "x, y, z, angle; SFInt32 a whole number, SFVec2f 2 numbers, SFString a string (a robot's customData and controller, a top-level solid's PROTO fields); an MF field's item (with index): MFBool true/false, MFInt32 a whole number, MFFloat a "
         "number, MFVec2f 2 numbers, MFVec3f/MFColor 3 numbers, MFRotation 4, MFString a string; none to remove")
     index: int | None = Field(default=None, ge=-(1 << 31), lt=1 << 31, description=(
         "an MF field's item (negative from the end, as Webots): setMF*, insertMF* (0 first, -1 after the last), "
@@ -824,6 +824,8 @@ class StepResult(Result):
     status: int = Field(description="0; -1 when the server quits; the lateness dt (ms) for asynchronous robots")
     time_ms: int
     values: dict[str, ScalarReading | LidarReading | VectorReading | ReceiverReading | SpeakerReading]
+    custom_data: str | None = Field(default=None, description="the robot's customData, when a Supervisor (or a "
+                                    "reset) changed it since the controller last had it (getCustomData)")
 
 
 class SuccessResult(Result):

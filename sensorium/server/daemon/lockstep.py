@@ -167,8 +167,9 @@ class Lockstep:
         if robot not in self.robots:
             raise LockstepError(ErrorCode.UNKNOWN_ROBOT, f"no robot {robot!r} (robots: {', '.join(self.robots) or 'none'})")
         if robot in self.uncontrolled:
-            raise LockstepError(ErrorCode.WRONG_STATE, f"robot {robot!r} has controller \"<none>\" in the world file: "
-                                                       "it takes no controller (set controller: \"<extern>\")")
+            raise LockstepError(ErrorCode.WRONG_STATE, f"robot {robot!r} has controller \"<none>\" (its world file's or a "
+                                                       "Supervisor's): it takes no controller (set controller: "
+                                                       "\"<extern>\")")
         current = self._by_robot.get(robot)
         if current is not None and now - current.last_heard > self.liveness_s:
             self._drop(current, now)              # dead but not yet collected

@@ -132,6 +132,8 @@ class Core(DeviceServices):
         self._announced = False              # the waiting / running-by-itself line was printed
         self.topics = Topics(sim)
         self._seen: dict[str, dict[str, int]] = {}          # session token -> device path -> measurements
+        self._custom_sent: dict[str, str] = {}    # session token -> the robot's customData its controller has
+        self._custom_news: set[str] = set()       # robots whose customData a Supervisor's request changed
         self._controls_by_robot: dict[str, list[Control]] = {name: [] for name in sim.robots}
         for ctl in self.topics.controls.values():
             self._controls_by_robot[ctl.robot].append(ctl)
@@ -430,6 +432,7 @@ class Core(DeviceServices):
 
     def _released(self, s: Session) -> None:
         self._seen.pop(s.token, None)
+        self._custom_sent.pop(s.token, None)
         self.topics.release_robot(s.robot)
         # a robot without a controller stops: with no collision response it would otherwise
         # drive through walls while the world steps for the others (Webots keeps the commands)
@@ -450,13 +453,29 @@ class Core(DeviceServices):
             values: dict[str, dict] = {}
             if d.status != -1 and d.session.alive and self._controls_by_robot[d.session.robot]:
                 values = self._new_values(d.session)
-            if not values:                        # most replies: no new value; the gate packs them
+            data = None                           # (an empty set: one test a reply)
+            if self._custom_news and d.session.robot in self._custom_news and d.status != -1 and d.session.alive:
+                data = self._custom_data_news(d.session)
+            if not values and data is None:       # most replies: no new value; the gate packs them
                 plain = (envelope, rid, d.status, d.time_ms)
                 d.session.last_step = (rid, plain)   # kept for a retry of a reply lost in transit
                 return plain
-            body = self._bounded_reply(rid, {"status": d.status, "time_ms": d.time_ms, "values": values})
+            result: dict[str, Any] = {"status": d.status, "time_ms": d.time_ms, "values": values}
+            if data is not None:
+                result["custom_data"] = data
+            body = self._bounded_reply(rid, result)
         d.session.last_step = (rid, body)         # kept for a retry of a reply lost in transit
         return envelope + [body]
+
+    def _custom_data_news(self, session: Session) -> str | None:
+        """The robot's customData when a Supervisor (or a reset) changed it since its controller last
+        had it, else None: Webots sends it with the step's answer (WbRobot::updateData)."""
+        self._custom_news.discard(session.robot)
+        data = self.sim.robots[session.robot].custom_data
+        if self._custom_sent.get(session.token) == data:
+            return None
+        self._custom_sent[session.token] = data
+        return data
 
     def _new_values(self, session: Session) -> dict[str, dict]:
         """The readings of the session's enabled devices that it has not received yet."""
@@ -530,6 +549,7 @@ class Core(DeviceServices):
         self._seen[s.token] = {ctl.path: getattr(ctl.device, "measurements", 0)
                                for ctl in self._robot_controls(s.robot)}
         robot = self.sim.robots[s.robot]
+        self._custom_sent[s.token] = robot.custom_data
         return {"session": s.token, "robot": s.robot, "basic_time_step": self.sim.basic_time_step,
                 "time_ms": self.sim.time_ms, "synchronization": bool(robot.synchronization),
                 "heartbeat_ms": self.lockstep.heartbeat_ms, "supervisor": bool(getattr(robot, "supervisor", False)),
@@ -618,7 +638,11 @@ class Core(DeviceServices):
             self._apply_motor_commands(commands)
             self._queue_packets(packets)
             self._draw(drawings)
-            return {"status": 0, "time_ms": self.sim.time_ms, "values": self._new_values(s)}
+            now: dict[str, Any] = {"status": 0, "time_ms": self.sim.time_ms, "values": self._new_values(s)}
+            data = self._custom_data_news(s) if c.robot in self._custom_news else None
+            if data is not None:
+                now["custom_data"] = data
+            return now
         done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.duration, c.now)
         if done is not None:                                 # quitting: -1 at once
             return {"status": done.status, "time_ms": done.time_ms, "values": {}}
@@ -739,6 +763,7 @@ class Core(DeviceServices):
 
     def _robot_set_custom_data(self, c: Call) -> dict:
         self.sim.robots[c.robot].custom_data = c.args.value
+        self._custom_sent[self._session(c).token] = c.args.value     # its controller has it (the field too)
         return {"success": True}
 
     def _robot_get_model(self, c: Call) -> dict:
@@ -788,13 +813,44 @@ class Core(DeviceServices):
 
     def _supervisor(self, item: str, c: Call) -> dict:
         """Every Supervisor service: :data:`supervisor.HANDLERS` (ValueError → INVALID_ARGUMENT)."""
+        # what a set field, a reset or a loaded state may change: a robot's controller, its customData
+        fields = {name: (r.controller, r.custom_data) for name, r in self.sim.robots.items()} \
+            if item in ("set_field", "simulation_reset", "load_node_state") else {}
         try:
             out = supervisor.HANDLERS[item](self.sim, self.lockstep, c.robot, c.args)
         except ValueError as exc:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{item}: {exc}") from None
         for line in out.pop(supervisor.LOG, ()):
             self.log_error(f"robot {c.robot!r}: {item}: {line}")
+        for name, (controller, data) in fields.items():     # (through a PROTO's field too)
+            robot = self.sim.robots[name]
+            if robot.custom_data != data:
+                self._custom_news.add(name)               # its controller gets it with its next step reply
+            if robot.controller != controller:
+                self._controller_changed(name, c)
         return out
+
+    def _controller_changed(self, robot: str, c: Call) -> None:
+        """Webots' WbRobot::updateControllerDir: the robot's running controller ends (a pending step
+        answers -1, as restartController's) and ``sensorium run``'s launcher starts the one now named
+        (``<extern>``: the robot waits for one to attach; ``""``/``<none>``: none). Under plain
+        ``serve`` every controller is the user's: the value changes, nothing ends or starts (one line)."""
+        name = self.sim.robots[robot].controller
+        ls = self.lockstep        # "<none>": no controller attaches (as one named so in the world file)
+        ls.uncontrolled = ls.uncontrolled | {robot} if name == "<none>" else ls.uncontrolled - {robot}
+        if name == "<none>" and robot in ls.extern_synchronous:
+            ls.extern_synchronous.remove(robot)
+        if self.launcher is None:
+            self.log_error(f"robot {c.robot!r}: set_field: robot {robot!r}'s controller is now {name!r}; nothing "
+                           "is ended or started: only `sensorium run` starts controllers")
+            return
+        ended = self.lockstep.end_controller(robot)
+        if ended is not None:
+            s, done = ended
+            self._released(s)
+            if done is not None:
+                c.extra.append(self._step_reply(done))
+        self.launcher.switch(robot, name, bool(self.sim.robots[robot].synchronization))
 
 
 def _ackermann(robot: Any) -> dict | None:

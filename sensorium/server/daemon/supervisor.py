@@ -35,6 +35,7 @@ from sensorium.server.daemon import appearance, nested, visuals
 from sensorium.server.daemon.mf_items import item_position
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import states, viewshot
+from sensorium.server.world.limits import RAISE, custom_data_chars
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
 from sensorium.server.world.top_nodes import Scenery
 
@@ -509,6 +510,22 @@ def _light_fields(kind: str) -> dict[str, tuple[str, Getter, Setter]]:
     return {name: (t, getter(attr), _set_light(attr, kind)) for name, (t, attr) in fields.items()}
 
 
+def _set_custom_data(sim: Any, node: Node, value: str) -> None:
+    """Webots' WbRobot::updateData: the robot's controller reads the new value with getCustomData once
+    its next step returns (services.py sends it with that step reply); bounded as the world file's."""
+    limit = custom_data_chars(sim.limits)
+    if len(value) > limit:
+        raise ValueError(f"field 'customData': {len(value)} characters, over the world's limit of {limit} "
+                         f"{RAISE}; nothing changed")
+    sim.robots[node.key].custom_data = value
+
+
+def _set_controller(sim: Any, node: Node, value: str) -> None:
+    """Webots' WbRobot::updateControllerDir: the value only; services.py ends the running controller and
+    `sensorium run`'s launcher starts the named one (a Supervisor's set_field compares before and after)."""
+    sim.robots[node.key].controller = value
+
+
 def _children(sim: Any, node: Node) -> list[int]:
     """A robot's, solid's or nested node's ``children``: the nodes inside it (nested.py)."""
     return nested.children(_table(sim), node.id)
@@ -520,8 +537,8 @@ FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
               "children": ("MFNode", _children, None),
               "name": ("SFString", lambda sim, n: n.name, None),
               "model": ("SFString", lambda sim, n: sim.robots[n.key].model.model, None),
-              "customData": ("SFString", lambda sim, n: sim.robots[n.key].custom_data, None),
-              "controller": ("SFString", lambda sim, n: sim.robots[n.key].model.controller, None),
+              "customData": ("SFString", lambda sim, n: sim.robots[n.key].custom_data, _set_custom_data),
+              "controller": ("SFString", lambda sim, n: sim.robots[n.key].controller, _set_controller),
               "supervisor": ("SFBool", lambda sim, n: bool(sim.robots[n.key].supervisor), None),
               "synchronization": ("SFBool", lambda sim, n: bool(sim.robots[n.key].synchronization), None),
               **_RADAR_FIELD},
@@ -1029,12 +1046,15 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
         ok = isinstance(value, int) and not isinstance(value, bool)
     elif kind == "SFFloat":
         ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+    elif kind == "SFString":
+        ok = isinstance(value, str)
     else:
         ok = isinstance(value, list) and len(value) == _VECTOR_SIZES.get(kind, -1)
-    if not ok and kind not in _VECTOR_SIZES and kind not in ("SFBool", "SFInt32", "SFFloat"):
+    if not ok and kind not in _VECTOR_SIZES and kind not in ("SFBool", "SFInt32", "SFFloat", "SFString"):
         raise ValueError(f"field {field!r} of {what} is an {kind}: not set as a whole here")
     if not ok:
-        want = {"SFBool": "true or false", "SFInt32": "a whole number", "SFFloat": "a finite number"}.get(kind, f"{_VECTOR_SIZES.get(kind)} numbers")
+        want = {"SFBool": "true or false", "SFInt32": "a whole number", "SFFloat": "a finite number",
+                "SFString": "a string"}.get(kind, f"{_VECTOR_SIZES.get(kind)} numbers")
         raise ValueError(f"field {field!r} is an {kind}: takes {want}, got {value!r}")
     if isinstance(value, list) and not all(math.isfinite(v) for v in value):
         raise ValueError(f"field {field!r}: values must be finite")

@@ -32,7 +32,7 @@ from pydantic import BaseModel
 from sensorium.schemas.devices import KINDS
 from sensorium.schemas.world import Rows
 
-__all__ = ["BYTES_PER_RAY", "BYTES_PER_TRIANGLE", "MAX_COORDINATE_M", "check_pose", "WorldLimits", "LimitError", "check_counts", "check_data", "check_work", "quote", "triangle_count"]
+__all__ = ["BYTES_PER_RAY", "BYTES_PER_TRIANGLE", "MAX_COORDINATE_M", "check_pose", "custom_data_chars", "WorldLimits", "LimitError", "check_counts", "check_data", "check_work", "quote", "triangle_count"]
 
 MiB = 1 << 20
 GiB = 1 << 30
@@ -123,9 +123,14 @@ def quote(value: Any, limit: int = 60) -> str:
 # ------------------------------------------------------------------------------------ parsing
 
 
+def custom_data_chars(limits: WorldLimits) -> int:
+    """The longest robot customData: the world file's and what a Supervisor sets (Webots has no bound)."""
+    return 1 * MiB if limits.string_chars < MiB else limits.string_chars
+
+
 def _string_limit(key: str, limits: WorldLimits) -> int:
     if key == "custom_data":
-        return 1 * MiB if limits.string_chars < MiB else limits.string_chars   # Webots customData
+        return custom_data_chars(limits)
     if key == "name" or key.endswith("motor"):
         return limits.name_chars
     return limits.string_chars

@@ -688,6 +688,12 @@ static int step_end(sn_robot *rb) {
   int status = (int)sn_int_or(rep.result, "status", 0);
   rb->time_ms = sn_int_or(rep.result, "time_ms", rb->time_ms);
   apply_values(rb, sn_get(rep.result, "values"));
+  /* a Supervisor set the robot's customData field: Webots sends it with the step's answer too */
+  char *data = sn_strdup_obj(sn_get(rep.result, "custom_data"));
+  if (data != NULL) {
+    free(rb->custom_data);
+    rb->custom_data = data;
+  }
   sn_reply_free(&rep);
   if (status == -1)
     rb->terminated = true;
