@@ -7,7 +7,10 @@ Both hold their Shapes too, numbered after every other nested node (:func:`_shap
 fields: appearance.py). They are
 numbered once per simulation, in scene order (robots, then solids, each depth first), from
 :data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
-imports) are never shifted by them. A nested node is found by DEF (first in scene order, as
+imports) are never shifted by them. The nodes inside a solid a Supervisor imported, or one a PROTO field set
+built again, follow as one segment each (:func:`add_solid`: its solids, then its shapes), numbered from the
+next id when the Supervisor first looks; :func:`drop` lets a removed or rebuilt solid's go (their ids read as
+removed, never given again). A nested node is found by DEF (first in scene order, as
 Webots' DEF dictionary) or by a dotted path ``A.B.C`` (each name after the first a direct child's
 DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``). A PROTO instance's body nodes are
 found by their DEF in that instance's scope (``getFromProtoDef``: :func:`inner_def`, from the import's

@@ -3,7 +3,8 @@
 Nodes are what the server simulates at the top of the world: the root (Webots' root Group, id 0,
 whose ``children`` lists the others), the robots (ids 1..R in world order), the top-level solids
 (R+1..R+S) and the world's top-level lights (then on), and the nodes inside robots and top-level
-solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``nested.FIRST_ID``). They
+solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``nested.FIRST_ID``; those of
+imported and rebuilt solids too, numbered when first looked at: :func:`_sync_imports`). They
 are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dotted path ``A.B`` walks
 direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
 a removed solid or light keeps its id, which then answers NULL and is never given to another node; a
