@@ -140,6 +140,27 @@ def test_a_colour_set_on_an_imported_shape_is_seen_as_a_world_file_with_that_col
         "baseColor 1 0 0", "baseColor 0.2 0.6 0.9 transparency 0.5"))))
 
 
+def test_a_texture_url_set_on_an_imported_shape_is_seen_as_the_world_file_with_that_url(tmp_path):
+    from PIL import Image
+
+    Image.new("RGB", (4, 4), (200, 100, 30)).save(tmp_path / "a.png")
+    Image.fromarray(np.random.default_rng(7).integers(0, 256, (4, 4, 3), dtype=np.uint8)).save(tmp_path / "b.png")
+    textured = WALL.replace("PBRAppearance { baseColor 1 0 0 roughness 1 metalness 0 }",
+                            'Appearance { material Material { } texture ImageTexture { url [ "a.png" ] } }')
+    (tmp_path / "world.wbt").write_text(WORLD.read_text())
+    sim = _sim(tmp_path / "world.wbt")                     # urls resolve against the world file's folder
+    sv.import_nodes(sim, sv.ROOT, "children", -1, textured)
+    shape = sv.node_by_id(sim, field(sim, sv.find_node(sim, "BOX"), "children")[0])
+    texture = sv.node_by_id(sim, field(sim, sv.node_by_id(sim, field(sim, shape, "appearance")), "texture"))
+    assert (texture.type, field(sim, texture, "url")) == ("ImageTexture", ["a.png"])
+    assert np.array_equal(_shot(sim), _shot(_written(tmp_path, textured)))
+    sv.change_item(sim, texture, "url", "set", 0, "b.png")
+    assert field(sim, texture, "url") == ["b.png"]
+    seen = _shot(sim)
+    assert np.array_equal(seen, _shot(_written(tmp_path, textured.replace("a.png", "b.png"))))
+    assert not np.array_equal(seen, _shot(_written(tmp_path, textured)))
+
+
 def test_a_removed_imports_inner_nodes_read_as_removed_and_their_ids_are_never_given_again():
     sim, (box_id, _) = _imported()
     inner = sv.find_node(sim, "BOX.INNER")
