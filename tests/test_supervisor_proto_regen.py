@@ -2,7 +2,7 @@
 PROTO node (README "Supervisor"): a field the template reads (``size``, ``round``, the list ``posts``) or one
 passing through IS to a node inside (``color``) is seen by every sensor from the next step exactly as the world
 file written with that value; the solid keeps its node id, DEF, name, place among the root's children and the
-pose a Supervisor gave it; the nodes of its old body read as removed; ``simulationReset`` puts it back where the
+pose a Supervisor gave it; the nodes of its old body read as removed, its new body's are served with new ids; ``simulationReset`` puts it back where the
 file put it and keeps the values set (Webots' reset resets no field); a value that does not build is one line
 and nothing changes. An imported instance is rebuilt the same way; kinematic contact and the ground robots ride
 see the new solid. The same from Python and C controllers.
@@ -121,14 +121,17 @@ def test_the_rebuilt_solid_keeps_its_id_def_name_place_and_the_pose_a_supervisor
     assert field(sim, "translation") == [1.5, 0.2, 0.0]
     assert _same(_readings(sim), _written(tmp_path, ("translation 1 0 0\n  size 0.2 0.2 0.2",
                                                      "translation 1.5 0.2 0\n  size 0.6 0.4 0.3")))
-    # the old body's nodes are gone (Webots deletes them); its new body's are not served here
+    # the old body's nodes are gone (Webots deletes them); its new body's are served, with new ids
     with pytest.raises(ValueError, match=r"node \d+ \(Shape ''\) was removed with 'obstacle' when a PROTO field "
                                          r"set built it again"):
         sv.node_by_id(sim, shape)
-    assert sv.get_field(sim, again, "children", level=0)["value"] == []
+    (new_shape,) = sv.get_field(sim, again, "children", level=0)["value"]
+    assert new_shape > shape and sv.node_by_id(sim, new_shape).type == "Shape"
     found, line = sv.from_proto_def(sim, again, "BODY")
-    assert found is None and "was built again by a PROTO field set" in line
-    assert sv.find_node(sim, "OBST.BODY") is None
+    assert found is not None and line == "" and found.type == "Box" and found.id > new_shape
+    assert sv.get_field(sim, sv.node_by_id(sim, new_shape), "geometry")["value"] == found.id
+    assert sv.get_field(sim, found, "size")["value"] == [0.6, 0.4, 0.3]
+    assert sv.find_node(sim, "OBST.BODY") is None          # a PROTO body's DEF: getFromProtoDef only
     # a field passing through IS is set as before: the rebuilt solid moves (its face 0.9 - 0.3 m away)
     sv.set_field(sim, again, "translation", [1.0, 0.0, 0.0])
     assert _readings(sim)["ds"] == pytest.approx(600.0, abs=1e-9)
@@ -198,9 +201,14 @@ def test_an_imported_instance_is_rebuilt_the_same_way(tmp_path):
     sim = _sim()
     sv.remove_node(sim, obst(sim))
     (added,) = sv.import_nodes(sim, sv.ROOT, "children", -1, "DEF OBST Obstacle { translation 1 0 0 }")
+    body, _ = sv.from_proto_def(sim, sv.node_by_id(sim, added), "BODY")     # the import's body is served
+    assert body is not None and sv.get_field(sim, body, "size")["value"] == [0.2, 0.2, 0.2]
     sv.set_field(sim, sv.node_by_id(sim, added), "size", [0.6, 0.4, 0.3])
     again = obst(sim)
     assert (again.id, again.proto) == (added, "Obstacle")
+    assert sv.node_from_id(sim, body.id) is None                # the old body's nodes removed, the new one's served
+    new_body, _ = sv.from_proto_def(sim, again, "BODY")
+    assert new_body is not None and new_body.id > body.id and sv.get_field(sim, new_body, "size")["value"] == [0.6, 0.4, 0.3]
     assert sv.get_field(sim, again, "size")["value"] == [0.6, 0.4, 0.3]
     got, ref = _readings(sim), _written(tmp_path, ("size 0.2 0.2 0.2", "size 0.6 0.4 0.3"))
     assert all(np.array_equal(got[k], ref[k]) for k in DEVICES)

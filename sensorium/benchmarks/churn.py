@@ -7,7 +7,8 @@ own calls of daemon/supervisor.py on an in-process ``Simulation``, no sockets), 
 supervisor robot with a camera (recognition on), a range finder, a lidar and two distance sensors looking
 at a PROTO obstacle (a PROTO of this module's own, no template) and a painted box:
 
-* ``import``: import a small solid (a box, its recognition colour) in front of the sensors, step, remove it;
+* ``import``: import a small solid (a box, its recognition colour) in front of the sensors, read its Shape's
+  geometry through its ``children`` (the nodes inside it served), step, remove it;
 * ``regen``:  set the obstacle's ``size`` (its solid built again, sim/regenerate.py), step;
 * ``colour``: set the painted box's ``baseColor``, step.
 
@@ -165,6 +166,10 @@ class Loop:
         self.k += 1
         if self.kind == "import":
             (node,) = sv.import_nodes(sim, sv.ROOT, "children", -1, BALL.format(x=1.0 + 0.001 * (k % 500)))
+            shape = sv.get_field(sim, sv.node_by_id(sim, node), "children")["value"]     # its inner nodes served
+            if shape:
+                sv.get_field(sim, sv.node_by_id(sim, sv.get_field(sim, sv.node_by_id(sim, shape[0]), "geometry")["value"]),
+                             "size")
             sim.step()
             sv.remove_node(sim, sv.node_by_id(sim, node))
         elif self.kind == "regen":

@@ -7,7 +7,10 @@ Both hold their Shapes too, numbered after every other nested node (:func:`_shap
 fields: appearance.py). They are
 numbered once per simulation, in scene order (robots, then solids, each depth first), from
 :data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
-imports) are never shifted by them. A nested node is found by DEF (first in scene order, as
+imports) are never shifted by them. The nodes inside a solid a Supervisor imported, or one a PROTO field set
+built again, follow as one segment each (:func:`add_solid`: its solids, then its shapes), numbered from the
+next id when the Supervisor first looks; :func:`drop` lets a removed or rebuilt solid's go (their ids read as
+removed, never given again). A nested node is found by DEF (first in scene order, as
 Webots' DEF dictionary) or by a dotted path ``A.B.C`` (each name after the first a direct child's
 DEF, Webots' ``getNodeFromDEF``), and by device (``getFromDevice``). A PROTO instance's body nodes are
 found by their DEF in that instance's scope (``getFromProtoDef``: :func:`inner_def`, from the import's
@@ -25,6 +28,7 @@ joint's ``endPoint`` and ``device`` fields (``end_point``, ``joint_devices``).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -84,18 +88,25 @@ class Nested:
     shape: Any = None     # a Shape or a node inside it: its appearance.ShapeRef (appearance.py serves its fields)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Table:
-    nodes: tuple[Nested, ...]
+    nodes: tuple[Nested, ...]                   # the world's, numbered once (:func:`build`)
     by_owner: dict[int, tuple[Nested, ...]]     # owner id -> its nodes, depth first
     by_parent: dict[int, tuple[Nested, ...]]    # parent id -> its direct subnodes
     bare_joints: frozenset[int] = frozenset()   # motorised joints without jointParameters (NULL)
     inner: dict[int, dict[str, int | str]] | None = None   # PROTO instance id -> DEF of its body -> node id, or why
                                                 # it is no node here (getFromProtoDef: :func:`inner_defs`)
+    added: dict[int, Nested] = dataclasses.field(default_factory=dict)  # the nodes of imported and rebuilt solids now there
+    forgotten: set[int] = dataclasses.field(default_factory=set)        # world nodes whose solid was built again (removed)
+    segments: dict[int, str] = dataclasses.field(default_factory=dict)  # owner id -> its solid's name, for those in ``added``
+    end: int = FIRST_ID                         # the next id to give (ids are never reused)
+    imports_seen: int = 0                       # how many of the simulation's imports were looked at
 
     def get(self, node_id: int) -> Nested | None:
+        """The node of that id: a world node (one a rebuild forgot too: :attr:`forgotten`), or an imported or
+        rebuilt solid's while that solid is there; None otherwise (below :attr:`end`: a removed one)."""
         k = node_id - FIRST_ID
-        return self.nodes[k] if 0 <= k < len(self.nodes) else None
+        return self.nodes[k] if 0 <= k < len(self.nodes) else self.added.get(node_id)
 
 
 def _robot_entries(robot: Any) -> list[wm.NestedNode]:
@@ -187,30 +198,40 @@ def _joint_parameters(sim: Any, robots: list[str], out: list[Nested]) -> tuple[l
     return added, frozenset(bare)
 
 
-def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nested],
-                 solid_ids: dict[int, int], shape_tags: list[tuple[int, wm.InnerDef, int]]) -> list[Nested]:
-    """The robots' and top-level solids' Shape nodes (appearance.py), each followed by the nodes inside
-    it, numbered after every other nested node: robots in world order, then solids (each solid's
-    shapes, then those of the solids inside it). A robot's shape sits under the node its world entry
-    names (``ShapeNode.parent``), a solid's under the solid holding it. ``shape_tags`` gets the PROTO-body
-    DEFs of the shapes and their nodes: (owner id, InnerDef, the node's id)."""
+Holder = tuple[Any, int, int, str, str]
+"""A shape to number and where it is: (its model, its parent's id, its owner's id, "Robot" | "Solid", owner key)."""
+
+
+def _solid_holders(s: wm.Solid, holder: int, owner: int, key: str, solid_ids: dict[int, int]) -> list[Holder]:
+    """A top-level solid's shapes (``holder``: its id), then those of the solids inside it, depth first."""
+    out: list[Holder] = [(shape, holder, owner, "Solid", key)
+                         for shape in ([s] if s.geometry is not None else []) + list(s.shapes)]
+    for child in s.children:
+        out += _solid_holders(child, solid_ids[id(child)], owner, key, solid_ids)
+    return out
+
+
+def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, int],
+                 shape_tags: list[tuple[int, wm.InnerDef, int]]) -> list[Nested]:
+    """The Shape nodes of ``holders`` (appearance.py), each followed by the nodes inside it, numbered from id
+    ``first``. A robot's shape sits under the node its world entry names (``ShapeNode.parent``: ``starts``
+    gives the id of each robot's first entry), a solid's under the solid holding it. A DEF'd appearance,
+    material or texture is one node for the shapes among ``holders`` that USE it (its peers: a setter changes
+    them all). ``shape_tags`` gets the PROTO-body DEFs of the shapes and their nodes: (owner id, InnerDef,
+    the node's id)."""
     scene = sim.scene
     index = {id(scene.loaded_model(k)): k for k in range(len(scene.shapes))}
     loaded = getattr(sim, "loaded", None)
     wbt = str(getattr(loaded, "source", "")).lower().endswith(".wbt")
     shared: dict[tuple[str, int], list[int]] = {}     # (role, the node's number) -> the shapes holding it
-    for k in range(len(scene.shapes)):
-        held = getattr(scene.loaded_model(k), "node", None)
-        if held is not None:
+    for shape, *_ in holders:
+        held, k = getattr(shape, "node", None), index.get(id(shape))
+        if held is not None and k is not None:
             for role, number in (("appearance", held.appearance_key), ("material", held.material_key),
                                  ("texture", held.texture_key)):
                 if number >= 0:
                     shared.setdefault((role, number), []).append(k)
     added: list[Nested] = []
-    starts: dict[int, int] = {}       # a robot's node id -> the id of its first world entry
-    for n in out:
-        if n.owner_kind == "Robot" and n.field != "jointParameters":
-            starts.setdefault(n.owner, n.id)
     inner_tags: list[tuple[int, wm.InnerDef, int]] = []     # (owner, tag, the id of the node it names)
 
     def add(shape: Any, parent: int, owner: int, kind: str, key: str) -> None:
@@ -221,18 +242,18 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
         if node is not None and kind == "Robot" and node.parent >= 0 and owner in starts:
             parent = starts[owner] + node.parent
         order = float("inf") if node is None else node.after + 0.5
-        me = FIRST_ID + len(out) + len(added)
+        me = first + len(added)
         added.append(Nested(me, "Shape", "", (node.def_name if node else None) or "", "", parent, "children", None,
                             None, "", owner, kind, key, order=order, shape=appearance.ShapeRef(k, node, "Shape", "Shape")))
         above = {"appearance": me, "geometry": me}
         ids = {"": me}
         for role, type_, def_name, field in appearance.inside(shape, k):
-            nid = FIRST_ID + len(out) + len(added)
+            nid = first + len(added)
             proto, face = ((node.appearance_proto or "", tuple(node.appearance_interface))
                            if node is not None and role == "appearance" else ("", ()))
             number = -1 if node is None else node.appearance_key if role == "appearance" else \
                 node.material_key if role == "material" else node.texture_key if role == "texture" else -1
-            peers = tuple(shared.get((role, number), (k,)))
+            peers = tuple(sorted(shared.get((role, number), (k,))))
             added.append(Nested(nid, type_, proto, def_name, "", above[role if role in above else "appearance"], field,
                                 None, None, "", owner, kind, key, interface=face,
                                 shape=appearance.ShapeRef(k, node, role, type_, peers)))
@@ -243,22 +264,47 @@ def _shape_nodes(sim: Any, robots: list[str], loaded_solids: int, out: list[Nest
             if tag.role in ids:
                 inner_tags.append((owner, tag, ids[tag.role]))
 
-    for i, name in enumerate(robots):
-        model = sim.robots[name].model
-        for shape in ([model.body] if model.body is not None else []) + list(model.shapes):
-            add(shape, i + 1, i + 1, "Robot", name)
-    for j in range(loaded_solids):
-        owner, key = len(robots) + 1 + j, sim.scene.solid_names[j]
-
-        def walk(s: wm.Solid, holder: int, owner: int = owner, key: str = key) -> None:
-            for shape in ([s] if s.geometry is not None else []) + list(s.shapes):
-                add(shape, holder, owner, "Solid", key)
-            for child in s.children:
-                walk(child, solid_ids[id(child)])
-
-        walk(sim.world.solids[j], owner)
+    for holder in holders:
+        add(*holder)
     shape_tags.extend(inner_tags)
     return added
+
+
+def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Nested], solid_ids: dict[int, int],
+                 tags: list[tuple[int, wm.InnerDef, int | str]], serials: dict[int, dict[int, int]]) -> None:
+    """The solids inside top-level solid ``solid`` (node ``owner``, named ``key``) at any depth, appended to
+    ``out`` depth first, numbered from ``first`` on (``first + len(out)``); ``solid_ids`` gets each one's id
+    by ``id()`` of its model, ``tags`` the PROTO-body DEFs, ``serials`` the PROTO instances by number."""
+
+    def walk(s: wm.Solid, parent: int, at: Pose | None) -> None:
+        for k, child in enumerate(s.children):
+            own = pose_from_model(child.pose)
+            local = own if at is None else at.compose(own)
+            node = Nested(first + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
+                          local, own, "", owner, "Solid", key, order=float(k))
+            out.append(node)
+            solid_ids[id(child)] = node.id
+            if child.proto_scope is not None:
+                serials.setdefault(owner, {})[child.proto_scope] = node.id
+            tags.extend((owner, t, node.id) for t in child.inner_defs)
+            walk(child, node.id, local)
+
+    walk(solid, owner, None)
+    tags.extend((owner, t, t.why) for t in solid.inner_defs if t.why)
+
+
+def _index(nodes: list[Nested], by_owner: dict[int, tuple[Nested, ...]],
+           by_parent: dict[int, tuple[Nested, ...]]) -> None:
+    """``nodes`` into the tables by owner and by parent (after what they hold)."""
+    owners: dict[int, list[Nested]] = {}
+    parents: dict[int, list[Nested]] = {}
+    for n in nodes:
+        owners.setdefault(n.owner, []).append(n)
+        parents.setdefault(n.parent, []).append(n)
+    for k, v in owners.items():
+        by_owner[k] = by_owner.get(k, ()) + tuple(v)
+    for k, v in parents.items():
+        by_parent[k] = by_parent.get(k, ()) + tuple(v)
 
 
 def build(sim: Any, loaded_solids: int) -> Table:
@@ -291,29 +337,24 @@ def build(sim: Any, loaded_solids: int) -> Table:
                               interface=tuple(e.interface), order=float(k)))
     solid_ids: dict[int, int] = {}          # id(nested solid model) -> its node id
     for j in range(loaded_solids):
-        owner = len(robots) + 1 + j
-        solid = sim.world.solids[j]
-
-        def walk(s: wm.Solid, parent: int, at: Pose | None, solid_name: str = sim.scene.solid_names[j],
-                 owner: int = owner) -> None:
-            for k, child in enumerate(s.children):
-                own = pose_from_model(child.pose)
-                local = own if at is None else at.compose(own)
-                node = Nested(FIRST_ID + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
-                              local, own, "", owner, "Solid", solid_name, order=float(k))
-                out.append(node)
-                solid_ids[id(child)] = node.id
-                if child.proto_scope is not None:
-                    serials.setdefault(owner, {})[child.proto_scope] = node.id
-                tags.extend((owner, t, node.id) for t in child.inner_defs)
-                walk(child, node.id, local)
-
-        walk(solid, owner, None)
-        tags.extend((owner, t, t.why) for t in solid.inner_defs if t.why)
+        _solid_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], FIRST_ID, out, solid_ids,
+                     tags, serials)
     parameters, bare = _joint_parameters(sim, robots, out)
     out += parameters
+    starts: dict[int, int] = {}       # a robot's node id -> the id of its first world entry
+    for n in out:
+        if n.owner_kind == "Robot" and n.field != "jointParameters":
+            starts.setdefault(n.owner, n.id)
+    holders: list[Holder] = []
+    for i, name in enumerate(robots):
+        model = sim.robots[name].model
+        holders += [(shape, i + 1, i + 1, "Robot", name)
+                    for shape in ([model.body] if model.body is not None else []) + list(model.shapes)]
+    for j in range(loaded_solids):
+        owner = len(robots) + 1 + j
+        holders += _solid_holders(sim.world.solids[j], owner, owner, sim.scene.solid_names[j], solid_ids)
     shape_tags: list[tuple[int, wm.InnerDef, int]] = []
-    out += _shape_nodes(sim, robots, loaded_solids, out, solid_ids, shape_tags)     # after all others: no other id moves
+    out += _shape_nodes(sim, holders, FIRST_ID + len(out), starts, shape_tags)     # after all others: no other id moves
     tags.extend(shape_tags)
     inner: dict[int, dict[str, int | str]] = {}
     for owner, tag, target in tags:
@@ -323,13 +364,52 @@ def build(sim: Any, loaded_solids: int) -> Table:
             instance = owner if tag.scope < 0 else serials.get(owner, {}).get(tag.scope)
         if instance is not None:
             inner.setdefault(instance, {}).setdefault(tag.name, target)
-    by_owner: dict[int, list[Nested]] = {}
-    by_parent: dict[int, list[Nested]] = {}
-    for n in out:
-        by_owner.setdefault(n.owner, []).append(n)
-        by_parent.setdefault(n.parent, []).append(n)
-    return Table(tuple(out), {k: tuple(v) for k, v in by_owner.items()}, {k: tuple(v) for k, v in by_parent.items()},
-                 bare, inner)
+    by_owner: dict[int, tuple[Nested, ...]] = {}
+    by_parent: dict[int, tuple[Nested, ...]] = {}
+    _index(out, by_owner, by_parent)
+    return Table(tuple(out), by_owner, by_parent, bare, inner, end=FIRST_ID + len(out))
+
+
+def add_solid(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid) -> None:
+    """The nodes inside top-level solid ``solid`` (node ``owner``, named ``key``: an imported solid, or one a
+    PROTO field set built again) join ``table`` as a world file's solid's would (its solids, then its shapes
+    and their nodes, with their PROTO-body DEFs), numbered from ``table.end`` on: new ids, never a removed
+    node's. :func:`drop` takes them out when the solid goes."""
+    out: list[Nested] = []
+    solid_ids: dict[int, int] = {}
+    tags: list[tuple[int, wm.InnerDef, int | str]] = []
+    serials: dict[int, dict[int, int]] = {}
+    _solid_nodes(solid, owner, key, table.end, out, solid_ids, tags, serials)
+    shape_tags: list[tuple[int, wm.InnerDef, int]] = []
+    out += _shape_nodes(sim, _solid_holders(solid, owner, owner, key, solid_ids), table.end + len(out), {},
+                        shape_tags)
+    tags.extend(shape_tags)
+    inner = table.inner if table.inner is not None else {}
+    for _, tag, target in tags:
+        instance = owner if tag.scope < 0 else serials.get(owner, {}).get(tag.scope)
+        if instance is not None:
+            inner.setdefault(instance, {}).setdefault(tag.name, target)
+    table.inner = inner
+    table.added.update((n.id, n) for n in out)
+    _index(out, table.by_owner, table.by_parent)
+    table.segments[owner] = key
+    table.end += len(out)
+
+
+def drop(table: Table, owner: int) -> None:
+    """The nodes inside top-level node ``owner`` leave the tree (it was removed, or built again): no walk, DEF
+    or getFromProtoDef finds them; a world node keeps its entry (:attr:`Table.forgotten`: it reads as removed),
+    an imported or rebuilt solid's is let go (its id reads as removed: below ``end``, in no table)."""
+    for n in table.by_owner.pop(owner, ()):
+        if table.added.pop(n.id, None) is None:
+            table.forgotten.add(n.id)
+        table.by_parent.pop(n.id, None)
+        if table.inner is not None:
+            table.inner.pop(n.id, None)
+    table.by_parent.pop(owner, None)
+    if table.inner is not None:
+        table.inner.pop(owner, None)
+    table.segments.pop(owner, None)
 
 
 def inner_def(table: Table, instance: int, name: str) -> int | str | None:

@@ -3,7 +3,8 @@
 Nodes are what the server simulates at the top of the world: the root (Webots' root Group, id 0,
 whose ``children`` lists the others), the robots (ids 1..R in world order), the top-level solids
 (R+1..R+S) and the world's top-level lights (then on), and the nodes inside robots and top-level
-solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``nested.FIRST_ID``). They
+solids (Solids, devices, Poses, Groups, joints: :mod:`.nested`, ids from ``nested.FIRST_ID``; those of
+imported and rebuilt solids too, numbered when first looked at: :func:`_sync_imports`). They
 are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dotted path ``A.B`` walks
 direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
 a removed solid or light keeps its id, which then answers NULL and is never given to another node; a
@@ -64,12 +65,36 @@ ROOT = Node(0, "Group", "", "", "")
 
 
 def _table(sim: Any) -> nested.Table:
-    """The world's nested nodes, numbered once per simulation (they never change: imports add none)."""
+    """The nested nodes: the world's, numbered once per simulation, then those of the solids a Supervisor
+    imported since (numbered as they are first looked at) and of the solids a PROTO field set built again
+    (:func:`_regenerate`); those of a removed solid are let go (:func:`_sync_imports`)."""
     table = getattr(sim, "_supervisor_nested", None)
     if table is None:
         table = nested.build(sim, _loaded_counts(sim)[0] if getattr(sim, "world", None) is not None else 0)
         sim._supervisor_nested = table
+    _sync_imports(sim, table)
     return table
+
+
+def _sync_imports(sim: Any, table: nested.Table) -> None:
+    """The nodes inside the imported solids (a Shape or Group imported at the root is visuals.py's) join the
+    table, after every node numbered before; those of a solid removed since leave it (memory stays that of
+    the solids there now). A solid imported and removed before anyone looked gets no ids."""
+    live = sim.scene.solid_poses
+    for owner in [o for o, k in table.segments.items() if k not in live]:
+        nested.drop(table, owner)
+    imported = getattr(sim, "imported", [])
+    if table.imports_seen >= len(imported):
+        table.imports_seen = min(table.imports_seen, len(imported))
+        return
+    first = len(_loaded_nodes(sim))                     # the imports' ids follow the loaded nodes' (_all_nodes)
+    shown = getattr(sim, "imported_visuals", {})
+    for i in range(table.imports_seen, len(imported)):
+        kind, key = imported[i]
+        if kind == "Solid" and key not in shown and key in live:
+            solid = next(s for s in reversed(sim.world.solids) if s.name == key)
+            nested.add_solid(sim, table, first + 1 + i, str(key), solid)
+    table.imports_seen = len(imported)
 
 
 def _nested_node(n: nested.Nested) -> Node:
@@ -207,9 +232,10 @@ def _removed(sim: Any, node: Node) -> bool:
     if node.visual:                  # with the solid holding it
         return node.key not in sim.scene.solid_poses
     if node.nested:                  # with its top-level solid, or when that solid was built again
-        n = _nested_of(sim, node)
-        return n.owner_kind == "Solid" and (n.owner_key not in sim.scene.solid_poses
-                                            or n.owner in getattr(sim, "_supervisor_rebuilt", ()))
+        table = _table(sim)
+        n = table.get(node.id)
+        return n is None or node.id in table.forgotten or (n.owner_kind == "Solid"
+                                                           and n.owner_key not in sim.scene.solid_poses)
     if node.type == "Solid":
         return node.key not in sim.scene.solid_poses
     return node.type in LIGHTS and node.key in sim.scene.removed_lights
@@ -316,8 +342,8 @@ def robot_node(sim: Any, robot: str) -> Node | None:
 
 def _known_ids(sim: Any) -> str:
     """The node ids there are, for an error line: the top-level ones, then the nested ones."""
-    inner = len(_table(sim).nodes)
-    nested_ids = f", nested {nested.FIRST_ID}..{nested.FIRST_ID + inner - 1}" if inner else ""
+    end = _table(sim).end
+    nested_ids = f", nested {nested.FIRST_ID}..{end - 1}" if end > nested.FIRST_ID else ""
     return f"ids 0..{len(_all_nodes(sim))}: 0 the root{nested_ids}"
 
 
@@ -334,7 +360,10 @@ def node_by_id(sim: Any, node: int) -> Node:
             raise ValueError(f"node {node} ({found.type}) was removed with the imported node holding it")
         return found
     if node >= nested.FIRST_ID:
-        inner = _table(sim).get(node)
+        table = _table(sim)
+        inner = table.get(node)
+        if inner is None and node < table.end:
+            raise ValueError(f"node {node} was removed with the imported or rebuilt solid holding it")
         if inner is None:
             raise ValueError(f"no node with id {node} ({_known_ids(sim)})")
         found = _nested_node(inner)
@@ -839,9 +868,6 @@ def from_proto_def(sim: Any, node: Node, name: str) -> tuple[Node | None, str]:
     if node.scenery or node.visual or node.type in LIGHTS or (node.nested and _nested_of(sim, node).shape is not None):
         return None, (f"the body of PROTO {node.proto} ({_what(node)}) is not searched here: DEF names are found in "
                       "the bodies of robots, solids and the PROTO instances inside them")
-    if node.id in getattr(sim, "_supervisor_rebuilt", ()):
-        return None, (f"PROTO {node.proto} ({_what(node)}) was built again by a PROTO field set: the DEF names of its "
-                      "new body are not served here (as an imported solid's)")
     found = nested.inner_def(_table(sim), node.id, name)
     if isinstance(found, str):
         return None, f"DEF {name} of PROTO {node.proto}'s body ({_what(node)}) names {found}"
@@ -964,7 +990,7 @@ def _regenerate(sim: Any, node: Node, field: str, kind: str, value: Any) -> list
     (sim/regenerate.py): it keeps its id, DEF, name, pose now and place among the root's children (built at
     the instance's written pose, as loaded, then moved where a Supervisor put it: its template reads the
     written ``translation`` and ``rotation``); the nodes inside it were Webots' internal nodes of the old
-    body: they read as removed, and those of the new body are not served (as an imported solid's). One line
+    body: they read as removed, and those of the new body are served with new ids (:func:`_forget`). One line
     and nothing changed when it does not build; returns the lines of the values corrected as in a world file."""
     from sensorium.server.sim.imports import ImportRefused
     from sensorium.server.sim.regenerate import regenerate
@@ -984,19 +1010,16 @@ def _regenerate(sim: Any, node: Node, field: str, kind: str, value: Any) -> list
                          f"not build with that value: {text}; nothing changed") from None
     if moved:                        # built where the instance says, as loaded (a reset puts it back there bit for
         sim.place_solid(key, now)    # bit), then moved where the Supervisor had put it
-    _forget(sim, table, node.id)
+    _forget(sim, table, node.id, key)
     return corrected
 
 
-def _forget(sim: Any, table: nested.Table, owner: int) -> None:
-    """The nodes inside top-level node ``owner`` leave the tree (its body was built again): they keep their
-    ids, which read as removed nodes, and no walk, DEF or getFromProtoDef finds them."""
-    gone = {n.id for n in table.by_owner.get(owner, ())}
-    by_owner = {k: v for k, v in table.by_owner.items() if k != owner}
-    by_parent = {k: tuple(n for n in v if n.id not in gone) for k, v in table.by_parent.items() if k not in gone}
-    inner = {k: v for k, v in (table.inner or {}).items() if k != owner and k not in gone}
-    sim._supervisor_nested = nested.Table(table.nodes, by_owner, by_parent, table.bare_joints, inner)
-    sim._supervisor_rebuilt = {*getattr(sim, "_supervisor_rebuilt", ()), owner}
+def _forget(sim: Any, table: nested.Table, owner: int, key: str) -> None:
+    """The nodes inside top-level solid ``owner`` leave the tree (its body was built again): their ids read
+    as removed nodes and no walk, DEF or getFromProtoDef finds them; the new body's nodes take their place,
+    with new ids (Webots' regenerated node holds new internal nodes)."""
+    nested.drop(table, owner)
+    nested.add_solid(sim, table, owner, key, next(s for s in reversed(sim.world.solids) if s.name == key))
 
 
 def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> list[str]:
