@@ -87,7 +87,7 @@ from sensorium.server.sim.contact import (
     shaped_obstacle,
     spin_reach,
 )
-from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, support_ceiling
+from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, settle_world, support_ceiling
 from sensorium.server.sim.motion import (
     _TO_ENU,
     AckermannDrive,
@@ -221,7 +221,8 @@ class BatchedSimulation:
         if int(copies) < 1:
             raise BatchedError(f"copies must be >= 1, got {copies}")
         self.loaded = world
-        self.world = w = world.world
+        # its wheeled robots settled on the ground as Simulation settles them (sim/ground.py)
+        self.world = w = settle_world(world.world, _TO_ENU[world.world.world_info.coordinate_system], world.source)[0]
         self.copies = C = int(copies)
         self.basic_time_step = w.world_info.basic_time_step
         self._check_supported()

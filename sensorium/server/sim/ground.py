@@ -63,11 +63,16 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import FLOOR, enu_body, robot_footprint
 from sensorium.server.world.geometry import Pose
+from sensorium.server.world.poses import pose_from_model
 
 __all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "placing_ceiling", "ride_height",
-           "support_ceiling"]
+           "settle_world", "support_ceiling"]
 
 UPRIGHT_TOL = 1e-12     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
+SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
+SETTLE_NOTE = 1e-3      # m: a robot settled by more than this gets a load note
+SETTLE_NOTES = 8        # load notes said one robot a line; more robots settled are counted in one more line
+ROBOT_UPRIGHT_TOL = 1e-6    # |x, y| of a robot's z axis (ENU) still taken as upright: it is settled
 
 
 class GroundWarning(UserWarning):
@@ -418,3 +423,70 @@ def ground_angular_velocity(gx: float, gy: float, c: float, s: float, turn: floa
     k = gx * c + gy * s
     w = turn / (1.0 + k * k)
     return -gx * w, -gy * w, w
+
+
+def _wheels(robot: wm.Robot) -> tuple[float, float] | None:
+    """(its lowest wheel's bottom from its origin, its smallest wheel radius) for a robot whose drive
+    gives the wheel bottom (``wheel_bottom``), else None."""
+    if robot.differential_drive is not None:
+        drive, radius = robot.differential_drive, robot.differential_drive.wheel_radius
+    elif robot.mecanum_drive is not None:
+        drive, radius = robot.mecanum_drive, robot.mecanum_drive.wheel_radius
+    elif robot.ackermann_drive is not None:
+        a = robot.ackermann_drive
+        drive, radius = a, min(a.front_wheel_radius, a.rear_wheel_radius)
+    elif robot.omni_drive is not None:
+        drive, radius = robot.omni_drive, min(w.radius for w in robot.omni_drive.wheels)
+    else:
+        return None
+    return None if drive.wheel_bottom is None else (float(drive.wheel_bottom), float(radius))
+
+
+def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tuple[wm.World, list[str]]:
+    """The world with its wheeled robots settled on the ground, as Webots' physics drops them at
+    load, and one note line per robot moved by more than SETTLE_NOTE (at most SETTLE_NOTES, then a
+    count).
+
+    A robot is settled when its drive gives ``wheel_bottom`` and it stands upright (its z axis the
+    world's up): its height becomes ``ground − wheel_bottom``, so its lowest wheel's bottom touches
+    the ground under its origin; x, y and its rotation are kept. The ground is this module's, box
+    and cylinder tops included whatever the world has (terrains or not), under the ceiling
+    ``max(origin, wheel bottom + smallest wheel radius) + FLOOR``: a box top above its wheels' axle
+    (and its origin) is something it sank into, not its floor. Over no ground, off by at most
+    SETTLE_TOL, or not upright, a robot keeps its pose bit for bit."""
+    settling = [(i, r, w) for i, r in enumerate(world.robots) if (w := _wheels(r)) is not None]
+    surfaces = [surface for s in world.solids for surface in _surfaces(s)] if settling else []
+    if not surfaces:
+        return world, []
+    ground = Ground(surfaces, {s.name: pose_from_model(s.pose) for s in world.solids}, to_enu)
+    up = 2 if to_enu is None else int(np.argmax(np.abs(to_enu[2])))   # the world axis that is up
+    sign = 1.0 if to_enu is None else float(to_enu[2, up])
+    robots = list(world.robots)
+    moved: list[tuple[str, float, float]] = []
+    for i, robot, (bottom, radius) in settling:
+        pose = pose_from_model(robot.pose)
+        r, t = pose.rotation, pose.translation
+        if to_enu is not None:
+            r, t = to_enu @ r, to_enu @ t
+        if abs(r[0, 2]) > ROBOT_UPRIGHT_TOL or abs(r[1, 2]) > ROBOT_UPRIGHT_TOL or r[2, 2] <= 0.0:
+            continue
+        x, y, z = (float(v) for v in t)
+        under = ground.at(x, y, max(z, z + bottom + radius) + FLOOR)
+        if under is None:
+            continue
+        height = under[0] - bottom
+        if abs(height - z) <= SETTLE_TOL:
+            continue
+        translation = list(robot.pose.translation)
+        translation[up] = sign * height
+        robots[i] = robot.model_copy(update={"pose": robot.pose.model_copy(update={"translation": tuple(translation)})})
+        moved.append((robot.name, z, height))
+    axis = "xyz"[up]
+    notes = [f"{source}: robot {name!r} settled on the ground at load, as Webots' physics drops it: its origin's "
+             f"{axis} from {sign * z:.4f} to {sign * h:.4f} m (its lowest wheel now touches the ground under it)"
+             for name, z, h in moved if abs(h - z) > SETTLE_NOTE]
+    if len(notes) > SETTLE_NOTES:
+        more = len(notes) - SETTLE_NOTES
+        notes = [*notes[:SETTLE_NOTES], f"{source}: {more} more robots settled on the ground at load"]
+    return (world.model_copy(update={"robots": robots}) if moved else world), notes
+

@@ -2033,7 +2033,15 @@ class Converter:
         self._drive_wheels(robot, wheels)
 
     def _drive_wheels(self, robot: Owner, wheels: list[dict]) -> None:
-        """The drive's wheels are its own: their encoders measure them, their motors' joint fields go."""
+        """The drive's wheels are its own: their encoders measure them, their motors' joint fields go;
+        their lowest bottom is the drive's ``wheel_bottom`` (the robot settles on the ground with it)."""
+        from sensorium.server.world.wbt.drive import wheel_bottom
+
+        bottom = wheel_bottom(wheels, self)
+        if bottom is not None:
+            for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive"):
+                if key in robot.data:
+                    robot.data[key]["wheel_bottom"] = bottom
         for w in wheels:    # the wheels' encoders measure the drive's wheels
             for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]
