@@ -78,7 +78,6 @@ def test_the_how_to_shaped_robot_keeps_its_drive_with_its_rear_axle_behind_the_o
     (robot,) = w.world.robots
     assert robot.ackermann_drive == wm.AckermannDrive(
         wheelbase=2 * HY, track_front=2 * HX, track_rear=2 * HX, front_wheel_radius=R_W, rear_wheel_radius=R_W,
-        wheel_bottom=-R_W,
         type="4x4", max_wheel_speed=10.0, max_steering_angle=0.7, max_steering_speed=10.0, positive_steers="left",
         forward=(0.0, 1.0), rear_axle_offset=-HY)
 

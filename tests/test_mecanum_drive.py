@@ -194,7 +194,7 @@ def test_wbt_wheels_with_turned_friction_are_a_mecanum_drive(tmp_path: Path) -> 
     (robot,) = w.world.robots
     assert robot.differential_drive is None
     assert robot.mecanum_drive == wm.MecanumDrive(
-        wheel_bottom=-R, wheel_radius=R, lx=LX, ly=LY, max_wheel_speed=14.81, front_left_motor=FL, front_right_motor=FR,
+        wheel_radius=R, lx=LX, ly=LY, max_wheel_speed=14.81, front_left_motor=FL, front_right_motor=FR,
         rear_left_motor=RL, rear_right_motor=RR, rollers=(-1, 1, 1, -1))
     assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == [FR, FL, RR, RL]
     assert w.warnings == []

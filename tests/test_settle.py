@@ -92,6 +92,16 @@ def test_a_box_top_above_its_axle_and_origin_is_no_ground_for_it() -> None:
     assert _t(_sim([FLOOR, table], [_robot(at=(0.3, -0.2, 0.1))]))[2] == 0.0 + R
 
 
+def test_a_driveless_robots_floor_is_ground_and_a_driven_robots_body_is_not() -> None:
+    """Webots' create.wbt keeps its floor Plane in a robot (its ground supervisor): a robot without a
+    drive is ground as it loads; another driven robot's body under it is not."""
+    keeper = {"name": "ground", "pose": {"translation": [0.0, 0.0, 0.05]},
+              "shapes": [{"geometry": {"type": "plane"}}]}
+    assert _t(_sim([], [keeper, _robot(at=(0.3, -0.2, 0.2))]))[2] == 0.05 - (-R)
+    other = _robot("other", at=(0.3, -0.2, 0.0), body={"geometry": {"type": "box", "size": [0.2, 0.2, 0.1]}})
+    assert _t(_sim([FLOOR], [other, _robot(at=(0.3, -0.2, 0.4))]))[2] == 0.0 + R
+
+
 def test_over_a_terrain_it_settles_on_the_triangle_under_its_origin() -> None:
     # at the grid point x = 1.0 (i = 2): height 0.25·1.0 exactly (0.25 * 2 * 0.5), plus the grid's height
     sim = _sim([_grid(0.1)], [_robot(at=(1.0, 0.5, 2.0), yaw=0.0)])
@@ -208,12 +218,13 @@ def _wheel(side: str, y: float) -> str:
 
 
 def test_a_wbt_robot_takes_its_wheel_bottom_from_its_wheels_and_settles(tmp_path: Path) -> None:
-    """Axles 3 cm above the origin, wheels of radius 2.5 cm: wheel_bottom 0.005; placed 4.5 cm
-    above a floor at 0, its origin settles at -0.005 (wheel bottoms on the floor)."""
+    """A Robot with physics, axles 3 cm above its origin, wheels of radius 2.5 cm: wheel_bottom
+    0.005; placed 4.5 cm above a floor at 0, its origin settles at -0.005 (wheel bottoms on the
+    floor)."""
     text = ("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
             'Solid { name "floor" children [ Shape { geometry Plane { size 4 4 } } ] boundingObject Plane { size 4 4 } }\n'
             'Robot { translation 0.1 0.2 0.045 name "bot" controller "<extern>" children [\n'
-            + _wheel("left", 0.05) + _wheel("right", -0.05) + "] }\n")
+            + _wheel("left", 0.05) + _wheel("right", -0.05) + "] physics Physics { } }\n")
     path = tmp_path / "w.wbt"
     path.write_text(text)
     w = load_world(path)
@@ -223,3 +234,8 @@ def test_a_wbt_robot_takes_its_wheel_bottom_from_its_wheels_and_settles(tmp_path
     assert [n for n in w.warnings if "settled" in n] == [
         f"{w.source}: robot 'bot' settled on the ground at load, as Webots' physics drops it: its origin's z from "
         "0.0450 to -0.0050 m (its lowest wheel now touches the ground under it)"]
+    # without physics Webots' gravity does not move the robot: no wheel_bottom, it stays where it is put
+    path.write_text(text.replace(" physics Physics { } }\n", " }\n"))
+    w = load_world(path)
+    assert w.world.robots[0].differential_drive.wheel_bottom is None
+    assert _t(Simulation(w), "bot")[2] == 0.045 and not [n for n in w.warnings if "settled" in n]

@@ -318,8 +318,7 @@ def test_hinge_wheels_become_a_differential_drive(tmp_path: Path) -> None:
     w = load_world(write(tmp_path, _two_wheels()))
     dd = w.world.robots[0].differential_drive
     assert dd == wm.DifferentialDrive(wheel_radius=0.03, axle_length=0.1, max_wheel_speed=10.0,
-                                      left_motor="left wheel motor", right_motor="right wheel motor",
-                                      wheel_bottom=0.02 - 0.03)      # axles at 0.02, radius 0.03
+                                      left_motor="left wheel motor", right_motor="right wheel motor")
 
 
 def test_slots_hold_wheels_and_devices(tmp_path: Path) -> None:
@@ -340,8 +339,7 @@ def test_slots_hold_wheels_and_devices(tmp_path: Path) -> None:
     assert not w.report.losses and not w.warnings, w.warnings
     (robot,) = w.world.robots
     assert robot.differential_drive == wm.DifferentialDrive(wheel_radius=0.03, axle_length=0.1, max_wheel_speed=10.0,
-                                                            left_motor="left", right_motor="right",
-                                                            wheel_bottom=0.02 - 0.03)
+                                                            left_motor="left", right_motor="right")
     assert [s.pose.translation for s in robot.shapes] == [(0.0, 0.05, 0.02), (0.0, -0.05, 0.02)]
     assert [s.seen_by for s in robot.shapes] == ["both", "both"]
     ds = next(d for d in robot.devices if d.name == "ds")
@@ -693,7 +691,7 @@ def test_drive_from_wheel_end_points_when_anchors_coincide(tmp_path: Path) -> No
              'boundingObject Transform {{ rotation 1 0 0 1.570796 children [ Cylinder {{ height 0.005 radius 0.02 }} ] }} }} }}\n')
     p = write(tmp_path, 'Robot { name "e" children [\n' + wheel.format("left", 0.026) + wheel.format("right", -0.026) + "] }\n")
     dd = load_world(p).world.robots[0].differential_drive
-    assert dd == wm.DifferentialDrive(wheel_bottom=0.0, wheel_radius=0.02, axle_length=0.052, max_wheel_speed=6.28)
+    assert dd == wm.DifferentialDrive(wheel_radius=0.02, axle_length=0.052, max_wheel_speed=6.28)
 
 
 def test_textures_summarised_once(tmp_path: Path) -> None:

@@ -56,7 +56,6 @@ def test_a_hinge2_car_maps_to_the_ackermann_drive_and_drives_the_circle(tmp_path
     assert not [x for x in w.warnings if "drive" in x]
     (robot,) = w.world.robots
     assert robot.ackermann_drive == wm.AckermannDrive(
-        wheel_bottom=0.0,      # the wheels' bottoms level with the origin
         wheelbase=L, track_front=T, track_rear=T, front_wheel_radius=R, rear_wheel_radius=R, type="propulsion",
         max_wheel_speed=80.0, max_steering_angle=0.6, max_steering_speed=5.0, positive_steers="right")
     sensors = {d.name: d.motor for d in robot.devices if d.device == "PositionSensor"}

@@ -54,7 +54,7 @@ def test_four_wheels_become_a_skid_steer_drive(tmp_path: Path) -> None:
     w = load_world(write(tmp_path, pioneer()))
     (robot,) = w.world.robots
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_bottom=0.0, wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="front left wheel",
+        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="front left wheel",
         right_motor="front right wheel", skid_steer=wm.SkidSteer(left=["back left wheel"], right=["back right wheel"]))
     names = [(d.name, d.device) for d in robot.devices]       # Webots' tree order: each joint's motor, then sensor
     assert names[:4] == [("front left wheel", "RotationalMotor"), ("front left wheel sensor", "PositionSensor"),
@@ -117,7 +117,7 @@ def test_a_car_like_robot_maps_to_the_ackermann_drive_or_gets_one_line(tmp_path:
     w = load_world(p)
     robot = w.world.robots[0]
     assert robot.differential_drive is None and robot.ackermann_drive == wm.AckermannDrive(
-        wheel_bottom=0.0, wheelbase=0.3, track_front=2 * Y, track_rear=2 * Y, front_wheel_radius=R, rear_wheel_radius=R,
+        wheelbase=0.3, track_front=2 * Y, track_rear=2 * Y, front_wheel_radius=R, rear_wheel_radius=R,
         type="propulsion", max_wheel_speed=12.3, max_steering_angle=1.5, max_steering_speed=12.3,
         positive_steers="left", right_steer="right steer", left_steer="left steer", right_rear_wheel="right rear",
         left_rear_wheel="left rear")
@@ -169,7 +169,6 @@ def test_a_devices_own_motorised_joints_are_no_wheels(tmp_path: Path) -> None:
     (robot,) = w.world.robots
     assert robot.ackermann_drive is None
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_bottom=0.0,      # the wheels' bottoms level with the origin
         wheel_radius=R, axle_length=0.16, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert [(d.name, d.device) for d in robot.devices][:3] == [
         ("spin", "Lidar"), ("spin_turret", "RotationalMotor"), ("spin_belt", "RotationalMotor")]
@@ -196,7 +195,6 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     w = load_world(p)
     (robot,) = w.world.robots
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_bottom=0.0,      # the wheels' bottoms level with the origin
         wheel_radius=R, axle_length=0.052, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert [(d.name, d.device) for d in robot.devices][:3] == [
         ("lift", "RotationalMotor"), ("lift sensor", "PositionSensor"), ("grip", "LinearMotor")]
@@ -232,7 +230,6 @@ def test_an_arm_of_plain_cylinders_on_a_two_wheel_robot_is_no_wheel(tmp_path: Pa
     w = load_world(p)
     (robot,) = w.world.robots
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_bottom=0.0,      # the wheels' bottoms level with the origin
         wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert not [x for x in w.warnings if "drive" in x]
     assert f"{p}:6:1: HingeJoint motor 'shoulder' is no wheel (nothing round at its end point turns about its " \
@@ -328,7 +325,6 @@ def test_a_pan_head_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Path) -> 
     w = load_world(p)
     (robot,) = w.world.robots
     assert robot.ackermann_drive is None and robot.differential_drive == wm.DifferentialDrive(
-        wheel_bottom=0.0,      # the wheels' bottoms level with the origin
         wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert not [x for x in w.warnings if "drive" in x], w.warnings
     assert [x.split(": ", 1)[1] for x in w.warnings if "head pan" in x] == [
@@ -353,7 +349,6 @@ def test_coupled_drive_wheels_are_said_and_turn_on_their_own(tmp_path: Path) -> 
     w = load_world(p)
     (robot,) = w.world.robots
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_bottom=0.0,      # the wheels' bottoms level with the origin
         wheel_radius=R, axle_length=0.16, max_wheel_speed=12.3, left_motor="wheel::left", right_motor="wheel::right")
     said = [x.split(": ", 1)[1] for x in w.warnings if "coupled" in x]
     assert said == [f"RotationalMotor 'wheel::{side}': a coupled motor (Webots passes a command to every motor whose "

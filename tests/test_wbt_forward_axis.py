@@ -71,7 +71,7 @@ def test_wheels_about_minus_x_make_a_drive_forward_along_y(tmp_path: Path) -> No
     (robot,) = w.world.robots
     # left = up × forward = -x: the wheels at x < 0 are the left side, as the how-to names them
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_bottom=-R, wheel_radius=R, axle_length=2 * HX, max_wheel_speed=9.0, left_motor="front_left_wheel",
+        wheel_radius=R, axle_length=2 * HX, max_wheel_speed=9.0, left_motor="front_left_wheel",
         right_motor="front_right_wheel", forward=(0.0, 1.0),
         skid_steer=wm.SkidSteer(left=["rear_left_wheel"], right=["rear_right_wheel"]))
     assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == list(WHEELS)
@@ -240,7 +240,6 @@ def test_a_car_whose_wheels_turn_about_minus_x_drives_along_y_and_circles_right(
     assert not [x for x in w.warnings if "drive" in x], w.warnings
     (robot,) = w.world.robots
     assert robot.ackermann_drive == wm.AckermannDrive(
-        wheel_bottom=-R,      # the axles level with the origin
         wheelbase=L, track_front=T, track_rear=T, front_wheel_radius=R, rear_wheel_radius=R, type="propulsion",
         max_wheel_speed=9.0, max_steering_angle=0.6, max_steering_speed=5.0, positive_steers="right",
         forward=(0.0, 1.0))

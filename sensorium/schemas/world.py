@@ -1304,7 +1304,8 @@ def _forward_field() -> Any:
 def _wheel_bottom_field() -> Any:
     return Field(default=None, description="m, the height of the robot's lowest wheel's bottom from its origin along "
                  "its z, its up (its axle's height less its radius; negative: below the origin; 0: the origin is where "
-                 "the wheels touch the ground). Given (the .wbt import gives it from the wheels' joints and shapes), "
+                 "the wheels touch the ground). Given (the .wbt import gives it from the wheels' joints and shapes for a "
+                 "Robot with physics), "
                  "the robot is lowered or raised at load, as Webots' physics drops it, until that point touches the "
                  "ground under its origin (README \"Settling on the ground\"); none: it keeps the height it is "
                  "placed at")

@@ -125,8 +125,13 @@ def _surfaces(s: wm.Solid) -> list[_Surface]:
     or cylinders."""
     from sensorium.server.sim.scene import solid_parts
 
+    return _parts_surfaces(s.name, solid_parts(s, Pose.identity()))
+
+
+def _parts_surfaces(owner: str, parts) -> list[_Surface]:
+    """The ground among ``parts`` ((name, pose in the owner's frame, shape)) of the solid or robot ``owner``."""
     surfaces: list[_Surface] = []
-    for _, local, shape in solid_parts(s, Pose.identity()):
+    for _, local, shape in parts:
         if shape.seen_by not in ("both", "bounding"):
             continue
         g = shape.geometry
@@ -134,14 +139,14 @@ def _surfaces(s: wm.Solid) -> list[_Surface]:
             xs = np.arange(g.x_dimension, dtype=np.float64) * float(g.x_spacing)
             ys = np.arange(g.y_dimension, dtype=np.float64) * float(g.y_spacing)
             h = np.asarray(g.height, dtype=np.float64).reshape(g.y_dimension, g.x_dimension)
-            surfaces.append(_Surface(s.name, local, _Grid(xs, ys, h)))
+            surfaces.append(_Surface(owner, local, _Grid(xs, ys, h)))
         elif isinstance(g, wm.Plane):
-            surfaces.append(_Surface(s.name, local, None))
+            surfaces.append(_Surface(owner, local, None))
         elif isinstance(g, wm.Box):
             sx, sy, sz = (float(v) / 2.0 for v in g.size)
-            surfaces.append(_Surface(s.name, local, None, (sx, sy, sz)))
+            surfaces.append(_Surface(owner, local, None, (sx, sy, sz)))
         elif isinstance(g, wm.Cylinder):
-            surfaces.append(_Surface(s.name, local, None, disc=(float(g.radius), float(g.height) / 2.0)))
+            surfaces.append(_Surface(owner, local, None, disc=(float(g.radius), float(g.height) / 2.0)))
     return surfaces
 
 
@@ -452,13 +457,25 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tup
     the ground under its origin; x, y and its rotation are kept. The ground is this module's, box
     and cylinder tops included whatever the world has (terrains or not), under the ceiling
     ``max(origin, wheel bottom + smallest wheel radius) + FLOOR``: a box top above its wheels' axle
-    (and its origin) is something it sank into, not its floor. Over no ground, off by at most
+    (and its origin) is something it sank into, not its floor. The shapes of robots without a drive
+    are ground here too, as the world loads them (Webots' physics drops a robot on any bounding
+    object; a world's floor may be a robot's). Over no ground, off by at most
     SETTLE_TOL, or not upright, a robot keeps its pose bit for bit."""
+    from sensorium.server.sim.scene import robot_parts
+
     settling = [(i, r, w) for i, r in enumerate(world.robots) if (w := _wheels(r)) is not None]
-    surfaces = [surface for s in world.solids for surface in _surfaces(s)] if settling else []
+    if not settling:
+        return world, []
+    # the solids' ground and the driveless robots' (a Webots world's floor may be a robot's: create.wbt's
+    # ground supervisor holds its Plane); a robot's keyed apart from any solid's name
+    static = [r for r in world.robots if not r.drive_motors]
+    surfaces = [surface for s in world.solids for surface in _surfaces(s)]
+    surfaces += [surface for r in static for surface in _parts_surfaces("\0" + r.name, robot_parts(r))]
     if not surfaces:
         return world, []
-    ground = Ground(surfaces, {s.name: pose_from_model(s.pose) for s in world.solids}, to_enu)
+    poses = {s.name: pose_from_model(s.pose) for s in world.solids}
+    poses.update({"\0" + r.name: pose_from_model(r.pose) for r in static})
+    ground = Ground(surfaces, poses, to_enu)
     up = 2 if to_enu is None else int(np.argmax(np.abs(to_enu[2])))   # the world axis that is up
     sign = 1.0 if to_enu is None else float(to_enu[2, up])
     robots = list(world.robots)
