@@ -239,3 +239,19 @@ def test_a_wbt_robot_takes_its_wheel_bottom_from_its_wheels_and_settles(tmp_path
     w = load_world(path)
     assert w.world.robots[0].differential_drive.wheel_bottom is None
     assert _t(Simulation(w), "bot")[2] == 0.045 and not [n for n in w.warnings if "settled" in n]
+
+
+def test_a_nue_world_settles_along_its_y() -> None:
+    from tests.test_batched_nue import _to_nue
+
+    plane = {**FLOOR, "pose": {"translation": [0.0, 0.0, 0.2]}}
+    enu = _loaded([plane], [_robot(at=(0.3, -0.2, 0.9))]).world
+    w = parse_world(_to_nue(enu), source="w.yaml")
+    sim = Simulation(w, precision="exact")
+    t = _t(sim)
+    assert t[1] == 0.2 - (-R) and (t[0], t[2]) == (-0.2, 0.3)     # NUE: (north, up, east) = (y, z, x)
+    assert [n for n in w.warnings if "settled" in n] == [
+        "w.yaml: robot 'r' settled on the ground at load, as Webots' physics drops it: its origin's y from "
+        "0.9000 to 0.2300 m (its lowest wheel now touches the ground under it)"]
+    bs = BatchedSimulation(w, copies=1, precision="exact")
+    assert np.array_equal(bs.pose(0, 0).translation, t)

@@ -478,21 +478,24 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tup
     ground = Ground(surfaces, poses, to_enu)
     up = 2 if to_enu is None else int(np.argmax(np.abs(to_enu[2])))   # the world axis that is up
     sign = 1.0 if to_enu is None else float(to_enu[2, up])
-    robots = list(world.robots)
-    moved: list[tuple[str, float, float]] = []
+    upright = []
     for i, robot, (bottom, radius) in settling:
         pose = pose_from_model(robot.pose)
         r, t = pose.rotation, pose.translation
         if to_enu is not None:
             r, t = to_enu @ r, to_enu @ t
-        if abs(r[0, 2]) > ROBOT_UPRIGHT_TOL or abs(r[1, 2]) > ROBOT_UPRIGHT_TOL or r[2, 2] <= 0.0:
-            continue
-        x, y, z = (float(v) for v in t)
-        under = ground.at(x, y, max(z, z + bottom + radius) + FLOOR)
-        if under is None:
-            continue
-        height = under[0] - bottom
-        if abs(height - z) <= SETTLE_TOL:
+        if abs(r[0, 2]) <= ROBOT_UPRIGHT_TOL and abs(r[1, 2]) <= ROBOT_UPRIGHT_TOL and r[2, 2] > 0.0:
+            upright.append((i, robot, bottom, float(t[0]), float(t[1]), float(t[2]), max(0.0, bottom + radius)))
+    if not upright:
+        return world, []
+    # every robot's ground in one call (element-wise: the bits Ground.at gives one robot)
+    _, _, bottoms, xs, ys, zs, axles = (np.array(c) for c in zip(*upright))
+    found, heights, _, _ = ground.under(xs, ys, (zs + axles) + FLOOR)
+    robots = list(world.robots)
+    moved: list[tuple[str, float, float]] = []
+    for k, (i, robot, bottom, _, _, z, _) in enumerate(upright):
+        height = float(heights[k]) - bottom
+        if not found[k] or abs(height - z) <= SETTLE_TOL:
             continue
         translation = list(robot.pose.translation)
         translation[up] = sign * height
