@@ -221,11 +221,12 @@ class BatchedSimulation:
         if int(copies) < 1:
             raise BatchedError(f"copies must be >= 1, got {copies}")
         self.loaded = world
-        # its wheeled robots settled on the ground as Simulation settles them (sim/ground.py)
-        self.world = w = settle_world(world.world, _TO_ENU[world.world.world_info.coordinate_system], world.source)[0]
+        self.world = w = world.world
         self.copies = C = int(copies)
         self.basic_time_step = w.world_info.basic_time_step
         self._check_supported()
+        # its wheeled robots settled on the ground as Simulation settles them (sim/ground.py)
+        self.world = w = settle_world(w, _TO_ENU[w.world_info.coordinate_system], world.source)[0]
         # world axes -> ENU (None in an ENU world): the drive state is ENU, as PlanarState's
         up = w.world_info.coordinate_system
         self.to_enu: np.ndarray | None = _TO_ENU[up]
