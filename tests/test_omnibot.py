@@ -30,6 +30,7 @@ def test_the_base_is_a_mecanum_drive_with_the_protos_layout() -> None:
     assert robot.differential_drive is None and robot.ackermann_drive is None
     assert robot.mecanum_drive == wm.MecanumDrive(
         wheel_radius=R, lx=LX, ly=LY, max_wheel_speed=12.0, front_left_motor="wheel2", front_right_motor="wheel1",
+        wheel_bottom=-0.098,      # the axles 5 cm below the origin, less R: at its 0.098 the robot stands on the floor
         rear_left_motor="wheel4", rear_right_motor="wheel3", rollers=(-1, 1, 1, -1))
     names = [d.name for d in robot.devices]
     assert names[:2] == ["gps", "compass"]                                   # the body slot's devices

@@ -1301,6 +1301,16 @@ def _forward_field() -> Any:
                  "y; a Webots robot whose wheels turn about its x axis drives along y)")
 
 
+def _wheel_bottom_field() -> Any:
+    return Field(default=None, description="m, the height of the robot's lowest wheel's bottom from its origin along "
+                 "its z, its up (its axle's height less its radius; negative: below the origin; 0: the origin is where "
+                 "the wheels touch the ground). Given (the .wbt import gives it from the wheels' joints and shapes for a "
+                 "Robot with physics), "
+                 "the robot is lowered or raised at load, as Webots' physics drops it, until that point touches the "
+                 "ground under its origin (README \"Settling on the ground\"); none: it keeps the height it is "
+                 "placed at")
+
+
 def _nonzero_forward(v: tuple[float, float]) -> tuple[float, float]:
     if math.hypot(*v) == 0:
         raise ValueError("forward must not be the zero vector")
@@ -1319,6 +1329,7 @@ class DifferentialDrive(Strict):
     right_motor: str = Field(default="right wheel motor", min_length=1)
     skid_steer: SkidSteer | None = Field(default=None, description="more wheels per side (skid steer)")
     forward: tuple[float, float] = _forward_field()
+    wheel_bottom: float | None = _wheel_bottom_field()
     axle_center: tuple[float, float] = Field(
         default=(0.0, 0.0), description="m, where the robot turns: the point midway between the wheel lines (the "
         "wheels' centre) from the robot's origin, along forward and its left; (0, 0): under the origin. Elsewhere "
@@ -1377,6 +1388,7 @@ class AckermannDrive(Strict):
     right_rear_wheel: str = Field(default="right_rear_wheel", min_length=1)
     left_rear_wheel: str = Field(default="left_rear_wheel", min_length=1)
     forward: tuple[float, float] = _forward_field()
+    wheel_bottom: float | None = _wheel_bottom_field()
     rear_axle_offset: float = Field(default=0.0, description="m, where the rear axle's centre is along forward from "
                                     "the robot's origin (negative: behind it); 0, the origin on the rear axle, as "
                                     "Webots' car PROTOs have it")
@@ -1435,6 +1447,7 @@ class MecanumDrive(Strict):
         "wheels (r·ω = vx + s·vy + (s·x − y)·ωz): diagonal wheels alike, the front two opposite; the default is "
         "the youBot's")
     forward: tuple[float, float] = _forward_field()
+    wheel_bottom: float | None = _wheel_bottom_field()
 
     _forward_nonzero = field_validator("forward")(_nonzero_forward)
 
@@ -1488,6 +1501,7 @@ class OmniDrive(Strict):
     (d, d · (up × p)) span three dimensions (not all axes parallel)."""
 
     wheels: list[OmniWheel] = Field(min_length=3, max_length=16)
+    wheel_bottom: float | None = _wheel_bottom_field()
     max_wheel_speed: float = Field(default=10.0, gt=0, description="rad/s, the wheel motors' maxVelocity")
 
     @property

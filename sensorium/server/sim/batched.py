@@ -87,7 +87,7 @@ from sensorium.server.sim.contact import (
     shaped_obstacle,
     spin_reach,
 )
-from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, support_ceiling
+from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, settle_world, support_ceiling
 from sensorium.server.sim.motion import (
     _TO_ENU,
     AckermannDrive,
@@ -225,6 +225,8 @@ class BatchedSimulation:
         self.copies = C = int(copies)
         self.basic_time_step = w.world_info.basic_time_step
         self._check_supported()
+        # its wheeled robots settled on the ground as Simulation settles them (sim/ground.py)
+        self.world = w = settle_world(w, _TO_ENU[w.world_info.coordinate_system], world.source)[0]
         # world axes -> ENU (None in an ENU world): the drive state is ENU, as PlanarState's
         up = w.world_info.coordinate_system
         self.to_enu: np.ndarray | None = _TO_ENU[up]

@@ -63,11 +63,16 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import FLOOR, enu_body, robot_footprint
 from sensorium.server.world.geometry import Pose
+from sensorium.server.world.poses import pose_from_model
 
 __all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "placing_ceiling", "ride_height",
-           "support_ceiling"]
+           "settle_world", "support_ceiling"]
 
 UPRIGHT_TOL = 1e-12     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
+SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
+SETTLE_NOTE = 1e-3      # m: a robot settled by more than this gets a load note
+SETTLE_NOTES = 8        # load notes said one robot a line; more robots settled are counted in one more line
+ROBOT_UPRIGHT_TOL = 1e-6    # |x, y| of a robot's z axis (ENU) still taken as upright: it is settled
 
 
 class GroundWarning(UserWarning):
@@ -120,8 +125,13 @@ def _surfaces(s: wm.Solid) -> list[_Surface]:
     or cylinders."""
     from sensorium.server.sim.scene import solid_parts
 
+    return _parts_surfaces(s.name, solid_parts(s, Pose.identity()))
+
+
+def _parts_surfaces(owner: str, parts) -> list[_Surface]:
+    """The ground among ``parts`` ((name, pose in the owner's frame, shape)) of the solid or robot ``owner``."""
     surfaces: list[_Surface] = []
-    for _, local, shape in solid_parts(s, Pose.identity()):
+    for _, local, shape in parts:
         if shape.seen_by not in ("both", "bounding"):
             continue
         g = shape.geometry
@@ -129,14 +139,14 @@ def _surfaces(s: wm.Solid) -> list[_Surface]:
             xs = np.arange(g.x_dimension, dtype=np.float64) * float(g.x_spacing)
             ys = np.arange(g.y_dimension, dtype=np.float64) * float(g.y_spacing)
             h = np.asarray(g.height, dtype=np.float64).reshape(g.y_dimension, g.x_dimension)
-            surfaces.append(_Surface(s.name, local, _Grid(xs, ys, h)))
+            surfaces.append(_Surface(owner, local, _Grid(xs, ys, h)))
         elif isinstance(g, wm.Plane):
-            surfaces.append(_Surface(s.name, local, None))
+            surfaces.append(_Surface(owner, local, None))
         elif isinstance(g, wm.Box):
             sx, sy, sz = (float(v) / 2.0 for v in g.size)
-            surfaces.append(_Surface(s.name, local, None, (sx, sy, sz)))
+            surfaces.append(_Surface(owner, local, None, (sx, sy, sz)))
         elif isinstance(g, wm.Cylinder):
-            surfaces.append(_Surface(s.name, local, None, disc=(float(g.radius), float(g.height) / 2.0)))
+            surfaces.append(_Surface(owner, local, None, disc=(float(g.radius), float(g.height) / 2.0)))
     return surfaces
 
 
@@ -418,3 +428,85 @@ def ground_angular_velocity(gx: float, gy: float, c: float, s: float, turn: floa
     k = gx * c + gy * s
     w = turn / (1.0 + k * k)
     return -gx * w, -gy * w, w
+
+
+def _wheels(robot: wm.Robot) -> tuple[float, float] | None:
+    """(its lowest wheel's bottom from its origin, its smallest wheel radius) for a robot whose drive
+    gives the wheel bottom (``wheel_bottom``), else None."""
+    if robot.differential_drive is not None:
+        drive, radius = robot.differential_drive, robot.differential_drive.wheel_radius
+    elif robot.mecanum_drive is not None:
+        drive, radius = robot.mecanum_drive, robot.mecanum_drive.wheel_radius
+    elif robot.ackermann_drive is not None:
+        a = robot.ackermann_drive
+        drive, radius = a, min(a.front_wheel_radius, a.rear_wheel_radius)
+    elif robot.omni_drive is not None:
+        drive, radius = robot.omni_drive, min(w.radius for w in robot.omni_drive.wheels)
+    else:
+        return None
+    return None if drive.wheel_bottom is None else (float(drive.wheel_bottom), float(radius))
+
+
+def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tuple[wm.World, list[str]]:
+    """The world with its wheeled robots settled on the ground, as Webots' physics drops them at
+    load, and one note line per robot moved by more than SETTLE_NOTE (at most SETTLE_NOTES, then a
+    count).
+
+    A robot is settled when its drive gives ``wheel_bottom`` and it stands upright (its z axis the
+    world's up): its height becomes ``ground − wheel_bottom``, so its lowest wheel's bottom touches
+    the ground under its origin; x, y and its rotation are kept. The ground is this module's, box
+    and cylinder tops included whatever the world has (terrains or not), under the ceiling
+    ``max(origin, wheel bottom + smallest wheel radius) + FLOOR``: a box top above its wheels' axle
+    (and its origin) is something it sank into, not its floor. The shapes of robots without a drive
+    are ground here too, as the world loads them (Webots' physics drops a robot on any bounding
+    object; a world's floor may be a robot's). Over no ground, off by at most
+    SETTLE_TOL, or not upright, a robot keeps its pose bit for bit."""
+    from sensorium.server.sim.scene import robot_parts
+
+    settling = [(i, r, w) for i, r in enumerate(world.robots) if (w := _wheels(r)) is not None]
+    if not settling:
+        return world, []
+    # the solids' ground and the driveless robots' (a Webots world's floor may be a robot's: create.wbt's
+    # ground supervisor holds its Plane); a robot's keyed apart from any solid's name
+    static = [r for r in world.robots if not r.drive_motors]
+    surfaces = [surface for s in world.solids for surface in _surfaces(s)]
+    surfaces += [surface for r in static for surface in _parts_surfaces("\0" + r.name, robot_parts(r))]
+    if not surfaces:
+        return world, []
+    poses = {s.name: pose_from_model(s.pose) for s in world.solids}
+    poses.update({"\0" + r.name: pose_from_model(r.pose) for r in static})
+    ground = Ground(surfaces, poses, to_enu)
+    up = 2 if to_enu is None else int(np.argmax(np.abs(to_enu[2])))   # the world axis that is up
+    sign = 1.0 if to_enu is None else float(to_enu[2, up])
+    upright = []
+    for i, robot, (bottom, radius) in settling:
+        pose = pose_from_model(robot.pose)
+        r, t = pose.rotation, pose.translation
+        if to_enu is not None:
+            r, t = to_enu @ r, to_enu @ t
+        if abs(r[0, 2]) <= ROBOT_UPRIGHT_TOL and abs(r[1, 2]) <= ROBOT_UPRIGHT_TOL and r[2, 2] > 0.0:
+            upright.append((i, robot, bottom, float(t[0]), float(t[1]), float(t[2]), max(0.0, bottom + radius)))
+    if not upright:
+        return world, []
+    # every robot's ground in one call (element-wise: the bits Ground.at gives one robot)
+    _, _, bottoms, xs, ys, zs, axles = (np.array(c) for c in zip(*upright))
+    found, heights, _, _ = ground.under(xs, ys, (zs + axles) + FLOOR)
+    robots = list(world.robots)
+    moved: list[tuple[str, float, float]] = []
+    for k, (i, robot, bottom, _, _, z, _) in enumerate(upright):
+        height = float(heights[k]) - bottom
+        if not found[k] or abs(height - z) <= SETTLE_TOL:
+            continue
+        translation = list(robot.pose.translation)
+        translation[up] = sign * height
+        robots[i] = robot.model_copy(update={"pose": robot.pose.model_copy(update={"translation": tuple(translation)})})
+        moved.append((robot.name, z, height))
+    axis = "xyz"[up]
+    notes = [f"{source}: robot {name!r} settled on the ground at load, as Webots' physics drops it: its origin's "
+             f"{axis} from {sign * z:.4f} to {sign * h:.4f} m (its lowest wheel now touches the ground under it)"
+             for name, z, h in moved if abs(h - z) > SETTLE_NOTE]
+    if len(notes) > SETTLE_NOTES:
+        more = len(notes) - SETTLE_NOTES
+        notes = [*notes[:SETTLE_NOTES], f"{source}: {more} more robots settled on the ground at load"]
+    return (world.model_copy(update={"robots": robots}) if moved else world), notes
+

@@ -29,7 +29,7 @@ from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch
 from sensorium.server.sim.cameras import Camera
 from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
-from sensorium.server.sim.ground import Ground, GroundWarning, band_low
+from sensorium.server.sim.ground import Ground, GroundWarning, band_low, settle_world
 from sensorium.server.sim.joints import JointMotor, Links
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, MecanumDrive, OmniDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
@@ -292,6 +292,10 @@ class Simulation:
         # solids and lists of its own: a Supervisor's imports append to them (the loaded world stays as read)
         self.world = loaded.world.model_copy(update={"solids": list(loaded.world.solids),
                                                     "lights": list(loaded.world.lights)})
+        # wheeled robots placed above (or into) the ground settle on it, as Webots' physics drops them
+        # (sim/ground.py); the load report says which moved (the note once, however many simulations)
+        self.world, settled = settle_world(self.world, _TO_ENU[self.world.world_info.coordinate_system], loaded.source)
+        loaded.warnings.extend(note for note in settled if note not in loaded.warnings)
         self.limits = limits or WorldLimits()
         self.allow_outside_meshes = allow_outside_meshes
         self.imported: list[tuple[str, str | int]] = []     # (node type, key) of each node a Supervisor imported

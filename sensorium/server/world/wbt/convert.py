@@ -1973,7 +1973,7 @@ class Converter:
                                 "wheels, which slip freely along their axes (Webots' physics makes plain wheels "
                                 "grip there, so such a robot moves only where no wheel would slide sideways)")
             robot.data["omni_drive"] = drive
-            self._drive_wheels(robot, wheels)
+            self._drive_wheels(node, robot, wheels)
             return
         turns = None                              # mecanum rollers: the wheels' friction turned (wbt/drive.py)
         if any(w["steers"] for w in wheels):
@@ -2030,10 +2030,19 @@ class Converter:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return
             robot.data["differential_drive"] = drive
-        self._drive_wheels(robot, wheels)
+        self._drive_wheels(node, robot, wheels)
 
-    def _drive_wheels(self, robot: Owner, wheels: list[dict]) -> None:
-        """The drive's wheels are its own: their encoders measure them, their motors' joint fields go."""
+    def _drive_wheels(self, node: Node, robot: Owner, wheels: list[dict]) -> None:
+        """The drive's wheels are its own: their encoders measure them, their motors' joint fields go;
+        their lowest bottom is the drive's ``wheel_bottom`` when the Robot has ``physics`` (Webots'
+        gravity drops it, so it settles on the ground at load; one without stays where it is put)."""
+        from sensorium.server.world.wbt.drive import wheel_bottom
+
+        bottom = wheel_bottom(wheels, self) if self.fields(node).node_("physics") is not None else None
+        if bottom is not None:
+            for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive"):
+                if key in robot.data:
+                    robot.data[key]["wheel_bottom"] = bottom
         for w in wheels:    # the wheels' encoders measure the drive's wheels
             for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]

@@ -584,6 +584,19 @@ def omni_wheels(wheels: list[dict], conv) -> bool:
     return max(bottoms) - min(bottoms) <= GROUND_TOL
 
 
+def wheel_bottom(wheels: list[dict], conv) -> float | None:
+    """The drive's ``wheel_bottom``: the lowest bottom, along the robot's z, of its wheels that do not
+    steer (each one's round part's centre, where it is as the world loads, less its radius), or None
+    without one whose radius is known. The robot settles on the ground with it at load."""
+    bottoms = []
+    for w in wheels:
+        radius = None if w["steers"] else wheel_radius(w["end"], conv)
+        if radius is not None:
+            centre = round_centre(w, conv)
+            bottoms.append(float((w["centre"] if centre is None else centre)[2]) - radius)
+    return min(bottoms) if bottoms else None
+
+
 def _on_axis(w: dict, conv) -> np.ndarray:
     """Where a wheel rolls on the ground (above it): the centre of its round part (:func:`round_centre`,
     else its end point's origin) taken onto its axis's line, in the robot's frame."""

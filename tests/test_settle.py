@@ -1,0 +1,257 @@
+"""Wheeled robots settle on the ground at load, as Webots' physics drops them (sim/ground.py
+``settle_world``): a robot whose drive gives ``wheel_bottom`` is lowered (or raised) so its lowest
+wheel's bottom touches the ground under its origin -- a floor plane, a box top, a terrain -- its
+x, y and rotation kept; over nothing, or without ``wheel_bottom``, it keeps its height bit for bit.
+Closed forms, the load note, a cliff sensor reading the floor, the .wbt import's wheel bottom, and
+the batched simulation's poses bit for bit."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world, parse_world
+
+R = 0.03                 # wheel radius; wheel_bottom -R: the axle through the robot's origin
+DRIVE = {"wheel_radius": R, "axle_length": 0.1, "wheel_bottom": -R}
+FLOOR = {"name": "floor", "geometry": {"type": "plane"}}
+
+
+def _robot(name: str = "r", at=(0.3, -0.2, 0.075), yaw: float = 0.7, drive: dict | None = None, **extra) -> dict:
+    return {"name": name, "pose": {"translation": list(at), "rotation": [0, 0, 1, yaw]},
+            "differential_drive": DRIVE if drive is None else drive, **extra}
+
+
+def _loaded(solids: list[dict], robots: list[dict], source: str = "<memory>"):
+    return parse_world({"solids": solids, "robots": robots}, source=source)
+
+
+def _sim(solids: list[dict], robots: list[dict]) -> Simulation:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")        # (a robot over no ground in a terrain world is said: not tested here)
+        return Simulation(_loaded(solids, robots), precision="exact")
+
+
+def _t(sim: Simulation, name: str = "r") -> np.ndarray:
+    return sim.robot(name).pose.translation
+
+
+def _grid(tz: float = 0.0) -> dict:
+    """A terrain rising 0.25 m per metre along +x: heights 0.25·x at its points, x, y in [0, 2]."""
+    heights = [0.25 * i * 0.5 for j in range(5) for i in range(5)]
+    return {"name": "hill", "pose": {"translation": [0.0, 0.0, tz]},
+            "geometry": {"type": "elevation_grid", "height": heights, "x_dimension": 5, "x_spacing": 0.5,
+                         "y_dimension": 5, "y_spacing": 0.5}}
+
+
+def _box(name: str, centre, size) -> dict:
+    return {"name": name, "pose": {"translation": list(centre)}, "geometry": {"type": "box", "size": list(size)}}
+
+
+# ---------------------------------------------------------------------- closed forms
+
+@pytest.mark.parametrize("h", [0.075, 0.0301, 5.0])
+def test_a_two_wheel_robot_above_a_plane_drops_until_its_wheels_touch_it(h: float) -> None:
+    sim = _sim([FLOOR], [_robot(at=(0.3, -0.2, h))])
+    t = _t(sim)
+    assert t[2] == 0.0 - (-R)                       # its wheel bottom (origin − R) on the plane at 0, exactly
+    assert (t[0], t[1]) == (0.3, -0.2)              # x, y kept
+    yaw = math.atan2(sim.robot("r").pose.rotation[1, 0], sim.robot("r").pose.rotation[0, 0])
+    assert yaw == pytest.approx(0.7, abs=1e-15)
+    sim.step()                                      # and it stays there
+    assert _t(sim)[2] == 0.0 + R
+
+
+def test_a_raised_plane_and_a_robot_below_it_half_sunk() -> None:
+    plane = {**FLOOR, "pose": {"translation": [0.0, 0.0, 0.2]}}
+    assert _t(_sim([plane], [_robot(at=(0.0, 0.0, 0.9))]))[2] == 0.2 - (-R)
+    # half sunk: the axle 1.5 cm above the floor (the wheel's lower half in it) -> raised
+    assert _t(_sim([plane], [_robot(at=(0.0, 0.0, 0.2 + R / 2))]))[2] == 0.2 - (-R)
+
+
+def test_over_a_box_floor_its_top_is_the_ground_and_not_the_plane_below() -> None:
+    deck = _box("deck", (0.0, 0.0, 0.1), (1.0, 1.0, 0.2))       # top at 0.1 + 0.1
+    top = 0.1 + 0.1
+    assert _t(_sim([FLOOR, deck], [_robot(at=(0.3, -0.2, 0.6))]))[2] == top - (-R)
+    # sunk 2 cm into the deck, its axle still above the top: raised onto it, not dropped to the plane
+    assert _t(_sim([FLOOR, deck], [_robot(at=(0.3, -0.2, top + 0.01))]))[2] == top - (-R)
+    # beside the deck: the plane
+    assert _t(_sim([FLOOR, deck], [_robot(at=(0.8, 0.0, 0.6))]))[2] == 0.0 + R
+
+
+def test_a_box_top_above_its_axle_and_origin_is_no_ground_for_it() -> None:
+    """A table top 0.5 m up over a robot on the floor: the robot was put under the table, not into
+    it, so it settles on the floor (its axle below the table top, the box is not its ground)."""
+    table = _box("table", (0.0, 0.0, 0.5), (1.0, 1.0, 0.04))
+    assert _t(_sim([FLOOR, table], [_robot(at=(0.3, -0.2, 0.1))]))[2] == 0.0 + R
+
+
+def test_a_driveless_robots_floor_is_ground_and_a_driven_robots_body_is_not() -> None:
+    """Webots' create.wbt keeps its floor Plane in a robot (its ground supervisor): a robot without a
+    drive is ground as it loads; another driven robot's body under it is not."""
+    keeper = {"name": "ground", "pose": {"translation": [0.0, 0.0, 0.05]},
+              "shapes": [{"geometry": {"type": "plane"}}]}
+    assert _t(_sim([], [keeper, _robot(at=(0.3, -0.2, 0.2))]))[2] == 0.05 - (-R)
+    other = _robot("other", at=(0.3, -0.2, 0.0), body={"geometry": {"type": "box", "size": [0.2, 0.2, 0.1]}})
+    assert _t(_sim([FLOOR], [other, _robot(at=(0.3, -0.2, 0.4))]))[2] == 0.0 + R
+
+
+def test_over_a_terrain_it_settles_on_the_triangle_under_its_origin() -> None:
+    # at the grid point x = 1.0 (i = 2): height 0.25·1.0 exactly (0.25 * 2 * 0.5), plus the grid's height
+    sim = _sim([_grid(0.1)], [_robot(at=(1.0, 0.5, 2.0), yaw=0.0)])
+    assert _t(sim)[2] == (0.1 + 0.25 * 2 * 0.5) - (-R)
+    r = sim.robot("r").pose.rotation                  # riding it: the slope's pitch, as before
+    assert math.atan2(-r[2, 0], r[0, 0]) == pytest.approx(-math.atan(0.25), abs=1e-12)
+    d = sim.robot("r").drive
+    for m in (*d.lefts, *d.rights):
+        m.set_position(math.inf)
+        m.set_velocity(2.0)
+    sim.run(10)                                         # drives up keeping its wheels on the ground
+    x = _t(sim)[0]
+    assert _t(sim)[2] == pytest.approx(0.1 + 0.25 * x + R, abs=1e-12)
+
+
+def test_over_nothing_without_wheel_bottom_or_not_upright_it_keeps_its_pose() -> None:
+    deck = _box("deck", (5.0, 5.0, 0.1), (1.0, 1.0, 0.2))     # nowhere under it
+    w = _loaded([deck], [_robot(at=(0.3, -0.2, 0.075))])
+    sim = Simulation(w)
+    assert w.world.robots[0].pose.translation == (0.3, -0.2, 0.075)
+    assert _t(sim)[2] == 0.075
+    assert not [n for n in w.warnings if "settled" in n]
+    plain = {k: v for k, v in DRIVE.items() if k != "wheel_bottom"}      # a YAML drive without it
+    assert _t(_sim([FLOOR], [_robot(drive=plain)]))[2] == 0.075
+    tilted = _robot()
+    tilted["pose"]["rotation"] = [1, 0, 0, 0.3]                          # rolled 0.3 rad: not settled
+    assert _t(_sim([FLOOR], [tilted]))[2] == 0.075
+    still = {"name": "arm", "pose": {"translation": [0.0, 0.0, 0.4]}}     # no drive: never moved
+    assert _sim([FLOOR], [still]).scene.robot_poses[0].translation[2] == 0.4
+
+
+def test_a_robot_touching_the_floor_changes_nothing_bit_for_bit() -> None:
+    """Wheels already on the floor (and within 1 µm of it): the pose is the world file's, its bits."""
+    for z in (R, R + 1e-7, R - 1e-7):
+        w = _loaded([FLOOR], [_robot(at=(0.3, -0.2, z))])
+        sim = Simulation(w)
+        assert _t(sim)[2] == z
+        assert sim.world.robots[0] is w.world.robots[0]
+
+
+# ---------------------------------------------------------------------- the load note
+
+def test_the_load_note_says_which_robot_from_what_height_to_what() -> None:
+    robots = [_robot("high", at=(0.0, 0.0, 0.075)), _robot("close", at=(1.0, 0.0, R + 0.0005)),
+              _robot("sunk", at=(2.0, 0.0, 0.01))]
+    w = _loaded([FLOOR], robots, source="w.yaml")
+    sim = Simulation(w)
+    assert _t(sim, "close")[2] == R                     # settled, but by 0.5 mm: no note
+    said = [n for n in w.warnings if "settled" in n]
+    assert said == [
+        "w.yaml: robot 'high' settled on the ground at load, as Webots' physics drops it: its origin's z from "
+        "0.0750 to 0.0300 m (its lowest wheel now touches the ground under it)",
+        "w.yaml: robot 'sunk' settled on the ground at load, as Webots' physics drops it: its origin's z from "
+        "0.0100 to 0.0300 m (its lowest wheel now touches the ground under it)"]
+    assert "warning: w.yaml: robot 'high' settled" in "\n".join(w.report.lines())
+    Simulation(w)                                       # a second simulation of it: said once
+    assert len([n for n in w.warnings if "settled" in n]) == 2
+
+
+def test_the_notes_are_capped() -> None:
+    w = _loaded([FLOOR], [_robot(f"r{i}", at=(float(i), 0.0, 0.5)) for i in range(11)], source="w.yaml")
+    Simulation(w)
+    said = [n for n in w.warnings if "settled" in n]
+    assert len(said) == 9 and said[-1] == "w.yaml: 3 more robots settled on the ground at load"
+    assert "'r7'" in said[7]
+
+
+# ---------------------------------------------------------------------- sensors see from the settled height
+
+CLIFF = {"device": "DistanceSensor", "name": "cliff", "type": "infra-red", "number_of_rays": 1,
+         "pose": {"translation": [0.1, 0.0, -0.02], "rotation": [0, 1, 0, math.pi / 2]},     # looking down
+         "lookup_table": [[0.0, 0.0, 0.0], [0.1, 1000.0, 0.0]]}
+
+
+def test_a_cliff_sensor_reads_the_floor_after_settling() -> None:
+    """Placed 4.5 cm high, as Webots' create.wbt places the Create, its cliff sensor 2 cm below the
+    axle would read 0.065 m of air (650); settled, the white floor 1 cm below it: 100."""
+    def cliff(drive: dict) -> float:
+        sim = _sim([FLOOR], [_robot(at=(0.3, -0.2, R + 0.045), devices=[CLIFF], drive=drive)])
+        sim.robot("r").device("cliff").enable(16)
+        sim.step()
+        return float(sim.robot("r").device("cliff").value)
+
+    assert cliff(DRIVE) == pytest.approx((R - 0.02) / 0.1 * 1000.0, abs=1e-9)
+    hovering = {k: v for k, v in DRIVE.items() if k != "wheel_bottom"}      # not settled: as before
+    assert cliff(hovering) == pytest.approx((R + 0.045 - 0.02) / 0.1 * 1000.0, abs=1e-9)
+
+
+# ---------------------------------------------------------------------- the batched simulation
+
+@pytest.mark.parametrize("solids", [[FLOOR], [FLOOR, _box("deck", (0.0, 0.0, 0.1), (1.0, 1.0, 0.2))], [_grid(0.1)]])
+def test_the_batched_copies_settle_as_the_simulation_does(solids: list[dict]) -> None:
+    robots = [_robot("a", at=(1.0, 0.5, 0.6), yaw=0.0), _robot("b", at=(0.2, 0.3, 0.011))]
+    sim = _sim(solids, robots)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        bs = BatchedSimulation(_loaded(solids, robots), copies=2, precision="exact")
+    for slot, name in enumerate(("a", "b")):
+        assert sim.robot(name).pose.translation[2] != robots[slot]["pose"]["translation"][2]
+        for c in range(2):
+            p = bs.pose(c, slot)
+            assert np.array_equal(p.translation, sim.robot(name).pose.translation)
+            assert np.array_equal(p.rotation, sim.robot(name).pose.rotation)
+
+
+# ---------------------------------------------------------------------- the .wbt import
+
+def _wheel(side: str, y: float) -> str:
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0.03 }}\n'
+            f'  device [ RotationalMotor {{ name "{side} wheel motor" maxVelocity 10 }} ]\n'
+            f'  endPoint Solid {{ translation 0 {y} 0.03 rotation 1 0 0 1.5707963267948966 name "{side} wheel"\n'
+            '    children [ Shape { geometry Cylinder { radius 0.025 height 0.01 } } ]\n'
+            '    boundingObject Cylinder { radius 0.025 height 0.01 } physics Physics { } } }\n')
+
+
+def test_a_wbt_robot_takes_its_wheel_bottom_from_its_wheels_and_settles(tmp_path: Path) -> None:
+    """A Robot with physics, axles 3 cm above its origin, wheels of radius 2.5 cm: wheel_bottom
+    0.005; placed 4.5 cm above a floor at 0, its origin settles at -0.005 (wheel bottoms on the
+    floor)."""
+    text = ("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+            'Solid { name "floor" children [ Shape { geometry Plane { size 4 4 } } ] boundingObject Plane { size 4 4 } }\n'
+            'Robot { translation 0.1 0.2 0.045 name "bot" controller "<extern>" children [\n'
+            + _wheel("left", 0.05) + _wheel("right", -0.05) + "] physics Physics { } }\n")
+    path = tmp_path / "w.wbt"
+    path.write_text(text)
+    w = load_world(path)
+    assert w.world.robots[0].differential_drive.wheel_bottom == pytest.approx(0.005, abs=1e-12)
+    sim = Simulation(w)
+    assert _t(sim, "bot")[2] == 0.0 - w.world.robots[0].differential_drive.wheel_bottom
+    assert [n for n in w.warnings if "settled" in n] == [
+        f"{w.source}: robot 'bot' settled on the ground at load, as Webots' physics drops it: its origin's z from "
+        "0.0450 to -0.0050 m (its lowest wheel now touches the ground under it)"]
+    # without physics Webots' gravity does not move the robot: no wheel_bottom, it stays where it is put
+    path.write_text(text.replace(" physics Physics { } }\n", " }\n"))
+    w = load_world(path)
+    assert w.world.robots[0].differential_drive.wheel_bottom is None
+    assert _t(Simulation(w), "bot")[2] == 0.045 and not [n for n in w.warnings if "settled" in n]
+
+
+def test_a_nue_world_settles_along_its_y() -> None:
+    from tests.test_batched_nue import _to_nue
+
+    plane = {**FLOOR, "pose": {"translation": [0.0, 0.0, 0.2]}}
+    enu = _loaded([plane], [_robot(at=(0.3, -0.2, 0.9))]).world
+    w = parse_world(_to_nue(enu), source="w.yaml")
+    sim = Simulation(w, precision="exact")
+    t = _t(sim)
+    assert t[1] == 0.2 - (-R) and (t[0], t[2]) == (-0.2, 0.3)     # NUE: (north, up, east) = (y, z, x)
+    assert [n for n in w.warnings if "settled" in n] == [
+        "w.yaml: robot 'r' settled on the ground at load, as Webots' physics drops it: its origin's y from "
+        "0.9000 to 0.2300 m (its lowest wheel now touches the ground under it)"]
+    bs = BatchedSimulation(w, copies=1, precision="exact")
+    assert np.array_equal(bs.pose(0, 0).translation, t)
