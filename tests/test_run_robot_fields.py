@@ -1,17 +1,22 @@
 """``sensorium run``: a Supervisor switches another robot's controller by setting its ``controller``
 field (the running one ends, the named one starts; a name not found leaves the robot without one;
 ``<extern>`` waits for one to attach) and passes it data through its ``customData`` field, which
-the robot's controller reads with ``getCustomData`` once its next step returns (Python and C)."""
+the robot's controller reads with ``getCustomData`` once its next step returns (Python and C); the same from a C
+and from a C++ Supervisor (tests/c/robot_fields_boss*), the robot's controller then C or C++, built with
+sanitizers."""
 
 from __future__ import annotations
 
+import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
 from _serve import Proc, sensorium, wait_until
-from test_run import clib, compile_controller, project, run  # noqa: F401  (clib: the fixture)
+from test_run import CLIB, clib, compile_controller, project, run  # noqa: F401  (clib: the fixture)
 
 pytestmark = pytest.mark.slow
+TESTS_C = Path(__file__).resolve().parent / "c"
 
 FIRST = '''from controller import Robot
 robot = Robot()
@@ -94,6 +99,50 @@ def check(proc: Proc) -> None:
 def test_a_supervisor_switches_a_robots_controller_and_gives_it_data(tmp_path: Path) -> None:
     world = project(tmp_path, WORLD, {"first.py": FIRST, "second.py": SECOND, "boss.py": BOSS})
     check(run(world, "--until", "1200"))
+
+
+@pytest.fixture(scope="module")
+def sanitized_clib(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
+    """Our libController built with -fsanitize=address,undefined: (its build folder, the libraries to link)."""
+    from test_c_client import _make
+
+    if shutil.which("cc") is None or shutil.which("c++") is None or shutil.which("make") is None:
+        pytest.skip("needs a C and C++ toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
+    build = tmp_path_factory.mktemp("sanbuild")
+    _make(f"BUILD={build}", "SANITIZE=1")
+    return build, _make("libs").split()
+
+
+def compile_sanitized(library: tuple[Path, list[str]], folder: Path, name: str, source: Path) -> None:
+    """controllers/NAME/NAME built from ``source`` (C or C++) with the sanitizers against ``library``."""
+    build, libs = library
+    folder.mkdir(parents=True, exist_ok=True)
+    compiler = ["c++", "-std=c++11"] if source.suffix == ".cpp" else ["cc", "-std=c99"]
+    done = subprocess.run([*compiler, "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+                           "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}", str(source), "-o",
+                           str(folder / name), str(build / "libController.a"), *libs, "-lm"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.parametrize("language", ["c", "cpp"])
+def test_a_c_or_cpp_supervisor_switches_a_c_or_cpp_robots_controller_and_gives_it_data(
+        tmp_path: Path, sanitized_clib: tuple[Path, list[str]], language: str) -> None:
+    """tests/c/robot_fields_boss.c (or _cpp.cpp) sets what the Python boss sets; alpha's "second" is the C
+    controller above (or tests/c/robot_fields_second_cpp.cpp) reading getCustomData: the same lines."""
+    from test_c_client import SAN_ENV
+
+    world = project(tmp_path, WORLD, {"first.py": FIRST})
+    if language == "c":
+        (tmp_path / "second.c").write_text(C_SECOND)
+        sources = {"boss": TESTS_C / "robot_fields_boss.c", "second": tmp_path / "second.c"}
+    else:
+        sources = {"boss": TESTS_C / "robot_fields_boss_cpp.cpp", "second": TESTS_C / "robot_fields_second_cpp.cpp"}
+    for name, source in sources.items():
+        compile_sanitized(sanitized_clib, tmp_path / "controllers" / name, name, source)
+    proc = run(world, "--until", "1200", env=SAN_ENV)
+    check(proc)
+    assert "Sanitizer" not in proc.stderr() and "runtime error" not in proc.stderr(), proc.stderr()
 
 
 def test_the_c_library_reads_the_data_a_supervisor_sets(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:  # noqa: F811

@@ -4,12 +4,15 @@ new ids never reused, their fields read as written; an inner solid's position is
 its own (closed form); a colour set on an imported shape is what the camera sees, bit for bit as the world file
 written with that colour (closed form: an ambient-only light of 0.5 on a flat face, a pixel is
 ``round(255 (1 - e^(-0.5 albedo))^(1/2.2))``); removed with their solid (one line), let go for good (memory
-stays that of the solids there now). The same from a Python controller through ``sensorium serve``."""
+stays that of the solids there now). The same from a Python controller through ``sensorium serve``, which also
+hides the wall (transparency 1), half shows it and shows it again, and from a C and a C++ controller (built with
+sanitizers) printing the Python one's lines."""
 
 from __future__ import annotations
 
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -214,6 +217,9 @@ EXPECTED = [
     "lid " + " ".join(f"{v:.6f}" for v in np.array([-1, 3, 0.5]) + rot([0, 0, 1], 0.5) @ np.array([0.2, 0.1, 0.3])),
     "before " + " ".join(map(str, expected_bytes([1, 0, 0]))),
     "after " + " ".join(map(str, expected_bytes([0.2, 0.6, 0.9]))),
+    "hidden 0 0 0",                                   # transparency 1: the world's black background
+    "half " + " ".join(map(str, expected_bytes([0.1, 0.3, 0.45]))),      # 0.5: half the face's light
+    "shown " + " ".join(map(str, expected_bytes([0.2, 0.6, 0.9]))),
     "removed 1 1",
 ]
 
@@ -223,4 +229,36 @@ EXPECTED = [
 def test_a_python_supervisor_reaches_the_nodes_inside_what_it_imported() -> None:
     lines, err = run_controller(WORLD, lambda url: sensorium(
         "controller", "--url", url, str(REPO / "tests" / "controllers" / "supervisor_inner_nodes.py")), robot="looker")
+    assert lines == EXPECTED, err
+
+
+@pytest.fixture(scope="module")
+def c_supervisors(tmp_path_factory) -> dict[str, str]:
+    """tests/c/supervisor_inner_nodes.c and its C++ twin linked to the library built with sanitizers."""
+    import shutil
+    import subprocess
+
+    from test_c_client import CLIB, TESTS_C, _make, sanitized_controller
+
+    c_exe = sanitized_controller(tmp_path_factory, TESTS_C / "supervisor_inner_nodes.c")
+    if shutil.which("c++") is None:
+        pytest.skip("needs a C++ toolchain")
+    build = Path(c_exe).parent
+    cpp_exe = build / "supervisor_inner_nodes_cpp"
+    done = subprocess.run(["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+                           f"-I{CLIB / 'include'}", str(TESTS_C / "supervisor_inner_nodes_cpp.cpp"), "-o", str(cpp_exe),
+                           str(build / "libController.a"), *_make("libs").split()],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return {"c": c_exe, "cpp": str(cpp_exe)}
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+@pytest.mark.parametrize("language", ["c", "cpp"])
+def test_a_c_or_cpp_supervisor_prints_what_the_python_one_prints(c_supervisors, language) -> None:
+    from test_c_client import SAN_ENV
+
+    lines, err = run_controller(WORLD, lambda url: [c_supervisors[language]], env=SAN_ENV, robot="looker")
+    assert "Sanitizer" not in err and "runtime error" not in err, err
     assert lines == EXPECTED, err

@@ -1,8 +1,9 @@
 """A Webots-style randomising supervisor reaching the nodes inside what it imported (tests/
 test_supervisor_inner_nodes.py on tests/worlds/supervisor_inner_nodes.wbt): a wall and a crate imported, the
-wall's Shape reached through its children, its PBRAppearance's baseColor set and seen by the camera; an inner
-solid found by a dotted DEF, its position read; the wall removed, its inner nodes then NULL by id. Written as
-for Webots; prints one line per check."""
+wall's Shape reached through its children, its PBRAppearance's baseColor set and seen by the camera, its
+transparency set to 1 (the wall hidden), 0.5 and 0 (shown again); an inner solid found by a dotted DEF, its
+position read; the wall removed, its inner nodes then NULL by id. Written as for Webots; prints one line per
+check (tests/c/supervisor_inner_nodes.c and supervisor_inner_nodes_cpp.cpp print the same)."""
 
 from controller import Supervisor
 
@@ -43,6 +44,11 @@ print("before", centre())
 shape.getField("appearance").getSFNode().getField("baseColor").setSFColor([0.2, 0.6, 0.9])
 robot.step(timestep)
 print("after", centre())
+transparency = shape.getField("appearance").getSFNode().getField("transparency")
+for label, value in (("hidden", 1.0), ("half", 0.5), ("shown", 0.0)):
+    transparency.setSFFloat(value)
+    robot.step(timestep)
+    print(label, centre())
 knob = robot.getFromDef("BOX.INNER.KNOB")
 ids = [inner.getId(), knob.getId()]
 box.remove()
