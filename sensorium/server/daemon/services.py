@@ -854,6 +854,7 @@ class Core(DeviceServices):
 
 
 def _ackermann(robot: Any) -> dict | None:
-    """A car-like robot's drive as ``attach`` describes it (its world entry), else None."""
+    """A car-like robot's drive as ``attach`` describes it (its world entry's fields that
+    ``AckermannDescription`` declares: a world-only field such as ``wheel_bottom`` stays home), else None."""
     drive = getattr(getattr(robot, "model", None), "ackermann_drive", None)
-    return drive.model_dump() if drive is not None else None
+    return drive.model_dump(include=set(S.AckermannDescription.model_fields)) if drive is not None else None
