@@ -164,7 +164,8 @@ def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
     devices they face away from; each group is a shape of its own (same pose, appearance, node)
     whose ``unseen_by`` lists them. Meshes with no device in their box stay whole, and so do a mesh
     that is also a bounding object (contact sees it whole) and one written ``ccw FALSE``
-    (``clockwise``: the ids of those geometries), whose front side is not judged here."""
+    (``clockwise``: the ids of those geometries), whose front side is not judged here. The robot's
+    radar targets name their shapes by index: they are renumbered, a split mesh's pieces all theirs."""
     shapes = robot.get("shapes")
     devices = [(d, np.asarray(d.get("pose", {}).get("translation", (0.0, 0.0, 0.0)), dtype=np.float64))
                for d in robot.get("devices", ())
@@ -172,7 +173,9 @@ def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
     if not shapes or not devices:
         return
     out: list[dict] = []
+    became: list[list[int]] = []        # per shape: its indices in ``out``
     for part in shapes:
+        became.append([len(out)])
         geometry = part.get("geometry", {})
         if part.get("seen_by") != "visual" or geometry.get("type") != "triangles" or id(geometry) in clockwise:
             out.append(part)
@@ -201,4 +204,7 @@ def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
             if names:
                 piece["unseen_by"] = sorted(names)
             out.append(piece)
+        became[-1] = list(range(became[-1][0], len(out)))
     robot["shapes"] = out
+    for target in robot.get("radar_targets", ()):
+        target["shapes"] = sorted(k for i in target.get("shapes", ()) for k in became[i])
