@@ -9,6 +9,7 @@ targets, which name their shapes by index, still name theirs after the split."""
 from __future__ import annotations
 
 import math
+import random
 from collections import Counter
 from fractions import Fraction
 from pathlib import Path
@@ -18,7 +19,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import SETTINGS
 
-from sensorium.server.world.loader import load_world
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world, parse_world
 from sensorium.server.world.wbt.inside import turn_meshes_away
 
 FEW = settings(SETTINGS, max_examples=150)
@@ -77,11 +79,12 @@ def test_pieces_hold_every_triangle_once_unseen_by_exactly_the_devices_behind_it
     used = [verts[i] for f in faces for i in f]
     low = [min(v[i] for v in used) for i in range(3)]
     high = [max(v[i] for v in used) for i in range(3)]
-    inside = {f"d{k}": p for k, p in enumerate(points) if all(low[i] < p[i] < high[i] for i in range(3))}
-    # float64 rounding: a device within ~1e-16 m of a triangle's plane (~1e-10 m a million metres
-    # out, where its place in the shape's frame is rounded) may fall either side of it; a ray from
-    # there only grazes the triangle
-    slack = Fraction(1e-9) if far else Fraction(1e-13)
+    # float64 rounding: a device within ~1e-16 m of a triangle's plane or of the box's faces (~1e-10 m
+    # a million metres out, where its place in the shape's frame is rounded) may fall either side of
+    # it; a ray from there only grazes the triangle
+    slack = 1e-9 if far else 1e-13
+    inside = {f"d{k}": p for k, p in enumerate(points) if all(low[i] + slack < p[i] < high[i] - slack for i in range(3))}
+    near = {f"d{k}": p for k, p in enumerate(points) if all(low[i] - slack < p[i] < high[i] + slack for i in range(3))}
     rows: list[tuple] = []
     keys = set()
     for piece in robot["shapes"]:
@@ -89,18 +92,24 @@ def test_pieces_hold_every_triangle_once_unseen_by_exactly_the_devices_behind_it
         key = tuple(sorted(unseen))
         assert key not in keys, key                     # one piece a set of devices
         keys.add(key)
-        assert piece["pose"] == shape["pose"] and piece["geometry"]["vertices"] is shape["geometry"]["vertices"]
-        assert unseen <= set(inside), (unseen, inside)
-        for row in np.asarray(piece["geometry"]["faces"]).reshape(-1, 3).tolist():
-            rows.append(tuple(row))
-            a, b, c = (verts[i] for i in row)
-            for name, p in inside.items():
+        assert piece["pose"] == shape["pose"]
+        assert unseen <= set(near), (unseen, near)
+        pts = np.asarray(piece["geometry"]["vertices"], dtype=np.float64).reshape(-1, 3)
+        mine = np.asarray(piece["geometry"]["faces"]).reshape(-1, 3)
+        # a piece of a split mesh holds its own points and the mesh's box (the default texture mapping's)
+        assert pts.min(axis=0).tolist() == np.min(verts, axis=0).tolist()
+        assert pts.max(axis=0).tolist() == np.max(verts, axis=0).tolist()
+        assert len(pts) <= max(3 * len(mine) + 2, len(verts))
+        for row in mine.tolist():
+            a, b, c = (pts[i].tolist() for i in row)
+            rows.append((tuple(a), tuple(b), tuple(c)))
+            for name, p in near.items():
                 s = side(p, a, b, c)
-                if s < -slack:
+                if s < -slack and name in inside:
                     assert name in unseen, (row, name, s)
                 elif s > slack:
                     assert name not in unseen, (row, name, s)
-    assert Counter(rows) == Counter(faces)
+    assert Counter(rows) == Counter(tuple(tuple(verts[i]) for i in f) for f in faces)
     assert len(robot["shapes"]) <= len(faces)
     assert robot["radar_targets"][0]["shapes"] == list(range(len(robot["shapes"])))
 
@@ -128,3 +137,85 @@ def test_a_radar_target_after_a_split_mesh_still_names_its_own_box(tmp_path: Pat
     [target] = robot.radar_targets
     assert target.shapes == [2]
     assert robot.shapes[2].pose.translation == (1.0, 0.0, 0.0)
+
+
+def soup(count: int, seed: int) -> tuple[list[tuple[float, float, float]], str]:
+    """``count`` triangles at random in a 0.4 m cube (each its own three points, none shared), written
+    as an IndexedFaceSet's points and coordIndex: devices within its box face some and not others."""
+    rng = random.Random(seed)
+    pts = [(round(rng.uniform(-0.2, 0.2), 6), round(rng.uniform(-0.2, 0.2), 6), round(rng.uniform(-0.2, 0.2), 6))
+           for _ in range(3 * count)]
+    index = " ".join(f"{3 * t} {3 * t + 1} {3 * t + 2} -1" for t in range(count))
+    return pts, index
+
+
+def soup_robot(tmp_path: Path, count: int, sensors: int, texture: bool = False) -> Path:
+    pts, index = soup(count, 1)
+    rng = random.Random(2)
+    devices = "".join(f'DistanceSensor {{ translation {rng.uniform(-0.18, 0.18):.4f} {rng.uniform(-0.18, 0.18):.4f} '
+                      f'{rng.uniform(-0.18, 0.18):.4f} name "d{k}" type "infra-red" '
+                      f'lookupTable [ 0 0 0 0.5 500 0 ] }}\n' for k in range(sensors))
+    look = "appearance Appearance { texture ImageTexture { url \"tex.png\" } } " if texture else ""
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+                 "DirectionalLight { direction 0.3 -0.2 -1 }\nPointLight { location 0 0 0 }\n"
+                 'Robot { name "r" children [\n'
+                 f'Shape {{ {look}geometry IndexedFaceSet {{ coord Coordinate {{ point [ '
+                 f'{", ".join(" ".join(map(repr, q)) for q in pts)} ] }} coordIndex [ {index} ] }} }}\n'
+                 'Camera { translation 0.01 0.02 0.03 width 64 height 48 }\n' + devices + "] }\n")
+    return p
+
+
+def test_a_mesh_split_in_thousands_of_pieces_loads_about_its_own_size(tmp_path: Path) -> None:
+    """2500 triangles at random and 64 infra-red sensors within their box: some 2000 pieces. Each
+    piece carried every point of the mesh (7500 of them), so the world went over the values limit
+    (2 000 000) and was refused, a 2500-triangle file; now each piece holds the points it uses and
+    the whole mesh's two box corners."""
+    robot = load_world(soup_robot(tmp_path, 2500, 64)).world.robots[0]
+    pieces = [s.geometry for s in robot.shapes if s.geometry.type == "triangles"]
+    assert len(pieces) > 1000
+    assert sum(len(g.faces) for g in pieces) == 2500
+    assert sum(len(g.vertices) for g in pieces) == 3 * 2500 + 2 * len(pieces)
+
+
+def test_split_readings_equal_the_world_written_with_the_split_and_every_point(tmp_path: Path) -> None:
+    """A textured mesh (Webots' default mapping: over the box of all its points) split by a camera
+    and 12 infra-red sensors inside its box: the camera's image and the sensors' readings are the
+    bits of the same world written with the split explicitly (``unseen_by`` in the world file),
+    each piece keeping every point of the mesh and its original indices. Without the box corners
+    kept in each piece, the texture's mapping (and so the image) changed with the piece."""
+    from PIL import Image
+
+    img = np.zeros((16, 16, 3), dtype=np.uint8)
+    img[..., 0] = np.arange(16)[:, None] * 16
+    img[..., 1] = np.arange(16)[None, :] * 16
+    img[::2, ::3, 2] = 255
+    Image.fromarray(img).save(tmp_path / "tex.png")
+    split = load_world(soup_robot(tmp_path, 300, 12, texture=True))
+    pts, _ = soup(300, 1)
+    where = {p: k for k, p in enumerate(pts)}
+    data = split.world.model_dump(mode="json", exclude_none=True)
+    pieces = 0
+    for shape in data["robots"][0]["shapes"]:
+        g = shape["geometry"]
+        if g["type"] != "triangles":
+            continue
+        pieces += 1
+        corners = [tuple(g["vertices"][i]) for face in g["faces"] for i in face]
+        g["vertices"] = [list(p) for p in pts]
+        g["faces"] = [[where[c] for c in corners[k:k + 3]] for k in range(0, len(corners), 3)]
+    assert pieces > 10
+    written = parse_world(data, base_dir=tmp_path)
+
+    def readings(w) -> tuple:
+        sim = Simulation(w)
+        for d in w.world.robots[0].devices:
+            sim.device(f"r/{d.name}").enable(16)
+        sim.step()
+        return (sim.device("r/camera").image.tobytes(),
+                [float(sim.device(f"r/d{k}").value) for k in range(12)])
+
+    got, expect = readings(split), readings(written)
+    assert got[1] == expect[1]
+    assert got[0] == expect[0]
+    assert len(set(got[0])) > 10 and any(0.0 < v < 500.0 for v in got[1])      # the mesh is seen
