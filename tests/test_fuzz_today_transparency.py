@@ -65,3 +65,53 @@ def test_random_sets_steps_and_resets_read_as_the_world_file_and_stay_bounded(op
                 now[op] = value
         passes.append((engine.held_tiers, len(sim.scene.transparency), len(sim.scene.shapes)))
     assert passes[1] == passes[2] == passes[3], passes
+
+
+BALL = ('Solid {{ translation 0.7 {y} 0 name "ball" children [ Shape {{ appearance PBRAppearance {{ '
+        'baseColor 0.9 0.2 0.2 transparency {t} }} geometry Box {{ size 0.05 0.1 0.3 }} }} ] }}')
+
+
+@settings(SETTINGS, max_examples=20)
+@given(st.lists(st.one_of(st.tuples(st.sampled_from(["block", "visor", "import", "imported"]), st.sampled_from(VALUES)),
+                          st.tuples(st.sampled_from(["remove", "step", "reset"]), st.just(0.0))),
+                min_size=1, max_size=14))
+def test_imported_shapes_crossing_and_removed_leave_the_world_files_readings_and_tables(ops):
+    """Translucent, invisible and opaque boxes a Supervisor imports between the robot and the block,
+    crossing classes themselves, removed again, with resets (which remove them too): whenever none is
+    left, every sensor reads the world file written with the block's and visor's values in force and
+    the scene's and engine's shape tables are a fresh world's."""
+    sim = _sim(world(0.0, "block"), "exact")
+    apps = {t: _appearance(sim, t) for t in ("block", "visor")}
+    now = {"block": 0.0, "visor": 0.0}
+    fresh = (sim.scene.engine.shape_count, len(sim.scene.shapes))
+    imported: list[int] = []
+    for op, value in [*ops, ("remove_all", 0.0), ("step", 0.0)]:
+        if op == "reset":
+            sim.reset()
+            for d in DEVICES:
+                sim.device(f"r/{d}").enable(16)
+            sim.device("r/cam").recognition_enable(16)
+            sim.device("r/cam").enable_segmentation(True)
+            apps = {t: _appearance(sim, t) for t in ("block", "visor")}
+            now = {"block": 0.0, "visor": 0.0}
+            imported = []
+        elif op == "import":
+            (node,) = sv.import_nodes(sim, sv.ROOT, "children", -1, BALL.format(y=0.05 * (len(imported) % 3), t=value))
+            imported.append(node)
+        elif op == "imported" and imported:
+            (shape,) = sv.get_field(sim, sv.node_by_id(sim, imported[-1]), "children")["value"]
+            app = sv.node_by_id(sim, sv.get_field(sim, sv.node_by_id(sim, shape), "appearance")["value"])
+            sv.set_field(sim, app, "transparency", value)
+        elif op == "remove" and imported:
+            sv.remove_node(sim, sv.node_by_id(sim, imported.pop()))
+        elif op == "remove_all":
+            while imported:
+                sv.remove_node(sim, sv.node_by_id(sim, imported.pop()))
+        elif op == "step":
+            sim.run(1)
+            if not imported:
+                assert same(readings(sim), reference(now["block"], now["visor"])) == [], (ops, now)
+                assert (sim.scene.engine.shape_count, len(sim.scene.shapes)) == fresh
+        elif op in now:
+            sv.set_field(sim, apps[op], "transparency", value)
+            now[op] = value
