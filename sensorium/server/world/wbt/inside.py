@@ -164,7 +164,8 @@ def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
     devices they face away from; each group is a shape of its own (same pose, appearance, node)
     whose ``unseen_by`` lists them. Meshes with no device in their box stay whole, and so do a mesh
     that is also a bounding object (contact sees it whole) and one written ``ccw FALSE``
-    (``clockwise``: the ids of those geometries), whose front side is not judged here."""
+    (``clockwise``: the ids of those geometries), whose front side is not judged here. The robot's
+    radar targets name their shapes by index: they are renumbered, a split mesh's pieces all theirs."""
     shapes = robot.get("shapes")
     devices = [(d, np.asarray(d.get("pose", {}).get("translation", (0.0, 0.0, 0.0)), dtype=np.float64))
                for d in robot.get("devices", ())
@@ -172,7 +173,9 @@ def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
     if not shapes or not devices:
         return
     out: list[dict] = []
+    became: list[list[int]] = []        # per shape: its indices in ``out``
     for part in shapes:
+        became.append([len(out)])
         geometry = part.get("geometry", {})
         if part.get("seen_by") != "visual" or geometry.get("type") != "triangles" or id(geometry) in clockwise:
             out.append(part)
@@ -191,14 +194,35 @@ def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
         groups: dict[tuple[str, ...], list[int]] = {}
         for t, key in enumerate(zip(*(behind.tolist() for _, behind in away))):
             groups.setdefault(tuple(name for (name, _), b in zip(away, key) if b), []).append(t)
-        triangles = np.asarray(geometry["faces"]).reshape(-1, 3)
+        points = np.asarray(geometry["vertices"], dtype=np.float64).reshape(-1, 3)
+        box = np.stack([points.min(axis=0), points.max(axis=0)])        # of all points, used or not
         for names, rows in groups.items():
-            picked = np.asarray(rows, dtype=np.int64)
-            g = dict(geometry, faces=triangles[picked])
-            if len(g.get("tex_coord_faces", ())):
-                g["tex_coord_faces"] = np.asarray(g["tex_coord_faces"]).reshape(-1, 3)[picked]
+            g = geometry if len(groups) == 1 else _piece(geometry, points, box, np.asarray(rows, dtype=np.int64))
             piece = dict(part, geometry=g)
             if names:
                 piece["unseen_by"] = sorted(names)
             out.append(piece)
+        became[-1] = list(range(became[-1][0], len(out)))
     robot["shapes"] = out
+    for target in robot.get("radar_targets", ()):
+        target["shapes"] = sorted(k for i in target.get("shapes", ()) for k in became[i])
+
+
+def _piece(geometry: dict, points: np.ndarray, box: np.ndarray, picked: np.ndarray) -> dict:
+    """The triangles ``picked`` of a mesh as a mesh of their own, holding only the points (and
+    texture coordinates) they use: a mesh split in k pieces stays about its size, not k times it.
+    The whole mesh's box corners (``box``, of all its ``points``) are kept as two unused points, so that Webots' default texture
+    mapping (over the box of all points: texcoords.default_triangle_uv) maps each piece as before.
+    Texture coordinates indexed by the faces' own indices get their indices written out first."""
+    faces = np.asarray(geometry["faces"], dtype=np.int64).reshape(-1, 3)[picked]
+    used, renumbered = np.unique(faces, return_inverse=True)
+    g = dict(geometry, vertices=np.concatenate([points[used], box]), faces=renumbered.reshape(-1, 3))
+    tex = geometry.get("tex_coords")
+    if tex is not None and len(tex):
+        written = geometry.get("tex_coord_faces")
+        tex_faces = (np.asarray(written, dtype=np.int64).reshape(-1, 3)[picked] if written is not None and len(written)
+                     else faces)
+        used, renumbered = np.unique(tex_faces, return_inverse=True)
+        g["tex_coords"] = np.asarray(tex, dtype=np.float64).reshape(-1, 2)[used]
+        g["tex_coord_faces"] = renumbered.reshape(-1, 3)
+    return g
