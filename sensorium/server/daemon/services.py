@@ -549,7 +549,7 @@ class Core(DeviceServices):
         self._seen[s.token] = {ctl.path: getattr(ctl.device, "measurements", 0)
                                for ctl in self._robot_controls(s.robot)}
         robot = self.sim.robots[s.robot]
-        self._custom_sent[s.token] = robot.custom_data
+        self._custom_sent[s.token] = str(getattr(robot, "custom_data", ""))
         return {"session": s.token, "robot": s.robot, "basic_time_step": self.sim.basic_time_step,
                 "time_ms": self.sim.time_ms, "synchronization": bool(robot.synchronization),
                 "heartbeat_ms": self.lockstep.heartbeat_ms, "supervisor": bool(getattr(robot, "supervisor", False)),
