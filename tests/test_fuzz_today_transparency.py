@@ -35,6 +35,17 @@ def reference(block: float, visor: float) -> dict:
     return _refs[key]
 
 
+
+def _reset(sim) -> dict:
+    """A simulation reset, the devices enabled again as the test's world enables them; the appearances."""
+    sim.reset()
+    for d in DEVICES:
+        sim.device(f"r/{d}").enable(16)
+    sim.device("r/cam").recognition_enable(16)
+    sim.device("r/cam").enable_segmentation(True)
+    return {t: _appearance(sim, t) for t in ("block", "visor")}
+
+
 @FEW
 @given(st.lists(st.one_of(st.tuples(st.sampled_from(["block", "visor"]), st.sampled_from(VALUES)),
                           st.just(("step", 0.0)), st.just(("reset", 0.0))), min_size=1, max_size=14))
@@ -48,12 +59,7 @@ def test_random_sets_steps_and_resets_read_as_the_world_file_and_stay_bounded(op
     for _ in range(4):          # the same sequence again and again: nothing grows from pass to pass
         for op, value in [*ops, ("step", 0.0)]:
             if op == "reset":
-                sim.reset()
-                for d in DEVICES:
-                    sim.device(f"r/{d}").enable(16)
-                sim.device("r/cam").recognition_enable(16)
-                sim.device("r/cam").enable_segmentation(True)
-                apps = {t: _appearance(sim, t) for t in ("block", "visor")}
+                apps = _reset(sim)
                 now = {"block": 0.0, "visor": 0.0}
             elif op == "step":
                 sim.run(1)
@@ -87,12 +93,7 @@ def test_imported_shapes_crossing_and_removed_leave_the_world_files_readings_and
     imported: list[int] = []
     for op, value in [*ops, ("remove_all", 0.0), ("step", 0.0)]:
         if op == "reset":
-            sim.reset()
-            for d in DEVICES:
-                sim.device(f"r/{d}").enable(16)
-            sim.device("r/cam").recognition_enable(16)
-            sim.device("r/cam").enable_segmentation(True)
-            apps = {t: _appearance(sim, t) for t in ("block", "visor")}
+            apps = _reset(sim)
             now = {"block": 0.0, "visor": 0.0}
             imported = []
         elif op == "import":
