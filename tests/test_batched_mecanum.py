@@ -334,7 +334,7 @@ def test_bad_actions_are_refused_in_one_line(bad):
     w = world(True)
     env = SensoriumEnv(w, agent_task())
     env.reset(seed=0)
-    with pytest.raises(ValueError, match=r"^yb: action must be 4 finite values in \[-1, 1\] \(front left, front "
+    with pytest.raises(ValueError, match=r"^yb: action must be 4 finite values \(in \[-1, 1\]: beyond it, clipped\) \(front left, front "
                                          r"right, rear left, rear right\), got .*$") as e:
         env.step(np.array(bad, dtype=np.float32))
     assert "\n" not in str(e.value)

@@ -417,7 +417,7 @@ def test_bad_actions_are_refused_in_one_line():
     w = world(True)
     env = SensoriumEnv(w, agent_task("quad"))
     env.reset(seed=0)
-    with pytest.raises(ValueError, match=r"^quad: action must be 4 finite values in \[-1, 1\] \(wheel1, wheel2, "
+    with pytest.raises(ValueError, match=r"^quad: action must be 4 finite values \(in \[-1, 1\]: beyond it, clipped\) \(wheel1, wheel2, "
                                          r"wheel3, wheel4\), got \[0\.1\d*, 0\.2\d*, 0\.3\d*\]$"):
         env.step(np.array([0.1, 0.2, 0.3], dtype=np.float32))
     venv = SensoriumVectorEnv(w, agent_task("quad"), 2)

@@ -263,7 +263,7 @@ def test_pettingzoo_cars_are_agents_and_both_engines_agree():
 def test_bad_actions_are_refused_in_one_line(bad):
     env = SensoriumEnv(WORLD, task("car"))
     env.reset(seed=0)
-    with pytest.raises(ValueError, match=r"^car: action must be 2 finite values in \[-1, 1\] \(steering, speed\), "
+    with pytest.raises(ValueError, match=r"^car: action must be 2 finite values \(in \[-1, 1\]: beyond it, clipped\) \(steering, speed\), "
                                          r"got .*$") as e:
         env.step(np.array(bad, dtype=np.float32))
     assert "\n" not in str(e.value)

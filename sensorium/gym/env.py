@@ -227,7 +227,7 @@ class Agent:
         omni-wheel robot's (n,) wheel velocities (rad/s, the drive's order); clamped later by the motors."""
         a = np.asarray(action, dtype=np.float64).reshape(-1)
         if a.shape != (self.n_actions,) or not np.all(np.isfinite(a)):
-            what = ("values in [-1, 1]" if self.actions == "normalized"
+            what = ("values (in [-1, 1]: beyond it, clipped)" if self.actions == "normalized"
                     else "wheel velocities" if self.car is None else "values (rad, rad/s)")
             names = ("steering, speed" if self.car is not None
                      else "front left, front right, rear left, rear right" if self.mecanum is not None
