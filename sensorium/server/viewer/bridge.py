@@ -39,6 +39,7 @@ loaded appearances back, the scene is sent again to every ``/scene`` subscriber.
 from __future__ import annotations
 
 import logging
+import math
 import re
 import sys
 import threading
@@ -111,6 +112,10 @@ def exposure_warning(host: str) -> str | None:
 WAITING_STATUS_ID = "sensorium-waiting"
 STATUS_REPEAT_S = 2.0          # a waiting status is sent again this often (viewers that connected since)
 STATUS_CHECK_S = 0.25          # the step loop looks at what the world waits for at most this often
+# the simulated time is broadcast at most this often: Time messages go through each viewer's lossless
+# control queue (as long as its backlog), whose overflow disconnects the viewer, so one sent each step
+# (hundreds a second in fast mode) dropped a viewer that stopped reading for a second or two
+TIME_EVERY_S = 0.05
 
 
 QUEUE_BUDGET_BYTES = 32 << 20     # the bridge's own queue (msgpack bodies waiting for the worker)
@@ -312,6 +317,7 @@ class FoxgloveBridge:
         self.errors: dict[str, str] = {}
         self._time_ns = 0
         self._sent_time_ns = -1
+        self._time_sent_at = -math.inf       # (monotonic) when the last Time message went out
         self._event = threading.Event()
         self._stop = False
         # what viewers are told (status): computed by the step thread, sent by the worker
@@ -549,9 +555,11 @@ class FoxgloveBridge:
             except IndexError:
                 break
             self._forward(topic, ros_type, body, ns)
-        if self._time_ns != self._sent_time_ns:
-            self._sent_time_ns = self._time_ns
-            self.server.broadcast_time(self._time_ns)
+        if self._time_ns != self._sent_time_ns:         # (else the next pass, within the worker's 0.05 s wait)
+            now = time.monotonic()
+            if now - self._time_sent_at >= TIME_EVERY_S:
+                self._sent_time_ns, self._time_sent_at = self._time_ns, now
+                self.server.broadcast_time(self._time_ns)
 
     def _forward(self, topic: str, ros_type: str, body: bytes, ns: int) -> None:
         subs = self._subs
