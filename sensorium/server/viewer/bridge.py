@@ -30,7 +30,8 @@ to one line per viewer connection plus a count (:class:`_SdkLog`).
 Never slowing the step loop: :meth:`record` (called by ``Topics`` in the step thread) only appends
 the msgpack bytes to a bounded queue (the oldest is dropped when full, ``dropped`` counts it); a
 worker thread encodes CDR/protobuf and hands the bytes to the SDK, whose per-client backlog drops
-the oldest messages of a slow client. Simulated time is broadcast as the server time. When a
+the oldest messages of a slow client. Simulated time is broadcast as the server time (at most every
+TIME_EVERY_S: those go through the lossless control queue). When a
 supervisor moves, removes or imports a solid or a light, or changes a shape's appearance (a colour,
 a transparency, a texture given or taken: ``Scene.appearance_version``), or a reset brings the
 loaded appearances back, the scene is sent again to every ``/scene`` subscriber.
