@@ -780,14 +780,19 @@ class Core(DeviceServices):
             target = supervisor.robot_of_node(self.sim, c.args.node)
         except ValueError as exc:
             raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"restart_controller: {exc}") from None
-        ended = self.lockstep.end_controller(target)
+        self._end_controller(target, c)
+        self.launcher.restart(target)
+        return {"success": True}
+
+    def _end_controller(self, robot: str, c: Call) -> None:
+        """The robot's controller session ends: a pending step answers -1 (sent with ``c``'s reply) and the
+        world waits for it no more (restartController, a Supervisor's controller field set)."""
+        ended = self.lockstep.end_controller(robot)
         if ended is not None:
             s, done = ended
             self._released(s)
             if done is not None:
                 c.extra.append(self._step_reply(done))
-        self.launcher.restart(target)
-        return {"success": True}
 
     def _robot_world_reload(self, c: Call) -> dict:
         """Webots' worldReload: ``sensorium run`` stops this simulation (every step answers -1), loads
@@ -844,12 +849,7 @@ class Core(DeviceServices):
             self.log_error(f"robot {c.robot!r}: set_field: robot {robot!r}'s controller is now {name!r}; nothing "
                            "is ended or started: only `sensorium run` starts controllers")
             return
-        ended = self.lockstep.end_controller(robot)
-        if ended is not None:
-            s, done = ended
-            self._released(s)
-            if done is not None:
-                c.extra.append(self._step_reply(done))
+        self._end_controller(robot, c)
         self.launcher.switch(robot, name, bool(self.sim.robots[robot].synchronization))
 
 
