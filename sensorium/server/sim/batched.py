@@ -101,6 +101,7 @@ from sensorium.server.sim.scene import (
     Scene,
     _entry,
     _shape_info,
+    blind_devices,
     infra_red_terms,
     primitive_from_model,
     robot_bounding_parts,
@@ -255,10 +256,8 @@ class BatchedSimulation:
                                                  pose_from_model(r.pose), owner=i, movable=True))
                 owned: dict[str, set[int]] = {}
                 for k, (_, _, shape) in enumerate(parts):
-                    if getattr(shape, "of_device", None) is not None:
-                        owned.setdefault(shape.of_device, set()).add(first + k)
-                    for unseen in getattr(shape, "unseen_by", ()):     # faces turned away from it
-                        owned.setdefault(unseen, set()).add(first + k)
+                    for device in blind_devices(shape):
+                        owned.setdefault(device, set()).add(first + k)
                 self._own_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
                 first += len(parts)
                 for name, _, shape in parts:

@@ -402,6 +402,13 @@ def solid_radar_targets(solid: wm.Solid) -> dict[TargetKey, float]:
     return out
 
 
+def blind_devices(shape: Any) -> tuple[str, ...]:
+    """The devices of its robot whose visual rays do not see a robot shape: the device whose own Solid it
+    belongs to (``of_device``) and those it is turned away from (``unseen_by``, a split mesh's piece)."""
+    device = getattr(shape, "of_device", None)
+    return (*(() if device is None else (device,)), *getattr(shape, "unseen_by", ()))
+
+
 class Scene:
     """Geometry and poses of a world; the only owner of the ray engine."""
 
@@ -474,11 +481,8 @@ class Scene:
                 for k, (_, _, shape) in enumerate(group):
                     if r.radar_targets:
                         placed[id(shape)] = first + k
-                    device = getattr(shape, "of_device", None)
-                    if device is not None:
+                    for device in blind_devices(shape):
                         owned.setdefault(device, set()).add(first + k)
-                    for unseen in getattr(shape, "unseen_by", ()):     # faces turned away from it
-                        owned.setdefault(unseen, set()).add(first + k)
             self._device_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
             for k, t in enumerate(r.radar_targets):          # solids it carries that radars detect apart
                 self.carried_targets[(i, k)] = (pose_from_model(t.pose), t.on_joint,
