@@ -64,6 +64,10 @@ OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane", "IndexedFaceSet", "Mesh", "ElevationGrid"}
 MAX_GRID_POINTS = 4_000_000    # ElevationGrid points (xDimension × yDimension, all grids together after DEF/USE:
                                # ProtoLimits.values), checked before a height is read or padded
+# what a Billboard may hold without losing anything a device reads (it follows the 3D view, no Camera sees it)
+BILLBOARD_CONTENT = {"Shape", "Transform", "Pose", "Group", "Appearance", "PBRAppearance", "Material",
+                     "ImageTexture", "TextureTransform", "Coordinate", "Normal", "TextureCoordinate", "Color",
+                     "IndexedLineSet", "PointSet"} | GEOMETRIES
 UNSEEN_GEOMETRIES = {"IndexedLineSet", "PointSet"}      # lines and points: no surface a ray could hit
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder", "Camera"}
@@ -619,6 +623,8 @@ class Converter:
                                 "else); skipped")
         elif t == "Viewpoint":           # its values are kept (top_node): the Supervisor's and snapshots' view
             pass
+        elif t == "Billboard":
+            self.billboard(node)
         elif t in SKIPPED:
             if t != "TexturedBackground":     # a PROTO not read: the PROTO note says what cameras lose
                 self.skipped[t] += 1
@@ -743,6 +749,27 @@ class Converter:
                 why = (f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
                        f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
             self.drop(node, why, "robot" if robot_like else "node", named if isinstance(named, str) else t)
+
+    def billboard(self, node: Node) -> None:
+        """A Billboard: Webots pins its children to the 3D view's viewpoint, and no Camera sees them nor
+        their shadows (Webots' reference), so no device reads anything of it: skipped as what does not
+        matter to sensors. A node inside that would matter (a Solid, a device, a light, a node not read
+        here) makes it a loss, naming that node."""
+        stack: list[Any] = [node.fields.get("children")]
+        while stack:
+            value = stack.pop()
+            if isinstance(value, list):
+                stack.extend(value)
+            elif isinstance(value, Node):
+                if value.type not in BILLBOARD_CONTENT:
+                    named = node.fields.get("name")
+                    self.drop(node, f"Billboard holding {value.type} (line {value.line}): only Webots' 3D view shows a "
+                                    "Billboard's children, and a Solid, device or light there is not simulated here; "
+                                    "skipped with everything inside it", "node",
+                              named if isinstance(named, str) else "Billboard")
+                    return
+                stack.extend(value.fields.values())
+        self.skipped["Billboard"] += 1
 
     def scaled_solid(self, node: Node, owner: Owner) -> None:
         """A Solid (a robot, a device, a joint's end point) under a Transform that scales: Webots
