@@ -608,7 +608,8 @@ class Scene:
             retextured = self._parts[shape][2].appearance
             self._use_model(shape, model)       # a shape loaded without an appearance gets none back
             if self.textures is not None and retextured is not None and model.appearance is not None and \
-                    _maps(retextured) != _maps(model.appearance):
+                    (_maps(retextured) != _maps(model.appearance) or retextured.texture is not None):
+                # (the same url may show its file read again since the load: the loaded image comes back)
                 self.textures.set_shape(shape, model.appearance)
             self._seen_again(shape)
         if self._loaded_models:
