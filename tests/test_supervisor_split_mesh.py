@@ -2,7 +2,8 @@
 facing away from the device are hidden from it) is one Shape node to a Supervisor, as in Webots: the
 robot's children, getFromDef and the node ids are those of the world file, and a colour, transparency
 or texture url set on the Shape's nodes reaches every piece -- two cameras, one seeing each piece, see
-the change bit for bit as the same world written with the new value. Our own world and images."""
+the change bit for bit as the same world written with the new value -- and removing the Shape removes every
+piece. Our own world and images."""
 
 from __future__ import annotations
 
@@ -53,10 +54,15 @@ Robot {{
 DIFFUSE = "0.8 0.2 0.1"
 
 
-def _world(folder: Path, name: str, diffuse: str = DIFFUSE, transparency: float = 0.0, url: str | None = None) -> Path:
+def _world(folder: Path, name: str, diffuse: str = DIFFUSE, transparency: float = 0.0, url: str | None = None,
+           body: bool = True) -> Path:
     texture = "" if url is None else f'texture ImageTexture {{ url [ "{url}" ] }}'
+    text = WORLD.format(diffuse=diffuse, transparency=transparency, texture=texture)
+    if not body:         # the world written without the Shape
+        start = text.index("    DEF BODY Shape")
+        text = text[:start] + text[text.index("    Camera {"):]
     path = folder / name
-    path.write_text(WORLD.format(diffuse=diffuse, transparency=transparency, texture=texture))
+    path.write_text(text)
     return path
 
 
@@ -129,3 +135,46 @@ def test_a_texture_url_set_on_the_split_shape_reaches_every_piece(images: Path) 
     assert got == _images(_sim(_world(images, "expect.wbt", url="b.png")))
     sim.reset()
     assert _images(sim) == before
+
+
+def test_removing_the_split_shape_removes_every_piece(tmp_path: Path) -> None:
+    sim = _sim(_world(tmp_path, "w.wbt"))
+    before = _images(sim)
+    body = sv.find_node(sim, "BODY")
+    inside = [body.id + k for k in (1, 2, 3)]                    # its Appearance, Material, IndexedFaceSet
+    assert [sv.node_by_id(sim, i).type for i in inside] == ["Appearance", "Material", "IndexedFaceSet"]
+    sv.remove_node(sim, body)
+    got = _images(sim)
+    expect = _images(_sim(_world(tmp_path, "bare.wbt", body=False)))
+    assert got[0] != before[0] and got[1] != before[1]
+    assert got == expect
+    assert sv.find_node(sim, "BODY") is None
+    kids = sv.get_field(sim, sv.find_node(sim, "r"), "children")["value"]
+    assert [sv.node_by_id(sim, i).type for i in kids] == ["Camera"]
+    for i in [body.id, *inside]:
+        assert sv.node_from_id(sim, i) is None                   # read as removed, never given again
+    with pytest.raises(ValueError):
+        sv.node_by_id(sim, body.id)
+    sim.reset()                                                  # Webots' reset keeps a removed node removed
+    assert _images(sim) == expect
+
+
+def test_a_removed_shapes_shared_material_set_later_leaves_it_removed(tmp_path: Path) -> None:
+    """Two Shapes share a DEF'd Material: one removed, a colour or transparency set through the other's
+    changes that one only."""
+    text = _world(tmp_path, "w.wbt").read_text()
+    text = text.replace("material Material", "material DEF MAT Material").replace(
+        '    Camera { name "inner"',
+        "    Pose { translation 0 0 5 children [ Shape { appearance Appearance { material USE MAT } "
+        "geometry Box { size 0.1 0.1 0.1 } } ] }\n    Camera { name \"inner\"")
+    (tmp_path / "w.wbt").write_text(text)
+    sim = _sim(tmp_path / "w.wbt")
+    sv.remove_node(sim, sv.find_node(sim, "BODY"))
+    gone = _images(sim)
+    assert sv.find_node(sim, "MAT") is None                       # the DEF was inside the removed Shape
+    (mat,) = [sv.node_by_id(sim, n.id) for n in sv._table(sim).nodes           # the USE: a node of its own
+              if n.type == "Material" and sv.node_from_id(sim, n.id) is not None]
+    sv.set_field(sim, mat, "diffuseColor", [0.0, 1.0, 0.0])
+    sv.set_field(sim, mat, "transparency", 0.0)                  # (would show the removed pieces again)
+    assert _images(sim) == gone
+    assert sv.get_field(sim, mat, "diffuseColor")["value"] == [0.0, 1.0, 0.0]

@@ -427,6 +427,27 @@ def drop(table: Table, owner: int) -> None:
     table.segments.pop(owner, None)
 
 
+def drop_shape(table: Table, shape: int) -> None:
+    """A Shape node a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
+    getFromProtoDef finds them and their ids read as removed (never given again)."""
+    gone = {shape}
+    todo = [shape]
+    while todo:
+        for c in table.by_parent.pop(todo.pop(), ()):
+            gone.add(c.id)
+            todo.append(c.id)
+    n = table.get(shape)
+    assert n is not None
+    table.by_parent[n.parent] = tuple(c for c in table.by_parent.get(n.parent, ()) if c.id != shape)
+    table.by_owner[n.owner] = tuple(c for c in table.by_owner.get(n.owner, ()) if c.id not in gone)
+    for node_id in gone:
+        if table.added.pop(node_id, None) is None:
+            table.forgotten.add(node_id)
+    for defs in (table.inner or {}).values():
+        for name in [k for k, v in defs.items() if v in gone]:
+            del defs[name]
+
+
 def inner_def(table: Table, instance: int, name: str) -> int | str | None:
     """getFromProtoDef: the node of PROTO instance ``instance``'s body with DEF ``name`` (its id), why the
     DEF'd node is no node here (a line), or None when the body has no such DEF. The scope is Webots':

@@ -1102,8 +1102,9 @@ def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
 
 
 def remove_node(sim: Any, node: Node) -> None:
-    """Webots' ``node.remove()`` for what is a node here: a top-level solid or light. The root and
-    robots are refused (a robot's controller, devices and lockstep slot cannot leave a running
+    """Webots' ``node.remove()`` for what is a node here: a top-level solid or light, a Shape inside a
+    robot or solid (``Scene.remove_shapes``: unseen from the next cast, a split mesh's pieces together; its
+    node and those inside it read as removed). The root and robots are refused (a robot's controller, devices and lockstep slot cannot leave a running
     server here; Webots removes a robot, the calling one at the end of the step)."""
     if node.scenery:
         raise ValueError(f"{node.type} (node {node.id}) cannot be removed here: only top-level solids and lights "
@@ -1114,9 +1115,15 @@ def remove_node(sim: Any, node: Node) -> None:
     if node.visual:
         sim.remove_solid(node.key)
         return
+    ref = _nested_of(sim, node).shape if node.nested else None
+    if ref is not None and ref.role == "Shape":      # a Shape inside a robot or solid: every piece of it unseen
+        sim.scene.remove_shapes(ref.peers or (ref.index,))
+        nested.drop_shape(_table(sim), node.id)
+        return
     if node.nested:
         raise ValueError(f"{node.type} {node.name or node.def_name or node.id!r} (node {node.id}) cannot be removed "
-                         "here: only top-level solids and lights can, not the nodes inside a robot or solid")
+                         "here: only top-level solids and lights and the Shapes inside robots and solids can, not "
+                         "the other nodes inside a robot or solid")
     if node.type == "Solid":
         sim.remove_solid(node.key)
     elif node.type in LIGHTS:
