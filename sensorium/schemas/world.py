@@ -470,6 +470,9 @@ class ShapeNode(Strict):
     values: dict[str, NodeValue] = Field(default={}, max_length=64, description="the written values: "
                                          "'<node>.<field>' (node: appearance, material, texture, geometry)")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
+    piece: bool = Field(default=False, description="a further piece of the shape before it: a mesh the .wbt import "
+                        "split around its robot's devices (README 'Worlds') is one Shape node to a "
+                        "Supervisor, its first piece's")
 
 _CAST_SHADOWS = ("Webots' Shape.castShadows: false lets cameras' shadow rays through this shape (it still hides "
                  "what is behind it, and other rays see it)")
