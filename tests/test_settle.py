@@ -255,3 +255,59 @@ def test_a_nue_world_settles_along_its_y() -> None:
         "0.9000 to 0.2300 m (its lowest wheel now touches the ground under it)"]
     bs = BatchedSimulation(w, copies=1, precision="exact")
     assert np.array_equal(bs.pose(0, 0).translation, t)
+
+
+# ---------------------------------------------------------------------- a car's free wheels
+
+CAR_L, CAR_T, AXLE_Z = 2.6, 1.5, 0.35         # wheelbase, track, both axles' height above the car's origin
+
+
+def _car_wheel(x: float, y: float, radius: float) -> str:
+    return (f'Solid {{ translation {x} {y} {AXLE_Z} rotation 1 0 0 1.5707963267948966 children [ DEF W Shape {{ '
+            f'geometry Cylinder {{ radius {radius} height 0.2 }} }} ] boundingObject USE W }}')
+
+
+def _car_front(side: str, y: float, radius: float, driven: bool) -> str:
+    spin = f'device2 [ RotationalMotor {{ name "{side}_front_wheel" maxVelocity 80 }} ] ' if driven else ""
+    return (f'Hinge2Joint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor {CAR_L} {y} {AXLE_Z} }} '
+            f'jointParameters2 JointParameters {{ axis 0 1 0 }} '
+            f'device [ RotationalMotor {{ name "{side}_steer" minPosition -0.6 maxPosition 0.6 maxVelocity 5 }} ] '
+            f'{spin}endPoint {_car_wheel(CAR_L, y, radius)} }}\n')
+
+
+def _car_rear(side: str, y: float, radius: float, driven: bool, sensor: bool = True) -> str:
+    devices = ([f'RotationalMotor {{ name "{side}_rear_wheel" maxVelocity 80 }}'] if driven else []) + (
+        [f'PositionSensor {{ name "{side}_rear_sensor" }}'] if sensor else [])
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} {AXLE_Z} }} '
+            f'device [ {" ".join(devices)} ] endPoint {_car_wheel(0.0, y, radius)} }}\n')
+
+
+def _car_world(tmp_path: Path, front_radius: float, rear_radius: float, traction: bool, sensor: bool = True) -> Path:
+    wheels = (_car_front("right", -CAR_T / 2, front_radius, traction) + _car_front("left", CAR_T / 2, front_radius, traction)
+              + _car_rear("right", -CAR_T / 2, rear_radius, not traction, sensor)
+              + _car_rear("left", CAR_T / 2, rear_radius, not traction, sensor))
+    path = tmp_path / "car.wbt"
+    path.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+                    'Solid { translation 0 0 0.1 name "floor" children [ Shape { geometry Plane { size 40 40 } } ] '
+                    "boundingObject Plane { size 40 40 } }\n"
+                    'Robot { translation 0 0 1.5 name "car" controller "<extern>" children [\n' + wheels
+                    + "] physics Physics { } }\n")
+    return path
+
+
+@pytest.mark.parametrize("traction, sensor", [(True, True), (True, False), (False, True)])
+def test_a_cars_free_wheels_hold_it_up_as_its_driven_ones_do(tmp_path: Path, traction: bool, sensor: bool) -> None:
+    """A front-wheel-drive car whose free rear wheels are larger (0.45 against 0.3: their bottoms 10 cm
+    below the front ones'), with or without encoders, and a rear-wheel-drive car whose free front
+    wheels are: it settles on its lowest wheels, origin = floor − (axle height − the larger radius)."""
+    small, large = 0.3, 0.45
+    front, rear = (small, large) if traction else (large, small)
+    w = load_world(_car_world(tmp_path, front, rear, traction, sensor))
+    car = w.world.robots[0].ackermann_drive
+    assert car is not None and car.type == ("traction" if traction else "propulsion")
+    assert car.wheel_bottom == AXLE_Z - large
+    assert not [n for n in w.warnings if "PositionSensor" in n]
+    assert _t(Simulation(w), "car")[2] == 0.1 - (AXLE_Z - large)
+    # equal wheels: the driven ones' bottom, as before
+    w = load_world(_car_world(tmp_path, small, small, traction, sensor))
+    assert w.world.robots[0].ackermann_drive.wheel_bottom == AXLE_Z - small

@@ -587,10 +587,11 @@ def omni_wheels(wheels: list[dict], conv) -> bool:
 def wheel_bottom(wheels: list[dict], conv) -> float | None:
     """The drive's ``wheel_bottom``: the lowest bottom, along the robot's z, of its wheels that do not
     steer (each one's round part's centre, where it is as the world loads, less its radius), or None
-    without one whose radius is known. The robot settles on the ground with it at load."""
+    without one whose radius is known. The robot settles on the ground with it at load. ``wheels``:
+    motorised hinges, or a car's free wheels (no ``steers``: their rolling axes)."""
     bottoms = []
     for w in wheels:
-        radius = None if w["steers"] else wheel_radius(w["end"], conv)
+        radius = None if w.get("steers") else wheel_radius(w["end"], conv)
         if radius is not None:
             centre = round_centre(w, conv)
             bottoms.append(float((w["centre"] if centre is None else centre)[2]) - radius)
