@@ -17,6 +17,7 @@ import pytest
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world, parse_world
+from sensorium.server.world.poses import pose_from_model
 
 R = 0.03                 # wheel radius; wheel_bottom -R: the axle through the robot's origin
 DRIVE = {"wheel_radius": R, "axle_length": 0.1, "wheel_bottom": -R}
@@ -311,3 +312,31 @@ def test_a_cars_free_wheels_hold_it_up_as_its_driven_ones_do(tmp_path: Path, tra
     # equal wheels: the driven ones' bottom, as before
     w = load_world(_car_world(tmp_path, small, small, traction, sensor))
     assert w.world.robots[0].ackermann_drive.wheel_bottom == AXLE_Z - small
+
+
+def test_a_nue_robot_built_y_up_settles_along_its_own_y() -> None:
+    """A NUE world (x north, y up, z east) whose robot is built y up, as Webots' robots were before
+    R2022a (identity rotation, or turned about the world's y): its wheel_bottom is along its own y,
+    and it settles with y = floor + R; its x, z and rotation kept. The floor Plane is turned so its
+    normal (local z) is the world's y."""
+    floor = {"name": "floor", "pose": {"translation": [0.0, 0.2, 0.0], "rotation": [1, 0, 0, -math.pi / 2]},
+             "geometry": {"type": "plane"}}
+    robots = [{"name": "r", "pose": {"translation": [0.3, 0.9, -0.2]}, "differential_drive": DRIVE},
+              {"name": "s", "pose": {"translation": [-1.0, 0.05, 0.5], "rotation": [0, 1, 0, 0.7]},
+               "differential_drive": DRIVE}]
+    w = parse_world({"world_info": {"coordinate_system": "NUE"}, "solids": [floor], "robots": robots},
+                    source="w.yaml")
+    sim = Simulation(w, precision="exact")
+    for name, (x, z) in (("r", (0.3, -0.2)), ("s", (-1.0, 0.5))):
+        t = _t(sim, name)
+        assert (t[0], t[1], t[2]) == (x, 0.2 - (-R), z)
+    assert np.array_equal(sim.robot("s").pose.rotation, pose_from_model(w.world.robots[1].pose).rotation)
+    assert [n for n in w.warnings if "settled" in n] == [
+        "w.yaml: robot 'r' settled on the ground at load, as Webots' physics drops it: its origin's y from "
+        "0.9000 to 0.2300 m (its lowest wheel now touches the ground under it)",
+        "w.yaml: robot 's' settled on the ground at load, as Webots' physics drops it: its origin's y from "
+        "0.0500 to 0.2300 m (its lowest wheel now touches the ground under it)"]
+    bs = BatchedSimulation(w, copies=2, precision="exact")
+    for slot, name in enumerate(("r", "s")):
+        for c in range(2):
+            assert np.array_equal(bs.pose(c, slot).translation, _t(sim, name))

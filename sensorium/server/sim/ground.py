@@ -66,7 +66,7 @@ from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
 __all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "placing_ceiling", "ride_height",
-           "settle_world", "support_ceiling"]
+           "robot_up", "settle_world", "support_ceiling"]
 
 UPRIGHT_TOL = 1e-12     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
@@ -447,13 +447,23 @@ def _wheels(robot: wm.Robot) -> tuple[float, float] | None:
     return None if drive.wheel_bottom is None else (float(drive.wheel_bottom), float(radius))
 
 
+def robot_up(r: np.ndarray, to_enu: np.ndarray | None) -> int | None:
+    """Which of a robot's own axes stands up (its rotation ``r`` in ENU axes): its z (2) when that is
+    the world's up, in a NUE world its y (1) when that is (a robot built y-up, as Webots' robots were
+    before R2022a); None when neither is (a tilted robot). Its ``wheel_bottom`` is along that axis."""
+    for k in ((2,) if to_enu is None else (2, 1)):
+        if abs(r[0, k]) <= ROBOT_UPRIGHT_TOL and abs(r[1, k]) <= ROBOT_UPRIGHT_TOL and r[2, k] > 0.0:
+            return k
+    return None
+
+
 def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tuple[wm.World, list[str]]:
     """The world with its wheeled robots settled on the ground, as Webots' physics drops them at
     load, and one note line per robot moved by more than SETTLE_NOTE (at most SETTLE_NOTES, then a
     count).
 
     A robot is settled when its drive gives ``wheel_bottom`` and it stands upright (its z axis the
-    world's up): its height becomes ``ground − wheel_bottom``, so its lowest wheel's bottom touches
+    world's up, or in a NUE world its y: :func:`robot_up`): its height becomes ``ground − wheel_bottom``, so its lowest wheel's bottom touches
     the ground under its origin; x, y and its rotation are kept. The ground is this module's, box
     and cylinder tops included whatever the world has (terrains or not), under the ceiling
     ``max(origin, wheel bottom + smallest wheel radius) + FLOOR``: a box top above its wheels' axle
@@ -484,7 +494,7 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tup
         r, t = pose.rotation, pose.translation
         if to_enu is not None:
             r, t = to_enu @ r, to_enu @ t
-        if abs(r[0, 2]) <= ROBOT_UPRIGHT_TOL and abs(r[1, 2]) <= ROBOT_UPRIGHT_TOL and r[2, 2] > 0.0:
+        if robot_up(r, to_enu) is not None:
             upright.append((i, robot, bottom, float(t[0]), float(t[1]), float(t[2]), max(0.0, bottom + radius)))
     if not upright:
         return world, []
