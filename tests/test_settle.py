@@ -340,3 +340,138 @@ def test_a_nue_robot_built_y_up_settles_along_its_own_y() -> None:
     for slot, name in enumerate(("r", "s")):
         for c in range(2):
             assert np.array_equal(bs.pose(c, slot).translation, _t(sim, name))
+
+
+# ---------------------------------------------------------------------- a Supervisor's move
+
+def _moves_world(coordinate_system: str = "ENU") -> dict:
+    deck = _box("deck", (2.0, 0.0, 0.1), (1.0, 1.0, 0.2))                  # top at 0.2
+    table = _box("table", (-2.0, 0.0, 0.5), (1.0, 1.0, 0.04))              # top at 0.52, far above any axle
+    keeper = {"name": "keeper", "pose": {"translation": [0.0, 5.0, 0.0]},  # a driveless robot holding a floor box
+              "shapes": [{"pose": {"translation": [0.0, 0.0, 0.35]}, "geometry": {"type": "box", "size": [1.0, 1.0, 0.1]}}]}
+    plain = {k: v for k, v in DRIVE.items() if k != "wheel_bottom"}
+    robots = [_robot(at=(0.3, -0.2, 0.2)), _robot("hover", at=(0.0, -3.0, 0.4), drive=plain),
+              {"name": "arm", "pose": {"translation": [0.0, 3.0, 0.0]}}, keeper,
+              {"name": "boss", "supervisor": True, "pose": {"translation": [9.0, 9.0, 0.0]}}]
+    data = {"solids": [FLOOR, deck, table], "robots": robots}
+    if coordinate_system == "NUE":
+        from tests.test_batched_nue import _to_nue
+        data = _to_nue(parse_world(data).world)
+    return data
+
+
+# where a Supervisor puts robot 'r' (ENU) -> where it settles: its wheels' bottom (origin - R) on the ground
+MOVES = [((1.0, 1.0, 0.9), 0.0 + R),            # in the air over the floor: dropped onto it
+         ((2.1, 0.2, 0.9), 0.2 + R),            # over the deck: onto its top
+         ((2.1, 0.2, 0.2 + R / 2), 0.2 + R),    # half sunk into the deck, axle above its top: raised onto it
+         ((-2.0, 0.0, 0.1), 0.0 + R),           # under the table: onto the floor below it
+         ((0.0, 5.0, 0.9), 0.4 + R)]            # onto the driveless robot's box (top at 0.35 + 0.05)
+
+
+@pytest.mark.parametrize("at, settled", MOVES)
+def test_a_supervisor_move_of_a_wheeled_robot_settles_it_at_once(at, settled) -> None:
+    """Webots' physics drops a robot a Supervisor puts in the air; here it settles at once, as at
+    load: its height ground − wheel_bottom (closed form), x, y and rotation as given."""
+    sim = _sim(*_split(_moves_world()))
+    r = sim.robot("r")
+    r.set_pose(list(at), rotation=[0, 0, 1, 0.4])
+    t = _t(sim)
+    assert (t[0], t[1]) == (at[0], at[1]) and t[2] == pytest.approx(settled, abs=1e-15)
+    sim.step()
+    assert np.array_equal(_t(sim), t)
+    yaw = math.atan2(r.pose.rotation[1, 0], r.pose.rotation[0, 0])
+    assert yaw == pytest.approx(0.4, abs=1e-15)
+
+
+def _split(data: dict) -> tuple[list, list]:
+    return data["solids"], data["robots"]
+
+
+def test_a_supervisor_move_of_a_robot_that_does_not_settle_keeps_its_height() -> None:
+    """A robot without a drive (an arm), one whose drive has no wheel_bottom, a tilted one: the
+    height a Supervisor gives is kept, bit for bit, as at load."""
+    sim = _sim(*_split(_moves_world()))
+    sim.robot("arm").set_pose([0.5, 3.0, 0.77])
+    sim.robot("hover").set_pose([0.5, -3.0, 0.66])
+    sim.step()
+    assert tuple(sim.robot("arm").pose.translation) == (0.5, 3.0, 0.77)
+    assert tuple(_t(sim, "hover")) == (0.5, -3.0, 0.66)
+    sim.robot("r").set_pose([1.0, 1.0, 0.9], rotation=[1, 0, 0, 0.3])
+    assert tuple(_t(sim)) == (1.0, 1.0, 0.9)
+
+
+def test_the_ground_a_supervisor_move_settles_on_is_the_world_as_it_is_now() -> None:
+    """The deck moved away, the driveless robot's box moved under the robot, a solid removed: each
+    move of the wheeled robot settles on the ground where it is then."""
+    sim = _sim(*_split(_moves_world()))
+    r = sim.robot("r")
+    sim.set_solid_pose("deck", [2.0, 0.0, 0.3])                      # top at 0.4
+    r.set_pose([2.1, 0.2, 0.9])
+    assert _t(sim)[2] == 0.4 + R
+    sim.robot("keeper").set_pose([4.0, 4.0, 0.1])                    # its box top at 0.1 + 0.35 + 0.05
+    r.set_pose([4.0, 4.0, 0.9])
+    assert _t(sim)[2] == pytest.approx((0.1 + 0.35 + 0.05) + R, abs=1e-15)
+    sim.remove_solid("deck")
+    r.set_pose([2.1, 0.2, 0.9])
+    assert _t(sim)[2] == 0.0 + R
+
+
+def test_a_supervisor_set_field_then_a_step_shows_the_settled_height() -> None:
+    """Through the server's core: the supervisor sets the robot's translation 0.9 m up over the deck;
+    after its next step the translation field and getPosition show it standing on the deck."""
+    import itertools
+
+    import msgpack
+
+    from sensorium.server.daemon.services import Core
+
+    sim = _sim(*_split(_moves_world()))
+    n = itertools.count()
+    core = Core(sim, new_token=lambda: f"s{next(n)}", log=lambda line: None)
+    ids = itertools.count(1)
+
+    def call(service: str, args: dict | None = None) -> dict:
+        rid = next(ids)
+        replies = list(core.handle([b"S", msgpack.packb({"id": rid, "service": service, "args": args or {}})], 0.0))
+        while not replies:
+            replies = core.step_once(0.0)[0]
+        r = msgpack.unpackb(replies[-1][-1])
+        assert r["id"] == rid and r["ok"] is True, r
+        return r["result"]
+
+    call("attach", {"robot": "boss"})
+    node = call("/boss/robot/get_from_def", {"name": "r"})["node"]
+    call("/boss/robot/set_field", {"node": node, "field": "translation", "value": [2.1, 0.2, 0.9]})
+    call("/boss/robot/step")
+    assert call("/boss/robot/get_field", {"node": node, "field": "translation"})["value"] == [2.1, 0.2, 0.2 + R]
+    assert call("/boss/robot/get_node_pose", {"node": node})["position"] == [2.1, 0.2, 0.2 + R]
+
+
+@pytest.mark.parametrize("coordinate_system", ["ENU", "NUE"])
+def test_the_batched_copies_settle_a_move_as_the_simulation_does(coordinate_system: str) -> None:
+    solids, robots = _split(_moves_world(coordinate_system))
+    world = {"solids": solids, "robots": robots}
+    if coordinate_system == "NUE":
+        world["world_info"] = {"coordinate_system": "NUE"}
+    sim = Simulation(parse_world(world), precision="exact")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        bs = BatchedSimulation(parse_world(world), copies=3, precision="exact")
+    names = [r["name"] for r in robots]
+    slot = names.index("r")
+    turn = {"ENU": lambda v: list(v), "NUE": lambda v: [v[1], v[2], v[0]]}[coordinate_system]
+    axis = turn((0.0, 0.0, 1.0))
+    bs.set_pose(2, names.index("keeper"), turn((4.0, 4.0, 0.1)))       # copy 2's floor robot moved
+    sim.robot("keeper").set_pose(turn((4.0, 4.0, 0.1)))
+    for at, _ in [*MOVES, (((4.0, 4.0, 0.9)), None)]:
+        sim.robot("r").set_pose(turn(at), rotation=[*axis, 0.4])
+        bs.set_pose(2, slot, turn(at), rotation=[*axis, 0.4])
+        p = bs.pose(2, slot)
+        assert np.array_equal(p.translation, sim.robot("r").pose.translation)
+        assert np.array_equal(p.rotation, sim.robot("r").pose.rotation)
+    assert sim.robot("r").pose.translation[{"ENU": 2, "NUE": 1}[coordinate_system]] == pytest.approx(0.5 + R, abs=1e-15)
+    bs.set_pose(0, slot, turn((4.0, 4.0, 0.9)), rotation=[*axis, 0.4])       # copy 0's keeper is elsewhere
+    assert bs.pose(0, slot).translation[{"ENU": 2, "NUE": 1}[coordinate_system]] == 0.0 + R
+    bs.step()
+    sim.step()
+    assert np.array_equal(bs.pose(2, slot).translation, sim.robot("r").pose.translation)
