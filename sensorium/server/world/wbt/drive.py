@@ -35,8 +35,10 @@ taken within AXIS_TOL, as the car's other axes are).
 Four wheels whose friction WorldInfo's ContactProperties makes asymmetric and turns
 (``frictionRotation``: a KUKA youBot's mecanum rollers, which Webots simulates so) map onto the
 kinematic ``mecanum_drive`` when they sit at the corners (±lx, ±ly) of a rectangle centred under
-the origin, of one radius; a wheel's roller sign is minus the sign of its friction's turn (the
-youBot's wheels turned by +0.785 are the ones its library's formulas give -1).
+the origin, of one radius; a wheel's roller sign is minus the sign of its friction's turn: Webots'
+contact frees a wheel along its cylinder's axis turned by -frictionRotation about the contact normal
+(up into the wheel), so a wheel turned by -0.785 slides along (1, -1) and grips along (1, 1), sign +1
+(the youBot's wheels turned by +0.785 are the ones its library's formulas give -1).
 
 Three or more wheels, none steering, about axes horizontal in the robot's frame that are not all
 along one line, each turning something round about its axis, their lowest points on one ground
