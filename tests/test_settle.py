@@ -475,3 +475,30 @@ def test_the_batched_copies_settle_a_move_as_the_simulation_does(coordinate_syst
     bs.step()
     sim.step()
     assert np.array_equal(bs.pose(2, slot).translation, sim.robot("r").pose.translation)
+
+
+def _y_up_wheel(side: str, x: float) -> str:
+    """A wheel of a robot built y-up (its axle along its x, 3 cm above its origin along its y)."""
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 1 0 0 anchor {x} 0.03 0 }}\n'
+            f'  device [ RotationalMotor {{ name "{side} wheel motor" maxVelocity 10 }} ]\n'
+            f'  endPoint Solid {{ translation {x} 0.03 0 rotation 0 1 0 1.5707963267948966 name "{side} wheel"\n'
+            '    children [ Shape { geometry Cylinder { radius 0.025 height 0.01 } } ]\n'
+            '    boundingObject Cylinder { radius 0.025 height 0.01 } physics Physics { } } }\n')
+
+
+def test_a_wbt_robot_built_y_up_in_a_nue_world_takes_its_wheel_bottom_along_its_y(tmp_path: Path) -> None:
+    """A NUE .wbt whose Robot is built y-up (axles 3 cm above its origin along its y, wheels of radius
+    2.5 cm): wheel_bottom 0.005 along its y; its floor (a Plane turned so its normal is the world's
+    y) at y = 0.1: it settles at y = 0.1 − 0.005."""
+    path = tmp_path / "w.wbt"
+    path.write_text("#VRML_SIM R2023b utf8\nWorldInfo { coordinateSystem \"NUE\" basicTimeStep 16 }\n"
+                    'Solid { translation 0 0.1 0 rotation 1 0 0 -1.5707963267948966 name "floor" '
+                    "children [ Shape { geometry Plane { size 4 4 } } ] boundingObject Plane { size 4 4 } }\n"
+                    'Robot { translation 0.2 0.3 -0.4 name "bot" controller "<extern>" children [\n'
+                    + _y_up_wheel("left", 0.05) + _y_up_wheel("right", -0.05) + "] physics Physics { } }\n")
+    w = load_world(path)
+    (robot,) = w.world.robots
+    drive = robot.differential_drive or robot.mecanum_drive or robot.omni_drive or robot.ackermann_drive
+    assert drive is not None and drive.wheel_bottom == pytest.approx(0.005, abs=1e-12)
+    t = _t(Simulation(w), "bot")
+    assert (t[0], t[2]) == (0.2, -0.4) and t[1] == 0.1 - drive.wheel_bottom

@@ -1885,16 +1885,27 @@ class Converter:
                 if id(free) not in rolling and free["line"] is not None:
                     self.warn(free["node"], free["line"])
             if car is not None and rolling and self.fields(node).node_("physics") is not None:
-                self._free_wheel_bottom(car, [f for f in robot.free if id(f) in rolling])
+                self._free_wheel_bottom(robot, car, [f for f in robot.free if id(f) in rolling])
 
-    def _free_wheel_bottom(self, car: dict, free: list[dict]) -> None:
+    def _free_wheel_bottom(self, robot: Owner, car: dict, free: list[dict]) -> None:
         """A car's free wheels (no motor: a propulsion car's front ones, a traction car's rear ones) hold
         it up as its driven ones do: its ``wheel_bottom`` is the lowest of them all, each with its radius."""
         from sensorium.server.world.wbt.drive import wheel_bottom
 
-        bottom = wheel_bottom(free, self)
+        bottom = wheel_bottom(free, self, self._robot_up(robot))
         if bottom is not None:
             car["wheel_bottom"] = min(car.get("wheel_bottom", bottom), bottom)
+
+    def _robot_up(self, robot: Owner) -> int:
+        """The robot's own axis its ``wheel_bottom`` is measured along: its z, or in a NUE world its y
+        when that is nearer the world's up (a robot built y-up, as Webots' were before R2022a;
+        sim/ground.py settles it along that axis)."""
+        if self.world["world_info"].get("coordinate_system", "ENU") != "NUE":
+            return 2
+        from sensorium.server.world.poses import pose_from_model
+
+        r = pose_from_model(wm.Pose.model_validate(robot.data["pose"])).rotation
+        return 1 if abs(r[1, 1]) > abs(r[1, 2]) else 2
 
     def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         if len(nowheel) <= MANY_JOINTS:
@@ -2056,7 +2067,8 @@ class Converter:
         gravity drops it, so it settles on the ground at load; one without stays where it is put)."""
         from sensorium.server.world.wbt.drive import wheel_bottom
 
-        bottom = wheel_bottom(wheels, self) if self.fields(node).node_("physics") is not None else None
+        bottom = (wheel_bottom(wheels, self, self._robot_up(robot)) if self.fields(node).node_("physics") is not None
+                  else None)
         if bottom is not None:
             for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive"):
                 if key in robot.data:

@@ -586,8 +586,9 @@ def omni_wheels(wheels: list[dict], conv) -> bool:
     return max(bottoms) - min(bottoms) <= GROUND_TOL
 
 
-def wheel_bottom(wheels: list[dict], conv) -> float | None:
-    """The drive's ``wheel_bottom``: the lowest bottom, along the robot's z, of its wheels that do not
+def wheel_bottom(wheels: list[dict], conv, up: int = 2) -> float | None:
+    """The drive's ``wheel_bottom``: the lowest bottom, along the robot's z (``up``: 1 along its y, a
+    robot built y-up in a NUE world), of its wheels that do not
     steer (each one's round part's centre, where it is as the world loads, less its radius), or None
     without one whose radius is known. The robot settles on the ground with it at load. ``wheels``:
     motorised hinges, or a car's free wheels (no ``steers``: their rolling axes)."""
@@ -596,7 +597,7 @@ def wheel_bottom(wheels: list[dict], conv) -> float | None:
         radius = None if w.get("steers") else wheel_radius(w["end"], conv)
         if radius is not None:
             centre = round_centre(w, conv)
-            bottoms.append(float((w["centre"] if centre is None else centre)[2]) - radius)
+            bottoms.append(float((w["centre"] if centre is None else centre)[up]) - radius)
     return min(bottoms) if bottoms else None
 
 
