@@ -502,3 +502,26 @@ def test_a_wbt_robot_built_y_up_in_a_nue_world_takes_its_wheel_bottom_along_its_
     assert drive is not None and drive.wheel_bottom == pytest.approx(0.005, abs=1e-12)
     t = _t(Simulation(w), "bot")
     assert (t[0], t[2]) == (0.2, -0.4) and t[1] == 0.1 - drive.wheel_bottom
+
+
+def test_a_supervisor_move_over_a_terrain_settles_on_the_triangle_and_rides_from_there() -> None:
+    """Put 2 m up over the terrain's grid point x = 1.5: it settles on it (0.1 + 0.25·1.5 + R), tilted
+    by the slope, and drives on keeping its wheels on the ground; the batched copy the same bits."""
+    robots = [_robot(at=(0.5, 0.5, 0.2), yaw=0.0)]
+    sim = _sim([_grid(0.1)], robots)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        bs = BatchedSimulation(_loaded([_grid(0.1)], robots), copies=2, precision="exact")
+    sim.robot("r").set_pose([1.5, 0.5, 2.0], rotation=[0, 0, 1, 0.0])
+    bs.set_pose(1, 0, [1.5, 0.5, 2.0], rotation=[0, 0, 1, 0.0])
+    assert _t(sim)[2] == pytest.approx(0.1 + 0.25 * 1.5 + R, abs=1e-15)
+    r = sim.robot("r").pose.rotation
+    assert math.atan2(-r[2, 0], r[0, 0]) == pytest.approx(-math.atan(0.25), abs=1e-12)
+    assert np.array_equal(bs.pose(1, 0).translation, _t(sim))
+    assert np.array_equal(bs.pose(1, 0).rotation, sim.robot("r").pose.rotation)
+    d = sim.robot("r").drive
+    for m in (*d.lefts, *d.rights):
+        m.set_position(math.inf)
+        m.set_velocity(-2.0)
+    sim.run(10)                                         # drives down the slope, its wheels on the ground
+    assert _t(sim)[2] == pytest.approx(0.1 + 0.25 * _t(sim)[0] + R, abs=1e-12)
