@@ -613,6 +613,72 @@ def test_a_robot_on_a_robot_is_dropped_with_a_reason(tmp_path: Path) -> None:
             "dropped with everything inside it") in w.warnings
 
 
+def test_a_robot_without_controller_or_device_rides_its_robot_as_part_of_its_body(tmp_path: Path) -> None:
+    """The shape of Webots' JetBot, whose Jetson Nano board is a Robot with controller "<none>": the
+    board is kept as part of the outer robot, where its rotation and translation put it, and a
+    sensor sees it. The base faces world +y; the board sits 0.3 m ahead, its box's far face at y =
+    0.35; a sensor at y = 1 looking back along -y reads 1 - 0.35 = 0.65 m."""
+    box = "Box { size 0.1 0.1 0.1 }"
+    p = write(tmp_path, f"""
+Robot {{ translation 0.2 0 0 rotation 0 0 1 1.5707963267948966 name "base" children [
+  Robot {{ translation 0.3 0 0.05 name "board" controller "<none>" children [
+    Pose {{ children [ Shape {{ geometry {box} }} ] }} ]
+    boundingObject {box} }} ] }}
+Robot {{ translation 0.2 1 0.05 rotation 0 0 1 -1.5707963267948966 name "eye" children [
+  DistanceSensor {{ name "d" lookupTable [ 0 0 0, 1 1000 0 ] }} ] }}
+""")
+    w = load_world(p)
+    assert [r.name for r in w.world.robots] == ["base", "eye"]
+    assert w.report.losses == ()
+    assert w.warnings == [f"{p}:4:3: Robot 'board' inside robot 'base': no controller and no device: its shapes "
+                          "and bounding objects are kept as part of 'base''s body (a robot riding on another "
+                          "robot is not simulated here)"]
+    sim = Simulation(w)
+    d = sim.device("eye/d")
+    d.enable(32)
+    sim.step()
+    assert d.value == pytest.approx(1000 * 0.65, abs=1e-9)
+
+
+@pytest.mark.parametrize("inner", ['controller "<none>" children [ DistanceSensor { } ]',
+                                   'controller "rider" children [ Pose { } ]',
+                                   'children [ Shape { geometry Box { size 0.1 0.1 0.1 } } ]'])
+def test_a_robot_with_a_controller_or_a_device_on_a_robot_is_still_dropped(tmp_path: Path, inner: str) -> None:
+    # a controller that would run (Webots' default one included) or a device it would read: a loss, said
+    p = write(tmp_path, f'Robot {{ name "base" children [ Robot {{ name "rider" {inner} }} ] }}\n')
+    w = load_world(p)
+    assert [r.name for r in w.world.robots] == ["base"]
+    (loss,) = w.report.losses
+    assert (loss.kind, loss.name) == ("robot", "rider")
+    assert loss.why.startswith("Robot 'rider' inside robot 'base': a robot riding on another robot is not supported")
+
+
+def test_cameras_in_a_world_without_light_lit_by_a_background_in_webots_are_said_black(tmp_path: Path) -> None:
+    """Webots' rosbot.wbt has no light: its renderer lights shapes by the TexturedBackground's cube
+    map (image-based lighting, not simulated here), so its cameras would see black without a word."""
+    robot = 'Robot { name "r" children [ Camera { width 4 height 4 } ] }\n'
+    lit_by_maps = 'Background { skyColor [ 0.5 0.5 0.5 ] backUrl [ "sky_back.png" ] }\n'
+    p = write(tmp_path, lit_by_maps + robot)
+    w = load_world(p)
+    assert w.warnings[:1] == [f"{p}: no light in this world: its cameras (r/camera) see every surface black; Webots' "
+                          "renderer also lights shapes by the background's image-based lighting (a "
+                          "TexturedBackground's cube map), which is not simulated here: add a DirectionalLight or "
+                          "TexturedBackgroundLight for them to see"]
+    # what it says: a surface in view reads black
+    floor = 'Solid { translation 0 0 -1 children [ Shape { geometry Box { size 10 10 0.1 } } ] }\n'
+    p = write(tmp_path, lit_by_maps + floor + robot.replace("Camera {", "Camera { rotation 0 1 0 1.5707963267948966"))
+    sim = Simulation(load_world(p))
+    cam = sim.device("r/camera")
+    cam.enable(32)
+    sim.step()
+    image = np.asarray(cam.image)
+    assert image.shape[:2] == (4, 4) and not image[..., :3].any()
+    # a light anywhere, a background without cube maps, or no camera: nothing to say
+    for world in (lit_by_maps + robot + "DirectionalLight { }\n", "Background { skyColor [ 0.5 0.5 0.5 ] }\n" + robot,
+                  lit_by_maps + 'Robot { name "r" }\n'):
+        assert not [m for m in load_world(write(tmp_path, world)).warnings if "no light" in m]
+
+
 def test_unsimulated_devices_keep_their_shapes(tmp_path: Path) -> None:
     p = write(tmp_path, 'Robot { name "r" children [ Camera { translation 0.1 0 0 children [\n'
                         '  Shape { geometry Box { size 0.01 0.02 0.03 } } ] } GPS { } ] }\n')

@@ -72,6 +72,11 @@ UNSEEN_GEOMETRIES = {"IndexedLineSet", "PointSet"}      # lines and points: no s
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder", "Camera"}
 JOINTS = {"HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"}
+# a Robot inside a robot holding only these (shapes and solids) and no controller rides it as part of its body
+PLAIN_ROBOT_CONTENT = {"Pose", "Transform", "Group", "Shape", "CadShape", "Solid", "Slot"}
+# a Background's cube maps: Webots' renderer lights PBR shapes by them (image-based lighting)
+BACKGROUND_MAPS = tuple(f"{side}{kind}Url" for side in ("back", "bottom", "front", "left", "right", "top")
+                        for kind in ("", "Irradiance"))
 MOTORS = {"RotationalMotor", "LinearMotor"}
 OTHER_MOTOR_NAMES = {"RotationalMotor": "rotational motor", "LinearMotor": "linear motor"}
 JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "max_torque", "position", "axis",
@@ -244,6 +249,8 @@ class Converter:
         self.scopes: list[_Scope] = []
         self.inner_owner: dict | None = None
         self.scope_serial = 0
+        self.lights_seen = 0               # lights converted anywhere (the world's, solids', robots', LEDs')
+        self.image_lit = False             # a TexturedBackground or a Background with cube maps (Webots' IBL)
 
     # ------------------------------------------------------------ messages
     def where(self, node: Node, pos: tuple[int, int] | None = None) -> str:
@@ -346,6 +353,7 @@ class Converter:
                 f"first corner (over {EAR_CLIP_CORNERS} corners, or past the world's {EAR_CLIP_WORLD:,} corners² for "
                 "cutting them into ears): they may cover space outside their outline"
                 + (f" ({n} IndexedFaceSets, the first here)" if n > 1 else ""))
+        self.unlit_cameras_note()
         if self.skipped:
             listed = ", ".join(f"{k} x{v}" if v > 1 else k for k, v in sorted(self.skipped.items()))
             self.warnings.append(f"{self.source}: skipped nodes that do not matter to these sensors: {listed}")
@@ -612,6 +620,7 @@ class Converter:
             else:
                 self.world_info(node)
         elif t == "Background" and top and f.has("skyColor"):     # what cameras see past everything
+            self.note_image_lighting(node)
             sky = f.colors("skyColor", [(0.0, 0.0, 0.0)])
             self.world["background"] = {"sky_color": list(sky[0]) if sky else [0.0, 0.0, 0.0]}
             self.skipped[t] += 1     # its other fields (textures, luminosity) are not read
@@ -626,6 +635,7 @@ class Converter:
         elif t == "Billboard":
             self.billboard(node)
         elif t in SKIPPED:
+            self.note_image_lighting(node)
             if t != "TexturedBackground":     # a PROTO not read: the PROTO note says what cameras lose
                 self.skipped[t] += 1
         elif not frame.rigid and (t in SOLIDS or t in OTHER_DEVICES):
@@ -719,7 +729,12 @@ class Converter:
             self.light(node, frame, owner)
         elif t == "Robot":
             name = self.fields(node).string("name", "robot")
-            if owner.kind == "robot":
+            if owner.kind == "robot" and self.plain_robot(node):
+                self.warn(node, f"Robot {name!r} inside robot {owner.data['name']!r}: no controller and no device: "
+                                f"its shapes and bounding objects are kept as part of {owner.data['name']!r}'s body "
+                                "(a robot riding on another robot is not simulated here)")
+                self.solid(node, frame, owner)
+            elif owner.kind == "robot":
                 self.drop(node, f"Robot {name!r} inside robot {owner.data['name']!r}: a robot riding on another "
                                 "robot is not supported here; dropped with everything inside it", "robot", name)
             else:     # at the top or nested in solids and groups: a robot placed where they put it
@@ -770,6 +785,43 @@ class Converter:
                     return
                 stack.extend(value.fields.values())
         self.skipped["Billboard"] += 1
+
+    def plain_robot(self, node: Node) -> bool:
+        """A Robot with no controller (``<none>`` or empty) holding only shapes and solids, through
+        Poses, Transforms, Groups and Slots (Webots' JetsonNano board on the JetBot): nothing of it
+        runs, so riding its outer robot as part of that body is all Webots does with it."""
+        f = self.fields(node)
+        if f.string("controller", "<generic>") not in ("<none>", ""):
+            return False
+        stack = list(f.nodes("children"))
+        while stack:
+            child = stack.pop()
+            if child.type not in PLAIN_ROBOT_CONTENT:
+                return False
+            sub = self.fields(child)
+            stack += sub.nodes("endPoint") if child.type == "Slot" else sub.nodes("children")
+        return True
+
+    def note_image_lighting(self, node: Node) -> None:
+        """Whether Webots' renderer lights the world's PBR shapes by a background (image-based
+        lighting): a TexturedBackground, or a Background with cube maps."""
+        if node.type == "TexturedBackground" or (
+                node.type == "Background" and any(self.fields(node).strings(k) for k in BACKGROUND_MAPS)):
+            self.image_lit = True
+
+    def unlit_cameras_note(self) -> None:
+        """One line when the world's cameras would see only black: no light anywhere, while Webots
+        lights its shapes by the background's image-based lighting (Webots' rosbot.wbt has no light)."""
+        if self.lights_seen or not self.image_lit:
+            return
+        cameras = [f"{r['name']}/{d['name']}" for r in self.world["robots"] for d in r.get("devices", [])
+                   if d.get("device") == "Camera"]
+        if cameras:
+            listed = ", ".join(cameras[:3]) + (f" and {len(cameras) - 3} more" if len(cameras) > 3 else "")
+            self.warnings.append(f"{self.source}: no light in this world: its cameras ({listed}) see every "
+                                 "surface black; Webots' renderer also lights shapes by the background's "
+                                 "image-based lighting (a TexturedBackground's cube map), which is not simulated "
+                                 "here: add a DirectionalLight or TexturedBackgroundLight for them to see")
 
     def scaled_solid(self, node: Node, owner: Owner) -> None:
         """A Solid (a robot, a device, a joint's end point) under a Transform that scales: Webots
@@ -1216,6 +1268,7 @@ class Converter:
     # ------------------------------------------------------------ lights
     def light(self, node: Node, frame: Frame, owner: Owner) -> None:
         self.tick(node)
+        self.lights_seen += 1
         data = fx.light(node, self.fields(node))
         if wm.light_value_problem("color", data["color"]) is not None:     # WbLight::updateColor
             self.warn(node, f"{node.type} color {' '.join(f'{c:g}' for c in data['color'])} clamped to [0, 1] "
