@@ -654,16 +654,20 @@ def test_a_robot_with_a_controller_or_a_device_on_a_robot_is_still_dropped(tmp_p
 
 
 def test_cameras_in_a_world_without_light_lit_by_a_background_in_webots_are_said_black(tmp_path: Path) -> None:
-    """Webots' rosbot.wbt has no light: its renderer lights shapes by the TexturedBackground's cube
-    map (image-based lighting, not simulated here), so its cameras would see black without a word."""
+    """Webots' rosbot.wbt has no light (spot.wbt's only one is off): its renderer lights shapes by the
+    TexturedBackground's cube map (image-based lighting, not simulated here), so their cameras would
+    see black without a word."""
     robot = 'Robot { name "r" children [ Camera { width 4 height 4 } ] }\n'
     lit_by_maps = 'Background { skyColor [ 0.5 0.5 0.5 ] backUrl [ "sky_back.png" ] }\n'
     p = write(tmp_path, lit_by_maps + robot)
     w = load_world(p)
-    assert w.warnings[:1] == [f"{p}: no light in this world: its cameras (r/camera) see every surface black; Webots' "
-                          "renderer also lights shapes by the background's image-based lighting (a "
-                          "TexturedBackground's cube map), which is not simulated here: add a DirectionalLight or "
-                          "TexturedBackgroundLight for them to see"]
+    said = (f"{p}: no light is on in this world: its cameras (r/camera) see every surface black; Webots' "
+            "renderer also lights shapes by the background's image-based lighting (a TexturedBackground's cube "
+            "map), which is not simulated here: add a DirectionalLight or TexturedBackgroundLight for them to see")
+    assert w.warnings[:1] == [said]
+    # a light that is off (spot.wbt's TexturedBackgroundLight of its "factory" background, as in Webots) lights nothing
+    w = load_world(write(tmp_path, lit_by_maps + robot + "DirectionalLight { on FALSE }\n"))
+    assert w.warnings[:1] == [said]
     # what it says: a surface in view reads black
     floor = 'Solid { translation 0 0 -1 children [ Shape { geometry Box { size 10 10 0.1 } } ] }\n'
     p = write(tmp_path, lit_by_maps + floor + robot.replace("Camera {", "Camera { rotation 0 1 0 1.5707963267948966"))
@@ -673,9 +677,11 @@ def test_cameras_in_a_world_without_light_lit_by_a_background_in_webots_are_said
     sim.step()
     image = np.asarray(cam.image)
     assert image.shape[:2] == (4, 4) and not image[..., :3].any()
-    # a light anywhere, a background without cube maps, or no camera: nothing to say
-    for world in (lit_by_maps + robot + "DirectionalLight { }\n", "Background { skyColor [ 0.5 0.5 0.5 ] }\n" + robot,
-                  lit_by_maps + 'Robot { name "r" }\n'):
+    # a light on anywhere, an LED's light (off until the LED is set), a background without cube maps, or no
+    # camera: nothing to say
+    led = 'Robot { name "r" children [ Camera { } LED { children [ PointLight { on FALSE } ] } ] }\n'
+    for world in (lit_by_maps + robot + "DirectionalLight { }\n", lit_by_maps + led,
+                  "Background { skyColor [ 0.5 0.5 0.5 ] }\n" + robot, lit_by_maps + 'Robot { name "r" }\n'):
         assert not [m for m in load_world(write(tmp_path, world)).warnings if "no light" in m]
 
 

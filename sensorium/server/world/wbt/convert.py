@@ -249,7 +249,7 @@ class Converter:
         self.scopes: list[_Scope] = []
         self.inner_owner: dict | None = None
         self.scope_serial = 0
-        self.lights_seen = 0               # lights converted anywhere (the world's, solids', robots', LEDs')
+        self.lights_seen = 0               # lights on, or an LED's, anywhere (the world's, solids', robots')
         self.image_lit = False             # a TexturedBackground or a Background with cube maps (Webots' IBL)
 
     # ------------------------------------------------------------ messages
@@ -810,15 +810,16 @@ class Converter:
             self.image_lit = True
 
     def unlit_cameras_note(self) -> None:
-        """One line when the world's cameras would see only black: no light anywhere, while Webots
-        lights its shapes by the background's image-based lighting (Webots' rosbot.wbt has no light)."""
+        """One line when the world's cameras would see only black: no light on anywhere, while Webots
+        lights its shapes by the background's image-based lighting (Webots' rosbot.wbt has no light;
+        spot.wbt's TexturedBackgroundLight of the "factory" background is off, as Webots has it)."""
         if self.lights_seen or not self.image_lit:
             return
         cameras = [f"{r['name']}/{d['name']}" for r in self.world["robots"] for d in r.get("devices", [])
                    if d.get("device") == "Camera"]
         if cameras:
             listed = ", ".join(cameras[:3]) + (f" and {len(cameras) - 3} more" if len(cameras) > 3 else "")
-            self.warnings.append(f"{self.source}: no light in this world: its cameras ({listed}) see every "
+            self.warnings.append(f"{self.source}: no light is on in this world: its cameras ({listed}) see every "
                                  "surface black; Webots' renderer also lights shapes by the background's "
                                  "image-based lighting (a TexturedBackground's cube map), which is not simulated "
                                  "here: add a DirectionalLight or TexturedBackgroundLight for them to see")
@@ -1268,8 +1269,9 @@ class Converter:
     # ------------------------------------------------------------ lights
     def light(self, node: Node, frame: Frame, owner: Owner) -> None:
         self.tick(node)
-        self.lights_seen += 1
         data = fx.light(node, self.fields(node))
+        if data["on"] or id(node) in self.led_of:   # (an LED's lights are off until it is set)
+            self.lights_seen += 1
         if wm.light_value_problem("color", data["color"]) is not None:     # WbLight::updateColor
             self.warn(node, f"{node.type} color {' '.join(f'{c:g}' for c in data['color'])} clamped to [0, 1] "
                             "(Webots resets it)")
