@@ -507,7 +507,7 @@ class Launcher:
         if spec.python:
             ini = spec.runtime
             python = (ini.python("COMMAND") if ini else None) or sys.executable
-            options = ((ini.python("OPTIONS") if ini else None) or "").split()
+            options = ini.python_options() if ini else []
             return [python, *options, "-m", "sensorium", "controller", str(spec.program), "--", *spec.args]
         return [str(spec.program), *spec.args]
 

@@ -10,7 +10,8 @@ trimmed with the spaces), a line's text ends at its first NUL byte and a UTF-8 b
 its start is skipped, as Webots' Qt reads the file line by line; bytes that are not UTF-8 read as U+FFFD. Sections applied here: ``environment variables
 with paths`` (and its deprecated name ``... with relative paths``), ``environment variables``, and
 the ones for this platform (``... for linux``, ``... for linux 64``; ``... for macos`` /
-``... for mac os x``); ``python`` gives ``COMMAND`` and ``OPTIONS``. ``java`` and ``matlab`` are
+``... for mac os x``); ``python`` gives ``COMMAND`` and ``OPTIONS`` (split at its spaces, as Webots
+splits it). ``java`` and ``matlab`` are
 for controllers Sensorium does not run.
 """
 
@@ -58,6 +59,13 @@ class RuntimeIni:
             if section == "python" and k == key:
                 found = value
         return found
+
+    def python_options(self) -> list[str]:
+        """The ``python`` section's ``OPTIONS`` as the arguments Webots makes of it (WbController splits
+        the value at each space, with no quoting: a tab stays inside its argument, and quotes inside the
+        value stay in theirs), less the empty ones two spaces in a row would make (Webots passes each
+        as an empty argument, which Python then takes for the script to run)."""
+        return [part for part in (self.python("OPTIONS") or "").split(" ") if part]
 
     def notes(self) -> list[str]:
         """Lines Webots would say about this file (unknown ``python`` keys, the deprecated section):
