@@ -307,7 +307,22 @@ def robot_controller(robot: str, name: str, args: list[str], dirs: list[Path], w
     robot_dirs = list(dict.fromkeys([dirs[0], own / "controllers", *dirs[1:]])) if own is not None and dirs else dirs
     spec = find_controller(robot, name, args, robot_dirs, webots, (protos or {}).get(robot))
     roots = [dirs[0].parent] if dirs else []
-    return dataclasses.replace(spec, libraries=library_folders([*roots, *([own] if own else [])]))
+    spec = dataclasses.replace(spec, libraries=library_folders([*roots, *([own] if own else [])]))
+    unlisted = [p for p in (*spec.libraries, spec.folder) if not _listable(p)]
+    if unlisted:
+        more = f" and {len(unlisted) - 1} more folder{'s' if len(unlisted) > 2 else ''}" if len(unlisted) > 1 else ""
+        spec = dataclasses.replace(spec, notes=(*spec.notes, (
+            f"robot '{robot}': {unlisted[0]}{more} left off the controller's library path: a '{os.pathsep}' in a "
+            f"folder's path would split it in two there (LD_LIBRARY_PATH's separator), so a shared library in it "
+            "is not found")))
+    return spec
+
+
+def _listable(path: Path) -> bool:
+    """Can ``path`` be an entry of a ``PATH``-like list (no ``os.pathsep`` in it)? Webots puts a
+    folder with a ``:`` on a controller's library path all the same, where it reads as two folders,
+    the second relative to the controller's folder."""
+    return os.pathsep not in str(path)
 
 
 def library_folders(projects: list[Path]) -> tuple[Path, ...]:
@@ -534,9 +549,15 @@ class Launcher:
         env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH", "")) if p)
         # as Webots: the project's libraries/ folders, WEBOTS_LIBRARY_PATH, the controller's folder (a shared
         # library shipped next to the controller loads) first on the library path, then our libController
-        libraries = [*(str(p) for p in spec.libraries), env.get("WEBOTS_LIBRARY_PATH", ""), str(spec.folder),
+        # (a folder with the list's separator in its path is left off: robot_controller says so)
+        libraries = [*(str(p) for p in spec.libraries if _listable(p)), env.get("WEBOTS_LIBRARY_PATH", ""),
+                     *([str(spec.folder)] if _listable(spec.folder) else []),
                      *([str(C_LIBRARY)] if not spec.python and C_LIBRARY.is_dir() else []), env.get("LD_LIBRARY_PATH", "")]
-        env["LD_LIBRARY_PATH"] = os.pathsep.join(dict.fromkeys(p for p in libraries if p))
+        library_path = os.pathsep.join(dict.fromkeys(p for p in libraries if p))
+        if library_path:
+            env["LD_LIBRARY_PATH"] = library_path
+        else:                  # none left: an empty one is no list to give
+            env.pop("LD_LIBRARY_PATH", None)
         return env
 
     def start(self, robot: str) -> None:
