@@ -24,7 +24,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
@@ -192,6 +192,8 @@ def _runtime_ini(robot: str, folder: Path) -> tuple[RuntimeIni | None, tuple[str
         return None, ()
     try:          # its $(...) references replaced against this environment: too long is said now
         runtime_ini.environment(ini, os.environ)
+        ini.python("COMMAND", os.environ)
+        ini.python("OPTIONS", os.environ)
     except runtime_ini.RuntimeIniError as exc:
         return None, (f"robot '{robot}': {exc}; the controller starts without it",)
     return ini, tuple(f"robot '{robot}': {folder / runtime_ini.FILE}: {line}" for line in ini.notes())
@@ -515,14 +517,21 @@ class Launcher:
 
     # ------------------------------------------------------------------ processes
     @staticmethod
-    def command(spec: ControllerSpec) -> list[str]:
+    def command(spec: ControllerSpec, base: Mapping[str, str] | None = None) -> list[str]:
         """The controller's command line: a Python one as `sensorium controller` runs it (`controller`
         importable, its folder as cwd), with runtime.ini's [python] COMMAND and OPTIONS as Webots
-        takes them (else this interpreter); an executable as itself."""
+        takes them, their ``$(NAME)`` replaced against ``base`` (this process's environment) and the
+        file's entries before them (else this interpreter); an executable as itself."""
         if spec.python:
             ini = spec.runtime
-            python = (ini.python("COMMAND") if ini else None) or sys.executable
-            options = ini.python_options() if ini else []
+            # as Webots resolves them: its environment, the robot's name already in it
+            env = {**(os.environ if base is None else base), "WEBOTS_ROBOT_NAME": spec.robot}
+            try:
+                python = (ini.python("COMMAND", env) if ini else None) or sys.executable
+                options = ini.python_options(env) if ini else []
+            except runtime_ini.RuntimeIniError:      # checked when planned; the environment grew since
+                python = (ini.python("COMMAND") if ini else None) or sys.executable
+                options = ini.python_options() if ini else []
             return [python, *options, "-m", "sensorium", "controller", str(spec.program), "--", *spec.args]
         return [str(spec.program), *spec.args]
 
@@ -530,6 +539,7 @@ class Launcher:
         """The controller's environment: ``base`` (this process's), its runtime.ini's variables, then
         what it needs here: the URL, Webots' variables, Sensorium on the Python and library paths."""
         env = dict(os.environ if base is None else base)
+        env["WEBOTS_ROBOT_NAME"] = spec.robot     # Webots sets it before it reads runtime.ini: $(WEBOTS_ROBOT_NAME) there
         if spec.runtime is not None:
             try:
                 env = runtime_ini.environment(spec.runtime, env)
