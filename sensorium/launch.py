@@ -77,6 +77,12 @@ class ControllerSpec:
     notes: tuple[str, ...] = ()            # lines to say about it when the world starts
     libraries: tuple[Path, ...] = ()       # the projects' libraries/ folders, for its library path
 
+    def said(self) -> tuple[str, ...]:
+        """What ``run`` says of it before starting it: where Webots' own copy was found, its notes
+        (runtime.ini's, a library folder left off): at load and when a Supervisor switches to it."""
+        found = (f"robot '{self.robot}': controller '{self.name}' found in Webots' projects: {self.program}",)
+        return (*(found if self.webots else ()), *self.notes)
+
 
 def controller_dirs(world: Path, extra: list[Path], projects: Sequence[Path] = ()) -> list[Path]:
     """Where controllers are looked for: the project's ``controllers/`` (the world's folder's parent),
@@ -387,8 +393,7 @@ def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: Webots
     specs, problems = plan(robots, dirs, webots, protos, projects)
     started = {s.robot for s in specs}
     missing = tuple((r.name, r.controller) for r in robots if r.controller not in SPECIAL and r.name not in started)
-    notes = [f"robot '{s.robot}': controller '{s.name}' found in Webots' projects: {s.program}" for s in specs if s.webots]
-    notes += [line for s in specs for line in s.notes]
+    notes = [line for s in specs for line in s.said()]
     for r in robots:
         if r.controller == "<generic>":
             which = "no controller field, so Webots' default '<generic>'" if r.default else "controller '<generic>'"
@@ -730,6 +735,8 @@ class Launcher:
                 if self.find is None:
                     raise LaunchError(f"robot {robot!r}: controller {name!r} not looked for (no world to look from)")
                 spec = self.find(robot, name)
+                for line in spec.said():
+                    self.log(line)
             except LaunchError as exc:
                 self.log(f"{exc}: the robot runs without a controller")
                 self.failed[robot] = name
