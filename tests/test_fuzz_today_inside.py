@@ -222,8 +222,6 @@ def test_split_readings_equal_the_world_written_with_the_split_and_every_point(t
     assert len(set(got[0])) > 10 and any(0.0 < v < 500.0 for v in got[1])      # the mesh is seen
 
 
-@pytest.mark.xfail(strict=True, reason="daemon/nested.py serves each piece of a split mesh as a Shape node of its "
-                                       "own (another helper's file: reported)")
 def test_a_split_mesh_is_one_shape_node_to_a_supervisor(tmp_path: Path) -> None:
     """The body mesh of test_a_radar_target_after_a_split_mesh_still_names_its_own_box, DEF'd, split
     in two by the sensors inside it: a Supervisor sees the robot's children as written (one Shape,

@@ -286,3 +286,33 @@ def test_python_controller_strafes_the_robot(tmp_path: Path) -> None:
     lines, err = run_controller(world, lambda url: sensorium("controller", str(script), "--url", url), robot="yb",
                                 cwd=tmp_path)
     assert lines[-1:] == ["gps 0.000000000 0.320000000"], err      # 1.6 s at r·ω = 0.2 m/s to its left
+
+
+@pytest.mark.parametrize("speeds, twist", [
+    ((-4.0, 4.0, -4.0, 4.0), (0.0, 0.0, -R * 4.0 / (LX + LY))),     # the youBot library's base_turn_left
+    ((4.0, -4.0, -4.0, 4.0), (0.0, R * 4.0, 0.0)),                   # its base_strafe_left
+    ((1.0 / R * (LX + LY) * 0.3, -1.0 / R * (LX + LY) * 0.3,          # its base_move(0, 0, 0.3)
+      1.0 / R * (LX + LY) * 0.3, -1.0 / R * (LX + LY) * 0.3), (0.0, 0.0, 0.3)),
+])
+def test_the_friction_rollers_move_the_base_as_webots_contact_turns_them(tmp_path: Path, speeds, twist) -> None:
+    """Webots' contact joint frees each wheel along its cylinder's axis turned by -frictionRotation
+    about the contact normal (up, into the wheel): the 'inner' wheels (-0.785398, front right and rear
+    left) slide along (1, -1) and grip along (1, 1), the 'outer' ones the reverse -- the X arrangement
+    whose inverse kinematics is the youBot library's base_move. So its fixed base_turn_left pattern
+    (wheel1..4 = front right, front left, rear right, rear left at -4, 4, -4, 4 rad/s) turns the base
+    clockwise at r·4/(lx + ly), its strafe pattern moves it left at r·4, and base_move(0, 0, 0.3)
+    turns it counter-clockwise at 0.3 rad/s (closed forms, 1 s)."""
+    sim = Simulation(load_world(youbot_like(tmp_path)))
+    r = sim.robot("yb")
+    for name, w in zip((FR, FL, RR, RL), speeds):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(w)
+    sim.run(62)                 # 0.992 s: 62 steps of 16 ms
+    t = 0.992
+    vx, vy, w = twist
+    yaw = math.atan2(r.pose.rotation[1, 0], r.pose.rotation[0, 0])
+    assert yaw == pytest.approx(w * t, abs=1e-9)
+    if w == 0.0:
+        assert (r.pose.translation[0], r.pose.translation[1]) == pytest.approx((vx * t, vy * t), abs=1e-9)
+    else:                       # turning in place about its centre
+        assert (r.pose.translation[0], r.pose.translation[1]) == pytest.approx((0.0, 0.0), abs=1e-9)

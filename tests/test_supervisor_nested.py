@@ -139,7 +139,7 @@ def test_fields_are_read_in_the_parents_frame_and_refused_when_set():
                    "and changes top-level robots, solids and lights only, not the nodes inside them")
     msg = lv.err(A, "/rover/robot/remove_node", {"node": CAM}, ErrorCode.INVALID_ARGUMENT)
     assert msg == (f"remove_node: Camera 'cam' (node {CAM}) cannot be removed here: only top-level solids and "
-                   "lights can, not the nodes inside a robot or solid")
+                   "lights and the Shapes inside robots and solids can, not the other nodes inside a robot or solid")
     # a wheel's joint parameters (SFNode) hold its position: the wheel's angle
     assert get(LEFT_JOINT, "jointParameters") == {"type": "SFNode", "value": LEFT_PARAMETERS}
     assert get(RIGHT_JOINT, "jointParameters") == {"type": "SFNode", "value": RIGHT_PARAMETERS}

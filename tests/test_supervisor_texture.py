@@ -302,6 +302,71 @@ def test_a_reset_brings_the_world_files_image_back(folder):
     assert np.array_equal(again[0], first[0]) and again[1] == first[1]
 
 
+def _overwrite(path, seed: int) -> None:
+    from PIL import Image
+    Image.fromarray(np.random.default_rng(seed).integers(0, 256, (4, 4, 3), dtype=np.uint8)).save(path)
+
+
+def test_an_image_written_again_under_its_url_is_read_again_when_the_url_changes(folder):
+    """Webots' updateUrl reads the first url's file again on any change of the list (an item set to another
+    value, one inserted or removed), not when an item is set to the value it has: the world's own image
+    overwritten on disk is seen once the url changes, bit for bit as a world loaded with the new file; a
+    reset brings back the image as loaded."""
+    sim = _sim(folder / "world.wbt")
+    first = _shot(sim)
+    tex = sv.find_node(sim, "TEX")
+    k = sv._table(sim).get(tex.id).shape.index
+    _overwrite(folder / "a.png", 11)
+    sv.change_item(sim, tex, "url", "set", 0, "a.png")           # the same value: no change, nothing read
+    assert np.array_equal(_shot(sim)[0], first[0])
+    sv.change_item(sim, tex, "url", "set", 0, "b.png")
+    sv.change_item(sim, tex, "url", "set", 0, "a.png")           # back: the file as it is now
+    got, written = _shot(sim), _shot(_sim(folder / "world.wbt"))
+    assert np.array_equal(got[0], written[0]) and got[1] == written[1]
+    assert not np.array_equal(got[0], first[0])
+    _overwrite(folder / "a.png", 12)
+    sv.change_item(sim, tex, "url", "insert", -1, "c.jpg")       # the first item unchanged, the list changed
+    got, written = _shot(sim), _shot(_sim(folder / "world.wbt"))
+    assert np.array_equal(got[0], written[0]) and got[1] == written[1]
+    sim.reset()
+    again = _shot(sim)
+    assert np.array_equal(again[0], first[0]) and again[1] == first[1]
+    assert sim.scene.textures.shapes[k].base.rgb is sim.scene.images["a.png"][1][0]    # the loaded image itself
+
+
+def test_an_unchanged_file_named_again_is_the_image_held_not_a_second_copy(folder):
+    sim = _sim(folder / "world.wbt")
+    tex = sv.find_node(sim, "TEX")
+    k = sv._table(sim).get(tex.id).shape.index
+    sv.change_item(sim, tex, "url", "set", 0, "b.png")
+    held = sim.scene.textures.shapes[k].base.rgb
+    sv.change_item(sim, tex, "url", "insert", -1, "a.png")       # read again: the same pixels, the same array
+    assert sim.scene.textures.shapes[k].base.rgb is held
+    sv.change_item(sim, tex, "url", "set", 0, "a.png")
+    assert sim.scene.textures.shapes[k].base.rgb is sim.scene.images["a.png"][1][0]
+    _overwrite(folder / "b.png", 13)                                # a Supervisor's file written again, read again
+    sv.change_item(sim, tex, "url", "set", 0, "b.png")
+    got = _shot(sim)
+    ref = _written(folder, '"b.png"')
+    assert np.array_equal(got[0], ref[0]) and got[1] == ref[1]
+
+
+def test_a_file_overwritten_with_no_image_is_refused_when_named_again(folder):
+    sim = _sim(folder / "world.wbt")
+    tex = sv.find_node(sim, "TEX")
+    sv.change_item(sim, tex, "url", "set", 0, "b.png")
+    shown = _shot(sim)
+    (folder / "a.png").write_bytes(b"\x89PNG\r\n\x1a\n" + b"broken" * 10)
+    with pytest.raises(ValueError) as exc:
+        sv.change_item(sim, tex, "url", "set", 0, "a.png")
+    line = str(exc.value)
+    assert line.startswith(f"field 'url' (MFString) of ImageTexture 'TEX' (node {tex.id}): ") and \
+        line.endswith("; nothing changed") and "\n" not in line and "a.png" in line, line
+    assert field(sim, tex, "url") == ["b.png"]
+    got = _shot(sim)
+    assert np.array_equal(got[0], shown[0]) and got[1] == shown[1]
+
+
 @pytest.mark.parametrize(("url", "problem"), [
     ("nope.png", "texture file 'nope.png' not found"),
     ("notes.png", "texture file 'notes.png' is not a PNG or JPEG image"),

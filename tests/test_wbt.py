@@ -270,11 +270,35 @@ def test_unknown_proto_is_skipped_with_its_position(tmp_path: Path) -> None:
     with pytest.raises(WorldError, match=r'line 2, column 1: EXTERNPROTO E-puck: "https://example.org/E-puck.proto" not found'):
         load_world(p)
     # a Webots node not read here is said to be one (not a PROTO whose file is missing)
-    p = write(tmp_path, 'Billboard { children [ Shape { geometry Box { size 1 1 0.1 } } ] }\n')
+    p = write(tmp_path, 'HingeJointParameters { axis 0 1 0 }\n')
     (loss,) = load_world(p).report.losses
     assert (loss.name, loss.where, loss.why) == (
-        "Billboard", f"{p}:2:1",
-        "Billboard: a Webots node not read here (or not in its place); skipped (with everything inside it)")
+        "HingeJointParameters", f"{p}:2:1",
+        "HingeJointParameters: a Webots node not read here (or not in its place); skipped (with everything inside it)")
+
+
+def test_billboard_is_seen_by_no_device(tmp_path: Path) -> None:
+    """Webots pins a Billboard's children to its 3D view's viewpoint and no Camera sees them: a world
+    with one loses nothing a device reads (a skipped-node note, no loss), and the lidar facing where its
+    box would be, were it placed as written, reads infinity as in the world without it. A Solid inside one
+    is a loss naming it."""
+    lidar_robot = ('Robot { children [ Lidar { horizontalResolution 3 fieldOfView 0.2 numberOfLayers 1 '
+                   'maxRange 5 } ] }\n')
+    p = write(tmp_path, lidar_robot + 'Billboard { children [ Transform { translation 1 0 0 children [\n'
+                        '  Shape { appearance PBRAppearance { } geometry Box { size 0.1 2 2 } } ] } ] }\n')
+    w = load_world(p)
+    assert w.report.losses == ()
+    assert f"{p}: skipped nodes that do not matter to these sensors: Billboard" in w.warnings
+    assert w.world.solids == []
+    sim = Simulation(w)
+    lidar = sim.device("robot/lidar")
+    lidar.enable(32)
+    sim.step()
+    assert np.isinf(np.asarray(lidar.range_image)).all()
+    p = write(tmp_path, 'Billboard {\n  children [\n    Solid { name "score" }\n  ]\n}\n')
+    (loss,) = load_world(p).report.losses
+    assert (loss.name, loss.where) == ("Billboard", f"{p}:2:1")
+    assert loss.why.startswith("Billboard holding Solid (line 4): only Webots' 3D view shows")
 
 
 def test_device_through_nested_rotated_poses_closed_form(tmp_path: Path) -> None:

@@ -470,6 +470,9 @@ class ShapeNode(Strict):
     values: dict[str, NodeValue] = Field(default={}, max_length=64, description="the written values: "
                                          "'<node>.<field>' (node: appearance, material, texture, geometry)")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
+    piece: bool = Field(default=False, description="a further piece of the shape before it: a mesh the .wbt import "
+                        "split around its robot's devices (README 'Worlds') is one Shape node to a "
+                        "Supervisor, its first piece's")
 
 _CAST_SHADOWS = ("Webots' Shape.castShadows: false lets cameras' shadow rays through this shape (it still hides "
                  "what is behind it, and other rays see it)")
@@ -1303,12 +1306,12 @@ def _forward_field() -> Any:
 
 def _wheel_bottom_field() -> Any:
     return Field(default=None, description="m, the height of the robot's lowest wheel's bottom from its origin along "
-                 "its z, its up (its axle's height less its radius; negative: below the origin; 0: the origin is where "
-                 "the wheels touch the ground). Given (the .wbt import gives it from the wheels' joints and shapes for a "
-                 "Robot with physics), "
-                 "the robot is lowered or raised at load, as Webots' physics drops it, until that point touches the "
-                 "ground under its origin (README \"Settling on the ground\"); none: it keeps the height it is "
-                 "placed at")
+                 "its z, its up (a robot built y-up in a NUE world: its y) (its axle's height less its radius; negative: "
+                 "below the origin; 0: the origin is where the wheels touch the ground). Given (the .wbt import gives it "
+                 "from the wheels' joints and shapes for a Robot with physics), "
+                 "the robot is lowered or raised at load, and where a Supervisor puts it, as Webots' physics drops it, "
+                 "until that point touches the ground under its origin (README \"Settling on the ground\"); none: it "
+                 "keeps the height it is placed at")
 
 
 def _nonzero_forward(v: tuple[float, float]) -> tuple[float, float]:

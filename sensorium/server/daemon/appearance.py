@@ -243,7 +243,8 @@ def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> None:
                              "nothing changed")
         name = known or url
         before = scene.textures.pixels(without=shapes) if scene.textures is not None else 0
-        try:      # (read once: the image checked is the image shown, whatever happens to the file after)
+        try:      # (the file as it is now, read once: the image checked is the image shown, whatever happens to
+                  # the file after; the same image as held is not held twice: TextureSampler)
             file, _, decoded = read_checked_image(
                 name, scene.base_dir, sim.limits, pixels_before=before,
                 allow_outside=known is not None or bool(getattr(sim, "allow_outside_meshes", False)))
@@ -259,8 +260,9 @@ def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> None:
 
 
 def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: Any) -> None:
-    """Webots' ``setMFString``/``insertMFString``/``removeMF`` on an ImageTexture's ``url``: when its
-    first item changes, the image it names is read (relative to the world file's folder, within the
+    """Webots' ``setMFString``/``insertMFString``/``removeMF`` on an ImageTexture's ``url``: when the list
+    changes (an item set to another value, one inserted or removed: Webots' ``updateUrl``), the image its
+    first item names is read from its file as it is now (relative to the world file's folder, within the
     world's texture limits) and every shape holding the texture shows it from the next step, as if the
     world file had named it; an empty url (or none) leaves the shapes untextured, as Webots. A url that
     cannot be read: ValueError (one line naming the node, the field and the problem), nothing changed."""
@@ -282,8 +284,8 @@ def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: A
         del new[at]
     else:
         new[at] = value.replace("\\", "/")
-    first, was = (new[0] if new else ""), (items[0] if items else "")
-    if first != was:
+    if new != items:        # Webots' updateUrl: any change of the list (not the same value set again) reads the image
+        first = new[0] if new else ""
         _retexture(sim, ref, where, first if first.strip() else None)
     for k in ref.peers or (ref.index,):
         sim.scene.appearance_values.setdefault(k, {})["texture.url"] = list(new)

@@ -217,7 +217,8 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
     ``first``. A robot's shape sits under the node its world entry names (``ShapeNode.parent``: ``starts``
     gives the id of each robot's first entry), a solid's under the solid holding it. A DEF'd appearance,
     material or texture is one node for the shapes among ``holders`` that USE it (its peers: a setter changes
-    them all). ``shape_tags`` gets the PROTO-body DEFs of the shapes and their nodes: (owner id, InnerDef,
+    them all), and so is a mesh the ``.wbt`` import split around its robot's devices: one Shape (its first
+    piece's, ``ShapeNode.piece`` on the others) whose nodes' changes reach every piece. ``shape_tags`` gets the PROTO-body DEFs of the shapes and their nodes: (owner id, InnerDef,
     the node's id)."""
     scene = sim.scene
     index = {id(scene.loaded_model(k)): k for k in range(len(scene.shapes))}
@@ -231,20 +232,34 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
                                  ("texture", held.texture_key)):
                 if number >= 0:
                     shared.setdefault((role, number), []).append(k)
+    pieces: dict[int, list[int]] = {}     # a split mesh's first piece -> all its pieces (one Shape node)
+    first_piece = -1
+    for shape, *_ in holders:
+        k = index.get(id(shape))
+        if k is None:
+            continue
+        held = getattr(shape, "node", None)
+        if held is not None and held.piece and first_piece >= 0:
+            pieces[first_piece].append(k)
+        else:
+            first_piece = k
+            pieces[k] = [k]
     added: list[Nested] = []
     inner_tags: list[tuple[int, wm.InnerDef, int]] = []     # (owner, tag, the id of the node it names)
 
     def add(shape: Any, parent: int, owner: int, kind: str, key: str) -> None:
         k = index.get(id(shape))
-        if k is None or not appearance.served(shape, wbt):
-            return
+        if k is None or k not in pieces or not appearance.served(shape, wbt):
+            return              # (a further piece of a split mesh is its first piece's node)
+        whole = tuple(pieces[k])
         node = getattr(shape, "node", None)
         if node is not None and kind == "Robot" and node.parent >= 0 and owner in starts:
             parent = starts[owner] + node.parent
         order = float("inf") if node is None else node.after + 0.5
         me = first + len(added)
         added.append(Nested(me, "Shape", "", (node.def_name if node else None) or "", "", parent, "children", None,
-                            None, "", owner, kind, key, order=order, shape=appearance.ShapeRef(k, node, "Shape", "Shape")))
+                            None, "", owner, kind, key, order=order,
+                            shape=appearance.ShapeRef(k, node, "Shape", "Shape", whole)))
         above = {"appearance": me, "geometry": me}
         ids = {"": me}
         for role, type_, def_name, field in appearance.inside(shape, k):
@@ -253,7 +268,7 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
                            if node is not None and role == "appearance" else ("", ()))
             number = -1 if node is None else node.appearance_key if role == "appearance" else \
                 node.material_key if role == "material" else node.texture_key if role == "texture" else -1
-            peers = tuple(sorted(shared.get((role, number), (k,))))
+            peers = tuple(sorted(set(shared.get((role, number), ())).union(whole)))
             added.append(Nested(nid, type_, proto, def_name, "", above[role if role in above else "appearance"], field,
                                 None, None, "", owner, kind, key, interface=face,
                                 shape=appearance.ShapeRef(k, node, role, type_, peers)))
@@ -410,6 +425,27 @@ def drop(table: Table, owner: int) -> None:
     if table.inner is not None:
         table.inner.pop(owner, None)
     table.segments.pop(owner, None)
+
+
+def drop_shape(table: Table, shape: int) -> None:
+    """A Shape node a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
+    getFromProtoDef finds them and their ids read as removed (never given again)."""
+    gone = {shape}
+    todo = [shape]
+    while todo:
+        for c in table.by_parent.pop(todo.pop(), ()):
+            gone.add(c.id)
+            todo.append(c.id)
+    n = table.get(shape)
+    assert n is not None
+    table.by_parent[n.parent] = tuple(c for c in table.by_parent.get(n.parent, ()) if c.id != shape)
+    table.by_owner[n.owner] = tuple(c for c in table.by_owner.get(n.owner, ()) if c.id not in gone)
+    for node_id in gone:
+        if table.added.pop(node_id, None) is None:
+            table.forgotten.add(node_id)
+    for defs in (table.inner or {}).values():
+        for name in [k for k, v in defs.items() if v in gone]:
+            del defs[name]
 
 
 def inner_def(table: Table, instance: int, name: str) -> int | str | None:

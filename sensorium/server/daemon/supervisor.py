@@ -770,7 +770,7 @@ def _fields(sim: Any, node: Node, level: int = -1) -> dict[str, tuple[str, Gette
     return _base_fields(sim, node) if level == 0 else _interface_fields(sim, node, level)
 
 
-_VECTOR_SIZES = {"SFVec3f": 3, "SFColor": 3, "SFRotation": 4}
+_VECTOR_SIZES = {"SFVec2f": 2, "SFVec3f": 3, "SFColor": 3, "SFRotation": 4}
 
 
 _JOINT_FIELDS = {"endPoint": frozenset(nested.JOINT_DEVICES), "device": frozenset(nested.JOINT_DEVICES),
@@ -963,7 +963,8 @@ _INT32 = (-(1 << 31), (1 << 31) - 1)
 
 
 def _check_value(field: str, kind: str, value: Any) -> None:
-    """A value a Supervisor sets into a PROTO field that rebuilds the node: of the field's type (one line)."""
+    """A value a Supervisor sets as a whole (``setSF*``, an MF item, a PROTO field that rebuilds its node): of
+    the field's type, numbers finite, an SFInt32 within 32 bits (one line otherwise)."""
     if kind == "SFBool":
         ok = isinstance(value, bool)
     elif kind == "SFInt32":
@@ -972,16 +973,15 @@ def _check_value(field: str, kind: str, value: Any) -> None:
         ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
     elif kind == "SFString":
         ok = isinstance(value, str)
-    elif kind in _VECTOR_SIZES or kind == "SFVec2f":
-        size = _VECTOR_SIZES.get(kind, 2)
-        ok = isinstance(value, list) and len(value) == size and all(
+    elif kind in _VECTOR_SIZES:
+        ok = isinstance(value, list) and len(value) == _VECTOR_SIZES[kind] and all(
             isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v) for v in value)
     else:
         raise ValueError(f"field {field!r} is an {kind}: set it item by item (setMF*, insertMF*, removeMF)" if
                          kind.startswith("MF") else f"field {field!r} is an {kind}: not set as a whole here")
     if not ok:
         want = {"SFBool": "true or false", "SFInt32": "a whole number within 32 bits", "SFFloat": "a finite number",
-                "SFString": "a string"}.get(kind, f"{_VECTOR_SIZES.get(kind, 2)} finite numbers")
+                "SFString": "a string"}.get(kind, f"{_VECTOR_SIZES.get(kind)} finite numbers")
         raise ValueError(f"field {field!r} is an {kind}: takes {want}, got {value!r}")
 
 
@@ -1063,24 +1063,7 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
                          "top-level robots, solids and lights only, not the nodes inside them")
     if setter is None:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here")
-    if kind == "SFBool":
-        ok = isinstance(value, bool)
-    elif kind == "SFInt32":
-        ok = isinstance(value, int) and not isinstance(value, bool)
-    elif kind == "SFFloat":
-        ok = isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
-    elif kind == "SFString":
-        ok = isinstance(value, str)
-    else:
-        ok = isinstance(value, list) and len(value) == _VECTOR_SIZES.get(kind, -1)
-    if not ok and kind not in _VECTOR_SIZES and kind not in ("SFBool", "SFInt32", "SFFloat", "SFString"):
-        raise ValueError(f"field {field!r} of {what} is an {kind}: not set as a whole here")
-    if not ok:
-        want = {"SFBool": "true or false", "SFInt32": "a whole number", "SFFloat": "a finite number",
-                "SFString": "a string"}.get(kind, f"{_VECTOR_SIZES.get(kind)} numbers")
-        raise ValueError(f"field {field!r} is an {kind}: takes {want}, got {value!r}")
-    if isinstance(value, list) and not all(math.isfinite(v) for v in value):
-        raise ValueError(f"field {field!r}: values must be finite")
+    _check_value(field, kind, value)
     setter(sim, node, value)
     return []
 
@@ -1119,8 +1102,9 @@ def _set_field(sim: Any, ls: Any, robot: str, a: Any) -> dict:
 
 
 def remove_node(sim: Any, node: Node) -> None:
-    """Webots' ``node.remove()`` for what is a node here: a top-level solid or light. The root and
-    robots are refused (a robot's controller, devices and lockstep slot cannot leave a running
+    """Webots' ``node.remove()`` for what is a node here: a top-level solid or light, a Shape inside a
+    robot or solid (``Scene.remove_shapes``: unseen from the next cast, a split mesh's pieces together; its
+    node and those inside it read as removed). The root and robots are refused (a robot's controller, devices and lockstep slot cannot leave a running
     server here; Webots removes a robot, the calling one at the end of the step)."""
     if node.scenery:
         raise ValueError(f"{node.type} (node {node.id}) cannot be removed here: only top-level solids and lights "
@@ -1131,9 +1115,15 @@ def remove_node(sim: Any, node: Node) -> None:
     if node.visual:
         sim.remove_solid(node.key)
         return
+    ref = _nested_of(sim, node).shape if node.nested else None
+    if ref is not None and ref.role == "Shape":      # a Shape inside a robot or solid: every piece of it unseen
+        sim.scene.remove_shapes(ref.peers or (ref.index,))
+        nested.drop_shape(_table(sim), node.id)
+        return
     if node.nested:
         raise ValueError(f"{node.type} {node.name or node.def_name or node.id!r} (node {node.id}) cannot be removed "
-                         "here: only top-level solids and lights can, not the nodes inside a robot or solid")
+                         "here: only top-level solids and lights and the Shapes inside robots and solids can, not "
+                         "the other nodes inside a robot or solid")
     if node.type == "Solid":
         sim.remove_solid(node.key)
     elif node.type in LIGHTS:

@@ -89,7 +89,17 @@ from sensorium.server.sim.contact import (
     shaped_obstacle,
     spin_reach,
 )
-from sensorium.server.sim.ground import Ground, band_low, ground_rotation, ride_height, settle_world, support_ceiling
+from sensorium.server.sim.ground import (
+    Ground,
+    band_low,
+    ground_rotation,
+    ride_height,
+    settle_pose,
+    settle_world,
+    settles,
+    settling_ground,
+    support_ceiling,
+)
 from sensorium.server.sim.motion import (
     _TO_ENU,
     AckermannDrive,
@@ -230,6 +240,7 @@ class BatchedSimulation:
         self._check_supported()
         # its wheeled robots settled on the ground as Simulation settles them (sim/ground.py)
         self.world = w = settle_world(w, _TO_ENU[w.world_info.coordinate_system], world.source)[0]
+        self._settling: dict[tuple, tuple[Ground | None]] = {}     # see _settled: by its copy's floors' poses
         # world axes -> ENU (None in an ENU world): the drive state is ENU, as PlanarState's
         up = w.world_info.coordinate_system
         self.to_enu: np.ndarray | None = _TO_ENU[up]
@@ -667,7 +678,7 @@ class BatchedSimulation:
         if self.tilted[copy, slot]:   # its own rotation, without the ground's attitude (PlanarState.own_pose)
             own = _rz(float(self.yaw[copy, slot])) @ self.base[copy, slot]
             current = Pose(own if self.to_enu is None else self.to_enu.T @ own, current.translation)
-        pose = moved_pose(current, translation, rotation, quaternion)
+        pose = self._settled(copy, slot, moved_pose(current, translation, rotation, quaternion))
         tpl = self._templates[slot]
         yaw = None
         if tpl is not None:
@@ -684,6 +695,23 @@ class BatchedSimulation:
             self.heights[copy, slot] = enu.translation[2]
             self.foot_yaw[copy, slot] = heading(enu) if yaw is None else yaw
         self.kinematic.placed(copy, slot)     # a jump, not motion, for its gyros and accelerometers
+
+    def _settled(self, copy: int, slot: int, pose: Pose) -> Pose:
+        """``Simulation.settled`` in one copy: a wheeled robot put at ``pose`` settles on the ground of
+        the solids and of that copy's robots without a drive, with the same arithmetic."""
+        model = self.world.robots[slot]
+        if not settles(model):
+            return pose
+        floors = [(r, self.pose(copy, k)) for k, r in enumerate(self.world.robots) if not r.drive_motors]
+        key = tuple(p.translation.tobytes() + p.rotation.tobytes() for _, p in floors)
+        got = self._settling.get(key)
+        if got is None:
+            alive = self.scene.solid_poses
+            if len(self._settling) >= self.copies:      # (bounded: one ground per copy's floors at most)
+                self._settling.clear()
+            got = self._settling[key] = (settling_ground([(s, alive[s.name]) for s in self.world.solids
+                                                          if s.name in alive], floors, self.to_enu),)
+        return settle_pose(model, pose, got[0], self.to_enu)
 
     def _take_template(self, idx: np.ndarray, slot: int, tpl: PlanarState) -> None:
         """The copies' drive state of a slot from a template drive just reset to a pose."""

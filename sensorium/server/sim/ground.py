@@ -66,7 +66,7 @@ from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
 __all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "placing_ceiling", "ride_height",
-           "settle_world", "support_ceiling"]
+           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "support_ceiling"]
 
 UPRIGHT_TOL = 1e-12     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
@@ -447,60 +447,129 @@ def _wheels(robot: wm.Robot) -> tuple[float, float] | None:
     return None if drive.wheel_bottom is None else (float(drive.wheel_bottom), float(radius))
 
 
+def robot_up(r: np.ndarray, to_enu: np.ndarray | None) -> int | None:
+    """Which of a robot's own axes stands up (its rotation ``r`` in ENU axes): its z (2) when that is
+    the world's up, in a NUE world its y (1) when that is (a robot built y-up, as Webots' robots were
+    before R2022a); None when neither is (a tilted robot). Its ``wheel_bottom`` is along that axis."""
+    for k in ((2,) if to_enu is None else (2, 1)):
+        if abs(r[0, k]) <= ROBOT_UPRIGHT_TOL and abs(r[1, k]) <= ROBOT_UPRIGHT_TOL and r[2, k] > 0.0:
+            return k
+    return None
+
+
+def settling_ground(solids: list[tuple[wm.Solid, Pose]], floors: list[tuple[wm.Robot, Pose]],
+                    to_enu: np.ndarray | None) -> Ground | None:
+    """The ground wheeled robots settle on: the top-level ``solids``' (each at its pose) and the shapes
+    of the robots without a drive (``floors``, each at its pose: a Webots world's floor may be a
+    robot's, create.wbt's ground supervisor holds its Plane), box and cylinder tops included whatever
+    the world has (terrains or not); None when there is none. A robot's surfaces are keyed apart from
+    any solid's name."""
+    from sensorium.server.sim.scene import robot_parts
+
+    surfaces = [surface for s, _ in solids for surface in _surfaces(s)]
+    surfaces += [surface for r, _ in floors for surface in _parts_surfaces("\0" + r.name, robot_parts(r))]
+    if not surfaces:
+        return None
+    poses = {s.name: pose for s, pose in solids}
+    poses.update({"\0" + r.name: pose for r, pose in floors})
+    return Ground(surfaces, poses, to_enu)
+
+
+def _settled(ground: Ground, bottoms: np.ndarray, axles: np.ndarray, xs: np.ndarray, ys: np.ndarray,
+             zs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which upright robots (ENU origins xs, ys, zs; wheel bottoms and axle heights above them) settle,
+    and their heights ``ground − bottom``: the ground under the origin not above ``(z + axle) +
+    FLOOR``, found and more than SETTLE_TOL away. Element-wise: one robot or many, the same bits."""
+    found, heights, _, _ = ground.under(xs, ys, (zs + axles) + FLOOR)
+    heights = heights - bottoms
+    return found & ~(np.abs(heights - zs) <= SETTLE_TOL), heights
+
+
+def _upright_wheels(robot: wm.Robot, pose: Pose, to_enu: np.ndarray | None) -> tuple[float, float, np.ndarray] | None:
+    """(wheel bottom, axle height above the origin, the origin in ENU) of a robot that settles at
+    ``pose`` (its drive gives ``wheel_bottom`` and it stands upright: :func:`robot_up`), else None."""
+    wheels = _wheels(robot)
+    if wheels is None:
+        return None
+    bottom, radius = wheels
+    r, t = pose.rotation, pose.translation
+    if to_enu is not None:
+        r, t = to_enu @ r, to_enu @ t
+    if robot_up(r, to_enu) is None:
+        return None
+    return bottom, max(0.0, bottom + radius), t
+
+
+def _up_axis(to_enu: np.ndarray | None) -> tuple[int, float]:
+    """The world axis that is up and its sign (ENU's z: the world's y in a NUE world)."""
+    if to_enu is None:
+        return 2, 1.0
+    up = int(np.argmax(np.abs(to_enu[2])))
+    return up, float(to_enu[2, up])
+
+
+def settles(robot: wm.Robot) -> bool:
+    """Whether a robot settles on the ground (its drive gives ``wheel_bottom``)."""
+    return _wheels(robot) is not None
+
+
+def settle_pose(robot: wm.Robot, pose: Pose, ground: Ground | None, to_enu: np.ndarray | None) -> Pose:
+    """The pose of a wheeled robot a Supervisor put at ``pose``: settled on ``ground``
+    (:func:`settling_ground` as the world is now) as :func:`settle_world` settles it at load, with
+    the same arithmetic (so a robot put back at its world-file pose takes its settled initial pose,
+    bit for bit); ``pose`` itself when it does not settle (no ``wheel_bottom``, not upright, over no
+    ground, within SETTLE_TOL of it)."""
+    got = None if ground is None else _upright_wheels(robot, pose, to_enu)
+    if got is None:
+        return pose
+    assert ground is not None
+    bottom, axle, t = got
+    move, heights = _settled(ground, np.array([bottom]), np.array([axle]), np.array([float(t[0])]),
+                             np.array([float(t[1])]), np.array([float(t[2])]))
+    if not move[0]:
+        return pose
+    up, sign = _up_axis(to_enu)
+    translation = np.array(pose.translation, dtype=np.float64)
+    translation[up] = sign * float(heights[0])
+    return Pose(pose.rotation, translation)
+
+
 def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tuple[wm.World, list[str]]:
     """The world with its wheeled robots settled on the ground, as Webots' physics drops them at
     load, and one note line per robot moved by more than SETTLE_NOTE (at most SETTLE_NOTES, then a
     count).
 
     A robot is settled when its drive gives ``wheel_bottom`` and it stands upright (its z axis the
-    world's up): its height becomes ``ground − wheel_bottom``, so its lowest wheel's bottom touches
-    the ground under its origin; x, y and its rotation are kept. The ground is this module's, box
-    and cylinder tops included whatever the world has (terrains or not), under the ceiling
-    ``max(origin, wheel bottom + smallest wheel radius) + FLOOR``: a box top above its wheels' axle
-    (and its origin) is something it sank into, not its floor. The shapes of robots without a drive
-    are ground here too, as the world loads them (Webots' physics drops a robot on any bounding
-    object; a world's floor may be a robot's). Over no ground, off by at most
-    SETTLE_TOL, or not upright, a robot keeps its pose bit for bit."""
-    from sensorium.server.sim.scene import robot_parts
-
-    settling = [(i, r, w) for i, r in enumerate(world.robots) if (w := _wheels(r)) is not None]
+    world's up, or in a NUE world its y: :func:`robot_up`): its height becomes ``ground −
+    wheel_bottom``, so its lowest wheel's bottom touches the ground under its origin; x, y and its
+    rotation are kept. The ground is :func:`settling_ground`'s, under the ceiling ``max(origin,
+    wheel bottom + smallest wheel radius) + FLOOR``: a box top above its wheels' axle (and its
+    origin) is something it sank into, not its floor. The shapes of robots without a drive are
+    ground here too, as the world loads them (Webots' physics drops a robot on any bounding object).
+    Over no ground, off by at most SETTLE_TOL, or not upright, a robot keeps its pose bit for bit."""
+    settling = [(i, r, got) for i, r in enumerate(world.robots)
+                if (got := _upright_wheels(r, pose_from_model(r.pose), to_enu)) is not None]
     if not settling:
         return world, []
-    # the solids' ground and the driveless robots' (a Webots world's floor may be a robot's: create.wbt's
-    # ground supervisor holds its Plane); a robot's keyed apart from any solid's name
-    static = [r for r in world.robots if not r.drive_motors]
-    surfaces = [surface for s in world.solids for surface in _surfaces(s)]
-    surfaces += [surface for r in static for surface in _parts_surfaces("\0" + r.name, robot_parts(r))]
-    if not surfaces:
+    ground = settling_ground([(s, pose_from_model(s.pose)) for s in world.solids],
+                             [(r, pose_from_model(r.pose)) for r in world.robots if not r.drive_motors], to_enu)
+    if ground is None:
         return world, []
-    poses = {s.name: pose_from_model(s.pose) for s in world.solids}
-    poses.update({"\0" + r.name: pose_from_model(r.pose) for r in static})
-    ground = Ground(surfaces, poses, to_enu)
-    up = 2 if to_enu is None else int(np.argmax(np.abs(to_enu[2])))   # the world axis that is up
-    sign = 1.0 if to_enu is None else float(to_enu[2, up])
-    upright = []
-    for i, robot, (bottom, radius) in settling:
-        pose = pose_from_model(robot.pose)
-        r, t = pose.rotation, pose.translation
-        if to_enu is not None:
-            r, t = to_enu @ r, to_enu @ t
-        if abs(r[0, 2]) <= ROBOT_UPRIGHT_TOL and abs(r[1, 2]) <= ROBOT_UPRIGHT_TOL and r[2, 2] > 0.0:
-            upright.append((i, robot, bottom, float(t[0]), float(t[1]), float(t[2]), max(0.0, bottom + radius)))
-    if not upright:
-        return world, []
-    # every robot's ground in one call (element-wise: the bits Ground.at gives one robot)
-    _, _, bottoms, xs, ys, zs, axles = (np.array(c) for c in zip(*upright))
-    found, heights, _, _ = ground.under(xs, ys, (zs + axles) + FLOOR)
+    up, sign = _up_axis(to_enu)
+    # every robot's ground in one call (element-wise: the bits settle_pose gives one robot)
+    bottoms, axles, xs, ys, zs = (np.array(c) for c in zip(*[(b, a, float(t[0]), float(t[1]), float(t[2]))
+                                                               for _, _, (b, a, t) in settling]))
+    move, heights = _settled(ground, bottoms, axles, xs, ys, zs)
     robots = list(world.robots)
     moved: list[tuple[str, float, float]] = []
-    for k, (i, robot, bottom, _, _, z, _) in enumerate(upright):
-        height = float(heights[k]) - bottom
-        if not found[k] or abs(height - z) <= SETTLE_TOL:
+    for k, (i, robot, _) in enumerate(settling):
+        if not move[k]:
             continue
+        height = float(heights[k])
         translation = list(robot.pose.translation)
         translation[up] = sign * height
         robots[i] = robot.model_copy(update={"pose": robot.pose.model_copy(update={"translation": tuple(translation)})})
-        moved.append((robot.name, z, height))
+        moved.append((robot.name, float(zs[k]), height))
     axis = "xyz"[up]
     notes = [f"{source}: robot {name!r} settled on the ground at load, as Webots' physics drops it: its origin's "
              f"{axis} from {sign * z:.4f} to {sign * h:.4f} m (its lowest wheel now touches the ground under it)"
@@ -509,4 +578,3 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tup
         more = len(notes) - SETTLE_NOTES
         notes = [*notes[:SETTLE_NOTES], f"{source}: {more} more robots settled on the ground at load"]
     return (world.model_copy(update={"robots": robots}) if moved else world), notes
-

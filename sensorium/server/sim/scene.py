@@ -12,7 +12,7 @@ without textures): ``infra_red_terms`` turns hits into the colour terms of Webot
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Collection, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -501,6 +501,7 @@ class Scene:
         # a Supervisor's appearance changes: shape -> its model as loaded, and the field values it set
         self._loaded_models: dict[int, wm.Shape | wm.Solid] = {}
         self.appearance_values: dict[int, dict[str, Any]] = {}
+        self.removed_shapes: set[int] = set()       # Shape nodes a Supervisor removed (:meth:`remove_shapes`)
         self._link_frames: dict[tuple[int, str], tuple[Pose, Pose, Pose]] = {}   # link -> (robot, link, world)
         self.lights_version = 0        # changes whenever a light moves with its owner
         self.solids_version = 0        # changes whenever a top-level solid moves, is added or removed (gym's TopDown)
@@ -543,7 +544,22 @@ class Scene:
         rays see the shape and its shadows (:meth:`_seen_again`: its body's ray scenes are made again
         at the next cast). ``appearance_version`` moves unless the appearance is the same as now (the
         Foxglove scene draws it again)."""
-        if self._take_appearance(shape, appearance):
+        if shape not in self.removed_shapes and self._take_appearance(shape, appearance):
+            self._seen_again(shape)
+
+    def remove_shapes(self, shapes: Collection[int]) -> None:
+        """Shapes a Supervisor removed from inside a robot or solid (a ``Shape`` node: a split mesh's pieces
+        together): from the next cast they are as a shape of transparency 1 -- no camera, range finder, lidar
+        or infra-red or laser ray sees them, they cast no shadow, the Foxglove scene draws them clear --
+        while bounding rays still meet a shape that is also its solid's boundingObject (Webots keeps that
+        node). They stay removed through a reset and any later appearance change (Webots' reset does not
+        bring back a removed node)."""
+        for shape in shapes:
+            if shape in self.removed_shapes:
+                continue
+            current = self._parts[shape][2].appearance or wm.Appearance()
+            self._take_appearance(shape, current.model_copy(update={"transparency": 1.0}))
+            self.removed_shapes.add(shape)
             self._seen_again(shape)
 
     def _take_appearance(self, shape: int, appearance: wm.Appearance) -> bool:
@@ -578,6 +594,8 @@ class Scene:
         and its image as the caller read and checked it, not read again), so every sensor sees them
         from the next measurement as if the world file had named them -- shadows too: a base image
         whose pixel format has alpha makes the shape cast none (:meth:`_seen_again`)."""
+        if shape in self.removed_shapes:
+            return
         if self.textures is None and appearance.texture is not None:     # (no shape textured until now)
             self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
                                            ink_evaporation=self._ink_evaporation, given=self.images)
@@ -604,16 +622,20 @@ class Scene:
 
     def restore_appearances(self) -> None:
         """Every shape's appearance as loaded (``simulationReset``)."""
+        kept = {shape: self._loaded_models[shape] for shape in self.removed_shapes if shape in self._loaded_models}
         for shape, model in self._loaded_models.items():
+            if shape in kept:        # removed: stays removed
+                continue
             retextured = self._parts[shape][2].appearance
             self._use_model(shape, model)       # a shape loaded without an appearance gets none back
             if self.textures is not None and retextured is not None and model.appearance is not None and \
-                    _maps(retextured) != _maps(model.appearance):
+                    (_maps(retextured) != _maps(model.appearance) or retextured.texture is not None):
+                # (the same url may show its file read again since the load: the loaded image comes back)
                 self.textures.set_shape(shape, model.appearance)
             self._seen_again(shape)
-        if self._loaded_models:
+        if len(self._loaded_models) > len(kept):
             self.appearance_version += 1
-        self._loaded_models.clear()
+        self._loaded_models = kept
         self.appearance_values.clear()
 
     def drawn_models(self) -> dict[int, wm.Shape | wm.Solid]:
@@ -726,6 +748,7 @@ class Scene:
             self._inverse.pop(shape, None)
             self._loaded_models.pop(shape, None)
             self.appearance_values.pop(shape, None)
+            self.removed_shapes.discard(shape)
         n = self.engine.shape_count
         kept = [shape for shape in dead if shape < n]
         for shape in kept:

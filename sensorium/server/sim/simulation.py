@@ -29,7 +29,15 @@ from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch
 from sensorium.server.sim.cameras import Camera
 from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
-from sensorium.server.sim.ground import Ground, GroundWarning, band_low, settle_world
+from sensorium.server.sim.ground import (
+    Ground,
+    GroundWarning,
+    band_low,
+    settle_pose,
+    settle_world,
+    settles,
+    settling_ground,
+)
 from sensorium.server.sim.joints import JointMotor, Links
 from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, MecanumDrive, OmniDrive, WheelMotor
 from sensorium.server.sim.pen import Pen, lay_ink
@@ -251,11 +259,13 @@ class RobotState:
         setters); the next measurement sees it there. Translation and rotation are independent
         (Webots): leave one out (``None``) and it keeps its current value. Non-finite values or a
         translation beyond ``limits.MAX_COORDINATE_M`` raise ValueError and the robot stays.
+        A wheeled robot that settled at load settles again where it is put (Simulation.settled: its
+        lowest wheel on the ground under its origin, at once, where Webots' physics would drop it).
         A driven robot set over a terrain rides it from there (sim/ground.py): the height given is
         its clearance, the rotation its own (upright) one, the ground's attitude applied over it."""
         check_pose(translation, rotation, quaternion)
         current = self.drive.own_pose() if self.drive is not None and self.drive.slope is not None else self.pose
-        pose = moved_pose(current, translation, rotation, quaternion)
+        pose = self._sim.settled(self.model, moved_pose(current, translation, rotation, quaternion))
         if self.drive is not None:
             self.drive.reset(pose)
             pose = self.drive.placed(pose)
@@ -346,6 +356,7 @@ class Simulation:
                          "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights(),
                          "radar_targets": dict(self.scene.radar_targets)}
         self._imported_poses: dict[str, Pose] = {}      # each imported solid's pose as imported
+        self._settling: tuple[tuple, Ground | None] | None = None    # see settled: (what it was made of, the ground)
 
     def _warn_ground(self) -> None:
         """One GroundWarning per thing a driven robot will not ride on: a tilted terrain, a robot
@@ -377,6 +388,22 @@ class Simulation:
         # each robot's heading as its drive keeps it (its footprint is turned to it: contact.drive_footprint)
         yaws = [None if (d := self.robots[r.name].drive) is None else d.yaw for r in self.world.robots]
         return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system], yaws)
+
+    def settled(self, model: wm.Robot, pose: Pose) -> Pose:
+        """The pose a robot a Supervisor puts at ``pose`` takes: a wheeled robot that settles at load
+        (its drive gives ``wheel_bottom``) settles there on the ground as the world is now -- the
+        solids where they are, the robots without a drive where they are -- with settle_world's
+        arithmetic (ground.settle_pose); any other robot keeps ``pose``."""
+        if not settles(model):
+            return pose
+        floors = [(r.model, self.scene.robot_poses[r.index]) for r in self.robots.values() if not r.model.drive_motors]
+        key = (self.scene.solids_version, self.scene.shapes_version, *(p.translation.tobytes() + p.rotation.tobytes() for _, p in floors))
+        if self._settling is None or self._settling[0] != key:
+            alive = self.scene.solid_poses
+            ground = settling_ground([(s, alive[s.name]) for s in self.world.solids if s.name in alive], floors,
+                                     _TO_ENU[self.world.world_info.coordinate_system])
+            self._settling = (key, ground)
+        return settle_pose(model, pose, self._settling[1], _TO_ENU[self.world.world_info.coordinate_system])
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a

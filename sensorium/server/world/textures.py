@@ -153,6 +153,12 @@ Decoded = tuple[np.ndarray, np.ndarray | None, bool]
 """An image as read: (RGB, alpha or None, whether its pixel format has alpha)."""
 
 
+def _same_image(a: Decoded, b: Decoded) -> bool:
+    """Whether two reads of a file gave the same image, bit for bit (its format's alpha too)."""
+    return a[2] == b[2] and np.array_equal(a[0], b[0]) and (
+        a[1] is b[1] if a[1] is None or b[1] is None else np.array_equal(a[1], b[1]))
+
+
 @lru_cache(maxsize=16)
 def _decode(path: str, _mtime: int, _size: int) -> Decoded:
     return _decode_from(path, path)
@@ -800,7 +806,13 @@ class TextureSampler:
             return None
         if given is not None and t.url in given:
             path, decoded = given[t.url]
-            if path not in self._kept:
+            held = self._images.get(path)
+            if held is not None and _same_image(held, decoded):
+                decoded = held              # the file as it was read before: the image held (one copy)
+            elif path in self._kept:        # a world's own file changed on disk since the load (a Supervisor named
+                rgb, alpha, translucent = decoded    # it again): shown, the loaded image kept for a reset
+                return TextureImage(rgb, t.repeat_s, t.repeat_t, alpha, translucent)
+            else:
                 self._images[path] = decoded
         else:
             try:

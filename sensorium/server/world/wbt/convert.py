@@ -64,6 +64,10 @@ OTHER_NAMES = {"RangeFinder": "range-finder", "InertialUnit": "inertial unit", "
 GEOMETRIES = {"Box", "Sphere", "Cylinder", "Capsule", "Cone", "Plane", "IndexedFaceSet", "Mesh", "ElevationGrid"}
 MAX_GRID_POINTS = 4_000_000    # ElevationGrid points (xDimension × yDimension, all grids together after DEF/USE:
                                # ProtoLimits.values), checked before a height is read or padded
+# what a Billboard may hold without losing anything a device reads (it follows the 3D view, no Camera sees it)
+BILLBOARD_CONTENT = {"Shape", "Transform", "Pose", "Group", "Appearance", "PBRAppearance", "Material",
+                     "ImageTexture", "TextureTransform", "Coordinate", "Normal", "TextureCoordinate", "Color",
+                     "IndexedLineSet", "PointSet"} | GEOMETRIES
 UNSEEN_GEOMETRIES = {"IndexedLineSet", "PointSet"}      # lines and points: no surface a ray could hit
 LIGHTS = {"PointLight", "SpotLight", "DirectionalLight"}
 SENSORS = {"DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "LED", "RangeFinder", "Camera"}
@@ -619,6 +623,8 @@ class Converter:
                                 "else); skipped")
         elif t == "Viewpoint":           # its values are kept (top_node): the Supervisor's and snapshots' view
             pass
+        elif t == "Billboard":
+            self.billboard(node)
         elif t in SKIPPED:
             if t != "TexturedBackground":     # a PROTO not read: the PROTO note says what cameras lose
                 self.skipped[t] += 1
@@ -743,6 +749,27 @@ class Converter:
                 why = (f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
                        f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
             self.drop(node, why, "robot" if robot_like else "node", named if isinstance(named, str) else t)
+
+    def billboard(self, node: Node) -> None:
+        """A Billboard: Webots pins its children to the 3D view's viewpoint, and no Camera sees them nor
+        their shadows (Webots' reference), so no device reads anything of it: skipped as what does not
+        matter to sensors. A node inside that would matter (a Solid, a device, a light, a node not read
+        here) makes it a loss, naming that node."""
+        stack: list[Any] = [node.fields.get("children")]
+        while stack:
+            value = stack.pop()
+            if isinstance(value, list):
+                stack.extend(value)
+            elif isinstance(value, Node):
+                if value.type not in BILLBOARD_CONTENT:
+                    named = node.fields.get("name")
+                    self.drop(node, f"Billboard holding {value.type} (line {value.line}): only Webots' 3D view shows a "
+                                    "Billboard's children, and a Solid, device or light there is not simulated here; "
+                                    "skipped with everything inside it", "node",
+                              named if isinstance(named, str) else "Billboard")
+                    return
+                stack.extend(value.fields.values())
+        self.skipped["Billboard"] += 1
 
     def scaled_solid(self, node: Node, owner: Owner) -> None:
         """A Solid (a robot, a device, a joint's end point) under a Transform that scales: Webots
@@ -1694,21 +1721,21 @@ class Converter:
         elif motors:
             self.warn(node, f"{node.type} motor(s) outside a robot: not simulated")
         # (a robot's Hinge2Joint: hinge2() said which of its axes has sensors but no motor)
-        if sensors and not motors and node.type != "Hinge2Joint":
+        if not motors and wheeled and node.type == "HingeJoint":     # perhaps a car's free rear wheel
             line = (f"PositionSensor on a joint without a motor: reads the joint's position, "
-                    f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)")
-            if wheeled and node.type == "HingeJoint":     # perhaps a car's free rear wheel (said after the drive)
-                pf = self.fields(f.node_("jointParameters")) if f.node_("jointParameters") is not None else None
-                axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
-                centre = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
-                wheel = self.slotted(end)
-                if wheel is not None and wheel.type == "Solid":
-                    centre = self.fields(wheel).vec("translation", (0.0, 0.0, 0.0))
-                owner.free.append({"node": node, "sensors": sensors, "line": line, "steer": None,
-                                   "axis": frame.rotation @ np.asarray(axis),
-                                   "centre": np.asarray(frame.apply(centre)), "end": end})
-            else:
-                self.warn(node, line)
+                    f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)") if sensors else None
+            pf = self.fields(f.node_("jointParameters")) if f.node_("jointParameters") is not None else None
+            axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
+            centre = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
+            wheel = self.slotted(end)
+            if wheel is not None and wheel.type == "Solid":
+                centre = self.fields(wheel).vec("translation", (0.0, 0.0, 0.0))
+            owner.free.append({"node": node, "sensors": sensors, "line": line, "steer": None,
+                               "axis": frame.rotation @ np.asarray(axis),
+                               "centre": np.asarray(frame.apply(centre)), "end": end, "frame": frame})
+        elif sensors and not motors and node.type != "Hinge2Joint":
+            self.warn(node, f"PositionSensor on a joint without a motor: reads the joint's position, "
+                            f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)")
         if end is not None:
             if end.type == "SolidReference":
                 return
@@ -1837,7 +1864,13 @@ class Converter:
                     else:               # a car's free front wheel rolls (said after the drive if it is none)
                         owner.free.append({"node": node, "sensors": found_sensors, "line": line,
                                            "steer": self.fields(motors[0]).string("name", "rotational motor"),
-                                           "axis": frame.rotation @ np.asarray(axis), "centre": centre, "end": end})
+                                           "axis": frame.rotation @ np.asarray(axis), "centre": centre, "end": end,
+                                           "frame": frame})
+                elif not steers and motors:     # a free front wheel without an encoder: it still holds the car up
+                    owner.free.append({"node": node, "sensors": [], "line": None,
+                                       "steer": self.fields(motors[0]).string("name", "rotational motor"),
+                                       "axis": frame.rotation @ np.asarray(axis), "centre": centre, "end": end,
+                                       "frame": frame})
                 continue
             m = self.fields(found[0])
             turn = frame.rotation @ np.asarray(axis)
@@ -1873,10 +1906,33 @@ class Converter:
             self._say_no_wheels(node, robot, nowheel)
             from sensorium.server.world.wbt.drive import free_car_wheels
 
-            rolling = free_car_wheels(robot.data.get("ackermann_drive"), robot.free, self)
+            car = robot.data.get("ackermann_drive")
+            rolling = free_car_wheels(car, robot.free, self)
             for free in robot.free:     # an encoder on a wheel axis no motor turns and no car rolls: still
-                if id(free) not in rolling:
+                if id(free) not in rolling and free["line"] is not None:
                     self.warn(free["node"], free["line"])
+            if car is not None and rolling and self.fields(node).node_("physics") is not None:
+                self._free_wheel_bottom(robot, car, [f for f in robot.free if id(f) in rolling])
+
+    def _free_wheel_bottom(self, robot: Owner, car: dict, free: list[dict]) -> None:
+        """A car's free wheels (no motor: a propulsion car's front ones, a traction car's rear ones) hold
+        it up as its driven ones do: its ``wheel_bottom`` is the lowest of them all, each with its radius."""
+        from sensorium.server.world.wbt.drive import wheel_bottom
+
+        bottom = wheel_bottom(free, self, self._robot_up(robot))
+        if bottom is not None:
+            car["wheel_bottom"] = min(car.get("wheel_bottom", bottom), bottom)
+
+    def _robot_up(self, robot: Owner) -> int:
+        """The robot's own axis its ``wheel_bottom`` is measured along: its z, or in a NUE world its y
+        when that is nearer the world's up (a robot built y-up, as Webots' were before R2022a;
+        sim/ground.py settles it along that axis)."""
+        if self.world["world_info"].get("coordinate_system", "ENU") != "NUE":
+            return 2
+        from sensorium.server.world.poses import pose_from_model
+
+        r = pose_from_model(wm.Pose.model_validate(robot.data["pose"])).rotation
+        return 1 if abs(r[1, 1]) > abs(r[1, 2]) else 2
 
     def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         if len(nowheel) <= MANY_JOINTS:
@@ -2038,7 +2094,8 @@ class Converter:
         gravity drops it, so it settles on the ground at load; one without stays where it is put)."""
         from sensorium.server.world.wbt.drive import wheel_bottom
 
-        bottom = wheel_bottom(wheels, self) if self.fields(node).node_("physics") is not None else None
+        bottom = (wheel_bottom(wheels, self, self._robot_up(robot)) if self.fields(node).node_("physics") is not None
+                  else None)
         if bottom is not None:
             for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive"):
                 if key in robot.data:

@@ -35,8 +35,10 @@ taken within AXIS_TOL, as the car's other axes are).
 Four wheels whose friction WorldInfo's ContactProperties makes asymmetric and turns
 (``frictionRotation``: a KUKA youBot's mecanum rollers, which Webots simulates so) map onto the
 kinematic ``mecanum_drive`` when they sit at the corners (±lx, ±ly) of a rectangle centred under
-the origin, of one radius; a wheel's roller sign is minus the sign of its friction's turn (the
-youBot's wheels turned by +0.785 are the ones its library's formulas give -1).
+the origin, of one radius; a wheel's roller sign is minus the sign of its friction's turn: Webots'
+contact frees a wheel along its cylinder's axis turned by -frictionRotation about the contact normal
+(up into the wheel), so a wheel turned by -0.785 slides along (1, -1) and grips along (1, 1), sign +1
+(the youBot's wheels turned by +0.785 are the ones its library's formulas give -1).
 
 Three or more wheels, none steering, about axes horizontal in the robot's frame that are not all
 along one line, each turning something round about its axis, their lowest points on one ground
@@ -584,16 +586,18 @@ def omni_wheels(wheels: list[dict], conv) -> bool:
     return max(bottoms) - min(bottoms) <= GROUND_TOL
 
 
-def wheel_bottom(wheels: list[dict], conv) -> float | None:
-    """The drive's ``wheel_bottom``: the lowest bottom, along the robot's z, of its wheels that do not
+def wheel_bottom(wheels: list[dict], conv, up: int = 2) -> float | None:
+    """The drive's ``wheel_bottom``: the lowest bottom, along the robot's z (``up``: 1 along its y, a
+    robot built y-up in a NUE world), of its wheels that do not
     steer (each one's round part's centre, where it is as the world loads, less its radius), or None
-    without one whose radius is known. The robot settles on the ground with it at load."""
+    without one whose radius is known. The robot settles on the ground with it at load. ``wheels``:
+    motorised hinges, or a car's free wheels (no ``steers``: their rolling axes)."""
     bottoms = []
     for w in wheels:
-        radius = None if w["steers"] else wheel_radius(w["end"], conv)
+        radius = None if w.get("steers") else wheel_radius(w["end"], conv)
         if radius is not None:
             centre = round_centre(w, conv)
-            bottoms.append(float((w["centre"] if centre is None else centre)[2]) - radius)
+            bottoms.append(float((w["centre"] if centre is None else centre)[up]) - radius)
     return min(bottoms) if bottoms else None
 
 

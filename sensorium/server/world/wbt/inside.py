@@ -196,9 +196,11 @@ def turn_meshes_away(robot: dict, clockwise: set[int]) -> None:
             groups.setdefault(tuple(name for (name, _), b in zip(away, key) if b), []).append(t)
         points = np.asarray(geometry["vertices"], dtype=np.float64).reshape(-1, 3)
         box = np.stack([points.min(axis=0), points.max(axis=0)])        # of all points, used or not
-        for names, rows in groups.items():
+        for j, (names, rows) in enumerate(groups.items()):
             g = geometry if len(groups) == 1 else _piece(geometry, points, box, np.asarray(rows, dtype=np.int64))
             piece = dict(part, geometry=g)
+            if j and part.get("node") is not None:      # one Shape node to a Supervisor: the first piece's
+                piece["node"] = dict(part["node"], piece=True)
             if names:
                 piece["unseen_by"] = sorted(names)
             out.append(piece)
