@@ -24,7 +24,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
@@ -76,6 +76,12 @@ class ControllerSpec:
     runtime: RuntimeIni | None = None      # its folder's runtime.ini (environment variables, [python] COMMAND)
     notes: tuple[str, ...] = ()            # lines to say about it when the world starts
     libraries: tuple[Path, ...] = ()       # the projects' libraries/ folders, for its library path
+
+    def said(self) -> tuple[str, ...]:
+        """What ``run`` says of it before starting it: where Webots' own copy was found, its notes
+        (runtime.ini's, a library folder left off): at load and when a Supervisor switches to it."""
+        found = (f"robot '{self.robot}': controller '{self.name}' found in Webots' projects: {self.program}",)
+        return (*(found if self.webots else ()), *self.notes)
 
 
 def controller_dirs(world: Path, extra: list[Path], projects: Sequence[Path] = ()) -> list[Path]:
@@ -192,6 +198,8 @@ def _runtime_ini(robot: str, folder: Path) -> tuple[RuntimeIni | None, tuple[str
         return None, ()
     try:          # its $(...) references replaced against this environment: too long is said now
         runtime_ini.environment(ini, os.environ)
+        ini.python("COMMAND", os.environ)
+        ini.python("OPTIONS", os.environ)
     except runtime_ini.RuntimeIniError as exc:
         return None, (f"robot '{robot}': {exc}; the controller starts without it",)
     return ini, tuple(f"robot '{robot}': {folder / runtime_ini.FILE}: {line}" for line in ini.notes())
@@ -307,7 +315,22 @@ def robot_controller(robot: str, name: str, args: list[str], dirs: list[Path], w
     robot_dirs = list(dict.fromkeys([dirs[0], own / "controllers", *dirs[1:]])) if own is not None and dirs else dirs
     spec = find_controller(robot, name, args, robot_dirs, webots, (protos or {}).get(robot))
     roots = [dirs[0].parent] if dirs else []
-    return dataclasses.replace(spec, libraries=library_folders([*roots, *([own] if own else [])]))
+    spec = dataclasses.replace(spec, libraries=library_folders([*roots, *([own] if own else [])]))
+    unlisted = [p for p in (*spec.libraries, spec.folder) if not _listable(p)]
+    if unlisted:
+        more = f" and {len(unlisted) - 1} more folder{'s' if len(unlisted) > 2 else ''}" if len(unlisted) > 1 else ""
+        spec = dataclasses.replace(spec, notes=(*spec.notes, (
+            f"robot '{robot}': {unlisted[0]}{more} left off the controller's library path: a '{os.pathsep}' in a "
+            f"folder's path would split it in two there (LD_LIBRARY_PATH's separator), so a shared library in it "
+            "is not found")))
+    return spec
+
+
+def _listable(path: Path) -> bool:
+    """Can ``path`` be an entry of a ``PATH``-like list (no ``os.pathsep`` in it)? Webots puts a
+    folder with a ``:`` on a controller's library path all the same, where it reads as two folders,
+    the second relative to the controller's folder."""
+    return os.pathsep not in str(path)
 
 
 def library_folders(projects: list[Path]) -> tuple[Path, ...]:
@@ -370,8 +393,7 @@ def plan_world(robots: list[Any], dirs: list[Path], rpc_url: str, webots: Webots
     specs, problems = plan(robots, dirs, webots, protos, projects)
     started = {s.robot for s in specs}
     missing = tuple((r.name, r.controller) for r in robots if r.controller not in SPECIAL and r.name not in started)
-    notes = [f"robot '{s.robot}': controller '{s.name}' found in Webots' projects: {s.program}" for s in specs if s.webots]
-    notes += [line for s in specs for line in s.notes]
+    notes = [line for s in specs for line in s.said()]
     for r in robots:
         if r.controller == "<generic>":
             which = "no controller field, so Webots' default '<generic>'" if r.default else "controller '<generic>'"
@@ -500,14 +522,21 @@ class Launcher:
 
     # ------------------------------------------------------------------ processes
     @staticmethod
-    def command(spec: ControllerSpec) -> list[str]:
+    def command(spec: ControllerSpec, base: Mapping[str, str] | None = None) -> list[str]:
         """The controller's command line: a Python one as `sensorium controller` runs it (`controller`
         importable, its folder as cwd), with runtime.ini's [python] COMMAND and OPTIONS as Webots
-        takes them (else this interpreter); an executable as itself."""
+        takes them, their ``$(NAME)`` replaced against ``base`` (this process's environment) and the
+        file's entries before them (else this interpreter); an executable as itself."""
         if spec.python:
             ini = spec.runtime
-            python = (ini.python("COMMAND") if ini else None) or sys.executable
-            options = ((ini.python("OPTIONS") if ini else None) or "").split()
+            # as Webots resolves them: its environment, the robot's name already in it
+            env = {**(os.environ if base is None else base), "WEBOTS_ROBOT_NAME": spec.robot}
+            try:
+                python = (ini.python("COMMAND", env) if ini else None) or sys.executable
+                options = ini.python_options(env) if ini else []
+            except runtime_ini.RuntimeIniError:      # checked when planned; the environment grew since
+                python = (ini.python("COMMAND") if ini else None) or sys.executable
+                options = ini.python_options() if ini else []
             return [python, *options, "-m", "sensorium", "controller", str(spec.program), "--", *spec.args]
         return [str(spec.program), *spec.args]
 
@@ -515,6 +544,7 @@ class Launcher:
         """The controller's environment: ``base`` (this process's), its runtime.ini's variables, then
         what it needs here: the URL, Webots' variables, Sensorium on the Python and library paths."""
         env = dict(os.environ if base is None else base)
+        env["WEBOTS_ROBOT_NAME"] = spec.robot     # Webots sets it before it reads runtime.ini: $(WEBOTS_ROBOT_NAME) there
         if spec.runtime is not None:
             try:
                 env = runtime_ini.environment(spec.runtime, env)
@@ -534,9 +564,15 @@ class Launcher:
         env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH", "")) if p)
         # as Webots: the project's libraries/ folders, WEBOTS_LIBRARY_PATH, the controller's folder (a shared
         # library shipped next to the controller loads) first on the library path, then our libController
-        libraries = [*(str(p) for p in spec.libraries), env.get("WEBOTS_LIBRARY_PATH", ""), str(spec.folder),
+        # (a folder with the list's separator in its path is left off: robot_controller says so)
+        libraries = [*(str(p) for p in spec.libraries if _listable(p)), env.get("WEBOTS_LIBRARY_PATH", ""),
+                     *([str(spec.folder)] if _listable(spec.folder) else []),
                      *([str(C_LIBRARY)] if not spec.python and C_LIBRARY.is_dir() else []), env.get("LD_LIBRARY_PATH", "")]
-        env["LD_LIBRARY_PATH"] = os.pathsep.join(dict.fromkeys(p for p in libraries if p))
+        library_path = os.pathsep.join(dict.fromkeys(p for p in libraries if p))
+        if library_path:
+            env["LD_LIBRARY_PATH"] = library_path
+        else:                  # none left: an empty one is no list to give
+            env.pop("LD_LIBRARY_PATH", None)
         return env
 
     def start(self, robot: str) -> None:
@@ -699,6 +735,8 @@ class Launcher:
                 if self.find is None:
                     raise LaunchError(f"robot {robot!r}: controller {name!r} not looked for (no world to look from)")
                 spec = self.find(robot, name)
+                for line in spec.said():
+                    self.log(line)
             except LaunchError as exc:
                 self.log(f"{exc}: the robot runs without a controller")
                 self.failed[robot] = name

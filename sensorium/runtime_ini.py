@@ -10,7 +10,8 @@ trimmed with the spaces), a line's text ends at its first NUL byte and a UTF-8 b
 its start is skipped, as Webots' Qt reads the file line by line; bytes that are not UTF-8 read as U+FFFD. Sections applied here: ``environment variables
 with paths`` (and its deprecated name ``... with relative paths``), ``environment variables``, and
 the ones for this platform (``... for linux``, ``... for linux 64``; ``... for macos`` /
-``... for mac os x``); ``python`` gives ``COMMAND`` and ``OPTIONS``. ``java`` and ``matlab`` are
+``... for mac os x``); ``python`` gives ``COMMAND`` and ``OPTIONS`` (split at its spaces, as Webots
+splits it). ``java`` and ``matlab`` are
 for controllers Sensorium does not run.
 """
 
@@ -51,13 +52,34 @@ class RuntimeIni:
     where: str = FILE                       # the file, for the lines said about it
     lines: tuple[int, ...] = ()             # each entry's line number in it
 
-    def python(self, key: str) -> str | None:
-        """The ``python`` section's ``COMMAND`` or ``OPTIONS`` (the last one given), else None."""
+    def python(self, key: str, env: Mapping[str, str] | None = None, platform: str = sys.platform) -> str | None:
+        """The ``python`` section's ``COMMAND`` or ``OPTIONS`` (the last one given), else None. With
+        ``env``, its ``$(NAME)`` references replaced as Webots replaces every entry's: against ``env``
+        with the file's entries before it applied for ``platform`` (RuntimeIniError when too long)."""
         found = None
-        for section, k, value in self.entries:
+        for i, (section, k, _) in enumerate(self.entries):
             if section == "python" and k == key:
-                found = value
-        return found
+                found = i
+        if found is None:
+            return None
+        value = self.entries[found][2]
+        if env is None or "$(" not in value:
+            return value
+        before = environment(RuntimeIni(self.entries[:found], self.where, self.lines[:found]), env, platform)
+        resolved = _resolve(value, before, False, MAX_SET)
+        if resolved is None:
+            line = f"line {self.lines[found]}: " if found < len(self.lines) else ""
+            raise RuntimeIniError(f"{self.where}: {line}[python] {key} with its $(...) references replaced is longer "
+                                  f"than the {MAX_SET} characters set at most")
+        return resolved
+
+    def python_options(self, env: Mapping[str, str] | None = None) -> list[str]:
+        """The ``python`` section's ``OPTIONS`` (``$(NAME)`` replaced against ``env`` as :meth:`python`
+        replaces it) as the arguments Webots makes of it (WbController splits the value at each space,
+        with no quoting: a tab stays inside its argument, and quotes inside the value stay in theirs),
+        less the empty ones two spaces in a row would make (Webots passes each as an empty argument,
+        which Python then takes for the script to run)."""
+        return [part for part in (self.python("OPTIONS", env) or "").split(" ") if part]
 
     def notes(self) -> list[str]:
         """Lines Webots would say about this file (unknown ``python`` keys, the deprecated section):

@@ -98,3 +98,23 @@ def test_switches_and_restarts_leave_one_process_per_named_controller(tmp_path_f
         launcher.close()
     assert all(p.poll() is not None for p in seen), "a controller outlived the launcher"
     assert "Traceback" not in lines.getvalue(), lines.getvalue()
+
+
+def test_a_switch_says_what_the_new_controllers_load_said(tmp_path: Path) -> None:
+    """A Supervisor's switch to a controller found with notes (runtime.ini's, a library folder left off)
+    or in Webots' projects prints those lines, as ``run`` prints them for the world's controllers."""
+    folders = specs_in(tmp_path)
+    lines = io.StringIO()
+    launcher = Launcher([], "tcp://127.0.0.1:1", out=lines, err=lines, grace_s=5.0)
+    launcher.bind(set(), lambda: None, lambda: False)
+    launcher.find = lambda robot, name: ControllerSpec(
+        robot, name, folders[name], folders[name] / f"{name}.py", True, webots=True,
+        notes=(f"robot '{robot}': runtime.ini: a note",))
+    try:
+        launcher.switch("r2", "sleeper", False)
+        assert lines.getvalue().splitlines()[:2] == [
+            f"sensorium run: robot 'r2': controller 'sleeper' found in Webots' projects: "
+            f"{folders['sleeper'] / 'sleeper.py'}",
+            "sensorium run: robot 'r2': runtime.ini: a note"]
+    finally:
+        launcher.close()

@@ -107,6 +107,24 @@ def test_is_at_any_depth_of_four_nested_protos(tmp_path: Path) -> None:
     assert not [n for n in nodes_of(given, "Leaf") + nodes_of(given, "Inner")]     # base nodes only
 
 
+def test_a_field_bound_by_is_keeps_its_parameter_when_the_node_gives_it_again(tmp_path: Path) -> None:
+    """A body node giving one field twice, once ``IS`` a parameter (Webots' PandaHand: ``name IS
+    name`` then ``name "hand"``): Webots keeps the field bound to the parameter whichever comes
+    first (the value read later leaves the binding, which instantiation follows); two plain values:
+    the last; two bindings: the last."""
+    proto_file(tmp_path, "Hand", """[ field SFString name "panda hand" field SFString other "o" ]
+{ Solid { name IS name children [
+  Solid { name "first" name IS name }
+  Solid { name "a" name "b" }
+  Solid { name IS other name IS name }
+] name "hand" } }""")
+    w = world_file(tmp_path, 'Hand { }\nHand { name "given" }\n', ["Hand.proto"])
+    default, given = expanded(w).nodes
+    assert [s.fields["name"] for s in nodes_of(default, "Solid")] == ["panda hand", "panda hand", "b", "panda hand"]
+    assert [s.fields["name"] for s in nodes_of(given, "Solid")] == ["given", "given", "b", "given"]
+    assert [s.name for s in load_world(w).world.solids] == ["panda hand", "given"]
+
+
 def test_slots_filled_from_the_world_keep_their_file_and_a_proto_default(tmp_path: Path) -> None:
     sensors = tmp_path / "sensors"
     proto_file(sensors, "MySensor", "[ field SFString name \"my sensor\" ] { DistanceSensor { name IS name } }")

@@ -464,6 +464,40 @@ def test_a_controller_gets_webots_variables_and_its_folder_on_the_library_path(t
             f"{tmp_path / 'controllers' / 'env'} /nowhere") in proc.stdout().splitlines()
 
 
+def test_a_project_folder_with_the_path_separator_is_left_off_the_library_path_in_one_line(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A project under a folder with a ':' in its name: its libraries/ folders and the controller's
+    folder cannot be entries of LD_LIBRARY_PATH (each would read as two folders, the second relative to
+    the controller's folder, as Webots puts them there); they are left off, one line says so, and the
+    controller runs with the rest of the list."""
+    base = tmp_path / "v1:v2"
+    base.mkdir()
+    script = ('import os\nfrom controller import Robot\nrobot = Robot()\n'
+              'print("path", os.environ.get("LD_LIBRARY_PATH", "<unset>"))\n')
+    world = project(base, 'Robot { name "r" controller "env" }', {"env.py": script})
+    (base / "libraries" / "lib").mkdir(parents=True)
+    folder = base / "controllers" / "env"
+    got = launch.plan_world([robot("r", "env")], [base / "controllers"], "tcp://127.0.0.1:5555", wbt=True)
+    line = (f"robot 'r': {base / 'libraries' / 'lib'} and 1 more folder left off the controller's library path: "
+            "a ':' in a folder's path would split it in two there (LD_LIBRARY_PATH's separator), so a shared "
+            "library in it is not found")
+    assert got.notes == (line,) and got.problems == ()
+    launcher = launch.Launcher(list(got.specs), "tcp://127.0.0.1:1")
+    try:
+        env = launcher.environment(got.specs[0], {"LD_LIBRARY_PATH": "/a:/b", "WEBOTS_LIBRARY_PATH": "/wl"})
+        assert env["LD_LIBRARY_PATH"] == "/wl:/a:/b"
+        assert "LD_LIBRARY_PATH" not in launcher.environment(got.specs[0], {})   # no list rather than an empty one
+    finally:
+        launcher.close()
+    plain = launch.plan_world([robot("r", "env")], [tmp_path / "plain" / "controllers"], "tcp://127.0.0.1:5555")
+    assert plain.problems and not any("library path" in n for n in plain.notes)
+    proc = run(world, "--until", "64", env={"LD_LIBRARY_PATH": "/nowhere"})
+    assert proc.wait() == 0, proc.stderr()
+    assert f"sensorium run: {line}" in proc.stderr().splitlines()
+    assert "[r] path /nowhere" in proc.stdout().splitlines()
+    assert str(folder) not in proc.stdout()
+
+
 UNDER_SERVE = '''from controller import Supervisor
 boss = Supervisor()
 boss.step(16)

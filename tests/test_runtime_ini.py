@@ -75,6 +75,60 @@ def test_an_invalid_file_is_one_line_and_odd_keys_are_said() -> None:
     assert environment(ini, {}, "linux") == {"P": "a"}
 
 
+def test_python_options_are_split_at_each_space_as_webots_splits_them(tmp_path: Path) -> None:
+    """WbController splits [python] OPTIONS at each space and nowhere else: no quoting (a quoted value's
+    quotes are the file's, gone once read; quotes inside stay), a tab inside an argument; the empty
+    arguments of two spaces in a row are left out (Python would take one for its script)."""
+    ini = parse('[python]\nOPTIONS = -X  dev -W "error"\tx\n')
+    assert ini.python("OPTIONS") == '-X  dev -W "error"\tx'
+    assert ini.python_options() == ["-X", "dev", "-W", '"error"\tx']
+    assert parse('[python]\nOPTIONS = "-X utf8" ; quoted\n').python_options() == ["-X", "utf8"]
+    assert parse("[python]\nOPTIONS =\n").python_options() == [] and RuntimeIni().python_options() == []
+    folder = tmp_path / "controllers" / "c"
+    folder.mkdir(parents=True)
+    (folder / "c.py").write_text("")
+    (folder / "runtime.ini").write_text("[python]\nOPTIONS =  -B   -X\tdev \n")
+    spec = find_controller("r", "c", [], [tmp_path / "controllers"])
+    launcher = Launcher([spec], "tcp://127.0.0.1:1")
+    try:
+        assert launcher.command(spec)[:5] == [sys.executable, "-B", "-X\tdev", "-m", "sensorium"]
+    finally:
+        launcher.close()
+
+
+def test_python_command_and_options_have_their_references_replaced_as_webots_does(tmp_path: Path) -> None:
+    """Webots replaces $(NAME) in every entry, [python] ones too, against its environment (the robot's
+    name already in it) with the file's earlier entries applied: a later one is not seen."""
+    text = ('[environment variables]\nVENV = /opt/venv\n[python]\nCOMMAND = $(VENV)/bin/python\n'
+            'OPTIONS = -X pycache_prefix=$(HOME)/$(WEBOTS_ROBOT_NAME)  -W $(LATER)x\n'
+            '[environment variables]\nLATER = late\n')
+    ini = parse(text)
+    assert ini.python("COMMAND") == "$(VENV)/bin/python"               # as written
+    assert ini.python("COMMAND", {}) == "/opt/venv/bin/python"
+    assert ini.python_options({"HOME": "/home/me", "WEBOTS_ROBOT_NAME": "r"}) == [
+        "-X", "pycache_prefix=/home/me/r", "-W", "x"]
+    folder = tmp_path / "controllers" / "c"
+    folder.mkdir(parents=True)
+    (folder / "c.py").write_text("")
+    (folder / "runtime.ini").write_text(text)
+    spec = find_controller("bee", "c", [], [tmp_path / "controllers"])
+    launcher = Launcher([spec], "tcp://127.0.0.1:1")
+    try:
+        assert launcher.command(spec, {"HOME": "/h", "WEBOTS_ROBOT_NAME": "stale"})[:5] == [
+            "/opt/venv/bin/python", "-X", "pycache_prefix=/h/bee", "-W", "x"]
+        env = launcher.environment(spec, {"WEBOTS_ROBOT_NAME": "stale"})
+        assert env["LATER"] == "late" and env["WEBOTS_ROBOT_NAME"] == "bee"
+    finally:
+        launcher.close()
+    (folder / "runtime.ini").write_text("[environment variables]\nWHO = $(WEBOTS_ROBOT_NAME)!\n")
+    spec = find_controller("bee", "c", [], [tmp_path / "controllers"])
+    launcher = Launcher([spec], "tcp://127.0.0.1:1")
+    try:
+        assert launcher.environment(spec, {})["WHO"] == "bee!"
+    finally:
+        launcher.close()
+
+
 def test_the_launcher_runs_a_controller_with_its_runtime_ini(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     folder = tmp_path / "controllers" / "c"
     folder.mkdir(parents=True)

@@ -4,9 +4,10 @@
 
 One robot in a walled 2.2 m square, with a GPS and four distance sensors, ``copies`` copies stepped
 together (FAST, one thread, kinematic contact on), random wheel speeds every 4 basic steps. The kinds
-(two-wheel in the C drive pass, two-wheel with its wheels' centre off its origin, mecanum, three- and
-four-wheel omni) run interleaved in one process, round after round; each figure is the median of the
-rounds. "drive" is the CPU time of the drive step alone per basic step (the same commands, no devices).
+(two-wheel and two-wheel with its wheels' centre off its origin, both in the C drive pass, mecanum,
+three- and four-wheel omni, and a mecanum robot with a two-wheel robot beside it: a mixed world, whose
+two-wheel robot's wheels and moves are C passes within the numpy drive) run interleaved in one
+process, round after round; each figure is the median of the rounds. "drive" is the CPU time of the drive step alone per basic step (the same commands, no devices).
 """
 
 from __future__ import annotations
@@ -41,6 +42,9 @@ KINDS: dict[str, dict] = {
     "omni3": {"omni_drive": {"max_wheel_speed": SPEED, "wheels": _omni_wheels(3, 0.1, 0.05, math.pi)}},
     "omni4": {"omni_drive": {"max_wheel_speed": SPEED, "wheels": _omni_wheels(4, 0.12, 0.05, math.pi / 4)}},
 }
+# a second robot beside the first (no devices): a mixed world, its two-wheel robot still in C passes
+KINDS["mecanum + two-wheel"] = KINDS["mecanum"]
+PARTNER = {"mecanum + two-wheel": KINDS["two-wheel"]}
 SENSORS = ["gps", "ds0", "ds1", "ds2", "ds3"]
 
 
@@ -63,7 +67,10 @@ def build(kind: str, copies: int) -> BatchedSimulation:
                                     _wall("e", 1.2, 0, 0.2, 2.2), _wall("w", -1.2, 0, 0.2, 2.2)],
                          "robots": [{"name": "r", "pose": {"translation": [0, 0, 0.05]},
                                      "body": {"geometry": {"type": "box", "size": [0.3, 0.3, 0.1]}},
-                                     **KINDS[kind], "devices": _devices()}]})
+                                     **KINDS[kind], "devices": _devices()},
+                                    *([{"name": "partner", "pose": {"translation": [0.6, 0.6, 0.05]},
+                                        "body": {"geometry": {"type": "box", "size": [0.3, 0.3, 0.1]}},
+                                        **PARTNER[kind]}] if kind in PARTNER else [])]})
     return BatchedSimulation(world, copies, precision="fast", threads=1)
 
 
@@ -71,8 +78,10 @@ def _command(sim: BatchedSimulation, kind: str, rng: np.random.Generator) -> Non
     c = sim.copies
     if kind.startswith("two-wheel"):
         sim.set_wheels(0, rng.uniform(-SPEED, SPEED, c), rng.uniform(-SPEED, SPEED, c))
-    elif kind == "mecanum":
+    elif kind.startswith("mecanum"):
         sim.mecanum.command(0, rng.uniform(-SPEED, SPEED, (c, 4)))
+        if kind in PARTNER:
+            sim.set_wheels(1, rng.uniform(-SPEED, SPEED, c), rng.uniform(-SPEED, SPEED, c))
     else:
         wheels = len(KINDS[kind]["omni_drive"]["wheels"])
         sim.omni.command(0, rng.uniform(-SPEED, SPEED, (c, wheels)))

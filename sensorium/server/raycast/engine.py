@@ -36,11 +36,13 @@ Speed (measured in ``sensorium bench``, peers section)
 
 Architecture
 ------------
-* Static tier: the shapes of all static bodies (never moved) that a ray kind sees, in ONE Embree
-  scene.  Its vertices are stored relative to the bounding-box centre (the *anchor*, subtracted
+* Static tier: the shapes of all static bodies (added static, at the pose they were added at)
+  that a ray kind sees, in ONE Embree scene.  Its vertices are stored relative to the bounding-box centre (the *anchor*, subtracted
   in float64 before the float32 conversion; skipped when the geometry already surrounds the
   origin) so worlds far from the origin keep float32 precision.
-* Mover tiers: a mover (``movable=True`` body, or a static body once moved) is cast against a
+* Mover tiers: a mover (``movable=True`` body, or a static body while away from the pose it was
+  added at; put back there, it is in the static tier again: a reset reads as the loaded world, bit
+  for bit under FAST too, whose float32 answers differ by an ulp between the frames) is cast against a
   scene of its shapes in its BODY frame, built once and shared by every mover with the same shapes
   (same primitives and local poses: a hundred identical robots cost one build).  Moving a body
   never rebuilds anything.  Per cast, a broad phase finds the (ray, mover) pairs whose segment
@@ -126,6 +128,7 @@ Known limits (measure-zero in practice)
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 import threading
 from collections.abc import Sequence
@@ -197,6 +200,8 @@ def _items_key(items) -> tuple:
     return tuple((i, prim, pose.rotation.tobytes(), pose.translation.tobytes()) for i, prim, pose in items)
 
 
+# static tiers kept by their items (_drop_static's keep_built): two static sets' worth of the variants'
+_STATIC_KEPT = 8
 _BOUND_ROWS = 32768   # rows of a large cast_local's bound test at a time (its temporaries stay in the cache)
 
 
@@ -249,7 +254,8 @@ class RayEngine(TierTracer):
             self._entries.append(e)
             self._shape_body.append(body)
         self._owner_of = np.append(self._owner_of, np.full(len(shapes), int(owner), dtype=np.int64))
-        self._bodies.append(_Body(list(range(first, len(self._entries))), pose, int(owner), bool(movable), body))
+        self._bodies.append(_Body(list(range(first, len(self._entries))), pose, int(owner), bool(movable), body,
+                                  baked=None if movable else pose))
         self._rot = np.concatenate([self._rot, pose.rotation[None]])
         self._pos = np.concatenate([self._pos, pose.translation[None]])
         self._epoch += 1               # a body added while casting (a Supervisor's import): caches rebuild
@@ -269,10 +275,21 @@ class RayEngine(TierTracer):
         self._epoch += 1
         self._rot[body] = pose.rotation
         self._pos[body] = pose.translation
-        if not b.mover:  # first move of a static body: it leaves the static tier for good
-            b.mover = True
-            self._movers.append(b)
-            self._drop_static()
+        if b.baked is None:   # added movable: a mover for good
+            return
+        # A body added static is cast in the world-frame static tier while it is at the pose it was
+        # added at, bit for bit, and as a mover (rays taken into its frame) while it is elsewhere: a
+        # body put back (a reset, loadState) reads as at load, also under FAST precision, whose
+        # float32 answers differ by an ulp between the two frames.
+        home = pose is b.baked or (pose.translation.tobytes() == b.baked.translation.tobytes()
+                                   and pose.rotation.tobytes() == b.baked.rotation.tobytes())
+        if home == b.mover:
+            b.mover = not home
+            if home:
+                self._movers.remove(b)
+            else:   # in body order: the movers' table a function of which bodies are away, not of history
+                bisect.insort(self._movers, b, key=lambda m: m.index)
+            self._drop_static(keep_built=True)
             self._mover_tables.clear()
 
     def remove_body(self, body: int) -> None:
@@ -403,15 +420,21 @@ class RayEngine(TierTracer):
             else:
                 items = [i for b in statics for i in self._items(b, variant, True)]
                 key = _items_key(items)
-                if key not in self._static_items:
-                    self._static_items[key] = self._build(items, self._owner_of)
-                self._static[variant] = self._static_items[key]
+                tier = self._static_items.pop(key) if key in self._static_items else self._build(items, self._owner_of)
+                self._static_items[key] = tier      # the most recently used last
+                while len(self._static_items) > _STATIC_KEPT:
+                    del self._static_items[next(iter(self._static_items))]
+                self._static[variant] = tier
         return self._static[variant]
 
-    def _drop_static(self) -> None:
-        """Forget the static tiers (a body added, moved for the first time or removed): rebuilt on use."""
+    def _drop_static(self, keep_built: bool = False) -> None:
+        """Forget the static tiers (a body added, removed, seen otherwise, or leaving or joining the
+        static bodies): rebuilt on use. ``keep_built`` (the same shapes, a body away or back): the tiers
+        already built stay at hand by their items, the last few of them, so a solid moved away and put
+        back again and again builds nothing after its first round trip."""
         self._static.clear()
-        self._static_items.clear()
+        if not keep_built:
+            self._static_items.clear()
 
     def _mover_tier(self, body: _Body, variant: str) -> _Tier | None:
         """The body-frame tier of a mover, shared by all bodies with the same shapes (primitive and

@@ -311,6 +311,7 @@ class _Body:
     index: int
     tiers: dict = field(default_factory=dict)  # variant -> shared body-frame _Tier (movers only)
     removed: bool = False      # taken out of every query (RayEngine.remove_body)
+    baked: Pose | None = None  # a body added static: the pose its shapes are baked in the static tier at
 
     @property
     def first(self) -> int:

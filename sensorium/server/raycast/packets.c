@@ -1431,38 +1431,95 @@ static inline double np_remainder(double a, double b) {
  * remainder((yaw + dyaw) + pi, 2 pi) - pi) and then the new yaw's cos and sin (the pose's Rz), the
  * libm calls math.cos/math.sin make. Returns the number of infinite angles handed to cos or sin
  * (math.cos refuses them: the caller's Python way says so); the outputs are then not to be used. */
-size_t sp_arc_steps(size_t n, const double* x, const double* y, const double* yaw, const double* v, const double* w,
-                    double dt, double* out_x, double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
+/* one robot's arc of sp_arc_steps (its new x, y and yaw); returns its infinite angles' count */
+static inline size_t arc_one(double x, double y, double yaw, double v, double w, double dt, double* out_x,
+                             double* out_y, double* out_yaw) {
   const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
   size_t inf = 0;
-  for (size_t i = 0; i < n; i++) {
-    const double dyaw = w[i] * dt;
-    if (fabs(dyaw) < 1e-9) {
-      const double mid = yaw[i] + 0.5 * dyaw;
-      const double cm = cos(mid);
-      const double sm = sin(mid);
-      inf += isinf(mid) != 0;
-      out_x[i] = x[i] + v[i] * dt * cm;
-      out_y[i] = y[i] + v[i] * dt * sm;
-    } else {
-      const double r = v[i] / w[i];
-      const double a1 = yaw[i] + dyaw;
-      const double c1 = cos(a1);
-      const double s1 = sin(a1);
-      const double c0 = cos(yaw[i]);
-      const double s0 = sin(yaw[i]);
-      inf += (isinf(a1) != 0) + (isinf(yaw[i]) != 0);
-      out_x[i] = x[i] + r * (s1 - s0);
-      out_y[i] = y[i] - r * (c1 - c0);
-    }
-    out_yaw[i] = np_remainder(yaw[i] + dyaw + pi, two_pi) - pi;
+  const double dyaw = w * dt;
+  if (fabs(dyaw) < 1e-9) {
+    const double mid = yaw + 0.5 * dyaw;
+    const double cm = cos(mid);
+    const double sm = sin(mid);
+    inf += isinf(mid) != 0;
+    *out_x = x + v * dt * cm;
+    *out_y = y + v * dt * sm;
+  } else {
+    const double r = v / w;
+    const double a1 = yaw + dyaw;
+    const double c1 = cos(a1);
+    const double s1 = sin(a1);
+    const double c0 = cos(yaw);
+    const double s0 = sin(yaw);
+    inf += (isinf(a1) != 0) + (isinf(yaw) != 0);
+    *out_x = x + r * (s1 - s0);
+    *out_y = y - r * (c1 - c0);
   }
+  *out_yaw = np_remainder(yaw + dyaw + pi, two_pi) - pi;
+  return inf;
+}
+
+/* one robot's step at the constant body twist (vx, vy, w) (batched_holonomic.py's twist_steps,
+ * motion.twist_step: a = dt, b = 0 when w is 0, else a = sin(w dt) / w, b = 2 sin(0.5 w dt)^2 / w;
+ * dx = a vx - b vy, dy = b vx + a vy turned by the starting heading; the new yaw wrapped as the
+ * arcs'), element by element the numpy path's float64 operations; returns its infinite angles' count */
+static inline size_t twist_one(double x, double y, double yaw, double vx, double vy, double w, double dt,
+                               double* out_x, double* out_y, double* out_yaw) {
+  const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
+  size_t inf = 0;
+  double a = dt, b = 0.0;
+  if (w != 0.0) {
+    const double h = 0.5 * w * dt, full = w * dt;
+    const double half = sin(h);
+    a = sin(full) / w;
+    b = 2.0 * half * half / w;
+    inf += (isinf(h) != 0) + (isinf(full) != 0);
+  }
+  const double dx = a * vx - b * vy, dy = b * vx + a * vy;
+  const double c = cos(yaw);
+  const double s = sin(yaw);
+  inf += isinf(yaw) != 0;
+  *out_x = x + c * dx - s * dy;
+  *out_y = y + s * dx + c * dy;
+  *out_yaw = np_remainder(yaw + w * dt + pi, two_pi) - pi;
+  return inf;
+}
+
+/* the new yaws' cos and sin, in two loops (see sp_cos_sin); the infinite yaws' count */
+static size_t new_yaws_cos_sin(size_t n, const double* out_yaw, double* out_cos, double* out_sin) {
+  size_t inf = 0;
   for (size_t i = 0; i < n; i++) {
     out_cos[i] = cos(out_yaw[i]);
     inf += isinf(out_yaw[i]) != 0;
   }
   for (size_t i = 0; i < n; i++) out_sin[i] = sin(out_yaw[i]);
   return inf;
+}
+
+size_t sp_arc_steps(size_t n, const double* x, const double* y, const double* yaw, const double* v, const double* w,
+                    double dt, double* out_x, double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
+  size_t inf = 0;
+  for (size_t i = 0; i < n; i++) inf += arc_one(x[i], y[i], yaw[i], v[i], w[i], dt, out_x + i, out_y + i, out_yaw + i);
+  return inf + new_yaws_cos_sin(n, out_yaw, out_cos, out_sin);
+}
+
+/* sp_drive_step's moves: move i of slot slot[i] by its arc about its origin, or, when the slot's
+ * wheels' centre (centre[2 slot], centre[2 slot + 1]) is off its origin (centre not NULL), by the
+ * origin's body twist (v + w cy, -w cx, w) (batched.py's _drive_numpy: DifferentialDrive.step's
+ * twist); then the new yaws' cos and sin. Returns the infinite angles' count. */
+static size_t drive_moves(size_t n, const int64_t* slot, const double* centre, const double* x, const double* y,
+                          const double* yaw, const double* v, const double* w, double dt, double* out_x,
+                          double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
+  size_t inf = 0;
+  for (size_t i = 0; i < n; i++) {
+    const double* cc = centre ? centre + 2 * (size_t)slot[i] : NULL;
+    if (cc && (cc[0] != 0.0 || cc[1] != 0.0))
+      inf += twist_one(x[i], y[i], yaw[i], v[i] + w[i] * cc[1], -w[i] * cc[0], w[i], dt, out_x + i, out_y + i,
+                       out_yaw + i);
+    else
+      inf += arc_one(x[i], y[i], yaw[i], v[i], w[i], dt, out_x + i, out_y + i, out_yaw + i);
+  }
+  return inf + new_yaws_cos_sin(n, out_yaw, out_cos, out_sin);
 }
 
 size_t sp_cos_sin(size_t n, const double* a, double* out_cos, double* out_sin) {
@@ -1520,10 +1577,19 @@ size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, in
   return hits;
 }
 
+/* drive_moves for the numpy drive pass of a world with other drives too (packets.drive_moves):
+ * the two-wheel robots' moves in C, the cars' and holonomic robots' beside them in numpy. */
+size_t sp_drive_moves(size_t n, const int64_t* slot, const double* centre, const double* x, const double* y,
+                      const double* yaw, const double* v, const double* w, double dt, double* out_x, double* out_y,
+                      double* out_yaw, double* out_cos, double* out_sin) {
+  return drive_moves(n, slot, centre, x, y, yaw, v, w, dt, out_x, out_y, out_yaw, out_cos, out_sin);
+}
+
 /* batched.py's _drive up to the contact narrow phase, in one pass over the state arrays (their
  * addresses in a[], see DriveStep in packets.py): the live copies' robots stop pressing; their
  * wheels and drives (sp_drive_wheels); the moving robots' arcs (sp_arc_steps, from x, y, yaw
- * gathered) and their new yaws written; with contact, each move's reach hypot(end - start) + eps
+ * gathered), or their origin's twist for a robot whose wheels' centre is off its origin (a[42]:
+ * the slots' centres (R, 2), NULL when none is: drive_moves), and their new yaws written; with contact, each move's reach hypot(end - start) + eps
  * + spin[slot] * fmin(|yaw1 - yaw0|, 2) (a shaped robot's push off what its turn goes into)
  * (np.hypot is libm's hypot), the grown discs (grow: 0, then the movers' reach) and the broad phase
  * (sp_contact_near). When no move is near anything, the moves end where Contact._clip without
@@ -1572,7 +1638,7 @@ size_t sp_drive_step(size_t L, const int64_t* live, size_t D, const int64_t* dri
     y0[m] = y[at];
     yaw0[m] = yaw[at];
   }
-  status[0] = (int64_t)sp_arc_steps(k, x0, y0, yaw0, v, w, dt, x1, y1, yaw1, cs, sn);
+  status[0] = (int64_t)drive_moves(k, ms, a[42], x0, y0, yaw0, v, w, dt, x1, y1, yaw1, cs, sn);
   if (status[0]) return k;
   for (size_t m = 0; m < k; m++) {
     const size_t at = (size_t)mc[m] * R + (size_t)ms[m];

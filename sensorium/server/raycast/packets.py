@@ -191,6 +191,8 @@ def _load() -> None:
                               vp, vp]
     lib.sp_arc_steps.restype = sz
     lib.sp_arc_steps.argtypes = [sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp]
+    lib.sp_drive_moves.restype = sz
+    lib.sp_drive_moves.argtypes = [sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp]
     lib.sp_cos_sin.restype = sz
     lib.sp_cos_sin.argtypes = [sz, vp, vp, vp]
     lib.sp_box3.restype = None
@@ -741,6 +743,33 @@ def arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: n
     return outs[0], outs[1], outs[2], outs[3], outs[4]
 
 
+def drive_moves(slots: np.ndarray, centre: np.ndarray | None, x: np.ndarray, y: np.ndarray, yaw: np.ndarray,
+                v: np.ndarray, w: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """Two-wheel robots' moves in one C pass (``sp_drive_moves``, :class:`DriveStep`'s): move i of
+    robot slot ``slots[i]`` by its arc about its origin (:func:`.batched._arc_steps`), or, when
+    ``centre[slot]`` (``centre``: (R, 2) float64, or None for none) is off its origin, by the
+    origin's body twist (v + w cy, -w cx, w) (:func:`.batched_holonomic.twist_steps`): the new
+    (x, y, yaw), the numpy path's bits; None without the helper or when an angle is infinite
+    (math.cos refuses it: the caller's numpy way says so)."""
+    lib = library()
+    if lib is None:
+        return None
+    n = len(x)
+    ins = [np.ascontiguousarray(a, dtype=np.float64) for a in (x, y, yaw, v, w)]
+    if any(a.shape != (n,) for a in ins) or len(slots) != n:
+        raise TypeError("drive_moves: inconsistent shapes")
+    slots = np.ascontiguousarray(slots, dtype=np.int64)
+    if centre is not None:
+        _check_buffer("drive_moves", centre, np.float64, centre.shape[:1] + (2,))
+        if n and (slots.min() < 0 or slots.max() >= len(centre)):
+            raise IndexError("drive_moves: a slot beyond the centres")
+    outs = [np.empty(n) for _ in range(5)]
+    p = _small_addresses([slots, *ins, *outs])
+    if lib.sp_drive_moves(n, p[0], _ptr(centre), *p[1:6], float(dt), *p[6:]):
+        return None
+    return outs[0], outs[1], outs[2]
+
+
 def box3(O: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     """(each column's minimum, maximum) of the rows of a C-contiguous float64 (n, 3) array, n >= 1,
     in one C pass (``sp_box3``: numpy's min and max, NaN propagated); None without the helper or
@@ -898,8 +927,9 @@ def lidar_beams(rot: np.ndarray, org: np.ndarray, columns, out=None) -> tuple[np
 
 class DriveStep:
     """:meth:`.batched.BatchedSimulation._drive` up to the contact narrow phase in one C pass
-    (``sp_drive_step``) and its last writes in another (``sp_pose_scatter``), over the simulation's
-    state arrays, whose addresses are taken once (the simulation writes them in place, never
+    (``sp_drive_step``: arcs about the robots' origins, the origin's twist for a robot whose
+    wheels' centre is off it, the state's optional ``centre`` (R, 2)) and its last writes in another
+    (``sp_pose_scatter``), over the simulation's state arrays, whose addresses are taken once (the simulation writes them in place, never
     rebinds them; the contact's solid arrays are re-read when a Supervisor rebuilds them). After
     :meth:`run` returned k moves, their copies, slots, starts and ends, the broad phase (when
     ``status[1]``: some move is near something) and the Rz and base of each lie in the first k
@@ -945,10 +975,14 @@ class DriveStep:
             _check_buffer("drive_step", contact["centres"], np.float64, (C, R, 2), writes=True)
             arrays += [contact[k] for k in ("foot_radius", "foot_low", "foot_high", "heights", "centres")]
             _check_buffer("drive_step", contact["spin"], np.float64, (R,))
-        # a[34..40]: the solids' arrays and the broad phase's outputs (run); a[41]: the spin reach
+        # a[34..40]: the solids' arrays and the broad phase's outputs (run); a[41]: the spin reach;
+        # a[42]: the wheels' centres of the slots (R, 2) when some robot's is off its origin, else NULL
         spin = contact["spin"] if contact is not None else self.reach
-        self.ptrs = (ctypes.c_void_p * 42)(*(a.ctypes.data for a in arrays), *([0] * (41 - len(arrays))),
-                                           spin.ctypes.data)
+        centre = state.get("centre")
+        if centre is not None:
+            _check_buffer("drive_step", centre, np.float64, (R, 2))
+        self.ptrs = (ctypes.c_void_p * 43)(*(a.ctypes.data for a in arrays), *([0] * (41 - len(arrays))),
+                                           spin.ctypes.data, None if centre is None else centre.ctypes.data)
         self._solids: tuple = ()
         self.p_status = self.status.ctypes.data
         self.p_scatter = [a.ctypes.data for a in (self.copies, self.slots, self.rot, state["x"], state["y"],

@@ -39,7 +39,9 @@ a speed per wheel), both on :mod:`~sensorium.server.sim.batched_holonomic`'s whe
 through the single drive's exact twist step (:func:`~sensorium.server.sim.batched_holonomic.twist_steps`),
 then the same contact and placing. A two-wheel or skid-steer robot whose wheels' centre is off its
 origin (``differential_drive.axle_center``) moves by the same twist step (its origin's body twist,
-as DifferentialDrive.step), the others by their arcs.
+as DifferentialDrive.step), the others by their arcs, both in the C drive pass (packets.c, the numpy
+path's operations); in a world with car-like, mecanum or omni-wheel robots those take the numpy
+drive and the two-wheel robots' wheels and moves are C passes within it.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
@@ -333,9 +335,10 @@ class BatchedSimulation:
         self.mecanum = (MecanumDrives(self._templates, C) if any(r.mecanum_drive for r in w.robots) else None)
         # omni-wheel robots: their wheels and body twist (batched_omni.py), None in a world without one
         self.omni = OmniDrives(self._templates, C) if any(r.omni_drive for r in w.robots) else None
-        # the drives the C drive pass does not step (it moves two-wheel robots about their origin by arcs)
+        # the drives the C drive pass does not step (it moves two-wheel robots by arcs about their
+        # origin, or by their origin's twist when their wheels' centre is off it)
         self._numpy_drives = (self.cars is not None or self.mecanum is not None or self.omni is not None
-                              or self._any_off_centre or self.to_enu is not None)
+                              or self.to_enu is not None)
         # -- per copy state
         self.time_ms = np.zeros(C, dtype=np.int64)
         self._every_copy = np.arange(C)             # (step's live copies when every copy steps; never written)
@@ -807,9 +810,9 @@ class BatchedSimulation:
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:
         driven = self._driven
         if self._numpy_drives:
-            # car-like, mecanum and omni-wheel robots (batched_car.py, batched_holonomic.py) and two-wheel
-            # robots off their origin: their moves join the numpy path's; a NUE world's poses are turned
-            # into its axes there (the C pass writes ENU poses)
+            # car-like, mecanum and omni-wheel robots (batched_car.py, batched_holonomic.py): their moves
+            # join the numpy path's; a NUE world's poses are turned into its axes there (the C pass
+            # writes ENU poses)
             self._drive_numpy(live, driven, dt_ms / 1000.0)
             return
         if not len(driven):
@@ -852,7 +855,7 @@ class BatchedSimulation:
                 {"target": self.target, "velocity": self.velocity, "angle": self.wheel_angle,
                  "sides": self.side_wheels, "radius": self.wheel_radius, "axle": self.axle, "x": self.x, "y": self.y,
                  "yaw": self.yaw, "z": self.z, "pressing": self.pressing, "base": self.base, "rot": self.rot,
-                 "pos": self.pos}, contact)
+                 "pos": self.pos, "centre": self.axle_center if self._any_off_centre else None}, contact)
         return got
 
     def _place(self, copies: np.ndarray, slots: np.ndarray, rz: np.ndarray, base: np.ndarray, cos: np.ndarray,
@@ -871,45 +874,35 @@ class BatchedSimulation:
         return rot
 
     def _drive_numpy(self, live: np.ndarray, driven: np.ndarray, dt: float) -> None:
-        """:meth:`_drive` without the C helper (the same values)."""
+        """:meth:`_drive` without the C drive pass (the same values): a world with car-like, mecanum or
+        omni-wheel robots (their moves in numpy; the two-wheel robots' wheels and moves still in C
+        passes where the helper is built), a NUE world, or no helper at all."""
         self.pressing[live] = False
-        # the moves by body twists (copies, slots, vx, vy, ωz): mecanum and omni-wheel robots', two-wheel
-        # robots' off their origin; they join the arcs' arrays after them
-        twists = [d.step(live, dt) for d in (self.mecanum, self.omni) if d is not None]
+        # each kind of drive's moves: (copies, slots, x0, y0, yaw0, x, y, yaw)
+        moves = []
         if len(driven):
-            copies, slots, v, w = self._drive_wheels(live, driven, dt)
-            if self._any_off_centre:
-                off = self.off_centre[slots]
-                if off.any():     # DifferentialDrive.step: the origin's twist, the wheels' centre moving at v
-                    on = ~off
-                    oc, os_, ov, ow = copies[off], slots[off], v[off], w[off]
-                    cx, cy = self.axle_center[os_, 0], self.axle_center[os_, 1]
-                    twists.append((oc, os_, ov + ow * cy, -ow * cx, ow))
-                    copies, slots, v, w = copies[on], slots[on], v[on], w[on]
-        else:         # no two-wheel or skid-steer robot (cars, mecanum or omni-wheel robots): nothing to gather
-            copies = slots = _NONE
-            v = w = _EMPTY
-        if self.cars is not None:     # the cars' moves too, sorted into slot order below where it matters (_narrow)
-            cars = self.cars.step(live, dt)
-            copies, slots, v, w = (np.concatenate(pair) for pair in zip((copies, slots, v, w), cars))
-        twists = [t for t in twists if len(t[0])]
-        if not len(copies) and not twists:
+            wheels = packets.drive_wheels(live, driven, self.target, self.velocity, self.wheel_angle, dt,
+                                          self.side_wheels, self.wheel_radius, self.axle)
+            copies, slots, v, w = wheels if wheels is not None else self._drive_wheels(live, driven, dt)
+            if len(copies):
+                moves.append(self._two_wheel_moves(copies, slots, v, w, dt))
+        if self.cars is not None:
+            copies, slots, v, w = self.cars.step(live, dt)
+            if len(copies):
+                x0, y0, yaw0 = self.x[copies, slots], self.y[copies, slots], self.yaw[copies, slots]
+                x, y, yaw = (_offset_arc_steps(x0, y0, yaw0, v, w, dt, self.cars.rear_axle[slots])
+                             if self.cars.offset else _arc_steps(x0, y0, yaw0, v, w, dt))   # offset: origin off the rear axle
+                moves.append((copies, slots, x0, y0, yaw0, x, y, yaw))
+        # the mecanum and omni-wheel robots' body twists, in one twist_steps call
+        twists = [t for t in (d.step(live, dt) for d in (self.mecanum, self.omni) if d is not None) if len(t[0])]
+        if twists:
+            copies, slots, vx, vy, w = (np.concatenate(col) if len(twists) > 1 else col[0] for col in zip(*twists))
+            x0, y0, yaw0 = self.x[copies, slots], self.y[copies, slots], self.yaw[copies, slots]
+            moves.append((copies, slots, x0, y0, yaw0, *twist_steps(x0, y0, yaw0, vx, vy, w, dt)))
+        if not moves:
             return
-        x0, y0 = self.x[copies, slots], self.y[copies, slots]
-        yaw0 = self.yaw[copies, slots]
-        if not len(copies):
-            x, y, yaw = x0, y0, yaw0
-        elif self.cars is not None and self.cars.offset:    # a car's origin off its rear axle
-            x, y, yaw = _offset_arc_steps(x0, y0, yaw0, v, w, dt, self.cars.rear_axle[slots])
-        else:
-            x, y, yaw = _arc_steps(x0, y0, yaw0, v, w, dt)
-        if twists:        # every twist move in one twist_steps call
-            tc, ts, vx, vy, tw = (np.concatenate(col) if len(twists) > 1 else col[0] for col in zip(*twists))
-            tx0, ty0, tyaw0 = self.x[tc, ts], self.y[tc, ts], self.yaw[tc, ts]
-            tx, ty, tyaw = twist_steps(tx0, ty0, tyaw0, vx, vy, tw, dt)
-            copies, slots = np.concatenate([copies, tc]), np.concatenate([slots, ts])
-            x0, y0, yaw0 = np.concatenate([x0, tx0]), np.concatenate([y0, ty0]), np.concatenate([yaw0, tyaw0])
-            x, y, yaw = np.concatenate([x, tx]), np.concatenate([y, ty]), np.concatenate([yaw, tyaw])
+        copies, slots, x0, y0, yaw0, x, y, yaw = (np.concatenate(col) if len(moves) > 1 else col[0]
+                                                  for col in zip(*moves))
         cos, sin = kin.libm_cos_sin(yaw)
         self.yaw[copies, slots] = yaw
         if self.contact is not None:
@@ -928,6 +921,25 @@ class BatchedSimulation:
             pos = np.matmul(back, pos[:, :, None])[:, :, 0]
         self.rot[copies, slots] = rot
         self.pos[copies, slots] = pos
+
+    def _two_wheel_moves(self, copies: np.ndarray, slots: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):
+        """The moving two-wheel robots' (copies, slots, x0, y0, yaw0, x, y, yaw): an arc about the origin,
+        or for a robot whose wheels' centre is off its origin the origin's body twist (v + ω cy, −ω cx, ω),
+        DifferentialDrive.step's; in one C pass (packets.drive_moves) where the helper is built."""
+        x0, y0, yaw0 = self.x[copies, slots], self.y[copies, slots], self.yaw[copies, slots]
+        centre = self.axle_center if self._any_off_centre else None
+        moved = packets.drive_moves(slots, centre, x0, y0, yaw0, v, w, dt)
+        if moved is not None:
+            return (copies, slots, x0, y0, yaw0, *moved)
+        off = self.off_centre[slots]
+        if not off.any():
+            return (copies, slots, x0, y0, yaw0, *_arc_steps(x0, y0, yaw0, v, w, dt))
+        x, y, yaw = np.empty_like(x0), np.empty_like(y0), np.empty_like(yaw0)
+        on = ~off
+        x[on], y[on], yaw[on] = _arc_steps(x0[on], y0[on], yaw0[on], v[on], w[on], dt)
+        cx, cy, wo = self.axle_center[slots[off], 0], self.axle_center[slots[off], 1], w[off]
+        x[off], y[off], yaw[off] = twist_steps(x0[off], y0[off], yaw0[off], v[off] + wo * cy, -wo * cx, wo, dt)
+        return copies, slots, x0, y0, yaw0, x, y, yaw
 
     def _ride(self, copies: np.ndarray, slots: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
         """PlanarState.settle for the moved robots placed over ground: height and slope under them."""
@@ -1718,8 +1730,6 @@ class _Stream:
 
 _NONE = np.zeros(0, dtype=np.int64)
 _NONE.setflags(write=False)
-_EMPTY = np.zeros(0)
-_EMPTY.setflags(write=False)
 
 
 def _by_table(devices: list) -> list[tuple]:

@@ -412,16 +412,20 @@ class Parser:
                 self.expect("name", "a field name after 'hidden'")
                 self.value(depth + 1)
                 continue
-            node.field_pos[ftok.text] = ftok.lines.at(ftok.pos)
             nxt = self.peek()
             if nxt.kind == "name" and nxt.text == "IS":
                 self.take()
                 ref = self.expect("name", "a PROTO field name after IS")
                 if not self.proto_body:
                     raise self.error(nxt, "IS is only allowed inside a PROTO body")
+                node.field_pos[ftok.text] = ftok.lines.at(ftok.pos)
                 node.fields[ftok.text] = IsRef(ref.text, *ref.lines.at(ref.pos))
                 continue
-            node.fields[ftok.text] = self.value(depth + 1)
+            value = self.value(depth + 1)
+            if isinstance(node.fields.get(ftok.text), IsRef):
+                continue     # given again after its IS: Webots keeps the field bound to the parameter
+            node.field_pos[ftok.text] = ftok.lines.at(ftok.pos)
+            node.fields[ftok.text] = value
         if def_name is not None:
             self.defs[def_name] = node
             self.def_weight[def_name] = (self.nodes - nodes0, self.values - values0)
