@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import WorldError, load_world
 
 WALL_X = 1.0          # the wall's face is at x = 0.95 (a 0.1 m thick box centred on x = 1)
@@ -132,3 +133,25 @@ def test_a_legged_robot_gets_one_line_for_its_joints_whatever_its_feet(tmp_path,
     assert f"robot 'hexapod': its 18 motorised joints are no wheels {why}: they move kinematically" in said[0]
     assert said[0].endswith("and 14 more)")
     assert not loaded.world.robots[0].differential_drive
+
+
+def test_a_legged_robot_with_physics_is_told_its_body_stays(tmp_path: Path) -> None:
+    """Webots' Spot lies down, sits and stands by its physics; here its joints move its legs and its
+    body stays where it is: one line says so for a robot with physics, many joints and no drive."""
+    feet = "Shape { geometry Box { size 0.03 0.03 0.3 } }"
+    p = legged(tmp_path, feet)
+    p.write_text(p.read_text().replace('Robot { name "hexapod"', 'Robot { name "hexapod" physics Physics { }'))
+    loaded = load_world(p)
+    said = [w for w in loaded.warnings if "never its body" in w]
+    assert said == [f"{p}:3:1: robot 'hexapod': its joints move its parts, never its body: without physics nothing "
+                    "here stands it on its limbs, walks, sits or drops it (its body stays where the world file or a "
+                    "Supervisor puts it)"]
+    sim = Simulation(loaded)
+    knees = [sim.robot("hexapod").motor(f"leg{k} knee") for k in range(6)]
+    for knee in knees:
+        knee.set_position(0.8)
+    sim.run(40)
+    assert [knee.position for knee in knees] == [0.8] * 6          # the legs moved ...
+    assert list(sim.robot("hexapod").pose.translation) == [0.0, 0.0, 0.5]   # ... the body did not
+    # without physics (Webots' kinematic robot), or with fewer joints, nothing more to say
+    assert not [w for w in load_world(legged(tmp_path, feet)).warnings if "never its body" in w]

@@ -1959,6 +1959,7 @@ class Converter:
             self._drive(node, robot, nowheel)
         finally:
             self._say_no_wheels(node, robot, nowheel)
+            self._say_body_stays(node, robot, nowheel)
             from sensorium.server.world.wbt.drive import free_car_wheels
 
             car = robot.data.get("ackermann_drive")
@@ -2004,6 +2005,18 @@ class Converter:
                         f"they move kinematically (Webots' rule without physics; their PositionSensors read them), "
                         f"and the shapes and devices past each joint with it ({shown} and "
                         f"{len(names) - MANY_JOINTS} more)")
+
+    def _say_body_stays(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
+        """A robot with physics, no drive and many motorised joints (a legged robot, a humanoid: Webots'
+        Spot, Nao): Webots' physics stands, walks or drops it by its limbs; here its joints move only
+        its parts. One line, so a controller's walk going nowhere is not a surprise."""
+        drives = ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive")
+        if (len(nowheel) <= MANY_JOINTS or any(k in robot.data for k in drives)
+                or self.fields(node).node_("physics") is None):
+            return
+        self.warn(node, f"robot {robot.data['name']!r}: its joints move its parts, never its body: without "
+                        "physics nothing here stands it on its limbs, walks, sits or drops it (its body stays "
+                        "where the world file or a Supervisor puts it)")
 
     def _drive(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         from sensorium.server.world.wbt.drive import (
