@@ -84,6 +84,25 @@ def test_skid_steer_straight_line_and_turn_radius_closed_form(tmp_path: Path) ->
     assert enc.value == pytest.approx(2.0 * 2.0 + 3.0 * (8.0 + 0.016), abs=1e-9)   # its own wheel's angle
 
 
+def test_right_wheels_turned_by_a_rounded_pi_still_make_the_skid_steer_drive(tmp_path: Path) -> None:
+    """Webots' Clearpath Moose: each right wheel's joint, axis 0 -1 0, sits in a Pose turned by 3.14159
+    about z (not pi), so it turns about (2.65e-6, 1, 0) in the robot's frame; within AXIS_TOL of +y
+    (as a car's axes are taken), the wheels make the drive, where before the robot did not move."""
+    def turned(name: str, x: float) -> str:     # our own right wheel, written the Moose's way
+        return (f'Pose {{ translation {x} {-Y} 0 rotation 0 0 1 3.14159 children [ '
+                + wheel(name, 0, 0, axis="0 -1 0") + '] }\n')
+    body = ('Robot { name "p3at" children [\n' + wheel("front left wheel", X, Y) + wheel("back left wheel", -X, Y)
+            + turned("front right wheel", X) + turned("back right wheel", -X) + '] }\n')
+    w = load_world(write(tmp_path, body))
+    (robot,) = w.world.robots
+    assert robot.differential_drive is not None and robot.differential_drive.axle_length == pytest.approx(2 * Y)
+    assert not [m for m in w.warnings if "not move" in m]
+    sim = Simulation(w, "fast")
+    drive(sim, "p3at", 2.0, 2.0)
+    sim.run(125)                                  # 2 s at 2 rad/s on 0.11 m wheels: 0.44 m straight ahead
+    assert sim.robot("p3at").pose.translation == pytest.approx([0.44, 0.0, 0.0], abs=1e-12)
+
+
 def test_skid_steer_side_speed_is_the_mean_of_its_wheels(tmp_path: Path) -> None:
     """Wheels of one side commanded differently (Webots' physics would skid): the side rolls at their mean."""
     sim = Simulation(load_world(write(tmp_path, pioneer())), "fast")

@@ -59,7 +59,7 @@ import numpy as np
 from sensorium.server.world.wbt.parser import Node
 
 TOL = 1e-6
-AXIS_TOL = 1e-4     # a car's joint axes: Webots' car PROTOs turn their joints' frames by 1.5708 (not pi/2)
+AXIS_TOL = 1e-4     # wheels' axes: Webots' PROTOs turn their joints' frames by 1.5708 or 3.14159 (not pi/2, pi)
 
 
 def wheel_radius(end: Node | None, conv) -> float | None:
@@ -182,11 +182,12 @@ def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
     steer), or (None, the sentence saying why not)."""
     if len(wheels) < 2:
         return None, f"{len(wheels)} motorised hinge joint; a drive needs two wheels or more, on both sides"
-    frame, why = drive_frame(wheels)
+    # (axes within AXIS_TOL, as a car's: Webots' Moose turns its right wheels' frames by 3.14159, not pi)
+    frame, why = drive_frame(wheels, AXIS_TOL)
     if why:
         return None, why
     wheels = _in_frame(wheels, frame)
-    off = _axis_off_y(wheels, TOL, "the kinematic drive needs every axis along +y so that positive speeds drive forward")
+    off = _axis_off_y(wheels, AXIS_TOL, "the kinematic drive needs every axis along +y so that positive speeds drive forward")
     if off:
         return None, off
     drive, why = _two_wheels(wheels, conv) if len(wheels) == 2 else _skid_steer(wheels, conv)
@@ -495,7 +496,7 @@ def mecanum_turns(wheels: list[dict], conv) -> list[float | None] | None:
 def mecanum_drive(wheels: list[dict], turns: list[float | None], conv) -> tuple[dict | None, str]:
     """The kinematic mecanum drive of four wheels whose friction is turned (:func:`mecanum_turns`),
     or (None, the sentence why not); judged in the drive's frame (x forward = the axis × z)."""
-    frame, why = drive_frame(wheels)
+    frame, why = drive_frame(wheels, AXIS_TOL)
     if why:
         return None, why
     drive, why = _mecanum(_in_frame(wheels, frame), turns, conv)
@@ -503,7 +504,7 @@ def mecanum_drive(wheels: list[dict], turns: list[float | None], conv) -> tuple[
 
 
 def _mecanum(wheels: list[dict], turns: list[float | None], conv) -> tuple[dict | None, str]:
-    off = _axis_off_y(wheels, TOL, "the mecanum drive needs every axis along +y so that positive speeds drive forward")
+    off = _axis_off_y(wheels, AXIS_TOL, "the mecanum drive needs every axis along +y so that positive speeds drive forward")
     if off:
         return None, off
     if len(wheels) != 4:
