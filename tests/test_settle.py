@@ -130,6 +130,10 @@ def test_over_nothing_without_wheel_bottom_or_not_upright_it_keeps_its_pose() ->
     tilted = _robot()
     tilted["pose"]["rotation"] = [1, 0, 0, 0.3]                          # rolled 0.3 rad: not settled
     assert _t(_sim([FLOOR], [tilted]))[2] == 0.075
+    tilted["pose"]["rotation"] = [1, 0, 0, 2e-3]                         # 2 mrad: past the tolerance
+    assert _t(_sim([FLOOR], [tilted]))[2] == 0.075
+    tilted["pose"]["rotation"] = [1, 0, 0, 5e-4]     # a tilt physics left in a saved world: settled
+    assert _t(_sim([FLOOR], [tilted]))[2] == R
     still = {"name": "arm", "pose": {"translation": [0.0, 0.0, 0.4]}}     # no drive: never moved
     assert _sim([FLOOR], [still]).scene.robot_poses[0].translation[2] == 0.4
 
