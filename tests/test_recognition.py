@@ -364,7 +364,7 @@ def test_the_view_planes_use_webots_float32_half_angles():
     assert rmath.frustum(imaging.ImageGeometry(W, H, 1.0, "cylindrical")) is None
 
 
-def test_occlusion_1_aims_at_the_whole_objects_centre_not_the_part_in_view():
+def test_occlusion_1_aims_at_the_objects_origin_not_the_part_in_view():
     # y 0.7..1.7 at x = 2: its whole centre (2, 1.2, 0) is out of view, the part in view is centred
     # at (2.12, 0.99, 0); a small pane at x = 1, y 0.58..0.66 blocks the ray to (2, 1.2, 0) (y = 0.6
     # at x = 1), not the one to the part in view (y = 0.47 there): the object counts as hidden, as
@@ -377,3 +377,20 @@ def test_occlusion_1_aims_at_the_whole_objects_centre_not_the_part_in_view():
     assert 0.4 < seen.position[1] / seen.position[0] < 0.5                   # 0.47: under the pane
     assert recognise(world([wide, pane], {"occlusion": 1}))[1] == []
     assert len(recognise(world([wide], {"occlusion": 1}))[1]) == 1
+
+
+def test_occlusion_1_aims_at_the_objects_origin_not_its_boxs_centre():
+    # Webots casts the occlusion ray to the Solid's position. This object's origin is (3, 0, 0) and
+    # its only shape sits 0.4 m to its right (box y -0.7..-0.1, centre (3, -0.4, 0)), as Webots'
+    # BiscuitBox PROTO's mesh sits beside its origin. A pane at x = 1.5 around y = -0.2 blocks the ray
+    # to the box's centre (y = -0.2 there) but neither the ray to the origin (y = 0) nor every pixel
+    # (the box's near edge y = -0.1 is at y = -0.05 there): recognised. A thin pane on y = 0 blocks the
+    # ray to the origin only: hidden, as in Webots, though pixels see the box
+    offset = solid("offset", {"translation": [3.0, 0.0, 0.0]}, None,
+                   shapes=[{"pose": {"translation": [0.0, -0.4, 0.0]}, "geometry": {"type": "box", "size": [0.2, 0.6, 0.2]}}])
+    centre_pane = {"name": "p1", "pose": {"translation": [1.5, -0.2, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.1, 0.1]}}
+    origin_pane = {"name": "p2", "pose": {"translation": [1.5, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.02, 0.04, 0.1]}}
+    [seen] = recognise(world([offset, centre_pane], {"occlusion": 1}))[1]
+    np.testing.assert_allclose(seen.position, [3.0, -0.4, 0.0], atol=1e-12)     # still its box's centre
+    assert recognise(world([offset, origin_pane], {"occlusion": 1}))[1] == []
+    assert len(recognise(world([offset, origin_pane], {"occlusion": 2}))[1]) == 1

@@ -637,3 +637,42 @@ def test_a_fixed_arm_of_round_links_is_no_failed_car(tmp_path: Path) -> None:
     arm.motor("yaw motor").set_position(math.pi / 2)
     sim.step()
     assert sim.device("arm/distance sensor").world_pose(arm.pose).translation == pytest.approx([0, 0.2, 0.33], abs=1e-12)
+
+
+def test_a_compass_needle_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Path) -> None:
+    """Webots' compass sample: a two-wheel robot carries a needle, a motorised hinge about z whose end
+    point holds a thin rod (a cylinder 0.1 long, 0.005 in radius, lying across the axis) and a cone.
+    The rod was taken for a wheel, so the hinge for a car's lone steering joint, and the robot lost
+    its drive ("no Ackermann drive ...; the robot will not move"). A cylinder more than twice as long
+    as its diameter is no wheel: the needle steers nothing and turns, and the wheels drive."""
+    needle = ('HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 anchor 0 0 0.1 }\n'
+              '  device [ RotationalMotor { name "arrow" } ]\n'
+              '  endPoint Solid { translation 0 0 0.1 children [\n'
+              '    Shape { geometry Cylinder { height 0.1 radius 0.005 } }\n'
+              '    Pose { translation 0 0.05 0 children [ Shape { geometry Cone { bottomRadius 0.01 height 0.02 } } ] }\n'
+              '    DistanceSensor { translation 0.06 0 0 } ] } }\n')
+    p = write(tmp_path, 'Robot { name "compass bot" children [\n' + needle + wheel("left wheel", 0, Y)
+              + wheel("right wheel", 0, -Y) + '] }\n')
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive is None and robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    assert [x.split(": ", 1)[1] for x in w.warnings if "arrow" in x] == [
+        "HingeJoint motor 'arrow' is no wheel and steers none (its end point holds no wheel): its joint moves "
+        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
+        "the joint with it"]
+    sim = Simulation(w)
+    bot = sim.robot("compass bot")
+    assert sorted(bot.drive.motors) == ["left wheel", "right wheel"] and sorted(bot.joints) == ["arrow"]
+    for name in ("left wheel", "right wheel"):
+        bot.motor(name).set_position(math.inf)
+        bot.motor(name).set_velocity(5.0)
+    bot.motor("arrow").set_position(math.pi / 2)
+    sim.step()
+    assert bot.pose.translation[0] == pytest.approx(5.0 * R * 0.016, rel=1e-9)     # one 16 ms step forward
+    for _ in range(199):                 # the needle ramps up (Webots' kinematic rule) and stops on its target
+        sim.step()
+    assert bot.pose.translation[0] == pytest.approx(200 * 5.0 * R * 0.016, rel=1e-9)  # straight on, at 5 rad/s
+    ds = sim.device("compass bot/distance sensor").world_pose(bot.pose)
+    assert ds.translation - bot.pose.translation == pytest.approx([0.0, 0.06, 0.1], abs=1e-12)   # turned a quarter

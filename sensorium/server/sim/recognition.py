@@ -4,9 +4,9 @@ objects' shapes from the scene once, places them at each recognition, and casts 
 occlusion test needs (Webots' ``occlusion`` field):
 
 * 0 — no test: every object in range and on the image is recognised;
-* 1 — one ray from the camera to the object's centre (that of its whole box, in view or not):
-  recognised if it reaches the centre or first meets one of the object's own shapes (Webots casts a
-  ray to the object's origin against bounding objects);
+* 1 — one ray from the camera to the object's origin (its Solid's or robot's translation, as
+  Webots aims it, in view or not): recognised if it reaches the origin or first meets one of the
+  object's own shapes (Webots' ray meets bounding objects; ours visible shapes);
 * 2 — the image's pixel rays: recognised if at least one pixel sees it (exact at the image's
   resolution; Webots tests the object's outline).
 
@@ -151,24 +151,22 @@ class Recognizer:
     def _box(self, obj: _Object, cam: Pose) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """The object's box (lo, hi) in the camera frame — for a planar camera the union of its
         shapes' parts in view (Webots' clipping, ``devices/recognition.py``), else of its whole
-        shapes — and the centre of its whole box (the occlusion ray's target); None if a shape is
-        unbounded or nothing of it is in view."""
+        shapes — and its origin there (the occlusion ray's target: Webots aims at the Solid's
+        position, which may lie far from its box's centre); None if a shape is unbounded or nothing
+        of it is in view."""
         owner = self.scene.owner_pose(obj.key)
         inv = cam.rotation.T
-        lo, whole_lo = np.full(3, np.inf), np.full(3, np.inf)
-        hi, whole_hi = np.full(3, -np.inf), np.full(3, -np.inf)
+        lo = np.full(3, np.inf)
+        hi = np.full(3, -np.inf)
         for link, local, kind, params, points in obj.parts:
             if kind == "unbounded":
                 return None
             pose = part_pose(self.scene, owner, link, local)
             rotation, centre = inv @ pose.rotation, inv @ (pose.translation - cam.translation)
             whole, b = rmath.clipped_bounds(kind, params, rotation, centre, points, self.frustum)
-            if whole is None:
-                continue
-            whole_lo, whole_hi = np.minimum(whole_lo, whole[0]), np.maximum(whole_hi, whole[1])
-            if b is not None:
+            if whole is not None and b is not None:
                 lo, hi = np.minimum(lo, b[0]), np.maximum(hi, b[1])
-        return (lo, hi, (whole_lo + whole_hi) / 2.0) if np.isfinite(lo).all() else None
+        return (lo, hi, inv @ (owner.translation - cam.translation)) if np.isfinite(lo).all() else None
 
     def recognise(self, cam: Pose, pixel_objects: np.ndarray | None, counters: Any) -> list[RecognisedObject]:
         """The objects seen from the camera pose ``cam``; ``pixel_objects`` (H·W,) the object index

@@ -2051,9 +2051,10 @@ class Converter:
                                 if not rolls else "the robot's only motorised joint"))
             return
         # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
-        # joint on a mobile robot) steers nothing: it is no wheel, and the others make the drive
+        # joint on a mobile robot) steers nothing: it is no wheel, and the others make the drive (with
+        # vertical hinges only, there is no vehicle: said below)
         pans = [w for w in wheels if w["steers"] and not holds_wheel(w["end"], self)]
-        if pans:
+        if pans and not all(w["steers"] for w in wheels):
             for w in pans:
                 nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers "
                                 f"none (its end point holds no wheel): {JOINT_MOVES}", "steering none"))

@@ -64,18 +64,27 @@ AXIS_TOL = 1e-4     # wheels' axes: Webots' PROTOs turn their joints' frames by 
 
 def wheel_radius(end: Node | None, conv) -> float | None:
     """Radius of a wheel end point: its boundingObject's (else its visual) cylinder or sphere."""
+    part = _round_part(end, conv)
+    return None if part is None else part[1]
+
+
+def _round_part(end: Node | None, conv) -> tuple[str, float, float] | None:
+    """(type, radius, height) of an end point's first cylinder, capsule or sphere (scaled; a
+    sphere's height its diameter), its boundingObject's first, else its visual one's."""
     while end is not None and end.type == "Slot":      # Webots' cars hold their wheels in Slots
         end = conv.fields(end).node_("endPoint")
     if end is None:
         return None
     f = conv.fields(end)
 
-    def find(node: Node | None, scale: float) -> float | None:
+    def find(node: Node | None, scale: float) -> tuple[str, float, float] | None:
         if node is None:
             return None
         conv.walk(node)
         if node.type in ("Cylinder", "Sphere", "Capsule"):
-            return conv.fields(node).num("radius", 1.0) * scale
+            nf = conv.fields(node)
+            radius = nf.num("radius", 1.0) * scale
+            return node.type, radius, (2.0 * radius if node.type == "Sphere" else nf.num("height", 2.0) * scale)
         nf = conv.fields(node)
         if node.type == "Shape":
             return find(nf.node_("geometry"), scale)
@@ -88,7 +97,8 @@ def wheel_radius(end: Node | None, conv) -> float | None:
                     return r
         return None
 
-    return find(f.node_("boundingObject"), 1.0) or find(end, 1.0)
+    bounding = find(f.node_("boundingObject"), 1.0)
+    return bounding if bounding is not None and bounding[1] else find(end, 1.0)   # (a 0 radius: the visual's)
 
 
 def rolls_about_its_axis(w: dict, conv) -> bool:
@@ -121,9 +131,11 @@ def rolls_about_its_axis(w: dict, conv) -> bool:
 
 def holds_wheel(end: Node | None, conv) -> bool:
     """Whether a steering-like (vertical) hinge's end point is or carries a wheel: something round
-    itself, or a hinge inside it whose end point is (a car's knuckle holding its wheel's joint).
-    A pan head's or an arm's end point is neither."""
-    if wheel_radius(end, conv) is not None:
+    itself -- a sphere, or a cylinder or capsule no longer than twice its diameter (a compass
+    needle's or a pointer's long thin rod is no wheel) --, or a hinge inside it whose end point is (a
+    car's knuckle holding its wheel's joint). A pan head's or an arm's end point is neither."""
+    part = _round_part(end, conv)
+    if part is not None and part[2] <= 4.0 * part[1]:
         return True
 
     def find(node: Node | None) -> bool:
