@@ -10,7 +10,7 @@ the same stacked ``Pose.compose``, its robot's body met apart for a housed camer
 copy's robots. The objects are the single Recognizer's, run per copy on :class:`_CopyScene`: the
 world's shapes numbered as the single scene numbers them (solids, then the robots'), the Supervisor's
 node ids (robots 1..R, then the top-level solids), each robot's pose in that copy. The occlusion rays
-(occlusion 1: one per candidate object, to its centre) of every due copy of a camera are one cast,
+(occlusion 1: one per candidate object, to its origin) of every due copy of a camera are one cast,
 each ray meeting only its copy's world, its camera's robot excluded, as the single camera casts it
 alone.
 """
@@ -174,8 +174,8 @@ class RecognitionDevices(PixelDevices):
         self.last[copies, col] = sim.time_ms[copies]
 
     def _occlusion(self, col: int, copies: np.ndarray, rec: Recognizer, seen: list) -> list:
-        """Occlusion 1 of every copy's candidates (Recognizer._centre_visible): their rays to the
-        objects' centres, each in its copy alone, its camera's robot excluded, in one cast."""
+        """Occlusion 1 of every copy's candidates (Recognizer._origin_visible): their rays to the
+        objects' origins, each in its copy alone, its camera's robot excluded, in one cast."""
         sim = self.sim
         rows, origins, dirs, far = [], [], [], []
         for q, (pose, found) in enumerate(seen):

@@ -173,7 +173,7 @@ class Recognizer:
         each pixel sees (-1 none), needed for occlusion 2."""
         seen = self.candidates(cam, pixel_objects)
         if self.config.occlusion == 1:
-            seen = [s for s in seen if self._centre_visible(s[0], cam, s[2], counters)]
+            seen = [s for s in seen if self._origin_visible(s[0], cam, s[2], counters)]
         return self.trim([s[1] for s in seen])
 
     def candidates(self, cam: Pose, pixel_objects: np.ndarray | None) -> list[tuple[int, RecognisedObject, np.ndarray]]:
@@ -211,8 +211,8 @@ class Recognizer:
             out = [out[i] for i in keep[:c.max_objects]]      # biggest first, as Webots lists them then
         return out
 
-    def _centre_visible(self, k: int, cam: Pose, centre: np.ndarray, counters: Any) -> bool:
-        ray = occlusion_ray(cam, centre)
+    def _origin_visible(self, k: int, cam: Pose, origin: np.ndarray, counters: Any) -> bool:
+        ray = occlusion_ray(cam, origin)
         if ray is None:
             return True
         hits = self.scene.engine.cast(cam.translation.reshape(1, 3), ray[0].reshape(1, 3), 0.0, ray[1],
