@@ -846,9 +846,12 @@ class RayEngine(TierTracer):
                 # mount_state and _mounted_pairs would build their per-ray tables only to find every
                 # ray unbounded and hand them all to the general broad phase, which this is, on the
                 # same values without their gathered copies (_sphere_pairs' test for rows of one
-                # origin, as it runs on such a copy), less the pairs with the mount itself
+                # origin, as it runs on such a copy), less the pairs with the mount itself, whose
+                # test is skipped where it runs mover by mover (a camera inside its robot's
+                # bounding sphere would pair every pixel with it, only to drop them all)
                 self.counters["unbounded_mounts"] += 1
-                pr, pm = _sphere_pairs(C, mt.r2, owner, O, D, t_near, lim, excl, cone=False)
+                others = np.delete(np.arange(len(C)), row)
+                pr, pm = _sphere_pairs(C, mt.r2, owner, O, D, t_near, lim, excl, among=others, cone=False)
                 keep = (pm != row).nonzero()[0]
                 order = np.argsort(pr[keep], kind="stable")
                 return pr[keep][order], pm[keep][order], -1, None
