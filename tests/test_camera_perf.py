@@ -229,3 +229,139 @@ def test_a_light_subset_keeps_every_value():
                  "beam_width", "cut_off_angle", "radius"):
         assert getattr(sub, name).tobytes() == getattr(lights, name)[[2, 0]].tobytes()
         assert not getattr(sub, name).flags.writeable
+
+
+# ------------------------------------------- a camera inside its own robot's bounding sphere
+
+_A, _WALL = 0.05, 0.95     # the hollow robot's inner half-size; the wall's face (x)
+
+
+def _hollow_robot_world(precision):
+    """A hollow box robot (five plates 1 cm thick around a cube of inner half-size _A, open towards
+    +x) turned and moved, a wall facing its opening, and a second robot behind it."""
+    eng = RayEngine(precision)
+    eng.add_body([ShapeEntry(Box((0.1, 60.0, 60.0)), Pose.identity(), True, True)],
+                 Pose(np.eye(3), np.array([_WALL + 0.05, 0.0, 0.0])))
+    t, a = 0.01, _A
+    plates = [((t, 2 * a + 2 * t, 2 * a + 2 * t), (-a - t / 2, 0.0, 0.0))]            # the back
+    plates += [((2 * a + t, t, 2 * a + 2 * t), (-t / 2, s * (a + t / 2), 0.0)) for s in (-1, 1)]
+    plates += [((2 * a + t, 2 * a, t), (-t / 2, 0.0, s * (a + t / 2))) for s in (-1, 1)]
+    body = eng.add_body([ShapeEntry(Box(size), Pose(np.eye(3), np.array(at)), True, True) for size, at in plates],
+                        Pose.identity(), owner=0, movable=True)
+    other = eng.add_body([ShapeEntry(Sphere(0.05), Pose.identity(), True, True)],
+                         Pose(np.eye(3), np.array([-0.5, 0.0, 0.0])), owner=1, movable=True)
+    return eng, body, other
+
+
+@pytest.mark.parametrize("precision,n", [(Precision.FAST, (1 << 16) + 1000), (Precision.EXACT, MIN_RAYS + 1000)])
+def test_a_camera_inside_its_robot_pays_no_pairs_with_it(precision, n, monkeypatch):
+    """A camera at the centre of a hollow box robot (inside the robot's bounding sphere, so no cone
+    test culls it) casts its unbounded pixel rays mounted on the robot, a cast in blocks (whose
+    pairs are listed up to t_far; a smaller cast's mounted broad phase pairs a body with its
+    neighbours only): the broad phase never tests
+    them against the robot (their pairs were made, then all dropped), and the hits are those of the
+    same rays given a plain mount array (the per-ray path) bit for bit, and the closed form: the
+    wall through the opening, the robot's own plates from the body-frame cast."""
+    from sensorium.server.raycast import engine as engine_module
+
+    eng, body, other = _hollow_robot_world(precision)
+    eng.threads = 2
+    roll = 0.4                  # about x: the opening still faces the wall
+    R = np.array([[1.0, 0.0, 0.0], [0.0, math.cos(roll), -math.sin(roll)], [0.0, math.sin(roll), math.cos(roll)]])
+    centre = np.array([0.1, -0.05, 0.02])
+    eng.set_body_pose(body, Pose(R, centre))
+    rng = np.random.default_rng(21)
+    local = rng.normal(size=(n, 3)) * np.array([0.35, 1.0, 1.0])
+    local[:, 0] = np.abs(local[:, 0]) + 0.3            # forward (within the wall), many out of the opening, many onto the plates
+    local /= np.linalg.norm(local, axis=1)[:, None]
+    D = local @ R.T
+    O = np.broadcast_to(centre, D.shape)                 # the camera at the robot's centre
+    tested = []
+    inner = engine_module._sphere_pairs
+
+    def spy(C, r2, owner, O_, D_, t_near, lim, excl, among=None, cone=True):
+        tested.append(list(range(len(C))) if among is None else among.tolist())
+        return inner(C, r2, owner, O_, D_, t_near, lim, excl, among=among, cone=cone)
+
+    monkeypatch.setattr(engine_module, "_sphere_pairs", spy)
+    mount = Mount(np.full(n, body))
+    for _ in range(2):          # the same rays cast again, as an image's each step
+        tested.clear()
+        got = eng.cast(O, D, 0.0, np.inf, kind=RayKind.VISUAL, exclude_owner=-1, mount=mount)
+        mt = eng._mover_table("visual")
+        row = int(mt.row_of[body])
+        assert tested and all(row not in t for t in tested)    # the robot's test skipped
+        assert any(int(mt.row_of[other]) in t for t in tested)  # the other robot's still made
+        want = eng.cast(O, D, 0.0, np.inf, kind=RayKind.VISUAL, exclude_owner=-1, mount=np.full(n, body))
+        assert got.distance.tobytes() == want.distance.tobytes()
+        assert got.shape.tobytes() == want.shape.tobytes()
+        assert got.normal.tobytes() == want.normal.tobytes()
+    # the closed form: in the world the robot is skipped, so every forward ray meets the wall; in the
+    # body frame a ray leaves through the opening (x the largest of its components) or meets a plate
+    wall = eng._bodies[0].first
+    assert (got.shape == wall).all()
+    np.testing.assert_allclose(got.distance, (_WALL - centre[0]) / D[:, 0], rtol=1e-6 if precision is Precision.FAST
+                               else 1e-12)
+    own = eng.cast_local(body, np.zeros((n, 3)), local, 0.0, np.inf, kind=RayKind.VISUAL)
+    side = np.maximum(np.abs(local[:, 1]), np.abs(local[:, 2]))
+    out = side < local[:, 0]
+    assert 0 < out.sum() < n
+    assert not np.isfinite(own.distance[out]).any()
+    np.testing.assert_allclose(own.distance[~out], _A / side[~out], rtol=1e-6 if precision is Precision.FAST else 1e-12)
+
+
+@pytest.mark.parametrize("precision", [Precision.FAST, Precision.EXACT])
+def test_a_smaller_camera_inside_its_robot_skips_it_for_its_unbounded_rays(precision, monkeypatch):
+    """A cast in one part (20,000 rays on one thread) of the same camera, half its rays looking
+    back, where nothing bounds them but the robot behind: those unbounded mounted rays take the
+    general broad phase, which no longer tests them against their own robot (their pairs with it
+    were dropped); the bounded ones pair with the robot's neighbours only, as before. The hits are
+    the per-ray mount path's bit for bit and the closed form (wall ahead, plates in the body frame)."""
+    from sensorium.server.raycast import engine as engine_module
+
+    eng, body, other = _hollow_robot_world(precision)
+    eng.threads = 1
+    centre = np.array([0.1, -0.05, 0.02])
+    roll = -0.3
+    R = np.array([[1.0, 0.0, 0.0], [0.0, math.cos(roll), -math.sin(roll)], [0.0, math.sin(roll), math.cos(roll)]])
+    eng.set_body_pose(body, Pose(R, centre))
+    n = 20000
+    rng = np.random.default_rng(22)
+    local = rng.normal(size=(n, 3)) * np.array([0.35, 1.0, 1.0])
+    local[:, 0] = np.abs(local[:, 0]) + 0.3
+    local[n // 2:, 0] *= -1.0                           # looking back: out of the wall's way
+    local /= np.linalg.norm(local, axis=1)[:, None]
+    D = local @ R.T
+    O = np.broadcast_to(centre, D.shape)
+    tested = []
+    inner = engine_module._sphere_pairs
+
+    def spy(C, r2, owner, O_, D_, t_near, lim, excl, among=None, cone=True):
+        if len(O_) * len(C) > 16384:                    # the test runs mover by mover
+            tested.append(list(range(len(C))) if among is None else among.tolist())
+        return inner(C, r2, owner, O_, D_, t_near, lim, excl, among=among, cone=cone)
+
+    monkeypatch.setattr(engine_module, "_sphere_pairs", spy)
+    mount = Mount(np.full(n, body))
+    for _ in range(2):
+        tested.clear()
+        got = eng.cast(O, D, 0.0, np.inf, kind=RayKind.VISUAL, exclude_owner=-1, mount=mount)
+        mt = eng._mover_table("visual")
+        assert tested and all(int(mt.row_of[body]) not in t for t in tested)
+        assert all(int(mt.row_of[other]) in t for t in tested)
+        want = eng.cast(O, D, 0.0, np.inf, kind=RayKind.VISUAL, exclude_owner=-1, mount=np.full(n, body))
+        assert got.distance.tobytes() == want.distance.tobytes()
+        assert got.shape.tobytes() == want.shape.tobytes()
+        assert got.normal.tobytes() == want.normal.tobytes()
+    tol = 1e-6 if precision is Precision.FAST else 1e-12
+    ahead = slice(0, n // 2)
+    assert (got.shape[ahead] == eng._bodies[0].first).all()
+    np.testing.assert_allclose(got.distance[ahead], (_WALL - centre[0]) / D[ahead, 0], rtol=tol)
+    back = got.shape[n // 2:]
+    assert set(back.tolist()) == {-1, eng._bodies[other].first}      # the other robot, else nothing
+    own = eng.cast_local(body, np.zeros((n, 3)), local, 0.0, np.inf, kind=RayKind.VISUAL)
+    big = np.abs(local).max(axis=1)
+    out = local[:, 0] == big                            # out through the opening
+    assert 0 < out.sum() < n // 2
+    assert not np.isfinite(own.distance[out]).any()
+    np.testing.assert_allclose(own.distance[~out], _A / big[~out], rtol=tol)

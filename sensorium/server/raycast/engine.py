@@ -834,6 +834,7 @@ class RayEngine(TierTracer):
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
         mounted = mrow = own = None
         tight = -1   # a mover row whose pairs are only a Mount's own pairs (already tested against its bound)
+        row = -1     # the mover row every ray rides (a kept Mount on one body), else -1
         if mount is not None:
             if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
                 mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
@@ -846,9 +847,12 @@ class RayEngine(TierTracer):
                 # mount_state and _mounted_pairs would build their per-ray tables only to find every
                 # ray unbounded and hand them all to the general broad phase, which this is, on the
                 # same values without their gathered copies (_sphere_pairs' test for rows of one
-                # origin, as it runs on such a copy), less the pairs with the mount itself
+                # origin, as it runs on such a copy), less the pairs with the mount itself, whose
+                # test is skipped where it runs mover by mover (a camera inside its robot's
+                # bounding sphere would pair every pixel with it, only to drop them all)
                 self.counters["unbounded_mounts"] += 1
-                pr, pm = _sphere_pairs(C, mt.r2, owner, O, D, t_near, lim, excl, cone=False)
+                others = np.delete(np.arange(len(C)), row)
+                pr, pm = _sphere_pairs(C, mt.r2, owner, O, D, t_near, lim, excl, among=others, cone=False)
                 keep = (pm != row).nonzero()[0]
                 order = np.argsort(pr[keep], kind="stable")
                 return pr[keep][order], pm[keep][order], -1, None
@@ -882,8 +886,9 @@ class RayEngine(TierTracer):
             if len(C) > _FEW_MOVERS and len(Os) * len(C) > _DENSE_PAIRS:
                 pr, pm = _grid_pairs(C, mt.radius, mt.r2, owner, Os, Ds, tn, ls, ex,
                                      origin=O[0] if O.strides[0] == 0 and len(O) else None)
-            else:
-                pr, pm = _sphere_pairs(C, mt.r2, owner, Os, Ds, tn, ls, ex)
+            else:   # rays that all ride one mover: its test skipped mover by mover (its pairs are dropped below)
+                pr, pm = _sphere_pairs(C, mt.r2, owner, Os, Ds, tn, ls, ex,
+                                       among=np.delete(np.arange(len(C)), row) if sub is not None and row >= 0 else None)
             if sub is not None:   # merge with the mounted rays' pairs, in ray order
                 pr = sub[pr]
                 if len(pr):       # an unbounded mounted ray never meets its own body here either

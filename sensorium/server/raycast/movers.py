@@ -41,8 +41,9 @@ def _sphere_pairs(C, r2, owner, O, D, t_near, lim, excl, among=None, cone: bool 
     sphere (centre C, squared radius r2) and whose owner is not excluded (``owner`` None: no
     check).  Small tables: one (rays, movers, 3) computation, pairs ordered by ray.  Large batches
     (a lidar): one mover at a time on contiguous columns, pairs ordered by mover (so the pairs of
-    any one mover are always in ray order); ``among`` (ascending mover indices, a superset of those
-    any ray can pass near) then skips the others' tests (the same pairs, the same arithmetic).
+    any one mover are always in ray order); ``among`` (ascending mover indices: a superset of those
+    any ray can pass near, or those whose pairs the caller keeps) then skips the others' tests (the
+    same pairs of those movers, the same arithmetic).
     ``cone`` False: rows of one origin given as a broadcast array take the test (and give the
     pairs) they would as a gathered copy of those rows, without the broadcast origin's cone test."""
     n, M = len(O), len(C)
