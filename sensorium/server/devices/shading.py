@@ -40,7 +40,7 @@ from .light import LightArrays, LightKind
 from .noise import gaussian
 
 __all__ = ["GAMMA", "FOG_TYPES", "background_radiance", "srgb_to_linear", "radiance", "within_radius", "fog_weight", "fog",
-           "tone_map", "to_bytes", "take_rows", "add_to_rows", "scaled_rows"]
+           "tone_map", "to_bytes", "take_rows", "add_to_rows", "set_rows", "scaled_rows"]
 
 GAMMA = 2.2
 """Webots' ``hdr_resolve.frag`` gamma."""
@@ -260,6 +260,14 @@ def add_to_rows(out: np.ndarray, rows: np.ndarray, values: np.ndarray) -> None:
     cur = items.take(rows).view(np.float64).reshape(-1, 3)
     cur += values
     items[rows] = cur.view(_ROW).reshape(-1)
+
+
+def set_rows(out: np.ndarray, where: np.ndarray, values: np.ndarray) -> None:
+    """``out[where] = values`` for an (n, 3) C-contiguous float64 ``out``, a bool mask ``where``
+    (n,) and ``values`` one row (3,) or one row per True (m, 3): moved as 24-byte items (a 2-D
+    mask assignment is several times slower)."""
+    rows = np.ascontiguousarray(values, dtype=np.float64).view(_ROW).reshape(-1)
+    out.view(_ROW).reshape(-1)[where] = rows[0] if values.ndim == 1 else rows
 
 
 def scaled_rows(v: np.ndarray, vec) -> np.ndarray:

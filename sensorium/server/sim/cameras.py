@@ -227,14 +227,19 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
         t, shape, normal = hits.distance, hits.shape, hits.normal
         assert shape is not None and normal is not None
         hit = np.isfinite(t)
-        miss = (~hit).nonzero()[0]
-        if len(miss):
-            rm = rows[miss]
-            shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], background))
+        if layer == 0:             # every weight 1, every sum 0: the sky is 0 + 1·background, filled by mask
+            sky = np.zeros(3)
+            sky += shading.scaled_rows(np.ones(1), background)[0]
+            shading.set_rows(out, ~hit, sky)
+        else:
+            miss = (~hit).nonzero()[0]
+            if len(miss):
+                rm = rows[miss]
+                shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], background))
         k = hit.nonzero()[0]
         if len(k) == 0:
             break
-        r, s = rows[k], shape[k]
+        r, s = (k, shape if len(k) == n else shape[k]) if layer == 0 else (rows[k], shape[k])
         tau = transparency[s]
         clear = tau > 0.0
         textured = None                # the hits on shapes with transparent texels (an alpha world only)
@@ -263,7 +268,8 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
             if layer < MAX_LAYERS:             # a clear texel adds nothing: not shaded
                 seen = seen[tau[seen] < 1.0]
         if len(seen):
-            kk, rr = k[seen], r[seen]
+            every = len(seen) == len(k)
+            kk, rr, ss = (k, r, s) if every else (k[seen], r[seen], s[seen])
             whole = len(kk) == len(D)
             Dk = D if whole else shading.take_rows(D, kk)
             tk = t if whole else t.take(kk)
@@ -272,14 +278,25 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
                 np.multiply(tk, Dk[:, ch], out=P[:, ch])
                 P[:, ch] += origin[ch]
             N = normal if whole else shading.take_rows(normal, kk)
-            back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+            dot = N[:, 0] * Dk[:, 0]            # N·D, summed as (x + y) + z
+            dot += N[:, 1] * Dk[:, 1]
+            dot += N[:, 2] * Dk[:, 2]
+            back = dot > 0.0
             if back.any():         # facing the camera
                 bk = back.nonzero()[0]
                 N = N.copy() if whole else N
                 N[bk] = np.negative(shading.take_rows(N, bk))
-            L = surface(s[seen], P, N, Dk, tk)
+            L = surface(ss, P, N, Dk, tk)
             if fog is not None:           # Webots mixes each surface (not the sky) with the fog colour
                 L = shading.fog(L, tk, *fog)
+            if layer == 0 and not any_clear and not tau.any():
+                # nothing seen through (the common opaque image): each share is 1 (1 - 0), each sum
+                # 0 + L; no ray goes on, so no weight is needed again
+                np.add(L, 0.0, out=L)           # 0 + L (as the sum: -0.0 becomes 0.0)
+                if whole:
+                    return L
+                shading.set_rows(out, hit, L)
+                break
             last = layer == MAX_LAYERS
             a = np.where(last, 0.0, tau[seen])
             share = weight[rr] * (1.0 - a)
