@@ -40,7 +40,7 @@ from .light import LightArrays, LightKind
 from .noise import gaussian
 
 __all__ = ["GAMMA", "FOG_TYPES", "background_radiance", "srgb_to_linear", "radiance", "within_radius", "fog_weight", "fog",
-           "tone_map", "to_bytes", "take_rows", "add_to_rows", "set_rows", "scaled_rows"]
+           "tone_map", "to_bytes", "resolve_bgra", "take_rows", "add_to_rows", "set_rows", "scaled_rows"]
 
 GAMMA = 2.2
 """Webots' ``hdr_resolve.frag`` gamma."""
@@ -241,6 +241,48 @@ def to_bytes(values: np.ndarray, noise: float = 0.0, rng: np.random.Generator | 
     x *= 255.0
     x += 0.5
     return np.floor(x, out=x).astype(np.uint8)
+
+
+def resolve_bgra(radiance: np.ndarray, exposure: float, noise: float = 0.0, rng: np.random.Generator | None = None,
+                 samples: int = 1) -> np.ndarray:
+    """A camera's pixels (M, 4) BGRA uint8 (alpha 255) from the radiance (samples·M, 3) of its
+    rays (sample-major, as ``pixel_directions`` makes them): the samples' mean, :func:`tone_map`,
+    :func:`to_bytes`, on blocks of pixels that stay in the CPU's cache: the same operations per
+    value in the same order, so the same bytes as those calls on the whole image (the noise drawn
+    first, all of it, in C order as ``to_bytes`` draws it)."""
+    L = np.asarray(radiance, dtype=np.float64).reshape(samples, -1, 3)
+    M = L.shape[1]
+    draws = float(noise) * gaussian(rng, M * 3).reshape(M, 3) if noise > 0.0 and rng is not None else None
+    out = np.empty((M, 4), dtype=np.uint8)
+    out[:, 3] = 255
+    x = np.empty((min(M, BLOCK), 3))
+    with np.errstate(over="ignore"):
+        for a in range(0, M, BLOCK):
+            b = min(M, a + BLOCK)
+            v = x[:b - a]
+            if samples > 1:        # numpy's mean over the samples: ((L0 + L1) + L2) + ... then / S
+                np.add(L[0, a:b], L[1, a:b], out=v)
+                for i in range(2, samples):
+                    v += L[i, a:b]
+                np.true_divide(v, samples, out=v)
+                np.maximum(v, 0.0, out=v)
+            else:
+                np.maximum(L[0, a:b], 0.0, out=v)
+            np.negative(v, out=v)            # tone_map
+            v *= float(exposure)
+            np.exp(v, out=v)
+            np.subtract(1.0, v, out=v)
+            np.power(v, 1.0 / GAMMA, out=v)
+            if draws is not None:            # to_bytes
+                v += draws[a:b]
+                np.clip(v, 0.0, 1.0, out=v)
+            np.clip(v, 0.0, 1.0, out=v)
+            v *= 255.0
+            v += 0.5
+            np.floor(v, out=v)
+            for ch in range(3):              # RGB → BGR
+                out[a:b, 2 - ch] = v[:, ch]
+    return out
 
 
 # Rows of (n, 3) float64 arrays, as an image's shading gathers and scatters them: numpy's fancy

@@ -555,14 +555,9 @@ class Camera(Device):
         rays = self._prepare()
         L = self._render(pose, rays, counters)
         c = self.config
-        S = len(self._samples)
-        if S > 1:      # supersampling: the mean radiance of the pixel's rays
-            L = L.reshape(S, -1, 3).mean(axis=0)
-        v = shading.tone_map(L, self.exposure).reshape(c.height, c.width, 3)
-        rgb = shading.to_bytes(v, c.noise, self.rng if c.noise > 0 else None)
-        image = np.empty((c.height, c.width, 4), dtype=np.uint8)
-        image[:, :, 0], image[:, :, 1], image[:, :, 2], image[:, :, 3] = rgb[:, :, 2], rgb[:, :, 1], rgb[:, :, 0], 255
-        self.image = image
+        # supersampling: the mean radiance of the pixel's rays; then the resolve, the noise, BGRA
+        bgra = shading.resolve_bgra(L, self.exposure, c.noise, self.rng if c.noise > 0 else None, len(self._samples))
+        self.image = bgra.reshape(c.height, c.width, 4)
 
     def _render(self, pose: Pose, rays: MountedRays, counters: Any) -> np.ndarray:
         """The radiance (N, 3) along every ray (:func:`composite`); the device's own shapes are
