@@ -65,6 +65,28 @@ def test_shadow_rays_are_the_one_pass_choice_on_any_threads():
             assert length.tobytes() == want[j][2].tobytes()
 
 
+def test_a_radius_a_hair_inside_the_farthest_point_still_cuts_it():
+    """A block whose points all lie well inside a light's radius skips radiance's distances; one
+    an ulp inside the farthest point must still cut that point (and only it), on any threads."""
+    q = np.array([0.3, -0.2, 0.9])
+    P, _ = _points(2 * shading.BLOCK + 77, 3)
+    P[7] = (0.0, 0.0, 0.0)
+    N = q - P
+    N /= np.linalg.norm(N, axis=1)[:, None]          # every point faces the light
+    v = q - P
+    far = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])     # radiance's distances
+    top = int(np.argmax(far))
+    shadows = np.array([True])
+    for radius, cut in ((float(np.nextafter(far[top], 0.0)), 1), (float(far[top]), 0), (1e3, 0)):
+        lights = LightArrays.from_lights([Light(LightKind.POINT, position=tuple(q), intensity=1.0, radius=radius)])
+        want = _one_pass(P, N, lights, shadows)
+        assert len(want[0][0]) == len(P) - cut and (cut == 0 or top not in want[0][0])
+        for threads in (1, 2):
+            got = shadow_rays(P, N, lights, shadows, threads)
+            assert got[0][0].tobytes() == want[0][0].tobytes()
+            assert got[0][1].tobytes() == want[0][1].tobytes() and got[0][2].tobytes() == want[0][2].tobytes()
+
+
 def test_shadow_rays_of_no_points_and_no_shadow_lights():
     lights = _lights()
     P, N = _points(10, 2)

@@ -612,7 +612,7 @@ class Camera(Device):
         for j, (i, unit, length) in shadow_rays(P, N, lights, shadows, engine.threads).items():
             if len(i) == 0:
                 continue
-            hits = engine.cast(P[i], unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1, distance_only=True)
+            hits = engine.cast(shading.take_rows(P, i), unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1, distance_only=True)
             counters["rays_camera"] += len(i)
             counters["cast_calls"] += 1
             lit[i, j] = ~(hits.distance <= length)
@@ -633,16 +633,25 @@ def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, sh
     # the shadow-casting lights only (each light's values are its own: the others change none of them)
     casting = lights if len(js) == len(lights) else lights.subset(js)
 
+    n = len(casting)
+    reach = [math.inf if int(casting.kind[j]) == light_math.LightKind.DIRECTIONAL else float(casting.radius[j])
+             for j in range(n)]
+
     def part(sl: slice) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         Pb = P[sl]
         direct, unit, length = light_math.direct_and_segments(Pb, N[sl], casting)
+        units, lengths = unit.reshape(-1, 3), length.reshape(-1)      # (point, light) pairs as rows
         out = []
-        for j in range(len(js)):
+        for j in range(n):
             i = (direct[:, j] > 0.0).nonzero()[0]
-            near = shading.within_radius(Pb[i], casting, j)       # beyond the light's radius: unlit anyway
-            if near is not None:
-                i = i[near]
-            out.append((i + sl.start, unit[i, j], length[i, j]))
+            # beyond the light's radius: unlit anyway. within_radius measures each distance its own way
+            # (radiance's), a few ulps from these: a block far inside the radius needs none of them
+            if len(i) and not length[:, j].max() < reach[j] * (1.0 - 1e-9):
+                near = shading.within_radius(shading.take_rows(Pb, i), casting, j)
+                if near is not None:
+                    i = i[near]
+            pair = i * n + j
+            out.append((i + sl.start, np.take(units, pair, axis=0), lengths.take(pair)))
         return out
 
     done = blocks.run(part, parts, threads) if js and S else []
