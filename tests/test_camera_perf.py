@@ -251,3 +251,27 @@ def test_a_light_subset_keeps_every_value():
                  "beam_width", "cut_off_angle", "radius"):
         assert getattr(sub, name).tobytes() == getattr(lights, name)[[2, 0]].tobytes()
         assert not getattr(sub, name).flags.writeable
+
+
+def test_radiance_channels_stay_apart_after_white_lights_share_their_sums():
+    """White (or grey) lights add to one array the three equal channel sums share; a coloured light
+    after them gives each channel its own: swapping every light's colour channels and the albedo's
+    must swap the radiance's channels, bit for bit, in any order of the lights."""
+    rng = np.random.default_rng(5)
+    P, N = _points(5000, 6)
+    A = rng.random((5000, 3))
+    white = Light(LightKind.POINT, position=(0.5, -0.5, 1.0), intensity=2.0, attenuation=(0.0, 0.0, 1.0))
+    grey = Light(LightKind.DIRECTIONAL, direction=(0.3, 0.2, -1.0), intensity=0.6, ambient_intensity=0.2,
+                 color=(0.5, 0.5, 0.5))
+    tint = (1.0, 0.9, 0.8)
+    swap = [2, 0, 1]
+    def arrays(order, colour):
+        return LightArrays.from_lights([Light(LightKind.SPOT, position=(-1.0, 0.0, 0.8), direction=(1.0, 0.0, -0.5),
+                                              intensity=1.0, beam_width=0.3, cut_off_angle=0.6, color=colour)
+                                        if x == "tinted" else x for x in order])
+
+    for order in ([white, "tinted", grey], [grey, white, "tinted"], ["tinted", white, grey]):
+        L = shading.radiance(P, N, A, arrays(order, tint))
+        Ls = shading.radiance(P, N, A[:, swap], arrays(order, tuple(tint[k] for k in swap)))
+        assert np.ascontiguousarray(L[:, swap]).tobytes() == np.ascontiguousarray(Ls).tobytes()
+        assert not np.array_equal(L[:, 0], L[:, 1])

@@ -93,7 +93,10 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                    ) -> np.ndarray:
     """:func:`radiance` of a block of rows."""
     S = len(P)
-    acc = np.zeros((3, S))    # per channel: a (S, 1) x (3,) broadcast is several times slower in numpy
+    # per channel (a (S, 1) x (3,) broadcast is several times slower in numpy); channels whose sums
+    # are equal so far (white lights) share one array: one pass adds a light to all of them
+    zero = np.zeros(S)
+    acc = [zero, zero, zero]
     px, py, pz = P[:, 0], P[:, 1], P[:, 2]
     nx, ny, nz = N[:, 0], N[:, 1], N[:, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -106,7 +109,8 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                 c += ny * dy
                 c += nz * dz
                 direct = np.maximum(c, 0.0)
-                direct *= intensity
+                if intensity != 1.0:                   # x·1 is x
+                    direct *= intensity
                 att: np.ndarray | None = None
                 length = None
             else:
@@ -115,13 +119,15 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                 att = 1.0 / (a1 + length * (a2 + a3 * length)) if (a2 or a3) else None
                 if att is None and a1 != 1.0:
                     att = np.full(S, 1.0 / a1)
-                safe = np.where(length > 0.0, length, 1.0)
+                away = length > 0.0
+                safe = np.where(away, length, 1.0)
                 c = nx * vx
                 c += ny * vy
                 c += nz * vz
                 c /= safe
                 direct = np.maximum(c, 0.0)
-                direct *= intensity
+                if intensity != 1.0:
+                    direct *= intensity
                 if kind == LightKind.SPOT:
                     # alpha = atan2(|L x R|, L.R) as the LightSensor; outside [bw, co] only its side matters
                     rx, ry, rz = (-float(v) for v in lights.direction[j])
@@ -143,12 +149,18 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
             weight = direct
             weight += ambient
             if att is not None:
-                if length is not None and not np.all(length > 0.0):     # a point at the light: att may be inf
+                if length is not None and not away.all():     # a point at the light: att may be inf
                     weight = np.where(weight == 0.0, 0.0, att * weight)    # a zero term stays zero
                 else:
                     weight *= att
-            for ch in range(3):
-                acc[ch] += weight * float(lights.color[j][ch])
+            color = [float(v) for v in lights.color[j]]
+            if acc[0] is acc[1] is acc[2] and color[0] == color[1] == color[2]:
+                acc[0] += weight if color[0] == 1.0 else weight * color[0]
+            else:
+                acc = [acc[0], acc[1] if acc[1] is not acc[0] else acc[1].copy(),
+                       acc[2] if acc[2] is not acc[0] and acc[2] is not acc[1] else acc[2].copy()]
+                for ch in range(3):
+                    acc[ch] += weight if color[ch] == 1.0 else weight * color[ch]
     out = np.empty((S, 3))
     for ch in range(3):
         np.multiply(A[:, ch], acc[ch], out=out[:, ch])
