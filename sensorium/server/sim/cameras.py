@@ -215,8 +215,8 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
     t_near, t_far = limits
     tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
     out = np.zeros((n, 3))            # when a ray first goes through a semi-transparent surface
-    weight = np.ones(n)
-    rows = np.arange(n)
+    weight = None                     # what each ray's next surface adds: 1 until a surface lets some through
+    rows = np.arange(0)               # the rays going on past the last layer's surfaces
     for layer in range(MAX_LAYERS + 1):
         if layer == 0:
             D, hits = dirs, first
@@ -234,6 +234,7 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
         else:
             miss = (~hit).nonzero()[0]
             if len(miss):
+                assert weight is not None
                 rm = rows[miss]
                 shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], background))
         k = hit.nonzero()[0]
@@ -297,6 +298,8 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
                     return L
                 shading.set_rows(out, hit, L)
                 break
+            if weight is None:
+                weight = np.ones(n)
             last = layer == MAX_LAYERS
             a = np.where(last, 0.0, tau[seen])
             share = weight[rr] * (1.0 - a)
@@ -308,6 +311,8 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
         go = clear & (layer < MAX_LAYERS)
         if not go.any():
             break
+        if weight is None:       # no surface seen yet (clear texels only): every weight still 1
+            weight = np.ones(n)
         assert inside is not None and tn is not None
         g = go.nonzero()[0]
         rg, sg = r[g], s[g]
