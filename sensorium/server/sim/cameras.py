@@ -274,10 +274,8 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
             whole = len(kk) == len(D)
             Dk = D if whole else shading.take_rows(D, kk)
             tk = t if whole else t.take(kk)
-            P = np.empty((len(kk), 3))          # origin + t D, column by column
-            for ch in range(3):
-                np.multiply(tk, Dk[:, ch], out=P[:, ch])
-                P[:, ch] += origin[ch]
+            P = np.multiply(Dk, tk[:, None])     # origin + t D: each value's product, then its sum
+            P += origin
             N = normal if whole else shading.take_rows(normal, kk)
             dot = N[:, 0] * Dk[:, 0]            # N·D, summed as (x + y) + z
             dot += N[:, 1] * Dk[:, 1]
