@@ -65,6 +65,28 @@ def test_shadow_rays_are_the_one_pass_choice_on_any_threads():
             assert length.tobytes() == want[j][2].tobytes()
 
 
+def test_a_radius_a_hair_inside_the_farthest_point_still_cuts_it():
+    """A block whose points all lie well inside a light's radius skips radiance's distances; one
+    an ulp inside the farthest point must still cut that point (and only it), on any threads."""
+    q = np.array([0.3, -0.2, 0.9])
+    P, _ = _points(2 * shading.BLOCK + 77, 3)
+    P[7] = (0.0, 0.0, 0.0)
+    N = q - P
+    N /= np.linalg.norm(N, axis=1)[:, None]          # every point faces the light
+    v = q - P
+    far = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])     # radiance's distances
+    top = int(np.argmax(far))
+    shadows = np.array([True])
+    for radius, cut in ((float(np.nextafter(far[top], 0.0)), 1), (float(far[top]), 0), (1e3, 0)):
+        lights = LightArrays.from_lights([Light(LightKind.POINT, position=tuple(q), intensity=1.0, radius=radius)])
+        want = _one_pass(P, N, lights, shadows)
+        assert len(want[0][0]) == len(P) - cut and (cut == 0 or top not in want[0][0])
+        for threads in (1, 2):
+            got = shadow_rays(P, N, lights, shadows, threads)
+            assert got[0][0].tobytes() == want[0][0].tobytes()
+            assert got[0][1].tobytes() == want[0][1].tobytes() and got[0][2].tobytes() == want[0][2].tobytes()
+
+
 def test_shadow_rays_of_no_points_and_no_shadow_lights():
     lights = _lights()
     P, N = _points(10, 2)
@@ -229,6 +251,30 @@ def test_a_light_subset_keeps_every_value():
                  "beam_width", "cut_off_angle", "radius"):
         assert getattr(sub, name).tobytes() == getattr(lights, name)[[2, 0]].tobytes()
         assert not getattr(sub, name).flags.writeable
+
+
+def test_radiance_channels_stay_apart_after_white_lights_share_their_sums():
+    """White (or grey) lights add to one array the three equal channel sums share; a coloured light
+    after them gives each channel its own: swapping every light's colour channels and the albedo's
+    must swap the radiance's channels, bit for bit, in any order of the lights."""
+    rng = np.random.default_rng(5)
+    P, N = _points(5000, 6)
+    A = rng.random((5000, 3))
+    white = Light(LightKind.POINT, position=(0.5, -0.5, 1.0), intensity=2.0, attenuation=(0.0, 0.0, 1.0))
+    grey = Light(LightKind.DIRECTIONAL, direction=(0.3, 0.2, -1.0), intensity=0.6, ambient_intensity=0.2,
+                 color=(0.5, 0.5, 0.5))
+    tint = (1.0, 0.9, 0.8)
+    swap = [2, 0, 1]
+    def arrays(order, colour):
+        return LightArrays.from_lights([Light(LightKind.SPOT, position=(-1.0, 0.0, 0.8), direction=(1.0, 0.0, -0.5),
+                                              intensity=1.0, beam_width=0.3, cut_off_angle=0.6, color=colour)
+                                        if x == "tinted" else x for x in order])
+
+    for order in ([white, "tinted", grey], [grey, white, "tinted"], ["tinted", white, grey]):
+        L = shading.radiance(P, N, A, arrays(order, tint))
+        Ls = shading.radiance(P, N, A[:, swap], arrays(order, tuple(tint[k] for k in swap)))
+        assert np.ascontiguousarray(L[:, swap]).tobytes() == np.ascontiguousarray(Ls).tobytes()
+        assert not np.array_equal(L[:, 0], L[:, 1])
 
 
 # ------------------------------------------- a camera inside its own robot's bounding sphere

@@ -40,7 +40,7 @@ from .light import LightArrays, LightKind
 from .noise import gaussian
 
 __all__ = ["GAMMA", "FOG_TYPES", "background_radiance", "srgb_to_linear", "radiance", "within_radius", "fog_weight", "fog",
-           "tone_map", "to_bytes", "take_rows", "add_to_rows", "scaled_rows"]
+           "tone_map", "to_bytes", "resolve_bgra", "take_rows", "add_to_rows", "set_rows", "scaled_rows"]
 
 GAMMA = 2.2
 """Webots' ``hdr_resolve.frag`` gamma."""
@@ -93,7 +93,10 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                    ) -> np.ndarray:
     """:func:`radiance` of a block of rows."""
     S = len(P)
-    acc = np.zeros((3, S))    # per channel: a (S, 1) x (3,) broadcast is several times slower in numpy
+    # per channel (a (S, 1) x (3,) broadcast is several times slower in numpy); channels whose sums
+    # are equal so far (white lights) share one array: one pass adds a light to all of them
+    zero = np.zeros(S)
+    acc = [zero, zero, zero]
     px, py, pz = P[:, 0], P[:, 1], P[:, 2]
     nx, ny, nz = N[:, 0], N[:, 1], N[:, 2]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -106,7 +109,8 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                 c += ny * dy
                 c += nz * dz
                 direct = np.maximum(c, 0.0)
-                direct *= intensity
+                if intensity != 1.0:                   # x·1 is x
+                    direct *= intensity
                 att: np.ndarray | None = None
                 length = None
             else:
@@ -115,13 +119,15 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
                 att = 1.0 / (a1 + length * (a2 + a3 * length)) if (a2 or a3) else None
                 if att is None and a1 != 1.0:
                     att = np.full(S, 1.0 / a1)
-                safe = np.where(length > 0.0, length, 1.0)
+                away = length > 0.0
+                safe = np.where(away, length, 1.0)
                 c = nx * vx
                 c += ny * vy
                 c += nz * vz
                 c /= safe
                 direct = np.maximum(c, 0.0)
-                direct *= intensity
+                if intensity != 1.0:
+                    direct *= intensity
                 if kind == LightKind.SPOT:
                     # alpha = atan2(|L x R|, L.R) as the LightSensor; outside [bw, co] only its side matters
                     rx, ry, rz = (-float(v) for v in lights.direction[j])
@@ -143,12 +149,18 @@ def _radiance_rows(P: np.ndarray, N: np.ndarray, A: np.ndarray, lights: LightArr
             weight = direct
             weight += ambient
             if att is not None:
-                if length is not None and not np.all(length > 0.0):     # a point at the light: att may be inf
+                if length is not None and not away.all():     # a point at the light: att may be inf
                     weight = np.where(weight == 0.0, 0.0, att * weight)    # a zero term stays zero
                 else:
                     weight *= att
-            for ch in range(3):
-                acc[ch] += weight * float(lights.color[j][ch])
+            color = [float(v) for v in lights.color[j]]
+            if acc[0] is acc[1] is acc[2] and color[0] == color[1] == color[2]:
+                acc[0] += weight if color[0] == 1.0 else weight * color[0]
+            else:
+                acc = [acc[0], acc[1] if acc[1] is not acc[0] else acc[1].copy(),
+                       acc[2] if acc[2] is not acc[0] and acc[2] is not acc[1] else acc[2].copy()]
+                for ch in range(3):
+                    acc[ch] += weight if color[ch] == 1.0 else weight * color[ch]
     out = np.empty((S, 3))
     for ch in range(3):
         np.multiply(A[:, ch], acc[ch], out=out[:, ch])
@@ -243,6 +255,48 @@ def to_bytes(values: np.ndarray, noise: float = 0.0, rng: np.random.Generator | 
     return np.floor(x, out=x).astype(np.uint8)
 
 
+def resolve_bgra(radiance: np.ndarray, exposure: float, noise: float = 0.0, rng: np.random.Generator | None = None,
+                 samples: int = 1) -> np.ndarray:
+    """A camera's pixels (M, 4) BGRA uint8 (alpha 255) from the radiance (samples·M, 3) of its
+    rays (sample-major, as ``pixel_directions`` makes them): the samples' mean, :func:`tone_map`,
+    :func:`to_bytes`, on blocks of pixels that stay in the CPU's cache: the same operations per
+    value in the same order, so the same bytes as those calls on the whole image (the noise drawn
+    first, all of it, in C order as ``to_bytes`` draws it)."""
+    L = np.asarray(radiance, dtype=np.float64).reshape(samples, -1, 3)
+    M = L.shape[1]
+    draws = float(noise) * gaussian(rng, M * 3).reshape(M, 3) if noise > 0.0 and rng is not None else None
+    out = np.empty((M, 4), dtype=np.uint8)
+    out[:, 3] = 255
+    x = np.empty((min(M, BLOCK), 3))
+    with np.errstate(over="ignore"):
+        for a in range(0, M, BLOCK):
+            b = min(M, a + BLOCK)
+            v = x[:b - a]
+            if samples > 1:        # numpy's mean over the samples: ((L0 + L1) + L2) + ... then / S
+                np.add(L[0, a:b], L[1, a:b], out=v)
+                for i in range(2, samples):
+                    v += L[i, a:b]
+                np.true_divide(v, samples, out=v)
+                np.maximum(v, 0.0, out=v)
+            else:
+                np.maximum(L[0, a:b], 0.0, out=v)
+            np.negative(v, out=v)            # tone_map
+            v *= float(exposure)
+            np.exp(v, out=v)
+            np.subtract(1.0, v, out=v)
+            np.power(v, 1.0 / GAMMA, out=v)
+            if draws is not None:            # to_bytes
+                v += draws[a:b]
+                np.clip(v, 0.0, 1.0, out=v)
+            np.clip(v, 0.0, 1.0, out=v)
+            v *= 255.0
+            v += 0.5
+            np.floor(v, out=v)
+            for ch in range(3):              # RGB → BGR
+                out[a:b, 2 - ch] = v[:, ch]
+    return out
+
+
 # Rows of (n, 3) float64 arrays, as an image's shading gathers and scatters them: numpy's fancy
 # indexing of such rows is ~3x slower than np.take and than moving each row as one 24-byte item.
 _ROW = np.dtype((np.void, 24))
@@ -260,6 +314,14 @@ def add_to_rows(out: np.ndarray, rows: np.ndarray, values: np.ndarray) -> None:
     cur = items.take(rows).view(np.float64).reshape(-1, 3)
     cur += values
     items[rows] = cur.view(_ROW).reshape(-1)
+
+
+def set_rows(out: np.ndarray, where: np.ndarray, values: np.ndarray) -> None:
+    """``out[where] = values`` for an (n, 3) C-contiguous float64 ``out``, a bool mask ``where``
+    (n,) and ``values`` one row (3,) or one row per True (m, 3): moved as 24-byte items (a 2-D
+    mask assignment is several times slower)."""
+    rows = np.ascontiguousarray(values, dtype=np.float64).view(_ROW).reshape(-1)
+    out.view(_ROW).reshape(-1)[where] = rows[0] if values.ndim == 1 else rows
 
 
 def scaled_rows(v: np.ndarray, vec) -> np.ndarray:

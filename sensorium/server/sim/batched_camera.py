@@ -413,13 +413,8 @@ class CameraDevices(PixelDevices):
         if S > 1:     # supersampling, per copy as the single camera averages its image's rays
             per = out.reshape(k, S * dev.height * dev.width, 3)
             out = np.concatenate([per[q].reshape(S, -1, 3).mean(axis=0) for q in range(k)])
-        v = shading.tone_map(out, dev.exposure).reshape(k, dev.height, dev.width, 3)
         rng = None
         if cfg.noise > 0:
-            rng = _Draws(sim.noise, copies.tolist(), sim._noise_col[("Camera", col)], [v[0].size] * k)
-        rgb = shading.to_bytes(v, cfg.noise, rng)      # type: ignore[arg-type]
-        img = self.images[col]
-        img[copies, :, :, 0] = rgb[..., 2]
-        img[copies, :, :, 1] = rgb[..., 1]
-        img[copies, :, :, 2] = rgb[..., 0]
-        img[copies, :, :, 3] = 255
+            rng = _Draws(sim.noise, copies.tolist(), sim._noise_col[("Camera", col)], [dev.height * dev.width * 3] * k)
+        bgra = shading.resolve_bgra(out, dev.exposure, cfg.noise, rng)      # type: ignore[arg-type]
+        self.images[col][copies] = bgra.reshape(k, dev.height, dev.width, 4)

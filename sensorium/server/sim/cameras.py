@@ -215,8 +215,8 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
     t_near, t_far = limits
     tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
     out = np.zeros((n, 3))            # when a ray first goes through a semi-transparent surface
-    weight = np.ones(n)
-    rows = np.arange(n)
+    weight = None                     # what each ray's next surface adds: 1 until a surface lets some through
+    rows = np.arange(0)               # the rays going on past the last layer's surfaces
     for layer in range(MAX_LAYERS + 1):
         if layer == 0:
             D, hits = dirs, first
@@ -227,14 +227,20 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
         t, shape, normal = hits.distance, hits.shape, hits.normal
         assert shape is not None and normal is not None
         hit = np.isfinite(t)
-        miss = (~hit).nonzero()[0]
-        if len(miss):
-            rm = rows[miss]
-            shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], background))
+        if layer == 0:             # every weight 1, every sum 0: the sky is 0 + 1·background, filled by mask
+            sky = np.zeros(3)
+            sky += shading.scaled_rows(np.ones(1), background)[0]
+            shading.set_rows(out, ~hit, sky)
+        else:
+            miss = (~hit).nonzero()[0]
+            if len(miss):
+                assert weight is not None
+                rm = rows[miss]
+                shading.add_to_rows(out, rm, shading.scaled_rows(weight[rm], background))
         k = hit.nonzero()[0]
         if len(k) == 0:
             break
-        r, s = rows[k], shape[k]
+        r, s = (k, shape if len(k) == n else shape[k]) if layer == 0 else (rows[k], shape[k])
         tau = transparency[s]
         clear = tau > 0.0
         textured = None                # the hits on shapes with transparent texels (an alpha world only)
@@ -263,23 +269,35 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
             if layer < MAX_LAYERS:             # a clear texel adds nothing: not shaded
                 seen = seen[tau[seen] < 1.0]
         if len(seen):
-            kk, rr = k[seen], r[seen]
+            every = len(seen) == len(k)
+            kk, rr, ss = (k, r, s) if every else (k[seen], r[seen], s[seen])
             whole = len(kk) == len(D)
             Dk = D if whole else shading.take_rows(D, kk)
             tk = t if whole else t.take(kk)
-            P = np.empty((len(kk), 3))          # origin + t D, column by column
-            for ch in range(3):
-                np.multiply(tk, Dk[:, ch], out=P[:, ch])
-                P[:, ch] += origin[ch]
+            P = np.multiply(Dk, tk[:, None])     # origin + t D: each value's product, then its sum
+            P += origin
             N = normal if whole else shading.take_rows(normal, kk)
-            back = (N[:, 0] * Dk[:, 0] + N[:, 1] * Dk[:, 1] + N[:, 2] * Dk[:, 2]) > 0.0
+            dot = N[:, 0] * Dk[:, 0]            # N·D, summed as (x + y) + z
+            dot += N[:, 1] * Dk[:, 1]
+            dot += N[:, 2] * Dk[:, 2]
+            back = dot > 0.0
             if back.any():         # facing the camera
                 bk = back.nonzero()[0]
                 N = N.copy() if whole else N
                 N[bk] = np.negative(shading.take_rows(N, bk))
-            L = surface(s[seen], P, N, Dk, tk)
+            L = surface(ss, P, N, Dk, tk)
             if fog is not None:           # Webots mixes each surface (not the sky) with the fog colour
                 L = shading.fog(L, tk, *fog)
+            if layer == 0 and not any_clear and not tau.any():
+                # nothing seen through (the common opaque image): each share is 1 (1 - 0), each sum
+                # 0 + L; no ray goes on, so no weight is needed again
+                np.add(L, 0.0, out=L)           # 0 + L (as the sum: -0.0 becomes 0.0)
+                if whole:
+                    return L
+                shading.set_rows(out, hit, L)
+                break
+            if weight is None:
+                weight = np.ones(n)
             last = layer == MAX_LAYERS
             a = np.where(last, 0.0, tau[seen])
             share = weight[rr] * (1.0 - a)
@@ -291,6 +309,8 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
         go = clear & (layer < MAX_LAYERS)
         if not go.any():
             break
+        if weight is None:       # no surface seen yet (clear texels only): every weight still 1
+            weight = np.ones(n)
         assert inside is not None and tn is not None
         g = go.nonzero()[0]
         rg, sg = r[g], s[g]
@@ -538,14 +558,9 @@ class Camera(Device):
         rays = self._prepare()
         L = self._render(pose, rays, counters)
         c = self.config
-        S = len(self._samples)
-        if S > 1:      # supersampling: the mean radiance of the pixel's rays
-            L = L.reshape(S, -1, 3).mean(axis=0)
-        v = shading.tone_map(L, self.exposure).reshape(c.height, c.width, 3)
-        rgb = shading.to_bytes(v, c.noise, self.rng if c.noise > 0 else None)
-        image = np.empty((c.height, c.width, 4), dtype=np.uint8)
-        image[:, :, 0], image[:, :, 1], image[:, :, 2], image[:, :, 3] = rgb[:, :, 2], rgb[:, :, 1], rgb[:, :, 0], 255
-        self.image = image
+        # supersampling: the mean radiance of the pixel's rays; then the resolve, the noise, BGRA
+        bgra = shading.resolve_bgra(L, self.exposure, c.noise, self.rng if c.noise > 0 else None, len(self._samples))
+        self.image = bgra.reshape(c.height, c.width, 4)
 
     def _render(self, pose: Pose, rays: MountedRays, counters: Any) -> np.ndarray:
         """The radiance (N, 3) along every ray (:func:`composite`); the device's own shapes are
@@ -600,7 +615,7 @@ class Camera(Device):
         for j, (i, unit, length) in shadow_rays(P, N, lights, shadows, engine.threads).items():
             if len(i) == 0:
                 continue
-            hits = engine.cast(P[i], unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1, distance_only=True)
+            hits = engine.cast(shading.take_rows(P, i), unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1, distance_only=True)
             counters["rays_camera"] += len(i)
             counters["cast_calls"] += 1
             lit[i, j] = ~(hits.distance <= length)
@@ -621,16 +636,25 @@ def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, sh
     # the shadow-casting lights only (each light's values are its own: the others change none of them)
     casting = lights if len(js) == len(lights) else lights.subset(js)
 
+    n = len(casting)
+    reach = [math.inf if int(casting.kind[j]) == light_math.LightKind.DIRECTIONAL else float(casting.radius[j])
+             for j in range(n)]
+
     def part(sl: slice) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         Pb = P[sl]
         direct, unit, length = light_math.direct_and_segments(Pb, N[sl], casting)
+        units, lengths = unit.reshape(-1, 3), length.reshape(-1)      # (point, light) pairs as rows
         out = []
-        for j in range(len(js)):
+        for j in range(n):
             i = (direct[:, j] > 0.0).nonzero()[0]
-            near = shading.within_radius(Pb[i], casting, j)       # beyond the light's radius: unlit anyway
-            if near is not None:
-                i = i[near]
-            out.append((i + sl.start, unit[i, j], length[i, j]))
+            # beyond the light's radius: unlit anyway. within_radius measures each distance its own way
+            # (radiance's), a few ulps from these: a block far inside the radius needs none of them
+            if len(i) and not length[:, j].max() < reach[j] * (1.0 - 1e-9):
+                near = shading.within_radius(shading.take_rows(Pb, i), casting, j)
+                if near is not None:
+                    i = i[near]
+            pair = i * n + j
+            out.append((i + sl.start, np.take(units, pair, axis=0), lengths.take(pair)))
         return out
 
     done = blocks.run(part, parts, threads) if js and S else []
