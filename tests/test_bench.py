@@ -61,3 +61,20 @@ def test_plots_when_matplotlib_is_installed(report) -> None:
     out, doc = report
     pngs = [out / p for p in doc["plots"].values()]
     assert pngs and all(p.is_file() and p.read_bytes()[:4] == b"\x89PNG" for p in pngs)
+
+
+def test_a_section_measured_again_keeps_the_headers_run_and_names_its_machine(report, tmp_path) -> None:
+    """``--only`` on another machine (or day): the header still says when and where the full run was,
+    the section says its own, and a line says the sections' machines differ."""
+    out, doc = report
+    doc = json.loads(json.dumps(doc))
+    doc["generated"], doc["machine"]["cpu"] = "2000-01-01 00:00 UTC", "Elsewhere CPU"
+    (tmp_path / "benchmarks.json").write_text(json.dumps(doc))
+    assert main(["bench", "--quick", "--only", "accuracy", "--out", str(tmp_path)]) == 0
+    again = json.loads((tmp_path / "benchmarks.json").read_text())
+    assert (again["generated"], again["machine"]["cpu"]) == ("2000-01-01 00:00 UTC", "Elsewhere CPU")
+    cpu = again["sections"]["accuracy"]["machine"]["cpu"]
+    assert cpu != "Elsewhere CPU"
+    md = (tmp_path / "benchmarks.md").read_text()
+    assert "Measured 2000-01-01 00:00 UTC on Elsewhere CPU" in md
+    assert "Sections measured again since on another machine: `accuracy` (" in md and f" on {cpu})" in md

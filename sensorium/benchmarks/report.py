@@ -153,6 +153,12 @@ def markdown(doc: dict) -> str:
              f"load average at start {m.get('load_average', '?')} (other jobs shared this machine: every ratio below "
              "compares things measured in the same run, interleaved where it matters). Full run: "
              f"{doc.get('elapsed_s', 0):.0f} s. Machine-readable results: [`benchmarks.json`](benchmarks.json).\n")
+    again = [f"`{name}` ({s.get('measured_at', '?')} on {s['machine'].get('cpu', '?')})"
+             for name in ORDER if (s := doc.get("sections", {}).get(name)) and s.get("machine")
+             and s["machine"].get("cpu") != m.get("cpu")]
+    if again:      # `--only` runs on another machine: compare within a section, not across them
+        L.append(f"Sections measured again since on another machine: {', '.join(again)}; compare figures "
+                 "within one section (its ratios), not across sections.\n")
     if "plots_note" in doc:
         L.append(f"_{doc['plots_note']}_\n")
     secs = doc.get("sections", {})
@@ -184,6 +190,8 @@ def markdown(doc: dict) -> str:
         s = secs[name]
         L.append(f"## {s['title']}\n")
         meta = f"_Section `{name}`: measured {s.get('measured_at', '?')}"
+        if s.get("machine") and s["machine"].get("cpu") != m.get("cpu"):
+            meta += f" on {s['machine'].get('cpu', '?')}"
         meta += f" in {s.get('elapsed_s', 0):.0f} s" + (" (quick run)" if s.get("quick") else "") + "._\n"
         L.append(meta)
         if s.get("intro"):

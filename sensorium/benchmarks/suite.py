@@ -37,7 +37,10 @@ def run_suite(out: Path, only: Sequence[str] | None, *, quick: bool, plots: bool
     names = list(dict.fromkeys(only or SECTIONS))
     cfg = Config(quick=quick, log=log)
     doc = report.load(out) if only else {}
-    doc.update({"schema": report.SCHEMA, "generated": _now(), "machine": machine(), "quick": quick})
+    here = machine()
+    doc["schema"] = report.SCHEMA
+    if not only or "generated" not in doc:     # the header keeps the full run's date and machine
+        doc.update({"generated": _now(), "machine": here, "quick": quick})
     if not only:
         doc["command"] = command
     else:
@@ -58,7 +61,7 @@ def run_suite(out: Path, only: Sequence[str] | None, *, quick: bool, plots: bool
             continue
         sec.elapsed_s = time.perf_counter() - t0
         js = sec.to_json()
-        js.update({"measured_at": _now(), "quick": quick, "command": command, "_fresh": True})
+        js.update({"measured_at": _now(), "machine": here, "quick": quick, "command": command, "_fresh": True})
         sections[name] = js
         log(f"sensorium bench: {name} done in {sec.elapsed_s:.0f} s")
     if not only:
