@@ -38,6 +38,17 @@ def _seeded(w, seed: int) -> Simulation:
         update={"random_seed": seed})}))
 
 
+def _same_poses(singles, batched, names, t: int) -> None:
+    """Every copy's robots in each batched simulation are at their single simulation's pose, bit for bit."""
+    for c, single in enumerate(singles):
+        for name in names:
+            p = single.robot(name).pose
+            for k, b in enumerate(batched):
+                r = b.slot(name)
+                assert b.pos[c, r].tobytes() == p.translation.tobytes(), (t, c, name, k)
+                assert b.rot[c, r].tobytes() == p.rotation.tobytes(), (t, c, name, k)
+
+
 @pytest.mark.parametrize("contact", [True, False])
 def test_off_centre_robots_take_the_c_pass_and_it_gives_the_numpy_and_single_bits(contact):
     if packets.library() is None:
@@ -68,14 +79,8 @@ def test_off_centre_robots_take_the_c_pass_and_it_gives_the_numpy_and_single_bit
             singles[c].step()
         c_pass.step()
         numpy_pass.step()
-        for c in range(n):
-            for name in NAMES:
-                p = singles[c].robot(name).pose
-                for b in (c_pass, numpy_pass):
-                    r = b.slot(name)
-                    assert b.pos[c, r].tobytes() == p.translation.tobytes(), (t, c, name, b is c_pass)
-                    assert b.rot[c, r].tobytes() == p.rotation.tobytes(), (t, c, name, b is c_pass)
-                pressed += bool(singles[c].robot(name).pressing)
+        _same_poses(singles, (c_pass, numpy_pass), NAMES, t)
+        pressed += sum(bool(singles[c].robot(name).pressing) for c in range(n) for name in NAMES)
     # the C pass did the stepping: made once and used (no numpy drive for these robots)
     assert not c_pass._numpy_drives and isinstance(c_pass.__dict__.get("_drive_step"), packets.DriveStep)
     assert c_pass.counters["contacts"] == numpy_pass.counters["contacts"]
@@ -128,11 +133,5 @@ def test_a_world_with_omni_and_mecanum_robots_steps_its_two_wheel_robots_in_c(mo
         monkeypatch.setattr(packets, "drive_moves", lambda *a: None)
         without.step()
         monkeypatch.setattr(packets, "drive_wheels", real_wheels)
-        for c in range(n):
-            for name in MIXED:
-                p = singles[c].robot(name).pose
-                for b in (with_c, without):
-                    r = b.slot(name)
-                    assert b.pos[c, r].tobytes() == p.translation.tobytes(), (t, c, name, b is with_c)
-                    assert b.rot[c, r].tobytes() == p.rotation.tobytes(), (t, c, name, b is with_c)
+        _same_poses(singles, (with_c, without), MIXED, t)
     assert moved_slots == {with_c.slot("boe"), with_c.slot("skid")}

@@ -328,6 +328,27 @@ def test_a_lone_motorised_turntable_is_no_failed_car(tmp_path: Path) -> None:
     assert ds.translation == pytest.approx([0.0, 0.05, 0.063], abs=1e-12)
 
 
+def _two_wheels_and_a_joint(tmp_path: Path, name: str, joint: str, motor: str) -> Simulation:
+    """A robot of two wheels and ``joint`` (a motorised vertical hinge, ``motor``, that must steer
+    nothing): loaded with its differential drive, no drive warning, the joint's one line, and the
+    simulation's drive and joints so."""
+    p = write(tmp_path, f'Robot {{ name "{name}" children [\n' + joint + wheel("left wheel", 0, Y)
+              + wheel("right wheel", 0, -Y) + '] }\n')
+    w = load_world(p)
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive is None and robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert not [x for x in w.warnings if "drive" in x], w.warnings
+    assert [x.split(": ", 1)[1] for x in w.warnings if motor in x] == [
+        f"HingeJoint motor '{motor}' is no wheel and steers none (its end point holds no wheel): its joint moves "
+        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
+        "the joint with it"]
+    sim = Simulation(w)
+    drive = sim.robot(name)
+    assert sorted(drive.drive.motors) == ["left wheel", "right wheel"] and sorted(drive.joints) == [motor]
+    return sim
+
+
 def test_a_pan_head_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Path) -> None:
     """A two-wheel robot with a pan head (a motorised hinge about z whose end point, a box, holds a
     camera), as a TIAGo's head or an arm's base joint on a mobile robot: the vertical hinge was
@@ -339,20 +360,8 @@ def test_a_pan_head_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Path) -> 
             '  device [ RotationalMotor { name "head pan" maxVelocity 100 maxTorque 100000 } ]\n'
             '  endPoint Solid { translation 0 0 0.2 children [ Shape { geometry Box { size 0.05 0.05 0.05 } }\n'
             '    Camera { translation 0.1 0 0 } ] } }\n')
-    p = write(tmp_path, 'Robot { name "rover" children [\n' + head + wheel("left wheel", 0, Y)
-              + wheel("right wheel", 0, -Y) + '] }\n')
-    w = load_world(p)
-    (robot,) = w.world.robots
-    assert robot.ackermann_drive is None and robot.differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
-    assert not [x for x in w.warnings if "drive" in x], w.warnings
-    assert [x.split(": ", 1)[1] for x in w.warnings if "head pan" in x] == [
-        "HingeJoint motor 'head pan' is no wheel and steers none (its end point holds no wheel): its joint moves "
-        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
-        "the joint with it"]
-    sim = Simulation(w)
+    sim = _two_wheels_and_a_joint(tmp_path, "rover", head, "head pan")
     rover = sim.robot("rover")
-    assert sorted(rover.drive.motors) == ["left wheel", "right wheel"] and sorted(rover.joints) == ["head pan"]
     rover.motor("head pan").set_position(math.pi / 2)
     sim.step()
     assert sim.device("rover/camera").world_pose(rover.pose).translation == pytest.approx([0.0, 0.1, 0.2], abs=1e-12)
@@ -651,20 +660,8 @@ def test_a_compass_needle_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Pat
               '    Shape { geometry Cylinder { height 0.1 radius 0.005 } }\n'
               '    Pose { translation 0 0.05 0 children [ Shape { geometry Cone { bottomRadius 0.01 height 0.02 } } ] }\n'
               '    DistanceSensor { translation 0.06 0 0 } ] } }\n')
-    p = write(tmp_path, 'Robot { name "compass bot" children [\n' + needle + wheel("left wheel", 0, Y)
-              + wheel("right wheel", 0, -Y) + '] }\n')
-    w = load_world(p)
-    (robot,) = w.world.robots
-    assert robot.ackermann_drive is None and robot.differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
-    assert not [x for x in w.warnings if "drive" in x], w.warnings
-    assert [x.split(": ", 1)[1] for x in w.warnings if "arrow" in x] == [
-        "HingeJoint motor 'arrow' is no wheel and steers none (its end point holds no wheel): its joint moves "
-        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
-        "the joint with it"]
-    sim = Simulation(w)
+    sim = _two_wheels_and_a_joint(tmp_path, "compass bot", needle, "arrow")
     bot = sim.robot("compass bot")
-    assert sorted(bot.drive.motors) == ["left wheel", "right wheel"] and sorted(bot.joints) == ["arrow"]
     for name in ("left wheel", "right wheel"):
         bot.motor(name).set_position(math.inf)
         bot.motor(name).set_velocity(5.0)
