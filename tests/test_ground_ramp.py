@@ -202,14 +202,18 @@ def _world(seed: int) -> wm.World:
         "world_info": {"random_seed": seed},
         "solids": [FLOOR, _ramp(), _ramp("high", lift=0.05, y=3.0)],
         "robots": [_robot("a", (0.2, 0.1, HALF), 0.05), _robot("b", (1.5, -0.2, _ramp_z(1.5) + HALF), 3.0),
-                   _robot("c", (0.3, 3.1, HALF), 0.02)]})
+                   _robot("c", (0.3, 3.1, HALF), 0.02),
+                   {**_robot("d", (2.4, -0.3, 1.0), 1.0), "differential_drive": {**DRIVE, "wheel_bottom": -0.05}},
+                   {**_robot("e", (1.2, 0.3, _ramp_z(1.2) + HALF)),
+                    "pose": {"translation": [1.2, 0.3, _ramp_z(1.2) + HALF], "rotation": [0, 1, 0, -A]}}]})
 
 
 @pytest.mark.parametrize("c_drive,nue", [(True, False), (False, False), (True, True)])
 def test_copies_riding_ramps_are_the_single_simulation_bit_for_bit(c_drive, nue) -> None:
-    """Three robots by the ramps (one on the flush one, one by the raised one), random wheel commands, a
-    supervisor move onto the ramp in one copy: every copy's poses equal a Simulation's after every step,
-    bit for bit, through the C drive and the numpy one, and in NUE axes."""
+    """Five robots by the ramps (on the flush one, by the raised one, one settling onto the ramp at load,
+    one placed tilted on it), random wheel commands, a supervisor move onto the ramp in one copy: every
+    copy's poses equal a Simulation's at load and after every step, bit for bit, through the C drive and
+    the numpy one, and in NUE axes."""
     if c_drive and packets.library() is None:
         pytest.skip(f"no packets helper: {packets.status()}")
 
@@ -225,9 +229,15 @@ def test_copies_riding_ramps_are_the_single_simulation_bit_for_bit(c_drive, nue)
     sims = [Simulation(world(s)) for s in seeds]
     rng = np.random.default_rng(11)
     heights: set[float] = set()
+    names = ("a", "b", "c", "d", "e")
+    for c, s in enumerate(sims):
+        for robot in names:
+            assert s.robot(robot).pose.translation.tobytes() == bs.pos[c, bs.slot(robot)].tobytes(), robot
+            assert s.robot(robot).pose.rotation.tobytes() == bs.rot[c, bs.slot(robot)].tobytes(), robot
+    assert float(sims[0].robot("d").pose.translation[up]) == pytest.approx(_ramp_z(2.4) + 0.05, abs=1e-12)
     for step in range(150):
         if step % 15 == 0:
-            for robot in ("a", "b", "c"):
+            for robot in names:
                 lr = rng.uniform(-12.0, 12.0, (3, 2)) if step % 30 else np.full((3, 2), 10.0)
                 bs.set_wheels(bs.slot(robot), lr[:, 0], lr[:, 1])
                 for c, s in enumerate(sims):
@@ -243,7 +253,7 @@ def test_copies_riding_ramps_are_the_single_simulation_bit_for_bit(c_drive, nue)
         bs.step()
         for c, s in enumerate(sims):
             s.step()
-            for robot in ("a", "b", "c"):
+            for robot in names:
                 slot = bs.slot(robot)
                 pose = s.robot(robot).pose
                 assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
