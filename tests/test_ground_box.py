@@ -205,10 +205,11 @@ def test_without_a_terrain_box_floors_do_not_make_a_ground() -> None:
 
 
 def test_a_tilted_box_is_not_ground_and_a_box_turned_on_its_side_is() -> None:
-    """A box whose faces are not horizontal has no top to ride; one turned a quarter about x (exactly:
-    its local y is the world's up) has its top at its centre plus half its y size."""
+    """A box none of whose faces leans less than 45° from up (standing on a corner: every face 54.7°)
+    has no top to ride (a box tilted less is a ramp: test_ground_ramp.py); one turned a quarter about x
+    (exactly: its local y is the world's up) has its top at its centre plus half its y size."""
     tilted = _box("tilted", (0.0, 5.0, 0.0), (1.0, 1.0, 0.1))
-    tilted["pose"]["rotation"] = [1, 0, 0, 0.3]
+    tilted["pose"]["rotation"] = [1 / math.sqrt(2), -1 / math.sqrt(2), 0, math.acos(1 / math.sqrt(3))]
     side = _box("side", (3.0, 5.0, 0.0), (1.0, 0.4, 2.0))
     side["pose"]["rotation"] = [1, 0, 0, math.pi / 2]
     sim = _sim(_shelf(extra=(tilted, side)), at=(-1.9, 0.0, DECK + HALF))

@@ -24,7 +24,9 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   its centre. A millimetre covers those settled poses several times over and stays below
   anything a robot's body should be stopped by; a solid rising more than that into the band is
   an obstacle. Robots' bodies meet one another without the tolerance (robots never stand on
-  robots);
+  robots). A solid's ramp (a tilted Box whose top face leans less than 45°, :func:`ramp_top`)
+  tops out, for this rule, at its top face's low edge: a robot that can drive on at that edge rides
+  the ramp (ground.py) and is never stopped by its box; for one below the edge it is an obstacle;
 * over one basic step a shaped robot first turns in place at its start, as far as the footprint
   sweeping through the turn overlaps nothing it did not already overlap, or deeper (each vertex's
   arc about the centre tested in closed form, :func:`turn_gap_holds`); where the turn would go into something,
@@ -73,6 +75,32 @@ BACK_OFF = 1e-12      # m: contact points are placed this far outside, never on 
 MAX_SLIDES = 3
 TURN_HALVINGS = 12    # a turn cut short by contact is found to 2^-12 of the step's turn
 UPRIGHT = 1.0 - 1e-12
+BOX_UPRIGHT_TOL = 1e-12   # |tilt| of a box's local axis from the world's up still upright (its top a flat floor)
+# a tilted box whose top face leans less than this from the world's up is a ramp (ground.py). Below 45°
+# at most one face can be its top (three orthogonal normals' up components squared sum to 1)
+RAMP_MAX_TILT = math.pi / 4
+
+
+def ramp_top(r: np.ndarray, t: np.ndarray, half: tuple[float, float, float]) -> tuple[int, float, np.ndarray, float] | None:
+    """A box (rotation ``r``, centre ``t`` in ENU, half sizes ``half``) that is a ramp: not upright
+    (none of its axes within BOX_UPRIGHT_TOL of the world's up: ground.py's box tops) and its top
+    face -- the one whose outward normal is most upward -- tilted less than RAMP_MAX_TILT. Returns
+    (the local axis of that normal, its sign, the box's 8 corners ``corners @ r.T + t`` as
+    :func:`obstacle` computes them, the top face's lowest corner height: its **low edge**), else
+    None. Kinematic contact takes the low edge as the ramp's top (the floor rule) and ground.py
+    takes it for the support rule, so a ramp is a robot's ground or its obstacle, never both."""
+    if any(abs(r[0, k]) <= BOX_UPRIGHT_TOL and abs(r[1, k]) <= BOX_UPRIGHT_TOL
+           and all(abs(r[2, j]) <= BOX_UPRIGHT_TOL for j in range(3) if j != k) for k in range(3)):
+        return None
+    k = max(range(3), key=lambda a: abs(float(r[2, a])))
+    sign = 1.0 if r[2, k] > 0.0 else -1.0
+    if not sign * float(r[2, k]) > math.cos(RAMP_MAX_TILT):
+        return None
+    hx, hy, hz = half
+    local = np.array([[x, y, z] for x in (-hx, hx) for y in (-hy, hy) for z in (-hz, hz)])
+    corners = local @ r.T + t
+    top = local[:, k] == sign * half[k]
+    return k, sign, corners, float(corners[top, 2].min())
 
 
 @dataclass(slots=True)
@@ -339,8 +367,9 @@ def enu_body(parts: list[tuple[geo.Primitive, Pose]], pose: Pose,
     return [(prim, Pose(base, np.zeros(3)).compose(local)) for prim, local in parts]
 
 
-def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle | None:
-    """A solid's (or robot body's) 2D obstacle at ``pose``; None for a non-vertical plane."""
+def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose, ramps: bool = False) -> Obstacle | None:
+    """A solid's (or robot body's) 2D obstacle at ``pose``; None for a non-vertical plane. ``ramps``:
+    a Box that is a ramp (:func:`ramp_top`) tops out at its low edge (kinematic contact's solids)."""
     if isinstance(prim, geo.Terrain):
         return None                              # ground (an ElevationGrid), like a floor plane
     r, t = pose.rotation, pose.translation
@@ -363,6 +392,12 @@ def obstacle(name: str, owner: int, prim: geo.Primitive, pose: Pose) -> Obstacle
                         (float(ends[:, 2].min()) - prim.radius, float(ends[:, 2].max()) + prim.radius))
     if isinstance(prim, geo.Box):
         sx, sy, sz = (s / 2.0 for s in prim.size)
+        ramp = ramp_top(r, t, (sx, sy, sz)) if ramps else None
+        if ramp is not None:
+            # a solid's ramp: its band reaches up to its top face's low edge only, so a robot whose band
+            # bottom is within FLOOR of that edge (it can drive on at it) rides it, never stopped by it
+            corners = ramp[2]
+            return Obstacle(name, owner, _hull(corners[:, :2]), 0.0, (float(corners[:, 2].min()), ramp[3]))
         local = np.array([[x, y, z] for x in (-sx, sx) for y in (-sy, sy) for z in (-sz, sz)])
     else:
         local, _ = geo.tessellate(prim)          # circumscribed: conservative
@@ -1177,6 +1212,8 @@ class Contact:
                 self.prims.setdefault(name, []).append((prim, local))
                 first_pose.setdefault(name, pose)
         self.solids: dict[tuple[str, int], Obstacle] = {}
+        # the solids whose ramps top out at their low edge: the world file's, which are ground (ground.py)
+        self._ramps = set(first_pose)
         for name, pose in first_pose.items():
             self.update_solid(name, pose)
         if yaws is None:
@@ -1202,7 +1239,7 @@ class Contact:
     def update_solid(self, name: str, pose: Pose) -> None:
         pose = enu_pose(pose, self._to_enu)
         for i, (prim, local) in enumerate(self.prims.get(name, ())):
-            ob = obstacle(name, -1, prim, pose.compose(local))
+            ob = obstacle(name, -1, prim, pose.compose(local), ramps=name in self._ramps)
             if ob is None:
                 self.solids.pop((name, i), None)
             else:
@@ -1210,9 +1247,16 @@ class Contact:
         if hasattr(self, "feet"):
             self._rebuild()
 
-    def add_solid(self, name: str, shapes: list[tuple[geo.Primitive, Pose, bool]], pose: Pose) -> None:
+    def add_solid(self, name: str, shapes: list[tuple[geo.Primitive, Pose, bool]], pose: Pose,
+                  ramps: bool = False) -> None:
         """A solid a Supervisor imported: an obstacle from now on (its bounding shapes: (primitive,
-        pose in the solid's frame, seen by bounding rays), as the constructor takes them)."""
+        pose in the solid's frame, seen by bounding rays), as the constructor takes them). ``ramps``:
+        its ramps are ground (a solid built again in a world with a Ground), so they top out at their
+        low edge; an imported solid is no ground, its ramps whole obstacles."""
+        if ramps:
+            self._ramps.add(name)
+        else:
+            self._ramps.discard(name)
         prims = [(prim, local) for prim, local, bounding in shapes if bounding]
         if prims:
             self.prims[name] = prims
@@ -1220,6 +1264,7 @@ class Contact:
 
     def remove_solid(self, name: str) -> None:
         """A solid removed by a Supervisor: no longer an obstacle."""
+        self._ramps.discard(name)
         for i in range(len(self.prims.pop(name, ()))):
             self.solids.pop((name, i), None)
         self._rebuild()

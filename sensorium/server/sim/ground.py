@@ -1,5 +1,5 @@
-"""The ground driven robots ride on: terrains (ElevationGrids) and the floor planes, box floors and
-cylinder tops around them.
+"""The ground driven robots ride on: terrains (ElevationGrids), ramps (tilted boxes) and the floor
+planes, box floors and cylinder tops around them.
 
 No physics: a driven robot keeps the clearance it was placed with above the ground under its
 origin. After each step's planar move its height is ``ground(x, y) + clearance`` and, over a
@@ -21,7 +21,17 @@ What counts as ground (seen by bounding rays, as kinematic contact reads the wor
   robot whose support ceiling it does not exceed* (below);
 * the top of an upright Cylinder (its local z the world's up or down, within UPRIGHT_TOL): a floor
   at its centre's height plus half its height (contact.obstacle's top of it) over its closed disc,
-  under the same support rule as a box top (what is said of box tops below holds for it).
+  under the same support rule as a box top (what is said of box tops below holds for it);
+* the top face of a **ramp**: a Box that is not upright whose top face (the one whose outward normal
+  is most upward) leans less than contact.RAMP_MAX_TILT (45°) from the world's up
+  (:func:`contact.ramp_top`): a plane over that closed rectangle, ridden as a terrain triangle is
+  (its height under the origin, its slope for the attitude). A ramp is judged by its top face's
+  **low edge** (its lowest corner): it is ground for a robot whose support ceiling (below) that edge
+  does not exceed -- everywhere over its face, however high it rises there -- and kinematic contact
+  takes the same edge as the ramp's top (contact.obstacle), so it never stops such a robot; for a
+  robot below the edge it is an obstacle (its whole outline) and never ground. A ramp flush with the
+  floor is driven onto at its low edge and climbed; one driven at from the side is climbed onto
+  there, as a terrain's cliff is.
 
 The support rule (box and cylinder tops only). A box top is ground for a robot only if it is not above the
 robot's **support ceiling**, ``max(band bottom, the ground it rides) + contact.FLOOR``: its
@@ -41,8 +51,8 @@ ceiling at that ground + FLOOR: a box top between its band bottom + FLOOR and th
 be both, but contact (when on) keeps its disc, and so its origin, off it.) Terrains and planes are ground
 whatever their height (contact never stops a robot at them), as before.
 
-Other solids are not ridden. In a world without terrains there is no Ground at all: robots keep
-their heights over Box floors and Planes alike.
+Other solids are not ridden. In a world without terrains or ramps there is no Ground at all: robots
+keep their heights over Box floors and Planes alike.
 
 Where several cover a point the highest is the ground (the first in world order on a tie). On a
 line shared by two triangles (a cell's diagonal or edge, a grid point) both triangles give the
@@ -61,14 +71,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.contact import FLOOR, enu_body, robot_footprint
+from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, ramp_top, robot_footprint
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
 __all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "placing_ceiling", "ride_height",
            "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "support_ceiling"]
 
-UPRIGHT_TOL = 1e-12     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
+UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
 SETTLE_NOTE = 1e-3      # m: a robot settled by more than this gets a load note
 SETTLE_NOTES = 8        # load notes said one robot a line; more robots settled are counted in one more line
@@ -116,6 +126,9 @@ class _Surface:
     r10: float = 0.0
     r11: float = 1.0
     upright: bool = True
+    # a box that is a ramp (contact.ramp_top; set by Ground.place): its top face's centre (cx, cy, cz),
+    # slope (gx, gy), in-face axes and half sizes (ai, hi), (aj, hj), and low edge
+    ramp: tuple | None = None
 
 
 def _is_upright(r: np.ndarray) -> bool:
@@ -167,13 +180,14 @@ class Ground:
 
     @classmethod
     def from_world(cls, world: wm.World, solid_poses: dict[str, Pose], to_enu: np.ndarray | None) -> Ground | None:
-        """The ground of a world with at least one terrain seen by bounding rays (None otherwise:
+        """The ground of a world with at least one terrain or ramp seen by bounding rays (None otherwise:
         robots then keep their heights, as they always did). ``solid_poses``: the top-level solids'
         world poses; ``to_enu``: world axes to ENU (None in an ENU world)."""
         surfaces = [surface for s in world.solids for surface in _surfaces(s)]
-        if not any(s.grid is not None for s in surfaces):
+        if not any(s.grid is not None or s.half is not None for s in surfaces):
             return None
-        return cls(surfaces, solid_poses, to_enu)
+        ground = cls(surfaces, solid_poses, to_enu)
+        return ground if any(s.grid is not None or s.ramp is not None for s in surfaces) else None
 
     def add_solid(self, solid: wm.Solid, pose: Pose) -> None:
         """A top-level solid built again (a Supervisor set a PROTO field of it): its terrains, floors and
@@ -215,7 +229,16 @@ class Ground:
         up = [k for k in range(3) if abs(r[0, k]) <= UPRIGHT_TOL and abs(r[1, k]) <= UPRIGHT_TOL
               and all(abs(r[2, j]) <= UPRIGHT_TOL for j in range(3) if j != k)]
         s.upright = bool(up)
+        s.ramp = None
         if not up:
+            ramp = ramp_top(r, t, s.half)
+            if ramp is not None:
+                k, sign, _, low = ramp
+                i, j = (a for a in range(3) if a != k)
+                n = sign * r[:, k]
+                c = t + (sign * s.half[k]) * r[:, k]
+                s.ramp = (float(c[0]), float(c[1]), float(c[2]), float(-n[0] / n[2]), float(-n[1] / n[2]),
+                          *(float(v) for v in r[:, i]), s.half[i], *(float(v) for v in r[:, j]), s.half[j], low)
             return
         i, j = (a for a in range(3) if a != up[0])
         hx, hy, hz = s.half
@@ -269,6 +292,20 @@ class Ground:
         found = np.zeros(x.shape, dtype=bool)
         first = np.full(x.shape, len(self._surfaces))     # the world-order index of each point's ground
         for i, s in enumerate(self._surfaces):
+            if s.ramp is not None:               # a ramp's top face: a plane over a rectangle
+                cx, cy, cz, sx, sy, aix, aiy, aiz, hi, ajx, ajy, ajz, hj, low = s.ramp
+                ex, ey = x - cx, y - cy
+                dz = sx * ex + sy * ey
+                u = aix * ex + aiy * ey + aiz * dz       # the point on the plane in the face's axes
+                v = ajx * ex + ajy * ey + ajz * dz
+                z = cz + dz
+                take = (np.abs(u) <= hi) & (np.abs(v) <= hj) & (low <= ceiling) & (z > best)
+                best = np.where(take, z, best)
+                gx = np.where(take, sx, gx)
+                gy = np.where(take, sy, gy)
+                first = np.where(take, i, first)
+                found |= take
+                continue
             if not s.upright or s.half is not None or s.disc is not None:    # (box and cylinder tops: below)
                 continue
             if s.grid is None:                   # an infinite floor

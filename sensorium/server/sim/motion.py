@@ -20,6 +20,7 @@ from sensorium.server.sim.ground import (
     ground_rotation,
     placing_ceiling,
     ride_height,
+    robot_up,
     support_ceiling,
 )
 from sensorium.server.world.geometry import Pose
@@ -204,6 +205,13 @@ class PlanarState:
             if under is not None:
                 self.rest = under[0]
                 self.slope = under[1:] if (under[1] or under[2]) else None
+            if self.slope is not None and robot_up(pose.rotation, self._to_enu) is None:
+                # placed tilted as the slope under it is (Webots' worlds put a robot on a ramp so): it stands
+                # on the slope, its own rotation the placed one without the ground's attitude, never tilted twice
+                gx, gy = self.slope
+                on = ground_rotation(gx, gy, math.cos(self.yaw), math.sin(self.yaw), np.eye(3)).T @ pose.rotation
+                if robot_up(on, self._to_enu) is not None:
+                    self.base = on
 
     def settle(self) -> None:
         """Ride the ground after a planar move (nothing to do without one)."""

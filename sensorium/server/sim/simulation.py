@@ -646,7 +646,8 @@ class Simulation:
         pose = self.scene.solid_poses[solid.name]
         if self.contact is not None:
             self.contact.add_solid(solid.name, [(e.primitive, local, shape.seen_by in ("both", "bounding"))
-                                                for (_, local, shape), e in zip(*prepared)], pose)
+                                                for (_, local, shape), e in zip(*prepared)], pose,
+                                   ramps=again and self.ground is not None)    # (ramps ground: contact.ramp_top)
         if self.ground is not None and again:
             self.ground.add_solid(solid, pose)
 
