@@ -160,3 +160,20 @@ def test_the_batched_simulation_refuses_a_pump_on_at_load(tmp_path: Path) -> Non
     with pytest.raises(BatchedError, match="vacuum gripper 'gripper' is on at load; the batched simulation carries nothing"):
         BatchedSimulation(load_world(p), copies=2)
     BatchedSimulation(load_world(REPO / "tests" / "worlds" / "vacuum_speaker.yaml"), copies=2)    # off: accepted
+
+
+def test_another_robot_is_never_held(tmp_path: Path) -> None:
+    """Webots would join a robot with physics by the fixed joint; here robots are never carried (their
+    poses are their drives' and controllers'), so the presence stays 0 on a robot's box as well."""
+    p = tmp_path / "w.yaml"
+    p.write_text(WORLD.read_text().replace("physics: true", "physics: false").replace(
+        "  - name: eye\n", "  - name: other\n    shapes:\n      - {pose: {translation: [0.0, 0.0, 0.05]}, "
+        "geometry: {type: box, size: [0.1, 0.1, 0.1]}}\n  - name: eye\n"))
+    sim = Simulation.from_file(p)
+    g = sim.device("arm/gripper")
+    g.enable(STEP)
+    g.set_on(True)                                           # type: ignore[attr-defined]
+    assert g.touched() is None                               # type: ignore[attr-defined]
+    sim.step()
+    assert g.value == 0.0 and g.held is None                 # type: ignore[attr-defined]
+    assert sim.robot("other").pose.translation.tolist() == [0.0, 0.0, 0.0]

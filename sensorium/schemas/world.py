@@ -634,7 +634,8 @@ Light = Annotated[PointLight | SpotLight | DirectionalLight, Field(discriminator
 # ---------------------------------------------------------------- solids
 
 class Solid(Strict):
-    """A static object (movable by a supervisor), seen by rays through its shapes.
+    """A static object (movable by a supervisor; carried by a VacuumGripper when it has ``physics``), seen
+    by rays through its shapes.
 
     ``geometry`` (with ``appearance``/``seen_by``) is the solid's own shape at its origin;
     ``shapes`` adds further shapes each with its own offset; ``children`` are solids fixed to this
