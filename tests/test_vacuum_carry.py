@@ -13,10 +13,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from sensorium.server.daemon import supervisor as sv
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
+from sensorium.server.sim.vacuum import GRIP_DISTANCE, _shape_obstacle, may_touch, prism_gap
+from sensorium.server.world import geometry as geo
+from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import load_world
 
 REPO = Path(__file__).resolve().parents[1]
@@ -177,3 +182,17 @@ def test_another_robot_is_never_held(tmp_path: Path) -> None:
     sim.step()
     assert g.value == 0.0 and g.held is None                 # type: ignore[attr-defined]
     assert sim.robot("other").pose.translation.tolist() == [0.0, 0.0, 0.0]
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(st.floats(-0.5, 0.5), st.floats(-0.3, 0.3), st.floats(0.0, 0.6), st.floats(0.0, math.pi))
+def test_the_screen_never_drops_a_touching_pair(x: float, y: float, z: float, turn: float) -> None:
+    """may_touch (the bounding boxes' per-axis gap, a lower bound of the prism distance) is False
+    only for pairs prism_gap puts farther than GRIP_DISTANCE: a turned cylinder around a 0.4 m crate."""
+    crate = _shape_obstacle(geo.Box((0.4, 0.4, 0.4)), Pose(np.eye(3), [0.0, 0.0, 0.2]))
+    cup = _shape_obstacle(geo.Cylinder(0.05, 0.02), Pose.from_axis_angle([1.0, 0.0, 0.0], turn, (x, y, z)))
+    assert crate is not None and cup is not None
+    if prism_gap(cup, crate) <= GRIP_DISTANCE:
+        assert may_touch(cup, crate)
+    if abs(x) > 0.3 or z > 0.5:         # clearly apart (0.05 m and more)
+        assert not may_touch(cup, crate)

@@ -34,7 +34,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
-__all__ = ["GRIP_DISTANCE", "VacuumGripper", "prism_gap"]
+__all__ = ["GRIP_DISTANCE", "VacuumGripper", "may_touch", "prism_gap"]
 
 GRIP_DISTANCE = 1e-3
 """m: a gripper whose bounding shapes come this near a solid's (or overlap it) touches it."""
@@ -71,6 +71,23 @@ def prism_gap(a: Obstacle, b: Obstacle) -> float:
     return math.hypot(d_xy, d_z)
 
 
+_SCREEN = GRIP_DISTANCE * (1.0 + 1e-9) + 1e-12
+"""m: a pair whose boxes are farther apart than this along one axis is no touch (margin over rounding)."""
+
+
+def may_touch(a: Obstacle, b: Obstacle) -> bool:
+    """False when the two prisms are surely farther apart than GRIP_DISTANCE: their heights, or their
+    sections' bounding boxes grown by their radii, are apart by more (a lower bound of the prism
+    distance), so :func:`prism_gap`'s hull is built only for pairs near each other."""
+    if max(b.z_range[0] - a.z_range[1], a.z_range[0] - b.z_range[1]) > _SCREEN:
+        return False
+    if math.isinf(a.radius) or math.isinf(b.radius) or a.normal is not None or b.normal is not None:   # sheets, walls
+        return True
+    lo_a, hi_a = a.points.min(axis=0) - a.radius, a.points.max(axis=0) + a.radius
+    lo_b, hi_b = b.points.min(axis=0) - b.radius, b.points.max(axis=0) + b.radius
+    return bool(max(float((lo_b - hi_a).max()), float((lo_a - hi_b).max())) <= _SCREEN)
+
+
 class VacuumGripper(Device):
     """One gripper: ``is_on`` (the pump), ``held`` (the name of the solid it carries, or None) and
     ``value`` (its presence: 1.0 holding, 0.0 not, read at its sampling period as other sensors)."""
@@ -92,6 +109,8 @@ class VacuumGripper(Device):
         self._solids: dict[str, tuple[Any, list[tuple[Any, Pose]]]] = {}
         self._models: dict[str, Any] = {}
         self._models_version = -1
+        self._mine: tuple[Pose, tuple, list[Obstacle]] | None = None    # its own prisms and the poses they are at
+        self._placed: dict[str, tuple[Pose, list, list[Obstacle]]] = {}     # name -> (pose, shapes, prisms)
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
@@ -154,6 +173,7 @@ class VacuumGripper(Device):
             self._models = {s.name: s for s in self._sim.world.solids if s.name in scene.solid_poses}
             self._models_version = scene.solids_version
             self._solids = {k: v for k, v in self._solids.items() if self._models.get(k) is v[0]}
+            self._placed = {k: v for k, v in self._placed.items() if k in self._solids}
         return self._models.get(name)
 
     def _solid_shapes(self, name: str) -> list[tuple[Any, Pose]] | None:
@@ -177,20 +197,38 @@ class VacuumGripper(Device):
         to_enu = self._robot.to_enu
         pose = self._robot.pose
         links = self._robot.links
-        mine = []
-        for prim, local, joint in self._own:
-            frame = pose if joint is None or links is None else pose.compose(links.poses[joint])
-            ob = _shape_obstacle(prim, enu_pose(frame.compose(local), to_enu))
-            if ob is not None:
-                mine.append(ob)
+        frames = tuple(None if joint is None or links is None else links.poses[joint] for _, _, joint in self._own)
+        if self._mine is not None and self._mine[0] is pose and all(a is b for a, b in zip(self._mine[1], frames)):
+            mine = self._mine[2]          # nothing it rides moved (poses are immutable objects)
+        else:
+            mine = []
+            for (prim, local, _), link in zip(self._own, frames):
+                frame = pose if link is None else pose.compose(link)
+                ob = _shape_obstacle(prim, enu_pose(frame.compose(local), to_enu))
+                if ob is not None:
+                    mine.append(ob)
+            self._mine = (pose, frames, mine)
         if not mine:
             return None
         for name, solid_pose in self._sim.scene.solid_poses.items():
-            for prim, local in self._solid_shapes(name) or ():
-                ob = _shape_obstacle(prim, enu_pose(solid_pose.compose(local), to_enu))
-                if ob is not None and any(prism_gap(m, ob) <= GRIP_DISTANCE for m in mine):
+            for ob in self._solid_obstacles(name, solid_pose):
+                if any(may_touch(m, ob) and prism_gap(m, ob) <= GRIP_DISTANCE for m in mine):
                     return name
         return None
+
+    def _solid_obstacles(self, name: str, pose: Pose) -> list[Obstacle]:
+        """A solid's bounding shapes as prisms at ``pose``, kept while its (immutable) pose and shapes
+        are the same objects: a pump on and holding nothing looks every step, and solids rarely move."""
+        shapes = self._solid_shapes(name)
+        if shapes is None:
+            return []
+        kept = self._placed.get(name)
+        if kept is None or kept[0] is not pose or kept[1] is not shapes:
+            to_enu = self._robot.to_enu
+            obs = [ob for prim, local in shapes
+                   if (ob := _shape_obstacle(prim, enu_pose(pose.compose(local), to_enu))) is not None]
+            kept = self._placed[name] = (pose, shapes, obs)
+        return kept[2]
 
     # -- measuring
     def measure(self, now_ms: int) -> None:
