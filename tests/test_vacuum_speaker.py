@@ -2,7 +2,9 @@
 
 tests/worlds/vacuum_speaker.yaml: the gripper's bounding cylinder (radius 0.05 m, 0.02 m tall) has
 its bottom face 0.5 m above the robot's origin; the crate is a 0.4 m cube on the ground (top at
-z = 0.4, sides at x, y = ±0.2). Lowering the robot by 0.1 m puts the gripper on the crate."""
+z = 0.4, sides at x, y = ±0.2) with physics. Lowering the robot by 0.1 m puts the gripper on the
+crate. The presence reads whether a solid is held (Webots' ``mSolid != NULL``): a crate once touched
+with the pump on is carried until the pump is off."""
 
 from __future__ import annotations
 
@@ -51,8 +53,8 @@ def _presence_at(sim: Simulation, x: float, y: float, z: float) -> float:
 def test_presence_on_the_crate_and_above_it(sim: Simulation) -> None:
     assert _presence_at(sim, 0.0, 0.0, 0.0) == 0.0            # 0.1 m above the crate
     assert _presence_at(sim, 0.0, 0.0, -0.1) == 1.0           # resting on its top: gap 0
-    assert sim.device("arm/gripper").touching == "crate"      # type: ignore[attr-defined]
-    assert _presence_at(sim, 0.0, 0.0, -0.15) == 1.0          # sunk 5 cm into it: overlap
+    assert sim.device("arm/gripper").held == "crate"          # type: ignore[attr-defined]
+    assert _presence_at(Simulation.from_file(WORLD), 0.0, 0.0, -0.15) == 1.0   # sunk 5 cm into it: overlap
 
 
 @pytest.mark.parametrize("delta, held", [(-1e-9, 1.0), (1e-9, 0.0)])
@@ -100,8 +102,8 @@ def test_presence_needs_the_pump_on(sim: Simulation) -> None:
 
 
 def test_presence_is_sampled_at_its_period(sim: Simulation) -> None:
-    """Enabled at 64 ms (4 basic steps) at t = 0: values at 64, 128, ... only; a touch that starts
-    at 16 ms is first read at 64 ms, one that ends at 80 ms at 128 ms."""
+    """Enabled at 64 ms (4 basic steps) at t = 0: values at 64, 128, ... only; a hold that starts
+    at 32 ms is first read at 64 ms, one that ends after 80 ms (the pump off) at 128 ms."""
     g = sim.device("arm/gripper")
     g.set_on(True)                                           # type: ignore[attr-defined]
     g.enable(64)
@@ -109,8 +111,8 @@ def test_presence_is_sampled_at_its_period(sim: Simulation) -> None:
     for k in range(1, 10):
         if k == 2:
             sim.robot("arm").set_pose(translation=[0.0, 0.0, -0.1])
-        if k == 6:
-            sim.robot("arm").set_pose(translation=[0.0, 0.0, 0.0])
+        if k == 6:             # moving away would carry the crate along: the pump lets it go
+            g.set_on(False)                                  # type: ignore[attr-defined]
         sim.step()
         got.append((sim.time_ms, g.value, g.measurements))   # type: ignore[attr-defined]
     assert got == [(16, 0.0, 0), (32, 0.0, 0), (48, 0.0, 0), (64, 1.0, 1), (80, 1.0, 1), (96, 1.0, 1),
@@ -223,7 +225,7 @@ def test_a_wbt_with_a_vacuum_gripper_and_a_speaker_loads_them_simulated(tmp_path
                  'contactPoints 0 boundingObject Cylinder { radius 0.05 height 0.02 } }\n'
                  'Speaker { name "voice" }\n] }\n'
                  'Solid { name "crate" translation 0 0 0.2 children [ Shape { geometry DEF B Box { size 0.4 0.4 0.4 } } ] '
-                 'boundingObject USE B }\n')
+                 'boundingObject USE B physics Physics { } }\n')
     w = load_world(p)
     assert not any("not simulated" in line for line in w.warnings), w.warnings
     assert [line.split(": ", 1)[1] for line in w.warnings] == [
@@ -235,6 +237,7 @@ def test_a_wbt_with_a_vacuum_gripper_and_a_speaker_loads_them_simulated(tmp_path
         ("VacuumGripper", "cup", True, 10.0, -1.0, 3)
     assert (voice.device, voice.name) == ("Speaker", "voice")
     assert [s.of_device for s in robot.shapes] == ["cup"]
+    assert w.world.solids[0].physics is True                 # its Physics node: what a gripper may carry
     sim = Simulation(w)
     g = sim.device("r/cup")
     g.enable(STEP)

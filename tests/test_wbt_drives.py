@@ -432,7 +432,7 @@ def test_vertical_finger_hinges_holding_their_axles_are_no_failed_car(tmp_path: 
 
 
 ARM = """Solid { translation 0.3 0 0.125 name "crate" children [ Shape { geometry DEF CRATE Box { size 0.2 0.2 0.25 } } ]
-  boundingObject USE CRATE }
+  boundingObject USE CRATE physics Physics { } }
 Robot { name "arm" children [
  HingeJoint { jointParameters HingeJointParameters { position 2 axis 0 0 1 } device [ RotationalMotor { name "yaw motor" } ]
   endPoint Solid { rotation 0 0 1 2 children [
@@ -466,8 +466,9 @@ def test_an_arms_chain_of_round_hinges_is_no_failed_car(tmp_path: Path) -> None:
     hinge steering a "wheel", the pitch hinge) and end in "no Ackermann drive (...); the robot will
     not move". As the sample does: with every joint at 0 the unit reads (0, 0, 0); lowering the
     slider puts the cup (its bottom 0.30 m up at travel 0) on the crate's top (0.25 m) and the
-    presence turns 1 within 1 mm of it; any yaw, pitch and roll are read back as the unit's
-    roll, pitch and yaw (the links' axes are the world's x, y, z at 0)."""
+    presence turns 1 within 1 mm of it (the crate has physics: the cup holds it, Webots' rule, and
+    carries it from then on); any yaw, pitch and roll are read back as the unit's roll, pitch and yaw
+    (the links' axes are the world's x, y, z at 0)."""
     w = load_world(write(tmp_path, ARM))
     assert not [x for x in w.warnings if "Ackermann" in x or "will not move" in x], w.warnings
     (robot,) = w.world.robots
@@ -506,7 +507,8 @@ def test_an_arms_chain_of_round_hinges_is_no_failed_car(tmp_path: Path) -> None:
     for _ in range(100):
         sim.step()
     assert imu.roll_pitch_yaw == pytest.approx([roll, pitch, yaw], abs=1e-6)   # type: ignore[attr-defined]
-    assert cup.value == 0.0                                  # type: ignore[attr-defined]   lifted off the crate
+    assert cup.value == 1.0                                  # type: ignore[attr-defined]   the crate lifted with it
+    assert sim.scene.solid_poses["crate"].translation[2] > 0.125 + 0.04
 
 
 def test_a_lone_hinge2_joint_is_no_failed_car(tmp_path: Path) -> None:

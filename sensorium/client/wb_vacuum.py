@@ -1,8 +1,8 @@
 """Webots' VacuumGripper functions (``wb_vacuum_gripper_*``) on Sensorium; :mod:`sensorium.client.wb`
 re-exports them.
 
-The presence (whether the gripper holds a solid: its pump on and its bounding shapes touching one,
-README "The VacuumGripper") arrives with the step reply at its sampling period, False before the
+The presence (whether the gripper holds a solid: one with physics its bounding shapes touched while
+the pump was on, carried until the pump is off, README "VacuumGripper and Speaker") arrives with the step reply at its sampling period, False before the
 first value, with Webots' message when read while disabled. ``turn_on``/``turn_off`` go to the
 server at once (one round trip each; libController sends them with the next step request: the next
 step's presence reads them either way); ``is_on`` answers this controller's copy at once, as

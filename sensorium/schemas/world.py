@@ -634,7 +634,8 @@ Light = Annotated[PointLight | SpotLight | DirectionalLight, Field(discriminator
 # ---------------------------------------------------------------- solids
 
 class Solid(Strict):
-    """A static object (movable by a supervisor), seen by rays through its shapes.
+    """A static object (movable by a supervisor; carried by a VacuumGripper when it has ``physics``), seen
+    by rays through its shapes.
 
     ``geometry`` (with ``appearance``/``seen_by``) is the solid's own shape at its origin;
     ``shapes`` adds further shapes each with its own offset; ``children`` are solids fixed to this
@@ -668,6 +669,8 @@ class Solid(Strict):
                                        "solid, those of its PROTO instances' DEFs that name no node here (`why`)")
     proto_scope: int | None = Field(default=None, ge=0, description="a PROTO instance inside a top-level solid: its "
                                     "number there (InnerDef.scope)")
+    physics: bool = Field(default=False, description="Webots: the solid has a Physics node. Nothing falls or is "
+                          "pushed here (no dynamics); a VacuumGripper carries only a top-level solid with physics")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 
@@ -1236,10 +1239,10 @@ class Display(_Device):
 
 class VacuumGripper(_Device):
     """Webots VacuumGripper: a suction pump (``is_on``, wb_vacuum_gripper_turn_on/off) whose presence
-    sensor reads whether it holds a solid: on, and its own bounding shapes (the robot's shapes with
-    ``of_device`` naming it) touching another solid's or robot's bounding shapes (README "The
-    VacuumGripper"). Webots' VacuumGripper.wrl defaults; nothing is lifted (no physics), so the
-    strengths and ``contact_points`` are kept for the record and read by nothing."""
+    sensor reads whether it holds a solid: pump on, its own bounding shapes (the robot's shapes with
+    ``of_device`` naming it) touched a top-level solid with ``physics``, which it then carries until
+    the pump is off (README "VacuumGripper and Speaker"). Webots' VacuumGripper.wrl defaults; no forces
+    here, so the strengths and ``contact_points`` are kept for the record and read by nothing."""
 
     device: Literal["VacuumGripper"]
     is_on: bool = Field(default=False, description="the pump is on at the start (Webots' isOn)")

@@ -403,6 +403,12 @@ class BatchedSimulation:
             if joints:
                 raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: motor {joints[0]!r} moves a joint; the "
                                    "batched simulation moves drive wheels only (use Simulation)")
+        # a VacuumGripper is not stepped here (no service turns its pump on): one on at load would carry a
+        # solid in Simulation that stays put here, so it is refused rather than silently different
+        pumps = [(r.name, d.name) for r in w.robots for d in r.devices if d.device == "VacuumGripper" and d.is_on]
+        if pumps:
+            raise BatchedError(f"{self.loaded.source}: robot {pumps[0][0]!r}: vacuum gripper {pumps[0][1]!r} is on at "
+                               "load; the batched simulation carries nothing (use Simulation, or its is_on: false)")
         # pens lay no ink here: a world whose ink infra-red sensors or cameras would read is refused,
         # not run with readings that silently differ from the single simulation's
         pens = [(r.name, d.name) for r in w.robots for d in r.devices if d.device == "Pen" and d.write]

@@ -335,6 +335,7 @@ class Simulation:
             self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
         self._speakers = [d for d in self.all_devices() if isinstance(d, Speaker)]
+        self._grippers = [d for d in self.all_devices() if isinstance(d, VacuumGripper)]
         connectors = [d for d in self.all_devices() if isinstance(d, Connector)]
         peers: list[Connector | SolidConnector] = [*connectors, *solid_connectors(self.world.solids, self.scene)]
         for con in connectors:        # a connector's presence looks at every other one of the world
@@ -419,7 +420,7 @@ class Simulation:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, joints to their initial positions, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data, radar cross sections, vacuum grippers' pumps and connectors' lock states as in the world file, speakers silent, GPS and Radar speeds
+        ``write`` and ink, as Webots' WbPen::reset), custom data, radar cross sections, vacuum grippers' pumps (nothing held) and connectors' lock states as in the world file, speakers silent, GPS and Radar speeds
         NaN at their next value (no previous position, as Webots' WbGps::reset and WbRadar::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
@@ -759,6 +760,8 @@ class Simulation:
                         self.contact.heights[robot.index] = drive.z    # (ENU, as contact works)
         for robot, _, _, pose in moved:
             self.scene.set_robot_pose(robot.index, pose)
+        for gripper in self._grippers:    # held solids follow their grippers; pumps on attach what they touch
+            gripper.carry()
         for con in self._auto_locking:    # Webots attaches a locked auto-lock connector to a present peer
             if con.is_locked:
                 con.attach_attempt()

@@ -1,21 +1,25 @@
-"""The simulation's VacuumGripper (Webots' WbVacuumGripper, without ODE).
+"""The simulation's VacuumGripper (Webots' WbVacuumGripper, kinematically: no ODE, no forces).
 
 What Webots does: the pump is on or off (``isOn``, ``turnOn``/``turnOff``); while it is on and holds
-nothing, the first solid its bounding object collides with is attached by a fixed joint, and the
-presence sensor reads whether a solid is attached (``mSolid != NULL``), refreshed at its sampling
-period. Turning the pump off detaches it. A gripper without a bounding object collides with nothing.
+nothing, a solid its bounding object collides with (the deepest contact, with at least
+``contactPoints`` points) is attached by a fixed joint after the physics step, and the presence sensor
+reads whether a solid is attached (``mSolid != NULL``), refreshed at its sampling period. Turning the
+pump off (or a reset) detaches it; a pull beyond ``tensileStrength``/``shearStrength`` breaks the joint.
+A gripper without a bounding object collides with nothing.
 
-Here there is no physics, so nothing is attached or lifted: the presence reads 1 exactly when the
-pump is on and the gripper's own bounding shapes (the robot's shapes whose ``of_device`` names it)
-touch the bounding shapes of another solid or robot at the end of the step -- overlap, or a gap of
-at most :data:`GRIP_DISTANCE`. Each shape is taken as contact.py takes obstacles (a 2D convex
-section ⊕ a disc, over a height range), so the distance between two shapes is the exact distance
-between those two vertical prisms, in float64: √(d_xy² + d_z²) with d_xy the gap between the
-sections (0 when they overlap) and d_z the gap between the height ranges. Exact for upright boxes
-and cylinders; other shapes are bounded as kinematic contact bounds them. A horizontal plane is a
-flat sheet (finite or not), a vertical one a wall line; terrains and tilted planes touch nothing.
+Here, at the end of every basic step (:meth:`VacuumGripper.carry`, before the sensors measure): a
+gripper holding a solid puts it at the pose it had relative to the gripper when attached (float64
+poses composed: the gripper's frame, the robot's pose with its link's displacement, then the held
+offset), through :meth:`Simulation.place_solid`, the path of a Supervisor's move; a gripper whose pump
+is on and holds nothing attaches the first top-level solid with ``physics`` (world order) that its own
+bounding shapes (the robot's shapes whose ``of_device`` names it) touch -- overlap, or a gap of at most
+:data:`GRIP_DISTANCE`. The presence reads 1 exactly while a solid is held. Each shape is taken as
+contact.py takes obstacles (a 2D convex section ⊕ a disc, over a height range), so the distance
+between two shapes is the exact distance between those two vertical prisms, in float64:
+√(d_xy² + d_z²) with d_xy the gap between the sections (0 when they overlap) and d_z the gap between
+the height ranges. Exact for upright boxes and cylinders; other shapes are bounded as kinematic contact
+bounds them. Robots are never attached, and no force breaks the hold (no physics).
 """
-
 from __future__ import annotations
 
 import math
@@ -24,13 +28,13 @@ from typing import Any
 import numpy as np
 
 from sensorium.server.sim.contact import UPRIGHT, Obstacle, _closest_on_list, _hull, enu_pose, obstacle
-from sensorium.server.sim.scene import primitive_from_model, robot_bounding_parts, solid_parts
+from sensorium.server.sim.scene import primitive_from_model, solid_parts
 from sensorium.server.sim.sensors import Device
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
-__all__ = ["GRIP_DISTANCE", "VacuumGripper", "prism_gap"]
+__all__ = ["GRIP_DISTANCE", "VacuumGripper", "may_touch", "prism_gap"]
 
 GRIP_DISTANCE = 1e-3
 """m: a gripper whose bounding shapes come this near a solid's (or overlap it) touches it."""
@@ -67,9 +71,26 @@ def prism_gap(a: Obstacle, b: Obstacle) -> float:
     return math.hypot(d_xy, d_z)
 
 
+_SCREEN = GRIP_DISTANCE * (1.0 + 1e-9) + 1e-12
+"""m: a pair whose boxes are farther apart than this along one axis is no touch (margin over rounding)."""
+
+
+def may_touch(a: Obstacle, b: Obstacle) -> bool:
+    """False when the two prisms are surely farther apart than GRIP_DISTANCE: their heights, or their
+    sections' bounding boxes grown by their radii, are apart by more (a lower bound of the prism
+    distance), so :func:`prism_gap`'s hull is built only for pairs near each other."""
+    if max(b.z_range[0] - a.z_range[1], a.z_range[0] - b.z_range[1]) > _SCREEN:
+        return False
+    if math.isinf(a.radius) or math.isinf(b.radius) or a.normal is not None or b.normal is not None:   # sheets, walls
+        return True
+    lo_a, hi_a = a.points.min(axis=0) - a.radius, a.points.max(axis=0) + a.radius
+    lo_b, hi_b = b.points.min(axis=0) - b.radius, b.points.max(axis=0) + b.radius
+    return bool(max(float((lo_b - hi_a).max()), float((lo_a - hi_b).max())) <= _SCREEN)
+
+
 class VacuumGripper(Device):
-    """One gripper: ``is_on`` (the pump), ``value`` (its presence: 1.0 holding, 0.0 not, read at its
-    sampling period as other sensors) and ``touching`` (what the latest measurement touched)."""
+    """One gripper: ``is_on`` (the pump), ``held`` (the name of the solid it carries, or None) and
+    ``value`` (its presence: 1.0 holding, 0.0 not, read at its sampling period as other sensors)."""
 
     kinematic = True
 
@@ -77,7 +98,9 @@ class VacuumGripper(Device):
         super().__post_init__()
         self.is_on = bool(self.config.is_on)
         self.value = 0.0                    # libController's presence before a value: false
-        self.touching: str | None = None
+        self.held: str | None = None
+        self._offset: Pose | None = None    # the held solid's pose in the gripper's frame
+        self._held_model: Any = None        # its world-file model when attached (a rebuilt one is another)
         self._sim: Any = None
         self._robot: Any = None
         self._own: list[tuple[Any, Pose, str | None]] = []          # (primitive, pose in robot frame, on_joint)
@@ -86,7 +109,8 @@ class VacuumGripper(Device):
         self._solids: dict[str, tuple[Any, list[tuple[Any, Pose]]]] = {}
         self._models: dict[str, Any] = {}
         self._models_version = -1
-        self._robots: dict[int, list[tuple[Any, Pose]]] = {}
+        self._mine: tuple[Pose, tuple, list[Obstacle]] | None = None    # its own prisms and the poses they are at
+        self._placed: dict[str, tuple[Pose, list, list[Obstacle]]] = {}     # name -> (pose, shapes, prisms)
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
@@ -98,22 +122,65 @@ class VacuumGripper(Device):
 
     # -- controller API
     def set_on(self, on: bool) -> None:
-        """``wb_vacuum_gripper_turn_on`` (True) / ``turn_off``: from now on (the next presence reads it)."""
+        """``wb_vacuum_gripper_turn_on`` (True: it attaches at the end of the next step) / ``turn_off``
+        (False: what it holds is let go at once, where it is, as WbVacuumGripper::turnOff detaches)."""
         self.is_on = bool(on)
+        if not self.is_on:
+            self.release()
+
+    def release(self) -> None:
+        self.held, self._offset, self._held_model = None, None, None
 
     def reset(self) -> None:
         """Webots' WbVacuumGripper::reset: the pump as the world file has it, nothing held (its
         controller learns the pump's state with its next presence value, as Webots' C_CONFIGURE)."""
         self.is_on = bool(self.config.is_on)
+        self.release()
 
-    # -- measuring
-    def _solid_shapes(self, name: str) -> list[tuple[Any, Pose]]:
+    # -- holding
+    def frame(self) -> Pose:
+        """The gripper's body frame in the world: the robot's pose, composed with its link's
+        displacement when it rides a joint."""
+        pose, links, joint = self._robot.pose, self._robot.links, self.on_joint
+        return pose if joint is None or links is None else pose.compose(links.poses[joint])
+
+    def carry(self) -> None:
+        """Once per basic step, after everything moved: the held solid put where the gripper now
+        holds it, or, pump on and nothing held, the first top-level solid with physics it touches
+        attached where it is. A held solid a Supervisor removed or rebuilt (a PROTO field set) is let
+        go first, as Webots' joint goes with the destroyed node."""
+        sim = self._sim
+        if self.held is not None and self._model(self.held) is not self._held_model:
+            self.release()
+        if self.held is not None:
+            assert self._offset is not None
+            current = sim.scene.solid_poses[self.held]
+            pose = self.frame().compose(self._offset)
+            if not (np.array_equal(pose.translation, current.translation)
+                    and np.array_equal(pose.rotation, current.rotation)):
+                sim.place_solid(self.held, pose)
+        elif self.is_on:
+            name = self.touched()
+            if name is not None:
+                self.held, self._held_model = name, self._model(name)
+                self._offset = self.frame().inverse().compose(sim.scene.solid_poses[name])
+
+    # -- touching
+    def _model(self, name: str) -> Any:
+        """The world-file model of the top-level solid now named so, None when there is none."""
         scene = self._sim.scene
         if self._models_version != scene.solids_version:
             self._models = {s.name: s for s in self._sim.world.solids if s.name in scene.solid_poses}
             self._models_version = scene.solids_version
             self._solids = {k: v for k, v in self._solids.items() if self._models.get(k) is v[0]}
-        model = self._models[name]
+            self._placed = {k: v for k, v in self._placed.items() if k in self._solids}
+        return self._models.get(name)
+
+    def _solid_shapes(self, name: str) -> list[tuple[Any, Pose]] | None:
+        """A top-level solid's bounding shapes in its frame, None when it has no physics (never attached)."""
+        model = self._model(name)
+        if not model.physics:
+            return None
         cached = self._solids.get(name)
         if cached is None or cached[0] is not model:
             base = self._sim.loaded.base_dir
@@ -122,45 +189,50 @@ class VacuumGripper(Device):
                                                    if shape.seen_by in ("both", "bounding")])
         return cached[1]
 
-    def _robot_shapes(self, index: int) -> list[tuple[Any, Pose]]:
-        shapes = self._robots.get(index)
-        if shapes is None:
-            shapes = self._robots[index] = robot_bounding_parts(self._sim.world.robots[index], self._sim.loaded.base_dir)
-        return shapes
-
     def touched(self) -> str | None:
-        """The first solid (world order) or robot the gripper's bounding shapes touch now, None if none."""
+        """The first top-level solid with physics (world order) the gripper's bounding shapes touch
+        now, None if none."""
         if not self._own:
             return None
-        sim, to_enu = self._sim, self._robot.to_enu
+        to_enu = self._robot.to_enu
         pose = self._robot.pose
         links = self._robot.links
-        mine = []
-        for prim, local, joint in self._own:
-            frame = pose if joint is None or links is None else pose.compose(links.poses[joint])
-            ob = _shape_obstacle(prim, enu_pose(frame.compose(local), to_enu))
-            if ob is not None:
-                mine.append(ob)
+        frames = tuple(None if joint is None or links is None else links.poses[joint] for _, _, joint in self._own)
+        if self._mine is not None and self._mine[0] is pose and all(a is b for a, b in zip(self._mine[1], frames)):
+            mine = self._mine[2]          # nothing it rides moved (poses are immutable objects)
+        else:
+            mine = []
+            for (prim, local, _), link in zip(self._own, frames):
+                frame = pose if link is None else pose.compose(link)
+                ob = _shape_obstacle(prim, enu_pose(frame.compose(local), to_enu))
+                if ob is not None:
+                    mine.append(ob)
+            self._mine = (pose, frames, mine)
         if not mine:
             return None
-        scene = sim.scene
-        for name, solid_pose in scene.solid_poses.items():
-            for prim, local in self._solid_shapes(name):
-                ob = _shape_obstacle(prim, enu_pose(solid_pose.compose(local), to_enu))
-                if ob is not None and any(prism_gap(m, ob) <= GRIP_DISTANCE for m in mine):
+        for name, solid_pose in self._sim.scene.solid_poses.items():
+            for ob in self._solid_obstacles(name, solid_pose):
+                if any(may_touch(m, ob) and prism_gap(m, ob) <= GRIP_DISTANCE for m in mine):
                     return name
-        for other in sim.robots.values():
-            if other.index == self.robot_index:
-                continue
-            for prim, local in self._robot_shapes(other.index):
-                ob = _shape_obstacle(prim, enu_pose(other.pose.compose(local), to_enu))
-                if ob is not None and any(prism_gap(m, ob) <= GRIP_DISTANCE for m in mine):
-                    return other.name
         return None
 
+    def _solid_obstacles(self, name: str, pose: Pose) -> list[Obstacle]:
+        """A solid's bounding shapes as prisms at ``pose``, kept while its (immutable) pose and shapes
+        are the same objects: a pump on and holding nothing looks every step, and solids rarely move."""
+        shapes = self._solid_shapes(name)
+        if shapes is None:
+            return []
+        kept = self._placed.get(name)
+        if kept is None or kept[0] is not pose or kept[1] is not shapes:
+            to_enu = self._robot.to_enu
+            obs = [ob for prim, local in shapes
+                   if (ob := _shape_obstacle(prim, enu_pose(pose.compose(local), to_enu))) is not None]
+            kept = self._placed[name] = (pose, shapes, obs)
+        return kept[2]
+
+    # -- measuring
     def measure(self, now_ms: int) -> None:
-        self.touching = self.touched() if self.is_on else None
-        self.value = 1.0 if self.touching is not None else 0.0
+        self.value = 1.0 if self.held is not None else 0.0
         self._mark(now_ms)
 
     def readings(self) -> dict:

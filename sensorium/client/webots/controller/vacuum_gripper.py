@@ -1,5 +1,5 @@
-"""Webots' ``VacuumGripper`` class: the pump and the presence of a held solid (touching it while on;
-nothing is lifted without physics: README "The VacuumGripper")."""
+"""Webots' ``VacuumGripper`` class: the pump and the presence of a held solid (one with physics it
+touched while on, carried kinematically until the pump is off: README "VacuumGripper and Speaker")."""
 
 from __future__ import annotations
 

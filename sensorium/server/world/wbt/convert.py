@@ -1348,6 +1348,8 @@ class Converter:
             if f.string("model", ""):
                 data["model"] = f.string("model", "")
             self.radar_cross_section(node, data)
+            if f.node_("physics") is not None:      # what a VacuumGripper may carry
+                data["physics"] = True
         elif f.has("recognitionColors") and f.rows("recognitionColors", 3, []):
             self.warn(node, f"Solid {name!r}: recognitionColors of a nested solid are not read (give them to the "
                             "top-level solid); ignored")
