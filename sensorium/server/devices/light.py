@@ -282,3 +282,82 @@ def _segments(vectors: tuple) -> tuple[np.ndarray, np.ndarray]:
     _, _, unit, d = vectors
     unit = np.where((d > 0.0)[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
     return unit, d
+
+
+def _sum_orders_are_numpy_s() -> bool:
+    """Whether numpy sums the three products of ``_direct``'s einsum as ``(p0 + p2) + p1`` and the
+    three squares of ``_vectors``' norm as ``(s0 + s1) + s2`` on this machine. The einsum order is
+    its SIMD build's (two float64 lanes: x86-64's baseline; an FMA build such as aarch64's fuses
+    p2 into p0), so :func:`lit_segments` writes these sums as columns only where a probe of varied
+    magnitudes shows they are the same bits, and otherwise uses ``_vectors``/``_direct`` themselves."""
+    rng = np.random.default_rng(20261206)
+    a, b = (rng.standard_normal((4096, 3)) * 10.0 ** rng.integers(-4, 5, (4096, 3)) for _ in range(2))
+    p, s = a * b, b * b
+    dot = np.einsum("sk,snk->sn", a, b[:, None, :])[:, 0]
+    norm = np.linalg.norm(b[:, None, :], axis=2)[:, 0]
+    return (np.array_equal(dot, (p[:, 0] + p[:, 2]) + p[:, 1])
+            and np.array_equal(norm, np.sqrt((s[:, 0] + s[:, 1]) + s[:, 2])))
+
+
+_COLUMN_SUMS = _sum_orders_are_numpy_s()
+
+
+def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j: int,
+                 keep=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Light ``j`` alone (lights (n, 3) shared by every point): the S points (ascending indices)
+    where its un-occluded direct term is above 0, with their occlusion segments towards it (unit
+    rows (m, 3), C-contiguous, and lengths (m,)). The bits of ``direct_and_segments``' column ``j``
+    (the same float64 operations per value, in the same order), made from (S,) columns without its
+    (S, n, 3) temporaries, and units only for the chosen points. ``keep(i, lengths)`` may drop
+    chosen points first (a bool per chosen point, or None: keep all)."""
+    P = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    kind = int(lights.kind[j])
+    if kind == LightKind.SPOT or not _COLUMN_SUMS:
+        one = lights.subset([j])
+        direct, unit, d = direct_and_segments(P, N, one)
+        i = (direct[:, 0] > 0.0).nonzero()[0]
+        lengths = d[:, 0].take(i)
+        if keep is not None and (near := keep(i, lengths)) is not None:
+            i, lengths = i[near], lengths[near]
+        return i, np.take(unit[:, 0], i, axis=0), lengths
+    directional = kind == LightKind.DIRECTIONAL
+    if directional:
+        x, y, z = -lights.direction[j]
+        length = np.sqrt((x * x + y * y) + z * z)
+    else:       # v = q - p as three columns (a (3,) minus (S, 3) rows is a slow loop of 3)
+        q = lights.position[j]
+        x, y, z = (np.subtract(q[k], P[:, k]) for k in range(3))
+        length = x * x
+        t = y * y
+        length += t
+        np.multiply(z, z, out=t)
+        length += t
+        np.sqrt(length, out=length)
+    # c = N·v/|v| as _direct's einsum sums it, (p0 + p2) + p1; 0 (and no ray) where |v| is 0
+    c = N[:, 0] * x
+    t = N[:, 2] * z
+    c += t
+    np.multiply(N[:, 1], y, out=t)
+    c += t
+    c /= np.where(length > 0.0, length, 1.0)
+    # direct = I·c (no spot factor) where c > 0: above 0 exactly where c·I is (I > 0), where c is (I >= 1: no underflow)
+    intensity = float(lights.intensity[j])
+    if intensity <= 0.0:
+        i = np.zeros(0, dtype=np.int64)
+    else:
+        i = ((c > 0.0) if intensity >= 1.0 else (np.multiply(c, intensity, out=c) > 0.0)).nonzero()[0]
+    lengths = np.full(len(i), DIRECTIONAL_DISTANCE) if directional else length.take(i)
+    if keep is not None and (near := keep(i, lengths)) is not None:
+        i, lengths = i[near], lengths[near]
+    unit = np.empty((len(i), 3))
+    if directional:
+        unit[:] = np.array([x, y, z]) / (length if length > 0.0 else 1.0)
+        return i, unit, lengths
+    far = lengths > 0.0
+    safe = lengths if far.all() else np.where(far, lengths, 1.0)
+    for k, col in enumerate((x, y, z)):
+        np.divide(col.take(i), safe, out=unit[:, k])
+    if safe is not lengths:      # a point at the light (or within 1e-162 m of it): _segments' (1, 0, 0), length 0
+        unit[~far] = (1.0, 0.0, 0.0)
+    return i, unit, lengths
