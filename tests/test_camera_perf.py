@@ -448,6 +448,10 @@ def _mixed_points(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
     v = np.array([-0.4, -1.1, 0.6]) - P[40:60]             # grazing the dim light: c about 1e-6
     w = np.cross(v, (0.0, 0.0, 1.0))
     N[40:60] = w / np.linalg.norm(w, axis=1)[:, None] + 1e-6 * v / np.linalg.norm(v, axis=1)[:, None]
+    # N·v of the light at the origin cancels: its sign is the order of the sum's terms ((p0 + p2) + p1
+    # is 0 at the first point, above 0 at the second; (p0 + p1) + p2 the other way round)
+    P[60:62] = ((-1.0, 1.0, -1e-17), (-1.0, -1e-17, 1.0))
+    N[60:62] = np.sqrt(1.0 / 3.0)
     return P, N
 
 
@@ -464,6 +468,7 @@ def test_one_light_s_columns_are_direct_and_segments_column_bit_for_bit():
         assert got_unit.tobytes() == np.ascontiguousarray(unit[want, j]).tobytes() and got_unit.flags.c_contiguous
         assert got_length.tobytes() == length[want, j].tobytes()
     i, unit, length = light_math.lit_segments(P, N, lights, 3)
+    assert 60 not in i and 61 in i
     assert 5 not in i and unit[i == 6].tolist() == [[1.0, 0.0, 0.0]] and length[i == 6].tolist() == [0.0]
     facing = ((N * (np.array([-0.4, -1.1, 0.6]) - P)).sum(axis=1) > 0.0).sum()
     assert 0 < len(light_math.lit_segments(P, N, lights, 4)[0]) < facing       # grazing points: I·c is 0
