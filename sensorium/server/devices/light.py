@@ -304,7 +304,7 @@ _COLUMN_SUMS = _sum_orders_are_numpy_s()
 
 def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j: int,
                  keep=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Light ``j`` alone (lights (n, 3) shared by every point): the S points (ascending indices)
+    """Light ``j`` alone: the S points (ascending indices)
     where its un-occluded direct term is above 0, with their occlusion segments towards it (unit
     rows (m, 3), C-contiguous, and lengths (m,)). The bits of ``direct_and_segments``' column ``j``
     (the same float64 operations per value, in the same order), made from (S,) columns without its
@@ -313,7 +313,7 @@ def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j
     P = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     kind = int(lights.kind[j])
-    if kind == LightKind.SPOT or not _COLUMN_SUMS:
+    if kind == LightKind.SPOT or not _COLUMN_SUMS or lights.position.ndim == 3:     # (S, n, 3): per point
         one = lights.subset([j])
         direct, unit, d = direct_and_segments(P, N, one)
         i = (direct[:, 0] > 0.0).nonzero()[0]
@@ -321,6 +321,9 @@ def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j
         if keep is not None and (near := keep(i, lengths)) is not None:
             i, lengths = i[near], lengths[near]
         return i, np.take(unit[:, 0], i, axis=0), lengths
+    intensity = float(lights.intensity[j])
+    if intensity <= 0.0 or len(P) == 0:        # I·c (no spot factor) is never above 0
+        return np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0)
     directional = kind == LightKind.DIRECTIONAL
     if directional:
         x, y, z = -lights.direction[j]
@@ -334,30 +337,27 @@ def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j
         np.multiply(z, z, out=t)
         length += t
         np.sqrt(length, out=length)
-    # c = N·v/|v| as _direct's einsum sums it, (p0 + p2) + p1; 0 (and no ray) where |v| is 0
+    positive = length.min() > 0.0          # no point at the light (nor NaN): every |v| is its own divisor
+    # c = N·v/|v| as _direct's einsum sums it, (p0 + p2) + p1; |v| = 0 divides by 1
     c = N[:, 0] * x
     t = N[:, 2] * z
     c += t
     np.multiply(N[:, 1], y, out=t)
     c += t
-    c /= np.where(length > 0.0, length, 1.0)
-    # direct = I·c (no spot factor) where c > 0: above 0 exactly where c·I is (I > 0), where c is (I >= 1: no underflow)
-    intensity = float(lights.intensity[j])
-    if intensity <= 0.0:
-        i = np.zeros(0, dtype=np.int64)
-    else:
-        i = ((c > 0.0) if intensity >= 1.0 else (np.multiply(c, intensity, out=c) > 0.0)).nonzero()[0]
+    c /= length if positive else np.where(length > 0.0, length, 1.0)
+    # direct = I·c where c > 0: above 0 exactly where c·I is (I > 0), where c is (I >= 1: no underflow)
+    i = ((c > 0.0) if intensity >= 1.0 else (np.multiply(c, intensity, out=c) > 0.0)).nonzero()[0]
     lengths = np.full(len(i), DIRECTIONAL_DISTANCE) if directional else length.take(i)
     if keep is not None and (near := keep(i, lengths)) is not None:
         i, lengths = i[near], lengths[near]
     unit = np.empty((len(i), 3))
     if directional:
-        unit[:] = np.array([x, y, z]) / (length if length > 0.0 else 1.0)
+        unit[:] = np.array([x, y, z]) / (length if positive else 1.0)
         return i, unit, lengths
-    far = lengths > 0.0
-    safe = lengths if far.all() else np.where(far, lengths, 1.0)
+    far = None if positive else lengths > 0.0
+    safe = lengths if far is None else np.where(far, lengths, 1.0)
     for k, col in enumerate((x, y, z)):
         np.divide(col.take(i), safe, out=unit[:, k])
-    if safe is not lengths:      # a point at the light (or within 1e-162 m of it): _segments' (1, 0, 0), length 0
+    if far is not None:      # a point at the light (or within 1e-162 m of it): _segments' (1, 0, 0), length 0
         unit[~far] = (1.0, 0.0, 0.0)
     return i, unit, lengths
