@@ -179,12 +179,14 @@ def _vectors(points: np.ndarray, lights: LightArrays):
     """For S points: unnormalised sensor→light vectors v (S,n,3), |v| (S,n), unit L (S,n,3; 0 where
     |v| = 0) and distances d (S,n; 1000 for directional lights)."""
     directional = lights.kind == LightKind.DIRECTIONAL
+    some = bool(directional.any())         # no directional light: no choice to make per pair
     v = _per_point(lights.position) - points[:, None, :]
-    v = np.where(directional[None, :, None], -_per_point(lights.direction), v)
+    if some:
+        v = np.where(directional[None, :, None], -_per_point(lights.direction), v)
     length = np.linalg.norm(v, axis=2)
     safe = np.where(length > 0.0, length, 1.0)
     unit = v / safe[:, :, None]
-    d = np.where(directional[None, :], DIRECTIONAL_DISTANCE, length)
+    d = np.where(directional[None, :], DIRECTIONAL_DISTANCE, length) if some else length
     return v, length, unit, d
 
 
@@ -208,17 +210,16 @@ def _direct(N: np.ndarray, lights: LightArrays, vectors: tuple) -> np.ndarray:
     # c = N·(q - p)/d: exactly 0 when the light is exactly in the sensor plane (and when d = 0).
     c = np.einsum("sk,snk->sn", N, v) / np.where(length > 0.0, length, 1.0)
 
-    spot = np.ones(c.shape)
     is_spot = lights.kind == LightKind.SPOT
-    if np.any(is_spot):
-        R = -_per_point(lights.direction)
-        alpha = np.arctan2(np.linalg.norm(np.cross(unit, R), axis=2), np.einsum("snk,snk->sn", unit, R))
-        bw, co = lights.beam_width[None, :], lights.cut_off_angle[None, :]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            linear = (alpha - co) / (bw - co)
-        factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, linear))
-        spot = np.where(is_spot[None, :], factor, 1.0)
-
+    if not np.any(is_spot):       # a spot factor of 1 everywhere: I·c·1 is I·c
+        return np.where(c > 0.0, lights.intensity[None, :] * c, 0.0)
+    R = -_per_point(lights.direction)
+    alpha = np.arctan2(np.linalg.norm(np.cross(unit, R), axis=2), np.einsum("snk,snk->sn", unit, R))
+    bw, co = lights.beam_width[None, :], lights.cut_off_angle[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        linear = (alpha - co) / (bw - co)
+    factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, linear))
+    spot = np.where(is_spot[None, :], factor, 1.0)
     return np.where(c > 0.0, lights.intensity[None, :] * c * spot, 0.0)
 
 
@@ -280,7 +281,9 @@ def occlusion_segments_many(positions: np.ndarray, lights: LightArrays) -> tuple
 
 def _segments(vectors: tuple) -> tuple[np.ndarray, np.ndarray]:
     _, _, unit, d = vectors
-    unit = np.where((d > 0.0)[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
+    far = d > 0.0
+    if not far.all():          # a point at a light
+        unit = np.where(far[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
     return unit, d
 
 
