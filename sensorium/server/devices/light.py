@@ -294,7 +294,7 @@ def _sum_orders_are_numpy_s() -> bool:
     p2 into p0), so :func:`lit_segments` writes these sums as columns only where a probe of varied
     magnitudes shows they are the same bits, and otherwise uses ``_vectors``/``_direct`` themselves."""
     rng = np.random.default_rng(20261206)
-    a, b = (rng.standard_normal((4096, 3)) * 10.0 ** rng.integers(-4, 5, (4096, 3)) for _ in range(2))
+    a, b = (rng.standard_normal((1024, 3)) * 10.0 ** rng.integers(-4, 5, (1024, 3)) for _ in range(2))
     p, s = a * b, b * b
     dot = np.einsum("sk,snk->sn", a, b[:, None, :])[:, 0]
     norm = np.linalg.norm(b[:, None, :], axis=2)[:, 0]
