@@ -421,7 +421,7 @@ import platform  # noqa: E402
 
 def _mixed_lights() -> list[Light]:
     """Every path of lit_segments: point lights of intensity above, at, below 1 and 0, one with a
-    radius that cuts, directional ones (one dim), a spot (the general path)."""
+    radius that cuts, directional ones (one dim), a spot."""
     return [
         Light(LightKind.POINT, position=(0.5, -0.5, 1.0), intensity=2.0, radius=1.6),
         Light(LightKind.DIRECTIONAL, direction=(0.3, 0.2, -1.0), intensity=0.6),

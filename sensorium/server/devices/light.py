@@ -289,7 +289,8 @@ def _segments(vectors: tuple) -> tuple[np.ndarray, np.ndarray]:
 
 def _sum_orders_are_numpy_s() -> bool:
     """Whether numpy sums the three products of ``_direct``'s einsum as ``(p0 + p2) + p1`` and the
-    three squares of ``_vectors``' norm as ``(s0 + s1) + s2`` on this machine. The einsum order is
+    three squares of ``_vectors``' norm as ``(s0 + s1) + s2`` on this machine (and the spot
+    factor's einsum and norm the same way). The einsum order is
     its SIMD build's (two float64 lanes: x86-64's baseline; an FMA build such as aarch64's fuses
     p2 into p0), so :func:`lit_segments` writes these sums as columns only where a probe of varied
     magnitudes shows they are the same bits, and otherwise uses ``_vectors``/``_direct`` themselves."""
@@ -298,7 +299,11 @@ def _sum_orders_are_numpy_s() -> bool:
     p, s = a * b, b * b
     dot = np.einsum("sk,snk->sn", a, b[:, None, :])[:, 0]
     norm = np.linalg.norm(b[:, None, :], axis=2)[:, 0]
+    r = b[:1]                                    # the spot factor's cosine: one axis for every point
+    q = a * r
+    cos = np.einsum("snk,snk->sn", a[:, None, :], r[None, :, :])[:, 0]
     return (np.array_equal(dot, (p[:, 0] + p[:, 2]) + p[:, 1])
+            and np.array_equal(cos, (q[:, 0] + q[:, 2]) + q[:, 1])
             and np.array_equal(norm, np.sqrt((s[:, 0] + s[:, 1]) + s[:, 2])))
 
 
@@ -307,16 +312,17 @@ _COLUMN_SUMS = _sum_orders_are_numpy_s()
 
 def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j: int,
                  keep=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Light ``j`` alone: the S points (ascending indices)
-    where its un-occluded direct term is above 0, with their occlusion segments towards it (unit
-    rows (m, 3), C-contiguous, and lengths (m,)). The bits of ``direct_and_segments``' column ``j``
-    (the same float64 operations per value, in the same order), made from (S,) columns without its
-    (S, n, 3) temporaries, and units only for the chosen points. ``keep(i, lengths)`` may drop
-    chosen points first (a bool per chosen point, or None: keep all)."""
+    """Light ``j`` alone: the S points (ascending indices) where its un-occluded direct term is
+    above 0, with their occlusion segments towards it (unit rows (m, 3), C-contiguous, and lengths
+    (m,)). The bits of ``direct_and_segments``' column ``j`` (the same float64 operations per value,
+    in the same order), made from (S,) columns without its (S, n, 3) temporaries, a spot factor only
+    where ``c > 0``, units only for the chosen points; ``direct_and_segments`` itself where numpy
+    sums otherwise (``_COLUMN_SUMS``) or lights are per point. ``keep(i, lengths)`` may drop chosen
+    points first (a bool per chosen point, or None: keep all)."""
     P = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
     kind = int(lights.kind[j])
-    if kind == LightKind.SPOT or not _COLUMN_SUMS or lights.position.ndim == 3:     # (S, n, 3): per point
+    if not _COLUMN_SUMS or lights.position.ndim == 3:     # (S, n, 3): per point
         one = lights.subset([j])
         direct, unit, d = direct_and_segments(P, N, one)
         i = (direct[:, 0] > 0.0).nonzero()[0]
@@ -347,9 +353,12 @@ def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j
     c += t
     np.multiply(N[:, 1], y, out=t)
     c += t
-    c /= length if positive else np.where(length > 0.0, length, 1.0)
-    # direct = I·c where c > 0: above 0 exactly where c·I is (I > 0), where c is (I >= 1: no underflow)
-    i = ((c > 0.0) if intensity >= 1.0 else (np.multiply(c, intensity, out=c) > 0.0)).nonzero()[0]
+    divisor = length if positive else np.where(length > 0.0, length, 1.0)
+    c /= divisor
+    if kind == LightKind.SPOT:
+        i = _spot_lit(c, divisor, (x, y, z), lights, j, intensity)
+    else:   # direct = I·c where c > 0: above 0 exactly where c·I is (I > 0), where c is (I >= 1: no underflow)
+        i = ((c > 0.0) if intensity >= 1.0 else (np.multiply(c, intensity, out=c) > 0.0)).nonzero()[0]
     lengths = np.full(len(i), DIRECTIONAL_DISTANCE) if directional else length.take(i)
     if keep is not None and (near := keep(i, lengths)) is not None:
         i, lengths = i[near], lengths[near]
@@ -364,3 +373,32 @@ def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j
     if far is not None:      # a point at the light (or within 1e-162 m of it): _segments' (1, 0, 0), length 0
         unit[~far] = (1.0, 0.0, 0.0)
     return i, unit, lengths
+
+
+def _spot_lit(c: np.ndarray, divisor: np.ndarray, v: tuple, lights: LightArrays, j: int, intensity: float) -> np.ndarray:
+    """The points (ascending) where spot light ``j``'s direct term ``I·c·spot`` is above 0, its
+    spot factor made (as ``_direct`` makes it: unit = v/divisor, the angle to the axis by
+    ``atan2(|unit × R|, unit·R)``, numpy's cross products) only where ``c > 0``."""
+    i = (c > 0.0).nonzero()[0]
+    d = divisor.take(i)
+    u0, u1, u2 = (col.take(i) / d for col in v)
+    r0, r1, r2 = -lights.direction[j]
+    cp0 = u1 * r2
+    cp0 -= u2 * r1
+    cp1 = u2 * r0
+    cp1 -= u0 * r2
+    cp2 = u0 * r1
+    cp2 -= u1 * r0
+    sin = cp0 * cp0
+    sin += cp1 * cp1
+    sin += cp2 * cp2
+    np.sqrt(sin, out=sin)
+    cos = u0 * r0
+    cos += u2 * r2
+    cos += u1 * r1
+    alpha = np.arctan2(sin, cos)
+    bw, co = lights.beam_width[j], lights.cut_off_angle[j]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        linear = (alpha - co) / (bw - co)
+    factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, linear))
+    return i[(intensity * c.take(i)) * factor > 0.0]
