@@ -411,3 +411,89 @@ def test_a_smaller_camera_inside_its_robot_skips_it_for_its_unbounded_rays(preci
     assert 0 < out.sum() < n // 2
     assert not np.isfinite(own.distance[out]).any()
     np.testing.assert_allclose(own.distance[~out], _A / big[~out], rtol=tol)
+
+
+# ------------------------------------------------- one light's columns (light.lit_segments)
+
+import itertools  # noqa: E402
+import platform  # noqa: E402
+
+
+def _mixed_lights() -> list[Light]:
+    """Every path of lit_segments: point lights of intensity above, at, below 1 and 0, one with a
+    radius that cuts, directional ones (one dim), a spot."""
+    return [
+        Light(LightKind.POINT, position=(0.5, -0.5, 1.0), intensity=2.0, radius=1.6),
+        Light(LightKind.DIRECTIONAL, direction=(0.3, 0.2, -1.0), intensity=0.6),
+        Light(LightKind.SPOT, position=(-1.0, 0.0, 0.8), direction=(1.0, 0.0, -0.5), beam_width=0.3,
+              cut_off_angle=0.6),
+        Light(LightKind.POINT, position=(0.0, 0.0, 0.0), intensity=1.0, attenuation=(0.0, 0.0, 1.0)),
+        Light(LightKind.POINT, position=(-0.4, -1.1, 0.6), intensity=1e-320),       # I·c underflows when c < 5e-4
+        Light(LightKind.POINT, position=(1.5, 1.5, 1.5), intensity=0.0),
+        Light(LightKind.DIRECTIONAL, direction=(-1e-3, 0.0, -1.0), intensity=3.0),
+    ]
+
+
+def _mixed_points(n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Points of every magnitude around the lights, a point at one (the origin), one 1e-170 m from
+    it (its distance's squares underflow: length 0 with a direction), normals in every direction."""
+    rng = np.random.default_rng(seed)
+    P = rng.uniform(-2.0, 2.0, size=(n, 3)) * 10.0 ** rng.integers(-3, 2, size=(n, 1))
+    N = rng.normal(size=(n, 3)) * 10.0 ** rng.integers(-3, 3, size=(n, 3))
+    N /= np.linalg.norm(N, axis=1)[:, None]
+    P[5] = 0.0
+    P[6] = 1e-170
+    N[6] = -np.sqrt(1.0 / 3.0)                              # facing the light at the origin
+    P[8:40] = rng.normal(size=(32, 3)) * 1e-9              # very near it
+    v = np.array([-0.4, -1.1, 0.6]) - P[40:60]             # grazing the dim light: c about 1e-6
+    w = np.cross(v, (0.0, 0.0, 1.0))
+    N[40:60] = w / np.linalg.norm(w, axis=1)[:, None] + 1e-6 * v / np.linalg.norm(v, axis=1)[:, None]
+    # N·v of the light at the origin cancels: its sign is the order of the sum's terms ((p0 + p2) + p1
+    # is 0 at the first point, above 0 at the second; (p0 + p1) + p2 the other way round)
+    P[60:62] = ((-1.0, 1.0, -1e-17), (-1.0, -1e-17, 1.0))
+    N[60:62] = np.sqrt(1.0 / 3.0)
+    return P, N
+
+
+def test_one_light_s_columns_are_direct_and_segments_column_bit_for_bit():
+    """lit_segments' points, units and lengths of each light are those of direct_and_segments'
+    column (the general (S, n, 3) path), for every kind of light and every point."""
+    lights = LightArrays.from_lights(_mixed_lights())
+    P, N = _mixed_points(20000, 21)
+    direct, unit, length = light_math.direct_and_segments(P, N, lights)
+    for j in range(len(lights)):
+        i, got_unit, got_length = light_math.lit_segments(P, N, lights, j)
+        want = (direct[:, j] > 0.0).nonzero()[0]
+        assert i.tobytes() == want.tobytes(), j
+        assert got_unit.tobytes() == np.ascontiguousarray(unit[want, j]).tobytes() and got_unit.flags.c_contiguous
+        assert got_length.tobytes() == length[want, j].tobytes()
+    i, unit, length = light_math.lit_segments(P, N, lights, 3)
+    assert 60 not in i and 61 in i
+    assert 5 not in i and unit[i == 6].tolist() == [[1.0, 0.0, 0.0]] and length[i == 6].tolist() == [0.0]
+    facing = ((N * (np.array([-0.4, -1.1, 0.6]) - P)).sum(axis=1) > 0.0).sum()
+    assert 0 < len(light_math.lit_segments(P, N, lights, 4)[0]) < facing       # grazing points: I·c is 0
+    assert len(light_math.lit_segments(P, N, lights, 5)[0]) == 0
+
+
+def test_the_column_sums_are_numpy_s_on_x86_64():
+    """The fast columns are used where numpy sums as they do (x86-64's SSE build: always)."""
+    if platform.machine().lower() in ("x86_64", "amd64"):
+        assert light_math._COLUMN_SUMS
+
+
+def test_shadow_rays_of_mixed_lights_in_every_order_are_the_general_choice():
+    """Lights that cast no shadow mixed with ones that do, in every order: each casting light's
+    points, segments and lengths are the one-pass general path's, bit for bit, on 1 and 2 threads."""
+    base = _mixed_lights()
+    P, N = _mixed_points(shading.BLOCK + 777, 22)
+    for order in itertools.permutations([0, 1, 2, 3]):
+        lights = LightArrays.from_lights([base[k] for k in order])
+        for casting in ([0, 2], [1, 3], [0, 1, 2, 3], [3]):
+            shadows = np.isin(np.arange(4), casting)
+            want = _one_pass(P, N, lights, shadows)
+            for threads in (1, 2):
+                got = shadow_rays(P, N, lights, shadows, threads)
+                assert sorted(got) == casting
+                for j in casting:
+                    for a, b in zip(got[j], want[j]):
+                        assert a.tobytes() == np.ascontiguousarray(b).tobytes(), (order, casting, j)

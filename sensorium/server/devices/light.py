@@ -179,12 +179,14 @@ def _vectors(points: np.ndarray, lights: LightArrays):
     """For S points: unnormalised sensor→light vectors v (S,n,3), |v| (S,n), unit L (S,n,3; 0 where
     |v| = 0) and distances d (S,n; 1000 for directional lights)."""
     directional = lights.kind == LightKind.DIRECTIONAL
+    some = bool(directional.any())         # no directional light: no choice to make per pair
     v = _per_point(lights.position) - points[:, None, :]
-    v = np.where(directional[None, :, None], -_per_point(lights.direction), v)
+    if some:
+        v = np.where(directional[None, :, None], -_per_point(lights.direction), v)
     length = np.linalg.norm(v, axis=2)
     safe = np.where(length > 0.0, length, 1.0)
     unit = v / safe[:, :, None]
-    d = np.where(directional[None, :], DIRECTIONAL_DISTANCE, length)
+    d = np.where(directional[None, :], DIRECTIONAL_DISTANCE, length) if some else length
     return v, length, unit, d
 
 
@@ -208,17 +210,16 @@ def _direct(N: np.ndarray, lights: LightArrays, vectors: tuple) -> np.ndarray:
     # c = N·(q - p)/d: exactly 0 when the light is exactly in the sensor plane (and when d = 0).
     c = np.einsum("sk,snk->sn", N, v) / np.where(length > 0.0, length, 1.0)
 
-    spot = np.ones(c.shape)
     is_spot = lights.kind == LightKind.SPOT
-    if np.any(is_spot):
-        R = -_per_point(lights.direction)
-        alpha = np.arctan2(np.linalg.norm(np.cross(unit, R), axis=2), np.einsum("snk,snk->sn", unit, R))
-        bw, co = lights.beam_width[None, :], lights.cut_off_angle[None, :]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            linear = (alpha - co) / (bw - co)
-        factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, linear))
-        spot = np.where(is_spot[None, :], factor, 1.0)
-
+    if not np.any(is_spot):       # a spot factor of 1 everywhere: I·c·1 is I·c
+        return np.where(c > 0.0, lights.intensity[None, :] * c, 0.0)
+    R = -_per_point(lights.direction)
+    alpha = np.arctan2(np.linalg.norm(np.cross(unit, R), axis=2), np.einsum("snk,snk->sn", unit, R))
+    bw, co = lights.beam_width[None, :], lights.cut_off_angle[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        linear = (alpha - co) / (bw - co)
+    factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, linear))
+    spot = np.where(is_spot[None, :], factor, 1.0)
     return np.where(c > 0.0, lights.intensity[None, :] * c * spot, 0.0)
 
 
@@ -280,5 +281,124 @@ def occlusion_segments_many(positions: np.ndarray, lights: LightArrays) -> tuple
 
 def _segments(vectors: tuple) -> tuple[np.ndarray, np.ndarray]:
     _, _, unit, d = vectors
-    unit = np.where((d > 0.0)[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
+    far = d > 0.0
+    if not far.all():          # a point at a light
+        unit = np.where(far[:, :, None], unit, np.array([1.0, 0.0, 0.0]))
     return unit, d
+
+
+def _sum_orders_are_numpy_s() -> bool:
+    """Whether numpy sums the three products of ``_direct``'s einsum as ``(p0 + p2) + p1`` and the
+    three squares of ``_vectors``' norm as ``(s0 + s1) + s2`` on this machine (and the spot
+    factor's einsum and norm the same way). The einsum order is
+    its SIMD build's (two float64 lanes: x86-64's baseline; an FMA build such as aarch64's fuses
+    p2 into p0), so :func:`lit_segments` writes these sums as columns only where a probe of varied
+    magnitudes shows they are the same bits, and otherwise uses ``_vectors``/``_direct`` themselves."""
+    rng = np.random.default_rng(20261206)
+    a, b = (rng.standard_normal((1024, 3)) * 10.0 ** rng.integers(-4, 5, (1024, 3)) for _ in range(2))
+    p, s = a * b, b * b
+    dot = np.einsum("sk,snk->sn", a, b[:, None, :])[:, 0]
+    norm = np.linalg.norm(b[:, None, :], axis=2)[:, 0]
+    r = b[:1]                                    # the spot factor's cosine: one axis for every point
+    q = a * r
+    cos = np.einsum("snk,snk->sn", a[:, None, :], r[None, :, :])[:, 0]
+    return (np.array_equal(dot, (p[:, 0] + p[:, 2]) + p[:, 1])
+            and np.array_equal(cos, (q[:, 0] + q[:, 2]) + q[:, 1])
+            and np.array_equal(norm, np.sqrt((s[:, 0] + s[:, 1]) + s[:, 2])))
+
+
+_COLUMN_SUMS = _sum_orders_are_numpy_s()
+
+
+def lit_segments(points: np.ndarray, normals: np.ndarray, lights: LightArrays, j: int,
+                 keep=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Light ``j`` alone: the S points (ascending indices) where its un-occluded direct term is
+    above 0, with their occlusion segments towards it (unit rows (m, 3), C-contiguous, and lengths
+    (m,)). The bits of ``direct_and_segments``' column ``j`` (the same float64 operations per value,
+    in the same order), made from (S,) columns without its (S, n, 3) temporaries, a spot factor only
+    where ``c > 0``, units only for the chosen points; ``direct_and_segments`` itself where numpy
+    sums otherwise (``_COLUMN_SUMS``) or lights are per point. ``keep(i, lengths)`` may drop chosen
+    points first (a bool per chosen point, or None: keep all)."""
+    P = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    N = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
+    kind = int(lights.kind[j])
+    if not _COLUMN_SUMS or lights.position.ndim == 3:     # (S, n, 3): per point
+        one = lights.subset([j])
+        direct, unit, d = direct_and_segments(P, N, one)
+        i = (direct[:, 0] > 0.0).nonzero()[0]
+        lengths = d[:, 0].take(i)
+        if keep is not None and (near := keep(i, lengths)) is not None:
+            i, lengths = i[near], lengths[near]
+        return i, np.take(unit[:, 0], i, axis=0), lengths
+    intensity = float(lights.intensity[j])
+    if intensity <= 0.0 or len(P) == 0:        # I·c (no spot factor) is never above 0
+        return np.zeros(0, dtype=np.int64), np.zeros((0, 3)), np.zeros(0)
+    directional = kind == LightKind.DIRECTIONAL
+    if directional:
+        x, y, z = -lights.direction[j]
+        length = np.sqrt((x * x + y * y) + z * z)
+    else:       # v = q - p as three columns (a (3,) minus (S, 3) rows is a slow loop of 3)
+        q = lights.position[j]
+        x, y, z = (np.subtract(q[k], P[:, k]) for k in range(3))
+        length = x * x
+        t = y * y
+        length += t
+        np.multiply(z, z, out=t)
+        length += t
+        np.sqrt(length, out=length)
+    positive = length.min() > 0.0          # no point at the light (nor NaN): every |v| is its own divisor
+    # c = N·v/|v| as _direct's einsum sums it, (p0 + p2) + p1; |v| = 0 divides by 1
+    c = N[:, 0] * x
+    t = N[:, 2] * z
+    c += t
+    np.multiply(N[:, 1], y, out=t)
+    c += t
+    divisor = length if positive else np.where(length > 0.0, length, 1.0)
+    c /= divisor
+    if kind == LightKind.SPOT:
+        i = _spot_lit(c, divisor, (x, y, z), lights, j, intensity)
+    else:   # direct = I·c where c > 0: above 0 exactly where c·I is (I > 0), where c is (I >= 1: no underflow)
+        i = ((c > 0.0) if intensity >= 1.0 else (np.multiply(c, intensity, out=c) > 0.0)).nonzero()[0]
+    lengths = np.full(len(i), DIRECTIONAL_DISTANCE) if directional else length.take(i)
+    if keep is not None and (near := keep(i, lengths)) is not None:
+        i, lengths = i[near], lengths[near]
+    unit = np.empty((len(i), 3))
+    if directional:
+        unit[:] = np.array([x, y, z]) / (length if positive else 1.0)
+        return i, unit, lengths
+    far = None if positive else lengths > 0.0
+    safe = lengths if far is None else np.where(far, lengths, 1.0)
+    for k, col in enumerate((x, y, z)):
+        np.divide(col.take(i), safe, out=unit[:, k])
+    if far is not None:      # a point at the light (or within 1e-162 m of it): _segments' (1, 0, 0), length 0
+        unit[~far] = (1.0, 0.0, 0.0)
+    return i, unit, lengths
+
+
+def _spot_lit(c: np.ndarray, divisor: np.ndarray, v: tuple, lights: LightArrays, j: int, intensity: float) -> np.ndarray:
+    """The points (ascending) where spot light ``j``'s direct term ``I·c·spot`` is above 0, its
+    spot factor made (as ``_direct`` makes it: unit = v/divisor, the angle to the axis by
+    ``atan2(|unit × R|, unit·R)``, numpy's cross products) only where ``c > 0``."""
+    i = (c > 0.0).nonzero()[0]
+    d = divisor.take(i)
+    u0, u1, u2 = (col.take(i) / d for col in v)
+    r0, r1, r2 = -lights.direction[j]
+    cp0 = u1 * r2
+    cp0 -= u2 * r1
+    cp1 = u2 * r0
+    cp1 -= u0 * r2
+    cp2 = u0 * r1
+    cp2 -= u1 * r0
+    sin = cp0 * cp0
+    sin += cp1 * cp1
+    sin += cp2 * cp2
+    np.sqrt(sin, out=sin)
+    cos = u0 * r0
+    cos += u2 * r2
+    cos += u1 * r1
+    alpha = np.arctan2(sin, cos)
+    bw, co = lights.beam_width[j], lights.cut_off_angle[j]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        linear = (alpha - co) / (bw - co)
+    factor = np.where(alpha > co, 0.0, np.where(alpha <= bw, 1.0, linear))
+    return i[(intensity * c.take(i)) * factor > 0.0]

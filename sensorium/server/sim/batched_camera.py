@@ -245,20 +245,20 @@ class CameraDevices(PixelDevices):
             q = int(copies[row_copy[rq[0]]])
             lights = self._lights_of(q)
             Pq, Nq = P[rq], N[rq]
-            direct = light_math.light_terms(Pq, Nq, lights)[1]
-            unit, length = light_math.occlusion_segments_many(Pq, lights)
             # the copy's own lights (with LEDs' lights: those on in it) are the first columns
             casting = self.shadows if sim.carried is None else sim.carried.shadows(q, self._fixed_shadows)
             for j in casting.nonzero()[0].tolist():
-                i = (direct[:, j] > 0.0).nonzero()[0]
-                near = shading.within_radius(Pq[i], lights, j)      # beyond the light's radius: unlit anyway
-                if near is not None:
-                    i = i[near]
+                # the facing points and their segments of this light only (light_terms' and
+                # occlusion_segments_many's values); beyond the light's radius: unlit anyway
+                def near(i: np.ndarray, _: np.ndarray, Pq: np.ndarray = Pq, lights=lights, j: int = j) -> np.ndarray | None:
+                    return shading.within_radius(Pq[i], lights, j)
+
+                i, unit, length = light_math.lit_segments(Pq, Nq, lights, j, near)
                 if len(i) == 0:
                     continue
-                h = sim.rays.cast(Pq[i], unit[i, j], 0.0, length[i, j], RayKind.SHADOW, np.full(len(i), q, dtype=np.int64),
+                h = sim.rays.cast(Pq[i], unit, 0.0, length, RayKind.SHADOW, np.full(len(i), q, dtype=np.int64),
                                   sim.rot, sim.pos, -1, -1, False, distance_only=True)
-                lit[rq[i], j] = ~(h.distance <= length[i, j])
+                lit[rq[i], j] = ~(h.distance <= length)
         return lit
 
     def _image(self, col: int, copies: np.ndarray, org: np.ndarray, dirs: np.ndarray, hits: RayHits) -> None:

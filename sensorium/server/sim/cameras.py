@@ -627,9 +627,10 @@ def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, sh
     """Per shadow-casting light ``j``: the points (ascending indices into ``P``) whose direct term
     from it is above 0 (``light.light_terms``) and which lie within its radius
     (``shading.within_radius``), with their unit segments towards it and the segments' lengths
-    (``light.occlusion_segments_many``; both from ``light.direct_and_segments``). Every value is elementwise, so it is worked out on row
-    blocks of ``shading.BLOCK`` points (each block's (S, n, 3) temporaries stay in the CPU's cache)
-    on up to ``threads`` threads: the same points and the same bits as one pass over all of them."""
+    (``light.occlusion_segments_many``), the bits ``light.direct_and_segments`` gives, made one light
+    at a time from (S,) columns (``light.lit_segments``). Every value is elementwise, so it is worked
+    out on row blocks of ``shading.BLOCK`` points (each block's columns stay in the CPU's cache) on
+    up to ``threads`` threads: the same points and the same bits as one pass over all of them."""
     js = shadows.nonzero()[0].tolist()
     S = len(P)
     parts = [slice(a, min(S, a + shading.BLOCK)) for a in range(0, S, shading.BLOCK)]
@@ -641,20 +642,18 @@ def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, sh
              for j in range(n)]
 
     def part(sl: slice) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-        Pb = P[sl]
-        direct, unit, length = light_math.direct_and_segments(Pb, N[sl], casting)
-        units, lengths = unit.reshape(-1, 3), length.reshape(-1)      # (point, light) pairs as rows
+        Pb, Nb = P[sl], N[sl]
         out = []
         for j in range(n):
-            i = (direct[:, j] > 0.0).nonzero()[0]
-            # beyond the light's radius: unlit anyway. within_radius measures each distance its own way
-            # (radiance's), a few ulps from these: a block far inside the radius needs none of them
-            if len(i) and not length[:, j].max() < reach[j] * (1.0 - 1e-9):
-                near = shading.within_radius(shading.take_rows(Pb, i), casting, j)
-                if near is not None:
-                    i = i[near]
-            pair = i * n + j
-            out.append((i + sl.start, np.take(units, pair, axis=0), lengths.take(pair)))
+            def near(i: np.ndarray, length: np.ndarray, j: int = j) -> np.ndarray | None:
+                # beyond the light's radius: unlit anyway. within_radius measures each distance its own way
+                # (radiance's), a few ulps from these: points far inside the radius need none of them
+                if len(i) == 0 or length.max() < reach[j] * (1.0 - 1e-9):
+                    return None
+                return shading.within_radius(shading.take_rows(Pb, i), casting, j)
+
+            i, unit, length = light_math.lit_segments(Pb, Nb, casting, j, None if reach[j] == math.inf else near)
+            out.append((i + sl.start, unit, length))
         return out
 
     done = blocks.run(part, parts, threads) if js and S else []
