@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 from _protos import proto_file, world_file
-from _serve import serve
+from _serve import serve, wait_until
 
 from sensorium.cli import main as cli
 from sensorium.server.world.loader import LoadedWorld, WorldError, load_world, parse_text, parse_world
@@ -195,8 +195,10 @@ def test_validate_lists_the_reset_and_passes(tmp_path: Path, capsys) -> None:
 @pytest.mark.slow
 def test_serve_prints_the_reset_before_serving(tmp_path: Path) -> None:
     p, _ = load(tmp_path, shape("Sphere { radius 0 }") + robot(""))
+    line = f"warning: {p}:2:55: Sphere.radius: 0 is not > 0; using 1 {AS_WEBOTS}"
     with serve(p, "--precision", "fast") as s:                      # free ports (fixed ones can be taken)
-        assert f"warning: {p}:2:55: Sphere.radius: 0 is not > 0; using 1 {AS_WEBOTS}" in s.stderr()
+        # printed before the ready line, but read from stderr by its own thread: wait for it
+        wait_until(lambda: line in s.stderr(), timeout=60.0, what="the reset line on stderr")
 
 
 # ---------------------------------------------------------------- what stays an error
