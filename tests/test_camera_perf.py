@@ -485,14 +485,17 @@ def test_shadow_rays_of_mixed_lights_in_every_order_are_the_general_choice():
     """Lights that cast no shadow mixed with ones that do, in every order: each casting light's
     points, segments and lengths are the one-pass general path's, bit for bit, on 1 and 2 threads."""
     base = _mixed_lights()
-    P, N = _mixed_points(shading.BLOCK + 777, 22)
+    P, N = _mixed_points(shading.BLOCK + 777, 22)          # over a block boundary: one order, both thread counts
+    few = slice(0, 3000)                                   # every order: within one block, one thread
     for order in itertools.permutations([0, 1, 2, 3]):
         lights = LightArrays.from_lights([base[k] for k in order])
+        whole = order == (0, 1, 2, 3)
+        Po, No = (P, N) if whole else (P[few], N[few])
         for casting in ([0, 2], [1, 3], [0, 1, 2, 3], [3]):
             shadows = np.isin(np.arange(4), casting)
-            want = _one_pass(P, N, lights, shadows)
-            for threads in (1, 2):
-                got = shadow_rays(P, N, lights, shadows, threads)
+            want = _one_pass(Po, No, lights, shadows)
+            for threads in ((1, 2) if whole else (1,)):
+                got = shadow_rays(Po, No, lights, shadows, threads)
                 assert sorted(got) == casting
                 for j in casting:
                     for a, b in zip(got[j], want[j]):
