@@ -744,8 +744,9 @@ class AckermannDescription(Result):
     left_front_wheel: str
     right_rear_wheel: str
     left_rear_wheel: str
-    forward: tuple[float, float] = Field(default=(1.0, 0.0), description="the drive's forward direction (x, y) "
-                                         "in the robot's frame; the geometry above is in the drive's axes")
+    forward: tuple[float, float] | tuple[float, float, float] = Field(
+        default=(1.0, 0.0), description="the drive's forward direction (x, y) in the robot's frame, or (x, y, z) "
+        "for a robot built y-up in a NUE world; the geometry above is in the drive's axes")
     rear_axle_offset: float = Field(default=0.0, description="m, the rear axle's centre along forward from the "
                                     "robot's origin (0: the origin is on it, as in Webots' cars)")
     engine_type: Literal["combustion", "electric", "parallel hybrid", "power-split hybrid"] = Field(
@@ -754,7 +755,7 @@ class AckermannDescription(Result):
     @field_validator("forward", mode="before")
     @classmethod
     def _pair(cls, v: Any) -> Any:
-        """msgpack gives a list: the pair it is."""
+        """msgpack gives a list: the pair (or triple) it is."""
         return tuple(v) if isinstance(v, list) else v
 
 

@@ -1302,9 +1302,12 @@ class SkidSteer(Strict):
 
 
 def _forward_field() -> Any:
-    return Field(default=(1.0, 0.0), description="the direction (x, y) in the robot's frame that positive wheel "
-                 "speeds drive it: the wheels' axis is along its left, z × forward (default x forward, wheels along "
-                 "y; a Webots robot whose wheels turn about its x axis drives along y)")
+    return Field(default=(1.0, 0.0), description="the drive's forward in the robot's frame, (x, y) or (x, y, z): "
+                 "the drive's geometry is along it, its left (up × forward) and up, up the robot's own axis that "
+                 "stands up (its z; a robot built y-up in a NUE world: its y, and forward (x, 0, z)); positive "
+                 "wheel speeds of a two-wheel, skid-steer, car or mecanum drive drive it along forward, the wheels' "
+                 "axis along its left (default x forward, wheels along y; a Webots robot whose wheels turn about "
+                 "its x axis drives along y, or along z when built y-up)")
 
 
 def _wheel_bottom_field() -> Any:
@@ -1317,7 +1320,11 @@ def _wheel_bottom_field() -> Any:
                  "keeps the height it is placed at")
 
 
-def _nonzero_forward(v: tuple[float, float]) -> tuple[float, float]:
+Forward = tuple[float, float] | tuple[float, float, float]
+"""A drive's ``forward``: (x, y) in the robot's frame, or (x, y, z) (a robot built y-up)."""
+
+
+def _nonzero_forward(v: Forward) -> Forward:
     if math.hypot(*v) == 0:
         raise ValueError("forward must not be the zero vector")
     return v
@@ -1334,7 +1341,7 @@ class DifferentialDrive(Strict):
     left_motor: str = Field(default="left wheel motor", min_length=1)
     right_motor: str = Field(default="right wheel motor", min_length=1)
     skid_steer: SkidSteer | None = Field(default=None, description="more wheels per side (skid steer)")
-    forward: tuple[float, float] = _forward_field()
+    forward: Forward = _forward_field()
     wheel_bottom: float | None = _wheel_bottom_field()
     axle_center: tuple[float, float] = Field(
         default=(0.0, 0.0), description="m, where the robot turns: the point midway between the wheel lines (the "
@@ -1393,7 +1400,7 @@ class AckermannDrive(Strict):
     left_front_wheel: str = Field(default="left_front_wheel", min_length=1)
     right_rear_wheel: str = Field(default="right_rear_wheel", min_length=1)
     left_rear_wheel: str = Field(default="left_rear_wheel", min_length=1)
-    forward: tuple[float, float] = _forward_field()
+    forward: Forward = _forward_field()
     wheel_bottom: float | None = _wheel_bottom_field()
     rear_axle_offset: float = Field(default=0.0, description="m, where the rear axle's centre is along forward from "
                                     "the robot's origin (negative: behind it); 0, the origin on the rear axle, as "
@@ -1452,7 +1459,7 @@ class MecanumDrive(Strict):
         default=(-1, 1, 1, -1), description="roller sign s of the front left, front right, rear left, rear right "
         "wheels (r·ω = vx + s·vy + (s·x − y)·ωz): diagonal wheels alike, the front two opposite; the default is "
         "the youBot's")
-    forward: tuple[float, float] = _forward_field()
+    forward: Forward = _forward_field()
     wheel_bottom: float | None = _wheel_bottom_field()
 
     _forward_nonzero = field_validator("forward")(_nonzero_forward)
@@ -1480,7 +1487,8 @@ class MecanumDrive(Strict):
 
 class OmniWheel(Strict):
     """One wheel of an omni drive: where it touches the ground, the axis it turns about, its radius
-    and motor (in the robot's frame: x forward, y left, z up)."""
+    and motor (in the robot's frame: x forward, y left, z up; with the drive's ``forward`` another
+    direction, along it and its left, up × forward)."""
 
     motor: str = Field(min_length=1, description="its RotationalMotor's name")
     position: tuple[float, float] = Field(description="m, (x, y) of the wheel in the robot's frame: where it rolls "
@@ -1509,6 +1517,9 @@ class OmniDrive(Strict):
     wheels: list[OmniWheel] = Field(min_length=3, max_length=16)
     wheel_bottom: float | None = _wheel_bottom_field()
     max_wheel_speed: float = Field(default=10.0, gt=0, description="rad/s, the wheel motors' maxVelocity")
+    forward: Forward = _forward_field()
+
+    _forward_nonzero = field_validator("forward")(_nonzero_forward)
 
     @property
     def motor_fields(self) -> list[tuple[str, str]]:

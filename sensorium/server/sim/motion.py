@@ -165,20 +165,23 @@ class PlanarState:
     band below its origin (ground.band_low), which with its height makes its support ceiling: box
     tops above it are not its ground (ground.py's support rule).
 
-    ``forward``: the direction in the robot's own frame it drives along, (x, y); None is its x axis
-    (the heading is then read straight off the rotation's first column, as it always was). The
-    heading ``yaw`` is that direction's, and ``base`` what is left of the rotation, so the pose
-    ``Rz(yaw) @ base`` is the robot's own rotation whichever of its axes is forward."""
+    ``forward``: the direction in the robot's own frame it drives along, (x, y) or (x, y, z) (a robot
+    built y-up, whose forward lies in its x–z plane); None is its x axis (the heading is then read
+    straight off the rotation's first column, as it always was). The heading ``yaw`` is that
+    direction's in the world, about the world's up, and ``base`` what is left of the rotation, so the
+    pose ``Rz(yaw) @ base`` is the robot's own rotation whichever of its axes is forward and whichever
+    is up: an upright robot, z-up or y-up, turns about the world's up and rolls in the ground plane."""
 
     def __init__(self, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0,
-                 forward: tuple[float, float] | None = None):
+                 forward: tuple[float, ...] | None = None):
         self._to_enu = _TO_ENU[up]
         self.ground = ground
         self.band_low = band_low
         self._forward: np.ndarray | None = None
-        if forward is not None and tuple(forward) != (1.0, 0.0):
-            norm = math.hypot(forward[0], forward[1])
-            self._forward = np.array([forward[0] / norm, forward[1] / norm, 0.0])
+        if forward is not None and tuple(forward) not in ((1.0, 0.0), (1.0, 0.0, 0.0)):
+            f = [float(v) for v in forward] + [0.0] * (3 - len(forward))
+            norm = math.hypot(*f)
+            self._forward = np.array([f[0] / norm, f[1] / norm, f[2] / norm])
         self.reset(pose)
 
     def reset(self, pose: Pose) -> None:
@@ -435,7 +438,7 @@ class OmniDrive(HolonomicDrive):
         """3 × N: the wheels' rim speeds (r_i·ω_i) to the body twist (vx, vy, ωz)."""
         self.columns = [(float(a), float(b), float(c)) for a, b, c in self.solve.T.tolist()]
         """Each wheel's column of :attr:`solve`, the numbers :meth:`twist` sums."""
-        super().__init__(pose, up, ground, band_low)
+        super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
 
     @property
     def motors(self) -> dict[str, WheelMotor]:

@@ -1965,7 +1965,7 @@ class Converter:
             from sensorium.server.world.wbt.drive import free_car_wheels
 
             car = robot.data.get("ackermann_drive")
-            rolling = free_car_wheels(car, robot.free, self)
+            rolling = free_car_wheels(car, robot.free, self, self._robot_up(robot))
             for free in robot.free:     # an encoder on a wheel axis no motor turns and no car rolls: still
                 if id(free) not in rolling and free["line"] is not None:
                     self.warn(free["node"], free["line"])
@@ -2038,6 +2038,11 @@ class Converter:
         wheels = robot.wheels
         if not wheels:
             return
+        up = self._robot_up(robot)      # the robot's own up axis: its z, a y-up robot's y in a NUE world
+        if up != 2:                     # a y-up robot's hinge steers about its y (the walk judged its z)
+            for w in wheels:
+                if w["node"].type == "HingeJoint":
+                    w["steers"] = abs(float(w["axis"][up])) > 0.9 * float(np.linalg.norm(w["axis"]))
         round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
         rounded = {id(w): r for w, r in zip(wheels, round_)}       # read once: the fallback below asks again
         if len({id(w["node"]) for w in wheels}) == 1 or not any(round_):
@@ -2088,8 +2093,8 @@ class Converter:
                                 f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
                                 "turning about a vertical axis"))
             return
-        if omni_wheels(wheels, self):     # three or more wheels about horizontal axes not along one line (drive.py)
-            drive, why = omni_drive(wheels, self)
+        if omni_wheels(wheels, self, up):     # three or more wheels about horizontal axes not along one line (drive.py)
+            drive, why = omni_drive(wheels, self, up)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no omni drive ({why}); the robot will not move")
                 return
@@ -2118,7 +2123,7 @@ class Converter:
         else:
             turns = mecanum_turns(wheels, self)
         if turns is None and any(w["steers"] for w in wheels):      # a car
-            drive, why = ackermann_drive(wheels, self)
+            drive, why = ackermann_drive(wheels, self, up)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no Ackermann drive ({why}); the robot will not move")
                 return
@@ -2127,13 +2132,13 @@ class Converter:
                 drive["engine_type"] = engine
             robot.data["ackermann_drive"] = drive
         elif turns is not None:                   # rollers: friction turned on the wheels
-            drive, why = mecanum_drive(wheels, turns, self)
+            drive, why = mecanum_drive(wheels, turns, self, up)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no mecanum drive ({why}); the robot will not move")
                 return
             robot.data["mecanum_drive"] = drive
         else:
-            drive, why = differential_drive(wheels, self)
+            drive, why = differential_drive(wheels, self, up)
             # a motorised hinge whose end point has nothing round to roll on (a gripper's lift arm, a
             # flipper) is no wheel, nor, that failing, one whose round part does not turn about its axis
             # (an arm's link of a plain cylinder, across the axis or off it): the drive is the wheels
@@ -2146,7 +2151,7 @@ class Converter:
                     break
                 kept = [w for w in wheels if rolls(w)]
                 if 2 <= len(kept) < len(wheels):
-                    drive, _ = differential_drive(kept, self)
+                    drive, _ = differential_drive(kept, self, up)
                     if drive is not None:
                         for w in wheels:
                             if not any(w is k for k in kept):

@@ -47,6 +47,11 @@ Robotino) map onto the kinematic ``omni_drive``: each wheel where its round part
 line, its axis and radius. Rollers (passive hinges across the wheel's axis, or asymmetric friction:
 :func:`has_rollers`) do not decide it; wheels without them are said in one warning.
 
+A robot built y-up in a NUE world (Webots before R2022a; convert.py's ``_robot_up``) is judged with its y
+for its z throughout: its axes horizontal when perpendicular to its y, forward = axis × y (a 3-D
+``forward``, its left y × forward), the drive's frame rows (forward, left, y) (:func:`drive_axes`);
+its omni wheels' places and axes along its x and its left.
+
 Anything else gets one sentence saying which of these failed.
 """
 
@@ -163,39 +168,55 @@ def _axis_off_y(wheels: list[dict], tol: float, why: str) -> str:
     return ""
 
 
-def drive_frame(wheels: list[dict], tol: float = TOL) -> tuple[np.ndarray | None, str]:
+def drive_frame(wheels: list[dict], tol: float = TOL, up: int = 2) -> tuple[np.ndarray | None, str]:
     """The rotation from the robot's frame to its drive's (rows: forward, left, up), or None when a
-    wheel turns about the robot's +y within ``tol`` (its frame is the drive's, as it always was) or
-    there is no wheel; with the sentence saying why there is none when the wheels turn about
-    different or non-horizontal axes."""
+    wheel turns about the robot's +y within ``tol`` on a z-up robot (its frame is the drive's, as it
+    always was) or there is no wheel; with the sentence saying why there is none when the wheels turn
+    about different or non-horizontal axes. ``up``: the robot's own axis that is up, 2 its z, 1 its y
+    (a robot built y-up in a NUE world, as Webots' were before R2022a)."""
     y = np.array([0.0, 1.0, 0.0])
     axes = [w["axis"] / np.linalg.norm(w["axis"]) for w in wheels]
-    if not axes or any(np.linalg.norm(a - y) <= tol for a in axes):
+    if not axes or (up == 2 and any(np.linalg.norm(a - y) <= tol for a in axes)):
         return None, ""
     a0 = axes[0]
     first = wheels[0]["motor"]
-    if abs(a0[2]) > tol:
-        return None, (f"wheel axis of motor {first!r} is {np.round(a0, 6).tolist()}, neither the robot's +y nor "
-                      "horizontal in its frame (perpendicular to its z): the kinematic drive rolls on wheels whose "
-                      "axis is horizontal")
+    name = "xyz"[up]
+    if abs(a0[up]) > tol:
+        plain = "neither the robot's +y nor " if up == 2 else ""
+        return None, (f"wheel axis of motor {first!r} is {np.round(a0, 6).tolist()}, {plain}"
+                      f"horizontal in its frame (perpendicular to its {name}, its up): the kinematic drive rolls on "
+                      "wheels whose axis is horizontal")
     for w, a in zip(wheels[1:], axes[1:]):
         if np.linalg.norm(a - a0) > tol:
             return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not "
                           f"{np.round(a0, 6).tolist()}, the axis of motor {first!r} (the kinematic drive needs every "
                           "axis along one direction so that positive speeds drive forward)")
-    fx, fy = a0[1], -a0[0]                  # axis × z: where a positive speed rolls the wheel
-    n = float(np.hypot(fx, fy))
-    fx, fy = fx / n, fy / n
-    return np.array([[fx, fy, 0.0], [-fy, fx, 0.0], [0.0, 0.0, 1.0]]), ""
+    u = np.zeros(3)
+    u[up] = 1.0
+    a = a0.copy()
+    a[up] = 0.0
+    return drive_axes(np.cross(a, u), up), ""      # axis × up: where a positive speed rolls the wheel
 
 
-def differential_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
+def drive_axes(forward, up: int = 2) -> np.ndarray:
+    """The rotation from the robot's frame to its drive's (rows: forward, left = up × forward, up) for
+    a ``forward`` in the robot's frame (two values: in its x–y plane) and its up axis ``up`` (2 its
+    z, 1 its y)."""
+    f = np.zeros(3)
+    f[:len(forward)] = forward
+    f /= math.hypot(*f)
+    u = np.zeros(3)
+    u[up] = 1.0
+    return np.array([f, np.cross(u, f), u])
+
+
+def differential_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
     """The kinematic drive of a robot's motorised hinges (two wheels, or several per side: skid
-    steer), or (None, the sentence saying why not)."""
+    steer), or (None, the sentence saying why not); ``up`` the robot's up axis (:func:`drive_frame`)."""
     if len(wheels) < 2:
         return None, f"{len(wheels)} motorised hinge joint; a drive needs two wheels or more, on both sides"
     # (axes within AXIS_TOL, as a car's: Webots' Moose turns its right wheels' frames by 3.14159, not pi)
-    frame, why = drive_frame(wheels, AXIS_TOL)
+    frame, why = drive_frame(wheels, AXIS_TOL, up)
     if why:
         return None, why
     wheels = _in_frame(wheels, frame)
@@ -221,9 +242,10 @@ def _framed(drive: dict | None, why: str, frame: np.ndarray | None) -> tuple[dic
     if frame is None:
         return drive, why
     if drive is None:
-        fwd = np.round(frame[0, :2], 6).tolist()
+        fwd = np.round(frame[0, :2 if frame[2, 2] == 1.0 else 3], 6).tolist()
         return None, f"{why}; in the drive's frame: x forward along {fwd} in the robot's, y its left"
-    drive["forward"] = [float(frame[0, 0]), float(frame[0, 1])]
+    # (x, y) for a z-up robot, as it always was; (x, y, z) for a y-up one, its up its y
+    drive["forward"] = [float(v) for v in frame[0, :2 if frame[2, 2] == 1.0 else 3]]
     return drive, ""
 
 
@@ -301,10 +323,10 @@ STEERING_UNLIMITED = 1.5
 below pi/2, where the bicycle model's turn radius reaches 0)."""
 
 
-def ackermann_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
+def ackermann_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
     """The kinematic Ackermann drive of a car's motorised hinges, or (None, the sentence why not);
     judged in the drive's frame, its driven wheels' axis along its y (see the module docstring)."""
-    frame, why = drive_frame([w for w in wheels if not w["steers"]], AXIS_TOL)
+    frame, why = drive_frame([w for w in wheels if not w["steers"]], AXIS_TOL, up)
     if why:
         return None, why
     drive, why = _ackermann(_in_frame(wheels, frame), conv)
@@ -406,7 +428,7 @@ def car_engine(custom_data: str) -> str | None:
     return ENGINES.get(words[7][0], "combustion")
 
 
-def free_car_wheels(car: dict | None, free: list[dict], conv) -> set[int]:
+def free_car_wheels(car: dict | None, free: list[dict], conv, up: int = 2) -> set[int]:
     """A car's wheels without a motor (Webots' Car: a propulsion car's front wheels, the second axis of
     its steering Hinge2Joints; a traction car's rear ones, HingeJoints on the rear axle under its
     origin) become the drive's free wheels: each encoder on them gets ``free_wheel`` (and
@@ -416,7 +438,7 @@ def free_car_wheels(car: dict | None, free: list[dict], conv) -> set[int]:
     if car is None or car["type"] == "4x4" or not free:
         return set()
     fwd = car.get("forward")
-    frame = np.eye(3) if fwd is None else np.array([[fwd[0], fwd[1], 0.0], [-fwd[1], fwd[0], 0.0], [0.0, 0.0, 1.0]])
+    frame = np.eye(3) if fwd is None else drive_axes(fwd, up)
     found: dict[str, tuple[dict, np.ndarray]] = {}      # right_front, ... -> (the axis, its centre in the drive's frame)
     for f in free:
         axis = frame @ (f["axis"] / np.linalg.norm(f["axis"]))
@@ -505,10 +527,10 @@ def mecanum_turns(wheels: list[dict], conv) -> list[float | None] | None:
     return turns if any(t is not None for t in turns) else None
 
 
-def mecanum_drive(wheels: list[dict], turns: list[float | None], conv) -> tuple[dict | None, str]:
+def mecanum_drive(wheels: list[dict], turns: list[float | None], conv, up: int = 2) -> tuple[dict | None, str]:
     """The kinematic mecanum drive of four wheels whose friction is turned (:func:`mecanum_turns`),
-    or (None, the sentence why not); judged in the drive's frame (x forward = the axis × z)."""
-    frame, why = drive_frame(wheels, AXIS_TOL)
+    or (None, the sentence why not); judged in the drive's frame (x forward = the axis × up)."""
+    frame, why = drive_frame(wheels, AXIS_TOL, up)
     if why:
         return None, why
     drive, why = _mecanum(_in_frame(wheels, frame), turns, conv)
@@ -571,7 +593,7 @@ GROUND_TOL = 1e-3
 """m: how far apart the omni wheels' lowest points may be and still stand on one ground plane."""
 
 
-def omni_wheels(wheels: list[dict], conv) -> bool:
+def omni_wheels(wheels: list[dict], conv, up: int = 2) -> bool:
     """Whether a robot's motorised hinges make an omni-wheel robot: three or more wheels, none
     steering, every axis horizontal in the robot's frame (perpendicular to its z) and not all along
     one line (parallel or opposite), each a wheel (something round at its end point turning about
@@ -580,11 +602,11 @@ def omni_wheels(wheels: list[dict], conv) -> bool:
     along one line and a car steers, so none of them is one; mirrored axes (one side's wheels about
     -y) stay with the differential drive, which says why it cannot drive them; an arm's hinge beside
     two wheels is no wheel (nothing round turns about its axis, or it is not on the ground), and the
-    differential drive takes the two."""
+    differential drive takes the two. ``up``: the robot's up axis (2 its z, 1 its y: a y-up robot)."""
     if len(wheels) < 3 or any(w["steers"] for w in wheels):
         return False
     axes = [np.asarray(w["axis"], dtype=np.float64) / np.linalg.norm(w["axis"]) for w in wheels]
-    if any(abs(a[2]) > AXIS_TOL for a in axes):
+    if any(abs(a[up]) > AXIS_TOL for a in axes):
         return False
     if not any(abs(float(np.dot(a, axes[0]))) < 1.0 - TOL for a in axes[1:]):
         return False
@@ -595,7 +617,7 @@ def omni_wheels(wheels: list[dict], conv) -> bool:
         radius = wheel_radius(w["end"], conv)
         if radius is None:
             return False
-        bottoms.append(float(_on_axis(w, conv)[2]) - radius)
+        bottoms.append(float(_on_axis(w, conv)[up]) - radius)
     return max(bottoms) - min(bottoms) <= GROUND_TOL
 
 
@@ -705,11 +727,13 @@ def has_rollers(w: dict, conv) -> bool:
     return False
 
 
-def omni_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
+def omni_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
     """The kinematic omni drive of a robot's wheels (:func:`omni_wheels` said they make one), or
     (None, the sentence why not). Each wheel rolls on the ground where its round part is: the centre
     of its cylinder (or sphere) taken onto its axis's line, else the end point's origin; its radius
-    that cylinder's. The wheels' places and axes are the robot's x and y."""
+    that cylinder's. The wheels' places and axes are the robot's x and y; a y-up robot's (``up`` 1)
+    along its x and its left, y × x = -z (its drive's ``forward`` its x, (1, 0, 0))."""
+    frame = None if up == 2 else drive_axes((1.0, 0.0, 0.0), up)
     out = []
     for w in wheels:
         radius = wheel_radius(w["end"], conv)
@@ -717,6 +741,8 @@ def omni_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
             return None, f"wheel {w['motor']!r}: its end point has no cylinder or sphere to take the wheel radius from"
         axis = np.asarray(w["axis"], dtype=np.float64) / np.linalg.norm(w["axis"])
         on_axis = _on_axis(w, conv)
+        if frame is not None:
+            axis, on_axis = frame @ axis, frame @ on_axis
         out.append({"motor": w["motor"], "position": [float(on_axis[0]), float(on_axis[1])],
                     "axis": [float(axis[0]), float(axis[1])], "radius": float(radius)})
     rows = []
@@ -729,4 +755,7 @@ def omni_drive(wheels: list[dict], conv) -> tuple[dict | None, str]:
                           f"({o['axis'][0]:g}, {o['axis'][1]:g})" for o in out)
         return None, (f"the wheels ({where}) cannot move the robot in every direction: their rolling leaves a twist "
                       "free")
-    return {"wheels": out, "max_wheel_speed": _max_speed(wheels, conv)}, ""
+    drive: dict = {"wheels": out, "max_wheel_speed": _max_speed(wheels, conv)}
+    if frame is not None:
+        drive["forward"] = [1.0, 0.0, 0.0]
+    return drive, ""
