@@ -244,3 +244,71 @@ def test_a_y_up_omni_wheel_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path:
             assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
     moved = nue.robot("bot").pose.translation - start
     assert math.hypot(moved[0], moved[2]) > 0.03 and moved[1] == 0.0
+
+
+def _car_world(tmp_path: Path, system: str) -> Path:
+    """A car: two steering hinges about its up 0.2 m ahead holding ball wheels, two driven rear wheels
+    about its left under its origin (rear-wheel drive), ball wheels of radius R: built y-up in the NUE
+    world, z-up in its ENU twin. Coordinates given in the twin's (ENU) robot frame."""
+    back = (lambda v: [v[1], v[2], v[0]]) if system == "NUE" else (lambda v: list(v))    # ENU -> NUE
+
+    def vec(v) -> str:
+        return " ".join(repr(float(x)) for x in back(v))
+
+    def ball(name: str, at) -> str:
+        return (f'Solid {{ translation {vec(at)} name "{name}" children [ Shape {{ geometry Sphere {{ radius {R} }} }} ] '
+                f'boundingObject Sphere {{ radius {R} }} physics Physics {{ }} }}')
+
+    joints = ""
+    for side, y in (("right", -0.08), ("left", 0.08)):
+        at = (0.2, y, R)
+        joints += (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {vec((0, 0, 1))} anchor {vec(at)} }}\n'
+                   f'  device [ RotationalMotor {{ name "{side}_steer" maxVelocity 5 minPosition -0.6 maxPosition 0.6 }} ]\n'
+                   f'  endPoint {ball(f"{side} front", at)} }}\n')
+        at = (0.0, y, R)
+        joints += (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {vec((0, 1, 0))} anchor {vec(at)} }}\n'
+                   f'  device [ RotationalMotor {{ name "{side}_rear_wheel" maxVelocity 30 }} ]\n'
+                   f'  endPoint {ball(f"{side} rear", at)} }}\n')
+    text = (f'#VRML_SIM R2023b utf8\nWorldInfo {{ coordinateSystem "{system}" basicTimeStep 16 }}\n'
+            f'Robot {{ translation {vec((0.3, -0.1, 0.0))} rotation {vec((0, 0, 1))} {YAW} name "car" '
+            f'controller "<extern>"\n  children [\n{joints}]\n  physics Physics {{ }} }}\n')
+    path = tmp_path / f"car-{system}.wbt"
+    path.write_text(text)
+    return path
+
+
+def test_a_y_up_car_in_a_nue_world_steers_and_drives_as_its_enu_twin(tmp_path: Path) -> None:
+    """A y-up car: the import finds its Ackermann drive with its y as up (steering about its y, its
+    forward its z); steered both ways and driven both ways with its z-up ENU twin's commands, their
+    poses agree with every axis permuted to 1e-12 after every step, and it has moved and turned; a
+    batched copy of the NUE world keeps the single simulation's poses bit for bit."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        nue, enu = (Simulation(load_world(_car_world(tmp_path, s)), precision="exact") for s in ("NUE", "ENU"))
+        bs = BatchedSimulation(load_world(_car_world(tmp_path, "NUE")), copies=1, precision="exact")
+    d = nue.world.robots[0].ackermann_drive
+    assert d is not None and tuple(d.forward) == (0.0, 0.0, 1.0)
+    assert (d.wheelbase, d.track_front, d.type) == (pytest.approx(0.2, abs=1e-15), pytest.approx(0.16, abs=1e-15),
+                                                    "propulsion")
+    p = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])     # NUE -> ENU
+    start = nue.robot("car").pose.rotation.copy()
+    for steer, speed in ((0.3, 10.0), (-0.4, 12.0), (0.2, -8.0)):
+        for sim in (nue, enu):
+            for name in ("right_steer", "left_steer"):
+                sim.robot("car").motor(name).set_position(steer)
+            for name in ("right_rear_wheel", "left_rear_wheel"):
+                m = sim.robot("car").motor(name)
+                m.set_position(math.inf)
+                m.set_velocity(speed)
+        bs.cars.command(0, np.array([steer]), np.array([steer]), np.array([speed]))
+        for _ in range(30):
+            nue.run(1)
+            enu.run(1)
+            bs.step()
+            a, b = nue.robot("car").pose, enu.robot("car").pose
+            assert np.array_equal(bs.pose(0, 0).translation, a.translation)
+            assert np.array_equal(bs.pose(0, 0).rotation, a.rotation)
+            assert np.abs(p @ a.translation - b.translation).max() <= 1e-12
+            assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
+    assert np.abs(nue.robot("car").pose.rotation - start).max() > 0.05
+    assert nue.robot("car").pose.translation[1] == 0.0      # (along up: its wheels stay on y = 0)
