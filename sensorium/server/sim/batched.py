@@ -94,10 +94,7 @@ from sensorium.server.sim.ground import (
     band_low,
     ground_rotation,
     ride_height,
-    settle_pose,
     settle_world,
-    settles,
-    settling_ground,
     support_ceiling,
 )
 from sensorium.server.sim.motion import (
@@ -121,7 +118,7 @@ from sensorium.server.sim.scene import (
     solid_parts,
 )
 from sensorium.server.sim.sensors import LED, DistanceSensor, Lidar, LightSensor, PositionSensor
-from sensorium.server.sim.simulation import lights_from_models
+from sensorium.server.sim.simulation import SettlingGrounds, lights_from_models
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import check_pose
 from sensorium.server.world.loader import LoadedWorld, from_model
@@ -240,7 +237,7 @@ class BatchedSimulation:
         self._check_supported()
         # its wheeled robots settled on the ground as Simulation settles them (sim/ground.py)
         self.world = w = settle_world(w, _TO_ENU[w.world_info.coordinate_system], world.source)[0]
-        self._settling: dict[tuple, tuple[Ground | None]] = {}     # see _settled: by its copy's floors' poses
+        self._settling = SettlingGrounds(_TO_ENU[w.world_info.coordinate_system], size=self.copies)
         # world axes -> ENU (None in an ENU world): the drive state is ENU, as PlanarState's
         up = w.world_info.coordinate_system
         self.to_enu: np.ndarray | None = _TO_ENU[up]
@@ -705,19 +702,8 @@ class BatchedSimulation:
     def _settled(self, copy: int, slot: int, pose: Pose) -> Pose:
         """``Simulation.settled`` in one copy: a wheeled robot put at ``pose`` settles on the ground of
         the solids and of that copy's robots without a drive, with the same arithmetic."""
-        model = self.world.robots[slot]
-        if not settles(model):
-            return pose
-        floors = [(r, self.pose(copy, k)) for k, r in enumerate(self.world.robots) if not r.drive_motors]
-        key = tuple(p.translation.tobytes() + p.rotation.tobytes() for _, p in floors)
-        got = self._settling.get(key)
-        if got is None:
-            alive = self.scene.solid_poses
-            if len(self._settling) >= self.copies:      # (bounded: one ground per copy's floors at most)
-                self._settling.clear()
-            got = self._settling[key] = (settling_ground([(s, alive[s.name]) for s in self.world.solids
-                                                          if s.name in alive], floors, self.to_enu),)
-        return settle_pose(model, pose, got[0], self.to_enu)
+        return self._settling.settled(self.world.robots[slot], pose, self.world.solids, self.scene, lambda: [
+            (r, self.pose(copy, k)) for k, r in enumerate(self.world.robots) if not r.drive_motors])
 
     def _take_template(self, idx: np.ndarray, slot: int, tpl: PlanarState) -> None:
         """The copies' drive state of a slot from a template drive just reset to a pose."""

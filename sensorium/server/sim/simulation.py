@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
@@ -74,6 +74,36 @@ from sensorium.server.world.report import warn_losses
 from sensorium.server.world.top_nodes import top_level
 
 _REMOVED = wm.Solid.model_construct(name="", def_name="")   # a removed imported solid's model: its name and DEF
+
+
+class SettlingGrounds:
+    """Where a robot a Supervisor puts at a pose settles, for ``Simulation.settled`` and each copy of
+    the batched simulation alike: a wheeled robot that settles at load (its drive gives
+    ``wheel_bottom``) settles there on the ground as the world is now -- the solids where they are,
+    the robots without a drive (``floors``: (model, pose) each) where they are -- with settle_world's
+    arithmetic (ground.settle_pose); any other robot keeps its pose. The ground is built once for
+    what it is made of (the scene's solids' and shapes' versions, the floors' poses), at most
+    ``size`` of them kept (one per batched copy)."""
+
+    def __init__(self, to_enu: np.ndarray | None, size: int = 1):
+        self.to_enu = to_enu
+        self.size = size
+        self._grounds: dict[tuple, Ground | None] = {}
+
+    def settled(self, model: wm.Robot, pose: Pose, solids: list[wm.Solid], scene: Scene,
+                floors: Callable[[], list[tuple[wm.Robot, Pose]]]) -> Pose:
+        if not settles(model):
+            return pose
+        under = floors()
+        key = (scene.solids_version, scene.shapes_version,
+               *(p.translation.tobytes() + p.rotation.tobytes() for _, p in under))
+        if key not in self._grounds:
+            if len(self._grounds) >= self.size:
+                self._grounds.clear()
+            alive = scene.solid_poses
+            self._grounds[key] = settling_ground([(s, alive[s.name]) for s in solids if s.name in alive], under,
+                                                 self.to_enu)
+        return settle_pose(model, pose, self._grounds[key], self.to_enu)
 
 
 def lights_from_models(models: list) -> light_math.LightArrays:
@@ -357,7 +387,7 @@ class Simulation:
                          "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights(),
                          "radar_targets": dict(self.scene.radar_targets)}
         self._imported_poses: dict[str, Pose] = {}      # each imported solid's pose as imported
-        self._settling: tuple[tuple, Ground | None] | None = None    # see settled: (what it was made of, the ground)
+        self._settling = SettlingGrounds(_TO_ENU[self.world.world_info.coordinate_system])
 
     def _warn_ground(self) -> None:
         """One GroundWarning per thing a driven robot will not ride on: a tilted terrain, a robot
@@ -391,20 +421,10 @@ class Simulation:
         return Contact(solids, robots, _TO_ENU[self.world.world_info.coordinate_system], yaws)
 
     def settled(self, model: wm.Robot, pose: Pose) -> Pose:
-        """The pose a robot a Supervisor puts at ``pose`` takes: a wheeled robot that settles at load
-        (its drive gives ``wheel_bottom``) settles there on the ground as the world is now -- the
-        solids where they are, the robots without a drive where they are -- with settle_world's
-        arithmetic (ground.settle_pose); any other robot keeps ``pose``."""
-        if not settles(model):
-            return pose
-        floors = [(r.model, self.scene.robot_poses[r.index]) for r in self.robots.values() if not r.model.drive_motors]
-        key = (self.scene.solids_version, self.scene.shapes_version, *(p.translation.tobytes() + p.rotation.tobytes() for _, p in floors))
-        if self._settling is None or self._settling[0] != key:
-            alive = self.scene.solid_poses
-            ground = settling_ground([(s, alive[s.name]) for s in self.world.solids if s.name in alive], floors,
-                                     _TO_ENU[self.world.world_info.coordinate_system])
-            self._settling = (key, ground)
-        return settle_pose(model, pose, self._settling[1], _TO_ENU[self.world.world_info.coordinate_system])
+        """The pose a robot a Supervisor puts at ``pose`` takes (:class:`SettlingGrounds`): the
+        robots without a drive where they are now."""
+        return self._settling.settled(model, pose, self.world.solids, self.scene, lambda: [
+            (r.model, self.scene.robot_poses[r.index]) for r in self.robots.values() if not r.model.drive_motors])
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
