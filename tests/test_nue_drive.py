@@ -312,3 +312,61 @@ def test_a_y_up_car_in_a_nue_world_steers_and_drives_as_its_enu_twin(tmp_path: P
             assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
     assert np.abs(nue.robot("car").pose.rotation - start).max() > 0.05
     assert nue.robot("car").pose.translation[1] == 0.0      # (along up: its wheels stay on y = 0)
+
+
+def _mecanum_world(tmp_path: Path, system: str) -> Path:
+    """Four mecanum wheels (ball wheels of radius R whose friction a ContactProperties turns by ±45°,
+    as a youBot's) at (±0.2, ±0.15) about its left axis: built y-up in the NUE world, z-up in its ENU
+    twin. Coordinates given in the twin's (ENU) robot frame."""
+    back = (lambda v: [v[1], v[2], v[0]]) if system == "NUE" else (lambda v: list(v))    # ENU -> NUE
+
+    def vec(v) -> str:
+        return " ".join(repr(float(x)) for x in back(v))
+
+    wheels = ""
+    for name, x, y, material in (("fl", 0.2, 0.15, "A"), ("fr", 0.2, -0.15, "B"), ("rl", -0.2, 0.15, "B"),
+                                 ("rr", -0.2, -0.15, "A")):
+        at = vec((x, y, R))
+        wheels += (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {vec((0, 1, 0))} anchor {at} }}\n'
+                   f'  device [ RotationalMotor {{ name "{name}" maxVelocity 20 }} ]\n'
+                   f'  endPoint Solid {{ translation {at} name "{name} wheel" contactMaterial "{material}" children '
+                   f'[ Shape {{ geometry Sphere {{ radius {R} }} }} ] boundingObject Sphere {{ radius {R} }} '
+                   'physics Physics { } } }\n')
+    text = (f'#VRML_SIM R2023b utf8\nWorldInfo {{ coordinateSystem "{system}" basicTimeStep 16 contactProperties [\n'
+            '  ContactProperties { material1 "A" coulombFriction [ 1.8 0 ] frictionRotation 0.785398 0 }\n'
+            '  ContactProperties { material1 "B" coulombFriction [ 1.8 0 ] frictionRotation -0.785398 0 } ] }\n'
+            f'Robot {{ translation {vec((0.1, 0.3, 0.0))} rotation {vec((0, 0, 1))} {YAW} name "base" '
+            f'controller "<extern>"\n  children [\n{wheels}]\n  physics Physics {{ }} }}\n')
+    path = tmp_path / f"mecanum-{system}.wbt"
+    path.write_text(text)
+    return path
+
+
+def test_a_y_up_mecanum_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path: Path) -> None:
+    """A y-up mecanum base: the import finds its drive with its y as up (its forward its z); driven,
+    strafed and turned with its z-up ENU twin's wheel speeds, their poses agree with every axis
+    permuted to 1e-12 after every step; all wheels at +ω carry it along its forward by r·ω·t."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        nue, enu = (Simulation(load_world(_mecanum_world(tmp_path, s)), precision="exact") for s in ("NUE", "ENU"))
+    d = nue.world.robots[0].mecanum_drive
+    assert d is not None and tuple(d.forward) == (0.0, 0.0, 1.0)
+    assert enu.world.robots[0].mecanum_drive is not None
+    assert tuple(d.rollers) == tuple(enu.world.robots[0].mecanum_drive.rollers)
+    p = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])     # NUE -> ENU
+    start = nue.robot("base").pose.translation.copy()
+    for k, speeds in enumerate(((6.0, 6.0, 6.0, 6.0), (-4.0, 4.0, 4.0, -4.0), (-3.0, 3.0, -3.0, 3.0))):
+        for sim in (nue, enu):
+            for name, u in zip(("fl", "fr", "rl", "rr"), speeds):
+                m = sim.robot("base").motor(name)
+                m.set_position(math.inf)
+                m.set_velocity(u)
+        for _ in range(30):
+            nue.run(1)
+            enu.run(1)
+            a, b = nue.robot("base").pose, enu.robot("base").pose
+            assert np.abs(p @ a.translation - b.translation).max() <= 1e-12
+            assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
+        if k == 0:
+            want = start + 6.0 * R * 30 * DT * np.array([math.sin(YAW), 0.0, math.cos(YAW)])
+            assert np.abs(nue.robot("base").pose.translation - want).max() <= 1e-9
