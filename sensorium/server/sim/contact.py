@@ -24,7 +24,9 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   its centre. A millimetre covers those settled poses several times over and stays below
   anything a robot's body should be stopped by; a solid rising more than that into the band is
   an obstacle. Robots' bodies meet one another without the tolerance (robots never stand on
-  robots). A solid's ramp (a tilted Box whose top face leans less than 45°, :func:`ramp_top`)
+  robots). A solid a robot's VacuumGripper holds (:meth:`Contact.hold`) is no obstacle to that
+  robot, nor touched by its bumpers (Webots' fixed joint makes them one body); it stays one to the
+  others. A solid's ramp (a tilted Box whose top face leans less than 45°, :func:`ramp_top`)
   tops out, for this rule, at its top face's low edge: a robot that can drive on at that edge rides
   the ramp (ground.py) and is never stopped by its box; for one below the edge it is an obstacle;
 * over one basic step a shaped robot first turns in place at its start, as far as the footprint
@@ -1234,6 +1236,9 @@ class Contact:
         self.initial = [(p, y) for (_, p), y in zip(robots, yaws)]     # what the footprints were made from
         self.contacts = 0                         # robot-steps whose motion was clipped
         self.checks = 0                           # narrow-phase obstacle tests
+        # robot index -> the solids its VacuumGrippers hold (sim/vacuum.py): Webots' fixed joint makes
+        # each one body with its carrier, so it never stops its carrier (other robots still meet it)
+        self.carried: dict[int, list[str]] = {}
         self._rebuild()
 
     def update_solid(self, name: str, pose: Pose) -> None:
@@ -1268,6 +1273,25 @@ class Contact:
         for i in range(len(self.prims.pop(name, ()))):
             self.solids.pop((name, i), None)
         self._rebuild()
+
+    def hold(self, index: int, name: str) -> None:
+        """Robot ``index`` now carries solid ``name`` (a VacuumGripper took it): it no longer stops it."""
+        self.carried.setdefault(index, []).append(name)
+
+    def let_go(self, index: int, name: str) -> None:
+        """Robot ``index`` no longer carries solid ``name``: an obstacle to it again."""
+        held = self.carried.get(index)
+        if held is not None and name in held:
+            held.remove(name)
+            if not held:
+                del self.carried[index]
+
+    def _carried_by(self, index: int) -> np.ndarray | None:
+        """Which of ``_obs`` robot ``index`` carries (a boolean per obstacle), None when it carries nothing."""
+        held = self.carried.get(index)
+        if not held:
+            return None
+        return np.array([ob.name in held for ob in self._obs], dtype=bool)
 
     def _rebuild(self) -> None:
         obs = list(self.solids.values())
@@ -1330,6 +1354,11 @@ class Contact:
             solid_hit = ((lo[None, :, 0] <= box_hi[:, None, 0]) & (lo[None, :, 1] <= box_hi[:, None, 1])
                          & (hi[None, :, 0] >= box_lo[:, None, 0]) & (hi[None, :, 1] >= box_lo[:, None, 1])
                          & (self._zhi[None] > band_lo[:, None] + FLOOR) & (self._zlo[None] < band_hi[:, None] - EPS))
+            if self.carried:             # what a robot carries is part of it: never its obstacle
+                for m, i in enumerate(indices):
+                    mine = self._carried_by(int(i))
+                    if mine is not None:
+                        solid_hit[m] &= ~mine
         robot_hit = None
         if len(self.feet) > 1:
             # where every robot may be during this step: its disc, grown by its own move if it moves
@@ -1407,8 +1436,10 @@ class Contact:
         """Whether robot ``index``'s ``pieces`` touch a solid or another robot where they all are now
         (:func:`pieces_touch`)."""
         robots = [self._robot_obstacle(j) for j, f in enumerate(self.feet) if f is not None and j != index]
+        mine = self._carried_by(index)      # what it carries is part of it: never touched
+        solids = self._obs if mine is None else [ob for ob, held in zip(self._obs, mine.tolist()) if not held]
         return pieces_touch(pieces, self.centres[index], float(self.yaw[index]), float(self.heights[index]),
-                            self._obs, robots)
+                            solids, robots)
 
     def _robot_obstacle(self, j: int) -> Obstacle:
         """Robot ``j``'s footprint where it is now, as an obstacle."""

@@ -19,6 +19,14 @@ between two shapes is the exact distance between those two vertical prisms, in f
 √(d_xy² + d_z²) with d_xy the gap between the sections (0 when they overlap) and d_z the gap between
 the height ranges. Exact for upright boxes and cylinders; other shapes are bounded as kinematic contact
 bounds them. Robots are never attached, and no force breaks the hold (no physics).
+
+A held solid is part of its carrier, as Webots' fixed joint makes the two one body: kinematic contact
+never stops the carrier at it nor do its bumpers touch it (``Contact.hold``/``let_go``), while it stops
+the other robots where it is. A solid let go (``turnOff``) is an obstacle to its carrier again at
+once and, at the end of that step, lands: ground.land_pose puts it straight down on the highest support
+under its origin (the settling ground without it: ``Simulation.landing_ground``), its lowest point on
+that support's top, its rotation kept -- no flight time, bounce or tipping, where Webots' physics
+lets it fall over the next steps.
 """
 from __future__ import annotations
 
@@ -28,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.server.sim.contact import UPRIGHT, Obstacle, _closest_on_list, _hull, enu_pose, obstacle
+from sensorium.server.sim.ground import land_pose
 from sensorium.server.sim.scene import primitive_from_model, solid_parts
 from sensorium.server.sim.sensors import Device
 from sensorium.server.world import geometry as geo
@@ -99,6 +108,7 @@ class VacuumGripper(Device):
         self.is_on = bool(self.config.is_on)
         self.value = 0.0                    # libController's presence before a value: false
         self.held: str | None = None
+        self._dropping: tuple[str, Any] | None = None     # (name, model) of a solid let go this step: it lands
         self._offset: Pose | None = None    # the held solid's pose in the gripper's frame
         self._held_model: Any = None        # its world-file model when attached (a rebuilt one is another)
         self._sim: Any = None
@@ -123,12 +133,18 @@ class VacuumGripper(Device):
     # -- controller API
     def set_on(self, on: bool) -> None:
         """``wb_vacuum_gripper_turn_on`` (True: it attaches at the end of the next step) / ``turn_off``
-        (False: what it holds is let go at once, where it is, as WbVacuumGripper::turnOff detaches)."""
+        (False: what it holds is let go at once, where it is, as WbVacuumGripper::turnOff detaches, and
+        lands at the end of the step: :meth:`carry`)."""
         self.is_on = bool(on)
         if not self.is_on:
+            if self.held is not None:
+                self._dropping = (self.held, self._held_model)
             self.release()
 
     def release(self) -> None:
+        """Nothing held from now on: the solid is an obstacle to the carrier again (contact.py)."""
+        if self.held is not None and self._sim.contact is not None:
+            self._sim.contact.let_go(self._robot.index, self.held)
         self.held, self._offset, self._held_model = None, None, None
 
     def reset(self) -> None:
@@ -136,6 +152,7 @@ class VacuumGripper(Device):
         controller learns the pump's state with its next presence value, as Webots' C_CONFIGURE)."""
         self.is_on = bool(self.config.is_on)
         self.release()
+        self._dropping = None
 
     # -- holding
     def frame(self) -> Pose:
@@ -150,6 +167,9 @@ class VacuumGripper(Device):
         attached where it is. A held solid a Supervisor removed or rebuilt (a PROTO field set) is let
         go first, as Webots' joint goes with the destroyed node."""
         sim = self._sim
+        if self._dropping is not None:
+            self._land(*self._dropping)
+            self._dropping = None
         if self.held is not None and self._model(self.held) is not self._held_model:
             self.release()
         if self.held is not None:
@@ -164,6 +184,26 @@ class VacuumGripper(Device):
             if name is not None:
                 self.held, self._held_model = name, self._model(name)
                 self._offset = self.frame().inverse().compose(sim.scene.solid_poses[name])
+                if sim.contact is not None:
+                    sim.contact.hold(self._robot.index, name)
+
+    def _land(self, name: str, model: Any) -> None:
+        """The solid let go this step put on what is under it (ground.land_pose: the highest support
+        under its origin, its lowest point on it, at once), unless it is gone, rebuilt, or held again
+        (by another gripper)."""
+        sim = self._sim
+        if self._model(name) is not model or any(
+                isinstance(d, VacuumGripper) and d.held == name for d in sim.all_devices()):
+            return
+        pose = sim.scene.solid_poses[name]
+        prisms = self._solid_obstacles(name, pose)
+        if not prisms:                 # no bounding shapes: nothing to land on (it stays)
+            return
+        low = min(p.z_range[0] for p in prisms)
+        high = max(p.z_range[1] for p in prisms)
+        landed = land_pose(pose, low, high, sim.landing_ground(name), self._robot.to_enu)
+        if landed is not pose:
+            sim.place_solid(name, landed)
 
     # -- touching
     def _model(self, name: str) -> Any:
