@@ -18,6 +18,8 @@ import numpy as np
 import pytest
 
 from sensorium.server.sim.simulation import Simulation
+from sensorium.server.sim.vacuum import _shape_obstacle, prism_depth
+from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import parse_world
 
@@ -245,3 +247,42 @@ def test_reset_puts_everything_back() -> None:
     assert car.contact is not None and car.contact.carried == {}
     assert car.scene.solid_poses["parcel"].translation.tolist() == [0.17, 0.0, 0.05]
     assert car.robot("carrier").pose.translation.tolist() == [0.0, 0.0, 0.05]
+
+
+# ---------------------------------------------------------------------- which of several
+
+def _two_parcels(depth_a: float, depth_b: float) -> Simulation:
+    """The crane's cup (bottom face at z = 0.5) over two 0.1 m parcels, "a" (first in the file) at
+    x = -0.055 and "b" at x = 0.055 (0.01 m apart), each pushed ``depth`` into the cup along z (negative: that far below)."""
+    crane = {"name": "crane", "pose": {"translation": [0.0, 0.0, 0.5]},
+             "shapes": [{"pose": {"translation": [0.0, 0.0, 0.01]}, "geometry": {"type": "cylinder", "radius": 0.05, "height": 0.02},
+                         "of_device": "cup", "seen_by": "bounding"}],
+             "devices": [{"device": "VacuumGripper", "name": "cup", "is_on": True}]}
+    parcels = [{**PARCEL, "name": n, "pose": {"translation": [x, 0.0, 0.45 + d]}} for n, x, d in (("a", -0.055, depth_a),
+                                                                                                    ("b", 0.055, depth_b))]
+    return Simulation(parse_world({"world_info": {"basic_time_step": STEP}, "solids": parcels, "robots": [crane]}),
+                      precision="exact")
+
+
+@pytest.mark.parametrize(("depth_a", "depth_b", "taken"), [(-0.0005, 0.003, "b"), (0.003, -0.0005, "a"),
+                                                           (0.002, 0.004, "b"), (0.004, 0.002, "a"),
+                                                           (0.002, 0.002, "a"), (-0.0005, -0.0002, "b")])
+def test_of_several_touched_the_deepest_is_taken(depth_a: float, depth_b: float, taken: str) -> None:
+    """Webots attaches the solid of the deepest contact: here the larger overlap along z (the parcels'
+    sections reach 0.055 m into the cup's disc, deeper than any z overlap), or the smaller gap."""
+    sim = _two_parcels(depth_a, depth_b)
+    g = sim.device("crane/cup")
+    assert g.touched() == taken                                         # type: ignore[attr-defined]
+    sim.step()
+    assert g.held == taken                                              # type: ignore[attr-defined]
+
+
+def test_prism_depth_closed_forms() -> None:
+    cup = _shape_obstacle(geo.Cylinder(0.05, 0.02), Pose(np.eye(3), [0.0, 0.0, 0.51]))
+    box = _shape_obstacle(geo.Box((0.1, 0.1, 0.1)), Pose(np.eye(3), [0.08, 0.0, 0.46]))    # x from 0.03, z to 0.51
+    assert cup is not None and box is not None
+    assert prism_depth(cup, box) == pytest.approx(0.01, abs=1e-15)        # z overlap 0.01 < the disc's 0.02 into it
+    low = _shape_obstacle(geo.Box((0.1, 0.1, 0.1)), Pose(np.eye(3), [0.08, 0.0, 0.3]))     # top 0.35: 0.15 below
+    assert low is not None and prism_depth(cup, low) == pytest.approx(-0.15, abs=1e-15)
+    side = _shape_obstacle(geo.Box((0.1, 0.1, 0.1)), Pose(np.eye(3), [0.099, 0.0, 0.51]))  # x from 0.049
+    assert side is not None and prism_depth(cup, side) == pytest.approx(0.001, abs=1e-15)  # 1 mm into the disc

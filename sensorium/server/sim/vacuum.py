@@ -11,9 +11,10 @@ Here, at the end of every basic step (:meth:`VacuumGripper.carry`, before the se
 gripper holding a solid puts it at the pose it had relative to the gripper when attached (float64
 poses composed: the gripper's frame, the robot's pose with its link's displacement, then the held
 offset), through :meth:`Simulation.place_solid`, the path of a Supervisor's move; a gripper whose pump
-is on and holds nothing attaches the first top-level solid with ``physics`` (world order) that its own
-bounding shapes (the robot's shapes whose ``of_device`` names it) touch -- overlap, or a gap of at most
-:data:`GRIP_DISTANCE`. The presence reads 1 exactly while a solid is held. Each shape is taken as
+is on and holds nothing attaches, of the top-level solids with ``physics`` that its own bounding shapes
+(the robot's shapes whose ``of_device`` names it) touch -- overlap, or a gap of at most
+:data:`GRIP_DISTANCE` -- the one it touches deepest (:func:`prism_depth`: Webots takes the deepest
+contact), the first in world order on a tie. The presence reads 1 exactly while a solid is held. Each shape is taken as
 contact.py takes obstacles (a 2D convex section ⊕ a disc, over a height range), so the distance
 between two shapes is the exact distance between those two vertical prisms, in float64:
 √(d_xy² + d_z²) with d_xy the gap between the sections (0 when they overlap) and d_z the gap between
@@ -43,7 +44,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
-__all__ = ["GRIP_DISTANCE", "VacuumGripper", "may_touch", "prism_gap"]
+__all__ = ["GRIP_DISTANCE", "VacuumGripper", "may_touch", "prism_depth", "prism_gap"]
 
 GRIP_DISTANCE = 1e-3
 """m: a gripper whose bounding shapes come this near a solid's (or overlap it) touches it."""
@@ -78,6 +79,24 @@ def prism_gap(a: Obstacle, b: Obstacle) -> float:
     d_xy = max(0.0, signed - a.radius - b.radius)
     d_z = max(0.0, b.z_range[0] - a.z_range[1], a.z_range[0] - b.z_range[1])
     return math.hypot(d_xy, d_z)
+
+
+def prism_depth(a: Obstacle, b: Obstacle) -> float:
+    """How deep two prisms (a gripper's shape ``a``, a solid's ``b``) overlap: the least distance one
+    must move to part them, along z or in the plane (> 0), or minus the gap between them (<= 0).
+    Webots attaches the solid of the deepest contact; float64."""
+    gap = prism_gap(a, b)
+    if gap > 0.0:
+        return -gap
+    dz = min(a.z_range[1] - b.z_range[0], b.z_range[1] - a.z_range[0])
+    if math.isinf(b.radius):                             # an unbounded sheet: parted along z only
+        return dz
+    if b.normal is not None:                             # a wall line: a's section pushed off it
+        s = a.points @ b.normal + b.offset
+        return min(dz, min(float(s.max()), -float(s.min())) + a.radius)
+    diff = (a.points[:, None, :] - b.points[None, :, :]).reshape(-1, 2)
+    signed, _ = _closest_on_list(0.0, 0.0, _hull(diff).tolist())      # origin to A ⊖ B: < 0 inside
+    return min(dz, a.radius + b.radius - signed)
 
 
 _SCREEN = GRIP_DISTANCE * (1.0 + 1e-9) + 1e-12
@@ -163,7 +182,7 @@ class VacuumGripper(Device):
 
     def carry(self) -> None:
         """Once per basic step, after everything moved: the held solid put where the gripper now
-        holds it, or, pump on and nothing held, the first top-level solid with physics it touches
+        holds it, or, pump on and nothing held, the top-level solid with physics it touches deepest
         attached where it is. A held solid a Supervisor removed or rebuilt (a PROTO field set) is let
         go first, as Webots' joint goes with the destroyed node."""
         sim = self._sim
@@ -230,8 +249,8 @@ class VacuumGripper(Device):
         return cached[1]
 
     def touched(self) -> str | None:
-        """The first top-level solid with physics (world order) the gripper's bounding shapes touch
-        now, None if none."""
+        """The top-level solid with physics the gripper's bounding shapes touch deepest now (the first
+        in world order on a tie), None if none."""
         if not self._own:
             return None
         to_enu = self._robot.to_enu
@@ -250,11 +269,15 @@ class VacuumGripper(Device):
             self._mine = (pose, frames, mine)
         if not mine:
             return None
+        chosen, deepest = None, -math.inf
         for name, solid_pose in self._sim.scene.solid_poses.items():
             for ob in self._solid_obstacles(name, solid_pose):
-                if any(may_touch(m, ob) and prism_gap(m, ob) <= GRIP_DISTANCE for m in mine):
-                    return name
-        return None
+                for m in mine:
+                    if may_touch(m, ob) and prism_gap(m, ob) <= GRIP_DISTANCE:
+                        depth = prism_depth(m, ob)
+                        if depth > deepest:          # the first in world order on a tie
+                            chosen, deepest = name, depth
+        return chosen
 
     def _solid_obstacles(self, name: str, pose: Pose) -> list[Obstacle]:
         """A solid's bounding shapes as prisms at ``pose``, kept while its (immutable) pose and shapes
