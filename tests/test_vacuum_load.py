@@ -286,3 +286,24 @@ def test_prism_depth_closed_forms() -> None:
     assert low is not None and prism_depth(cup, low) == pytest.approx(-0.15, abs=1e-15)
     side = _shape_obstacle(geo.Box((0.1, 0.1, 0.1)), Pose(np.eye(3), [0.099, 0.0, 0.51]))  # x from 0.049
     assert side is not None and prism_depth(cup, side) == pytest.approx(0.001, abs=1e-15)  # 1 mm into the disc
+
+
+def test_in_a_nue_world_it_lands_along_the_world_y() -> None:
+    """NUE (x north, y up, z east): the floor Plane turned so its normal is the world's y, at y = 0.2;
+    the cup (a box thin along y) holds the parcel by its top at y = 0.9; let go, its y becomes 0.25."""
+    floor = {"name": "floor", "pose": {"translation": [0.0, 0.2, 0.0], "rotation": [1, 0, 0, -math.pi / 2]},
+             "geometry": {"type": "plane"}}
+    crane = {"name": "crane", "pose": {"translation": [0.3, 0.9, -0.2]},
+             "shapes": [{"pose": {"translation": [0.0, 0.01, 0.0]}, "geometry": {"type": "box", "size": [0.1, 0.02, 0.1]},
+                         "of_device": "cup", "seen_by": "bounding"}],
+             "devices": [{"device": "VacuumGripper", "name": "cup", "is_on": True}]}
+    parcel = {**PARCEL, "pose": {"translation": [0.3, 0.85, -0.2]}}
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": STEP, "coordinate_system": "NUE"},
+                                  "solids": [floor, parcel], "robots": [crane]}), precision="exact")
+    g = sim.device("crane/cup")
+    sim.step()
+    assert g.held == "parcel"                                           # type: ignore[attr-defined]
+    g.set_on(False)                                                     # type: ignore[attr-defined]
+    sim.step()
+    t = sim.scene.solid_poses["parcel"].translation
+    assert t[1] == pytest.approx(0.2 + 0.05, abs=1e-12) and (t[0], t[2]) == (0.3, -0.2)
