@@ -307,3 +307,22 @@ def test_in_a_nue_world_it_lands_along_the_world_y() -> None:
     sim.step()
     t = sim.scene.solid_poses["parcel"].translation
     assert t[1] == pytest.approx(0.2 + 0.05, abs=1e-12) and (t[0], t[2]) == (0.3, -0.2)
+
+
+def test_contact_moves_a_carried_solid_in_place_as_a_rebuild_would() -> None:
+    """Contact.update_solid changes a moved solid's rows in place (a carried solid moves every step):
+    the arrays and obstacles a full rebuild makes, bit for bit, with other solids around it."""
+    boxes = [{"name": f"b{i}", "pose": {"translation": [1.0 + 0.3 * i, 0.5, 0.05]},
+              "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}} for i in range(4)]
+    sim = _sim([boxes[0], PARCEL, *boxes[1:]], [_carrier(), _other(x=2.5)])
+    sim.step()
+    _drive(sim, "carrier", W)
+    _run(sim, 30)
+    c = sim.contact
+    assert c is not None
+    kept = [a.copy() for a in (c._lo, c._hi, c._zlo, c._zhi)]
+    obs = list(c._obs)
+    assert obs[1].name == "parcel" and obs[1].lo[0] == pytest.approx(0.17 - 0.05 + 0.125 * 30 * STEP / 1000.0, abs=1e-12)
+    c._rebuild()
+    assert all(np.array_equal(a, b) for a, b in zip(kept, (c._lo, c._hi, c._zlo, c._zhi)))
+    assert all(a is b for a, b in zip(obs, c._obs))

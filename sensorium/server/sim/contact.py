@@ -1243,14 +1243,28 @@ class Contact:
 
     def update_solid(self, name: str, pose: Pose) -> None:
         pose = enu_pose(pose, self._to_enu)
+        moved: list[tuple[str, int]] = []        # obstacles that were there and are still: changed in place
+        same = True
         for i, (prim, local) in enumerate(self.prims.get(name, ())):
             ob = obstacle(name, -1, prim, pose.compose(local), ramps=name in self._ramps)
             if ob is None:
-                self.solids.pop((name, i), None)
+                same = self.solids.pop((name, i), None) is None and same
             else:
+                same = same and (name, i) in self.solids
                 self.solids[(name, i)] = ob
-        if hasattr(self, "feet"):
+                moved.append((name, i))
+        if not hasattr(self, "feet"):
+            return
+        if not same:
             self._rebuild()
+            return
+        # a solid moved with the same obstacles (a carried one, every step): its rows of the arrays
+        # _rebuild makes, in place (a dict keeps a key's place when its value changes: the same arrays)
+        for key in moved:
+            j, ob = self._slot[key], self.solids[key]
+            self._obs[j] = ob
+            self._lo[j], self._hi[j] = ob.lo, ob.hi
+            self._zlo[j], self._zhi[j] = ob.z_range
 
     def add_solid(self, name: str, shapes: list[tuple[geo.Primitive, Pose, bool]], pose: Pose,
                   ramps: bool = False) -> None:
@@ -1286,16 +1300,10 @@ class Contact:
             if not held:
                 del self.carried[index]
 
-    def _carried_by(self, index: int) -> np.ndarray | None:
-        """Which of ``_obs`` robot ``index`` carries (a boolean per obstacle), None when it carries nothing."""
-        held = self.carried.get(index)
-        if not held:
-            return None
-        return np.array([ob.name in held for ob in self._obs], dtype=bool)
-
     def _rebuild(self) -> None:
         obs = list(self.solids.values())
         self._obs = obs
+        self._slot = {key: j for j, key in enumerate(self.solids)}
         self._lo = np.array([o.lo for o in obs]).reshape(-1, 2)
         self._hi = np.array([o.hi for o in obs]).reshape(-1, 2)
         self._zlo = np.array([o.z_range[0] for o in obs], dtype=np.float64)
@@ -1356,9 +1364,11 @@ class Contact:
                          & (self._zhi[None] > band_lo[:, None] + FLOOR) & (self._zlo[None] < band_hi[:, None] - EPS))
             if self.carried:             # what a robot carries is part of it: never its obstacle
                 for m, i in enumerate(indices):
-                    mine = self._carried_by(int(i))
-                    if mine is not None:
-                        solid_hit[m] &= ~mine
+                    held = self.carried.get(int(i))
+                    if held:
+                        for j in np.flatnonzero(solid_hit[m]).tolist():
+                            if self._obs[j].name in held:
+                                solid_hit[m, j] = False
         robot_hit = None
         if len(self.feet) > 1:
             # where every robot may be during this step: its disc, grown by its own move if it moves
@@ -1436,8 +1446,8 @@ class Contact:
         """Whether robot ``index``'s ``pieces`` touch a solid or another robot where they all are now
         (:func:`pieces_touch`)."""
         robots = [self._robot_obstacle(j) for j, f in enumerate(self.feet) if f is not None and j != index]
-        mine = self._carried_by(index)      # what it carries is part of it: never touched
-        solids = self._obs if mine is None else [ob for ob, held in zip(self._obs, mine.tolist()) if not held]
+        held = self.carried.get(index)      # what it carries is part of it: never touched
+        solids = [ob for ob in self._obs if ob.name not in held] if held else self._obs
         return pieces_touch(pieces, self.centres[index], float(self.yaw[index]), float(self.heights[index]),
                             solids, robots)
 

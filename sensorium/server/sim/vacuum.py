@@ -197,7 +197,10 @@ class VacuumGripper(Device):
             pose = self.frame().compose(self._offset)
             if not (np.array_equal(pose.translation, current.translation)
                     and np.array_equal(pose.rotation, current.rotation)):
+                known = self._models_version == sim.scene.solids_version
                 sim.place_solid(self.held, pose)
+                if known:       # a move changes no model: the models by name stay current (none taken again)
+                    self._models_version = sim.scene.solids_version
         elif self.is_on:
             name = self.touched()
             if name is not None:
