@@ -669,8 +669,9 @@ class Solid(Strict):
                                        "solid, those of its PROTO instances' DEFs that name no node here (`why`)")
     proto_scope: int | None = Field(default=None, ge=0, description="a PROTO instance inside a top-level solid: its "
                                     "number there (InnerDef.scope)")
-    physics: bool = Field(default=False, description="Webots: the solid has a Physics node. Nothing falls or is "
-                          "pushed here (no dynamics); a VacuumGripper carries only a top-level solid with physics")
+    physics: bool = Field(default=False, description="Webots: the solid has a Physics node. Nothing is pushed here "
+                          "(no dynamics); a VacuumGripper carries only a top-level solid with physics, and one it lets "
+                          "go lands at once on what is under it (no other solid falls)")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 

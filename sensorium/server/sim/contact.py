@@ -24,7 +24,9 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   its centre. A millimetre covers those settled poses several times over and stays below
   anything a robot's body should be stopped by; a solid rising more than that into the band is
   an obstacle. Robots' bodies meet one another without the tolerance (robots never stand on
-  robots). A solid's ramp (a tilted Box whose top face leans less than 45°, :func:`ramp_top`)
+  robots). A solid a robot's VacuumGripper holds (:meth:`Contact.hold`) is no obstacle to that
+  robot, nor touched by its bumpers (Webots' fixed joint makes them one body); it stays one to the
+  others. A solid's ramp (a tilted Box whose top face leans less than 45°, :func:`ramp_top`)
   tops out, for this rule, at its top face's low edge: a robot that can drive on at that edge rides
   the ramp (ground.py) and is never stopped by its box; for one below the edge it is an obstacle;
 * over one basic step a shaped robot first turns in place at its start, as far as the footprint
@@ -1234,18 +1236,35 @@ class Contact:
         self.initial = [(p, y) for (_, p), y in zip(robots, yaws)]     # what the footprints were made from
         self.contacts = 0                         # robot-steps whose motion was clipped
         self.checks = 0                           # narrow-phase obstacle tests
+        # robot index -> the solids its VacuumGrippers hold (sim/vacuum.py): Webots' fixed joint makes
+        # each one body with its carrier, so it never stops its carrier (other robots still meet it)
+        self.carried: dict[int, list[str]] = {}
         self._rebuild()
 
     def update_solid(self, name: str, pose: Pose) -> None:
         pose = enu_pose(pose, self._to_enu)
+        moved: list[tuple[str, int]] = []        # obstacles that were there and are still: changed in place
+        same = True
         for i, (prim, local) in enumerate(self.prims.get(name, ())):
             ob = obstacle(name, -1, prim, pose.compose(local), ramps=name in self._ramps)
             if ob is None:
-                self.solids.pop((name, i), None)
+                same = self.solids.pop((name, i), None) is None and same
             else:
+                same = same and (name, i) in self.solids
                 self.solids[(name, i)] = ob
-        if hasattr(self, "feet"):
+                moved.append((name, i))
+        if not hasattr(self, "feet"):
+            return
+        if not same:
             self._rebuild()
+            return
+        # a solid moved with the same obstacles (a carried one, every step): its rows of the arrays
+        # _rebuild makes, in place (a dict keeps a key's place when its value changes: the same arrays)
+        for key in moved:
+            j, ob = self._slot[key], self.solids[key]
+            self._obs[j] = ob
+            self._lo[j], self._hi[j] = ob.lo, ob.hi
+            self._zlo[j], self._zhi[j] = ob.z_range
 
     def add_solid(self, name: str, shapes: list[tuple[geo.Primitive, Pose, bool]], pose: Pose,
                   ramps: bool = False) -> None:
@@ -1269,9 +1288,22 @@ class Contact:
             self.solids.pop((name, i), None)
         self._rebuild()
 
+    def hold(self, index: int, name: str) -> None:
+        """Robot ``index`` now carries solid ``name`` (a VacuumGripper took it): it no longer stops it."""
+        self.carried.setdefault(index, []).append(name)
+
+    def let_go(self, index: int, name: str) -> None:
+        """Robot ``index`` no longer carries solid ``name``: an obstacle to it again."""
+        held = self.carried.get(index)
+        if held is not None and name in held:
+            held.remove(name)
+            if not held:
+                del self.carried[index]
+
     def _rebuild(self) -> None:
         obs = list(self.solids.values())
         self._obs = obs
+        self._slot = {key: j for j, key in enumerate(self.solids)}
         self._lo = np.array([o.lo for o in obs]).reshape(-1, 2)
         self._hi = np.array([o.hi for o in obs]).reshape(-1, 2)
         self._zlo = np.array([o.z_range[0] for o in obs], dtype=np.float64)
@@ -1330,6 +1362,13 @@ class Contact:
             solid_hit = ((lo[None, :, 0] <= box_hi[:, None, 0]) & (lo[None, :, 1] <= box_hi[:, None, 1])
                          & (hi[None, :, 0] >= box_lo[:, None, 0]) & (hi[None, :, 1] >= box_lo[:, None, 1])
                          & (self._zhi[None] > band_lo[:, None] + FLOOR) & (self._zlo[None] < band_hi[:, None] - EPS))
+            if self.carried:             # what a robot carries is part of it: never its obstacle
+                for m, i in enumerate(indices):
+                    held = self.carried.get(int(i))
+                    if held:
+                        for j in np.flatnonzero(solid_hit[m]).tolist():
+                            if self._obs[j].name in held:
+                                solid_hit[m, j] = False
         robot_hit = None
         if len(self.feet) > 1:
             # where every robot may be during this step: its disc, grown by its own move if it moves
@@ -1407,8 +1446,10 @@ class Contact:
         """Whether robot ``index``'s ``pieces`` touch a solid or another robot where they all are now
         (:func:`pieces_touch`)."""
         robots = [self._robot_obstacle(j) for j, f in enumerate(self.feet) if f is not None and j != index]
+        held = self.carried.get(index)      # what it carries is part of it: never touched
+        solids = [ob for ob in self._obs if ob.name not in held] if held else self._obs
         return pieces_touch(pieces, self.centres[index], float(self.yaw[index]), float(self.heights[index]),
-                            self._obs, robots)
+                            solids, robots)
 
     def _robot_obstacle(self, j: int) -> Obstacle:
         """Robot ``j``'s footprint where it is now, as an obstacle."""

@@ -75,7 +75,7 @@ from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, ramp_
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "placing_ceiling", "ride_height",
+__all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "land_pose", "placing_ceiling", "ride_height",
            "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "support_ceiling"]
 
 UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
@@ -498,16 +498,18 @@ def robot_up(r: np.ndarray, to_enu: np.ndarray | None) -> int | None:
 
 
 def settling_ground(solids: list[tuple[wm.Solid, Pose]], floors: list[tuple[wm.Robot, Pose]],
-                    to_enu: np.ndarray | None) -> Ground | None:
+                    to_enu: np.ndarray | None, floor_parts: list[list] | None = None) -> Ground | None:
     """The ground wheeled robots settle on: the top-level ``solids``' (each at its pose) and the shapes
     of the robots without a drive (``floors``, each at its pose: a Webots world's floor may be a
     robot's, create.wbt's ground supervisor holds its Plane), box and cylinder tops included whatever
     the world has (terrains or not); None when there is none. A robot's surfaces are keyed apart from
-    any solid's name."""
+    any solid's name. ``floor_parts``: each floor robot's parts as scene.robot_parts gives them, where its
+    joints hold them now (None: as the world file places them)."""
     from sensorium.server.sim.scene import robot_parts
 
     surfaces = [surface for s, _ in solids for surface in _surfaces(s)]
-    surfaces += [surface for r, _ in floors for surface in _parts_surfaces("\0" + r.name, robot_parts(r))]
+    parts = floor_parts if floor_parts is not None else [list(robot_parts(r)) for r, _ in floors]
+    surfaces += [surface for (r, _), p in zip(floors, parts) for surface in _parts_surfaces("\0" + r.name, p)]
     if not surfaces:
         return None
     poses = {s.name: pose for s, pose in solids}
@@ -571,6 +573,30 @@ def settle_pose(robot: wm.Robot, pose: Pose, ground: Ground | None, to_enu: np.n
     up, sign = _up_axis(to_enu)
     translation = np.array(pose.translation, dtype=np.float64)
     translation[up] = sign * float(heights[0])
+    return Pose(pose.rotation, translation)
+
+
+def land_pose(pose: Pose, low: float, high: float, ground: Ground | None, to_enu: np.ndarray | None) -> Pose:
+    """The pose a solid let go at ``pose`` lands at (a VacuumGripper's pump turned off, sim/vacuum.py):
+    its bounding shapes span the heights ``low`` to ``high`` (ENU z) there; it goes straight down (or
+    up) onto the highest ground under its origin (``ground``: :func:`settling_ground` without it) not
+    above the middle of that span + FLOOR, its lowest point on that ground, its x, y and rotation
+    kept -- settle_pose's rule with the span's middle for the axle (a top it sank into less than half
+    its height is its support; a higher one it sank into more is not). ``pose`` itself over no such
+    ground or within SETTLE_TOL of it."""
+    if ground is None:
+        return pose
+    t = pose.translation if to_enu is None else to_enu @ pose.translation
+    found, z, _, _ = ground.under(np.array([float(t[0])]), np.array([float(t[1])]),
+                                  np.array([(low + high) / 2.0 + FLOOR]))
+    if not found[0]:
+        return pose
+    height = float(z[0]) + (float(t[2]) - low)         # its origin that far above its lowest point
+    if abs(height - float(t[2])) <= SETTLE_TOL:
+        return pose
+    up, sign = _up_axis(to_enu)
+    translation = np.array(pose.translation, dtype=np.float64)
+    translation[up] = sign * height
     return Pose(pose.rotation, translation)
 
 

@@ -426,6 +426,19 @@ class Simulation:
         return self._settling.settled(model, pose, self.world.solids, self.scene, lambda: [
             (r.model, self.scene.robot_poses[r.index]) for r in self.robots.values() if not r.model.drive_motors])
 
+    def landing_ground(self, solid: str) -> Ground | None:
+        """The ground a solid let go lands on (ground.land_pose): ground.settling_ground as the world is
+        now, the other top-level solids where they are, the robots without a drive where they are with
+        their shapes where their joints hold them (a lift's cup that just let go of a parcel is above it)."""
+        floors = [r for r in self.robots.values() if not r.model.drive_motors]
+        alive = self.scene.solid_poses
+        parts = [[(name, local if r.links is None or (j := getattr(shape, "on_joint", None)) not in r.links.poses
+                   else r.links.poses[j].compose(local), shape) for name, local, shape in robot_parts(r.model)]
+                 for r in floors]
+        return settling_ground([(s, alive[s.name]) for s in self.world.solids if s.name in alive and s.name != solid],
+                               [(r.model, self.scene.robot_poses[r.index]) for r in floors],
+                               _TO_ENU[self.world.world_info.coordinate_system], parts)
+
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
         jump, not motion: their poses start over from there (_MotionSensor.placed)."""

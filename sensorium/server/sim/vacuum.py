@@ -11,14 +11,23 @@ Here, at the end of every basic step (:meth:`VacuumGripper.carry`, before the se
 gripper holding a solid puts it at the pose it had relative to the gripper when attached (float64
 poses composed: the gripper's frame, the robot's pose with its link's displacement, then the held
 offset), through :meth:`Simulation.place_solid`, the path of a Supervisor's move; a gripper whose pump
-is on and holds nothing attaches the first top-level solid with ``physics`` (world order) that its own
-bounding shapes (the robot's shapes whose ``of_device`` names it) touch -- overlap, or a gap of at most
-:data:`GRIP_DISTANCE`. The presence reads 1 exactly while a solid is held. Each shape is taken as
+is on and holds nothing attaches, of the top-level solids with ``physics`` that its own bounding shapes
+(the robot's shapes whose ``of_device`` names it) touch -- overlap, or a gap of at most
+:data:`GRIP_DISTANCE` -- the one it touches deepest (:func:`prism_depth`: Webots takes the deepest
+contact), the first in world order on a tie. The presence reads 1 exactly while a solid is held. Each shape is taken as
 contact.py takes obstacles (a 2D convex section ⊕ a disc, over a height range), so the distance
 between two shapes is the exact distance between those two vertical prisms, in float64:
 √(d_xy² + d_z²) with d_xy the gap between the sections (0 when they overlap) and d_z the gap between
 the height ranges. Exact for upright boxes and cylinders; other shapes are bounded as kinematic contact
 bounds them. Robots are never attached, and no force breaks the hold (no physics).
+
+A held solid is part of its carrier, as Webots' fixed joint makes the two one body: kinematic contact
+never stops the carrier at it nor do its bumpers touch it (``Contact.hold``/``let_go``), while it stops
+the other robots where it is. A solid let go (``turnOff``) is an obstacle to its carrier again at
+once and, at the end of that step, lands: ground.land_pose puts it straight down on the highest support
+under its origin (the settling ground without it: ``Simulation.landing_ground``), its lowest point on
+that support's top, its rotation kept -- no flight time, bounce or tipping, where Webots' physics
+lets it fall over the next steps.
 """
 from __future__ import annotations
 
@@ -28,13 +37,14 @@ from typing import Any
 import numpy as np
 
 from sensorium.server.sim.contact import UPRIGHT, Obstacle, _closest_on_list, _hull, enu_pose, obstacle
+from sensorium.server.sim.ground import land_pose
 from sensorium.server.sim.scene import primitive_from_model, solid_parts
 from sensorium.server.sim.sensors import Device
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
-__all__ = ["GRIP_DISTANCE", "VacuumGripper", "may_touch", "prism_gap"]
+__all__ = ["GRIP_DISTANCE", "VacuumGripper", "may_touch", "prism_depth", "prism_gap"]
 
 GRIP_DISTANCE = 1e-3
 """m: a gripper whose bounding shapes come this near a solid's (or overlap it) touches it."""
@@ -71,6 +81,24 @@ def prism_gap(a: Obstacle, b: Obstacle) -> float:
     return math.hypot(d_xy, d_z)
 
 
+def prism_depth(a: Obstacle, b: Obstacle) -> float:
+    """How deep two prisms (a gripper's shape ``a``, a solid's ``b``) overlap: the least distance one
+    must move to part them, along z or in the plane (> 0), or minus the gap between them (<= 0).
+    Webots attaches the solid of the deepest contact; float64."""
+    gap = prism_gap(a, b)
+    if gap > 0.0:
+        return -gap
+    dz = min(a.z_range[1] - b.z_range[0], b.z_range[1] - a.z_range[0])
+    if math.isinf(b.radius):                             # an unbounded sheet: parted along z only
+        return dz
+    if b.normal is not None:                             # a wall line: a's section pushed off it
+        s = a.points @ b.normal + b.offset
+        return min(dz, min(float(s.max()), -float(s.min())) + a.radius)
+    diff = (a.points[:, None, :] - b.points[None, :, :]).reshape(-1, 2)
+    signed, _ = _closest_on_list(0.0, 0.0, _hull(diff).tolist())      # origin to A ⊖ B: < 0 inside
+    return min(dz, a.radius + b.radius - signed)
+
+
 _SCREEN = GRIP_DISTANCE * (1.0 + 1e-9) + 1e-12
 """m: a pair whose boxes are farther apart than this along one axis is no touch (margin over rounding)."""
 
@@ -99,6 +127,7 @@ class VacuumGripper(Device):
         self.is_on = bool(self.config.is_on)
         self.value = 0.0                    # libController's presence before a value: false
         self.held: str | None = None
+        self._dropping: tuple[str, Any] | None = None     # (name, model) of a solid let go this step: it lands
         self._offset: Pose | None = None    # the held solid's pose in the gripper's frame
         self._held_model: Any = None        # its world-file model when attached (a rebuilt one is another)
         self._sim: Any = None
@@ -123,12 +152,18 @@ class VacuumGripper(Device):
     # -- controller API
     def set_on(self, on: bool) -> None:
         """``wb_vacuum_gripper_turn_on`` (True: it attaches at the end of the next step) / ``turn_off``
-        (False: what it holds is let go at once, where it is, as WbVacuumGripper::turnOff detaches)."""
+        (False: what it holds is let go at once, where it is, as WbVacuumGripper::turnOff detaches, and
+        lands at the end of the step: :meth:`carry`)."""
         self.is_on = bool(on)
         if not self.is_on:
+            if self.held is not None:
+                self._dropping = (self.held, self._held_model)
             self.release()
 
     def release(self) -> None:
+        """Nothing held from now on: the solid is an obstacle to the carrier again (contact.py)."""
+        if self.held is not None and self._sim.contact is not None:
+            self._sim.contact.let_go(self._robot.index, self.held)
         self.held, self._offset, self._held_model = None, None, None
 
     def reset(self) -> None:
@@ -136,6 +171,7 @@ class VacuumGripper(Device):
         controller learns the pump's state with its next presence value, as Webots' C_CONFIGURE)."""
         self.is_on = bool(self.config.is_on)
         self.release()
+        self._dropping = None
 
     # -- holding
     def frame(self) -> Pose:
@@ -146,10 +182,13 @@ class VacuumGripper(Device):
 
     def carry(self) -> None:
         """Once per basic step, after everything moved: the held solid put where the gripper now
-        holds it, or, pump on and nothing held, the first top-level solid with physics it touches
+        holds it, or, pump on and nothing held, the top-level solid with physics it touches deepest
         attached where it is. A held solid a Supervisor removed or rebuilt (a PROTO field set) is let
         go first, as Webots' joint goes with the destroyed node."""
         sim = self._sim
+        if self._dropping is not None:
+            self._land(*self._dropping)
+            self._dropping = None
         if self.held is not None and self._model(self.held) is not self._held_model:
             self.release()
         if self.held is not None:
@@ -158,12 +197,35 @@ class VacuumGripper(Device):
             pose = self.frame().compose(self._offset)
             if not (np.array_equal(pose.translation, current.translation)
                     and np.array_equal(pose.rotation, current.rotation)):
+                known = self._models_version == sim.scene.solids_version
                 sim.place_solid(self.held, pose)
+                if known:       # a move changes no model: the models by name stay current (none taken again)
+                    self._models_version = sim.scene.solids_version
         elif self.is_on:
             name = self.touched()
             if name is not None:
                 self.held, self._held_model = name, self._model(name)
                 self._offset = self.frame().inverse().compose(sim.scene.solid_poses[name])
+                if sim.contact is not None:
+                    sim.contact.hold(self._robot.index, name)
+
+    def _land(self, name: str, model: Any) -> None:
+        """The solid let go this step put on what is under it (ground.land_pose: the highest support
+        under its origin, its lowest point on it, at once), unless it is gone, rebuilt, or held again
+        (by another gripper)."""
+        sim = self._sim
+        if self._model(name) is not model or any(
+                isinstance(d, VacuumGripper) and d.held == name for d in sim.all_devices()):
+            return
+        pose = sim.scene.solid_poses[name]
+        prisms = self._solid_obstacles(name, pose)
+        if not prisms:                 # no bounding shapes: nothing to land on (it stays)
+            return
+        low = min(p.z_range[0] for p in prisms)
+        high = max(p.z_range[1] for p in prisms)
+        landed = land_pose(pose, low, high, sim.landing_ground(name), self._robot.to_enu)
+        if landed is not pose:
+            sim.place_solid(name, landed)
 
     # -- touching
     def _model(self, name: str) -> Any:
@@ -190,8 +252,8 @@ class VacuumGripper(Device):
         return cached[1]
 
     def touched(self) -> str | None:
-        """The first top-level solid with physics (world order) the gripper's bounding shapes touch
-        now, None if none."""
+        """The top-level solid with physics the gripper's bounding shapes touch deepest now (the first
+        in world order on a tie), None if none."""
         if not self._own:
             return None
         to_enu = self._robot.to_enu
@@ -210,11 +272,15 @@ class VacuumGripper(Device):
             self._mine = (pose, frames, mine)
         if not mine:
             return None
+        chosen, deepest = None, -math.inf
         for name, solid_pose in self._sim.scene.solid_poses.items():
             for ob in self._solid_obstacles(name, solid_pose):
-                if any(may_touch(m, ob) and prism_gap(m, ob) <= GRIP_DISTANCE for m in mine):
-                    return name
-        return None
+                for m in mine:
+                    if may_touch(m, ob) and prism_gap(m, ob) <= GRIP_DISTANCE:
+                        depth = prism_depth(m, ob)
+                        if depth > deepest:          # the first in world order on a tie
+                            chosen, deepest = name, depth
+        return chosen
 
     def _solid_obstacles(self, name: str, pose: Pose) -> list[Obstacle]:
         """A solid's bounding shapes as prisms at ``pose``, kept while its (immutable) pose and shapes
