@@ -1937,16 +1937,16 @@ class Converter:
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
     def _steered_casters(self, wheels: list[dict]) -> str | None:
-        """Why a base on more than two steered casters (each steering joint carrying driven wheels of
-        its own: a PR2's four) has no drive, else None (a car steers two)."""
+        """Why a base on more than two steering joints, each carrying driven wheels of its own (a PR2's
+        four casters, a rover's steered corners), has no drive, else None (a car steers two)."""
         steering = [w for w in wheels if w["steers"]]
         held = [self._inside(w["end"]) for w in steering]
         riding = [w for w in wheels if not w["steers"] and any(id(w["node"]) in h for h in held)]
         if len(steering) <= 2 or not all(any(id(w["node"]) in h for w in riding) for h in held):
             return None
-        return (f"its {len(riding)} driven wheels ride {len(steering)} steered casters, each steering joint turning "
-                f"its own wheels ({', '.join(repr(w['motor']) for w in steering)}): no kinematic drive here steers "
-                "casters")
+        return (f"its {len(riding)} driven wheels ride {len(steering)} steering joints, each turning wheels of its own "
+                f"({', '.join(repr(w['motor']) for w in steering)}): no kinematic drive here steers more than a car's "
+                "two")
 
     def _inside(self, end: Node | None) -> set[int]:
         """The ids of every node inside the end point ``end`` (its children, its joints' end points
