@@ -150,6 +150,41 @@ def test_a_car_like_robot_maps_to_the_ackermann_drive_or_gets_one_line(tmp_path:
                     "has 1 steering motor(s) ('left front')); the robot will not move")
 
 
+def caster(name: str, x: float, y: float) -> str:
+    """A steered caster (a PR2's): a motorised vertical hinge whose end point carries two driven wheels."""
+    wheels = "".join(wheel(f"{name} {side} wheel", 0, d) for side, d in (("left", 0.05), ("right", -0.05)))
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor {x} {y} 0 }} '
+            f'device [ RotationalMotor {{ name "{name} rotation" }} ] '
+            f'endPoint Solid {{ translation {x} {y} 0 name "{name} caster" children [\n{wheels}] }} }}\n')
+
+
+def test_a_base_on_steered_casters_gets_one_line_naming_them(tmp_path: Path) -> None:
+    """Four casters, each steering joint turning its own two wheels (a PR2's base): no kinematic drive
+    steers them, and the line says so (it used to blame a car's missing front steering)."""
+    robot = ('Robot { name "base" children [\n' + caster("fl", 0.22, 0.22) + caster("fr", 0.22, -0.22)
+             + caster("bl", -0.22, 0.22) + caster("br", -0.22, -0.22) + '] }\n')
+    p = write(tmp_path, robot)
+    w = load_world(p)
+    r = w.world.robots[0]
+    assert r.differential_drive is None and r.ackermann_drive is None and r.mecanum_drive is None
+    assert r.omni_drive is None
+    (line,) = [x for x in w.warnings if "will not move" in x]
+    assert line == (f"{p}:3:1: robot 'base': no drive (its 8 driven wheels ride 4 steering joints, each turning "
+                    "wheels of its own ('fl rotation', 'fr rotation', 'bl rotation', 'br rotation'): no kinematic "
+                    "drive here steers more than a car's two); the robot will not move")
+    # three casters, a motorised tilt hinge on the body (a PR2's laser) that rides none: still casters
+    robot = ('Robot { name "base" children [\n' + caster("fl", 0.22, 0.22) + caster("fr", 0.22, -0.22)
+             + caster("bl", -0.22, 0.22) + wheel("tilt", -0.22, -0.2) + '] }\n')
+    p = write(tmp_path, robot)
+    (line,) = [x for x in load_world(p).warnings if "will not move" in x]
+    assert "no drive (its 6 driven wheels ride 3 steering joints" in line
+    # two steering joints carrying their wheels (a Webots car's front axle) stay the Ackermann drive's case
+    robot = ('Robot { name "car" children [\n' + caster("fl", 0.3, 0.2) + caster("fr", 0.3, -0.2)
+             + wheel("left rear", 0, Y) + wheel("right rear", 0, -Y) + '] }\n')
+    p = write(tmp_path, robot)
+    assert not [x for x in load_world(p).warnings if "steering joints, each" in x]
+
+
 def test_skid_steer_in_a_world_file_and_its_checks() -> None:
     data = {"robots": [{"name": "r", "differential_drive": {
         "left_motor": "fl", "right_motor": "fr", "skid_steer": {"left": ["bl"], "right": ["br"]}},

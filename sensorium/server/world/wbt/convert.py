@@ -1936,6 +1936,18 @@ class Converter:
                                  "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
+    def _steered_casters(self, wheels: list[dict]) -> str | None:
+        """Why a base on more than two steering joints, each carrying driven wheels of its own (a PR2's
+        four casters, a rover's steered corners), has no drive, else None (a car steers two)."""
+        steering = [w for w in wheels if w["steers"]]
+        held = [self._inside(w["end"]) for w in steering]
+        riding = [w for w in wheels if not w["steers"] and any(id(w["node"]) in h for h in held)]
+        if len(steering) <= 2 or not all(any(id(w["node"]) in h for w in riding) for h in held):
+            return None
+        return (f"its {len(riding)} driven wheels ride {len(steering)} steering joints, each turning wheels of its own "
+                f"({', '.join(repr(w['motor']) for w in steering)}): no kinematic drive here steers more than a car's "
+                "two")
+
     def _inside(self, end: Node | None) -> set[int]:
         """The ids of every node inside the end point ``end`` (its children, its joints' end points
         and devices, to any depth)."""
@@ -2123,6 +2135,10 @@ class Converter:
         else:
             turns = mecanum_turns(wheels, self)
         if turns is None and any(w["steers"] for w in wheels):      # a car
+            casters = self._steered_casters(wheels)
+            if casters:
+                self.warn(node, f"robot {robot.data['name']!r}: no drive ({casters}); the robot will not move")
+                return
             drive, why = ackermann_drive(wheels, self, up)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no Ackermann drive ({why}); the robot will not move")
