@@ -64,7 +64,7 @@ def _drive(sim: Simulation, name: str, speed: float) -> None:
 # ---------------------------------------------------------------------- closed forms
 
 def test_a_robot_driving_up_a_ramp_climbs_it_pitched_and_its_accelerometer_and_altimeter_say_so() -> None:
-    """From the floor at x = 0 it drives at 0.2 m/s (seen from above) onto the ramp at its low edge
+    """From the floor at x = 0 it drives at 0.2 m/s (along the ground: its cosine along x on the ramp) onto the ramp at its low edge
     (contact on: the ramp's box never stops it): z = 0.04 before the edge, 0.04 + (x − 1)·tan A over the
     ramp; its forward axis (cos A, 0, sin A) and up axis (−sin A, 0, cos A) (pitch −A); the accelerometer
     reads gravity in that frame, (g·sin A, 0, g·cos A), once two steps were on the ramp; the altimeter z."""

@@ -80,9 +80,11 @@ def test_a_robot_driving_up_a_uniform_slope_rises_with_it_and_takes_its_attitude
         assert np.abs(p.rotation - want).max() <= 1e-12
         assert np.abs(imu.roll_pitch_yaw - [0.0, -math.atan(SLOPE), 0.0]).max() <= 1e-12
         assert np.array_equal(gps.values, p.translation)
-    assert p.translation[0] > 3.0                                    # it climbed 2.5 m along x, ~0.6 m up
+    # 2 m/s along the slope for 40 steps of 32 ms: 2.56 m along it, 2.56·cos(atan(slope)) along x
+    cos = 1.0 / math.sqrt(1.0 + SLOPE * SLOPE)
+    assert p.translation[0] == pytest.approx(0.5 + 2.56 * cos, abs=1e-12)
     vel = r.drive.velocity()                                         # the Supervisor's getVelocity
-    assert np.abs(np.array(vel) - [2.0, 0.0, 2.0 * SLOPE, 0.0, 0.0, 0.0]).max() <= 1e-12
+    assert np.abs(np.array(vel) - [2.0 * cos, 0.0, 2.0 * cos * SLOPE, 0.0, 0.0, 0.0]).max() <= 1e-12
 
 
 @pytest.mark.parametrize("yaw", [0.7, -2.3])
@@ -101,15 +103,20 @@ def test_across_a_skewed_slope_the_yaw_stays_the_drives_and_up_is_the_normal(yaw
     assert np.abs(r.pose.rotation - _attitude(gx, gy, yaw)).max() <= 1e-12   # set on the slope when placed
     _drive(sim, 3.0, 4.0)
     for _ in range(30):
+        yaw0 = r.drive.yaw
         sim.step()
         p = r.pose
         assert abs(p.translation[2] - (plane(*p.translation[:2]) - plane(0.0, 0.0) + CLEAR)) <= 1e-12
         assert np.abs(p.rotation - _attitude(gx, gy, r.drive.yaw)).max() <= 1e-12
         assert abs(imu.roll_pitch_yaw[2] - r.drive.yaw) <= 1e-12
+    # the wheels turn it at 1/3 rad/s about the normal: its yaw at that times (1 + k0²)/|(-gx, -gy, 1)|
+    # (k0 the slope along the heading the step started with), reported about the normal again
     turn = 0.1 * (4.0 - 3.0) / 0.3
+    k0 = gx * math.cos(yaw0) + gy * math.sin(yaw0)
+    yaw_rate = turn * (1.0 + k0 * k0) / math.sqrt(1.0 + gx * gx + gy * gy)
     k = gx * math.cos(r.drive.yaw) + gy * math.sin(r.drive.yaw)
     ang = np.array(r.drive.velocity()[3:])
-    assert np.abs(ang - turn * np.array([-gx, -gy, 1.0]) / (1.0 + k * k)).max() <= 1e-12
+    assert np.abs(ang - yaw_rate * np.array([-gx, -gy, 1.0]) / (1.0 + k * k)).max() <= 1e-12
 
 
 def test_a_distance_sensor_on_the_slope_reads_a_wall_at_the_analytic_distance() -> None:

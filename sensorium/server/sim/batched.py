@@ -95,6 +95,7 @@ from sensorium.server.sim.ground import (
     ground_rotation,
     ride_height,
     settle_world,
+    slope_scales,
     support_ceiling,
 )
 from sensorium.server.sim.motion import (
@@ -801,7 +802,9 @@ class BatchedSimulation:
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:
         driven = self._driven
-        if self._numpy_drives:
+        if self._numpy_drives or (self.ground is not None and self.tilted.any()):
+            # (robots on a slope: their wheels' speeds are scaled to the horizontal between the wheels'
+            # pass and the moves', _over_ground; the C pass does both at once)
             # car-like, mecanum and omni-wheel robots (batched_car.py, batched_holonomic.py): their moves
             # join the numpy path's; a NUE world's poses are turned into its axes there (the C pass
             # writes ENU poses)
@@ -877,10 +880,12 @@ class BatchedSimulation:
                                           self.side_wheels, self.wheel_radius, self.axle)
             copies, slots, v, w = wheels if wheels is not None else self._drive_wheels(live, driven, dt)
             if len(copies):
+                v, w = self._over_ground(copies, slots, v, w)
                 moves.append(self._two_wheel_moves(copies, slots, v, w, dt))
         if self.cars is not None:
             copies, slots, v, w = self.cars.step(live, dt)
             if len(copies):
+                v, w = self._over_ground(copies, slots, v, w)
                 x0, y0, yaw0 = self.x[copies, slots], self.y[copies, slots], self.yaw[copies, slots]
                 x, y, yaw = (_offset_arc_steps(x0, y0, yaw0, v, w, dt, self.cars.rear_axle[slots])
                              if self.cars.offset else _arc_steps(x0, y0, yaw0, v, w, dt))   # offset: origin off the rear axle
@@ -913,6 +918,24 @@ class BatchedSimulation:
             pos = np.matmul(back, pos[:, :, None])[:, :, 0]
         self.rot[copies, slots] = rot
         self.pos[copies, slots] = pos
+
+    def _over_ground(self, copies: np.ndarray, slots: np.ndarray, v: np.ndarray,
+                     w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """PlanarState.over_ground for the moving robots: those on a slope (``tilted``) have their speed
+        along the ground and turn rate about its normal seen from above (ground.slope_scales, at the
+        heading the step starts with, libm's cos and sin as math.cos/math.sin); the others' untouched."""
+        if self.ground is None:
+            return v, w
+        k = self.tilted[copies, slots].nonzero()[0]
+        if not len(k):
+            return v, w
+        c, r = copies[k], slots[k]
+        cos, sin = kin.libm_cos_sin(self.yaw[c, r])
+        root, turn = slope_scales(self.slope[c, r, 0], self.slope[c, r, 1], cos, sin)
+        v, w = v.copy(), w.copy()
+        v[k] = v[k] / root
+        w[k] = w[k] * turn
+        return v, w
 
     def _two_wheel_moves(self, copies: np.ndarray, slots: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):
         """The moving two-wheel robots' (copies, slots, x0, y0, yaw0, x, y, yaw): an arc about the origin,

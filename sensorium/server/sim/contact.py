@@ -26,7 +26,9 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   an obstacle. Robots' bodies meet one another without the tolerance (robots never stand on
   robots). A solid a robot's VacuumGripper holds (:meth:`Contact.hold`) is no obstacle to that
   robot, nor touched by its bumpers (Webots' fixed joint makes them one body); it stays one to the
-  others. A solid's ramp (a tilted Box whose top face leans less than 45°, :func:`ramp_top`)
+  others. Its shapes are pieces of the carrier's outline, each with its own height band (the floor
+  rule per piece), so the carrier stops where its load meets something; the carrier's own footprint,
+  band and floor line stay its own (:meth:`Contact._clip_carrying`: its turn cut short, never pushed). A solid's ramp (a tilted Box whose top face leans less than 45°, :func:`ramp_top`)
   tops out, for this rule, at its top face's low edge: a robot that can drive on at that edge rides
   the ramp (ground.py) and is never stopped by its box; for one below the edge it is an obstacle;
 * over one basic step a shaped robot first turns in place at its start, as far as the footprint
@@ -1239,6 +1241,10 @@ class Contact:
         # robot index -> the solids its VacuumGrippers hold (sim/vacuum.py): Webots' fixed joint makes
         # each one body with its carrier, so it never stops its carrier (other robots still meet it)
         self.carried: dict[int, list[str]] = {}
+        # robot index -> {held solid -> its shapes' pieces (device_pieces: each its outline and its own
+        # height band in the footprint's frame)}: the load is part of its carrier's outline, so the
+        # carrier stops where its load meets something (:meth:`_clip_carrying`)
+        self.loads: dict[int, dict[str, list[Footprint]]] = {}
         self._rebuild()
 
     def update_solid(self, name: str, pose: Pose) -> None:
@@ -1288,17 +1294,34 @@ class Contact:
             self.solids.pop((name, i), None)
         self._rebuild()
 
-    def hold(self, index: int, name: str) -> None:
-        """Robot ``index`` now carries solid ``name`` (a VacuumGripper took it): it no longer stops it."""
-        self.carried.setdefault(index, []).append(name)
+    def hold(self, index: int, name: str, parts: list[tuple[geo.Primitive, Pose]] | None = None) -> None:
+        """Robot ``index`` now carries solid ``name`` (a VacuumGripper took it): it no longer stops it,
+        and its bounding shapes ``parts`` (robot frame, as :meth:`reshape` takes the robot's own) are
+        part of the carrier's outline, each shape a piece with its own height band. Called again for
+        a solid held, its pieces are made again (the gripper's joint moved it in the robot's frame)."""
+        held = self.carried.setdefault(index, [])
+        if name not in held:
+            held.append(name)
+        pieces = self.pieces(index, parts) if parts else []
+        if pieces:
+            self.loads.setdefault(index, {})[name] = pieces
+        else:
+            self._unload(index, name)
 
     def let_go(self, index: int, name: str) -> None:
-        """Robot ``index`` no longer carries solid ``name``: an obstacle to it again."""
+        """Robot ``index`` no longer carries solid ``name``: an obstacle to it again, and its outline
+        the robot's own again (the same footprint object: it moves as if it never held anything)."""
         held = self.carried.get(index)
         if held is not None and name in held:
             held.remove(name)
             if not held:
                 del self.carried[index]
+        self._unload(index, name)
+
+    def _unload(self, index: int, name: str) -> None:
+        loads = self.loads.get(index)
+        if loads is not None and loads.pop(name, None) is not None and not loads:
+            del self.loads[index]
 
     def _rebuild(self) -> None:
         obs = list(self.solids.values())
@@ -1353,10 +1376,21 @@ class Contact:
         if yaws is not None:             # a shaped robot's turn may push it off what it turns into
             reach = reach + self._spin[idx] * np.minimum(np.abs(yaws[:, 1] - yaws[:, 0]), 2.0)
         R = self._radius[idx]
-        box_lo = starts - (reach + R)[:, None]
-        box_hi = starts + (reach + R)[:, None]
         band_lo = self.heights[idx] + self._z_low[idx]
         band_hi = self.heights[idx] + self._z_high[idx]
+        loaded: dict[int, list[Footprint]] = {}
+        if self.loads:                   # a carrier reaches as far as its loads, over their bands too
+            R, band_lo, band_hi = R.copy(), band_lo.copy(), band_hi.copy()
+            for m, i in enumerate(indices):
+                held = self.loads.get(int(i))
+                if held and self.feet[int(i)] is not None:
+                    pieces = loaded[m] = [piece for pcs in held.values() for piece in pcs]
+                    h = float(self.heights[int(i)])
+                    R[m] = max(float(R[m]), *(pc.radius for pc in pieces))
+                    band_lo[m] = min(float(band_lo[m]), *(h + pc.z_low for pc in pieces))
+                    band_hi[m] = max(float(band_hi[m]), *(h + pc.z_high for pc in pieces))
+        box_lo = starts - (reach + R)[:, None]
+        box_hi = starts + (reach + R)[:, None]
         if len(self._obs):
             lo, hi = self._lo, self._hi
             solid_hit = ((lo[None, :, 0] <= box_hi[:, None, 0]) & (lo[None, :, 1] <= box_hi[:, None, 1])
@@ -1421,6 +1455,13 @@ class Contact:
                 self.yaw[i] = yaw1
                 out[m] = (ends[m].copy(), False, yaw1)
                 continue
+            if m in loaded:
+                p, clipped, kept = self._clip_carrying(i, foot, loaded[m], starts[m].copy(), ends[m] - starts[m],
+                                                       yaw0, yaw1, near_solids[m], near_robots[m])
+                self.centres[i] = p
+                self.yaw[i] = kept
+                out[m] = (p, clipped, kept)
+                continue
             cands: list[Obstacle] = [self._in_band(self._obs[j], float(band_lo[m]), float(band_hi[m]))
                                      for j in near_solids[m]]
             if near_robots[m]:
@@ -1483,6 +1524,68 @@ class Contact:
         if not cands:
             return p + d, False
         return self._sweep(p, d, [(ob, R) for ob in cands])
+
+    def _clip_carrying(self, i: int, foot: Footprint, loads: list[Footprint], p: np.ndarray, d: np.ndarray,
+                       yaw: float, yaw1: float, solids: list[int], robots: list[int]) -> tuple[np.ndarray, bool, float]:
+        """The narrow phase of robot ``i`` carrying loads: its own footprint and each load's pieces,
+        every piece against what is in its own height band (the floor rule per piece: a solid rising
+        more than FLOOR above the piece's bottom, a robot more than EPS), all turning and moving as one
+        body. The turn first, in place, as far as every piece sweeping through it overlaps nothing
+        it did not already (:meth:`_turn_clear`; cut short by halving as :meth:`_clip_shaped` cuts
+        it, never pushed), then the move at the heading kept, stopped by the first contact of any
+        piece and slid on (:meth:`_sweep` over every piece's grown candidates). ``solids``,
+        ``robots``: the broad phase's candidates over all the pieces' reach and bands."""
+        h = float(self.heights[i])
+        own = foot if not foot.disc else Footprint(foot.radius, foot.z_low, foot.z_high, np.zeros((1, 2)),
+                                                   foot.disc_radius)
+        robot_obs = [self._robot_obstacle(j) for j in robots]
+        pieces: list[tuple[Footprint, list[Obstacle]]] = []
+        for piece in [own, *loads]:
+            lo, hi = h + piece.z_low, h + piece.z_high
+            cands = [self._in_band(self._obs[j], lo, hi) for j in solids
+                     if self._zhi[j] > lo + FLOOR and self._zlo[j] < hi - EPS]
+            cands += [ob for ob in robot_obs if ob.z_range[1] > lo + EPS and ob.z_range[0] < hi - EPS]
+            if cands:
+                pieces.append((piece, cands))
+        if not pieces:
+            return p + d, False, yaw1
+        kept = yaw1
+        turn = math.remainder(yaw1 - yaw, math.tau)
+        if turn != 0.0:
+            tests = []
+            for piece, cands in pieces:
+                assert piece.points is not None
+                near = _in_reach(cands, p, _STILL, piece.radius)
+                if near:
+                    here = _turned(piece.points, yaw)
+                    tests.append((piece, near, [_gap(p, *_grown(ob, here, piece.round, p)) for ob in near]))
+
+            def clear(part: float) -> bool:
+                return all(self._turn_clear(pc, p, yaw, turn * part, near, now) for pc, near, now in tests)
+
+            if tests and not clear(1.0):
+                lo_, hi_ = 0.0, 1.0
+                least = 0.5 ** TURN_HALVINGS
+                if clear(least):
+                    lo_ = least
+                    for _ in range(TURN_HALVINGS):
+                        mid = 0.5 * (lo_ + hi_)
+                        if clear(mid):
+                            lo_ = mid
+                        else:
+                            hi_ = mid
+                kept = _wrap(yaw + turn * lo_) if lo_ > 0.0 else yaw
+        grown: list[tuple[Obstacle, float]] = []
+        for piece, cands in pieces:
+            assert piece.points is not None
+            reached = _in_reach(cands, p, d, piece.radius)
+            if reached:
+                shape = _turned(piece.points, kept)
+                grown += [_grown(ob, shape, piece.round, p) for ob in reached]
+        end, clipped = self._sweep(p, d, grown)
+        if kept != yaw1 and not clipped:
+            self.contacts += 1
+        return end, clipped or kept != yaw1, kept
 
     def _clip_shaped(self, foot: Footprint, p: np.ndarray, d: np.ndarray, yaw: float, yaw1: float,
                      cands: list[Obstacle]) -> tuple[np.ndarray, bool, float]:

@@ -76,7 +76,7 @@ from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
 __all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "land_pose", "placing_ceiling", "ride_height",
-           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "support_ceiling"]
+           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "slope_scales", "support_ceiling"]
 
 UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
@@ -468,6 +468,18 @@ def ground_angular_velocity(gx: float, gy: float, c: float, s: float, turn: floa
     k = gx * c + gy * s
     w = turn / (1.0 + k * k)
     return -gx * w, -gy * w, w
+
+
+def slope_scales(gx, gy, c, s):
+    """What a slope (gx, gy) does to wheels rolling with heading (cos, sin) = (c, s): ``(root, turn)``,
+    the horizontal speed being the speed along the ground over ``root`` = √(1 + k²) = 1/cos θ (k =
+    tan θ the slope along the heading), and the yaw rate about the world's up the turn rate about the
+    ground's normal times ``turn`` = (1 + k²)/√(1 + gx² + gy²). (A forward axis f ∝ (c, s, k) turning
+    at ω about the unit normal n ∝ (−gx, −gy, 1) has its heading turn at ω·n_z·|f|²/(f_x² + f_y²):
+    the inverse of :func:`ground_angular_velocity`.) Element-wise: the same bits on scalars and arrays."""
+    k = gx * c + gy * s
+    q = 1.0 + k * k
+    return np.sqrt(q), q / np.sqrt(1.0 + gx * gx + gy * gy)
 
 
 def _wheels(robot: wm.Robot) -> tuple[float, float] | None:

@@ -21,6 +21,7 @@ from sensorium.server.sim.ground import (
     placing_ceiling,
     ride_height,
     robot_up,
+    slope_scales,
     support_ceiling,
 )
 from sensorium.server.world.geometry import Pose
@@ -161,7 +162,8 @@ class PlanarState:
     after each planar move, sets its height to the ground under its origin plus the clearance it
     was placed with, and over a sloped triangle its rotation becomes ``ground_rotation(slope, yaw)
     @ base`` (the ground's roll and pitch, the drive's yaw). A robot placed over nothing keeps its
-    height wherever it goes, as without a ground. ``band_low``: the bottom of its body's height
+    height wherever it goes, as without a ground. On a slope the wheels' speed is along the ground and
+    their turn about its normal (:meth:`over_ground`), as Webots' wheels roll. ``band_low``: the bottom of its body's height
     band below its origin (ground.band_low), which with its height makes its support ceiling: box
     tops above it are not its ground (ground.py's support rule).
 
@@ -244,6 +246,17 @@ class PlanarState:
         finally:
             self.slope = slope
 
+    def over_ground(self, v: float, w: float) -> tuple[float, float]:
+        """The wheels' speed along the ground ``v`` and turn rate about its normal ``w`` as the planar
+        state integrates them, seen from above: on the slope under the origin at the step's start,
+        ``v / √(1 + k²)`` (cos θ of the slope along the heading) and ``w·(1 + k²)/√(1 + gx² + gy²)``
+        (:func:`ground.slope_scales`); level or off the ground, ``(v, w)`` untouched."""
+        if self.slope is None:
+            return v, w
+        gx, gy = self.slope
+        root, turn = slope_scales(gx, gy, math.cos(self.yaw), math.sin(self.yaw))
+        return float(v / root), float(w * turn)
+
     def moved(self, v: float, w: float) -> None:
         """Record the step's motion (v along the heading the step ends with, turn rate w): what
         :meth:`velocity` reports until the next step (worked out only when asked)."""
@@ -324,6 +337,7 @@ class DifferentialDrive(PlanarState):
             return None
         v = self.wheel_radius * (wl + wr) / 2.0
         w = self.wheel_radius * (wr - wl) / self.axle_length
+        v, w = self.over_ground(v, w)
         if self.center is None:
             self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
             self.moved(v, w)
@@ -548,15 +562,16 @@ class AckermannDrive(PlanarState):
         if self.free:
             self.roll_free(v, kl, dt)
         a = self.rear_axle
+        v, w = self.over_ground(v, v * kl)
         if a == 0.0:
-            self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, v * kl, dt)
-            self.moved(v, v * kl)
+            self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
+            self.moved(v, w)
         else:
-            self.x, self.y, self.yaw = offset_arc_step(self.x, self.y, self.yaw, v, v * kl, dt, a)
-            self.moved(v, v * kl)
+            self.x, self.y, self.yaw = offset_arc_step(self.x, self.y, self.yaw, v, w, dt, a)
+            self.moved(v, w)
             # the origin's own velocity: the axle's v along the heading plus ω × (origin - axle)
             c, s = math.cos(self.yaw), math.sin(self.yaw)
-            self.linear = (v * c + a * (v * kl) * s, v * s - a * (v * kl) * c)
+            self.linear = (v * c + a * w * s, v * s - a * w * c)
         return self.pose()
 
 

@@ -130,6 +130,7 @@ class VacuumGripper(Device):
         self._dropping: tuple[str, Any] | None = None     # (name, model) of a solid let go this step: it lands
         self._offset: Pose | None = None    # the held solid's pose in the gripper's frame
         self._held_model: Any = None        # its world-file model when attached (a rebuilt one is another)
+        self._outline: tuple[str, Pose | None] | None = None     # (held, link pose) its outline was given at
         self._sim: Any = None
         self._robot: Any = None
         self._own: list[tuple[Any, Pose, str | None]] = []          # (primitive, pose in robot frame, on_joint)
@@ -164,7 +165,7 @@ class VacuumGripper(Device):
         """Nothing held from now on: the solid is an obstacle to the carrier again (contact.py)."""
         if self.held is not None and self._sim.contact is not None:
             self._sim.contact.let_go(self._robot.index, self.held)
-        self.held, self._offset, self._held_model = None, None, None
+        self.held, self._offset, self._held_model, self._outline = None, None, None, None
 
     def reset(self) -> None:
         """Webots' WbVacuumGripper::reset: the pump as the world file has it, nothing held (its
@@ -193,6 +194,7 @@ class VacuumGripper(Device):
             self.release()
         if self.held is not None:
             assert self._offset is not None
+            self._hold_outline()
             current = sim.scene.solid_poses[self.held]
             pose = self.frame().compose(self._offset)
             if not (np.array_equal(pose.translation, current.translation)
@@ -206,8 +208,24 @@ class VacuumGripper(Device):
             if name is not None:
                 self.held, self._held_model = name, self._model(name)
                 self._offset = self.frame().inverse().compose(sim.scene.solid_poses[name])
-                if sim.contact is not None:
-                    sim.contact.hold(self._robot.index, name)
+                self._hold_outline()
+
+    def _hold_outline(self) -> None:
+        """The held solid's bounding shapes, where the gripper holds them in its robot's frame, part of
+        the robot's outline for kinematic contact (:meth:`Contact.hold`): given when it is attached and
+        again when the gripper's joint moved it (the link's displacement, an immutable pose, changed)."""
+        contact = self._sim.contact
+        if contact is None or self.held is None:
+            return
+        links, joint = self._robot.links, self.on_joint
+        link = None if joint is None or links is None else links.poses[joint]
+        if self._outline is not None and self._outline[0] == self.held and self._outline[1] is link:
+            return
+        assert self._offset is not None
+        in_robot = self._offset if link is None else link.compose(self._offset)
+        parts = [(prim, in_robot.compose(local)) for prim, local in self._solid_shapes(self.held) or []]
+        contact.hold(self._robot.index, self.held, parts)
+        self._outline = (self.held, link)
 
     def _land(self, name: str, model: Any) -> None:
         """The solid let go this step put on what is under it (ground.land_pose: the highest support
