@@ -20,7 +20,7 @@ import numpy as np
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import blocks
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import RayHits, RayKind, Riding
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import light_from_model
 from sensorium.server.sim.sensors import Device, Schedule
@@ -33,11 +33,13 @@ __all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info
 class MountedRays:
     """A device's pixel rays: local directions (made once), world directions kept until the
     device's rotation changes (a parked or translating robot rotates nothing), and their float32
-    copy for Embree. ``own``: how they are cast when the device has shapes of its own."""
+    copy for Embree. ``own``: how they are cast when the device has shapes of its own; ``riding``:
+    else, the robot's body they ride, which they see (which of them can meet it decided once)."""
 
-    def __init__(self, local: np.ndarray, own: OwnBodyRays | None = None):
+    def __init__(self, local: np.ndarray, own: OwnBodyRays | None = None, riding: Riding | None = None):
         self.local = np.ascontiguousarray(local.reshape(-1, 3))
         self.own = own
+        self.riding = riding
         self._cols = tuple(np.ascontiguousarray(self.local[:, k]) for k in range(3))
         self._key: bytes | None = None
         self.world = np.empty((0, 3))
@@ -71,10 +73,16 @@ class MountedRays:
 
 def _mounted(device: Any, dirs: np.ndarray, limits: tuple[Any, Any]) -> MountedRays:
     """A device's pixel rays (directions in its frame) and, when it has shapes of its own, their
-    cast mounted on its robot's body, blind to those shapes (``own_shapes.py``, the lidar's way)."""
-    body = device._scene.device_body(device.robot_index, device.on_joint) if device.own_shapes else None
-    own = None if body is None else OwnBodyRays(body, device.mount_pose, dirs.reshape(-1, 3), *limits, device.own_shapes)
-    return MountedRays(dirs, own)
+    cast mounted on its robot's body, blind to those shapes (``own_shapes.py``, the lidar's way);
+    else, on a robot with a body, which of them can meet that body, decided once in its frame."""
+    body = device._scene.device_body(device.robot_index, device.on_joint)
+    if body is None:
+        return MountedRays(dirs)
+    mount = device.mount_pose
+    if device.own_shapes:
+        return MountedRays(dirs, own=OwnBodyRays(body, mount, dirs.reshape(-1, 3), *limits, device.own_shapes))
+    local = dirs.reshape(-1, 3) @ mount.rotation.T
+    return MountedRays(dirs, riding=Riding(body, mount.translation, local, *limits))
 
 
 def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, Any],
@@ -88,7 +96,7 @@ def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, 
         return rays.own.cast(engine, origins, dirs, device.carrier_rotation(device._robot.pose), dirs32,
                              distance_only)
     return engine.cast(origins, dirs, *limits, kind=RayKind.VISUAL, exclude_owner=-1, distance_only=distance_only,
-                       directions32=dirs32)
+                       directions32=dirs32, riding=rays.riding)
 
 
 def _shade(P: np.ndarray, N: np.ndarray, albedo: np.ndarray, lights: light_math.LightArrays, lit: np.ndarray | None,
