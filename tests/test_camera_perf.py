@@ -619,3 +619,64 @@ def test_a_camera_without_a_housing_images_its_robot_as_the_general_cast(tmp_pat
                                        kind=RayKind.VISUAL)
         robot_shapes = cam._scene.engine.body_shapes(cam._scene.device_body(cam.robot_index, None))
         assert np.isin(first.shape, robot_shapes).any()     # its robot is in view
+
+
+_SHADOW_WBT = """#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 16 }
+PointLight { location 0.4 0.3 1.0 intensity 2 castShadows TRUE }
+DirectionalLight { direction -0.3 0.2 -1 intensity 0.5 castShadows TRUE }
+Solid { translation 0 0 -0.05 children [ Shape { geometry Box { size 10 10 0.1 } } ] }
+Solid { translation 1 0.1 0.15 children [ Shape { geometry Box { size 0.3 0.3 0.3 } } ] }
+Solid { translation 0.8 -0.4 0.1 children [ Shape { geometry Sphere { radius 0.1 } } ] }
+Robot {
+  translation 0 0 0.3
+  rotation 0 1 0 0.4
+  controller "<extern>"
+  children [ Camera { name "cam" width 200 height 150 fieldOfView 1.2 antiAliasing TRUE } ]
+}
+"""
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_shadow_buffers_kept_between_images_give_each_image_s_own_shadows(tmp_path, monkeypatch, precision):
+    """A camera keeps its shadow rays' buffers from image to image (the same arrays, sized once for
+    its rays and lights): an image taken after the point light moved, through buffers still
+    holding the last image's rays, is the bytes of the general path's (new arrays), which a
+    stale row would change (the two light poses give other shadows)."""
+    from sensorium.server.sim import cameras
+    from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.loader import load_world
+
+    path = tmp_path / "shadows.wbt"
+    path.write_text(_SHADOW_WBT)
+    sim = Simulation(load_world(path))
+    sim.scene.engine.precision = precision
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    robot = sim.robot("robot")
+    scene = sim.scene
+
+    def image() -> bytes:
+        cam._capture_image(cam.world_pose(robot.pose), sim._counters)
+        return cam.image.tobytes()
+
+    def general() -> bytes:
+        with monkeypatch.context() as m:
+            m.setattr(cameras, "shadow_rays", lambda *a: shadows_of(*a[:5]))
+            m.setattr(cameras.ShadowBuffers, "origins", lambda self, k, P, i: shading.take_rows(P, i))
+            return image()
+
+    shadows_of = cameras.shadow_rays
+    first = image()
+    out = cam._shadow_out
+    assert out is not None and out.rows == 200 * 150 * 4           # sized for every ray of the camera
+    kept = [id(a) for s in out._sets for a in s]
+    assert len(kept) == 8                                           # two shadow-casting lights
+    assert first == general()
+    light = scene.top_lights()[0]
+    for location in ([-0.3, 0.6, 0.8], [1.4, -0.5, 0.5]):
+        scene.set_top_light(0, light.model_copy(update={"location": location}))
+        got = image()
+        assert cam._shadow_out is out and [id(a) for s in out._sets for a in s] == kept   # not made again
+        assert got == general()
+        assert got != first
