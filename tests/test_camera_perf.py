@@ -680,3 +680,21 @@ def test_shadow_buffers_kept_between_images_give_each_image_s_own_shadows(tmp_pa
         assert cam._shadow_out is out and [id(a) for s in out._sets for a in s] == kept   # not made again
         assert got == general()
         assert got != first
+
+
+def test_a_small_riding_cast_is_the_general_one_and_bad_riding_is_refused():
+    """Under _PRUNE rays the general pairing decides (no pairs counted), with the same hits; a
+    Riding for rays of several origins, or of another count, is refused in one line."""
+    eng, body = _robot_world(Precision.FAST)
+    local_o = np.array([0.05, 0.0, 0.03])
+    D = _fan(40, 9)
+    D[:20, 2] = -np.abs(D[:20, 2])
+    riding = Riding(body, local_o, D, 0.001, np.inf)
+    O = np.broadcast_to(local_o + [0.0, 0.0, 0.04], D.shape)
+    got = eng.cast(O, D, 0.001, np.inf, kind=RayKind.VISUAL, riding=riding)
+    assert eng.counters["riding_rays"] == 0
+    _same(got, eng.cast(O, D, 0.001, np.inf, kind=RayKind.VISUAL))
+    with pytest.raises(ValueError, match="riding takes one-origin rays"):
+        eng.cast(np.ascontiguousarray(O), D, 0.001, np.inf, kind=RayKind.VISUAL, riding=riding)
+    with pytest.raises(ValueError, match="riding takes one-origin rays"):
+        eng.cast(O[:10], D[:10], 0.001, np.inf, kind=RayKind.VISUAL, riding=riding)
