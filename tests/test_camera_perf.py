@@ -500,3 +500,201 @@ def test_shadow_rays_of_mixed_lights_in_every_order_are_the_general_choice():
                 for j in casting:
                     for a, b in zip(got[j], want[j]):
                         assert a.tobytes() == np.ascontiguousarray(b).tobytes(), (order, casting, j)
+
+
+# ---- a camera without shapes of its own on its robot: which rays can meet the robot, decided once
+
+from sensorium.server.raycast.engine import Riding  # noqa: E402
+
+
+def _yawed(yaw: float, t) -> Pose:
+    R = np.array([[math.cos(yaw), -math.sin(yaw), 0.0], [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]])
+    return Pose(R, np.asarray(t, dtype=np.float64))
+
+
+def _same(got, want) -> None:
+    assert got.distance.tobytes() == want.distance.tobytes()
+    assert got.shape.tobytes() == want.shape.tobytes()
+    assert got.normal.tobytes() == want.normal.tobytes()
+
+
+@pytest.mark.parametrize("precision,n,threads", [(Precision.FAST, (1 << 16) + 3000, 2), (Precision.FAST, 20000, 1),
+                                                 (Precision.EXACT, MIN_RAYS + 3000, 2)])
+@pytest.mark.parametrize("local_o", [(0.05, 0.0, 0.03), (0.0, 0.0, 0.2)], ids=["inside", "above"])
+def test_rays_riding_their_robot_see_it_as_the_general_cast(precision, n, threads, local_o):
+    """A camera's rays from one origin on a moving robot, cast unmounted (they see the robot): with
+    a Riding, only the rays that may meet the robot's bound are paired with it (counted), and every
+    hit is the general cast's bit for bit as the robot drives and turns -- its own body in view (a
+    ray half looking down past it), the other robot and the static world too. From inside the
+    robot's bounding sphere (beside the box on its cylinder) and from above it."""
+    eng, body = _robot_world(precision)
+    eng.threads = threads
+    local_o = np.array(local_o)                  # in the body frame
+    D_local = _fan(n, 7)
+    D_local[: n // 2, 2] = -np.abs(D_local[: n // 2, 2])      # half of them look down past the body
+    riding = Riding(body, local_o, D_local, 0.001, np.inf)
+    seen_own = 0
+    for yaw, t in [(0.0, (0.0, 0.0, 0.04)), (0.7, (0.3, -0.1, 0.04)), (-2.1, (0.25, -0.15, 0.04))]:
+        pose = _yawed(yaw, t)
+        eng.set_body_pose(body, pose)
+        O = np.broadcast_to(pose.translation + pose.rotation @ local_o, D_local.shape)
+        D = D_local @ pose.rotation.T
+        before = eng.counters["riding_rays"]
+        got = eng.cast(O, D, 0.001, np.inf, kind=RayKind.VISUAL, exclude_owner=-1, riding=riding)
+        paired = eng.counters["riding_rays"] - before
+        assert 0 < paired < n                       # only the rays near the robot are paired with it
+        want = eng.cast(O, D, 0.001, np.inf, kind=RayKind.VISUAL, exclude_owner=-1)
+        _same(got, want)
+        seen_own += int(np.isin(got.shape, [eng._bodies[body].first, eng._bodies[body].first + 1]).sum())
+    assert seen_own > 0                              # its own body is in view
+    assert len(riding.rows(eng._bodies[body].tiers["visual"])) < n
+
+
+def test_a_riding_cast_breaks_when_its_rows_miss_the_robot():
+    """The check above can fail: rows that leave out rays meeting the robot give other hits."""
+    eng, body = _robot_world(Precision.FAST)
+    n = 20000
+    local_o = np.array([0.05, 0.0, 0.03])
+    D_local = _fan(n, 7)
+    D_local[: n // 2, 2] = -np.abs(D_local[: n // 2, 2])
+    riding = Riding(body, local_o, D_local, 0.001, np.inf)
+    eng.cast(np.broadcast_to(local_o + [0, 0, 0.04], D_local.shape), D_local, 0.001, np.inf, kind=RayKind.VISUAL)
+    tier = eng._bodies[body].tiers["visual"]
+    riding._rows = (tier, riding.rows(tier)[::2])      # half of them forgotten
+    O = np.broadcast_to(local_o + [0.0, 0.0, 0.04], D_local.shape)
+    got = eng.cast(O, D_local, 0.001, np.inf, kind=RayKind.VISUAL, exclude_owner=-1, riding=riding)
+    want = eng.cast(O, D_local, 0.001, np.inf, kind=RayKind.VISUAL, exclude_owner=-1)
+    assert got.distance.tobytes() != want.distance.tobytes()
+
+
+_ROBOT_WBT = """#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 16 }
+PointLight { location 0.3 0.5 0.6 intensity 2 castShadows TRUE }
+Solid { translation 0 0 -0.05 children [ Shape { geometry Box { size 10 10 0.1 } } ] }
+Solid { translation 1 0.3 0.15 children [ Shape { geometry Box { size 0.3 0.3 0.3 } } ] }
+Robot {
+  rotation 0 0 1 0.25
+  controller "<extern>"
+  children [
+    Transform { translation 0 0 0.0415 children [ Shape { geometry Cylinder { height 0.08 radius 0.045 } } ] }
+    Transform { translation 0 0.05 0.025 rotation 1 0 0 1.5708
+      children [ Shape { geometry Cylinder { height 0.01 radius 0.025 } } ] }
+    Camera { name "cam" translation 0.02 0 0.09 rotation 0 1 0 0.6 width 160 height 120 fieldOfView 1.4
+             antiAliasing TRUE }
+  ]
+}
+"""
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_a_camera_without_a_housing_images_its_robot_as_the_general_cast(tmp_path, precision):
+    """A camera with no shapes of its own looking down past its robot's body and wheel: its rays
+    pair with the robot only where they may meet it (decided once), and its images are the
+    general cast's bytes, before and after the robot turns."""
+    from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.loader import load_world
+
+    path = tmp_path / "robot.wbt"
+    path.write_text(_ROBOT_WBT)
+    sim = Simulation(load_world(path))
+    sim.scene.engine.precision = precision
+    cam = sim.device("robot/cam")
+    assert not cam.own_shapes
+    cam.enable(16)
+    robot = sim.robot("robot")
+    for turn in (0.0, 0.9):
+        if turn:
+            sim.place_robot(robot, _yawed(turn, robot.pose.translation))
+        pose = cam.world_pose(robot.pose)
+        rays = cam._prepare()
+        assert rays.riding is not None
+        before = sim.scene.engine.counters["riding_rays"]
+        got = cam._render(pose, rays, sim._counters)
+        assert 0 < sim.scene.engine.counters["riding_rays"] - before < len(rays)
+        rays.riding, riding = None, rays.riding            # the general cast
+        want = cam._render(pose, rays, sim._counters)
+        rays.riding = riding
+        assert got.tobytes() == want.tobytes()
+        first = cam._scene.engine.cast(np.broadcast_to(pose.translation, rays.world.shape), rays.world, *cam._limits,
+                                       kind=RayKind.VISUAL)
+        robot_shapes = cam._scene.engine.body_shapes(cam._scene.device_body(cam.robot_index, None))
+        assert np.isin(first.shape, robot_shapes).any()     # its robot is in view
+
+
+_SHADOW_WBT = """#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 16 }
+PointLight { location 0.4 0.3 1.0 intensity 2 castShadows TRUE }
+DirectionalLight { direction -0.3 0.2 -1 intensity 0.5 castShadows TRUE }
+Solid { translation 0 0 -0.05 children [ Shape { geometry Box { size 10 10 0.1 } } ] }
+Solid { translation 1 0.1 0.15 children [ Shape { geometry Box { size 0.3 0.3 0.3 } } ] }
+Solid { translation 0.8 -0.4 0.1 children [ Shape { geometry Sphere { radius 0.1 } } ] }
+Robot {
+  translation 0 0 0.3
+  rotation 0 1 0 0.4
+  controller "<extern>"
+  children [ Camera { name "cam" width 200 height 150 fieldOfView 1.2 antiAliasing TRUE } ]
+}
+"""
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_shadow_buffers_kept_between_images_give_each_image_s_own_shadows(tmp_path, monkeypatch, precision):
+    """A camera keeps its shadow rays' buffers from image to image (the same arrays, sized once for
+    its rays and lights): an image taken after the point light moved, through buffers still
+    holding the last image's rays, is the bytes of the general path's (new arrays), which a
+    stale row would change (the two light poses give other shadows)."""
+    from sensorium.server.sim import cameras
+    from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.loader import load_world
+
+    path = tmp_path / "shadows.wbt"
+    path.write_text(_SHADOW_WBT)
+    sim = Simulation(load_world(path))
+    sim.scene.engine.precision = precision
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    robot = sim.robot("robot")
+    scene = sim.scene
+
+    def image() -> bytes:
+        cam._capture_image(cam.world_pose(robot.pose), sim._counters)
+        return cam.image.tobytes()
+
+    def general() -> bytes:
+        with monkeypatch.context() as m:
+            m.setattr(cameras, "shadow_rays", lambda *a: shadows_of(*a[:5]))
+            m.setattr(cameras.ShadowBuffers, "origins", lambda self, k, P, i: shading.take_rows(P, i))
+            return image()
+
+    shadows_of = cameras.shadow_rays
+    first = image()
+    out = cam._shadow_out
+    assert out is not None and out.rows == 200 * 150 * 4           # sized for every ray of the camera
+    kept = [id(a) for s in out._sets for a in s]
+    assert len(kept) == 8                                           # two shadow-casting lights
+    assert first == general()
+    light = scene.top_lights()[0]
+    for location in ([-0.3, 0.6, 0.8], [1.4, -0.5, 0.5]):
+        scene.set_top_light(0, light.model_copy(update={"location": location}))
+        got = image()
+        assert cam._shadow_out is out and [id(a) for s in out._sets for a in s] == kept   # not made again
+        assert got == general()
+        assert got != first
+
+
+def test_a_small_riding_cast_is_the_general_one_and_bad_riding_is_refused():
+    """Under _PRUNE rays the general pairing decides (no pairs counted), with the same hits; a
+    Riding for rays of several origins, or of another count, is refused in one line."""
+    eng, body = _robot_world(Precision.FAST)
+    local_o = np.array([0.05, 0.0, 0.03])
+    D = _fan(40, 9)
+    D[:20, 2] = -np.abs(D[:20, 2])
+    riding = Riding(body, local_o, D, 0.001, np.inf)
+    O = np.broadcast_to(local_o + [0.0, 0.0, 0.04], D.shape)
+    got = eng.cast(O, D, 0.001, np.inf, kind=RayKind.VISUAL, riding=riding)
+    assert eng.counters["riding_rays"] == 0
+    _same(got, eng.cast(O, D, 0.001, np.inf, kind=RayKind.VISUAL))
+    with pytest.raises(ValueError, match="riding takes one-origin rays"):
+        eng.cast(np.ascontiguousarray(O), D, 0.001, np.inf, kind=RayKind.VISUAL, riding=riding)
+    with pytest.raises(ValueError, match="riding takes one-origin rays"):
+        eng.cast(O[:10], D[:10], 0.001, np.inf, kind=RayKind.VISUAL, riding=riding)

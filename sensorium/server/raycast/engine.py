@@ -130,6 +130,7 @@ from __future__ import annotations
 
 import bisect
 import dataclasses
+import math
 import threading
 from collections.abc import Sequence
 
@@ -159,6 +160,7 @@ from sensorium.server.raycast.exact import (
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind, ShapeEntry
 from sensorium.server.raycast.movers import (
     Mount,
+    Riding,
     _Body,
     _grid_pairs,
     _mounted_pairs,
@@ -175,7 +177,7 @@ from sensorium.server.raycast.tiers import _Tier, new_device
 from sensorium.server.raycast.trace import TierTracer
 from sensorium.server.world.geometry import Plane, Pose
 
-__all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine", "Mount"]
+__all__ = ["RayKind", "Precision", "ShapeEntry", "RayHits", "RayEngine", "Mount", "Riding"]
 
 
 # variants: which shapes a scene holds
@@ -232,7 +234,7 @@ class RayEngine(TierTracer):
         self.counters: dict[str, int] = {
             "bvh_builds": 0, "embree_calls": 0, "rays_cast": 0, "leak_repairs": 0,
             "continued_rays": 0, "unresolved_rays": 0, "edge_guard_hits": 0, "neighbour_lists": 0, "ray_lists": 0,
-            "unbounded_mounts": 0, "local_pruned": 0,
+            "unbounded_mounts": 0, "local_pruned": 0, "riding_rays": 0,
         }
 
     # ---- configuration ----------------------------------------------------------------------
@@ -485,7 +487,8 @@ class RayEngine(TierTracer):
 
     def cast(self, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
              exclude_owner=-1, skip_transparent=False, mount=None, distance_only=False,
-             directions32=None, coherent: bool = False, origin_rows=None, run: int = 0) -> RayHits:
+             directions32=None, coherent: bool = False, origin_rows=None, run: int = 0,
+             riding: Riding | None = None) -> RayHits:
         """Nearest hits of rays ``origins + t directions``, t in [t_near, t_far] (scalars or per ray).
 
         ``mount``: optional (n,) body index each ray is rigidly mounted on (-1: none).  Such a ray
@@ -517,7 +520,11 @@ class RayEngine(TierTracer):
         lidar cast) -- from which the cast takes the largest coordinate and the box of the origins
         (the same values) instead of passes over all n rows; where they are a few per ray, FAST
         also screens the curved shells' pre-pass by them (unit directions, as that pre-pass's
-        one-origin screen assumes: every start point lies within t_near of its row)."""
+        one-origin screen assumes: every start point lies within t_near of its row).
+
+        ``riding``: the rays (from one origin, ``mount`` None) ride that :class:`Riding`'s body, which
+        they see: while their origin lies inside the body's bounding sphere, only the rays it keeps
+        are paired with that body (the others cannot meet it), with the same answers."""
         O = np.asarray(origins, dtype=np.float64)
         D = np.asarray(directions, dtype=np.float64)
         if O.ndim == 1:
@@ -540,6 +547,8 @@ class RayEngine(TierTracer):
             mount = np.asarray(mount, dtype=np.int64).reshape(n)
             if n and (int(mount.max()) >= len(self._bodies) or int(mount.min()) < -1):
                 raise ValueError(f"mount must hold body indices in [-1, {len(self._bodies) - 1}]")
+        if riding is not None and (mount is not None or len(riding) != n or (n > 1 and O.strides[0] != 0)):
+            raise ValueError("riding takes one-origin rays (a broadcast origin) without a mount, one per ray")
         self.counters["rays_cast"] += n
         variant = self._variant(kind, skip_transparent)
         # builds happen on the first cast after a change, even with no rays
@@ -548,6 +557,7 @@ class RayEngine(TierTracer):
         movers = self._mover_table(variant) if self._movers else None
         if n == 0:
             return RayHits(np.zeros(0), np.zeros((0, 3)), np.zeros(0, dtype=np.int64))
+        ride = None if riding is None or movers is None else self._riding(movers, riding, variant)
         # largest |coordinate| of the origins (a Python max beats two numpy reductions on a few rays)
         box = rows = None
         if O.strides[0] == 0:   # one origin for all rays (a broadcast array)
@@ -569,14 +579,14 @@ class RayEngine(TierTracer):
             if n <= _CHUNK and (threads <= 1 or n < MIN_RAYS or (self._precision is Precision.FAST and self.native
                                                                    and packets.library() is not None)):
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
-                                  directions32, coherent, box, rows, run)
+                                  directions32, coherent, box, rows, run, ride)
             parts = split(n, threads, _CHUNK)
             if coherent and run > 0:   # blocks start where runs start (each run packed as its own cast)
                 size = -(-parts[0].stop // run) * run
                 parts = [slice(a, min(n, a + size)) for a in range(0, n, size)]
             if len(parts) == 1:
                 return self._cast(O, D, t_near, t_far, excl, planes, static, movers, big, mount, distance_only,
-                                  directions32, coherent, box, rows, run)
+                                  directions32, coherent, box, rows, run, ride)
             # large batches in blocks: the temporaries (~150 bytes per ray) stay a few MB whatever the
             # batch, and the blocks of the planes and the static tier run side by side on the
             # threads; then the movers, on the whole batch (a Mount keeps its lists for it) or in
@@ -642,7 +652,8 @@ class RayEngine(TierTracer):
                 for sl in split(n, 1, _CHUNK):
                     self._cast_movers(movers, O[sl], D[sl], _take(t_near, sl), _take(t_far, sl), _take(excl, sl),
                                       eps64, exact, *(None if x is None else x[sl] for x in hits),
-                                      mount=None if mount is None else np.asarray(mount)[sl])
+                                      mount=None if mount is None else np.asarray(mount)[sl],
+                                      riding=None if ride is None else (*ride, sl.start))
             return RayHits(dist, normal, shape)
 
     def cast_local(self, body: int, origins, directions, t_near=0.0, t_far=np.inf, kind=RayKind.BOUNDING,
@@ -706,13 +717,14 @@ class RayEngine(TierTracer):
 
     def _cast(self, O, D, t_near, t_far, excl, planes, static, movers, big: float, mount=None,
               distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None,
-              run: int = 0) -> RayHits:
+              run: int = 0, ride: tuple | None = None) -> RayHits:
         exact = self._precision is Precision.EXACT
         hits = self._cast_static(O, D, t_near, t_far, excl, planes, static, big, distance_only, d32, coherent, box,
                                  rows, run)
         if movers is not None:
             self._cast_movers(movers, O, D, t_near, t_far, excl, 1e-9 + 1e-14 * big, exact, *hits, mount=mount,
-                              own_apart=distance_only and not exact)
+                              own_apart=distance_only and not exact,
+                              riding=None if ride is None else (*ride, 0))
         return RayHits(hits[0], hits[2], hits[1])
 
     def _cast_static(self, O, D, t_near, t_far, excl, planes, static, big: float, distance_only: bool = False,
@@ -771,15 +783,75 @@ class RayEngine(TierTracer):
                     s[sl], nrm[sl] = o[1], o[2]
         return t, s, nrm
 
+    def _mover_poses(self, mt: _Movers) -> None:
+        if mt.epoch != self._epoch:  # poses changed since the last cast (rotations gathered when needed)
+            mt.T = self._pos[mt.index]
+            mt.R = self._rot[mt.index] if mt.anchored else None
+            mt.C = mt.T + np.einsum("mij,mj->mi", mt.R, mt.anchor) if mt.anchored else mt.T
+            mt.epoch = self._epoch
+
+    def _riding(self, mt: _Movers, riding: Riding, variant: str) -> tuple | None:
+        """(mover row, rays that may meet it, how far from the origin they start) of a :class:`Riding`'s body, or None when the general
+        pairing applies: the body is no mover of this variant, or there are more movers than
+        :meth:`_trace_pairs` traces one by one (its order over a shared tier would change)."""
+        if len(mt.index) > _FEW_MOVERS or not 0 <= riding.body < len(self._bodies):
+            return None
+        if len(mt.row_of) != len(self._bodies) + 1:   # body index -> mover row (-1: none)
+            mt.row_of = np.full(len(self._bodies) + 1, -1, dtype=np.int64)
+            mt.row_of[mt.index] = np.arange(len(mt.index))
+        row = int(mt.row_of[riding.body])
+        if row < 0:
+            return None
+        return row, riding.rows(mt.tiers[mt.group[row]]), riding.reach
+
+    def _riding_pairs(self, mt: _Movers, O, D, t_near, lim, excl, riding: tuple) -> np.ndarray | None:
+        """The rays of this one-origin cast (ascending) the broad phase pairs with the body a
+        :class:`Riding` rides, among those that may meet its bound (the others' pairs would all be
+        dropped by the bound test), tested as every ray is; None when the general pairing must
+        decide (fewer than :data:`_PRUNE` pairs, when the bound test may not run; an excluded
+        owner; a body far from the world's origin). An origin inside the body's bounding sphere (by
+        far more than its test's rounding, with the rays' start points) pairs every ray with it:
+        those rays' pairs then, without a test."""
+        row, rows, reach, start = riding
+        n = len(O)
+        if n < _PRUNE or (mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0)):
+            return None
+        self._mover_poses(mt)
+        T = mt.T[row]
+        if max(abs(float(T[0])), abs(float(T[1])), abs(float(T[2]))) > 1e5:
+            return None
+        lo, hi = np.searchsorted(rows, [start, start + n])
+        sub = rows[lo:hi] - start
+        rel = mt.C[row] - O[0]
+        far = math.sqrt(float(rel @ rel)) + reach
+        if far * far <= float(mt.r2[row]) * (1.0 - 1e-6):
+            return sub
+        if len(sub) < _PRUNE:
+            return None
+        pr, pm = _sphere_pairs(mt.C, mt.r2, None, _one_row(O[:1], len(sub)), D.take(sub, axis=0), _take(t_near, sub),
+                               lim[sub], excl, among=np.array([row]))
+        got = sub[pr[pm == row]]
+        return got if len(got) >= _PRUNE else None
+
     def _cast_movers(self, mt: _Movers, O, D, t_near, t_far, excl, eps64, exact, dist, shape, normal,
-                     mount=None, own_apart: bool = False) -> None:
+                     mount=None, own_apart: bool = False, riding: tuple | None = None) -> None:
         """Broad phase over all movers, then one trace per shared tier over its (ray, mover) pairs
         moved into their body frames; improves dist/shape/normal in place. ``own_apart``: see
-        :meth:`_mover_pairs`."""
+        :meth:`_mover_pairs`; ``riding``: :meth:`_riding`'s answer and the row of this chunk's
+        first ray."""
         lim = np.minimum(t_far, dist)
-        pr, pm, tight, own = self._mover_pairs(mt, O, D, t_near, t_far, lim, excl, mount, own_apart)
+        mine = None if riding is None else self._riding_pairs(mt, O, D, t_near, lim, excl, riding)
+        rode = -1 if mine is None else riding[0]
+        pr, pm, tight, own = self._mover_pairs(mt, O, D, t_near, t_far, lim, excl, mount, own_apart, skip=rode)
+        if mine is not None:
+            # the pairs with the ridden body: only those of rays that may meet its bound, which the
+            # bound test then keeps or drops as it does every pair (the general pairs are >= _PRUNE)
+            other = (pm != rode).nonzero()[0]
+            pr = np.concatenate([pr[other], mine])
+            pm = np.concatenate([pm[other], np.full(len(mine), rode, dtype=np.int64)])
+            self.counters["riding_rays"] += len(mine)
         if len(pr):
-            self._trace_pairs(mt, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight)
+            self._trace_pairs(mt, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight, rode=rode)
         if own is not None:
             self._apply_own_hits(own, mt, O, D, t_near, t_far, eps64, dist)
 
@@ -817,18 +889,16 @@ class RayEngine(TierTracer):
             np.minimum(cur, t, out=cur)
             dist[rows] = cur
 
-    def _mover_pairs(self, mt: _Movers, O, D, t_near, t_far, lim, excl, mount=None, own_apart: bool = False) -> tuple:
+    def _mover_pairs(self, mt: _Movers, O, D, t_near, t_far, lim, excl, mount=None, own_apart: bool = False,
+                     skip: int = -1) -> tuple:
         """(rays, mover rows, tight row, own) of the (ray, mover) pairs whose segment up to ``lim`` can
         meet the mover (every test is conservative: a larger ``lim`` gives more pairs, never fewer);
         ``tight``: a mover row whose pairs are only a Mount's own pairs (tested against its bound
         when listed), else -1. ``own_apart`` (a FAST cast of distances only): a lidar's own-mount
         pairs are left out when its Mount keeps their hits (scalar limits, as when its state was
-        made); ``own`` is then that state, for :meth:`_apply_own_hits`, else None."""
-        if mt.epoch != self._epoch:  # poses changed since the last cast (rotations gathered when needed)
-            mt.T = self._pos[mt.index]
-            mt.R = self._rot[mt.index] if mt.anchored else None
-            mt.C = mt.T + np.einsum("mij,mj->mi", mt.R, mt.anchor) if mt.anchored else mt.T
-            mt.epoch = self._epoch
+        made); ``own`` is then that state, for :meth:`_apply_own_hits`, else None. ``skip`` (no mount):
+        a mover row whose test may be skipped, its pairs the caller's (they may still be listed)."""
+        self._mover_poses(mt)
         C = mt.C
         n = len(O)
         owner = mt.owner if mt.owned and not (not isinstance(excl, np.ndarray) and excl < 0) else None
@@ -887,8 +957,9 @@ class RayEngine(TierTracer):
                 pr, pm = _grid_pairs(C, mt.radius, mt.r2, owner, Os, Ds, tn, ls, ex,
                                      origin=O[0] if O.strides[0] == 0 and len(O) else None)
             else:   # rays that all ride one mover: its test skipped mover by mover (its pairs are dropped below)
+                cut = row if sub is not None and row >= 0 else skip if sub is None else -1
                 pr, pm = _sphere_pairs(C, mt.r2, owner, Os, Ds, tn, ls, ex,
-                                       among=np.delete(np.arange(len(C)), row) if sub is not None and row >= 0 else None)
+                                       among=np.delete(np.arange(len(C)), cut) if cut >= 0 else None)
             if sub is not None:   # merge with the mounted rays' pairs, in ray order
                 pr = sub[pr]
                 if len(pr):       # an unbounded mounted ray never meets its own body here either
@@ -901,10 +972,12 @@ class RayEngine(TierTracer):
         return pr, pm, tight, own
 
     def _trace_pairs(self, mt: _Movers, O, D, t_near, lim, eps64, exact, dist, shape, normal, pr, pm, tight: int,
-                     split: bool = True) -> None:
+                     split: bool = True, rode: int = -1) -> None:
         """One trace per mover (few) or shared tier over the pairs (``pr``, ``pm``, as
         :meth:`_mover_pairs` gives them), the rays moved into their body frames; improves
-        dist/shape/normal in place. ``split``: large traces in blocks on the engine's threads."""
+        dist/shape/normal in place. ``split``: large traces in blocks on the engine's threads.
+        ``rode``: a mover row whose pairs stand for every ray's (a :class:`Riding`): tested against
+        its bound whatever their number, as every ray's would be."""
         n = len(O)
         T, C = mt.T, mt.C
         if mt.R is None:
@@ -955,7 +1028,7 @@ class RayEngine(TierTracer):
             lim_r = lim[rr]
             # many pairs (many movers): drop those missing the tier's tight bound (a Mount's own
             # pairs passed that test when they were listed)
-            if len(rr) >= _PRUNE and not (one and int(mm[0]) == tight):
+            if (len(rr) >= _PRUNE or (one and int(mm[0]) == rode)) and not (one and int(mm[0]) == tight):
                 keep = tier.may_hit(Ob, Db, _take(t_near, rr), lim_r).nonzero()[0]
                 if len(keep) < len(rr):
                     if len(keep) == 0:

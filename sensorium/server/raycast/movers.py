@@ -459,6 +459,46 @@ class Mount:
         return self.bodies if dtype is None else self.bodies.astype(dtype)
 
 
+class Riding:
+    """Rays from one origin rigidly mounted on one moving body but cast unmounted, so they meet that
+    body as any ray does (a camera without shapes of its own on its robot): ``origin`` and
+    ``directions`` in the body frame, the limits the casts use. Which rays can meet the body is
+    decided once, in the body frame, by its tier's bound grown by ``GROW`` (far beyond the rounding
+    of the rays' world round trip); each cast pairs only those with the body (its broad phase and
+    bound test run on them alone, or its bound test only from inside the body's bounding sphere,
+    where every ray is paired: the rays it then traces are those every ray's tests keep, traced as
+    before, the same bits; RayEngine.cast)."""
+
+    __slots__ = ("body", "origin", "directions", "t_near", "t_far", "reach", "_rows")
+
+    GROW = 1e-6
+
+    def __init__(self, body: int, origin: np.ndarray, directions: np.ndarray, t_near, t_far) -> None:
+        self.body = int(body)
+        self.origin = np.asarray(origin, dtype=np.float64).reshape(3)
+        self.directions = np.ascontiguousarray(directions, dtype=np.float64).reshape(-1, 3)
+        self.t_near, self.t_far = t_near, t_far
+        # how far from the origin the rays start (t_near times the longest direction)
+        longest = float(np.sqrt((self.directions * self.directions).sum(axis=1).max())) if len(self.directions) else 0.0
+        self.reach = (float(np.max(t_near)) if np.size(t_near) else 0.0) * max(longest, 1.0)
+        self._rows: tuple[object, np.ndarray] | None = None
+
+    def __len__(self) -> int:
+        return len(self.directions)
+
+    def rows(self, tier) -> np.ndarray:
+        """The rays (ascending) that may meet ``tier`` (the body's, in its frame), kept per tier."""
+        if self._rows is None or self._rows[0] is not tier:
+            n = len(self.directions)
+            O = np.ndarray((n, 3), np.float64, self.origin, 0, (0, 8))
+            lo = np.broadcast_to(np.asarray(self.t_near, dtype=np.float64), (n,))
+            hi = np.broadcast_to(np.asarray(self.t_far, dtype=np.float64), (n,))
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                may = tier.may_hit(O, self.directions, lo, hi, grow=self.GROW)
+            self._rows = (tier, may.nonzero()[0])
+        return self._rows[1]
+
+
 _SKIN = 0.25          # neighbour-list margin, as a fraction of the median reach of the bodies' rays
 
 

@@ -20,24 +20,27 @@ import numpy as np
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import blocks
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import RayHits, RayKind, Riding
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import light_from_model
 from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["Camera", "RangeFinder", "MountedRays", "camera_lights", "camera_info", "composite", "lens_of"]
+__all__ = ["Camera", "RangeFinder", "MountedRays", "ShadowBuffers", "camera_lights", "camera_info", "composite",
+           "lens_of"]
 
 
 class MountedRays:
     """A device's pixel rays: local directions (made once), world directions kept until the
     device's rotation changes (a parked or translating robot rotates nothing), and their float32
-    copy for Embree. ``own``: how they are cast when the device has shapes of its own."""
+    copy for Embree. ``own``: how they are cast when the device has shapes of its own; ``riding``:
+    else, the robot's body they ride, which they see (which of them can meet it decided once)."""
 
-    def __init__(self, local: np.ndarray, own: OwnBodyRays | None = None):
+    def __init__(self, local: np.ndarray, own: OwnBodyRays | None = None, riding: Riding | None = None):
         self.local = np.ascontiguousarray(local.reshape(-1, 3))
         self.own = own
+        self.riding = riding
         self._cols = tuple(np.ascontiguousarray(self.local[:, k]) for k in range(3))
         self._key: bytes | None = None
         self.world = np.empty((0, 3))
@@ -71,10 +74,16 @@ class MountedRays:
 
 def _mounted(device: Any, dirs: np.ndarray, limits: tuple[Any, Any]) -> MountedRays:
     """A device's pixel rays (directions in its frame) and, when it has shapes of its own, their
-    cast mounted on its robot's body, blind to those shapes (``own_shapes.py``, the lidar's way)."""
-    body = device._scene.device_body(device.robot_index, device.on_joint) if device.own_shapes else None
-    own = None if body is None else OwnBodyRays(body, device.mount_pose, dirs.reshape(-1, 3), *limits, device.own_shapes)
-    return MountedRays(dirs, own)
+    cast mounted on its robot's body, blind to those shapes (``own_shapes.py``, the lidar's way);
+    else, on a robot with a body, which of them can meet that body, decided once in its frame."""
+    body = device._scene.device_body(device.robot_index, device.on_joint)
+    if body is None:
+        return MountedRays(dirs)
+    mount = device.mount_pose
+    if device.own_shapes:
+        return MountedRays(dirs, own=OwnBodyRays(body, mount, dirs.reshape(-1, 3), *limits, device.own_shapes))
+    local = dirs.reshape(-1, 3) @ mount.rotation.T
+    return MountedRays(dirs, riding=Riding(body, mount.translation, local, *limits))
 
 
 def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, Any],
@@ -88,7 +97,7 @@ def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, 
         return rays.own.cast(engine, origins, dirs, device.carrier_rotation(device._robot.pose), dirs32,
                              distance_only)
     return engine.cast(origins, dirs, *limits, kind=RayKind.VISUAL, exclude_owner=-1, distance_only=distance_only,
-                       directions32=dirs32)
+                       directions32=dirs32, riding=rays.riding)
 
 
 def _shade(P: np.ndarray, N: np.ndarray, albedo: np.ndarray, lights: light_math.LightArrays, lit: np.ndarray | None,
@@ -355,6 +364,7 @@ class Camera(Device):
         self._scene: Any = None
         self._background = np.zeros(3)
         self._lights: tuple[int, light_math.LightArrays, np.ndarray] | None = None
+        self._shadow_out: ShadowBuffers | None = ShadowBuffers()   # None while a render holds it
         self._bytes: tuple[int, bytes] = (-1, b"")
         # recognition (Webots' Recognition node): its own period, objects, segmentation image
         self.recognition_schedule = Schedule()
@@ -612,25 +622,66 @@ class Camera(Device):
         engine's threads); each light's rays are then one cast, as one batch."""
         lit = np.ones((len(P), len(lights)), dtype=bool)
         engine = self._scene.engine
-        for j, (i, unit, length) in shadow_rays(P, N, lights, shadows, engine.threads).items():
-            if len(i) == 0:
-                continue
-            hits = engine.cast(shading.take_rows(P, i), unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1, distance_only=True)
-            counters["rays_camera"] += len(i)
-            counters["cast_calls"] += 1
-            lit[i, j] = ~(hits.distance <= length)
+        # this camera's kept outputs, taken for this call (another thread rendering it meanwhile
+        # finds none and makes its own): sized for all its rays, they are made once
+        out, self._shadow_out = self._shadow_out, None
+        if out is None:
+            out = ShadowBuffers()
+        try:
+            rays = shadow_rays(P, N, lights, shadows, engine.threads, out, max(len(P), len(self._rays or ())))
+            for k, (j, (i, unit, length)) in enumerate(rays.items()):
+                if len(i) == 0:
+                    continue
+                hits = engine.cast(out.origins(k, P, i), unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1,
+                                   distance_only=True)
+                counters["rays_camera"] += len(i)
+                counters["cast_calls"] += 1
+                lit[i, j] = ~(hits.distance <= length)
+        finally:
+            self._shadow_out = out
         return lit
 
 
+class ShadowBuffers:
+    """A camera's shadow rays kept between images: per shadow-casting light (in the order of
+    :func:`shadow_rays`' lights), the chosen points' rows, unit segments, lengths and the segments'
+    origins, each for up to ``rows`` points (the camera's rays), made again only when more rows or
+    lights are asked for. An image of a 640 x 480 anti-aliased camera would otherwise map and fault
+    in some 60 MB afresh per shadow-casting light. One call uses them at a time: what it returns
+    are views into them, valid until the next call."""
+
+    def __init__(self) -> None:
+        self.rows = 0
+        self._sets: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
+
+    def sized(self, rows: int, lights: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]]:
+        """The (index, unit, length, origin) buffers of ``lights`` lights, each for ``rows`` points."""
+        if rows > self.rows:
+            self.rows, self._sets = rows, []
+        while len(self._sets) < lights:
+            n = self.rows
+            self._sets.append((np.empty(n, dtype=np.int64), np.empty((n, 3)), np.empty(n), np.empty((n, 3))))
+        return self._sets[:lights]
+
+    def origins(self, k: int, P: np.ndarray, i: np.ndarray) -> np.ndarray:
+        """``P[i]`` (light ``k``'s chosen points) in that light's origin buffer when ``i`` fits it."""
+        if k >= len(self._sets) or len(i) > self.rows:
+            return shading.take_rows(P, i)
+        return np.take(P, i, axis=0, out=self._sets[k][3][: len(i)], mode="clip")   # (valid rows: clip is a no-op)
+
+
 def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
-                threads: int) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+                threads: int, out: ShadowBuffers | None = None,
+                rows: int = 0) -> dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """Per shadow-casting light ``j``: the points (ascending indices into ``P``) whose direct term
     from it is above 0 (``light.light_terms``) and which lie within its radius
     (``shading.within_radius``), with their unit segments towards it and the segments' lengths
     (``light.occlusion_segments_many``), the bits ``light.direct_and_segments`` gives, made one light
     at a time from (S,) columns (``light.lit_segments``). Every value is elementwise, so it is worked
     out on row blocks of ``shading.BLOCK`` points (each block's columns stay in the CPU's cache) on
-    up to ``threads`` threads: the same points and the same bits as one pass over all of them."""
+    up to ``threads`` threads: the same points and the same bits as one pass over all of them.
+    ``out``: the blocks' parts are joined in its buffers (sized for ``rows`` points, at least
+    ``len(P)``) instead of new arrays; the answers are then views into them."""
     js = shadows.nonzero()[0].tolist()
     S = len(P)
     parts = [slice(a, min(S, a + shading.BLOCK)) for a in range(0, S, shading.BLOCK)]
@@ -658,10 +709,16 @@ def shadow_rays(P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, sh
 
     done = blocks.run(part, parts, threads) if js and S else []
     rays = {}
+    kept = out.sized(max(rows, S), len(js)) if out is not None and len(done) > 1 else None
     for k, j in enumerate(js):
         got = [d[k] for d in done]
         if len(got) == 1:
             rays[j] = got[0]
+        elif kept is not None:
+            m = sum(len(g[0]) for g in got)
+            idx, unit, length, _ = kept[k]
+            rays[j] = (np.concatenate([g[0] for g in got], out=idx[:m]), np.concatenate([g[1] for g in got], out=unit[:m]),
+                       np.concatenate([g[2] for g in got], out=length[:m]))
         elif got:
             rays[j] = (np.concatenate([g[0] for g in got]), np.concatenate([g[1] for g in got]),
                        np.concatenate([g[2] for g in got]))

@@ -118,6 +118,8 @@ class _Eye:
     shapes of its own, the scene's lights and background."""
 
     own_shapes: frozenset[int] = frozenset()
+    _rays: Any = None          # (its rays are render()'s; its shadow buffers made per picture)
+    _shadow_out: Any = None
     _render = Camera._render
     _shadows = Camera._shadows
     _light_arrays = Camera._light_arrays
