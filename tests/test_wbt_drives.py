@@ -710,3 +710,38 @@ def test_a_compass_needle_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Pat
     assert bot.pose.translation[0] == pytest.approx(200 * 5.0 * R * 0.016, rel=1e-9)  # straight on, at 5 rad/s
     ds = sim.device("compass bot/distance sensor").world_pose(bot.pose)
     assert ds.translation - bot.pose.translation == pytest.approx([0.0, 0.06, 0.1], abs=1e-12)   # turned a quarter
+
+
+def test_a_ball_robot_on_one_steered_wheel_gets_one_line_naming_its_wheel_not_a_car(tmp_path: Path) -> None:
+    """A ball robot of our own (a BB-8's shape): a vertical yaw hinge carrying a pitch hinge whose end
+    point is the 0.25 m ball, and a head on a second vertical hinge. One driven wheel inside a
+    steering joint is no car: the line says so, where it blamed the car's front axle."""
+    body = ('Robot { name "ball" children [\n'
+            '  HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 } '
+            'device [ RotationalMotor { name "yaw" maxVelocity 8 } ]\n'
+            '    endPoint Solid { translation 0 0 0.25 children [\n'
+            '      HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } '
+            'device [ RotationalMotor { name "pitch" maxVelocity 8 } ]\n'
+            '        endPoint Solid { children [ Shape { geometry Sphere { radius 0.25 } } ] '
+            'boundingObject Sphere { radius 0.25 } physics Physics { } } }\n'
+            '    ] name "inner" } }\n'
+            '  HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 } '
+            'device [ RotationalMotor { name "head yaw" maxVelocity 8 } ]\n'
+            '    endPoint Solid { translation 0 0 0.525 children [ Shape { geometry Sphere { radius 0.15 } } ] '
+            'name "head" } }\n'
+            '] physics Physics { } }\n')
+    w = load_world(write(tmp_path, body))
+    (robot,) = w.world.robots
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    drive_lines = [x for x in w.warnings if "will not move" in x]
+    assert len(drive_lines) == 1, w.warnings
+    assert drive_lines[0].endswith(
+        "robot 'ball': no drive (its only driven wheel, 'pitch', turns inside the steering joint 'yaw': a robot on "
+        "one wheel (a ball its weight rolls, a unicycle) moves by Webots' physics, and no kinematic drive here rolls "
+        "on one wheel); the robot will not move")
+    sim = Simulation(w, "fast")
+    for m in ("yaw", "pitch"):
+        sim.robot("ball").motor(m).set_position(math.inf)
+        sim.robot("ball").motor(m).set_velocity(4.0)
+    sim.run(62)
+    assert sim.robot("ball").pose.translation == pytest.approx([0.0, 0.0, 0.0], abs=1e-12)

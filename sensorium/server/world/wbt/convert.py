@@ -1948,6 +1948,20 @@ class Converter:
                 f"({', '.join(repr(w['motor']) for w in steering)}): no kinematic drive here steers more than a car's "
                 "two")
 
+    def _one_steered_wheel(self, wheels: list[dict]) -> str | None:
+        """Why a robot whose only driven wheel rides a steering joint (a BB-8's ball rolled inside
+        its body yaw joint, a unicycle's wheel under its fork) has no drive, else None: no car rolls
+        on one wheel."""
+        driven = [w for w in wheels if not w["steers"]]
+        if len(driven) != 1:
+            return None
+        carriers = [w for w in wheels if w["steers"] and id(driven[0]["node"]) in self._inside(w["end"])]
+        if not carriers:
+            return None
+        return (f"its only driven wheel, {driven[0]['motor']!r}, turns inside the steering joint "
+                f"{carriers[0]['motor']!r}: a robot on one wheel (a ball its weight rolls, a unicycle) moves by "
+                "Webots' physics, and no kinematic drive here rolls on one wheel")
+
     def _inside(self, end: Node | None) -> set[int]:
         """The ids of every node inside the end point ``end`` (its children, its joints' end points
         and devices, to any depth)."""
@@ -2135,7 +2149,7 @@ class Converter:
         else:
             turns = mecanum_turns(wheels, self)
         if turns is None and any(w["steers"] for w in wheels):      # a car
-            casters = self._steered_casters(wheels)
+            casters = self._steered_casters(wheels) or self._one_steered_wheel(wheels)
             if casters:
                 self.warn(node, f"robot {robot.data['name']!r}: no drive ({casters}); the robot will not move")
                 return
