@@ -212,6 +212,11 @@ def test_distinct_messages_are_never_folded(tmp_path: Path) -> None:
                                        "a.wbt:3:1: robot 'z': no drive (one)", "a.wbt:4:1: robot 'y': no drive (one)"))
     assert report.lines() == ["warning (x3, first at a.wbt:1:1; then a.wbt:3:1, a.wbt:4:1): robots 'x', 'z' and 'y': "
                               "no drive (one)", "warning: a.wbt:2:1: robot 'y': no drive (two)"]
+    # one PROTO instance repeating a message at several lines of its PROTO: the later lines alone
+    inst = " (in PROTO P at w.wbt:9:1)"
+    one = LoadReport("w", warnings=tuple(f"P.proto:{n}:5{inst}: a sensor without a motor" for n in (3, 7, 11, 15)))
+    assert one.lines() == [f"warning (x4, first at P.proto:3:5{inst}; then P.proto:7:5, P.proto:11:5 and 1 more): "
+                           "a sensor without a motor"]
     named_twice = LoadReport("w", warnings=("a.wbt:1:1: robot 'x': a", "a.wbt:2:1: robot 'x': a"))
     assert named_twice.lines() == ["warning (x2, first at a.wbt:1:1; then a.wbt:2:1): robot 'x': a"]
 

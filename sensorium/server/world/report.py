@@ -85,14 +85,19 @@ def _listed(names: list[str], one: str, many: str) -> str:
 
 
 def _places(places: list[str]) -> str:
-    """``first at A; then B, C and 7 more``: a place inside a PROTO instance that repeats the first
-    one's place in the PROTO file is shortened to the instance's own place."""
+    """``first at A; then B, C and 7 more``: a place inside a PROTO instance is shortened to what
+    differs from the first place: the instance's own place when the line in the PROTO file is the
+    same (fifty instances of one PROTO), the line in the PROTO file when the instance is."""
     first = places[0]
-    inner = first.split(" (in PROTO ", 1)[0] if " (in PROTO " in first else None
+    inner, sep0, outer = first.partition(" (in PROTO ")
     rest = []
     for place in places[1:_SHOWN]:
         head, sep, instance = place.partition(" (in PROTO ")
-        rest.append("PROTO " + instance[:-1] if sep and head == inner and instance.endswith(")") else place)
+        if sep and sep0 and head == inner and instance.endswith(")"):
+            place = "PROTO " + instance[:-1]
+        elif sep and sep0 and instance == outer:
+            place = head
+        rest.append(place)
     text = f"first at {first}" if first else "first without a place"
     more = len(places) - _SHOWN
     if rest:
