@@ -150,3 +150,84 @@ def test_a_wbt_load_times_each_stage() -> None:
     w = load_world(Path(__file__).parent / "worlds" / "proto" / "minipuck.wbt", proto_path=[])
     assert set(w.timings) == {"parse", "proto files", "instantiate", "template", "convert", "validate"}
     assert all(v >= 0.0 for v in w.timings.values()) and w.timings["template"] > 0.0
+
+
+# Two wheels on one axle whose motors differ in maxVelocity (an Elisa-3's shape), or, with ``odd``,
+# of different radii on two axles: each instance warns once, naming its robot in the second case.
+def _duo_proto(odd: bool) -> str:
+    z2, r2 = (0.03, 0.03) if odd else (0.02, 0.02)
+    return (HEADER + 'PROTO Duo [ field SFVec3f translation 0 0 0 field SFString name "duo" ]\n{\n'
+            '  Robot { translation IS translation name IS name children [\n'
+            '    HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0.03 0.02 }\n'
+            '      device [ RotationalMotor { name "left" maxVelocity 10 } ]\n'
+            '      endPoint Solid { translation 0 0.03 0.02 rotation 1 0 0 1.5708 children [ Shape { geometry '
+            'Cylinder { radius 0.02 height 0.01 } } ] } }\n'
+            f'    HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 -0.03 {z2} }}\n'
+            '      device [ RotationalMotor { name "right" maxVelocity 12 } ]\n'
+            f'      endPoint Solid {{ translation 0 -0.03 {z2} rotation 1 0 0 1.5708 children [ Shape {{ geometry '
+            f'Cylinder {{ radius {r2} height 0.01 }} }} ] }} }}\n'
+            '  ] }\n}\n')
+
+
+def _duos(tmp_path: Path, n: int, odd: bool = False) -> Path:
+    (tmp_path / "protos").mkdir(exist_ok=True)
+    (tmp_path / "protos" / "Duo.proto").write_text(_duo_proto(odd))
+    robots = "".join(f'Duo {{ translation {i} 0 0 name "duo{i}" }}\n' for i in range(n))
+    return write(tmp_path, 'EXTERNPROTO "protos/Duo.proto"\nWorldInfo { }\n' + robots)
+
+
+def test_identical_warnings_of_many_robots_fold_into_one_line_with_their_first_places(tmp_path: Path) -> None:
+    p = _duos(tmp_path, 10)
+    report = load_world(p).report
+    assert report.counts() == "10 warnings"
+    proto = tmp_path / "protos" / "Duo.proto"
+    (line,) = report.lines()
+    assert line == (f"warning (x10, first at {proto}:5:5 (in PROTO Duo at {p}:4:1); then PROTO Duo at {p}:5:1, "
+                    f"PROTO Duo at {p}:6:1 and 7 more): wheel motors have different maxVelocity [10.0, 12.0]: "
+                    "using the smaller")
+    assert len(report.lines(every=True)) == 10 and len(report.warnings) == 10    # every one kept
+
+
+def test_warnings_the_same_but_for_the_robot_they_name_fold_into_one_line_naming_the_robots(tmp_path: Path) -> None:
+    p = _duos(tmp_path, 10, odd=True)
+    report = load_world(p).report
+    lines = report.lines()
+    assert len(lines) == 1, lines
+    assert lines[0].startswith("warning (x10, first at ")
+    assert lines[0].endswith("): robots 'duo0', 'duo1', 'duo2' and 7 more: no differential drive (the two wheel "
+                             "anchors are not on one axle parallel to the robot's y axis); the robot will not move")
+    every = report.lines(every=True)
+    assert [w.split(": ", 2)[2].split(":")[0] for w in every] == [f"robot 'duo{i}'" for i in range(10)]
+    # two robots: both named; a distinct message stays a line of its own
+    (tmp_path / "two").mkdir()
+    p2 = _duos(tmp_path / "two", 2, odd=True)
+    two = load_world(p2).report.lines()
+    assert len(two) == 1 and "): robots 'duo0' and 'duo1': no differential drive" in two[0]
+
+
+def test_distinct_messages_are_never_folded(tmp_path: Path) -> None:
+    from sensorium.server.world.report import LoadReport
+
+    report = LoadReport("w", warnings=("a.wbt:1:1: robot 'x': no drive (one)", "a.wbt:2:1: robot 'y': no drive (two)",
+                                       "a.wbt:3:1: robot 'z': no drive (one)", "a.wbt:4:1: robot 'y': no drive (one)"))
+    assert report.lines() == ["warning (x3, first at a.wbt:1:1; then a.wbt:3:1, a.wbt:4:1): robots 'x', 'z' and 'y': "
+                              "no drive (one)", "warning: a.wbt:2:1: robot 'y': no drive (two)"]
+    # one PROTO instance repeating a message at several lines of its PROTO: the later lines alone
+    inst = " (in PROTO P at w.wbt:9:1)"
+    one = LoadReport("w", warnings=tuple(f"P.proto:{n}:5{inst}: a sensor without a motor" for n in (3, 7, 11, 15)))
+    assert one.lines() == [f"warning (x4, first at P.proto:3:5{inst}; then P.proto:7:5, P.proto:11:5 and 1 more): "
+                           "a sensor without a motor"]
+    named_twice = LoadReport("w", warnings=("a.wbt:1:1: robot 'x': a", "a.wbt:2:1: robot 'x': a"))
+    assert named_twice.lines() == ["warning (x2, first at a.wbt:1:1; then a.wbt:2:1): robot 'x': a"]
+
+
+def test_validate_folds_repeats_and_lists_each_with_every(tmp_path: Path, capsys) -> None:
+    p = _duos(tmp_path, 10)
+    assert main(["validate", str(p)]) == 0
+    out = capsys.readouterr()
+    assert out.out.strip() == f"{p}: OK"
+    assert out.err.splitlines()[0] == f"{p}: 10 warnings" and len(out.err.splitlines()) == 2
+    assert "warning (x10, first at " in out.err
+    assert main(["validate", "--every", str(p)]) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 11 and all(line.startswith("  warning: ") for line in err[1:])

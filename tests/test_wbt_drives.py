@@ -710,3 +710,79 @@ def test_a_compass_needle_on_a_two_wheel_robot_leaves_it_its_drive(tmp_path: Pat
     assert bot.pose.translation[0] == pytest.approx(200 * 5.0 * R * 0.016, rel=1e-9)  # straight on, at 5 rad/s
     ds = sim.device("compass bot/distance sensor").world_pose(bot.pose)
     assert ds.translation - bot.pose.translation == pytest.approx([0.0, 0.06, 0.1], abs=1e-12)   # turned a quarter
+
+
+def test_a_ball_robot_on_one_steered_wheel_gets_one_line_naming_its_wheel_not_a_car(tmp_path: Path) -> None:
+    """A ball robot of our own (a BB-8's shape): a vertical yaw hinge carrying a pitch hinge whose end
+    point is the 0.25 m ball, and a head on a second vertical hinge. One driven wheel inside a
+    steering joint is no car: the line says so, where it blamed the car's front axle."""
+    body = ('Robot { name "ball" children [\n'
+            '  HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 } '
+            'device [ RotationalMotor { name "yaw" maxVelocity 8 } ]\n'
+            '    endPoint Solid { translation 0 0 0.25 children [\n'
+            '      HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } '
+            'device [ RotationalMotor { name "pitch" maxVelocity 8 } ]\n'
+            '        endPoint Solid { children [ Shape { geometry Sphere { radius 0.25 } } ] '
+            'boundingObject Sphere { radius 0.25 } physics Physics { } } }\n'
+            '    ] name "inner" } }\n'
+            '  HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 } '
+            'device [ RotationalMotor { name "head yaw" maxVelocity 8 } ]\n'
+            '    endPoint Solid { translation 0 0 0.525 children [ Shape { geometry Sphere { radius 0.15 } } ] '
+            'name "head" } }\n'
+            '] physics Physics { } }\n')
+    w = load_world(write(tmp_path, body))
+    (robot,) = w.world.robots
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    drive_lines = [x for x in w.warnings if "will not move" in x]
+    assert len(drive_lines) == 1, w.warnings
+    assert drive_lines[0].endswith(
+        "robot 'ball': no drive (its only driven wheel, 'pitch', turns inside the steering joint 'yaw': a robot on "
+        "one wheel (a ball its weight rolls, a unicycle) moves by Webots' physics, and no kinematic drive here rolls "
+        "on one wheel); the robot will not move")
+    sim = Simulation(w, "fast")
+    for m in ("yaw", "pitch"):
+        sim.robot("ball").motor(m).set_position(math.inf)
+        sim.robot("ball").motor(m).set_velocity(4.0)
+    sim.run(62)
+    assert sim.robot("ball").pose.translation == pytest.approx([0.0, 0.0, 0.0], abs=1e-12)
+
+
+def test_a_head_on_a_pan_hinge_high_above_the_wheels_is_no_steered_wheel(tmp_path: Path) -> None:
+    """A two-wheel base of our own (a TIAGo's shape) with a pan-tilt head 0.8 m up whose tilt hinge's
+    end point is a sphere: the pan hinge carrying a round part about a horizontal axis looked like a
+    car's steering and its wheel, and the robot lost its drive ('no Ackermann drive'). A round part
+    whose bottom is more than a wheel's diameter above the wheels never touches the ground: the drive
+    is the base's two wheels, and the head's joints are said to move as joints."""
+    def hub(name: str, y: float) -> str:
+        return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0.1 }} '
+                f'device [ RotationalMotor {{ name "{name}" maxVelocity 10 }} ] endPoint Solid {{ translation 0 {y} 0.1 '
+                f'rotation 1 0 0 1.5708 children [ Shape {{ geometry Cylinder {{ radius 0.1 height 0.04 }} }} ] '
+                f'boundingObject Cylinder {{ radius 0.1 height 0.04 }} physics Physics {{ }} }} }}\n')
+    body = ('Robot { name "tiagoish" translation 0 0 0.1 children [\n' + hub("wheel_left", 0.2) + hub("wheel_right", -0.2)
+            + '  HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 anchor 0.1 0 0.8 } '
+            'device [ RotationalMotor { name "head_pan" maxVelocity 3 } ]\n'
+            '    endPoint Solid { translation 0.1 0 0.8 children [\n'
+            '      HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 } '
+            'device [ RotationalMotor { name "head_tilt" maxVelocity 3 } PositionSensor { name "head_tilt_sensor" } ]\n'
+            '        endPoint Solid { children [ Shape { geometry Sphere { radius 0.09 } } ] name "head" } }\n'
+            '    ] name "neck" } }\n'
+            '] boundingObject Pose { translation 0 0 0.3 children [ Box { size 0.4 0.3 0.3 } ] } physics Physics { } }\n')
+    w = load_world(write(tmp_path, body))
+    (robot,) = w.world.robots
+    drive = robot.differential_drive
+    assert drive is not None and (drive.left_motor, drive.right_motor) == ("wheel_left", "wheel_right")
+    assert drive.wheel_radius == pytest.approx(0.1) and drive.axle_length == pytest.approx(0.4)
+    assert not any("Ackermann" in x or "will not move" in x for x in w.warnings), w.warnings
+    (tilt,) = [x for x in w.warnings if "'head_tilt'" in x]
+    # the sphere's bottom: 0.1 + 0.8 - 0.09 over the wheels' 0.1 - 0.1 = 0.71 m up
+    assert "is no wheel (its round part's bottom is 0.71 m above the robot's lowest wheels" in tilt
+    assert any("'head_pan' is no wheel and steers none" in x for x in w.warnings), w.warnings
+    sim = Simulation(w, "fast")
+    drive_robot = sim.robot("tiagoish")
+    for m in ("wheel_left", "wheel_right"):
+        drive_robot.motor(m).set_position(math.inf)
+        drive_robot.motor(m).set_velocity(2.0)
+    drive_robot.motor("head_tilt").set_position(0.3)
+    sim.run(125)                                        # 2 s at 2 rad/s on 0.1 m wheels: 0.4 m
+    assert drive_robot.pose.translation[0] == pytest.approx(0.4, abs=1e-9)
+    assert drive_robot.motor("head_tilt").position == pytest.approx(0.3, abs=1e-9)      # 3 rad/s: there in 0.1 s

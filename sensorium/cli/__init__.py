@@ -29,6 +29,8 @@ def _validate_args(p: argparse.ArgumentParser) -> None:
     add_world_options(p)
     p.add_argument("--allow-skipped", action="store_true",
                    help="exit 0 although the world lost a robot, a sensor device or a shape sensors see (listed)")
+    p.add_argument("--every", action="store_true",
+                   help="one line for each loss and warning, where repeats are folded into one line with their count")
 
 
 @command("convert", "write a Webots world (.wbt) as an equivalent Sensorium world file",

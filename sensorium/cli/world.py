@@ -44,7 +44,7 @@ def validate(args: argparse.Namespace) -> int:
             print(f"{path}: INVALID ({len(exc.problems)} problem{'s' if len(exc.problems) != 1 else ''})", file=sys.stderr)
             status = 1
             continue
-        print_report(loaded, every=True)
+        print_report(loaded, every=getattr(args, "every", False))
         losses = loaded.report.losses
         if losses and not getattr(args, "allow_skipped", False):
             print(f"{path}: INVALID ({loaded.report.counts()}; --allow-skipped accepts what was left out)",

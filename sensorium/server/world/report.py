@@ -62,6 +62,49 @@ def _split(text: str) -> tuple[str, str]:
     return (where, msg) if sep else ("", text)
 
 
+# a robot named in a message, as the loaders write it: robot 'name' (repr: double quotes when it holds one)
+_ROBOT = re.compile(r"""\brobot ('(?:[^'\\]|\\.)*'|"(?:[^"\\]|\\.)*")""")
+_NAMED = "\x00"  # where a robot's name was taken out of a message
+_SHOWN = 3      # places and robot names a folded line shows before "and N more"
+
+
+def _robot_names(msg: str) -> tuple[str, tuple[str, ...]]:
+    """``msg`` with each robot it names taken out (``_NAMED``), and those names (as written, quoted)."""
+    if _NAMED in msg:               # a name written with a NUL in it: folded only with its exact repeats
+        return msg, ()
+    return _ROBOT.sub(_NAMED, msg), tuple(m.group(1) for m in _ROBOT.finditer(msg))
+
+
+def _listed(names: list[str], one: str, many: str) -> str:
+    """``robot 'a'`` or ``robots 'a', 'b', 'c' and 7 more``."""
+    if len(names) == 1:
+        return f"{one} {names[0]}"
+    if len(names) > _SHOWN:
+        return f"{many} {', '.join(names[:_SHOWN])} and {len(names) - _SHOWN} more"
+    return f"{many} {', '.join(names[:-1])} and {names[-1]}"
+
+
+def _places(places: list[str]) -> str:
+    """``first at A; then B, C and 7 more``: a place inside a PROTO instance is shortened to what
+    differs from the first place: the instance's own place when the line in the PROTO file is the
+    same (fifty instances of one PROTO), the line in the PROTO file when the instance is."""
+    first = places[0]
+    inner, sep0, outer = first.partition(" (in PROTO ")
+    rest = []
+    for place in places[1:_SHOWN]:
+        head, sep, instance = place.partition(" (in PROTO ")
+        if sep and sep0 and head == inner and instance.endswith(")"):
+            place = "PROTO " + instance[:-1]
+        elif sep and sep0 and instance == outer:
+            place = head
+        rest.append(place)
+    text = f"first at {first}" if first else "first without a place"
+    more = len(places) - _SHOWN
+    if rest:
+        text += "; then " + ", ".join(rest) + (f" and {more} more" if more > 0 else "")
+    return text
+
+
 def _count(n: int, one: str, many: str) -> str:
     return f"{n} {one if n == 1 else many}"
 
@@ -98,27 +141,35 @@ class LoadReport:
 
     def lines(self, *, every: bool = False) -> list[str]:
         """The report as lines (without the header): each loss as ``lost <what>: where: why``, then
-        the warnings; messages repeated at several places (the same PROTO instantiated fifty times)
-        are one line with their count and first place, unless ``every``."""
+        the warnings. Unless ``every``, messages repeated at several places are one line with their
+        count and first places (the same PROTO instantiated fifty times), and so are messages the same
+        but for the robot they name (ten robots of one kind: ``robots 'e1', 'e2', 'e3' and 7 more``)."""
         out: list[str] = []
         if every:
             out += [f"lost {loss.label()}: {loss.text}" for loss in self.losses]
             out += [f"warning: {w}" for w in self.notes]
             return out
-        groups: dict[tuple[str, str], list[tuple[str, str]]] = {}     # (head, message) -> (where, label)
+        # (head, message with its robot names taken out) -> [(where, label, message, names)]
+        groups: dict[tuple[str, str], list[tuple[str, str, str, tuple[str, ...]]]] = {}
         for loss in self.losses:
             where, msg = _split(loss.text)
             word = _KIND_WORDS[loss.kind][0] if loss.kind in _KIND_WORDS else loss.kind
-            groups.setdefault(("lost " + word, msg), []).append((where, "lost " + loss.label()))
+            shape, names = _robot_names(msg)
+            groups.setdefault(("lost " + word, shape), []).append((where, "lost " + loss.label(), msg, names))
         for w in self.notes:
             where, msg = _split(w)
-            groups.setdefault(("warning", msg), []).append((where, "warning"))
-        for (head, msg), places in groups.items():
-            where, label = places[0]
+            shape, names = _robot_names(msg)
+            groups.setdefault(("warning", shape), []).append((where, "warning", msg, names))
+        for (head, shape), places in groups.items():
+            where, label, msg, _ = places[0]
             if len(places) == 1:
                 out.append(f"{label}: {where}: {msg}" if where else f"{label}: {msg}")
-            else:
-                out.append(f"{head} (x{len(places)}, first at {where}): {msg}")
+                continue
+            slots = [_listed(list(dict.fromkeys(p[3][i] for p in places)), "robot", "robots")
+                     for i in range(len(places[0][3]))]
+            pieces = shape.split(_NAMED)
+            msg = pieces[0] + "".join(slot + piece for slot, piece in zip(slots, pieces[1:], strict=True))
+            out.append(f"{head} (x{len(places)}, {_places([p[0] for p in places])}): {msg}")
         return out
 
     def text(self, *, every: bool = False) -> str:

@@ -1948,6 +1948,42 @@ class Converter:
                 f"({', '.join(repr(w['motor']) for w in steering)}): no kinematic drive here steers more than a car's "
                 "two")
 
+    def _lifted_wheels(self, wheels: list[dict], up: int) -> list[tuple[dict, float]]:
+        """The motorised hinges about horizontal axes riding a steering (vertical) hinge whose round
+        part's bottom is more than the lowest wheel's diameter above the lowest wheels' bottom, with
+        that height, when at least two wheels are at the bottom (a base that stands on them); else none."""
+        from sensorium.server.world.wbt.drive import GROUND_TOL, wheel_bottom, wheel_radius
+
+        rolling = []
+        for w in wheels:
+            radius = None if w["steers"] else wheel_radius(w["end"], self)
+            bottom = wheel_bottom([w], self, up) if radius is not None else None
+            if radius is not None and bottom is not None:
+                rolling.append((w, bottom, radius))
+        if len(rolling) < 3:
+            return []
+        lowest = min(b for _, b, _ in rolling)
+        base = [(w, r) for w, b, r in rolling if b - lowest <= GROUND_TOL]
+        if len(base) < 2:
+            return []
+        reach = 2.0 * max(r for _, r in base)
+        steered: set[int] = set().union(*(self._inside(w["end"]) for w in wheels if w["steers"]))
+        return [(w, b - lowest) for w, b, _ in rolling if b - lowest > reach and id(w["node"]) in steered]
+
+    def _one_steered_wheel(self, wheels: list[dict]) -> str | None:
+        """Why a robot whose only driven wheel rides a steering joint (a BB-8's ball rolled inside
+        its body yaw joint, a unicycle's wheel under its fork) has no drive, else None: no car rolls
+        on one wheel."""
+        driven = [w for w in wheels if not w["steers"]]
+        if len(driven) != 1:
+            return None
+        carriers = [w for w in wheels if w["steers"] and id(driven[0]["node"]) in self._inside(w["end"])]
+        if not carriers:
+            return None
+        return (f"its only driven wheel, {driven[0]['motor']!r}, turns inside the steering joint "
+                f"{carriers[0]['motor']!r}: a robot on one wheel (a ball its weight rolls, a unicycle) moves by "
+                "Webots' physics, and no kinematic drive here rolls on one wheel")
+
     def _inside(self, end: Node | None) -> set[int]:
         """The ids of every node inside the end point ``end`` (its children, its joints' end points
         and devices, to any depth)."""
@@ -2069,10 +2105,22 @@ class Converter:
                                                        f"{JOINT_MOVES}", "with no cylinder or sphere at their end point to roll on"
                                 if not rolls else "the robot's only motorised joint"))
             return
+        # a steered "wheel" high above the robot's lowest ones (a head's tilt hinge whose end point is
+        # a sphere, riding the pan hinge as a car's wheel rides its steering) never touches the ground
+        # they roll on: no wheel, and a steering joint left holding none of them steers none
+        lifted = self._lifted_wheels(wheels, up)
+        if lifted:
+            for w, height in lifted:
+                nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (its round "
+                                f"part's bottom is {height:.3g} m above the robot's lowest wheels: it never touches "
+                                f"the ground): {JOINT_MOVES}", "high above the ground the wheels roll on"))
+            wheels = [w for w in wheels if not any(w is l for l, _ in lifted)]
         # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
         # joint on a mobile robot) steers nothing: it is no wheel, and the others make the drive (with
         # vertical hinges only, there is no vehicle: said below)
-        pans = [w for w in wheels if w["steers"] and not holds_wheel(w["end"], self)]
+        gone = {id(w["node"]) for w, _ in lifted}
+        pans = [w for w in wheels if w["steers"] and (not holds_wheel(w["end"], self) or (gone and not any(
+            id(o["node"]) in self._inside(w["end"]) for o in wheels if not o["steers"])))]
         if pans and not all(w["steers"] for w in wheels):
             for w in pans:
                 nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers "
@@ -2135,7 +2183,7 @@ class Converter:
         else:
             turns = mecanum_turns(wheels, self)
         if turns is None and any(w["steers"] for w in wheels):      # a car
-            casters = self._steered_casters(wheels)
+            casters = self._steered_casters(wheels) or self._one_steered_wheel(wheels)
             if casters:
                 self.warn(node, f"robot {robot.data['name']!r}: no drive ({casters}); the robot will not move")
                 return
