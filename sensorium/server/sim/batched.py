@@ -295,8 +295,9 @@ class BatchedSimulation:
                                       for r in w.robots], dtype=np.float64)
         self.axle = np.array([r.differential_drive.axle_length if r.differential_drive else 1.0
                               for r in w.robots], dtype=np.float64)
-        self.max_wheel = np.array([[r.differential_drive.max_wheel_speed] * 2 if r.differential_drive else [0.0, 0.0]
-                                   for r in w.robots], dtype=np.float64)
+        # each side's maxVelocity (a skid-steer side's wheels share theirs: the schema's rule)
+        self.max_wheel = np.array([[wm.wheel_max_speed(d, d.left_motor), wm.wheel_max_speed(d, d.right_motor)]
+                                   if (d := r.differential_drive) else [0.0, 0.0] for r in w.robots], dtype=np.float64)
         self.motor_names = [(r.differential_drive.left_motor, r.differential_drive.right_motor)
                             if r.differential_drive else ("", "") for r in w.robots]
         # every wheel motor's side (0 left, 1 right): a skid-steer robot's wheels of one side are
