@@ -23,6 +23,7 @@ from sensorium.server.sim.ground import (
     ride_height,
     robot_up,
     slope_scales,
+    slope_twist,
     support_ceiling,
 )
 from sensorium.server.world.geometry import Pose
@@ -258,6 +259,16 @@ class PlanarState:
         root, turn = slope_scales(gx, gy, math.cos(self.yaw), math.sin(self.yaw))
         return float(v / root), float(w * turn)
 
+    def twist_over_ground(self, vx: float, vy: float, w: float) -> tuple[float, float, float]:
+        """A holonomic drive's body twist (``vx`` ahead, ``vy`` to the left, both along the ground, ``w``
+        about its normal) as the planar state integrates it, seen from above: on the slope under the
+        origin at the step's start, :func:`ground.slope_twist`; level or off the ground, untouched."""
+        if self.slope is None:
+            return vx, vy, w
+        gx, gy = self.slope
+        hx, hy, hw = slope_twist(gx, gy, math.cos(self.yaw), math.sin(self.yaw), vx, vy, w)
+        return float(hx), float(hy), float(hw)
+
     def moved(self, v: float, w: float) -> None:
         """Record the step's motion (v along the heading the step ends with, turn rate w): what
         :meth:`velocity` reports until the next step (worked out only when asked)."""
@@ -379,7 +390,7 @@ class HolonomicDrive(PlanarState):
         if all(u == 0.0 for u in speeds):
             self.moved(0.0, 0.0)
             return None
-        vx, vy, w = self.twist(speeds)
+        vx, vy, w = self.twist_over_ground(*self.twist(speeds))
         self.x, self.y, self.yaw = twist_step(self.x, self.y, self.yaw, vx, vy, w, dt)
         self.moved(vx, w)
         c, s = math.cos(self.yaw), math.sin(self.yaw)
