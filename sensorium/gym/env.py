@@ -24,16 +24,17 @@ RGB box (recognition and segmentation enabled at the observation's period; black
 (sorted) key order, as ``gymnasium.wrappers.FlattenObservation`` gives.
 
 Action: float32 ``(2,)`` = left, right wheel (every wheel of its side, for a skid-steer robot).
-``actions="normalized"`` (the default): in ``[-1, 1]``, times the drive's max wheel speed (rad/s) --
-the symmetric, normalised box training libraries and Gymnasium's checker recommend;
-``actions="wheel"``: the wheel velocities themselves (rad/s), bounded by the max wheel speed.
+``actions="normalized"`` (the default): in ``[-1, 1]``, each times its own wheel's maxVelocity (rad/s:
+``max_wheel_speed``, or the wheel motor's ``motor_max_speeds`` entry; an Elisa-3's +1 is 133.33 rad/s
+left, 140 right) -- the symmetric, normalised box training libraries and Gymnasium's checker recommend;
+``actions="wheel"``: the wheel velocities themselves (rad/s), each bounded by its wheel's maximum.
 Either way a velocity beyond the maximum is clamped, as Webots does. One action lasts
 ``control_period_ms``.
 
 A car-like robot (``ackermann_drive``) acts with float32 ``(2,)`` = steering, speed. Normalised:
 steering in ``[-1, 1]`` times ``max_steering_angle``, **+1 turning left** (counter-clockwise seen from
 above, as ROS's REP 103, whatever the motors' ``positive_steers``), speed in ``[-1, 1]`` times
-``max_wheel_speed`` for every driven wheel (+1 forward); ``actions="wheel"``: the steering angle
+the driven wheels' smallest maxVelocity for every driven wheel (+1 forward, all alike); ``actions="wheel"``: the steering angle
 (rad, positive left, beyond ``±max_steering_angle`` the limit) and the wheels' velocity (rad/s).
 The steering angle is the bicycle model's: the two steering motors are set to Webots' Driver's
 Ackermann angles for it (``cot δ_inner = cot δ - track_front/2L``, outer ``+``), which their
@@ -42,7 +43,7 @@ there at ``max_steering_speed`` (position control), so a new steering takes a fe
 
 A mecanum robot (``mecanum_drive``, a youBot's base) acts with float32 ``(4,)`` = its four wheels'
 velocities in the drive's order (front left, front right, rear left, rear right): normalised, each in
-``[-1, 1]`` times ``max_wheel_speed``; ``actions="wheel"``: rad/s, bounded by it. All four at +1 drive
+``[-1, 1]`` times its own wheel's maxVelocity; ``actions="wheel"``: rad/s, bounded by it. All four at +1 drive
 forward, and with the default (youBot) rollers (-1, +1, +1, -1) strafes left and (-1, +1, -1, +1)
 turns left on the spot (README "mecanum"); the body twist is the wheels' least-squares fit. An
 omni-wheel robot (``omni_drive``, three or more omni wheels) acts alike with one velocity per wheel,
@@ -182,10 +183,14 @@ class Agent:
         if self.car is None:
             drive = model.differential_drive or holonomic
             assert drive is not None
-            self.vmax = vmax = float(drive.max_wheel_speed)
-            raw = spaces.Box(-vmax, vmax, shape=(self.n_actions,), dtype=np.float32)
+            two = model.differential_drive
+            motors = [two.left_motor, two.right_motor] if two is not None else self.wheel_motors or []
+            # each action's own wheel's maxVelocity (a skid-steer side's wheels share theirs)
+            self.vmax: Any = (vmax := np.array([wm.wheel_max_speed(drive, m) for m in motors]))
+            raw = spaces.Box(-vmax.astype(np.float32), vmax.astype(np.float32), dtype=np.float32)
         else:
-            self.vmax = float(self.car.max_wheel_speed)
+            # one speed for every driven wheel: the slowest one's maximum, so +1 turns them all alike
+            self.vmax = min(wm.wheel_max_speed(self.car, m) for _, m in self.car.driven)
             self.max_steer = float(self.car.max_steering_angle)
             self.scale = np.array([self.max_steer, self.vmax])
             raw = spaces.Box(-self.scale.astype(np.float32), self.scale.astype(np.float32), dtype=np.float32)

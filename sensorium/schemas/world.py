@@ -1321,6 +1321,36 @@ def _wheel_bottom_field() -> Any:
                  "keeps the height it is placed at")
 
 
+def _motor_max_speeds_field() -> Any:
+    return Field(default={}, max_length=16, description="rad/s by wheel motor name: a wheel motor's own maxVelocity "
+                 "where it differs from max_wheel_speed (Webots' Elisa-3: 133.33 left, 140 right); each motor clamps "
+                 "to its own and its controller's warning names it; a motor not named here has max_wheel_speed")
+
+
+def _maxima_are_numbers(v: Any) -> Any:
+    """A bool where a maxVelocity is due is refused (not read as 0 or 1)."""
+    if isinstance(v, dict):
+        for name, value in v.items():
+            if isinstance(value, bool):
+                raise ValueError(f"{name!r}: expected a number, got {value!r}")
+    return v
+
+
+def _check_motor_max_speeds(maxima: dict[str, float], wheels: list[str], where: str) -> None:
+    """Each named motor is one of the drive's ``wheels``, each maximum a positive number."""
+    for name, value in maxima.items():
+        if name not in wheels:
+            raise ValueError(f"motor_max_speeds: {name!r} is not one of the {where} ({', '.join(map(repr, wheels))})")
+        if not value > 0:
+            raise ValueError(f"motor_max_speeds[{name!r}]: a maxVelocity must be a number > 0, got {value!r}")
+
+
+def wheel_max_speed(drive: Any, motor: str) -> float:
+    """A wheel motor's maxVelocity (rad/s): its own ``motor_max_speeds`` entry, else the drive's
+    ``max_wheel_speed``."""
+    return float(drive.motor_max_speeds.get(motor, drive.max_wheel_speed))
+
+
 Forward = tuple[float, float] | tuple[float, float, float]
 """A drive's ``forward``: (x, y) in the robot's frame, or (x, y, z) (a robot built y-up)."""
 
@@ -1339,6 +1369,8 @@ class DifferentialDrive(Strict):
     wheel_radius: float = Field(default=0.0205, gt=0)
     axle_length: float = Field(default=0.052, gt=0, description="distance between the wheels (the wheel lines)")
     max_wheel_speed: float = Field(default=6.28, gt=0, description="rad/s, Webots maxVelocity")
+    motor_max_speeds: dict[str, float] = _motor_max_speeds_field()
+    _maxima_numbers = field_validator("motor_max_speeds", mode="before")(_maxima_are_numbers)
     left_motor: str = Field(default="left wheel motor", min_length=1)
     right_motor: str = Field(default="right wheel motor", min_length=1)
     skid_steer: SkidSteer | None = Field(default=None, description="more wheels per side (skid steer)")
@@ -1366,6 +1398,12 @@ class DifferentialDrive(Strict):
         names = [*left, *right]
         if len(set(names)) != len(names):
             raise ValueError(f"every wheel motor needs its own name, got {names}")
+        _check_motor_max_speeds(self.motor_max_speeds, names, "drive's wheel motors")
+        for side, motors in zip(("left", "right"), self.motor_names):
+            # a side's wheels roll as one (their mean), stepped as one state in the batched simulation
+            if len({wheel_max_speed(self, m) for m in motors}) > 1:
+                raise ValueError(f"motor_max_speeds: the {side} side's wheels {motors} must share one maxVelocity "
+                                 "(a skid-steer side rolls as one)")
         return self
 
 
@@ -1390,6 +1428,8 @@ class AckermannDrive(Strict):
         default="propulsion", description="which wheels have motors (Webots): traction the front ones, propulsion the "
         "rear ones, 4x4 all four")
     max_wheel_speed: float = Field(default=100.0, gt=0, description="rad/s, the wheel motors' maxVelocity")
+    motor_max_speeds: dict[str, float] = _motor_max_speeds_field()
+    _maxima_numbers = field_validator("motor_max_speeds", mode="before")(_maxima_are_numbers)
     max_steering_angle: float = Field(default=0.6, gt=0, lt=math.pi / 2, description="rad, the steering motors' "
                                       "maxPosition (and -minPosition): Webots clamps set_position to it")
     max_steering_speed: float = Field(default=10.0, gt=0, description="rad/s, the steering motors' maxVelocity")
@@ -1429,6 +1469,7 @@ class AckermannDrive(Strict):
         names = [m for _, m in self.motor_fields]
         if len(set(names)) != len(names):
             raise ValueError(f"every motor of the drive needs its own name, got {names}")
+        _check_motor_max_speeds(self.motor_max_speeds, [m for _, m in self.driven], "car's driven wheel motors")
         return self
 
 
@@ -1452,6 +1493,8 @@ class MecanumDrive(Strict):
     lx: float = Field(gt=0, description="m, half the wheelbase: the wheels' distance ahead of and behind the origin")
     ly: float = Field(gt=0, description="m, half the track: the wheels' distance either side of the origin")
     max_wheel_speed: float = Field(default=14.81, gt=0, description="rad/s, the wheel motors' maxVelocity")
+    motor_max_speeds: dict[str, float] = _motor_max_speeds_field()
+    _maxima_numbers = field_validator("motor_max_speeds", mode="before")(_maxima_are_numbers)
     front_left_motor: str = Field(default="wheel2", min_length=1)
     front_right_motor: str = Field(default="wheel1", min_length=1)
     rear_left_motor: str = Field(default="wheel4", min_length=1)
@@ -1475,6 +1518,7 @@ class MecanumDrive(Strict):
         names = [m for _, m in self.motor_fields]
         if len(set(names)) != len(names):
             raise ValueError(f"every wheel motor needs its own name, got {names}")
+        _check_motor_max_speeds(self.motor_max_speeds, names, "drive's wheel motors")
         fl, fr, rl, rr = self.rollers
         if any(s not in (-1, 1) for s in self.rollers) or fl != rr or fr != rl or fl == fr:
             raise ValueError(f"rollers {list(self.rollers)} (front left, front right, rear left, rear right): each is "
@@ -1518,6 +1562,8 @@ class OmniDrive(Strict):
     wheels: list[OmniWheel] = Field(min_length=3, max_length=16)
     wheel_bottom: float | None = _wheel_bottom_field()
     max_wheel_speed: float = Field(default=10.0, gt=0, description="rad/s, the wheel motors' maxVelocity")
+    motor_max_speeds: dict[str, float] = _motor_max_speeds_field()
+    _maxima_numbers = field_validator("motor_max_speeds", mode="before")(_maxima_are_numbers)
     forward: Forward = _forward_field()
 
     _forward_nonzero = field_validator("forward")(_nonzero_forward)
@@ -1532,6 +1578,7 @@ class OmniDrive(Strict):
         names = [w.motor for w in self.wheels]
         if len(set(names)) != len(names):
             raise ValueError(f"every wheel motor needs its own name, got {names}")
+        _check_motor_max_speeds(self.motor_max_speeds, names, "drive's wheel motors")
         rows = []
         for w in self.wheels:
             n = math.hypot(*w.axis)

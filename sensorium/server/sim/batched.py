@@ -96,6 +96,7 @@ from sensorium.server.sim.ground import (
     ride_height,
     settle_world,
     slope_scales,
+    slope_twist,
     support_ceiling,
 )
 from sensorium.server.sim.motion import (
@@ -295,8 +296,9 @@ class BatchedSimulation:
                                       for r in w.robots], dtype=np.float64)
         self.axle = np.array([r.differential_drive.axle_length if r.differential_drive else 1.0
                               for r in w.robots], dtype=np.float64)
-        self.max_wheel = np.array([[r.differential_drive.max_wheel_speed] * 2 if r.differential_drive else [0.0, 0.0]
-                                   for r in w.robots], dtype=np.float64)
+        # each side's maxVelocity (a skid-steer side's wheels share theirs: the schema's rule)
+        self.max_wheel = np.array([[wm.wheel_max_speed(d, d.left_motor), wm.wheel_max_speed(d, d.right_motor)]
+                                   if (d := r.differential_drive) else [0.0, 0.0] for r in w.robots], dtype=np.float64)
         self.motor_names = [(r.differential_drive.left_motor, r.differential_drive.right_motor)
                             if r.differential_drive else ("", "") for r in w.robots]
         # every wheel motor's side (0 left, 1 right): a skid-steer robot's wheels of one side are
@@ -894,6 +896,7 @@ class BatchedSimulation:
         twists = [t for t in (d.step(live, dt) for d in (self.mecanum, self.omni) if d is not None) if len(t[0])]
         if twists:
             copies, slots, vx, vy, w = (np.concatenate(col) if len(twists) > 1 else col[0] for col in zip(*twists))
+            vx, vy, w = self._twist_over_ground(copies, slots, vx, vy, w)
             x0, y0, yaw0 = self.x[copies, slots], self.y[copies, slots], self.yaw[copies, slots]
             moves.append((copies, slots, x0, y0, yaw0, *twist_steps(x0, y0, yaw0, vx, vy, w, dt)))
         if not moves:
@@ -936,6 +939,22 @@ class BatchedSimulation:
         v[k] = v[k] / root
         w[k] = w[k] * turn
         return v, w
+
+    def _twist_over_ground(self, copies: np.ndarray, slots: np.ndarray, vx: np.ndarray, vy: np.ndarray,
+                           w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """PlanarState.twist_over_ground for the moving mecanum and omni-wheel robots: those on a slope
+        have their body twist in the ground's plane seen from above (ground.slope_twist, at the heading
+        the step starts with); the others' untouched."""
+        if self.ground is None:
+            return vx, vy, w
+        k = self.tilted[copies, slots].nonzero()[0]
+        if not len(k):
+            return vx, vy, w
+        c, r = copies[k], slots[k]
+        cos, sin = kin.libm_cos_sin(self.yaw[c, r])
+        vx, vy, w = vx.copy(), vy.copy(), w.copy()
+        vx[k], vy[k], w[k] = slope_twist(self.slope[c, r, 0], self.slope[c, r, 1], cos, sin, vx[k], vy[k], w[k])
+        return vx, vy, w
 
     def _two_wheel_moves(self, copies: np.ndarray, slots: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):
         """The moving two-wheel robots' (copies, slots, x0, y0, yaw0, x, y, yaw): an arc about the origin,

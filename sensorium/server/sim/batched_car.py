@@ -62,7 +62,7 @@ class CarDrives:
             self.columns.append({name: j for j, (_, name) in enumerate(a.motor_fields)})
             self.n_wheels[k] = len(a.driven)
             self.max_velocity[k, :2] = float(a.max_steering_speed)
-            self.max_velocity[k, 2:2 + len(a.driven)] = float(a.max_wheel_speed)
+            self.max_velocity[k, 2:2 + len(a.driven)] = [wm.wheel_max_speed(a, name) for _, name in a.driven]
             self.limit[k] = float(a.max_steering_angle)
             self.sign[k] = 1.0 if a.positive_steers == "right" else -1.0
             self.wheelbase[k] = float(a.wheelbase)

@@ -482,6 +482,30 @@ def slope_scales(gx, gy, c, s):
     return np.sqrt(q), q / np.sqrt(1.0 + gx * gx + gy * gy)
 
 
+def slope_twist(gx, gy, c, s, vx, vy, w):
+    """A body twist in the slope's plane seen from above: a robot with heading (cos, sin) = (c, s) on
+    the slope (gx, gy), moving at ``vx`` along its forward axis and ``vy`` along its left axis, both in
+    the ground's plane, and turning at ``w`` about the ground's normal, moves its origin horizontally at
+    (``vx_h`` ahead, ``vy_h`` to the left, in the heading's horizontal frame) and turns its heading about
+    the world's up at ``w_h``.
+
+    Derivation. In the heading's horizontal frame a (ahead), b (left), z (up) the plane is
+    z = k·a + m·b, k = gx·c + gy·s and m = gy·c − gx·s the slopes along a and b, its normal
+    n ∝ (−k, −m, 1). The forward axis in the plane is f ∝ (1, 0, k), |f| = √(1 + k²): seen from above
+    (1, 0)/√(1 + k²). The left axis is n × f = (−m·k, 1 + k², m), of length √((1 + k²)·G²) with
+    G² = 1 + k² + m² = 1 + gx² + gy² (the gradient's length in any horizontal frame): seen from above
+    (−m·k, 1 + k²)/(√(1 + k²)·G). So vx_h = (vx − vy·m·k/G)/√(1 + k²), vy_h = vy·√(1 + k²)/G; the heading
+    turns as :func:`slope_scales` has it, w_h = w·(1 + k²)/G. Heading up a slope of angle A (k = tan A,
+    m = 0): vx·cos A ahead, vy to the left; sideways up it (k = 0, m = tan A): vx ahead, vy·cos A to the
+    left; with vy = 0 it is :func:`slope_scales`' v/√(1 + k²), operation for operation. Element-wise:
+    the same bits on scalars and arrays."""
+    k = gx * c + gy * s
+    m = gy * c - gx * s
+    root, turn = slope_scales(gx, gy, c, s)
+    g = np.sqrt(1.0 + gx * gx + gy * gy)
+    return (vx - vy * (m * k / g)) / root, vy * (root / g), w * turn
+
+
 def _wheels(robot: wm.Robot) -> tuple[float, float] | None:
     """(its lowest wheel's bottom from its origin, its smallest wheel radius) for a robot whose drive
     gives the wheel bottom (``wheel_bottom``), else None."""

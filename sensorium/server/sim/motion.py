@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sensorium.schemas.world import wheel_max_speed
 from sensorium.server.sim.ground import (
     Ground,
     ground_angular_velocity,
@@ -22,6 +23,7 @@ from sensorium.server.sim.ground import (
     ride_height,
     robot_up,
     slope_scales,
+    slope_twist,
     support_ceiling,
 )
 from sensorium.server.world.geometry import Pose
@@ -257,6 +259,16 @@ class PlanarState:
         root, turn = slope_scales(gx, gy, math.cos(self.yaw), math.sin(self.yaw))
         return float(v / root), float(w * turn)
 
+    def twist_over_ground(self, vx: float, vy: float, w: float) -> tuple[float, float, float]:
+        """A holonomic drive's body twist (``vx`` ahead, ``vy`` to the left, both along the ground, ``w``
+        about its normal) as the planar state integrates it, seen from above: on the slope under the
+        origin at the step's start, :func:`ground.slope_twist`; level or off the ground, untouched."""
+        if self.slope is None:
+            return vx, vy, w
+        gx, gy = self.slope
+        hx, hy, hw = slope_twist(gx, gy, math.cos(self.yaw), math.sin(self.yaw), vx, vy, w)
+        return float(hx), float(hy), float(hw)
+
     def moved(self, v: float, w: float) -> None:
         """Record the step's motion (v along the heading the step ends with, turn rate w): what
         :meth:`velocity` reports until the next step (worked out only when asked)."""
@@ -312,12 +324,11 @@ class DifferentialDrive(PlanarState):
         self.axle_length = float(config.axle_length)
         cx, cy = getattr(config, "axle_center", (0.0, 0.0))
         self.center: tuple[float, float] | None = (float(cx), float(cy)) if (cx or cy) else None
-        speed = float(config.max_wheel_speed)
         skid = getattr(config, "skid_steer", None)
-        self.left = WheelMotor(config.left_motor, speed)
-        self.right = WheelMotor(config.right_motor, speed)
-        self.lefts = [self.left, *(WheelMotor(name, speed) for name in (skid.left if skid else ()))]
-        self.rights = [self.right, *(WheelMotor(name, speed) for name in (skid.right if skid else ()))]
+        self.left = WheelMotor(config.left_motor, wheel_max_speed(config, config.left_motor))
+        self.right = WheelMotor(config.right_motor, wheel_max_speed(config, config.right_motor))
+        self.lefts = [self.left, *(WheelMotor(n, wheel_max_speed(config, n)) for n in (skid.left if skid else ()))]
+        self.rights = [self.right, *(WheelMotor(n, wheel_max_speed(config, n)) for n in (skid.right if skid else ()))]
         super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
 
     @property
@@ -379,7 +390,7 @@ class HolonomicDrive(PlanarState):
         if all(u == 0.0 for u in speeds):
             self.moved(0.0, 0.0)
             return None
-        vx, vy, w = self.twist(speeds)
+        vx, vy, w = self.twist_over_ground(*self.twist(speeds))
         self.x, self.y, self.yaw = twist_step(self.x, self.y, self.yaw, vx, vy, w, dt)
         self.moved(vx, w)
         c, s = math.cos(self.yaw), math.sin(self.yaw)
@@ -401,10 +412,9 @@ class MecanumDrive(HolonomicDrive):
     def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
         self.wheel_radius = float(config.wheel_radius)
         lx, ly = float(config.lx), float(config.ly)
-        speed = float(config.max_wheel_speed)
         places = ((lx, ly), (lx, -ly), (-lx, ly), (-lx, -ly))      # front left, front right, rear left, rear right
         # each wheel: its motor, its roller sign, its c = s·x − y
-        self.wheels = [(WheelMotor(name, speed), float(s), float(s) * px - py)
+        self.wheels = [(WheelMotor(name, wheel_max_speed(config, name)), float(s), float(s) * px - py)
                        for (_, name), s, (px, py) in zip(config.motor_fields, config.rollers, places)]
         self.c2 = 4.0 * self.wheels[0][2] ** 2
         super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
@@ -439,7 +449,6 @@ class OmniDrive(HolonomicDrive):
     basic step the twist is constant and :func:`twist_step` moves the robot exactly."""
 
     def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
-        speed = float(config.max_wheel_speed)
         rows = []
         self.wheels: list[tuple[WheelMotor, float]] = []
         for w in config.wheels:
@@ -447,7 +456,7 @@ class OmniDrive(HolonomicDrive):
             dx, dy = float(w.axis[1]) / n, -float(w.axis[0]) / n
             px, py = float(w.position[0]), float(w.position[1])
             rows.append((dx, dy, dx * -py + dy * px))
-            self.wheels.append((WheelMotor(w.motor, speed), float(w.radius)))
+            self.wheels.append((WheelMotor(w.motor, wheel_max_speed(config, w.motor)), float(w.radius)))
         self.solve = np.linalg.pinv(np.array(rows, dtype=np.float64))
         """3 × N: the wheels' rim speeds (r_i·ω_i) to the body twist (vx, vy, ωz)."""
         self.columns = [(float(a), float(b), float(c)) for a, b, c in self.solve.T.tolist()]
@@ -519,10 +528,9 @@ class AckermannDrive(PlanarState):
         limit, steer_speed = float(config.max_steering_angle), float(config.max_steering_speed)
         self.right_steer = SteeringMotor(config.right_steer, steer_speed, max_position=limit)
         self.left_steer = SteeringMotor(config.left_steer, steer_speed, max_position=limit)
-        speed = float(config.max_wheel_speed)
         place = wheel_places(config)
         # each driven wheel: its motor, its (x, y) on the car, its radius
-        self.wheels = [(WheelMotor(name, speed), *place[field]) for field, name in config.driven]
+        self.wheels = [(WheelMotor(name, wheel_max_speed(config, name)), *place[field]) for field, name in config.driven]
         # the wheels without a motor (Webots' Car: a propulsion car's front ones, a traction car's rear
         # ones): each rolls with the car; key -> (x, y, radius, steering index: 0 right, 1 left, -1 none)
         driven = {field for field, _ in config.driven}

@@ -263,10 +263,29 @@ def _radius(wheels: list[dict], conv) -> tuple[float | None, str]:
 
 
 def _max_speed(wheels: list[dict], conv) -> float:
+    """One maxVelocity for motors the drive moves as one (a car's two steering motors): the smaller."""
     speeds = {w["max_velocity"] for w in wheels}
     if len(speeds) > 1:
-        conv.warn(wheels[0]["node"], f"wheel motors have different maxVelocity {sorted(speeds)}: using the smaller")
+        conv.warn(wheels[0]["node"], f"motors have different maxVelocity {sorted(speeds)}: using the smaller")
     return min(speeds)
+
+
+def _wheel_speeds(wheels: list[dict], conv, sides: tuple[list[dict], ...] = ()) -> dict:
+    """The drive's ``max_wheel_speed`` (the smallest wheel's) and ``motor_max_speeds`` (each wheel whose
+    own maxVelocity is more), as Webots clamps each motor to its own. ``sides``: a skid-steer drive's
+    wheels of each side, which roll as one, so share the side's smallest (said at load)."""
+    own = {w["motor"]: float(w["max_velocity"]) for w in wheels}
+    for side in sides:
+        speeds = {w["max_velocity"] for w in side}
+        if len(speeds) > 1:
+            conv.warn(side[0]["node"], f"the wheel motors of one side have different maxVelocity {sorted(speeds)}: the side rolls as "
+                      "one, at the smaller")
+        own.update({w["motor"]: float(min(speeds)) for w in side})
+    low = min(own.values())
+    out: dict = {"max_wheel_speed": low}
+    if any(v != low for v in own.values()):
+        out["motor_max_speeds"] = {name: v for name, v in own.items() if v != low}
+    return out
 
 
 def _two_wheels(wheels: list[dict], conv) -> tuple[dict | None, str]:
@@ -283,7 +302,7 @@ def _two_wheels(wheels: list[dict], conv) -> tuple[dict | None, str]:
         return None, why
     left, right = (wheels[0], wheels[1]) if a0[1] > a1[1] else (wheels[1], wheels[0])
     return _centred({"wheel_radius": r0, "axle_length": float(abs(a0[1] - a1[1])),
-                     "max_wheel_speed": _max_speed(wheels, conv), "left_motor": left["motor"],
+                     **_wheel_speeds(wheels, conv), "left_motor": left["motor"],
                      "right_motor": right["motor"]}, mid[0], mid[1]), ""
 
 
@@ -312,7 +331,8 @@ def _skid_steer(wheels: list[dict], conv) -> tuple[dict | None, str]:
     r0, why = _radius(wheels, conv)
     if r0 is None:
         return None, why
-    return _centred({"wheel_radius": r0, "axle_length": float(yl[0] - yr[0]), "max_wheel_speed": _max_speed(wheels, conv),
+    return _centred({"wheel_radius": r0, "axle_length": float(yl[0] - yr[0]),
+                     **_wheel_speeds(wheels, conv, (left, right)),
                      "left_motor": left[0]["motor"], "right_motor": right[0]["motor"],
                      "skid_steer": {"left": [w["motor"] for w in left[1:]], "right": [w["motor"] for w in right[1:]]}},
                     float(centres[:, 0].mean()), float(yl[0] + yr[0]) / 2.0), ""
@@ -397,7 +417,7 @@ def _ackermann(wheels: list[dict], conv) -> tuple[dict | None, str]:
         radii["front"] = r if r is not None else radii["rear"]
     out["front_wheel_radius"], out["rear_wheel_radius"] = radii["front"], radii.get("rear", radii["front"])
     out.setdefault("track_rear", out["track_front"])
-    out["max_wheel_speed"] = _max_speed(driven, conv)
+    out.update(_wheel_speeds(driven, conv))
     out["max_steering_speed"] = _max_speed(steering, conv)
     limits = [abs(v) for w in steering for v in w["limits"] if w["limits"] != (0.0, 0.0)]
     out["max_steering_angle"] = min([*limits, STEERING_UNLIMITED])
@@ -575,7 +595,7 @@ def _mecanum(wheels: list[dict], turns: list[float | None], conv) -> tuple[dict 
         w, t = odd[0]
         conv.warn(w["node"], f"mecanum wheel {w['motor']!r}: its friction is turned by {t:g} rad; the kinematic "
                              "drive takes its rollers at 45°")
-    out: dict = {"wheel_radius": r0, "lx": lx, "ly": ly, "max_wheel_speed": _max_speed(wheels, conv),
+    out: dict = {"wheel_radius": r0, "lx": lx, "ly": ly, **_wheel_speeds(wheels, conv),
                  "rollers": rollers}
     for (end_, side), key in zip(order, ("front_left", "front_right", "rear_left", "rear_right")):
         out[f"{key}_motor"] = slots[(end_, side)][0]["motor"]
@@ -755,7 +775,7 @@ def omni_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]
                           f"({o['axis'][0]:g}, {o['axis'][1]:g})" for o in out)
         return None, (f"the wheels ({where}) cannot move the robot in every direction: their rolling leaves a twist "
                       "free")
-    drive: dict = {"wheels": out, "max_wheel_speed": _max_speed(wheels, conv)}
+    drive: dict = {"wheels": out, **_wheel_speeds(wheels, conv)}
     if frame is not None:
         drive["forward"] = [1.0, 0.0, 0.0]
     return drive, ""
