@@ -332,9 +332,11 @@ class Simulation:
         # solids and lists of its own: a Supervisor's imports append to them (the loaded world stays as read)
         self.world = loaded.world.model_copy(update={"solids": list(loaded.world.solids),
                                                     "lights": list(loaded.world.lights)})
-        # wheeled robots placed above (or into) the ground settle on it, as Webots' physics drops them
-        # (sim/ground.py); the load report says which moved (the note once, however many simulations)
-        self.world, settled = settle_world(self.world, _TO_ENU[self.world.world_info.coordinate_system], loaded.source)
+        # solids with physics and wheeled robots placed above (or into) the ground settle on it, as Webots'
+        # physics drops them (sim/ground.py); the load report says which moved (the note once, however many
+        # simulations)
+        self.world, settled = settle_world(self.world, _TO_ENU[self.world.world_info.coordinate_system], loaded.source,
+                                           loaded.base_dir)
         loaded.warnings.extend(note for note in settled if note not in loaded.warnings)
         self.limits = limits or WorldLimits()
         self.allow_outside_meshes = allow_outside_meshes
