@@ -94,10 +94,10 @@ def test_a_stack_of_two_boxes_lands_one_on_the_other(upper_first: bool) -> None:
 
 def test_a_solid_over_nothing_keeps_its_height_and_one_without_physics_never_moves() -> None:
     sim = _sim([_ball("high", at=(0, 0, 3.0)), _box("slab", (5.0, 0, 0.02), (1, 1, 0.04)),
-                _ball("still", at=(5.0, 0, 0.5), physics=False)])
-    assert _at(sim, "high")[2] == 3.0 and _at(sim, "still")[2] == 0.5 and not _notes(sim)
-    sim = _sim([FLOOR, _ball(physics=False)])
-    assert np.array_equal(_at(sim, "ball"), [0.4, -0.1, 0.08]) and not _notes(sim)
+                _ball("still", at=(5.0, 0, 0.5), physics=False), _ball("falls", at=(5.2, 0, 0.5))])
+    assert _at(sim, "high")[2] == 3.0 and _at(sim, "still")[2] == 0.5
+    assert abs(_at(sim, "falls")[2] - (0.04 + R)) <= 1e-12
+    assert [n.split("'")[1] for n in _notes(sim)] == ["falls"]
 
 
 def test_a_solid_resting_within_a_micrometre_keeps_its_pose_bit_for_bit() -> None:
@@ -144,6 +144,7 @@ def test_a_nue_world_settles_along_its_y() -> None:
 def test_reset_and_load_state_init_restore_the_settled_pose() -> None:
     sim = _sim([FLOOR, _ball()])
     settled = sim.scene.solid_poses["ball"]
+    assert abs(settled.translation[2] - R) <= 1e-12
     sim.place_solid("ball", Pose(np.eye(3), np.array([1.0, 1.0, 2.0])))
     sim.reset()
     assert np.array_equal(sim.scene.solid_poses["ball"].translation, settled.translation)
