@@ -3,7 +3,7 @@
 support under its origin whose top is not above the middle of its height + 1 mm, its lowest point on
 that top, x, y and rotation kept; lowest first, each landed solid a support for the next. A solid
 without physics never moves. Closed forms, the load lines and their cap, reset and loadState, the
-batched simulation bit for bit, a NUE world."""
+batched simulation bit for bit, a NUE world, a solid a VacuumGripper on at load touches (held, not dropped)."""
 
 from __future__ import annotations
 
@@ -164,3 +164,18 @@ def test_the_batched_copies_take_the_same_settled_world_bit_for_bit() -> None:
         assert np.array_equal(bs.scene.solid_poses[name].translation, sim.scene.solid_poses[name].translation)
         assert np.array_equal(bs.scene.solid_poses[name].rotation, sim.scene.solid_poses[name].rotation)
     assert abs(_at(sim, "lid")[2] - 0.805) <= 1e-12
+
+
+def test_a_solid_a_gripper_on_at_load_touches_is_held_not_dropped() -> None:
+    """Webots' VacuumGripper catches it in its first step; a parcel beside it, touched by no pump, falls."""
+    crane = {"name": "crane", "pose": {"translation": [0.0, 0.0, 0.6]},
+             "shapes": [{"pose": {"translation": [0.0, 0.0, 0.01]}, "geometry": {"type": "cylinder", "radius": 0.05, "height": 0.02},
+                         "of_device": "cup", "seen_by": "bounding"}],
+             "devices": [{"device": "VacuumGripper", "name": "cup", "is_on": True}]}
+    hung, loose = _box("hung", (0.0, 0.0, 0.55), (0.1, 0.1, 0.1), True), _box("loose", (1.0, 0.0, 0.55), (0.1, 0.1, 0.1), True)
+    sim = _sim([FLOOR, hung, loose], [crane])
+    assert _at(sim, "hung")[2] == 0.55 and abs(_at(sim, "loose")[2] - 0.05) <= 1e-12
+    sim.step()
+    assert sim.device("crane/cup").held == "hung"                       # type: ignore[attr-defined]
+    off = _sim([FLOOR, hung, loose], [{**crane, "devices": [{"device": "VacuumGripper", "name": "cup", "is_on": False}]}])
+    assert abs(_at(off, "hung")[2] - 0.05) <= 1e-12

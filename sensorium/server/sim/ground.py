@@ -66,6 +66,7 @@ too), so the batched simulation's copies ride exactly as the single simulation's
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -649,7 +650,7 @@ def _falling(solid: wm.Solid, base_dir: Path, to_enu: np.ndarray | None) -> tupl
     return min(p.z_range[0] for p in prisms), max(p.z_range[1] for p in prisms), box
 
 
-def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, source: str
+def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, source: str, caught: Collection[str]
                    ) -> tuple[wm.World, list[str]]:
     """The world with its top-level solids with physics landed at load (settle_world's first part) and
     their note lines.
@@ -658,8 +659,10 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
     solid let go, on the ground of what is settled already: every solid that does not fall (no physics,
     no bounding shape, a Plane or ElevationGrid among them) and the robots without a drive as the world
     file places them, and the solids with physics landed before it where they landed (a box stacked on
-    a box lands on it once that one has landed). A solid with physics not yet landed is no support."""
-    falling = [(i, s, got) for i, s in enumerate(world.solids) if (got := _falling(s, base_dir, to_enu)) is not None]
+    a box lands on it once that one has landed). A solid with physics not yet landed is no support. The
+    solids in ``caught`` (held by a VacuumGripper from the first step: vacuum.caught_at_load) stay."""
+    falling = [(i, s, got) for i, s in enumerate(world.solids)
+               if s.name not in caught and (got := _falling(s, base_dir, to_enu)) is not None]
     if not falling:
         return world, []
     moving = {i for i, _, _ in falling}
@@ -702,10 +705,12 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
     return (world.model_copy(update={"solids": solids}) if moved else world), notes
 
 
-def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str, base_dir: Path) -> tuple[wm.World, list[str]]:
+def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str, base_dir: Path,
+                 caught: Collection[str] = ()) -> tuple[wm.World, list[str]]:
     """The world with its top-level solids with physics and its wheeled robots settled on the ground,
     as Webots' physics drops them at load, and one note line per solid or robot moved by more than
-    SETTLE_NOTE (at most SETTLE_NOTES of each, then a count). ``base_dir``: where the world's meshes are.
+    SETTLE_NOTE (at most SETTLE_NOTES of each, then a count). ``base_dir``: where the world's meshes are;
+    ``caught``: the solids a VacuumGripper holds from the first step (they stay).
 
     The solids first (:func:`_settle_solids`: each on the highest support under its origin, by
     :func:`land_pose`'s rule), then the robots on the world so settled.
@@ -718,7 +723,7 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str, base_d
     origin) is something it sank into, not its floor. The shapes of robots without a drive are
     ground here too, as the world loads them (Webots' physics drops a robot on any bounding object).
     Over no ground, off by at most SETTLE_TOL, or not upright, a robot keeps its pose bit for bit."""
-    world, solid_notes = _settle_solids(world, to_enu, base_dir, source)
+    world, solid_notes = _settle_solids(world, to_enu, base_dir, source, caught)
     settling = [(i, r, got) for i, r in enumerate(world.robots)
                 if (got := _upright_wheels(r, pose_from_model(r.pose), to_enu)) is not None]
     if not settling:
