@@ -681,13 +681,13 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
                       else _landing_heights(still, xs, ys, zs, lows, highs))
     up, sign = _up_axis(to_enu)
     solids = list(world.solids)
-    landed: list[tuple[wm.Solid, Pose]] = []      # (model, pose) of the falling solids already landed
+    landed = Ground([], {}, to_enu)               # the falling solids already landed, each added where it landed
     moved: list[tuple[str, float, float]] = []
     for k, (i, solid, _) in enumerate(falling):
-        under = [m for m in range(k) if boxes[m, 0] <= xs[k] <= boxes[m, 2] and boxes[m, 1] <= ys[k] <= boxes[m, 3]]
-        below = None if not under else settling_ground([landed[m] for m in under], [], to_enu)
-        if below is not None:
-            on, h = _landing_heights(below, xs[k:k + 1], ys[k:k + 1], zs[k:k + 1], lows[k:k + 1], highs[k:k + 1])
+        # asked only when one of them may be under it (its shapes' xy box holds the origin: x, y never change)
+        if (k and ((boxes[:k, 0] <= xs[k]) & (xs[k] <= boxes[:k, 2]) & (boxes[:k, 1] <= ys[k])
+                   & (ys[k] <= boxes[:k, 3])).any()):
+            on, h = _landing_heights(landed, xs[k:k + 1], ys[k:k + 1], zs[k:k + 1], lows[k:k + 1], highs[k:k + 1])
             if on[0] and (not found[k] or h[0] > heights[k]):
                 found[k], heights[k] = True, h[0]
         height = float(heights[k])
@@ -697,7 +697,7 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
             solid = solids[i] = solid.model_copy(
                 update={"pose": solid.pose.model_copy(update={"translation": tuple(translation)})})
             moved.append((solid.name, float(zs[k]), height))
-        landed.append((solid, pose_from_model(solid.pose)))
+        landed.add_solid(solid, pose_from_model(solid.pose))
     notes = [f"{source}: solid {name!r} settled on the ground at load, as Webots' physics drops it: its origin's "
              f"{'xyz'[up]} from {sign * z:.4f} to {sign * h:.4f} m" for name, z, h in moved if abs(h - z) > SETTLE_NOTE]
     if len(notes) > SETTLE_NOTES:
