@@ -670,8 +670,9 @@ class Solid(Strict):
     proto_scope: int | None = Field(default=None, ge=0, description="a PROTO instance inside a top-level solid: its "
                                     "number there (InnerDef.scope)")
     physics: bool = Field(default=False, description="Webots: the solid has a Physics node. Nothing is pushed here "
-                          "(no dynamics); a VacuumGripper carries only a top-level solid with physics, and one it lets "
-                          "go lands at once on what is under it (no other solid falls)")
+                          "(no dynamics); a top-level solid with physics settles at load on what is under it (as "
+                          "Webots' physics drops it), a VacuumGripper carries only such a solid, and one it lets go "
+                          "lands at once on what is under it (no solid falls at any other time)")
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 

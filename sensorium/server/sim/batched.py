@@ -237,8 +237,8 @@ class BatchedSimulation:
         self.copies = C = int(copies)
         self.basic_time_step = w.world_info.basic_time_step
         self._check_supported()
-        # its wheeled robots settled on the ground as Simulation settles them (sim/ground.py)
-        self.world = w = settle_world(w, _TO_ENU[w.world_info.coordinate_system], world.source)[0]
+        # its solids with physics and wheeled robots settled on the ground as Simulation settles them (sim/ground.py)
+        self.world = w = settle_world(w, _TO_ENU[w.world_info.coordinate_system], world.source, world.base_dir)[0]
         self._settling = SettlingGrounds(_TO_ENU[w.world_info.coordinate_system], size=self.copies)
         # world axes -> ENU (None in an ENU world): the drive state is ENU, as PlanarState's
         up = w.world_info.coordinate_system

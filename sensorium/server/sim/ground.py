@@ -66,12 +66,14 @@ too), so the batched simulation's copies ride exactly as the single simulation's
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, ramp_top, robot_footprint
+from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_pose, obstacle, ramp_top, robot_footprint
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
@@ -612,6 +614,16 @@ def settle_pose(robot: wm.Robot, pose: Pose, ground: Ground | None, to_enu: np.n
     return Pose(pose.rotation, translation)
 
 
+def _landing_heights(ground: Ground, xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, lows: np.ndarray,
+                     highs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where solids (ENU origins xs, ys, zs; their bounding shapes spanning the heights lows to highs)
+    land on ``ground``: whether a support is under each origin not above the middle of its span +
+    FLOOR, and the origin's height with its lowest point on that support's top. Element-wise: one
+    solid or many, the same bits (land_pose and settle_world share it)."""
+    found, z, _, _ = ground.under(xs, ys, (lows + highs) / 2.0 + FLOOR)
+    return found, z + (zs - lows)
+
+
 def land_pose(pose: Pose, low: float, high: float, ground: Ground | None, to_enu: np.ndarray | None) -> Pose:
     """The pose a solid let go at ``pose`` lands at (a VacuumGripper's pump turned off, sim/vacuum.py):
     its bounding shapes span the heights ``low`` to ``high`` (ENU z) there; it goes straight down (or
@@ -623,11 +635,11 @@ def land_pose(pose: Pose, low: float, high: float, ground: Ground | None, to_enu
     if ground is None:
         return pose
     t = pose.translation if to_enu is None else to_enu @ pose.translation
-    found, z, _, _ = ground.under(np.array([float(t[0])]), np.array([float(t[1])]),
-                                  np.array([(low + high) / 2.0 + FLOOR]))
+    found, heights = _landing_heights(ground, np.array([float(t[0])]), np.array([float(t[1])]),
+                                      np.array([float(t[2])]), np.array([low]), np.array([high]))
     if not found[0]:
         return pose
-    height = float(z[0]) + (float(t[2]) - low)         # its origin that far above its lowest point
+    height = float(heights[0])
     if abs(height - float(t[2])) <= SETTLE_TOL:
         return pose
     up, sign = _up_axis(to_enu)
@@ -636,10 +648,96 @@ def land_pose(pose: Pose, low: float, high: float, ground: Ground | None, to_enu
     return Pose(pose.rotation, translation)
 
 
-def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tuple[wm.World, list[str]]:
-    """The world with its wheeled robots settled on the ground, as Webots' physics drops them at
-    load, and one note line per robot moved by more than SETTLE_NOTE (at most SETTLE_NOTES, then a
-    count).
+def _falling(solid: wm.Solid, base_dir: Path, to_enu: np.ndarray | None) -> tuple[float, float, np.ndarray] | None:
+    """(lowest, highest point, xy box (x0, y0, x1, y1)) of the bounding shapes of a top-level solid that
+    falls at load (``physics``, at least one bounding shape, none of them a Plane or ElevationGrid: those
+    are ground, static in Webots' physics too), in ENU at its world-file pose, as kinematic contact and
+    the VacuumGripper take them (contact.obstacle); None for any other solid."""
+    from sensorium.server.sim.scene import primitive_from_model, solid_parts
+
+    if not solid.physics:
+        return None
+    pose = pose_from_model(solid.pose)
+    prisms = []
+    for _, local, shape in solid_parts(solid, Pose.identity()):
+        if shape.seen_by not in ("both", "bounding"):
+            continue
+        if isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid)):
+            return None
+        ob = obstacle("shape", -1, primitive_from_model(shape.geometry, base_dir), enu_pose(pose.compose(local), to_enu))
+        if ob is not None:
+            prisms.append(ob)
+    if not prisms:
+        return None
+    xy = np.array([[*(p.points.min(axis=0) - p.radius), *(p.points.max(axis=0) + p.radius)] for p in prisms])
+    box = np.array([xy[:, 0].min(), xy[:, 1].min(), xy[:, 2].max(), xy[:, 3].max()])
+    return min(p.z_range[0] for p in prisms), max(p.z_range[1] for p in prisms), box
+
+
+def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, source: str, caught: Collection[str]
+                   ) -> tuple[wm.World, list[str]]:
+    """The world with its top-level solids with physics landed at load (settle_world's first part) and
+    their note lines.
+
+    Lowest first (by their lowest point; world order on a tie), each lands as :func:`land_pose` lands a
+    solid let go, on the ground of what is settled already: every solid that does not fall (no physics,
+    no bounding shape, a Plane or ElevationGrid among them) and the robots without a drive as the world
+    file places them, and the solids with physics landed before it where they landed (a box stacked on
+    a box lands on it once that one has landed). A solid with physics not yet landed is no support. The
+    solids in ``caught`` (held by a VacuumGripper from the first step: vacuum.caught_at_load) stay."""
+    falling = [(i, s, got) for i, s in enumerate(world.solids)
+               if s.name not in caught and (got := _falling(s, base_dir, to_enu)) is not None]
+    if not falling:
+        return world, []
+    moving = {i for i, _, _ in falling}
+    poses = {s.name: pose_from_model(s.pose) for s in world.solids}
+    floors = [(r, pose_from_model(r.pose)) for r in world.robots if not r.drive_motors]
+    still = settling_ground([(s, poses[s.name]) for i, s in enumerate(world.solids) if i not in moving], floors, to_enu)
+    falling.sort(key=lambda f: f[2][0])          # lowest first (a stable sort: world order on a tie)
+    ts = [pose.translation if to_enu is None else to_enu @ pose.translation
+          for pose in (poses[s.name] for _, s, _ in falling)]
+    xs, ys, zs = (np.array([float(t[k]) for t in ts]) for k in range(3))
+    lows = np.array([f[2][0] for f in falling])
+    highs = np.array([f[2][1] for f in falling])
+    boxes = np.array([f[2][2] for f in falling]).reshape(-1, 4)
+    # the ground that stays, under every falling solid in one call; the landed ones below, one by one
+    found, heights = ((np.zeros(len(falling), dtype=bool), np.zeros(len(falling))) if still is None
+                      else _landing_heights(still, xs, ys, zs, lows, highs))
+    up, sign = _up_axis(to_enu)
+    solids = list(world.solids)
+    landed = Ground([], {}, to_enu)               # the falling solids already landed, each added where it landed
+    moved: list[tuple[str, float, float]] = []
+    for k, (i, solid, _) in enumerate(falling):
+        # asked only when one of them may be under it (its shapes' xy box holds the origin: x, y never change)
+        if (k and ((boxes[:k, 0] <= xs[k]) & (xs[k] <= boxes[:k, 2]) & (boxes[:k, 1] <= ys[k])
+                   & (ys[k] <= boxes[:k, 3])).any()):
+            on, h = _landing_heights(landed, xs[k:k + 1], ys[k:k + 1], zs[k:k + 1], lows[k:k + 1], highs[k:k + 1])
+            if on[0] and (not found[k] or h[0] > heights[k]):
+                found[k], heights[k] = True, h[0]
+        height = float(heights[k])
+        if found[k] and not abs(height - float(zs[k])) <= SETTLE_TOL:
+            translation = list(solid.pose.translation)
+            translation[up] = sign * height
+            solid = solids[i] = solid.model_copy(
+                update={"pose": solid.pose.model_copy(update={"translation": tuple(translation)})})
+            moved.append((solid.name, float(zs[k]), height))
+        landed.add_solid(solid, pose_from_model(solid.pose))
+    notes = [f"{source}: solid {name!r} settled on the ground at load, as Webots' physics drops it: its origin's "
+             f"{'xyz'[up]} from {sign * z:.4f} to {sign * h:.4f} m" for name, z, h in moved if abs(h - z) > SETTLE_NOTE]
+    if len(notes) > SETTLE_NOTES:
+        notes = [*notes[:SETTLE_NOTES], f"{source}: {len(notes) - SETTLE_NOTES} more solids settled on the ground at load"]
+    return (world.model_copy(update={"solids": solids}) if moved else world), notes
+
+
+def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str, base_dir: Path,
+                 caught: Collection[str] = ()) -> tuple[wm.World, list[str]]:
+    """The world with its top-level solids with physics and its wheeled robots settled on the ground,
+    as Webots' physics drops them at load, and one note line per solid or robot moved by more than
+    SETTLE_NOTE (at most SETTLE_NOTES of each, then a count). ``base_dir``: where the world's meshes are;
+    ``caught``: the solids a VacuumGripper holds from the first step (they stay).
+
+    The solids first (:func:`_settle_solids`: each on the highest support under its origin, by
+    :func:`land_pose`'s rule), then the robots on the world so settled.
 
     A robot is settled when its drive gives ``wheel_bottom`` and it stands upright (its z axis the
     world's up, or in a NUE world its y: :func:`robot_up`): its height becomes ``ground −
@@ -649,14 +747,15 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tup
     origin) is something it sank into, not its floor. The shapes of robots without a drive are
     ground here too, as the world loads them (Webots' physics drops a robot on any bounding object).
     Over no ground, off by at most SETTLE_TOL, or not upright, a robot keeps its pose bit for bit."""
+    world, solid_notes = _settle_solids(world, to_enu, base_dir, source, caught)
     settling = [(i, r, got) for i, r in enumerate(world.robots)
                 if (got := _upright_wheels(r, pose_from_model(r.pose), to_enu)) is not None]
     if not settling:
-        return world, []
+        return world, solid_notes
     ground = settling_ground([(s, pose_from_model(s.pose)) for s in world.solids],
                              [(r, pose_from_model(r.pose)) for r in world.robots if not r.drive_motors], to_enu)
     if ground is None:
-        return world, []
+        return world, solid_notes
     up, sign = _up_axis(to_enu)
     # every robot's ground in one call (element-wise: the bits settle_pose gives one robot)
     bottoms, axles, xs, ys, zs = (np.array(c) for c in zip(*[(b, a, float(t[0]), float(t[1]), float(t[2]))
@@ -679,4 +778,4 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str) -> tup
     if len(notes) > SETTLE_NOTES:
         more = len(notes) - SETTLE_NOTES
         notes = [*notes[:SETTLE_NOTES], f"{source}: {more} more robots settled on the ground at load"]
-    return (world.model_copy(update={"robots": robots}) if moved else world), notes
+    return (world.model_copy(update={"robots": robots}) if moved else world), [*solid_notes, *notes]

@@ -65,7 +65,7 @@ from sensorium.server.sim.sensors import (
     device_class,
 )
 from sensorium.server.sim.speaker import Speaker
-from sensorium.server.sim.vacuum import VacuumGripper
+from sensorium.server.sim.vacuum import VacuumGripper, caught_at_load
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, from_model, load_world
@@ -332,9 +332,13 @@ class Simulation:
         # solids and lists of its own: a Supervisor's imports append to them (the loaded world stays as read)
         self.world = loaded.world.model_copy(update={"solids": list(loaded.world.solids),
                                                     "lights": list(loaded.world.lights)})
-        # wheeled robots placed above (or into) the ground settle on it, as Webots' physics drops them
-        # (sim/ground.py); the load report says which moved (the note once, however many simulations)
-        self.world, settled = settle_world(self.world, _TO_ENU[self.world.world_info.coordinate_system], loaded.source)
+        # solids with physics and wheeled robots placed above (or into) the ground settle on it, as Webots'
+        # physics drops them (sim/ground.py); the load report says which moved (the note once, however many
+        # simulations)
+        # (a solid a VacuumGripper on at load touches is held from the first step: it stays)
+        to_enu = _TO_ENU[self.world.world_info.coordinate_system]
+        self.world, settled = settle_world(self.world, to_enu, loaded.source, loaded.base_dir,
+                                           caught_at_load(self.world, loaded.base_dir, to_enu))
         loaded.warnings.extend(note for note in settled if note not in loaded.warnings)
         self.limits = limits or WorldLimits()
         self.allow_outside_meshes = allow_outside_meshes

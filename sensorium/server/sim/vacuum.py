@@ -44,7 +44,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
-__all__ = ["GRIP_DISTANCE", "VacuumGripper", "may_touch", "prism_depth", "prism_gap"]
+__all__ = ["GRIP_DISTANCE", "VacuumGripper", "caught_at_load", "may_touch", "prism_depth", "prism_gap"]
 
 GRIP_DISTANCE = 1e-3
 """m: a gripper whose bounding shapes come this near a solid's (or overlap it) touches it."""
@@ -114,6 +114,45 @@ def may_touch(a: Obstacle, b: Obstacle) -> bool:
     lo_a, hi_a = a.points.min(axis=0) - a.radius, a.points.max(axis=0) + a.radius
     lo_b, hi_b = b.points.min(axis=0) - b.radius, b.points.max(axis=0) + b.radius
     return bool(max(float((lo_b - hi_a).max()), float((lo_a - hi_b).max())) <= _SCREEN)
+
+
+def caught_at_load(world: Any, base_dir: Any, to_enu: np.ndarray | None) -> set[str]:
+    """The top-level solids with physics that a VacuumGripper on at load holds from its first step: each
+    such gripper's choice (:meth:`VacuumGripper.touched`'s rule, deepest first, the world order on a tie)
+    among the solids its bounding shapes touch as the world file places them (the robot at its world-file
+    pose). Webots' gripper catches such a solid at the end of its first step, after a fall of about a
+    millimetre; here it does not settle at load (ground.settle_world) and is held from the first step."""
+    if not any(d.device == "VacuumGripper" and d.is_on for r in world.robots for d in r.devices):
+        return set()
+    solids = []
+    for s in world.solids:
+        if not s.physics:
+            continue
+        pose = pose_from_model(s.pose)
+        solids.append((s.name, [ob for _, local, shape in solid_parts(s, Pose.identity())
+                                if shape.seen_by in ("both", "bounding") and (ob := _shape_obstacle(
+                                    primitive_from_model(shape.geometry, base_dir),
+                                    enu_pose(pose.compose(local), to_enu))) is not None]))
+    caught: set[str] = set()
+    for r in world.robots:
+        pose = pose_from_model(r.pose)
+        for d in r.devices:
+            if d.device != "VacuumGripper" or not d.is_on:
+                continue
+            mine = [ob for p in r.shapes if p.of_device == d.name and p.seen_by in ("both", "bounding")
+                    and (ob := _shape_obstacle(primitive_from_model(p.geometry, base_dir),
+                                               enu_pose(pose.compose(pose_from_model(p.pose)), to_enu))) is not None]
+            chosen, deepest = None, -math.inf
+            for name, obs in solids:
+                for ob in obs:
+                    for m in mine:
+                        if may_touch(m, ob) and prism_gap(m, ob) <= GRIP_DISTANCE:
+                            depth = prism_depth(m, ob)
+                            if depth > deepest:
+                                chosen, deepest = name, depth
+            if chosen is not None:
+                caught.add(chosen)
+    return caught
 
 
 class VacuumGripper(Device):
