@@ -158,6 +158,7 @@ def _duo_proto(odd: bool) -> str:
     z2, r2 = (0.03, 0.03) if odd else (0.02, 0.02)
     return (HEADER + 'PROTO Duo [ field SFVec3f translation 0 0 0 field SFString name "duo" ]\n{\n'
             '  Robot { translation IS translation name IS name children [\n'
+            + ('' if odd else '    Shape { geometry Sphere { radius 0 } }\n') +      # one reset per instance
             '    HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0 0.03 0.02 }\n'
             '      device [ RotationalMotor { name "left" maxVelocity 10 } ]\n'
             '      endPoint Solid { translation 0 0.03 0.02 rotation 1 0 0 1.5708 children [ Shape { geometry '
@@ -182,9 +183,8 @@ def test_identical_warnings_of_many_robots_fold_into_one_line_with_their_first_p
     assert report.counts() == "10 warnings"
     proto = tmp_path / "protos" / "Duo.proto"
     (line,) = report.lines()
-    assert line == (f"warning (x10, first at {proto}:5:5 (in PROTO Duo at {p}:4:1); then PROTO Duo at {p}:5:1, "
-                    f"PROTO Duo at {p}:6:1 and 7 more): wheel motors have different maxVelocity [10.0, 12.0]: "
-                    "using the smaller")
+    assert line == (f"warning (x10, first at {proto}:5:31 (in PROTO Duo at {p}:4:1); then PROTO Duo at {p}:5:1, "
+                    f"PROTO Duo at {p}:6:1 and 7 more): Sphere.radius: 0 is not > 0; using 1 (as Webots does)")
     assert len(report.lines(every=True)) == 10 and len(report.warnings) == 10    # every one kept
 
 
