@@ -454,11 +454,11 @@ def test_the_gap_and_reward_passes_are_task_pys_numpy_on_nan_inf_and_empty_input
     assert gap is not None and gap.tobytes() == want.tobytes()
     velocity = np.array(vel, dtype=np.float64).reshape(4, 1, 2)
     copies = (np.arange(n) % 4).astype(np.int64)
-    near, contact, penalty, vmax = 0.05, 0.005, 1.0, 6.28
+    near, contact, penalty, vmax = 0.05, 0.005, 1.0, (6.28, 7.5)     # each wheel over its own maximum
     got = packets.avoid_reward(copies, 0, velocity, vmax, gap, near, contact, penalty)
     v = velocity[copies, 0]
     with np.errstate(all="ignore"):
-        wl, wr = v[:, 0] / vmax, v[:, 1] / vmax
+        wl, wr = v[:, 0] / vmax[0], v[:, 1] / vmax[1]
         p = np.minimum(np.maximum(1.0 - gap / near, 0.0), 1.0)
         r = 0.5 * (wl + wr) * (1.0 - np.sqrt(np.abs(wl - wr) / 2.0)) * (1.0 - p)
         want_r = np.where(gap < contact, r - penalty, r)
@@ -506,8 +506,8 @@ void sp_atan2(size_t, const double*, size_t, const double*, size_t, double*, siz
 void sp_cross_norm(size_t, const double*, const double*, double*);
 void sp_sonar_nearest(size_t, size_t, const double*, const double*, const double*, double, double*);
 void sp_clearance_gaps(size_t, size_t, const double*, double, double, double*);
-void sp_avoid_reward(size_t, const int64_t*, size_t, size_t, const double*, double, const double*, double, double,
-                     double, double*);
+void sp_avoid_reward(size_t, const int64_t*, size_t, size_t, const double*, double, double, const double*, double,
+                     double, double, double*);
 void sp_pose_scatter(size_t, size_t, const int64_t*, const int64_t*, const double*, const double*, const double*,
                      const double*, double*, double*);
 void sp_roll_pitch_yaw(size_t, const double*, int, double*);
@@ -568,13 +568,13 @@ int main(void) {
   put("gaps0", g_o, 2);
   /* reward: copies 0 and 2 of 3, slot 1 of 2; a NaN gap */
   int64_t rc[] = {0, 2};
-  double rv[12] = {0, 0, 6.28, 6.28, 0, 0, 0, 0, 0, 0, -6.28, 6.28}, rg[] = {1.0, nan};
+  double rv[12] = {0, 0, 6.28, 7.5, 0, 0, 0, 0, 0, 0, -6.28, 6.28}, rg[] = {1.0, nan};   /* both wheels at their maximum */
   int64_t* r_c = malloc(sizeof rc);
   memcpy(r_c, rc, sizeof rc);
   double *r_v = dup(rv, 12), *r_g = dup(rg, 2), *r_o = malloc(2 * sizeof(double));
-  sp_avoid_reward(2, r_c, 2, 1, r_v, 6.28, r_g, 0.05, 0.005, 1.0, r_o);
+  sp_avoid_reward(2, r_c, 2, 1, r_v, 6.28, 7.5, r_g, 0.05, 0.005, 1.0, r_o);
   put("reward", r_o, 2);
-  sp_avoid_reward(0, NULL, 2, 1, r_v, 6.28, NULL, 0.05, 0.005, 1.0, NULL);
+  sp_avoid_reward(0, NULL, 2, 1, r_v, 6.28, 7.5, NULL, 0.05, 0.005, 1.0, NULL);
   /* the pose scatter into the last copy's last slot */
   int64_t pc[] = {2}, ps[] = {1};
   int64_t *p_c = malloc(sizeof pc), *p_s = malloc(sizeof ps);

@@ -195,3 +195,32 @@ def test_bad_per_motor_maxima_are_one_clear_line() -> None:
             parse_world({"robots": [{"name": "bot", "differential_drive": {**base, **extra}}]})
         assert words in str(err.value), str(err.value)
         assert "robots[0] (bot).differential_drive" in str(err.value) and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("helper", [True, False], ids=["helper", "numpy"])
+def test_avoid_obstacles_scores_each_wheel_over_its_own_maximum(tmp_path: Path, helper: bool, monkeypatch) -> None:
+    """Both wheels at their own maximum (the gym's (+1, +1)) drive straight at full speed: AvoidObstacles'
+    v is 1 and dv 0, so in open space the reward is exactly 1 (the left's maximum for both would give
+    1.025 * (1 - sqrt(0.025)) = 0.863); the single env and the vector env's C and numpy passes agree."""
+    pytest.importorskip("gymnasium")
+    from sensorium.gym.env import SensoriumEnv
+    from sensorium.gym.task import AvoidObstacles, Task
+    from sensorium.gym.vector import SensoriumVectorEnv
+    from sensorium.server.raycast import packets
+
+    if not helper:
+        monkeypatch.setattr(packets, "avoid_reward", lambda *args: None)
+        monkeypatch.setattr(packets, "avoid_outcome", lambda *args: None)
+    goal = AvoidObstacles(near=0.05)
+    task = Task(robot="bot", observations=[], reward=goal, terminated=goal.terminated)
+    env = SensoriumEnv(load_world(_wbt(tmp_path)), task)
+    env.reset(seed=0)
+    venv = SensoriumVectorEnv(load_world(_wbt(tmp_path)), task, 2)
+    venv.reset(seed=0)
+    for action in ([1.0, 1.0], [0.5, 0.5], [1.0, 0.0]):
+        _, reward, *_ = env.step(np.array(action, dtype=np.float32))
+        _, rewards, *_ = venv.step(np.array([action, action], dtype=np.float32))
+        wl, wr = action
+        want = 0.5 * (wl + wr) * (1.0 - math.sqrt(abs(wl - wr) / 2.0))
+        assert reward == pytest.approx(want, abs=1e-12)
+        assert rewards.tolist() == [reward, reward]

@@ -272,7 +272,7 @@ _NO_WHEEL_PAIR = ("AvoidObstacles' reward reads a left and a right wheel speed: 
 
 class AvoidObstacles:
     """Explore without touching anything: per action, ``v (1 - sqrt(|dv|)) (1 - p)`` with ``v`` the
-    mean wheel speed and ``dv`` the wheel speed difference (both / max wheel speed) and ``p`` the
+    mean wheel speed and ``dv`` the wheel speed difference (each wheel over its own maximum) and ``p`` the
     proximity ``1 - clearance / near`` (0 when nothing is within ``near`` m of the body), minus
     ``contact_penalty`` on contact. Contact (terminates): clearance below the body radius plus
     ``contact_distance``."""
@@ -298,8 +298,8 @@ class AvoidObstacles:
         drive = robot.drive
         if robot.model.differential_drive is None:
             raise ValueError(_NO_WHEEL_PAIR.format(robot.name))
-        vmax = drive.left.max_velocity
-        wl, wr = drive.left.velocity / vmax, drive.right.velocity / vmax
+        wl = drive.left.velocity / drive.left.max_velocity          # each over its own maximum, as actions scale
+        wr = drive.right.velocity / drive.right.max_velocity
         v = 0.5 * (wl + wr)
         dv = abs(wl - wr) / 2.0
         gap = self._gap(sim, robot)
@@ -329,7 +329,7 @@ class _AvoidObstaclesCopies(VectorGoal):
         self.goal, self.sim, self.slot = goal, sim, slot
         self.radius = body_radius(SimpleNamespace(model=sim.world.robots[slot]), sim.loaded.base_dir, sim.world)
         self.dirs = horizontal_directions(enu_axes(sim.world), self.RAYS)   # clearance()'s directions
-        self.vmax = float(sim.max_wheel[slot, 0])
+        self.vmax = (float(sim.max_wheel[slot, 0]), float(sim.max_wheel[slot, 1]))    # each wheel's own
         self.wheels = sim.world.robots[slot].differential_drive is not None    # (a car has no wheel pair)
         self._gap: tuple | None = None     # (step key, copies, gaps, terminations or None)
         self._passes = packets.avoid_outcome(sim.velocity)   # (None without the C helper)
@@ -387,7 +387,7 @@ class _AvoidObstaclesCopies(VectorGoal):
         if got is not None:
             return got
         vel = self.sim.velocity[copies, self.slot]
-        wl, wr = vel[:, 0] / self.vmax, vel[:, 1] / self.vmax
+        wl, wr = vel[:, 0] / self.vmax[0], vel[:, 1] / self.vmax[1]
         v = 0.5 * (wl + wr)
         dv = np.abs(wl - wr) / 2.0
         p = np.minimum(np.maximum(1.0 - gap / g.near, 0.0), 1.0)

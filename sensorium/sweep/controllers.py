@@ -46,6 +46,11 @@ def _velocity(robot, left: float, right: float) -> None:
             motor.set_velocity(v)
 
 
+def _top_speed(robot) -> float:
+    # one speed both wheels reach (each wheel motor has its own maxVelocity): the smaller maximum
+    return min(robot.drive.left.max_velocity, robot.drive.right.max_velocity)
+
+
 def idle(sim) -> None:
     return None
 
@@ -53,7 +58,7 @@ def idle(sim) -> None:
 def circle(sim) -> None:
     for robot in sim.robots.values():
         if _wheeled(robot):
-            vmax = robot.drive.left.max_velocity
+            vmax = _top_speed(robot)
             _velocity(robot, 0.5 * vmax, vmax)
     return None
 
@@ -61,7 +66,7 @@ def circle(sim) -> None:
 def spin(sim) -> None:
     for robot in sim.robots.values():
         if _wheeled(robot):
-            vmax = robot.drive.left.max_velocity
+            vmax = _top_speed(robot)
             _velocity(robot, -0.5 * vmax, 0.5 * vmax)
     return None
 
@@ -82,7 +87,7 @@ def braitenberg(sim) -> Step:
 
     def step(sim) -> None:
         for robot, (l0, l1), ir in crew:
-            vmax = robot.drive.left.max_velocity
+            vmax = _top_speed(robot)
             a, b = l0.value, l1.value
             left = right = 0.5 * vmax
             if a == a and b == b and a + b > 0:           # NaN before the first measurement

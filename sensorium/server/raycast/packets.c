@@ -1788,14 +1788,14 @@ void sp_clearance_gaps(size_t n, size_t rays, const double* d, double far, doubl
 }
 
 /* task.py's AvoidObstacles reward for n copies: wheel speeds wl, wr (velocity (C, R, 2) at copy
- * copies[i], slot `slot`) over vmax, v = 0.5 (wl + wr), dv = |wl - wr| / 2, p = min(max(1 - gap / near,
+ * copies[i], slot `slot`) each over its own maximum (vmax_l, vmax_r), v = 0.5 (wl + wr), dv = |wl - wr| / 2, p = min(max(1 - gap / near,
  * 0), 1), r = v (1 - sqrt(dv)) (1 - p), minus the penalty when gap < contact -- the numpy path's
  * operations, element by element (np.maximum/np.minimum's NaN). */
-void sp_avoid_reward(size_t n, const int64_t* copies, size_t R, size_t slot, const double* velocity, double vmax,
-                     const double* gap, double near, double contact, double penalty, double* out) {
+void sp_avoid_reward(size_t n, const int64_t* copies, size_t R, size_t slot, const double* velocity, double vmax_l,
+                     double vmax_r, const double* gap, double near, double contact, double penalty, double* out) {
   for (size_t i = 0; i < n; i++) {
     const double* vel = velocity + ((size_t)copies[i] * R + slot) * 2;
-    const double wl = vel[0] / vmax, wr = vel[1] / vmax;
+    const double wl = vel[0] / vmax_l, wr = vel[1] / vmax_r;
     const double v = 0.5 * (wl + wr);
     const double dv = fabs(wl - wr) / 2.0;
     const double q = 1.0 - gap[i] / near;
@@ -1935,12 +1935,12 @@ void sp_box_clip32(size_t n, const float* in, float lo, float hi, float* out) {
  * distances d (n, rays) into gap, then sp_avoid_reward into reward and gap < contact into term.
  * Returns 1 (nothing written) when a copy lies outside [0, C). */
 int sp_avoid_outcome(size_t n, size_t rays, const double* d, double far, double radius, const int64_t* copies,
-                     size_t C, size_t R, size_t slot, const double* velocity, double vmax, double near,
+                     size_t C, size_t R, size_t slot, const double* velocity, double vmax_l, double vmax_r, double near,
                      double contact, double penalty, double* gap, double* reward, uint8_t* term) {
   for (size_t i = 0; i < n; i++)
     if (copies[i] < 0 || (size_t)copies[i] >= C) return 1;
   sp_clearance_gaps(n, rays, d, far, radius, gap);
-  sp_avoid_reward(n, copies, R, slot, velocity, vmax, gap, near, contact, penalty, reward);
+  sp_avoid_reward(n, copies, R, slot, velocity, vmax_l, vmax_r, gap, near, contact, penalty, reward);
   for (size_t i = 0; i < n; i++) term[i] = gap[i] < contact;
   return 0;
 }

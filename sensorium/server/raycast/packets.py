@@ -222,8 +222,8 @@ def _load() -> None:
             ("sp_cross_norm", None, [sz, vp, vp, vp]),
             ("sp_sonar_nearest", None, [sz, sz, vp, vp, vp, d, vp]),
             ("sp_clearance_gaps", None, [sz, sz, vp, d, d, vp]),
-            ("sp_avoid_reward", None, [sz, vp, sz, sz, vp, d, vp, d, d, d, vp]),
-            ("sp_avoid_outcome", i, [sz, sz, vp, d, d, vp, sz, sz, sz, vp, d, d, d, d, vp, vp, vp]),
+            ("sp_avoid_reward", None, [sz, vp, sz, sz, vp, d, d, vp, d, d, d, vp]),
+            ("sp_avoid_outcome", i, [sz, sz, vp, d, d, vp, sz, sz, sz, vp, d, d, d, d, d, vp, vp, vp]),
             ("sp_box_clip32", None, [sz, vp, f, f, vp]),
             ("sp_due", sz, [sz, sz, vp, vp, vp, vp, vp]),
             ("sp_roll_pitch_yaw", None, [sz, vp, i, vp]),
@@ -1144,10 +1144,10 @@ def clearance_gaps(d: np.ndarray, far: float, radius: float) -> np.ndarray | Non
     return gap
 
 
-def avoid_reward(copies: np.ndarray, slot: int, velocity: np.ndarray, vmax: float, gap: np.ndarray, near: float,
-                 contact: float, penalty: float) -> np.ndarray | None:
+def avoid_reward(copies: np.ndarray, slot: int, velocity: np.ndarray, vmax: tuple[float, float], gap: np.ndarray,
+                 near: float, contact: float, penalty: float) -> np.ndarray | None:
     """AvoidObstacles' reward of the named copies (int64 ``copies``, their robot ``slot``'s wheel
-    ``velocity`` (C, R, 2), their ``gap`` (n,)) in one C pass (``sp_avoid_reward``, task.py's numpy
+    ``velocity`` (C, R, 2) over each wheel's own maximum ``vmax`` (left, right), their ``gap`` (n,)) in one C pass (``sp_avoid_reward``, task.py's numpy
     operations element by element); None without the helper or for other arrays."""
     lib = library()
     if lib is None or copies.dtype != np.int64 or gap.dtype != np.float64 or gap.shape != copies.shape \
@@ -1159,8 +1159,8 @@ def avoid_reward(copies: np.ndarray, slot: int, velocity: np.ndarray, vmax: floa
         raise IndexError(f"avoid_reward: slot {slot} or copies outside ({C}, {R})")
     copies, gap = np.ascontiguousarray(copies), np.ascontiguousarray(gap)
     out = np.empty(len(copies))
-    lib.sp_avoid_reward(len(copies), copies.ctypes.data, R, int(slot), velocity.ctypes.data, float(vmax),
-                        gap.ctypes.data, float(near), float(contact), float(penalty), out.ctypes.data)
+    lib.sp_avoid_reward(len(copies), copies.ctypes.data, R, int(slot), velocity.ctypes.data, float(vmax[0]),
+                        float(vmax[1]), gap.ctypes.data, float(near), float(contact), float(penalty), out.ctypes.data)
     return out
 
 
@@ -1263,8 +1263,9 @@ class AvoidOutcome:
         self.velocity = velocity
         self.p_velocity = velocity.ctypes.data
 
-    def __call__(self, d: np.ndarray, far: float, radius: float, copies: np.ndarray, slot: int, vmax: float,
-                 near: float, contact: float, penalty: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    def __call__(self, d: np.ndarray, far: float, radius: float, copies: np.ndarray, slot: int,
+                 vmax: tuple[float, float], near: float, contact: float,
+                 penalty: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
         """(gap, reward, terminated) of copies ``copies`` (int64 (n,)) whose clearance distances are
         ``d`` ((n, rays) float64), their robot in ``slot``; None for other arrays."""
         n = len(copies)
@@ -1276,7 +1277,7 @@ class AvoidOutcome:
         gap, reward, term = np.empty(n), np.empty(n), np.empty(n, dtype=np.bool_)
         p = _small_addresses((d, copies, gap, reward, term))
         if self.lib.sp_avoid_outcome(n, d.shape[1], p[0], far, radius, p[1], self.C, self.R, slot, self.p_velocity,
-                                     vmax, near, contact, penalty, p[2], p[3], p[4]):
+                                     vmax[0], vmax[1], near, contact, penalty, p[2], p[3], p[4]):
             raise IndexError(f"avoid_outcome: a copy outside [0, {self.C})")
         return gap, reward, term
 
