@@ -837,6 +837,18 @@ def test_repeated_device_names_get_a_suffix(tmp_path: Path) -> None:
     assert f"{p}:2:48: device name 'distance sensor' used before in robot 'r': renamed 'distance sensor(1)'" in w.warnings
 
 
+def test_a_robot_name_with_a_slash_is_one_topic_segment_said_at_load(tmp_path: Path) -> None:
+    """ABB's IRB 4600 PROTO names its robot 'IRB 4600/40': a '/' cannot be in a topic path's robot
+    segment, so the import renames it (once, said at its line) instead of refusing the world; a second
+    one is renamed as any repeated name is."""
+    p = write(tmp_path, 'Robot { name "IRB 4600/40" }\nRobot { name "IRB 4600/40" translation 1 0 0 }\n')
+    w = load_world(p)
+    assert [r.name for r in w.world.robots] == ["IRB 4600_40", "IRB 4600_40(1)"]
+    assert (f"{p}:2:1: robot name 'IRB 4600/40' holds '/', which topic paths cannot: renamed 'IRB 4600_40' "
+            "(getName() reads it)") in w.warnings
+    assert f"{p}:3:1: robot name 'IRB 4600_40' used before: renamed 'IRB 4600_40(1)'" in w.warnings
+
+
 def test_def_use_walk_is_bounded_without_shapes(tmp_path: Path, monkeypatch) -> None:
     from sensorium.server.world.wbt import convert
 

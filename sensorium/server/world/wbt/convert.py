@@ -1436,6 +1436,11 @@ class Converter:
         f = self.fields(node)
         inner = self.child_frame(node, frame)
         name = f.string("name", "robot")
+        if "/" in name:      # a robot's name is one segment of its topic paths (ABB's 'IRB 4600/40')
+            segment = name.replace("/", "_")
+            self.warn(node, f"robot name {name!r} holds '/', which topic paths cannot: renamed {segment!r} "
+                            "(getName() reads it)")
+            name = segment
         unique = self.unique_robot(name)
         if unique != name:
             self.warn(node, f"robot name {name!r} used before: renamed {unique!r}")
