@@ -77,7 +77,7 @@ from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_p
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "ground_rotation", "land_pose", "placing_ceiling", "ride_height",
+__all__ = ["Ground", "GroundWarning", "band_low", "falling_span", "ground_rotation", "land_pose", "placing_ceiling", "ride_height",
            "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "slope_scales", "support_ceiling"]
 
 UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
@@ -648,16 +648,17 @@ def land_pose(pose: Pose, low: float, high: float, ground: Ground | None, to_enu
     return Pose(pose.rotation, translation)
 
 
-def _falling(solid: wm.Solid, base_dir: Path, to_enu: np.ndarray | None) -> tuple[float, float, np.ndarray] | None:
+def falling_span(solid: wm.Solid, base_dir: Path, to_enu: np.ndarray | None,
+                 pose: Pose | None = None) -> tuple[float, float, np.ndarray] | None:
     """(lowest, highest point, xy box (x0, y0, x1, y1)) of the bounding shapes of a top-level solid that
-    falls at load (``physics``, at least one bounding shape, none of them a Plane or ElevationGrid: those
-    are ground, static in Webots' physics too), in ENU at its world-file pose, as kinematic contact and
-    the VacuumGripper take them (contact.obstacle); None for any other solid."""
+    falls (``physics``, at least one bounding shape, none of them a Plane or ElevationGrid: those
+    are ground, static in Webots' physics too), in ENU at ``pose`` (default its world-file pose), as
+    kinematic contact and the VacuumGripper take them (contact.obstacle); None for any other solid."""
     from sensorium.server.sim.scene import primitive_from_model, solid_parts
 
     if not solid.physics:
         return None
-    pose = pose_from_model(solid.pose)
+    pose = pose_from_model(solid.pose) if pose is None else pose
     prisms = []
     for _, local, shape in solid_parts(solid, Pose.identity()):
         if shape.seen_by not in ("both", "bounding"):
@@ -686,7 +687,7 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
     a box lands on it once that one has landed). A solid with physics not yet landed is no support. The
     solids in ``caught`` (held by a VacuumGripper from the first step: vacuum.caught_at_load) stay."""
     falling = [(i, s, got) for i, s in enumerate(world.solids)
-               if s.name not in caught and (got := _falling(s, base_dir, to_enu)) is not None]
+               if s.name not in caught and (got := falling_span(s, base_dir, to_enu)) is not None]
     if not falling:
         return world, []
     moving = {i for i, _, _ in falling}

@@ -33,6 +33,8 @@ from sensorium.server.sim.ground import (
     Ground,
     GroundWarning,
     band_low,
+    falling_span,
+    land_pose,
     settle_pose,
     settle_world,
     settles,
@@ -715,6 +717,14 @@ class Simulation:
         self._take_out(name)
         self.world.solids[k] = solid
         self._join_solid(solid, node_id, prepared, again=True)
+        # rebuilt with physics, it lands on what is under it, as the world file written so settles at load
+        to_enu = _TO_ENU[self.world.world_info.coordinate_system]
+        pose = self.scene.solid_poses[name]
+        span = falling_span(solid, self.loaded.base_dir, to_enu, pose)
+        if span is not None:
+            landed = land_pose(pose, span[0], span[1], self.landing_ground(name), to_enu)
+            if landed is not pose:
+                self.place_solid(name, landed)
         if name in self._initial["solids"]:       # a reset keeps the new values (Webots resets no field)
             targets = self._initial["radar_targets"]
             for key in [t for t in targets if t == name or (isinstance(t, tuple) and t[0] == name)]:
