@@ -24,3 +24,29 @@ def test_an_old_proto_is_said_only_when_it_places_something(tmp_path: Path) -> N
     said = [x for x in w.warnings if "before R2022a" in x]
     assert len(said) == 1 and "PROTO Post was written for Webots R2021b" in said[0], said
     assert [d.name for d in w.world.robots[0].devices] == ["front_lights"]
+
+
+def test_a_proto_without_a_header_loads_as_a_current_one(tmp_path: Path) -> None:
+    """Webots needs the header line of worlds only: a PROTO file without one (Webots' tutorial
+    FourWheelsRobot.proto once had none) is read with a warning, as a z-up PROTO; it was refused."""
+    (tmp_path / "Rover.proto").write_text(
+        "PROTO Rover [ field SFVec3f translation 0 0 0 field SFString name \"rover\" ]\n"
+        "{ Robot { translation IS translation name IS name controller \"<extern>\" children [\n"
+        "  DistanceSensor { translation 0.1 0 0 name \"front\" } ] } }\n")
+    # a leading comment that is not a header: still read; its comments are the header's (JavaScript template)
+    (tmp_path / "Pair.proto").write_text(
+        "# template language: javascript\nPROTO Pair [ field SFInt32 count 2 ]\n"
+        "{ Robot { name \"pair\" controller \"<extern>\" children [\n"
+        "%< for (let i = 0; i < fields.count.value; ++i) { >%\n"
+        "  DistanceSensor { name \"ds%<= i >%\" }\n%< } >%\n] } }\n")
+    world = tmp_path / "w.wbt"
+    world.write_text('#VRML_SIM R2023b utf8\nEXTERNPROTO "Rover.proto"\nEXTERNPROTO "Pair.proto"\n'
+                     "Rover { translation 0.3 -0.2 0.1 }\nPair { count 3 }\n")
+    w = load_world(world)
+    rover, pair = w.world.robots
+    assert rover.name == "rover" and rover.pose.translation == (0.3, -0.2, 0.1)
+    assert [d.name for d in rover.devices] == ["front"]
+    assert [d.name for d in pair.devices] == ["ds0", "ds1", "ds2"]
+    said = [x for x in w.warnings if "no '#VRML_SIM R20xxy utf8' header" in x]
+    assert len(said) == 2 and any("Rover.proto:1:1: PROTO Rover" in x for x in said), w.warnings
+    assert not any("before R2022a" in x for x in w.warnings)

@@ -31,7 +31,7 @@ from sensorium.server.world.wbt.parser import (
     Token,
     Tokens,
     header_comments,
-    parse_header,
+    header_version,
     read_text,
     short,
     unquote,
@@ -137,7 +137,7 @@ _POSED = re.compile(r"\b(translation|rotation|location|direction|Box|Cylinder|Ca
 def read_proto_file(path: Path, source: str, limits: ProtoLimits) -> ProtoDef:
     """A PROTO file: header comments, EXTERNPROTO declarations, interface, body text."""
     text = read_text(path, "PROTO", limits.proto_file_bytes)
-    year, letter = parse_header(text, source, "PROTO file")
+    version = header_version(text)
     parser = Parser(Tokens(text, source, chunk=1), source, limits=limits)
     decls: list[ExternProto] = []
     while True:
@@ -156,6 +156,14 @@ def read_proto_file(path: Path, source: str, limits: ProtoLimits) -> ProtoDef:
         raise parser.error(tok, f"expected PROTO or EXTERNPROTO, found {_describe(tok)}")
     proto = read_proto_definition(parser, text, inline=False)
     proto.externprotos = decls
+    if version is None:
+        # Webots requires the header of worlds only: a PROTO without one is read, with a warning, as a file of
+        # its own version (z up); every line of its leading comment block is a header comment
+        proto.header = header_comments("\n" + text)
+        proto.warnings.append(f"{source}:1:1: PROTO {proto.name}: no '#VRML_SIM R20xxy utf8' header on the "
+                              "first line; read as a current (R2022a and later, z-up) PROTO, as Webots reads it")
+        return proto
+    year, letter = version
     proto.header = header_comments(text)
     proto.version = f"R{year}{letter}"
     if (year, letter) < (2022, "a") and _POSED.search(proto.body):    # a PROTO of devices alone has no poses to turn

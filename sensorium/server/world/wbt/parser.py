@@ -550,13 +550,18 @@ def _describe(tok: Token) -> str:
     return quote(tok.text, 60)
 
 
+def header_version(text: str) -> tuple[int, str] | None:
+    """The version of ``#VRML_SIM R20xxy utf8`` on the first line, (year, letter); None without one."""
+    m = _HEADER.match(text.split("\n", 1)[0])
+    return (int(m.group(1)), m.group(2)) if m else None
+
+
 def parse_header(text: str, source: str, what: str = "world") -> tuple[int, str]:
     """The version of ``#VRML_SIM R20xxy utf8`` on the first line: (year, letter)."""
-    first = text.split("\n", 1)[0]
-    m = _HEADER.match(first)
-    if m is None:
+    version = header_version(text)
+    if version is None:
         raise WbtSyntaxError(source, 1, 1, f"not a Webots {what}: the first line must be '#VRML_SIM R20xxy utf8'")
-    return int(m.group(1)), m.group(2)
+    return version
 
 
 def header_comments(text: str) -> list[str]:
