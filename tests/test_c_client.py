@@ -688,7 +688,7 @@ def test_webots_cpp_camera_and_range_finder_names(cbin, servers):
     assert lines[1] == "pixel 1 1"
     period, n, same, first, segmentation = (int(v) for v in lines[2].split()[1:])
     assert (period, same, segmentation) == (16, 1, 0) and n >= 1 and first > 0
-    assert lines[3] == "paths [] [] []"
+    assert lines[3] == 'paths [] [] [<?xml version="1.0"?>]'
 
 
 def test_c_client_replays_the_conformance_session(cbin, servers):

@@ -1,7 +1,7 @@
 """Webots' user-input and robot extras on a headless server: ``wb_joystick_*`` (never connected),
 ``wb_mouse_*`` (no state: NaN), ``wb_robot_wait_for_user_input_event`` (no event ever comes: the
-simulation runs for the whole timeout), the battery (none: NaN), project/world paths and URDF
-(""), robot-window messages (none). The keyboard is in :mod:`sensorium.client.wb_robot`."""
+simulation runs for the whole timeout), the battery (none: NaN), project/world paths (""), the URDF (the server's
+``get_urdf``), robot-window messages (none). The keyboard is in :mod:`sensorium.client.wb_robot`."""
 
 from __future__ import annotations
 
@@ -77,8 +77,12 @@ def wb_robot_get_world_path() -> str:
 
 
 def wb_robot_get_urdf(prefix: str = "") -> str:
-    current()
-    return ""
+    """The robot's URDF as Webots exports it, ``prefix`` before every link and joint name (the
+    server's ``get_urdf``: the poses the world file gives, README "getUrdf")."""
+    r = current()
+    if not isinstance(prefix, str):
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_robot_get_urdf(): prefix must be a string, got {prefix!r}")
+    return str(r.conn.call(f"/{r.name}/robot/get_urdf", {"prefix": prefix})["value"])
 
 
 def wb_robot_wwi_send_text(text: str) -> None:

@@ -290,6 +290,11 @@ class StringArgs(Args):
     value: str = Field(max_length=1 << 20)
 
 
+class UrdfArgs(Args):
+    prefix: str = Field(default="", max_length=4096, description="put before every link and joint name "
+                        "(Webots wb_robot_get_urdf's prefix)")
+
+
 class NodeNameArgs(Args):
     name: str = Field(min_length=1, max_length=4096, description="a node's DEF name, or a dotted path of DEF names "
                       "(A.B: B a direct child of A); else a robot's, solid's or light's name")
@@ -1065,6 +1070,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_custom_data", "robot", NoArgs, StringValue),
     ServiceSpec("set_custom_data", "robot", StringArgs, SuccessResult, attached=True),
     ServiceSpec("get_model", "robot", NoArgs, StringValue),
+    ServiceSpec("get_urdf", "robot", UrdfArgs, StringValue),
     ServiceSpec("get_from_def", "robot", NodeNameArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_from_proto_def", "robot", ProtoDefArgs, ProtoDefResult, attached=True, supervisor=True),
     ServiceSpec("get_self", "robot", NoArgs, NodeResult, attached=True, supervisor=True),

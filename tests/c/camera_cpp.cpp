@@ -39,7 +39,7 @@ int main() {
               n == wb_camera_recognition_get_number_of_objects(cam->getTag()), n > 0 ? objects[0].id : -1,
               cam->hasRecognitionSegmentation() ? 1 : 0);
   std::printf("paths [%s] [%s] [%s]\n", robot->getProjectPath().c_str(), robot->getWorldPath().c_str(),
-              robot->getUrdf().c_str());
+              robot->getUrdf("b_").substr(0, 21).c_str()); /* the URDF's XML declaration */
   delete robot;
   return 0;
 }

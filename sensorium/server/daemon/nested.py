@@ -109,7 +109,7 @@ class Table:
         return self.nodes[k] if 0 <= k < len(self.nodes) else self.added.get(node_id)
 
 
-def _robot_entries(robot: Any) -> list[wm.NestedNode]:
+def robot_entries(robot: Any) -> list[wm.NestedNode]:
     """A robot's nodes: its world entry's, else one per device of its device list (a drive's wheel
     motors too), at the device's pose."""
     model = robot.model
@@ -182,7 +182,7 @@ def _joint_parameters(sim: Any, robots: list[str], out: list[Nested]) -> tuple[l
     first = 0
     for i, name in enumerate(robots):
         robot = sim.robots[name]
-        entries = _robot_entries(robot)
+        entries = robot_entries(robot)
         motors = _first_motors(entries)
         for k, e in enumerate(entries):
             motor = motors.get(k, "")
@@ -331,7 +331,7 @@ def build(sim: Any, loaded_solids: int) -> Table:
     serials: dict[int, dict[int, int]] = {}     # a top-level solid's id -> its PROTO instances' ids by number
     for i, name in enumerate(robots):
         owner = i + 1
-        entries = _robot_entries(sim.robots[name])
+        entries = robot_entries(sim.robots[name])
         joints = _riding(sim.robots[name], entries)
         first = FIRST_ID + len(out)
         firsts[owner] = first

@@ -42,9 +42,11 @@ from sensorium.schemas.wire import (
 from sensorium.server.daemon import roles, supervisor
 from sensorium.server.daemon.device_services import MOTOR, DeviceServices, ServiceError
 from sensorium.server.daemon.lockstep import Lockstep, LockstepError, Session, StepDone
+from sensorium.server.daemon.nested import robot_entries
 from sensorium.server.daemon.topics import Control, Topics, pose_quaternion
 from sensorium.server.sim.joints import JointMotor
 from sensorium.server.sim.simulation import DeviceEntry
+from sensorium.server.world.urdf import robot_urdf
 
 __all__ = ["Core", "ServiceError"]
 
@@ -768,6 +770,11 @@ class Core(DeviceServices):
 
     def _robot_get_model(self, c: Call) -> dict:
         return {"value": self.sim.robots[c.robot].model.model}
+
+    def _robot_get_urdf(self, c: Call) -> dict:
+        """Webots' wb_robot_get_urdf: the robot's URDF from its nodes as the world loads (world/urdf.py)."""
+        robot = self.sim.robots[c.robot]
+        return {"value": robot_urdf(robot.model, robot_entries(robot), c.args.prefix)}
 
     # ------------------------------------------------------------------ supervisor services
     def _robot_restart_controller(self, c: Call) -> dict:

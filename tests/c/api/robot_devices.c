@@ -3,6 +3,7 @@
  * without advancing time; waiting for user input runs the simulation for the timeout; tasks and
  * mutexes. */
 #define _POSIX_C_SOURCE 200809L
+#include <string.h>
 #include <time.h>
 
 #include <webots/camera.h>
@@ -68,9 +69,10 @@ int main(void) {
   ts_assert_int_equal(e, WB_EVENT_NO_EVENT, "no user input event");
   ts_assert_double_in_delta(wb_robot_get_time(), 0.016 + 0.048, 1e-12, "waited 48 ms");
   ts_assert_boolean_equal(isinf(INFINITY), true, "INFINITY");
-  /* no Webots project here; tasks and mutexes are threads */
+  /* no Webots project here (the URDF is the server's); tasks and mutexes are threads */
   ts_assert_string_equal(wb_robot_get_project_path(), "", "no project path");
-  ts_assert_string_equal(wb_robot_get_urdf(""), "", "no URDF");
+  static const char urdf_head[] = "<?xml version=\"1.0\"?>\n<robot name=\"gadget\">\n  <link name=\"q_base_link\">";
+  ts_assert_int_equal(strncmp(wb_robot_get_urdf("q_"), urdf_head, strlen(urdf_head)), 0, "the URDF, prefixed");
   g_mutex = wb_robot_mutex_new();
   static const int answer = 42;
   wb_robot_task_new(task, (void *)&answer);

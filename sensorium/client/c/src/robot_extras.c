@@ -22,10 +22,24 @@ const char *wb_robot_get_world_path(void) {
   return "";
 }
 
+static void add_prefix(sn_req *r, const void *arg) {
+  sn_req_key(r, "prefix");
+  sn_req_str(r, (const char *)arg);
+}
+
+/* The server's get_urdf. As libController, the library owns the string: it stays valid until the
+ * next call (which frees it); "" when the call failed. */
 const char *wb_robot_get_urdf(const char *prefix) {
-  (void)prefix;
-  sn_robot_get("wb_robot_get_urdf");
-  return "";
+  static char *urdf;
+  sn_robot *rb = sn_robot_get("wb_robot_get_urdf");
+  free(urdf);
+  urdf = NULL;
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/get_urdf", 1, add_prefix, prefix != NULL ? prefix : "", "wb_robot_get_urdf", &rep) != 0)
+    return "";
+  urdf = sn_strdup_obj(sn_get(rep.result, "value"));
+  sn_reply_free(&rep);
+  return urdf != NULL ? urdf : "";
 }
 
 void wb_robot_pin_to_static_environment(bool pin) {

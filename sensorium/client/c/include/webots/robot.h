@@ -57,8 +57,8 @@ void wb_robot_battery_sensor_disable(void);
 int wb_robot_battery_sensor_get_sampling_period(void);
 double wb_robot_battery_sensor_get_value(void);
 
-/* What a controller of a Sensorium server does not have: a Webots project ("" paths), a URDF
- * export (""), a robot window to pin. */
+/* What a controller of a Sensorium server does not have: a Webots project ("" paths), a robot
+ * window to pin. The URDF is the server's export (the library owns the string until the next call). */
 const char *wb_robot_get_project_path(void);
 const char *wb_robot_get_world_path(void);
 const char *wb_robot_get_urdf(const char *prefix);
