@@ -7,7 +7,8 @@ it starts a subprocess itself or through a helper or fixture of its module (foun
 source: a function or class that mentions ``subprocess``/``Popen`` or starts one with tests/_serve.py
 — ``Proc(``, ``Served(``, ``serve(``, ``run_example(`` — or test_multiprocess's ``start_server(``/``run_paused(``,
 or starts a local Ray cluster (``init_ray(``), or calls one that does), or when it is listed in
-``SLOW_TESTS`` (long single-process runs, worker pools).
+``SLOW_TESTS`` (long single-process runs, worker pools). The long randomized tests (Hypothesis, seeded
+loops) draw a share of their cases in the fast suite and all of them as slow cases (tests/_fuzz.py).
 """
 
 from __future__ import annotations
@@ -93,7 +94,7 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:  # no
     left_out = config.stash.get(_SLOW_LEFT_OUT, 0)
     if left_out:
         terminalreporter.write_line(
-            f"sensorium: {left_out} slow test(s) (servers, controllers and tools as processes) left out: "
+            f"sensorium: {left_out} slow test(s) (servers, controllers and tools as processes, full fuzz runs) left out: "
             "run `pytest -m slow` for them, or SENSORIUM_SLOW=1 pytest for everything (CI runs both)", yellow=True)
     skipped = terminalreporter.stats.get("skipped", [])
     node = [r for r in skipped if any(m in str(getattr(r, "longrepr", "")) for m in NODE_SKIP_MARKERS)]
