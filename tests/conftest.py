@@ -5,9 +5,10 @@ runs those, ``pytest -m "slow or not slow"`` (or ``SENSORIUM_SLOW=1``) everythin
 A test is slow when its module runs servers and controllers as processes (``SLOW_MODULES``), when
 it starts a subprocess itself or through a helper or fixture of its module (found in the module's
 source: a function or class that mentions ``subprocess``/``Popen`` or starts one with tests/_serve.py
-— ``Proc(``, ``Served(``, ``serve(`` — or test_multiprocess's ``start_server(``/``run_paused(``, or
-calls one that does), or when it is listed in
-``SLOW_TESTS`` (long single-process runs, worker pools).
+— ``Proc(``, ``Served(``, ``serve(``, ``run_example(`` — or test_multiprocess's ``start_server(``/``run_paused(``,
+or starts a local Ray cluster (``init_ray(``), or calls one that does), or when it is listed in
+``SLOW_TESTS`` (long single-process runs, worker pools). The long randomized tests (Hypothesis, seeded
+loops) draw a share of their cases in the fast suite and all of them as slow cases (tests/_fuzz.py).
 """
 
 from __future__ import annotations
@@ -27,11 +28,17 @@ SLOW_TESTS = {
     "test_sweep.py::test_same_sweep_on_ray_and_on_the_process_pool_gives_identical_results",   # a Ray cluster
     "test_train.py::test_ppo_on_the_batched_env_reaches_the_lamp",                             # ~1.5 min of PPO
     "test_train.py::test_evolution_strategy_on_ray_actors_equals_the_same_workers_in_process",  # a Ray cluster
+    # mesh worker processes: a file read until the worker's memory limit stops it (~20 s), and five
+    # workers started one per file; test_mesh_worker's other tests keep a worker reading in the fast suite
+    "test_mesh_worker.py::test_a_file_over_the_memory_limit_is_one_line_and_the_next_file_loads",
+    "test_mesh_worker.py::test_the_files_of_a_world_are_read_by_one_worker_with_the_triangles_of_a_worker_per_file",
 }
 
 
-# tests/_serve.py's helpers and test_multiprocess's (imported by other modules) start processes
-SPAWNS = re.compile(r"subprocess|Popen|\b(?:Proc|Served|serve|start_server|run_paused|run_controller|sanitized_controller)\(")
+# tests/_serve.py's helpers and test_multiprocess's (imported by other modules) start processes; so
+# does sensorium.sweep's init_ray (Ray's GCS, raylet and workers)
+SPAWNS = re.compile(r"subprocess|Popen|\b(?:Proc|Served|serve|start_server|run_paused|run_controller|run_example"
+                    r"|sanitized_controller|init_ray)\(")
 
 
 @cache
@@ -87,7 +94,7 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:  # no
     left_out = config.stash.get(_SLOW_LEFT_OUT, 0)
     if left_out:
         terminalreporter.write_line(
-            f"sensorium: {left_out} slow test(s) (servers, controllers and tools as processes) left out: "
+            f"sensorium: {left_out} slow test(s) (servers, controllers and tools as processes, full fuzz runs) left out: "
             "run `pytest -m slow` for them, or SENSORIUM_SLOW=1 pytest for everything (CI runs both)", yellow=True)
     skipped = terminalreporter.stats.get("skipped", [])
     node = [r for r in skipped if any(m in str(getattr(r, "longrepr", "")) for m in NODE_SKIP_MARKERS)]

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from _fuzz import seeds
 
 from sensorium.server.sim import contact as C
 from sensorium.server.sim.simulation import Simulation
@@ -366,7 +367,7 @@ def _moves_near(rng, ob: C.Obstacle, rho: float, count: int):
         yield p, u * length
 
 
-@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("seed", seeds(6))
 def test_time_of_impact_skips_give_the_exhaustive_answer_bit_for_bit(seed):
     rng = np.random.default_rng(seed)
     finite = skipped_any = touching = clear = swept = 0

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 import pytest
+from _fuzz import example_counts, seeds
 from test_contact import drive, world, xy  # the same world, wheels and positions as the disc tests
 
 from sensorium.server.sim import contact as C
@@ -609,7 +610,7 @@ def _rect_gap(p, rect):
     return float(np.hypot(max(q[0], 0.0), max(q[1], 0.0)) + min(max(q[0], q[1]), 0.0))
 
 
-@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("seed", seeds(4))
 def test_random_crowds_of_box_robots_never_penetrate(seed):
     """Random turned boxes and posts, box robots of random sizes with random curvy and spinning
     drives and big steps (up to 0.8 m and 1.3 rad a step): after every step no robot's rectangle
@@ -668,7 +669,8 @@ def test_a_box_robot_meeting_a_wall_obliquely_slides_along_it_on_its_corner():
     assert heading(sim, "r") == pytest.approx(yaw, abs=1e-12) and sim.robot("r").pressing
 
 
-def test_the_exact_turn_test_agrees_with_the_turn_sampled_densely():
+@pytest.mark.parametrize("examples", example_counts(200))
+def test_the_exact_turn_test_agrees_with_the_turn_sampled_densely(examples: int):
     # random footprints and obstacles (points, segments, polygons, round or not, wall lines, near and
     # 1e5 m from the origin, already overlapping or apart) turned by random amounts: where the arcs
     # say the turn holds the signed distance above its target, no sampled heading goes below it;
@@ -676,7 +678,7 @@ def test_the_exact_turn_test_agrees_with_the_turn_sampled_densely():
     # point of the turn missed between samples: 0.6 (pi / 400)^2 / 2 < 2e-5 m) of it: sound, and
     # not pessimistic beyond the sampling's reach
     rng = np.random.default_rng(7)
-    for _ in range(200):
+    for _ in range(examples):
         pts = C._hull(rng.uniform(-0.3, 0.3, (int(rng.integers(1, 6)), 2)))
         off = np.array([1e5, -1e5]) if rng.random() < 0.5 else np.zeros(2)
         q = C._hull(rng.uniform(-0.3, 0.3, (int(rng.integers(1, 6)), 2)) + rng.uniform(-0.5, 0.5, 2) + off)

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import msgpack
 import pytest
+from _fuzz import example_counts
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -139,11 +140,12 @@ def messages(draw, core: Core):
     return envelope, msgpack.packb(req), rid
 
 
+@pytest.mark.parametrize("examples", example_counts(400))
 @pytest.mark.parametrize("world", ["server.yaml", "webots_api.yaml"])
-def test_every_request_gets_one_well_formed_reply(world):
+def test_every_request_gets_one_well_formed_reply(world, examples):
     f = fuzzed(world)
 
-    @SETTINGS
+    @settings(SETTINGS, max_examples=examples)
     @given(st.lists(messages(f.core), min_size=1, max_size=8))
     def run(batch):
         for envelope, body, rid in batch:
@@ -156,15 +158,16 @@ def test_every_request_gets_one_well_formed_reply(world):
     run()
 
 
+@pytest.mark.parametrize("examples", example_counts(400))
 @pytest.mark.parametrize("world", ["server.yaml", "webots_api.yaml"])
-def test_subscription_events_keep_the_demand_consistent(world):
+def test_subscription_events_keep_the_demand_consistent(world, examples):
     f = fuzzed(world)
     frames = [t.frame for t in f.core.topics.topics]
     prefixes = st.sampled_from(frames) | st.sampled_from(frames).map(lambda b: b[: max(0, len(b) // 2)]) \
         | st.binary(max_size=16) | st.just(b"")
     events = st.tuples(st.sampled_from([0, 1]), prefixes).map(lambda e: bytes([e[0]]) + e[1]) | st.binary(max_size=8)
 
-    @SETTINGS
+    @settings(SETTINGS, max_examples=examples)
     @given(st.lists(events, max_size=20))
     def run(evs):
         model: Counter[bytes] = Counter()        # subscriptions per prefix (several subscribers may share one)

@@ -13,6 +13,7 @@ import threading
 from pathlib import Path
 
 import pytest
+from _fuzz import example_counts
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import SETTINGS
@@ -59,11 +60,12 @@ hostile = st.one_of(
                      b"glTF\x02\x00\x00\x00\xff\xff\xff\x7f", b"OFF\n99999999 99999999 0\n"]))
 
 
-def test_hostile_files_then_good_files(tmp_path: Path, starts) -> None:  # noqa: F811
+@pytest.mark.parametrize("examples", example_counts(60))
+def test_hostile_files_then_good_files(tmp_path: Path, starts, examples: int) -> None:  # noqa: F811
     good = _good(tmp_path, starts)
     suffixes = ["stl", "obj", "dae", "ply", "glb", "off"]
 
-    @settings(SETTINGS, max_examples=60)
+    @settings(SETTINGS, max_examples=examples)
     @given(hostile, st.sampled_from(suffixes), st.sampled_from(sorted(good)))
     def run(data, suffix, name):
         bad = tmp_path / f"bad.{suffix}"

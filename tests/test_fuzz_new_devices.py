@@ -21,7 +21,8 @@ from pathlib import Path
 
 import msgpack
 import pytest
-from hypothesis import given
+from _fuzz import example_counts
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import CODES, SETTINGS, Fuzzed
 
@@ -112,10 +113,11 @@ def attached() -> Fuzzed:
     return f
 
 
-def test_the_new_devices_services_refuse_bad_arguments_in_one_line_and_change_nothing(attached: Fuzzed) -> None:
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_the_new_devices_services_refuse_bad_arguments_in_one_line_and_change_nothing(attached: Fuzzed, examples: int) -> None:
     f = attached
 
-    @SETTINGS
+    @settings(SETTINGS, max_examples=examples)
     @given(st.lists(requests(), min_size=1, max_size=6))
     def run(batch):
         for service, args in batch:
@@ -155,7 +157,8 @@ GETTERS = {"get_field", "get_node_pose", "get_node_velocity", "get_from_def", "g
 
 
 @pytest.mark.parametrize(("world", "robot"), [("nested_joints.wbt", "armbot"), ("nested_nodes.wbt", "rover")])
-def test_supervisor_services_on_nested_nodes_answer_or_refuse_in_one_line(world: str, robot: str) -> None:
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_supervisor_services_on_nested_nodes_answer_or_refuse_in_one_line(world: str, robot: str, examples: int) -> None:
     """get_field and set_field (SFNode jointParameters included), get_node_pose/velocity, get_from_def
     (DEF names, dotted paths, noise), get_from_id, remove_node, set_joint_position and
     save/load_node_state on every node id and ids that are none: one reply each; a refusal, or a
@@ -217,7 +220,7 @@ def test_supervisor_services_on_nested_nodes_answer_or_refuse_in_one_line(world:
     assert len(seen) > len(real) or world != "nested_joints.wbt", seen      # jointParameters nodes reached
     assert kinds or world != "nested_joints.wbt"
 
-    @SETTINGS
+    @settings(SETTINGS, max_examples=examples)
     @given(st.lists(item_args, min_size=1, max_size=6))
     def run(batch):
         for item, args in batch:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from _fuzz import example_counts
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import SETTINGS, Fuzzed
@@ -49,7 +50,8 @@ def _check_value(kind: str, value: object) -> None:
         assert isinstance(value, list), (kind, value)
 
 
-def test_proto_field_services_answer_or_refuse_in_one_line_and_change_nothing(fuzzed) -> None:
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_proto_field_services_answer_or_refuse_in_one_line_and_change_nothing(fuzzed, examples: int) -> None:
     f, ids = fuzzed
     node = st.sampled_from(ids) | st.sampled_from(ids) | st.integers(-3, 40) | st.integers(-(1 << 63), (1 << 64) - 1) | values
     level = (st.integers(-2, 5) | st.sampled_from([16, 17, -1 << 40, 1 << 63, (1 << 64) - 1, 1.0, 1.5, True, "1", None])
@@ -76,7 +78,7 @@ def test_proto_field_services_answer_or_refuse_in_one_line_and_change_nothing(fu
                                                                 "level": st.integers(-1, 4) | st.just(-1),
                                                                 "value": value})))
 
-    @SETTINGS
+    @settings(SETTINGS, max_examples=examples)
     @given(st.lists(requests, min_size=1, max_size=6))
     def run(batch):
         for item, a in batch:

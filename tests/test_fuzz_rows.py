@@ -13,7 +13,8 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import pytest
-from hypothesis import given
+from _fuzz import example_counts
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from pydantic import Field, ValidationError
 from test_fuzz_core import SETTINGS
@@ -59,11 +60,19 @@ def _outcome(model: type, data: Any, as_json: bool) -> tuple[str, Any]:
     return "ok", out
 
 
-@SETTINGS
-@given(st.fixed_dictionaries({"type": st.just("triangles"), "vertices": rows, "faces": rows},
-                             optional={"tex_coords": rows, "tex_coord_faces": rows}),
-       st.booleans())
-def test_rows_validate_as_the_plain_lists_did(data, as_json) -> None:
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_rows_validate_as_the_plain_lists_did(examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.fixed_dictionaries({"type": st.just("triangles"), "vertices": rows, "faces": rows},
+                                 optional={"tex_coords": rows, "tex_coord_faces": rows}),
+           st.booleans())
+    def run(data, as_json) -> None:
+        _rows_validate_as_the_plain_lists_did(data, as_json)
+
+    run()
+
+
+def _rows_validate_as_the_plain_lists_did(data, as_json) -> None:
     want = _outcome(PlainTriangles, data, as_json)
     got = _outcome(wm.Triangles, data, as_json)
     assert got == want, (data, as_json)
@@ -106,10 +115,18 @@ def _read(text: str, folder: Path) -> tuple[str, Any]:
                        for v in (g.vertices, g.faces, g.tex_coords, g.tex_coord_faces))
 
 
-@SETTINGS
-@given(st.lists(st.sampled_from(TOKENS), min_size=0, max_size=40), st.lists(st.sampled_from(TOKENS), max_size=40),
-       st.integers(1, 3), st.none() | st.lists(st.sampled_from(TOKENS), max_size=30))
-def test_wbt_runs_read_as_one_number_at_a_time(points, index, run_min, tex) -> None:
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_wbt_runs_read_as_one_number_at_a_time(examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.lists(st.sampled_from(TOKENS), min_size=0, max_size=40), st.lists(st.sampled_from(TOKENS), max_size=40),
+           st.integers(1, 3), st.none() | st.lists(st.sampled_from(TOKENS), max_size=30))
+    def run(points, index, run_min, tex) -> None:
+        _wbt_runs_read_as_one_number_at_a_time(points, index, run_min, tex)
+
+    run()
+
+
+def _wbt_runs_read_as_one_number_at_a_time(points, index, run_min, tex) -> None:
     text = _world(points * 3, index * 2, None if tex is None else tex * 2)
     with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as mp:
         mp.setattr(wp, "RUN_MIN", run_min)

@@ -10,6 +10,7 @@ import os
 from pathlib import Path
 
 import pytest
+from _fuzz import example_counts
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -36,9 +37,17 @@ def one_line(exc: RuntimeIniError, where: str) -> str:
     return text
 
 
-@SETTINGS
-@given(st.lists(ANY_TEXT, max_size=30), st.sampled_from(["\n", "\r\n", "\r", "\x0b", "\u2028"]), st.booleans())
-def test_any_text_parses_to_entries_or_one_line(pieces: list[str], newline: str, bom: bool) -> None:
+@pytest.mark.parametrize("examples", example_counts(300))
+def test_any_text_parses_to_entries_or_one_line(examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.lists(ANY_TEXT, max_size=30), st.sampled_from(["\n", "\r\n", "\r", "\x0b", "\u2028"]), st.booleans())
+    def run(pieces: list[str], newline: str, bom: bool) -> None:
+        _any_text_parses_to_entries_or_one_line(pieces, newline, bom)
+
+    run()
+
+
+def _any_text_parses_to_entries_or_one_line(pieces: list[str], newline: str, bom: bool) -> None:
     text = ("\ufeff" if bom else "") + newline.join(pieces)
     try:
         ini = parse(text, "p/runtime.ini")
@@ -91,9 +100,17 @@ def ini_file(draw: st.DrawFn) -> tuple[str, list[tuple[str, str, str]]]:
     return ("\ufeff" if draw(st.booleans()) else "") + newline.join(lines), expected
 
 
-@SETTINGS
-@given(ini_file())
-def test_a_well_formed_file_gives_webots_entries(made: tuple[str, list[tuple[str, str, str]]]) -> None:
+@pytest.mark.parametrize("examples", example_counts(300))
+def test_a_well_formed_file_gives_webots_entries(examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(ini_file())
+    def run(made: tuple[str, list[tuple[str, str, str]]]) -> None:
+        _a_well_formed_file_gives_webots_entries(made)
+
+    run()
+
+
+def _a_well_formed_file_gives_webots_entries(made: tuple[str, list[tuple[str, str, str]]]) -> None:
     text, expected = made
     assert list(parse(text).entries) == expected
 
@@ -144,12 +161,20 @@ def test_an_expansion_past_the_bound_is_one_line_naming_file_and_line() -> None:
     assert len(environment(parse(many.replace("V4", "W")), {"BIG": "y" * 10}, "linux")) == 51
 
 
-@SETTINGS
-@given(st.lists(st.tuples(st.sampled_from(SECTIONS[:3]), st.sampled_from(ATTACH + ["A", "SENSORIUM_CONTROLLER_TIMEOUT"]),
-                          st.sampled_from(["", "tcp://127.0.0.1:9/evil", "other", "$(A)", "/x:$(PYTHONPATH)",
-                                           "tcp://10.0.0.1:1", "0" * 40, "$(WEBOTS_ROBOT_NAME)x"])), max_size=12),
-       st.sampled_from(["alpha", "beta %41", "é/ü"]), st.booleans())
-def test_a_runtime_ini_cannot_change_where_the_controller_attaches(entries: list[tuple[str, str, str]], robot: str,
+@pytest.mark.parametrize("examples", example_counts(300))
+def test_a_runtime_ini_cannot_change_where_the_controller_attaches(examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.lists(st.tuples(st.sampled_from(SECTIONS[:3]), st.sampled_from(ATTACH + ["A", "SENSORIUM_CONTROLLER_TIMEOUT"]),
+                              st.sampled_from(["", "tcp://127.0.0.1:9/evil", "other", "$(A)", "/x:$(PYTHONPATH)",
+                                               "tcp://10.0.0.1:1", "0" * 40, "$(WEBOTS_ROBOT_NAME)x"])), max_size=12),
+           st.sampled_from(["alpha", "beta %41", "é/ü"]), st.booleans())
+    def run(entries: list[tuple[str, str, str]], robot: str, python: bool) -> None:
+        _a_runtime_ini_cannot_change_where_the_controller_attaches(entries, robot, python)
+
+    run()
+
+
+def _a_runtime_ini_cannot_change_where_the_controller_attaches(entries: list[tuple[str, str, str]], robot: str,
                                                                    python: bool) -> None:
     text = "".join(f"[{section}]\n{key} = {value}\n" for section, key, value in entries)
     folder = Path("/nowhere/controllers/c")

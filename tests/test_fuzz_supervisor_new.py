@@ -13,7 +13,8 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from _fuzz import example_counts
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import SETTINGS, Fuzzed
 from test_fuzz_new_devices import send, values
@@ -33,7 +34,8 @@ def fuzzed() -> tuple[Fuzzed, list[int]]:
     return f, [0, *ids]
 
 
-def test_new_supervisor_services_answer_or_refuse_in_one_line(fuzzed) -> None:
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_new_supervisor_services_answer_or_refuse_in_one_line(fuzzed, examples: int) -> None:
     f, ids = fuzzed
     node = st.one_of(st.sampled_from(ids), st.sampled_from(ids), st.integers(-2, 80), values)
     unit = st.floats(0.0, 1.0) | st.sampled_from([-0.0, 1.0, 1.0000001, -1e-300, math.nan, math.inf]) | values
@@ -61,7 +63,7 @@ def test_new_supervisor_services_answer_or_refuse_in_one_line(fuzzed) -> None:
         return repr(r.pose), repr([(m.name, m.position, m.target_position) for m in r.motors.values()]), \
             repr(getattr(f.sim, "_labels", viewshot.Labels()).items())
 
-    @SETTINGS
+    @settings(SETTINGS, max_examples=examples)
     @given(st.lists(requests, min_size=1, max_size=5))
     def run(batch):
         for item, args in batch:

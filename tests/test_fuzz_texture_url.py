@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import example, given
+from _fuzz import example_counts
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import SETTINGS
 from test_supervisor_texture import WORLD, _images, _shot, _sim, field
@@ -84,7 +85,8 @@ op = st.one_of(
     st.tuples(st.just("reset"), st.none(), st.none()))
 
 
-def test_random_url_changes_read_as_the_world_file_with_that_url(folder: Path, monkeypatch) -> None:
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_random_url_changes_read_as_the_world_file_with_that_url(folder: Path, monkeypatch, examples: int) -> None:
     refs = References(folder)
     sim = _sim(folder / "world.wbt", LIMITS)
     tex = sv.find_node(sim, "TEX")
@@ -111,7 +113,7 @@ def test_random_url_changes_read_as_the_world_file_with_that_url(folder: Path, m
 
     monkeypatch.setattr(textures, "image_header", header_then_swap)
 
-    @SETTINGS
+    @settings(SETTINGS, max_examples=examples)
     @given(st.lists(op, min_size=1, max_size=6))
     @example([("swap", "b.png", "out_link.png")])       # found: the file read after its check, outside the folder
     @example([("swap", "c.jpg", "alpha.png")])
@@ -200,7 +202,8 @@ def test_a_world_image_deleted_after_load_still_comes_back_on_reset(tmp_path: Pa
         sv.change_item(sim, tex, "url", "set", 0, "a.png")
 
 
-def test_url_changes_through_the_core_answer_or_refuse_in_one_line(folder: Path) -> None:
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_url_changes_through_the_core_answer_or_refuse_in_one_line(folder: Path, examples: int) -> None:
     """The same changes as a controller sends them (set_field with an index and an op), random
     arguments included: one reply each, a refusal one line and never INTERNAL, the core healthy."""
     from test_fuzz_core import Fuzzed
@@ -222,7 +225,7 @@ def test_url_changes_through_the_core_answer_or_refuse_in_one_line(folder: Path)
 
     done = {True: 0, False: 0}
 
-    @SETTINGS
+    @settings(SETTINGS, max_examples=examples)
     @given(st.lists(request | st.just("reset"), min_size=1, max_size=5))
     def run(batch):
         for args in batch:

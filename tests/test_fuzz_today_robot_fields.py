@@ -11,6 +11,8 @@ per-session tables do not outlive the sessions."""
 from __future__ import annotations
 
 import msgpack
+import pytest
+from _fuzz import example_counts
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import SETTINGS
@@ -18,8 +20,6 @@ from test_supervisor_robot_fields import A, B, Logged, Switches
 
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.world.limits import custom_data_chars
-
-FEW = settings(SETTINGS, max_examples=200)
 
 texts = (st.text(max_size=12) | st.sampled_from(["", "gain=2", "é\x00\n", "x" * 4096, "x" * 4097]) | st.integers(0, 3)
          | st.none())
@@ -29,9 +29,17 @@ ops = st.one_of(st.tuples(st.just("sup_cd"), texts), st.tuples(st.just("own_cd")
                     ["step", "step", "step", "step", "detach", "attach", "attach", "restart", "reset"]), st.none()))
 
 
-@FEW
-@given(st.lists(ops, min_size=1, max_size=16))
-def test_custom_data_and_controller_sets_interleaved(seq):
+@pytest.mark.parametrize("examples", example_counts(200))
+def test_custom_data_and_controller_sets_interleaved(examples: int):
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.lists(ops, min_size=1, max_size=16))
+    def run(seq):
+        _interleaved(seq)
+
+    run()
+
+
+def _interleaved(seq) -> None:
     live = Logged()
     launcher = Switches()
     live.core.launcher = launcher

@@ -8,6 +8,8 @@ scene's tables stay bounded."""
 
 from __future__ import annotations
 
+import pytest
+from _fuzz import example_counts
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import SETTINGS
@@ -16,7 +18,6 @@ from test_supervisor_transparency import DEVICES, _appearance, _sim, readings, s
 from sensorium.schemas import world as wm
 from sensorium.server.daemon import supervisor as sv
 
-FEW = settings(SETTINGS, max_examples=25)
 # (a world file takes no magnitude under 1e-30 but 0: limits.py; a Supervisor's set does, see the report)
 VALUES = [0.0, 0.5, 1.0, 1e-30, 0.9999999999999999, 1.0 - 1e-9, 1e-9, 0.25]
 
@@ -50,10 +51,14 @@ OPS = st.lists(st.one_of(st.tuples(st.sampled_from(["block", "visor"]), st.sampl
                          st.just(("step", 0.0)), st.just(("reset", 0.0))), min_size=1, max_size=14)
 
 
-@FEW
-@given(OPS)
-def test_random_sets_steps_and_resets_read_as_the_world_file_and_stay_bounded(ops):
-    _sets_steps_and_resets(ops, "exact")
+@pytest.mark.parametrize("examples", example_counts(25))
+def test_random_sets_steps_and_resets_read_as_the_world_file_and_stay_bounded(examples: int):
+    @settings(SETTINGS, max_examples=examples)
+    @given(OPS)
+    def run(ops):
+        _sets_steps_and_resets(ops, "exact")
+
+    run()
 
 
 @settings(SETTINGS, max_examples=10)

@@ -234,7 +234,8 @@ def test_cli_unreachable_ray_cluster_is_one_line_not_a_hang(tmp_path):
     assert p.stderr.strip().count("\n") == 0 and "cannot join the Ray cluster at '127.0.0.1:1'" in p.stderr
 
 
-@pytest.mark.parametrize("engine", ["local", "ray"])
+# the Ray case starts a local Ray cluster (processes): slow, as the module's other Ray tests (conftest)
+@pytest.mark.parametrize("engine", ["local", pytest.param("ray", marks=pytest.mark.slow)])
 def test_a_run_that_kills_its_worker_is_an_error_row_and_the_others_complete(tmp_path, engine, request):
     if engine == "ray":
         request.getfixturevalue("local_ray")
