@@ -7,6 +7,8 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
+import pytest
+from _fuzz import example_counts
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -82,21 +84,25 @@ def test_the_unmutated_files_expand(tmp_path: Path) -> None:
     assert [(n.type, n.proto) for n in nodes] == [("WorldInfo", None), ("Solid", "Fuzz"), ("Solid", "Fuzz"), ("Group", None)]
 
 
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(which=st.integers(0, 2), cuts=edits)
-def test_mutated_protos_and_worlds_load_or_fail_in_one_line(which: int, cuts: list) -> None:
-    files = {"Fuzz.proto": PROTO, "Leaf.proto": LEAF, "w.wbt": WORLD}
-    name = ["Fuzz.proto", "Leaf.proto", "w.wbt"][which]
-    files[name] = mutate(files[name], cuts)
-    files = {n: HEADER + text for n, text in files.items()}
-    with tempfile.TemporaryDirectory() as tmp:
-        folder = Path(tmp)
-        for n, text in files.items():
-            (folder / n).write_text(text)
-        world = folder / "w.wbt"
-        try:
-            wbt = parse_wbt(world.read_text(), str(world), LIMITS)
-            expansion = expand(wbt, ProtoSearch.create(folder), LIMITS)
-            Converter(expansion.as_wbt(), str(world), expansion.search).run()     # the expanded tree converts
-        except WbtSyntaxError as exc:
-            assert "\n" not in str(exc) and len(str(exc)) < 2600
+@pytest.mark.parametrize("examples", example_counts(200))
+def test_mutated_protos_and_worlds_load_or_fail_in_one_line(examples: int) -> None:
+    @settings(max_examples=examples, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(which=st.integers(0, 2), cuts=edits)
+    def run(which: int, cuts: list) -> None:
+        files = {"Fuzz.proto": PROTO, "Leaf.proto": LEAF, "w.wbt": WORLD}
+        name = ["Fuzz.proto", "Leaf.proto", "w.wbt"][which]
+        files[name] = mutate(files[name], cuts)
+        files = {n: HEADER + text for n, text in files.items()}
+        with tempfile.TemporaryDirectory() as tmp:
+            folder = Path(tmp)
+            for n, text in files.items():
+                (folder / n).write_text(text)
+            world = folder / "w.wbt"
+            try:
+                wbt = parse_wbt(world.read_text(), str(world), LIMITS)
+                expansion = expand(wbt, ProtoSearch.create(folder), LIMITS)
+                Converter(expansion.as_wbt(), str(world), expansion.search).run()     # the expanded tree converts
+            except WbtSyntaxError as exc:
+                assert "\n" not in str(exc) and len(str(exc)) < 2600
+
+    run()
