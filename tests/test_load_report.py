@@ -99,8 +99,8 @@ def test_a_controller_asking_for_a_lost_robot_is_told_why(tmp_path: Path) -> Non
     assert reply["ok"] is False and reply["error"]["code"] == ErrorCode.UNKNOWN_ROBOT
     assert reply["error"]["message"] == (
         f"no robot 'e-puck' (robots: kept); it was dropped when the world loaded: {p}:4:1: E-puck: not a built-in "
-        "node or PROTO here; skipped (with everything inside it). Built-in PROTOs: Floor, RectangleArena, SolidBox, "
-        "TexturedBackgroundLight, WoodenBox")
+        "node or PROTO here; skipped (with everything inside it). Built-in PROTOs: CircleArena, Floor, RectangleArena, "
+        "SolidBox, SolidPipe, TexturedBackgroundLight, WoodenBox")
     other = _attach(core, "scout")["error"]["message"]     # a name the world never wrote: the candidates
     assert other.startswith("no robot 'scout' (robots: kept); the world lost 2 nodes that may have been it")
     assert _attach(core, "kept")["ok"] is True

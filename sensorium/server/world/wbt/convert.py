@@ -50,6 +50,7 @@ SCENERY_VALUES = {
 # the base node type of Webots' PROTOs that Sensorium builds in (wbt/protos.py) or skips (TexturedBackground)
 # when their file is not at hand: the Supervisor names them as Webots does
 KNOWN_PROTO_BASES = {"RectangleArena": "Solid", "Floor": "Solid", "SolidBox": "Solid", "WoodenBox": "Solid",
+                     "CircleArena": "Solid", "SolidPipe": "Solid",
                      "TexturedBackgroundLight": "DirectionalLight", "TexturedBackground": "Background"}
 SKIPPED = {"Background", "TexturedBackground", "Physics", "ImmersionProperties",
            "ContactProperties", "Damping", "Muscle"}
