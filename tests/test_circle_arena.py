@@ -310,7 +310,7 @@ def test_solid_pipe_resets_follow_its_template(tmp_path: Path) -> None:
     assert said == ["SolidPipe.thickness 0: 'thickness' must be greater than 0. Value reset to 0.5. (as Webots' "
                     "SolidPipe does)"]
     assert len(loaded.world.solids[0].shapes) == 1 + 8
-    with pytest.raises(WorldError, match=r"w\.wbt.*SolidPipe\.subdivision: 300,000: more than 200,000"):
+    with pytest.raises(WorldError, match=r"w\.wbt: line 4, column 13: SolidPipe\.subdivision: 300,000 segments: more than 200,000"):
         _load(_world(tmp_path, "SolidPipe { subdivision 300000 }\n", declared=PIPE))
 
 

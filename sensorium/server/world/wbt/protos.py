@@ -112,8 +112,8 @@ def _replaced(f: Fields, name: str, message: str, who: str = "", then: str = "")
 def _subdivision(f: Fields, default: int, at_least: int, message: str) -> int:
     n = f.integer("subdivision", default)
     if n > MAX_PIPE_SUBDIVISION:
-        raise f.error("subdivision", f"{n:,}: more than {MAX_PIPE_SUBDIVISION:,} wall segments (each one a bounding "
-                                     "box, a shape) is more than a world may hold here")
+        raise f.error("subdivision", f"{n:,} segments: more than {MAX_PIPE_SUBDIVISION:,} (each segment is a "
+                                     "bounding box, a shape, and a world holds at most that many shapes here)")
     if n < at_least:
         _replaced(f, "subdivision", message)
         return 8
