@@ -368,3 +368,20 @@ def test_loaded_by_name_and_the_real_proto_preferred_when_installed(tmp_path: Pa
     loaded = _load(w, webots_home=home)
     assert [s.name for s in loaded.world.solids] == ["real arena"]
     assert not [x for x in loaded.warnings if "CircleArena" in x]
+
+
+def test_a_stand_ins_unknown_field_is_one_warning_at_its_line(tmp_path: Path) -> None:
+    """A field outside a stand-in's PROTO interface (a typo Webots skips with an error) is said at its
+    line, with the close field it likely meant; the stand-in is built from its other fields."""
+    from sensorium.server.world.loader import load_world
+
+    p = tmp_path / "w.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { }\nRectangleArena {\n  floorsize 3 3\n  wallHeight 0.2\n"
+                 "  banana 1\n}\nCircleArena { radius 2 wallheight 0.3 }\nTexturedBackgroundLight { luminosity 1 }\n")
+    w = load_world(p)
+    typos = [x for x in w.warnings if "not a field of PROTO" in x]
+    assert typos == [f"{p}:4:3: RectangleArena.floorsize: not a field of PROTO RectangleArena, ignored "
+                     "(did you mean floorSize?)",
+                     f"{p}:6:3: RectangleArena.banana: not a field of PROTO RectangleArena, ignored",
+                     f"{p}:8:24: CircleArena.wallheight: not a field of PROTO CircleArena, ignored "
+                     "(did you mean wallHeight?)"]

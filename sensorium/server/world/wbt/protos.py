@@ -292,3 +292,21 @@ BUILTIN_PROTOS: dict[str, Callable[[Node, Fields, str], Node]] = {
     "RectangleArena": rectangle_arena, "Floor": floor, "SolidBox": solid_box, "WoodenBox": wooden_box,
     "CircleArena": circle_arena, "SolidPipe": solid_pipe, "TexturedBackgroundLight": textured_background_light,
 }
+
+_SOLID = ("translation", "rotation", "name", "contactMaterial")
+BUILTIN_FIELDS: dict[str, frozenset[str]] = {
+    # each stand-in's PROTO interface as Webots' releases publish it (hidden deprecated fields included):
+    # an instance field outside it is a typo Webots would skip with an error
+    "RectangleArena": frozenset((*_SOLID, "floorSize", "floorTileSize", "floorAppearance", "wallThickness",
+                                 "wallHeight", "wallAppearance", "floorTextureUrl", "wallTextureUrl", "wallColor",
+                                 "wallTileSize")),
+    "Floor": frozenset((*_SOLID, "size", "tileSize", "appearance", "texture")),
+    "SolidBox": frozenset((*_SOLID, "size", "appearance", "physics", "enableBoundingObject", "castShadows",
+                           "recognitionColors")),
+    "WoodenBox": frozenset(("translation", "rotation", "name", "size", "mass", "immersionProperties", "locked")),
+    "CircleArena": frozenset((*_SOLID, "radius", "floorAppearance", "floorTileSize", "wallThickness", "wallHeight",
+                              "wallAppearance", "subdivision", "floorTextureUrl", "wallTextureUrl", "wallTileSize")),
+    "SolidPipe": frozenset((*_SOLID, "height", "radius", "thickness", "subdivision", "accuracy", "appearance",
+                            "physics", "enableBoundingObject")),
+    "TexturedBackgroundLight": frozenset(("texture", "luminosity", "castShadows")),
+}
