@@ -31,7 +31,7 @@ def write(tmp_path: Path, body: str, name: str = "w.wbt") -> Path:
 LOSSY = ('WorldInfo { }\n'                                                          # line 2
          'Solid { name "floor" children [ Shape { geometry DEF F Plane { size 2 2 } } ] boundingObject USE F }\n'
          'E-puck { name "e-puck" controller "braitenberg" }\n'                      # line 4: a robot PROTO not found
-         'CircleArena { }\n'                                                        # line 5: unknown, maybe anything
+         'OilBarrel { }\n'                                                          # line 5: unknown, maybe anything
          'Solid { name "pillar" children [ Shape { geometry Mesh { url [ "gone.stl" ] } } ] }\n')   # line 6
 
 
@@ -41,7 +41,7 @@ def test_validate_fails_naming_each_loss_and_allow_skipped_accepts(tmp_path: Pat
     err = capsys.readouterr().err
     assert f"{p}: 3 losses sensors notice (1 robot, 1 shape, 1 unknown node)" in err
     assert f"lost robot 'e-puck': {p}:4:1: E-puck: not a built-in node or PROTO here" in err
-    assert f"lost unknown node 'CircleArena': {p}:5:1: CircleArena: not a built-in node or PROTO here" in err
+    assert f"lost unknown node 'OilBarrel': {p}:5:1: OilBarrel: not a built-in node or PROTO here" in err
     assert f"lost shape of 'pillar': {p}:6:51: mesh file 'gone.stl' not found" in err
     assert f"{p}: INVALID" in err
     assert main(["validate", str(p), "--allow-skipped"]) == 0
@@ -99,8 +99,8 @@ def test_a_controller_asking_for_a_lost_robot_is_told_why(tmp_path: Path) -> Non
     assert reply["ok"] is False and reply["error"]["code"] == ErrorCode.UNKNOWN_ROBOT
     assert reply["error"]["message"] == (
         f"no robot 'e-puck' (robots: kept); it was dropped when the world loaded: {p}:4:1: E-puck: not a built-in "
-        "node or PROTO here; skipped (with everything inside it). Built-in PROTOs: Floor, RectangleArena, SolidBox, "
-        "TexturedBackgroundLight, WoodenBox")
+        "node or PROTO here; skipped (with everything inside it). Built-in PROTOs: CircleArena, Floor, RectangleArena, "
+        "SolidBox, SolidPipe, TexturedBackgroundLight, WoodenBox")
     other = _attach(core, "scout")["error"]["message"]     # a name the world never wrote: the candidates
     assert other.startswith("no robot 'scout' (robots: kept); the world lost 2 nodes that may have been it")
     assert _attach(core, "kept")["ok"] is True
@@ -110,7 +110,7 @@ def test_in_process_loads_warn_once_and_keep_the_list(tmp_path: Path) -> None:
     p = write(tmp_path, LOSSY + 'Robot { name "kept" }\n')
     with pytest.warns(WorldLossWarning, match="3 losses sensors notice"):
         sim = Simulation.from_file(p, precision="fast")
-    assert [(x.kind, x.name) for x in sim.loaded.losses] == [("robot", "e-puck"), ("node", "CircleArena"),
+    assert [(x.kind, x.name) for x in sim.loaded.losses] == [("robot", "e-puck"), ("node", "OilBarrel"),
                                                              ("shape", "pillar")]
     assert sim.loaded.dropped == [x.text for x in sim.loaded.losses]
     clean = write(tmp_path, 'WorldInfo { }\nRobot { name "r" }\n', "clean.wbt")

@@ -36,7 +36,7 @@ from sensorium.server.world.wbt.fields import Fields
 from sensorium.server.world.wbt.frames import Frame, bounding_constraint, bounding_geometry, visual_geometry
 from sensorium.server.world.wbt.inside import enclosing_shapes, turn_meshes_away, unread_image_fields
 from sensorium.server.world.wbt.parser import Node, WbtFile, WbtSyntaxError
-from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
+from sensorium.server.world.wbt.protos import BUILTIN_FIELDS, BUILTIN_PROTOS
 
 MAX_PARTS = 200_000     # shapes, devices and lights after DEF/USE expansion
 MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USEd over and over)
@@ -50,6 +50,7 @@ SCENERY_VALUES = {
 # the base node type of Webots' PROTOs that Sensorium builds in (wbt/protos.py) or skips (TexturedBackground)
 # when their file is not at hand: the Supervisor names them as Webots does
 KNOWN_PROTO_BASES = {"RectangleArena": "Solid", "Floor": "Solid", "SolidBox": "Solid", "WoodenBox": "Solid",
+                     "CircleArena": "Solid", "SolidPipe": "Solid",
                      "TexturedBackgroundLight": "DirectionalLight", "TexturedBackground": "Background"}
 SKIPPED = {"Background", "TexturedBackground", "Physics", "ImmersionProperties",
            "ContactProperties", "Damping", "Muscle"}
@@ -746,6 +747,7 @@ class Converter:
         elif t in JOINTS:
             self.joint(node, frame, owner)
         elif t in BUILTIN_PROTOS:
+            self.stand_in_typos(node)
             system = self.world["world_info"].get("coordinate_system", "ENU")
             expanded = BUILTIN_PROTOS[t](node, f, system)
             expanded.def_name = node.def_name
@@ -860,6 +862,20 @@ class Converter:
             line, col = node.field_pos.get(name, (node.line, node.col))
             self.warnings.append(f"{self.where(node, (line, col))}: {node.type}.{name}: not a {node.type} field, "
                                  f"ignored (did you mean {meant}?)")
+
+    def stand_in_typos(self, node: Node) -> None:
+        """A built-in stand-in's fields outside its PROTO's interface: each one warning at its line (Webots
+        skips an unknown PROTO field with an error; the stand-in would silently use the default)."""
+        import difflib
+
+        known = BUILTIN_FIELDS[node.type]
+        for name in node.fields:
+            if name not in known:
+                close = difflib.get_close_matches(name, sorted(known), n=1, cutoff=0.75)
+                meant = f" (did you mean {close[0]}?)" if close else ""
+                line, col = node.field_pos.get(name, (node.line, node.col))
+                self.warnings.append(f"{self.where(node, (line, col))}: {node.type}.{name}: not a field of "
+                                     f"PROTO {node.type}, ignored{meant}")
 
     def child_frame(self, node: Node, frame: Frame, scale: tuple[float, float, float] | None = None) -> Frame:
         """The frame of a Pose, Transform or Solid under ``frame``; ``scale``: a Transform's scale
