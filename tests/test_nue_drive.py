@@ -188,14 +188,32 @@ def test_the_batched_simulation_drives_a_y_up_robot_as_the_single_one(tmp_path: 
             assert np.abs(bs.pose(0, slot).translation - want).max() <= 1e-9
 
 
+def _twin_vec(system: str):
+    """Coordinates given in the ENU twin's robot frame as a .wbt vector of ``system``'s world: permuted
+    (ENU -> NUE) for the y-up robot, as they are for its z-up twin."""
+    back = (lambda v: [v[1], v[2], v[0]]) if system == "NUE" else (lambda v: list(v))
+
+    def vec(v) -> str:
+        return " ".join(repr(float(x)) for x in back(v))
+    return vec
+
+
+def _twin_world(tmp_path: Path, system: str, stem: str, robot: str, at, children: str, info: str = "") -> Path:
+    """A world of one robot ``robot`` with physics at ``at`` (ENU twin's coordinates), turned by YAW about
+    its up, with ``children``; ``info``: more WorldInfo fields."""
+    vec = _twin_vec(system)
+    path = tmp_path / f"{stem}-{system}.wbt"
+    path.write_text(f'#VRML_SIM R2023b utf8\nWorldInfo {{ coordinateSystem "{system}" basicTimeStep 16{info} }}\n'
+                    f'Robot {{ translation {vec(at)} rotation {vec((0, 0, 1))} {YAW} name "{robot}" '
+                    f'controller "<extern>"\n  children [\n{children}]\n  physics Physics {{ }} }}\n')
+    return path
+
+
 def _omni_world(tmp_path: Path, system: str) -> Path:
     """Three omni wheels (spheres of radius R) 120° apart, 0.1 m from the centre, each turning about
     the line from the centre out through it (the omni_wheels how-to's layout): in the NUE world built
     y-up, in the ENU world its twin built z-up. Coordinates given in the twin's (ENU) robot frame."""
-    back = (lambda v: [v[1], v[2], v[0]]) if system == "NUE" else (lambda v: list(v))    # ENU -> NUE
-
-    def vec(v) -> str:
-        return " ".join(repr(float(x)) for x in back(v))
+    vec = _twin_vec(system)
 
     wheels = ""
     for i in range(3):
@@ -205,12 +223,7 @@ def _omni_world(tmp_path: Path, system: str) -> Path:
                    f'anchor {at} }}\n  device [ RotationalMotor {{ name "w{i}" maxVelocity 20 }} ]\n'
                    f'  endPoint Solid {{ translation {at} name "wheel {i}" children [ Shape {{ geometry Sphere '
                    f'{{ radius {R} }} }} ] boundingObject Sphere {{ radius {R} }} physics Physics {{ }} }} }}\n')
-    text = (f'#VRML_SIM R2023b utf8\nWorldInfo {{ coordinateSystem "{system}" basicTimeStep 16 }}\n'
-            f'Robot {{ translation {vec((-0.4, 0.2, 0.0))} rotation {vec((0, 0, 1))} {YAW} name "bot" '
-            f'controller "<extern>"\n  children [\n{wheels}]\n  physics Physics {{ }} }}\n')
-    path = tmp_path / f"omni-{system}.wbt"
-    path.write_text(text)
-    return path
+    return _twin_world(tmp_path, system, "omni", "bot", (-0.4, 0.2, 0.0), wheels)
 
 
 def test_a_y_up_omni_wheel_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path: Path) -> None:
@@ -250,10 +263,7 @@ def _car_world(tmp_path: Path, system: str) -> Path:
     """A car: two steering hinges about its up 0.2 m ahead holding ball wheels, two driven rear wheels
     about its left under its origin (rear-wheel drive), ball wheels of radius R: built y-up in the NUE
     world, z-up in its ENU twin. Coordinates given in the twin's (ENU) robot frame."""
-    back = (lambda v: [v[1], v[2], v[0]]) if system == "NUE" else (lambda v: list(v))    # ENU -> NUE
-
-    def vec(v) -> str:
-        return " ".join(repr(float(x)) for x in back(v))
+    vec = _twin_vec(system)
 
     def ball(name: str, at) -> str:
         return (f'Solid {{ translation {vec(at)} name "{name}" children [ Shape {{ geometry Sphere {{ radius {R} }} }} ] '
@@ -269,12 +279,7 @@ def _car_world(tmp_path: Path, system: str) -> Path:
         joints += (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {vec((0, 1, 0))} anchor {vec(at)} }}\n'
                    f'  device [ RotationalMotor {{ name "{side}_rear_wheel" maxVelocity 30 }} ]\n'
                    f'  endPoint {ball(f"{side} rear", at)} }}\n')
-    text = (f'#VRML_SIM R2023b utf8\nWorldInfo {{ coordinateSystem "{system}" basicTimeStep 16 }}\n'
-            f'Robot {{ translation {vec((0.3, -0.1, 0.0))} rotation {vec((0, 0, 1))} {YAW} name "car" '
-            f'controller "<extern>"\n  children [\n{joints}]\n  physics Physics {{ }} }}\n')
-    path = tmp_path / f"car-{system}.wbt"
-    path.write_text(text)
-    return path
+    return _twin_world(tmp_path, system, "car", "car", (0.3, -0.1, 0.0), joints)
 
 
 def test_a_y_up_car_in_a_nue_world_steers_and_drives_as_its_enu_twin(tmp_path: Path) -> None:
@@ -318,10 +323,7 @@ def _mecanum_world(tmp_path: Path, system: str) -> Path:
     """Four mecanum wheels (ball wheels of radius R whose friction a ContactProperties turns by ±45°,
     as a youBot's) at (±0.2, ±0.15) about its left axis: built y-up in the NUE world, z-up in its ENU
     twin. Coordinates given in the twin's (ENU) robot frame."""
-    back = (lambda v: [v[1], v[2], v[0]]) if system == "NUE" else (lambda v: list(v))    # ENU -> NUE
-
-    def vec(v) -> str:
-        return " ".join(repr(float(x)) for x in back(v))
+    vec = _twin_vec(system)
 
     wheels = ""
     for name, x, y, material in (("fl", 0.2, 0.15, "A"), ("fr", 0.2, -0.15, "B"), ("rl", -0.2, 0.15, "B"),
@@ -332,14 +334,10 @@ def _mecanum_world(tmp_path: Path, system: str) -> Path:
                    f'  endPoint Solid {{ translation {at} name "{name} wheel" contactMaterial "{material}" children '
                    f'[ Shape {{ geometry Sphere {{ radius {R} }} }} ] boundingObject Sphere {{ radius {R} }} '
                    'physics Physics { } } }\n')
-    text = (f'#VRML_SIM R2023b utf8\nWorldInfo {{ coordinateSystem "{system}" basicTimeStep 16 contactProperties [\n'
+    info = (' contactProperties [\n'
             '  ContactProperties { material1 "A" coulombFriction [ 1.8 0 ] frictionRotation 0.785398 0 }\n'
-            '  ContactProperties { material1 "B" coulombFriction [ 1.8 0 ] frictionRotation -0.785398 0 } ] }\n'
-            f'Robot {{ translation {vec((0.1, 0.3, 0.0))} rotation {vec((0, 0, 1))} {YAW} name "base" '
-            f'controller "<extern>"\n  children [\n{wheels}]\n  physics Physics {{ }} }}\n')
-    path = tmp_path / f"mecanum-{system}.wbt"
-    path.write_text(text)
-    return path
+            '  ContactProperties { material1 "B" coulombFriction [ 1.8 0 ] frictionRotation -0.785398 0 } ]')
+    return _twin_world(tmp_path, system, "mecanum", "base", (0.1, 0.3, 0.0), wheels, info)
 
 
 def test_a_y_up_mecanum_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path: Path) -> None:
