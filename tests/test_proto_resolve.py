@@ -365,9 +365,19 @@ def test_a_world_before_r2022b_finds_its_protos_by_name(tmp_path: Path, monkeypa
     assert [d.name for d in loaded.world.robots[0].devices] == ["eye"]
     (gadget,) = loaded.world.solids
     assert gadget.name == "gadget" and [c.name for c in gadget.children] == ["knob"]
-    w.write_text(w.read_text().replace("R2022a", "R2023b"))      # since R2022b: declared, or not found
+    # since R2022b a file must declare them: Webots says which line to add and loads them (found by name)
+    w.write_text(w.read_text().replace("R2022a", "R2023b"))
     later = load_world(w, webots_home=home)
-    assert later.world.robots == [] and [x.name for x in later.losses] == ["AcmeBot", "Gadget"]
+    assert [r.name for r in later.world.robots] == ["acme"] and not later.losses
+    missing = [x for x in later.warnings if "missing declaration" in x]
+    acme = next(home.rglob("AcmeBot.proto")).relative_to(home).as_posix()
+    assert missing == [f"{w}:2:1: missing declaration for AcmeBot: add 'EXTERNPROTO \"webots://{acme}\"' to the file "
+                       "(found by its file name, as Webots finds it and says so)",
+                       f"{w}:3:1: missing declaration for Gadget: add 'EXTERNPROTO \"../protos/Gadget.proto\"' to the "
+                       "file (found by its file name, as Webots finds it and says so)",
+                       f"{project / 'protos' / 'Gadget.proto'}:2:53: missing declaration for Knob: add 'EXTERNPROTO "
+                       "\"parts/Knob.proto\"' to the file (found by its file name, as Webots finds it and says so)"
+                       ], later.warnings
 
 
 def test_snapshot_takes_the_proto_flags_its_messages_name(tmp_path: Path, monkeypatch, capsys) -> None:

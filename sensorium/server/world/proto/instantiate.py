@@ -257,15 +257,20 @@ class _Expander:
             self.use(found, "", found.source)
         elif name in scope.declared:
             found = self.load(scope, scope.declared[name])
-        elif self.by_name and name not in BASE_NODES and (path := self.undeclared(name)) is not None:
+        elif name not in BASE_NODES and (path := self.undeclared(name)) is not None:
+            if not self.by_name:       # since R2022b a file must declare it: Webots says so, and loads it
+                self.warnings.append(f"{scope.source}:{node.line}:{node.col}: missing declaration for {short(name)}: "
+                                     f"add 'EXTERNPROTO \"{self.declaration(path, scope.source)}\"' to the file (found "
+                                     "by its file name, as Webots finds it and says so)")
             found = self.load(scope, ExternProto(str(path), node.line, node.col))
         scope.found[name] = found
         return found
 
     def undeclared(self, name: str) -> Path | None:
-        """A PROTO a world before R2022b uses without declaring it (Webots had no EXTERNPROTO then and
-        looked a type up by file name): NAME.proto in the world's project's ``protos`` folder, then
-        under the --proto-path folders, then in the installation's ``projects`` tree."""
+        """A PROTO a file uses without declaring it, looked up by file name as Webots looks it up (a world
+        before R2022b had no EXTERNPROTO; a later one missing a declaration gets Webots' error line and
+        the PROTO): NAME.proto in the world's project's ``protos`` folder, then under the --proto-path
+        folders, then in the installation's ``projects`` tree."""
         file = f"{name}.proto"
         project = Path(self.world).resolve().parent.parent / "protos"
         home = self.search.home
@@ -277,6 +282,14 @@ class _Expander:
             if hit is not None:
                 return hit
         return None
+
+    def declaration(self, path: Path, source: str) -> str:
+        """The url an EXTERNPROTO declaring ``path`` from file ``source`` gives: ``webots://`` within the
+        installation, else relative to the file's folder."""
+        home = self.search.home
+        if home is not None and path.resolve().is_relative_to(home.resolve()):
+            return "webots://" + path.resolve().relative_to(home.resolve()).as_posix()
+        return Path(os.path.relpath(path.resolve(), Path(source).resolve().parent)).as_posix()
 
     def load(self, scope: _Scope, decl: ExternProto) -> ProtoDef | None:
         try:
