@@ -220,6 +220,38 @@ def test_a_box_robot_spinning_flush_against_walls_keeps_turning_pushed_off_as_fa
     assert all(d == pytest.approx(math.hypot(0.2, 0.1), abs=1e-9) for d in dist.values())
 
 
+@pytest.mark.parametrize("rate", [1.0, 3.0, 7.0, 10.0])
+@pytest.mark.parametrize("sense", [1.0, -1.0])
+def test_a_square_robot_spinning_in_a_corner_keeps_turning_off_both_walls_at_once(sense, rate):
+    # a 0.2 m square flush in a corner (faces y = 0.1 and x = -0.1): its half-extent along both
+    # walls' normals, 0.1 (|cos h| + |sin h|), peaks at 45 degrees for both walls in the same step,
+    # so a step passing it ends clear of both but sweeps into both: pushed off each by as far as
+    # its corner reached, at once. It used to stop turning there for good, pressed every step (the
+    # push off either wall alone left the sweep in the other), as the tutorials' e-puck did in
+    # compound_solid.wbt's corner
+    sim = world([block("n", -3.0, 3.0, 0.1, 0.3), block("w", -0.3, -0.1, -3.0, 3.0)],
+                [box_robot("r", 0.0, 0.0, size=(0.2, 0.2))])
+    drive(sim, "r", -sense * rate, sense * rate)
+    def extent(h):
+        return 0.1 * (abs(math.cos(h)) + abs(math.sin(h)))
+
+    reach, h0 = 0.1, 0.0
+    for k in range(1, int(math.tau / (rate * PER_STEP)) + 2):
+        sim.step()
+        turned = sense * k * rate * PER_STEP
+        assert heading(sim, "r") == pytest.approx(math.remainder(turned, math.tau), abs=1e-9)
+        # as a wall alone: an end reaching beyond pushes to touch there; else a peak passed (an odd
+        # multiple of 45 degrees within the step) pushes as far as the corner reached
+        peak = math.floor((max(h0, turned) - math.pi / 4) / (math.pi / 2)) >= math.ceil((min(h0, turned) - math.pi / 4) / (math.pi / 2))
+        end = extent(turned)
+        reach = end if end > reach + 1e-9 else max(reach, 0.1 * math.sqrt(2.0) if peak else end)
+        h0 = turned
+        centre, c = xy(sim, "r"), corners(sim, "r", (0.2, 0.2))
+        assert centre[0] + 0.1 == pytest.approx(reach, abs=1e-9) and 0.1 - centre[1] == pytest.approx(reach, abs=1e-9)
+        assert float(c[:, 0].min()) >= -0.1 - 1e-9 and float(c[:, 1].max()) <= 0.1 + 1e-9
+    assert reach == 0.1 * math.sqrt(2.0)                  # a whole turn passes every peak
+
+
 def test_a_box_robot_that_drove_head_on_into_a_wall_turns_away_and_drives_off():
     # its front face stops on the wall x = 1; turning in place both front corners would go in, so
     # it used to be held there for good; now the wall pushes it back (its centre 1 - (0.25 cos h +

@@ -37,8 +37,8 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   the whole turn is kept and the centre pushed off it the least distance, to touching
   (:meth:`Contact._push`, closed form; in a corner of two polygons, off both at once:
   :meth:`Contact._push_off_both`; where the turn ends clear of it but a corner's arc dips into it
-  on the way, past the peak of its reach, off by as far as the arc went in:
-  :meth:`Contact._push_sweep`), unless that push meets something else: then the turn is
+  on the way, past the peak of its reach, off by as far as the arc went in, off two at once where
+  it dips into both walls of a corner: :meth:`Contact._push_sweep`), unless that push meets something else: then the turn is
   cut short, found by halving to 2^-12 of the step's turn (either counts as a contact); then its centre moves along the chord from
   its start to its end pose (poses are only observed at the end of steps, and the end point is
   the exact arc end unless contact clips it) at the heading it kept. The chord is tested against
@@ -1727,7 +1727,9 @@ class Contact:
         it rests on), or None: the least move along one of that candidate's axes (its edge normals,
         fixed; a wall line's normal) that keeps the footprint at least touching it at every heading of
         the turn -- the turn's least separation along the axis (:func:`_least_along`, exact), so the
-        centre ends as far off as the footprint reached into it. Checked as :meth:`_push` checks a push:
+        centre ends as far off as the footprint reached into it; where no one axis's push clears the
+        turn and it dips into two candidates (a square's corners passing their peaks toward both walls
+        of a corner in one step), the least move meeting one axis of each. Checked as :meth:`_push` checks a push:
         not back toward the side the robot came from, no longer than any footprint point moved in the
         turn, neither its path nor its end meets another candidate (deeper than it already was), and
         the whole turn from there is clear of every candidate (:meth:`_turn_clear`)."""
@@ -1760,14 +1762,29 @@ class Contact:
                 t = float(need[k])
                 if 0.0 < t <= limit and float(axes[k] @ back) > 0.0:
                     tries.append((t, i, k, axes[k]))
-        for t, i, _, n in sorted(tries, key=lambda a: (a[0], a[1], a[2])):
-            step = (t + BACK_OFF) * n
+        # one axis's push first; then, for a turn that dips into two candidates at once (a square's
+        # corners passing their peaks toward both walls of a corner in one step), the least move
+        # meeting one axis of each (both needs met exactly: each separation is linear in the centre)
+        moves = [((t + BACK_OFF) * n, (i,)) for t, i, _, n in sorted(tries, key=lambda a: (a[0], a[1], a[2]))]
+        pairs = []
+        for a, (ta, ia, _, na) in enumerate(tries):
+            for tb, ib, _, nb in tries[a + 1:]:
+                det = float(na[0] * nb[1] - na[1] * nb[0])
+                if ia == ib or abs(det) < 1e-9:
+                    continue
+                ua, ub = ta + BACK_OFF, tb + BACK_OFF
+                s = np.array([ua * nb[1] - ub * na[1], ub * na[0] - ua * nb[0]]) / det
+                size = float(np.hypot(*s))
+                if size <= limit:
+                    pairs.append((size, s, (ia, ib)))
+        moves += [(s, ij) for _, s, ij in sorted(pairs, key=lambda a: (a[0], a[2]))]
+        for step, into in moves:
             q = p + step
             after = []
             for j, (g, before) in enumerate(zip(grown, now)):
                 self.checks += 1
                 gap = _gap(q, *_grown(cands[j], here, rnd, q))
-                if gap < min(before, 0.0) - EPS or (j != i and time_of_impact(p, step, *g)[1] is not None):
+                if gap < min(before, 0.0) - EPS or (j not in into and time_of_impact(p, step, *g)[1] is not None):
                     break
                 after.append(gap)
             else:
