@@ -257,8 +257,11 @@ class _Expander:
             self.use(found, "", found.source)
         elif name in scope.declared:
             found = self.load(scope, scope.declared[name])
-        elif name not in BASE_NODES and (path := self.undeclared(name)) is not None:
-            if not self.by_name:       # since R2022b a file must declare it: Webots says so, and loads it
+        elif name not in BASE_NODES and (self.by_name or os.path.isfile(scope.source)) \
+                and (path := self.undeclared(name)) is not None:
+            # since R2022b a file must declare it: Webots says so, and loads it (a Supervisor's node string,
+            # no file, imports only what the world declares, as in Webots)
+            if not self.by_name:
                 self.warnings.append(f"{scope.source}:{node.line}:{node.col}: missing declaration for {short(name)}: "
                                      f"add 'EXTERNPROTO \"{self.declaration(path, scope.source)}\"' to the file (found "
                                      "by its file name, as Webots finds it and says so)")
