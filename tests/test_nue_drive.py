@@ -33,6 +33,10 @@ def _nue_to_enu(v) -> list[float]:
     return [v[2], v[0], v[1]]
 
 
+NUE_TO_ENU = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+"""The NUE -> ENU permutation as a matrix (:func:`_nue_to_enu`)."""
+
+
 def _world(tmp_path: Path, system: str, axle_ahead: float = 0.0) -> Path:
     """One two-wheel robot with encoders and a GPS off its origin: in a NUE world built y-up (its
     wheels turning about its x, axles R above its origin along its y), or in an ENU world its twin
@@ -136,7 +140,7 @@ def test_a_y_up_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path: Path) -> N
     world and its z-up twin in the ENU world: after every step their poses agree with every axis
     permuted to 1e-12, their encoders read the same and their GPSs the same position permuted."""
     nue, enu = _sim(_world(tmp_path, "NUE")), _sim(_world(tmp_path, "ENU"))
-    p = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])     # NUE -> ENU
+    p = NUE_TO_ENU
     for sim in (nue, enu):
         for name in ("left wheel sensor", "right wheel sensor", "gps"):
             sim.robot("bot").device(name).enable(16)
@@ -209,6 +213,21 @@ def _twin_world(tmp_path: Path, system: str, stem: str, robot: str, at, children
     return path
 
 
+def _step_twins(nue: Simulation, enu: Simulation, bs: BatchedSimulation, robot: str, steps: int) -> None:
+    """``steps`` basic steps of the NUE world, its ENU twin and the NUE world's batched copy 0: the copy's
+    pose is the NUE one bit for bit, the twin's the NUE one with every axis permuted, to 1e-12."""
+    p = NUE_TO_ENU
+    for _ in range(steps):
+        nue.run(1)
+        enu.run(1)
+        bs.step()
+        a, b = nue.robot(robot).pose, enu.robot(robot).pose
+        assert np.array_equal(bs.pose(0, 0).translation, a.translation)
+        assert np.array_equal(bs.pose(0, 0).rotation, a.rotation)
+        assert np.abs(p @ a.translation - b.translation).max() <= 1e-12
+        assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
+
+
 def _omni_world(tmp_path: Path, system: str) -> Path:
     """Three omni wheels (spheres of radius R) 120° apart, 0.1 m from the centre, each turning about
     the line from the centre out through it (the omni_wheels how-to's layout): in the NUE world built
@@ -237,7 +256,6 @@ def test_a_y_up_omni_wheel_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path:
         bs = BatchedSimulation(load_world(_omni_world(tmp_path, "NUE")), copies=1, precision="exact")
     d = nue.world.robots[0].omni_drive
     assert d is not None and tuple(d.forward) == (1.0, 0.0, 0.0)
-    p = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])     # NUE -> ENU
     start = nue.robot("bot").pose.translation.copy()
     for speeds in ((4.0, -2.0, 1.0), (3.0, 3.0, 3.0), (-5.0, 2.0, 6.0)):
         for sim in (nue, enu):
@@ -246,15 +264,7 @@ def test_a_y_up_omni_wheel_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path:
                 m.set_position(math.inf)
                 m.set_velocity(u)
         bs.omni.command(0, np.array([speeds]))
-        for _ in range(30):
-            nue.run(1)
-            enu.run(1)
-            bs.step()
-            a, b = nue.robot("bot").pose, enu.robot("bot").pose
-            assert np.array_equal(bs.pose(0, 0).translation, a.translation)
-            assert np.array_equal(bs.pose(0, 0).rotation, a.rotation)
-            assert np.abs(p @ a.translation - b.translation).max() <= 1e-12
-            assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
+        _step_twins(nue, enu, bs, "bot", 30)
     moved = nue.robot("bot").pose.translation - start
     assert math.hypot(moved[0], moved[2]) > 0.03 and moved[1] == 0.0
 
@@ -295,7 +305,6 @@ def test_a_y_up_car_in_a_nue_world_steers_and_drives_as_its_enu_twin(tmp_path: P
     assert d is not None and tuple(d.forward) == (0.0, 0.0, 1.0)
     assert (d.wheelbase, d.track_front, d.type) == (pytest.approx(0.2, abs=1e-15), pytest.approx(0.16, abs=1e-15),
                                                     "propulsion")
-    p = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])     # NUE -> ENU
     start = nue.robot("car").pose.rotation.copy()
     for steer, speed in ((0.3, 10.0), (-0.4, 12.0), (0.2, -8.0)):
         for sim in (nue, enu):
@@ -306,15 +315,7 @@ def test_a_y_up_car_in_a_nue_world_steers_and_drives_as_its_enu_twin(tmp_path: P
                 m.set_position(math.inf)
                 m.set_velocity(speed)
         bs.cars.command(0, np.array([steer]), np.array([steer]), np.array([speed]))
-        for _ in range(30):
-            nue.run(1)
-            enu.run(1)
-            bs.step()
-            a, b = nue.robot("car").pose, enu.robot("car").pose
-            assert np.array_equal(bs.pose(0, 0).translation, a.translation)
-            assert np.array_equal(bs.pose(0, 0).rotation, a.rotation)
-            assert np.abs(p @ a.translation - b.translation).max() <= 1e-12
-            assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
+        _step_twins(nue, enu, bs, "car", 30)
     assert np.abs(nue.robot("car").pose.rotation - start).max() > 0.05
     assert nue.robot("car").pose.translation[1] == 0.0      # (along up: its wheels stay on y = 0)
 
@@ -351,7 +352,7 @@ def test_a_y_up_mecanum_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path: Pa
     assert d is not None and tuple(d.forward) == (0.0, 0.0, 1.0)
     assert enu.world.robots[0].mecanum_drive is not None
     assert tuple(d.rollers) == tuple(enu.world.robots[0].mecanum_drive.rollers)
-    p = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])     # NUE -> ENU
+    p = NUE_TO_ENU
     start = nue.robot("base").pose.translation.copy()
     for k, speeds in enumerate(((6.0, 6.0, 6.0, 6.0), (-4.0, 4.0, 4.0, -4.0), (-3.0, 3.0, -3.0, 3.0))):
         for sim in (nue, enu):
