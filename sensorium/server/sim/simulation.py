@@ -651,6 +651,7 @@ class Simulation:
                 solid = node.model
                 self.world.solids.append(solid)
                 self._join_solid(solid, node_id, prep)
+                self._land(solid)      # with physics it drops onto what is under it, as Webots' does
                 self._imported_poses[solid.name] = self.scene.solid_poses[solid.name]
                 key: str | int = solid.name
             else:
@@ -691,6 +692,18 @@ class Simulation:
         if self.ground is not None and again:
             self.ground.add_solid(solid, pose)
 
+    def _land(self, solid: wm.Solid) -> None:
+        """A top-level solid with physics just added (imported, or built again) lands at once on what is
+        under it now (ground.land_pose, the rule of a solid let go and of settle_world at load); any
+        other solid stays where it is."""
+        to_enu = _TO_ENU[self.world.world_info.coordinate_system]
+        pose = self.scene.solid_poses[solid.name]
+        span = falling_span(solid, self.loaded.base_dir, to_enu, pose)
+        if span is not None:
+            landed = land_pose(pose, span[0], span[1], self.landing_ground(solid.name), to_enu)
+            if landed is not pose:
+                self.place_solid(solid.name, landed)
+
     def replace_solid(self, name: str, node: Any, node_id: int) -> None:
         """Top-level solid ``name`` built again (a Supervisor set one of its PROTO fields, sim/regenerate.py):
         ``node`` (an ``ImportedNode``, its solid named ``name``) takes its place from the next measurement,
@@ -718,13 +731,7 @@ class Simulation:
         self.world.solids[k] = solid
         self._join_solid(solid, node_id, prepared, again=True)
         # rebuilt with physics, it lands on what is under it, as the world file written so settles at load
-        to_enu = _TO_ENU[self.world.world_info.coordinate_system]
-        pose = self.scene.solid_poses[name]
-        span = falling_span(solid, self.loaded.base_dir, to_enu, pose)
-        if span is not None:
-            landed = land_pose(pose, span[0], span[1], self.landing_ground(name), to_enu)
-            if landed is not pose:
-                self.place_solid(name, landed)
+        self._land(solid)
         if name in self._initial["solids"]:       # a reset keeps the new values (Webots resets no field)
             targets = self._initial["radar_targets"]
             for key in [t for t in targets if t == name or (isinstance(t, tuple) and t[0] == name)]:
