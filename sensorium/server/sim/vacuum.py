@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.server.sim.contact import UPRIGHT, Obstacle, _closest_on_list, _hull, enu_pose, obstacle
-from sensorium.server.sim.ground import land_pose
+from sensorium.server.sim.ground import falling_span, land_solid, lift_pose
 from sensorium.server.sim.scene import primitive_from_model, solid_parts
 from sensorium.server.sim.sensors import Device
 from sensorium.server.world import geometry as geo
@@ -170,6 +170,7 @@ class VacuumGripper(Device):
         self._offset: Pose | None = None    # the held solid's pose in the gripper's frame
         self._held_model: Any = None        # its world-file model when attached (a rebuilt one is another)
         self._outline: tuple[str, Pose | None] | None = None     # (held, link pose) its outline was given at
+        self._ground: tuple[tuple, Any] | None = None     # (what it was built from, the held solid's support)
         self._sim: Any = None
         self._robot: Any = None
         self._own: list[tuple[Any, Pose, str | None]] = []          # (primitive, pose in robot frame, on_joint)
@@ -205,6 +206,7 @@ class VacuumGripper(Device):
         if self.held is not None and self._sim.contact is not None:
             self._sim.contact.let_go(self._robot.index, self.held)
         self.held, self._offset, self._held_model, self._outline = None, None, None, None
+        self._ground = None
 
     def reset(self) -> None:
         """Webots' WbVacuumGripper::reset: the pump as the world file has it, nothing held (its
@@ -235,7 +237,7 @@ class VacuumGripper(Device):
             assert self._offset is not None
             self._hold_outline()
             current = sim.scene.solid_poses[self.held]
-            pose = self.frame().compose(self._offset)
+            pose = self._on_support(self.frame().compose(self._offset))
             if not (np.array_equal(pose.translation, current.translation)
                     and np.array_equal(pose.rotation, current.rotation)):
                 known = self._models_version == sim.scene.solids_version
@@ -248,6 +250,32 @@ class VacuumGripper(Device):
                 self.held, self._held_model = name, self._model(name)
                 self._offset = self.frame().inverse().compose(sim.scene.solid_poses[name])
                 self._hold_outline()
+
+    def _on_support(self, pose: Pose) -> Pose:
+        """The held solid at ``pose``, raised onto the support it is held into (ground.lift_pose: the one
+        it would land on, the carrier left out): the kinematic carrier is not stopped by the floor, so
+        its load is put on it instead of into it. Its heights are ground.falling_span's, the ones it lands
+        by; a solid that does not fall (a Plane or ElevationGrid among its bounding shapes) is put where
+        it is held."""
+        sim = self._sim
+        span = falling_span(self._held_model, sim.loaded.base_dir, self._robot.to_enu, pose)
+        return pose if span is None else lift_pose(pose, span[0], span[1], self._support(), self._robot.to_enu)
+
+    def _support(self) -> Any:
+        """Simulation.landing_ground for the held solid without its carrier, built again only when
+        something in it moved (poses and joint displacements are immutable objects: compared by identity)."""
+        sim, scene = self._sim, self._sim.scene
+        poses = [p for n, p in scene.solid_poses.items() if n != self.held]
+        for r in sim.robots.values():
+            if not r.model.drive_motors and r.index != self._robot.index:
+                poses.append(scene.robot_poses[r.index])
+                poses.extend(() if r.links is None else r.links.poses.values())
+        key = (scene.solids_version, self.held, *poses)
+        kept = self._ground
+        if (kept is None or kept[0][:2] != key[:2] or len(kept[0]) != len(key)
+                or not all(a is b for a, b in zip(kept[0][2:], key[2:]))):
+            kept = self._ground = (key, sim.landing_ground(self.held, self._robot.index))
+        return kept[1]
 
     def _hold_outline(self) -> None:
         """The held solid's bounding shapes, where the gripper holds them in its robot's frame, part of
@@ -267,20 +295,15 @@ class VacuumGripper(Device):
         self._outline = (self.held, link)
 
     def _land(self, name: str, model: Any) -> None:
-        """The solid let go this step put on what is under it (ground.land_pose: the highest support
-        under its origin, its lowest point on it, at once), unless it is gone, rebuilt, or held again
-        (by another gripper)."""
+        """The solid let go this step put to rest on what is under it (ground.land_solid: tipped onto the
+        face under it, its lowest point on the highest support under its origin, at once), unless it is
+        gone, rebuilt, or held again (by another gripper)."""
         sim = self._sim
         if self._model(name) is not model or any(
                 isinstance(d, VacuumGripper) and d.held == name for d in sim.all_devices()):
             return
         pose = sim.scene.solid_poses[name]
-        prisms = self._solid_obstacles(name, pose)
-        if not prisms:                 # no bounding shapes: nothing to land on (it stays)
-            return
-        low = min(p.z_range[0] for p in prisms)
-        high = max(p.z_range[1] for p in prisms)
-        landed = land_pose(pose, low, high, sim.landing_ground(name), self._robot.to_enu)
+        landed = land_solid(model, pose, sim.loaded.base_dir, sim.landing_ground(name), self._robot.to_enu)
         if landed is not pose:
             sim.place_solid(name, landed)
 
