@@ -77,7 +77,7 @@ from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_p
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "resting_pose", "placing_ceiling", "ride_height",
+__all__ = ["Ground", "GroundWarning", "band_low", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "placing_ceiling", "resting_pose", "ride_height",
            "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "slope_scales", "support_ceiling"]
 
 UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
