@@ -77,8 +77,8 @@ from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_p
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "placing_ceiling", "resting_pose", "ride_height",
-           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "slope_scales", "support_ceiling"]
+__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "placing_ceiling", "resting_pose", "ride_height",
+           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling"]
 
 UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
@@ -746,44 +746,79 @@ def land_solid(solid: wm.Solid, pose: Pose, base_dir: Path, ground: Ground | Non
     return land_pose(pose, span[0], span[1], ground, to_enu)
 
 
-def falling_span(solid: wm.Solid, base_dir: Path, to_enu: np.ndarray | None,
-                 pose: Pose | None = None) -> tuple[float, float, np.ndarray] | None:
-    """(lowest, highest point, xy box (x0, y0, x1, y1)) of the bounding shapes of a top-level solid that
-    falls (``physics``, at least one bounding shape, none of them a Plane or ElevationGrid: those
-    are ground, static in Webots' physics too), in ENU at ``pose`` (default its world-file pose), as
-    kinematic contact and the VacuumGripper take them (contact.obstacle); None for any other solid."""
+def falling_shapes(solid: wm.Solid, base_dir: Path) -> list[tuple[Pose, object, object]] | None:
+    """The bounding shapes of a top-level solid that falls -- ``physics``, at least one bounding shape,
+    none of them a Plane or ElevationGrid (those are ground, static in Webots' physics too) -- as (pose
+    in the solid's frame, primitive, geometry model); None for any other solid."""
     from sensorium.server.sim.scene import primitive_from_model, solid_parts
 
     if not solid.physics:
         return None
-    pose = pose_from_model(solid.pose) if pose is None else pose
-    prisms = []
-    spans: list[tuple[float, float]] = []
+    shapes = []
     for _, local, shape in solid_parts(solid, Pose.identity()):
         if shape.seen_by not in ("both", "bounding"):
             continue
         if isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid)):
             return None
+        shapes.append((local, primitive_from_model(shape.geometry, base_dir), shape.geometry))
+    return shapes or None
+
+
+def _exact_reach(g: object, r: np.ndarray) -> float | None:
+    """How far a Box, Sphere, Cylinder or Capsule with ENU rotation ``r`` reaches above and below its
+    centre, exactly (a box's half sizes times the vertical parts of its axes; a cylinder's or capsule's
+    axis's vertical part a, each end's rim (or cap) reaching r·√(1 − a²) (or r) beyond), where
+    contact.obstacle bounds a tilted cylinder by its circumscribed facets; None for other shapes."""
+    if isinstance(g, wm.Box):
+        return sum(abs(float(r[2, k])) * float(g.size[k]) / 2.0 for k in range(3))
+    if isinstance(g, wm.Sphere):
+        return float(g.radius)
+    if isinstance(g, (wm.Cylinder, wm.Capsule)):
+        a = abs(float(r[2, 2]))
+        return float(g.height) / 2.0 * a + float(g.radius) * (
+            math.sqrt(max(0.0, 1.0 - a * a)) if isinstance(g, wm.Cylinder) else 1.0)
+    return None
+
+
+def shapes_span(shapes: list[tuple[Pose, object, object]], pose: Pose, to_enu: np.ndarray | None,
+                footprint: bool = True) -> tuple[float, float, np.ndarray | None] | None:
+    """(lowest, highest point, xy box (x0, y0, x1, y1)) in ENU of :func:`falling_shapes` at ``pose``:
+    a Box's, Sphere's, Cylinder's or Capsule's heights exact (:func:`_exact_reach`), any other shape's
+    as kinematic contact takes it (contact.obstacle, which gives every xy box); None when none of them
+    is an obstacle. ``footprint`` False: the heights alone (the xy box None)."""
+    spans: list[tuple[float, float]] = []
+    boxes = []
+    for local, prim, g in shapes:
         at = enu_pose(pose.compose(local), to_enu)
-        ob = obstacle("shape", -1, primitive_from_model(shape.geometry, base_dir), at)
+        reach = _exact_reach(g, at.rotation)
+        ob = obstacle("shape", -1, prim, at) if footprint or reach is None else None
+        if reach is not None:
+            z = float(at.translation[2])
+            spans.append((z - reach, z + reach))
+        elif ob is not None:
+            spans.append(ob.z_range)
+        else:
+            continue
         if ob is not None:
-            prisms.append(ob)
-            g = shape.geometry
-            if isinstance(g, (wm.Cylinder, wm.Capsule)):
-                # exact heights, where contact.obstacle bounds a tilted one by its circumscribed facets:
-                # its axis's vertical part a, each end's rim (or cap) reaching r·√(1 − a²) (or r) beyond
-                a = abs(float(at.rotation[2, 2]))
-                reach = float(g.height) / 2.0 * a + float(g.radius) * (
-                    math.sqrt(max(0.0, 1.0 - a * a)) if isinstance(g, wm.Cylinder) else 1.0)
-                z = float(at.translation[2])
-                spans.append((z - reach, z + reach))
-            else:
-                spans.append(ob.z_range)
-    if not prisms:
+            boxes.append([*(ob.points.min(axis=0) - ob.radius), *(ob.points.max(axis=0) + ob.radius)])
+    if not spans:
         return None
-    xy = np.array([[*(p.points.min(axis=0) - p.radius), *(p.points.max(axis=0) + p.radius)] for p in prisms])
-    box = np.array([xy[:, 0].min(), xy[:, 1].min(), xy[:, 2].max(), xy[:, 3].max()])
+    box = None
+    if footprint:
+        xy = np.array(boxes)
+        box = np.array([xy[:, 0].min(), xy[:, 1].min(), xy[:, 2].max(), xy[:, 3].max()])
     return min(lo for lo, _ in spans), max(hi for _, hi in spans), box
+
+
+def falling_span(solid: wm.Solid, base_dir: Path, to_enu: np.ndarray | None,
+                 pose: Pose | None = None) -> tuple[float, float, np.ndarray] | None:
+    """:func:`shapes_span` of a top-level solid's :func:`falling_shapes` at ``pose`` (default its
+    world-file pose): the one span every falling solid is judged by (settling at load, landing, a
+    carried load's support); None for a solid that does not fall."""
+    shapes = falling_shapes(solid, base_dir)
+    if shapes is None:
+        return None
+    return shapes_span(shapes, pose_from_model(solid.pose) if pose is None else pose, to_enu)
 
 
 def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, source: str, caught: Collection[str]

@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.server.sim.contact import UPRIGHT, Obstacle, _closest_on_list, _hull, enu_pose, obstacle
-from sensorium.server.sim.ground import falling_span, land_solid, lift_pose
+from sensorium.server.sim.ground import falling_shapes, land_solid, lift_pose, shapes_span
 from sensorium.server.sim.scene import primitive_from_model, solid_parts
 from sensorium.server.sim.sensors import Device
 from sensorium.server.world import geometry as geo
@@ -172,6 +172,7 @@ class VacuumGripper(Device):
         self._offset: Pose | None = None    # the held solid's pose in the gripper's frame
         self._held_model: Any = None        # its world-file model when attached (a rebuilt one is another)
         self._outline: tuple[str, Pose | None] | None = None     # (held, link pose) its outline was given at
+        self._falling: tuple[Any] | None = None     # (ground.falling_shapes of the held solid,)
         self._ground: tuple[tuple, Any] | None = None     # (what it was built from, the held solid's support)
         self._sim: Any = None
         self._robot: Any = None
@@ -208,7 +209,7 @@ class VacuumGripper(Device):
         if self.held is not None and self._sim.contact is not None:
             self._sim.contact.let_go(self._robot.index, self.held)
         self.held, self._offset, self._held_model, self._outline = None, None, None, None
-        self._ground = None
+        self._falling, self._ground = None, None
 
     def reset(self) -> None:
         """Webots' WbVacuumGripper::reset: the pump as the world file has it, nothing held (its
@@ -259,8 +260,10 @@ class VacuumGripper(Device):
         its load is put on it instead of into it. Its heights are ground.falling_span's, the ones it lands
         by; a solid that does not fall (a Plane or ElevationGrid among its bounding shapes) is put where
         it is held."""
-        sim = self._sim
-        span = falling_span(self._held_model, sim.loaded.base_dir, self._robot.to_enu, pose)
+        if self._falling is None:             # the held solid's shapes, once per hold
+            self._falling = (falling_shapes(self._held_model, self._sim.loaded.base_dir),)
+        shapes = self._falling[0]
+        span = None if shapes is None else shapes_span(shapes, pose, self._robot.to_enu, footprint=False)
         return pose if span is None else lift_pose(pose, span[0], span[1], self._support(), self._robot.to_enu)
 
     def _support(self) -> Any:
@@ -272,10 +275,9 @@ class VacuumGripper(Device):
             if not r.model.drive_motors and r.index != self._robot.index:
                 poses.append(scene.robot_poses[r.index])
                 poses.extend(() if r.links is None else r.links.poses.values())
-        key = (scene.solids_version, self.held, *poses)
+        key = (*sim.world.solids, *poses)        # the models (a rebuilt solid is a new one) and where they are
         kept = self._ground
-        if (kept is None or kept[0][:2] != key[:2] or len(kept[0]) != len(key)
-                or not all(a is b for a, b in zip(kept[0][2:], key[2:]))):
+        if kept is None or len(kept[0]) != len(key) or not all(a is b for a, b in zip(kept[0], key)):
             kept = self._ground = (key, sim.landing_ground(self.held, self._robot.index))
         return kept[1]
 
