@@ -75,10 +75,10 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_pose, obstacle, ramp_top, robot_footprint
 from sensorium.server.world.geometry import Pose
-from sensorium.server.world.poses import pose_from_model
+from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "falling_span", "ground_rotation", "land_pose", "placing_ceiling", "ride_height",
-           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "slope_scales", "support_ceiling"]
+__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "placing_ceiling", "resting_pose", "ride_height",
+           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling"]
 
 UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
@@ -624,55 +624,201 @@ def _landing_heights(ground: Ground, xs: np.ndarray, ys: np.ndarray, zs: np.ndar
     return found, z + (zs - lows)
 
 
-def land_pose(pose: Pose, low: float, high: float, ground: Ground | None, to_enu: np.ndarray | None) -> Pose:
-    """The pose a solid let go at ``pose`` lands at (a VacuumGripper's pump turned off, sim/vacuum.py):
-    its bounding shapes span the heights ``low`` to ``high`` (ENU z) there; it goes straight down (or
-    up) onto the highest ground under its origin (``ground``: :func:`settling_ground` without it) not
-    above the middle of that span + FLOOR, its lowest point on that ground, its x, y and rotation
-    kept -- settle_pose's rule with the span's middle for the axle (a top it sank into less than half
-    its height is its support; a higher one it sank into more is not). ``pose`` itself over no such
-    ground or within SETTLE_TOL of it."""
+def _land_height(pose: Pose, low: float, high: float, ground: Ground | None,
+                 to_enu: np.ndarray | None) -> float | None:
+    """The ENU height a solid at ``pose`` spanning ``low`` to ``high`` lands at (land_pose's rule),
+    None over no support."""
     if ground is None:
-        return pose
+        return None
     t = pose.translation if to_enu is None else to_enu @ pose.translation
     found, heights = _landing_heights(ground, np.array([float(t[0])]), np.array([float(t[1])]),
                                       np.array([float(t[2])]), np.array([low]), np.array([high]))
-    if not found[0]:
-        return pose
-    height = float(heights[0])
-    if abs(height - float(t[2])) <= SETTLE_TOL:
-        return pose
+    return float(heights[0]) if found[0] else None
+
+
+def _at_height(pose: Pose, height: float, to_enu: np.ndarray | None) -> Pose:
+    """``pose`` with its origin's ENU height set (its x, y and rotation kept)."""
     up, sign = _up_axis(to_enu)
     translation = np.array(pose.translation, dtype=np.float64)
     translation[up] = sign * height
     return Pose(pose.rotation, translation)
 
 
-def falling_span(solid: wm.Solid, base_dir: Path, to_enu: np.ndarray | None,
-                 pose: Pose | None = None) -> tuple[float, float, np.ndarray] | None:
-    """(lowest, highest point, xy box (x0, y0, x1, y1)) of the bounding shapes of a top-level solid that
-    falls (``physics``, at least one bounding shape, none of them a Plane or ElevationGrid: those
-    are ground, static in Webots' physics too), in ENU at ``pose`` (default its world-file pose), as
-    kinematic contact and the VacuumGripper take them (contact.obstacle); None for any other solid."""
+def land_pose(pose: Pose, low: float, high: float, ground: Ground | None, to_enu: np.ndarray | None) -> Pose:
+    """The pose a solid at ``pose`` lands at, its rotation as it is (:func:`land_solid` tips it first):
+    its bounding shapes span the heights ``low`` to ``high`` (ENU z) there; it goes straight down (or
+    up) onto the highest ground under its origin (``ground``: :func:`settling_ground` without it) not
+    above the middle of that span + FLOOR, its lowest point on that ground, its x, y and rotation
+    kept -- settle_pose's rule with the span's middle for the axle (a top it sank into less than half
+    its height is its support; a higher one it sank into more is not). ``pose`` itself over no such
+    ground or within SETTLE_TOL of it."""
+    height = _land_height(pose, low, high, ground, to_enu)
+    t = pose.translation if to_enu is None else to_enu @ pose.translation
+    if height is None or abs(height - float(t[2])) <= SETTLE_TOL:
+        return pose
+    return _at_height(pose, height, to_enu)
+
+
+def lift_pose(pose: Pose, low: float, high: float, ground: Ground | None, to_enu: np.ndarray | None) -> Pose:
+    """A carried solid at ``pose`` (spanning ``low`` to ``high``) held into its support -- the one
+    :func:`land_pose` would put it on -- raised so its lowest point lies on that support's top; ``pose``
+    itself when it is not below it by more than SETTLE_TOL (held above it, or over none)."""
+    height = _land_height(pose, low, high, ground, to_enu)
+    t = pose.translation if to_enu is None else to_enu @ pose.translation
+    if height is None or height - float(t[2]) <= SETTLE_TOL:
+        return pose
+    return _at_height(pose, height, to_enu)
+
+
+TIP_TOL = 1e-6
+"""sin of the tilt of a solid's resting face from the ground under which it is taken as resting on it
+(kept bit for bit: the small tilts Webots' saved worlds hold, under 1 µm per metre)."""
+
+_SIDE_OR_END = math.sqrt(0.5)     # |cos| of a cylinder's axis from the vertical at 45°: nearer an end above it
+
+
+def _world_up(to_enu: np.ndarray | None) -> np.ndarray:
+    """The world's up as a vector in world axes (ENU's z; the world's y in a NUE world)."""
+    return np.array([0.0, 0.0, 1.0]) if to_enu is None else np.array(to_enu[2], dtype=np.float64)
+
+
+def _down_face(geometry: wm.Box | wm.Cylinder, r: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """The outward normal (world axes) of the face a box or cylinder with world rotation ``r`` comes
+    to rest on: a box's face whose normal is nearest straight down; a cylinder's end when its axis
+    (local z) is within 45° of the vertical, else its side along the line nearest down."""
+    if isinstance(geometry, wm.Box):
+        ups = r.T @ up                                  # each local axis's upward part
+        k = int(np.argmax(np.abs(ups)))
+        return -math.copysign(1.0, float(ups[k])) * r[:, k]
+    axis = r[:, 2]
+    a = float(axis @ up)
+    if abs(a) >= _SIDE_OR_END:
+        return -math.copysign(1.0, a) * axis
+    side = a * axis - up                                # -up without its part along the axis
+    return side / float(np.linalg.norm(side))
+
+
+def resting_pose(solid: wm.Solid, pose: Pose, to_enu: np.ndarray | None) -> Pose:
+    """The pose a solid with physics at ``pose`` has once it has tipped onto the face under it, as
+    Webots' physics lets a box stood on a corner or edge fall onto a face: for a solid whose bounding
+    shapes are one Box or one Cylinder, that shape turned by the least rotation (about a horizontal axis
+    through its centre, so its yaw about the world's up and its centre's x, y kept) that puts
+    :func:`_down_face`'s normal straight down. ``pose`` itself for any other solid (spheres, capsules,
+    cones, meshes, several shapes: their rotation is kept) or when that face is within TIP_TOL of
+    lying flat."""
+    if not solid.physics:
+        return pose
+    from sensorium.server.sim.scene import solid_parts
+
+    parts = [(local, shape.geometry) for _, local, shape in solid_parts(solid, Pose.identity())
+             if shape.seen_by in ("both", "bounding")]
+    if len(parts) != 1 or not isinstance(parts[0][1], (wm.Box, wm.Cylinder)):
+        return pose
+    local, geometry = parts[0]
+    shape = pose.compose(local)
+    up = _world_up(to_enu)
+    normal = _down_face(geometry, shape.rotation, up)
+    axis = np.cross(normal, -up)                        # horizontal: both are unit, -up is vertical
+    sin = float(np.linalg.norm(axis))
+    if sin <= TIP_TOL:
+        return pose
+    turn = axis_angle_matrix(axis / sin, math.atan2(sin, float(normal @ -up)))
+    centre = shape.translation
+    return Pose(turn @ pose.rotation, centre + turn @ (pose.translation - centre))
+
+
+def land_solid(solid: wm.Solid, pose: Pose, base_dir: Path, ground: Ground | None,
+               to_enu: np.ndarray | None) -> Pose:
+    """Where a top-level solid let go at ``pose`` comes to rest: over a support (:func:`land_pose`'s
+    rule), tipped onto the face under it (:func:`resting_pose`) and then put straight down (or up)
+    on that support, its lowest point on its top. ``pose`` itself for a solid that does not fall
+    (:func:`falling_span`), over no support (judged tipped), or already resting there (within TIP_TOL
+    and SETTLE_TOL)."""
+    span = falling_span(solid, base_dir, to_enu, pose)
+    if span is None:
+        return pose
+    tipped = resting_pose(solid, pose, to_enu)
+    if tipped is not pose:
+        span = falling_span(solid, base_dir, to_enu, tipped)
+        assert span is not None
+        height = _land_height(tipped, span[0], span[1], ground, to_enu)
+        return pose if height is None else _at_height(tipped, height, to_enu)
+    return land_pose(pose, span[0], span[1], ground, to_enu)
+
+
+def falling_shapes(solid: wm.Solid, base_dir: Path) -> list[tuple[Pose, object, object]] | None:
+    """The bounding shapes of a top-level solid that falls -- ``physics``, at least one bounding shape,
+    none of them a Plane or ElevationGrid (those are ground, static in Webots' physics too) -- as (pose
+    in the solid's frame, primitive, geometry model); None for any other solid."""
     from sensorium.server.sim.scene import primitive_from_model, solid_parts
 
     if not solid.physics:
         return None
-    pose = pose_from_model(solid.pose) if pose is None else pose
-    prisms = []
+    shapes = []
     for _, local, shape in solid_parts(solid, Pose.identity()):
         if shape.seen_by not in ("both", "bounding"):
             continue
         if isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid)):
             return None
-        ob = obstacle("shape", -1, primitive_from_model(shape.geometry, base_dir), enu_pose(pose.compose(local), to_enu))
+        shapes.append((local, primitive_from_model(shape.geometry, base_dir), shape.geometry))
+    return shapes or None
+
+
+def _exact_reach(g: object, r: np.ndarray) -> float | None:
+    """How far a Box, Sphere, Cylinder or Capsule with ENU rotation ``r`` reaches above and below its
+    centre, exactly (a box's half sizes times the vertical parts of its axes; a cylinder's or capsule's
+    axis's vertical part a, each end's rim (or cap) reaching r·√(1 − a²) (or r) beyond), where
+    contact.obstacle bounds a tilted cylinder by its circumscribed facets; None for other shapes."""
+    if isinstance(g, wm.Box):
+        return sum(abs(float(r[2, k])) * float(g.size[k]) / 2.0 for k in range(3))
+    if isinstance(g, wm.Sphere):
+        return float(g.radius)
+    if isinstance(g, (wm.Cylinder, wm.Capsule)):
+        a = abs(float(r[2, 2]))
+        return float(g.height) / 2.0 * a + float(g.radius) * (
+            math.sqrt(max(0.0, 1.0 - a * a)) if isinstance(g, wm.Cylinder) else 1.0)
+    return None
+
+
+def shapes_span(shapes: list[tuple[Pose, object, object]], pose: Pose, to_enu: np.ndarray | None,
+                footprint: bool = True) -> tuple[float, float, np.ndarray | None] | None:
+    """(lowest, highest point, xy box (x0, y0, x1, y1)) in ENU of :func:`falling_shapes` at ``pose``:
+    a Box's, Sphere's, Cylinder's or Capsule's heights exact (:func:`_exact_reach`), any other shape's
+    as kinematic contact takes it (contact.obstacle, which gives every xy box); None when none of them
+    is an obstacle. ``footprint`` False: the heights alone (the xy box None)."""
+    spans: list[tuple[float, float]] = []
+    boxes = []
+    for local, prim, g in shapes:
+        at = enu_pose(pose.compose(local), to_enu)
+        reach = _exact_reach(g, at.rotation)
+        ob = obstacle("shape", -1, prim, at) if footprint or reach is None else None
+        if reach is not None:
+            z = float(at.translation[2])
+            spans.append((z - reach, z + reach))
+        elif ob is not None:
+            spans.append(ob.z_range)
+        else:
+            continue
         if ob is not None:
-            prisms.append(ob)
-    if not prisms:
+            boxes.append([*(ob.points.min(axis=0) - ob.radius), *(ob.points.max(axis=0) + ob.radius)])
+    if not spans:
         return None
-    xy = np.array([[*(p.points.min(axis=0) - p.radius), *(p.points.max(axis=0) + p.radius)] for p in prisms])
-    box = np.array([xy[:, 0].min(), xy[:, 1].min(), xy[:, 2].max(), xy[:, 3].max()])
-    return min(p.z_range[0] for p in prisms), max(p.z_range[1] for p in prisms), box
+    box = None
+    if footprint:
+        xy = np.array(boxes)
+        box = np.array([xy[:, 0].min(), xy[:, 1].min(), xy[:, 2].max(), xy[:, 3].max()])
+    return min(lo for lo, _ in spans), max(hi for _, hi in spans), box
+
+
+def falling_span(solid: wm.Solid, base_dir: Path, to_enu: np.ndarray | None,
+                 pose: Pose | None = None) -> tuple[float, float, np.ndarray] | None:
+    """:func:`shapes_span` of a top-level solid's :func:`falling_shapes` at ``pose`` (default its
+    world-file pose): the one span every falling solid is judged by (settling at load, landing, a
+    carried load's support); None for a solid that does not fall."""
+    shapes = falling_shapes(solid, base_dir)
+    if shapes is None:
+        return None
+    return shapes_span(shapes, pose_from_model(solid.pose) if pose is None else pose, to_enu)
 
 
 def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, source: str, caught: Collection[str]
@@ -686,17 +832,24 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
     file places them, and the solids with physics landed before it where they landed (a box stacked on
     a box lands on it once that one has landed). A solid with physics not yet landed is no support. The
     solids in ``caught`` (held by a VacuumGripper from the first step: vacuum.caught_at_load) stay."""
-    falling = [(i, s, got) for i, s in enumerate(world.solids)
-               if s.name not in caught and (got := falling_span(s, base_dir, to_enu)) is not None]
+    poses = {s.name: pose_from_model(s.pose) for s in world.solids}
+    # each falling solid tipped onto the face under it first (resting_pose), then landed as it lies
+    falling = []
+    for i, s in enumerate(world.solids):
+        if s.name in caught or (got := falling_span(s, base_dir, to_enu)) is None:
+            continue
+        tipped = resting_pose(s, poses[s.name], to_enu)
+        if tipped is not poses[s.name]:
+            got = falling_span(s, base_dir, to_enu, tipped)
+            assert got is not None
+        falling.append((i, s, got, tipped))
     if not falling:
         return world, []
-    moving = {i for i, _, _ in falling}
-    poses = {s.name: pose_from_model(s.pose) for s in world.solids}
+    moving = {i for i, *_ in falling}
     floors = [(r, pose_from_model(r.pose)) for r in world.robots if not r.drive_motors]
     still = settling_ground([(s, poses[s.name]) for i, s in enumerate(world.solids) if i not in moving], floors, to_enu)
     falling.sort(key=lambda f: f[2][0])          # lowest first (a stable sort: world order on a tie)
-    ts = [pose.translation if to_enu is None else to_enu @ pose.translation
-          for pose in (poses[s.name] for _, s, _ in falling)]
+    ts = [pose.translation if to_enu is None else to_enu @ pose.translation for *_, pose in falling]
     xs, ys, zs = (np.array([float(t[k]) for t in ts]) for k in range(3))
     lows = np.array([f[2][0] for f in falling])
     highs = np.array([f[2][1] for f in falling])
@@ -707,8 +860,8 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
     up, sign = _up_axis(to_enu)
     solids = list(world.solids)
     landed = Ground([], {}, to_enu)               # the falling solids already landed, each added where it landed
-    moved: list[tuple[str, float, float]] = []
-    for k, (i, solid, _) in enumerate(falling):
+    moved: list[tuple[str, float, float, bool]] = []
+    for k, (i, solid, _, tipped) in enumerate(falling):
         # asked only when one of them may be under it (its shapes' xy box holds the origin: x, y never change)
         if (k and ((boxes[:k, 0] <= xs[k]) & (xs[k] <= boxes[:k, 2]) & (boxes[:k, 1] <= ys[k])
                    & (ys[k] <= boxes[:k, 3])).any()):
@@ -716,15 +869,20 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
             if on[0] and (not found[k] or h[0] > heights[k]):
                 found[k], heights[k] = True, h[0]
         height = float(heights[k])
-        if found[k] and not abs(height - float(zs[k])) <= SETTLE_TOL:
-            translation = list(solid.pose.translation)
+        turned = tipped is not poses[solid.name]
+        if found[k] and (turned or not abs(height - float(zs[k])) <= SETTLE_TOL):
+            translation = [float(v) for v in tipped.translation] if turned else list(solid.pose.translation)
             translation[up] = sign * height
-            solid = solids[i] = solid.model_copy(
-                update={"pose": solid.pose.model_copy(update={"translation": tuple(translation)})})
-            moved.append((solid.name, float(zs[k]), height))
+            update: dict = {"translation": tuple(translation)}
+            if turned:                  # its rotation as the world file wrote it (axis-angle or quaternion)
+                update.update({"rotation": None, "quaternion": matrix_quaternion(tipped.rotation)}
+                              if solid.pose.quaternion is not None else {"rotation": tuple(axis_angle(tipped.rotation))})
+            solid = solids[i] = solid.model_copy(update={"pose": solid.pose.model_copy(update=update)})
+            moved.append((solid.name, float(zs[k]), height, turned))
         landed.add_solid(solid, pose_from_model(solid.pose))
-    notes = [f"{source}: solid {name!r} settled on the ground at load, as Webots' physics drops it: its origin's "
-             f"{'xyz'[up]} from {sign * z:.4f} to {sign * h:.4f} m" for name, z, h in moved if abs(h - z) > SETTLE_NOTE]
+    notes = [f"{source}: solid {name!r} settled on the ground at load, as Webots' physics drops it: "
+             f"{'tipped onto a face, ' if turned else ''}its origin's {'xyz'[up]} from {sign * z:.4f} to {sign * h:.4f} m"
+             for name, z, h, turned in moved if turned or abs(h - z) > SETTLE_NOTE]
     if len(notes) > SETTLE_NOTES:
         notes = [*notes[:SETTLE_NOTES], f"{source}: {len(notes) - SETTLE_NOTES} more solids settled on the ground at load"]
     return (world.model_copy(update={"solids": solids}) if moved else world), notes

@@ -33,8 +33,7 @@ from sensorium.server.sim.ground import (
     Ground,
     GroundWarning,
     band_low,
-    falling_span,
-    land_pose,
+    land_solid,
     settle_pose,
     settle_world,
     settles,
@@ -432,11 +431,12 @@ class Simulation:
         return self._settling.settled(model, pose, self.world.solids, self.scene, lambda: [
             (r.model, self.scene.robot_poses[r.index]) for r in self.robots.values() if not r.model.drive_motors])
 
-    def landing_ground(self, solid: str) -> Ground | None:
-        """The ground a solid let go lands on (ground.land_pose): ground.settling_ground as the world is
+    def landing_ground(self, solid: str, carrier: int | None = None) -> Ground | None:
+        """The ground a solid let go lands on (ground.land_solid): ground.settling_ground as the world is
         now, the other top-level solids where they are, the robots without a drive where they are with
-        their shapes where their joints hold them (a lift's cup that just let go of a parcel is above it)."""
-        floors = [r for r in self.robots.values() if not r.model.drive_motors]
+        their shapes where their joints hold them (a lift's cup that just let go of a parcel is above it).
+        ``carrier``: a robot (index) left out, the one holding the solid (one body with it)."""
+        floors = [r for r in self.robots.values() if not r.model.drive_motors and r.index != carrier]
         alive = self.scene.solid_poses
         parts = [[(name, local if r.links is None or (j := getattr(shape, "on_joint", None)) not in r.links.poses
                    else r.links.poses[j].compose(local), shape) for name, local, shape in robot_parts(r.model)]
@@ -694,15 +694,13 @@ class Simulation:
 
     def _land(self, solid: wm.Solid) -> None:
         """A top-level solid with physics just added (imported, or built again) lands at once on what is
-        under it now (ground.land_pose, the rule of a solid let go and of settle_world at load); any
+        under it now (ground.land_solid, the rule of a solid let go and of settle_world at load); any
         other solid stays where it is."""
         to_enu = _TO_ENU[self.world.world_info.coordinate_system]
         pose = self.scene.solid_poses[solid.name]
-        span = falling_span(solid, self.loaded.base_dir, to_enu, pose)
-        if span is not None:
-            landed = land_pose(pose, span[0], span[1], self.landing_ground(solid.name), to_enu)
-            if landed is not pose:
-                self.place_solid(solid.name, landed)
+        landed = land_solid(solid, pose, self.loaded.base_dir, self.landing_ground(solid.name), to_enu)
+        if landed is not pose:
+            self.place_solid(solid.name, landed)
 
     def replace_solid(self, name: str, node: Any, node_id: int) -> None:
         """Top-level solid ``name`` built again (a Supervisor set one of its PROTO fields, sim/regenerate.py):

@@ -24,10 +24,12 @@ bounds them. Robots are never attached, and no force breaks the hold (no physics
 A held solid is part of its carrier, as Webots' fixed joint makes the two one body: kinematic contact
 never stops the carrier at it nor do its bumpers touch it (``Contact.hold``/``let_go``), while it stops
 the other robots where it is. A solid let go (``turnOff``) is an obstacle to its carrier again at
-once and, at the end of that step, lands: ground.land_pose puts it straight down on the highest support
-under its origin (the settling ground without it: ``Simulation.landing_ground``), its lowest point on
-that support's top, its rotation kept -- no flight time, bounce or tipping, where Webots' physics
-lets it fall over the next steps.
+once and, at the end of that step, lands: ground.land_solid tips a single box or cylinder onto the face
+under it and puts it straight down on the highest support under its origin (the settling ground without
+it: ``Simulation.landing_ground``), its lowest point on that support's top -- no flight time, bounce or
+rolling, where Webots' physics lets it fall over the next steps. While held, a load the kinematic
+carrier holds below the top of that support is raised onto it (:meth:`VacuumGripper._on_support`),
+where Webots' contact would push back on the load and, through the joint, on the arm.
 """
 from __future__ import annotations
 
@@ -37,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.server.sim.contact import UPRIGHT, Obstacle, _closest_on_list, _hull, enu_pose, obstacle
-from sensorium.server.sim.ground import land_pose
+from sensorium.server.sim.ground import falling_shapes, land_solid, lift_pose, shapes_span
 from sensorium.server.sim.scene import primitive_from_model, solid_parts
 from sensorium.server.sim.sensors import Device
 from sensorium.server.world import geometry as geo
@@ -170,6 +172,8 @@ class VacuumGripper(Device):
         self._offset: Pose | None = None    # the held solid's pose in the gripper's frame
         self._held_model: Any = None        # its world-file model when attached (a rebuilt one is another)
         self._outline: tuple[str, Pose | None] | None = None     # (held, link pose) its outline was given at
+        self._falling: tuple[Any] | None = None     # (ground.falling_shapes of the held solid,)
+        self._ground: tuple[tuple, Any] | None = None     # (what it was built from, the held solid's support)
         self._sim: Any = None
         self._robot: Any = None
         self._own: list[tuple[Any, Pose, str | None]] = []          # (primitive, pose in robot frame, on_joint)
@@ -205,6 +209,7 @@ class VacuumGripper(Device):
         if self.held is not None and self._sim.contact is not None:
             self._sim.contact.let_go(self._robot.index, self.held)
         self.held, self._offset, self._held_model, self._outline = None, None, None, None
+        self._falling, self._ground = None, None
 
     def reset(self) -> None:
         """Webots' WbVacuumGripper::reset: the pump as the world file has it, nothing held (its
@@ -235,7 +240,7 @@ class VacuumGripper(Device):
             assert self._offset is not None
             self._hold_outline()
             current = sim.scene.solid_poses[self.held]
-            pose = self.frame().compose(self._offset)
+            pose = self._on_support(self.frame().compose(self._offset))
             if not (np.array_equal(pose.translation, current.translation)
                     and np.array_equal(pose.rotation, current.rotation)):
                 known = self._models_version == sim.scene.solids_version
@@ -248,6 +253,33 @@ class VacuumGripper(Device):
                 self.held, self._held_model = name, self._model(name)
                 self._offset = self.frame().inverse().compose(sim.scene.solid_poses[name])
                 self._hold_outline()
+
+    def _on_support(self, pose: Pose) -> Pose:
+        """The held solid at ``pose``, raised onto the support it is held into (ground.lift_pose: the one
+        it would land on, the carrier left out): the kinematic carrier is not stopped by the floor, so
+        its load is put on it instead of into it. Its heights are ground.falling_span's, the ones it lands
+        by; a solid that does not fall (a Plane or ElevationGrid among its bounding shapes) is put where
+        it is held."""
+        if self._falling is None:             # the held solid's shapes, once per hold
+            self._falling = (falling_shapes(self._held_model, self._sim.loaded.base_dir),)
+        shapes = self._falling[0]
+        span = None if shapes is None else shapes_span(shapes, pose, self._robot.to_enu, footprint=False)
+        return pose if span is None else lift_pose(pose, span[0], span[1], self._support(), self._robot.to_enu)
+
+    def _support(self) -> Any:
+        """Simulation.landing_ground for the held solid without its carrier, built again only when
+        something in it moved (poses and joint displacements are immutable objects: compared by identity)."""
+        sim, scene = self._sim, self._sim.scene
+        poses = [p for n, p in scene.solid_poses.items() if n != self.held]
+        for r in sim.robots.values():
+            if not r.model.drive_motors and r.index != self._robot.index:
+                poses.append(scene.robot_poses[r.index])
+                poses.extend(() if r.links is None else r.links.poses.values())
+        key = (*sim.world.solids, *poses)        # the models (a rebuilt solid is a new one) and where they are
+        kept = self._ground
+        if kept is None or len(kept[0]) != len(key) or not all(a is b for a, b in zip(kept[0], key)):
+            kept = self._ground = (key, sim.landing_ground(self.held, self._robot.index))
+        return kept[1]
 
     def _hold_outline(self) -> None:
         """The held solid's bounding shapes, where the gripper holds them in its robot's frame, part of
@@ -267,20 +299,15 @@ class VacuumGripper(Device):
         self._outline = (self.held, link)
 
     def _land(self, name: str, model: Any) -> None:
-        """The solid let go this step put on what is under it (ground.land_pose: the highest support
-        under its origin, its lowest point on it, at once), unless it is gone, rebuilt, or held again
-        (by another gripper)."""
+        """The solid let go this step put to rest on what is under it (ground.land_solid: tipped onto the
+        face under it, its lowest point on the highest support under its origin, at once), unless it is
+        gone, rebuilt, or held again (by another gripper)."""
         sim = self._sim
         if self._model(name) is not model or any(
                 isinstance(d, VacuumGripper) and d.held == name for d in sim.all_devices()):
             return
         pose = sim.scene.solid_poses[name]
-        prisms = self._solid_obstacles(name, pose)
-        if not prisms:                 # no bounding shapes: nothing to land on (it stays)
-            return
-        low = min(p.z_range[0] for p in prisms)
-        high = max(p.z_range[1] for p in prisms)
-        landed = land_pose(pose, low, high, sim.landing_ground(name), self._robot.to_enu)
+        landed = land_solid(model, pose, sim.loaded.base_dir, sim.landing_ground(name), self._robot.to_enu)
         if landed is not pose:
             sim.place_solid(name, landed)
 
