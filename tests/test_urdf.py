@@ -164,3 +164,35 @@ def test_a_c_controller_reads_the_servers_urdf(tmp_path, tmp_path_factory):
     ctl = run_paused(WORLD, tmp_path, exe, "arm", env=SAN_ENV)
     assert ctl.out[-1] == "same 1"
     assert "\n".join(ctl.out[:-1]) + "\n" == served_urdf(prefix="p_")
+
+
+FREE = REPO / "tests" / "worlds" / "urdf_free_joints.wbt"
+
+
+def free_urdf() -> ET.Element:
+    world = load_world(FREE).world
+    rig = next(r for r in world.robots if r.name == "rig")
+    return ET.fromstring(robot_urdf(rig, rig.nodes))
+
+
+def test_joints_no_motor_turns_keep_their_axis_and_anchor():
+    """A hinge with a PositionSensor only, a hinge and a slider with no device (urdf_free_joints.wbt's
+    header): each joint's own axis and anchor, as Webots exports them (before: x or z and the end point's
+    translation)."""
+    by_child = {j.find("child").get("link"): j for j in free_urdf().iter("joint")}
+    knob, flap, drawer = by_child["knob"], by_child["flap"], by_child["drawer"]
+    assert (knob.get("name"), knob.get("type")) == ("knob sensor", "continuous")
+    # the Pose turns the axis and anchor into the robot frame; the axis is in the end point's frame
+    assert floats(knob.find("axis").get("xyz")) == pytest.approx(list(rx(0.2).T @ [0.0, 1.0, 0.0]), abs=1e-15)
+    anchor = rz(0.5) @ [0.3, 0.1, 0.05] + np.array([0.1, 0.0, 0.2])
+    assert floats(knob.find("origin").get("xyz")) == pytest.approx(list(anchor), abs=1e-15)
+    assert floats(knob.find("origin").get("rpy")) == pytest.approx([0.2, 0.0, 0.5], abs=1e-15)
+    assert knob.find("limit") is None and flap.find("limit") is None and drawer.find("limit") is None
+    # a passive hinge: its child frame on the anchor, not on the end point 0.05 m past it
+    assert (flap.get("name"), flap.get("type")) == ("FLAP", "continuous")
+    assert floats(flap.find("axis").get("xyz")) == pytest.approx([0.5 ** 0.5, 0.5 ** 0.5, 0.0], abs=1e-15)
+    assert floats(flap.find("origin").get("xyz")) == pytest.approx([-0.2, 0.0, 0.1], abs=1e-15)
+    # a passive slider: its axis, its end point's place
+    assert (drawer.get("name"), drawer.get("type")) == ("DRAWER", "prismatic")
+    assert floats(drawer.find("axis").get("xyz")) == pytest.approx([0.0, 0.6, 0.8], abs=1e-15)
+    assert floats(drawer.find("origin").get("xyz")) == pytest.approx([0.0, -0.3, 0.0], abs=1e-15)

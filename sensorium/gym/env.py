@@ -74,7 +74,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from sensorium.gym.frame import enu_axes, planar_pose
+from sensorium.gym.frame import drive_forward, enu_axes, planar_pose
 from sensorium.gym.render import TopDown, TopDownRendering, check_render_size
 from sensorium.gym.task import Task, whole
 from sensorium.gym.views import CopySim
@@ -130,6 +130,7 @@ class Agent:
             raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive, ackermann_drive, "
                              "mecanum_drive or omni_drive to act with")
         self.robot = name
+        self.forward = drive_forward(model)     # its heading's direction in its own frame (None: its x)
         ctrl = basic if task.control_period_ms is None else task.control_period_ms
         if not whole(ctrl) or ctrl <= 0 or ctrl % basic:
             raise ValueError(f"task control_period_ms={ctrl} must be a positive multiple of the world's "
@@ -317,10 +318,11 @@ class Agent:
 
     def info(self, sim: Simulation, steps: int) -> dict[str, Any]:
         """``time_ms``, ``steps`` and ``pose``: the robot's (east, north, yaw) in the world's ENU view
-        (:mod:`sensorium.gym.frame`; in an ENU world its x, y and heading about z)."""
+        (:mod:`sensorium.gym.frame`; in an ENU world its x, y and heading about z), the yaw its
+        drive's forward's."""
         pose = sim.robot(self.robot).pose
         return {"time_ms": sim.time_ms, "steps": steps,
-                "pose": np.array(planar_pose(self.axes, pose.translation, pose.rotation))}
+                "pose": np.array(planar_pose(self.axes, pose.translation, pose.rotation, self.forward))}
 
 
 def has_drive(model: wm.Robot) -> bool:

@@ -8,6 +8,12 @@ the world's up axis), a pose is (east, north, yaw counter-clockwise about up fro
 has it. :func:`enu_axes` turns the simulation's world-to-ENU permutation into the world axes that
 are east, north and up, so a helper reads a world vector's ENU components by indexing: exactly
 (no arithmetic), and in an ENU world the very values it always read.
+
+A robot's heading is its drive's ``forward`` (:func:`drive_forward`; a robot built like Webots'
+``four_wheels`` how-to drives along its own y, a y-up robot in a NUE world along its z or -z), as
+the drives take it (sim/motion.py): ``info["pose"]``'s yaw, ``random_start``'s yaw and ``render()``'s
+heading line all read :func:`heading`. A drive whose forward is its own x (the default) reads the
+rotation's first column, the very values it always read.
 """
 
 from __future__ import annotations
@@ -20,7 +26,8 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
 
-__all__ = ["ENU_AXES", "to_enu", "enu_axes", "planar_pose", "horizontal_directions", "own_up", "upright_quaternion"]
+__all__ = ["ENU_AXES", "to_enu", "enu_axes", "drive_forward", "heading", "planar_pose", "horizontal_directions",
+           "own_up", "forward_turn", "upright_quaternion"]
 
 ENU_AXES = (0, 1, 2)
 """An ENU world's east, north and up axes: its own x, y, z."""
@@ -42,11 +49,35 @@ def enu_axes(world: wm.World) -> tuple[int, int, int]:
     return east, north, up
 
 
-def planar_pose(axes: tuple[int, int, int], translation: np.ndarray, rotation: np.ndarray) -> tuple[float, float, float]:
-    """(east, north, yaw) of a pose: its place on the ground plane and its heading (its own x axis,
-    the drives' forward) as an angle counter-clockwise about up from east."""
+def drive_forward(robot: wm.Robot) -> np.ndarray | None:
+    """The robot's drive's ``forward`` as a unit vector in its own frame, normalised as the drives
+    normalise it (sim/motion.py); None when it is its own x (the default) or it has no drive."""
+    drive = robot.differential_drive or robot.ackermann_drive or robot.mecanum_drive or robot.omni_drive
+    forward = getattr(drive, "forward", None)
+    if forward is None or tuple(forward) in ((1.0, 0.0), (1.0, 0.0, 0.0)):
+        return None
+    f = [float(v) for v in forward] + [0.0] * (3 - len(forward))
+    norm = math.hypot(*f)
+    return np.array([f[0] / norm, f[1] / norm, f[2] / norm])
+
+
+def heading(rotation: np.ndarray, forward: np.ndarray | None) -> np.ndarray:
+    """The world direction a robot at ``rotation`` ((3, 3), or (m, 3, 3) for m copies) drives along:
+    its own x axis (``forward`` None: the rotation's first column, exactly) or ``rotation @ forward``,
+    written out element-wise so that one robot and a batch of copies give the same bits."""
+    if forward is None:
+        return rotation[..., :, 0]
+    return rotation[..., :, 0] * forward[0] + rotation[..., :, 1] * forward[1] + rotation[..., :, 2] * forward[2]
+
+
+def planar_pose(axes: tuple[int, int, int], translation: np.ndarray, rotation: np.ndarray,
+                forward: np.ndarray | None = None) -> tuple[float, float, float]:
+    """(east, north, yaw) of a pose: its place on the ground plane and its heading (its drive's
+    ``forward``, :func:`heading`; its own x axis by default) as an angle counter-clockwise about up
+    from east."""
     e, n, _ = axes
-    return float(translation[e]), float(translation[n]), math.atan2(rotation[n, 0], rotation[e, 0])
+    h = heading(rotation, forward)
+    return float(translation[e]), float(translation[n]), math.atan2(h[n], h[e])
 
 
 def horizontal_directions(axes: tuple[int, int, int], count: int) -> np.ndarray:
@@ -67,17 +98,35 @@ def own_up(axes: tuple[int, int, int], rotation: np.ndarray) -> tuple[int, float
     return k, (1.0 if up[k] >= 0.0 else -1.0)
 
 
-def upright_quaternion(axes: tuple[int, int, int], rotation: np.ndarray, yaw: float) -> tuple[float, float, float, float]:
-    """The rotation (a quaternion, x y z w) of a robot whose pose has ``rotation`` turned upright
-    and to ``yaw`` (counter-clockwise about up from east): its own x axis (forward) level at that
-    heading, and whichever of its own y and z axes is closer to the world's up (its up axis) along
-    the world's up -- a NUE robot built y-up (Webots before R2022a) and one built z-up both stand."""
+def _level(axes: tuple[int, int, int], rotation: np.ndarray) -> np.ndarray:
+    """Own frame -> a frame on level ground (ENU axes) with the robot's own x east: its up axis
+    (:func:`own_up`) up, the third right-handed; the identity for a z-up robot."""
     k, s = own_up(axes, rotation)
-    # own frame -> a frame facing east on level ground: x forward, the up axis up, the third right-handed
     level = np.zeros((3, 3))
     level[0, 0] = 1.0
     level[2, k] = s
     level[1, 3 - k] = s if k == 2 else -s
+    return level
+
+
+def forward_turn(axes: tuple[int, int, int], rotation: np.ndarray, forward: np.ndarray | None) -> float:
+    """The angle about up from the robot's own x axis to its drive's ``forward`` once it stands
+    upright (:func:`upright_quaternion`; in an ENU world as ``random_start`` stands it, z up): a pose
+    whose own x is at ``yaw - forward_turn`` heads at ``yaw``. 0 for ``forward`` None (its own x)."""
+    if forward is None:
+        return 0.0
+    level = np.eye(3) if axes == ENU_AXES else _level(axes, rotation)
+    f = level @ forward
+    return math.atan2(f[1], f[0])
+
+
+def upright_quaternion(axes: tuple[int, int, int], rotation: np.ndarray, yaw: float) -> tuple[float, float, float, float]:
+    """The rotation (a quaternion, x y z w) of a robot whose pose has ``rotation`` turned upright
+    and to ``yaw`` (counter-clockwise about up from east): its own x axis level at that heading
+    (:func:`forward_turn` takes a drive's other forward there), and whichever of its own y and z
+    axes is closer to the world's up (its up axis) along the world's up -- a NUE robot built y-up
+    (Webots before R2022a) and one built z-up both stand."""
+    level = _level(axes, rotation)
     turned = axis_angle_matrix((0.0, 0.0, 1.0), yaw) @ level      # in ENU axes
     world = np.empty((3, 3))
     world[list(axes), :] = turned                                  # back to the world's axes (exact)

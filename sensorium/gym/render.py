@@ -2,7 +2,8 @@
 
 Every shape (of solids, their nested children and multi-shape bodies) is drawn as the convex hull of its tessellation projected on the world's
 ground plane, filled with its ``base_color``, lowest top first (so a tall wall covers the floor); sized planes
-(floors) are drawn first. Robots are drawn on top with a white heading line, lights as yellow
+(floors) are drawn first. Robots are drawn on top with a white heading line (along the drive's forward,
+:func:`sensorium.gym.frame.heading`), lights as yellow
 dots. The view looks down the world's up axis with east to the right and north up (the world's
 ENU view, :mod:`sensorium.gym.frame`: in an ENU world +x right, +y up the image; in a NUE world +z
 right, +x up); it covers the bounding box of everything drawn plus a margin.
@@ -15,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from sensorium.gym.frame import ENU_AXES, enu_axes, own_up
+from sensorium.gym.frame import ENU_AXES, drive_forward, enu_axes, heading, own_up
 from sensorium.gym.task import whole
 from sensorium.schemas import world as wm
 from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
@@ -82,6 +83,7 @@ class TopDown:
         # horizontal axes (x and y; in a NUE world x and the one of y, z its world-file pose has level)
         self._robot_parts: list[list[tuple[np.ndarray, tuple[int, int, int]]]] = []
         self._robot_level: list[list[int]] = []
+        self._robot_forward = [drive_forward(r) for r in sim.world.robots]    # the heading line's direction
         for r in sim.world.robots:
             level = [0, 1]
             if axes != ENU_AXES:
@@ -188,7 +190,8 @@ class TopDown:
         for lt in self.sim.scene.world_lights():
             if lt.type != "DirectionalLight" and lt.on:
                 self._disc(img, np.asarray(lt.location)[self._ground], 4, (255, 230, 40))
-        for rb, parts, level in zip(self.sim.robots.values(), self._robot_parts, self._robot_level):
+        for rb, parts, level, forward in zip(self.sim.robots.values(), self._robot_parts, self._robot_level,
+                                             self._robot_forward):
             pose = rb.pose
             reach = 4.0 / self.scale
             if parts:
@@ -198,7 +201,7 @@ class TopDown:
             else:
                 self._disc(img, pose.translation[self._ground], 3, (200, 200, 200))
             at = pose.translation[self._ground]
-            fwd = pose.rotation[self._ground, 0]
+            fwd = heading(pose.rotation, forward)[self._ground]
             norm = math.hypot(*fwd) or 1.0
             self._line(img, at, at + fwd / norm * reach * 1.4, (255, 255, 255))
         return img

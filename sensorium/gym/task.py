@@ -34,7 +34,15 @@ from typing import Any
 
 import numpy as np
 
-from sensorium.gym.frame import ENU_AXES, enu_axes, horizontal_directions, to_enu, upright_quaternion
+from sensorium.gym.frame import (
+    ENU_AXES,
+    drive_forward,
+    enu_axes,
+    forward_turn,
+    horizontal_directions,
+    to_enu,
+    upright_quaternion,
+)
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.batched_lights import copy_world_lights
@@ -124,10 +132,11 @@ class random_start:
     so a seed fixes the start.
 
     The ranges are the world's ENU view (:mod:`sensorium.gym.frame`): ``x`` east, ``y`` north, ``yaw``
-    counter-clockwise about up from east. In an ENU world the robot's rotation becomes the turn
-    ``yaw`` about z; in a NUE world (x north, y up, z east) ``x`` ranges over the world's z, ``y``
+    counter-clockwise about up from east, the heading of the robot's drive's ``forward`` (its own x
+    axis by default). In an ENU world the robot's rotation becomes a turn about z, ``yaw`` for an
+    x-forward drive; in a NUE world (x north, y up, z east) ``x`` ranges over the world's z, ``y``
     over its x, the height is kept along y, and the robot stands upright (the one of its own y and
-    z axes that was closer to up along the world's y) with its own x axis at ``yaw``."""
+    z axes that was closer to up along the world's y) with its forward at ``yaw``."""
 
     def __init__(self, x: tuple[float, float], y: tuple[float, float], yaw: tuple[float, float] = (-math.pi, math.pi)):
         self.x, self.y, self.yaw = x, y, yaw
@@ -139,7 +148,11 @@ class random_start:
         z = float(now.translation[u])
         x = rng.uniform(*self.x)
         y = rng.uniform(*self.y)
+        # the yaw is the drive's forward's: its own x goes forward_turn short of it (0 for an x-forward drive)
         yaw = rng.uniform(*self.yaw)
+        turn = forward_turn(axes, now.rotation, drive_forward(robot.model))
+        if turn:
+            yaw -= turn
         ground = getattr(sim, "ground", None)         # (in ENU axes in any world)
         if ground is not None:      # its ground here (box tops up to its origin + 1 mm), the highest there
             here = ground.at(float(now.translation[e]), float(now.translation[n]), placing_ceiling(z, 0.0))

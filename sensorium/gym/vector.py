@@ -46,6 +46,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from sensorium.gym.env import DEFAULT_PRECISION, SEGMENTATION, Agent, check_precision, device_of, load, missing_fill
+from sensorium.gym.frame import heading
 from sensorium.gym.render import TopDown, check_render_size
 from sensorium.gym.task import Task, VectorGoal, never, whole, zero
 from sensorium.gym.views import CopySim
@@ -367,9 +368,12 @@ class SensoriumVectorEnv(VectorEnv):
             pose[:, :2] = pos[:, :2]
         else:
             pose[:, 0], pose[:, 1] = pos[:, e], pos[:, n]
-        # the yaw as math.atan2 gives it (the single environment's): libm's atan2 in one C pass
-        if packets.atan2(rot[:, n, 0], rot[:, e, 0], pose[:, 2]) is None:
-            pose[:, 2] = list(map(math.atan2, rot[:, n, 0].tolist(), rot[:, e, 0].tolist()))
+        # the yaw as math.atan2 gives it (the single environment's): libm's atan2 in one C pass, of
+        # the drive's forward (frame.heading, element-wise as the single env's)
+        head = heading(rot, self.agent.forward)
+        north, east = head[:, n], head[:, e]
+        if packets.atan2(north, east, pose[:, 2]) is None:
+            pose[:, 2] = list(map(math.atan2, north.tolist(), east.tolist()))
         return {"time_ms": self.sim.time_ms[copies].copy(), "steps": self.steps[copies].copy(), "pose": pose}
 
     def _full_info(self, mask: np.ndarray) -> dict[str, np.ndarray]:

@@ -1648,6 +1648,11 @@ class NestedNode(Strict):
                                "(Supervisor getFromDevice)")
     joint_parameters: bool = Field(default=False, description="a HingeJoint or SliderJoint whose world file gives "
                                    "its jointParameters node (a Supervisor reads its position there)")
+    axis: Vec3 | None = Field(default=None, description="a HingeJoint's or SliderJoint's axis in the robot's frame as "
+                              "the world loads (its jointParameters' axis, else Webots' default), whatever its devices: "
+                              "getUrdf writes it for joints no motor turns too; none for other nodes")
+    anchor: Vec3 | None = Field(default=None, description="a HingeJoint's anchor in the robot's frame as the world "
+                                "loads (its axis passes through it); none for other nodes")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
 
 

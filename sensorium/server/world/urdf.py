@@ -1,14 +1,15 @@
 """A robot's URDF as Webots' ``wb_robot_get_urdf(prefix)`` exports it, from the robot's nodes
 (``schemas.world.NestedNode``: Solids, Poses, joints and devices in the robot's frame as the world
-loads) and its motors (axis, anchor, limits).
+loads; a joint's axis and anchor on its node) and its motors (limits).
 
 What Webots writes, and so what is written here: a link ``base_link`` for the robot; a link per
 Solid (devices that are Solids too), named by its ``name`` (else its DEF name, else its node type in
 lower case; a name already given gets ``_N``, N counting such clashes); a joint per HingeJoint
-(``revolute`` when its motor has limits, else ``continuous``) and SliderJoint (``prismatic``) named
-after its motor (else its position sensor), whose child link's frame sits on the hinge's anchor with
-the end point's orientation, its axis in that frame, ``<limit>`` from the motor (effort: maxTorque or
-maxForce, velocity: maxVelocity, lower/upper when the motor has limits); a ``fixed`` joint
+(``revolute`` when its motor has limits, else ``continuous``) and SliderJoint (``prismatic``), with a
+motor, a position sensor only or no device at all, named after its motor (else its position sensor,
+else as a link is), whose child link's frame sits on the hinge's anchor with the end point's
+orientation, its axis (a unit vector) in that frame, ``<limit>`` from the motor if it has one (effort:
+maxTorque or maxForce, velocity: maxVelocity, lower/upper when the motor has limits); a ``fixed`` joint
 ``PARENT_CHILD_joint`` for every other Solid. Origins are relative to the parent link's frame,
 ``rpy`` Z-Y-X as URDF reads it. Links and joints come in the order Webots writes them (a last-in,
 first-out queue of the link roots and joints met under each link), so that a chain built by
@@ -178,12 +179,16 @@ class _Export:
         up = self.upper_root(i)
         rotation, at = self.pose(end)
         m = self.motor(i)
-        hinge = self.entries[i].type == "HingeJoint"
-        if m is not None and hinge:
-            at = np.asarray(m.anchor, dtype=np.float64)     # the child frame on the hinge's axis
-        axis = np.asarray(m.joint_axis if m is not None else ((1.0, 0.0, 0.0) if hinge else (0.0, 0.0, 1.0)),
-                          dtype=np.float64)
-        axis = rotation.T @ (axis / float(np.linalg.norm(axis)))
+        node = self.entries[i]
+        hinge = node.type == "HingeJoint"
+        # the joint's own axis and anchor (a .wbt joint's, whatever its devices), else its motor's
+        anchor = node.anchor if node.anchor is not None else m.anchor if m is not None else None
+        if hinge and anchor is not None:
+            at = np.asarray(anchor, dtype=np.float64)       # the child frame on the hinge's axis
+        axis = np.asarray(node.axis if node.axis is not None else m.joint_axis if m is not None
+                          else (1.0, 0.0, 0.0) if hinge else (0.0, 0.0, 1.0), dtype=np.float64)
+        length = float(np.linalg.norm(axis))
+        axis = rotation.T @ (axis / length if length > 0.0 else np.array([0.0, 0.0, 1.0]))  # Webots' reset of 0
         self.frames[end] = _Frame(rotation, at)
         limited = m is not None and (m.min_position != 0.0 or m.max_position != 0.0)
         kind = "prismatic" if not hinge else "revolute" if limited else "continuous"

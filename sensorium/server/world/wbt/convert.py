@@ -540,8 +540,10 @@ class Converter:
         entry: dict[str, Any] = {"type": t}
         if posed:
             entry["pose"] = self.child_frame(node, frame).pose()
-        if t in ("HingeJoint", "SliderJoint") and self.fields(node).node_("jointParameters") is not None:
-            entry["joint_parameters"] = True
+        if t in ("HingeJoint", "SliderJoint"):
+            if self.fields(node).node_("jointParameters") is not None:
+                entry["joint_parameters"] = True
+            self.joint_frame(node, frame, entry)      # for getUrdf, whatever turns the joint (or nothing)
         self.tree_entry(node, entry, field, proto)
         self.tree_stack.append((node, len(self.tree) - 1))
         return True
@@ -1735,7 +1737,7 @@ class Converter:
 
     def joint_frame(self, node: Node, frame: Frame, entry: dict) -> None:
         """A HingeJoint's axis and anchor, a SliderJoint's axis, from its parent Solid's frame into
-        the robot's (``frame``: the joint's place in the robot), on its motor's entry."""
+        the robot's (``frame``: the joint's place in the robot), on ``entry``: its motor's, its node's."""
         params = self.fields(node).node_("jointParameters")
         pf = self.fields(params) if params is not None else None
         default = (1.0, 0.0, 0.0) if node.type == "HingeJoint" else (0.0, 0.0, 1.0)
