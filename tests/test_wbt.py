@@ -879,9 +879,9 @@ def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
     """A tracked robot written as Webots' Track sample is: each Track's motor is in the Track's
     ``device`` field and its wheels are TrackWheels, placed at (position.x, 0, position.y) in the
     Track's frame (WbTrackWheel). The motors were silently missing (getDevice found nothing) and the
-    wheels were dropped as unknown nodes; now the motors are listed (not simulated: tracks do not
-    move here) with one warning per Track, the wheels' shapes are where Webots draws them, and the
-    belt Webots animates along them is in the skipped summary."""
+    wheels were dropped as unknown nodes; now the wheels' shapes are where Webots draws them, the
+    belt Webots animates along them is in the skipped summary, and the two motors are the robot's
+    drive (tests/test_wbt_tracks.py drives it), listed as rotational motors."""
     def track(side: str, y: float) -> str:
         return (f'Track {{ translation 0 {y} 0 name "{side} track" children [\n'
                 f'  TrackWheel {{ position -0.15 0.0075 radius 0.046 children [ Shape {{ geometry Cylinder {{ '
@@ -896,18 +896,15 @@ def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
     assert not w.report.losses
     (robot,) = w.world.robots
     assert [(d.device, d.name) for d in robot.devices] == [
-        ("LinearMotor", "left motor"), ("PositionSensor", "left sensor"),
-        ("LinearMotor", "right motor"), ("PositionSensor", "right sensor")]
+        ("RotationalMotor", "left motor"), ("PositionSensor", "left sensor"),
+        ("RotationalMotor", "right motor"), ("PositionSensor", "right sensor")]
     assert [(s.geometry.type, s.pose.translation) for s in robot.shapes] == [
         ("box", (0.0, 0.0, 0.0)), ("cylinder", (-0.15, 0.07, 0.0075)), ("sphere", (0.0925, 0.07, -0.044)),
         ("cylinder", (-0.15, -0.07, 0.0075)), ("sphere", (0.0925, -0.07, -0.044))]
     assert [x for x in w.warnings if "Track" in x] == [
-        f"{p}:4:1: Track 'left track': its motor's position moves kinematically (its sensor reads it); the belt "
-        "and its wheels do not move here",
-        f"{p}:9:1: Track 'right track': its motor's position moves kinematically (its sensor reads it); the belt "
-        "and its wheels do not move here",
         f"{p}: skipped nodes that do not matter to these sensors: Track.animatedGeometry x2"]
-    entries = Simulation(w).robot("tank").device_list     # what a controller's getDevice finds (kinematic motors)
+    assert robot.differential_drive is not None and robot.differential_drive.axle_length == 0.14
+    entries = Simulation(w).robot("tank").device_list     # what a controller's getDevice finds (the drive's motors)
     assert [(e.name, e.simulated) for e in entries if e.name.endswith("motor")] == [
         ("left motor", True), ("right motor", True)]
 

@@ -105,6 +105,7 @@ class Owner:
     keys: dict[tuple, dict] = field(default_factory=dict)      # visual parts by (geometry, frame)
     wheels: list[dict] = field(default_factory=list)           # motorised hinges (robots)
     free: list[dict] = field(default_factory=list)             # a robot's wheel axes with encoders, no motor
+    tracks: list[dict] = field(default_factory=list)           # a robot's motorised Tracks (wbt/drive.py track_drive)
     placed: Frame = field(default_factory=Frame.identity)      # the owner's frame in the world
 
 
@@ -679,8 +680,11 @@ class Converter:
                                 else "its motor's position moves kinematically" if motors     # Webots' ConveyorBelt
                                 else "its sensor reads a still position (no motor)" if sensors
                                 else "its devices do nothing")
-                        self.warn(node, f"Track {f.string('name', 'solid')!r}: {what}; the belt and its wheels do not "
-                                        "move here")
+                        line = f"Track {f.string('name', 'solid')!r}: {what}; the belt and its wheels do not move here"
+                        if motors:      # two of them may drive the robot (said in drive() if they do not)
+                            self.track(node, inner, owner, motors[0], line)
+                        else:
+                            self.warn(node, line)
                 self.device_contents(node, inner, owner, data)
             elif t == "Connector":       # a solid that robots' connectors dock with (Webots allows it)
                 out = self.solid(node, frame, owner, "connector")
@@ -2028,6 +2032,7 @@ class Converter:
         (one line each, or one line for the robot when it has more than MANY_JOINTS of them: a
         humanoid's, a legged robot's or an arm's joints)."""
         nowheel: list[tuple[Node, str, str, str]] = []      # (joint node, motor, its own line, the reason)
+        self._track_drive(node, robot)
         try:
             self._drive(node, robot, nowheel)
         finally:
@@ -2042,6 +2047,50 @@ class Converter:
                     self.warn(free["node"], free["line"])
             if car is not None and rolling and self.fields(node).node_("physics") is not None:
                 self._free_wheel_bottom(robot, car, [f for f in robot.free if id(f) in rolling])
+
+    def track(self, node: Node, frame: Frame, owner: Owner, motor: dict, line: str) -> None:
+        """A robot's Track driven by its LinearMotor (``motor``'s entry), kept for ``_track_drive``:
+        its belt's direction (the Track's x) and origin in the robot's frame, its TrackWheels, and the
+        load report's line for it should it drive nothing."""
+        wheels = []
+        for child in self.fields(node).nodes("children"):
+            if child.type == "TrackWheel":
+                cf = self.fields(child)
+                x, y = cf.vec("position", (0.0, 0.0))
+                wheels.append((x, y, cf.num("radius", 0.1)))
+        owner.tracks.append({"node": node, "entry": motor, "motor": motor["name"], "line": line,
+                             "max_velocity": float(motor.get("max_velocity", 10.0)),
+                             "forward": np.asarray(frame.rotation, dtype=np.float64)[:, 0],
+                             "origin": np.asarray(frame.apply((0.0, 0.0, 0.0))),
+                             "frame": frame, "wheels": wheels})
+
+    def _track_drive(self, node: Node, robot: Owner) -> None:
+        """A robot with two motorised Tracks and no motorised hinge drives on them: their motors are
+        its ``differential_drive``'s wheels of radius 1 (wbt/drive.py ``track_drive``), reported to
+        controllers as rotational motors; otherwise each Track is said once (a conveyor belt's one)."""
+        from sensorium.server.world.wbt.drive import belt_bottom, track_drive
+
+        tracks = robot.tracks
+        if not tracks:
+            return
+        drive, why = (None, "") if robot.wheels or len(tracks) != 2 else track_drive(tracks, self, self._robot_up(robot))
+        if drive is None:
+            if why:
+                self.warn(node, f"robot {robot.data['name']!r}: no tracked drive ({why}); the robot will not move")
+            for t in tracks:
+                self.warn(t["node"], t["line"])
+            return
+        up = self._robot_up(robot)
+        bottoms = [belt_bottom(t["frame"], t["wheels"], up) for t in tracks]
+        if self.fields(node).node_("physics") is not None and all(b is not None for b in bottoms):
+            drive["wheel_bottom"] = min(b for b in bottoms if b is not None)
+        robot.data["differential_drive"] = drive
+        for t in tracks:    # the drive's wheel now: its linear joint's fields go (its speed is the drive's)
+            entry = t["entry"]
+            entry["device"] = "RotationalMotor"
+            for key in (*JOINT_KEYS, "max_force"):
+                entry.pop(key, None)
+            entry["_wheel"] = True
 
     def _free_wheel_bottom(self, robot: Owner, car: dict, free: list[dict]) -> None:
         """A car's free wheels (no motor: a propulsion car's front ones, a traction car's rear ones) hold

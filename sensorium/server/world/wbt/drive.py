@@ -779,3 +779,48 @@ def omni_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]
     if frame is not None:
         drive["forward"] = [1.0, 0.0, 0.0]
     return drive, ""
+
+
+def track_drive(tracks: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
+    """Two ``Track``s, a left and a right belt each driven by its LinearMotor, as the kinematic
+    ``differential_drive`` they are (v = (vl + vr)/2, w = (vr - vl)/W, W between the belts' centre
+    lines), or (None, the sentence saying why not). A belt at v m/s is a wheel of radius 1 m at
+    v rad/s (``wheel_radius`` 1): the motor's position (m) is that wheel's angle, its maxVelocity
+    (m/s) the wheel's. A positive velocity moves the robot along the Track's own +x (Webots' track
+    sample drives forward so). ``tracks``: {"motor", "max_velocity", "node", "forward" (the Track's
+    x in the robot's frame), "origin" (the Track's origin there)}; ``up`` as :func:`drive_frame`'s.
+    The robot turns about the midpoint of the two tracks' origins."""
+    if len(tracks) != 2:
+        return None, f"{len(tracks)} Tracks with a motor; a tracked drive needs two, a left and a right one"
+    axes = [np.asarray(t["forward"], dtype=np.float64) / np.linalg.norm(t["forward"]) for t in tracks]
+    for t, a in zip(tracks, axes):
+        if abs(a[up]) > AXIS_TOL:
+            return None, (f"the belt of Track motor {t['motor']!r} runs along {np.round(a, 6).tolist()}, not "
+                          f"horizontal in the robot's frame (perpendicular to its {'xyz'[up]})")
+    if np.linalg.norm(axes[1] - axes[0]) > AXIS_TOL:
+        return None, (f"the belts run along {np.round(axes[0], 6).tolist()} and {np.round(axes[1], 6).tolist()}, "
+                      "not one direction (a tracked drive needs parallel belts moving the same way)")
+    forward = axes[0].copy()
+    forward[up] = 0.0
+    frame = drive_axes(forward, up)
+    places = [frame @ np.asarray(t["origin"], dtype=np.float64) for t in tracks]
+    if abs(places[0][1] - places[1][1]) <= TOL:
+        return None, "both Tracks are on one centre line (a tracked drive needs a left and a right belt)"
+    (left, pl), (right, pr) = sorted(zip(tracks, places), key=lambda tp: -tp[1][1])
+    drive = _centred({"wheel_radius": 1.0, "axle_length": float(pl[1] - pr[1]), **_wheel_speeds(tracks, conv),
+                      "left_motor": left["motor"], "right_motor": right["motor"]},
+                     float(pl[0] + pr[0]) / 2.0, float(pl[1] + pr[1]) / 2.0)
+    along_x = up == 2 and float(np.linalg.norm(forward - np.array([1.0, 0.0, 0.0]))) <= AXIS_TOL
+    return _framed(drive, "", None if along_x else frame)
+
+
+def belt_bottom(track_frame, wheels: list[tuple[float, float, float]], up: int = 2) -> float | None:
+    """A Track's lowest point along the robot's ``up`` axis: the lowest of its TrackWheels' circles,
+    each (x, y, radius) in the Track's frame (a TrackWheel sits at (x, 0, y) there and turns in the
+    Track's x-z plane, the belt around it); None without a TrackWheel. The belt's own thickness is
+    not counted (Webots draws the belt's pads around the wheels)."""
+    if not wheels:
+        return None
+    r = np.asarray(track_frame.rotation, dtype=np.float64)
+    reach = track_frame.scale * math.hypot(float(r[up, 0]), float(r[up, 2]))   # a unit circle's half-height
+    return min(float(track_frame.apply((x, 0.0, y))[up]) - radius * reach for x, y, radius in wheels)
