@@ -158,6 +158,15 @@ def test_the_batched_simulation_drives_a_tank_as_its_simulation_does(tmp_path: P
                                                   abs=1e-12)
 
 
+def test_a_tracks_brake_names_the_drives_motor(tmp_path: Path) -> None:
+    """A Brake in a Track's device list shares its motor's joint: the drive's wheel, rotational (the
+    world was refused: "'linear', but its motor 'left motor' is rotational")."""
+    brakes = (track("left", Y) + track("right", -Y)).replace('PositionSensor {', 'Brake { name "b" } PositionSensor {')
+    robot = load_world(write(tmp_path, brakes)).world.robots[0]
+    assert [(d.name, d.motor, d.joint_type) for d in robot.devices if d.device == "Brake"] == [
+        ("b", "left motor", "rotational"), ("b(1)", "right motor", "rotational")]
+
+
 def test_one_track_or_tracks_beside_wheels_keep_their_warning(tmp_path: Path) -> None:
     """A single Track (a conveyor belt) drives nothing: its line stays; so do three Tracks."""
     w = load_world(write(tmp_path, track("left", Y)))
@@ -168,3 +177,21 @@ def test_one_track_or_tracks_beside_wheels_keep_their_warning(tmp_path: Path) ->
     w = load_world(write(tmp_path, track("left", Y) + track("right", -Y) + track("mid", 0.0)))
     assert w.world.robots[0].differential_drive is None
     assert len([x for x in w.warnings if "Track '" in x]) == 3
+
+
+def test_a_tracks_scale_scales_its_wheels_and_the_belts_bottom(tmp_path: Path) -> None:
+    """A Solid's ``scale`` before R2023a (Webots' track sample halves its Tracks): it was not read,
+    so the Tracks' wheels and bounding objects were twice their size and the robot settled on them."""
+    half = (track("left", Y) + track("right", -Y)).replace(' name "left track"', ' scale 0.5 0.5 0.5 name "left track"') \
+        .replace(' name "right track"', ' scale 0.5 0.5 0.5 name "right track"')
+    floor = 'Solid { name "floor" children [ DEF F Shape { geometry Plane { size 10 10 } } ] boundingObject USE F }\n'
+    p = write(tmp_path, half, place="translation 0 0 0.3", physics="physics Physics { }", extra=floor)
+    p.write_text(p.read_text().replace("R2023b", "R2022a"))
+    w = load_world(p)
+    robot = w.world.robots[0]
+    assert robot.differential_drive.wheel_bottom == pytest.approx(-0.025, abs=1e-15)
+    assert [(s.geometry.radius, s.pose.translation) for s in robot.shapes if s.geometry.type == "cylinder"] == [
+        (0.025, (-0.05, Y, 0.0)), (0.025, (-0.05, -Y, 0.0))]
+    sim = Simulation(w)
+    sim.step()
+    assert sim.robot("tank").pose.translation[2] == pytest.approx(0.025, abs=1e-12)

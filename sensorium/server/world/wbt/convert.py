@@ -672,6 +672,8 @@ class Converter:
                         self.warn(node, f"{t} {data['name']!r} of robot {owner.data['name']!r}: listed (a controller "
                                         "finds it), not simulated here: its functions answer Webots' \"no value\"")
                 elif t == "Track":           # a Solid whose device field holds its motor (and sensor, brake)
+                    if "scale" in node.fields:     # a Solid's scale before R2023a (Webots' track sample halves its Tracks)
+                        inner = self.child_frame(node, frame, self.transform_scale(node))
                     if f.node_("animatedGeometry") is not None:     # the belt Webots draws along its wheels
                         self.skipped["Track.animatedGeometry"] += 1
                     motors, sensors = self.joint_devices(node, owner)
@@ -2091,6 +2093,10 @@ class Converter:
             for key in (*JOINT_KEYS, "max_force"):
                 entry.pop(key, None)
             entry["_wheel"] = True
+        names = {t["motor"] for t in tracks}
+        for entry in robot.data["devices"]:     # a Track's brake shares its motor's joint: the drive's, rotational
+            if entry["device"] == "Brake" and entry.get("motor") in names:
+                entry.pop("joint_type", None)
 
     def _free_wheel_bottom(self, robot: Owner, car: dict, free: list[dict]) -> None:
         """A car's free wheels (no motor: a propulsion car's front ones, a traction car's rear ones) hold
