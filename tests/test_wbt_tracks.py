@@ -195,3 +195,26 @@ def test_a_tracks_scale_scales_its_wheels_and_the_belts_bottom(tmp_path: Path) -
     sim = Simulation(w)
     sim.step()
     assert sim.robot("tank").pose.translation[2] == pytest.approx(0.025, abs=1e-12)
+
+
+def test_the_gyms_actions_are_belt_speeds(tmp_path: Path) -> None:
+    """The gym's normalised action +1 is the LinearMotor's maxVelocity in m/s (0.15 here), so +1 on
+    both belts covers 0.15 m/s straight, in the single and the vector env alike; -1/+1 turns in place
+    at 2 * 0.15 / 0.3 = 1 rad/s."""
+    from sensorium.gym import SensoriumEnv, Task
+    from sensorium.gym.vector import SensoriumVectorEnv
+
+    w = load_world(write(tmp_path, track("left", Y, "maxVelocity 0.15") + track("right", -Y, "maxVelocity 0.15")))
+    env = SensoriumEnv(w, Task(max_steps=None), precision="exact")
+    venv = SensoriumVectorEnv(w, Task(max_steps=None), num_envs=2, precision="exact")
+    _, info = env.reset(seed=1)
+    venv.reset(seed=1)
+    period = env.control_period_ms / 1000.0
+    for _ in range(5):
+        _, _, _, _, info = env.step(np.array([1.0, 1.0]))
+        _, _, _, _, vinfo = venv.step(np.array([[1.0, 1.0], [-1.0, 1.0]]))
+    assert info["pose"] == pytest.approx([0.15 * 5 * period, 0.0, 0.0], abs=1e-12)
+    assert vinfo["pose"][0].tobytes() == info["pose"].tobytes()
+    assert vinfo["pose"][1] == pytest.approx([0.0, 0.0, 1.0 * 5 * period], abs=1e-12)
+    env.close()
+    venv.close()
