@@ -1957,17 +1957,18 @@ class Converter:
                                  "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
-    def _steered_casters(self, wheels: list[dict]) -> str | None:
-        """Why a base on more than two steering joints, each carrying driven wheels of its own (a PR2's
-        four casters, a rover's steered corners), has no drive, else None (a car steers two)."""
+    def _steering_groups(self, wheels: list[dict]) -> list[tuple[dict | None, list[dict]]] | None:
+        """A base on more than two steering joints, each carrying driven wheels of its own (a PR2's four
+        casters, a rover's steered corners): each steering joint with the driven wheels it turns, then
+        (None, the driven wheels riding none); else None (a car steers two)."""
         steering = [w for w in wheels if w["steers"]]
         held = [self._inside(w["end"]) for w in steering]
-        riding = [w for w in wheels if not w["steers"] and any(id(w["node"]) in h for h in held)]
-        if len(steering) <= 2 or not all(any(id(w["node"]) in h for w in riding) for h in held):
+        riding = [[w for w in wheels if not w["steers"] and id(w["node"]) in h] for h in held]
+        if len(steering) <= 2 or not all(riding):
             return None
-        return (f"its {len(riding)} driven wheels ride {len(steering)} steering joints, each turning wheels of its own "
-                f"({', '.join(repr(w['motor']) for w in steering)}): no kinematic drive here steers more than a car's "
-                "two")
+        carried = {id(w["node"]) for r in riding for w in r}
+        free = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
+        return [*zip(steering, riding), *([(None, free)] if free else [])]
 
     def _lifted_wheels(self, wheels: list[dict], up: int) -> list[tuple[dict, float]]:
         """The motorised hinges about horizontal axes riding a steering (vertical) hinge whose round
@@ -2081,7 +2082,7 @@ class Converter:
         """A robot with physics, no drive and many motorised joints (a legged robot, a humanoid: Webots'
         Spot, Nao): Webots' physics stands, walks or drops it by its limbs; here its joints move only
         its parts. One line, so a controller's walk going nowhere is not a surprise."""
-        drives = ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive")
+        drives = ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive")
         if (len(nowheel) <= MANY_JOINTS or any(k in robot.data for k in drives)
                 or self.fields(node).node_("physics") is None):
             return
@@ -2101,6 +2102,7 @@ class Converter:
             omni_drive,
             omni_wheels,
             rolls_about_its_axis,
+            steered_drive,
             wheel_radius,
         )
 
@@ -2203,8 +2205,22 @@ class Converter:
                 wheels = base
         else:
             turns = mecanum_turns(wheels, self)
+        groups = self._steering_groups(wheels) if turns is None else None
+        if groups is not None:                    # steered casters or corners: each wheel steered on its own
+            positions = {d["name"]: float(d.get("position", 0.0)) for d in robot.data["devices"]
+                         if d.get("device") == "RotationalMotor"}
+            drive, why = steered_drive(groups, positions, self, up)
+            if drive is None:
+                self.warn(node, f"robot {robot.data['name']!r}: no steered-wheel drive ({why}); the robot will not "
+                                "move")
+                return
+            robot.data["steered_drive"] = drive
+            # the steering hinges stay joints (moved as Webots' kinematic motor control moves them; the drive
+            # reads their positions); the rolling wheels are the drive's
+            self._drive_wheels(node, robot, [w for _, riding in groups for w in riding])
+            return
         if turns is None and any(w["steers"] for w in wheels):      # a car
-            casters = self._steered_casters(wheels) or self._one_steered_wheel(wheels)
+            casters = self._one_steered_wheel(wheels)
             if casters:
                 self.warn(node, f"robot {robot.data['name']!r}: no drive ({casters}); the robot will not move")
                 return
@@ -2258,7 +2274,7 @@ class Converter:
         bottom = (wheel_bottom(wheels, self, self._robot_up(robot)) if self.fields(node).node_("physics") is not None
                   else None)
         if bottom is not None:
-            for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive"):
+            for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive"):
                 if key in robot.data:
                     robot.data[key]["wheel_bottom"] = bottom
         for w in wheels:    # the wheels' encoders measure the drive's wheels
@@ -2311,6 +2327,7 @@ def drive_motor_names(robot: dict) -> list[str]:
     motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
     motors += [v for k, v in (robot.get("mecanum_drive") or {}).items() if k.endswith("_motor")]
     motors += [w["motor"] for w in (robot.get("omni_drive") or {}).get("wheels", ())]
+    motors += [w["motor"] for w in (robot.get("steered_drive") or {}).get("wheels", ())]
     return [m for m in motors if isinstance(m, str)]
 
 
