@@ -819,3 +819,57 @@ def test_a_head_on_a_pan_hinge_high_above_the_wheels_is_no_steered_wheel(tmp_pat
     sim.run(125)                                        # 2 s at 2 rad/s on 0.1 m wheels: 0.4 m
     assert drive_robot.pose.translation[0] == pytest.approx(0.4, abs=1e-9)
     assert drive_robot.motor("head_tilt").position == pytest.approx(0.3, abs=1e-9)      # 3 rad/s: there in 0.1 s
+
+
+def corner(name: str, x: float, y: float, axis: str = "0 0 1") -> str:
+    """A rover's steered corner (a Sojourner's): a motorised vertical hinge whose end point carries one
+    driven wheel under its axis."""
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor {x} {y} 0 }} '
+            f'device [ RotationalMotor {{ name "{name} arm" maxVelocity 5 }} ] '
+            f'endPoint Solid {{ translation {x} {y} 0 name "{name} arm" children [\n{wheel(f"{name} wheel", 0, 0)}] '
+            '} }\n')
+
+
+def test_a_rover_on_four_steered_corners_and_two_middle_wheels_drives_by_their_fit(tmp_path: Path) -> None:
+    """Four steered corners and two unsteered middle wheels (a Sojourner's six): the corners' wheels
+    steered by their arms (one hinge about -z: it steers the other way), the middle ones at their fixed
+    heading. Spinning as the rover's 'turn around' does (corner arms at ±0.87, left wheels +ω, right -ω)
+    moves it by the least-squares fit of the six wheels' velocities (closed form below)."""
+    places = {"front left": (0.3, 0.25), "front right": (0.3, -0.25), "back left": (-0.3, 0.25),
+              "back right": (-0.3, -0.25)}
+    robot = ('Robot { name "rover" children [\n'
+             + "".join(corner(k, *xy, axis="0 0 -1" if k == "back right" else "0 0 1") for k, xy in places.items())
+             + wheel("middle left wheel", 0.0, 0.25) + wheel("middle right wheel", 0.0, -0.25)
+             + '] controller "<extern>" }\n')
+    w = load_world(write(tmp_path, robot))
+    drive = w.world.robots[0].steered_drive
+    assert drive is not None and not [x for x in w.warnings if "will not move" in x]
+    by_motor = {x.motor: x for x in drive.wheels}
+    assert by_motor["back right wheel"].steer_sign == -1 and by_motor["front left wheel"].steer_sign == 1
+    assert (by_motor["middle left wheel"].steer, by_motor["middle left wheel"].position) == (None, (0.0, 0.25))
+    sim = Simulation(w, "fast")
+    rover = sim.robot("rover")
+    arms = {"front left": -0.87, "front right": 0.87, "back left": 0.87, "back right": -0.87}
+    for k, a in arms.items():
+        rover.motor(f"{k} arm").set_position(a)
+    sim.run(50)                                   # the arms turn (the wheels hold: the rover stays)
+    assert rover.pose.translation[:2] == pytest.approx([0.0, 0.0], abs=0.0)
+    omega = 3.0
+    speeds = {"front left": omega, "back left": omega, "middle left": omega,
+              "front right": -omega, "back right": -omega, "middle right": -omega}
+    for k, s in speeds.items():
+        rover.motor(f"{k} wheel").set_position(math.inf)
+        rover.motor(f"{k} wheel").set_velocity(s)
+    sim.run(1)
+    # the fit: Σx = Σy = 0, so vx = Σux/6, vy = Σuy/6, ωz = Σ(x·uy − y·ux)/Σ(x² + y²)
+    where = {**places, "middle left": (0.0, 0.25), "middle right": (0.0, -0.25)}
+    heading = {k: (-1.0 if k == "back right" else 1.0) * a for k, a in arms.items()}
+    u = {k: (R * s * math.cos(heading.get(k, 0.0)), R * s * math.sin(heading.get(k, 0.0))) for k, s in speeds.items()}
+    vx = sum(v[0] for v in u.values()) / 6
+    vy = sum(v[1] for v in u.values()) / 6
+    wz = sum(x * u[k][1] - y * u[k][0] for k, (x, y) in where.items()) / sum(x * x + y * y for x, y in where.values())
+    assert rover.drive.velocity()[5] == pytest.approx(wz, abs=1e-12)
+    lin = rover.drive.velocity()[:2]
+    dt = 0.016                                    # the origin's velocity at the step's end: the twist turned by ωz·dt
+    c, s = math.cos(wz * dt), math.sin(wz * dt)
+    assert lin == pytest.approx([vx * c - vy * s, vx * s + vy * c], abs=1e-12)

@@ -1970,6 +1970,35 @@ class Converter:
         free = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
         return [*zip(steering, riding), *([(None, free)] if free else [])]
 
+    def _grounded(self, groups: list[tuple[dict | None, list[dict]]], nowheel: list[tuple[Node, str, str, str]],
+                  up: int) -> list[tuple[dict | None, list[dict]]]:
+        """The steering groups with the driven hinges riding no steering joint kept only where they are
+        wheels on the steered wheels' ground (their round part's bottom within the smallest steered
+        wheel's radius of the lowest steered wheel's): a head's tilt hinge or an arm's joint beside
+        the casters is no wheel (said once, with the robot's other joints)."""
+        from sensorium.server.world.wbt.drive import wheel_bottom, wheel_radius
+
+        steered = [w for steering, riding in groups if steering is not None for w in riding]
+        radii = [r for r in (wheel_radius(w["end"], self) for w in steered) if r is not None]
+        lowest = wheel_bottom(steered, self, up)
+        out: list[tuple[dict | None, list[dict]]] = []
+        for steering, riding in groups:
+            if steering is not None:
+                out.append((steering, riding))
+                continue
+            kept = []
+            for w in riding:
+                bottom = wheel_bottom([w], self, up)
+                if bottom is not None and lowest is not None and radii and abs(bottom - lowest) <= min(radii):
+                    kept.append(w)
+                else:
+                    nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (no "
+                                    f"round part on the ground the steered wheels roll on): {JOINT_MOVES}",
+                                    "off the ground the steered wheels roll on"))
+            if kept:
+                out.append((None, kept))
+        return out
+
     def _lifted_wheels(self, wheels: list[dict], up: int) -> list[tuple[dict, float]]:
         """The motorised hinges about horizontal axes riding a steering (vertical) hinge whose round
         part's bottom is more than the lowest wheel's diameter above the lowest wheels' bottom, with
@@ -2207,6 +2236,7 @@ class Converter:
             turns = mecanum_turns(wheels, self)
         groups = self._steering_groups(wheels) if turns is None else None
         if groups is not None:                    # steered casters or corners: each wheel steered on its own
+            groups = self._grounded(groups, nowheel, up)
             positions = {d["name"]: float(d.get("position", 0.0)) for d in robot.data["devices"]
                          if d.get("device") == "RotationalMotor"}
             drive, why = steered_drive(groups, positions, self, up)
