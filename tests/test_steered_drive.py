@@ -154,3 +154,10 @@ def test_the_batched_simulation_refuses_it_in_one_line() -> None:
     loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [swerve()]})
     with pytest.raises(BatchedError, match="robot 'sw' has a steered_drive; the batched simulation drives"):
         BatchedSimulation(loaded, 2)
+
+
+def test_the_gym_refuses_it_as_an_agent_in_one_line() -> None:
+    gym = pytest.importorskip("sensorium.gym")
+    loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [swerve()]})
+    with pytest.raises(ValueError, match="task robot 'sw' has a steered_drive, which the gym's actions"):
+        gym.SensoriumEnv(loaded, gym.Task(robot="sw"))
