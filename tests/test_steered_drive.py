@@ -161,3 +161,31 @@ def test_the_gym_refuses_it_as_an_agent_in_one_line() -> None:
     loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [swerve()]})
     with pytest.raises(ValueError, match="task robot 'sw' has a steered_drive, which the gym's actions"):
         gym.SensoriumEnv(loaded, gym.Task(robot="sw"))
+
+
+def test_contact_stops_a_strafing_robot_at_a_wall() -> None:
+    wall = {"name": "wall", "pose": {"translation": [0.0, 1.0, 0.25]}, "geometry": {"type": "box", "size": [4, 0.2, 0.5]}}
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 16, "contact": True}, "solids": [wall],
+                                  "robots": [swerve()]}))
+    steer(sim, dict.fromkeys(CORNERS, math.pi / 2))
+    roll(sim, dict.fromkeys(CORNERS, 10.0))
+    sim.run(200)                                        # 3.2 s at 0.5 m/s: far past the wall unless stopped
+    x, y, yaw = pose2d(sim)
+    assert (x, yaw) == pytest.approx((0.0, 0.0), abs=1e-12)     # (cos(pi/2) is 6e-17, not 0)
+    assert y == pytest.approx(0.9 - CY, abs=1e-9)       # its body's left side against the wall's face
+    assert sim.robot("sw").pressing
+
+
+def test_nue_world_strafes_to_the_robots_left_on_its_ground_plane() -> None:
+    robot = swerve()
+    robot["pose"] = {"translation": [0.0, 0.0, 0.0]}
+    for d in robot["devices"]:                          # a robot built y-up: its steering hinges about its y
+        if d["device"] == "RotationalMotor":
+            d["axis"] = [0.0, 1.0, 0.0]
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 16, "coordinate_system": "NUE", "contact": False},
+                                  "robots": [robot]}))
+    steer(sim, dict.fromkeys(CORNERS, math.pi / 2))
+    roll(sim, dict.fromkeys(CORNERS, 4.0))
+    sim.run(100)
+    # x north (the robot's forward), y up, z east: its left is west, -z
+    assert list(sim.robot("sw").pose.translation) == pytest.approx([0.0, 0.0, -R * 4.0 * 1.6], abs=1e-12)
