@@ -189,3 +189,21 @@ def test_nue_world_strafes_to_the_robots_left_on_its_ground_plane() -> None:
     sim.run(100)
     # x north (the robot's forward), y up, z east: its left is west, -z
     assert list(sim.robot("sw").pose.translation) == pytest.approx([0.0, 0.0, -R * 4.0 * 1.6], abs=1e-12)
+
+
+def test_strafing_sideways_up_a_ramp_covers_r_omega_t_along_the_ground() -> None:
+    """On tests/test_ground_ramp.py's ramp (angle A, rising along +x), heading -y with every wheel
+    steered to its left (up the ramp): r·ω·t·cos A along x, r·ω·t·sin A up, as the holonomic drives."""
+    from tests.test_ground_ramp import FLOOR, HALF, A, _ramp, _ramp_z
+
+    robot = {**swerve(), "body": {"geometry": {"type": "cylinder", "radius": 0.1, "height": 2 * HALF}},
+             "pose": {"translation": [1.3, 0.0, _ramp_z(1.3) + HALF], "rotation": [0, 0, 1, -math.pi / 2]}}
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 16}, "solids": [FLOOR, _ramp()],
+                                  "robots": [robot]}), precision="exact")
+    steer(sim, dict.fromkeys(CORNERS, math.pi / 2))
+    start = sim.robot("sw").pose.translation.copy()
+    roll(sim, dict.fromkeys(CORNERS, 4.0))
+    sim.run(60)
+    d = sim.robot("sw").pose.translation - start
+    dist = R * 4.0 * 0.96
+    assert list(d) == pytest.approx([dist * math.cos(A), 0.0, dist * math.sin(A)], abs=1e-9)
