@@ -158,31 +158,64 @@ def caster(name: str, x: float, y: float) -> str:
             f'endPoint Solid {{ translation {x} {y} 0 name "{name} caster" children [\n{wheels}] }} }}\n')
 
 
-def test_a_base_on_steered_casters_gets_one_line_naming_them(tmp_path: Path) -> None:
-    """Four casters, each steering joint turning its own two wheels (a PR2's base): no kinematic drive
-    steers them, and the line says so (it used to blame a car's missing front steering)."""
-    robot = ('Robot { name "base" children [\n' + caster("fl", 0.22, 0.22) + caster("fr", 0.22, -0.22)
-             + caster("bl", -0.22, 0.22) + caster("br", -0.22, -0.22) + '] }\n')
+def test_a_base_on_steered_casters_gets_the_steered_wheel_drive(tmp_path: Path) -> None:
+    """Four casters, each steering joint turning its own two wheels (a PR2's base): a steered_drive whose
+    wheels stand under their casters' steering axes, each steered by its caster's motor; it drives,
+    strafes and turns in place in closed form (it used to get a line saying nothing drives it)."""
+    places = {"fl": (0.22, 0.22), "fr": (0.22, -0.22), "bl": (-0.22, 0.22), "br": (-0.22, -0.22)}
+    robot = ('Robot { name "base" children [\n' + "".join(caster(k, *xy) for k, xy in places.items())
+             + '] controller "<extern>" }\n')
     p = write(tmp_path, robot)
     w = load_world(p)
     r = w.world.robots[0]
     assert r.differential_drive is None and r.ackermann_drive is None and r.mecanum_drive is None
-    assert r.omni_drive is None
-    (line,) = [x for x in w.warnings if "will not move" in x]
-    assert line == (f"{p}:3:1: robot 'base': no drive (its 8 driven wheels ride 4 steering joints, each turning "
-                    "wheels of its own ('fl rotation', 'fr rotation', 'bl rotation', 'br rotation'): no kinematic "
-                    "drive here steers more than a car's two); the robot will not move")
-    # three casters, a motorised tilt hinge on the body (a PR2's laser) that rides none: still casters
+    assert r.steered_drive is not None
+    assert [(x.motor, x.steer, x.position, x.radius, x.heading, x.steer_sign) for x in r.steered_drive.wheels] == [
+        (f"{k} {side} wheel", f"{k} rotation", xy, R, 0.0, 1) for k, xy in places.items() for side in ("left", "right")]
+    assert r.steered_drive.max_wheel_speed == 12.3
+    assert not [x for x in w.warnings if "will not move" in x or "drive" in x]
+    sim = Simulation(w, "fast")
+    base = sim.robot("base")
+
+    def steer_and_roll(angles: dict[str, float], omega: float, steps: int) -> None:
+        for k, a in angles.items():
+            base.motor(f"{k} rotation").set_position(a)
+        for m in [m for m in base.motors if m.endswith(" wheel")]:
+            base.motor(m).set_velocity(0.0)
+        sim.run(200)                              # the casters turn (the wheels hold: the base stays)
+        for k in angles:
+            for side in ("left", "right"):
+                base.motor(f"{k} {side} wheel").set_position(math.inf)
+                base.motor(f"{k} {side} wheel").set_velocity(omega)
+        sim.run(steps)
+
+    def pose2d() -> tuple[float, float, float]:
+        t, rot = base.pose.translation, base.pose.rotation
+        return float(t[0]), float(t[1]), math.atan2(rot[1, 0], rot[0, 0])
+
+    z0 = float(base.pose.translation[2])
+    steer_and_roll(dict.fromkeys(places, 0.0), 2.0, 125)          # 2 s forward at r·2
+    assert pose2d() == pytest.approx((2 * R * 2.0, 0.0, 0.0), abs=1e-12)
+    steer_and_roll(dict.fromkeys(places, math.pi / 2), 1.0, 125)  # 2 s to the left at r·1
+    assert pose2d() == pytest.approx((2 * R * 2.0, 2 * R, 0.0), abs=1e-12)
+    # tangent to the circle through the casters: a turn in place at r·ω/R, R = 0.22·√2
+    steer_and_roll({k: math.atan2(x, -y) for k, (x, y) in places.items()}, 1.5, 50)
+    assert pose2d() == pytest.approx((2 * R * 2.0, 2 * R, R * 1.5 * 0.8 / (0.22 * math.sqrt(2))), abs=1e-12)
+    assert float(base.pose.translation[2]) == z0
+    # three casters, a motorised tilt hinge on the body (a PR2's laser) that rides none: the steered drive
+    # with that wheel unsteered (its heading fixed) under its own axle
     robot = ('Robot { name "base" children [\n' + caster("fl", 0.22, 0.22) + caster("fr", 0.22, -0.22)
              + caster("bl", -0.22, 0.22) + wheel("tilt", -0.22, -0.2) + '] }\n')
     p = write(tmp_path, robot)
-    (line,) = [x for x in load_world(p).warnings if "will not move" in x]
-    assert "no drive (its 6 driven wheels ride 3 steering joints" in line
+    loaded = load_world(p)
+    drive = loaded.world.robots[0].steered_drive
+    assert drive is not None and not [x for x in loaded.warnings if "will not move" in x]
+    assert [(x.motor, x.steer, x.position) for x in drive.wheels][-1] == ("tilt", None, (-0.22, -0.2))
     # two steering joints carrying their wheels (a Webots car's front axle) stay the Ackermann drive's case
     robot = ('Robot { name "car" children [\n' + caster("fl", 0.3, 0.2) + caster("fr", 0.3, -0.2)
              + wheel("left rear", 0, Y) + wheel("right rear", 0, -Y) + '] }\n')
     p = write(tmp_path, robot)
-    assert not [x for x in load_world(p).warnings if "steering joints, each" in x]
+    assert load_world(p).world.robots[0].steered_drive is None
 
 
 def test_skid_steer_in_a_world_file_and_its_checks() -> None:
@@ -786,3 +819,57 @@ def test_a_head_on_a_pan_hinge_high_above_the_wheels_is_no_steered_wheel(tmp_pat
     sim.run(125)                                        # 2 s at 2 rad/s on 0.1 m wheels: 0.4 m
     assert drive_robot.pose.translation[0] == pytest.approx(0.4, abs=1e-9)
     assert drive_robot.motor("head_tilt").position == pytest.approx(0.3, abs=1e-9)      # 3 rad/s: there in 0.1 s
+
+
+def corner(name: str, x: float, y: float, axis: str = "0 0 1") -> str:
+    """A rover's steered corner (a Sojourner's): a motorised vertical hinge whose end point carries one
+    driven wheel under its axis."""
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor {x} {y} 0 }} '
+            f'device [ RotationalMotor {{ name "{name} arm" maxVelocity 5 }} ] '
+            f'endPoint Solid {{ translation {x} {y} 0 name "{name} arm" children [\n{wheel(f"{name} wheel", 0, 0)}] '
+            '} }\n')
+
+
+def test_a_rover_on_four_steered_corners_and_two_middle_wheels_drives_by_their_fit(tmp_path: Path) -> None:
+    """Four steered corners and two unsteered middle wheels (a Sojourner's six): the corners' wheels
+    steered by their arms (one hinge about -z: it steers the other way), the middle ones at their fixed
+    heading. Spinning as the rover's 'turn around' does (corner arms at ±0.87, left wheels +ω, right -ω)
+    moves it by the least-squares fit of the six wheels' velocities (closed form below)."""
+    places = {"front left": (0.3, 0.25), "front right": (0.3, -0.25), "back left": (-0.3, 0.25),
+              "back right": (-0.3, -0.25)}
+    robot = ('Robot { name "rover" children [\n'
+             + "".join(corner(k, *xy, axis="0 0 -1" if k == "back right" else "0 0 1") for k, xy in places.items())
+             + wheel("middle left wheel", 0.0, 0.25) + wheel("middle right wheel", 0.0, -0.25)
+             + '] controller "<extern>" }\n')
+    w = load_world(write(tmp_path, robot))
+    drive = w.world.robots[0].steered_drive
+    assert drive is not None and not [x for x in w.warnings if "will not move" in x]
+    by_motor = {x.motor: x for x in drive.wheels}
+    assert by_motor["back right wheel"].steer_sign == -1 and by_motor["front left wheel"].steer_sign == 1
+    assert (by_motor["middle left wheel"].steer, by_motor["middle left wheel"].position) == (None, (0.0, 0.25))
+    sim = Simulation(w, "fast")
+    rover = sim.robot("rover")
+    arms = {"front left": -0.87, "front right": 0.87, "back left": 0.87, "back right": -0.87}
+    for k, a in arms.items():
+        rover.motor(f"{k} arm").set_position(a)
+    sim.run(50)                                   # the arms turn (the wheels hold: the rover stays)
+    assert rover.pose.translation[:2] == pytest.approx([0.0, 0.0], abs=0.0)
+    omega = 3.0
+    speeds = {"front left": omega, "back left": omega, "middle left": omega,
+              "front right": -omega, "back right": -omega, "middle right": -omega}
+    for k, s in speeds.items():
+        rover.motor(f"{k} wheel").set_position(math.inf)
+        rover.motor(f"{k} wheel").set_velocity(s)
+    sim.run(1)
+    # the fit: Σx = Σy = 0, so vx = Σux/6, vy = Σuy/6, ωz = Σ(x·uy − y·ux)/Σ(x² + y²)
+    where = {**places, "middle left": (0.0, 0.25), "middle right": (0.0, -0.25)}
+    heading = {k: (-1.0 if k == "back right" else 1.0) * a for k, a in arms.items()}
+    u = {k: (R * s * math.cos(heading.get(k, 0.0)), R * s * math.sin(heading.get(k, 0.0))) for k, s in speeds.items()}
+    vx = sum(v[0] for v in u.values()) / 6
+    vy = sum(v[1] for v in u.values()) / 6
+    wz = sum(x * u[k][1] - y * u[k][0] for k, (x, y) in where.items()) / sum(x * x + y * y for x, y in where.values())
+    assert rover.drive.velocity()[5] == pytest.approx(wz, abs=1e-12)
+    lin = rover.drive.velocity()[:2]
+    dt = 0.016                                    # the origin's velocity at the step's end: the twist turned by ωz·dt
+    c, s = math.cos(wz * dt), math.sin(wz * dt)
+    assert lin == pytest.approx([vx * c - vy * s, vx * s + vy * c], abs=1e-12)

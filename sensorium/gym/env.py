@@ -126,6 +126,9 @@ class Agent:
         if name not in robots:
             raise ValueError(f"{loaded.source}: task robot {name!r} not in the world (robots: {', '.join(robots)})")
         model = robots[name]
+        if model.steered_drive is not None:     # its steering hinges are joints: no action maps onto them
+            raise ValueError(f"{loaded.source}: task robot {name!r} has a steered_drive, which the gym's actions "
+                             "(wheel speeds) do not drive: use Simulation")
         if not has_drive(model):
             raise ValueError(f"{loaded.source}: task robot {name!r} has no differential_drive, ackermann_drive, "
                              "mecanum_drive or omni_drive to act with")

@@ -1593,6 +1593,65 @@ class OmniDrive(Strict):
         return self
 
 
+class SteeredWheel(Strict):
+    """One wheel of a steered-wheel drive: its rolling motor, the steering motor that turns it about the
+    up axis (none: it keeps its heading), where it touches the ground and its radius (in the robot's frame:
+    x forward, y left, z up; with the drive's ``forward`` another direction, along it and its left)."""
+
+    motor: str = Field(min_length=1, description="its rolling RotationalMotor's name")
+    steer: str | None = Field(default=None, min_length=1, description="the RotationalMotor of the hinge that "
+                              "steers it (one of the robot's devices, moved as any joint is); none: its heading "
+                              "is fixed")
+    position: tuple[float, float] = Field(description="m, (x, y) where it touches the ground (a steered wheel: on "
+                                          "its steering axis)")
+    radius: float = Field(gt=0, description="m")
+    heading: float = Field(default=0.0, ge=-2 * math.pi, le=2 * math.pi, description="rad, the direction a positive "
+                           "speed rolls it at steering position 0, from forward towards the left (pi: its hinge "
+                           "axis points right)")
+    steer_sign: Literal[1, -1] = Field(default=1, description="1: a positive steering position turns it to the left "
+                                       "(a steering hinge about up); -1: to the right (about down)")
+
+
+class SteeredDrive(Strict):
+    """Kinematic drive on wheels that each roll along their own heading, steered or not (a PR2's four
+    casters, a rover's steered corners, a swerve base; no physics, no slip): wheel i at p_i = (x_i, y_i)
+    with heading h_i (its fixed ``heading`` plus ``steer_sign`` times its steering motor's position that
+    step) turning at ω_i moves its ground point at r_i·ω_i·(cos h_i, sin h_i). The body twist (vx, vy, ωz)
+    over a step is the least-squares fit of those velocities to v + ωz × p_i (the 2N rows (1, 0, -y_i) and
+    (0, 1, x_i)): exact when the wheels agree with one twist, their best fit when they do not (a real
+    robot's wheels would slip or scuff). The wheels must stand at two places at least."""
+
+    wheels: list[SteeredWheel] = Field(min_length=2, max_length=16)
+    wheel_bottom: float | None = _wheel_bottom_field()
+    max_wheel_speed: float = Field(default=10.0, gt=0, description="rad/s, the rolling motors' maxVelocity")
+    motor_max_speeds: dict[str, float] = _motor_max_speeds_field()
+    _maxima_numbers = field_validator("motor_max_speeds", mode="before")(_maxima_are_numbers)
+    forward: Forward = _forward_field()
+
+    _forward_nonzero = field_validator("forward")(_nonzero_forward)
+
+    @property
+    def motor_fields(self) -> list[tuple[str, str]]:
+        """(field, motor name) of the rolling motors, in the wheels' order (the steering motors are the
+        robot's joint motors, not the drive's)."""
+        return [(f"wheels[{i}].motor", w.motor) for i, w in enumerate(self.wheels)]
+
+    @model_validator(mode="after")
+    def _valid(self) -> SteeredDrive:
+        names = [w.motor for w in self.wheels]
+        if len(set(names)) != len(names):
+            raise ValueError(f"every wheel motor needs its own name, got {names}")
+        _check_motor_max_speeds(self.motor_max_speeds, names, "drive's wheel motors")
+        steers = [w.steer for w in self.wheels if w.steer is not None]
+        both = sorted(set(steers) & set(names))
+        if both:
+            raise ValueError(f"motor {both[0]!r} both rolls and steers a wheel")
+        if len({w.position for w in self.wheels}) < 2:
+            raise ValueError("the wheels all stand at one place: their velocities leave the turn rate free (a "
+                             "steered drive needs wheels at two places at least)")
+        return self
+
+
 # ---------------------------------------------------------------- robots and world
 
 class ProtoField(Strict):
@@ -1721,6 +1780,8 @@ class Robot(Strict):
                                                "wheels (a KUKA youBot); a robot has one drive at most")
     omni_drive: OmniDrive | None = Field(default=None, description="an omnidirectional robot on three or more omni "
                                          "wheels (Webots' omni_wheels how-to, a Robotino); a robot has one drive at most")
+    steered_drive: SteeredDrive | None = Field(default=None, description="a robot on wheels that each steer (a PR2's "
+                                               "casters, a rover's corners); a robot has one drive at most")
     devices: list[Device] = Field(default=[], description="in Webots' tree order (the order of the device "
                                   "indices); every Webots device type is accepted, those not simulated as present")
     recognition_colors: list[Color] = Field(
@@ -1742,11 +1803,17 @@ class Robot(Strict):
 
     @model_validator(mode="after")
     def _one_drive(self) -> Robot:
-        given = [k for k in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive")
+        given = [k for k in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive")
                  if getattr(self, k) is not None]
         if len(given) > 1:
             raise ValueError(f"a robot has one drive at most: give one of differential_drive, ackermann_drive, "
-                             f"mecanum_drive and omni_drive, not {' and '.join(given)}")
+                             f"mecanum_drive, omni_drive and steered_drive, not {' and '.join(given)}")
+        if self.steered_drive is not None:
+            rotational = {d.name for d in self.devices if isinstance(d, RotationalMotor)}
+            for i, w in enumerate(self.steered_drive.wheels):
+                if w.steer is not None and w.steer not in rotational:
+                    raise ValueError(f"steered_drive.wheels[{i}].steer: {w.steer!r} is not one of the robot's "
+                                     "RotationalMotor devices (a steering hinge's motor, moved as a joint)")
         for i, t in enumerate(self.radar_targets):
             bad = [k for k in t.shapes if k >= len(self.shapes)]
             if bad:
@@ -1783,6 +1850,8 @@ class Robot(Strict):
             return [(f"mecanum_drive.{f}", m) for f, m in self.mecanum_drive.motor_fields]
         if self.omni_drive is not None:
             return [(f"omni_drive.{f}", m) for f, m in self.omni_drive.motor_fields]
+        if self.steered_drive is not None:
+            return [(f"steered_drive.{f}", m) for f, m in self.steered_drive.motor_fields]
         return []
 
 

@@ -397,6 +397,11 @@ class BatchedSimulation:
         if w.world_info.coordinate_system not in _TO_ENU:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
+        steered = [r.name for r in w.robots if r.steered_drive is not None]
+        if steered:                   # its fit is not written for the copies' arrays
+            raise BatchedError(f"{self.loaded.source}: robot {steered[0]!r} has a steered_drive; the batched "
+                               "simulation drives two-wheel, skid-steer, car-like, mecanum and omni-wheel robots "
+                               "only (use Simulation)")
         for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
             drive = {m for _, m in r.drive_motors}
             joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]

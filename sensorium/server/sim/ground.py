@@ -520,6 +520,8 @@ def _wheels(robot: wm.Robot) -> tuple[float, float] | None:
         drive, radius = a, min(a.front_wheel_radius, a.rear_wheel_radius)
     elif robot.omni_drive is not None:
         drive, radius = robot.omni_drive, min(w.radius for w in robot.omni_drive.wheels)
+    elif robot.steered_drive is not None:
+        drive, radius = robot.steered_drive, min(w.radius for w in robot.steered_drive.wheels)
     else:
         return None
     return None if drive.wheel_bottom is None else (float(drive.wheel_bottom), float(radius))

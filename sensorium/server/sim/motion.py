@@ -1,5 +1,5 @@
 """Kinematic wheeled drives (two wheels, skid steer, car-like Ackermann steering, four mecanum
-wheels, three or more omni wheels): Webots-style wheel motors and exact pose integration.
+wheels, three or more omni wheels, wheels that each steer): Webots-style wheel motors and exact pose integration.
 
 No physics: wheels never slip and nothing collides. Over a basic step the wheel speeds are
 constant, so the robot follows an exact circular arc (or a straight segment); integrating the arc
@@ -481,6 +481,64 @@ class OmniDrive(HolonomicDrive):
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
         dt = dt_ms / 1000.0
         speeds = [m.advance(dt) for m, _ in self.wheels]
+        return self.roll(speeds, dt)
+
+
+class SteeredDrive(HolonomicDrive):
+    """Wheels that each roll along their own heading (``steered_drive``: a PR2's casters, a rover's
+    steered corners), no slip. Wheel i at p_i = (x_i, y_i) with heading h_i turning at ω_i moves its
+    ground point at u_i = r_i·ω_i·(cos h_i, sin h_i); a body twist t = (vx, vy, ωz) moves it at
+    v + ωz × p_i, the two rows (1, 0, -y_i) and (0, 1, x_i) of a matrix A that the headings do not
+    change. The twist over a step is the least-squares fit A⁺·u, A's pseudo-inverse (the normal
+    equations' closed form) computed once: exact when the wheels agree with one twist, their best
+    fit when they do not. A steered wheel's heading is its fixed ``heading`` plus ``steer_sign`` times
+    its steering joint's position that step (the joint moves first, by Webots' kinematic motor
+    control, sim/joints.py; :meth:`bind` hands the drive the robot's joints)."""
+
+    def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
+        rows = []
+        # each wheel: its motor, radius, fixed heading, steer sign, steering motor's name (None: fixed)
+        self.wheels: list[tuple[WheelMotor, float, float, float, str | None]] = []
+        for w in config.wheels:
+            px, py = float(w.position[0]), float(w.position[1])
+            rows += [(1.0, 0.0, -py), (0.0, 1.0, px)]
+            self.wheels.append((WheelMotor(w.motor, wheel_max_speed(config, w.motor)), float(w.radius),
+                                float(w.heading), float(w.steer_sign), w.steer))
+        solve = np.linalg.pinv(np.array(rows, dtype=np.float64))
+        """3 × 2N: the wheels' ground velocities (u_ix, u_iy, ...) to the body twist (vx, vy, ωz)."""
+        self.columns = [(tuple(float(v) for v in solve[:, 2 * i]), tuple(float(v) for v in solve[:, 2 * i + 1]))
+                        for i in range(len(self.wheels))]
+        """Each wheel's two columns of the pseudo-inverse (for u_ix, for u_iy), the numbers :meth:`twist` sums."""
+        self.steering: list[object | None] = [None] * len(self.wheels)
+        super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
+
+    def bind(self, joints: dict) -> None:
+        """The robot's joint motors: each steered wheel reads its steering motor's position."""
+        self.steering = [joints[name] if name is not None else None for *_, name in self.wheels]
+
+    @property
+    def motors(self) -> dict[str, WheelMotor]:
+        return {m.name: m for m, *_ in self.wheels}
+
+    def headings(self) -> list[float]:
+        """Each wheel's heading now (rad, from forward towards the left)."""
+        return [h + sign * float(joint.position) if joint is not None else h     # type: ignore[attr-defined]
+                for (_, _, h, sign, _), joint in zip(self.wheels, self.steering)]
+
+    def twist(self, speeds: list[float]) -> tuple[float, float, float]:
+        """(vx, vy, ωz) in the robot's frame for the wheels' speeds (rad/s, the wheels' order) at their
+        headings now: the pseudo-inverse's columns times the wheels' ground velocities, summed wheel by
+        wheel in plain float64."""
+        vx = vy = w = 0.0
+        for u, (_, r, _, _, _), h, (a, b) in zip(speeds, self.wheels, self.headings(), self.columns):
+            ux, uy = u * r * math.cos(h), u * r * math.sin(h)
+            vx, vy, w = vx + a[0] * ux + b[0] * uy, vy + a[1] * ux + b[1] * uy, w + a[2] * ux + b[2] * uy
+        return vx, vy, w
+
+    def step(self, dt_ms: int) -> Pose | None:
+        """Advance one basic step; the new pose, or None when the wheels did not turn."""
+        dt = dt_ms / 1000.0
+        speeds = [m.advance(dt) for m, *_ in self.wheels]
         return self.roll(speeds, dt)
 
 

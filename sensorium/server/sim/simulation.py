@@ -40,7 +40,15 @@ from sensorium.server.sim.ground import (
     settling_ground,
 )
 from sensorium.server.sim.joints import JointMotor, Links
-from sensorium.server.sim.motion import _TO_ENU, AckermannDrive, DifferentialDrive, MecanumDrive, OmniDrive, WheelMotor
+from sensorium.server.sim.motion import (
+    _TO_ENU,
+    AckermannDrive,
+    DifferentialDrive,
+    MecanumDrive,
+    OmniDrive,
+    SteeredDrive,
+    WheelMotor,
+)
 from sensorium.server.sim.pen import Pen, lay_ink
 from sensorium.server.sim.radar import Radar
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
@@ -178,7 +186,7 @@ class RobotState:
                                        clock=lambda: sim.time_ms, own_shapes=sim.scene.device_shapes(index, d.name))
         up = sim.world.world_info.coordinate_system
         self.initial_pose = sim.scene.robot_poses[index]     # as the world file places it (reset puts it back there)
-        self.drive: DifferentialDrive | AckermannDrive | MecanumDrive | OmniDrive | None = None
+        self.drive: DifferentialDrive | AckermannDrive | MecanumDrive | OmniDrive | SteeredDrive | None = None
         low = sim.band_low(index) if sim.ground is not None else 0.0     # (its support ceiling: sim/ground.py)
         if model.differential_drive is not None:
             self.drive = DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index], up=up,
@@ -192,6 +200,9 @@ class RobotState:
         elif model.omni_drive is not None:
             self.drive = OmniDrive(model.omni_drive, sim.scene.robot_poses[index], up=up, ground=sim.ground,
                                    band_low=low)
+        elif model.steered_drive is not None:
+            self.drive = SteeredDrive(model.steered_drive, sim.scene.robot_poses[index], up=up, ground=sim.ground,
+                                      band_low=low)
         if self.drive is not None and self.drive.slope is not None:   # placed on a slope: its attitude
             sim.scene.set_robot_pose(index, self.drive.pose())
         drive_motors: dict[str, WheelMotor] = self.drive.motors if self.drive else {}
@@ -199,6 +210,8 @@ class RobotState:
         self.joints: dict[str, JointMotor] = {d.name: joint_motor(d) for d in model.devices
                                               if isinstance(d, wm.Motor) and d.name not in drive_motors}
         couple(self.joints)
+        if isinstance(self.drive, SteeredDrive):     # its wheels' headings are its steering joints' positions
+            self.drive.bind(self.joints)
         self.motors: dict[str, WheelMotor | JointMotor] = (
             {**drive_motors, **self.joints} if self.joints else cast("dict[str, WheelMotor | JointMotor]", drive_motors))
         # what rides on the joints (``on_joint``): their links, and the devices on each (None: nothing rides)
@@ -768,7 +781,8 @@ class Simulation:
         self.scene.evaporate_ink(dt)
         for speaker in self._speakers:     # sounds and speech played for this step (sim/speaker.py)
             speaker.advance(dt, now)
-        moved: list[tuple[RobotState, DifferentialDrive | AckermannDrive | MecanumDrive | OmniDrive, tuple[float, float], Pose]] = []
+        moved: list[tuple[RobotState, DifferentialDrive | AckermannDrive | MecanumDrive | OmniDrive | SteeredDrive,
+                         tuple[float, float], Pose]] = []
         if self._jointed:             # joints move kinematically (sim/joints.py), and what rides on them
             dt_s = dt * 0.001
             for joint in self._jointed:

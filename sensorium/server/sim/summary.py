@@ -36,6 +36,11 @@ def drive_line(r: wm.Robot) -> str:
         wheels = ", ".join(f"{w.motor} at ({w.position[0]:g}, {w.position[1]:g}) m about ({w.axis[0]:g}, "
                            f"{w.axis[1]:g}), radius {w.radius:g} m" for w in r.omni_drive.wheels)
         return f"omni wheels, {len(r.omni_drive.wheels)}: {wheels}"
+    if r.steered_drive is not None:
+        wheels = ", ".join(f"{w.motor} at ({w.position[0]:g}, {w.position[1]:g}) m"
+                           + (f" steered by {w.steer}" if w.steer is not None else f" heading {w.heading:g} rad")
+                           + f", radius {w.radius:g} m" for w in r.steered_drive.wheels)
+        return f"steered wheels, {len(r.steered_drive.wheels)}: {wheels}"
     if r.mecanum_drive is not None:
         m = r.mecanum_drive
         return (f"mecanum: wheels of radius {m.wheel_radius:g} m at (±{m.lx:g}, ±{m.ly:g}) m, rollers "

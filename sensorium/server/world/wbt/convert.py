@@ -1965,17 +1965,47 @@ class Converter:
                                  "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
-    def _steered_casters(self, wheels: list[dict]) -> str | None:
-        """Why a base on more than two steering joints, each carrying driven wheels of its own (a PR2's
-        four casters, a rover's steered corners), has no drive, else None (a car steers two)."""
+    def _steering_groups(self, wheels: list[dict]) -> list[tuple[dict | None, list[dict]]] | None:
+        """A base on more than two steering joints, each carrying driven wheels of its own (a PR2's four
+        casters, a rover's steered corners): each steering joint with the driven wheels it turns, then
+        (None, the driven wheels riding none); else None (a car steers two)."""
         steering = [w for w in wheels if w["steers"]]
         held = [self._inside(w["end"]) for w in steering]
-        riding = [w for w in wheels if not w["steers"] and any(id(w["node"]) in h for h in held)]
-        if len(steering) <= 2 or not all(any(id(w["node"]) in h for w in riding) for h in held):
+        riding = [[w for w in wheels if not w["steers"] and id(w["node"]) in h] for h in held]
+        if len(steering) <= 2 or not all(riding):
             return None
-        return (f"its {len(riding)} driven wheels ride {len(steering)} steering joints, each turning wheels of its own "
-                f"({', '.join(repr(w['motor']) for w in steering)}): no kinematic drive here steers more than a car's "
-                "two")
+        carried = {id(w["node"]) for r in riding for w in r}
+        free = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
+        return [*zip(steering, riding), *([(None, free)] if free else [])]
+
+    def _grounded(self, groups: list[tuple[dict | None, list[dict]]], nowheel: list[tuple[Node, str, str, str]],
+                  up: int) -> list[tuple[dict | None, list[dict]]]:
+        """The steering groups with the driven hinges riding no steering joint kept only where they are
+        wheels on the steered wheels' ground (their round part's bottom within the smallest steered
+        wheel's radius of the lowest steered wheel's): a head's tilt hinge or an arm's joint beside
+        the casters is no wheel (said once, with the robot's other joints)."""
+        from sensorium.server.world.wbt.drive import wheel_bottom, wheel_radius
+
+        steered = [w for steering, riding in groups if steering is not None for w in riding]
+        radii = [r for r in (wheel_radius(w["end"], self) for w in steered) if r is not None]
+        lowest = wheel_bottom(steered, self, up)
+        out: list[tuple[dict | None, list[dict]]] = []
+        for steering, riding in groups:
+            if steering is not None:
+                out.append((steering, riding))
+                continue
+            kept = []
+            for w in riding:
+                bottom = wheel_bottom([w], self, up)
+                if bottom is not None and lowest is not None and radii and abs(bottom - lowest) <= min(radii):
+                    kept.append(w)
+                else:
+                    nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (no "
+                                    f"round part on the ground the steered wheels roll on): {JOINT_MOVES}",
+                                    "off the ground the steered wheels roll on"))
+            if kept:
+                out.append((None, kept))
+        return out
 
     def _lifted_wheels(self, wheels: list[dict], up: int) -> list[tuple[dict, float]]:
         """The motorised hinges about horizontal axes riding a steering (vertical) hinge whose round
@@ -2138,7 +2168,7 @@ class Converter:
         """A robot with physics, no drive and many motorised joints (a legged robot, a humanoid: Webots'
         Spot, Nao): Webots' physics stands, walks or drops it by its limbs; here its joints move only
         its parts. One line, so a controller's walk going nowhere is not a surprise."""
-        drives = ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive")
+        drives = ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive")
         if (len(nowheel) <= MANY_JOINTS or any(k in robot.data for k in drives)
                 or self.fields(node).node_("physics") is None):
             return
@@ -2158,6 +2188,7 @@ class Converter:
             omni_drive,
             omni_wheels,
             rolls_about_its_axis,
+            steered_drive,
             wheel_radius,
         )
 
@@ -2260,8 +2291,23 @@ class Converter:
                 wheels = base
         else:
             turns = mecanum_turns(wheels, self)
+        groups = self._steering_groups(wheels) if turns is None else None
+        if groups is not None:                    # steered casters or corners: each wheel steered on its own
+            groups = self._grounded(groups, nowheel, up)
+            positions = {d["name"]: float(d.get("position", 0.0)) for d in robot.data["devices"]
+                         if d.get("device") == "RotationalMotor"}
+            drive, why = steered_drive(groups, positions, self, up)
+            if drive is None:
+                self.warn(node, f"robot {robot.data['name']!r}: no steered-wheel drive ({why}); the robot will not "
+                                "move")
+                return
+            robot.data["steered_drive"] = drive
+            # the steering hinges stay joints (moved as Webots' kinematic motor control moves them; the drive
+            # reads their positions); the rolling wheels are the drive's
+            self._drive_wheels(node, robot, [w for _, riding in groups for w in riding])
+            return
         if turns is None and any(w["steers"] for w in wheels):      # a car
-            casters = self._steered_casters(wheels) or self._one_steered_wheel(wheels)
+            casters = self._one_steered_wheel(wheels)
             if casters:
                 self.warn(node, f"robot {robot.data['name']!r}: no drive ({casters}); the robot will not move")
                 return
@@ -2315,7 +2361,7 @@ class Converter:
         bottom = (wheel_bottom(wheels, self, self._robot_up(robot)) if self.fields(node).node_("physics") is not None
                   else None)
         if bottom is not None:
-            for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive"):
+            for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive"):
                 if key in robot.data:
                     robot.data[key]["wheel_bottom"] = bottom
         for w in wheels:    # the wheels' encoders measure the drive's wheels
@@ -2368,6 +2414,7 @@ def drive_motor_names(robot: dict) -> list[str]:
     motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
     motors += [v for k, v in (robot.get("mecanum_drive") or {}).items() if k.endswith("_motor")]
     motors += [w["motor"] for w in (robot.get("omni_drive") or {}).get("wheels", ())]
+    motors += [w["motor"] for w in (robot.get("steered_drive") or {}).get("wheels", ())]
     return [m for m in motors if isinstance(m, str)]
 
 

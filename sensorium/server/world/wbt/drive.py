@@ -824,3 +824,50 @@ def belt_bottom(track_frame, wheels: list[tuple[float, float, float]], up: int =
     r = np.asarray(track_frame.rotation, dtype=np.float64)
     reach = track_frame.scale * math.hypot(float(r[up, 0]), float(r[up, 2]))   # a unit circle's half-height
     return min(float(track_frame.apply((x, 0.0, y))[up]) - radius * reach for x, y, radius in wheels)
+
+
+# ---------------------------------------------------------------- steered wheels (a PR2's casters, a rover's corners)
+
+def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions: dict[str, float], conv,
+                  up: int = 2) -> tuple[dict | None, str]:
+    """The kinematic steered-wheel drive of a robot whose driven wheels ride steering hinges of their
+    own, or (None, the sentence why not). ``groups``: each steering hinge (None: the wheels that ride
+    none, which keep their heading) with the driven wheels it turns; ``steer_positions``: each steering
+    motor's position as the world loads. A steered wheel touches the ground under its steering axis
+    (the hinge's anchor: a caster's two wheels, beside it, are taken there); an unsteered one where its
+    round part is on its axis. Its heading at steering position 0 is where a positive speed rolls it,
+    axis × up, less the hinge's turn as loaded; a hinge about up turns it left as its position grows
+    (``steer_sign`` 1), one about down right (-1)."""
+    if up != 2:
+        return None, "a robot built y-up: the steered-wheel drive takes robots whose z is up"
+    out = []
+    rolling = []
+    for steering, riding in groups:
+        for w in riding:
+            radius = wheel_radius(w["end"], conv)
+            if radius is None:
+                return None, (f"wheel {w['motor']!r}: its end point has no cylinder or sphere to take the wheel "
+                              "radius from")
+            axis = np.asarray(w["axis"], dtype=np.float64)
+            if abs(float(axis[2])) > AXIS_TOL * float(np.linalg.norm(axis)):
+                return None, (f"wheel axis of motor {w['motor']!r} is {np.round(axis, 6).tolist()}, not horizontal "
+                              "in the robot's frame: a steered wheel rolls about a horizontal axis")
+            wheel: dict = {"motor": w["motor"], "radius": float(radius)}
+            heading = math.atan2(-float(axis[0]), float(axis[1]))      # axis × up: (a_y, -a_x)
+            if steering is None:
+                at = _on_axis(w, conv)
+            else:
+                at = np.asarray(steering["anchor"], dtype=np.float64)
+                sign = 1 if float(steering["axis"][2]) > 0.0 else -1
+                heading -= sign * steer_positions.get(steering["motor"], 0.0)
+                wheel["steer"] = steering["motor"]
+                if sign < 0:
+                    wheel["steer_sign"] = -1
+            wheel["position"] = [float(at[0]), float(at[1])]
+            if heading != 0.0:
+                wheel["heading"] = math.remainder(heading, 2.0 * math.pi)
+            out.append(wheel)
+            rolling.append(w)
+    if len({tuple(w["position"]) for w in out}) < 2:
+        return None, "the wheels all stand at one place"
+    return {"wheels": out, **_wheel_speeds(rolling, conv)}, ""

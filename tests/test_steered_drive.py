@@ -1,0 +1,209 @@
+"""Steered-wheel robots (``steered_drive``): four wheels at the corners of a 0.4 x 0.3 box, each on a
+steering hinge moved as any joint is, strafe, turn in place and drive as closed form says; the fit
+of a two-wheel arrangement is the differential drive's twist; bad declarations are one line; the
+batched simulation refuses them. Our own worlds."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.motion import DifferentialDrive, SteeredDrive
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.geometry import Pose
+from sensorium.server.world.loader import WorldError, parse_world
+
+R = 0.05                               # wheel radius
+CX, CY = 0.2, 0.15                     # the corners of the 0.4 x 0.3 box
+CORNERS = {"fl": (CX, CY), "fr": (CX, -CY), "rl": (-CX, CY), "rr": (-CX, -CY)}
+DT = 0.016
+
+
+def swerve(**drive) -> dict:
+    return {"name": "sw", "pose": {"translation": [0.0, 0.0, 0.1]},
+            "body": {"geometry": {"type": "box", "size": [0.4, 0.3, 0.1]}},
+            "steered_drive": {"max_wheel_speed": 20.0, "wheels": [
+                {"motor": f"{k} wheel", "steer": f"{k} steer", "position": list(p), "radius": R}
+                for k, p in CORNERS.items()], **drive},
+            "devices": [{"device": "RotationalMotor", "name": f"{k} steer", "axis": [0.0, 0.0, 1.0],
+                         "anchor": [p[0], p[1], 0.0], "max_velocity": 100.0} for k, p in CORNERS.items()]
+            + [{"device": "PositionSensor", "name": "fl steer sensor", "motor": "fl steer"}]}
+
+
+def sim_of(robot: dict) -> Simulation:
+    return Simulation(parse_world({"world_info": {"basic_time_step": 16, "contact": False}, "robots": [robot]}))
+
+
+def steer(sim: Simulation, angles: dict[str, float], steps: int = 60) -> None:
+    for k, a in angles.items():
+        sim.robot("sw").motor(f"{k} steer").set_position(a)
+    sim.run(steps)
+    for k, a in angles.items():
+        assert sim.robot("sw").motor(f"{k} steer").position == a
+
+
+def roll(sim: Simulation, speeds: dict[str, float]) -> None:
+    for k, omega in speeds.items():
+        m = sim.robot("sw").motor(f"{k} wheel")
+        m.set_position(math.inf)
+        m.set_velocity(omega)
+
+
+def pose2d(sim: Simulation) -> tuple[float, float, float]:
+    p = sim.robot("sw").pose
+    return float(p.translation[0]), float(p.translation[1]), math.atan2(p.rotation[1, 0], p.rotation[0, 0])
+
+
+def test_steering_does_not_move_the_body_and_straight_wheels_drive_forward() -> None:
+    sim = sim_of(swerve())
+    steer(sim, dict.fromkeys(CORNERS, 0.7))
+    assert pose2d(sim) == (0.0, 0.0, 0.0)              # the wheels did not roll
+    steer(sim, dict.fromkeys(CORNERS, 0.0))
+    roll(sim, dict.fromkeys(CORNERS, 4.0))
+    sim.run(100)                                        # 1.6 s at r·ω = 0.2 m/s
+    assert pose2d(sim) == pytest.approx((R * 4.0 * 1.6, 0.0, 0.0), abs=1e-12)
+
+
+@pytest.mark.parametrize("omega", [4.0, -2.5])
+def test_all_steered_to_a_quarter_turn_moves_sideways_at_r_omega(omega: float) -> None:
+    sim = sim_of(swerve())
+    steer(sim, dict.fromkeys(CORNERS, math.pi / 2))
+    roll(sim, dict.fromkeys(CORNERS, omega))
+    sim.run(100)
+    assert pose2d(sim) == pytest.approx((0.0, R * omega * 1.6, 0.0), abs=1e-12)
+    assert sim.robot("sw").drive.velocity()[:3] == pytest.approx([0.0, R * omega, 0.0], abs=1e-12)
+
+
+@pytest.mark.parametrize("omega", [3.0, -5.0])
+def test_wheels_tangent_to_a_circle_about_the_centre_turn_in_place_at_r_omega_over_radius(omega: float) -> None:
+    sim = sim_of(swerve())
+    # a wheel at (x, y) rolls along (-y, x) for a turn to the left
+    steer(sim, {k: math.atan2(x, -y) for k, (x, y) in CORNERS.items()})
+    roll(sim, dict.fromkeys(CORNERS, omega))
+    sim.run(50)                                         # 0.8 s
+    rate = R * omega / math.hypot(CX, CY)
+    x, y, yaw = pose2d(sim)
+    assert (x, y) == pytest.approx((0.0, 0.0), abs=1e-12)
+    assert yaw == pytest.approx(math.remainder(rate * 0.8, math.tau), abs=1e-12)
+
+
+def test_wheels_that_disagree_move_the_robot_by_their_least_squares_twist() -> None:
+    """Front wheels straight, rear ones at a quarter turn, all at ω: the fit of the four wheels'
+    velocities (normal equations: vx = Σux/4, vy = Σuy/4, ωz = Σ(x·uy − y·ux)/Σ(x² + y²))."""
+    sim = sim_of(swerve())
+    steer(sim, {"fl": 0.0, "fr": 0.0, "rl": math.pi / 2, "rr": math.pi / 2})
+    roll(sim, dict.fromkeys(CORNERS, 2.0))
+    u = R * 2.0
+    vel = {"fl": (u, 0.0), "fr": (u, 0.0), "rl": (0.0, u), "rr": (0.0, u)}
+    vx = sum(v[0] for v in vel.values()) / 4
+    vy = sum(v[1] for v in vel.values()) / 4
+    w = sum(x * vel[k][1] - y * vel[k][0] for k, (x, y) in CORNERS.items()) / (4 * (CX * CX + CY * CY))
+    sim.run(1)
+    assert sim.robot("sw").drive.velocity()[5] == pytest.approx(w, abs=1e-12)
+    half = math.sin(0.5 * w * DT)                       # one step of the exact twist move from the origin
+    a, b = math.sin(w * DT) / w, 2.0 * half * half / w
+    assert pose2d(sim) == pytest.approx((a * vx - b * vy, b * vx + a * vy, w * DT), abs=1e-12)
+
+
+def test_two_wheels_at_plus_minus_y_steered_straight_are_the_differential_drive() -> None:
+    config = wm.SteeredDrive.model_validate({"wheels": [
+        {"motor": "left", "position": [0.0, 0.026], "radius": 0.0205},
+        {"motor": "right", "position": [0.0, -0.026], "radius": 0.0205}]})
+    diff = wm.DifferentialDrive.model_validate({"wheel_radius": 0.0205, "axle_length": 0.052,
+                                                "left_motor": "left", "right_motor": "right"})
+    steered = SteeredDrive(config, Pose.identity())
+    steered.bind({})
+    two = DifferentialDrive(diff, Pose.identity())
+    for wl, wr in ((3.0, 3.0), (2.0, -1.5), (-4.0, 6.25), (0.0, 5.0)):
+        vx, vy, w = steered.twist([wl, wr])
+        assert vx == pytest.approx(two.wheel_radius * (wl + wr) / 2.0, abs=1e-12)
+        assert vy == pytest.approx(0.0, abs=1e-12)
+        assert w == pytest.approx(two.wheel_radius * (wr - wl) / two.axle_length, abs=1e-12)
+
+
+def test_a_steering_hinge_about_down_turns_the_wheel_the_other_way() -> None:
+    robot = swerve()
+    for wheel in robot["steered_drive"]["wheels"]:
+        wheel["steer_sign"] = -1
+    sim = sim_of(robot)
+    steer(sim, dict.fromkeys(CORNERS, math.pi / 2))
+    roll(sim, dict.fromkeys(CORNERS, 4.0))
+    sim.run(100)
+    assert pose2d(sim) == pytest.approx((0.0, -R * 4.0 * 1.6, 0.0), abs=1e-12)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda r: r["steered_drive"]["wheels"][0].update(steer="nowhere"),
+     r"steered_drive\.wheels\[0\]\.steer: 'nowhere' is not one of the robot's RotationalMotor devices"),
+    (lambda r: r["steered_drive"]["wheels"][1].update(steer="fl wheel"), "motor 'fl wheel' both rolls and steers"),
+    (lambda r: [w.update(position=[0.1, 0.0]) for w in r["steered_drive"]["wheels"]],
+     "the wheels all stand at one place"),
+    (lambda r: r.update(differential_drive={}), "a robot has one drive at most"),
+])
+def test_bad_declarations_are_one_line(change, message: str) -> None:
+    robot = swerve()
+    change(robot)
+    with pytest.raises(WorldError, match=message):
+        sim_of(robot)
+
+
+def test_the_batched_simulation_refuses_it_in_one_line() -> None:
+    loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [swerve()]})
+    with pytest.raises(BatchedError, match="robot 'sw' has a steered_drive; the batched simulation drives"):
+        BatchedSimulation(loaded, 2)
+
+
+def test_the_gym_refuses_it_as_an_agent_in_one_line() -> None:
+    gym = pytest.importorskip("sensorium.gym")
+    loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [swerve()]})
+    with pytest.raises(ValueError, match="task robot 'sw' has a steered_drive, which the gym's actions"):
+        gym.SensoriumEnv(loaded, gym.Task(robot="sw"))
+
+
+def test_contact_stops_a_strafing_robot_at_a_wall() -> None:
+    wall = {"name": "wall", "pose": {"translation": [0.0, 1.0, 0.25]}, "geometry": {"type": "box", "size": [4, 0.2, 0.5]}}
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 16, "contact": True}, "solids": [wall],
+                                  "robots": [swerve()]}))
+    steer(sim, dict.fromkeys(CORNERS, math.pi / 2))
+    roll(sim, dict.fromkeys(CORNERS, 10.0))
+    sim.run(200)                                        # 3.2 s at 0.5 m/s: far past the wall unless stopped
+    x, y, yaw = pose2d(sim)
+    assert (x, yaw) == pytest.approx((0.0, 0.0), abs=1e-12)     # (cos(pi/2) is 6e-17, not 0)
+    assert y == pytest.approx(0.9 - CY, abs=1e-9)       # its body's left side against the wall's face
+    assert sim.robot("sw").pressing
+
+
+def test_nue_world_strafes_to_the_robots_left_on_its_ground_plane() -> None:
+    robot = swerve()
+    robot["pose"] = {"translation": [0.0, 0.0, 0.0]}
+    for d in robot["devices"]:                          # a robot built y-up: its steering hinges about its y
+        if d["device"] == "RotationalMotor":
+            d["axis"] = [0.0, 1.0, 0.0]
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 16, "coordinate_system": "NUE", "contact": False},
+                                  "robots": [robot]}))
+    steer(sim, dict.fromkeys(CORNERS, math.pi / 2))
+    roll(sim, dict.fromkeys(CORNERS, 4.0))
+    sim.run(100)
+    # x north (the robot's forward), y up, z east: its left is west, -z
+    assert list(sim.robot("sw").pose.translation) == pytest.approx([0.0, 0.0, -R * 4.0 * 1.6], abs=1e-12)
+
+
+def test_strafing_sideways_up_a_ramp_covers_r_omega_t_along_the_ground() -> None:
+    """On tests/test_ground_ramp.py's ramp (angle A, rising along +x), heading -y with every wheel
+    steered to its left (up the ramp): r·ω·t·cos A along x, r·ω·t·sin A up, as the holonomic drives."""
+    from tests.test_ground_ramp import FLOOR, HALF, A, _ramp, _ramp_z
+
+    robot = {**swerve(), "body": {"geometry": {"type": "cylinder", "radius": 0.1, "height": 2 * HALF}},
+             "pose": {"translation": [1.3, 0.0, _ramp_z(1.3) + HALF], "rotation": [0, 0, 1, -math.pi / 2]}}
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 16}, "solids": [FLOOR, _ramp()],
+                                  "robots": [robot]}), precision="exact")
+    steer(sim, dict.fromkeys(CORNERS, math.pi / 2))
+    start = sim.robot("sw").pose.translation.copy()
+    roll(sim, dict.fromkeys(CORNERS, 4.0))
+    sim.run(60)
+    d = sim.robot("sw").pose.translation - start
+    dist = R * 4.0 * 0.96
+    assert list(d) == pytest.approx([dist * math.cos(A), 0.0, dist * math.sin(A)], abs=1e-9)
