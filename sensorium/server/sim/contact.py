@@ -188,6 +188,9 @@ class Footprint:
     # a concave body (:func:`robot_footprint`'s rule): its convex pieces, each a Footprint in the same
     # frame with its own band; the hull above stays the broad phase's. None: the hull is the footprint
     pieces: tuple[Footprint, ...] | None = None
+    # which shapes (their indices among those with a footprint) make each piece, as decided when the
+    # robot loaded: a joint moving its shapes keeps the grouping (:meth:`Contact.reshape`). () the hull
+    groups: tuple[tuple[int, ...], ...] = ()
 
     @property
     def disc(self) -> bool:
@@ -266,11 +269,14 @@ def _z_extent(prim: geo.Primitive, rotation: np.ndarray) -> tuple[float, float]:
     return -e, e
 
 
-def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None:
+def robot_footprint(parts: list[tuple[geo.Primitive, Pose]],
+                    grouping: tuple[tuple[int, ...], ...] | None = None) -> Footprint | None:
     """A robot's footprint from its body shapes, each at its pose in the robot frame: the convex
     piece holding their outlines (:func:`_section`, :func:`_body_section`), the height band, and
     the disc about the origin holding the piece at any heading (the old footprint's radius, which
-    it always was, or wider where a tilted round part's circumscribed polygon reaches past it)."""
+    it always was, or wider where a tilted round part's circumscribed polygon reaches past it).
+    ``grouping``: the shapes' pieces as an earlier footprint of the same shapes grouped them
+    (:attr:`Footprint.groups`); None: decided here (:func:`_concave_groups`)."""
     feet = []
     bands: list[Footprint] = []             # per shape with a footprint: its band (and its section below)
     sections: list[tuple[np.ndarray, float] | None] = []
@@ -296,8 +302,9 @@ def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None
     # the disc about the origin (the broad phase's) must hold the shape at every heading: the old
     # radius does, but for a tilted round part's circumscribed polygon, which may reach past it
     reach = float(np.max(np.hypot(points[:, 0], points[:, 1]))) + rnd
+    groups = _concave_groups(sections) if grouping is None else grouping
     return Footprint(max(radius, reach), min(f.z_low for f in feet), max(f.z_high for f in feet), points, rnd,
-                     _concave_pieces(sections, bands))
+                     _pieces(groups, sections, bands), groups)
 
 
 CONCAVE = 0.01        # a body whose hull's area exceeds its shapes' union's by more than this: its pieces
@@ -320,25 +327,37 @@ def _area(poly: np.ndarray) -> float:
 def _union_area(polys: list[np.ndarray]) -> float:
     """The area of the union of convex counter-clockwise polygons (Green's theorem over the parts of
     each edge no other polygon covers; an edge lying on an earlier polygon's edge of the same
-    direction counts once, opposite edges cancel)."""
+    direction counts once, opposite edges cancel). Plain floats: a moving joint's body makes it again."""
+    vs = [p.tolist() for p in polys]
+    boxes = [(min(x for x, _ in v), min(y for _, y in v), max(x for x, _ in v), max(y for _, y in v)) if v else None
+             for v in vs]
     total = 0.0
-    for i, poly in enumerate(polys):
+    for i, poly in enumerate(vs):
         if len(poly) < 3:
             continue
-        for a, b in zip(poly, np.roll(poly, -1, axis=0)):
-            d = b - a
+        others = [j for j, v in enumerate(vs) if j != i and len(v) >= 3]
+        for k in range(len(poly)):
+            ax, ay = poly[k]
+            bx, by = poly[(k + 1) % len(poly)]
+            dx, dy = bx - ax, by - ay
+            dn = math.hypot(dx, dy)
             covered = []
-            for j, other in enumerate(polys):
-                if j == i or len(other) < 3:
+            for j in others:
+                x0, y0, x1, y1 = boxes[j]            # type: ignore[misc]
+                if max(ax, bx) < x0 or min(ax, bx) > x1 or max(ay, by) < y0 or min(ay, by) > y1:
                     continue
                 lo, hi = 0.0, 1.0
-                for v, w in zip(other, np.roll(other, -1, axis=0)):
-                    e = w - v
-                    f0 = e[0] * (a[1] - v[1]) - e[1] * (a[0] - v[0])      # > 0: a left of (inside) edge e
-                    df = e[0] * d[1] - e[1] * d[0]
-                    tol = 1e-12 * math.hypot(*e) * (math.hypot(*d) + math.hypot(*(a - v)))
-                    if abs(df) <= 1e-12 * math.hypot(*e) * math.hypot(*d):
-                        if f0 > tol or (abs(f0) <= tol and j < i and float(e @ d) > 0.0):
+                other = vs[j]
+                for m in range(len(other)):
+                    vx, vy = other[m]
+                    wx, wy = other[(m + 1) % len(other)]
+                    ex, ey = wx - vx, wy - vy
+                    en = math.hypot(ex, ey)
+                    f0 = ex * (ay - vy) - ey * (ax - vx)      # > 0: a left of (inside) edge e
+                    df = ex * dy - ey * dx
+                    if abs(df) <= 1e-12 * en * dn:
+                        tol = 1e-12 * en * (dn + math.hypot(ax - vx, ay - vy))
+                        if f0 > tol or (abs(f0) <= tol and j < i and ex * dx + ey * dy > 0.0):
                             continue
                         lo, hi = 1.0, 0.0
                         break
@@ -347,43 +366,55 @@ def _union_area(polys: list[np.ndarray]) -> float:
                         lo = max(lo, t)
                     else:
                         hi = min(hi, t)
+                    if lo >= hi:
+                        break
                 if lo < hi:
                     covered.append((lo, hi))
             t0 = 0.0
             for lo, hi in sorted(covered) + [(1.0, 1.0)]:
                 if lo > t0:
-                    p, q = a + t0 * d, a + lo * d
-                    total += 0.5 * float(p[0] * q[1] - q[0] * p[1])
+                    px, py, qx, qy = ax + t0 * dx, ay + t0 * dy, ax + lo * dx, ay + lo * dy
+                    total += 0.5 * (px * qy - qx * py)
                 t0 = max(t0, hi)
     return total
 
 
-def _concave_pieces(sections: list[tuple[np.ndarray, float] | None],
-                    bands: list[Footprint]) -> tuple[Footprint, ...] | None:
-    """A body's convex pieces where the hull of its shapes' outlines closes a notch: None (the hull
-    is the footprint, as it always was) when the hull's area is within CONCAVE (1 %) of the union's;
-    else the shapes grouped -- the two groups whose hull adds least over their union merged, while
-    that is under CONCAVE -- each group one piece (:func:`_body_section`) with its own height band."""
+def _concave_groups(sections: list[tuple[np.ndarray, float] | None]) -> tuple[tuple[int, ...], ...]:
+    """A body's shapes grouped into convex pieces where the hull of their outlines closes a notch:
+    () (the hull is the footprint, as it always was) when the hull's area is within CONCAVE (1 %) of
+    the union's; else the groups -- the two whose hull adds least over their union merged, while that
+    is under CONCAVE."""
     groups = [[k] for k, sec in enumerate(sections) if sec is not None]
     if len(groups) < 2:
-        return None
+        return ()
     outline = {k: _outline(sections[k]) for k, in groups}       # type: ignore[arg-type]
     everything = [outline[k] for k, in groups]
     if _area(_hull(np.concatenate(everything))) <= (1.0 + CONCAVE) * _union_area(everything):
-        return None
+        return ()
+    excesses: dict[tuple[int, ...], float] = {}       # by the pair's shapes, kept from round to round
     while len(groups) > 1:
         best = None
         for gi in range(len(groups)):
             for gj in range(gi + 1, len(groups)):
-                polys = [outline[k] for k in groups[gi] + groups[gj]]
-                excess = _area(_hull(np.concatenate(polys))) / _union_area(polys) - 1.0
+                key = tuple(groups[gi] + groups[gj])
+                excess = excesses.get(key)
+                if excess is None:
+                    polys = [outline[k] for k in key]
+                    excess = excesses[key] = _area(_hull(np.concatenate(polys))) / _union_area(polys) - 1.0
                 if excess <= CONCAVE and (best is None or excess < best[0]):
                     best = (excess, gi, gj)
         if best is None:
             break
         _, gi, gj = best
         groups[gi] = groups[gi] + groups.pop(gj)
-    if len(groups) < 2:
+    return tuple(tuple(g) for g in groups) if len(groups) > 1 else ()
+
+
+def _pieces(groups: tuple[tuple[int, ...], ...], sections: list[tuple[np.ndarray, float] | None],
+            bands: list[Footprint]) -> tuple[Footprint, ...] | None:
+    """Each group of shapes one convex piece (:func:`_body_section`) with its own height band; None
+    for no groups (the hull)."""
+    if not groups:
         return None
     out = []
     for g in groups:
@@ -757,11 +788,12 @@ def heading(pose: Pose) -> float:
 
 
 def drive_footprint(parts: list[tuple[geo.Primitive, Pose]], pose: Pose, to_enu: np.ndarray | None,
-                    yaw: float | None = None) -> Footprint | None:
+                    yaw: float | None = None,
+                    grouping: tuple[tuple[int, ...], ...] | None = None) -> Footprint | None:
     """A robot's footprint (:func:`robot_footprint` of :func:`enu_body`) about the heading its drive
     keeps, ``yaw`` at ``pose`` (None: :func:`heading` of the pose, whose turn enu_body takes out):
     a drive whose forward axis is not the robot's x axis has its heading off that one."""
-    foot = robot_footprint(enu_body(parts, pose, to_enu))
+    foot = robot_footprint(enu_body(parts, pose, to_enu), grouping)
     if foot is None or yaw is None or foot.points is None:
         return foot
     off = heading(enu_pose(pose, to_enu)) - yaw
@@ -770,7 +802,7 @@ def drive_footprint(parts: list[tuple[geo.Primitive, Pose]], pose: Pose, to_enu:
     pieces = None if foot.pieces is None else tuple(
         Footprint(pc.radius, pc.z_low, pc.z_high, _turned(pc.points, off), pc.round) for pc in foot.pieces
         if pc.points is not None)
-    return Footprint(foot.radius, foot.z_low, foot.z_high, _turned(foot.points, off), foot.round, pieces)
+    return Footprint(foot.radius, foot.z_low, foot.z_high, _turned(foot.points, off), foot.round, pieces, foot.groups)
 
 
 def shaped_obstacle(j: int, foot: Footprint, centre: np.ndarray, yaw: float, band: tuple[float, float]) -> Obstacle:
@@ -1450,11 +1482,13 @@ class Contact:
     def reshape(self, index: int, parts: list[tuple[geo.Primitive, Pose]]) -> None:
         """Robot ``index``'s bounding shapes moved on its joints: its footprint is made again from
         ``parts`` (as the constructor's ``robots`` give them, robot frame), at its world-file pose and
-        heading as the first was (:func:`drive_footprint`), and its broad-phase disc, spin reach and
-        height band with it. Called only for a robot one of whose joints carrying bounding shapes
+        heading as the first was (:func:`drive_footprint`), its shapes grouped into pieces as they were
+        at load (:attr:`Footprint.groups`: no areas measured again each step a joint moves), and its
+        broad-phase disc, spin reach and height band with it. Called only for a robot one of whose joints carrying bounding shapes
         moved (sim/simulation.py ``RobotState.move_links``)."""
         pose, yaw = self.initial[index]
-        foot = self.feet[index] = drive_footprint(parts, pose, self._to_enu, yaw)
+        old = self.feet[index]
+        foot = self.feet[index] = drive_footprint(parts, pose, self._to_enu, yaw, None if old is None else old.groups)
         nan = math.nan
         self._radius[index] = foot.radius if foot else nan
         self._spin[index] = spin_reach([foot])[0]
