@@ -180,6 +180,7 @@ def test_the_batched_engine_moves_pieces_robots_as_the_single_simulation_bit_for
     if not native:
         bs._drive_step = None
     bs.reset(np.arange(n), [1] * n)
+    assert [f.pieces is not None for f in bs.feet] == [True, True, False]        # two concave, one box
     singles = [Simulation(_notch_world()) for _ in range(n)]
     rng = np.random.default_rng(11)
     for step in range(300):

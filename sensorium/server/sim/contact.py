@@ -10,7 +10,10 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   part's disc dropped and a part rounder than the rest its circumscribed 16-gon
   (:func:`robot_footprint`). A robot that is one centred upright cylinder is the disc it always
   was, on the old path, bit for bit. The disc about the origin holding the piece at every heading
-  (``Footprint.radius``) is the broad phase's;
+  (``Footprint.radius``) is the broad phase's. A concave body -- its hull's area more than CONCAVE
+  (1 %) over its shapes' union -- is its convex pieces (``Footprint.pieces``: the shapes grouped at
+  load while a group's hull adds under 1 %), each in its own band, any of them stopping it
+  (:meth:`Contact._clip_pieces`; its turn pushed as its hull's push, :meth:`Contact._push_pieces`);
 * an obstacle is a convex 2D set ``hull(points) ⊕ disc(radius)``: an upright box is its 4
   corners, an upright cylinder or capsule a point with its radius, a sphere a point with the
   radius of its widest section inside the band, anything else the convex hull of its projected
