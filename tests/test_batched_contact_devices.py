@@ -234,7 +234,7 @@ def _touch_everything(bs: BatchedSimulation, c: int, col: int) -> float:
     k = bs.kinematic
     r = int(k.slot["TouchSensor"][col])
     pieces, _, _ = k._bumper_shapes(col)
-    robots = [k._robot_obstacle(c, j) for j, f in enumerate(bs.feet) if f is not None and j != r]
+    robots = [ob for j, f in enumerate(bs.feet) if f is not None and j != r for ob in k._robot_obstacles(c, j)]
     return 1.0 if pieces_touch(pieces, bs.centres[c, r], float(bs.foot_yaw[c, r]), float(bs.heights[c, r]),
                                bs.contact._obs, robots) else 0.0
 

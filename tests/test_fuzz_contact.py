@@ -148,6 +148,15 @@ def _robot_shape(sim, i):
     return C._turned(foot.points, float(c.yaw[i])) + c.centres[i][None, :], foot.round
 
 
+def _robot_pieces(sim, i):
+    """Robot i's outline where it is: its convex pieces (a concave body's, contact.CONCAVE), else its shape."""
+    c = sim.contact
+    foot = c.feet[i]
+    if foot is None or foot.pieces is None:
+        return None if foot is None else [_robot_shape(sim, i)]
+    return [(C._turned(pc.points, float(c.yaw[i])) + c.centres[i][None, :], pc.round) for pc in foot.pieces]
+
+
 def check(sim, names, offset, nue) -> None:
     c = sim.contact
     for i, name in enumerate(names):
@@ -155,7 +164,7 @@ def check(sim, names, offset, nue) -> None:
         assert np.isfinite(t).all() and np.isfinite(sim.robot(name).pose.rotation).all()
         enu = np.array([t[2], t[0]]) if nue else t[:2]
         assert np.allclose(enu, c.centres[i], rtol=0, atol=1e-9 * max(1.0, abs(offset[0]))), (name, enu, c.centres[i])
-    shapes = [_robot_shape(sim, i) for i in range(len(names))]
+    shapes = [_robot_pieces(sim, i) for i in range(len(names))]
     # the height bands that meet (README: a solid whose top is at most 1 mm above a band's bottom is
     # its floor; robots' bands meet beyond the 1e-9 m tolerance)
     band = [(c.heights[i] + f.z_low, c.heights[i] + f.z_high) if (f := c.feet[i]) else None for i in range(len(names))]
@@ -166,10 +175,13 @@ def check(sim, names, offset, nue) -> None:
         for ob in c._obs:
             if ob.normal is not None or not (ob.z_range[1] > lo + C.FLOOR and ob.z_range[0] < hi - C.EPS):
                 continue
-            assert _overlap(me[0], me[1], ob.points, ob.radius) <= 1e-9, (names[i], ob.name)
+            for pts, rnd in me:
+                assert _overlap(pts, rnd, ob.points, ob.radius) <= 1e-9, (names[i], ob.name)
         for j in range(i + 1, len(shapes)):
             if shapes[j] is not None and band[j][1] > lo + C.EPS and band[j][0] < hi - C.EPS:
-                assert _overlap(me[0], me[1], shapes[j][0], shapes[j][1]) <= 1e-9, (names[i], names[j])
+                for pts, rnd in me:
+                    for other, orr in shapes[j]:
+                        assert _overlap(pts, rnd, other, orr) <= 1e-9, (names[i], names[j])
 
 
 def drive(sim, name, left, right):
@@ -294,7 +306,9 @@ def test_a_sliver_robot_far_from_the_origin_curving_into_a_box_stays_out() -> No
     in radius 0.0625 m to its left, 1e5 m from the origin, curving into a box. The box grown by its
     footprint (their Minkowski sum) lost a vertex whose edge was 2e-7 m long -- within 1e-12 of
     the coordinates (2e-7 m there) of the previous one -- tilting the long edge next to it: the
-    footprint's rounded end went 2.1e-8 m into the box's face y = 0.75. It now stops touching it."""
+    footprint's rounded end went 2.1e-8 m into the box's face y = 0.75. It now stops touching it.
+    Its two spheres 0.0625 m apart are now its pieces (contact.CONCAVE), each its exact disc: the
+    sphere's disc stops touching the face."""
     me = ({"type": "sphere", "radius": 5e-13},
           [{"geometry": {"type": "sphere", "radius": 5e-07},
             "pose": {"translation": [0.0, 0.0625, 0.0], "rotation": [0.0, 0.0, 1.0, 0.0]}}])
@@ -308,11 +322,12 @@ def test_a_sliver_robot_far_from_the_origin_curving_into_a_box_stays_out() -> No
         if sim.robot("r0").pressing:
             break
     assert sim.robot("r0").pressing
-    pts, rnd = _robot_shape(sim, 0)
+    pieces = _robot_pieces(sim, 0)
+    assert len(pieces) == 2
     box = sim.contact._obs[0].points
     # touching the box's bottom face (y = 0.75 - 1e5), from below: no deeper than the 1e-9 tolerance
-    assert float(pts[:, 1].max()) + rnd - (0.75 - 1e5) == pytest.approx(0.0, abs=1e-9)
-    assert _overlap(pts, rnd, box, 0.0) <= 1e-9
+    assert max(float(pts[:, 1].max()) + rnd for pts, rnd in pieces) - (0.75 - 1e5) == pytest.approx(0.0, abs=1e-9)
+    assert max(_overlap(pts, rnd, box, 0.0) for pts, rnd in pieces) <= 1e-9
 
 
 STUCK_TURNS: list[int] = []

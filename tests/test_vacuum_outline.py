@@ -63,8 +63,10 @@ def test_without_a_load_it_drives_to_its_own_pad() -> None:
 
 
 def test_a_load_held_above_the_wall_does_not_stop_it() -> None:
-    """The wall 0.09 m tall, the parcel held from z 0.10: the carrier drives to its own pad (z 0.12 to
-    0.18, part of its own outline, which the robot's one band holds), as with nothing held, bit for bit."""
+    """The wall 0.09 m tall, the parcel held from z 0.10: the carrier drives until its body (z 0.03 to
+    0.11, its front face at x = 0.1) meets the wall, as with nothing held, bit for bit: its pad (z 0.12 to
+    0.18) sticks out of the body's square, so the robot's footprint is its pieces (a concave robot's),
+    each with its own band, and the pad passes over the wall as the parcel held above it does."""
     loaded = _sim([_wall(0.09), HIGH_PARCEL], [_high_carrier()])
     loaded.step()
     assert loaded.device("carrier/cup").held == "parcel"                # type: ignore[attr-defined]
@@ -74,7 +76,7 @@ def test_a_load_held_above_the_wall_does_not_stop_it() -> None:
         _drive(sim, "carrier", W)
         _run(sim, 300)
     assert _x(loaded) == _x(bare)
-    assert _x(loaded) == pytest.approx(0.6 - 0.12, abs=1e-9)           # past where the parcel's face is over the wall
+    assert _x(loaded) == pytest.approx(0.6 - 0.1, abs=1e-9)            # the pad and the parcel over the wall
     assert bare.scene.solid_poses.get("parcel") is None
     assert loaded.scene.solid_poses["parcel"].translation[0] + 0.05 > 0.6 + 0.09
 

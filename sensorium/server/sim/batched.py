@@ -86,7 +86,7 @@ from sensorium.server.sim.contact import (
     drive_footprint,
     enu_pose,
     heading,
-    shaped_obstacle,
+    robot_obstacles,
     spin_reach,
 )
 from sensorium.server.sim.ground import (
@@ -1173,18 +1173,31 @@ class BatchedSimulation:
             lo = float(self.heights[cm, r] + self.foot_low[r])
             hi = float(self.heights[cm, r] + self.foot_high[r])
             # candidates as resolve_all lists them: solids, then robots, in index order
-            cands = ([ct._in_band(ct._obs[j], lo, hi) for j in solid_hit[m].nonzero()[0].tolist()]
-                     if solid_hit is not None else [])
+            near_solids = solid_hit[m].nonzero()[0].tolist() if solid_hit is not None else []
+            robot_obs: list[Obstacle] = []
             if robot_hit is not None:
                 for j in robot_hit[m].nonzero()[0].tolist():
                     at = waiting.get((cm, j))
                     centre = self.centres[cm, j] if at is None else at
                     band = (float(self.heights[cm, j] + self.foot_low[j]), float(self.heights[cm, j] + self.foot_high[j]))
-                    if self._shaped[j]:    # (a waiting robot's foot_yaw is still its start's)
-                        cands.append(shaped_obstacle(j, self.feet[j], centre, float(self.foot_yaw[cm, j]), band))
-                    else:
-                        cands.append(Obstacle(f"robot {j}", int(j), centre[None, :].copy(), float(self.foot_disc[j]),
-                                              band))
+                    # (a waiting robot's foot_yaw is still its start's)
+                    robot_obs += robot_obstacles(j, self.feet[j], centre, float(self.foot_yaw[cm, j]), band)
+            foot = self.feet[r]
+            if foot.pieces is not None:           # a concave body: its pieces (Contact.resolve_all's path)
+                p, clipped, heading_ = ct._clip_pieces(list(foot.pieces), float(self.heights[cm, r]), starts[m].copy(),
+                                                       ends[m] - starts[m], float(yaw0[m]), float(self.yaw[cm, r]),
+                                                       near_solids, robot_obs, foot)
+                if heading_ != self.yaw[cm, r]:      # the turn cut short
+                    self.yaw[cm, r] = heading_
+                    kept.append(m)
+                self.centres[cm, r] = p
+                self.foot_yaw[cm, r] = self.yaw[cm, r]
+                if clipped:
+                    self.pressing[cm, r] = True
+                    self.counters["contacts"] += 1
+                    out[m] = p
+                continue
+            cands = [ct._in_band(ct._obs[j], lo, hi) for j in near_solids] + robot_obs
             if self._shaped[r]:
                 p, clipped, heading_ = ct._clip_shaped(self.feet[r], starts[m].copy(), ends[m] - starts[m],
                                                        float(yaw0[m]), float(self.yaw[cm, r]), cands)

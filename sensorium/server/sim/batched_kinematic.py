@@ -56,7 +56,7 @@ from sensorium.server.devices import motion_sensors as motion_math
 from sensorium.server.devices import orientation as orient
 from sensorium.server.devices.lookup import RESOLUTION_OFF
 from sensorium.server.raycast import packets
-from sensorium.server.sim.contact import EPS, FLOOR, TOUCH, Obstacle, device_pieces, pieces_touch, shaped_obstacle
+from sensorium.server.sim.contact import EPS, FLOOR, TOUCH, Obstacle, device_pieces, pieces_touch, robot_obstacles
 from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.sim.sensors import (
     GPS,
@@ -782,20 +782,18 @@ class KinematicDevices:
             cc = int(copies[m])
             for q, piece in enumerate(pieces):
                 obs = [solids[k] for k in near_solid[m, q].nonzero()[0].tolist()]
-                robots = [self._robot_obstacle(cc, others[k]) for k in near_robot[m, q].nonzero()[0].tolist()]
+                robots = [ob for k in near_robot[m, q].nonzero()[0].tolist() for ob in self._robot_obstacles(cc, others[k])]
                 if (obs or robots) and pieces_touch([piece], sim.centres[cc, r], float(sim.foot_yaw[cc, r]),
                                                     float(sim.heights[cc, r]), obs, robots):
                     out[m] = 1.0
                     break
         return out
 
-    def _robot_obstacle(self, c: int, j: int) -> Obstacle:
-        """Robot ``j`` of copy ``c`` where it is now, as an obstacle (Contact._robot_obstacle)."""
+    def _robot_obstacles(self, c: int, j: int) -> list[Obstacle]:
+        """Robot ``j`` of copy ``c`` where it is now, as obstacles (Contact._robot_obstacles)."""
         sim = self.sim
         band = (float(sim.heights[c, j] + sim.foot_low[j]), float(sim.heights[c, j] + sim.foot_high[j]))
-        if sim._shaped[j]:
-            return shaped_obstacle(j, sim.feet[j], sim.centres[c, j], float(sim.foot_yaw[c, j]), band)
-        return Obstacle(f"robot {j}", j, sim.centres[c, j][None, :].copy(), float(sim.foot_disc[j]), band)
+        return robot_obstacles(j, sim.feet[j], sim.centres[c, j], float(sim.foot_yaw[c, j]), band)
 
     def _altimeter(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Altimeter.measure: the device's height (+ the reference altitude), its Gaussian

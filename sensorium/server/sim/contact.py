@@ -10,7 +10,10 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   part's disc dropped and a part rounder than the rest its circumscribed 16-gon
   (:func:`robot_footprint`). A robot that is one centred upright cylinder is the disc it always
   was, on the old path, bit for bit. The disc about the origin holding the piece at every heading
-  (``Footprint.radius``) is the broad phase's;
+  (``Footprint.radius``) is the broad phase's. A concave body -- its hull's area more than CONCAVE
+  (1 %) over its shapes' union -- is its convex pieces (``Footprint.pieces``: the shapes grouped at
+  load while a group's hull adds under 1 %), each in its own band, any of them stopping it
+  (:meth:`Contact._clip_pieces`; its turn pushed as its hull's push, :meth:`Contact._push_pieces`);
 * an obstacle is a convex 2D set ``hull(points) ⊕ disc(radius)``: an upright box is its 4
   corners, an upright cylinder or capsule a point with its radius, a sphere a point with the
   radius of its widest section inside the band, anything else the convex hull of its projected
@@ -185,6 +188,12 @@ class Footprint:
     z_high: float
     points: np.ndarray | None = None
     round: float = 0.0
+    # a concave body (:func:`robot_footprint`'s rule): its convex pieces, each a Footprint in the same
+    # frame with its own band; the hull above stays the broad phase's. None: the hull is the footprint
+    pieces: tuple[Footprint, ...] | None = None
+    # which shapes (their indices among those with a footprint) make each piece, as decided when the
+    # robot loaded: a joint moving its shapes keeps the grouping (:meth:`Contact.reshape`). () the hull
+    groups: tuple[tuple[int, ...], ...] = ()
 
     @property
     def disc(self) -> bool:
@@ -263,12 +272,17 @@ def _z_extent(prim: geo.Primitive, rotation: np.ndarray) -> tuple[float, float]:
     return -e, e
 
 
-def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None:
+def robot_footprint(parts: list[tuple[geo.Primitive, Pose]],
+                    grouping: tuple[tuple[int, ...], ...] | None = None) -> Footprint | None:
     """A robot's footprint from its body shapes, each at its pose in the robot frame: the convex
     piece holding their outlines (:func:`_section`, :func:`_body_section`), the height band, and
     the disc about the origin holding the piece at any heading (the old footprint's radius, which
-    it always was, or wider where a tilted round part's circumscribed polygon reaches past it)."""
+    it always was, or wider where a tilted round part's circumscribed polygon reaches past it).
+    ``grouping``: the shapes' pieces as an earlier footprint of the same shapes grouped them
+    (:attr:`Footprint.groups`); None: decided here (:func:`_concave_groups`)."""
     feet = []
+    bands: list[Footprint] = []             # per shape with a footprint: its band (and its section below)
+    sections: list[tuple[np.ndarray, float] | None] = []
     for prim, local in parts:
         f = footprint(prim)
         if f is None:
@@ -282,14 +296,135 @@ def robot_footprint(parts: list[tuple[geo.Primitive, Pose]]) -> Footprint | None
             lo, hi = _z_extent(prim, np.asarray(local.rotation, dtype=np.float64))
             f = Footprint(r, max(lo, -r), min(hi, r))
         feet.append(Footprint(math.hypot(x, y) + f.radius, z + f.z_low, z + f.z_high))
+        bands.append(feet[-1])
+        sections.append(_section(prim, local))
     if not feet:
         return None
     radius = max(f.radius for f in feet)
-    points, rnd = _body_section([sec for prim, local in parts if (sec := _section(prim, local)) is not None])
+    points, rnd = _body_section([sec for sec in sections if sec is not None])
     # the disc about the origin (the broad phase's) must hold the shape at every heading: the old
     # radius does, but for a tilted round part's circumscribed polygon, which may reach past it
     reach = float(np.max(np.hypot(points[:, 0], points[:, 1]))) + rnd
-    return Footprint(max(radius, reach), min(f.z_low for f in feet), max(f.z_high for f in feet), points, rnd)
+    groups = _concave_groups(sections) if grouping is None else grouping
+    return Footprint(max(radius, reach), min(f.z_low for f in feet), max(f.z_high for f in feet), points, rnd,
+                     _pieces(groups, sections, bands), groups)
+
+
+CONCAVE = 0.01        # a body whose hull's area exceeds its shapes' union's by more than this: its pieces
+
+
+def _outline(sec: tuple[np.ndarray, float]) -> np.ndarray:
+    """A section ``hull(points) ⊕ disc(r)`` as a convex polygon for the area rule (a round part its
+    points ⊕ the circumscribed ROUND_SIDES-gon, as merged round parts are taken)."""
+    pts, r = sec
+    return _hull(pts if r == 0.0 else (pts[:, None, :] + _polygon(r)[None]).reshape(-1, 2))
+
+
+def _area(poly: np.ndarray) -> float:
+    if len(poly) < 3:
+        return 0.0
+    x, y = poly[:, 0], poly[:, 1]
+    return 0.5 * float(np.sum(x * np.roll(y, -1) - np.roll(x, -1) * y))
+
+
+def _union_area(polys: list[np.ndarray]) -> float:
+    """The area of the union of convex counter-clockwise polygons (Green's theorem over the parts of
+    each edge no other polygon covers; an edge lying on an earlier polygon's edge of the same
+    direction counts once, opposite edges cancel). Plain floats: a moving joint's body makes it again."""
+    vs = [p.tolist() for p in polys]
+    boxes = [(min(x for x, _ in v), min(y for _, y in v), max(x for x, _ in v), max(y for _, y in v)) if v else None
+             for v in vs]
+    total = 0.0
+    for i, poly in enumerate(vs):
+        if len(poly) < 3:
+            continue
+        others = [j for j, v in enumerate(vs) if j != i and len(v) >= 3]
+        for k in range(len(poly)):
+            ax, ay = poly[k]
+            bx, by = poly[(k + 1) % len(poly)]
+            dx, dy = bx - ax, by - ay
+            dn = math.hypot(dx, dy)
+            covered = []
+            for j in others:
+                x0, y0, x1, y1 = boxes[j]            # type: ignore[misc]
+                if max(ax, bx) < x0 or min(ax, bx) > x1 or max(ay, by) < y0 or min(ay, by) > y1:
+                    continue
+                lo, hi = 0.0, 1.0
+                other = vs[j]
+                for m in range(len(other)):
+                    vx, vy = other[m]
+                    wx, wy = other[(m + 1) % len(other)]
+                    ex, ey = wx - vx, wy - vy
+                    en = math.hypot(ex, ey)
+                    f0 = ex * (ay - vy) - ey * (ax - vx)      # > 0: a left of (inside) edge e
+                    df = ex * dy - ey * dx
+                    if abs(df) <= 1e-12 * en * dn:
+                        tol = 1e-12 * en * (dn + math.hypot(ax - vx, ay - vy))
+                        if f0 > tol or (abs(f0) <= tol and j < i and ex * dx + ey * dy > 0.0):
+                            continue
+                        lo, hi = 1.0, 0.0
+                        break
+                    t = -f0 / df
+                    if df > 0.0:
+                        lo = max(lo, t)
+                    else:
+                        hi = min(hi, t)
+                    if lo >= hi:
+                        break
+                if lo < hi:
+                    covered.append((lo, hi))
+            t0 = 0.0
+            for lo, hi in sorted(covered) + [(1.0, 1.0)]:
+                if lo > t0:
+                    px, py, qx, qy = ax + t0 * dx, ay + t0 * dy, ax + lo * dx, ay + lo * dy
+                    total += 0.5 * (px * qy - qx * py)
+                t0 = max(t0, hi)
+    return total
+
+
+def _concave_groups(sections: list[tuple[np.ndarray, float] | None]) -> tuple[tuple[int, ...], ...]:
+    """A body's shapes grouped into convex pieces where the hull of their outlines closes a notch:
+    () (the hull is the footprint, as it always was) when the hull's area is within CONCAVE (1 %) of
+    the union's; else the groups -- the two whose hull adds least over their union merged, while that
+    is under CONCAVE."""
+    groups = [[k] for k, sec in enumerate(sections) if sec is not None]
+    if len(groups) < 2:
+        return ()
+    outline = {k: _outline(sections[k]) for k, in groups}       # type: ignore[arg-type]
+    everything = [outline[k] for k, in groups]
+    if _area(_hull(np.concatenate(everything))) <= (1.0 + CONCAVE) * _union_area(everything):
+        return ()
+    excesses: dict[tuple[int, ...], float] = {}       # by the pair's shapes, kept from round to round
+    while len(groups) > 1:
+        best = None
+        for gi in range(len(groups)):
+            for gj in range(gi + 1, len(groups)):
+                key = tuple(groups[gi] + groups[gj])
+                excess = excesses.get(key)
+                if excess is None:
+                    polys = [outline[k] for k in key]
+                    excess = excesses[key] = _area(_hull(np.concatenate(polys))) / _union_area(polys) - 1.0
+                if excess <= CONCAVE and (best is None or excess < best[0]):
+                    best = (excess, gi, gj)
+        if best is None:
+            break
+        _, gi, gj = best
+        groups[gi] = groups[gi] + groups.pop(gj)
+    return tuple(tuple(g) for g in groups) if len(groups) > 1 else ()
+
+
+def _pieces(groups: tuple[tuple[int, ...], ...], sections: list[tuple[np.ndarray, float] | None],
+            bands: list[Footprint]) -> tuple[Footprint, ...] | None:
+    """Each group of shapes one convex piece (:func:`_body_section`) with its own height band; None
+    for no groups (the hull)."""
+    if not groups:
+        return None
+    out = []
+    for g in groups:
+        pts, rnd = _body_section([sections[k] for k in g])     # type: ignore[misc]
+        out.append(Footprint(float(np.max(np.hypot(pts[:, 0], pts[:, 1]))) + rnd,
+                             min(bands[k].z_low for k in g), max(bands[k].z_high for k in g), pts, rnd))
+    return tuple(out)
 
 
 ROUND_SIDES = 16      # a round part merged with others: its circumscribed 16-gon (1.9 % wider)
@@ -656,23 +791,38 @@ def heading(pose: Pose) -> float:
 
 
 def drive_footprint(parts: list[tuple[geo.Primitive, Pose]], pose: Pose, to_enu: np.ndarray | None,
-                    yaw: float | None = None) -> Footprint | None:
+                    yaw: float | None = None,
+                    grouping: tuple[tuple[int, ...], ...] | None = None) -> Footprint | None:
     """A robot's footprint (:func:`robot_footprint` of :func:`enu_body`) about the heading its drive
     keeps, ``yaw`` at ``pose`` (None: :func:`heading` of the pose, whose turn enu_body takes out):
     a drive whose forward axis is not the robot's x axis has its heading off that one."""
-    foot = robot_footprint(enu_body(parts, pose, to_enu))
+    foot = robot_footprint(enu_body(parts, pose, to_enu), grouping)
     if foot is None or yaw is None or foot.points is None:
         return foot
     off = heading(enu_pose(pose, to_enu)) - yaw
     if off == 0.0:
         return foot
-    return Footprint(foot.radius, foot.z_low, foot.z_high, _turned(foot.points, off), foot.round)
+    pieces = None if foot.pieces is None else tuple(
+        Footprint(pc.radius, pc.z_low, pc.z_high, _turned(pc.points, off), pc.round) for pc in foot.pieces
+        if pc.points is not None)
+    return Footprint(foot.radius, foot.z_low, foot.z_high, _turned(foot.points, off), foot.round, pieces, foot.groups)
 
 
 def shaped_obstacle(j: int, foot: Footprint, centre: np.ndarray, yaw: float, band: tuple[float, float]) -> Obstacle:
     """Robot ``j``'s shaped footprint at ``centre``, heading ``yaw``, as an obstacle."""
     assert foot.points is not None
     return Obstacle(f"robot {j}", int(j), _turned(foot.points, yaw) + centre[None, :], foot.round, band)
+
+
+def robot_obstacles(j: int, foot: Footprint, centre: np.ndarray, yaw: float,
+                    band: tuple[float, float]) -> list[Obstacle]:
+    """Robot ``j``'s footprint at ``centre``, heading ``yaw``, as the obstacles others meet: its disc,
+    its shape (:func:`shaped_obstacle`), or one per piece of a concave body, each over the robot's band."""
+    if foot.disc:
+        return [Obstacle(f"robot {j}", int(j), centre[None, :].copy(), foot.disc_radius, band)]
+    if foot.pieces is None:
+        return [shaped_obstacle(j, foot, centre, yaw, band)]
+    return [shaped_obstacle(j, pc, centre, yaw, band) for pc in foot.pieces]
 
 
 def spin_reach(feet: list[Footprint | None]) -> np.ndarray:
@@ -1335,11 +1485,13 @@ class Contact:
     def reshape(self, index: int, parts: list[tuple[geo.Primitive, Pose]]) -> None:
         """Robot ``index``'s bounding shapes moved on its joints: its footprint is made again from
         ``parts`` (as the constructor's ``robots`` give them, robot frame), at its world-file pose and
-        heading as the first was (:func:`drive_footprint`), and its broad-phase disc, spin reach and
-        height band with it. Called only for a robot one of whose joints carrying bounding shapes
+        heading as the first was (:func:`drive_footprint`), its shapes grouped into pieces as they were
+        at load (:attr:`Footprint.groups`: no areas measured again each step a joint moves), and its
+        broad-phase disc, spin reach and height band with it. Called only for a robot one of whose joints carrying bounding shapes
         moved (sim/simulation.py ``RobotState.move_links``)."""
         pose, yaw = self.initial[index]
-        foot = self.feet[index] = drive_footprint(parts, pose, self._to_enu, yaw)
+        old = self.feet[index]
+        foot = self.feet[index] = drive_footprint(parts, pose, self._to_enu, yaw, None if old is None else old.groups)
         nan = math.nan
         self._radius[index] = foot.radius if foot else nan
         self._spin[index] = spin_reach([foot])[0]
@@ -1455,8 +1607,8 @@ class Contact:
                 self.yaw[i] = yaw1
                 out[m] = (ends[m].copy(), False, yaw1)
                 continue
-            if m in loaded:
-                p, clipped, kept = self._clip_carrying(i, foot, loaded[m], starts[m].copy(), ends[m] - starts[m],
+            if m in loaded or foot.pieces is not None:
+                p, clipped, kept = self._clip_carrying(i, foot, loaded.get(m, []), starts[m].copy(), ends[m] - starts[m],
                                                        yaw0, yaw1, near_solids[m], near_robots[m])
                 self.centres[i] = p
                 self.yaw[i] = kept
@@ -1466,7 +1618,7 @@ class Contact:
                                      for j in near_solids[m]]
             if near_robots[m]:
                 for j in near_robots[m]:
-                    cands.append(self._robot_obstacle(j))
+                    cands += self._robot_obstacles(j)
             if foot.disc:                    # a disc turns freely
                 p, clipped = self._clip(starts[m].copy(), ends[m] - starts[m], foot.disc_radius, cands)
                 kept = yaw1
@@ -1486,21 +1638,18 @@ class Contact:
     def touching(self, index: int, pieces: list[Footprint]) -> bool:
         """Whether robot ``index``'s ``pieces`` touch a solid or another robot where they all are now
         (:func:`pieces_touch`)."""
-        robots = [self._robot_obstacle(j) for j, f in enumerate(self.feet) if f is not None and j != index]
+        robots = [ob for j, f in enumerate(self.feet) if f is not None and j != index for ob in self._robot_obstacles(j)]
         held = self.carried.get(index)      # what it carries is part of it: never touched
         solids = [ob for ob in self._obs if ob.name not in held] if held else self._obs
         return pieces_touch(pieces, self.centres[index], float(self.yaw[index]), float(self.heights[index]),
                             solids, robots)
 
-    def _robot_obstacle(self, j: int) -> Obstacle:
-        """Robot ``j``'s footprint where it is now, as an obstacle."""
+    def _robot_obstacles(self, j: int) -> list[Obstacle]:
+        """Robot ``j``'s footprint where it is now, as obstacles (:func:`robot_obstacles`)."""
         foot = self.feet[j]
         assert foot is not None
         band = (float(self.heights[j] + self._z_low[j]), float(self.heights[j] + self._z_high[j]))
-        if foot.disc:
-            return Obstacle(f"robot {j}", int(j), self.centres[j][None, :].copy(), foot.disc_radius, band)
-        assert foot.points is not None
-        return shaped_obstacle(j, foot, self.centres[j], float(self.yaw[j]), band)
+        return robot_obstacles(j, foot, self.centres[j], float(self.yaw[j]), band)
 
     @staticmethod
     def _in_band(ob: Obstacle, low: float, high: float) -> Obstacle:
@@ -1535,12 +1684,23 @@ class Contact:
         it, never pushed), then the move at the heading kept, stopped by the first contact of any
         piece and slid on (:meth:`_sweep` over every piece's grown candidates). ``solids``,
         ``robots``: the broad phase's candidates over all the pieces' reach and bands."""
-        h = float(self.heights[i])
         own = foot if not foot.disc else Footprint(foot.radius, foot.z_low, foot.z_high, np.zeros((1, 2)),
                                                    foot.disc_radius)
-        robot_obs = [self._robot_obstacle(j) for j in robots]
+        robot_obs = [ob for j in robots for ob in self._robot_obstacles(j)]
+        return self._clip_pieces([*(own.pieces or (own,)), *loads], float(self.heights[i]), p, d, yaw, yaw1,
+                                 solids, robot_obs, None if loads else own)
+
+    def _clip_pieces(self, set_: list[Footprint], h: float, p: np.ndarray, d: np.ndarray, yaw: float, yaw1: float,
+                     solids: list[int], robot_obs: list[Obstacle],
+                     hull: Footprint | None = None) -> tuple[np.ndarray, bool, float]:
+        """The narrow phase of a robot whose outline is the convex pieces ``set_`` (a concave body's,
+        :attr:`Footprint.pieces`, and what it carries), at height ``h``: :meth:`_clip_carrying`'s rule,
+        every piece against the solids ``solids`` (indices) and the robots' obstacles ``robot_obs`` in
+        its own height band. ``hull``: a concave body's own footprint (its pieces' hull, nothing
+        carried): a turn the pieces cannot make in place pushes the robot off as its hull would be
+        pushed (:meth:`_push_pieces`) before it is cut short."""
         pieces: list[tuple[Footprint, list[Obstacle]]] = []
-        for piece in [own, *loads]:
+        for piece in set_:
             lo, hi = h + piece.z_low, h + piece.z_high
             cands = [self._in_band(self._obs[j], lo, hi) for j in solids
                      if self._zhi[j] > lo + FLOOR and self._zlo[j] < hi - EPS]
@@ -1563,6 +1723,18 @@ class Contact:
             def clear(part: float) -> bool:
                 return all(self._turn_clear(pc, p, yaw, turn * part, near, now) for pc, near, now in tests)
 
+            if tests and not clear(1.0) and hull is not None:
+                pushed = self._push_pieces(hull, pieces, solids, robot_obs, h, p, yaw, yaw1, turn)
+                if pushed is not None:
+                    grown = []
+                    for piece, cands in pieces:
+                        assert piece.points is not None
+                        shape = _turned(piece.points, yaw1)
+                        grown += [_grown(ob, shape, piece.round, pushed) for ob in _in_reach(cands, pushed, d, piece.radius)]
+                    end, clipped = self._sweep(pushed, d, grown)
+                    if not clipped:
+                        self.contacts += 1
+                    return end, True, yaw1
             if tests and not clear(1.0):
                 lo_, hi_ = 0.0, 1.0
                 least = 0.5 ** TURN_HALVINGS
@@ -1586,6 +1758,34 @@ class Contact:
         if kept != yaw1 and not clipped:
             self.contacts += 1
         return end, clipped or kept != yaw1, kept
+
+    def _push_pieces(self, hull: Footprint, pieces: list[tuple[Footprint, list[Obstacle]]], solids: list[int],
+                     robot_obs: list[Obstacle], h: float, p: np.ndarray, yaw: float, yaw1: float,
+                     turn: float) -> np.ndarray | None:
+        """Where a concave body whose pieces' turn in place would go into something is pushed, or None:
+        :meth:`_push` of its hull (the pieces lie in it, so the hull turned and pushed clear of a
+        candidate leaves every piece clear of it) among the candidates in the whole body's band,
+        taken only where every piece at the pushed centre, turned to ``yaw1``, is no deeper in any of
+        its candidates than it was at ``p`` before the turn (an obstacle in a notch, which the hull
+        overlaps already, may not be swept through by a piece)."""
+        assert hull.points is not None
+        lo, hi = h + hull.z_low, h + hull.z_high
+        cands = [self._in_band(self._obs[j], lo, hi) for j in solids] + robot_obs
+        near = _in_reach(cands, p, _STILL, hull.radius * (1.0 + min(abs(turn), 2.0)))
+        if not near:
+            return None
+        here = _turned(hull.points, yaw)
+        q = self._push(hull, p, yaw, yaw1, turn, near, [_gap(p, *_grown(ob, here, hull.round, p)) for ob in near])
+        if q is None:
+            return None
+        for piece, pcands in pieces:
+            assert piece.points is not None
+            before, after = _turned(piece.points, yaw), _turned(piece.points, yaw1)
+            for ob in pcands:
+                self.checks += 1
+                if _gap(q, *_grown(ob, after, piece.round, q)) < min(_gap(p, *_grown(ob, before, piece.round, p)), 0.0) - EPS:
+                    return None
+        return q
 
     def _clip_shaped(self, foot: Footprint, p: np.ndarray, d: np.ndarray, yaw: float, yaw1: float,
                      cands: list[Obstacle]) -> tuple[np.ndarray, bool, float]:
