@@ -1,4 +1,4 @@
-"""The gym's heading is the drive's ``forward`` (sensorium/gym/frame.py ``heading``), not the robot's
+"""The gym's heading is the drive's ``forward`` (sensorium/server/sim/frames.py ``heading``), not the robot's
 own x axis: ``info["pose"]``'s yaw, ``random_start``'s yaw and ``render()``'s heading line, in the
 single and the vector env alike.
 

@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 
 from sensorium.gym import SensoriumEnv, Task
-from sensorium.gym.frame import ENU_AXES, enu_axes
 from sensorium.gym.task import AvoidObstacles, ReachLight, clearance, random_start
 from sensorium.gym.vector import SensoriumVectorEnv
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.frames import ENU_AXES, enu_axes
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, default_world_path, load_world

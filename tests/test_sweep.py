@@ -160,6 +160,37 @@ def test_a_python_file_controller_and_parameters(tmp_path):
     assert res.rows[0]["param:robots[bot].differential_drive.wheel_radius"] == 0.01
 
 
+def test_a_nue_world_row_is_east_north_and_the_heading_of_the_drive(tmp_path):
+    """In a NUE world (x north, y up, z east) a row's x, y are the robot's east and north and its yaw
+    the heading of its drive's forward about up from east (sim/frames.py, as the gym's info["pose"]).
+    The robot is built y-up, its forward its own -z, turned 0.7 about up: driven straight it goes
+    d = r * w * t along (-cos 0.7, -sin 0.7) (east, north) and heads at 0.7 - pi. Before, the row read
+    the world's x and y (north and up) and the own x's angle about the world's z."""
+    turn, d = 0.7, 0.02 * 2.0 * 0.32
+    c, s = math.cos(turn), math.sin(turn)
+    # the rotation about y by `turn` as a quaternion (x y z w)
+    data = {"world_info": {"coordinate_system": "NUE", "basic_time_step": 32},
+            "robots": [{"name": "bot", "pose": {"translation": [0.4, 0.0, -0.3],
+                                                "quaternion": [0.0, math.sin(turn / 2), 0.0, math.cos(turn / 2)]},
+                        "differential_drive": {"wheel_radius": 0.02, "axle_length": 0.1, "max_wheel_speed": 10.0,
+                                               "forward": [0.0, 0.0, -1.0]}}]}
+    world = tmp_path / "nue.yaml"
+    world.write_text(yaml.safe_dump(data))
+    ctrl = tmp_path / "fwd.py"
+    ctrl.write_text("import math\n"
+                    "def make(sim):\n"
+                    "    for m in sim.robot('bot').motors.values():\n"
+                    "        m.set_position(math.inf); m.set_velocity(2.0)\n")
+    res = run_sweep({"worlds": [str(world)], "seeds": [0], "duration_ms": 320, "controllers": [f"{ctrl}:make"],
+                     "record": False}, None, engine="local", workers=1, progress=False)
+    row = res.rows[0]
+    assert row["status"] == "ok", row["error"]
+    assert row["bot.x"] == pytest.approx(-0.3 - d * c, abs=1e-12)          # east: the world's z
+    assert row["bot.y"] == pytest.approx(0.4 - d * s, abs=1e-12)           # north: the world's x
+    assert row["bot.yaw"] == pytest.approx(turn - math.pi, abs=1e-12)
+    assert row["bot.path_m"] == pytest.approx(d, abs=1e-12)
+
+
 # ------------------------------------------------------------------------------ engines
 
 def _messages(path: Path) -> list[tuple]:

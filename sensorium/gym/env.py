@@ -74,12 +74,12 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from sensorium.gym.frame import drive_forward, enu_axes, planar_pose
 from sensorium.gym.render import TopDown, TopDownRendering, check_render_size
 from sensorium.gym.task import Task, whole
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
 from sensorium.server.raycast.kinds import Precision
+from sensorium.server.sim.frames import drive_forward, enu_axes, planar_pose
 from sensorium.server.sim.motion import ackermann_angles
 from sensorium.server.sim.sensors import altitude_offset
 from sensorium.server.sim.simulation import Simulation
@@ -321,7 +321,7 @@ class Agent:
 
     def info(self, sim: Simulation, steps: int) -> dict[str, Any]:
         """``time_ms``, ``steps`` and ``pose``: the robot's (east, north, yaw) in the world's ENU view
-        (:mod:`sensorium.gym.frame`; in an ENU world its x, y and heading about z), the yaw its
+        (:mod:`sensorium.server.sim.frames`; in an ENU world its x, y and heading about z), the yaw its
         drive's forward's."""
         pose = sim.robot(self.robot).pose
         return {"time_ms": sim.time_ms, "steps": steps,

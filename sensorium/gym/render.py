@@ -3,9 +3,9 @@
 Every shape (of solids, their nested children and multi-shape bodies) is drawn as the convex hull of its tessellation projected on the world's
 ground plane, filled with its ``base_color``, lowest top first (so a tall wall covers the floor); sized planes
 (floors) are drawn first. Robots are drawn on top with a white heading line (along the drive's forward,
-:func:`sensorium.gym.frame.heading`), lights as yellow
+:func:`sensorium.server.sim.frames.heading`), lights as yellow
 dots. The view looks down the world's up axis with east to the right and north up (the world's
-ENU view, :mod:`sensorium.gym.frame`: in an ENU world +x right, +y up the image; in a NUE world +z
+ENU view, :mod:`sensorium.server.sim.frames`: in an ENU world +x right, +y up the image; in a NUE world +z
 right, +x up); it covers the bounding box of everything drawn plus a margin.
 """
 
@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from sensorium.gym.frame import ENU_AXES, drive_forward, enu_axes, heading, own_up
 from sensorium.gym.task import whole
 from sensorium.schemas import world as wm
+from sensorium.server.sim.frames import ENU_AXES, drive_forward, enu_axes, heading, own_up
 from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
 from sensorium.server.world.geometry import Plane, Pose, tessellate
 from sensorium.server.world.poses import pose_from_model

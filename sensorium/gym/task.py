@@ -34,7 +34,10 @@ from typing import Any
 
 import numpy as np
 
-from sensorium.gym.frame import (
+from sensorium.server.raycast import packets
+from sensorium.server.raycast.engine import RayKind
+from sensorium.server.sim.batched_lights import copy_world_lights
+from sensorium.server.sim.frames import (
     ENU_AXES,
     drive_forward,
     enu_axes,
@@ -43,9 +46,6 @@ from sensorium.gym.frame import (
     to_enu,
     upright_quaternion,
 )
-from sensorium.server.raycast import packets
-from sensorium.server.raycast.engine import RayKind
-from sensorium.server.sim.batched_lights import copy_world_lights
 from sensorium.server.sim.ground import placing_ceiling
 
 __all__ = ["Task", "ReachLight", "AvoidObstacles", "clearance", "never", "random_start", "VectorGoal"]
@@ -131,7 +131,7 @@ class random_start:
     (x, y), a table's top included: keep the ranges off tables). Draws from the environment's seeded generator,
     so a seed fixes the start.
 
-    The ranges are the world's ENU view (:mod:`sensorium.gym.frame`): ``x`` east, ``y`` north, ``yaw``
+    The ranges are the world's ENU view (:mod:`sensorium.server.sim.frames`): ``x`` east, ``y`` north, ``yaw``
     counter-clockwise about up from east, the heading of the robot's drive's ``forward`` (its own x
     axis by default). In an ENU world the robot's rotation becomes a turn about z, ``yaw`` for an
     x-forward drive; in a NUE world (x north, y up, z east) ``x`` ranges over the world's z, ``y``
@@ -190,7 +190,7 @@ class ReachLight:
 
     def target_among(self, lights: list, axes: tuple[int, int, int] = ENU_AXES) -> np.ndarray:
         """The (east, north) of the light this goal drives to among light models placed in the
-        world (``axes``: the world's east, north and up, :func:`~sensorium.gym.frame.enu_axes`)."""
+        world (``axes``: the world's east, north and up, :func:`~sensorium.server.sim.frames.enu_axes`)."""
         for lt in lights:
             if lt.type == "DirectionalLight":
                 continue

@@ -46,7 +46,6 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from sensorium.gym.env import DEFAULT_PRECISION, SEGMENTATION, Agent, check_precision, device_of, load, missing_fill
-from sensorium.gym.frame import heading
 from sensorium.gym.render import TopDown, check_render_size
 from sensorium.gym.task import Task, VectorGoal, never, whole, zero
 from sensorium.gym.views import CopySim
@@ -54,6 +53,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.raycast import packets
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation, check_observable
 from sensorium.server.sim.batched_holonomic import HolonomicDrives
+from sensorium.server.sim.frames import heading
 from sensorium.server.world.loader import LoadedWorld
 
 __all__ = ["SensoriumVectorEnv", "SubEnv"]

@@ -4,7 +4,8 @@
 The row holds only values fixed by the run's inputs (so a sweep gives the same table on any
 engine), except ``wall_s``. Columns: ``run, world, seed, controller, param:<path>..., status,
 error, steps, sim_time_ms, messages, digest, recording`` then per robot ``<robot>.x, .y, .yaw,
-.path_m`` (final planar pose, distance driven) and per light/distance sensor that measured
+.path_m`` (final planar pose -- east, north and the heading about up from east, the drive's forward,
+in a NUE world too: sim/frames.py -- and the distance driven on the ground plane) and per light/distance sensor that measured
 ``<robot>/<device>.mean, .min, .max, .n``. ``digest`` is the SHA-256 of every recorded message
 (topic, log time, sequence, bytes) in order: equal digests mean equal recordings.
 """
@@ -122,6 +123,7 @@ def run_one(run: RunSpec) -> dict:
 def _simulate(run: RunSpec, row: dict) -> None:
     from sensorium.server.daemon.topics import Topics
     from sensorium.server.recording.writer import McapRecorder
+    from sensorium.server.sim.frames import drive_forward, enu_axes, planar_pose
     from sensorium.server.sim.sensors import Lidar
     from sensorium.server.sim.simulation import Simulation
     from sensorium.sweep.controllers import resolve
@@ -144,7 +146,8 @@ def _simulate(run: RunSpec, row: dict) -> None:
         step = factory(sim)
         steps = math.ceil(run.duration_ms / sim.basic_time_step)
         stats: dict[str, list[float]] = {}
-        last = {r.name: r.pose.translation[:2].copy() for r in sim.robots.values()}
+        east, north, _ = axes = enu_axes(sim.world)
+        last = {r.name: r.pose.translation[[east, north]] for r in sim.robots.values()}
         travelled = dict.fromkeys(sim.robots, 0.0)
         for _ in range(steps):
             if step is not None:
@@ -160,9 +163,9 @@ def _simulate(run: RunSpec, row: dict) -> None:
                         s[2] = max(s[2], v)
                         s[3] += 1
             for r in sim.robots.values():
-                xy = r.pose.translation[:2]
+                xy = r.pose.translation[[east, north]]
                 travelled[r.name] += math.hypot(*(xy - last[r.name]))
-                last[r.name] = xy.copy()
+                last[r.name] = xy
             topics.publish(sim.time_ms)
         row["steps"] = steps
         row["sim_time_ms"] = sim.time_ms
@@ -173,10 +176,8 @@ def _simulate(run: RunSpec, row: dict) -> None:
         row["messages"] = digest.count
         row["digest"] = digest.h.hexdigest()
     for r in sim.robots.values():
-        p = r.pose
-        row[f"{r.name}.x"] = float(p.translation[0])
-        row[f"{r.name}.y"] = float(p.translation[1])
-        row[f"{r.name}.yaw"] = math.atan2(p.rotation[1, 0], p.rotation[0, 0])
+        x, y, yaw = planar_pose(axes, r.pose.translation, r.pose.rotation, drive_forward(r.model))
+        row[f"{r.name}.x"], row[f"{r.name}.y"], row[f"{r.name}.yaw"] = x, y, yaw
         row[f"{r.name}.path_m"] = travelled[r.name]
     for path in sorted(stats):
         total, lo, hi, n = stats[path]

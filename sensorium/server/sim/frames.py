@@ -1,4 +1,4 @@
-"""The world's ENU view (x east, y north, z up) the gym helpers work in.
+"""The world's ENU view (x east, y north, z up) the gym helpers and the sweep's summary rows work in.
 
 A world in Webots' NUE convention (``world_info: {coordinate_system: NUE}``: x north, y up, z east)
 is simulated in an ENU view of itself (the drives, contact and terrains: ``motion._TO_ENU``). The
