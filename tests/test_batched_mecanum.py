@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 import pytest
 
-from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.batched import BatchedSimulation, DeviceRef
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
 from tests._motors import assert_same_readings
@@ -108,41 +108,12 @@ def test_every_copy_steps_as_the_single_simulation_bit_for_bit(contact):
     """Three copies, each against its own Simulation (world seeds 5, 6, 7), 400 steps of random
     commands changed every 40 steps (velocity and position control), a set_pose at step 200: every
     robot's pose and every device's reading the same bits every step; contact clipped moves."""
-    from sensorium.gym.views import CopySim
-
-    w = world(contact)
-    n = 3
-    batched = BatchedSimulation(w, n)
-    batched.reset(np.arange(n), [5, 6, 7])
-    singles = [Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
-        update={"random_seed": s})})) for s in (5, 6, 7)]
-    views = [CopySim(batched, c) for c in range(n)]
-    for s in (*singles, *views):
-        for r in s.robots.values():
-            for d in r.model.devices:
-                r.device(d.name).enable(32 if d.device != "GPS" else 16)
-    rng = np.random.default_rng(8)
-    pressed = 0
-    for t in range(400):
-        if t % 40 == 0:
-            cmds = [random_commands(rng, w.world) for _ in range(n)]
-        if t == 200:
-            for s in (singles[1], views[1]):
-                s.robot("yb").set_pose(translation=[-0.5, -0.5, 0.1], rotation=[0, 0, 1, 0.7])
-        for c in range(n):
-            command(singles[c], cmds[c])
-            command(views[c], cmds[c])
-            singles[c].step()
-        batched.step()
-        for c in range(n):
-            for name in ("yb", "yb2", "dd"):
-                assert same_pose(singles[c], views[c], name), (t, c, name)
-                assert_same_readings(singles[c], views[c], name, (t, c))
-            pressed += sum(singles[c].robot(name).pressing for name in ("yb", "yb2"))
+    batched, _, pressed = lockstep(world(contact), 400, (5, 6, 7), rng_seed=8, sample_ms=32,
+                                   set_poses=(200, 1, {"yb": ([-0.5, -0.5, 0.1], [0, 0, 1, 0.7])}))
     if contact:
-        assert pressed > 20 and batched.counters["contacts"] > 0      # walls and robots were met
+        assert pressed["yb"] + pressed["yb2"] > 20 and batched.counters["contacts"] > 0      # walls and robots were met
     else:
-        assert batched.contact is None and pressed == 0
+        assert batched.contact is None and pressed["yb"] + pressed["yb2"] == 0
 
 
 def test_strafe_turn_and_diagonal_in_closed_form_each_copy_its_own():
@@ -193,6 +164,35 @@ def test_a_pure_strafe_is_exact_in_closed_form_every_step():
         assert (batched.rot[:, 0] == np.eye(3)).all()
 
 
+def plan_copies(w, plan: list[dict], drive: str, motors, bumper_of: str, steps: int) -> tuple[BatchedSimulation, DeviceRef]:
+    """A copy of ``w`` per entry of ``plan`` ({robot: its wheels' speeds in ``motors``' order}), each
+    commanded through the batched simulation's ``drive`` ("mecanum" or "omni"), run ``steps`` with the
+    bumper of robot ``bumper_of`` enabled; beside each, a Simulation commanded alike whose poses (the
+    plan's robots) and bumper reading are the copy's bit for bit. Returns the batched simulation and
+    its bumper device."""
+    batched = BatchedSimulation(w, len(plan))
+    for name in plan[0]:
+        getattr(batched, drive).command(batched.slot(name), [p[name] for p in plan])
+    bumper = batched.device(bumper_of, "bumper")
+    batched.enable(bumper, 16)
+    batched.run(steps)
+    for c, p in enumerate(plan):
+        single = Simulation(w)
+        single.device(f"{bumper_of}/bumper").enable(16)
+        for name, speeds in p.items():
+            for m, u in zip(motors, speeds):
+                single.robot(name).motor(m).set_position(math.inf)
+                single.robot(name).motor(m).set_velocity(u)
+        single.run(steps)
+        for name in p:
+            pose = single.robot(name).pose
+            slot = batched.slot(name)
+            assert pose.translation.tobytes() == batched.pos[c, slot].tobytes(), (c, name)
+            assert pose.rotation.tobytes() == batched.rot[c, slot].tobytes(), (c, name)
+        assert single.device(f"{bumper_of}/bumper").value == batched.value(bumper)[c]
+    return batched, bumper
+
+
 LEFT, RIGHT, STAND = [-10.0, 10.0, 10.0, -10.0], [10.0, -10.0, -10.0, 10.0], [0.0] * 4
 
 
@@ -206,12 +206,7 @@ def test_strafes_against_a_wall_and_a_robot_stop_there_and_copies_never_meet():
                      "solids": [wall("wall", 0.0, 1.0, 4.0, 0.2)],
                      "robots": [youbot("yb", 0.0, 0.0), youbot("other", 0.0, -1.0)]})
     plan = [{"yb": RIGHT, "other": STAND}, {"yb": RIGHT, "other": RIGHT}, {"yb": LEFT, "other": STAND}]
-    batched = BatchedSimulation(w, len(plan))
-    for name in ("yb", "other"):
-        batched.mecanum.command(batched.slot(name), [p[name] for p in plan])
-    bumper = batched.device("yb", "bumper")
-    batched.enable(bumper, 16)
-    batched.run(100)                                # 1.6 s at 0.5 m/s
+    batched, bumper = plan_copies(w, plan, "mecanum", WHEELS, "yb", 100)       # 1.6 s at 0.5 m/s
     yb, other = batched.slot("yb"), batched.slot("other")
     assert batched.pos[0, yb, 1] == pytest.approx(-1.0 + 2 * HALF_W, abs=1e-6)      # side against side
     assert batched.pos[0, other, 1] == -1.0
@@ -220,20 +215,6 @@ def test_strafes_against_a_wall_and_a_robot_stop_there_and_copies_never_meet():
     assert batched.pos[2, yb, 1] == pytest.approx(0.9 - HALF_W, abs=1e-9)           # its left side on the face
     assert batched.pos[:, yb, 0].tolist() == [0.0] * 3 and (batched.rot[:, yb] == np.eye(3)).all()
     assert batched.value(bumper).tolist() == [1.0, 0.0, 1.0]
-    for c, p in enumerate(plan):
-        single = Simulation(w)
-        single.device("yb/bumper").enable(16)
-        for name, speeds in p.items():
-            for m, u in zip(WHEELS, speeds):
-                single.robot(name).motor(m).set_position(math.inf)
-                single.robot(name).motor(m).set_velocity(u)
-        single.run(100)
-        for name in ("yb", "other"):
-            pose = single.robot(name).pose
-            slot = batched.slot(name)
-            assert pose.translation.tobytes() == batched.pos[c, slot].tobytes(), (c, name)
-            assert pose.rotation.tobytes() == batched.rot[c, slot].tobytes(), (c, name)
-        assert single.device("yb/bumper").value == batched.value(bumper)[c]
 
 
 def test_set_wheels_on_a_mecanum_robot_says_how_to_command_it():
@@ -399,11 +380,15 @@ def test_the_workers_env_carries_four_wheel_actions_bit_for_bit():
         envs.close()
 
 
-def lockstep(w, steps: int, seeds=(5, 6)) -> tuple[BatchedSimulation, int, int]:
-    """Copies of ``w`` (one per seed) and a Simulation per copy with random commands changed every
-    40 steps (:func:`random_commands`): every robot's pose and readings the same bits every step.
-    Returns the batched simulation and the copy-steps in which a robot was tilted (on a slope) and
-    pressed against something."""
+def lockstep(w, steps: int, seeds=(5, 6), commands=random_commands, rng_seed: int | None = None,
+             sample_ms: int = 16, set_poses=None) -> tuple[BatchedSimulation, int, dict[str, int]]:
+    """Copies of ``w`` (one per seed, the world's random_seed that seed) and a Simulation per copy, with
+    ``commands(rng, world)`` per copy changed every 40 steps (rng seeded ``rng_seed``, by default the
+    robots' count): every robot's pose and readings the same bits every step. Every device is
+    sampled every ``sample_ms`` but the GPSs, every 16 ms; ``set_poses``, (step, copy, {robot:
+    (translation, rotation)}), moves those robots by set_pose in that copy and its Simulation before
+    that step. Returns the batched simulation, the copy-steps in which a robot was tilted (on a
+    slope), and per robot the copy-steps in which it was pressed against something."""
     from sensorium.gym.views import CopySim
 
     n = len(seeds)
@@ -415,12 +400,17 @@ def lockstep(w, steps: int, seeds=(5, 6)) -> tuple[BatchedSimulation, int, int]:
     for s in (*singles, *views):
         for r in s.robots.values():
             for d in r.model.devices:
-                r.device(d.name).enable(16)
-    rng = np.random.default_rng(len(w.world.robots))
-    tilted = pressed = 0
+                r.device(d.name).enable(sample_ms if d.device != "GPS" else 16)
+    rng = np.random.default_rng(len(w.world.robots) if rng_seed is None else rng_seed)
+    tilted = 0
+    pressed = {r.name: 0 for r in w.world.robots}
     for t in range(steps):
         if t % 40 == 0:
-            cmds = [random_commands(rng, w.world) for _ in range(n)]
+            cmds = [commands(rng, w.world) for _ in range(n)]
+        if set_poses is not None and t == set_poses[0]:
+            for s in (singles[set_poses[1]], views[set_poses[1]]):
+                for name, (translation, rotation) in set_poses[2].items():
+                    s.robot(name).set_pose(translation=translation, rotation=rotation)
         for c in range(n):
             command(singles[c], cmds[c])
             command(views[c], cmds[c])
@@ -430,7 +420,7 @@ def lockstep(w, steps: int, seeds=(5, 6)) -> tuple[BatchedSimulation, int, int]:
             for name in singles[c].robots:
                 assert same_pose(singles[c], views[c], name), (t, c, name)
                 assert_same_readings(singles[c], views[c], name, (t, c))
-                pressed += bool(singles[c].robot(name).pressing)
+                pressed[name] += bool(singles[c].robot(name).pressing)
         tilted += int(batched.tilted.sum())
     return batched, tilted, pressed
 
@@ -463,4 +453,4 @@ def test_a_nue_world_batches_mecanum_robots_bit_for_bit():
                                                         ("n", 0.9, 0.0, 0.2, 1.6), ("s", -0.9, 0.0, 0.2, 1.6))],
                      "robots": [robot]})
     batched, _, pressed = lockstep(w, 240)
-    assert batched.to_enu is not None and pressed > 0
+    assert batched.to_enu is not None and sum(pressed.values()) > 0
