@@ -329,18 +329,19 @@ def test_bad_actions_are_refused_in_one_line(bad):
             venv.step(np.zeros((2, len(bad)), dtype=np.float32))
 
 
-def test_pettingzoo_mecanum_robots_are_agents_and_both_engines_agree():
+def parallel_engines_agree(w, robots: tuple[str, ...]):
+    """Every robot of ``w`` (``robots``, in order) an agent of a PettingZoo env on each engine, random
+    actions from the same seeds: every GPS observation, reward and flag the same bits until all are
+    truncated after 20 actions. Returns the simulation engine's env (for its action spaces)."""
     from sensorium.gym import Task
     from sensorium.gym.multi import SensoriumParallelEnv
 
-    w = world(True)
-    assert SensoriumParallelEnv(w).possible_agents == ["yb", "yb2", "dd"]
+    assert SensoriumParallelEnv(w).possible_agents == list(robots)
 
     def make(engine):
         return SensoriumParallelEnv(w, {r: Task(robot=r, control_period_ms=32, max_steps=20, observations=["gps"])
-                                        for r in ("yb", "yb2", "dd")}, engine=engine)
+                                        for r in robots}, engine=engine)
     a, b = make("simulation"), make("batched")
-    assert a.action_space("yb").shape == (4,) and a.action_space("dd").shape == (2,)
     oa, _ = a.reset(seed=7)
     ob, _ = b.reset(seed=7)
     rng = np.random.default_rng(0)
@@ -353,31 +354,42 @@ def test_pettingzoo_mecanum_robots_are_agents_and_both_engines_agree():
         ob, rb, tb, ub, _ = b.step(acts)
         assert (ra, ta, ua) == (rb, tb, ub)
     assert not a.agents                                  # all truncated after 20 actions, robots stopped
+    return a
+
+
+def test_pettingzoo_mecanum_robots_are_agents_and_both_engines_agree():
+    a = parallel_engines_agree(world(True), ("yb", "yb2", "dd"))
+    assert a.action_space("yb").shape == (4,) and a.action_space("dd").shape == (2,)
+
+
+def workers_agree(w, task, n: int, width: int) -> None:
+    """SensoriumWorkersEnv (two processes) and the one-process vector env of ``n`` sub-envs of ``task``:
+    the same action space, (n, ``width``) random actions, every reset and step the same (autoresets
+    included); a wrong action shape refused in one line."""
+    from sensorium.gym.vector import SensoriumVectorEnv
+    from sensorium.gym.workers import SensoriumWorkersEnv
+    from tests.test_gym_workers import _same
+
+    ref, envs = SensoriumVectorEnv(w, task, n), SensoriumWorkersEnv(w, task, n, workers=2)
+    try:
+        assert envs.action_space == ref.action_space and envs.single_action_space.shape == (width,)
+        _same(envs.reset(seed=2), ref.reset(seed=2), "reset")
+        rng = np.random.default_rng(1)
+        for t in range(12):
+            a = rng.uniform(-1, 1, (n, width)).astype(np.float32)
+            _same(envs.step(a), ref.step(a), f"step {t}")
+        with pytest.raises(ValueError, match=rf"^actions must have shape \({n}, {width}\)"):
+            envs.step(np.zeros((n, 2), dtype=np.float32))
+    finally:
+        ref.close()
+        envs.close()
 
 
 @pytest.mark.slow           # starts worker processes
 def test_the_workers_env_carries_four_wheel_actions_bit_for_bit():
     """SensoriumWorkersEnv (two processes) shares (n, 4) actions: sub-env i equals the one-process
     vector env's, autoresets included."""
-    from sensorium.gym.vector import SensoriumVectorEnv
-    from sensorium.gym.workers import SensoriumWorkersEnv
-    from tests.test_gym_workers import _same
-
-    w, n = world(True), 3
-    ref, envs = SensoriumVectorEnv(w, agent_task(max_steps=5), n), SensoriumWorkersEnv(w, agent_task(max_steps=5), n,
-                                                                                       workers=2)
-    try:
-        assert envs.action_space == ref.action_space and envs.single_action_space.shape == (4,)
-        _same(envs.reset(seed=2), ref.reset(seed=2), "reset")
-        rng = np.random.default_rng(1)
-        for t in range(12):
-            a = rng.uniform(-1, 1, (n, 4)).astype(np.float32)
-            _same(envs.step(a), ref.step(a), f"step {t}")
-        with pytest.raises(ValueError, match=r"^actions must have shape \(3, 4\)"):
-            envs.step(np.zeros((n, 2), dtype=np.float32))
-    finally:
-        ref.close()
-        envs.close()
+    workers_agree(world(True), agent_task(max_steps=5), 3, 4)
 
 
 def lockstep(w, steps: int, seeds=(5, 6), commands=random_commands, rng_seed: int | None = None,

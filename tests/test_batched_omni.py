@@ -19,7 +19,7 @@ import pytest
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
-from tests.test_batched_mecanum import lockstep, plan_copies, wall, youbot
+from tests.test_batched_mecanum import lockstep, parallel_engines_agree, plan_copies, wall, workers_agree, youbot
 
 STEP = 16
 DT = STEP / 1000.0
@@ -379,51 +379,12 @@ def test_bad_actions_are_refused_in_one_line():
 
 
 def test_pettingzoo_omni_and_off_centre_robots_are_agents_and_both_engines_agree():
-    from sensorium.gym import Task
-    from sensorium.gym.multi import SensoriumParallelEnv
-
-    w = world(True)
-    assert SensoriumParallelEnv(w).possible_agents == list(NAMES)
-
-    def make(engine):
-        return SensoriumParallelEnv(w, {r: Task(robot=r, control_period_ms=32, max_steps=20, observations=["gps"])
-                                        for r in NAMES}, engine=engine)
-    a, b = make("simulation"), make("batched")
+    a = parallel_engines_agree(world(True), NAMES)
     assert [a.action_space(r).shape for r in NAMES] == [(3,), (4,), (4,), (2,), (2,)]
-    oa, _ = a.reset(seed=7)
-    ob, _ = b.reset(seed=7)
-    rng = np.random.default_rng(0)
-    for _ in range(25):
-        assert all(np.asarray(oa[k]["gps"]).tobytes() == np.asarray(ob[k]["gps"]).tobytes() for k in oa)
-        if not a.agents:
-            break
-        acts = {k: rng.uniform(-1, 1, a.action_space(k).shape).astype(np.float32) for k in a.agents}
-        oa, ra, ta, ua, _ = a.step(acts)
-        ob, rb, tb, ub, _ = b.step(acts)
-        assert (ra, ta, ua) == (rb, tb, ub)
-    assert not a.agents
 
 
 @pytest.mark.slow           # starts worker processes
 def test_the_workers_env_carries_omni_wheel_actions_bit_for_bit():
     """SensoriumWorkersEnv (two processes) shares (n, 3) actions: sub-env i equals the one-process
     vector env's, autoresets included."""
-    from sensorium.gym.vector import SensoriumVectorEnv
-    from sensorium.gym.workers import SensoriumWorkersEnv
-    from tests.test_gym_workers import _same
-
-    w, n = world(True), 3
-    ref = SensoriumVectorEnv(w, agent_task(max_steps=5), n)
-    envs = SensoriumWorkersEnv(w, agent_task(max_steps=5), n, workers=2)
-    try:
-        assert envs.action_space == ref.action_space and envs.single_action_space.shape == (3,)
-        _same(envs.reset(seed=2), ref.reset(seed=2), "reset")
-        rng = np.random.default_rng(1)
-        for t in range(12):
-            a = rng.uniform(-1, 1, (n, 3)).astype(np.float32)
-            _same(envs.step(a), ref.step(a), f"step {t}")
-        with pytest.raises(ValueError, match=r"^actions must have shape \(3, 3\)"):
-            envs.step(np.zeros((n, 2), dtype=np.float32))
-    finally:
-        ref.close()
-        envs.close()
+    workers_agree(world(True), agent_task(max_steps=5), 3, 3)
