@@ -17,8 +17,8 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
+from tests._copies import copies_and_singles, reseed_copy, steer_randomly
 from tests.test_batched_depth import scout_ahead_in_copy_0
-from tests.test_batched_sim import _enable_both, _wheels_both
 from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "camera.yaml"
@@ -57,13 +57,11 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
     after every basic step every image of every copy equals that of a Simulation built with that
     copy's seed, byte for byte (black before the first capture)."""
     seeds = [5, 6, 7]
-    make = _glass if glass else _world
-    bs = BatchedSimulation(make(0, texture_dir), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(make(s, texture_dir), precision=precision) for s in seeds]
 
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
+    def make(seed: int) -> LoadedWorld:
+        return (_glass if glass else _world)(seed, texture_dir)
+
+    bs, sims = copies_and_singles(make, seeds, precision, PERIODS)
     through = []                                 # the casts of rays going on past a semi-transparent surface
     cast = bs.rays.cast
 
@@ -77,13 +75,9 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
     seen = {"black": 0, "sky": 0, "textured": 0}
     for step in range(70):
         if step % 10 == 0:
-            for robot in PERIODS:
-                vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
-                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            steer_randomly(bs, sims, rng, PERIODS)
         if step == 40:                          # copy 1 as a new world with another seed
-            bs.reset([1], [42])
-            sims[1] = Simulation(make(42, texture_dir), precision=precision)
-            _enable_both(bs, sims, PERIODS, 1)
+            reseed_copy(bs, sims, make, 1, 42, precision, PERIODS)
         bs.step()
         for c, s in enumerate(sims):
             s.step()

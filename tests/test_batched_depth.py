@@ -18,7 +18,7 @@ from sensorium.server.sim import batched_depth
 from sensorium.server.sim.batched import BatchedSimulation, NoiseStreams
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
-from tests.test_batched_sim import _enable_both, _wheels_both
+from tests._copies import copies_and_singles, reseed_copy, seeded, steer_randomly
 from tests.test_gym_vector import _random_steps, _reset_both
 
 WORLD = Path(__file__).parent / "worlds" / "depth.yaml"
@@ -27,9 +27,7 @@ BOTH = ["fast", "exact"]
 
 
 def _world(seed: int) -> LoadedWorld:
-    lw = load_world(WORLD)
-    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
-    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+    return seeded(WORLD, seed)
 
 
 @pytest.mark.parametrize("precision", BOTH)
@@ -41,23 +39,14 @@ def test_every_copy_captures_its_range_finders_as_the_single_simulation(precisio
     Simulation built with that copy's seed, bit for bit (zeros before the first capture, +inf for
     no hit)."""
     seeds = [5, 6, 7]
-    bs = BatchedSimulation(_world(0), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(_world(s), precision=precision) for s in seeds]
-
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
+    bs, sims = copies_and_singles(_world, seeds, precision, PERIODS)
     rng = np.random.default_rng(1)
     seen = {"inf": 0, "finite": 0, "zeros": 0, "near": 0}
     for step in range(90):
         if step % 10 == 0:
-            for robot in PERIODS:
-                vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
-                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            steer_randomly(bs, sims, rng, PERIODS)
         if step == 50:                          # copy 1 as a new world with another seed
-            bs.reset([1], [42])
-            sims[1] = Simulation(_world(42), precision=precision)
-            _enable_both(bs, sims, PERIODS, 1)
+            reseed_copy(bs, sims, _world, 1, 42, precision, PERIODS)
         bs.step()
         for c, s in enumerate(sims):
             s.step()

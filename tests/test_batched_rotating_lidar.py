@@ -15,8 +15,8 @@ import pytest
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import LoadedWorld, from_model, load_world
-from tests.test_batched_sim import _enable_both, _wheels_both
+from sensorium.server.world.loader import LoadedWorld, from_model
+from tests._copies import copies_and_singles, reseed_copy, seeded, steer_randomly
 from tests.test_gym_vector import _random_steps, _reset_both
 
 WORLD = Path(__file__).parent / "worlds" / "rotating_lidar.yaml"
@@ -26,9 +26,7 @@ BOTH = ["fast", "exact"]
 
 
 def _world(seed: int) -> LoadedWorld:
-    lw = load_world(WORLD)
-    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
-    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+    return seeded(WORLD, seed)
 
 
 def _enable_one(bs: BatchedSimulation, sims: list, copy: int, robot: str, name: str, period: int) -> None:
@@ -46,23 +44,15 @@ def test_every_copy_sweeps_its_rotating_lidars_as_the_single_simulation(precisio
     that of a Simulation built with that copy's seed, bit for bit (zeros where the head has not swept
     yet, +inf for no hit)."""
     seeds = [5, 6, 7]
-    bs = BatchedSimulation(_world(0), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(_world(s), precision=precision) for s in seeds]
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
+    bs, sims = copies_and_singles(_world, seeds, precision, PERIODS)
     rng = np.random.default_rng(1)
     seen = {"inf": 0, "finite": 0, "unswept": 0, "mast": 0}
     held = None
     for step in range(130):
         if step % 10 == 0:
-            for robot in PERIODS:
-                vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
-                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            steer_randomly(bs, sims, rng, PERIODS)
         if step == 50:                          # copy 1 as a new world with another seed
-            bs.reset([1], [42])
-            sims[1] = Simulation(_world(42), precision=precision)
-            _enable_both(bs, sims, PERIODS, 1)
+            reseed_copy(bs, sims, _world, 1, 42, precision, PERIODS)
         if step == 70:                          # copy 2's head stops where it is, its image kept
             _enable_one(bs, sims, 2, "rover", "spin", 0)
             held = bs.range_image(bs.device("rover", "spin"))[2].copy()

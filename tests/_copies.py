@@ -1,0 +1,51 @@
+"""Batched copies of a world beside one Simulation per copy, each built with its copy's seed: the
+setup, the random wheel commands and the mid-run reseed of one copy that the sensor comparisons
+share (tests/test_batched_depth.py, test_batched_rotating_lidar.py, test_batched_camera.py)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_batched_sim import _enable_both, _wheels_both
+
+
+def seeded(path: Path, seed: int) -> LoadedWorld:
+    """The world file at ``path`` with its random_seed ``seed``."""
+    lw = load_world(path)
+    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
+    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+
+
+def copies_and_singles(make: Callable[[int], LoadedWorld], seeds: Sequence[int], precision: str,
+                       periods: dict) -> tuple[BatchedSimulation, list[Simulation]]:
+    """A BatchedSimulation of ``make(0)`` with a copy per seed, reset with those seeds, a Simulation of
+    ``make(seed)`` per copy, and the devices of ``periods`` ({robot: {device: ms}}) enabled in both."""
+    bs = BatchedSimulation(make(0), len(seeds), precision=precision)
+    bs.reset(np.arange(len(seeds)), list(seeds))
+    sims = [Simulation(make(s), precision=precision) for s in seeds]
+    for c in range(len(seeds)):
+        _enable_both(bs, sims, periods, c)
+    return bs, sims
+
+
+def steer_randomly(bs: BatchedSimulation, sims: list[Simulation], rng: np.random.Generator, robots) -> None:
+    """Each of ``robots``' two wheels at a random speed within 30 % of its maximum, per copy, in the
+    copies and their Simulations alike."""
+    for robot in robots:
+        vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
+        _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(sims), 2)))
+
+
+def reseed_copy(bs: BatchedSimulation, sims: list[Simulation], make: Callable[[int], LoadedWorld], copy: int,
+                seed: int, precision: str, periods: dict) -> None:
+    """Copy ``copy`` reset as a new world with ``seed``, its Simulation rebuilt from ``make(seed)``, and
+    the devices of ``periods`` enabled again in both."""
+    bs.reset([copy], [seed])
+    sims[copy] = Simulation(make(seed), precision=precision)
+    _enable_both(bs, sims, periods, copy)
