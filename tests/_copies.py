@@ -4,6 +4,7 @@ share (tests/test_batched_depth.py, test_batched_rotating_lidar.py, test_batched
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -49,3 +50,24 @@ def reseed_copy(bs: BatchedSimulation, sims: list[Simulation], make: Callable[[i
     bs.reset([copy], [seed])
     sims[copy] = Simulation(make(seed), precision=precision)
     _enable_both(bs, sims, periods, copy)
+
+
+def vector_beside_singles(world, task, n: int, precision: str) -> tuple:
+    """A vector env of ``n`` sub-envs of ``task`` and, for sub-envs 0 to 2, the single env on the
+    engines "simulation", "auto" (which picks the one-copy batched engine) and "simulation"."""
+    from sensorium.gym import SensoriumEnv
+    from sensorium.gym.vector import SensoriumVectorEnv
+
+    venv = SensoriumVectorEnv(world, task, n, precision=precision)
+    singles = [SensoriumEnv(world, task, precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
+    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
+    return venv, singles
+
+
+def check_sub_env(venv) -> None:
+    """Gymnasium's checker passes on sub-env 1 of ``venv``, no warning allowed."""
+    from gymnasium.utils.env_checker import check_env
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(venv.sub_env(1), skip_render_check=True)

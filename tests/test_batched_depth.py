@@ -6,7 +6,6 @@ them, and a camera measured next to them."""
 from __future__ import annotations
 
 import math
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +17,7 @@ from sensorium.server.sim import batched_depth
 from sensorium.server.sim.batched import BatchedSimulation, NoiseStreams
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
-from tests._copies import copies_and_singles, reseed_copy, seeded, steer_randomly
+from tests._copies import check_sub_env, copies_and_singles, reseed_copy, seeded, steer_randomly, vector_beside_singles
 from tests.test_gym_vector import _random_steps, _reset_both
 
 WORLD = Path(__file__).parent / "worlds" / "depth.yaml"
@@ -176,7 +175,6 @@ def test_noise_draws_continue_each_stream_in_order_whatever_the_block_sizes():
 
 gym = pytest.importorskip("gymnasium")
 
-from gymnasium.utils.env_checker import check_env  # noqa: E402
 
 from sensorium.gym import SensoriumEnv, Task  # noqa: E402
 from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
@@ -195,18 +193,14 @@ def test_the_vector_env_observes_range_finders_as_the_single_env(precision: str)
     batched engine, which "auto" now picks) with its seed, observations, rewards and poses bit for
     bit, across autoresets; "no hit" reads max_range; a sub-env passes Gymnasium's checker."""
     n = 3
-    venv = SensoriumVectorEnv(WORLD, _task(), n, precision=precision)
+    venv, singles = vector_beside_singles(WORLD, _task(), n, precision)
     space = venv.single_observation_space
     assert space["depth"].shape == (12, 16) and space["wide"].shape == (6, 24)
     assert space["depth"].dtype == np.float32 and space["depth"].high.max() == np.float32(2.5)
-    singles = [SensoriumEnv(WORLD, _task(), precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
-    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
     obs = _reset_both(venv, singles, 4)
     assert (obs["depth"] == np.float32(2.5)).any() and (obs["depth"] < 2.5).any()   # no hit: max_range
     assert _random_steps(venv, singles, OBSERVED, 45) >= n       # autoresets happened
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(venv.sub_env(1), skip_render_check=True)
+    check_sub_env(venv)
     venv.close()
 
 
