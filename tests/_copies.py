@@ -71,3 +71,32 @@ def check_sub_env(venv) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(venv.sub_env(1), skip_render_check=True)
+
+
+def drive_and_compare(bs: BatchedSimulation, sims: list[Simulation], robots, rng: np.random.Generator, steps: int,
+                      every: int, full_every: int | None = None, move=None, up: int = 2) -> set[float]:
+    """``steps`` steps of ``bs`` and of each copy's Simulation. Every ``every`` steps each of ``robots``
+    (two-wheel) gets random wheel speeds in [-12, 12] rad/s per copy, or all 10 rad/s at the multiples
+    of ``full_every``; ``move``, (step, robot, place), puts that robot there by set_pose in copy 1 and
+    its Simulation before that step. After each step every robot's pose is its Simulation's bit for
+    bit. Returns the heights (coordinate ``up``) the robots were at."""
+    heights: set[float] = set()
+    for step in range(steps):
+        if step % every == 0:
+            for robot in robots:
+                full = full_every is not None and step % full_every == 0
+                _wheels_both(bs, sims, robot, np.full((len(sims), 2), 10.0) if full
+                             else rng.uniform(-12.0, 12.0, (len(sims), 2)))
+        if move is not None and step == move[0]:
+            bs.set_pose(1, bs.slot(move[1]), move[2])
+            sims[1].robot(move[1]).set_pose(move[2])
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot in robots:
+                slot = bs.slot(robot)
+                pose = s.robot(robot).pose
+                assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
+                assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
+                heights.add(float(pose.translation[up]))
+    return heights

@@ -22,6 +22,7 @@ from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import parse_world
+from tests._copies import drive_and_compare
 from tests.test_batched_nue import TO_NUE, _to_nue
 
 SLOPE = 0.25
@@ -252,31 +253,8 @@ def test_copies_riding_box_floors_and_terrains_are_the_single_simulation_bit_for
         bs._drive_step = None
     bs.reset(np.arange(3), seeds)
     sims = [Simulation(world(s)) for s in seeds]
-    rng = np.random.default_rng(7)
-    heights: set[float] = set()
-    for step in range(150):
-        if step % 15 == 0:
-            for robot in ("a", "b", "c"):
-                lr = rng.uniform(-12.0, 12.0, (3, 2)) if step % 30 else np.full((3, 2), 10.0)
-                bs.set_wheels(bs.slot(robot), lr[:, 0], lr[:, 1])
-                for c, s in enumerate(sims):
-                    for m in s.robot(robot).motors.values():
-                        m.set_position(math.inf)
-                    s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
-                    s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
-        if step == 70:
-            onto = (TO_NUE @ np.array([-1.5, 0.0, 0.8 + HALF])).tolist() if nue else [-1.5, 0.0, 0.8 + HALF]
-            bs.set_pose(1, bs.slot("a"), onto)
-            sims[1].robot("a").set_pose(onto)
-        bs.step()
-        for c, s in enumerate(sims):
-            s.step()
-            for robot in ("a", "b", "c"):
-                slot = bs.slot(robot)
-                pose = s.robot(robot).pose
-                assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
-                assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
-                heights.add(float(pose.translation[up]))
+    onto = (TO_NUE @ np.array([-1.5, 0.0, 0.8 + HALF])).tolist() if nue else [-1.5, 0.0, 0.8 + HALF]
+    heights = drive_and_compare(bs, sims, ("a", "b", "c"), np.random.default_rng(7), 150, 15, 30, (70, "a", onto), up)
     assert DECK + HALF in heights and len(heights) > 10
     assert sims[1].robot("a").drive.rest == pytest.approx(0.78 + 0.04 / 2, abs=1e-15)   # put on the table: it rides it
 
