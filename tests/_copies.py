@@ -11,10 +11,14 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
+import pytest
 
+from sensorium.schemas import world as wm
+from sensorium.server.raycast import packets
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_batched_nue import _to_nue
 from tests.test_batched_sim import _enable_both, _wheels_both
 
 
@@ -102,3 +106,22 @@ def drive_and_compare(bs: BatchedSimulation, sims: list[Simulation], robots, rng
                 assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
                 heights.add(float(pose.translation[up]))
     return heights
+
+
+def ground_copies(world: Callable[[int], wm.World], nue: bool, c_drive: bool) -> tuple[BatchedSimulation,
+                                                                                       list[Simulation], int]:
+    """Three copies of ``world(seed)`` reset with seeds 3, 4, 5 (the world written in NUE axes, y up,
+    with ``nue``), stepped by the C drive pass or (``c_drive`` False) the numpy one, a Simulation per
+    copy, and the index of the up axis. Skips the test when the C pass is asked for and not built."""
+    if c_drive and packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+
+    def make(seed: int) -> wm.World:
+        return wm.World.model_validate(_to_nue(world(seed))) if nue else world(seed)
+
+    seeds = [3, 4, 5]
+    bs = BatchedSimulation(make(0), len(seeds))
+    if not c_drive:
+        bs._drive_step = None
+    bs.reset(np.arange(3), seeds)
+    return bs, [Simulation(make(s)) for s in seeds], 1 if nue else 2

@@ -262,7 +262,6 @@ def test_template_recognition_and_exposure_changes_are_refused_in_one_line(textu
 
 gym = pytest.importorskip("gymnasium")
 
-
 from sensorium.gym import Task  # noqa: E402
 
 OBSERVED = {"eye": 32, "housed": 32}

@@ -175,7 +175,6 @@ def test_noise_draws_continue_each_stream_in_order_whatever_the_block_sizes():
 
 gym = pytest.importorskip("gymnasium")
 
-
 from sensorium.gym import SensoriumEnv, Task  # noqa: E402
 from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
 

@@ -136,7 +136,6 @@ def test_each_swept_column_reads_the_closed_form_distance_to_the_walls(precision
 
 gym = pytest.importorskip("gymnasium")
 
-
 from sensorium.gym import Task  # noqa: E402
 
 OBSERVED = {"spin": 32, "flat": 32}

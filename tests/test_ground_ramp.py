@@ -14,13 +14,11 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
-from sensorium.server.raycast import packets
 from sensorium.server.sim import contact as cmod
-from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
-from tests._copies import drive_and_compare
-from tests.test_batched_nue import TO_NUE, _to_nue
+from tests._copies import drive_and_compare, ground_copies
+from tests.test_batched_nue import TO_NUE
 
 A = 0.3                        # the ramp's angle (rad)
 HX, HY, HZ = 1.0, 0.5, 0.05    # its half sizes: 2 m long along x, 1 m wide, 0.1 m thick
@@ -215,19 +213,7 @@ def test_copies_riding_ramps_are_the_single_simulation_bit_for_bit(c_drive, nue)
     one placed tilted on it), random wheel commands, a supervisor move onto the ramp in one copy: every
     copy's poses equal a Simulation's at load and after every step, bit for bit, through the C drive and
     the numpy one, and in NUE axes."""
-    if c_drive and packets.library() is None:
-        pytest.skip(f"no packets helper: {packets.status()}")
-
-    def world(seed: int) -> wm.World:
-        return wm.World.model_validate(_to_nue(_world(seed))) if nue else _world(seed)
-
-    up = 1 if nue else 2
-    seeds = [3, 4, 5]
-    bs = BatchedSimulation(world(0), len(seeds))
-    if not c_drive:
-        bs._drive_step = None
-    bs.reset(np.arange(3), seeds)
-    sims = [Simulation(world(s)) for s in seeds]
+    bs, sims, up = ground_copies(_world, nue, c_drive)
     names = ("a", "b", "c", "d", "e")
     for c, s in enumerate(sims):
         for robot in names:
