@@ -204,15 +204,21 @@ def blocker_images(precision: str, **shape) -> np.ndarray:
                            "shapes": [{"pose": {"translation": [0, 0, 0.1]},
                                        "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}, **shape}]})
     lw = LoadedWorld(world=wm.World.model_validate(data), source="<test>", base_dir=Path.cwd())
-    bs = BatchedSimulation(lw, 2, precision=precision)
-    places = [[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]]
+    return images_with_robot_placed(lw, precision, "blocker", [[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]])
+
+
+def images_with_robot_placed(lw: LoadedWorld, precision: str, robot: str, places: list) -> np.ndarray:
+    """A copy of ``lw`` per place, ``robot`` put there by set_pose (and in a Simulation per copy alike),
+    one step with robot "bot"'s camera "cam" enabled at 8 ms: each copy's image, checked to be its
+    Simulation's byte for byte."""
+    bs = BatchedSimulation(lw, len(places), precision=precision)
     ref = bs.device("bot", "cam")
     bs.enable(ref, 8)
     singles = []
     for c, t in enumerate(places):
-        bs.set_pose(c, bs.slot("blocker"), translation=t)
+        bs.set_pose(c, bs.slot(robot), translation=t)
         single = Simulation(lw, precision=precision)
-        single.robot("blocker").set_pose(t)
+        single.robot(robot).set_pose(t)
         single.robot("bot").device("cam").enable(8)
         singles.append(single)
     bs.step()
