@@ -41,11 +41,12 @@ def copies_and_singles(make: Callable[[int], LoadedWorld], seeds: Sequence[int],
     return bs, sims
 
 
-def steer_randomly(bs: BatchedSimulation, sims: list[Simulation], rng: np.random.Generator, robots) -> None:
-    """Each of ``robots``' two wheels at a random speed within 30 % of its maximum, per copy, in the
-    copies and their Simulations alike."""
+def steer_randomly(bs: BatchedSimulation, sims: list[Simulation], rng: np.random.Generator, robots,
+                   share: float = 0.3) -> None:
+    """Each of ``robots``' two wheels at a random speed within ``share`` of its maximum, per copy, in
+    the copies and their Simulations alike."""
     for robot in robots:
-        vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
+        vmax = share * float(bs.max_wheel[bs.slot(robot), 0])
         _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(sims), 2)))
 
 
