@@ -1,8 +1,9 @@
 """Batched copies of a world beside one Simulation per copy (and a vector env beside single envs):
 the seeded setup, the random wheel commands, the mid-run reseed of one copy and the pose-for-pose
 loop that the sensor comparisons (tests/test_batched_depth.py, test_batched_rotating_lidar.py,
-test_batched_camera.py) and the ground-riding ones (tests/test_ground_box.py, test_ground_ramp.py,
-test_ground_cylinder.py) share."""
+test_batched_camera.py, test_camera_light_radius.py, test_batched_led_lights.py,
+test_batched_robot_lights.py, test_lens.py) and the ground-riding ones (tests/test_ground_box.py,
+test_ground_ramp.py, test_ground_cylinder.py) share."""
 
 from __future__ import annotations
 
