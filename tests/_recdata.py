@@ -91,3 +91,20 @@ def make_recording(path, steps: int = 50, topics=None, record_topics=None, chunk
         for item in out:
             rec.record(*item)
     return out
+
+
+def recorded_simulation(path, world: dict, name: str):
+    """A Simulation of ``world`` whose topics record each publish into the MCAP file ``path`` (the world's
+    JSON as its world text, ``name`` as its file name): (sim, topics, recorder), the recorder to close."""
+    import json
+
+    from sensorium.schemas import world as wm
+    from sensorium.server.daemon.topics import Topics
+    from sensorium.server.sim.simulation import Simulation
+
+    w = wm.World.model_validate(world)
+    sim = Simulation(w)
+    topics = Topics(sim)
+    rec = McapRecorder(path, json.dumps(world), name, world=w, flush_interval=None, background_flush=False)
+    topics.set_recorder(rec)
+    return sim, topics, rec

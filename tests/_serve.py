@@ -313,6 +313,15 @@ def run_example(world: str, example: str, robot: str, steps: int) -> tuple[dict,
         return server.conn.call(f"/{robot}/robot/get_pose"), proc
 
 
+def alive(pid: int) -> bool:
+    """Whether process ``pid`` still exists (a zombie not yet reaped counts)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
 def wait_until(pred, timeout: float = 30.0, what: str = "condition", every: float = 0.01):
     """Poll ``pred`` until it returns something truthy (returned) or ``timeout`` seconds pass."""
     deadline = time.monotonic() + timeout

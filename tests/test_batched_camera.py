@@ -7,7 +7,6 @@ environment observing them, and the template's refusals (recognition: test_batch
 from __future__ import annotations
 
 import math
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -17,8 +16,8 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
+from tests._copies import check_sub_env, copies_and_singles, reseed_copy, steer_randomly, vector_beside_singles
 from tests.test_batched_depth import scout_ahead_in_copy_0
-from tests.test_batched_sim import _enable_both, _wheels_both
 from tests.test_gym_vector import _reset_both, _step_both
 
 WORLD = Path(__file__).parent / "worlds" / "camera.yaml"
@@ -57,13 +56,11 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
     after every basic step every image of every copy equals that of a Simulation built with that
     copy's seed, byte for byte (black before the first capture)."""
     seeds = [5, 6, 7]
-    make = _glass if glass else _world
-    bs = BatchedSimulation(make(0, texture_dir), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(make(s, texture_dir), precision=precision) for s in seeds]
 
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
+    def make(seed: int) -> LoadedWorld:
+        return (_glass if glass else _world)(seed, texture_dir)
+
+    bs, sims = copies_and_singles(make, seeds, precision, PERIODS)
     through = []                                 # the casts of rays going on past a semi-transparent surface
     cast = bs.rays.cast
 
@@ -77,13 +74,9 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
     seen = {"black": 0, "sky": 0, "textured": 0}
     for step in range(70):
         if step % 10 == 0:
-            for robot in PERIODS:
-                vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
-                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            steer_randomly(bs, sims, rng, PERIODS)
         if step == 40:                          # copy 1 as a new world with another seed
-            bs.reset([1], [42])
-            sims[1] = Simulation(make(42, texture_dir), precision=precision)
-            _enable_both(bs, sims, PERIODS, 1)
+            reseed_copy(bs, sims, make, 1, 42, precision, PERIODS)
         bs.step()
         for c, s in enumerate(sims):
             s.step()
@@ -211,15 +204,21 @@ def blocker_images(precision: str, **shape) -> np.ndarray:
                            "shapes": [{"pose": {"translation": [0, 0, 0.1]},
                                        "geometry": {"type": "box", "size": [0.1, 0.1, 0.1]}, **shape}]})
     lw = LoadedWorld(world=wm.World.model_validate(data), source="<test>", base_dir=Path.cwd())
-    bs = BatchedSimulation(lw, 2, precision=precision)
-    places = [[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]]
+    return images_with_robot_placed(lw, precision, "blocker", [[1.5, -0.25, 0.0], [-3.0, 3.0, 0.0]])
+
+
+def images_with_robot_placed(lw: LoadedWorld, precision: str, robot: str, places: list) -> np.ndarray:
+    """A copy of ``lw`` per place, ``robot`` put there by set_pose (and in a Simulation per copy alike),
+    one step with robot "bot"'s camera "cam" enabled at 8 ms: each copy's image, checked to be its
+    Simulation's byte for byte."""
+    bs = BatchedSimulation(lw, len(places), precision=precision)
     ref = bs.device("bot", "cam")
     bs.enable(ref, 8)
     singles = []
     for c, t in enumerate(places):
-        bs.set_pose(c, bs.slot("blocker"), translation=t)
+        bs.set_pose(c, bs.slot(robot), translation=t)
         single = Simulation(lw, precision=precision)
-        single.robot("blocker").set_pose(t)
+        single.robot(robot).set_pose(t)
         single.robot("bot").device("cam").enable(8)
         singles.append(single)
     bs.step()
@@ -269,10 +268,7 @@ def test_template_recognition_and_exposure_changes_are_refused_in_one_line(textu
 
 gym = pytest.importorskip("gymnasium")
 
-from gymnasium.utils.env_checker import check_env  # noqa: E402
-
-from sensorium.gym import SensoriumEnv, Task  # noqa: E402
-from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
+from sensorium.gym import Task  # noqa: E402
 
 OBSERVED = {"eye": 32, "housed": 32}
 
@@ -289,11 +285,9 @@ def test_the_vector_env_observes_cameras_as_the_single_env(precision: str, textu
     autoresets; a sub-env passes Gymnasium's checker."""
     n = 3
     world = _world(3, texture_dir)
-    venv = SensoriumVectorEnv(world, _task(), n, precision=precision)
+    venv, singles = vector_beside_singles(world, _task(), n, precision)
     space = venv.single_observation_space
     assert space["eye"].shape == (12, 16, 3) and space["eye"].dtype == np.uint8
-    singles = [SensoriumEnv(world, _task(), precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
-    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
     _reset_both(venv, singles, 4)
     rng = np.random.default_rng(5)
     done = np.zeros(n, dtype=bool)
@@ -305,7 +299,5 @@ def test_the_vector_env_observes_cameras_as_the_single_env(precision: str, textu
         assert all(space[k].contains(vobs[k][0]) for k in OBSERVED)
         assert vobs["eye"][0].std() > 5.0                     # a picture, not a flat colour
     assert ended >= n                                           # autoresets happened
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(venv.sub_env(1), skip_render_check=True)
+    check_sub_env(venv)
     venv.close()

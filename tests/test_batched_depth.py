@@ -6,7 +6,6 @@ them, and a camera measured next to them."""
 from __future__ import annotations
 
 import math
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +17,7 @@ from sensorium.server.sim import batched_depth
 from sensorium.server.sim.batched import BatchedSimulation, NoiseStreams
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
-from tests.test_batched_sim import _enable_both, _wheels_both
+from tests._copies import check_sub_env, copies_and_singles, reseed_copy, seeded, steer_randomly, vector_beside_singles
 from tests.test_gym_vector import _random_steps, _reset_both
 
 WORLD = Path(__file__).parent / "worlds" / "depth.yaml"
@@ -27,9 +26,7 @@ BOTH = ["fast", "exact"]
 
 
 def _world(seed: int) -> LoadedWorld:
-    lw = load_world(WORLD)
-    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
-    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+    return seeded(WORLD, seed)
 
 
 @pytest.mark.parametrize("precision", BOTH)
@@ -41,23 +38,14 @@ def test_every_copy_captures_its_range_finders_as_the_single_simulation(precisio
     Simulation built with that copy's seed, bit for bit (zeros before the first capture, +inf for
     no hit)."""
     seeds = [5, 6, 7]
-    bs = BatchedSimulation(_world(0), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(_world(s), precision=precision) for s in seeds]
-
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
+    bs, sims = copies_and_singles(_world, seeds, precision, PERIODS)
     rng = np.random.default_rng(1)
     seen = {"inf": 0, "finite": 0, "zeros": 0, "near": 0}
     for step in range(90):
         if step % 10 == 0:
-            for robot in PERIODS:
-                vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
-                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            steer_randomly(bs, sims, rng, PERIODS)
         if step == 50:                          # copy 1 as a new world with another seed
-            bs.reset([1], [42])
-            sims[1] = Simulation(_world(42), precision=precision)
-            _enable_both(bs, sims, PERIODS, 1)
+            reseed_copy(bs, sims, _world, 1, 42, precision, PERIODS)
         bs.step()
         for c, s in enumerate(sims):
             s.step()
@@ -187,8 +175,6 @@ def test_noise_draws_continue_each_stream_in_order_whatever_the_block_sizes():
 
 gym = pytest.importorskip("gymnasium")
 
-from gymnasium.utils.env_checker import check_env  # noqa: E402
-
 from sensorium.gym import SensoriumEnv, Task  # noqa: E402
 from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
 
@@ -206,18 +192,14 @@ def test_the_vector_env_observes_range_finders_as_the_single_env(precision: str)
     batched engine, which "auto" now picks) with its seed, observations, rewards and poses bit for
     bit, across autoresets; "no hit" reads max_range; a sub-env passes Gymnasium's checker."""
     n = 3
-    venv = SensoriumVectorEnv(WORLD, _task(), n, precision=precision)
+    venv, singles = vector_beside_singles(WORLD, _task(), n, precision)
     space = venv.single_observation_space
     assert space["depth"].shape == (12, 16) and space["wide"].shape == (6, 24)
     assert space["depth"].dtype == np.float32 and space["depth"].high.max() == np.float32(2.5)
-    singles = [SensoriumEnv(WORLD, _task(), precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
-    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
     obs = _reset_both(venv, singles, 4)
     assert (obs["depth"] == np.float32(2.5)).any() and (obs["depth"] < 2.5).any()   # no hit: max_range
     assert _random_steps(venv, singles, OBSERVED, 45) >= n       # autoresets happened
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(venv.sub_env(1), skip_render_check=True)
+    check_sub_env(venv)
     venv.close()
 
 

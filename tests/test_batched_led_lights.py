@@ -13,7 +13,7 @@ from test_batched_robot_lights import PERIODS, SENSORS, _world
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld
-from tests.test_batched_sim import _enable_both, _wheels_both
+from tests._copies import copies_and_singles, reseed_copy, steer_randomly
 
 LEDS = [
     {"device": "LED", "name": "lamp", "pose": {"translation": [0.02, 0.0, 0.12], "rotation": [0, 0, 1, 0.7]},
@@ -48,12 +48,8 @@ def _assert_same(bs: BatchedSimulation, sims: list[Simulation], step: int) -> No
 @pytest.mark.parametrize("precision", ["fast", "exact"])
 def test_every_copy_is_lit_by_its_own_leds_as_the_single_simulation(precision: str):
     seeds = [5, 6, 7]
-    bs = BatchedSimulation(_led_world(0), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(_led_world(s), precision=precision) for s in seeds]
+    bs, sims = copies_and_singles(_led_world, seeds, precision, PERIODS)
     assert bs.carried is not None and bs.carried.switched
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
     leader = bs.slot("leader")
     rng = np.random.default_rng(3)
     front = bs.device("seeker", "front")
@@ -62,18 +58,14 @@ def test_every_copy_is_lit_by_its_own_leds_as_the_single_simulation(precision: s
             20: ("rgb", 0xFF2000, [0]), 26: ("plain", 1, [2])}
     for step in range(34):
         if step % 10 == 0:
-            for robot in ("leader", "seeker"):
-                vmax = 0.4 * float(bs.max_wheel[bs.slot(robot), 0])
-                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            steer_randomly(bs, sims, rng, ("leader", "seeker"), 0.4)
         if step in plan:
             name, value, copies = plan[step]
             bs.set_led(leader, name, value, copies)
             for c in copies:
                 sims[c].device(f"leader/{name}").set(value, sims[c].time_ms)
         if step == 30:                          # copy 2 as a new world: its LEDs off again
-            bs.reset([2], [42])
-            sims[2] = Simulation(_led_world(42), precision=precision)
-            _enable_both(bs, sims, PERIODS, 2)
+            reseed_copy(bs, sims, _led_world, 2, 42, precision, PERIODS)
         bs.step()
         for s in sims:
             s.step()

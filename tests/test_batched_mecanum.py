@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 import pytest
 
-from sensorium.server.sim.batched import BatchedSimulation
+from sensorium.server.sim.batched import BatchedSimulation, DeviceRef
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
 from tests._motors import assert_same_readings
@@ -108,41 +108,12 @@ def test_every_copy_steps_as_the_single_simulation_bit_for_bit(contact):
     """Three copies, each against its own Simulation (world seeds 5, 6, 7), 400 steps of random
     commands changed every 40 steps (velocity and position control), a set_pose at step 200: every
     robot's pose and every device's reading the same bits every step; contact clipped moves."""
-    from sensorium.gym.views import CopySim
-
-    w = world(contact)
-    n = 3
-    batched = BatchedSimulation(w, n)
-    batched.reset(np.arange(n), [5, 6, 7])
-    singles = [Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
-        update={"random_seed": s})})) for s in (5, 6, 7)]
-    views = [CopySim(batched, c) for c in range(n)]
-    for s in (*singles, *views):
-        for r in s.robots.values():
-            for d in r.model.devices:
-                r.device(d.name).enable(32 if d.device != "GPS" else 16)
-    rng = np.random.default_rng(8)
-    pressed = 0
-    for t in range(400):
-        if t % 40 == 0:
-            cmds = [random_commands(rng, w.world) for _ in range(n)]
-        if t == 200:
-            for s in (singles[1], views[1]):
-                s.robot("yb").set_pose(translation=[-0.5, -0.5, 0.1], rotation=[0, 0, 1, 0.7])
-        for c in range(n):
-            command(singles[c], cmds[c])
-            command(views[c], cmds[c])
-            singles[c].step()
-        batched.step()
-        for c in range(n):
-            for name in ("yb", "yb2", "dd"):
-                assert same_pose(singles[c], views[c], name), (t, c, name)
-                assert_same_readings(singles[c], views[c], name, (t, c))
-            pressed += sum(singles[c].robot(name).pressing for name in ("yb", "yb2"))
+    batched, _, pressed = lockstep(world(contact), 400, (5, 6, 7), rng_seed=8, sample_ms=32,
+                                   set_poses=(200, 1, {"yb": ([-0.5, -0.5, 0.1], [0, 0, 1, 0.7])}))
     if contact:
-        assert pressed > 20 and batched.counters["contacts"] > 0      # walls and robots were met
+        assert pressed["yb"] + pressed["yb2"] > 20 and batched.counters["contacts"] > 0      # walls and robots were met
     else:
-        assert batched.contact is None and pressed == 0
+        assert batched.contact is None and pressed["yb"] + pressed["yb2"] == 0
 
 
 def test_strafe_turn_and_diagonal_in_closed_form_each_copy_its_own():
@@ -193,6 +164,35 @@ def test_a_pure_strafe_is_exact_in_closed_form_every_step():
         assert (batched.rot[:, 0] == np.eye(3)).all()
 
 
+def plan_copies(w, plan: list[dict], drive: str, motors, bumper_of: str, steps: int) -> tuple[BatchedSimulation, DeviceRef]:
+    """A copy of ``w`` per entry of ``plan`` ({robot: its wheels' speeds in ``motors``' order}), each
+    commanded through the batched simulation's ``drive`` ("mecanum" or "omni"), run ``steps`` with the
+    bumper of robot ``bumper_of`` enabled; beside each, a Simulation commanded alike whose poses (the
+    plan's robots) and bumper reading are the copy's bit for bit. Returns the batched simulation and
+    its bumper device."""
+    batched = BatchedSimulation(w, len(plan))
+    for name in plan[0]:
+        getattr(batched, drive).command(batched.slot(name), [p[name] for p in plan])
+    bumper = batched.device(bumper_of, "bumper")
+    batched.enable(bumper, 16)
+    batched.run(steps)
+    for c, p in enumerate(plan):
+        single = Simulation(w)
+        single.device(f"{bumper_of}/bumper").enable(16)
+        for name, speeds in p.items():
+            for m, u in zip(motors, speeds):
+                single.robot(name).motor(m).set_position(math.inf)
+                single.robot(name).motor(m).set_velocity(u)
+        single.run(steps)
+        for name in p:
+            pose = single.robot(name).pose
+            slot = batched.slot(name)
+            assert pose.translation.tobytes() == batched.pos[c, slot].tobytes(), (c, name)
+            assert pose.rotation.tobytes() == batched.rot[c, slot].tobytes(), (c, name)
+        assert single.device(f"{bumper_of}/bumper").value == batched.value(bumper)[c]
+    return batched, bumper
+
+
 LEFT, RIGHT, STAND = [-10.0, 10.0, 10.0, -10.0], [10.0, -10.0, -10.0, 10.0], [0.0] * 4
 
 
@@ -206,12 +206,7 @@ def test_strafes_against_a_wall_and_a_robot_stop_there_and_copies_never_meet():
                      "solids": [wall("wall", 0.0, 1.0, 4.0, 0.2)],
                      "robots": [youbot("yb", 0.0, 0.0), youbot("other", 0.0, -1.0)]})
     plan = [{"yb": RIGHT, "other": STAND}, {"yb": RIGHT, "other": RIGHT}, {"yb": LEFT, "other": STAND}]
-    batched = BatchedSimulation(w, len(plan))
-    for name in ("yb", "other"):
-        batched.mecanum.command(batched.slot(name), [p[name] for p in plan])
-    bumper = batched.device("yb", "bumper")
-    batched.enable(bumper, 16)
-    batched.run(100)                                # 1.6 s at 0.5 m/s
+    batched, bumper = plan_copies(w, plan, "mecanum", WHEELS, "yb", 100)       # 1.6 s at 0.5 m/s
     yb, other = batched.slot("yb"), batched.slot("other")
     assert batched.pos[0, yb, 1] == pytest.approx(-1.0 + 2 * HALF_W, abs=1e-6)      # side against side
     assert batched.pos[0, other, 1] == -1.0
@@ -220,20 +215,6 @@ def test_strafes_against_a_wall_and_a_robot_stop_there_and_copies_never_meet():
     assert batched.pos[2, yb, 1] == pytest.approx(0.9 - HALF_W, abs=1e-9)           # its left side on the face
     assert batched.pos[:, yb, 0].tolist() == [0.0] * 3 and (batched.rot[:, yb] == np.eye(3)).all()
     assert batched.value(bumper).tolist() == [1.0, 0.0, 1.0]
-    for c, p in enumerate(plan):
-        single = Simulation(w)
-        single.device("yb/bumper").enable(16)
-        for name, speeds in p.items():
-            for m, u in zip(WHEELS, speeds):
-                single.robot(name).motor(m).set_position(math.inf)
-                single.robot(name).motor(m).set_velocity(u)
-        single.run(100)
-        for name in ("yb", "other"):
-            pose = single.robot(name).pose
-            slot = batched.slot(name)
-            assert pose.translation.tobytes() == batched.pos[c, slot].tobytes(), (c, name)
-            assert pose.rotation.tobytes() == batched.rot[c, slot].tobytes(), (c, name)
-        assert single.device("yb/bumper").value == batched.value(bumper)[c]
 
 
 def test_set_wheels_on_a_mecanum_robot_says_how_to_command_it():
@@ -348,18 +329,19 @@ def test_bad_actions_are_refused_in_one_line(bad):
             venv.step(np.zeros((2, len(bad)), dtype=np.float32))
 
 
-def test_pettingzoo_mecanum_robots_are_agents_and_both_engines_agree():
+def parallel_engines_agree(w, robots: tuple[str, ...]):
+    """Every robot of ``w`` (``robots``, in order) an agent of a PettingZoo env on each engine, random
+    actions from the same seeds: every GPS observation, reward and flag the same bits until all are
+    truncated after 20 actions. Returns the simulation engine's env (for its action spaces)."""
     from sensorium.gym import Task
     from sensorium.gym.multi import SensoriumParallelEnv
 
-    w = world(True)
-    assert SensoriumParallelEnv(w).possible_agents == ["yb", "yb2", "dd"]
+    assert SensoriumParallelEnv(w).possible_agents == list(robots)
 
     def make(engine):
         return SensoriumParallelEnv(w, {r: Task(robot=r, control_period_ms=32, max_steps=20, observations=["gps"])
-                                        for r in ("yb", "yb2", "dd")}, engine=engine)
+                                        for r in robots}, engine=engine)
     a, b = make("simulation"), make("batched")
-    assert a.action_space("yb").shape == (4,) and a.action_space("dd").shape == (2,)
     oa, _ = a.reset(seed=7)
     ob, _ = b.reset(seed=7)
     rng = np.random.default_rng(0)
@@ -372,38 +354,53 @@ def test_pettingzoo_mecanum_robots_are_agents_and_both_engines_agree():
         ob, rb, tb, ub, _ = b.step(acts)
         assert (ra, ta, ua) == (rb, tb, ub)
     assert not a.agents                                  # all truncated after 20 actions, robots stopped
+    return a
 
 
-@pytest.mark.slow           # starts worker processes
-def test_the_workers_env_carries_four_wheel_actions_bit_for_bit():
-    """SensoriumWorkersEnv (two processes) shares (n, 4) actions: sub-env i equals the one-process
-    vector env's, autoresets included."""
+def test_pettingzoo_mecanum_robots_are_agents_and_both_engines_agree():
+    a = parallel_engines_agree(world(True), ("yb", "yb2", "dd"))
+    assert a.action_space("yb").shape == (4,) and a.action_space("dd").shape == (2,)
+
+
+def workers_agree(w, task, n: int, width: int) -> None:
+    """SensoriumWorkersEnv (two processes) and the one-process vector env of ``n`` sub-envs of ``task``:
+    the same action space, (n, ``width``) random actions, every reset and step the same (autoresets
+    included); a wrong action shape refused in one line."""
     from sensorium.gym.vector import SensoriumVectorEnv
     from sensorium.gym.workers import SensoriumWorkersEnv
     from tests.test_gym_workers import _same
 
-    w, n = world(True), 3
-    ref, envs = SensoriumVectorEnv(w, agent_task(max_steps=5), n), SensoriumWorkersEnv(w, agent_task(max_steps=5), n,
-                                                                                       workers=2)
+    ref, envs = SensoriumVectorEnv(w, task, n), SensoriumWorkersEnv(w, task, n, workers=2)
     try:
-        assert envs.action_space == ref.action_space and envs.single_action_space.shape == (4,)
+        assert envs.action_space == ref.action_space and envs.single_action_space.shape == (width,)
         _same(envs.reset(seed=2), ref.reset(seed=2), "reset")
         rng = np.random.default_rng(1)
         for t in range(12):
-            a = rng.uniform(-1, 1, (n, 4)).astype(np.float32)
+            a = rng.uniform(-1, 1, (n, width)).astype(np.float32)
             _same(envs.step(a), ref.step(a), f"step {t}")
-        with pytest.raises(ValueError, match=r"^actions must have shape \(3, 4\)"):
+        with pytest.raises(ValueError, match=rf"^actions must have shape \({n}, {width}\)"):
             envs.step(np.zeros((n, 2), dtype=np.float32))
     finally:
         ref.close()
         envs.close()
 
 
-def lockstep(w, steps: int, seeds=(5, 6)) -> tuple[BatchedSimulation, int, int]:
-    """Copies of ``w`` (one per seed) and a Simulation per copy with random commands changed every
-    40 steps (:func:`random_commands`): every robot's pose and readings the same bits every step.
-    Returns the batched simulation and the copy-steps in which a robot was tilted (on a slope) and
-    pressed against something."""
+@pytest.mark.slow           # starts worker processes
+def test_the_workers_env_carries_four_wheel_actions_bit_for_bit():
+    """SensoriumWorkersEnv (two processes) shares (n, 4) actions: sub-env i equals the one-process
+    vector env's, autoresets included."""
+    workers_agree(world(True), agent_task(max_steps=5), 3, 4)
+
+
+def lockstep(w, steps: int, seeds=(5, 6), commands=random_commands, rng_seed: int | None = None,
+             sample_ms: int = 16, set_poses=None) -> tuple[BatchedSimulation, int, dict[str, int]]:
+    """Copies of ``w`` (one per seed, the world's random_seed that seed) and a Simulation per copy, with
+    ``commands(rng, world)`` per copy changed every 40 steps (rng seeded ``rng_seed``, by default the
+    robots' count): every robot's pose and readings the same bits every step. Every device is
+    sampled every ``sample_ms`` but the GPSs, every 16 ms; ``set_poses``, (step, copy, {robot:
+    (translation, rotation)}), moves those robots by set_pose in that copy and its Simulation before
+    that step. Returns the batched simulation, the copy-steps in which a robot was tilted (on a
+    slope), and per robot the copy-steps in which it was pressed against something."""
     from sensorium.gym.views import CopySim
 
     n = len(seeds)
@@ -415,12 +412,17 @@ def lockstep(w, steps: int, seeds=(5, 6)) -> tuple[BatchedSimulation, int, int]:
     for s in (*singles, *views):
         for r in s.robots.values():
             for d in r.model.devices:
-                r.device(d.name).enable(16)
-    rng = np.random.default_rng(len(w.world.robots))
-    tilted = pressed = 0
+                r.device(d.name).enable(sample_ms if d.device != "GPS" else 16)
+    rng = np.random.default_rng(len(w.world.robots) if rng_seed is None else rng_seed)
+    tilted = 0
+    pressed = {r.name: 0 for r in w.world.robots}
     for t in range(steps):
         if t % 40 == 0:
-            cmds = [random_commands(rng, w.world) for _ in range(n)]
+            cmds = [commands(rng, w.world) for _ in range(n)]
+        if set_poses is not None and t == set_poses[0]:
+            for s in (singles[set_poses[1]], views[set_poses[1]]):
+                for name, (translation, rotation) in set_poses[2].items():
+                    s.robot(name).set_pose(translation=translation, rotation=rotation)
         for c in range(n):
             command(singles[c], cmds[c])
             command(views[c], cmds[c])
@@ -430,7 +432,7 @@ def lockstep(w, steps: int, seeds=(5, 6)) -> tuple[BatchedSimulation, int, int]:
             for name in singles[c].robots:
                 assert same_pose(singles[c], views[c], name), (t, c, name)
                 assert_same_readings(singles[c], views[c], name, (t, c))
-                pressed += bool(singles[c].robot(name).pressing)
+                pressed[name] += bool(singles[c].robot(name).pressing)
         tilted += int(batched.tilted.sum())
     return batched, tilted, pressed
 
@@ -463,4 +465,4 @@ def test_a_nue_world_batches_mecanum_robots_bit_for_bit():
                                                         ("n", 0.9, 0.0, 0.2, 1.6), ("s", -0.9, 0.0, 0.2, 1.6))],
                      "robots": [robot]})
     batched, _, pressed = lockstep(w, 240)
-    assert batched.to_enu is not None and pressed > 0
+    assert batched.to_enu is not None and sum(pressed.values()) > 0

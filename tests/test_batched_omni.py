@@ -19,8 +19,7 @@ import pytest
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
-from tests._motors import assert_same_readings
-from tests.test_batched_mecanum import command, lockstep, same_pose, wall, youbot
+from tests.test_batched_mecanum import lockstep, parallel_engines_agree, plan_copies, wall, workers_agree, youbot
 
 STEP = 16
 DT = STEP / 1000.0
@@ -126,39 +125,11 @@ def test_every_copy_steps_as_the_single_simulation_bit_for_bit(contact):
     """Three copies, each against its own Simulation (world seeds 5, 6, 7), 400 steps of random
     commands changed every 40 steps (velocity and position control), set_poses at step 200: every
     robot's pose and every device's reading the same bits every step; contact clipped moves."""
-    from sensorium.gym.views import CopySim
-
-    w = world(contact)
-    n = 3
-    batched = BatchedSimulation(w, n)
+    moves = {"tri": ([-0.5, -0.1, 0.05], [0, 0, 1, 0.7]), "boe": ([0.2, 0.8, 0.04], [0, 0, 1, -2.0])}
+    batched, _, pressed = lockstep(world(contact), 400, (5, 6, 7), random_commands, rng_seed=8, sample_ms=32,
+                                   set_poses=(200, 1, moves))
     assert batched.omni is not None and batched.omni.width == 4 and batched.omni.count.tolist() == [3, 4]
-    batched.reset(np.arange(n), [5, 6, 7])
-    singles = [Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
-        update={"random_seed": s})})) for s in (5, 6, 7)]
-    views = [CopySim(batched, c) for c in range(n)]
-    for s in (*singles, *views):
-        for r in s.robots.values():
-            for d in r.model.devices:
-                r.device(d.name).enable(32 if d.device != "GPS" else 16)
-    rng = np.random.default_rng(8)
-    pressed = dict.fromkeys(NAMES, 0)
-    for t in range(400):
-        if t % 40 == 0:
-            cmds = [random_commands(rng, w.world) for _ in range(n)]
-        if t == 200:
-            for s in (singles[1], views[1]):
-                s.robot("tri").set_pose(translation=[-0.5, -0.1, 0.05], rotation=[0, 0, 1, 0.7])
-                s.robot("boe").set_pose(translation=[0.2, 0.8, 0.04], rotation=[0, 0, 1, -2.0])
-        for c in range(n):
-            command(singles[c], cmds[c])
-            command(views[c], cmds[c])
-            singles[c].step()
-        batched.step()
-        for c in range(n):
-            for name in NAMES:
-                assert same_pose(singles[c], views[c], name), (t, c, name)
-                assert_same_readings(singles[c], views[c], name, (t, c))
-                pressed[name] += bool(singles[c].robot(name).pressing)
+    assert list(pressed) == list(NAMES)
     if contact:       # walls and robots were met, by every kind of robot
         assert all(p > 0 for p in pressed.values()), pressed
     else:
@@ -253,12 +224,7 @@ def test_strafes_against_a_wall_and_a_robot_stop_there_and_copies_never_meet():
     drive = w.world.robots[0].omni_drive
     right, left, stand = rim_speeds(drive, 0.0, -0.5, 0.0), rim_speeds(drive, 0.0, 0.5, 0.0), [0.0] * 3
     plan = [{"tri": right, "other": stand}, {"tri": right, "other": right}, {"tri": left, "other": stand}]
-    batched = BatchedSimulation(w, len(plan))
-    for name in ("tri", "other"):
-        batched.omni.command(batched.slot(name), [p[name] for p in plan])
-    bumper = batched.device("tri", "bumper")
-    batched.enable(bumper, 16)
-    batched.run(100)                                # 1.6 s at 0.5 m/s
+    batched, bumper = plan_copies(w, plan, "omni", ("wheel1", "wheel2", "wheel3"), "tri", 100)     # 1.6 s at 0.5 m/s
     tri, other = batched.slot("tri"), batched.slot("other")
     assert batched.pos[0, tri, 1] == pytest.approx(-1.0 + 2 * BODY3, abs=1e-6)      # disc against disc
     assert batched.pos[0, other, 1] == -1.0
@@ -267,20 +233,6 @@ def test_strafes_against_a_wall_and_a_robot_stop_there_and_copies_never_meet():
     assert batched.pos[2, tri, 1] == pytest.approx(0.9 - BODY3, abs=1e-9)           # its disc on the face
     assert batched.pos[:, tri, 0] == pytest.approx([0.0] * 3, abs=1e-12)
     assert batched.value(bumper).tolist() == [1.0, 0.0, 1.0]
-    for c, p in enumerate(plan):
-        single = Simulation(w)
-        single.device("tri/bumper").enable(16)
-        for name, speeds in p.items():
-            for i, u in enumerate(speeds):
-                single.robot(name).motor(f"wheel{i + 1}").set_position(math.inf)
-                single.robot(name).motor(f"wheel{i + 1}").set_velocity(u)
-        single.run(100)
-        for name in ("tri", "other"):
-            pose = single.robot(name).pose
-            slot = batched.slot(name)
-            assert pose.translation.tobytes() == batched.pos[c, slot].tobytes(), (c, name)
-            assert pose.rotation.tobytes() == batched.rot[c, slot].tobytes(), (c, name)
-        assert single.device("tri/bumper").value == batched.value(bumper)[c]
 
 
 def test_commands_are_checked_in_one_line():
@@ -323,7 +275,7 @@ def test_omni_and_off_centre_robots_ride_a_ramp_and_a_nue_world_as_in_the_single
                      "robots": [nue(omni("tri", 0, 0), 0.0, 0.0, 0.24, 0.24),
                                 nue(boebot("boe", 0, 0), 0.5, 0.3, 0.1, 0.12)]})
     batched, _, pressed = lockstep(w, 240)
-    assert batched.to_enu is not None and pressed > 0
+    assert batched.to_enu is not None and sum(pressed.values()) > 0
 
 
 # ---------------------------------------------------------------- an omni-wheel agent (Gymnasium)
@@ -427,51 +379,12 @@ def test_bad_actions_are_refused_in_one_line():
 
 
 def test_pettingzoo_omni_and_off_centre_robots_are_agents_and_both_engines_agree():
-    from sensorium.gym import Task
-    from sensorium.gym.multi import SensoriumParallelEnv
-
-    w = world(True)
-    assert SensoriumParallelEnv(w).possible_agents == list(NAMES)
-
-    def make(engine):
-        return SensoriumParallelEnv(w, {r: Task(robot=r, control_period_ms=32, max_steps=20, observations=["gps"])
-                                        for r in NAMES}, engine=engine)
-    a, b = make("simulation"), make("batched")
+    a = parallel_engines_agree(world(True), NAMES)
     assert [a.action_space(r).shape for r in NAMES] == [(3,), (4,), (4,), (2,), (2,)]
-    oa, _ = a.reset(seed=7)
-    ob, _ = b.reset(seed=7)
-    rng = np.random.default_rng(0)
-    for _ in range(25):
-        assert all(np.asarray(oa[k]["gps"]).tobytes() == np.asarray(ob[k]["gps"]).tobytes() for k in oa)
-        if not a.agents:
-            break
-        acts = {k: rng.uniform(-1, 1, a.action_space(k).shape).astype(np.float32) for k in a.agents}
-        oa, ra, ta, ua, _ = a.step(acts)
-        ob, rb, tb, ub, _ = b.step(acts)
-        assert (ra, ta, ua) == (rb, tb, ub)
-    assert not a.agents
 
 
 @pytest.mark.slow           # starts worker processes
 def test_the_workers_env_carries_omni_wheel_actions_bit_for_bit():
     """SensoriumWorkersEnv (two processes) shares (n, 3) actions: sub-env i equals the one-process
     vector env's, autoresets included."""
-    from sensorium.gym.vector import SensoriumVectorEnv
-    from sensorium.gym.workers import SensoriumWorkersEnv
-    from tests.test_gym_workers import _same
-
-    w, n = world(True), 3
-    ref = SensoriumVectorEnv(w, agent_task(max_steps=5), n)
-    envs = SensoriumWorkersEnv(w, agent_task(max_steps=5), n, workers=2)
-    try:
-        assert envs.action_space == ref.action_space and envs.single_action_space.shape == (3,)
-        _same(envs.reset(seed=2), ref.reset(seed=2), "reset")
-        rng = np.random.default_rng(1)
-        for t in range(12):
-            a = rng.uniform(-1, 1, (n, 3)).astype(np.float32)
-            _same(envs.step(a), ref.step(a), f"step {t}")
-        with pytest.raises(ValueError, match=r"^actions must have shape \(3, 3\)"):
-            envs.step(np.zeros((n, 2), dtype=np.float32))
-    finally:
-        ref.close()
-        envs.close()
+    workers_agree(world(True), agent_task(max_steps=5), 3, 3)

@@ -15,7 +15,8 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
-from tests.test_batched_sim import _enable_both, _wheels_both
+from tests._copies import copies_and_singles, reseed_copy, steer_randomly
+from tests.test_batched_sim import _wheels_both
 
 WORLD = Path(__file__).parent / "worlds" / "robot_lights.yaml"
 PERIODS = {"seeker": {"front": 16, "left": 32, "tinted": 48, "eye": 32}}
@@ -50,24 +51,16 @@ def test_every_copy_is_lit_by_its_own_leader_as_the_single_simulation(precision:
     with that copy's seed, bit for bit. The leader's lights reach the sensors (values change with the
     copy and over time) and the wall hides them sometimes (the occluded sensor drops)."""
     seeds = [5, 6, 7, 8]
-    bs = BatchedSimulation(_world(0), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(_world(s), precision=precision) for s in seeds]
+    bs, sims = copies_and_singles(_world, seeds, precision, PERIODS)
     assert bs.carried is not None and bs.carried.count == 3          # the "spare" light is off
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
     rng = np.random.default_rng(11)
     front = bs.device("seeker", "front")
     seen: list[np.ndarray] = []
     for step in range(60):
         if step % 12 == 0:
-            for robot in ("leader", "seeker"):
-                vmax = 0.4 * float(bs.max_wheel[bs.slot(robot), 0])
-                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            steer_randomly(bs, sims, rng, ("leader", "seeker"), 0.4)
         if step == 30:                          # copy 1 as a new world with another seed
-            bs.reset([1], [42])
-            sims[1] = Simulation(_world(42), precision=precision)
-            _enable_both(bs, sims, PERIODS, 1)
+            reseed_copy(bs, sims, _world, 1, 42, precision, PERIODS)
         bs.step()
         for s in sims:
             s.step()
@@ -244,12 +237,11 @@ def test_textured_robot_bodies_read_as_in_the_single_simulation(precision: str, 
     simulation's with that copy's seed, bit for bit; the body's and the dome's texels were looked
     up, and the copies' images differ (each its own pose of the painted robot)."""
     seeds = [3, 4, 9]
-    bs = BatchedSimulation(_textured(0, textured_dir), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(_textured(s, textured_dir), precision=precision) for s in seeds]
+    def textured(seed: int) -> LoadedWorld:
+        return _textured(seed, textured_dir)
+
+    bs, sims = copies_and_singles(textured, seeds, precision, TEXTURED_PERIODS)
     assert bs.robot_textures is not None
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, TEXTURED_PERIODS, c)
     rng = np.random.default_rng(2)
     textures = bs.robot_textures
     looked_up: list[int] = []                    # the robot shapes whose texels a copy read
@@ -271,9 +263,7 @@ def test_textured_robot_bodies_read_as_in_the_single_simulation(precision: str, 
                 lr = rng.uniform(-2.0, 2.0, (len(seeds), 2))
                 _wheels_both(bs, sims, robot, lr if robot == "painted" else 0.2 * lr)
         if step == 20:
-            bs.reset([2], [77])
-            sims[2] = Simulation(_textured(77, textured_dir), precision=precision)
-            _enable_both(bs, sims, TEXTURED_PERIODS, 2)
+            reseed_copy(bs, sims, textured, 2, 77, precision, TEXTURED_PERIODS)
         bs.step()
         for s in sims:
             s.step()

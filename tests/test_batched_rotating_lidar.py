@@ -6,7 +6,6 @@ of a square room; the vector environment observing one, as the single env."""
 from __future__ import annotations
 
 import math
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -15,8 +14,8 @@ import pytest
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import LoadedWorld, from_model, load_world
-from tests.test_batched_sim import _enable_both, _wheels_both
+from sensorium.server.world.loader import LoadedWorld, from_model
+from tests._copies import check_sub_env, copies_and_singles, reseed_copy, seeded, steer_randomly, vector_beside_singles
 from tests.test_gym_vector import _random_steps, _reset_both
 
 WORLD = Path(__file__).parent / "worlds" / "rotating_lidar.yaml"
@@ -26,9 +25,7 @@ BOTH = ["fast", "exact"]
 
 
 def _world(seed: int) -> LoadedWorld:
-    lw = load_world(WORLD)
-    w = lw.world.model_copy(update={"world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})
-    return LoadedWorld(world=w, source=lw.source, base_dir=lw.base_dir)
+    return seeded(WORLD, seed)
 
 
 def _enable_one(bs: BatchedSimulation, sims: list, copy: int, robot: str, name: str, period: int) -> None:
@@ -46,23 +43,15 @@ def test_every_copy_sweeps_its_rotating_lidars_as_the_single_simulation(precisio
     that of a Simulation built with that copy's seed, bit for bit (zeros where the head has not swept
     yet, +inf for no hit)."""
     seeds = [5, 6, 7]
-    bs = BatchedSimulation(_world(0), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(_world(s), precision=precision) for s in seeds]
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
+    bs, sims = copies_and_singles(_world, seeds, precision, PERIODS)
     rng = np.random.default_rng(1)
     seen = {"inf": 0, "finite": 0, "unswept": 0, "mast": 0}
     held = None
     for step in range(130):
         if step % 10 == 0:
-            for robot in PERIODS:
-                vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
-                _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+            steer_randomly(bs, sims, rng, PERIODS)
         if step == 50:                          # copy 1 as a new world with another seed
-            bs.reset([1], [42])
-            sims[1] = Simulation(_world(42), precision=precision)
-            _enable_both(bs, sims, PERIODS, 1)
+            reseed_copy(bs, sims, _world, 1, 42, precision, PERIODS)
         if step == 70:                          # copy 2's head stops where it is, its image kept
             _enable_one(bs, sims, 2, "rover", "spin", 0)
             held = bs.range_image(bs.device("rover", "spin"))[2].copy()
@@ -147,10 +136,7 @@ def test_each_swept_column_reads_the_closed_form_distance_to_the_walls(precision
 
 gym = pytest.importorskip("gymnasium")
 
-from gymnasium.utils.env_checker import check_env  # noqa: E402
-
-from sensorium.gym import SensoriumEnv, Task  # noqa: E402
-from sensorium.gym.vector import SensoriumVectorEnv  # noqa: E402
+from sensorium.gym import Task  # noqa: E402
 
 OBSERVED = {"spin": 32, "flat": 32}
 
@@ -167,12 +153,10 @@ def test_the_vector_env_observes_rotating_lidars_as_the_single_env(precision: st
     autoresets that happen at different times (each sub-env's head its own); a sub-env passes
     Gymnasium's checker."""
     n = 3
-    venv = SensoriumVectorEnv(WORLD, _task(), n, precision=precision)
+    venv, singles = vector_beside_singles(WORLD, _task(), n, precision)
     space = venv.single_observation_space
     assert space["spin"].shape == (4, 90) and space["flat"].shape == (3, 40)
     assert space["spin"].dtype == np.float32 and space["spin"].high.max() == np.float32(2.5)
-    singles = [SensoriumEnv(WORLD, _task(), precision=precision, engine=e) for e in ("simulation", "auto", "simulation")]
-    assert [e.engine for e in singles] == ["simulation", "batched", "simulation"]
     obs = _reset_both(venv, singles, 4)
     assert (obs["spin"] == 0.0).any() and (obs["spin"] > 0.0).any()     # a part swept, the rest not yet
     def reset_sub_env_0(t: int) -> None:
@@ -182,7 +166,5 @@ def test_the_vector_env_observes_rotating_lidars_as_the_single_env(precision: st
             assert all(o[k].tobytes() == vobs[k][0].tobytes() for k in OBSERVED)
 
     assert _random_steps(venv, singles, OBSERVED, 50, before=reset_sub_env_0) >= n     # autoresets happened
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        check_env(venv.sub_env(1), skip_render_check=True)
+    check_sub_env(venv)
     venv.close()

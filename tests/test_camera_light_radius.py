@@ -19,11 +19,10 @@ import pytest
 from sensorium.schemas import world as wm
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
-from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld
-from tests.test_batched_camera import PERIODS, _world
-from tests.test_batched_sim import _enable_both
+from tests._copies import copies_and_singles
+from tests.test_batched_camera import PERIODS, _world, images_with_robot_placed
 
 WALL = {"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
         "appearance": {"base_color": [1.0, 1.0, 1.0]}}
@@ -145,22 +144,7 @@ def test_every_copy_cuts_as_the_single_simulation(precision: str):
     (radius 3, at x = -1) light a copy's wall fully, partly or not at all; each copy's image is the
     single simulation's with the robot where the copy has it, byte for byte."""
     x = [1.4, 1.0, 0.9, 0.5, -1.0, -1.6]                  # the camera's distance to the face: 1.95 - x
-    lw = _facing(1.0)
-    bs = BatchedSimulation(lw, len(x), precision=precision)
-    ref = bs.device("bot", "cam")
-    bs.enable(ref, 8)
-    singles = []
-    for c, xc in enumerate(x):
-        bs.set_pose(c, 0, translation=[xc, 0.0, 0.0])
-        single = Simulation(lw, precision=precision)
-        single.robot("bot").set_pose([xc, 0.0, 0.0])
-        single.robot("bot").device("cam").enable(8)
-        singles.append(single)
-    bs.step()
-    img = bs.image(ref)
-    for c, single in enumerate(singles):
-        single.step()
-        assert img[c].tobytes() == single.robot("bot").device("cam").image.tobytes(), c
+    img = images_with_robot_placed(_facing(1.0), precision, "bot", [[xc, 0.0, 0.0] for xc in x])
     # the centre pixel (its ray along +x): carried light within 1 m, spot within 3 m of x = -1
     centre = img[:, 2, 5, 2::-1].astype(np.int64)
     for c, xc in enumerate(x):
@@ -205,12 +189,8 @@ def test_the_camera_world_with_short_radii_is_the_single_simulations_in_every_co
                            source=lw.source, base_dir=lw.base_dir)
 
     seeds = [5, 6]
-    bs = BatchedSimulation(short(0), len(seeds), precision=precision)
-    bs.reset(np.arange(len(seeds)), seeds)
-    sims = [Simulation(short(s), precision=precision) for s in seeds]
+    bs, sims = copies_and_singles(short, seeds, precision, PERIODS)
     default = Simulation(_world(seeds[0], texture_dir), precision=precision)
-    for c in range(len(seeds)):
-        _enable_both(bs, sims, PERIODS, c)
     default.robot("rover").device("eye").enable(PERIODS["rover"]["eye"])
     differs = 0
     for _ in range(6):

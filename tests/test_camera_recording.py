@@ -4,20 +4,16 @@ bytes, a CameraInfo with its pinhole; a ROS 2 bag export carries both; the layou
 
 from __future__ import annotations
 
-import json
 import math
 
 import msgpack
 import pytest
 from _node import require_node, run_script
+from _recdata import recorded_simulation
 
 pytest.importorskip("foxglove")
 
-from sensorium.schemas import world as wm  # noqa: E402
-from sensorium.server.daemon.topics import Topics  # noqa: E402
 from sensorium.server.recording.reader import Recording  # noqa: E402
-from sensorium.server.recording.writer import McapRecorder  # noqa: E402
-from sensorium.server.sim.simulation import Simulation  # noqa: E402
 
 WORLD = {
     "world_info": {"basic_time_step": 16, "random_seed": 2},
@@ -33,11 +29,7 @@ WORLD = {
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
     path = tmp_path_factory.mktemp("cam") / "run.mcap"
-    w = wm.World.model_validate(WORLD)
-    sim = Simulation(w)
-    topics = Topics(sim)
-    rec = McapRecorder(path, json.dumps(WORLD), "cam.yaml", world=w, flush_interval=None, background_flush=False)
-    topics.set_recorder(rec)
+    sim, topics, rec = recorded_simulation(path, WORLD, "cam.yaml")
     images = []
     for _ in range(3):
         sim.step()

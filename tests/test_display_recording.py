@@ -4,20 +4,15 @@ ROS 2 bag export carries it, as for a camera image."""
 
 from __future__ import annotations
 
-import json
-
 import msgpack
 import numpy as np
 import pytest
 from _node import require_node, run_script
+from _recdata import recorded_simulation
 
 pytest.importorskip("foxglove")
 
-from sensorium.schemas import world as wm  # noqa: E402
-from sensorium.server.daemon.topics import Topics  # noqa: E402
 from sensorium.server.recording.reader import Recording  # noqa: E402
-from sensorium.server.recording.writer import McapRecorder  # noqa: E402
-from sensorium.server.sim.simulation import Simulation  # noqa: E402
 
 WORLD = {"world_info": {"basic_time_step": 16},
          "robots": [{"name": "r", "controller": "<none>",
@@ -27,11 +22,7 @@ WORLD = {"world_info": {"basic_time_step": 16},
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
     path = tmp_path_factory.mktemp("disp") / "run.mcap"
-    w = wm.World.model_validate(WORLD)
-    sim = Simulation(w)
-    topics = Topics(sim)
-    rec = McapRecorder(path, json.dumps(WORLD), "disp.yaml", world=w, flush_interval=None, background_flush=False)
-    topics.set_recorder(rec)
+    sim, topics, rec = recorded_simulation(path, WORLD, "disp.yaml")
     d = sim.device("r/screen")
     shown = []
     for k in range(3):

@@ -14,15 +14,14 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
-from sensorium.server.raycast import packets
 from sensorium.server.sim import contact as cmod
 from sensorium.server.sim import ground as gmod
-from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import parse_world
-from tests.test_batched_nue import TO_NUE, _to_nue
+from tests._copies import drive_and_compare, ground_copies
+from tests.test_batched_nue import TO_NUE
 
 SLOPE = 0.25
 DX = 0.5
@@ -239,44 +238,9 @@ def test_copies_riding_box_floors_and_terrains_are_the_single_simulation_bit_for
     onto the table in one copy: every copy's poses equal a Simulation's after every step, bit for
     bit, through the C drive and the numpy one; and the same world written in NUE axes (y up), where
     robot b, starting on the ramp's slope, has its upright footprint in both (its world-file pose)."""
-    if c_drive and packets.library() is None:
-        pytest.skip(f"no packets helper: {packets.status()}")
-
-    def world(seed: int) -> wm.World:
-        return wm.World.model_validate(_to_nue(_world(seed))) if nue else _world(seed)
-
-    up = 1 if nue else 2
-    seeds = [3, 4, 5]
-    bs = BatchedSimulation(world(0), len(seeds))
-    if not c_drive:
-        bs._drive_step = None
-    bs.reset(np.arange(3), seeds)
-    sims = [Simulation(world(s)) for s in seeds]
-    rng = np.random.default_rng(7)
-    heights: set[float] = set()
-    for step in range(150):
-        if step % 15 == 0:
-            for robot in ("a", "b", "c"):
-                lr = rng.uniform(-12.0, 12.0, (3, 2)) if step % 30 else np.full((3, 2), 10.0)
-                bs.set_wheels(bs.slot(robot), lr[:, 0], lr[:, 1])
-                for c, s in enumerate(sims):
-                    for m in s.robot(robot).motors.values():
-                        m.set_position(math.inf)
-                    s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
-                    s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
-        if step == 70:
-            onto = (TO_NUE @ np.array([-1.5, 0.0, 0.8 + HALF])).tolist() if nue else [-1.5, 0.0, 0.8 + HALF]
-            bs.set_pose(1, bs.slot("a"), onto)
-            sims[1].robot("a").set_pose(onto)
-        bs.step()
-        for c, s in enumerate(sims):
-            s.step()
-            for robot in ("a", "b", "c"):
-                slot = bs.slot(robot)
-                pose = s.robot(robot).pose
-                assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
-                assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
-                heights.add(float(pose.translation[up]))
+    bs, sims, up = ground_copies(_world, nue, c_drive)
+    onto = (TO_NUE @ np.array([-1.5, 0.0, 0.8 + HALF])).tolist() if nue else [-1.5, 0.0, 0.8 + HALF]
+    heights = drive_and_compare(bs, sims, ("a", "b", "c"), np.random.default_rng(7), 150, 15, 30, (70, "a", onto), up)
     assert DECK + HALF in heights and len(heights) > 10
     assert sims[1].robot("a").drive.rest == pytest.approx(0.78 + 0.04 / 2, abs=1e-15)   # put on the table: it rides it
 

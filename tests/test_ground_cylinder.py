@@ -13,7 +13,7 @@ import pytest
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
-from tests.test_batched_sim import _drive_single
+from tests._copies import drive_and_compare
 from tests.test_ground_box import BODY, HALF, _drive, _robot, _sim
 
 DRUM = 0.25 + 0.1 / 2          # the drum's top: its centre plus half its height
@@ -97,22 +97,5 @@ def test_copies_riding_a_drum_are_the_single_simulation_bit_for_bit() -> None:
     assert BODY["geometry"]["type"] == "cylinder"
     bs = BatchedSimulation(world, 3)
     sims = [Simulation(world) for _ in range(3)]
-    rng = np.random.default_rng(5)
-    heights: set[float] = set()
-    for step in range(120):
-        if step % 20 == 0:
-            for robot in ("a", "b"):
-                lr = rng.uniform(-12.0, 12.0, (3, 2))
-                bs.set_wheels(bs.slot(robot), lr[:, 0], lr[:, 1])
-                for c, s in enumerate(sims):
-                    _drive_single(s, robot, float(lr[c, 0]), float(lr[c, 1]))
-        bs.step()
-        for c, s in enumerate(sims):
-            s.step()
-            for robot in ("a", "b"):
-                slot = bs.slot(robot)
-                pose = s.robot(robot).pose
-                assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
-                assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
-                heights.add(float(pose.translation[2]))
+    heights = drive_and_compare(bs, sims, ("a", "b"), np.random.default_rng(5), 120, 20)
     assert DRUM + HALF in heights and min(heights) == pytest.approx(HALF, abs=1e-12)   # on the drum, and off it

@@ -14,12 +14,11 @@ import numpy as np
 import pytest
 
 from sensorium.schemas import world as wm
-from sensorium.server.raycast import packets
 from sensorium.server.sim import contact as cmod
-from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
-from tests.test_batched_nue import TO_NUE, _to_nue
+from tests._copies import drive_and_compare, ground_copies
+from tests.test_batched_nue import TO_NUE
 
 A = 0.3                        # the ramp's angle (rad)
 HX, HY, HZ = 1.0, 0.5, 0.05    # its half sizes: 2 m long along x, 1 m wide, 0.1 m thick
@@ -214,49 +213,14 @@ def test_copies_riding_ramps_are_the_single_simulation_bit_for_bit(c_drive, nue)
     one placed tilted on it), random wheel commands, a supervisor move onto the ramp in one copy: every
     copy's poses equal a Simulation's at load and after every step, bit for bit, through the C drive and
     the numpy one, and in NUE axes."""
-    if c_drive and packets.library() is None:
-        pytest.skip(f"no packets helper: {packets.status()}")
-
-    def world(seed: int) -> wm.World:
-        return wm.World.model_validate(_to_nue(_world(seed))) if nue else _world(seed)
-
-    up = 1 if nue else 2
-    seeds = [3, 4, 5]
-    bs = BatchedSimulation(world(0), len(seeds))
-    if not c_drive:
-        bs._drive_step = None
-    bs.reset(np.arange(3), seeds)
-    sims = [Simulation(world(s)) for s in seeds]
-    rng = np.random.default_rng(11)
-    heights: set[float] = set()
+    bs, sims, up = ground_copies(_world, nue, c_drive)
     names = ("a", "b", "c", "d", "e")
     for c, s in enumerate(sims):
         for robot in names:
             assert s.robot(robot).pose.translation.tobytes() == bs.pos[c, bs.slot(robot)].tobytes(), robot
             assert s.robot(robot).pose.rotation.tobytes() == bs.rot[c, bs.slot(robot)].tobytes(), robot
     assert float(sims[0].robot("d").pose.translation[up]) == pytest.approx(_ramp_z(2.4) + 0.05, abs=1e-12)
-    for step in range(150):
-        if step % 15 == 0:
-            for robot in names:
-                lr = rng.uniform(-12.0, 12.0, (3, 2)) if step % 30 else np.full((3, 2), 10.0)
-                bs.set_wheels(bs.slot(robot), lr[:, 0], lr[:, 1])
-                for c, s in enumerate(sims):
-                    for m in s.robot(robot).motors.values():
-                        m.set_position(math.inf)
-                    s.robot(robot).drive.left.set_velocity(float(lr[c, 0]))
-                    s.robot(robot).drive.right.set_velocity(float(lr[c, 1]))
-        if step == 70:
-            onto = [1.8, 0.0, _ramp_z(1.8) + HALF]
-            onto = (TO_NUE @ np.array(onto)).tolist() if nue else onto
-            bs.set_pose(1, bs.slot("a"), onto)
-            sims[1].robot("a").set_pose(onto)
-        bs.step()
-        for c, s in enumerate(sims):
-            s.step()
-            for robot in names:
-                slot = bs.slot(robot)
-                pose = s.robot(robot).pose
-                assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c, robot)
-                assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c, robot)
-                heights.add(float(pose.translation[up]))
+    onto = [1.8, 0.0, _ramp_z(1.8) + HALF]
+    onto = (TO_NUE @ np.array(onto)).tolist() if nue else onto
+    heights = drive_and_compare(bs, sims, names, np.random.default_rng(11), 150, 15, 30, (70, "a", onto), up)
     assert HALF in heights and len(heights) > 10                # on the floor, and at many heights on the ramp

@@ -12,12 +12,11 @@ import math
 import numpy as np
 import pytest
 
-from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
-from tests.test_ground_ramp import BODY, FLOOR, HALF, A, _ramp, _ramp_z
+from tests._slopes import STEP, copies_at_headings, ramp_world, step_copies_as_singles
+from tests.test_ground_ramp import BODY, HALF, A, _ramp_z
 
-STEP = 16
 N = 60                                   # 0.96 s
 R, LX, LY = 0.05, 0.1, 0.12
 MECANUM = {"wheel_radius": R, "lx": LX, "ly": LY, "max_wheel_speed": 12.0}
@@ -32,11 +31,6 @@ OMNI = {"max_wheel_speed": 20.0,
 def _robot(at: tuple[float, float, float], yaw: float, omni: bool = False) -> dict:
     drive = {"omni_drive": OMNI} if omni else {"mecanum_drive": MECANUM}
     return {"name": "r", "pose": {"translation": list(at), "rotation": [0, 0, 1, yaw]}, "body": BODY, **drive}
-
-
-def _world(robot: dict, ramp: bool = True) -> dict:
-    return {"world_info": {"basic_time_step": STEP}, "solids": [FLOOR, _ramp()] if ramp else [FLOOR],
-            "robots": [robot]}
 
 
 def _mecanum_speeds(vx: float, vy: float, w: float = 0.0) -> list[float]:
@@ -58,7 +52,7 @@ def _command(sim: Simulation, names, speeds) -> None:
 
 
 def _run(at, yaw: float, speeds, omni: bool = False, ramp: bool = True) -> tuple[np.ndarray, np.ndarray, Simulation]:
-    sim = Simulation(parse_world(_world(_robot(at, yaw, omni), ramp)), precision="exact")
+    sim = Simulation(parse_world(ramp_world([_robot(at, yaw, omni)], ramp)), precision="exact")
     start = sim.robot("r").pose.translation.copy()
     _command(sim, [w["motor"] for w in OMNI["wheels"]] if omni else ORDER, speeds)
     for _ in range(N):
@@ -109,7 +103,7 @@ def test_turning_in_place_on_the_ramp_turns_faster_seen_from_above() -> None:
     w = 1.5
     for on_ramp in (True, False):
         at = (1.3, 0.0, _ramp_z(1.3) + HALF) if on_ramp else (0.0, 0.0, HALF)
-        sim = Simulation(parse_world(_world(_robot(at, 0.0))), precision="exact")
+        sim = Simulation(parse_world(ramp_world([_robot(at, 0.0)])), precision="exact")
         _command(sim, ORDER, _mecanum_speeds(0.0, 0.0, w))
         sim.step()
         rot = sim.robot("r").pose.rotation
@@ -127,15 +121,8 @@ def test_on_the_floor_a_world_with_a_ramp_drives_as_one_without(omni: bool) -> N
 
 @pytest.mark.parametrize("omni", [False, True])
 def test_batched_copies_on_the_ramp_are_the_single_simulation_bit_for_bit(omni: bool) -> None:
-    yaws = [0.0, 0.8, -2.0, 2.9]
     at = [1.6, 0.0, _ramp_z(1.6) + HALF]
-    worlds = [parse_world(_world(_robot(tuple(at), yaw, omni))) for yaw in yaws]
-    bs = BatchedSimulation(worlds[0], len(yaws))
-    slot = bs.slot("r")
-    sims = []
-    for c, yaw in enumerate(yaws):
-        bs.set_pose(c, slot, at, [0, 0, 1, yaw])
-        sims.append(Simulation(worlds[c], precision="exact"))
+    bs, slot, sims = copies_at_headings(lambda yaw: _robot(tuple(at), yaw, omni), at, [0.0, 0.8, -2.0, 2.9])
     names = [w["motor"] for w in OMNI["wheels"]] if omni else list(ORDER)
     twists = [(0.15, 0.05, 0.3), (-0.05, 0.2, -0.6), (0.1, -0.1, 1.1), (0.0, 0.18, 0.0)]
     if omni:
@@ -146,13 +133,4 @@ def test_batched_copies_on_the_ramp_are_the_single_simulation_bit_for_bit(omni: 
     (bs.omni if omni else bs.mecanum).command(slot, speeds)
     for c, s in enumerate(sims):
         _command(s, names, speeds[c])
-    tilted = 0
-    for step in range(80):
-        bs.step()
-        for c, s in enumerate(sims):
-            s.step()
-            pose = s.robot("r").pose
-            assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c)
-            assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c)
-            tilted += s.robot("r").drive.slope is not None
-    assert tilted > 150
+    assert step_copies_as_singles(bs, slot, sims, 80) > 150

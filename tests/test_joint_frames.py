@@ -10,20 +10,19 @@ by q sits at (0.1 cos q, 0.1 sin q, 0.3) with the rotation (0, 0, sin(q/2), cos(
 from __future__ import annotations
 
 import hashlib
-import json
 import math
 
 import msgpack
 import numpy as np
 import pytest
 from _node import require_node, run_script
+from _recdata import recorded_simulation
 
 pytest.importorskip("foxglove")
 
 from sensorium.schemas import world as wm  # noqa: E402
 from sensorium.server.daemon.topics import Topics  # noqa: E402
 from sensorium.server.recording.reader import Recording  # noqa: E402
-from sensorium.server.recording.writer import McapRecorder  # noqa: E402
 from sensorium.server.sim.simulation import Simulation  # noqa: E402
 
 QUARTER = math.pi / 2
@@ -64,11 +63,7 @@ PLAIN_WORLD = {
 
 
 def _record(path, world: dict, steps: int, turn: float | None = None) -> None:
-    w = wm.World.model_validate(world)
-    sim = Simulation(w)
-    topics = Topics(sim)
-    rec = McapRecorder(path, json.dumps(world), "w.yaml", world=w, flush_interval=None, background_flush=False)
-    topics.set_recorder(rec)
+    sim, topics, rec = recorded_simulation(path, world, "w.yaml")
     for k in range(steps):
         if k == 1 and turn is not None:
             sim.robot("r").motor("pan").set_position(turn)

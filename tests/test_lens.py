@@ -19,10 +19,9 @@ import pytest
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import imaging
-from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
-from tests.test_batched_sim import _enable_both, _wheels_both
+from tests._copies import copies_and_singles, steer_randomly
 
 WORLDS = Path(__file__).parent / "worlds"
 BOTH = ["fast", "exact"]
@@ -317,18 +316,12 @@ def test_batched_lens_images_equal_the_single_ones_and_zero_coefficients_change_
     seeds = [5, 9]
     runs = {}
     for name, lens in (("none", None), ("zero", ZERO), ("lens", LENS)):
-        bs = BatchedSimulation(_loaded(path, 0, lens, names, base), len(seeds), precision=precision)
-        bs.reset(np.arange(len(seeds)), seeds)
-        sims = [Simulation(_loaded(path, s, lens, names, base), precision=precision) for s in seeds]
-        for c in range(len(seeds)):
-            _enable_both(bs, sims, periods, c)
+        bs, sims = copies_and_singles(lambda s, lens=lens: _loaded(path, s, lens, names, base), seeds, precision, periods)
         rng = np.random.default_rng(2)
         frames = []
         for step in range(36):
             if step % 12 == 0:
-                for robot in periods:
-                    vmax = 0.3 * float(bs.max_wheel[bs.slot(robot), 0])
-                    _wheels_both(bs, sims, robot, rng.uniform(-vmax, vmax, (len(seeds), 2)))
+                steer_randomly(bs, sims, rng, periods)
             bs.step()
             for c, s in enumerate(sims):
                 s.step()

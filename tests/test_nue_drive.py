@@ -77,6 +77,20 @@ def _sim(path: Path) -> Simulation:
         return Simulation(load_world(path), precision="exact")
 
 
+def _batched(path: Path, copies: int) -> BatchedSimulation:
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return BatchedSimulation(load_world(path), copies=copies, precision="exact")
+
+
+def _spin(sim: Simulation, robot: str, motors, speeds) -> None:
+    """Each of ``motors`` in velocity control at its speed."""
+    for name, u in zip(motors, speeds):
+        m = sim.robot(robot).motor(name)
+        m.set_position(math.inf)
+        m.set_velocity(u)
+
+
 def _drive(sim: Simulation, left: float, right: float) -> None:
     d = sim.robot("bot").drive
     for motors, speed in ((d.lefts, left), (d.rights, right)):
@@ -140,7 +154,6 @@ def test_a_y_up_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path: Path) -> N
     world and its z-up twin in the ENU world: after every step their poses agree with every axis
     permuted to 1e-12, their encoders read the same and their GPSs the same position permuted."""
     nue, enu = _sim(_world(tmp_path, "NUE")), _sim(_world(tmp_path, "ENU"))
-    p = NUE_TO_ENU
     for sim in (nue, enu):
         for name in ("left wheel sensor", "right wheel sensor", "gps"):
             sim.robot("bot").device(name).enable(16)
@@ -149,15 +162,12 @@ def test_a_y_up_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path: Path) -> N
         for sim in (nue, enu):
             _drive(sim, left, right)
         for _ in range(40):
-            nue.run(1)
-            enu.run(1)
-            a, b = nue.robot("bot").pose, enu.robot("bot").pose
-            assert np.abs(p @ a.translation - b.translation).max() <= 1e-12
-            assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
+            _step_twins(nue, enu, "bot", 1)
             for name in ("left wheel sensor", "right wheel sensor"):
                 assert nue.robot("bot").device(name).value == enu.robot("bot").device(name).value
             ga, gb = nue.robot("bot").device("gps").values, enu.robot("bot").device("gps").values
-            assert np.abs(p @ ga - gb).max() <= 1e-12
+            assert np.abs(NUE_TO_ENU @ ga - gb).max() <= 1e-12
+            a = nue.robot("bot").pose
             moved = max(moved, float(np.hypot(a.translation[0] - START[0], a.translation[2] - START[2])))
     assert moved > 0.1 and nue.robot("bot").pose.translation[1] == START[1]
 
@@ -167,9 +177,7 @@ def test_the_batched_simulation_drives_a_y_up_robot_as_the_single_one(tmp_path: 
     v·t), against a Simulation per copy: every pose bit for bit after every step (the C drive pass and
     its numpy fallback)."""
     path = _world(tmp_path, "NUE")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        bs = BatchedSimulation(load_world(path), copies=3, precision="exact")
+    bs = _batched(path, 3)
     sims = [_sim(path) for _ in range(3)]
     rng = np.random.default_rng(7)
     slot = bs.slot("bot")
@@ -213,17 +221,19 @@ def _twin_world(tmp_path: Path, system: str, stem: str, robot: str, at, children
     return path
 
 
-def _step_twins(nue: Simulation, enu: Simulation, bs: BatchedSimulation, robot: str, steps: int) -> None:
-    """``steps`` basic steps of the NUE world, its ENU twin and the NUE world's batched copy 0: the copy's
-    pose is the NUE one bit for bit, the twin's the NUE one with every axis permuted, to 1e-12."""
+def _step_twins(nue: Simulation, enu: Simulation, robot: str, steps: int, bs: BatchedSimulation | None = None) -> None:
+    """``steps`` basic steps of the NUE world, its ENU twin (and the NUE world's batched copy 0, given
+    ``bs``): the twin's pose is the NUE one with every axis permuted, to 1e-12; the copy's the NUE one
+    bit for bit."""
     p = NUE_TO_ENU
     for _ in range(steps):
         nue.run(1)
         enu.run(1)
-        bs.step()
         a, b = nue.robot(robot).pose, enu.robot(robot).pose
-        assert np.array_equal(bs.pose(0, 0).translation, a.translation)
-        assert np.array_equal(bs.pose(0, 0).rotation, a.rotation)
+        if bs is not None:
+            bs.step()
+            assert np.array_equal(bs.pose(0, 0).translation, a.translation)
+            assert np.array_equal(bs.pose(0, 0).rotation, a.rotation)
         assert np.abs(p @ a.translation - b.translation).max() <= 1e-12
         assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
 
@@ -250,21 +260,16 @@ def test_a_y_up_omni_wheel_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path:
     to its y (its drive's forward its x); driven with the same wheel speeds as its z-up ENU twin, their
     poses agree with every axis permuted to 1e-12 after every step, and it has moved; a batched copy
     of the NUE world keeps the single simulation's poses bit for bit."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        nue, enu = (Simulation(load_world(_omni_world(tmp_path, s)), precision="exact") for s in ("NUE", "ENU"))
-        bs = BatchedSimulation(load_world(_omni_world(tmp_path, "NUE")), copies=1, precision="exact")
+    nue, enu = (_sim(_omni_world(tmp_path, s)) for s in ("NUE", "ENU"))
+    bs = _batched(_omni_world(tmp_path, "NUE"), 1)
     d = nue.world.robots[0].omni_drive
     assert d is not None and tuple(d.forward) == (1.0, 0.0, 0.0)
     start = nue.robot("bot").pose.translation.copy()
     for speeds in ((4.0, -2.0, 1.0), (3.0, 3.0, 3.0), (-5.0, 2.0, 6.0)):
         for sim in (nue, enu):
-            for i, u in enumerate(speeds):
-                m = sim.robot("bot").motor(f"w{i}")
-                m.set_position(math.inf)
-                m.set_velocity(u)
+            _spin(sim, "bot", ("w0", "w1", "w2"), speeds)
         bs.omni.command(0, np.array([speeds]))
-        _step_twins(nue, enu, bs, "bot", 30)
+        _step_twins(nue, enu, "bot", 30, bs)
     moved = nue.robot("bot").pose.translation - start
     assert math.hypot(moved[0], moved[2]) > 0.03 and moved[1] == 0.0
 
@@ -297,10 +302,8 @@ def test_a_y_up_car_in_a_nue_world_steers_and_drives_as_its_enu_twin(tmp_path: P
     forward its z); steered both ways and driven both ways with its z-up ENU twin's commands, their
     poses agree with every axis permuted to 1e-12 after every step, and it has moved and turned; a
     batched copy of the NUE world keeps the single simulation's poses bit for bit."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        nue, enu = (Simulation(load_world(_car_world(tmp_path, s)), precision="exact") for s in ("NUE", "ENU"))
-        bs = BatchedSimulation(load_world(_car_world(tmp_path, "NUE")), copies=1, precision="exact")
+    nue, enu = (_sim(_car_world(tmp_path, s)) for s in ("NUE", "ENU"))
+    bs = _batched(_car_world(tmp_path, "NUE"), 1)
     d = nue.world.robots[0].ackermann_drive
     assert d is not None and tuple(d.forward) == (0.0, 0.0, 1.0)
     assert (d.wheelbase, d.track_front, d.type) == (pytest.approx(0.2, abs=1e-15), pytest.approx(0.16, abs=1e-15),
@@ -310,12 +313,9 @@ def test_a_y_up_car_in_a_nue_world_steers_and_drives_as_its_enu_twin(tmp_path: P
         for sim in (nue, enu):
             for name in ("right_steer", "left_steer"):
                 sim.robot("car").motor(name).set_position(steer)
-            for name in ("right_rear_wheel", "left_rear_wheel"):
-                m = sim.robot("car").motor(name)
-                m.set_position(math.inf)
-                m.set_velocity(speed)
+            _spin(sim, "car", ("right_rear_wheel", "left_rear_wheel"), (speed, speed))
         bs.cars.command(0, np.array([steer]), np.array([steer]), np.array([speed]))
-        _step_twins(nue, enu, bs, "car", 30)
+        _step_twins(nue, enu, "car", 30, bs)
     assert np.abs(nue.robot("car").pose.rotation - start).max() > 0.05
     assert nue.robot("car").pose.translation[1] == 0.0      # (along up: its wheels stay on y = 0)
 
@@ -345,27 +345,16 @@ def test_a_y_up_mecanum_robot_in_a_nue_world_drives_as_its_enu_twin(tmp_path: Pa
     """A y-up mecanum base: the import finds its drive with its y as up (its forward its z); driven,
     strafed and turned with its z-up ENU twin's wheel speeds, their poses agree with every axis
     permuted to 1e-12 after every step; all wheels at +ω carry it along its forward by r·ω·t."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        nue, enu = (Simulation(load_world(_mecanum_world(tmp_path, s)), precision="exact") for s in ("NUE", "ENU"))
+    nue, enu = (_sim(_mecanum_world(tmp_path, s)) for s in ("NUE", "ENU"))
     d = nue.world.robots[0].mecanum_drive
     assert d is not None and tuple(d.forward) == (0.0, 0.0, 1.0)
     assert enu.world.robots[0].mecanum_drive is not None
     assert tuple(d.rollers) == tuple(enu.world.robots[0].mecanum_drive.rollers)
-    p = NUE_TO_ENU
     start = nue.robot("base").pose.translation.copy()
     for k, speeds in enumerate(((6.0, 6.0, 6.0, 6.0), (-4.0, 4.0, 4.0, -4.0), (-3.0, 3.0, -3.0, 3.0))):
         for sim in (nue, enu):
-            for name, u in zip(("fl", "fr", "rl", "rr"), speeds):
-                m = sim.robot("base").motor(name)
-                m.set_position(math.inf)
-                m.set_velocity(u)
-        for _ in range(30):
-            nue.run(1)
-            enu.run(1)
-            a, b = nue.robot("base").pose, enu.robot("base").pose
-            assert np.abs(p @ a.translation - b.translation).max() <= 1e-12
-            assert np.abs(p @ a.rotation @ p.T - b.rotation).max() <= 1e-12
+            _spin(sim, "base", ("fl", "fr", "rl", "rr"), speeds)
+        _step_twins(nue, enu, "base", 30)
         if k == 0:
             want = start + 6.0 * R * 30 * DT * np.array([math.sin(YAW), 0.0, math.cos(YAW)])
             assert np.abs(nue.robot("base").pose.translation - want).max() <= 1e-9

@@ -16,18 +16,14 @@ from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.motion import arc_step
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import parse_world
-from tests.test_ground_ramp import FLOOR, HALF, A, _drive, _ramp, _ramp_z, _robot
+from tests._slopes import STEP, copies_at_headings, ramp_world, step_copies_as_singles
+from tests.test_ground_ramp import HALF, A, _drive, _ramp_z, _robot
 
-STEP = 16
 N = 100                                  # 1.6 s at 0.2 m/s: 0.32 m along the ramp
 
 
-def _world(robots: list[dict], ramp: bool = True) -> dict:
-    return {"world_info": {"basic_time_step": STEP}, "solids": [FLOOR, _ramp()] if ramp else [FLOOR], "robots": robots}
-
-
 def _single(robots: list[dict], ramp: bool = True) -> Simulation:
-    return Simulation(parse_world(_world(robots, ramp)), precision="exact")
+    return Simulation(parse_world(ramp_world(robots, ramp)), precision="exact")
 
 
 def test_driving_straight_up_a_ramp_covers_r_w_t_along_it_and_its_cosine_across() -> None:
@@ -90,16 +86,10 @@ def test_batched_copies_on_the_ramp_are_the_single_simulation_bit_for_bit(c_driv
     is a Simulation's, bit for bit, through the C drive pass and the numpy one."""
     if c_drive and packets.library() is None:
         pytest.skip(f"no packets helper: {packets.status()}")
-    yaws = [0.0, 0.8, -2.0]
-    worlds = [parse_world(_world([_robot("r", (1.6, 0.0, _ramp_z(1.6) + HALF), yaw)])) for yaw in yaws]
-    bs = BatchedSimulation(worlds[0], len(yaws))
+    at = [1.6, 0.0, _ramp_z(1.6) + HALF]
+    bs, slot, sims = copies_at_headings(lambda yaw: _robot("r", tuple(at), yaw), at, [0.0, 0.8, -2.0])
     if not c_drive:
         bs._drive_step = None
-    sims = []
-    for c, yaw in enumerate(yaws):
-        bs.set_pose(c, bs.slot("r"), [1.6, 0.0, _ramp_z(1.6) + HALF], [0, 0, 1, yaw])
-        sims.append(Simulation(worlds[c], precision="exact"))
-    slot = bs.slot("r")
     for c, s in enumerate(sims):
         assert s.robot("r").pose.rotation.tobytes() == bs.rot[c, slot].tobytes()
     bs.set_wheels(slot, np.array([3.0, 5.0, 4.0]), np.array([4.0, 4.0, 2.0]))
@@ -108,16 +98,7 @@ def test_batched_copies_on_the_ramp_are_the_single_simulation_bit_for_bit(c_driv
         for m, w in ((left, [3.0, 5.0, 4.0][c]), (right, [4.0, 4.0, 2.0][c])):
             m.set_position(math.inf)
             m.set_velocity(w)
-    tilted = 0
-    for step in range(80):
-        bs.step()
-        for c, s in enumerate(sims):
-            s.step()
-            pose = s.robot("r").pose
-            assert pose.translation.tobytes() == bs.pos[c, slot].tobytes(), (step, c)
-            assert pose.rotation.tobytes() == bs.rot[c, slot].tobytes(), (step, c)
-            tilted += s.robot("r").drive.slope is not None
-    assert tilted > 100
+    assert step_copies_as_singles(bs, slot, sims, 80) > 100
 
 
 CAR = {"wheelbase": 0.3, "track_front": 0.2, "track_rear": 0.2, "front_wheel_radius": 0.05, "rear_wheel_radius": 0.05,
@@ -152,7 +133,7 @@ def test_a_car_drives_up_the_ramp_at_its_wheels_speed_along_it_and_batched_copie
     assert math.hypot(end[0] - at[0], end[2] - at[2]) == pytest.approx(along, abs=1e-9)
 
     from sensorium.gym.views import CopySim
-    world = parse_world(_world([_car((1.6, -0.1, _ramp_z(1.6) + HALF), 0.4)]))
+    world = parse_world(ramp_world([_car((1.6, -0.1, _ramp_z(1.6) + HALF), 0.4)]))
     single, batched = Simulation(world, precision="exact"), BatchedSimulation(world, 2)
     view = CopySim(batched, 1)
     tilted = 0

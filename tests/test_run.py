@@ -15,7 +15,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import pytest
-from _serve import REPO, Proc, run_controller, sensorium, wait_until
+from _serve import REPO, Proc, alive, run_controller, sensorium, wait_until
 
 from sensorium import launch
 from sensorium.launch import LaunchError, WebotsProjects, find_controller
@@ -63,14 +63,6 @@ def run(world: Path, *extra: str, env: dict | None = None) -> Proc:
 def pids(folder: Path, robot: str) -> list[int]:
     path = folder / f"pid-{robot}"
     return [int(x) for x in path.read_text().split()] if path.exists() else []
-
-
-def alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    return True
 
 
 # ---------------------------------------------------------------------- finding controllers (no process)

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from _serve import ANY_PORT, Proc, sensorium, wait_until
+from _serve import ANY_PORT, Proc, alive, sensorium, wait_until
 
 from sensorium import launch
 from sensorium.launch import ControllerSpec, Launcher, LaunchError, find_controller, name_problem
@@ -50,14 +50,6 @@ def run(world: Path, *extra: str) -> Proc:
     that made CI fail with 'Address already in use')."""
     return Proc(sensorium("run", str(world), "--rpc", ANY_PORT, "--pub", ANY_PORT, *extra),
                 env={"WEBOTS_HOME": None, "WEBOTS_EXTRA_PROJECT_PATH": None})
-
-
-def alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    return True
 
 
 # ---------------------------------------------------------------------- no process
