@@ -873,3 +873,99 @@ def test_a_rover_on_four_steered_corners_and_two_middle_wheels_drives_by_their_f
     dt = 0.016                                    # the origin's velocity at the step's end: the twist turned by ωz·dt
     c, s = math.cos(wz * dt), math.sin(wz * dt)
     assert lin == pytest.approx([vx * c - vy * s, vx * s + vy * c], abs=1e-12)
+
+
+def rocker_side(side: str, y: float) -> str:
+    """One side of a rocker-bogie (a Sojourner's): a motorised rocker hinge on the body carrying the back
+    steered corner and a motorised bogie hinge, which carries the front steered corner and the middle
+    wheel: every wheel rides two or three motorised hinges."""
+    bogie = (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0.15 0 {R} }} '
+             f'device [ RotationalMotor {{ name "{side} bogie" }} ] '
+             f'endPoint Solid {{ translation 0.15 0 0 name "{side} bogie" children [\n'
+             + corner(f"front {side}", 0.15, 0) + wheel(f"middle {side} wheel", -0.15, 0) + '] } }\n')
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} {R} }} '
+            f'device [ RotationalMotor {{ name "{side} rocker" }} ] '
+            f'endPoint Solid {{ translation 0 {y} 0 name "{side} rocker" children [\n'
+            + corner(f"back {side}", -0.3, 0) + bogie + '] } }\n')
+
+
+def test_a_rocker_bogie_rover_keeps_its_six_wheels_and_drives_by_their_fit(tmp_path: Path) -> None:
+    """Six wheels on a rocker-bogie (a Sojourner's): the corners' steering hinges and the middle wheels
+    ride motorised rocker and bogie hinges. Those hinges are its suspension, no wheels (one line each);
+    the six wheels stay the steered drive's (they used to be dropped as links of a chain of motorised
+    joints, leaving the rover without a drive). All wheels at ω roll it straight at r·ω; the rover's
+    'turn around' (arms at ±0.87, left +ω, right -ω) moves it by the six wheels' fit, as on a flat base."""
+    robot = ('Robot { name "rover" children [\n' + rocker_side("left", 0.25) + rocker_side("right", -0.25)
+             + '] controller "<extern>" }\n')
+    w = load_world(write(tmp_path, robot))
+    drive = w.world.robots[0].steered_drive
+    assert drive is not None and not [x for x in w.warnings if "will not move" in x]
+    where = {"front left": (0.3, 0.25), "front right": (0.3, -0.25), "back left": (-0.3, 0.25),
+             "back right": (-0.3, -0.25), "middle left": (0.0, 0.25), "middle right": (0.0, -0.25)}
+    assert {x.motor: (x.steer, x.position, x.radius) for x in drive.wheels} == {
+        f"{k} wheel": (None if k.startswith("middle") else f"{k} arm", xy, R) for k, xy in where.items()}
+    for hinge, carried in (("left rocker", "'back left wheel', 'front left wheel', 'middle left wheel'"),
+                           ("left bogie", "'front left wheel', 'middle left wheel'")):
+        assert sum(f"motor '{hinge}' is no wheel (a rocker-bogie's suspension hinge: its end point carries the "
+                   f"wheels {carried})" in x for x in w.warnings) == 1
+    sim = Simulation(w, "fast")
+    rover = sim.robot("rover")
+    omega = 3.0
+    for k in where:
+        rover.motor(f"{k} wheel").set_position(math.inf)
+        rover.motor(f"{k} wheel").set_velocity(omega)
+    sim.run(125)                                  # 2 s straight ahead at r·ω
+    assert rover.pose.translation[:2] == pytest.approx([2 * R * omega, 0.0], abs=1e-12)
+    for k in where:
+        rover.motor(f"{k} wheel").set_velocity(0.0)
+    arms = {"front left": -0.87, "front right": 0.87, "back left": 0.87, "back right": -0.87}
+    for k, a in arms.items():
+        rover.motor(f"{k} arm").set_position(a)
+    sim.run(50)                                   # the arms turn (the wheels hold: the rover stays)
+    assert rover.pose.translation[:2] == pytest.approx([2 * R * omega, 0.0], abs=1e-12)
+    speeds = {k: omega if k.endswith("left") else -omega for k in where}
+    for k, s in speeds.items():
+        rover.motor(f"{k} wheel").set_velocity(s)
+    sim.run(1)
+    u = {k: (R * s * math.cos(arms.get(k, 0.0)), R * s * math.sin(arms.get(k, 0.0))) for k, s in speeds.items()}
+    wz = sum(x * u[k][1] - y * u[k][0] for k, (x, y) in where.items()) / sum(x * x + y * y for x, y in where.values())
+    assert rover.drive.velocity()[5] == pytest.approx(wz, abs=1e-12)
+    assert wz < 0.0                               # the arms at ±0.87 with left +ω, right -ω: clockwise
+
+
+def test_a_rover_built_y_up_in_a_nue_world_gets_the_steered_drive(tmp_path: Path) -> None:
+    """A robot built y-up (a NUE world's: x north, y up, z east) on four steered corners: its steering
+    hinges turn about its y, its wheels about ±z. The drive takes places and headings along its x and
+    its left (-z), forward its x (it used to get 'no steered-wheel drive (a robot built y-up ...)').
+    Every corner steered a quarter turn and rolling at ω moves it to its left, west, at r·ω."""
+    def corner_y_up(name: str, x: float, z: float) -> str:
+        return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor {x} 0 {z} }} '
+                f'device [ RotationalMotor {{ name "{name} arm" maxVelocity 5 }} ] '
+                f'endPoint Solid {{ translation {x} 0 {z} name "{name} arm" children [\n'
+                f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 -1 anchor 0 {R} 0 }} '
+                f'device [ RotationalMotor {{ name "{name} wheel" maxVelocity 12.3 }} ] '
+                f'endPoint Solid {{ translation 0 {R} 0 children [ DEF W Shape {{ geometry '
+                f'Cylinder {{ radius {R} height 0.095 }} }} ] boundingObject USE W }} }}\n] }} }}\n')
+
+    places = {"front left": (0.3, -0.25), "front right": (0.3, 0.25), "back left": (-0.3, -0.25),
+              "back right": (-0.3, 0.25)}                  # (x, z): the left is -z
+    p = tmp_path / "nue.wbt"
+    p.write_text(HEADER + 'WorldInfo { coordinateSystem "NUE" basicTimeStep 16 }\nRobot { name "rover" children [\n'
+                 + "".join(corner_y_up(k, x, z) for k, (x, z) in places.items()) + '] controller "<extern>" }\n')
+    w = load_world(p)
+    drive = w.world.robots[0].steered_drive
+    assert drive is not None, w.warnings
+    assert tuple(drive.forward) == (1.0, 0.0, 0.0)
+    assert {x.motor: (x.steer, x.position, x.heading, x.steer_sign) for x in drive.wheels} == {
+        f"{k} wheel": (f"{k} arm", (x, -z), 0.0, 1) for k, (x, z) in places.items()}
+    sim = Simulation(w, "fast")
+    rover = sim.robot("rover")
+    for k in places:
+        rover.motor(f"{k} arm").set_position(math.pi / 2)
+    sim.run(50)                                   # the arms turn (the wheels hold: the rover stays)
+    start = rover.pose.translation.copy()
+    for k in places:
+        rover.motor(f"{k} wheel").set_position(math.inf)
+        rover.motor(f"{k} wheel").set_velocity(4.0)
+    sim.run(100)                                  # 1.6 s to its left, west (-z), at r·4
+    assert list(rover.pose.translation - start) == pytest.approx([0.0, 0.0, -R * 4.0 * 1.6], abs=1e-12)

@@ -2007,6 +2007,36 @@ class Converter:
                 out.append((None, kept))
         return out
 
+    def _suspension(self, wheels: list[dict], up: int) -> list[tuple[dict, str]]:
+        """The hinges of a rocker-bogie (a Sojourner's rockers and bogies), each with the names of the
+        wheels it carries: a motorised hinge that steers nothing and whose end point carries one or more
+        of the robot's wheels on the ground -- motorised hinges carrying no motorised hinge whose round
+        part turns about their axis as a wheel's does (:func:`rolls_about_its_axis`), its bottom within
+        the smallest such radius of the lowest, three such wheels at least (a Sojourner's front bogie
+        carries its front wheel only). An arm's chain or a leg (its knee's round foot below the knee's
+        axis, not on it) carries none of them, so its hinges stay links (no wheels)."""
+        from sensorium.server.world.wbt.drive import rolls_about_its_axis, wheel_bottom, wheel_radius
+
+        inside = {id(w["node"]): self._inside(w["end"]) for w in wheels}
+        motorised = {id(w["node"]) for w in wheels}
+        ends = []
+        for w in wheels:
+            if w["steers"] or inside[id(w["node"])] & motorised or not rolls_about_its_axis(w, self):
+                continue
+            radius, bottom = wheel_radius(w["end"], self), wheel_bottom([w], self, up)
+            if radius is not None and bottom is not None:
+                ends.append((w, bottom, radius))
+        if len(ends) < 3:
+            return []
+        lowest, reach = min(b for _, b, _ in ends), min(r for _, _, r in ends)
+        ground = [w for w, b, _ in ends if b - lowest <= reach]
+        out = []
+        for w in wheels:
+            carried = [g["motor"] for g in ground if id(g["node"]) in inside[id(w["node"])]]
+            if not w["steers"] and carried:
+                out.append((w, ", ".join(repr(m) for m in carried)))
+        return out
+
     def _lifted_wheels(self, wheels: list[dict], up: int) -> list[tuple[dict, float]]:
         """The motorised hinges about horizontal axes riding a steering (vertical) hinge whose round
         part's bottom is more than the lowest wheel's diameter above the lowest wheels' bottom, with
@@ -2235,6 +2265,15 @@ class Converter:
                 nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers "
                                 f"none (its end point holds no wheel): {JOINT_MOVES}", "steering none"))
             wheels = [w for w in wheels if not any(w is p for p in pans)]
+        # a rocker-bogie's suspension (a Sojourner's rockers and bogies): motorised hinges carrying the
+        # wheels; they are no wheels, and the wheels riding them are wheels still
+        suspension = self._suspension(wheels, up)
+        if suspension:
+            for w, carried in suspension:
+                nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (a "
+                                f"rocker-bogie's suspension hinge: its end point carries the wheels {carried}): "
+                                f"{JOINT_MOVES}", "suspension hinges of a rocker-bogie"))
+            wheels = [w for w in wheels if not any(w is s for s, _ in suspension)]
         # an arm's chain (a vacuum gripper's pitch and roll hinges): a wheel carries no motorised
         # hinge and rides on none but its steering joint, so a hinge that does either is no wheel
         inside = {id(w["node"]): self._inside(w["end"]) for w in wheels if not w["steers"]}

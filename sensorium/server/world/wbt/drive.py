@@ -837,9 +837,10 @@ def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions:
     (the hinge's anchor: a caster's two wheels, beside it, are taken there); an unsteered one where its
     round part is on its axis. Its heading at steering position 0 is where a positive speed rolls it,
     axis × up, less the hinge's turn as loaded; a hinge about up turns it left as its position grows
-    (``steer_sign`` 1), one about down right (-1)."""
-    if up != 2:
-        return None, "a robot built y-up: the steered-wheel drive takes robots whose z is up"
+    (``steer_sign`` 1), one about down right (-1). ``up``: the robot's up axis (2 its z; 1 its y, a
+    robot built y-up, whose places and headings are taken along its x and its left, y × x = -z, its
+    drive's ``forward`` its x, (1, 0, 0), as :func:`omni_drive` takes them)."""
+    frame = None if up == 2 else drive_axes((1.0, 0.0, 0.0), up)
     out = []
     rolling = []
     for steering, riding in groups:
@@ -849,20 +850,25 @@ def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions:
                 return None, (f"wheel {w['motor']!r}: its end point has no cylinder or sphere to take the wheel "
                               "radius from")
             axis = np.asarray(w["axis"], dtype=np.float64)
+            if frame is not None:
+                axis = frame @ axis
             if abs(float(axis[2])) > AXIS_TOL * float(np.linalg.norm(axis)):
-                return None, (f"wheel axis of motor {w['motor']!r} is {np.round(axis, 6).tolist()}, not horizontal "
-                              "in the robot's frame: a steered wheel rolls about a horizontal axis")
+                return None, (f"wheel axis of motor {w['motor']!r} is {np.round(w['axis'], 6).tolist()}, not "
+                              f"horizontal in the robot's frame (perpendicular to its {'xyz'[up]}): a steered wheel "
+                              "rolls about a horizontal axis")
             wheel: dict = {"motor": w["motor"], "radius": float(radius)}
             heading = math.atan2(-float(axis[0]), float(axis[1]))      # axis × up: (a_y, -a_x)
             if steering is None:
                 at = _on_axis(w, conv)
             else:
                 at = np.asarray(steering["anchor"], dtype=np.float64)
-                sign = 1 if float(steering["axis"][2]) > 0.0 else -1
+                sign = 1 if float(steering["axis"][up]) > 0.0 else -1
                 heading -= sign * steer_positions.get(steering["motor"], 0.0)
                 wheel["steer"] = steering["motor"]
                 if sign < 0:
                     wheel["steer_sign"] = -1
+            if frame is not None:
+                at = frame @ at
             wheel["position"] = [float(at[0]), float(at[1])]
             if heading != 0.0:
                 wheel["heading"] = math.remainder(heading, 2.0 * math.pi)
@@ -870,4 +876,7 @@ def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions:
             rolling.append(w)
     if len({tuple(w["position"]) for w in out}) < 2:
         return None, "the wheels all stand at one place"
-    return {"wheels": out, **_wheel_speeds(rolling, conv)}, ""
+    drive: dict = {"wheels": out, **_wheel_speeds(rolling, conv)}
+    if frame is not None:
+        drive["forward"] = [1.0, 0.0, 0.0]
+    return drive, ""
