@@ -1,0 +1,161 @@
+"""Conveyor belts (schemas ``ConveyorBelt``; Webots' ``ConveyorBelt``, one ``Track`` whose LinearMotor
+moves the belt): each basic step, a top-level solid with physics lying on a moving belt's top face -- its
+lowest point within contact.FLOOR of the face, its origin over the face -- moves along the belt by the
+motor's travel that step, as Webots' physics carries it on the Track's moving contact surface. Once its
+origin is past the face's edge it lands (ground.land_solid) on what is under it. A carried solid whose
+move would put it into another solid or a robot's part (above the belt's face) stays where it is that
+step, and so do the solids behind it on that belt (a row stops together). Only a belt whose motor moved
+costs anything; a world without belts builds no ``Belts``."""
+
+from __future__ import annotations
+
+import warnings
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.contact import EPS, FLOOR
+from sensorium.server.sim.ground import GroundWarning, falling_shapes, land_solid, shapes_span
+from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
+from sensorium.server.world.poses import Pose
+
+if TYPE_CHECKING:
+    from sensorium.server.sim.joints import JointMotor
+    from sensorium.server.sim.simulation import RobotState, Simulation
+
+_UPRIGHT = 1e-9         # a face whose normal leans more than this (1 - cos) from the up carries nothing
+
+
+class Belts:
+    """The world's conveyor belts and what they carry (``carry`` once per basic step, after the joints
+    moved their motors)."""
+
+    def __init__(self, sim: Simulation, to_enu: np.ndarray | None):
+        self._sim = sim
+        self._to_enu = to_enu
+        self._belts: list[tuple[RobotState, wm.ConveyorBelt, JointMotor]] = [
+            (r, b, r.joints[b.motor]) for r in sim.robots.values() for b in r.model.belts]
+        self._shapes: dict[str, list | None] = {}       # each solid's falling shapes, by name (see _falling)
+        for robot, belt, _ in self._belts:
+            if self._face(robot, belt) is None:
+                warnings.warn(f"{sim.loaded.source}: robot {robot.name!r}: the belt of {belt.motor!r} is not level "
+                              "(its top face's normal is not the world's up): it carries nothing",
+                              GroundWarning, stacklevel=3)
+
+    def __bool__(self) -> bool:
+        return bool(self._belts)
+
+    def _enu(self, v: np.ndarray) -> np.ndarray:
+        return v if self._to_enu is None else self._to_enu @ v
+
+    def _face(self, robot: RobotState, belt: wm.ConveyorBelt) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The belt's top face in ENU (its centre, unit along and across), None when it is not level."""
+        pose = self._sim.scene.robot_poses[robot.index]
+        r = np.asarray(pose.rotation, dtype=np.float64)
+        along = self._enu(r @ np.asarray(belt.along, dtype=np.float64))
+        across = self._enu(r @ np.asarray(belt.across, dtype=np.float64))
+        normal = np.cross(along, across)
+        if abs(along[2]) > _UPRIGHT or abs(across[2]) > _UPRIGHT or normal[2] < 1.0 - _UPRIGHT:
+            return None
+        centre = self._enu(np.asarray(pose.translation, dtype=np.float64) + r @ np.asarray(belt.top, dtype=np.float64))
+        return centre, along, across
+
+    def _falling(self, solid: wm.Solid) -> list | None:
+        if solid.name not in self._shapes:
+            self._shapes[solid.name] = falling_shapes(solid, self._sim.loaded.base_dir)
+        return self._shapes[solid.name]
+
+    def carry(self, dt_s: float) -> None:
+        sim = self._sim
+        for robot, belt, motor in self._belts:
+            travel = motor.rate * dt_s          # the belt's own travel this step (its motor's position moved so)
+            if travel == 0.0:
+                continue
+            face = self._face(robot, belt)
+            if face is None:
+                continue
+            centre, along, across = face
+            held = {g.held for g in sim._grippers if g.held is not None}
+            poses = sim.scene.solid_poses
+            on: list[tuple[wm.Solid, Pose, tuple[float, float, np.ndarray]]] = []
+            for solid in sim.world.solids:
+                if solid.name not in poses or solid.name in held or not solid.physics:
+                    continue
+                pose = poses[solid.name]
+                offset = self._enu(np.asarray(pose.translation, dtype=np.float64)) - centre
+                if abs(offset @ along) > belt.length / 2.0 or abs(offset @ across) > belt.width / 2.0:
+                    continue
+                shapes = self._falling(solid)
+                span = None if shapes is None else shapes_span(shapes, pose, self._to_enu)
+                if span is None or abs(span[0] - centre[2]) > FLOOR:
+                    continue
+                on.append((solid, pose, span))
+            if on:
+                self._move(on, travel, along, centre, belt)
+
+    def _move(self, on: list, travel: float, along: np.ndarray, centre: np.ndarray, belt: wm.ConveyorBelt) -> None:
+        sim = self._sim
+        step = along * travel                               # ENU
+        shift = np.array([step[0], step[1], step[0], step[1]])
+        carried = {s.name for s, _, _ in on}
+        walls = self._obstacles(carried, float(centre[2]))
+        boxes = {s.name: box for s, _, (_, _, box) in on}
+        spans = {s.name: (lo, hi) for s, _, (lo, hi, _) in on}
+
+        def hits(name: str, others: list[tuple[float, float, np.ndarray]]) -> bool:
+            lo, hi = spans[name]
+            now, moved = boxes[name], boxes[name] + shift
+            return any(_overlap(moved, box) and not _overlap(now, box) and top > lo + FLOOR and bottom < hi
+                       for bottom, top, box in others)
+
+        stopped = {name for name in carried if hits(name, walls)}
+        while True:         # a row stops together: one behind a stopped solid stops too
+            more = {name for name in carried - stopped
+                    if hits(name, [(*spans[o], boxes[o]) for o in stopped])}
+            if not more:
+                break
+            stopped |= more
+        world_step = step if self._to_enu is None else self._to_enu.T @ step
+        for solid, pose, _ in on:
+            if solid.name in stopped:
+                continue
+            moved = Pose(pose.rotation, np.asarray(pose.translation, dtype=np.float64) + world_step)
+            offset = self._enu(np.asarray(moved.translation, dtype=np.float64)) - centre
+            if abs(offset @ along) > belt.length / 2.0:     # past the belt's end: it falls onto what is under it
+                sim.place_solid(solid.name, moved)
+                moved = land_solid(solid, moved, sim.loaded.base_dir, sim.landing_ground(solid.name), self._to_enu)
+            sim.place_solid(solid.name, moved)
+
+    def _obstacles(self, carried: set[str], face: float) -> list[tuple[float, float, np.ndarray]]:
+        """(lowest, highest ENU point, xy box) of every bounding shape above the belt's face that is not
+        carried: the other top-level solids' and the robots' (their joints' links where they hold them)."""
+        sim = self._sim
+        base = sim.loaded.base_dir
+        out = []
+
+        def add(parts, pose: Pose) -> None:
+            for local, shape in parts:
+                if shape.seen_by not in ("both", "bounding") or isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid)):
+                    continue
+                span = shapes_span([(local, primitive_from_model(shape.geometry, base), shape.geometry)], pose,
+                                   self._to_enu)
+                if span is not None and span[1] > face + FLOOR and span[2] is not None:
+                    out.append(span)
+
+        for solid in sim.world.solids:
+            if solid.name in sim.scene.solid_poses and solid.name not in carried:
+                add([(local, shape) for _, local, shape in solid_parts(solid, Pose.identity())],
+                    sim.scene.solid_poses[solid.name])
+        for r in sim.robots.values():
+            links = r.links
+            add([(local if links is None or (j := getattr(shape, "on_joint", None)) not in links.poses
+                  else links.poses[j].compose(local), shape) for _, local, shape in robot_parts(r.model)],
+                sim.scene.robot_poses[r.index])
+        return out
+
+
+def _overlap(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two xy boxes (x0, y0, x1, y1) overlap by more than EPS both ways."""
+    return (min(a[2], b[2]) - max(a[0], b[0]) > EPS) and (min(a[3], b[3]) - max(a[1], b[1]) > EPS)
+
