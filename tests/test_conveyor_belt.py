@@ -155,3 +155,48 @@ def test_the_batched_simulation_refuses_a_belt(tmp_path: Path) -> None:
     with pytest.raises(BatchedError, match=r"robot 'conveyor': its conveyor belt \(motor 'belt motor'\) carries "
                        r"solids; the batched simulation moves no belt \(use Simulation\)"):
         BatchedSimulation(w.world, 2)
+
+
+YAML = """world_info: {{name: belt, basic_time_step: 10}}
+solids:
+  - {{name: floor, geometry: {{type: plane, size: [4, 4]}}}}
+  - {{name: parcel, physics: true, pose: {{translation: [0, 0, 0.15]}}, geometry: {{type: box, size: [0.1, 0.1, 0.1]}}}}
+robots:
+  - name: conveyor
+    controller: "<none>"
+    body: {{geometry: {{type: box, size: [1, 0.3, 0.1]}}}}
+    pose: {{translation: [0, 0, 0.05]}}
+    devices: [{{name: belt motor, device: LinearMotor, max_velocity: 1, max_force: 1000}}]
+    belts: [{{motor: {motor}, top: [0, 0, 0.05], along: [0, 1, 0], across: [-1, 0, 0], length: 1, width: 0.3}}]
+"""
+
+
+def test_a_yaml_robot_gives_its_belt(tmp_path: Path) -> None:
+    """A YAML world's robot names its belt (schemas ConveyorBelt): along its +y here, 0.1 m top face."""
+    p = tmp_path / "belt.yaml"
+    p.write_text(YAML.format(motor='"belt motor"'))
+    sim = Simulation(load_world(p))
+    belt(sim, 0.25)
+    sim.run(100)
+    assert at(sim, "parcel") == pytest.approx([0.0, 0.25, 0.15], abs=1e-12)
+
+
+def test_a_belt_naming_no_linear_motor_is_one_clear_line(tmp_path: Path) -> None:
+    p = tmp_path / "belt.yaml"
+    p.write_text(YAML.format(motor="roller"))
+    with pytest.raises(Exception, match=r"belts\[0\]\.motor: 'roller' is not one of the robot's LinearMotor devices"):
+        load_world(p)
+
+
+def test_a_tilted_belt_carries_nothing_and_says_so(tmp_path: Path) -> None:
+    """Only a level face carries (no slope rule here): a conveyor tilted 0.1 rad about its x warns once."""
+    from sensorium.server.sim.ground import GroundWarning
+
+    w = load_world(world(tmp_path, place="rotation 1 0 0 0.1"))
+    with pytest.warns(GroundWarning, match=r"robot 'conveyor': the belt of 'belt motor' is not level .*: it carries "
+                      "nothing"):
+        sim = Simulation(w)
+    before = at(sim)
+    belt(sim, 0.2)
+    sim.run(20)
+    assert at(sim) == before

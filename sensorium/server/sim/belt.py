@@ -36,7 +36,9 @@ class Belts:
         self._to_enu = to_enu
         self._belts: list[tuple[RobotState, wm.ConveyorBelt, JointMotor]] = [
             (r, b, r.joints[b.motor]) for r in sim.robots.values() for b in r.model.belts]
-        self._shapes: dict[str, list | None] = {}       # each solid's falling shapes, by name (see _falling)
+        self._shapes: dict[str, tuple[wm.Solid, list | None]] = {}   # each solid's falling shapes (_falling)
+        self._kept: dict[tuple[str, str], tuple[tuple, list]] = {}     # obstacles' spans while still (_spans)
+        self._moved: dict[str, tuple[Pose, wm.Solid, tuple]] = {}       # carried solids' spans where moved (_span)
         for robot, belt, _ in self._belts:
             if self._face(robot, belt) is None:
                 warnings.warn(f"{sim.loaded.source}: robot {robot.name!r}: the belt of {belt.motor!r} is not level "
@@ -62,9 +64,10 @@ class Belts:
         return centre, along, across
 
     def _falling(self, solid: wm.Solid) -> list | None:
-        if solid.name not in self._shapes:
-            self._shapes[solid.name] = falling_shapes(solid, self._sim.loaded.base_dir)
-        return self._shapes[solid.name]
+        kept = self._shapes.get(solid.name)
+        if kept is None or kept[0] is not solid:       # (a Supervisor may build a solid again under its name)
+            kept = self._shapes[solid.name] = (solid, falling_shapes(solid, self._sim.loaded.base_dir))
+        return kept[1]
 
     def carry(self, dt_s: float) -> None:
         sim = self._sim
@@ -86,13 +89,21 @@ class Belts:
                 offset = self._enu(np.asarray(pose.translation, dtype=np.float64)) - centre
                 if abs(offset @ along) > belt.length / 2.0 or abs(offset @ across) > belt.width / 2.0:
                     continue
-                shapes = self._falling(solid)
-                span = None if shapes is None else shapes_span(shapes, pose, self._to_enu)
+                span = self._span(solid, pose)
                 if span is None or abs(span[0] - centre[2]) > FLOOR:
                     continue
                 on.append((solid, pose, span))
             if on:
                 self._move(on, travel, along, centre, belt)
+
+    def _span(self, solid: wm.Solid, pose: Pose) -> tuple[float, float, np.ndarray] | None:
+        """ground.shapes_span of a solid with physics at ``pose``: kept for the pose a belt moved it to
+        (a level move shifts its xy box and keeps its heights)."""
+        kept = self._moved.get(solid.name)
+        if kept is not None and kept[0] is pose and kept[1] is solid:
+            return kept[2]
+        shapes = self._falling(solid)
+        return None if shapes is None else shapes_span(shapes, pose, self._to_enu)
 
     def _move(self, on: list, travel: float, along: np.ndarray, centre: np.ndarray, belt: wm.ConveyorBelt) -> None:
         sim = self._sim
@@ -103,18 +114,24 @@ class Belts:
         boxes = {s.name: box for s, _, (_, _, box) in on}
         spans = {s.name: (lo, hi) for s, _, (lo, hi, _) in on}
 
-        def hits(name: str, others: list[tuple[float, float, np.ndarray]]) -> bool:
+        def arrays(others: list[tuple[float, float, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            return (np.array([o[0] for o in others]), np.array([o[1] for o in others]),
+                    np.array([o[2] for o in others]).reshape(-1, 4))
+
+        def hits(name: str, others: tuple[np.ndarray, np.ndarray, np.ndarray]) -> bool:
+            bottoms, tops, other = others
+            if not len(tops):
+                return False
             lo, hi = spans[name]
             now, moved = boxes[name], boxes[name] + shift
-            return any(_overlap(moved, box) and not _overlap(now, box) and top > lo + FLOOR and bottom < hi
-                       for bottom, top, box in others)
+            return bool(np.any(_overlap(moved, other) & ~_overlap(now, other) & (tops > lo + FLOOR) & (bottoms < hi)))
 
-        stopped = {name for name in carried if hits(name, walls)}
-        while True:         # a row stops together: one behind a stopped solid stops too
-            more = {name for name in carried - stopped
-                    if hits(name, [(*spans[o], boxes[o]) for o in stopped])}
-            if not more:
-                break
+        fixed = arrays(walls)
+        stopped = {name for name in carried if hits(name, fixed)}
+        more = stopped
+        while more:         # a row stops together: one behind a solid that just stopped stops too
+            last = arrays([(*spans[o], boxes[o]) for o in more])
+            more = {name for name in carried - stopped if hits(name, last)}
             stopped |= more
         world_step = step if self._to_enu is None else self._to_enu.T @ step
         for solid, pose, _ in on:
@@ -125,37 +142,50 @@ class Belts:
             if abs(offset @ along) > belt.length / 2.0:     # past the belt's end: it falls onto what is under it
                 sim.place_solid(solid.name, moved)
                 moved = land_solid(solid, moved, sim.loaded.base_dir, sim.landing_ground(solid.name), self._to_enu)
+                sim.place_solid(solid.name, moved)
+                continue
             sim.place_solid(solid.name, moved)
+            lo, hi = spans[solid.name]
+            self._moved[solid.name] = (sim.scene.solid_poses[solid.name], solid, (lo, hi, boxes[solid.name] + shift))
 
     def _obstacles(self, carried: set[str], face: float) -> list[tuple[float, float, np.ndarray]]:
         """(lowest, highest ENU point, xy box) of every bounding shape above the belt's face that is not
-        carried: the other top-level solids' and the robots' (their joints' links where they hold them)."""
+        carried: the other top-level solids' and the robots' (their joints' links where they hold them).
+        Each solid's and robot's spans are kept while its pose (and its links' poses) are the same objects."""
         sim = self._sim
-        base = sim.loaded.base_dir
         out = []
-
-        def add(parts, pose: Pose) -> None:
-            for local, shape in parts:
-                if shape.seen_by not in ("both", "bounding") or isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid)):
-                    continue
-                span = shapes_span([(local, primitive_from_model(shape.geometry, base), shape.geometry)], pose,
-                                   self._to_enu)
-                if span is not None and span[1] > face + FLOOR and span[2] is not None:
-                    out.append(span)
-
         for solid in sim.world.solids:
-            if solid.name in sim.scene.solid_poses and solid.name not in carried:
-                add([(local, shape) for _, local, shape in solid_parts(solid, Pose.identity())],
-                    sim.scene.solid_poses[solid.name])
+            pose = sim.scene.solid_poses.get(solid.name)
+            if pose is not None and solid.name not in carried:
+                out += self._spans(("solid", solid.name), (pose, solid), lambda s=solid: [
+                    (local, shape) for _, local, shape in solid_parts(s, Pose.identity())], pose)
         for r in sim.robots.values():
             links = r.links
-            add([(local if links is None or (j := getattr(shape, "on_joint", None)) not in links.poses
-                  else links.poses[j].compose(local), shape) for _, local, shape in robot_parts(r.model)],
-                sim.scene.robot_poses[r.index])
-        return out
+            pose = sim.scene.robot_poses[r.index]
+            held = (pose, r.model) if links is None else (pose, r.model, *links.poses.values())
+            out += self._spans(("robot", r.name), held, lambda r=r, links=links: [
+                (local if links is None or (j := getattr(shape, "on_joint", None)) not in links.poses
+                 else links.poses[j].compose(local), shape) for _, local, shape in robot_parts(r.model)], pose)
+        return [span for span in out if span[1] > face + FLOOR]
+
+    def _spans(self, key: tuple[str, str], held: tuple, parts, pose: Pose) -> list[tuple[float, float, np.ndarray]]:
+        kept = self._kept.get(key)
+        if kept is not None and len(kept[0]) == len(held) and all(a is b for a, b in zip(kept[0], held)):
+            return kept[1]
+        base = self._sim.loaded.base_dir
+        spans = []
+        for local, shape in parts():
+            if shape.seen_by not in ("both", "bounding") or isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid)):
+                continue
+            span = shapes_span([(local, primitive_from_model(shape.geometry, base), shape.geometry)], pose, self._to_enu)
+            if span is not None and span[2] is not None:
+                spans.append(span)
+        self._kept[key] = (held, spans)
+        return spans
 
 
-def _overlap(a: np.ndarray, b: np.ndarray) -> bool:
-    """Whether two xy boxes (x0, y0, x1, y1) overlap by more than EPS both ways."""
-    return (min(a[2], b[2]) - max(a[0], b[0]) > EPS) and (min(a[3], b[3]) - max(a[1], b[1]) > EPS)
+def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Whether xy box ``a`` (x0, y0, x1, y1) overlaps each of boxes ``b`` (n x 4) by more than EPS both ways."""
+    return ((np.minimum(a[2], b[:, 2]) - np.maximum(a[0], b[:, 0]) > EPS)
+            & (np.minimum(a[3], b[:, 3]) - np.maximum(a[1], b[:, 1]) > EPS))
 
