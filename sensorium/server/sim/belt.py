@@ -24,7 +24,9 @@ if TYPE_CHECKING:
     from sensorium.server.sim.joints import JointMotor
     from sensorium.server.sim.simulation import RobotState, Simulation
 
-_UPRIGHT = 1e-9         # a face whose normal leans more than this (1 - cos) from the up carries nothing
+# a face whose axes rise more than this (a sine: 0.06 degrees) carries nothing; within it (world files
+# write rotations to a few digits) the face is taken level and carries along its axis's horizontal part
+_LEVEL = 1e-3
 
 
 class Belts:
@@ -45,21 +47,19 @@ class Belts:
                               "(its top face's normal is not the world's up): it carries nothing",
                               GroundWarning, stacklevel=3)
 
-    def __bool__(self) -> bool:
-        return bool(self._belts)
-
     def _enu(self, v: np.ndarray) -> np.ndarray:
         return v if self._to_enu is None else self._to_enu @ v
 
     def _face(self, robot: RobotState, belt: wm.ConveyorBelt) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """The belt's top face in ENU (its centre, unit along and across), None when it is not level."""
+        """The belt's top face in ENU (its centre, unit along and across, both horizontal), None when it is
+        not level."""
         pose = self._sim.scene.robot_poses[robot.index]
         r = np.asarray(pose.rotation, dtype=np.float64)
         along = self._enu(r @ np.asarray(belt.along, dtype=np.float64))
         across = self._enu(r @ np.asarray(belt.across, dtype=np.float64))
-        normal = np.cross(along, across)
-        if abs(along[2]) > _UPRIGHT or abs(across[2]) > _UPRIGHT or normal[2] < 1.0 - _UPRIGHT:
+        if abs(along[2]) > _LEVEL or abs(across[2]) > _LEVEL or np.cross(along, across)[2] <= 0.0:
             return None
+        along, across = (np.array([v[0], v[1], 0.0]) / np.hypot(v[0], v[1]) for v in (along, across))
         centre = self._enu(np.asarray(pose.translation, dtype=np.float64) + r @ np.asarray(belt.top, dtype=np.float64))
         return centre, along, across
 
