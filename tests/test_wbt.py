@@ -911,13 +911,15 @@ def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
 
 def test_a_track_with_a_motor_alone_is_said_without_a_sensor(tmp_path: Path) -> None:
     """A conveyor belt as Webots builds one (a Robot whose Track holds a LinearMotor and no
-    PositionSensor): its line said "(its sensor reads it)" of a sensor it does not have."""
+    PositionSensor): its line said "(its sensor reads it)" of a sensor it does not have. It is now a
+    belt that carries (tests/test_conveyor_belt.py): its line says that, of no sensor."""
     p = write(tmp_path, 'Robot { name "belt" children [\n'
               'Track { translation 0 0 0.45 children [ DEF B Shape { geometry Box { size 8 0.7 0.3 } } ] '
               'boundingObject USE B device [ LinearMotor { name "belt_motor" maxVelocity 0.2 } ] }\n] }\n')
     w = load_world(p)
     assert [x.split(": ", 1)[1] for x in w.warnings if "Track" in x] == [
-        "Track 'solid': its motor's position moves kinematically; the belt and its wheels do not move here"]
+        "Track 'solid': its belt carries the solids with physics lying on its top face at its motor's velocity; "
+        "its texture animation and wheels do not move here"]
     assert [(d.device, d.name) for d in w.world.robots[0].devices] == [("LinearMotor", "belt_motor")]
 
 

@@ -1362,6 +1362,20 @@ def _nonzero_forward(v: Forward) -> Forward:
     return v
 
 
+class ConveyorBelt(Strict):
+    """A robot's belt that carries what lies on it (Webots' ``ConveyorBelt``: one ``Track`` whose
+    LinearMotor moves the belt's contact surface): its top face, a ``length`` x ``width`` rectangle
+    centred at ``top`` in the robot's frame, moving along ``along`` (the Track's +x) at the motor's
+    velocity. The .wbt import writes one for a single motorised Track whose boundingObject is a Box."""
+
+    motor: str = Field(min_length=1, description="the robot's LinearMotor that moves the belt (m/s)")
+    top: Vec3 = Field(description="the top face's centre in the robot's frame")
+    along: Vec3 = Field(description="unit: the belt's direction of travel at a positive velocity, robot frame")
+    across: Vec3 = Field(description="unit: the face's other side's direction, robot frame")
+    length: float = Field(gt=0, description="the face's extent along `along` (m)")
+    width: float = Field(gt=0, description="the face's extent along `across` (m)")
+
+
 class DifferentialDrive(Strict):
     """Kinematic wheeled drive (no physics, no collision response): the robot moves in the world
     xy-plane from its wheel motors, controlled with Webots' motor API. Two wheels, or several per
@@ -1782,6 +1796,8 @@ class Robot(Strict):
                                          "wheels (Webots' omni_wheels how-to, a Robotino); a robot has one drive at most")
     steered_drive: SteeredDrive | None = Field(default=None, description="a robot on wheels that each steer (a PR2's "
                                                "casters, a rover's corners); a robot has one drive at most")
+    belts: list[ConveyorBelt] = Field(default=[], max_length=1024, description="conveyor belts on the robot: "
+                                      "each carries the solids with physics lying on its top face")
     devices: list[Device] = Field(default=[], description="in Webots' tree order (the order of the device "
                                   "indices); every Webots device type is accepted, those not simulated as present")
     recognition_colors: list[Color] = Field(
@@ -1830,6 +1846,10 @@ class Robot(Strict):
                 if any(field == f"{d.free_wheel}_wheel" for field, _ in car.driven):
                     raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel!r} has a motor in this "
                                      f"{car.type} car (name its motor instead)")
+        linear = {d.name for d in self.devices if isinstance(d, LinearMotor)}
+        for i, b in enumerate(self.belts):
+            if b.motor not in linear:
+                raise ValueError(f"belts[{i}].motor: {b.motor!r} is not one of the robot's LinearMotor devices")
         for i, node in enumerate(self.nodes):
             if node.parent >= i:
                 raise ValueError(f"nodes[{i}] ({node.type}): parent {node.parent} must be an earlier node's index "

@@ -402,6 +402,10 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: robot {steered[0]!r} has a steered_drive; the batched "
                                "simulation drives two-wheel, skid-steer, car-like, mecanum and omni-wheel robots "
                                "only (use Simulation)")
+        belts = [(r.name, b.motor) for r in w.robots for b in r.belts]
+        if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
+            raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "
+                               "carries solids; the batched simulation moves no belt (use Simulation)")
         for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
             drive = {m for _, m in r.drive_motors}
             joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]

@@ -26,6 +26,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
+from sensorium.server.sim.belt import Belts
 from sensorium.server.sim.cameras import Camera
 from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
@@ -406,6 +407,9 @@ class Simulation:
                          "radar_targets": dict(self.scene.radar_targets)}
         self._imported_poses: dict[str, Pose] = {}      # each imported solid's pose as imported
         self._settling = SettlingGrounds(_TO_ENU[self.world.world_info.coordinate_system])
+        # conveyor belts (sim/belt.py): none in most worlds, which then pay nothing for them
+        self._belts = Belts(self, _TO_ENU[self.world.world_info.coordinate_system]) \
+            if any(r.belts for r in self.world.robots) else None
 
     def _warn_ground(self) -> None:
         """One GroundWarning per thing a driven robot will not ride on: a tilted terrain, a robot
@@ -826,6 +830,8 @@ class Simulation:
                         self.contact.heights[robot.index] = drive.z    # (ENU, as contact works)
         for robot, _, _, pose in moved:
             self.scene.set_robot_pose(robot.index, pose)
+        if self._belts is not None:   # belts carry what lies on them by their motors' travel this step
+            self._belts.carry(dt * 0.001)
         for gripper in self._grippers:    # held solids follow their grippers; pumps on attach what they touch
             gripper.carry()
         for con in self._auto_locking:    # Webots attaches a locked auto-lock connector to a present peer

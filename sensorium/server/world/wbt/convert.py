@@ -2124,7 +2124,21 @@ class Converter:
                              "max_velocity": float(motor.get("max_velocity", 10.0)),
                              "forward": np.asarray(frame.rotation, dtype=np.float64)[:, 0],
                              "origin": np.asarray(frame.apply((0.0, 0.0, 0.0))),
-                             "frame": frame, "wheels": wheels})
+                             "frame": frame, "wheels": wheels, "belt": self.belt(node, frame, motor["name"])})
+
+    def belt(self, node: Node, frame: Frame, motor: str) -> dict | None:
+        """A Track's belt as a conveyor carries on it (schemas ConveyorBelt): the top face of its
+        boundingObject, a Box (or a Shape of one) in the Track's frame; None for any other bounding object."""
+        bo = self.fields(node).node_("boundingObject")
+        if bo is not None and bo.type == "Shape":
+            bo = self.fields(bo).node_("geometry")
+        if bo is None or bo.type != "Box":
+            return None
+        sx, sy, sz = (float(v) for v in self.fields(bo).vec("size", (2.0, 2.0, 2.0)))
+        r = np.asarray(frame.rotation, dtype=np.float64)
+        return {"motor": motor, "top": tuple(float(v) for v in frame.apply((0.0, 0.0, sz / 2.0))),
+                "along": tuple(float(v) for v in r[:, 0]), "across": tuple(float(v) for v in r[:, 1]),
+                "length": sx * frame.scale, "width": sy * frame.scale}
 
     def _track_drive(self, node: Node, robot: Owner) -> None:
         """A robot with two motorised Tracks and no motorised hinge drives on them: their motors are
@@ -2140,7 +2154,13 @@ class Converter:
             if why:
                 self.warn(node, f"robot {robot.data['name']!r}: no tracked drive ({why}); the robot will not move")
             for t in tracks:
-                self.warn(t["node"], t["line"])
+                if t["belt"] is None:
+                    self.warn(t["node"], t["line"])
+                    continue
+                robot.data.setdefault("belts", []).append(t["belt"])   # a conveyor (sim/belt.py)
+                self.warn(t["node"], f"Track {self.fields(t['node']).string('name', 'solid')!r}: its belt carries "
+                          "the solids with physics lying on its top face at its motor's velocity; its texture "
+                          "animation and wheels do not move here")
             return
         up = self._robot_up(robot)
         bottoms = [belt_bottom(t["frame"], t["wheels"], up) for t in tracks]

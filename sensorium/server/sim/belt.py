@@ -1,0 +1,191 @@
+"""Conveyor belts (schemas ``ConveyorBelt``; Webots' ``ConveyorBelt``, one ``Track`` whose LinearMotor
+moves the belt): each basic step, a top-level solid with physics lying on a moving belt's top face -- its
+lowest point within contact.FLOOR of the face, its origin over the face -- moves along the belt by the
+motor's travel that step, as Webots' physics carries it on the Track's moving contact surface. Once its
+origin is past the face's edge it lands (ground.land_solid) on what is under it. A carried solid whose
+move would put it into another solid or a robot's part (above the belt's face) stays where it is that
+step, and so do the solids behind it on that belt (a row stops together). Only a belt whose motor moved
+costs anything; a world without belts builds no ``Belts``."""
+
+from __future__ import annotations
+
+import warnings
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.contact import EPS, FLOOR
+from sensorium.server.sim.ground import GroundWarning, falling_shapes, land_solid, shapes_span
+from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
+from sensorium.server.world.poses import Pose
+
+if TYPE_CHECKING:
+    from sensorium.server.sim.joints import JointMotor
+    from sensorium.server.sim.simulation import RobotState, Simulation
+
+# a face whose axes rise more than this (a sine: 0.06 degrees) carries nothing; within it (world files
+# write rotations to a few digits) the face is taken level and carries along its axis's horizontal part
+_LEVEL = 1e-3
+
+
+class Belts:
+    """The world's conveyor belts and what they carry (``carry`` once per basic step, after the joints
+    moved their motors)."""
+
+    def __init__(self, sim: Simulation, to_enu: np.ndarray | None):
+        self._sim = sim
+        self._to_enu = to_enu
+        self._belts: list[tuple[RobotState, wm.ConveyorBelt, JointMotor]] = [
+            (r, b, r.joints[b.motor]) for r in sim.robots.values() for b in r.model.belts]
+        self._shapes: dict[str, tuple[wm.Solid, list | None]] = {}   # each solid's falling shapes (_falling)
+        self._kept: dict[tuple[str, str], tuple[tuple, list]] = {}     # obstacles' spans while still (_spans)
+        self._moved: dict[str, tuple[Pose, wm.Solid, tuple]] = {}       # carried solids' spans where moved (_span)
+        for robot, belt, _ in self._belts:
+            if self._face(robot, belt) is None:
+                warnings.warn(f"{sim.loaded.source}: robot {robot.name!r}: the belt of {belt.motor!r} is not level "
+                              "(its top face's normal is not the world's up): it carries nothing",
+                              GroundWarning, stacklevel=3)
+
+    def _enu(self, v: np.ndarray) -> np.ndarray:
+        return v if self._to_enu is None else self._to_enu @ v
+
+    def _face(self, robot: RobotState, belt: wm.ConveyorBelt) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """The belt's top face in ENU (its centre, unit along and across, both horizontal), None when it is
+        not level."""
+        pose = self._sim.scene.robot_poses[robot.index]
+        r = np.asarray(pose.rotation, dtype=np.float64)
+        along = self._enu(r @ np.asarray(belt.along, dtype=np.float64))
+        across = self._enu(r @ np.asarray(belt.across, dtype=np.float64))
+        if abs(along[2]) > _LEVEL or abs(across[2]) > _LEVEL or np.cross(along, across)[2] <= 0.0:
+            return None
+        along, across = (np.array([v[0], v[1], 0.0]) / np.hypot(v[0], v[1]) for v in (along, across))
+        centre = self._enu(np.asarray(pose.translation, dtype=np.float64) + r @ np.asarray(belt.top, dtype=np.float64))
+        return centre, along, across
+
+    def _falling(self, solid: wm.Solid) -> list | None:
+        kept = self._shapes.get(solid.name)
+        if kept is None or kept[0] is not solid:       # (a Supervisor may build a solid again under its name)
+            kept = self._shapes[solid.name] = (solid, falling_shapes(solid, self._sim.loaded.base_dir))
+        return kept[1]
+
+    def carry(self, dt_s: float) -> None:
+        sim = self._sim
+        for robot, belt, motor in self._belts:
+            travel = motor.rate * dt_s          # the belt's own travel this step (its motor's position moved so)
+            if travel == 0.0:
+                continue
+            face = self._face(robot, belt)
+            if face is None:
+                continue
+            centre, along, across = face
+            held = {g.held for g in sim._grippers if g.held is not None}
+            poses = sim.scene.solid_poses
+            on: list[tuple[wm.Solid, Pose, tuple[float, float, np.ndarray]]] = []
+            for solid in sim.world.solids:
+                if solid.name not in poses or solid.name in held or not solid.physics:
+                    continue
+                pose = poses[solid.name]
+                offset = self._enu(np.asarray(pose.translation, dtype=np.float64)) - centre
+                if abs(offset @ along) > belt.length / 2.0 or abs(offset @ across) > belt.width / 2.0:
+                    continue
+                span = self._span(solid, pose)
+                if span is None or abs(span[0] - centre[2]) > FLOOR:
+                    continue
+                on.append((solid, pose, span))
+            if on:
+                self._move(on, travel, along, centre, belt)
+
+    def _span(self, solid: wm.Solid, pose: Pose) -> tuple[float, float, np.ndarray] | None:
+        """ground.shapes_span of a solid with physics at ``pose``: kept for the pose a belt moved it to
+        (a level move shifts its xy box and keeps its heights)."""
+        kept = self._moved.get(solid.name)
+        if kept is not None and kept[0] is pose and kept[1] is solid:
+            return kept[2]
+        shapes = self._falling(solid)
+        return None if shapes is None else shapes_span(shapes, pose, self._to_enu)
+
+    def _move(self, on: list, travel: float, along: np.ndarray, centre: np.ndarray, belt: wm.ConveyorBelt) -> None:
+        sim = self._sim
+        step = along * travel                               # ENU
+        shift = np.array([step[0], step[1], step[0], step[1]])
+        carried = {s.name for s, _, _ in on}
+        walls = self._obstacles(carried, float(centre[2]))
+        boxes = {s.name: box for s, _, (_, _, box) in on}
+        spans = {s.name: (lo, hi) for s, _, (lo, hi, _) in on}
+
+        def arrays(others: list[tuple[float, float, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            return (np.array([o[0] for o in others]), np.array([o[1] for o in others]),
+                    np.array([o[2] for o in others]).reshape(-1, 4))
+
+        def hits(name: str, others: tuple[np.ndarray, np.ndarray, np.ndarray]) -> bool:
+            bottoms, tops, other = others
+            if not len(tops):
+                return False
+            lo, hi = spans[name]
+            now, moved = boxes[name], boxes[name] + shift
+            return bool(np.any(_overlap(moved, other) & ~_overlap(now, other) & (tops > lo + FLOOR) & (bottoms < hi)))
+
+        fixed = arrays(walls)
+        stopped = {name for name in carried if hits(name, fixed)}
+        more = stopped
+        while more:         # a row stops together: one behind a solid that just stopped stops too
+            last = arrays([(*spans[o], boxes[o]) for o in more])
+            more = {name for name in carried - stopped if hits(name, last)}
+            stopped |= more
+        world_step = step if self._to_enu is None else self._to_enu.T @ step
+        for solid, pose, _ in on:
+            if solid.name in stopped:
+                continue
+            moved = Pose(pose.rotation, np.asarray(pose.translation, dtype=np.float64) + world_step)
+            offset = self._enu(np.asarray(moved.translation, dtype=np.float64)) - centre
+            if abs(offset @ along) > belt.length / 2.0:     # past the belt's end: it falls onto what is under it
+                sim.place_solid(solid.name, moved)
+                moved = land_solid(solid, moved, sim.loaded.base_dir, sim.landing_ground(solid.name), self._to_enu)
+                sim.place_solid(solid.name, moved)
+                continue
+            sim.place_solid(solid.name, moved)
+            lo, hi = spans[solid.name]
+            self._moved[solid.name] = (sim.scene.solid_poses[solid.name], solid, (lo, hi, boxes[solid.name] + shift))
+
+    def _obstacles(self, carried: set[str], face: float) -> list[tuple[float, float, np.ndarray]]:
+        """(lowest, highest ENU point, xy box) of every bounding shape above the belt's face that is not
+        carried: the other top-level solids' and the robots' (their joints' links where they hold them).
+        Each solid's and robot's spans are kept while its pose (and its links' poses) are the same objects."""
+        sim = self._sim
+        out = []
+        for solid in sim.world.solids:
+            pose = sim.scene.solid_poses.get(solid.name)
+            if pose is not None and solid.name not in carried:
+                out += self._spans(("solid", solid.name), (pose, solid), lambda s=solid: [
+                    (local, shape) for _, local, shape in solid_parts(s, Pose.identity())], pose)
+        for r in sim.robots.values():
+            links = r.links
+            pose = sim.scene.robot_poses[r.index]
+            held = (pose, r.model) if links is None else (pose, r.model, *links.poses.values())
+            out += self._spans(("robot", r.name), held, lambda r=r, links=links: [
+                (local if links is None or (j := getattr(shape, "on_joint", None)) not in links.poses
+                 else links.poses[j].compose(local), shape) for _, local, shape in robot_parts(r.model)], pose)
+        return [span for span in out if span[1] > face + FLOOR]
+
+    def _spans(self, key: tuple[str, str], held: tuple, parts, pose: Pose) -> list[tuple[float, float, np.ndarray]]:
+        kept = self._kept.get(key)
+        if kept is not None and len(kept[0]) == len(held) and all(a is b for a, b in zip(kept[0], held)):
+            return kept[1]
+        base = self._sim.loaded.base_dir
+        spans = []
+        for local, shape in parts():
+            if shape.seen_by not in ("both", "bounding") or isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid)):
+                continue
+            span = shapes_span([(local, primitive_from_model(shape.geometry, base), shape.geometry)], pose, self._to_enu)
+            if span is not None and span[2] is not None:
+                spans.append(span)
+        self._kept[key] = (held, spans)
+        return spans
+
+
+def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Whether xy box ``a`` (x0, y0, x1, y1) overlaps each of boxes ``b`` (n x 4) by more than EPS both ways."""
+    return ((np.minimum(a[2], b[:, 2]) - np.maximum(a[0], b[:, 0]) > EPS)
+            & (np.minimum(a[3], b[:, 3]) - np.maximum(a[1], b[:, 1]) > EPS))
+

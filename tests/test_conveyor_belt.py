@@ -1,0 +1,202 @@
+"""A conveyor belt (one ``Track`` on a robot, its LinearMotor moving the belt, as Webots' ConveyorBelt
+PROTO is built) carries the solids with physics lying on its top face by the motor's travel, as Webots'
+physics does with the Track's moving contact surface; past its end they land on what is under them.
+Before, the belt did not move and neither did what lay on it. Our own worlds; closed-form poses."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+TOP = 0.2          # the belt's top face: a 1 x 0.3 x 0.1 box centred at z 0.15, x from -0.5 to 0.5
+X0 = -0.3          # the box's start: 0.1 m cube resting on the belt (its origin 0.05 above the face)
+
+
+def box(name: str, x: float, y: float = 0.0, z: float = TOP + 0.05, physics: str = "physics Physics { }") -> str:
+    return (f'Solid {{ name "{name}" translation {x} {y} {z} children [ DEF {name.upper()} Shape {{ geometry Box '
+            f'{{ size 0.1 0.1 0.1 }} }} ] boundingObject USE {name.upper()} {physics} }}\n')
+
+
+def world(tmp_path: Path, extra: str = "", bounding: str = "USE BELT", place: str = "") -> Path:
+    p = tmp_path / "conveyor.wbt"
+    p.write_text(
+        '#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 10 }\n'
+        'Solid { name "floor" children [ DEF F Shape { geometry Plane { size 10 10 } } ] boundingObject USE F }\n'
+        f'Robot {{ name "conveyor" {place} controller "<none>" children [\n'
+        '  Track { name "belt" translation 0 0 0.15 children [ DEF BELT Shape { geometry Box { size 1 0.3 0.1 } } ]\n'
+        f'    boundingObject {bounding} device [ LinearMotor {{ name "belt motor" maxVelocity 1 maxForce 1000 }}\n'
+        '    PositionSensor { name "belt sensor" } ] }\n] }\n'
+        # an observer looking along +x at the carried box's back face (0.25 m up: above the belt)
+        'Robot { name "eye" translation -1 0 0.25 controller "<none>" children [\n'
+        '  DistanceSensor { name "ds" lookupTable [ 0 0 0, 3 3 0 ] } ] }\n'
+        + box("box", X0) + box("side", X0, y=1.0, z=0.05) + extra)
+    return p
+
+
+def belt(sim: Simulation, velocity: float, position: float = math.inf) -> None:
+    m = sim.robot("conveyor").motor("belt motor")
+    m.set_position(position)
+    m.set_velocity(velocity)
+
+
+def at(sim: Simulation, name: str = "box") -> list[float]:
+    return [float(v) for v in sim.scene.solid_poses[name].translation]
+
+
+def test_a_box_on_a_belt_moves_at_the_belt_speed(tmp_path: Path) -> None:
+    w = load_world(world(tmp_path))
+    assert any("its belt carries the solids" in x for x in w.warnings), w.warnings
+    assert not any("the belt and its wheels do not move" in x for x in w.warnings), w.warnings
+    b = w.world.robots[0].belts[0]
+    assert (b.motor, b.top, b.along, b.length, b.width) == ("belt motor", (0.0, 0.0, TOP), (1.0, 0.0, 0.0), 1.0, 0.3)
+    sim = Simulation(w)
+    ds, sensor = sim.device("eye/ds"), sim.device("conveyor/belt sensor")
+    ds.enable(10)
+    sensor.enable(10)
+    belt(sim, 0.2)
+    for n in range(1, 151):        # 1.5 s at 0.2 m/s: x = X0 + 0.2 t
+        sim.step()
+        assert at(sim) == pytest.approx([X0 + 0.2 * 0.01 * n, 0.0, TOP + 0.05], abs=1e-12)
+    assert sensor.value == pytest.approx(0.3, abs=1e-12)
+    # the observer's ray meets the box's back face where the box now is: 1 m to x = -1
+    assert ds.value == pytest.approx(X0 + 0.3 - 0.05 + 1.0, abs=1e-9)
+    assert at(sim, "side") == [X0, 1.0, 0.05]      # beside the belt: not carried
+
+
+def test_a_stopped_belt_leaves_it_and_reverse_moves_it_back(tmp_path: Path) -> None:
+    sim = Simulation(load_world(world(tmp_path)))
+    sim.run(50)
+    assert at(sim) == [X0, 0.0, TOP + 0.05]        # velocity 0 (no command): nothing moves
+    belt(sim, 0.0)
+    sim.run(50)
+    assert at(sim) == [X0, 0.0, TOP + 0.05]
+    belt(sim, -0.1)                                # reverse: back along -x
+    sim.run(100)
+    assert at(sim) == pytest.approx([X0 - 0.1, 0.0, TOP + 0.05], abs=1e-12)
+    belt(sim, 0.5, position=-0.05)     # position control: the belt (at -0.1) travels to -0.05 and stops
+    sim.run(100)
+    assert at(sim) == pytest.approx([X0 - 0.1 + 0.05, 0.0, TOP + 0.05], abs=1e-12)
+
+
+def test_past_the_belts_end_it_lands_on_the_floor(tmp_path: Path) -> None:
+    sim = Simulation(load_world(world(tmp_path)))
+    belt(sim, 0.2)
+    steps = 0
+    while at(sim)[2] > 0.1:                       # carried until its origin passes x = 0.5
+        sim.step()
+        steps += 1
+        assert steps < 1000
+    x = at(sim)[0]
+    assert x == pytest.approx(X0 + 0.2 * 0.01 * steps, abs=1e-12) and 0.5 < x <= 0.5 + 0.002 + 1e-12
+    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)     # on the floor at its half height
+    sim.run(50)
+    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)     # off the belt: it stays
+
+
+def test_a_wall_stops_the_box_and_the_one_behind_it(tmp_path: Path) -> None:
+    """A fixed wall (no physics) across the belt at x 0.3 (its face at 0.29): the carried box stops
+    less than one step's travel (2 mm) short of it; a second box in a row behind it stops with it."""
+    wall = box("wall", 0.34, physics="").replace("size 0.1 0.1 0.1", "size 0.1 0.5 0.1")
+    sim = Simulation(load_world(world(tmp_path, extra=wall + box("second", X0 - 0.2))))
+    belt(sim, 0.2)
+    sim.run(400)
+    front = at(sim)[0] + 0.05
+    assert 0.29 - 0.002 < front <= 0.29 + 1e-9      # (contact's EPS: touching is not overlapping)
+    assert at(sim, "second")[0] + 0.05 <= at(sim)[0] - 0.05 + 1e-12     # behind it, not into it
+    assert at(sim, "second")[0] - 0.05 > at(sim)[0] - 0.05 - 0.1 - 0.002 - 1e-12   # stopped against it
+    assert at(sim, "wall") == [0.34, 0.0, TOP + 0.05]
+
+
+def test_reset_restores_the_box_and_the_belt(tmp_path: Path) -> None:
+    sim = Simulation(load_world(world(tmp_path)))
+    belt(sim, 0.2)
+    sim.run(100)
+    assert at(sim)[0] == pytest.approx(X0 + 0.2, abs=1e-12)
+    sim.reset()
+    assert at(sim) == [X0, 0.0, TOP + 0.05]
+    sim.run(100)                                   # the motor's command is reset too (velocity control off)
+    assert at(sim) == [X0, 0.0, TOP + 0.05]
+    belt(sim, 0.2)
+    sim.run(100)
+    assert at(sim)[0] == pytest.approx(X0 + 0.2, abs=1e-12)
+
+
+def test_a_turned_conveyor_carries_along_its_tracks_x(tmp_path: Path) -> None:
+    """The conveyor robot turned 90 degrees about z: its belt runs along the world's +y; the box on it
+    (put at the belt's world position) goes along +y."""
+    p = world(tmp_path, place="rotation 0 0 1 1.5707963267948966")
+    p.write_text(p.read_text().replace(f'name "box" translation {X0} 0.0 ', f'name "box" translation 0 {X0} '))
+    sim = Simulation(load_world(p))
+    belt(sim, 0.2)
+    sim.run(100)
+    assert at(sim) == pytest.approx([0.0, X0 + 0.2, TOP + 0.05], abs=1e-12)
+
+
+def test_a_belt_without_a_box_bounding_object_keeps_its_warning(tmp_path: Path) -> None:
+    """Only a Box (or a Shape of one) is read as a belt's top face: a Box inside a Transform is not."""
+    w = load_world(world(tmp_path, bounding="Transform { children [ USE BELT ] }"))
+    assert w.world.robots[0].belts == []
+    assert any("the belt and its wheels do not move here" in x for x in w.warnings), w.warnings
+    sim = Simulation(w)
+    assert sim._belts is None                      # nothing to carry: nothing computed per step
+    belt(sim, 0.2)
+    sim.run(50)
+    assert at(sim) == [X0, 0.0, TOP + 0.05]
+
+
+def test_the_batched_simulation_refuses_a_belt(tmp_path: Path) -> None:
+    w = load_world(world(tmp_path))
+    with pytest.raises(BatchedError, match=r"robot 'conveyor': its conveyor belt \(motor 'belt motor'\) carries "
+                       r"solids; the batched simulation moves no belt \(use Simulation\)"):
+        BatchedSimulation(w.world, 2)
+
+
+YAML = """world_info: {{name: belt, basic_time_step: 10}}
+solids:
+  - {{name: floor, geometry: {{type: plane, size: [4, 4]}}}}
+  - {{name: parcel, physics: true, pose: {{translation: [0, 0, 0.15]}}, geometry: {{type: box, size: [0.1, 0.1, 0.1]}}}}
+robots:
+  - name: conveyor
+    controller: "<none>"
+    body: {{geometry: {{type: box, size: [1, 0.3, 0.1]}}}}
+    pose: {{translation: [0, 0, 0.05]}}
+    devices: [{{name: belt motor, device: LinearMotor, max_velocity: 1, max_force: 1000}}]
+    belts: [{{motor: {motor}, top: [0, 0, 0.05], along: [0, 1, 0], across: [-1, 0, 0], length: 1, width: 0.3}}]
+"""
+
+
+def test_a_yaml_robot_gives_its_belt(tmp_path: Path) -> None:
+    """A YAML world's robot names its belt (schemas ConveyorBelt): along its +y here, 0.1 m top face."""
+    p = tmp_path / "belt.yaml"
+    p.write_text(YAML.format(motor='"belt motor"'))
+    sim = Simulation(load_world(p))
+    belt(sim, 0.25)
+    sim.run(100)
+    assert at(sim, "parcel") == pytest.approx([0.0, 0.25, 0.15], abs=1e-12)
+
+
+def test_a_belt_naming_no_linear_motor_is_one_clear_line(tmp_path: Path) -> None:
+    p = tmp_path / "belt.yaml"
+    p.write_text(YAML.format(motor="roller"))
+    with pytest.raises(Exception, match=r"belts\[0\]\.motor: 'roller' is not one of the robot's LinearMotor devices"):
+        load_world(p)
+
+
+def test_a_tilted_belt_carries_nothing_and_says_so(tmp_path: Path) -> None:
+    """Only a level face carries (no slope rule here): a conveyor tilted 0.1 rad about its x warns once."""
+    from sensorium.server.sim.ground import GroundWarning
+
+    w = load_world(world(tmp_path, place="rotation 1 0 0 0.1"))
+    with pytest.warns(GroundWarning, match=r"robot 'conveyor': the belt of 'belt motor' is not level .*: it carries "
+                      "nothing"):
+        sim = Simulation(w)
+    before = at(sim)
+    belt(sim, 0.2)
+    sim.run(20)
+    assert at(sim) == before
