@@ -391,3 +391,52 @@ def test_an_end_point_turned_back_to_no_rotation_reads_webots_identity(tmp_path)
     assert arm.position("CUP") == pytest.approx([0.3, 0.0, -0.1], abs=1e-12)
     arm.move("roll", 0.25)                                   # a real turn keeps its axis and angle
     assert arm.field("LINK", "rotation") == pytest.approx([1.0, 0.0, 0.0, 0.25], abs=1e-12)
+
+
+DEF_PARAMETERS = """#VRML_SIM R2023b utf8
+Robot {
+  name "tuner" controller "<extern>" supervisor TRUE
+  children [
+    HingeJoint {
+      jointParameters DEF TURN_PARAMETERS HingeJointParameters { axis 0 0 1 position 0.25 }
+      device [ RotationalMotor { name "turn" maxVelocity 100 } ]
+      endPoint DEF ARM Solid { translation 0.2 0 0 rotation 0 0 1 0.25 }
+    }
+    SliderJoint {
+      jointParameters DEF SLIDE_PARAMETERS JointParameters { axis 1 0 0 }
+      device [ LinearMotor { name "slide" maxPosition 1 } ]
+      endPoint Solid { translation 0 0.5 0 }
+    }
+    HingeJoint {
+      jointParameters USE TURN_PARAMETERS
+      device [ RotationalMotor { name "twin" } ]
+      endPoint Solid { translation 0 -0.5 0 }
+    }
+  ]
+}
+"""
+
+
+def test_a_joints_parameters_are_found_by_their_def(tmp_path):
+    """Webots' ziegler_nichols how-to finds its hinge's HingeJointParameters by DEF (getFromDef) and
+    sets its ``position`` to start each trial from 0: the node found is the joint's jointParameters,
+    its position the joint's, and setting it moves the joint and its end point at once. A USE of the
+    DEF is no second DEF (the first joint's is found)."""
+    path = tmp_path / "tuner.wbt"
+    path.write_text(DEF_PARAMETERS)
+    arm = Arm(path, "tuner")
+    turn = arm.node("TURN_PARAMETERS")
+    joint = arm.call("get_from_id", {"id": turn})["parent"]
+    assert arm.call("get_from_id", {"id": turn})["type"] == "HingeJointParameters"
+    assert arm.call("get_field", {"node": joint, "field": "jointParameters"})["value"] == turn
+    assert arm.call("get_from_id", {"id": turn})["def_name"] == "TURN_PARAMETERS"
+    slide = arm.node("SLIDE_PARAMETERS")
+    assert arm.call("get_from_id", {"id": slide})["type"] == "JointParameters"
+    assert arm.call("get_field", {"node": turn, "field": "position"})["value"] == 0.25
+    arm.call("set_field", {"node": turn, "field": "position", "value": HALF_PI})
+    assert arm.lv.sim.robot("tuner").motor("turn").position == HALF_PI
+    # the file's end point is where the joint at 0.25 puts it: a turn by HALF_PI - 0.25 about z from there
+    assert arm.position("ARM") == pytest.approx([0.2 * math.cos(HALF_PI - 0.25), 0.2 * math.sin(HALF_PI - 0.25), 0.0],
+                                                abs=1e-12)
+    arm.call("set_field", {"node": slide, "field": "position", "value": 0.3})
+    assert arm.lv.sim.robot("tuner").motor("slide").position == 0.3

@@ -372,10 +372,14 @@ def test_a_file_overwritten_with_no_image_is_refused_when_named_again(folder):
     ("notes.png", "texture file 'notes.png' is not a PNG or JPEG image"),
     ("../outside.png", "texture url '../outside.png' leaves the world's folder"),
     ("https://example.com/t.png", "only local image files are read here"),
-    ("webots://projects/default/worlds/textures/stone.jpg", "only local image files are read here"),
+    ("webots://projects/default/worlds/textures/stone.jpg",
+     '"webots://projects/default/worlds/textures/stone.jpg" not found (Webots); looked in: nothing'),
+    ("ftp://example.com/t.png", "only local image files are read here"),
     ("big.png", "'big.png' has 64x64 = 4,096 pixels, more than the limit of 1,000"),
 ])
-def test_a_url_that_cannot_be_read_is_refused_and_nothing_changes(folder, url, problem):
+def test_a_url_that_cannot_be_read_is_refused_and_nothing_changes(folder, url, problem, monkeypatch):
+    monkeypatch.delenv("WEBOTS_HOME", raising=False)
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
     (folder.parent / "outside.png").write_bytes((folder / "a.png").read_bytes())
     sim = _sim(folder / "world.wbt", limits=WorldLimits(texture_pixels=1000))
     before = _shot(sim)
@@ -388,6 +392,46 @@ def test_a_url_that_cannot_be_read_is_refused_and_nothing_changes(folder, url, p
     assert field(sim, tex, "url") == ["a.png"]
     got = _shot(sim)
     assert np.array_equal(got[0], before[0]) and got[1] == before[1]
+
+
+def _home(tmp_path):
+    """A Webots installation of ours holding one texture (a 4 x 4 image of random colours)."""
+    from PIL import Image
+    home = tmp_path / "home"
+    textures = home / "projects" / "default" / "worlds" / "textures"
+    textures.mkdir(parents=True)
+    rng = np.random.default_rng(11)
+    Image.fromarray(rng.integers(0, 256, (4, 4, 3), dtype=np.uint8)).save(textures / "stone.png")
+    return home
+
+
+def test_a_webots_url_of_the_installation_is_read_from_it(folder, tmp_path, monkeypatch):
+    """Webots' texture_change how-to sets webots:// urls its world file never writes: with
+    --webots-home (WEBOTS_HOME) the image is read from the installation, and the camera and the
+    infra-red sensor see what they see in the world written with that file; one the installation
+    lacks is refused with one line naming where it looked, nothing changed."""
+    home = _home(tmp_path)
+    monkeypatch.setenv("WEBOTS_HOME", str(home))
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    (folder / "copy.png").write_bytes((home / "projects/default/worlds/textures/stone.png").read_bytes())
+    sim = _sim(folder / "world.wbt")
+    before = _shot(sim)
+    tex = sv.find_node(sim, "TEX")
+    url = "webots://projects/default/worlds/textures/stone.png"
+    sv.change_item(sim, tex, "url", "set", 0, url)
+    assert field(sim, tex, "url") == [url]
+    got = _shot(sim)
+    ref = _written(folder, '"copy.png"')
+    assert np.array_equal(got[0], ref[0]) and got[1] == ref[1]
+    assert not np.array_equal(got[0], before[0])
+    with pytest.raises(ValueError) as err:
+        sv.change_item(sim, tex, "url", "set", 0, "webots://projects/default/worlds/textures/none.png")
+    line = str(err.value)
+    assert '"webots://projects/default/worlds/textures/none.png" not found' in line and str(home) in line, line
+    assert line.endswith("; nothing changed") and "\n" not in line
+    assert field(sim, tex, "url") == [url]
+    again = _shot(sim)
+    assert np.array_equal(again[0], got[0])
 
 
 def test_bad_indices_and_values_are_one_line(folder):

@@ -1721,6 +1721,9 @@ class NestedNode(Strict):
                                "(Supervisor getFromDevice)")
     joint_parameters: bool = Field(default=False, description="a HingeJoint or SliderJoint whose world file gives "
                                    "its jointParameters node (a Supervisor reads its position there)")
+    joint_parameters_def: str | None = Field(default=None, min_length=1, description="that jointParameters node's "
+                                             "DEF name (Supervisor getFromDef, as Webots' ziegler_nichols how-to "
+                                             "finds it to set its position)")
     axis: Vec3 | None = Field(default=None, description="a HingeJoint's or SliderJoint's axis in the robot's frame as "
                               "the world loads (its jointParameters' axis, else Webots' default), whatever its devices: "
                               "getUrdf writes it for joints no motor turns too; none for other nodes")

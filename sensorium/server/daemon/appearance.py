@@ -229,6 +229,26 @@ def _world_url(scene: Any, url: str) -> str | None:
     return None
 
 
+def _installed_url(scene: Any, url: str, where: str) -> str:
+    """The file a ``webots://`` url names in the Webots installation (``--webots-home``/``WEBOTS_HOME``)
+    or the ``--proto-path`` folders, found as a world file's are: Webots reads any such url a Supervisor
+    sets (its how-to ``texture_change`` swaps two of its textures). Not found there: ValueError (one line
+    naming the places tried)."""
+    from sensorium.server.world.proto import ProtoError, ProtoSearch, asset_roots, resolve_url
+
+    search = ProtoSearch.create(scene.base_dir)
+    try:
+        path = resolve_url(url, scene.base_dir / "world.wbt", search).resolve()
+    except ProtoError as exc:
+        raise ValueError(f"{where}: texture file {exc.message}; nothing changed") from None
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"{where}: {_quoted(url)} cannot be resolved ({exc}); nothing changed") from None
+    if not any(path.is_relative_to(root) for root in asset_roots(search)):
+        raise ValueError(f"{where}: {_quoted(url)} names a file outside the Webots installation and the --proto-path "
+                         "folders; nothing changed")
+    return str(path)
+
+
 def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> None:
     """Every shape holding the texture takes ``url`` (checked as a world file's textures are), or
     none of them does (ValueError: one line)."""
@@ -237,9 +257,11 @@ def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> None:
     name = url
     if url is not None:
         known = _world_url(scene, url)
+        if known is None and url.startswith("webots://"):
+            known = _installed_url(scene, url, where)
         if known is None and "://" in url:
             raise ValueError(f"{where}: {_quoted(url)}: only local image files are read here, named relative to the world "
-                             "file's folder (no downloads; a webots:// url only where the world file writes it); "
+                             "file's folder, or webots:// urls of the Webots installation (no downloads); "
                              "nothing changed")
         name = known or url
         before = scene.textures.pixels(without=shapes) if scene.textures is not None else 0

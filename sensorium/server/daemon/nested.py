@@ -192,7 +192,8 @@ def _joint_parameters(sim: Any, robots: list[str], out: list[Nested]) -> tuple[l
                 bare.add(FIRST_ID + first + k)
                 continue
             kind = "HingeJointParameters" if e.type == "HingeJoint" else "JointParameters"
-            added.append(Nested(FIRST_ID + len(out) + len(added), kind, "", "", "", FIRST_ID + first + k,
+            added.append(Nested(FIRST_ID + len(out) + len(added), kind, "", e.joint_parameters_def or "", "",
+                                FIRST_ID + first + k,
                                 "jointParameters", None, None, "", i + 1, "Robot", name, motor=motor))
         first += len(entries)
     return added, frozenset(bare)

@@ -542,8 +542,11 @@ class Converter:
         if posed:
             entry["pose"] = self.child_frame(node, frame).pose()
         if t in ("HingeJoint", "SliderJoint"):
-            if self.fields(node).node_("jointParameters") is not None:
+            parameters = self.fields(node).node_("jointParameters")
+            if parameters is not None:
                 entry["joint_parameters"] = True
+                if self.nested_def(parameters):
+                    entry["joint_parameters_def"] = parameters.def_name
             self.joint_frame(node, frame, entry)      # for getUrdf, whatever turns the joint (or nothing)
         self.tree_entry(node, entry, field, proto)
         self.tree_stack.append((node, len(self.tree) - 1))
