@@ -312,6 +312,9 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
     # counts the 10 fields served for a Robot
     assert "Error: wb_supervisor_field_get_mf_int32() called with wrong field type: SFRotation." in err
     assert "simulation_quit" not in err
+    contacts = [line for line in err.splitlines() if "contact points" in line]   # said once, at the first query
+    assert contacts == ["Warning: wb_supervisor_node_get_contact_points(): Sensorium computes no contact points: "
+                        "every node touches nothing (none, even on the ground)."], err
 
 
 # ====================================================================== readings, bit for bit

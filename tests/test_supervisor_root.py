@@ -123,6 +123,27 @@ def test_webots_adds_the_missing_world_info_and_viewpoint_at_places_0_and_1(tmp_
     assert field(lv, 4, "basicTimeStep") == {"type": "SFFloat", "value": 32.0}
 
 
+def test_a_top_level_def_group_of_solids_is_no_node_and_validate_says_so(tmp_path):
+    """Webots' robotbenchmark obstacle-avoidance referee asks getFromDef("CUBE_OBSTACLES") for a
+    top-level DEF Group of solids, then its children: here such a Group is served as its children
+    only (the cube is a top-level solid, found by its name) and getFromDef answers NULL, so loading
+    says so in one line at the Group; a DEF Group of shapes only is a (visual) node and says nothing."""
+    world = tmp_path / "groups.wbt"
+    world.write_text(HEADER + 'Robot { name "boss" supervisor TRUE controller "<extern>" }\n'
+                     'DEF CUBES Group {\n  children [ Solid { translation 1 0 0.05 name "cube" } ]\n}\n'
+                     'DEF LOOKS Group { children [ Shape { geometry Box { size 0.1 0.1 0.1 } } ] }\n')
+    loaded = load_world(world)
+    assert loaded.warnings == [
+        f'{world}:3:11: DEF CUBES Group: served as its children only (solids, robots and lights at the top '
+        'level): a Supervisor\'s getFromDef("CUBES") finds nothing (NULL), so neither its children field nor '
+        'their count']
+    lv = Live(Simulation(loaded))
+    lv.ok(A, "attach", {"robot": "boss"})
+    assert boss(lv, "get_from_def", {"name": "CUBES"})["node"] == 0                     # NULL, as the line says
+    assert boss(lv, "get_from_def", {"name": "cube"})["type"] == "Solid"
+    assert boss(lv, "get_from_def", {"name": "LOOKS"})["type"] == "Group"
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
 def test_a_webots_supervisor_walks_the_roots_children(tmp_path):
     """tests/controllers/root_children.py through ``sensorium serve``: getMFNode(0) is WorldInfo, its

@@ -1595,25 +1595,39 @@ WbSimulationMode wb_supervisor_simulation_get_mode(void) {
 
 /* ------------------------------------------------------------------ contact points */
 /* No physics here: a node never touches anything, so every query answers "none". The supervisor check
- * still applies, as for every wb_supervisor_* function. */
+ * still applies, as for every wb_supervisor_* function. In Webots a robot on the ground always has
+ * contact points (its wheels'): a supervisor that waits for one (a benchmark's "has it touched
+ * something?") would wait forever here without a word, so the first query says so, once. */
+static void contact_points_unsimulated(const char *func) {
+  static bool warned;
+  if (warned)
+    return;
+  warned = true;
+  fprintf(stderr, "Warning: %s(): Sensorium computes no contact points: every node touches nothing (none, even "
+                  "on the ground).\n", func);
+}
+
 const double *wb_supervisor_node_get_contact_point(WbNodeRef node, int index) {
   (void)node;
   (void)index;
-  supervisor("wb_supervisor_node_get_contact_point");
+  if (supervisor("wb_supervisor_node_get_contact_point"))
+    contact_points_unsimulated("wb_supervisor_node_get_contact_point");
   return sn_no_values();
 }
 
 WbNodeRef wb_supervisor_node_get_contact_point_node(WbNodeRef node, int index) {
   (void)node;
   (void)index;
-  supervisor("wb_supervisor_node_get_contact_point_node");
+  if (supervisor("wb_supervisor_node_get_contact_point_node"))
+    contact_points_unsimulated("wb_supervisor_node_get_contact_point_node");
   return NULL;
 }
 
 int wb_supervisor_node_get_number_of_contact_points(WbNodeRef node, bool include_descendants) {
   (void)node;
   (void)include_descendants;
-  supervisor("wb_supervisor_node_get_number_of_contact_points");
+  if (supervisor("wb_supervisor_node_get_number_of_contact_points"))
+    contact_points_unsimulated("wb_supervisor_node_get_number_of_contact_points");
   return 0;
 }
 
@@ -1622,7 +1636,8 @@ WbContactPoint *wb_supervisor_node_get_contact_points(WbNodeRef node, bool inclu
   (void)include_descendants;
   if (size != NULL)
     *size = 0;
-  supervisor("wb_supervisor_node_get_contact_points");
+  if (supervisor("wb_supervisor_node_get_contact_points"))
+    contact_points_unsimulated("wb_supervisor_node_get_contact_points");
   return NULL;
 }
 

@@ -249,6 +249,18 @@ class Field:
         return f"Field({self._ref[1]!r} of node {self._ref[0]})"
 
 
+
+_contact_points_warned: list[bool] = []
+
+
+def _contact_points_unsimulated(method: str) -> None:
+    """In Webots a robot on the ground always has contact points (its wheels'); here none: one line, once."""
+    if _contact_points_warned:
+        return
+    _contact_points_warned.append(True)
+    print(f"Warning: Node.{method}(): Sensorium computes no contact points: every node touches nothing (none, "
+          "even on the ground).", file=sys.stderr)
+
 class Node:
     """A node of the scene tree Sensorium has: the root (id 0), a robot, a top-level solid or light, a
     node inside a robot or solid (a Solid, device, Pose, Group, joint).
@@ -363,8 +375,10 @@ class Node:
         """Put back the state saved under ``stateName`` (``"__init__"``: as the world loaded)."""
         wb.wb_supervisor_node_load_state(self._ref, stateName)
 
-    # -- contact points: Sensorium has no physics contacts, so a node touches nothing (as in the C client)
+    # -- contact points: Sensorium has no physics contacts, so a node touches nothing (as in the C client);
+    # the first query says so once (a supervisor waiting for a contact would otherwise wait silently)
     def getContactPoints(self, includeDescendants: bool = False) -> list[ContactPoint]:  # noqa: N803
+        _contact_points_unsimulated("getContactPoints")
         return []
 
     def enableContactPointsTracking(self, samplingPeriod: int, includeDescendants: bool = False) -> None:  # noqa: N803
@@ -374,12 +388,15 @@ class Node:
         pass
 
     def getNumberOfContactPoints(self, includeDescendants: bool = False) -> int:  # noqa: N803
+        _contact_points_unsimulated("getNumberOfContactPoints")
         return 0
 
     def getContactPoint(self, index: int) -> list[float]:
+        _contact_points_unsimulated("getContactPoint")
         return [math.nan] * 3
 
     def getContactPointNode(self, index: int) -> Node | None:
+        _contact_points_unsimulated("getContactPointNode")
         return None
 
     id = property(getId)

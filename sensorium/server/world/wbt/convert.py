@@ -704,6 +704,11 @@ class Converter:
                                 "are kept as a solid")
                 self.solid(node, frame, owner, OTHER_NAMES.get(t, t.lower()))
         elif t == "Group":
+            if top and node.def_name and not self.shapes_only(node):
+                # its solids become top-level nodes of their own; the Group itself is no node here
+                self.warn(node, f"DEF {node.def_name} Group: served as its children only (solids, robots and "
+                                f"lights at the top level): a Supervisor's getFromDef(\"{node.def_name}\") finds "
+                                "nothing (NULL), so neither its children field nor their count")
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
         elif t == "Propeller":           # a robot's motor (listed: controllers ask for it) and its helix
@@ -1409,8 +1414,10 @@ class Converter:
 
     def marker(self, node: Node, frame: Frame) -> bool:
         """A Pose or Transform (not scaled) with only shapes inside it, through Poses, Transforms and Groups."""
-        if not self.child_frame(node, frame).rigid:
-            return False
+        return self.child_frame(node, frame).rigid and self.shapes_only(node)
+
+    def shapes_only(self, node: Node) -> bool:
+        """Only shapes inside ``node``, through Poses, Transforms and Groups (a visual node of its own)."""
         stack = list(self.fields(node).nodes("children"))
         while stack:
             child = stack.pop()
