@@ -145,13 +145,18 @@ def test_builtin_controllers_drive_every_wheel_of_a_skid_steer_robot(tmp_path):
     assert rows[1]["bot.path_m"] == rows[0]["bot.path_m"] > 0
 
 
-def test_a_python_file_controller_and_parameters(tmp_path):
-    world = room_world(tmp_path / "room.yaml")
+def forward_controller(tmp_path: Path) -> Path:
+    """A Python file controller driving every wheel of robot 'bot' at 2 rad/s."""
     ctrl = tmp_path / "fwd.py"
     ctrl.write_text("import math\n"
                     "def make(sim):\n"
                     "    for m in sim.robot('bot').motors.values():\n"
                     "        m.set_position(math.inf); m.set_velocity(2.0)\n")
+    return ctrl
+
+def test_a_python_file_controller_and_parameters(tmp_path):
+    world = room_world(tmp_path / "room.yaml")
+    ctrl = forward_controller(tmp_path)
     res = run_sweep({"worlds": [str(world)], "seeds": [0], "duration_ms": 320, "controllers": [f"{ctrl}:make"],
                      "parameters": {"robots[bot].differential_drive.wheel_radius": [0.01, 0.02]}, "record": False},
                     None, engine="local", workers=1, progress=False)
@@ -168,7 +173,6 @@ def test_a_nue_world_row_is_east_north_and_the_heading_of_the_drive(tmp_path):
     the world's x and y (north and up) and the own x's angle about the world's z."""
     turn, d = 0.7, 0.02 * 2.0 * 0.32
     c, s = math.cos(turn), math.sin(turn)
-    # the rotation about y by `turn` as a quaternion (x y z w)
     data = {"world_info": {"coordinate_system": "NUE", "basic_time_step": 32},
             "robots": [{"name": "bot", "pose": {"translation": [0.4, 0.0, -0.3],
                                                 "quaternion": [0.0, math.sin(turn / 2), 0.0, math.cos(turn / 2)]},
@@ -176,11 +180,7 @@ def test_a_nue_world_row_is_east_north_and_the_heading_of_the_drive(tmp_path):
                                                "forward": [0.0, 0.0, -1.0]}}]}
     world = tmp_path / "nue.yaml"
     world.write_text(yaml.safe_dump(data))
-    ctrl = tmp_path / "fwd.py"
-    ctrl.write_text("import math\n"
-                    "def make(sim):\n"
-                    "    for m in sim.robot('bot').motors.values():\n"
-                    "        m.set_position(math.inf); m.set_velocity(2.0)\n")
+    ctrl = forward_controller(tmp_path)
     res = run_sweep({"worlds": [str(world)], "seeds": [0], "duration_ms": 320, "controllers": [f"{ctrl}:make"],
                      "record": False}, None, engine="local", workers=1, progress=False)
     row = res.rows[0]

@@ -1191,25 +1191,17 @@ class BatchedSimulation:
                 p, clipped, heading_ = ct._clip_pieces(list(foot.pieces), float(self.heights[cm, r]), starts[m].copy(),
                                                        ends[m] - starts[m], float(yaw0[m]), float(self.yaw[cm, r]),
                                                        near_solids, robot_obs, foot)
-                if heading_ != self.yaw[cm, r]:      # the turn cut short
-                    self.yaw[cm, r] = heading_
-                    kept.append(m)
-                self.centres[cm, r] = p
-                self.foot_yaw[cm, r] = self.yaw[cm, r]
-                if clipped:
-                    self.pressing[cm, r] = True
-                    self.counters["contacts"] += 1
-                    out[m] = p
-                continue
-            cands = [ct._in_band(ct._obs[j], lo, hi) for j in near_solids] + robot_obs
-            if self._shaped[r]:
-                p, clipped, heading_ = ct._clip_shaped(self.feet[r], starts[m].copy(), ends[m] - starts[m],
-                                                       float(yaw0[m]), float(self.yaw[cm, r]), cands)
-                if heading_ != self.yaw[cm, r]:      # the turn cut short
-                    self.yaw[cm, r] = heading_
-                    kept.append(m)
             else:
-                p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(self.foot_disc[r]), cands)
+                cands = [ct._in_band(ct._obs[j], lo, hi) for j in near_solids] + robot_obs
+                if self._shaped[r]:
+                    p, clipped, heading_ = ct._clip_shaped(foot, starts[m].copy(), ends[m] - starts[m],
+                                                           float(yaw0[m]), float(self.yaw[cm, r]), cands)
+                else:
+                    p, clipped = ct._clip(starts[m].copy(), ends[m] - starts[m], float(self.foot_disc[r]), cands)
+                    heading_ = self.yaw[cm, r]         # a disc turns freely
+            if heading_ != self.yaw[cm, r]:          # the turn cut short
+                self.yaw[cm, r] = heading_
+                kept.append(m)
             self.centres[cm, r] = p
             self.foot_yaw[cm, r] = self.yaw[cm, r]
             if clipped:
