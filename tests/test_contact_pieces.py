@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 from test_contact import drive, world, xy
-from test_contact_shape import block, box_robot, heading
+from test_contact_shape import _step_both, block, box_robot, heading
 
 from sensorium.server.sim import contact as C
 from sensorium.server.sim.simulation import Simulation
@@ -190,12 +190,5 @@ def test_the_batched_engine_moves_pieces_robots_as_the_single_simulation_bit_for
                 bs.set_wheels(r, lr[r, :, 0], lr[r, :, 1])
                 for c in range(n):
                     drive(singles[c], name, lr[r, c, 0], lr[r, c, 1])
-        bs.step()
-        for c, sim in enumerate(singles):
-            sim.step()
-            for r, name in enumerate("abc"):
-                pose = sim.robot(name).pose
-                assert bs.pos[c, r].tobytes() == pose.translation.tobytes(), (step, c, name)
-                assert bs.rot[c, r].tobytes() == pose.rotation.tobytes(), (step, c, name)
-                assert bool(bs.pressing[c, r]) == sim.robot(name).pressing, (step, c, name)
+        _step_both(bs, singles, step)
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
