@@ -12,10 +12,9 @@ import math
 import numpy as np
 import pytest
 from test_contact import drive, world, xy
-from test_contact_shape import _step_both, block, box_robot, heading
+from test_contact_shape import _step_both, batched_and_singles, block, box_robot, drive_randomly, heading
 
 from sensorium.server.sim import contact as C
-from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import parse_world
@@ -171,24 +170,11 @@ def test_the_batched_engine_moves_pieces_robots_as_the_single_simulation_bit_for
     """Concave robots among posts and walls and one another, driven at random: the batched engine
     (its C drive pass and its numpy path) keeps the single simulation's poses and pressing flags
     bit for bit."""
-    from sensorium.server.raycast import packets
-    from sensorium.server.sim.batched import BatchedSimulation
-    if native and packets.library() is None:
-        pytest.skip(f"no packets helper: {packets.status()}")
-    n = 3
-    bs = BatchedSimulation(_notch_world(), n)
-    if not native:
-        bs._drive_step = None
-    bs.reset(np.arange(n), [1] * n)
+    bs, singles = batched_and_singles(_notch_world, native, 3)
     assert [f.pieces is not None for f in bs.feet] == [True, True, False]        # two concave, one box
-    singles = [Simulation(_notch_world()) for _ in range(n)]
     rng = np.random.default_rng(11)
     for step in range(300):
         if step % 25 == 0:
-            lr = rng.uniform(-12.0, 12.0, (3, n, 2))
-            for r, name in enumerate("abc"):
-                bs.set_wheels(r, lr[r, :, 0], lr[r, :, 1])
-                for c in range(n):
-                    drive(singles[c], name, lr[r, c, 0], lr[r, c, 1])
+            drive_randomly(bs, singles, rng)
         _step_both(bs, singles, step)
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50

@@ -434,6 +434,29 @@ def _pen_world():
                                    disc]})
 
 
+def batched_and_singles(make_world, native: bool, n: int):
+    """``n`` batched copies of ``make_world()`` (its C drive pass, or its numpy path when not
+    ``native``; skipped without the packets helper) reset alike, and ``n`` single simulations of it."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.batched import BatchedSimulation
+    if native and packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    bs = BatchedSimulation(make_world(), n)
+    if not native:
+        bs._drive_step = None
+    bs.reset(np.arange(n), [1] * n)
+    return bs, [Simulation(make_world()) for _ in range(n)]
+
+
+def drive_randomly(bs, singles, rng) -> None:
+    """Robots a, b, c of every copy and of its single simulation set to the same random wheel speeds."""
+    lr = rng.uniform(-12.0, 12.0, (3, len(singles), 2))
+    for r, name in enumerate("abc"):
+        bs.set_wheels(r, lr[r, :, 0], lr[r, :, 1])
+        for c, sim in enumerate(singles):
+            drive(sim, name, lr[r, c, 0], lr[r, c, 1])
+
+
 def _step_both(bs, singles, step):
     """One step of the batched simulation and of each copy's single one: the same poses, bit for
     bit, and the same pressing flags (robots a, b, c)."""
@@ -452,25 +475,13 @@ def test_the_batched_engine_clips_and_refuses_turns_as_the_single_simulation_bit
     """Shaped footprints in the batched engine (its numpy path and its C drive pass): every copy,
     driven with its own random wheel speeds into the walls and one another, keeps the single
     simulation's poses and pressing flags bit for bit, turns refused included."""
-    from sensorium.server.raycast import packets
-    from sensorium.server.sim.batched import BatchedSimulation
-    if native and packets.library() is None:
-        pytest.skip(f"no packets helper: {packets.status()}")
     n = 3
-    bs = BatchedSimulation(_pen_world(), n)
-    if not native:
-        bs._drive_step = None
-    bs.reset(np.arange(n), [1] * n)
-    singles = [Simulation(_pen_world()) for _ in range(n)]
+    bs, singles = batched_and_singles(_pen_world, native, n)
     rng = np.random.default_rng(7)
     held = 0                                  # steps a robot asked to turn and kept its heading
     for step in range(300):
         if step % 25 == 0:
-            lr = rng.uniform(-12.0, 12.0, (3, n, 2))
-            for r, name in enumerate("abc"):
-                bs.set_wheels(r, lr[r, :, 0], lr[r, :, 1])
-                for c in range(n):
-                    drive(singles[c], name, lr[r, c, 0], lr[r, c, 1])
+            drive_randomly(bs, singles, rng)
         yaw_before = bs.yaw.copy()
         _step_both(bs, singles, step)
         held += int(np.count_nonzero((bs.yaw == yaw_before) & (bs.velocity[:, :, 0] != bs.velocity[:, :, 1])))
@@ -494,10 +505,6 @@ def test_the_batched_engine_pushes_turning_robots_off_walls_as_the_single_simula
     engine (its C drive pass and its numpy path, whose broad phases grow a turning move by what its
     push may need) keeps the single simulation's poses, pressing flags and contacts bit for bit, the
     corner's pushes off both walls at once included."""
-    from sensorium.server.raycast import packets
-    from sensorium.server.sim.batched import BatchedSimulation
-    if native and packets.library() is None:
-        pytest.skip(f"no packets helper: {packets.status()}")
     pushes = []
     push = C.Contact._push
 
@@ -515,11 +522,7 @@ def test_the_batched_engine_pushes_turning_robots_off_walls_as_the_single_simula
         return got
     monkeypatch.setattr(C.Contact, "_push_off_both", counted_both)
     n = 3
-    bs = BatchedSimulation(_flush_pen_world(), n)
-    if not native:
-        bs._drive_step = None
-    bs.reset(np.arange(n), [1] * n)
-    singles = [Simulation(_flush_pen_world()) for _ in range(n)]
+    bs, singles = batched_and_singles(_flush_pen_world, native, n)
     rng = np.random.default_rng(11)
     for step in range(200):
         if step % 20 == 0:
