@@ -200,3 +200,29 @@ def test_a_tilted_belt_carries_nothing_and_says_so(tmp_path: Path) -> None:
     belt(sim, 0.2)
     sim.run(20)
     assert at(sim) == before
+
+
+def test_a_python_controller_sees_the_belts_linear_motor_and_sensor(tmp_path: Path,
+                                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+    """The conveyor's LinearMotor and its PositionSensor answer Webots' linear types (the sensor
+    answered rotational before), over a real server in a thread."""
+    from _inproc import inproc_server
+
+    import sensorium.client.webots.controller as controller
+    from sensorium.client import wb
+
+    path = world(tmp_path)
+    text = path.read_text()
+    assert text.count('name "conveyor"  controller "<none>"') == 1       # the conveyor robot takes a controller
+    path.write_text(text.replace('name "conveyor"  controller "<none>"', 'name "conveyor"'))
+    with inproc_server(heartbeat_ms=2000, world=path) as (_core, transport):
+        monkeypatch.setenv("SENSORIUM_CONTROLLER_URL", f"{transport.rpc_endpoint}/conveyor")
+        try:
+            robot = controller.Robot()
+            motor, sensor = robot.getDevice("belt motor"), robot.getDevice("belt sensor")
+            assert isinstance(motor, controller.LinearMotor) and motor.getType() == controller.Motor.LINEAR
+            assert sensor.getType() == controller.PositionSensor.LINEAR and sensor.getMotor() is motor
+            assert motor.getMaxVelocity() == 1.0
+        finally:
+            wb.wb_robot_cleanup()
+            controller.Robot.created = None

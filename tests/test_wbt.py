@@ -881,7 +881,7 @@ def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
     Track's frame (WbTrackWheel). The motors were silently missing (getDevice found nothing) and the
     wheels were dropped as unknown nodes; now the wheels' shapes are where Webots draws them, the
     belt Webots animates along them is in the skipped summary, and the two motors are the robot's
-    drive (tests/test_wbt_tracks.py drives it), listed as rotational motors."""
+    drive (tests/test_wbt_tracks.py drives it), listed as the LinearMotors they are (Webots' type)."""
     def track(side: str, y: float) -> str:
         return (f'Track {{ translation 0 {y} 0 name "{side} track" children [\n'
                 f'  TrackWheel {{ position -0.15 0.0075 radius 0.046 children [ Shape {{ geometry Cylinder {{ '
@@ -896,8 +896,8 @@ def test_a_track_lists_its_motor_and_places_its_wheels(tmp_path: Path) -> None:
     assert not w.report.losses
     (robot,) = w.world.robots
     assert [(d.device, d.name) for d in robot.devices] == [
-        ("RotationalMotor", "left motor"), ("PositionSensor", "left sensor"),
-        ("RotationalMotor", "right motor"), ("PositionSensor", "right sensor")]
+        ("LinearMotor", "left motor"), ("PositionSensor", "left sensor"),
+        ("LinearMotor", "right motor"), ("PositionSensor", "right sensor")]
     assert [(s.geometry.type, s.pose.translation) for s in robot.shapes] == [
         ("box", (0.0, 0.0, 0.0)), ("cylinder", (-0.15, 0.07, 0.0075)), ("sphere", (0.0925, 0.07, -0.044)),
         ("cylinder", (-0.15, -0.07, 0.0075)), ("sphere", (0.0925, -0.07, -0.044))]

@@ -159,12 +159,90 @@ def test_the_batched_simulation_drives_a_tank_as_its_simulation_does(tmp_path: P
 
 
 def test_a_tracks_brake_names_the_drives_motor(tmp_path: Path) -> None:
-    """A Brake in a Track's device list shares its motor's joint: the drive's wheel, rotational (the
-    world was refused: "'linear', but its motor 'left motor' is rotational")."""
+    """A Brake in a Track's device list shares its motor's joint: the drive's wheel, a LinearMotor
+    (linear, as in Webots; it was rotational while the drive made its motor a RotationalMotor)."""
     brakes = (track("left", Y) + track("right", -Y)).replace('PositionSensor {', 'Brake { name "b" } PositionSensor {')
     robot = load_world(write(tmp_path, brakes)).world.robots[0]
     assert [(d.name, d.motor, d.joint_type) for d in robot.devices if d.device == "Brake"] == [
-        ("b", "left motor", "rotational"), ("b(1)", "right motor", "rotational")]
+        ("b", "left motor", "linear"), ("b(1)", "right motor", "linear")]
+
+
+def test_the_track_motors_stay_linear_motors_of_the_drive(tmp_path: Path) -> None:
+    """The drive's motors keep their LinearMotor entries (Webots' type), at their places in the
+    device list, and attach describes them as LinearMotors in m/s."""
+    from pydantic import TypeAdapter
+
+    from sensorium.schemas.services import DeviceDescription
+    from sensorium.server.daemon.services import Core
+    from sensorium.server.sim.summary import device_line
+
+    w = load_world(write(tmp_path, track("left", Y, "maxVelocity 0.15") + track("right", -Y, "maxVelocity 0.15")))
+    robot = w.world.robots[0]
+    assert [(d.device, d.name) for d in robot.devices] == [
+        ("LinearMotor", "left motor"), ("PositionSensor", "left sensor"),
+        ("LinearMotor", "right motor"), ("PositionSensor", "right sensor")]
+    assert device_line(robot.devices[0]) == "LinearMotor"          # sensorium info's line
+    devs = {d["name"]: d for d in Core(Simulation(w))._describe_robot("tank")}
+    assert {k: devs["left motor"][k] for k in ("type", "maxVelocity", "minPosition", "maxPosition", "index")} == \
+        {"type": "LinearMotor", "maxVelocity": 0.15, "minPosition": 0.0, "maxPosition": 0.0, "index": 0}
+    assert devs["right motor"]["type"] == "LinearMotor" and devs["right sensor"]["motor"] == "right motor"
+    for d in devs.values():
+        TypeAdapter(DeviceDescription).validate_python(d)
+
+
+def test_a_yaml_drive_may_name_its_linear_motor_entries(tmp_path: Path) -> None:
+    """In a YAML world a LinearMotor entry named like a drive motor is that motor (no 'device name
+    repeated' refusal); its joint fields are refused as a RotationalMotor entry's are."""
+    from sensorium.server.world.loader import WorldError, parse_world
+
+    def robot(extra: dict) -> dict:
+        return {"name": "tank", "differential_drive": {
+            "wheel_radius": 1.0, "axle_length": 0.3, "left_motor": "l", "right_motor": "r", "max_wheel_speed": 0.5},
+            "devices": [{"device": "LinearMotor", "name": "l", **extra}, {"device": "LinearMotor", "name": "r"}]}
+
+    sim = Simulation(parse_world({"world_info": {"basic_time_step": 10}, "robots": [robot({})]}))
+    assert [(e.type, e.name) for e in sim.robot("tank").device_list] == [("LinearMotor", "l"), ("LinearMotor", "r")]
+    for name in ("l", "r"):
+        sim.robot("tank").motor(name).set_position(math.inf)
+        sim.robot("tank").motor(name).set_velocity(0.2)
+    sim.run(100)
+    assert sim.robot("tank").pose.translation == pytest.approx([0.2, 0.0, 0.0], abs=1e-12)
+    with pytest.raises(WorldError, match=r"robots\[0\] \(tank\)\.devices\[0\] \(l\)\.max_force: 'l' is a motor of the robot's "
+                                         r"drive, which sets its speed and limits: leave out max_force"):
+        parse_world({"robots": [robot({"max_force": 5.0})]})
+
+
+def test_python_controllers_see_linear_motors_and_sensors(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A Python controller (a real server in a thread) gets Webots' types for a tracked robot's
+    motors and their sensors, and drives it in m/s."""
+    from _inproc import inproc_server
+
+    import sensorium.client.webots.controller as controller
+    from sensorium.client import wb
+    from sensorium.client.nodes import WEBOTS_NODE_TYPES
+
+    with inproc_server(heartbeat_ms=2000, world=tank(tmp_path)) as (core, transport):
+        monkeypatch.setenv("SENSORIUM_CONTROLLER_URL", f"{transport.rpc_endpoint}/tank")
+        try:
+            robot = controller.Robot()
+            left, right = robot.getDevice("left motor"), robot.getDevice("right motor")
+            sensor = robot.getDevice("left sensor")
+            assert isinstance(left, controller.LinearMotor) and isinstance(right, controller.LinearMotor)
+            assert left.getType() == controller.Motor.LINEAR == wb.WB_LINEAR
+            assert left.getNodeType() == WEBOTS_NODE_TYPES["WB_NODE_LINEAR_MOTOR"] == sensor.getMotor().getNodeType()
+            assert sensor.getType() == controller.PositionSensor.LINEAR and sensor.getMotor() is left
+            assert (left.getMaxVelocity(), left.getMinPosition(), left.getMaxPosition()) == (10.0, 0.0, 0.0)
+            sensor.enable(10)
+            for m in (left, right):
+                m.setPosition(math.inf)
+                m.setVelocity(0.2)
+            for _ in range(100):
+                robot.step(10)
+            assert sensor.getValue() == pytest.approx(0.2, abs=1e-12)
+            assert core.sim.robot("tank").pose.translation == pytest.approx([0.2, 0.0, 0.0], abs=1e-12)
+        finally:
+            wb.wb_robot_cleanup()
+            controller.Robot.created = None
 
 
 def test_one_track_or_tracks_beside_wheels_keep_their_warning(tmp_path: Path) -> None:
@@ -218,3 +296,17 @@ def test_the_gyms_actions_are_belt_speeds(tmp_path: Path) -> None:
     assert vinfo["pose"][1] == pytest.approx([0.0, 0.0, 1.0 * 5 * period], abs=1e-12)
     env.close()
     venv.close()
+
+
+@pytest.mark.slow
+def test_c_controllers_see_linear_motors_and_sensors(tmp_path_factory: pytest.TempPathFactory) -> None:
+    """tests/c/tracks.c (the C library built with AddressSanitizer and UBSan) against ``sensorium serve``:
+    wb_device_get_node_type, wb_motor_get_type and wb_position_sensor_get_type answer Webots' linear
+    types, and the belts at 0.2 m/s for 1 s travel 0.2 m."""
+    from _serve import run_controller
+    from test_c_client import SAN_ENV, sanitized_controller
+
+    exe = sanitized_controller(tmp_path_factory, Path(__file__).parent / "c" / "tracks.c")
+    lines, err = run_controller(tank(tmp_path_factory.mktemp("tank")), lambda url: [exe], env=SAN_ENV, robot="tank")
+    assert "Sanitizer" not in err and "runtime error" not in err, err
+    assert lines == ["node 1 1 1", "type 1 1 1", "motor 1 limits 10 0 0", "travel 0.200000000000"], err

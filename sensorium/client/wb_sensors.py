@@ -12,7 +12,9 @@ from sensorium.client.wb_robot import (
     DISTANCE_SENSOR,
     LIDAR,
     LIGHT_SENSOR,
+    LINEAR_MOTOR,
     POSITION_SENSOR,
+    WB_LINEAR,
     WB_ROTATIONAL,
     DeviceState,
     RobotClient,
@@ -299,8 +301,9 @@ def wb_position_sensor_get_value(tag: int) -> float:
 
 
 def wb_position_sensor_get_type(tag: int) -> int:
-    _position_sensor(tag, "wb_position_sensor_get_type")
-    return WB_ROTATIONAL
+    """Its joint's type, which is its motor's (a slider's or a Track's LinearMotor: ``WB_LINEAR``)."""
+    motor = current().by_name.get(str(_position_sensor(tag, "wb_position_sensor_get_type").desc.get("motor", "")))
+    return WB_LINEAR if motor is not None and motor.kind == LINEAR_MOTOR else WB_ROTATIONAL
 
 
 def wb_position_sensor_get_motor(tag: int) -> int:

@@ -712,6 +712,7 @@ def _description_tag(v: Any) -> str:
 DeviceDescription = Annotated[
     Annotated[LightSensorDescription, Tag("LightSensor")] | Annotated[DistanceSensorDescription, Tag("DistanceSensor")]
     | Annotated[LidarDescription, Tag("Lidar")] | Annotated[MotorDescription, Tag("RotationalMotor")]
+    | Annotated[MotorDescription, Tag("LinearMotor")]
     | Annotated[JointMotorDescription, Tag("joint motor")]
     | Annotated[PositionSensorDescription, Tag("PositionSensor")] | Annotated[LEDDescription, Tag("LED")]
     | Annotated[GPSDescription, Tag("GPS")] | Annotated[InertialUnitDescription, Tag("InertialUnit")]

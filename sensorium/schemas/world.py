@@ -1135,8 +1135,10 @@ class RotationalMotor(Motor):
 
 
 class LinearMotor(Motor):
-    """A SliderJoint's LinearMotor, moved kinematically (see the base class); positions in metres.
-    ``pose`` is unused."""
+    """A LinearMotor; positions in metres. An entry named like one of the robot's ``differential_drive``
+    motors *is* that drive motor, as a RotationalMotor entry is (a tracked robot's: its belt at v m/s is
+    a wheel of radius 1 at v rad/s; controllers see a LinearMotor, as in Webots). Any other is a
+    SliderJoint's motor moved kinematically (see the base class). ``pose`` is unused."""
 
     device: Literal["LinearMotor"]
     max_force: float = Field(default=10.0, ge=0.0, description="N: the kinematic acceleration bound "

@@ -56,7 +56,7 @@ class DeviceServices:
             if not e.simulated:
                 d: dict[str, Any] = {"name": e.name, "type": e.type, "simulated": False}
             elif e.type in MOTORS:
-                d = self._describe_motor(r.motors[e.name])
+                d = self._describe_motor(r.motors[e.name], e.type)
             else:
                 d = self._describe(self.topics.controls[f"{robot}/{e.name}"])
             d.update(model=e.model, index=e.index, simulated=e.simulated)
@@ -74,7 +74,9 @@ class DeviceServices:
         return out
 
     @staticmethod
-    def _describe_motor(m: Any) -> dict:
+    def _describe_motor(m: Any, kind: str = MOTOR) -> dict:
+        """A motor's description; ``kind`` is its entry's type, which a drive's wheel keeps (a tracked
+        robot's LinearMotor: m and m/s, its belt a wheel of radius 1)."""
         if isinstance(m, JointMotor):                          # a joint moved kinematically
             return {"name": m.name, "type": m.kind, "maxVelocity": float(m.max_velocity),
                     "minPosition": float(m.min_position), "maxPosition": float(m.max_position),
@@ -84,7 +86,7 @@ class DeviceServices:
                     "coupled": [c.name for c in m.coupled]}
         limit = float(getattr(m, "max_position", math.inf))      # a car's steering motor has limits
         limit = 0.0 if math.isinf(limit) else limit              # Webots: 0 and 0 mean none (a wheel)
-        return {"name": m.name, "type": MOTOR, "maxVelocity": float(m.max_velocity), "minPosition": -limit if limit else 0.0,
+        return {"name": m.name, "type": kind, "maxVelocity": float(m.max_velocity), "minPosition": -limit if limit else 0.0,
                 "maxPosition": limit, "targetPosition": float(m.target_position), "velocity": float(m.velocity)}
 
     @staticmethod

@@ -475,8 +475,9 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
     for r_i, robot in enumerate(world.robots):
         rp = f"robots[{r_i}]"
         names = [(f"{rp}.devices[{d_i}].name", d.name) for d_i, d in enumerate(robot.devices)]
-        # a RotationalMotor entry named like a drive motor is that motor (its place in the device list)
-        listed = {d.name for d in robot.devices if d.device == "RotationalMotor"}
+        # a RotationalMotor or LinearMotor entry named like a drive motor is that motor (its place in the
+        # device list; a Track's LinearMotor drives a tracked robot)
+        listed = {d.name for d in robot.devices if isinstance(d, wm.Motor)}
         names += [(f"{rp}.{field}", m) for field, m in robot.drive_motors if m not in listed]
         unique(names, "device")
         device_names = {d.name for d in robot.devices}
@@ -501,9 +502,9 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                             f"{dp}.lookup_table[{k}]",
                             f"lookup table inputs must be strictly increasing: input {table[k][0]} "
                             f"follows {table[k - 1][0]}"))
-            if isinstance(dev, wm.RotationalMotor) and dev.name in {m for _, m in robot.drive_motors}:
+            if isinstance(dev, wm.Motor) and dev.name in {m for _, m in robot.drive_motors}:
                 joint = sorted(dev.model_fields_set & set(wm.Motor.model_fields) - set(wm._Device.model_fields)
-                               | (dev.model_fields_set & {"max_torque"}))
+                               | (dev.model_fields_set & {"max_torque", "max_force"}))
                 if joint:
                     problems.append(Problem(f"{dp}.{joint[0]}", f"{dev.name!r} is a motor of the robot's drive, which "
                                                                 "sets its speed and limits: leave out "

@@ -33,7 +33,13 @@ double wb_position_sensor_get_value(WbDeviceTag tag) {
 
 WbJointType wb_position_sensor_get_type(WbDeviceTag tag) {
   POSITION("wb_position_sensor_get_type");
-  (void)d;
+  if (d == NULL || d->motor_name == NULL)
+    return WB_ROTATIONAL;
+  /* its joint's type, which is its motor's (a slider's or a Track's LinearMotor: linear) */
+  sn_robot *rb = sn_robot_get("wb_position_sensor_get_type");
+  for (int i = 0; i < rb->n_devices; i++)
+    if (strcmp(rb->devices[i].name, d->motor_name) == 0)
+      return rb->devices[i].node_type == WB_NODE_LINEAR_MOTOR ? WB_LINEAR : WB_ROTATIONAL;
   return WB_ROTATIONAL;
 }
 

@@ -143,5 +143,5 @@ class RotationalMotor(Motor):
 
 
 class LinearMotor(Motor):
-    """What ``Robot.getDevice`` returns for a linear motor (listed, not simulated: no slider joint
-    moves here; its functions answer Webots' "no value")."""
+    """What ``Robot.getDevice`` returns for a linear motor: a slider's, its joint moved kinematically,
+    or a Track's (a tracked robot's drive wheel, in m and m/s)."""

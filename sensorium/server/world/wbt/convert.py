@@ -1561,7 +1561,7 @@ class Converter:
     def unique_devices(self, robot: dict) -> None:
         """Device names address topics and services, so a repeated one gets a suffix (Webots warns
         and its getDevice returns the first); the wheel motors' names count too."""
-        listed = {d["name"] for d in robot["devices"] if d["device"] == "RotationalMotor"}
+        listed = {d["name"] for d in robot["devices"] if d["device"] in MOTORS}
         seen: Counter[str] = Counter(v for v in drive_motor_names(robot) if v not in listed)
         for dev in robot["devices"]:
             name = dev["name"]
@@ -2152,8 +2152,8 @@ class Converter:
 
     def _track_drive(self, node: Node, robot: Owner) -> None:
         """A robot with two motorised Tracks and no motorised hinge drives on them: their motors are
-        its ``differential_drive``'s wheels of radius 1 (wbt/drive.py ``track_drive``), reported to
-        controllers as rotational motors; otherwise each Track is said once (a conveyor belt's one)."""
+        its ``differential_drive``'s wheels of radius 1 (wbt/drive.py ``track_drive``), their entries kept
+        LinearMotors (controllers see Webots' types); otherwise each Track is said once (a conveyor belt's one)."""
         from sensorium.server.world.wbt.drive import belt_bottom, track_drive
 
         tracks = robot.tracks
@@ -2177,16 +2177,11 @@ class Converter:
         if self.fields(node).node_("physics") is not None and all(b is not None for b in bottoms):
             drive["wheel_bottom"] = min(b for b in bottoms if b is not None)
         robot.data["differential_drive"] = drive
-        for t in tracks:    # the drive's wheel now: its linear joint's fields go (its speed is the drive's)
+        for t in tracks:    # the drive's wheel now, still a LinearMotor (Webots' getType); its speed is the drive's
             entry = t["entry"]
-            entry["device"] = "RotationalMotor"
             for key in (*JOINT_KEYS, "max_force"):
                 entry.pop(key, None)
             entry["_wheel"] = True
-        names = {t["motor"] for t in tracks}
-        for entry in robot.data["devices"]:     # a Track's brake shares its motor's joint: the drive's, rotational
-            if entry["device"] == "Brake" and entry.get("motor") in names:
-                entry.pop("joint_type", None)
 
     def _free_wheel_bottom(self, robot: Owner, car: dict, free: list[dict]) -> None:
         """A car's free wheels (no motor: a propulsion car's front ones, a traction car's rear ones) hold
