@@ -213,6 +213,56 @@ def test_images_copy_paste_blend_load_and_delete(disp) -> None:
     assert (disp.pixels == before).all()
 
 
+def _words(w: int, h: int) -> np.ndarray:
+    """A gradient image, 0xAARRGGBB words: r = x, g = y, b = x + y, alpha 255 - x (mod 256)."""
+    ys, xs = np.mgrid[0:h, 0:w].astype(np.uint32)
+    return ((255 - xs) % 256) << 24 | (xs % 256) << 16 | (ys % 256) << 8 | ((xs + ys) % 256)
+
+
+def _band(rows: np.ndarray) -> bytes:
+    return rows.astype("<u4").tobytes()
+
+
+def test_an_image_sent_in_bands_of_rows_is_kept_at_its_last_band_as_one_load_keeps_it(disp) -> None:
+    """``rows``: an image larger than one request comes in bands of whole rows, in order; it is kept
+    (a paste shows it) only once its last row came, and is then the image one ``load`` keeps."""
+    img = _words(7, 10)
+    draw(disp, ["load", 1, 7, 10, _band(img)])
+    draw(disp, ["rows", 2, 7, 10, 0, _band(img[:4])], ["rows", 2, 7, 10, 4, _band(img[4:5])])
+    assert 2 not in disp.images
+    draw(disp, ["paste", 2, 0, 0, False])               # a partial upload is never shown
+    assert (disp.pixels == BLACK).all()
+    draw(disp, ["rows", 2, 7, 10, 5, _band(img[5:])], ["paste", 2, 1, 2, False])
+    assert disp.images[2].dtype == disp.images[1].dtype and (disp.images[2] == disp.images[1]).all()
+    assert (disp.pixels[2:12, 1:8] == img).all() and disp.loading == {}
+    # a band left half way is forgotten by delete and by a reset; a new first band starts over
+    draw(disp, ["rows", 3, 7, 10, 0, _band(img[:3])], ["delete", 3])
+    assert 3 not in disp.loading and 3 not in disp.images
+    with pytest.raises(ValueError, match=r"command 0 \(rows\): y 3: image 3 has no band before"):
+        disp.check([["rows", 3, 7, 10, 3, _band(img[3:])]])
+    draw(disp, ["rows", 4, 7, 10, 0, _band(img[:3])])
+    disp.reset()
+    assert disp.loading == {} and disp.images == {}
+
+
+@pytest.mark.parametrize("commands, message", [
+    ([["rows", 5, 7, 10, 0, _band(_words(7, 3))], ["rows", 5, 7, 10, 4, _band(_words(7, 2))]],
+     "command 1 (rows): y 4 is out of order: image 5's next band starts at row 3"),
+    ([["rows", 5, 7, 10, 0, _band(_words(7, 3))], ["rows", 5, 8, 10, 3, _band(_words(8, 2))]],
+     "command 1 (rows): width x height 8 x 10 differs from the image's first band (7 x 10)"),
+    ([["rows", 5, 7, 10, 0, _band(_words(7, 8))], ["rows", 5, 7, 10, 8, _band(_words(7, 3))]],
+     "command 1 (rows): data holds 3 rows from row 8, past the image's height 10"),
+    ([["rows", 5, 7, 10, 0, b"\0" * 30]], "command 0 (rows): data must be whole rows of 7 BGRA pixels (28 bytes each), got 30"),
+    ([["rows", 5, 2049, 2048, 0, b"\0" * 4 * 2049]], "command 0 (rows): an image is 1 to 4194304 pixels, got 2049 x 2048"),
+    ([["rows", 5, 7, 10, 10, _band(_words(7, 1))]], "command 0 (rows): y must be a row of the image, 0 to 9, got 10"),
+])
+def test_bad_bands_are_refused_with_the_command_and_field(disp, commands, message) -> None:
+    with pytest.raises(ValueError) as exc:
+        disp.check(commands)
+    assert str(exc.value) == message
+    assert disp.loading == {} and disp.images == {}
+
+
 def test_text_is_drawn_in_the_colour_at_its_corner(disp) -> None:
     draw(disp, ["color", 0x00FF00], ["text", "Hi", 1, 1])
     got = painted(disp, 0xFF00FF00)
@@ -398,10 +448,11 @@ def test_a_reset_makes_the_display_black_again_and_a_batched_world_ignores_it() 
     bs.step()                                         # builds and steps; the display draws nothing here
 
 
-def test_a_python_controller_drawing_more_than_a_request_carries_keeps_its_order(tmp_path) -> None:
+def test_a_python_controller_drawing_more_than_a_request_carries_keeps_its_order(tmp_path, capsys) -> None:
     """A full 160 x 120 map drawn pixel by pixel with a colour each (38,400 commands, beyond the
     4,096 a request may carry per display): the client sends its list ahead in order, and the
-    image is the map. A too large image for one request is one error line, not a failed step."""
+    image is the map. An image over the Display's 4,194,304 pixels, or one row of it over what a
+    request carries, is one error line each, not a failed step."""
     import yaml
     from _inproc import inproc_server
 
@@ -412,14 +463,21 @@ def test_a_python_controller_drawing_more_than_a_request_carries_keeps_its_order
     with inproc_server(heartbeat_ms=5000, world=path) as (core, transport):
         wb.wb_robot_init(f"{transport.rpc_endpoint}/bot")
         try:
+            capsys.readouterr()
             tag = wb.wb_robot_get_device("map")
             for y in range(120):
                 for x in range(160):
                     wb.wb_display_set_color(tag, (x << 16) | (y << 8) | ((x + y) & 0xFF))
                     wb.wb_display_draw_pixel(tag, x, y)
-            assert wb.wb_display_image_new(tag, 600, 600, bytes(3 * 600 * 600), wb.WB_IMAGE_RGB) is None
+            assert wb.wb_display_image_new(tag, 2049, 2048, bytes(3 * 2049 * 2048), wb.WB_IMAGE_RGB) is None
+            assert wb.wb_display_image_new(tag, 300_000, 1, bytes(3 * 300_000), wb.WB_IMAGE_RGB) is None
             assert wb.wb_robot_step(16) == 0
             pixels = core.sim.robots["bot"].devices["map"].pixels
+            assert capsys.readouterr().err.splitlines() == [
+                "Error: wb_display_image_new(): a 2049 x 2048 image is 4196352 pixels, more than a Display keeps "
+                "(4194304).",
+                "Error: wb_display_image_new(): a row of 300000 pixels is 1200000 bytes, more than one request "
+                "carries (524288)."]
         finally:
             wb.wb_robot_cleanup()
     ys, xs = np.mgrid[0:120, 0:160]

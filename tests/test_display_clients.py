@@ -316,3 +316,81 @@ def test_c_and_python_controllers_load_jpeg_images_alike(tmp_path: Path, load_co
             assert JpegImagePlugin.get_sampling(im) == 0               # 4:4:4
             saved = np.asarray(im).astype(int)
         assert np.abs(saved - shown).max() <= 2, out                   # quality 100: a unit or two of rounding
+
+
+BIG = 2048
+WINDOWS = [(0, 0), (1000, 700), (BIG - 320, BIG - 240)]      # the parts of the image each saved display shows
+
+
+def _gradient(w: int, h: int) -> np.ndarray:
+    """RGBA rows telling each pixel's place: r = x mod 256, g = y mod 256, b = the 256-pixel block
+    (x // 256 · 16 + y // 256), alpha 255 - (x + y) mod 128."""
+    ys, xs = np.mgrid[0:h, 0:w]
+    return np.stack([xs % 256, ys % 256, (xs // 256 * 16 + ys // 256) % 256, 255 - (xs + ys) % 128],
+                    axis=-1).astype(np.uint8)
+
+
+def _python_big(src: Path, out: Path, name: str) -> str:
+    """tests/c/display_big.c's sequence from the Python client, against a server in this process."""
+    from _inproc import inproc_server
+
+    from sensorium.client import wb
+    with inproc_server(heartbeat_ms=5000, world=WORLDS[0]) as (_core, transport):
+        wb.wb_robot_init(f"{transport.rpc_endpoint}/bot")
+        try:
+            tag = wb.wb_robot_get_device("screen")
+            wb.wb_robot_step(16)
+            ref = wb.wb_display_image_load(tag, str(src / name))
+            for x, y in WINDOWS if ref is not None else []:
+                wb.wb_display_image_paste(tag, ref, -x, -y, False)
+                wb.wb_display_image_save(tag, None, str(out / f"{x}_{y}.png"))
+            if ref is not None:
+                wb.wb_display_image_delete(tag, ref)
+            wb.wb_robot_step(16)
+        finally:
+            wb.wb_robot_cleanup()
+    return f"{'unreadable' if ref is None else 'loaded'} {name}"
+
+
+@pytest.fixture(scope="module")
+def big_controller(tmp_path_factory) -> str:
+    return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "display_big.c")
+
+
+@pytest.mark.slow
+def test_a_2048_square_image_loads_in_bands_from_c_and_python_alike(tmp_path: Path, big_controller: str,
+                                                                   capsys) -> None:
+    """A 2048 x 2048 PNG (16 MiB of pixels, 16 times what one request carries) is loaded by
+    wb_display_image_load in both clients, sent in bands of rows and kept whole by the server: pasted
+    at three offsets on the 320 x 240 screen, each saved display is the image's part there, pixel for
+    pixel (the gradient's closed form), the same in C and Python. An image one pixel row wider than
+    the Display's 4,194,304 pixels is one "unreadable" line and NULL/None in both."""
+    src, c_out, py_out = tmp_path / "in", tmp_path / "c", tmp_path / "py"
+    for d in (src, c_out, py_out):
+        d.mkdir()
+    Image.fromarray(_gradient(BIG, BIG), "RGBA").save(src / "ground.png", compress_level=1)
+    Image.fromarray(_gradient(BIG + 1, BIG)[..., :3], "RGB").save(src / "over.png", compress_level=1)
+    args = [str(v) for xy in WINDOWS for v in xy]
+    lines, err = run_controller(WORLDS[0], lambda url: [big_controller, "ground.png", *args],
+                                env={**SAN_ENV, "DISPLAY_IN": str(src), "DISPLAY_OUT": str(c_out)})
+    assert "Sanitizer" not in err and "runtime error" not in err, err
+    assert lines == ["loaded ground.png", "done"], err
+    assert not err.strip(), err
+    capsys.readouterr()
+    assert _python_big(src, py_out, "ground.png") == "loaded ground.png"
+    assert "Error" not in capsys.readouterr().err
+    for x, y in WINDOWS:
+        want = _gradient(x + 320, y + 240)[y:, x:]
+        with Image.open(c_out / f"{x}_{y}.png") as a, Image.open(py_out / f"{x}_{y}.png") as b:
+            c_px, py_px = np.asarray(a.convert("RGBA")), np.asarray(b.convert("RGBA"))
+        assert (c_px == want).all() and (py_px == want).all(), (x, y)
+    assert (_gradient(BIG, BIG)[BIG - 1, BIG - 1] == [255, 255, 119, 129]).all()      # the closed form's corner
+
+    lines, err = run_controller(WORLDS[0], lambda url: [big_controller, "over.png", "0", "0"],
+                                env={**SAN_ENV, "DISPLAY_IN": str(src), "DISPLAY_OUT": str(c_out)})
+    assert lines == ["unreadable over.png", "done"], err
+    refused = (f'Error: wb_display_image_load(): the "{src / "over.png"}" image is unreadable (2049 x 2048 pixels, '
+               "more than one image may hold (4194304)).")
+    assert err.strip().splitlines() == [refused], err
+    assert _python_big(src, py_out, "over.png") == "unreadable over.png"
+    assert [e for e in capsys.readouterr().err.splitlines() if e.startswith("Error")] == [refused]

@@ -43,7 +43,8 @@ __all__ = ["DISPLAY", "ImageRef", "WB_IMAGE_RGB", "WB_IMAGE_RGBA", "WB_IMAGE_ARG
 FLUSH_COMMANDS = 4096
 FLUSH_ITEMS = 40_000
 FLUSH_BYTES = 512 * 1024
-MAX_IMAGE_BYTES = 1_000_000
+MAX_IMAGE_PIXELS = 1 << 22     # the server's bound on one kept image
+BAND_BYTES = FLUSH_BYTES       # a larger image goes in bands of whole rows, each at most this (one request)
 IMAGE_TYPES = (".png", ".jpg", ".jpeg")    # the names libController reads and writes (any case)
 
 
@@ -273,9 +274,11 @@ def wb_display_image_new(tag: int, width: Any, height: Any, data: Any, format: i
     if fmt not in (WB_IMAGE_RGB, WB_IMAGE_RGBA, WB_IMAGE_ARGB, WB_IMAGE_BGRA, WB_IMAGE_ABGR):
         _err(func, "'format' argument is invalid.")
         return None
-    if 4 * w * h > MAX_IMAGE_BYTES:
-        _err(func, f"a {w} x {h} image is {4 * w * h} bytes, more than one request carries ({MAX_IMAGE_BYTES}): "
-                   "send it in parts.")
+    if w * h > MAX_IMAGE_PIXELS:
+        _err(func, f"a {w} x {h} image is {w * h} pixels, more than a Display keeps ({MAX_IMAGE_PIXELS}).")
+        return None
+    if 4 * w > BAND_BYTES:
+        _err(func, f"a row of {w} pixels is {4 * w} bytes, more than one request carries ({BAND_BYTES}).")
         return None
     raw = data.tobytes() if hasattr(data, "tobytes") else bytes(data)
     bgra = _to_bgra(raw, fmt, w * h)
@@ -286,7 +289,12 @@ def wb_display_image_new(tag: int, width: Any, height: Any, data: Any, format: i
     if dev is None:
         return None
     ref = ImageRef(_next_id(dev), tag)
-    _add(dev, ["load", ref.id, w, h, bgra])
+    if 4 * w * h <= BAND_BYTES:
+        _add(dev, ["load", ref.id, w, h, bgra])
+        return ref
+    band = BAND_BYTES // (4 * w)                    # rows per request; the server keeps the image at its last row
+    for y in range(0, h, band):
+        _add(dev, ["rows", ref.id, w, h, y, bgra[4 * w * y:4 * w * min(h, y + band)]])
     return ref
 
 
@@ -305,6 +313,11 @@ def wb_display_image_load(tag: int, filename: str) -> ImageRef | None:
         return None
     try:
         with Image.open(filename, formats=["PNG", "JPEG"]) as im:
+            w, h = im.size
+            if w * h > MAX_IMAGE_PIXELS:
+                _err(func, f"the \"{filename}\" image is unreadable ({w} x {h} pixels, more than one image may hold "
+                           f"({MAX_IMAGE_PIXELS})).")
+                return None
             rgba = im.convert("RGBA")
             w, h = rgba.size
             data = rgba.tobytes()

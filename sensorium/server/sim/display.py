@@ -19,7 +19,8 @@ WbDisplay's rules, pixel for pixel where they are simple:
   (the pixels differ from Webots'; position and colour rules are the same: top-left at (x, y),
   ``\\n`` starts a new line);
 * images: ``copy`` keeps a clipped region (blended over the attached camera's image when one is
-  attached), ``load`` keeps a client's pixels, ``paste`` puts one back (``blend``: "over" by the
+  attached), ``load`` keeps a client's pixels (``rows``: an image larger than one request, in bands
+  of whole rows sent in order, kept only once its last row came), ``paste`` puts one back (``blend``: "over" by the
   image's alpha, alpha channels added and capped at 255), ``delete`` forgets it; id 0 is the
   display itself (``save``).
 * ``attach`` a camera of the same robot: the display's pixels still black and opaque become
@@ -134,7 +135,7 @@ def _image_id(v: Any) -> int:
 
 
 _ARITY = {"color": 1, "alpha": 1, "opacity": 1, "font": 3, "pixel": 2, "line": 4, "rectangle": 5, "oval": 5,
-          "polygon": 3, "text": 3, "copy": 5, "paste": 4, "load": 4, "delete": 1, "attach": 1, "detach": 0}
+          "polygon": 3, "text": 3, "copy": 5, "paste": 4, "load": 4, "rows": 5, "delete": 1, "attach": 1, "detach": 0}
 
 
 def line_pixels(x0: int, y0: int, x1: int, y1: int, width: int | None = None,
@@ -182,6 +183,7 @@ class Display(Device):
         self.pixels = np.full((self.height, self.width), BLACK, dtype=np.uint32)
         self.color, self.alpha, self.opacity = 0xFFFFFF, 0xFF, 0xFF
         self.images: dict[int, np.ndarray] = {}
+        self.loading: dict[int, tuple[np.ndarray, int]] = {}  # images still coming in bands: rows, next row
         self.camera: Any = None
         self._cameras: dict[str, Any] = {}
         self._camera_seen = -1
@@ -233,10 +235,11 @@ class Display(Device):
             raise ValueError(f"{len(commands)} commands, at most {MAX_COMMANDS} per display and request")
         out: list[tuple] = []
         work = 0
-        stored = set(self.images)
+        stored = set(self.images) | set(self.loading)
+        loading = {iid: (rows.shape[1], rows.shape[0], y) for iid, (rows, y) in self.loading.items()}
         for i, cmd in enumerate(commands):
             try:
-                t, cost = self._check_one(cmd, stored)
+                t, cost = self._check_one(cmd, stored, loading)
             except ValueError as exc:
                 op = cmd[0] if isinstance(cmd, list) and cmd and isinstance(cmd[0], str) else "?"
                 raise ValueError(f"command {i} ({op}): {exc}") from None
@@ -247,7 +250,7 @@ class Display(Device):
             out.append(t)
         return out
 
-    def _check_one(self, cmd: Any, stored: set[int]) -> tuple[tuple, int]:
+    def _check_one(self, cmd: Any, stored: set[int], loading: dict[int, tuple[int, int, int]]) -> tuple[tuple, int]:
         if not isinstance(cmd, list) or not cmd or not isinstance(cmd[0], str) or cmd[0] not in _ARITY:
             raise ValueError(f"not a display command: {str(cmd)[:60]} (commands: {', '.join(_ARITY)})")
         op, args = cmd[0], cmd[1:]
@@ -314,9 +317,12 @@ class Display(Device):
                                  f"{len(data) if isinstance(data, bytes) else type(data).__name__}")
             self._room(stored, iid)
             return (op, iid, w, h, data), 1
+        if op == "rows":
+            return self._check_rows(args, stored, loading), 1
         if op == "delete":
             iid = _image_id(args[0])
             stored.discard(iid)
+            loading.pop(iid, None)
             return (op, iid), 0
         if op == "attach":
             name = args[0]
@@ -325,6 +331,38 @@ class Display(Device):
                 raise ValueError(f"{name!r} is no camera of robot {self.robot_name!r}")
             return (op, name), 0
         return (op,), 0
+
+    def _check_rows(self, args: list, stored: set[int], loading: dict[int, tuple[int, int, int]]) -> tuple:
+        """``rows`` id width height y data: the band of whole rows from row ``y`` of an image of
+        width x height, the bands in order (the first at row 0, each where the last one ended)."""
+        iid, w, h, y, data = args
+        iid = _image_id(iid)
+        if any(isinstance(v, bool) or not isinstance(v, int) for v in (w, h)) \
+                or w < 1 or h < 1 or w * h > MAX_IMAGE_PIXELS:
+            raise ValueError(f"an image is 1 to {MAX_IMAGE_PIXELS} pixels, got {w!r} x {h!r}")
+        if isinstance(y, bool) or not isinstance(y, int) or not 0 <= y < h:
+            raise ValueError(f"y must be a row of the image, 0 to {h - 1}, got {y!r}")
+        if not isinstance(data, bytes) or not data or len(data) % (4 * w):
+            raise ValueError(f"data must be whole rows of {w} BGRA pixels ({4 * w} bytes each), got "
+                             f"{len(data) if isinstance(data, bytes) else type(data).__name__}")
+        n = len(data) // (4 * w)
+        if y == 0:
+            self._room(stored, iid)
+        else:
+            if iid not in loading:
+                raise ValueError(f"y {y}: image {iid} has no band before (the first band is row 0)")
+            lw, lh, expect = loading[iid]
+            if (w, h) != (lw, lh):
+                raise ValueError(f"width x height {w} x {h} differs from the image's first band ({lw} x {lh})")
+            if y != expect:
+                raise ValueError(f"y {y} is out of order: image {iid}'s next band starts at row {expect}")
+        if y + n > h:
+            raise ValueError(f"data holds {n} rows from row {y}, past the image's height {h}")
+        if y + n == h:
+            loading.pop(iid, None)
+        else:
+            loading[iid] = (w, h, y + n)
+        return ("rows", iid, w, h, y, data)
 
     @staticmethod
     def _room(stored: set[int], iid: int) -> None:
@@ -352,6 +390,7 @@ class Display(Device):
         self.pixels[:] = BLACK
         self.color, self.alpha, self.opacity = 0xFFFFFF, 0xFF, 0xFF
         self.images.clear()
+        self.loading.clear()
         self.camera = None
 
     # -- the rasteriser (WbDisplay's rules)
@@ -540,7 +579,20 @@ class Display(Device):
         self.images[iid] = np.frombuffer(data, dtype="<u4").astype(np.uint32).reshape(h, w)
         return False
 
+    def _op_rows(self, iid: int, w: int, h: int, y: int, data: bytes) -> bool:
+        # the image is assembled aside and kept (a paste may show it) once its last row came
+        rows = np.empty((h, w), dtype=np.uint32) if y == 0 else self.loading[iid][0]
+        n = len(data) // (4 * w)
+        rows[y:y + n] = np.frombuffer(data, dtype="<u4").reshape(n, w)
+        if y + n == h:
+            self.loading.pop(iid, None)
+            self.images[iid] = rows
+        else:
+            self.loading[iid] = (rows, y + n)
+        return False
+
     def _op_delete(self, iid: int) -> bool:
+        self.loading.pop(iid, None)
         self.images.pop(iid, None)
         return False
 

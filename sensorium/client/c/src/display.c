@@ -27,7 +27,8 @@ struct WbImageStructPrivate {
 #define FLUSH_COMMANDS 4096
 #define FLUSH_ITEMS 40000
 #define FLUSH_BYTES (512u * 1024u)
-#define MAX_IMAGE_BYTES 1000000u
+#define MAX_IMAGE_PIXELS (1u << 22) /* the server's bound on one kept image */
+#define BAND_BYTES FLUSH_BYTES      /* a larger image goes in bands of whole rows, each at most this (one request) */
 
 static const char *g_func = "wb_display"; /* the drawing function being called (flush errors name it) */
 static void flush(sn_device *d);
@@ -337,9 +338,14 @@ static WbImageRef image_new(const char *func, WbDeviceTag tag, int width, int he
     return NULL;
   }
   size_t n = (size_t)width * (size_t)height;
-  if (n > MAX_IMAGE_BYTES / 4) {
-    fprintf(stderr, "Error: %s(): a %d x %d image is %zu bytes, more than one request carries (%u): send it in "
-                    "parts.\n", func, width, height, 4 * n, MAX_IMAGE_BYTES);
+  if (n > MAX_IMAGE_PIXELS) {
+    fprintf(stderr, "Error: %s(): a %d x %d image is %zu pixels, more than a Display keeps (%u).\n", func, width,
+            height, n, MAX_IMAGE_PIXELS);
+    return NULL;
+  }
+  if (4 * (size_t)width > BAND_BYTES) {
+    fprintf(stderr, "Error: %s(): a row of %d pixels is %zu bytes, more than one request carries (%u).\n", func,
+            width, 4 * (size_t)width, BAND_BYTES);
     return NULL;
   }
   sn_device *d = display(tag, func, true);
@@ -374,10 +380,21 @@ static WbImageRef image_new(const char *func, WbDeviceTag tag, int width, int he
         break;
     }
   }
-  msgpack_packer *pk = command_sized(d, "load", 5, 0, 4 * n);
-  ints(pk, (const int[]){ir->id, width, height}, 3);
-  msgpack_pack_bin(pk, 4 * n);
-  msgpack_pack_bin_body(pk, bgra, 4 * n);
+  if (4 * n <= BAND_BYTES) {
+    msgpack_packer *pk = command_sized(d, "load", 5, 0, 4 * n);
+    ints(pk, (const int[]){ir->id, width, height}, 3);
+    msgpack_pack_bin(pk, 4 * n);
+    msgpack_pack_bin_body(pk, bgra, 4 * n);
+  } else { /* rows per request; the server keeps the image at its last row */
+    const int band = (int)(BAND_BYTES / (4 * (size_t)width));
+    for (int y = 0; y < height; y += band) {
+      const size_t bytes = 4 * (size_t)width * (size_t)(y + band < height ? band : height - y);
+      msgpack_packer *pk = command_sized(d, "rows", 6, 0, bytes);
+      ints(pk, (const int[]){ir->id, width, height, y}, 4);
+      msgpack_pack_bin(pk, bytes);
+      msgpack_pack_bin_body(pk, bgra + 4 * (size_t)width * (size_t)y, bytes);
+    }
+  }
   free(bgra);
   return ir;
 }
@@ -401,7 +418,7 @@ static int read_image(const char *filename, int *width, int *height, unsigned ch
   unsigned char head[4] = {0};
   size_t n = fread(head, 1, sizeof head, f);
   fclose(f);
-  const long max_pixels = (long)(MAX_IMAGE_BYTES / 4);
+  const long max_pixels = (long)MAX_IMAGE_PIXELS;
   if (n >= 3 && memcmp(head, JPEG, 3) == 0)
     return sn_read_jpeg(filename, max_pixels, width, height, rgba, why, why_len);
   if (n == 4 && memcmp(head, PNG, 4) == 0)

@@ -64,8 +64,12 @@ int sn_read_png(const char *filename, long max_pixels, int *width, int *height, 
   png_set_sig_bytes(png, 8);
   png_read_info(png, info);
   const png_uint_32 w = png_get_image_width(png, info), h = png_get_image_height(png, info);
-  if ((long)w > max_pixels / (long)h)
-    png_error(png, "more pixels than one image may hold");
+  if ((long)w > max_pixels / (long)h) {
+    char too_large[96];
+    snprintf(too_large, sizeof too_large, "%lu x %lu pixels, more than one image may hold (%ld)", (unsigned long)w,
+             (unsigned long)h, max_pixels);
+    png_error(png, too_large);
+  }
   const int ctype = png_get_color_type(png, info);
   png_set_expand(png);   /* palette to RGB, grey below 8 bits to 8, tRNS to an alpha channel */
   png_set_strip_16(png); /* 16 bits a sample: the high byte */
