@@ -38,7 +38,7 @@ ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "car_lights", "car_hostile", "supervisor_scene",
                "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos",
-               "nested_nodes", "top_groups"]
+               "nested_nodes", "top_groups", "robot_window"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
@@ -609,6 +609,22 @@ def test_c_supervisor_walks_a_top_level_group_of_solids(cbin, servers):
     assert code == 0, err
     assert out == ["group 1 Pose 3", "at 1.000000000 3.000000000 0.050000000", "at 0.500000000 2.000000000 0.000000000",
                    "at 1.000000000 1.000000000 0.000000000", "same 1", "translation 1 2 0"]
+
+
+def test_c_robot_window_text_is_printed_on_stderr_when_asked(cbin, servers):
+    """tests/c/robot_window.c, built with sanitizers: with SENSORIUM_ROBOT_WINDOW_LOG=1 (what `sensorium
+    run --robot-window-log` sets) each wb_robot_wwi_send is one stderr line, line breaks shown as \\n, at
+    most 65536 bytes shown and the rest counted, a size short of the text cutting it; without it nothing."""
+    url = servers(ARENA).url("epuck")
+    code, out, err = finish(start([cbin["robot_window"]], url, SENSORIUM_ROBOT_WINDOW_LOG="1"))
+    assert code == 0, err
+    assert out == ["scored nothing received"]
+    said = [line for line in err.splitlines() if line.startswith("robot window:")]
+    assert said == ["robot window: time:1.500", "robot window: record:0.87\\nsecond line",
+                    "robot window: " + "x" * 4096 + " ... (65904 more characters not shown)", "robot window: byt"]
+    code, out, err = finish(start([cbin["robot_window"]], servers(ARENA).url("epuck")))
+    assert code == 0, err
+    assert out == ["scored nothing received"] and "robot window" not in err
 
 
 def test_c_supervisor_reaches_nested_nodes(cbin, servers):
