@@ -154,6 +154,8 @@ def test_a_top_level_group_of_solids_is_a_node_holding_them(tmp_path):
     assert inside[1] == boss(lv, "get_from_def", {"name": "MID"})["node"] == \
         boss(lv, "get_from_def", {"name": "TRIO.MID"})["node"]
     assert [boss(lv, "get_from_id", {"id": i})["def_name"] for i in inside] == ["", "MID", ""]
+    assert [boss(lv, "get_from_id", {"id": i})["parent"] for i in inside] == [trio["node"]] * 3   # getParentNode
+    assert cube["parent"] == cubes["node"] and trio["parent"] == 0
     roots = children(lv)
     assert cubes["node"] in roots and trio["node"] in roots and not set(inside) & set(roots)
     # world positions: (1, 2, 0) + Rz(90°) applied to each solid's translation (c through a plain Group)

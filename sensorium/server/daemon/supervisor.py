@@ -284,19 +284,33 @@ def root_children(sim: Any) -> list[Node]:
     return [by_id[i] for i in order if i in by_id]
 
 
+def _member_ids(sim: Any, members: tuple[tuple[str, int], ...]) -> list[int]:
+    """The ids of a top-level group's members (world/top_nodes.py), removed ones included."""
+    solids, _ = _loaded_counts(sim)
+    first = {"robots": 1, "solids": 1 + len(sim.robots)}           # ids as _all_nodes gives them
+    first["lights"] = first["solids"] + solids
+    return [first[kind] + index for kind, index in members]
+
+
 def _group_members(sim: Any, node: Node) -> list[Node]:
     """A top-level Group's, Pose's or Transform's children (world/top_nodes.py): the robots, solids and
     lights it holds, removed ones left out."""
-    if not node.scenery:
+    if not node.scenery or not _scenery(sim)[int(node.key)].members:
         return []
-    members = _scenery(sim)[int(node.key)].members
-    if not members:
-        return []
-    solids, lights = _loaded_counts(sim)
-    first = {"robots": 1, "solids": 1 + len(sim.robots)}           # ids as _all_nodes gives them
-    first["lights"] = first["solids"] + solids
     by_id = {n.id: n for n in _nodes(sim)}
-    return [by_id[i] for i in (first[kind] + index for kind, index in members) if i in by_id]
+    return [by_id[i] for i in _member_ids(sim, _scenery(sim)[int(node.key)].members) if i in by_id]
+
+
+def _group_of(sim: Any, node: Node) -> int:
+    """The id of the top-level group holding a top-level node; the root's (0) for one no group holds."""
+    if node.scenery or node.nested or node.visual:
+        return 0
+    layout = getattr(sim, "top_level", None)
+    if layout is None or not any(s.members for s in layout.scenery):
+        return 0
+    first = 1 + len(sim.robots) + sum(_loaded_counts(sim))           # the first scenery node's id
+    return next((first + x for x, s in enumerate(layout.scenery) if s.members and node.id in _member_ids(sim, s.members)),
+                0)
 
 
 def _scene_tops(sim: Any) -> list[Node]:
@@ -423,7 +437,7 @@ def node_ref(sim: Any, node: Node | None) -> dict:
     if node is None:
         return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
     parent = _nested_of(sim, node).parent if node.nested else _vnode(sim, node).parent \
-        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else 0
+        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else _group_of(sim, node)
     return {"node": node.id, "type": node.type, "name": node.name, "def_name": node.def_name,
             "parent": parent, "proto": node.proto}
 
