@@ -46,6 +46,7 @@ EXTRA_MAX = 64           # extra project folders read at most (each costs one lo
 WEBOTS_SKIP = frozenset({"protos", "worlds", "plugins", "libraries", "textures", "meshes", "icons", "docs", "build"})
 # Webots' WbController: a controller gets the quit packet (-1), then 1 s to end before it is terminated
 GRACE_S = 1.0
+ROBOT_WINDOW_ENV = "SENSORIUM_ROBOT_WINDOW_LOG"   # "1": the clients print robot-window text on stderr
 CURVE_ENV = "SENSORIUM_CURVE_SERVERKEY"    # the clients' CURVE server key (sensorium.client.connection)
 LINE_MAX = 1 << 16       # bytes of a controller's line printed at once
 # seconds a controller's output is read on after its process ended: what it wrote is in the pipe by then; a
@@ -467,8 +468,9 @@ class Launcher:
 
     def __init__(self, specs: list[ControllerSpec], url: str, *, out: IO[str] | None = None,
                  err: IO[str] | None = None, grace_s: float = GRACE_S, serverkey: str | None = None,
-                 attach_timeout_s: float | None = None):
+                 attach_timeout_s: float | None = None, robot_window_log: bool = False):
         self.specs = {s.robot: s for s in specs}
+        self.robot_window_log = robot_window_log   # controllers print their robot-window text (ROBOT_WINDOW_ENV)
         self.attach_timeout_s = attach_timeout_s   # None: wait for a started controller to attach, as Webots
         self.url = url
         self.serverkey = serverkey        # the server's CURVE public key (Z85), None for a plain one
@@ -559,6 +561,8 @@ class Launcher:
             env.pop(CURVE_ENV, None)
         env["WEBOTS_ROBOT_NAME"] = spec.robot     # as Webots sets it for every controller it starts
         env["PYTHONUNBUFFERED"] = "1"            # lines reach the console as they are printed
+        if self.robot_window_log:
+            env[ROBOT_WINDOW_ENV] = "1"
         env["PYTHONIOENCODING"] = "UTF-8"        # as Webots sets it
         package_root = str(Path(__file__).resolve().parent.parent)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH", "")) if p)
@@ -812,6 +816,7 @@ class RunOptions:
     grace_s: float = GRACE_S
     require_controllers: bool = False          # a controller that cannot be started: exit 1 before the world runs
     attach_timeout_s: float | None = None      # a started controller not attached after this: ended (None: waited for)
+    robot_window_log: bool = False             # --robot-window-log: what controllers send their robot window, on stderr
 
     def check(self, world: Path) -> None:
         """Raise ValueError naming the first bad option (one line)."""
@@ -925,7 +930,8 @@ class ProjectRun:
                 self._say(f"sensorium run: extra project path {p} is not a folder: not looked in")
         launcher = Launcher(list(world_plan.specs), server.transport.rpc_endpoint, out=self.out, err=self.err,
                             grace_s=self.options.grace_s, serverkey=self._serverkey(),
-                            attach_timeout_s=self.options.attach_timeout_s)
+                            attach_timeout_s=self.options.attach_timeout_s,
+                            robot_window_log=self.options.robot_window_log)
         self._server = server
         old_handlers = {}
         if signals and threading.current_thread() is threading.main_thread():    # Python's signals: main thread only

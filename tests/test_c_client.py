@@ -38,7 +38,7 @@ ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "car_lights", "car_hostile", "supervisor_scene",
                "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos",
-               "nested_nodes"]
+               "nested_nodes", "top_groups", "robot_window"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
@@ -49,6 +49,7 @@ REMOVE_WORLD = REPO / "tests" / "worlds" / "supervisor_remove.yaml"
 ROOT_WORLD = REPO / "tests" / "worlds" / "root_children.wbt"
 PROTOS_WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_protos.wbt"
 NESTED_WORLD = REPO / "tests" / "worlds" / "nested_nodes.wbt"
+GROUPS_WORLD = REPO / "tests" / "worlds" / "top_groups.wbt"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev)")
@@ -598,6 +599,32 @@ def test_c_supervisor_walks_the_roots_children_in_file_order(cbin, servers):
     assert out[2] == "view 0 -4 2"
     assert out[3] == "imported WorldInfo:INFO Viewpoint:VIEW Background:SKY Solid:BALL Solid:BOX Robot:BOSS PointLight:LAMP"
     assert out[4] == f"removed {order}"
+
+
+def test_c_supervisor_walks_a_top_level_group_of_solids(cbin, servers):
+    """tests/c/top_groups.c on tests/worlds/top_groups.wbt, built with sanitizers: getFromDef("TRIO") is a
+    Pose of three solids at (1, 2, 0) + Rz(90°)·their translations (closed forms), the second the node
+    getFromDef("MID") gives, the Pose's translation the file's."""
+    code, out, err = finish(start([cbin["top_groups"]], servers(GROUPS_WORLD).url("boss")))
+    assert code == 0, err
+    assert out == ["group 1 Pose 3", "at 1.000000000 3.000000000 0.050000000", "at 0.500000000 2.000000000 0.000000000",
+                   "at 1.000000000 1.000000000 0.000000000", "same 1", "translation 1 2 0"]
+
+
+def test_c_robot_window_text_is_printed_on_stderr_when_asked(cbin, servers):
+    """tests/c/robot_window.c, built with sanitizers: with SENSORIUM_ROBOT_WINDOW_LOG=1 (what `sensorium
+    run --robot-window-log` sets) each wb_robot_wwi_send is one stderr line, line breaks shown as \\n, at
+    most 65536 bytes shown and the rest counted, a size short of the text cutting it; without it nothing."""
+    url = servers(ARENA).url("epuck")
+    code, out, err = finish(start([cbin["robot_window"]], url, SENSORIUM_ROBOT_WINDOW_LOG="1"))
+    assert code == 0, err
+    assert out == ["scored nothing received"]
+    said = [line for line in err.splitlines() if line.startswith("robot window:")]
+    assert said == ["robot window: time:1.500", "robot window: record:0.87\\nsecond line",
+                    "robot window: " + "x" * 4096 + " ... (65904 more characters not shown)", "robot window: byt"]
+    code, out, err = finish(start([cbin["robot_window"]], servers(ARENA).url("epuck")))
+    assert code == 0, err
+    assert out == ["scored nothing received"] and "robot window" not in err
 
 
 def test_c_supervisor_reaches_nested_nodes(cbin, servers):

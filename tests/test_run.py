@@ -865,3 +865,33 @@ def test_a_controllers_runtime_ini_sets_its_environment_and_python(tmp_path: Pat
     assert proc.wait() == 0, proc.stderr()
     assert "[alpha] shared hello; world 1" in proc.stdout().splitlines()
     assert "[alpha] wrapped python" in proc.stderr().splitlines()
+
+
+# a benchmark's referee: its score goes to the robot window (Webots' wwiSendText), its stdout its own
+SCORER = '''from controller import Robot
+robot = Robot()
+robot.step(16)
+robot.wwiSendText("time:1.500")
+robot.wwiSendText("record:0.87\\nsecond line")
+robot.wwiSendText("x" * 70000)
+print("scored")
+'''
+
+
+def test_robot_window_text_is_printed_on_stderr_with_robot_window_log(tmp_path: Path) -> None:
+    """`sensorium run --robot-window-log`: each wwiSendText is one stderr line 'robot window: TEXT' of its
+    robot (line breaks shown as \\n, at most 4096 characters shown, the rest counted); stdout keeps the
+    controller's own lines; without the option the text goes nowhere."""
+    world = project(tmp_path, 'Robot { name "referee" controller "s" }', {"s.py": SCORER})
+    proc = run(world, "--until", "64", "--robot-window-log")
+    assert proc.wait() == 0, proc.stderr()
+    err = [line for line in proc.stderr().splitlines() if "robot window:" in line]
+    assert err[0] == "[referee] robot window: time:1.500"
+    assert err[1] == "[referee] robot window: record:0.87\\nsecond line"
+    assert err[2] == "[referee] robot window: " + "x" * 4096 + " ... (65904 more characters not shown)"
+    assert len(err) == 3
+    assert "[referee] scored" in proc.stdout().splitlines()
+    assert "robot window" not in proc.stdout()
+    quiet = run(world, "--until", "64")
+    assert quiet.wait() == 0, quiet.stderr()
+    assert "robot window" not in quiet.stderr() and "[referee] scored" in quiet.stdout().splitlines()

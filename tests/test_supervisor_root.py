@@ -123,25 +123,58 @@ def test_webots_adds_the_missing_world_info_and_viewpoint_at_places_0_and_1(tmp_
     assert field(lv, 4, "basicTimeStep") == {"type": "SFFloat", "value": 32.0}
 
 
-def test_a_top_level_def_group_of_solids_is_no_node_and_validate_says_so(tmp_path):
+GROUPS_WORLD = (HEADER + 'Robot { name "boss" supervisor TRUE controller "<extern>" }\n'
+                'DEF CUBES Group {\n  children [ Solid { translation 1 0 0.05 name "cube" } ]\n}\n'
+                'DEF LOOKS Group { children [ Shape { geometry Box { size 0.1 0.1 0.1 } } ] }\n'
+                'DEF TRIO Pose {\n  translation 1 2 0 rotation 0 0 1 1.5707963267948966\n  children [\n'
+                '    Solid { translation 1 0 0.05 name "a" }\n    DEF MID Solid { translation 0 0.5 0 name "b" }\n'
+                '    Group { children [ Solid { translation -1 0 0 name "c" } ] }\n  ]\n}\n')
+
+
+def test_a_top_level_group_of_solids_is_a_node_holding_them(tmp_path):
     """Webots' robotbenchmark obstacle-avoidance referee asks getFromDef("CUBE_OBSTACLES") for a
-    top-level DEF Group of solids, then its children: here such a Group is served as its children
-    only (the cube is a top-level solid, found by its name) and getFromDef answers NULL, so loading
-    says so in one line at the Group; a DEF Group of shapes only is a (visual) node and says nothing."""
+    top-level DEF Group of solids, then walks its children: such a Group (or Pose, Transform) is a
+    root child whose ``children`` are its solids (the same ids their own DEFs and names give), and they
+    are no longer the root's; a Pose's pose is the file's (closed form: a quarter turn about z, then
+    (1, 2, 0)); a DEF Group of shapes only is still a (visual) node. Loading says nothing about them."""
     world = tmp_path / "groups.wbt"
-    world.write_text(HEADER + 'Robot { name "boss" supervisor TRUE controller "<extern>" }\n'
-                     'DEF CUBES Group {\n  children [ Solid { translation 1 0 0.05 name "cube" } ]\n}\n'
-                     'DEF LOOKS Group { children [ Shape { geometry Box { size 0.1 0.1 0.1 } } ] }\n')
+    world.write_text(GROUPS_WORLD)
     loaded = load_world(world)
-    assert loaded.warnings == [
-        f'{world}:3:11: DEF CUBES Group: served as its children only (solids, robots and lights at the top '
-        'level): a Supervisor\'s getFromDef("CUBES") finds nothing (NULL), so neither its children field nor '
-        'their count']
+    assert not any("Group" in w for w in loaded.warnings)
     lv = Live(Simulation(loaded))
     lv.ok(A, "attach", {"robot": "boss"})
-    assert boss(lv, "get_from_def", {"name": "CUBES"})["node"] == 0                     # NULL, as the line says
-    assert boss(lv, "get_from_def", {"name": "cube"})["type"] == "Solid"
-    assert boss(lv, "get_from_def", {"name": "LOOKS"})["type"] == "Group"
+    cubes = boss(lv, "get_from_def", {"name": "CUBES"})
+    assert [cubes["type"], cubes["def_name"], cubes["parent"]] == ["Group", "CUBES", 0]
+    cube = boss(lv, "get_from_def", {"name": "cube"})
+    assert field(lv, cubes["node"], "children") == {"type": "MFNode", "value": [cube["node"]]}
+    trio = boss(lv, "get_from_def", {"name": "TRIO"})
+    assert trio["type"] == "Pose"
+    inside = field(lv, trio["node"], "children")["value"]
+    assert len(inside) == 3
+    assert inside[1] == boss(lv, "get_from_def", {"name": "MID"})["node"] == \
+        boss(lv, "get_from_def", {"name": "TRIO.MID"})["node"]
+    assert [boss(lv, "get_from_id", {"id": i})["def_name"] for i in inside] == ["", "MID", ""]
+    assert [boss(lv, "get_from_id", {"id": i})["parent"] for i in inside] == [trio["node"]] * 3   # getParentNode
+    assert cube["parent"] == cubes["node"] and trio["parent"] == 0
+    roots = children(lv)
+    assert cubes["node"] in roots and trio["node"] in roots and not set(inside) & set(roots)
+    # world positions: (1, 2, 0) + Rz(90°) applied to each solid's translation (c through a plain Group)
+    want = [[1.0, 3.0, 0.05], [0.5, 2.0, 0.0], [1.0, 1.0, 0.0]]
+    for i, w in zip(inside, want):
+        assert boss(lv, "get_node_pose", {"node": i})["position"] == pytest.approx(w, abs=1e-9)
+    assert field(lv, trio["node"], "translation") == {"type": "SFVec3f", "value": [1.0, 2.0, 0.0]}
+    assert field(lv, trio["node"], "rotation")["value"] == pytest.approx([0, 0, 1, math.pi / 2])
+    pose = boss(lv, "get_node_pose", {"node": trio["node"]})
+    assert pose["position"] == [1.0, 2.0, 0.0]
+    assert pose["orientation"] == pytest.approx([0, -1, 0, 1, 0, 0, 0, 0, 1], abs=1e-12)
+    assert all(math.isnan(v) for v in boss(lv, "get_node_pose", {"node": cubes["node"]})["position"])
+    msg = lv.err(A, "/boss/robot/set_field", {"node": trio["node"], "field": "translation", "value": [0, 0, 1]},
+                 ErrorCode.INVALID_ARGUMENT)
+    assert msg == ("set_field: field 'translation' (SFVec3f) of Pose 'TRIO' is read-only here: a top-level group's "
+                   "solids are moved one by one (getMFNode(i) of its children); nothing changed")
+    looks = boss(lv, "get_from_def", {"name": "LOOKS"})
+    assert looks["type"] == "Group"
+    assert field(lv, looks["node"], "children") == {"type": "", "value": []}
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
@@ -157,3 +190,19 @@ def test_a_webots_supervisor_walks_the_roots_children(tmp_path):
     assert out["imported"] == [*TYPES_DEFS[:3], ["Solid", "BALL"], *TYPES_DEFS[3:5], ["PointLight", "SPARK"],
                                TYPES_DEFS[5]]
     assert out["removed"] == TYPES_DEFS
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_webots_supervisor_walks_a_top_level_group_of_solids(tmp_path):
+    """tests/controllers/top_groups.py through ``sensorium serve`` on tests/worlds/top_groups.wbt: the DEF
+    Pose is a Pose node of three solids at (1, 2, 0) + Rz(90°)·their translations, the DEF'd one the
+    same node as getFromDef("MID") gives."""
+    ctl = run_paused(REPO / "tests" / "worlds" / "top_groups.wbt", tmp_path, "top_groups.py", "boss")
+    out = json.loads(ctl.out[-1])
+    assert out["group"] == [True, "Pose", "TRIO"]
+    assert out["count"] == 3
+    assert out["positions"] == [pytest.approx(p, abs=1e-9) for p in ([1, 3, 0.05], [0.5, 2, 0], [1, 1, 0])]
+    assert out["same"] is True
+    assert out["translation"] == [1.0, 2.0, 0.0]
+    assert out["trio_position"] == [1.0, 2.0, 0.0]

@@ -43,6 +43,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--require-controllers", action="store_true",
                    help="a controller that cannot be found or started is an error: exit 1 before the world runs "
                    "(default: as Webots, the robot runs without it and the world goes on; run exits 1 at the end)")
+    p.add_argument("--robot-window-log", action="store_true",
+                   help="each text a controller sends its robot window (wwiSendText, wb_robot_wwi_send: a "
+                   "benchmark's score) printed as a line 'robot window: TEXT' on the controller's stderr")
     add_world_options(p)
 
 
@@ -59,7 +62,7 @@ def main(args: argparse.Namespace) -> int:
         controllers_dirs=tuple(Path(d) for d in args.controllers_dir),
         extra_projects=tuple(extra_project_paths(os.environ.get(EXTRA_ENV))),   # --extra-project-path too
         webots_home=Path(home) if home else None, grace_s=args.grace, require_controllers=args.require_controllers,
-        attach_timeout_s=args.attach_timeout)
+        attach_timeout_s=args.attach_timeout, robot_window_log=args.robot_window_log)
     try:
         options.check(Path(args.world))
     except ValueError as exc:

@@ -6,6 +6,7 @@ simulation runs for the whole timeout), the battery (none: NaN), project/world p
 from __future__ import annotations
 
 import math
+import os
 import sys
 from dataclasses import dataclass
 
@@ -85,9 +86,26 @@ def wb_robot_get_urdf(prefix: str = "") -> str:
     return str(r.conn.call(f"/{r.name}/robot/get_urdf", {"prefix": prefix})["value"])
 
 
+ROBOT_WINDOW_ENV = "SENSORIUM_ROBOT_WINDOW_LOG"   # set to "1" by `sensorium run --robot-window-log`
+ROBOT_WINDOW_CHARS = 4096     # of one message printed; the rest is counted, not shown (the C client's bound too)
+
+
+def robot_window_line(text: str) -> str:
+    """The stderr line of a robot-window message: one line (its line breaks shown as \\n), bounded."""
+    shown = text[:ROBOT_WINDOW_CHARS].replace("\\", "\\\\").replace("\n", "\\n").replace("\r", "\\r")
+    cut = len(text) - ROBOT_WINDOW_CHARS
+    return f"robot window: {shown}" + (f" ... ({cut} more characters not shown)" if cut > 0 else "")
+
+
 def wb_robot_wwi_send_text(text: str) -> None:
-    """No robot window: the text goes nowhere."""
+    """No robot window here: with $SENSORIUM_ROBOT_WINDOW_LOG set to 1 (``sensorium run
+    --robot-window-log``) the text is printed on stderr as one line (a benchmark's score); else it goes
+    nowhere. The controller's stdout is left to the controller."""
     current()
+    if not isinstance(text, str):
+        raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_robot_wwi_send_text(): text must be a string, got {text!r}")
+    if os.environ.get(ROBOT_WINDOW_ENV) == "1":
+        print(robot_window_line(text), file=sys.stderr, flush=True)
 
 
 def wb_robot_wwi_receive_text() -> str | None:

@@ -284,11 +284,45 @@ def root_children(sim: Any) -> list[Node]:
     return [by_id[i] for i in order if i in by_id]
 
 
+def _member_ids(sim: Any, members: tuple[tuple[str, int], ...]) -> list[int]:
+    """The ids of a top-level group's members (world/top_nodes.py), removed ones included."""
+    solids, _ = _loaded_counts(sim)
+    first = {"robots": 1, "solids": 1 + len(sim.robots)}           # ids as _all_nodes gives them
+    first["lights"] = first["solids"] + solids
+    return [first[kind] + index for kind, index in members]
+
+
+def _group_members(sim: Any, node: Node) -> list[Node]:
+    """A top-level Group's, Pose's or Transform's children (world/top_nodes.py): the robots, solids and
+    lights it holds, removed ones left out."""
+    if not node.scenery or not _scenery(sim)[int(node.key)].members:
+        return []
+    by_id = {n.id: n for n in _nodes(sim)}
+    return [by_id[i] for i in _member_ids(sim, _scenery(sim)[int(node.key)].members) if i in by_id]
+
+
+def _group_of(sim: Any, node: Node) -> int:
+    """The id of the top-level group holding a top-level node; the root's (0) for one no group holds."""
+    if node.scenery or node.nested or node.visual:
+        return 0
+    layout = getattr(sim, "top_level", None)
+    if layout is None or not any(s.members for s in layout.scenery):
+        return 0
+    first = 1 + len(sim.robots) + sum(_loaded_counts(sim))           # the first scenery node's id
+    return next((first + x for x, s in enumerate(layout.scenery) if s.members and node.id in _member_ids(sim, s.members)),
+                0)
+
+
+def _scene_tops(sim: Any) -> list[Node]:
+    """The root's children, each group followed by the nodes it holds."""
+    return [m for top in root_children(sim) for m in (top, *_group_members(sim, top))]
+
+
 def _first_def(sim: Any, name: str) -> Node | None:
     """The first node in Webots' scene order (the root's children, each followed by the nodes inside
     it) with DEF ``name``; only that one is made a Node."""
     table = _table(sim)
-    for top in root_children(sim):
+    for top in _scene_tops(sim):
         if top.def_name == name:
             return top
         if top.visual:
@@ -318,6 +352,9 @@ def find_node(sim: Any, name: str) -> Node | None:
     for part in path:
         if found is None:
             return None
+        if found.scenery:
+            found = next((m for m in _group_members(sim, found) if m.def_name == part), None)
+            continue
         if found.visual:
             store = _visuals(sim)
             v = next((v for v in store.nodes.values() if v.parent == found.id and v.def_name == part), None)
@@ -400,7 +437,7 @@ def node_ref(sim: Any, node: Node | None) -> dict:
     if node is None:
         return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
     parent = _nested_of(sim, node).parent if node.nested else _vnode(sim, node).parent \
-        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else 0
+        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else _group_of(sim, node)
     return {"node": node.id, "type": node.type, "name": node.name, "def_name": node.def_name,
             "parent": parent, "proto": node.proto}
 
@@ -612,7 +649,14 @@ SCENERY_FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
                   "follow": ("SFString", _written("follow", ""), None)},
     "Background": {"skyColor": ("MFColor", _written("skyColor", [[0.0, 0.0, 0.0]]), None),
                    "luminosity": ("SFFloat", _written("luminosity", 1.0), None)},
+    # a top-level group holding solids (world/top_nodes.py): its children are those nodes (the same ids their
+    # DEFs give); its pose is the world file's, read-only (its solids move one by one: setting it moves none)
+    "Group": {"children": ("MFNode", lambda sim, n: [m.id for m in _group_members(sim, n)], None)},
+    "Pose": {"children": ("MFNode", lambda sim, n: [m.id for m in _group_members(sim, n)], None),
+             "translation": ("SFVec3f", _written("translation", [0.0, 0.0, 0.0]), None),
+             "rotation": ("SFRotation", _written("rotation", [0.0, 0.0, 1.0, 0.0]), None)},
 }
+SCENERY_FIELDS["Transform"] = {**SCENERY_FIELDS["Pose"], "scale": ("SFVec3f", _written("scale", [1.0, 1.0, 1.0]), None)}
 """Fields of the top-level nodes Sensorium does not simulate; any other field of theirs (and any
 field of Fog, a Transform, ...) answers Webots' "no value"."""
 
@@ -721,6 +765,8 @@ def _base_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
         return _visual_fields(sim, node)
     if node.nested:
         return _nested_fields(sim, node)
+    if node.scenery and node.type in ("Group", "Pose", "Transform") and not _scenery(sim)[int(node.key)].members:
+        return {}            # a group of shapes only: a visual node (visuals.py), not served from here
     return SCENERY_FIELDS.get(node.type, {}) if node.scenery else FIELDS[node.type]
 
 
@@ -1061,6 +1107,10 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
     if setter is None and node.nested:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
                          "top-level robots, solids and lights only, not the nodes inside them")
+    if setter is None and node.scenery and node.type in ("Pose", "Transform", "Group"):
+        raise ValueError(f"field {field!r} ({kind}) of {node.type} {node.def_name or node.id!r} is read-only here: "
+                         "a top-level group's solids are moved one by one (getMFNode(i) of its children); "
+                         "nothing changed")
     if setter is None:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here")
     _check_value(field, kind, value)
@@ -1068,9 +1118,24 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
     return []
 
 
+def _axis_angle_matrix(r: list[float]) -> np.ndarray:
+    """The rotation matrix of an axis-angle (x, y, z, angle); a zero axis is no rotation."""
+    axis, angle = np.asarray(r[:3], dtype=float), float(r[3])
+    norm = float(np.linalg.norm(axis))
+    if norm == 0.0:
+        return np.eye(3)
+    x, y, z = axis / norm
+    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+
+
 def node_pose(sim: Any, node: Node) -> dict:
     pose = nested.world_pose(sim, _nested_of(sim, node)) if node.nested else \
         _pose(sim, node) if node.type in ("Robot", "Solid") else None
+    if pose is None and node.scenery and node.type in ("Pose", "Transform") and _group_members(sim, node):
+        written = _scenery(sim)[int(node.key)].fields      # a top-level group's: the world file's, fixed
+        return {"position": [float(v) for v in written.get("translation", [0.0, 0.0, 0.0])],
+                "orientation": [float(v) for v in _axis_angle_matrix(written.get("rotation", [0, 0, 1, 0])).reshape(9)]}
     if pose is None:                                 # Webots: NaN for a node that is no Pose
         return {"position": [math.nan] * 3, "orientation": [math.nan] * 9}
     return {"position": [float(v) for v in pose.translation],

@@ -6,7 +6,9 @@ file has none. A ``.wbt`` world records its top-level nodes (``World.top_nodes``
 world has none recorded: its root holds a default ``WorldInfo`` and ``Viewpoint``, then its robots,
 solids and lights in the lists' order. Nodes Sensorium does not simulate ("scenery": ``WorldInfo``,
 ``Viewpoint``, ``Background``, ...) keep their type and DEF name (and a Viewpoint's or Background's
-written values). A PROTO instance keeps its PROTO's name: a scenery node's, and a robot's, solid's
+written values). A top-level Group, Pose or Transform (not a PROTO instance) holding robots, solids or
+lights is a node of its own there, as in Webots: its members (what it became, in file order; a
+group nested in it is flattened into it) are its ``children`` and no longer the root's. A PROTO instance keeps its PROTO's name: a scenery node's, and a robot's, solid's
 or light's when the top-level node became that node alone (a PROTO whose base is a Group holding
 several solids names none of them).
 """
@@ -18,6 +20,7 @@ from dataclasses import dataclass, field
 from sensorium.schemas import world as wm
 
 KINDS = ("robots", "solids", "lights")
+GROUPS = ("Group", "Pose", "Transform")    # the top-level groups served as nodes holding what they became
 
 
 # the base types a simulated node of each kind has (a PROTO instance of another base is not named after it):
@@ -37,6 +40,7 @@ class Scenery:
     proto: str = ""    # the PROTO it is an instance of ("" for a base node)
     fields: dict = field(default_factory=dict)   # a Viewpoint's or Background's written values (TopNode.fields)
     interface: tuple = ()   # a PROTO instance's interface (TopNode.interface: wm.ProtoLevel each)
+    members: tuple[tuple[str, int], ...] = ()   # a group's: the (kind, index) of each node it holds, in order
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,6 +65,17 @@ def top_level(world: wm.World) -> TopLevel:
             order.append(("scenery", len(scenery)))
             scenery.append(Scenery(node.type, node.def_name or "", node.proto or "", dict(node.fields),
                                    tuple(node.interface)))
+            continue
+        marker = counts["solids"] == 1 and not counts["robots"] and not counts["lights"] and node.def_name and \
+            used["solids"] < sizes["solids"] and world.solids[used["solids"]].def_name == node.def_name
+        if node.type in GROUPS and not node.proto and not marker:   # (a DEF Pose of shapes became that solid)
+            members = []
+            for kind in KINDS:
+                take = min(counts[kind], sizes[kind] - used[kind])
+                members += [(kind, used[kind] + i) for i in range(take)]
+                used[kind] += take
+            order.append(("scenery", len(scenery)))
+            scenery.append(Scenery(node.type, node.def_name or "", "", dict(node.fields), (), tuple(members)))
             continue
         alone = [kind for kind in KINDS if counts[kind]]
         if node.proto and sum(counts.values()) == 1 and node.type in BASES[alone[0]] \

@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <webots/device.h>
 #include <webots/plugins/robot_window/default.h>
@@ -47,11 +48,39 @@ void wb_robot_pin_to_static_environment(bool pin) {
   sn_robot_get("wb_robot_pin_to_static_environment");
 }
 
-/* No robot window here: messages to it go nowhere, none come from it. */
+/* No robot window here: none sends messages; what a controller sends it goes nowhere, or with
+ * $SENSORIUM_ROBOT_WINDOW_LOG set to 1 (sensorium run --robot-window-log) is printed on stderr as one
+ * line "robot window: TEXT" (line breaks shown as \n, at most ROBOT_WINDOW_CHARS bytes shown: the
+ * Python client's line). stdout is left to the controller. */
+#define ROBOT_WINDOW_CHARS 4096
+
 void wb_robot_wwi_send(const char *data, int size) {
-  (void)data;
-  (void)size;
   sn_robot_get("wb_robot_wwi_send");
+  const char *on = getenv("SENSORIUM_ROBOT_WINDOW_LOG");
+  if (on == NULL || strcmp(on, "1") != 0 || data == NULL || size <= 0)
+    return;
+  int n = 0;
+  while (n < size && data[n] != '\0') /* text: up to its NUL (wb_robot_wwi_send_text counts it) */
+    n++;
+  int shown = n < ROBOT_WINDOW_CHARS ? n : ROBOT_WINDOW_CHARS;
+  flockfile(stderr);
+  fputs("robot window: ", stderr);
+  for (int i = 0; i < shown; i++) {
+    char c = data[i];
+    if (c == '\n')
+      fputs("\\n", stderr);
+    else if (c == '\r')
+      fputs("\\r", stderr);
+    else if (c == '\\')
+      fputs("\\\\", stderr);
+    else
+      fputc(c, stderr);
+  }
+  if (n > shown)
+    fprintf(stderr, " ... (%d more characters not shown)", n - shown);
+  fputc('\n', stderr);
+  funlockfile(stderr);
+  fflush(stderr);
 }
 
 const char *wb_robot_wwi_receive(int *size) {

@@ -46,6 +46,9 @@ SCENERY_VALUES = {
     "Viewpoint": {"fieldOfView": "SFFloat", "orientation": "SFRotation", "position": "SFVec3f", "near": "SFFloat",
                   "far": "SFFloat", "exposure": "SFFloat", "description": "SFString", "follow": "SFString"},
     "Background": {"skyColor": "MFColor", "luminosity": "SFFloat"},
+    # a top-level Pose or Transform holding solids (world/top_nodes.py): a Supervisor reads where it is
+    "Pose": {"translation": "SFVec3f", "rotation": "SFRotation"},
+    "Transform": {"translation": "SFVec3f", "rotation": "SFRotation", "scale": "SFVec3f"},
 }
 # the base node type of Webots' PROTOs that Sensorium builds in (wbt/protos.py) or skips (TexturedBackground)
 # when their file is not at hand: the Supervisor names them as Webots does
@@ -704,11 +707,6 @@ class Converter:
                                 "are kept as a solid")
                 self.solid(node, frame, owner, OTHER_NAMES.get(t, t.lower()))
         elif t == "Group":
-            if top and node.def_name and not self.shapes_only(node):
-                # its solids become top-level nodes of their own; the Group itself is no node here
-                self.warn(node, f"DEF {node.def_name} Group: served as its children only (solids, robots and "
-                                f"lights at the top level): a Supervisor's getFromDef(\"{node.def_name}\") finds "
-                                "nothing (NULL), so neither its children field nor their count")
             for child in f.nodes("children"):
                 self.visit(child, frame, owner)
         elif t == "Propeller":           # a robot's motor (listed: controllers ask for it) and its helix

@@ -1,6 +1,7 @@
 /* Sensorium C controller library: a controller's side of Webots' robot window messages. A headless
- * server has no robot window: what is sent goes nowhere and nothing is ever received (NULL, size 0),
- * as in the Python client (Robot.wwiSendText / wwiReceiveText). */
+ * server has no robot window: nothing is ever received (NULL, size 0) and what is sent goes nowhere,
+ * or with $SENSORIUM_ROBOT_WINDOW_LOG=1 (sensorium run --robot-window-log) is printed on stderr as
+ * "robot window: TEXT", as in the Python client (Robot.wwiSendText / wwiReceiveText). */
 #ifndef WB_ROBOT_WWI_H
 #define WB_ROBOT_WWI_H
 
