@@ -139,8 +139,9 @@ def test_a_turned_conveyor_carries_along_its_tracks_x(tmp_path: Path) -> None:
 
 
 def test_a_belt_without_a_box_bounding_object_keeps_its_warning(tmp_path: Path) -> None:
-    """Only a Box (or a Shape of one) is read as a belt's top face: a Box inside a Transform is not."""
-    w = load_world(world(tmp_path, bounding="Transform { children [ USE BELT ] }"))
+    """Only a Box (or a Shape of one, or one inside a Pose/Transform) is read as a belt's top face: a
+    Cylinder inside a Transform is not."""
+    w = load_world(world(tmp_path, bounding="Transform { children [ Cylinder { height 0.1 radius 0.5 } ] }"))
     assert w.world.robots[0].belts == []
     assert any("the belt and its wheels do not move here" in x for x in w.warnings), w.warnings
     sim = Simulation(w)
@@ -226,3 +227,108 @@ def test_a_python_controller_sees_the_belts_linear_motor_and_sensor(tmp_path: Pa
         finally:
             wb.wb_robot_cleanup()
             controller.Robot.created = None
+
+
+def nue_twin(tmp_path: Path) -> tuple[Path, Path]:
+    """An ENU world whose conveyor runs north (turned 90 degrees about z) and its NUE twin (x north, y up,
+    z east; ENU (e, n, u) is NUE (n, u, e)): the twin's robot built y-up as Webots' were before R2022a,
+    its Track's Box 1 long (x), 0.1 high (y), 0.3 wide (z)."""
+    enu = world(tmp_path, place="rotation 0 0 1 1.5707963267948966")
+    enu.write_text(enu.read_text().replace(f'name "box" translation {X0} 0.0 ', f'name "box" translation 0 {X0} '))
+    nue = tmp_path / "conveyor_nue.wbt"
+    nue.write_text(
+        '#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 10 coordinateSystem "NUE" }\n'
+        # the floor: a Plane turned so its normal is the world's y
+        'Solid { name "floor" rotation 1 0 0 -1.5707963267948966 children [ DEF F Shape { geometry Plane '
+        '{ size 10 10 } } ] boundingObject USE F }\n'
+        'Robot { name "conveyor" controller "<none>" children [\n'
+        '  Track { name "belt" translation 0 0.15 0 children [ DEF BELT Shape { geometry Box { size 1 0.1 0.3 } } ]\n'
+        '    boundingObject USE BELT device [ LinearMotor { name "belt motor" maxVelocity 1 maxForce 1000 } ] }\n'
+        '] }\n' + box("box", X0, y=TOP + 0.05, z=0.0) + box("side", X0, y=0.05, z=-1.0))
+    return enu, nue
+
+
+def test_a_nue_belt_carries_as_its_enu_twin(tmp_path: Path) -> None:
+    """A belt in a NUE world carries along its Track's +x (north) as the ENU twin's does, every step,
+    and past its end the box lands where the twin's does, mapped through the axes (1e-12). Before, the
+    y-up Track's face was read about its z: not level, it carried nothing."""
+    enu, nue = nue_twin(tmp_path)
+    w = load_world(nue)
+    assert any("its belt carries the solids" in x for x in w.warnings), w.warnings
+    sims = Simulation(load_world(enu)), Simulation(w)
+    for sim in sims:
+        belt(sim, 0.23)        # (its end, 0.8 m ahead, is not met on a step's boundary: no tie to round)
+    for n in range(1, 451):
+        for sim in sims:
+            sim.step()
+        e, u = at(sims[0]), at(sims[1])
+        assert [u[2], u[0], u[1]] == pytest.approx(e, abs=1e-12)
+        if n == 100:
+            assert e == pytest.approx([0.0, X0 + 0.23, TOP + 0.05], abs=1e-12)
+    assert e[2] == pytest.approx(0.05, abs=1e-12) and e[1] > 0.5        # past the end: on the floor
+    assert at(sims[1], "side") == [X0, 0.05, -1.0]                      # beside the belt: not carried
+
+
+def test_a_wall_on_a_nue_belt_stops_the_box_as_on_its_enu_twin(tmp_path: Path) -> None:
+    """A fixed wall across each twin's belt, 0.34 m ahead of its centre: the NUE box stops where the
+    ENU one does, mapped through the axes (1e-12), short of the wall's face at 0.29."""
+    enu, nue = nue_twin(tmp_path)
+    enu.write_text(enu.read_text() + box("wall", 0.0, y=0.34, physics="").replace("size 0.1 0.1 0.1", "size 0.5 0.1 0.1"))
+    nue.write_text(nue.read_text() + box("wall", 0.34, y=TOP + 0.05, z=0.0, physics="").replace(
+        "size 0.1 0.1 0.1", "size 0.1 0.1 0.5"))
+    sims = Simulation(load_world(enu)), Simulation(load_world(nue))
+    for sim in sims:
+        belt(sim, 0.2)
+        sim.run(400)
+    e, u = at(sims[0]), at(sims[1])
+    assert [u[2], u[0], u[1]] == pytest.approx(e, abs=1e-12)
+    assert 0.29 - 0.002 < e[1] + 0.05 <= 0.29 + 1e-9
+
+
+def test_a_box_inside_a_pose_is_the_belts_face(tmp_path: Path) -> None:
+    """The Track's Box inside a Pose 0.2 m along x and 0.05 m up (the Track 0.05 lower), turned a
+    quarter about the Track's up: the face is 0.3 x 1 in the Box's frame, 1 m along the Track's x,
+    centred at x 0.2; the belt carries along the Track's +x and the box falls past x 0.7. Before, the
+    Track kept its warning and nothing moved."""
+    pose = "Pose { translation 0.2 0 0.05 rotation 0 0 1 1.5707963267948966 children [ Box { size 0.3 1 0.1 } ] }"
+    p = world(tmp_path, bounding=pose)
+    p.write_text(p.read_text().replace('Track { name "belt" translation 0 0 0.15', 'Track { name "belt" translation 0 0 0.1'))
+    w = load_world(p)
+    assert not any("the belt and its wheels do not move" in x for x in w.warnings), w.warnings
+    b = w.world.robots[0].belts[0]
+    assert b.top == pytest.approx((0.2, 0.0, TOP), abs=1e-15)
+    assert (b.along, b.length, b.width) == (pytest.approx((1.0, 0.0, 0.0), abs=1e-15), 1.0, 0.3)
+    sim = Simulation(w)
+    belt(sim, 0.2)
+    steps = 0
+    while at(sim)[2] > 0.1:
+        sim.step()
+        steps += 1
+        assert steps < 1000
+        if steps == 100:
+            assert at(sim) == pytest.approx([X0 + 0.2, 0.0, TOP + 0.05], abs=1e-12)
+    x = at(sim)[0]
+    assert x == pytest.approx(X0 + 0.2 * 0.01 * steps, abs=1e-12) and 0.7 < x <= 0.7 + 0.002 + 1e-12
+    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+
+
+def test_a_box_turned_half_about_up_still_carries_along_the_tracks_x(tmp_path: Path) -> None:
+    """A Transform turning the Box half a turn about the Track's up: the belt still moves along the
+    Track's +x (its face's sides are taken facing it)."""
+    p = world(tmp_path, bounding="Transform { rotation 0 0 1 3.141592653589793 children [ USE BELT ] }")
+    sim = Simulation(load_world(p))
+    belt(sim, 0.2)
+    sim.run(100)
+    assert at(sim) == pytest.approx([X0 + 0.2, 0.0, TOP + 0.05], abs=1e-12)
+
+
+def test_a_box_tilted_inside_a_pose_carries_nothing_and_says_so(tmp_path: Path) -> None:
+    from sensorium.server.sim.ground import GroundWarning
+
+    w = load_world(world(tmp_path, bounding="Pose { rotation 1 0 0 0.1 children [ USE BELT ] }"))
+    with pytest.warns(GroundWarning, match=r"robot 'conveyor': the belt of 'belt motor' is not level"):
+        sim = Simulation(w)
+    before = at(sim)
+    belt(sim, 0.2)
+    sim.run(20)
+    assert at(sim) == before

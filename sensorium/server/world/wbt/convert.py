@@ -2132,21 +2132,41 @@ class Converter:
                              "max_velocity": float(motor.get("max_velocity", 10.0)),
                              "forward": np.asarray(frame.rotation, dtype=np.float64)[:, 0],
                              "origin": np.asarray(frame.apply((0.0, 0.0, 0.0))),
-                             "frame": frame, "wheels": wheels, "belt": self.belt(node, frame, motor["name"])})
+                             "frame": frame, "wheels": wheels})
 
-    def belt(self, node: Node, frame: Frame, motor: str) -> dict | None:
+    def belt(self, node: Node, frame: Frame, motor: str, up: int = 2) -> dict | None:
         """A Track's belt as a conveyor carries on it (schemas ConveyorBelt): the top face of its
-        boundingObject, a Box (or a Shape of one) in the Track's frame; None for any other bounding object."""
+        boundingObject, a Box (or a Shape of one), itself or the one child of Pose/Transform nodes (an
+        offset or a turn; a tilt the simulation finds not level), in the Track's frame; None for any other
+        bounding object. The face's normal is the Box's axis ``up`` (the robot's: z, or y for a robot built
+        y-up in a NUE world); it moves along the face's side nearest the Track's own +x."""
         bo = self.fields(node).node_("boundingObject")
+        place = frame
+        while bo is not None and bo.type in ("Pose", "Transform"):
+            children = self.fields(bo).nodes("children")
+            if len(children) != 1:
+                return None
+            place, bo = self.child_frame(bo, place), children[0]
         if bo is not None and bo.type == "Shape":
             bo = self.fields(bo).node_("geometry")
-        if bo is None or bo.type != "Box":
+        if bo is None or bo.type != "Box" or place.stretch is not None:
             return None
-        sx, sy, sz = (float(v) for v in self.fields(bo).vec("size", (2.0, 2.0, 2.0)))
-        r = np.asarray(frame.rotation, dtype=np.float64)
-        return {"motor": motor, "top": tuple(float(v) for v in frame.apply((0.0, 0.0, sz / 2.0))),
-                "along": tuple(float(v) for v in r[:, 0]), "across": tuple(float(v) for v in r[:, 1]),
-                "length": sx * frame.scale, "width": sy * frame.scale}
+        size = [float(v) for v in self.fields(bo).vec("size", (2.0, 2.0, 2.0))]
+        r = np.asarray(place.rotation, dtype=np.float64)
+        # the face's two sides, right-handed about its normal (x, y about z; x, -z about y)
+        side = r[:, 1] if up == 2 else -r[:, 2]
+        length, width = size[0], size[1] if up == 2 else size[2]
+        top = [0.0, 0.0, 0.0]
+        top[up] = size[up] / 2.0
+        along, across = r[:, 0], side
+        forward = np.asarray(frame.rotation, dtype=np.float64)[:, 0]
+        if abs(side @ forward) > abs(along @ forward):     # a Box turned a quarter: its other side runs along
+            along, across, length, width = side, -r[:, 0], width, length
+        if along @ forward < 0.0:
+            along, across = -along, -across
+        return {"motor": motor, "top": tuple(float(v) for v in place.apply(tuple(top))),
+                "along": tuple(float(v) for v in along), "across": tuple(float(v) for v in across),
+                "length": length * place.scale, "width": width * place.scale}
 
     def _track_drive(self, node: Node, robot: Owner) -> None:
         """A robot with two motorised Tracks and no motorised hinge drives on them: their motors are
@@ -2161,11 +2181,13 @@ class Converter:
         if drive is None:
             if why:
                 self.warn(node, f"robot {robot.data['name']!r}: no tracked drive ({why}); the robot will not move")
+            up = self._robot_up(robot)
             for t in tracks:
-                if t["belt"] is None:
+                belt = self.belt(t["node"], t["frame"], t["motor"], up)
+                if belt is None:
                     self.warn(t["node"], t["line"])
                     continue
-                robot.data.setdefault("belts", []).append(t["belt"])   # a conveyor (sim/belt.py)
+                robot.data.setdefault("belts", []).append(belt)   # a conveyor (sim/belt.py)
                 self.warn(t["node"], f"Track {self.fields(t['node']).string('name', 'solid')!r}: its belt carries "
                           "the solids with physics lying on its top face at its motor's velocity; its texture "
                           "animation and wheels do not move here")
