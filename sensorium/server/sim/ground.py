@@ -736,16 +736,29 @@ def land_solid(solid: wm.Solid, pose: Pose, base_dir: Path, ground: Ground | Non
     on that support, its lowest point on its top. ``pose`` itself for a solid that does not fall
     (:func:`falling_span`), over no support (judged tipped), or already resting there (within TIP_TOL
     and SETTLE_TOL)."""
+    got = _tipped_span(solid, pose, base_dir, to_enu)
+    if got is None:
+        return pose
+    tipped, (low, high, _) = got
+    if tipped is pose:
+        return land_pose(pose, low, high, ground, to_enu)
+    height = _land_height(tipped, low, high, ground, to_enu)
+    return pose if height is None else _at_height(tipped, height, to_enu)
+
+
+def _tipped_span(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.ndarray | None
+                 ) -> tuple[Pose, tuple[float, float, np.ndarray]] | None:
+    """A falling solid at ``pose`` tipped onto the face under it (:func:`resting_pose`; ``pose`` itself
+    when it does not tip) and its :func:`falling_span` there; None for a solid that does not fall."""
     span = falling_span(solid, base_dir, to_enu, pose)
     if span is None:
-        return pose
+        return None
     tipped = resting_pose(solid, pose, to_enu)
-    if tipped is not pose:
-        span = falling_span(solid, base_dir, to_enu, tipped)
-        assert span is not None
-        height = _land_height(tipped, span[0], span[1], ground, to_enu)
-        return pose if height is None else _at_height(tipped, height, to_enu)
-    return land_pose(pose, span[0], span[1], ground, to_enu)
+    if tipped is pose:
+        return pose, span
+    turned = falling_span(solid, base_dir, to_enu, tipped)
+    assert turned is not None            # the same shapes, turned: they still fall
+    return tipped, turned
 
 
 def falling_shapes(solid: wm.Solid, base_dir: Path) -> list[tuple[Pose, object, object]] | None:
@@ -838,13 +851,8 @@ def _settle_solids(world: wm.World, to_enu: np.ndarray | None, base_dir: Path, s
     # each falling solid tipped onto the face under it first (resting_pose), then landed as it lies
     falling = []
     for i, s in enumerate(world.solids):
-        if s.name in caught or (got := falling_span(s, base_dir, to_enu)) is None:
-            continue
-        tipped = resting_pose(s, poses[s.name], to_enu)
-        if tipped is not poses[s.name]:
-            got = falling_span(s, base_dir, to_enu, tipped)
-            assert got is not None
-        falling.append((i, s, got, tipped))
+        if s.name not in caught and (got := _tipped_span(s, poses[s.name], base_dir, to_enu)) is not None:
+            falling.append((i, s, got[1], got[0]))
     if not falling:
         return world, []
     moving = {i for i, *_ in falling}
