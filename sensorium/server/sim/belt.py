@@ -140,9 +140,9 @@ class Belts:
             moved = Pose(pose.rotation, np.asarray(pose.translation, dtype=np.float64) + world_step)
             offset = self._enu(np.asarray(moved.translation, dtype=np.float64)) - centre
             if abs(offset @ along) > belt.length / 2.0:     # past the belt's end: it falls onto what is under it
-                sim.place_solid(solid.name, moved)
-                moved = land_solid(solid, moved, sim.loaded.base_dir, sim.landing_ground(solid.name), self._to_enu)
-                sim.place_solid(solid.name, moved)
+                # (landing_ground leaves the solid itself out: it need not be placed at ``moved`` first)
+                landed = land_solid(solid, moved, sim.loaded.base_dir, sim.landing_ground(solid.name), self._to_enu)
+                sim.place_solid(solid.name, landed)
                 continue
             sim.place_solid(solid.name, moved)
             lo, hi = spans[solid.name]
