@@ -37,7 +37,7 @@ from sensorium.server.daemon.mf_items import item_position
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import states, viewshot
 from sensorium.server.world.limits import RAISE, custom_data_chars
-from sensorium.server.world.poses import matrix_quaternion, pose_from_model
+from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion, pose_from_model
 from sensorium.server.world.top_nodes import Scenery
 
 T = TypeVar("T")
@@ -1118,24 +1118,14 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
     return []
 
 
-def _axis_angle_matrix(r: list[float]) -> np.ndarray:
-    """The rotation matrix of an axis-angle (x, y, z, angle); a zero axis is no rotation."""
-    axis, angle = np.asarray(r[:3], dtype=float), float(r[3])
-    norm = float(np.linalg.norm(axis))
-    if norm == 0.0:
-        return np.eye(3)
-    x, y, z = axis / norm
-    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
-
-
 def node_pose(sim: Any, node: Node) -> dict:
     pose = nested.world_pose(sim, _nested_of(sim, node)) if node.nested else \
         _pose(sim, node) if node.type in ("Robot", "Solid") else None
     if pose is None and node.scenery and node.type in ("Pose", "Transform") and _group_members(sim, node):
         written = _scenery(sim)[int(node.key)].fields      # a top-level group's: the world file's, fixed
+        rotation = [float(v) for v in written.get("rotation", [0.0, 0.0, 1.0, 0.0])]
         return {"position": [float(v) for v in written.get("translation", [0.0, 0.0, 0.0])],
-                "orientation": [float(v) for v in _axis_angle_matrix(written.get("rotation", [0, 0, 1, 0])).reshape(9)]}
+                "orientation": [float(v) for v in axis_angle_matrix(rotation[:3], rotation[3]).reshape(9)]}
     if pose is None:                                 # Webots: NaN for a node that is no Pose
         return {"position": [math.nan] * 3, "orientation": [math.nan] * 9}
     return {"position": [float(v) for v in pose.translation],
