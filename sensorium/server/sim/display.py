@@ -138,6 +138,12 @@ _ARITY = {"color": 1, "alpha": 1, "opacity": 1, "font": 3, "pixel": 2, "line": 4
           "polygon": 3, "text": 3, "copy": 5, "paste": 4, "load": 4, "rows": 5, "delete": 1, "attach": 1, "detach": 0}
 
 
+def _check_image_size(w: Any, h: Any) -> None:
+    """A ``load``'s or ``rows``' width and height: integers, 1 to MAX_IMAGE_PIXELS pixels in all."""
+    if any(isinstance(v, bool) or not isinstance(v, int) for v in (w, h)) or w < 1 or h < 1 \
+            or w * h > MAX_IMAGE_PIXELS:
+        raise ValueError(f"an image is 1 to {MAX_IMAGE_PIXELS} pixels, got {w!r} x {h!r}")
+
 def line_pixels(x0: int, y0: int, x1: int, y1: int, width: int | None = None,
                 height: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The pixels of WbDisplay's Bresenham line from (x0, y0) to (x1, y1), in order; with ``width``
@@ -309,9 +315,7 @@ class Display(Device):
         if op == "load":
             iid, w, h, data = args
             iid = _image_id(iid)
-            if isinstance(w, bool) or isinstance(h, bool) or not isinstance(w, int) or not isinstance(h, int) \
-                    or w < 1 or h < 1 or w * h > MAX_IMAGE_PIXELS:
-                raise ValueError(f"an image is 1 to {MAX_IMAGE_PIXELS} pixels, got {w!r} x {h!r}")
+            _check_image_size(w, h)
             if not isinstance(data, bytes) or len(data) != 4 * w * h:
                 raise ValueError(f"data must be {4 * w * h} bytes (BGRA, {w} x {h}), got "
                                  f"{len(data) if isinstance(data, bytes) else type(data).__name__}")
@@ -337,9 +341,7 @@ class Display(Device):
         width x height, the bands in order (the first at row 0, each where the last one ended)."""
         iid, w, h, y, data = args
         iid = _image_id(iid)
-        if any(isinstance(v, bool) or not isinstance(v, int) for v in (w, h)) \
-                or w < 1 or h < 1 or w * h > MAX_IMAGE_PIXELS:
-            raise ValueError(f"an image is 1 to {MAX_IMAGE_PIXELS} pixels, got {w!r} x {h!r}")
+        _check_image_size(w, h)
         if isinstance(y, bool) or not isinstance(y, int) or not 0 <= y < h:
             raise ValueError(f"y must be a row of the image, 0 to {h - 1}, got {y!r}")
         if not isinstance(data, bytes) or not data or len(data) % (4 * w):
