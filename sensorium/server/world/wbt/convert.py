@@ -2177,11 +2177,11 @@ class Converter:
         tracks = robot.tracks
         if not tracks:
             return
-        drive, why = (None, "") if robot.wheels or len(tracks) != 2 else track_drive(tracks, self, self._robot_up(robot))
+        up = self._robot_up(robot)
+        drive, why = (None, "") if robot.wheels or len(tracks) != 2 else track_drive(tracks, self, up)
         if drive is None:
             if why:
                 self.warn(node, f"robot {robot.data['name']!r}: no tracked drive ({why}); the robot will not move")
-            up = self._robot_up(robot)
             for t in tracks:
                 belt = self.belt(t["node"], t["frame"], t["motor"], up)
                 if belt is None:
@@ -2192,7 +2192,6 @@ class Converter:
                           "the solids with physics lying on its top face at its motor's velocity; its texture "
                           "animation and wheels do not move here")
             return
-        up = self._robot_up(robot)
         bottoms = [belt_bottom(t["frame"], t["wheels"], up) for t in tracks]
         if self.fields(node).node_("physics") is not None and all(b is not None for b in bottoms):
             drive["wheel_bottom"] = min(b for b in bottoms if b is not None)
