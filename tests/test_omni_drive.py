@@ -358,3 +358,25 @@ def load_world_from(text: str):
 
 
 assert wm.OmniDrive  # the schema's model (sensorium/schemas/world.py)
+
+
+def test_an_omni_robot_with_a_camera_ball_on_a_tilt_hinge_keeps_its_omni_drive(tmp_path: Path) -> None:
+    """The three-wheeler with a tilt hinge on its body whose end point is a ball 0.1 m up: its bottom
+    is 0.12 m above the wheels' (more than their diameter, 0.1 m), so it is no fourth omni wheel (before,
+    it made the robot lose its drive), and the three wheels still translate it at the closed form."""
+    head = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0.05 0 0.1 } device [ '
+            'RotationalMotor { name "tilt" } ] endPoint Solid { translation 0.05 0 0.1 name "head" children [ Shape { '
+            'geometry Sphere { radius 0.03 } } ] } }\n')
+    w = load_world(three_wheeler(tmp_path, extra=head))
+    assert [x.split(": ", 1)[1] for x in w.warnings] == [
+        "HingeJoint motor 'tilt' is no wheel (its round part's bottom is 0.12 m above the robot's lowest wheels: it "
+        "never touches the ground): its joint moves kinematically (Webots' rule without physics; its PositionSensor "
+        "reads it), and the shapes and devices past the joint with it"]
+    drive = w.world.robots[0].omni_drive
+    assert drive is not None and [wh.motor for wh in drive.wheels] == ["wheel1", "wheel2", "wheel3"]
+    sim = Simulation(w)
+    spin(sim, three_speeds(0.0, 0.2, 0.0))
+    for _ in range(50):
+        sim.step()
+    x, y, yaw = pose2d(sim)
+    assert x == pytest.approx(0.0, abs=1e-12) and y == pytest.approx(0.2 * 50 * DT, abs=1e-9) and yaw == pytest.approx(0.0, abs=1e-12)

@@ -304,7 +304,8 @@ def test_an_arm_of_plain_cylinders_on_a_two_wheel_robot_is_no_wheel(tmp_path: Pa
     Cylinder standing up from the joint (along z, its centre 0.1 above the axis): something round, but
     it does not turn about the hinge as a wheel does, so the robot keeps its two-wheel drive (three
     "wheels", one on the x axis, made none) and the shoulder moves its joint with its one warning. A
-    link that is coaxial with its hinge (a roller) would still roll: it is judged a wheel as before."""
+    link that is coaxial with its hinge (a roller) would roll, but its bottom is 0.28 m above the
+    wheels' (more than their diameter): it never touches the ground, so it is no wheel either."""
     def body(link: str) -> str:
         arm = ('HingeJoint { jointParameters HingeJointParameters { axis 0 1 0 anchor 0.05 0 0.3 }\n'
                '  device [ RotationalMotor { name "shoulder" } PositionSensor { name "shoulder sensor" } ]\n'
@@ -324,9 +325,19 @@ def test_an_arm_of_plain_cylinders_on_a_two_wheel_robot_is_no_wheel(tmp_path: Pa
            "reads it), and the shapes and devices past the joint with it" in w.warnings
     sim = Simulation(w).robot("armbot")
     assert sorted(sim.drive.motors) == ["left wheel", "right wheel"] and sorted(sim.joints) == ["shoulder"]
-    # the same link lying along the hinge's axis, centred on it, is a roller: no drive, as before
+    # the same link lying along the hinge's axis, centred on it, is a roller high above the ground
     roller = 'Pose { rotation 1 0 0 1.5708 children [ Shape { geometry Cylinder { radius 0.02 height 0.2 } } ] }'
-    w = load_world(write(tmp_path, body(roller)))
+    p = write(tmp_path, body(roller))
+    w = load_world(p)
+    assert w.world.robots[0].differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert f"{p}:6:1: HingeJoint motor 'shoulder' is no wheel (its round part's bottom is 0.28 m above the robot's " \
+           "lowest wheels: it never touches the ground): its joint moves kinematically (Webots' rule without " \
+           "physics; its PositionSensor reads it), and the shapes and devices past the joint with it" in w.warnings
+    # low enough to reach the ground (its bottom within the wheels' diameter of theirs), it still rolls: no drive
+    low = body(roller).replace("anchor 0.05 0 0.3", "anchor 0.05 0 0.1").replace("translation 0.05 0 0.3",
+                                                                                 "translation 0.05 0 0.1")
+    w = load_world(write(tmp_path, low))
     assert w.world.robots[0].differential_drive is None
     assert [x for x in w.warnings if "no differential drive" in x]
 
@@ -969,3 +980,25 @@ def test_a_rover_built_y_up_in_a_nue_world_gets_the_steered_drive(tmp_path: Path
         rover.motor(f"{k} wheel").set_velocity(4.0)
     sim.run(100)                                  # 1.6 s to its left, west (-z), at r·4
     assert list(rover.pose.translation - start) == pytest.approx([0.0, 0.0, -R * 4.0 * 1.6], abs=1e-12)
+
+
+def test_a_camera_ball_on_a_tilt_hinge_is_no_wheel_of_a_two_wheel_or_omni_robot(tmp_path: Path) -> None:
+    """A tilt hinge on the body (riding no pan hinge) whose end point is a ball: something round that
+    turns about its axis as a wheel would, but its bottom (0.3 - 0.03 m) is 0.27 m above the wheels'
+    (0), more than their diameter (0.22 m). It is no wheel, with its height in its one line, and the
+    two wheels keep their drive, whether the hinge is about the wheels' axis or across it. Before, a
+    third "wheel" made the robot lose its drive ('no differential drive ...; the robot will not move')."""
+    for axis in ("0 1 0", "1 0 0"):
+        head = (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor 0.05 0 0.3 }} device [ '
+                'RotationalMotor { name "tilt" } ] endPoint Solid { translation 0.05 0 0.3 children [ Shape { '
+                'geometry Sphere { radius 0.03 } } ] } }\n')
+        p = write(tmp_path, 'Robot { name "cam" children [\n' + wheel("left wheel", 0, 0.15)
+                  + wheel("right wheel", 0, -0.15) + head + '] }\n')
+        w = load_world(p)
+        assert w.world.robots[0].differential_drive == wm.DifferentialDrive(
+            wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+        assert w.warnings == [
+            f"{p}:6:1: HingeJoint motor 'tilt' is no wheel (its round part's bottom is 0.27 m above the robot's lowest "
+            "wheels: it never touches the ground): its joint moves kinematically (Webots' rule without physics; its "
+            "PositionSensor reads it), and the shapes and devices past the joint with it"], axis
+        assert sorted(Simulation(w).robot("cam").joints) == ["tilt"]

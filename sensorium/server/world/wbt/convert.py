@@ -2046,10 +2046,13 @@ class Converter:
         return out
 
     def _lifted_wheels(self, wheels: list[dict], up: int) -> list[tuple[dict, float]]:
-        """The motorised hinges about horizontal axes riding a steering (vertical) hinge whose round
-        part's bottom is more than the lowest wheel's diameter above the lowest wheels' bottom, with
-        that height, when at least two wheels are at the bottom (a base that stands on them); else none."""
-        from sensorium.server.world.wbt.drive import GROUND_TOL, wheel_bottom, wheel_radius
+        """The motorised hinges about horizontal axes whose round part's bottom is more than the lowest
+        wheels' diameter above their bottom, with that height, when at least two wheels are at the
+        bottom (a base that stands on them); else none. Such a part never touches the ground the base
+        rolls on, whether it rides a pan hinge (a TIAGo++'s head) or, turning about its axis as a wheel
+        would, the body itself (a camera ball on a tilt hinge); an arm's link that turns otherwise is
+        left to the drive's own reason (nothing round turns about its axis)."""
+        from sensorium.server.world.wbt.drive import GROUND_TOL, rolls_about_its_axis, wheel_bottom, wheel_radius
 
         rolling = []
         for w in wheels:
@@ -2065,7 +2068,8 @@ class Converter:
             return []
         reach = 2.0 * max(r for _, r in base)
         steered: set[int] = set().union(*(self._inside(w["end"]) for w in wheels if w["steers"]))
-        return [(w, b - lowest) for w, b, _ in rolling if b - lowest > reach and id(w["node"]) in steered]
+        return [(w, b - lowest) for w, b, _ in rolling
+                if b - lowest > reach and (id(w["node"]) in steered or rolls_about_its_axis(w, self))]
 
     def _one_steered_wheel(self, wheels: list[dict]) -> str | None:
         """Why a robot whose only driven wheel rides a steering joint (a BB-8's ball rolled inside
