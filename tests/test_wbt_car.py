@@ -298,3 +298,18 @@ def test_free_wheels_in_turned_joint_frames_and_slots_as_webots_cars_hold_them(t
     travel = 0.4 * 5.0 * 100 * 0.016                # straight: the front wheels' v t; the rear ones turn v t / r
     assert r.pose.translation[0] == pytest.approx(travel, rel=1e-12)
     assert sensor.value == pytest.approx(0.25 + travel / 0.4, rel=1e-12)
+
+
+def test_a_car_with_a_spinning_lidar_on_its_roof_keeps_its_ackermann_drive(tmp_path: Path) -> None:
+    """A third vertical hinge on the roof spinning a cylinder about its own axis steers no wheel: the
+    car keeps its drive (before: 'no Ackermann drive (... 3 steering motor(s) ...)')."""
+    lidar = ('HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 anchor 1.3 0 1.0 } device [ '
+             'RotationalMotor { name "lidar spin" } ] endPoint Solid { translation 1.3 0 1.0 children [ Shape { '
+             'geometry Cylinder { radius 0.1 height 0.1 } } ] } }\n')
+    w = load_world(write(tmp_path, car(hinge2_front("right", -T / 2) + hinge2_front("left", T / 2) + lidar)))
+    (robot,) = w.world.robots
+    assert robot.ackermann_drive is not None and robot.ackermann_drive.wheelbase == pytest.approx(L, abs=1e-12)
+    assert [x.split(": ", 1)[1] for x in w.warnings] == [
+        "HingeJoint motor 'lidar spin' is no wheel and steers none (it spins its round part in place about its own "
+        "axis): its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and the "
+        "shapes and devices past the joint with it"]

@@ -1002,3 +1002,34 @@ def test_a_camera_ball_on_a_tilt_hinge_is_no_wheel_of_a_two_wheel_or_omni_robot(
             "wheels: it never touches the ground): its joint moves kinematically (Webots' rule without physics; its "
             "PositionSensor reads it), and the shapes and devices past the joint with it"], axis
         assert sorted(Simulation(w).robot("cam").joints) == ["tilt"]
+
+
+SPINNING_HEAD = ('HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 anchor 0 0 0.3 } device [ '
+                 'RotationalMotor { name "spin" } ] endPoint Solid { translation 0 0 0.3 children [ Shape { geometry '
+                 'Cylinder { radius 0.04 height 0.05 } } ] } }\n')
+"""A lidar's head spinning about the robot's z: a cylinder along its hinge's axis, centred on it."""
+
+
+def test_a_spinning_lidar_head_steers_no_wheel(tmp_path: Path) -> None:
+    """A vertical hinge whose end point is a cylinder along its axis (a spinning lidar head) turns it in
+    place: something round that "steers", but it holds no wheel's joint and nothing it holds rolls. It
+    is no wheel and steers none (its one line says so), and the two wheels keep their drive. Before,
+    the robot was taken for a car with one steering motor ('no Ackermann drive ...; the robot will not
+    move'). A vertical hinge carrying a wheel's joint still steers (the cars' tests)."""
+    p = write(tmp_path, 'Robot { name "scan" children [\n' + wheel("left wheel", 0, 0.15)
+              + wheel("right wheel", 0, -0.15) + SPINNING_HEAD + '] }\n')
+    w = load_world(p)
+    assert w.world.robots[0].differential_drive == wm.DifferentialDrive(
+        wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+    assert w.warnings == [
+        f"{p}:6:1: HingeJoint motor 'spin' is no wheel and steers none (it spins its round part in place about its "
+        "own axis): its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
+        "the shapes and devices past the joint with it"]
+    sim = Simulation(w)
+    r = sim.robot("scan")
+    assert sorted(r.joints) == ["spin"]
+    for name in ("left wheel", "right wheel"):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(2.0)
+    sim.run(100)
+    assert r.pose.translation[0] == pytest.approx(R * 2.0 * 100 * 0.016, abs=1e-9)

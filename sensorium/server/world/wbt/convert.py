@@ -2266,6 +2266,7 @@ class Converter:
             omni_drive,
             omni_wheels,
             rolls_about_its_axis,
+            spins_in_place,
             steered_drive,
             wheel_radius,
         )
@@ -2305,13 +2306,19 @@ class Converter:
         # a vertical hinge whose end point neither is nor carries a wheel (a pan head, an arm's base
         # joint on a mobile robot) steers nothing: it is no wheel, and the others make the drive (with
         # vertical hinges only, there is no vehicle: said below)
+        # so is one that spins its round part in place about its own axis (a lidar's spinning head)
         gone = {id(w["node"]) for w, _ in lifted}
-        pans = [w for w in wheels if w["steers"] and (not holds_wheel(w["end"], self) or (gone and not any(
-            id(o["node"]) in self._inside(w["end"]) for o in wheels if not o["steers"])))]
+        holding = {id(w["node"]) for w in wheels if w["steers"] and holds_wheel(w["end"], self)}
+        spinning = {id(w["node"]) for w in wheels if id(w["node"]) in holding and w["node"].type == "HingeJoint"
+                    and spins_in_place(w, self)}
+        pans = [w for w in wheels if w["steers"] and (id(w["node"]) not in holding or id(w["node"]) in spinning or (
+            gone and not any(id(o["node"]) in self._inside(w["end"]) for o in wheels if not o["steers"])))]
         if pans and not all(w["steers"] for w in wheels):
             for w in pans:
+                why = ("it spins its round part in place about its own axis" if id(w["node"]) in spinning
+                       else "its end point holds no wheel")
                 nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel and steers "
-                                f"none (its end point holds no wheel): {JOINT_MOVES}", "steering none"))
+                                f"none ({why}): {JOINT_MOVES}", "steering none"))
             wheels = [w for w in wheels if not any(w is p for p in pans)]
         # a rocker-bogie's suspension (a Sojourner's rockers and bogies): motorised hinges carrying the
         # wheels; they are no wheels, and the wheels riding them are wheels still

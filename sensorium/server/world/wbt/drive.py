@@ -142,7 +142,26 @@ def holds_wheel(end: Node | None, conv) -> bool:
     part = _round_part(end, conv)
     if part is not None and part[2] <= 4.0 * part[1]:
         return True
+    return _holds_wheel_joint(end, conv)
 
+
+def spins_in_place(w: dict, conv) -> bool:
+    """Whether a steering-like (vertical) hinge only spins what it holds where it is: its end point's
+    first round part is a cylinder or capsule lying along the hinge's own axis, centred on it (a
+    lidar's spinning head, a turntable: :func:`rolls_about_its_axis`), and it carries no hinge whose
+    end point is round (no wheel's joint, as a BB-8's yaw hinge carries its ball's). Nothing it holds
+    rolls on the ground, so it steers no wheel. A ball on the axis may be a steered ball wheel: not
+    this."""
+    end = conv.slotted(w["end"])
+    if end is None or _first_round_part(conv, end, w["frame"], lambda kind, nf, frame: kind) not in ("Cylinder",
+                                                                                                    "Capsule"):
+        return False
+    return rolls_about_its_axis(w, conv) and not _holds_wheel_joint(w["end"], conv)
+
+
+def _holds_wheel_joint(end: Node | None, conv) -> bool:
+    """Whether an end point holds a hinge whose end point has something round (a car's knuckle holding
+    its wheel's joint)."""
     def find(node: Node | None) -> bool:
         if node is None:
             return False
