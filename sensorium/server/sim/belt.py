@@ -3,9 +3,10 @@ moves the belt): each basic step, a top-level solid with physics lying on a movi
 lowest point within contact.FLOOR of the face, its origin over the face -- moves along the belt by the
 motor's travel that step, as Webots' physics carries it on the Track's moving contact surface. Once its
 origin is past the face's edge it lands (ground.land_solid) on what is under it. A carried solid whose
-move would put it into another solid or a robot's part (above the belt's face) stays where it is that
-step, and so do the solids behind it on that belt (a row stops together). Only a belt whose motor moved
-costs anything; a world without belts builds no ``Belts``."""
+move would put it into another solid or a robot's part (above the belt's face) goes as far as their faces
+meet, and the solids behind it on that belt as far as they meet it (a row stops together). A Track with
+several Boxes has a face for each, all moving along its +x; a solid moves once a step. Only a belt whose
+motor moved costs anything; a world without belts builds no ``Belts``."""
 
 from __future__ import annotations
 
@@ -50,18 +51,19 @@ class Belts:
     def _enu(self, v: np.ndarray) -> np.ndarray:
         return v if self._to_enu is None else self._to_enu @ v
 
-    def _face(self, robot: RobotState, belt: wm.ConveyorBelt) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-        """The belt's top face in ENU (its centre, unit along and across, both horizontal), None when it is
-        not level."""
+    def _face(self, robot: RobotState, belt: wm.ConveyorBelt) -> tuple[np.ndarray, ...] | None:
+        """The belt's top face in ENU (its centre, unit along and across, both horizontal) and its unit
+        horizontal direction of travel; None when it is not level."""
         pose = self._sim.scene.robot_poses[robot.index]
         r = np.asarray(pose.rotation, dtype=np.float64)
         along = self._enu(r @ np.asarray(belt.along, dtype=np.float64))
         across = self._enu(r @ np.asarray(belt.across, dtype=np.float64))
-        if abs(along[2]) > _LEVEL or abs(across[2]) > _LEVEL or np.cross(along, across)[2] <= 0.0:
+        way = along if belt.direction is None else self._enu(r @ np.asarray(belt.direction, dtype=np.float64))
+        if max(abs(along[2]), abs(across[2]), abs(way[2])) > _LEVEL or np.cross(along, across)[2] <= 0.0:
             return None
-        along, across = (np.array([v[0], v[1], 0.0]) / np.hypot(v[0], v[1]) for v in (along, across))
+        along, across, way = (np.array([v[0], v[1], 0.0]) / np.hypot(v[0], v[1]) for v in (along, across, way))
         centre = self._enu(np.asarray(pose.translation, dtype=np.float64) + r @ np.asarray(belt.top, dtype=np.float64))
-        return centre, along, across
+        return centre, along, across, way
 
     def _falling(self, solid: wm.Solid) -> list | None:
         kept = self._shapes.get(solid.name)
@@ -71,6 +73,7 @@ class Belts:
 
     def carry(self, dt_s: float) -> None:
         sim = self._sim
+        moved: set[str] = set()        # a solid over two faces of one Track moves once a step
         for robot, belt, motor in self._belts:
             travel = motor.rate * dt_s          # the belt's own travel this step (its motor's position moved so)
             if travel == 0.0:
@@ -78,12 +81,12 @@ class Belts:
             face = self._face(robot, belt)
             if face is None:
                 continue
-            centre, along, across = face
+            centre, along, across, way = face
             held = {g.held for g in sim._grippers if g.held is not None}
             poses = sim.scene.solid_poses
             on: list[tuple[wm.Solid, Pose, tuple[float, float, np.ndarray]]] = []
             for solid in sim.world.solids:
-                if solid.name not in poses or solid.name in held or not solid.physics:
+                if solid.name not in poses or solid.name in held or not solid.physics or solid.name in moved:
                     continue
                 pose = poses[solid.name]
                 offset = self._enu(np.asarray(pose.translation, dtype=np.float64)) - centre
@@ -94,7 +97,8 @@ class Belts:
                     continue
                 on.append((solid, pose, span))
             if on:
-                self._move(on, travel, along, centre, belt)
+                self._move(on, way * travel, face, belt)
+                moved |= {s.name for s, _, _ in on}
 
     def _span(self, solid: wm.Solid, pose: Pose) -> tuple[float, float, np.ndarray] | None:
         """ground.shapes_span of a solid with physics at ``pose``: kept for the pose a belt moved it to
@@ -105,48 +109,57 @@ class Belts:
         shapes = self._falling(solid)
         return None if shapes is None else shapes_span(shapes, pose, self._to_enu)
 
-    def _move(self, on: list, travel: float, along: np.ndarray, centre: np.ndarray, belt: wm.ConveyorBelt) -> None:
+    def _move(self, on: list, step: np.ndarray, face: tuple[np.ndarray, ...], belt: wm.ConveyorBelt) -> None:
+        """Move the solids ``on`` the face by ``step`` (ENU), each as far as it goes before its xy box meets
+        a wall's (another solid's or a robot part's above the face) or one carried ahead of it where that
+        one stops: the faces meet there."""
         sim = self._sim
-        step = along * travel                               # ENU
-        shift = np.array([step[0], step[1], step[0], step[1]])
-        carried = {s.name for s, _, _ in on}
-        walls = self._obstacles(carried, float(centre[2]))
+        centre, along, across, _ = face
+        xy = step[:2]
+        carried = [s.name for s, _, _ in on]
         boxes = {s.name: box for s, _, (_, _, box) in on}
         spans = {s.name: (lo, hi) for s, _, (lo, hi, _) in on}
-
-        def arrays(others: list[tuple[float, float, np.ndarray]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-            return (np.array([o[0] for o in others]), np.array([o[1] for o in others]),
-                    np.array([o[2] for o in others]).reshape(-1, 4))
-
-        def hits(name: str, others: tuple[np.ndarray, np.ndarray, np.ndarray]) -> bool:
-            bottoms, tops, other = others
-            if not len(tops):
-                return False
+        walls = self._obstacles(set(carried), float(centre[2]))
+        bottoms = np.array([w[0] for w in walls])
+        tops = np.array([w[1] for w in walls])
+        others = np.array([w[2] for w in walls]).reshape(-1, 4)
+        reach = {}          # the part of the step each solid makes before its faces meet a wall's
+        for name in carried:
             lo, hi = spans[name]
-            now, moved = boxes[name], boxes[name] + shift
-            return bool(np.any(_overlap(moved, other) & ~_overlap(now, other) & (tops > lo + FLOOR) & (bottoms < hi)))
-
-        fixed = arrays(walls)
-        stopped = {name for name in carried if hits(name, fixed)}
-        more = stopped
-        while more:         # a row stops together: one behind a solid that just stopped stops too
-            last = arrays([(*spans[o], boxes[o]) for o in more])
-            more = {name for name in carried - stopped if hits(name, last)}
-            stopped |= more
-        world_step = step if self._to_enu is None else self._to_enu.T @ step
+            tall = (tops > lo + FLOOR) & (bottoms < hi)
+            reach[name] = min([1.0, *_meets(boxes[name], others[tall], xy)])
+        # a row stops together: each stops where it meets the one ahead where that one stops (reach[j] plus
+        # their gap, measured from where they are as both move along the same step); settled as shortest
+        # paths are, in at most one round per solid, and no round at all while nothing is stopped
+        for _ in carried:
+            changed = False
+            for i in carried:
+                for j in carried:
+                    if reach[i] <= reach[j]:
+                        continue
+                    meet = _meets(boxes[i], boxes[j].reshape(1, 4), xy, reach[i] - reach[j])
+                    if meet and reach[j] + meet[0] < reach[i]:
+                        reach[i], changed = reach[j] + meet[0], True
+            if not changed:
+                break
+        world_xy = np.array([xy[0], xy[1], 0.0])
+        world_step = world_xy if self._to_enu is None else self._to_enu.T @ world_xy
         for solid, pose, _ in on:
-            if solid.name in stopped:
+            part = reach[solid.name]
+            if part <= 0.0:
                 continue
-            moved = Pose(pose.rotation, np.asarray(pose.translation, dtype=np.float64) + world_step)
+            moved = Pose(pose.rotation, np.asarray(pose.translation, dtype=np.float64) + world_step * part)
             offset = self._enu(np.asarray(moved.translation, dtype=np.float64)) - centre
-            if abs(offset @ along) > belt.length / 2.0:     # past the belt's end: it falls onto what is under it
-                # (landing_ground leaves the solid itself out: it need not be placed at ``moved`` first)
+            if abs(offset @ along) > belt.length / 2.0 or abs(offset @ across) > belt.width / 2.0:
+                # past the face's edge: it falls onto what is under it (landing_ground leaves the solid
+                # itself out: it need not be placed at ``moved`` first)
                 landed = land_solid(solid, moved, sim.loaded.base_dir, sim.landing_ground(solid.name), self._to_enu)
                 sim.place_solid(solid.name, landed)
                 continue
             sim.place_solid(solid.name, moved)
             lo, hi = spans[solid.name]
-            self._moved[solid.name] = (sim.scene.solid_poses[solid.name], solid, (lo, hi, boxes[solid.name] + shift))
+            shifted = boxes[solid.name] + np.concatenate([xy, xy]) * part
+            self._moved[solid.name] = (sim.scene.solid_poses[solid.name], solid, (lo, hi, shifted))
 
     def _obstacles(self, carried: set[str], face: float) -> list[tuple[float, float, np.ndarray]]:
         """(lowest, highest ENU point, xy box) of every bounding shape above the belt's face that is not
@@ -184,8 +197,24 @@ class Belts:
         return spans
 
 
-def _overlap(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Whether xy box ``a`` (x0, y0, x1, y1) overlaps each of boxes ``b`` (n x 4) by more than EPS both ways."""
-    return ((np.minimum(a[2], b[:, 2]) - np.maximum(a[0], b[:, 0]) > EPS)
-            & (np.minimum(a[3], b[:, 3]) - np.maximum(a[1], b[:, 1]) > EPS))
+def _meets(box: np.ndarray, others: np.ndarray, xy: np.ndarray, limit: float = 1.0) -> list[float]:
+    """For each of xy boxes ``others`` (n x 4) that xy box ``box`` moved by f * ``xy``, f in [0, limit],
+    comes to overlap by more than contact.EPS both ways (touching is not overlapping) and does not
+    overlap now: the f at which
+    their faces meet (0 when they touch now)."""
+    lo, hi, olo, ohi = box[:2], box[2:], others[:, :2], others[:, 2:]
 
+    def window(by: float) -> tuple[np.ndarray, np.ndarray]:
+        """Each other box's f interval over which the two overlap by more than ``by`` both ways."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a, b = (olo - hi + by) / xy, (ohi - lo - by) / xy
+        still = np.minimum(hi, ohi) - np.maximum(lo, olo) > by      # along an axis the step does not move
+        start = np.where(xy > 0.0, a, np.where(xy < 0.0, b, np.where(still, -np.inf, np.inf)))
+        end = np.where(xy > 0.0, b, np.where(xy < 0.0, a, np.where(still, np.inf, -np.inf)))
+        return start.max(axis=1, initial=-np.inf), end.min(axis=1, initial=np.inf)
+
+    enter, leave = window(EPS)
+    hit = (enter >= 0.0) & (enter < limit) & (enter < leave)
+    if not hit.any():
+        return []
+    return [max(0.0, float(f)) for f in window(0.0)[0][hit]]
