@@ -127,21 +127,10 @@ class Belts:
         for name in carried:
             lo, hi = spans[name]
             tall = (tops > lo + FLOOR) & (bottoms < hi)
-            reach[name] = min([1.0, *_meets(boxes[name], others[tall], xy)])
-        # a row stops together: each stops where it meets the one ahead where that one stops (reach[j] plus
-        # their gap, measured from where they are as both move along the same step); settled as shortest
-        # paths are, in at most one round per solid, and no round at all while nothing is stopped
-        for _ in carried:
-            changed = False
-            for i in carried:
-                for j in carried:
-                    if reach[i] <= reach[j]:
-                        continue
-                    meet = _meets(boxes[i], boxes[j].reshape(1, 4), xy, reach[i] - reach[j])
-                    if meet and reach[j] + meet[0] < reach[i]:
-                        reach[i], changed = reach[j] + meet[0], True
-            if not changed:
-                break
+            enter, meet = _meets(boxes[name], others[tall], xy)
+            reach[name] = min(1.0, float(meet[enter < 1.0].min(initial=1.0)))
+        if min(reach.values()) < 1.0:
+            self._rows(carried, boxes, xy, reach)
         world_xy = np.array([xy[0], xy[1], 0.0])
         world_step = world_xy if self._to_enu is None else self._to_enu.T @ world_xy
         for solid, pose, _ in on:
@@ -160,6 +149,25 @@ class Belts:
             lo, hi = spans[solid.name]
             shifted = boxes[solid.name] + np.concatenate([xy, xy]) * part
             self._moved[solid.name] = (sim.scene.solid_poses[solid.name], solid, (lo, hi, shifted))
+
+    @staticmethod
+    def _rows(carried: list[str], boxes: dict[str, np.ndarray], xy: np.ndarray, reach: dict[str, float]) -> None:
+        """A row stops together: each solid stops where it meets the one ahead where that one stops (its
+        reach plus their gap, measured from where they are as both move along the same step); settled as
+        shortest paths are, in at most one round per solid."""
+        every = np.array([boxes[name] for name in carried])
+        pairs = []
+        for i, name in enumerate(carried):
+            enter, meet = _meets(boxes[name], every, xy)
+            enter[i] = np.inf
+            pairs += [(name, carried[j], float(enter[j]), float(meet[j])) for j in np.flatnonzero(enter < 1.0)]
+        for _ in carried:
+            changed = False
+            for i, j, enter_ij, meet_ij in pairs:
+                if reach[i] - reach[j] > enter_ij and reach[j] + meet_ij < reach[i]:
+                    reach[i], changed = reach[j] + meet_ij, True
+            if not changed:
+                break
 
     def _obstacles(self, carried: set[str], face: float) -> list[tuple[float, float, np.ndarray]]:
         """(lowest, highest ENU point, xy box) of every bounding shape above the belt's face that is not
@@ -197,11 +205,10 @@ class Belts:
         return spans
 
 
-def _meets(box: np.ndarray, others: np.ndarray, xy: np.ndarray, limit: float = 1.0) -> list[float]:
-    """For each of xy boxes ``others`` (n x 4) that xy box ``box`` moved by f * ``xy``, f in [0, limit],
-    comes to overlap by more than contact.EPS both ways (touching is not overlapping) and does not
-    overlap now: the f at which
-    their faces meet (0 when they touch now)."""
+def _meets(box: np.ndarray, others: np.ndarray, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each of xy boxes ``others`` (n x 4), xy box ``box`` moved by f * ``xy``: the least f >= 0 at which
+    they come to overlap by more than contact.EPS both ways (touching is not overlapping; inf when they
+    never do, or overlap now), and the f at which their faces meet (0 when they touch now)."""
     lo, hi, olo, ohi = box[:2], box[2:], others[:, :2], others[:, 2:]
 
     def window(by: float) -> tuple[np.ndarray, np.ndarray]:
@@ -214,7 +221,4 @@ def _meets(box: np.ndarray, others: np.ndarray, xy: np.ndarray, limit: float = 1
         return start.max(axis=1, initial=-np.inf), end.min(axis=1, initial=np.inf)
 
     enter, leave = window(EPS)
-    hit = (enter >= 0.0) & (enter < limit) & (enter < leave)
-    if not hit.any():
-        return []
-    return [max(0.0, float(f)) for f in window(0.0)[0][hit]]
+    return np.where((enter >= 0.0) & (enter < leave), enter, np.inf), np.maximum(window(0.0)[0], 0.0)
