@@ -123,14 +123,15 @@ class Belts:
         bottoms = np.array([w[0] for w in walls])
         tops = np.array([w[1] for w in walls])
         others = np.array([w[2] for w in walls]).reshape(-1, 4)
-        reach = {}          # the part of the step each solid makes before its faces meet a wall's
-        for name in carried:
-            lo, hi = spans[name]
-            tall = (tops > lo + FLOOR) & (bottoms < hi)
-            enter, meet = _meets(boxes[name], others[tall], xy)
-            reach[name] = min(1.0, float(meet[enter < 1.0].min(initial=1.0)))
+        every = np.array([boxes[name] for name in carried])
+        lows = np.array([spans[name][0] for name in carried])
+        highs = np.array([spans[name][1] for name in carried])
+        tall = (tops[None, :] > lows[:, None] + FLOOR) & (bottoms[None, :] < highs[:, None])
+        enter, meet = _meets(every, others, xy)
+        # the part of the step each solid makes before its faces meet a wall's
+        reach = dict(zip(carried, np.where(tall & (enter < 1.0), meet, 1.0).min(axis=1, initial=1.0).tolist()))
         if min(reach.values()) < 1.0:
-            self._rows(carried, boxes, xy, reach)
+            self._rows(carried, every, xy, reach)
         world_xy = np.array([xy[0], xy[1], 0.0])
         world_step = world_xy if self._to_enu is None else self._to_enu.T @ world_xy
         for solid, pose, _ in on:
@@ -151,16 +152,13 @@ class Belts:
             self._moved[solid.name] = (sim.scene.solid_poses[solid.name], solid, (lo, hi, shifted))
 
     @staticmethod
-    def _rows(carried: list[str], boxes: dict[str, np.ndarray], xy: np.ndarray, reach: dict[str, float]) -> None:
+    def _rows(carried: list[str], every: np.ndarray, xy: np.ndarray, reach: dict[str, float]) -> None:
         """A row stops together: each solid stops where it meets the one ahead where that one stops (its
         reach plus their gap, measured from where they are as both move along the same step); settled as
         shortest paths are, in at most one round per solid."""
-        every = np.array([boxes[name] for name in carried])
-        pairs = []
-        for i, name in enumerate(carried):
-            enter, meet = _meets(boxes[name], every, xy)
-            enter[i] = np.inf
-            pairs += [(name, carried[j], float(enter[j]), float(meet[j])) for j in np.flatnonzero(enter < 1.0)]
+        enter, meet = _meets(every, every, xy)
+        np.fill_diagonal(enter, np.inf)
+        pairs = [(carried[i], carried[j], float(enter[i, j]), float(meet[i, j])) for i, j in zip(*np.nonzero(enter < 1.0))]
         for _ in carried:
             changed = False
             for i, j, enter_ij, meet_ij in pairs:
@@ -205,20 +203,24 @@ class Belts:
         return spans
 
 
-def _meets(box: np.ndarray, others: np.ndarray, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """For each of xy boxes ``others`` (n x 4), xy box ``box`` moved by f * ``xy``: the least f >= 0 at which
-    they come to overlap by more than contact.EPS both ways (touching is not overlapping; inf when they
-    never do, or overlap now), and the f at which their faces meet (0 when they touch now)."""
-    lo, hi, olo, ohi = box[:2], box[2:], others[:, :2], others[:, 2:]
+def _meets(boxes: np.ndarray, others: np.ndarray, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each of xy boxes ``boxes`` (m x 4: x0, y0, x1, y1) moved by f * ``xy`` and each of ``others``
+    (n x 4), m x n: the least f >= 0 at which they come to overlap by more than contact.EPS both ways
+    (touching is not overlapping; inf when they never do, or overlap now), and the f at which their
+    faces meet (0 when they touch now)."""
+    lo, hi, olo, ohi = boxes[:, None, :2], boxes[:, None, 2:], others[None, :, :2], others[None, :, 2:]
 
-    def window(by: float) -> tuple[np.ndarray, np.ndarray]:
-        """Each other box's f interval over which the two overlap by more than ``by`` both ways."""
-        with np.errstate(divide="ignore", invalid="ignore"):
-            a, b = (olo - hi + by) / xy, (ohi - lo - by) / xy
-        still = np.minimum(hi, ohi) - np.maximum(lo, olo) > by      # along an axis the step does not move
-        start = np.where(xy > 0.0, a, np.where(xy < 0.0, b, np.where(still, -np.inf, np.inf)))
-        end = np.where(xy > 0.0, b, np.where(xy < 0.0, a, np.where(still, np.inf, -np.inf)))
-        return start.max(axis=1, initial=-np.inf), end.min(axis=1, initial=np.inf)
+    def axis(k: int, by: float) -> tuple[np.ndarray, np.ndarray]:
+        """The f interval over which the two overlap by more than ``by`` along axis k."""
+        low, high, other_low, other_high, d = lo[..., k], hi[..., k], olo[..., k], ohi[..., k], float(xy[k])
+        if d > 0.0:
+            return (other_low - high + by) / d, (other_high - low - by) / d
+        if d < 0.0:
+            return (other_high - low - by) / d, (other_low - high + by) / d
+        still = np.minimum(high, other_high) - np.maximum(low, other_low) > by     # the step does not move along k
+        return np.where(still, -np.inf, np.inf), np.where(still, np.inf, -np.inf)
 
-    enter, leave = window(EPS)
-    return np.where((enter >= 0.0) & (enter < leave), enter, np.inf), np.maximum(window(0.0)[0], 0.0)
+    (x0, x1), (y0, y1) = axis(0, EPS), axis(1, EPS)
+    enter, leave = np.maximum(x0, y0), np.minimum(x1, y1)
+    return (np.where((enter >= 0.0) & (enter < leave), enter, np.inf),
+            np.maximum(np.maximum(axis(0, 0.0)[0], axis(1, 0.0)[0]), 0.0))
