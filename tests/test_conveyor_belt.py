@@ -332,3 +332,71 @@ def test_a_box_tilted_inside_a_pose_carries_nothing_and_says_so(tmp_path: Path) 
     belt(sim, 0.2)
     sim.run(20)
     assert at(sim) == before
+
+
+def test_each_box_of_a_group_is_a_face_carrying_along_the_tracks_x(tmp_path: Path) -> None:
+    """The Track's boundingObject a Group: a Pose holding a 0.5 m Box 0.25 m behind the Track's origin,
+    and a Transform holding another 0.5 m Box 0.25 m ahead with a Cylinder (an end roller) beside it.
+    Each Box's top face carries, as every contact of a Track's bounding object moves in Webots: the box
+    rides across the seam at x 0 at x0 + 0.2 t every step (1e-12) and falls past x 0.5. Before, a Group
+    was no belt: the Track kept its warning and nothing moved."""
+    group = ("Group { children [ Pose { translation -0.25 0 0 children [ Box { size 0.5 0.3 0.1 } ] }\n"
+             "  Transform { translation 0.25 0 0 children [ Box { size 0.5 0.3 0.1 }\n"
+             "    Pose { translation 0.25 0 0 rotation 1 0 0 1.5707963267948966 children [ Cylinder { radius 0.05 height 0.3 } ] } ] } ] }")
+    w = load_world(world(tmp_path, bounding=group))
+    assert not any("the belt and its wheels do not move" in x for x in w.warnings), w.warnings
+    faces = w.world.robots[0].belts
+    assert [(b.top, b.along, b.direction, b.length, b.width) for b in faces] == [
+        ((-0.25, 0.0, TOP), (1.0, 0.0, 0.0), None, 0.5, 0.3), ((0.25, 0.0, TOP), (1.0, 0.0, 0.0), None, 0.5, 0.3)]
+    sim = Simulation(w)
+    belt(sim, 0.2)
+    steps = 0
+    while at(sim)[2] > 0.1:
+        sim.step()
+        steps += 1
+        assert steps < 1000
+        if at(sim)[2] > 0.1:
+            assert at(sim) == pytest.approx([X0 + 0.2 * 0.01 * steps, 0.0, TOP + 0.05], abs=1e-12)
+    x = at(sim)[0]
+    assert x == pytest.approx(X0 + 0.2 * 0.01 * steps, abs=1e-12) and 0.5 < x <= 0.5 + 0.002 + 1e-12
+    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+
+
+def test_a_box_turned_30_degrees_carries_along_the_tracks_x(tmp_path: Path) -> None:
+    """The Track's 1 x 0.3 Box turned 30 degrees about its up in a Pose: the face is the turned Box's top,
+    but the belt moves along the Track's own +x, as Webots' contact motion does: the box stays at y 0
+    every step (1e-12), and falls once its origin leaves the face across it (|x| sin 30 > 0.15: x > 0.3).
+    Before, it went along the Box's side, 30 degrees off."""
+    X1 = -0.25          # (at X0 the origin would sit on the face's side edge: 0.3 sin 30 = 0.15)
+    p = world(tmp_path, bounding="Pose { rotation 0 0 1 0.5235987755982988 children [ USE BELT ] }")
+    p.write_text(p.read_text().replace(f'name "box" translation {X0} 0.0 ', f'name "box" translation {X1} 0.0 '))
+    w = load_world(p)
+    b = w.world.robots[0].belts[0]
+    assert b.direction == (1.0, 0.0, 0.0)
+    assert b.along == pytest.approx((math.sqrt(3) / 2, 0.5, 0.0), abs=1e-15)
+    sim = Simulation(w)
+    belt(sim, 0.2)
+    steps = 0
+    while at(sim)[2] > 0.1:
+        sim.step()
+        steps += 1
+        assert steps < 1000
+        if at(sim)[2] > 0.1:
+            assert at(sim) == pytest.approx([X1 + 0.2 * 0.01 * steps, 0.0, TOP + 0.05], abs=1e-12)
+    x = at(sim)[0]
+    assert x == pytest.approx(X1 + 0.2 * 0.01 * steps, abs=1e-12) and 0.3 < x <= 0.3 + 0.002 + 1e-12
+    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+
+
+def test_a_blocked_box_stops_with_its_face_on_the_walls(tmp_path: Path) -> None:
+    """A fixed wall across the belt, its face at x 0.29, the belt at 0.23 m/s (2.3 mm a step: the box's
+    front face, 0.54 m away, meets it mid-step): the box stops with its front face on the wall's, and the
+    box behind it with its front face on the first one's back (1e-9). Before, each stopped up to one
+    step's travel short."""
+    wall = box("wall", 0.34, physics="").replace("size 0.1 0.1 0.1", "size 0.1 0.5 0.1")
+    sim = Simulation(load_world(world(tmp_path, extra=wall + box("second", X0 - 0.2))))
+    belt(sim, 0.23)
+    sim.run(400)
+    assert at(sim) == pytest.approx([0.29 - 0.05, 0.0, TOP + 0.05], abs=1e-9)
+    assert at(sim, "second") == pytest.approx([0.29 - 0.15, 0.0, TOP + 0.05], abs=1e-9)
+    assert at(sim, "wall") == [0.34, 0.0, TOP + 0.05]

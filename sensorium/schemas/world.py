@@ -1367,13 +1367,16 @@ def _nonzero_forward(v: Forward) -> Forward:
 class ConveyorBelt(Strict):
     """A robot's belt that carries what lies on it (Webots' ``ConveyorBelt``: one ``Track`` whose
     LinearMotor moves the belt's contact surface): its top face, a ``length`` x ``width`` rectangle
-    centred at ``top`` in the robot's frame, moving along ``along`` (the Track's +x) at the motor's
-    velocity. The .wbt import writes one for a single motorised Track whose boundingObject is a Box."""
+    centred at ``top`` in the robot's frame, moving along ``direction`` (the Track's +x; ``along`` when
+    not given) at the motor's velocity. The .wbt import writes one for each Box in the boundingObject of
+    a single motorised Track."""
 
     motor: str = Field(min_length=1, description="the robot's LinearMotor that moves the belt (m/s)")
     top: Vec3 = Field(description="the top face's centre in the robot's frame")
-    along: Vec3 = Field(description="unit: the belt's direction of travel at a positive velocity, robot frame")
+    along: Vec3 = Field(description="unit: the face's side nearest the belt's direction of travel, robot frame")
     across: Vec3 = Field(description="unit: the face's other side's direction, robot frame")
+    direction: Vec3 | None = Field(default=None, description="unit: the belt's direction of travel at a positive "
+                                   "velocity, robot frame, when it is not `along` (a face turned on its Track)")
     length: float = Field(gt=0, description="the face's extent along `along` (m)")
     width: float = Field(gt=0, description="the face's extent along `across` (m)")
 

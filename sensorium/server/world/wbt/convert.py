@@ -2138,24 +2138,37 @@ class Converter:
                              "origin": np.asarray(frame.apply((0.0, 0.0, 0.0))),
                              "frame": frame, "wheels": wheels})
 
-    def belt(self, node: Node, frame: Frame, motor: str, up: int = 2) -> dict | None:
-        """A Track's belt as a conveyor carries on it (schemas ConveyorBelt): the top face of its
-        boundingObject, a Box (or a Shape of one), itself or the one child of Pose/Transform nodes (an
-        offset or a turn; a tilt the simulation finds not level), in the Track's frame; None for any other
-        bounding object. The face's normal is the Box's axis ``up`` (the robot's: z, or y for a robot built
-        y-up in a NUE world); it moves along the face's side nearest the Track's own +x."""
-        bo = self.fields(node).node_("boundingObject")
-        place = frame
-        while bo is not None and bo.type in ("Pose", "Transform"):
-            children = self.fields(bo).nodes("children")
-            if len(children) != 1:
-                return None
-            place, bo = self.child_frame(bo, place), children[0]
-        if bo is not None and bo.type == "Shape":
-            bo = self.fields(bo).node_("geometry")
-        if bo is None or bo.type != "Box" or place.stretch is not None:
-            return None
-        size = [float(v) for v in self.fields(bo).vec("size", (2.0, 2.0, 2.0))]
+    def belts(self, node: Node, frame: Frame, motor: str, up: int = 2) -> list[dict]:
+        """A Track's belt as a conveyor carries on it (schemas ConveyorBelt): the top face of each Box in
+        its boundingObject (the Box itself, a Shape of one, or under Group, Pose and Transform nodes of any
+        number of children: an offset or a turn; a tilt the simulation finds not level), in the robot's
+        frame, each moving along the Track's own +x as Webots moves every contact of a Track's bounding
+        object; no face when it holds no Box (its other geometries carry nothing here). The face's normal
+        is the Box's axis ``up`` (the robot's: z, or y for a robot built y-up in a NUE world)."""
+        forward = np.asarray(frame.rotation, dtype=np.float64)[:, 0]
+        faces: list[dict] = []
+
+        def visit(bo: Node | None, place: Frame) -> None:
+            if bo is None:
+                return
+            if bo.type in ("Group", "Pose", "Transform"):
+                inner = place if bo.type == "Group" else self.child_frame(bo, place)
+                for child in self.fields(bo).nodes("children"):
+                    visit(child, inner)
+                return
+            if bo.type == "Shape":
+                bo = self.fields(bo).node_("geometry")
+            if bo is not None and bo.type == "Box" and place.stretch is None:
+                faces.append(self._belt_face(bo, place, forward, motor, up))
+
+        visit(self.fields(node).node_("boundingObject"), frame)
+        return faces
+
+    def _belt_face(self, box: Node, place: Frame, forward: np.ndarray, motor: str, up: int) -> dict:
+        """One Box's top face placed at ``place``: its sides named so that ``along`` is the one nearest the
+        Track's +x (``forward``), and ``direction``, the Track's +x, given when it is not ``along`` exactly
+        (a Box turned in a Pose about the Track's up)."""
+        size = [float(v) for v in self.fields(box).vec("size", (2.0, 2.0, 2.0))]
         r = np.asarray(place.rotation, dtype=np.float64)
         # the face's two sides, right-handed about its normal (x, y about z; x, -z about y)
         side = r[:, 1] if up == 2 else -r[:, 2]
@@ -2163,14 +2176,16 @@ class Converter:
         top = [0.0, 0.0, 0.0]
         top[up] = size[up] / 2.0
         along, across = r[:, 0], side
-        forward = np.asarray(frame.rotation, dtype=np.float64)[:, 0]
         if abs(side @ forward) > abs(along @ forward):     # a Box turned a quarter: its other side runs along
             along, across, length, width = side, -r[:, 0], width, length
         if along @ forward < 0.0:
             along, across = -along, -across
-        return {"motor": motor, "top": tuple(float(v) for v in place.apply(tuple(top))),
+        face = {"motor": motor, "top": tuple(float(v) for v in place.apply(tuple(top))),
                 "along": tuple(float(v) for v in along), "across": tuple(float(v) for v in across),
                 "length": length * place.scale, "width": width * place.scale}
+        if not np.array_equal(along, forward):
+            face["direction"] = tuple(float(v) for v in forward)
+        return face
 
     def _track_drive(self, node: Node, robot: Owner) -> None:
         """A robot with two motorised Tracks and no motorised hinge drives on them: their motors are
@@ -2187,11 +2202,11 @@ class Converter:
             if why:
                 self.warn(node, f"robot {robot.data['name']!r}: no tracked drive ({why}); the robot will not move")
             for t in tracks:
-                belt = self.belt(t["node"], t["frame"], t["motor"], up)
-                if belt is None:
+                faces = self.belts(t["node"], t["frame"], t["motor"], up)
+                if not faces:
                     self.warn(t["node"], t["line"])
                     continue
-                robot.data.setdefault("belts", []).append(belt)   # a conveyor (sim/belt.py)
+                robot.data.setdefault("belts", []).extend(faces)   # a conveyor (sim/belt.py)
                 self.warn(t["node"], f"Track {self.fields(t['node']).string('name', 'solid')!r}: its belt carries "
                           "the solids with physics lying on its top face at its motor's velocity; its texture "
                           "animation and wheels do not move here")
