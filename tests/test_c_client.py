@@ -38,7 +38,7 @@ ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "car_lights", "car_hostile", "supervisor_scene",
                "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos",
-               "nested_nodes", "top_groups", "robot_window"]
+               "nested_nodes", "top_groups", "robot_window", "window_echo"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
@@ -625,6 +625,37 @@ def test_c_robot_window_text_is_printed_on_stderr_when_asked(cbin, servers):
     code, out, err = finish(start([cbin["robot_window"]], servers(ARENA).url("epuck")))
     assert code == 0, err
     assert out == ["scored nothing received"] and "robot window" not in err
+
+
+def test_c_controller_robot_window_receives_the_cli_texts_in_order_and_its_answers_are_published(cbin, servers):
+    """tests/c/window_echo.c: texts queued before it attached come whole with its first step
+    (wb_robot_wwi_receive: each followed by its NUL); `sensorium window` texts are read one per
+    wb_robot_wwi_receive_text call, in order; its wb_robot_wwi_send_text answers are on
+    /epuck/robot_window, bytes that are not UTF-8 as U+FFFD."""
+    from _serve import child_env, sensorium, wait_until
+
+    from sensorium.client.topics import Subscriber
+
+    server = servers(ARENA, "--mode", "fast")
+    for text in ("one", "two", "three"):
+        server.conn.call("/epuck/robot/window_send", {"text": text})
+    with Subscriber(server.pub, "/epuck/robot_window") as sub:
+        wait_until(lambda: b"/epuck/robot_window\0" in server.conn.call("get_counters")["subscriptions"],
+                   what="the subscription")
+        ctl = start([cbin["window_echo"]], server.url("epuck"))
+        ready = sub.recv(timeout=60)
+        assert ready is not None and ready.body == {"data": "ready"}
+        for text in ("go", "stop"):
+            done = subprocess.run(sensorium("window", "epuck", text, "--url", server.rpc), capture_output=True,
+                                  text=True, timeout=60, env=child_env())
+            assert done.returncode == 0, done.stderr
+            echo = sub.recv(timeout=60)
+            assert echo is not None and echo.body == {"data": f"echo:{text}"}
+        bad = sub.recv(timeout=60)
+        assert bad is not None and bad.body == {"data": "bad\ufffd\ufffd!"}
+        code, out, err = finish(ctl)
+    assert code == 0, err
+    assert out == ["raw 14 one two three", "then NULL", "received go", "received stop"]
 
 
 def test_c_supervisor_reaches_nested_nodes(cbin, servers):

@@ -46,8 +46,10 @@ def test_topic_names_and_types():
         ("/bot/lidar2/range_image", M.IMAGE),             # two layers: no LaserScan
         ("/bot/lidar2/point_cloud", M.POINT_CLOUD),
         ("/bot/pose", M.POSE_STAMPED),                    # every robot: its pose after each basic step
+        ("/bot/robot_window", M.STRING),                  # ... and what its controller sends its robot window
         ("/free/ls/value", M.ILLUMINANCE),
         ("/free/pose", M.POSE_STAMPED),
+        ("/free/robot_window", M.STRING),
     ]
 
 
@@ -55,7 +57,7 @@ def test_topic_names_and_types():
     ([], set()),
     ([b""], {"/clock", "/bot/ls/value", "/bot/ds/value", "/bot/lidar/range_image", "/bot/lidar/laser_scan",
              "/bot/lidar/point_cloud", "/bot/lidar2/range_image", "/bot/lidar2/point_cloud", "/bot/pose",
-             "/free/ls/value", "/free/pose"}),
+             "/bot/robot_window", "/free/ls/value", "/free/pose", "/free/robot_window"}),
     ([b"/bot/pose\0"], {"/bot/pose"}),
     ([b"/bot/pose/"], set()),
     ([b"/bot/lidar/"], {"/bot/lidar/range_image", "/bot/lidar/laser_scan", "/bot/lidar/point_cloud"}),

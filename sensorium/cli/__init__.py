@@ -142,6 +142,15 @@ def _call_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print the result as JSON")
 
 
+@command("window", "send a text to a robot's controller as its robot window would (wwiReceiveText reads it)",
+         "sensorium.cli.services:window")
+def _window_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("robot", help="the robot whose controller receives the text")
+    p.add_argument("text", help="the text (one wwiReceiveText call returns it)")
+    p.add_argument("--url", help="RPC endpoint (default tcp://127.0.0.1:5560)")
+    p.add_argument("--timeout", type=positive_seconds, default=5.0, help="seconds to wait for the reply (default 5)")
+
+
 # --- recording: record / replay / export / recover (cli/recording.py) ---
 @command("record", "record a running server's topics to MCAP as a subscriber (reports gaps)",
          "sensorium.cli.recording:record")

@@ -1,6 +1,7 @@
 """``sensorium services`` and ``sensorium call``: list and call a running server's services from the
 shell, like ``ros2 service list -t`` / ``ros2 service call`` (pyzmq + msgpack only; PyYAML, when
-installed, lets arguments be written in YAML flow style as well as JSON)."""
+installed, lets arguments be written in YAML flow style as well as JSON); ``sensorium window``: one
+text to a robot's controller (``window_send``)."""
 
 from __future__ import annotations
 
@@ -107,6 +108,19 @@ def _unsendable(value: Any, where: str) -> str | None:
             return None
         return f"the integer{at} does not fit in 64 bits"
     return f"the {type(value).__name__} value {str(value)!r}{at} cannot be sent (write it in quotes for a string)"
+
+
+def window(args: argparse.Namespace) -> int:
+    """``sensorium window ROBOT TEXT``: the service ``/<robot>/robot/window_send``."""
+    service = f"/{args.robot}/robot/window_send"
+    try:
+        with Connection(_endpoint(args.url), timeout=args.timeout) as conn:
+            result = conn.call(service, {"text": args.text})
+    except SensoriumError as exc:
+        print(f"sensorium window: {exc}", file=sys.stderr)
+        return 1
+    print(f"queued: {result.get('queued')}")
+    return 0
 
 
 def call(args: argparse.Namespace) -> int:

@@ -1,7 +1,7 @@
 """Webots' user-input and robot extras on a headless server: ``wb_joystick_*`` (never connected),
 ``wb_mouse_*`` (no state: NaN), ``wb_robot_wait_for_user_input_event`` (no event ever comes: the
 simulation runs for the whole timeout), the battery (none: NaN), project/world paths (""), the URDF (the server's
-``get_urdf``), robot-window messages (none). The keyboard is in :mod:`sensorium.client.wb_robot`."""
+``get_urdf``), robot-window texts (sent to the server's ``wwi_send``, received with the step replies). The keyboard is in :mod:`sensorium.client.wb_robot`."""
 
 from __future__ import annotations
 
@@ -88,6 +88,7 @@ def wb_robot_get_urdf(prefix: str = "") -> str:
 
 ROBOT_WINDOW_ENV = "SENSORIUM_ROBOT_WINDOW_LOG"   # set to "1" by `sensorium run --robot-window-log`
 ROBOT_WINDOW_CHARS = 4096     # of one message printed; the rest is counted, not shown (the C client's bound too)
+MAX_WINDOW_TEXT = 1 << 18     # characters of one text the server takes (schemas/services.py's bound)
 
 
 def robot_window_line(text: str) -> str:
@@ -98,19 +99,35 @@ def robot_window_line(text: str) -> str:
 
 
 def wb_robot_wwi_send_text(text: str) -> None:
-    """No robot window here: with $SENSORIUM_ROBOT_WINDOW_LOG set to 1 (``sensorium run
-    --robot-window-log``) the text is printed on stderr as one line (a benchmark's score); else it goes
-    nowhere. The controller's stdout is left to the controller."""
-    current()
+    """The text goes to the server at once (Webots sends it so too), which publishes it on the topic
+    ``/<robot>/robot_window`` (std_msgs/String); with $SENSORIUM_ROBOT_WINDOW_LOG set to 1 (``sensorium
+    run --robot-window-log``) it is also printed on stderr as one line (a benchmark's score). The
+    controller's stdout is left to the controller. A text over MAX_WINDOW_TEXT characters is not sent
+    (one error line)."""
+    r = current()
     if not isinstance(text, str):
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_robot_wwi_send_text(): text must be a string, got {text!r}")
     if os.environ.get(ROBOT_WINDOW_ENV) == "1":
         print(robot_window_line(text), file=sys.stderr, flush=True)
+    if len(text) > MAX_WINDOW_TEXT:
+        print(f"Error: wb_robot_wwi_send_text(): a text of {len(text):,} characters is longer than "
+              f"{MAX_WINDOW_TEXT:,}: not sent", file=sys.stderr, flush=True)
+        return
+    if not r.terminated:
+        r.conn.call(f"/{r.name}/robot/wwi_send", {"text": text})
 
 
 def wb_robot_wwi_receive_text() -> str | None:
-    current()
-    return None
+    """The next text the robot's window side sent (``sensorium window ROBOT TEXT``, the service
+    ``window_send``), None when there is none: as libController, the first call after a step takes
+    every text that came with the step replies since the last such call, and returns them one per
+    call, in order; what is left of them when the next step begins is dropped."""
+    r = current()
+    if r.window_fresh:
+        r.window_fresh = False
+        r.window_batch, r.window_inbox = r.window_inbox, []
+        r.window_batch.reverse()                # popped from the end: oldest first
+    return r.window_batch.pop() if r.window_batch else None
 
 
 # ---------------------------------------------------------------------- joystick (never connected)

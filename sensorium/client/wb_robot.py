@@ -273,6 +273,12 @@ class RobotClient:
         drive = reply.get("ackermann_drive")          # a car-like robot's geometry (the vehicle library's)
         self.ackermann_drive: dict | None = dict(drive) if isinstance(drive, dict) else None
         self.keyboard_period = 0
+        # robot-window texts (wwiReceiveText, libController's rule): those come with step replies wait in
+        # window_inbox; the first read after a step takes them all as the batch read one per call, and
+        # the next step drops what is left of that batch
+        self.window_inbox: list[str] = []
+        self.window_batch: list[str] = []
+        self.window_fresh = True                 # a step began since the batch was taken
         self._warned_duration = False
         self.devices = [DeviceState(i, d) for i, d in enumerate(reply.get("devices", []))]
         self.by_name = {d.name: d for d in self.devices}
@@ -313,6 +319,7 @@ class RobotClient:
                   f"time step ({self.basic_time_step} ms); the server rounds it up.", file=sys.stderr)
         for hook in self.step_hooks:
             hook(duration)
+        self.window_fresh = True
         args: dict[str, Any] = {"duration": duration}
         if self.motor_commands:
             args["motors"], self.motor_commands = self.motor_commands, {}
@@ -388,6 +395,9 @@ class RobotClient:
         data = result.get("custom_data")
         if data is not None:            # a Supervisor set the robot's customData field (Webots sends it so too)
             self.custom_data = str(data)
+        texts = result.get("robot_window")
+        if texts:                       # what the robot's window side sent it (window_send)
+            self.window_inbox.extend(str(t) for t in texts)
         if status == -1:
             self.terminated = True
         return status

@@ -259,6 +259,13 @@ class Float64(Msg):
     data: float
 
 
+class String(Msg):
+    """``std_msgs/msg/String``: a text a controller sent its robot window (``wwiSendText``); its time
+    is the envelope's ``stamp_ns``."""
+
+    data: str
+
+
 class RadarReturn(Msg):
     """``radar_msgs/msg/RadarReturn`` (ROS 2's radar_msgs): one Radar target. ``azimuth`` follows
     REP 103 (positive to the left), so it is minus Webots' azimuth; ``amplitude`` is the received
@@ -303,6 +310,7 @@ IMU = "sensor_msgs/msg/Imu"
 MAGNETIC_FIELD = "sensor_msgs/msg/MagneticField"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
 RADAR_SCAN = "radar_msgs/msg/RadarScan"
+STRING = "std_msgs/msg/String"
 
 MESSAGE_TYPES: dict[str, type[Msg]] = {
     ILLUMINANCE: Illuminance,
@@ -322,6 +330,7 @@ MESSAGE_TYPES: dict[str, type[Msg]] = {
     MAGNETIC_FIELD: MagneticField,
     CAMERA_INFO: CameraInfo,
     RADAR_SCAN: RadarScan,
+    STRING: String,
 }
 """ROS type name → model, for every topic the server publishes."""
 

@@ -26,6 +26,9 @@ MAX_PERIOD_MS = (1 << 31) - 1
 MAX_MOTOR_COMMANDS = 256        # per step request (a robot has a handful of motors)
 MAX_EMITTERS = 256              # emitters named in one step request
 MAX_DISPLAYS = 64               # displays named in one step request
+MAX_WINDOW_TEXT = 1 << 18       # characters of one robot-window text (at most 1 MiB of UTF-8: one request)
+MAX_WINDOW_QUEUE = 256          # texts waiting for a robot's controller (window_send)
+MAX_WINDOW_QUEUE_CHARS = 1 << 20   # characters of those texts in all
 Mode = Literal["fast", "realtime", "pause"]
 FieldName = Annotated[str, Field(min_length=1, max_length=256, description=(
     "a Webots field name (translation, rotation, name, children, on, intensity, color, ...: README "
@@ -288,6 +291,17 @@ class SpeakArgs(Args):
 
 class StringArgs(Args):
     value: str = Field(max_length=1 << 20)
+
+
+class WindowTextArgs(Args):
+    """A robot-window text: from the controller (``wwi_send``, Webots' ``wb_robot_wwi_send_text``) or
+    to it (``window_send``, what a robot window's page sends)."""
+
+    text: str = Field(max_length=MAX_WINDOW_TEXT, description=f"at most {MAX_WINDOW_TEXT:,} characters")
+
+
+class WindowQueuedResult(Result):
+    queued: int = Field(description="the texts now waiting for the robot's controller, this one included")
 
 
 class UrdfArgs(Args):
@@ -833,6 +847,8 @@ class StepResult(Result):
     values: dict[str, ScalarReading | LidarReading | VectorReading | ReceiverReading | SpeakerReading]
     custom_data: str | None = Field(default=None, description="the robot's customData, when a Supervisor (or a "
                                     "reset) changed it since the controller last had it (getCustomData)")
+    robot_window: list[str] | None = Field(default=None, description="the texts sent to the robot's window side "
+                                           "(window_send) since the previous reply, oldest first (wwiReceiveText)")
 
 
 class SuccessResult(Result):
@@ -1072,6 +1088,8 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("set_custom_data", "robot", StringArgs, SuccessResult, attached=True),
     ServiceSpec("get_model", "robot", NoArgs, StringValue),
     ServiceSpec("get_urdf", "robot", UrdfArgs, StringValue),
+    ServiceSpec("wwi_send", "robot", WindowTextArgs, SuccessResult, attached=True),
+    ServiceSpec("window_send", "robot", WindowTextArgs, WindowQueuedResult),
     ServiceSpec("get_from_def", "robot", NodeNameArgs, NodeResult, attached=True, supervisor=True),
     ServiceSpec("get_from_proto_def", "robot", ProtoDefArgs, ProtoDefResult, attached=True, supervisor=True),
     ServiceSpec("get_self", "robot", NoArgs, NodeResult, attached=True, supervisor=True),

@@ -3,7 +3,8 @@
 * **Controllers** control their own robot: the robot and device services check that the caller is
   the robot's attached controller (:meth:`sensorium.server.daemon.services.Core.handle`).
 * **World-wide controls** (:data:`WORLD_CONTROLS`: ``set_mode``, which pauses or speeds up the world
-  for everyone, ``/<robot>/robot/set_pose``, which moves any robot, and the debug ``get_counters``) need the *supervisor role*: the caller is the attached controller of a robot with
+  for everyone, ``/<robot>/robot/set_pose``, which moves any robot, ``/<robot>/robot/window_send``, which hands any
+  robot's controller a text as its robot window would, and the debug ``get_counters``) need the *supervisor role*: the caller is the attached controller of a robot with
   ``supervisor: true``, or the server runs with open controls. ``serve --controls`` chooses:
   ``open`` (any caller), ``supervisor`` (supervisor role only) or ``auto`` (the default): open
   when the RPC endpoint is only reachable from this machine (loopback tcp, ipc, inproc),
@@ -26,8 +27,8 @@ __all__ = ["WORLD_CONTROLS", "MAX_COORDINATE_M", "CONTROLS", "open_controls", "i
 
 # services any caller could otherwise use to change (or watch) the world for everyone: pausing it,
 # moving robots (``/<robot>/robot/set_pose`` is not limited to the robot's own controller), the
-# debug counters (which topics others demand)
-WORLD_CONTROLS = frozenset({"set_mode", "set_pose", "get_counters"})
+# debug counters (which topics others demand), ``/<robot>/robot/window_send`` (text into any robot's controller)
+WORLD_CONTROLS = frozenset({"set_mode", "set_pose", "get_counters", "window_send"})
 CONTROLS = ("auto", "open", "supervisor")
 
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import sys
 import traceback
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -136,6 +137,10 @@ class Core(DeviceServices):
         self._seen: dict[str, dict[str, int]] = {}          # session token -> device path -> measurements
         self._custom_sent: dict[str, str] = {}    # session token -> the robot's customData its controller has
         self._custom_news: set[str] = set()       # robots whose customData a Supervisor's request changed
+        # texts sent to each robot's window side (window_send), for its controller's next step reply
+        self._window_inbox: dict[str, deque[str]] = {name: deque() for name in sim.robots}
+        self._window_chars: dict[str, int] = dict.fromkeys(sim.robots, 0)
+        self._window_news: set[str] = set()       # robots with texts waiting
         self._controls_by_robot: dict[str, list[Control]] = {name: [] for name in sim.robots}
         for ctl in self.topics.controls.values():
             self._controls_by_robot[ctl.robot].append(ctl)
@@ -458,13 +463,18 @@ class Core(DeviceServices):
             data = None                           # (an empty set: one test a reply)
             if self._custom_news and d.session.robot in self._custom_news and d.status != -1 and d.session.alive:
                 data = self._custom_data_news(d.session)
-            if not values and data is None:       # most replies: no new value; the gate packs them
+            texts = None
+            if self._window_news and d.session.robot in self._window_news and d.status != -1 and d.session.alive:
+                texts = self._window_texts(d.session.robot)
+            if not values and data is None and texts is None:   # most replies: no new value; the gate packs them
                 plain = (envelope, rid, d.status, d.time_ms)
                 d.session.last_step = (rid, plain)   # kept for a retry of a reply lost in transit
                 return plain
             result: dict[str, Any] = {"status": d.status, "time_ms": d.time_ms, "values": values}
             if data is not None:
                 result["custom_data"] = data
+            if texts is not None:
+                result["robot_window"] = texts
             body = self._bounded_reply(rid, result)
         d.session.last_step = (rid, body)         # kept for a retry of a reply lost in transit
         return envelope + [body]
@@ -478,6 +488,15 @@ class Core(DeviceServices):
             return None
         self._custom_sent[session.token] = data
         return data
+
+    def _window_texts(self, robot: str) -> list[str]:
+        """The texts waiting for the robot's controller, oldest first; the queue is emptied."""
+        self._window_news.discard(robot)
+        q = self._window_inbox[robot]
+        texts = list(q)
+        q.clear()
+        self._window_chars[robot] = 0
+        return texts
 
     def _new_values(self, session: Session) -> dict[str, dict]:
         """The readings of the session's enabled devices that it has not received yet."""
@@ -644,6 +663,8 @@ class Core(DeviceServices):
             data = self._custom_data_news(s) if c.robot in self._custom_news else None
             if data is not None:
                 now["custom_data"] = data
+            if c.robot in self._window_news:
+                now["robot_window"] = self._window_texts(c.robot)
             return now
         done = self.lockstep.request_step(self._session(c), (c.envelope, c.id), c.args.duration, c.now)
         if done is not None:                                 # quitting: -1 at once
@@ -775,6 +796,29 @@ class Core(DeviceServices):
         """Webots' wb_robot_get_urdf: the robot's URDF from its nodes as the world loads (world/urdf.py)."""
         robot = self.sim.robots[c.robot]
         return {"value": robot_urdf(robot.model, robot_entries(robot), c.args.prefix)}
+
+    def _robot_wwi_send(self, c: Call) -> dict:
+        """Webots' wb_robot_wwi_send_text: the controller's text for its robot window, published on
+        ``/<robot>/robot_window`` now (an immediate request in Webots too), stamped with the time."""
+        self.topics.robot_window(c.robot, c.args.text, self.sim.time_ms)
+        return {"success": True}
+
+    def _robot_window_send(self, c: Call) -> dict:
+        """What a robot window's page sends its controller: queued for the controller's next step
+        reply (wwiReceiveText reads them one per call), at most MAX_WINDOW_QUEUE texts and
+        MAX_WINDOW_QUEUE_CHARS characters waiting."""
+        q = self._window_inbox[c.robot]
+        chars = self._window_chars[c.robot] + len(c.args.text)
+        if len(q) >= S.MAX_WINDOW_QUEUE or chars > S.MAX_WINDOW_QUEUE_CHARS:
+            raise ServiceError(ErrorCode.WRONG_STATE,
+                               f"window_send: robot {c.robot!r}'s window queue is full ({len(q)} texts, "
+                               f"{self._window_chars[c.robot]:,} characters waiting; at most {S.MAX_WINDOW_QUEUE} "
+                               f"texts and {S.MAX_WINDOW_QUEUE_CHARS:,} characters): its controller takes them "
+                               f"with its steps")
+        q.append(c.args.text)
+        self._window_chars[c.robot] = chars
+        self._window_news.add(c.robot)
+        return {"queued": len(q)}
 
     # ------------------------------------------------------------------ supervisor services
     def _robot_restart_controller(self, c: Call) -> dict:

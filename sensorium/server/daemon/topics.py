@@ -13,7 +13,9 @@ After each basic step :meth:`Topics.publish` builds the messages of every demand
 device produced a new value (plus ``/clock``, each demanded ``/<robot>/pose`` and, for a robot with
 joints, ``/<robot>/joint_states``) as ready-to-send
 frames, calls the recorder (and the viewer sink, sensorium.server.viewer) with the very same bytes,
-and counts ``seq`` per topic. A robot's pose
+and counts ``seq`` per topic. A text a controller sends its robot window (``wwi_send``) is published
+on ``/<robot>/robot_window`` when it arrives, not after a step: :meth:`Topics.robot_window` leaves its
+frames in :attr:`Topics.outbox`, which the transport sends after the requests it served. A robot's pose
 is read and packed only while its pose topic is demanded (``work["poses_built"]`` counts them).
 This module does no I/O.
 """
@@ -53,7 +55,7 @@ _SONAR = 2
 class Topic:
     name: str
     type: str
-    kind: str                # value | range_image | laser_scan | point_cloud | clock | pose | joint_states
+    kind: str                # value | range_image | laser_scan | point_cloud | clock | pose | joint_states | robot_window
     path: str | None         # "robot/device"; the robot's name for pose; None for /clock
     frame: bytes             # name + NUL
 
@@ -219,6 +221,7 @@ class Topics:
         self.topics: list[Topic] = [Topic(CLOCK, msgs.CLOCK, "clock", None, topic_frame(CLOCK))]
         self.pose_topics: dict[str, Topic] = {}      # robot -> its /<robot>/pose topic
         self.joint_topics: dict[str, Topic] = {}     # robot with joints -> its /<robot>/joint_states topic
+        self.window_topics: dict[str, Topic] = {}    # robot -> its /<robot>/robot_window topic
         world_info = getattr(getattr(sim, "world", None), "world_info", None)
         for robot_name, robot in sim.robots.items():
             for dev_name, dev in robot.devices.items():
@@ -237,6 +240,10 @@ class Topics:
                 joint_topic = Topic(name, msgs.JOINT_STATE, "joint_states", robot_name, topic_frame(name))
                 self.topics.append(joint_topic)
                 self.joint_topics[robot_name] = joint_topic
+            name = f"/{robot_name}/robot_window"
+            window_topic = Topic(name, msgs.STRING, "robot_window", robot_name, topic_frame(name))
+            self.topics.append(window_topic)
+            self.window_topics[robot_name] = window_topic
         self.by_name = {t.name: t for t in self.topics}
         self.seq: dict[str, int] = {t.name: 0 for t in self.topics}
         self.prefixes: dict[bytes, int] = {}       # accepted subscription prefix -> subscriptions
@@ -253,6 +260,7 @@ class Topics:
         self._poses: list[Topic] = []                # demanded pose topics
         self._joint_states: list[Topic] = []         # demanded joint_states topics
         self.work: Counter[str] = Counter()          # what publishing computed (poses_built)
+        self.outbox: list[list[bytes]] = []          # published between steps (robot-window texts), to send
 
     # ------------------------------------------------------------------ demand
     @property
@@ -423,6 +431,11 @@ class Topics:
                     if body is not None:
                         self._emit(t, at, body, out)
         return out
+
+    def robot_window(self, robot: str, text: str, time_ms: int) -> None:
+        """A text the robot's controller sent its robot window: published now (subscribers get it
+        from :attr:`outbox`; the recorder and the viewer at once), stamped with the time it was sent."""
+        self._emit(self.window_topics[robot], time_ms, {"data": text}, self.outbox)
 
     def _emit(self, t: Topic, ms: int, body: dict, out: list[list[bytes]]) -> None:
         seq = self.seq[t.name]

@@ -434,6 +434,11 @@ class Transport:
                     replies.append([item, TOO_MANY_FRAMES])
         if replies:
             self.gate.send(replies)
+        said = core.topics.outbox                       # robot-window texts the requests published
+        if said:
+            core.topics.outbox = []
+            for frames in said:
+                self.xpub.send_multipart(frames, copy=False)
 
     def _flush(self) -> None:
         """Send the step replies still in the outbox (before anything but the busy receive)."""

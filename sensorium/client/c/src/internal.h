@@ -247,7 +247,15 @@ typedef struct {
   int n_devices;
   sn_device *devices;
   sn_car car;
+  /* robot-window texts that came with step replies, each followed by its NUL (libController's
+     reception buffer), and the batch wb_robot_wwi_receive took from it (robot_extras.c) */
+  char *wwi_inbox, *wwi_batch;
+  size_t wwi_inbox_size, wwi_inbox_cap, wwi_batch_size, wwi_batch_read;
+  bool wwi_fresh; /* a step began since wb_robot_wwi_receive_text took a batch */
 } sn_robot;
+
+/* The texts of a step reply's "robot_window" list, appended to the robot's window inbox. */
+void sn_wwi_received(sn_robot *rb, const msgpack_object *texts);
 
 /* The playing motions set their motors' target positions for their current time, then move it on
  * by millis (motion.c; wb_robot_step_begin calls it before building the step request). */

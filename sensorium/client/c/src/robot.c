@@ -280,6 +280,8 @@ static void free_robot(sn_robot *rb) {
   free(rb->session);
   free(rb->model);
   free(rb->custom_data);
+  free(rb->wwi_inbox);
+  free(rb->wwi_batch);
   for (int i = 0; i < 6; i++)
     free(rb->car.motors[i]);
   free(rb->prefix);
@@ -423,6 +425,7 @@ int wb_robot_init(void) {
   rb->time_ms = sn_int_or(res, "time_ms", 0);
   rb->synchronization = sn_bool_or(res, "synchronization", true);
   rb->supervisor = sn_bool_or(res, "supervisor", false);
+  rb->wwi_fresh = true;
   int heartbeat_ms = (int)sn_int_or(res, "heartbeat_ms", 1000);
   size_t plen = strlen(rb->name) + 3;
   rb->prefix = malloc(plen);
@@ -587,6 +590,7 @@ int wb_robot_step_begin(int duration) {
             "the server rounds it up.\n", duration, rb->name, rb->basic_time_step);
   }
   sn_motion_step_all(duration); /* the playing motions set their motors' positions (motion.c) */
+  rb->wwi_fresh = true;         /* what is left of the robot-window batch being read is dropped */
   int motors = 0, emitters = 0;
   for (int i = 0; i < rb->n_devices; i++) {
     motors += rb->devices[i].kind == SN_MOTOR && (rb->devices[i].cmd_position || rb->devices[i].cmd_velocity ||
@@ -694,6 +698,7 @@ static int step_end(sn_robot *rb) {
     free(rb->custom_data);
     rb->custom_data = data;
   }
+  sn_wwi_received(rb, sn_get(rep.result, "robot_window"));
   sn_reply_free(&rep);
   if (status == -1)
     rb->terminated = true;

@@ -125,7 +125,8 @@ public:
   int getNumberOfDevices() const { return wb_robot_get_number_of_devices(); }
   Device *getDeviceByIndex(int index) { return internal::deviceFromTag(wb_robot_get_device_by_index(index)); }
   Device *getDevice(const std::string &name) { return internal::deviceFromTag(wb_robot_get_device(name.c_str())); }
-  // robot window messages: none here (headless), see plugins/robot_window/robot_wwi.h
+  // robot window messages: to the server's topic /<robot>/robot_window and from `sensorium window`,
+  // see plugins/robot_window/robot_wwi.h
   void wwiSend(const char *data, int size) { wb_robot_wwi_send(data, size); }
   void wwiSendText(const std::string &text) { wb_robot_wwi_send(text.c_str(), static_cast<int>(text.size()) + 1); }
   const char *wwiReceive(int *size) { return wb_robot_wwi_receive(size); }

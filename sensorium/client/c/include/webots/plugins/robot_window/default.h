@@ -1,6 +1,6 @@
 /* Sensorium C controller library: the functions a controller calls to feed Webots' default robot
  * window (its devices' configuration, then their values each step). A headless server has no robot
- * window, so they send nothing (wb_robot_wwi_send only prints with --robot-window-log); a Webots controller that calls them
+ * window, so they send nothing (wb_robot_wwi_send's texts go to /<robot>/robot_window); a Webots controller that calls them
  * (the Thymio II and e-puck demos) compiles and runs unchanged. */
 #ifndef WBU_DEFAULT_ROBOT_WINDOW_H
 #define WBU_DEFAULT_ROBOT_WINDOW_H

@@ -1,7 +1,9 @@
 /* Sensorium C controller library: a controller's side of Webots' robot window messages. A headless
- * server has no robot window: nothing is ever received (NULL, size 0) and what is sent goes nowhere,
- * or with $SENSORIUM_ROBOT_WINDOW_LOG=1 (sensorium run --robot-window-log) is printed on stderr as
- * "robot window: TEXT", as in the Python client (Robot.wwiSendText / wwiReceiveText). */
+ * server has no robot window page: what is sent is published on the topic /<robot>/robot_window
+ * (std_msgs/String; with $SENSORIUM_ROBOT_WINDOW_LOG=1, sensorium run --robot-window-log, also printed
+ * on stderr as "robot window: TEXT"), and what the window side sends (`sensorium window ROBOT TEXT`)
+ * comes with the step replies, read one text per wb_robot_wwi_receive_text call as in Webots; as the
+ * Python client (Robot.wwiSendText / wwiReceiveText). */
 #ifndef WB_ROBOT_WWI_H
 #define WB_ROBOT_WWI_H
 
