@@ -106,6 +106,20 @@ def test_an_l_stood_on_its_bar_end_tips_onto_its_slanted_face() -> None:
     assert pose.translation[2] == pytest.approx(1.1 / math.sqrt(13.0), abs=1e-12)
 
 
+def test_an_l_in_a_nue_world_tips_about_its_horizontal_edge() -> None:
+    """The same L in a NUE world (up is the world's y), stood on its bar's end by a turn of -90° about
+    the world's z: it tips about its local y (the world's x there) onto the slanted face."""
+    world = {"world_info": {"coordinate_system": "NUE"},
+             "solids": [{"name": "floor", "pose": {"rotation": [1, 0, 0, -math.pi / 2]}, "geometry": {"type": "plane"}},
+                        {"name": "load", "physics": True, "pose": {"translation": [0.0, 2.0, 0.0],
+                                                                  "rotation": _rotation((0, 0, 1), -90.0)}, **L_SHAPE}]}
+    pose = Simulation(parse_world(world, source="w.yaml"), precision="exact").scene.solid_poses["load"]
+    slanted = np.array([3.0, 0.0, 2.0]) / math.sqrt(13.0)
+    np.testing.assert_allclose(pose.rotation @ slanted, [0.0, -1.0, 0.0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(pose.rotation @ [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], rtol=0, atol=1e-12)
+    assert pose.translation[1] == pytest.approx(1.1 / math.sqrt(13.0), abs=1e-12)
+
+
 def test_an_l_tilted_off_its_bar_lies_back_on_it() -> None:
     """Turned 20° about y its bar's bottom is the face nearest down and holds its centre: it lies flat
     on it, turned back about a horizontal axis through the centre (no yaw)."""

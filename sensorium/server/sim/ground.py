@@ -898,6 +898,8 @@ def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.nd
         rel = at - pivot
         s, z = rel @ out, rel[:, 2]
         past = s > tol
+        if not past.any():          # (the centre is inside the hull: some corner is beyond it)
+            break
         theta = float(np.arctan2(z[past], s[past]).min())
         step = axis_angle_matrix(np.cross([0.0, 0.0, 1.0], out), theta)
         turn, shift = step @ turn, step @ (shift - pivot) + pivot

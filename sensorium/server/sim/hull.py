@@ -117,8 +117,7 @@ def convex_hull(points: np.ndarray) -> Hull:
         k = int(np.argmax(far))
         if far[k] <= 0.0:
             break
-        live = np.flatnonzero(alive[:count])
-        seen = live[normals[live] @ p[k] - offsets[live] > tol]
+        seen = np.flatnonzero((normals[:count] @ p[k] - offsets[:count] > tol) & alive[:count])
         edges = {(int(tri[f, j]), int(tri[f, (j + 1) % 3])) for f in seen for j in range(3)}
         horizon = [e for e in edges if (e[1], e[0]) not in edges]
         alive[seen] = False
@@ -127,13 +126,19 @@ def convex_hull(points: np.ndarray) -> Hull:
             grow = len(tri) + len(horizon)
             tri, normals, offsets, alive = (np.concatenate([a, np.zeros((grow,) + a.shape[1:], a.dtype)])
                                             for a in (tri, normals, offsets, alive))
-        for f, (a, b) in zip(new, horizon):
-            tri[f] = (a, b, k)
-            normals[f], offsets[f] = _plane(p, a, b, k)
-            alive[f] = True
+        ends = np.array(horizon, dtype=np.int64).reshape(-1, 2)
+        tri[new, :2], tri[new, 2] = ends, k
+        u, v = p[ends[:, 1]] - p[ends[:, 0]], p[k] - p[ends[:, 0]]
+        n = np.column_stack([u[:, 1] * v[:, 2] - u[:, 2] * v[:, 1], u[:, 2] * v[:, 0] - u[:, 0] * v[:, 2],
+                             u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]])        # (np.cross costs more than this)
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        normals[new], offsets[new] = n, np.einsum("ij,ij->i", n, p[ends[:, 0]])
+        alive[new] = True
         count += len(horizon)
         # the points outside the faces that went: outside a new face, or inside the hull now
-        moved = np.flatnonzero(np.isin(owner, seen))
+        gone = np.zeros(len(tri) + 1, dtype=bool)      # (the last entry: owner -1, no face)
+        gone[seen] = True
+        moved = np.flatnonzero(gone[owner])
         owner[k], far[k] = -1, 0.0
         moved = moved[moved != k]
         if len(moved):
