@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from sensorium.server.sim.ground import GroundWarning
-from sensorium.server.sim.hull import FlatPoints, convex_hull
+from sensorium.server.sim.hull import FlatPoints, beyond, convex_hull
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import parse_world
@@ -156,6 +156,7 @@ def _check_hull(points: np.ndarray) -> None:
         return
     p = hull.points
     # every point inside or on the hull
+    assert not beyond(p[hull.faces[:, 0]], p[hull.faces[:, 1]], p[hull.faces[:, 2]], p).any()     # exactly
     assert (p @ hull.normals.T - hull.offsets).max() <= hull.tolerance
     # the hull's corners are input points, each on its faces' planes
     assert set(hull.vertices.tolist()) <= set(range(len(points)))
@@ -166,7 +167,8 @@ def _check_hull(points: np.ndarray) -> None:
     assert all((b, a) in edges for a, b in edges) and len(edges) == 3 * len(hull.faces)
     assert len(hull.vertices) - len(edges) // 2 + len(hull.faces) == 2
     volume, _ = hull.volume_centroid()
-    assert volume > 0.0
+    extent = float((p.max(axis=0) - p.min(axis=0)).max())
+    assert volume > -hull.tolerance * extent ** 2        # (a needle of near-duplicates: about 0)
 
 
 coordinate = st.integers(-4, 4).map(float) | st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
