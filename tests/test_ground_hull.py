@@ -183,6 +183,19 @@ def test_the_hull_holds_every_point_and_its_corners_are_points(rows: list, copie
     _check_hull(points)
 
 
+tiny = st.floats(-1e-8, 1e-8, allow_nan=False)
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=12),
+       st.lists(st.tuples(tiny, tiny, tiny), min_size=2, max_size=4))
+def test_the_hull_of_near_duplicate_clusters_holds_every_point(centres: list, offsets: list) -> None:
+    """Each point repeated a few times 1e-8 or less apart (a mesh's vertices written twice, rounded):
+    thin slivers whose float64 normals would be wrong; the sides are decided exactly."""
+    points = (np.array(centres)[:, None, :] + np.array(offsets)[None, :, :]).reshape(-1, 3)
+    _check_hull(points)
+
+
 @pytest.mark.parametrize("points, kind", [
     (np.zeros((4, 3)), "point"),
     (np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0], [2.0, 2.0, 2.0], [0.5, 0.5, 0.5]]), "line"),
