@@ -12,6 +12,7 @@ physics) and stays where it is let go; settling at load tips a solid the same wa
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -118,7 +119,7 @@ def test_a_nue_world_tips_about_its_horizontal_axes() -> None:
     nue = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])     # world (N, U, E) -> ENU
     solid = parse_world({"solids": [_solid(BOX, (1.0, 0.0, 0.0, math.radians(30.0)))]}).world.solids[0]
     start = Pose(_rot((1, 0, 0), math.radians(30.0)), np.array([0.0, HIGH, 0.0]))
-    pose = resting_pose(solid, start, nue)
+    pose = resting_pose(solid, start, Path("."), nue)
     assert np.allclose(pose.rotation[:, 1], [0.0, 1.0, 0.0], rtol=0, atol=1e-12)    # a local axis along up
     assert np.allclose(pose.rotation, np.eye(3), rtol=0, atol=1e-12)       # its local y (0, cos 30°, sin 30°) nearest
     assert np.allclose(pose.translation, start.translation, rtol=0, atol=1e-15)     # turned about its centre

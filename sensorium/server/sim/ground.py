@@ -66,6 +66,7 @@ too), so the batched simulation's copies ride exactly as the single simulation's
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Collection
 from dataclasses import dataclass
 from pathlib import Path
@@ -74,6 +75,8 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_pose, obstacle, ramp_top, robot_footprint
+from sensorium.server.sim.hull import FlatPoints, convex_hull
+from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
 
@@ -700,22 +703,26 @@ def _down_face(geometry: wm.Box | wm.Cylinder, r: np.ndarray, up: np.ndarray) ->
     return side / float(np.linalg.norm(side))
 
 
-def resting_pose(solid: wm.Solid, pose: Pose, to_enu: np.ndarray | None) -> Pose:
+def resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.ndarray | None) -> Pose:
     """The pose a solid with physics at ``pose`` has once it has tipped onto the face under it, as
-    Webots' physics lets a box stood on a corner or edge fall onto a face: for a solid whose bounding
-    shapes are one Box or one Cylinder, that shape turned by the least rotation (about a horizontal axis
+    Webots' physics lets a box stood on a corner or edge fall onto a face. A solid whose bounding
+    shapes are one Box or one Cylinder: that shape turned by the least rotation (about a horizontal axis
     through its centre, so its yaw about the world's up and its centre's x, y kept) that puts
-    :func:`_down_face`'s normal straight down. ``pose`` itself for any other solid (spheres, capsules,
-    cones, meshes, several shapes: their rotation is kept) or when that face is within TIP_TOL of
-    lying flat."""
+    :func:`_down_face`'s normal straight down. One Sphere keeps its rotation. Any other falling solid
+    (meshes, capsules, cones, several shapes: :func:`falling_shapes`) by :func:`_hull_tip`'s rule on
+    the convex hull of its shapes' support points; one whose shapes lie on a plane or a line keeps its
+    rotation (a GroundWarning says so). ``pose`` itself when the face is within TIP_TOL of lying flat
+    and holds the solid up."""
     if not solid.physics:
         return pose
     from sensorium.server.sim.scene import solid_parts
 
     parts = [(local, shape.geometry) for _, local, shape in solid_parts(solid, Pose.identity())
              if shape.seen_by in ("both", "bounding")]
-    if len(parts) != 1 or not isinstance(parts[0][1], (wm.Box, wm.Cylinder)):
+    if len(parts) == 1 and isinstance(parts[0][1], wm.Sphere):
         return pose
+    if len(parts) != 1 or not isinstance(parts[0][1], (wm.Box, wm.Cylinder)):
+        return _hull_resting_pose(solid, pose, base_dir, to_enu)
     local, geometry = parts[0]
     shape = pose.compose(local)
     up = _world_up(to_enu)
@@ -727,6 +734,207 @@ def resting_pose(solid: wm.Solid, pose: Pose, to_enu: np.ndarray | None) -> Pose
     turn = axis_angle_matrix(axis / sin, math.atan2(sin, float(normal @ -up)))
     centre = shape.translation
     return Pose(turn @ pose.rotation, centre + turn @ (pose.translation - centre))
+
+
+# Support points of curved shapes: rims and rings of _AROUND points, a hemisphere _RINGS rings of
+# latitude (π/16 apart) and its pole, all on the true surface, so the hull lies inside the shape by at
+# most r·(1 − cos(π/32)), 0.48 % of its radius r, and a resting face's normal is within π/32 of the
+# true surface's there (a capsule or cylinder side's facets are parallel to its axis: it lies with its
+# axis level, exactly)
+_AROUND = 32
+_RINGS = 8
+
+
+def _ring(radius: float, z: float) -> np.ndarray:
+    a = np.arange(_AROUND) * (2.0 * math.pi / _AROUND)
+    return np.column_stack([radius * np.cos(a), radius * np.sin(a), np.full(_AROUND, z)])
+
+
+def _dome(radius: float, z: float, sign: float) -> np.ndarray:
+    """A hemisphere of ``radius`` centred at height ``z`` of the local axis, towards ``sign``."""
+    lat = np.arange(_RINGS) * (math.pi / 2.0 / _RINGS)
+    return np.vstack([*(_ring(radius * math.cos(t), z + sign * radius * math.sin(t)) for t in lat),
+                      [[0.0, 0.0, z + sign * radius]]])
+
+
+def _support_points(g: object, prim: object) -> np.ndarray:
+    """Points (local frame) whose convex hull is the shape's, curved ones sampled (above)."""
+    if isinstance(g, wm.Box):
+        hx, hy, hz = (float(v) / 2.0 for v in g.size)
+        return np.array([[x, y, z] for x in (-hx, hx) for y in (-hy, hy) for z in (-hz, hz)])
+    if isinstance(g, wm.Cylinder):
+        return np.vstack([_ring(float(g.radius), -float(g.height) / 2.0), _ring(float(g.radius), float(g.height) / 2.0)])
+    if isinstance(g, wm.Cone):
+        return np.vstack([_ring(float(g.bottom_radius), -float(g.height) / 2.0), [[0.0, 0.0, float(g.height) / 2.0]]])
+    if isinstance(g, wm.Sphere):
+        return np.vstack([_dome(float(g.radius), 0.0, 1.0), _dome(float(g.radius), 0.0, -1.0)])
+    if isinstance(g, wm.Capsule):
+        return np.vstack([_dome(float(g.radius), float(g.height) / 2.0, 1.0),
+                          _dome(float(g.radius), -float(g.height) / 2.0, -1.0)])
+    assert isinstance(prim, geo.Mesh)
+    return np.asarray(prim.vertices, dtype=np.float64)
+
+
+def _volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
+    """A shape's volume and the centre of that volume (local frame), for uniform density: a closed
+    mesh's own (signed tetrahedra), an open one's convex hull's, a flat one none."""
+    r = float(getattr(g, "radius", 0.0))
+    if isinstance(g, wm.Box):
+        return float(np.prod(np.asarray(g.size, dtype=np.float64))), np.zeros(3)
+    if isinstance(g, wm.Sphere):
+        return 4.0 / 3.0 * math.pi * r ** 3, np.zeros(3)
+    if isinstance(g, wm.Cylinder):
+        return math.pi * r * r * float(g.height), np.zeros(3)
+    if isinstance(g, wm.Capsule):
+        return math.pi * r * r * (float(g.height) + 4.0 / 3.0 * r), np.zeros(3)
+    if isinstance(g, wm.Cone):      # its centroid a quarter of its height above its base
+        return math.pi * float(g.bottom_radius) ** 2 * float(g.height) / 3.0, np.array([0.0, 0.0, -float(g.height) / 4.0])
+    assert isinstance(prim, geo.Mesh)
+    v = np.asarray(prim.vertices, dtype=np.float64)
+    if prim.closed and len(prim.faces):
+        a, b, c = (v[prim.faces[:, k]] for k in range(3))
+        six = np.einsum("ij,ij->i", a, np.cross(b, c))
+        total = float(six.sum())
+        if total != 0.0:
+            return abs(total) / 6.0, (six[:, None] * (a + b + c)).sum(axis=0) / (4.0 * total)
+    try:
+        return convex_hull(v).volume_centroid()
+    except FlatPoints:
+        return 0.0, v.mean(axis=0)
+
+
+def _polygon(xy: np.ndarray) -> np.ndarray:
+    """The 2-D convex hull of points, counter-clockwise, no collinear corners (Andrew's monotone chain)."""
+    pts = sorted({(float(x), float(y)) for x, y in xy})
+    if len(pts) <= 2:
+        return np.array(pts, dtype=np.float64).reshape(-1, 2)
+
+    def cross(o: tuple, a: tuple, b: tuple) -> float:
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    chain: list[tuple[float, float]] = []
+    for sweep in (pts, pts[::-1]):
+        half: list[tuple[float, float]] = []
+        for p in sweep:
+            while len(half) >= 2 and cross(half[-2], half[-1], p) <= 0.0:
+                half.pop()
+            half.append(p)
+        chain += half[:-1]
+    return np.array(chain, dtype=np.float64).reshape(-1, 2)
+
+
+def _tipping_edge(poly: np.ndarray, q: np.ndarray, tol: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The edge of the resting polygon ``poly`` (counter-clockwise) a centre over ``q`` tips the solid
+    across, as (a point of it, its outward unit normal): the nearest edge ``q`` is beyond (more than
+    ``tol``), the one it is farthest beyond on a tie (a corner nearest); None when ``q`` is over the
+    polygon (or within ``tol`` of its edges)."""
+    best = None
+    for i in range(len(poly)):
+        a, b = poly[i], poly[(i + 1) % len(poly)]
+        d = b - a
+        length = float(np.hypot(d[0], d[1]))
+        m = np.array([d[1], -d[0]]) / length
+        beyond = float((q - a) @ m)
+        if beyond <= tol:
+            continue
+        t = min(max(float((q - a) @ d) / (length * length), 0.0), 1.0)
+        gap = float(np.hypot(*(q - a - t * d)))
+        if best is None or (gap, -beyond) < best[0]:
+            best = ((gap, -beyond), a, m)
+    return None if best is None else (best[1], best[2])
+
+
+def _balanced(corners: np.ndarray, centre: np.ndarray, tol: float) -> bool:
+    """Whether the centre is over (within ``tol`` of) what the lowest corners span seen from above: a
+    face, an edge or a point it stands on as it is (an upright capsule on its pole, Webots' balance)."""
+    low = corners[corners[:, 2] <= float(corners[:, 2].min()) + tol][:, :2]
+    poly, q = _polygon(low), centre[:2]
+    if len(poly) >= 3:
+        return _tipping_edge(poly, q, tol) is None
+    a, b = poly[0], poly[-1]
+    d = b - a
+    t = 0.0 if len(poly) == 1 else min(max(float((q - a) @ d) / float(d @ d), 0.0), 1.0)
+    return float(np.hypot(*(q - a - t * d))) <= tol
+
+
+def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """How a solid whose support points (ENU) are ``points`` and centre of mass ``centre`` tips onto
+    its hull: (turn, shift), the map x → turn·x + shift of ENU points, or None when it rests as it is.
+
+    It stays when its centre is over the face, edge or point its lowest corners span (:func:`_balanced`).
+    Else, as a box's rule (:func:`resting_pose`): the hull face whose outward normal is nearest straight
+    down is laid flat by the least rotation about a horizontal axis through the centre (none within
+    TIP_TOL). Then, while the centre seen from above is off that face's polygon (its corners within
+    the hull's tolerance of the ground), the solid tips about the polygon's edge nearest it
+    (:func:`_tipping_edge`), that edge staying on the ground, until the next hull corner touches: the
+    next face. Each tip lowers the centre, so no face comes twice. :class:`FlatPoints` for points on a
+    plane or a line."""
+    hull = convex_hull(points)
+    corners = hull.points[hull.vertices]
+    tol = hull.tolerance
+    if _balanced(corners, centre, tol):
+        return None
+    down = np.array([0.0, 0.0, -1.0])
+    normal = hull.normals[int(np.argmax(hull.normals @ down))]
+    turn, shift = np.eye(3), np.zeros(3)
+    axis = np.cross(normal, down)
+    sin = float(np.linalg.norm(axis))
+    tipped = sin > TIP_TOL
+    if tipped:
+        turn = axis_angle_matrix(axis / sin, math.atan2(sin, float(normal @ down)))
+        shift = centre - turn @ centre
+    for _ in range(2 * len(corners) + 2):
+        at = corners @ turn.T + shift
+        ground = float(at[:, 2].min())
+        poly = _polygon(at[at[:, 2] <= ground + tol][:, :2])
+        if len(poly) < 3:
+            break
+        edge = _tipping_edge(poly, (turn @ centre + shift)[:2], tol)
+        if edge is None:
+            break
+        a, m = edge
+        pivot = np.array([a[0], a[1], ground])
+        out = np.array([m[0], m[1], 0.0])
+        rel = at - pivot
+        s, z = rel @ out, rel[:, 2]
+        past = s > tol
+        if not past.any():          # (the centre is inside the hull: some corner is beyond it)
+            break
+        theta = float(np.arctan2(z[past], s[past]).min())
+        step = axis_angle_matrix(np.cross([0.0, 0.0, 1.0], out), theta)
+        turn, shift = step @ turn, step @ (shift - pivot) + pivot
+        tipped = True
+    return (turn, shift) if tipped else None
+
+
+def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.ndarray | None) -> Pose:
+    """:func:`resting_pose` for a solid of several shapes, a mesh, a capsule or a cone: its shapes'
+    support points and centre of mass (uniform density over their volumes), placed at ``pose`` in ENU,
+    tipped by :func:`_hull_tip`."""
+    shapes = falling_shapes(solid, base_dir)
+    if shapes is None:
+        return pose
+    points, volumes, centres = [], [], []
+    for local, prim, g in shapes:
+        at = enu_pose(pose.compose(local), to_enu)
+        points.append(_support_points(g, prim) @ at.rotation.T + at.translation)
+        volume, centre = _volume_centre(g, prim)
+        volumes.append(volume)
+        centres.append(at.rotation @ centre + at.translation)
+    cloud = np.vstack(points)
+    total = sum(volumes)
+    centre = (sum(v * c for v, c in zip(volumes, centres)) / total) if total > 0.0 else cloud.mean(axis=0)
+    try:
+        got = _hull_tip(cloud, centre)
+    except FlatPoints as flat:
+        warnings.warn(f"solid {solid.name!r}: its bounding shapes lie {flat.where}, "
+                      "no face to tip onto: it keeps its rotation", GroundWarning, stacklevel=2)
+        return pose
+    if got is None:
+        return pose
+    turn, shift = got
+    t = np.eye(3) if to_enu is None else np.asarray(to_enu, dtype=np.float64)
+    return Pose(t.T @ turn @ t @ pose.rotation, t.T @ (turn @ (t @ pose.translation) + shift))
 
 
 def land_solid(solid: wm.Solid, pose: Pose, base_dir: Path, ground: Ground | None,
@@ -753,7 +961,7 @@ def _tipped_span(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.ndarray
     span = falling_span(solid, base_dir, to_enu, pose)
     if span is None:
         return None
-    tipped = resting_pose(solid, pose, to_enu)
+    tipped = resting_pose(solid, pose, base_dir, to_enu)
     if tipped is pose:
         return pose, span
     turned = falling_span(solid, base_dir, to_enu, tipped)

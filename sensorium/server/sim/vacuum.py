@@ -24,8 +24,8 @@ bounds them. Robots are never attached, and no force breaks the hold (no physics
 A held solid is part of its carrier, as Webots' fixed joint makes the two one body: kinematic contact
 never stops the carrier at it nor do its bumpers touch it (``Contact.hold``/``let_go``), while it stops
 the other robots where it is. A solid let go (``turnOff``) is an obstacle to its carrier again at
-once and, at the end of that step, lands: ground.land_solid tips a single box or cylinder onto the face
-under it and puts it straight down on the highest support under its origin (the settling ground without
+once and, at the end of that step, lands: ground.land_solid tips it onto the face
+under it (ground.resting_pose) and puts it straight down on the highest support under its origin (the settling ground without
 it: ``Simulation.landing_ground``), its lowest point on that support's top -- no flight time, bounce or
 rolling, where Webots' physics lets it fall over the next steps. While held, a load the kinematic
 carrier holds below the top of that support is raised onto it (:meth:`VacuumGripper._on_support`),
