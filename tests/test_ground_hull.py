@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from sensorium.server.sim.ground import GroundWarning
-from sensorium.server.sim.hull import FlatPoints, beyond, convex_hull
+from sensorium.server.sim.hull import MAX_POINTS, FlatPoints, beyond, convex_hull, extreme_points
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.loader import parse_world
@@ -216,3 +216,21 @@ def test_a_cube_sampled_on_its_faces_has_its_eight_corners() -> None:
     volume, centre = hull.volume_centroid()
     assert volume == pytest.approx(1.0, abs=1e-12)
     np.testing.assert_allclose(centre, [0.5, 0.5, 0.5], rtol=0, atol=1e-12)
+
+
+def test_many_points_are_cut_to_extreme_ones_whose_hull_is_exact_for_a_box() -> None:
+    """Past MAX_POINTS the hull is built from the points farthest along 1,030 directions (its time
+    grows with the square of its corners): a dense 27,000-point grid in a box keeps its eight corners,
+    so the hull's volume and centre are the box's exactly; every kept point is an input point, and a
+    small cloud is kept whole."""
+    g = np.linspace(-1.0, 2.0, 30)
+    grid = np.array([[x, y, 0.5 * z] for x in g for y in g for z in g])
+    assert len(grid) > MAX_POINTS
+    kept = extreme_points(grid)
+    assert len(kept) <= 1030 and {tuple(p) for p in kept.tolist()} <= {tuple(p) for p in grid.tolist()}
+    assert {(x, y, z) for x in (-1.0, 2.0) for y in (-1.0, 2.0) for z in (-0.5, 1.0)} <= {tuple(p) for p in kept.tolist()}
+    volume, centre = convex_hull(kept).volume_centroid()
+    assert volume == pytest.approx(3.0 * 3.0 * 1.5, rel=1e-12)
+    np.testing.assert_allclose(centre, [0.5, 0.5, 0.25], rtol=0, atol=1e-12)
+    small = grid[:MAX_POINTS]
+    assert np.array_equal(extreme_points(small), small)

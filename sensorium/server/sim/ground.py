@@ -75,7 +75,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_pose, obstacle, ramp_top, robot_footprint
-from sensorium.server.sim.hull import FlatPoints, convex_hull
+from sensorium.server.sim.hull import FlatPoints, convex_hull, extreme_points
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
@@ -798,7 +798,7 @@ def _volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
         if total != 0.0:
             return abs(total) / 6.0, (six[:, None] * (a + b + c)).sum(axis=0) / (4.0 * total)
     try:
-        return convex_hull(v).volume_centroid()
+        return convex_hull(extreme_points(v)).volume_centroid()
     except FlatPoints:
         return 0.0, v.mean(axis=0)
 
@@ -925,7 +925,7 @@ def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.n
     total = sum(volumes)
     centre = (sum(v * c for v, c in zip(volumes, centres)) / total) if total > 0.0 else cloud.mean(axis=0)
     try:
-        got = _hull_tip(cloud, centre)
+        got = _hull_tip(extreme_points(cloud), centre)
     except FlatPoints as flat:
         warnings.warn(f"solid {solid.name!r}: its bounding shapes lie {flat.where}, "
                       "no face to tip onto: it keeps its rotation", GroundWarning, stacklevel=2)

@@ -18,9 +18,41 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FlatPoints", "Hull", "beyond", "convex_hull", "hull_tolerance"]
+__all__ = ["FlatPoints", "Hull", "MAX_POINTS", "beyond", "convex_hull", "extreme_points", "hull_tolerance"]
 
 _RELATIVE_TOL = 1e-10
+
+MAX_POINTS = 2048
+"""Points beyond which a hull is built from :func:`extreme_points` instead: the hull's time grows with
+the square of its corners (measured: 1,000 points on a sphere 0.28 s of CPU, 4,000 2.7 s), and a world
+file's round mesh may have a hundred thousand."""
+
+_DIRECTIONS = 1024
+_CHUNK = 4096
+
+
+def extreme_points(points: np.ndarray, limit: int = MAX_POINTS) -> np.ndarray:
+    """``points`` themselves when there are at most ``limit``, else those farthest along each of 1,024
+    directions spread evenly over the sphere (a Fibonacci lattice) and the six axes' (each one a
+    corner of the true hull; their hull lies inside it, its corners exact input points, at most 1,030
+    of them). Read in blocks of rows, so memory stays bounded whatever the count."""
+    points = np.asarray(points, dtype=np.float64)
+    if len(points) <= limit:
+        return points
+    k = np.arange(_DIRECTIONS) + 0.5
+    z = 1.0 - 2.0 * k / _DIRECTIONS
+    ring = np.sqrt(1.0 - z * z)
+    turn = np.pi * (3.0 - np.sqrt(5.0)) * k
+    dirs = np.vstack([np.column_stack([ring * np.cos(turn), ring * np.sin(turn), z]), np.eye(3), -np.eye(3)])
+    best = np.full(len(dirs), -np.inf)
+    index = np.zeros(len(dirs), dtype=np.int64)
+    for start in range(0, len(points), _CHUNK):
+        proj = points[start:start + _CHUNK] @ dirs.T
+        rows = np.argmax(proj, axis=0)
+        top = proj[rows, np.arange(len(dirs))]
+        better = top > best
+        best[better], index[better] = top[better], rows[better] + start
+    return points[np.unique(index)]
 
 
 class FlatPoints(ValueError):
