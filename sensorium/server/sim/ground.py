@@ -75,7 +75,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_pose, obstacle, ramp_top, robot_footprint
-from sensorium.server.sim.hull import FlatPoints, convex_hull, extreme_points
+from sensorium.server.sim.hull import FlatPoints, convex_hull, extreme_points, hull_tolerance
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
@@ -869,11 +869,11 @@ def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.nd
     (:func:`_tipping_edge`), that edge staying on the ground, until the next hull corner touches: the
     next face. Each tip lowers the centre, so no face comes twice. :class:`FlatPoints` for points on a
     plane or a line."""
+    if _balanced(points, centre, hull_tolerance(points)):
+        return None      # (the lowest points span what the lowest corners do: no hull needed to stay)
     hull = convex_hull(points)
     corners = hull.points[hull.vertices]
     tol = hull.tolerance
-    if _balanced(corners, centre, tol):
-        return None
     down = np.array([0.0, 0.0, -1.0])
     normal = hull.normals[int(np.argmax(hull.normals @ down))]
     turn, shift = np.eye(3), np.zeros(3)
