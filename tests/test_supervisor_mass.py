@@ -190,6 +190,19 @@ def test_bad_physics_values_are_reset_with_one_line(tmp_path):
     assert "mass" not in done.data["solids"][1]
 
 
+def test_a_mesh_bounding_object_and_extra_centres_are_said(tmp_path):
+    path = tmp_path / "mesh.wbt"
+    path.write_text('#VRML_SIM R2023b utf8\nSolid {\n  name "m"\n'
+                    '  boundingObject Group { children [ Box { size 1 1 1 } Mesh { url "part.stl" } ] }\n'
+                    '  physics Physics { mass 2 }\n}\n'
+                    'Solid {\n  name "c"\n  physics Physics { mass 1 centerOfMass [ 0 0 1, 0 0 2 ] }\n}\n')
+    done = wbt_convert(path)
+    assert any(w.startswith(f"{path}:4:") and "a Mesh in the boundingObject" in w for w in done.warnings), done.warnings
+    assert done.data["solids"][0]["mass"] == {"kg": 2.0, "center": [0.0, 0.0, 0.0]}   # the Box's centre only
+    assert any(w.startswith(f"{path}:9:") and "Physics.centerOfMass: 2 items" in w for w in done.warnings)
+    assert done.data["solids"][1]["mass"] == {"kg": 1.0, "center": [0.0, 0.0, 1.0]}
+
+
 def test_a_yaml_world_gives_masses(tmp_path):
     path = tmp_path / "w.yaml"
     path.write_text("robots:\n- name: r\n  supervisor: true\n  pose: {translation: [1.0, 0.0, 0.0]}\n"

@@ -41,8 +41,13 @@ def solid_mass(conv: Any, solid: Node) -> dict | None:
                          "is -1 while the mass is not > 0")
     if mass <= 0 and mass != -1:
         mass = f.used("mass", mass, -1.0, "is not > 0 (nor -1: computed from the density)")
-    volume, centroid = _volume(conv, conv.fields(solid).node_("boundingObject"), np.eye(3), np.zeros(3), 1.0)
     centers = f.rows("centerOfMass", 3, [])
+    if len(centers) > 1:                # Webots keeps the first
+        conv.warn_once(physics, f"Physics.centerOfMass: {len(centers)} items; it holds 0 or 1: the first is used "
+                                "(as Webots does)")
+    if mass > 0 and centers:            # all given: the bounding object is not needed
+        return {"kg": float(mass), "center": [float(v) for v in centers[0]]}
+    volume, centroid = _volume(conv, conv.fields(solid).node_("boundingObject"), np.eye(3), np.zeros(3), 1.0)
     if mass > 0:
         kg = mass
     elif volume > 0:
@@ -100,8 +105,9 @@ def _parts(conv: Any, node: Node | None, rot: np.ndarray, at: np.ndarray, scale:
     if t == "IndexedFaceSet":
         return _mesh_part(conv, node, rot, at, s)
     if t == "Mesh":
-        conv.warn_once(node, "a Mesh in the boundingObject of a Solid whose mass comes from its density: its volume "
-                             "is not computed here (an IndexedFaceSet's is); give the Physics a mass")
+        conv.warn_once(node, "a Mesh in the boundingObject of a Solid with Physics: its volume is not computed here "
+                             "(an IndexedFaceSet's is), so it adds no mass and no centre: give the Physics a mass "
+                             "and a centerOfMass for getCenterOfMass")
     return []
 
 
