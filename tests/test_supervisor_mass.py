@@ -217,3 +217,45 @@ def test_a_yaml_world_gives_masses(tmp_path):
     solid = lv.ok(A, "/r/robot/get_from_def", {"name": "S"})["node"]
     assert lv.ok(A, "/r/robot/get_node_center_of_mass", {"node": solid})["value"] == \
         pytest.approx([0.75, 3.0, 0.125])          # (1 kg at (0, 3, 0.5) + 3 kg at (1, 3, 0)) / 4
+
+
+ARM_WORLD = """#VRML_SIM R2023b utf8
+Robot {
+  name "arm" controller "<extern>" supervisor TRUE
+  children [
+    HingeJoint {
+      jointParameters HingeJointParameters { axis 0 0 1 anchor 0 0 0.2 }
+      device [ RotationalMotor { name "pan" maxVelocity 100 } ]
+      endPoint DEF LINK Solid {
+        translation 0.1 0 0.2
+        name "link"
+        boundingObject Box { size 0.2 0.02 0.02 }
+        physics Physics { mass 3 centerOfMass [ 0.1 0 0 ] }
+      }
+    }
+  ]
+  boundingObject Box { size 0.1 0.1 0.1 }
+  physics Physics { mass 1 }
+}
+"""
+
+
+def test_the_center_of_mass_follows_a_turned_joint(tmp_path):
+    """A 3 kg link whose centre is 0.2 m out from a vertical hinge through (0, 0, 0.2), on a 1 kg base:
+    (0.15, 0, 0.15), and a quarter turn later (0, 0.15, 0.15)."""
+    path = tmp_path / "arm.wbt"
+    path.write_text(ARM_WORLD)
+    lv = Live(Simulation(load_world(path)))
+    lv.ok(A, "attach", {"robot": "arm"})
+    me = lv.ok(A, "/arm/robot/get_self")["node"]
+    link = lv.ok(A, "/arm/robot/get_from_def", {"name": "LINK"})["node"]
+    assert lv.ok(A, "/arm/robot/get_node_center_of_mass", {"node": me})["value"] == \
+        pytest.approx([0.15, 0.0, 0.15], abs=1e-12)
+    lv.sim.robot("arm").motor("pan").set_position(QUARTER)
+    for _ in range(20):                     # 100 rad/s and Webots' 10 rad/s^2 ramp: there well before
+        lv.step(A, "arm")
+    assert lv.sim.robot("arm").motor("pan").position == QUARTER
+    assert lv.ok(A, "/arm/robot/get_node_center_of_mass", {"node": me})["value"] == \
+        pytest.approx([0.0, 0.15, 0.15], abs=1e-12)
+    assert lv.ok(A, "/arm/robot/get_node_center_of_mass", {"node": link})["value"] == \
+        pytest.approx([0.0, 0.2, 0.2], abs=1e-12)
