@@ -300,7 +300,8 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
                       "wwi (null) (null) 0",                 # no robot window
                       "default window (null)",               # its default window's functions: compile, run, no effect
                       "step 0",
-                      "supervisor NULL 1 SFRotation -1 10 nan  1 0",   # beyond the subset: "no value"; 10 fields
+                      "supervisor NULL 1 SFRotation -1 10 0 0 0  1 0",   # beyond the subset: "no value"; 10 fields;
+                      # getCenterOfMass served: 0 0 0 for a robot without Physics (Webots)
                       "after quit -1"]     # the simulation ended for this controller: the next step ends it
     warned = [line for line in err.splitlines() if "does not simulate" in line]
     assert "wbu_default_robot_window" not in err, err
@@ -308,7 +309,7 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
     unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
     assert unserved == ["Error: wb_supervisor_" + f for f in ("movie_is_ready", "node_export_string",
-                                                              "node_get_center_of_mass", "node_get_selected")], err
+                                                              "node_get_selected")], err
     # served for a PROTO's interface fields: Webots' line for the robot's SFRotation, 0; the robot (no PROTO)
     # counts the 10 fields served for a Robot
     assert "Error: wb_supervisor_field_get_mf_int32() called with wrong field type: SFRotation." in err
@@ -663,8 +664,8 @@ def test_c_supervisor_reaches_nested_nodes(cbin, servers):
     Python and its closed forms), built with sanitizers: nested DEFs and dotted paths, parents, a
     device's node (a motor: no position), the robot's children; the camera at (1, 2.15, 0.3) moves
     10 steps · 32 ms · 2 rad/s · 0.05 m along +y with the robot and stays at (0.15, 0, 0.3) in its
-    frame; the left wheel's jointParameters (SFNode) hold its angle; setting a nested field gets the
-    server's one line."""
+    frame, and the solid ARM's centre of mass (with TIP's) moves with it; the left wheel's jointParameters
+    (SFNode) hold its angle; setting a nested field gets the server's one line."""
     code, out, err = finish(start([cbin["nested_nodes"]], servers(NESTED_WORLD).url("rover")))
     assert code == 0, err
     assert out[:6] == ["found Camera:CAM:cam Solid:TIP:tip Solid:LID:lid",
@@ -681,6 +682,10 @@ def test_c_supervisor_reaches_nested_nodes(cbin, servers):
     assert values["before"] == pytest.approx([1.0, 2.15, 0.3], abs=1e-9)
     assert values["after"] == pytest.approx([1.0, 2.15 + d, 0.3], abs=1e-9)
     assert values["in_robot"] == pytest.approx([0.15, 0.0, 0.3], abs=1e-9)
+    # ARM (2 kg at (-0.1, 0, 0.1) in the robot) and TIP (1 kg at (-0.1, 0, 0.5)): (-0.1, 0, 0.7/3), turned
+    assert values["com_before"] == pytest.approx([1.0, 1.9, 0.7 / 3], abs=1e-9)
+    assert values["com_after"] == pytest.approx([1.0, 1.9 + d, 0.7 / 3], abs=1e-9)
+    assert values["com_robot"] == [0.0, 0.0, 0.0]
     assert "not served" not in err
     assert "field 'translation' (SFVec3f) of Solid 'tip' is read-only here" in err
 

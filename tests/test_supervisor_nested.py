@@ -252,6 +252,10 @@ def test_a_webots_supervisor_finds_nested_nodes(tmp_path):
     assert out["cam_after"] == pytest.approx([1.0, 2.15 + d, 0.3], abs=1e-9)
     assert out["pose_in_robot"] == pytest.approx([0.15, 0.0, 0.3], abs=1e-9)
     assert out["no_pose"] is True
+    # ARM: 2 kg at (-0.1, 0, 0.1) in the robot, TIP 1 kg at (-0.1, 0, 0.5): (-0.1, 0, 0.7/3), turned about z
+    assert out["com_before"] == pytest.approx([1.0, 1.9, 0.7 / 3], abs=1e-9)
+    assert out["com_after"] == pytest.approx([1.0, 1.9 + d, 0.7 / 3], abs=1e-9)
+    assert out["com_robot"] == [0.0, 0.0, 0.0]                  # no Physics (Webots: the zero vector)
 
 
 PAN_WORLD = """#VRML_SIM R2023b utf8

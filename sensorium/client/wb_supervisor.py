@@ -311,6 +311,16 @@ def wb_supervisor_node_get_velocity(node: int | None) -> list[float]:
     return [math.nan] * 6 if got is None else [float(v) for v in got["value"]]
 
 
+def wb_supervisor_node_get_center_of_mass(node: int | None) -> list[float]:
+    """The centre of mass in world coordinates of a robot, solid or device with the Solids inside it that
+    have a Physics node (masses from the world file, poses now); 0 0 0 for one without Physics, NaN for a
+    node that is no Solid (Webots)."""
+    func = "wb_supervisor_node_get_center_of_mass"
+    r = _checked_node(node, func)
+    got = None if r is None else _answer(r, "get_node_center_of_mass", {"node": int(node)}, func)  # type: ignore[arg-type]
+    return [math.nan] * 3 if got is None else [float(v) for v in got["value"]]
+
+
 def wb_supervisor_node_remove(node: int | None) -> None:
     """Take a top-level solid or light out of the world for good: from the next step no sensor sees
     it and robots drive through where it stood; its id answers NULL from then on and is never reused;

@@ -1101,6 +1101,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_proto", "robot", ProtoArgs, ProtoResult, attached=True, supervisor=True),
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
+    ServiceSpec("get_node_center_of_mass", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("remove_node", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("set_joint_position", "robot", SetJointPositionArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("save_node_state", "robot", NodeStateArgs, SuccessResult, attached=True, supervisor=True),

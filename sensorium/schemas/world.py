@@ -633,6 +633,19 @@ Light = Annotated[PointLight | SpotLight | DirectionalLight, Field(discriminator
 
 # ---------------------------------------------------------------- solids
 
+class Mass(Strict):
+    """Webots' Physics of a Solid, a Robot or a device, as the Supervisor's getCenterOfMass reads it: its mass
+    and its centre of mass in its own frame (the .wbt import resolves Webots' rules: a mass, or density ×
+    the boundingObject's volume; centerOfMass, or the boundingObject's centroid). Nothing is pushed here."""
+
+    kg: float = Field(gt=0.0, description="the mass (kg)")
+    center: Vec3 = Field(default=(0.0, 0.0, 0.0), description="the centre of mass in the node's frame (m)")
+
+
+_MASS = ("Webots' Physics node: its mass and centre of mass (Supervisor getCenterOfMass: this node's and those "
+         "of the nodes inside it with one, in world coordinates); none: no Physics (getCenterOfMass reads 0 0 0)")
+
+
 class Solid(Strict):
     """A static object (movable by a supervisor; carried by a VacuumGripper when it has ``physics``), seen
     by rays through its shapes.
@@ -673,6 +686,7 @@ class Solid(Strict):
                           "(no dynamics); a top-level solid with physics settles at load on what is under it (as "
                           "Webots' physics drops it), a VacuumGripper carries only such a solid, and one it lets go "
                           "lands at once on what is under it (no solid falls at any other time)")
+    mass: Mass | None = Field(default=None, description=_MASS)
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 
@@ -1735,6 +1749,7 @@ class NestedNode(Strict):
     anchor: Vec3 | None = Field(default=None, description="a HingeJoint's anchor in the robot's frame as the world "
                                 "loads (its axis passes through it); none for other nodes")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
+    mass: Mass | None = Field(default=None, description=_MASS + "; a Solid or device only")
 
 
 class CarriedTarget(Strict):
@@ -1822,6 +1837,7 @@ class Robot(Strict):
         "getFromDevice, children, parents, world poses); written by the .wbt import; empty: one per device")
     inner_defs: list[InnerDef] = Field(default=[], max_length=1024, description="the DEF names of its PROTO "
                                        "instances' bodies that name no node here, with why (InnerDef)")
+    mass: Mass | None = Field(default=None, description=_MASS)
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 

@@ -111,10 +111,11 @@ static void online(void) {
   WbNodeRef selected = wb_supervisor_node_get_selected();
   wb_supervisor_node_get_selected();
   WbFieldRef rotation = wb_supervisor_node_get_field(self, "rotation");
-  printf("supervisor %s %d %s %d %d %s %s %d %d\n", selected == NULL ? "NULL" : "node",
+  const double *com = wb_supervisor_node_get_center_of_mass(self); /* served: 0 0 0 without Physics */
+  printf("supervisor %s %d %s %d %d %g %g %g %s %d %d\n", selected == NULL ? "NULL" : "node",
          wb_supervisor_node_get_id(self) > 0, wb_supervisor_field_get_type_name(rotation),
          wb_supervisor_field_get_count(rotation), wb_supervisor_node_get_number_of_fields(self),
-         isnan(wb_supervisor_node_get_center_of_mass(self)[2]) ? "nan" : "value", wb_supervisor_node_export_string(self),
+         com[0], com[1], com[2], wb_supervisor_node_export_string(self),
          (int)wb_supervisor_movie_is_ready(), (int)wb_supervisor_field_get_mf_int32(rotation, 0));
   wb_supervisor_simulation_quit(3);
   printf("after quit %d\n", wb_robot_step(16)); /* -1, then the next step ends the process (libController) */

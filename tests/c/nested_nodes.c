@@ -1,7 +1,8 @@
 /* A Webots-style C supervisor reaching the nodes inside its robot and a solid
  * (tests/worlds/nested_nodes.wbt): by DEF and dotted path, by device, through parents and children;
  * the camera's world position before and after driving straight ahead, and in the robot's frame;
- * the left wheel's joint parameters (an SFNode) and their position after driving.
+ * the left wheel's joint parameters (an SFNode) and their position after driving; the solid ARM's centre of
+ * mass (with TIP's) before and after driving, and the robot's (no Physics: 0 0 0).
  * Prints "key values" lines for tests/test_c_client.py. */
 #include <math.h>
 #include <stdio.h>
@@ -45,6 +46,11 @@ int main(void) {
   printf("tip %.12f %.12f %.12f\n", t[0], t[1], t[2]);
   const double *p = wb_supervisor_node_get_position(cam);
   printf("before %.12f %.12f %.12f\n", p[0], p[1], p[2]);
+  WbNodeRef arm = wb_supervisor_node_get_from_def("ARM");
+  const double *c = wb_supervisor_node_get_center_of_mass(arm);
+  printf("com_before %.12f %.12f %.12f\n", c[0], c[1], c[2]);
+  c = wb_supervisor_node_get_center_of_mass(wb_supervisor_node_get_self()); /* no Physics: 0 0 0 */
+  printf("com_robot %g %g %g\n", c[0], c[1], c[2]);
   WbDeviceTag right = wb_robot_get_device("right wheel");
   wb_motor_set_position(left, INFINITY);
   wb_motor_set_position(right, INFINITY);
@@ -54,6 +60,8 @@ int main(void) {
     wb_robot_step(dt);
   p = wb_supervisor_node_get_position(cam);
   printf("after %.12f %.12f %.12f\n", p[0], p[1], p[2]);
+  c = wb_supervisor_node_get_center_of_mass(arm);
+  printf("com_after %.12f %.12f %.12f\n", c[0], c[1], c[2]);
   WbNodeRef joint = wb_supervisor_node_get_from_def("LEFT_JOINT");
   WbNodeRef params = wb_supervisor_field_get_sf_node(wb_supervisor_node_get_field(joint, "jointParameters"));
   printf("parameters %s %d %.12f\n", wb_supervisor_node_get_type_name(params),

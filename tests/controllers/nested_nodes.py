@@ -1,6 +1,6 @@
 """A Webots-style supervisor reaching the nodes inside its robot and a solid (tests/test_supervisor_nested.py
 on tests/worlds/nested_nodes.wbt): by DEF and dotted path, by device, through parents and children; a
-camera's world position before and after driving straight ahead. Written as for Webots; prints one JSON line."""
+camera's world position and the solid ARM's centre of mass before and after driving straight ahead. Written as for Webots; prints one JSON line."""
 
 import json
 import math
@@ -25,6 +25,8 @@ device = [wheel is not None, wheel.getTypeName(), wheel.getParentNode().getDef()
 children = robot.getSelf().getField("children")
 kinds = [children.getMFNode(i).getTypeName() for i in range(children.getCount())]
 cam_before = cam.getPosition()
+arm = robot.getFromDef("ARM")
+com_before = arm.getCenterOfMass()
 
 for name in ("left wheel", "right wheel"):
     m = robot.getDevice(name)
@@ -36,4 +38,5 @@ pose = cam.getPose(robot.getSelf())
 print(json.dumps({"found": found, "parents": parents, "device": device, "children": kinds,
                   "tip": tip.getField("translation").getSFVec3f(), "cam_before": cam_before,
                   "cam_after": cam.getPosition(), "pose_in_robot": [pose[3], pose[7], pose[11]],
-                  "no_pose": math.isnan(wheel.getPosition()[0])}), flush=True)
+                  "no_pose": math.isnan(wheel.getPosition()[0]), "com_before": com_before,
+                  "com_after": arm.getCenterOfMass(), "com_robot": robot.getSelf().getCenterOfMass()}), flush=True)

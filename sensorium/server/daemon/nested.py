@@ -86,6 +86,7 @@ class Nested:
     interface: tuple = () # a PROTO instance's interface (wm.ProtoLevel each: supervisor.py serves its fields)
     order: float = 0.0    # its place among its parent's children (file order: Shapes between the others)
     shape: Any = None     # a Shape or a node inside it: its appearance.ShapeRef (appearance.py serves its fields)
+    mass: wm.Mass | None = None   # a Solid's or device's Physics (supervisor.center_of_mass)
 
 
 @dataclass(slots=True)
@@ -297,7 +298,7 @@ def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Ne
             own = pose_from_model(child.pose)
             local = own if at is None else at.compose(own)
             node = Nested(first + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
-                          local, own, "", owner, "Solid", key, order=float(k))
+                          local, own, "", owner, "Solid", key, order=float(k), mass=child.mass)
             out.append(node)
             solid_ids[id(child)] = node.id
             if child.proto_scope is not None:
@@ -350,7 +351,7 @@ def build(sim: Any, loaded_solids: int) -> Table:
             out.append(Nested(first + k, e.type, e.proto or "", e.def_name or "", e.name or "",
                               owner if e.parent < 0 else first + e.parent, e.field, local, _own(local, above),
                               e.device or "", owner, "Robot", name, joints[k], above_id,
-                              interface=tuple(e.interface), order=float(k)))
+                              interface=tuple(e.interface), order=float(k), mass=e.mass))
     solid_ids: dict[int, int] = {}          # id(nested solid model) -> its node id
     for j in range(loaded_solids):
         _solid_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], FIRST_ID, out, solid_ids,

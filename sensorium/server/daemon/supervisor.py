@@ -1132,6 +1132,43 @@ def node_pose(sim: Any, node: Node) -> dict:
             "orientation": [float(v) for v in np.asarray(pose.rotation).reshape(9)]}
 
 
+def center_of_mass(sim: Any, node: Node) -> list[float]:
+    """Webots' ``getCenterOfMass``: the mass-weighted centre of a Solid (a Robot, a device) and of the
+    Solids inside it with a Physics node, in world coordinates now (a driving robot's moves with it, a
+    joint's end point with the joint); 0 0 0 for one without Physics (Webots' zero vector); NaN for a
+    node that is no Solid (Webots warns and answers NaN)."""
+    nan = [math.nan] * 3
+    if node.nested:
+        me = _nested_of(sim, node)
+        if me.shape is not None or me.local is None or me.type in ("Pose", "Transform"):
+            return nan
+        own = me.mass
+        table = _table(sim)
+        inside: list[nested.Nested] = []
+        stack = [me.id]
+        while stack:
+            for child in table.by_parent.get(stack.pop(), ()):
+                inside.append(child)
+                stack.append(child.id)
+    elif node.type in ("Robot", "Solid") and not node.visual:
+        model = sim.robots[node.key].model if node.type == "Robot" else \
+            next((s for s in sim.world.solids if s.name == node.key), None)
+        own = None if model is None else model.mass
+        inside = [n for n in _table(sim).by_owner.get(node.id, ())]
+    else:
+        return nan
+    if own is None:
+        return [0.0, 0.0, 0.0]
+    pose = nested.world_pose(sim, me) if node.nested else _pose(sim, node)
+    weighted = [(own.kg, pose.rotation @ np.asarray(own.center) + pose.translation)]
+    for n in inside:
+        at = nested.world_pose(sim, n) if n.mass is not None else None
+        if n.mass is not None and at is not None:
+            weighted.append((n.mass.kg, at.rotation @ np.asarray(n.mass.center) + at.translation))
+    total = sum(kg for kg, _ in weighted)
+    return [float(v) for v in sum(kg * p for kg, p in weighted) / total]
+
+
 def node_velocity(sim: Any, node: Node) -> list[float]:
     """Webots' ``getVelocity``: a driven robot's from its kinematic drive's last step (world axes,
     linear m/s then angular rad/s), a node inside it moving with it; anything else never moves by
@@ -1406,6 +1443,7 @@ HANDLERS = {
     "set_field": _set_field,
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},
+    "get_node_center_of_mass": lambda sim, ls, robot, a: {"value": center_of_mass(sim, node_by_id(sim, a.node))},
     "remove_node": _remove,
     "set_joint_position": _set_joint_position,
     "save_node_state": _save_state,

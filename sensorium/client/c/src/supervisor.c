@@ -24,6 +24,7 @@ struct WbNodeStructPrivate {
   double position[3];
   double orientation[9];
   double velocity[6];
+  double center_of_mass[3];
   double pose[16];
   struct WbNodeStructPrivate *next;
 };
@@ -463,6 +464,21 @@ const double *wb_supervisor_node_get_velocity(WbNodeRef node) {
   if (!ok)
     fprintf(stderr, "Error: %s(): malformed reply\n", func);
   return ok ? node->velocity : sn_no_values();
+}
+
+/* the centre of mass in world coordinates of a robot, solid or device with the Solids inside it that
+   have a Physics node, where they are now; 0 0 0 without Physics, NaNs for a node that is no Solid */
+const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
+  const char *func = "wb_supervisor_node_get_center_of_mass";
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/get_node_center_of_mass", 1, args_node, &node->id, func, &rep) != 0)
+    return sn_no_values();
+  bool ok = copy_numbers(sn_get(rep.result, "value"), node->center_of_mass, 3);
+  sn_reply_free(&rep);
+  if (!ok)
+    fprintf(stderr, "Error: %s(): malformed reply\n", func);
+  return ok ? node->center_of_mass : sn_no_values();
 }
 
 /* Webots' node.remove() for a top-level solid or light: no sensor sees it from the next step and its

@@ -59,11 +59,6 @@ WbNodeRef wb_supervisor_node_get_selected(void) {
 
 
 
-const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return sn_no_values();
-}
-
 bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
   SN_UNSUPPORTED();
   return false;

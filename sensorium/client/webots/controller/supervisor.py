@@ -350,6 +350,9 @@ class Node:
     def getVelocity(self) -> list[float]:
         return wb.wb_supervisor_node_get_velocity(self._ref)
 
+    def getCenterOfMass(self) -> list[float]:
+        return wb.wb_supervisor_node_get_center_of_mass(self._ref)
+
     def setVelocity(self, velocity: list[float]) -> None:
         wb.wb_supervisor_node_set_velocity(self._ref, velocity)
 
@@ -577,7 +580,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9, "")},
     Node: {
         "exportString": ("node_export_string", "", ""),
-        "getCenterOfMass": ("node_get_center_of_mass", [_NAN] * 3, ""),
         "getStaticBalance": ("node_get_static_balance", False, ""),
         "moveViewpoint": ("node_move_viewpoint", None, ""),
         "setVisibility": ("node_set_visibility", None, "fromNode, visible"),

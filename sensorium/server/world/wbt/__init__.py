@@ -1,7 +1,7 @@
 """Webots worlds (``.wbt``): tokenizer and parser (``parser``), PROTO expansion
 (:mod:`sensorium.server.world.proto`), node-to-world conversion (``convert``, ``fields``, ``drive``,
 ``protos``: built-in stand-ins for common PROTOs; ``inside``: what a device's rays meet differently
-here, said at load). ``load_wbt`` is what ``load_world`` calls for a
+here, said at load; ``mass``: a Solid's mass and centre of mass from its Physics node). ``load_wbt`` is what ``load_world`` calls for a
 ``.wbt`` file; ``wbt_to_dict`` gives the equivalent world file (``sensorium convert``)."""
 
 from __future__ import annotations

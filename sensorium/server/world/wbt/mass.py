@@ -1,0 +1,142 @@
+"""A Solid's mass and centre of mass from its ``Physics`` node, by Webots' rules (WbPhysics, WbSolid).
+
+``mass`` > 0 is the mass (``density`` then unused); ``mass`` -1 takes ``density`` × the volume of the
+``boundingObject``. ``centerOfMass`` (its one item) is the centre in the Solid's frame; left empty, the
+centre is the bounding object's centroid (every part of the same density), or the Solid's origin when
+it has none. Values Webots would not use are reset as Webots resets them, one warning at the field's line:
+``density`` <= 0 (but -1 with a positive mass) becomes 1000, ``mass`` <= 0 other than -1 becomes -1.
+
+Volumes: Box, Sphere, Cylinder and Capsule in closed form; an IndexedFaceSet's from its faces (the
+signed tetrahedra from the origin to each triangle of a fan: a closed mesh's volume and centroid);
+a Mesh, an ElevationGrid or a Plane adds none (said once for a Mesh). Poses and Transforms place
+(and a Transform's scale scales) what they hold; Groups and Shapes hold geometries.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from sensorium.server.world.poses import axis_angle_matrix
+from sensorium.server.world.wbt.parser import Node
+
+DENSITY = 1000.0
+"""Webots' Physics ``density`` default and reset value (kg/m³)."""
+
+
+def solid_mass(conv: Any, solid: Node) -> dict | None:
+    """``{"kg": mass, "center": [x, y, z]}`` (the centre in the Solid's frame) for a Solid with a
+    ``Physics`` node; None without one, or when its mass comes from a density and its bounding
+    object has no volume here (said in a warning)."""
+    physics = conv.fields(solid).node_("physics")
+    if physics is None or physics.type != "Physics":
+        return None
+    f = conv.fields(physics)
+    mass = f.num("mass", -1.0)
+    density = f.num("density", DENSITY)
+    if (mass <= 0 and density <= 0) or (density <= 0 and density != -1):
+        density = f.used("density", density, DENSITY, "is not > 0" if density != -1 else
+                         "is -1 while the mass is not > 0")
+    if mass <= 0 and mass != -1:
+        mass = f.used("mass", mass, -1.0, "is not > 0 (nor -1: computed from the density)")
+    centers = f.rows("centerOfMass", 3, [])
+    if len(centers) > 1:                # Webots keeps the first
+        conv.warn_once(physics, f"Physics.centerOfMass: {len(centers)} items; it holds 0 or 1: the first is used "
+                                "(as Webots does)")
+    if mass > 0 and centers:            # all given: the bounding object is not needed
+        return {"kg": float(mass), "center": [float(v) for v in centers[0]]}
+    volume, centroid = _volume(conv, conv.fields(solid).node_("boundingObject"), np.eye(3), np.zeros(3), 1.0)
+    if mass > 0:
+        kg = mass
+    elif volume > 0:
+        kg = density * volume
+    else:
+        conv.warn_once(physics, "Physics: mass -1 takes density × the boundingObject's volume, and it has no volume here "
+                                "(give a mass): it counts for no mass (getCenterOfMass reads it as without physics)")
+        return None
+    center = centers[0] if centers else centroid if volume > 0 else (0.0, 0.0, 0.0)
+    return {"kg": float(kg), "center": [float(v) for v in center]}
+
+
+def _volume(conv: Any, node: Node | None, rot: np.ndarray, at: np.ndarray, scale: float) -> tuple[float, tuple]:
+    """The volume of what ``node`` holds and its centroid in the Solid's frame (``rot``, ``at`` and
+    ``scale`` place the node's frame there)."""
+    parts = _parts(conv, node, rot, at, scale)
+    total = sum(v for v, _ in parts)
+    if total <= 0:
+        return 0.0, (0.0, 0.0, 0.0)
+    c = sum(v * np.asarray(p) for v, p in parts) / total
+    return total, tuple(float(x) for x in c)
+
+
+def _parts(conv: Any, node: Node | None, rot: np.ndarray, at: np.ndarray, scale: np.ndarray | float
+           ) -> list[tuple[float, np.ndarray]]:
+    if node is None:
+        return []
+    f = conv.fields(node)
+    t = node.type
+    if t in ("Group", "Pose", "Transform"):
+        if t != "Group":
+            r = f.vec("rotation", (0.0, 0.0, 1.0, 0.0))
+            inner_at = at + rot @ (np.asarray(f.vec("translation", (0.0, 0.0, 0.0))) * scale)
+            inner_rot = rot @ axis_angle_matrix(r[:3], r[3])
+            inner_scale = scale * np.asarray(f.vec("scale", (1.0, 1.0, 1.0))) if t == "Transform" else scale
+        else:
+            inner_at, inner_rot, inner_scale = at, rot, scale
+        return [p for child in f.nodes("children") for p in _parts(conv, child, inner_rot, inner_at, inner_scale)]
+    if t == "Shape":
+        return _parts(conv, f.node_("geometry"), rot, at, scale)
+    s = np.broadcast_to(np.asarray(scale, dtype=np.float64), (3,))
+    factor = float(abs(s[0] * s[1] * s[2]))     # a Transform's scale over a geometry (Webots keeps it uniform)
+    if t == "Box":
+        size = f.vec("size", (0.1, 0.1, 0.1))
+        return [(abs(size[0] * size[1] * size[2]) * factor, at)]
+    if t == "Sphere":
+        r = f.num("radius", 1.0)
+        return [(4.0 / 3.0 * math.pi * abs(r) ** 3 * factor, at)]
+    if t == "Cylinder":
+        r, h = f.num("radius", 1.0), f.num("height", 2.0)
+        return [(math.pi * r * r * abs(h) * factor, at)]
+    if t == "Capsule":
+        r, h = f.num("radius", 1.0), f.num("height", 2.0)
+        return [((math.pi * r * r * abs(h) + 4.0 / 3.0 * math.pi * abs(r) ** 3) * factor, at)]
+    if t == "IndexedFaceSet":
+        return _mesh_part(conv, node, rot, at, s)
+    if t == "Mesh":
+        conv.warn_once(node, "a Mesh in the boundingObject of a Solid with Physics: its volume is not computed here "
+                             "(an IndexedFaceSet's is), so it adds no mass and no centre: give the Physics a mass "
+                             "and a centerOfMass for getCenterOfMass")
+    return []
+
+
+def _mesh_part(conv: Any, node: Node, rot: np.ndarray, at: np.ndarray, s: np.ndarray
+               ) -> list[tuple[float, np.ndarray]]:
+    """A closed IndexedFaceSet's volume and centroid: the signed tetrahedra from the origin to each
+    triangle of every face's fan (either winding)."""
+    f = conv.fields(node)
+    coord = f.node_("coord")
+    if coord is None:
+        return []
+    points = conv.fields(coord).row_array("point", 3)
+    index = np.asarray(f.index_array("coordIndex"), dtype=np.int64)
+    if len(points) == 0 or len(index) == 0 or index.max() >= len(points):
+        return []
+    world = (points * s) @ rot.T + at
+    volume, moment = 0.0, np.zeros(3)
+    face: list[int] = []
+    for k in list(index) + [-1]:
+        if k >= 0:
+            face.append(int(k))
+            continue
+        for i in range(1, len(face) - 1):
+            a, b, c = world[face[0]], world[face[i]], world[face[i + 1]]
+            v = float(np.dot(a, np.cross(b, c))) / 6.0
+            volume += v
+            moment += v * (a + b + c) / 4.0
+        face = []
+    if abs(volume) < 1e-300:
+        conv.warn_once(node, "an IndexedFaceSet in a boundingObject that encloses no volume: it adds no mass")
+        return []
+    return [(abs(volume), moment / volume)]     # faces turned inward (ccw FALSE): the same solid
