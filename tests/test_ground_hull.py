@@ -234,3 +234,15 @@ def test_many_points_are_cut_to_extreme_ones_whose_hull_is_exact_for_a_box() -> 
     np.testing.assert_allclose(centre, [0.5, 0.5, 0.25], rtol=0, atol=1e-12)
     small = grid[:MAX_POINTS]
     assert np.array_equal(extreme_points(small), small)
+
+
+def test_a_physics_centre_of_mass_over_the_face_it_stands_on_keeps_the_l_standing() -> None:
+    """The L on its bar's end tips with uniform density (its centre 0.1 beyond the end face); with its
+    Physics' centre of mass given at (0, 0, 0.05) in its frame -- 0.05 inside that face, seen from
+    above -- it stands as it is, on the face, its bar upright (the centre of mass getCenterOfMass reads)."""
+    turned = {"translation": [0.0, 0.0, 2.0], "rotation": _rotation((0, 1, 0), 90.0)}
+    pose = _settled({"pose": turned, "mass": {"kg": 2.0, "center": [0.0, 0.0, 0.05]}, **L_SHAPE})
+    np.testing.assert_allclose(pose.rotation, axis_angle_matrix((0.0, 1.0, 0.0), math.pi / 2.0), rtol=0, atol=1e-12)
+    assert pose.translation[2] == pytest.approx(0.3, abs=1e-12)
+    tipped = _settled({"pose": turned, **L_SHAPE})
+    assert abs(float(tipped.rotation[2, 0])) < 0.99      # without it: tipped onto the slanted face (above)

@@ -909,8 +909,9 @@ def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.nd
 
 def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.ndarray | None) -> Pose:
     """:func:`resting_pose` for a solid of several shapes, a mesh, a capsule or a cone: its shapes'
-    support points and centre of mass (uniform density over their volumes), placed at ``pose`` in ENU,
-    tipped by :func:`_hull_tip`."""
+    support points and centre of mass (its Physics' masses where the world gives them and no mesh file
+    is among its shapes, else uniform density over their volumes), placed at ``pose`` in ENU, tipped by
+    :func:`_hull_tip`."""
     shapes = falling_shapes(solid, base_dir)
     if shapes is None:
         return pose
@@ -924,6 +925,11 @@ def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.n
     cloud = np.vstack(points)
     total = sum(volumes)
     centre = (sum(v * c for v, c in zip(volumes, centres)) / total) if total > 0.0 else cloud.mean(axis=0)
+    # its Physics' masses (the .wbt import's, Webots' rules) over uniform density, unless a mesh file is
+    # among its shapes (the import does not read the mesh, so its centre there would leave the mesh out)
+    weighed = None if any(isinstance(g, wm.Mesh) for _, _, g in shapes) else _mass_centre(solid)
+    if weighed is not None:
+        centre = enu_pose(pose, to_enu).rotation @ weighed + enu_pose(pose, to_enu).translation
     try:
         got = _hull_tip(extreme_points(cloud), centre)
     except FlatPoints as flat:
@@ -935,6 +941,22 @@ def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.n
     turn, shift = got
     t = np.eye(3) if to_enu is None else np.asarray(to_enu, dtype=np.float64)
     return Pose(t.T @ turn @ t @ pose.rotation, t.T @ (turn @ (t @ pose.translation) + shift))
+
+
+def _mass_centre(solid: wm.Solid) -> np.ndarray | None:
+    """The centre of mass, in the solid's frame, of a solid with a Physics mass and of the solids inside
+    it with one (as the Supervisor's getCenterOfMass weighs them); None without a mass of its own."""
+    if solid.mass is None:
+        return None
+    weighted = [(solid.mass.kg, np.asarray(solid.mass.center, dtype=np.float64))]
+    stack = [(child, pose_from_model(child.pose)) for child in solid.children]
+    while stack:
+        child, at = stack.pop()
+        if child.mass is not None:
+            weighted.append((child.mass.kg, at.rotation @ np.asarray(child.mass.center, dtype=np.float64)
+                             + at.translation))
+        stack += [(inner, at.compose(pose_from_model(inner.pose))) for inner in child.children]
+    return sum(kg * c for kg, c in weighted) / sum(kg for kg, _ in weighted)
 
 
 def land_solid(solid: wm.Solid, pose: Pose, base_dir: Path, ground: Ground | None,
