@@ -1,0 +1,209 @@
+"""Sweep 15: Webots robots not swept before, each a stand-in of ours (tests/data/sweep15/: the PROTO's
+device names, joint axes and anchors and wheel radii, our own text) driven in process by the calls
+its Webots sample controller makes, checked against closed forms."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+DATA = Path(__file__).parent / "data" / "sweep15"
+
+# BlueBotics' Shrimp III: six wheels of radius 0.058 m, the front and back ones on steering hinges
+# (front at x 0.271, back at -0.252), two per side on passive bogies at x ±0.089, y ±0.182.
+SHRIMP_R = 0.058
+SHRIMP_SIGNS = (-1, 1, -1, 1, -1, -1)       # wheel motor 00..05: the sign of a forward roll (their axes)
+
+
+def shrimp_command(velocity: int, direction: int) -> tuple[list[float], float, float]:
+    """The Shrimp protocol's speed-and-direction command (0x04) as its Webots controller turns it
+    into motor commands: a 5000 rpm motor behind an 86:1 gear at full scale 127, the back wheel
+    steered by ``direction`` degrees, the others set for a turn about one point 0.242 m ahead of the
+    back wheel's axis (the controller's geometry). Returns the six wheel speeds (rad/s, signed as
+    set), the front and back steering positions."""
+    back = math.radians(direction)
+    v_back = velocity * 5000 * 2 * math.pi / (60 * 86 * 127)
+    r_back = 0.242 / math.cos(math.pi / 2 - abs(back))
+    rate = v_back / r_back
+    r_centre = math.sqrt(r_back ** 2 - 0.242 ** 2) if abs(r_back) != 0.242 else 0.0
+    r_front = math.hypot(r_centre, 0.271)
+    front = (math.pi / 2 - math.asin(r_centre / r_front)) * (-1 if direction < 0 else 1)
+    near, far = math.hypot(r_centre - 0.182, 0.089), math.hypot(r_centre + 0.182, 0.089)
+    left, right = (far, near) if direction > 0 else (near, far)
+    speeds = [rate * r_front, rate * left, rate * right, 0.0, 0.0, v_back]
+    if r_centre < 0.182:                     # the turning point between the body and the near side
+        speeds[1 if direction < 0 else 2] *= -1
+    speeds[3], speeds[4] = speeds[1], speeds[2]
+    return [s * k for s, k in zip(speeds, SHRIMP_SIGNS)], -front, back
+
+
+def set_shrimp(robot, velocity: int, direction: int) -> None:
+    speeds, front, back = shrimp_command(velocity, direction)
+    for i, s in enumerate(speeds):
+        m = robot.motor(f"wheel motor 0{i}")
+        m.set_position(math.inf)
+        m.set_velocity(s)
+    robot.motor("front wheel rotation").set_position(front)
+    robot.motor("back wheel rotation").set_position(back)
+
+
+def test_the_shrimp_keeps_its_six_wheels_steered_front_and_back() -> None:
+    """The Shrimp's two steering hinges stand one behind the other on its x axis, no car's front axle:
+    it gets the steered-wheel drive (each steered wheel under its hinge, the four bogie wheels where
+    they roll). Before, two steering joints were taken for a car's and the robot lost its drive ('no
+    Ackermann drive (... not on one front axle ...); the robot will not move')."""
+    w = load_world(DATA / "shrimp.wbt")
+    assert not [x for x in w.warnings if "will not move" in x], w.warnings
+    (robot,) = w.world.robots
+    assert [d.name for d in robot.devices] == [
+        "back wheel rotation", "wheel motor 05", "wheel sensor 05", "wheel motor 04", "wheel sensor 04",
+        "wheel motor 02", "wheel sensor 02", "wheel motor 03", "wheel sensor 03", "wheel motor 01",
+        "wheel sensor 01", "front wheel rotation", "wheel motor 00", "wheel sensor 00"]
+    drive = robot.steered_drive
+    assert drive is not None
+    by_motor = {x.motor: x for x in drive.wheels}
+    assert by_motor["wheel motor 05"].steer == "back wheel rotation"
+    assert by_motor["wheel motor 00"].steer == "front wheel rotation"
+    assert by_motor["wheel motor 05"].position == pytest.approx((-0.252, 0.0), abs=1e-12)
+    # the front fork's two frames (turned by -0.4712 and back about y) put its hinge at x 0.271
+    assert by_motor["wheel motor 00"].position == pytest.approx((0.271, 0.0), abs=1e-4)
+    for i, (x, y) in {1: (0.089, 0.182), 2: (0.089, -0.182), 3: (-0.089, 0.182), 4: (-0.089, -0.182)}.items():
+        assert by_motor[f"wheel motor 0{i}"].steer is None
+        assert by_motor[f"wheel motor 0{i}"].position == pytest.approx((x, y), abs=1e-4)
+    assert {x.radius for x in drive.wheels} == {SHRIMP_R}
+
+
+def test_the_shrimp_drives_straight_at_r_omega() -> None:
+    """The controller's first command (speed 95 of 127, straight): every wheel at
+    95·5000·2π/(60·86·127) = 4.5543 rad/s, the Shrimp along its x at 0.058·4.5543 = 0.26415 m/s.
+    (The left bogies are turned by 3.1415, not π, as in the PROTO: their wheels 9.3e-5 rad off.)"""
+    w = load_world(DATA / "shrimp.wbt")
+    sim = Simulation(w, "fast")
+    robot = sim.robot("Shrimp")
+    set_shrimp(robot, 95, 0)
+    speeds, front, back = shrimp_command(95, 0)
+    assert (front, back) == (0.0, 0.0)
+    assert speeds == pytest.approx([-4.5543, 4.5543, -4.5543, 4.5543, -4.5543, -4.5543], abs=1e-4)
+    start = robot.pose.translation.copy()
+    sim.run(125)                                            # 2 s
+    moved = robot.pose.translation - start
+    assert moved[0] == pytest.approx(SHRIMP_R * 4.55432 * 2.0, rel=1e-4)
+    assert abs(moved[1]) < 1e-4
+
+
+def fit_twist(wheels, speeds: dict[str, float], steer: dict[str, float]) -> tuple[float, float, float]:
+    """The body's (vx, vy, ωz) whose velocity at each wheel is nearest (least squares) to where the
+    wheel rolls it: r·ω along its heading (steered ones turned by their hinge)."""
+    rows, rhs = [], []
+    for x in wheels:
+        heading = (x.heading or 0.0) + x.steer_sign * steer.get(x.steer or "", 0.0)
+        u = x.radius * speeds[x.motor]
+        px, py = x.position
+        rows += [[1.0, 0.0, -py], [0.0, 1.0, px]]
+        rhs += [u * math.cos(heading), u * math.sin(heading)]
+    sol = np.linalg.lstsq(np.array(rows), np.array(rhs), rcond=None)[0]
+    return float(sol[0]), float(sol[1]), float(sol[2])
+
+
+def test_the_shrimp_turns_by_its_six_wheels_fit() -> None:
+    """The controller's second command (full speed 127, back wheel steered 75° right): back at
+    -1.309 rad, front at +1.336, the left wheels backwards (the turning point 0.065 m to the left,
+    inside the wheels). The Shrimp turns left at the least-squares fit of its six wheels (closed form
+    below), within 1 % of the 6.088·0.058/0.2505 = 1.409 rad/s its controller means (the back wheel
+    stands 0.252 m behind, its formula says 0.242)."""
+    w = load_world(DATA / "shrimp.wbt")
+    sim = Simulation(w, "fast")
+    robot = sim.robot("Shrimp")
+    speeds, front, back = shrimp_command(127, -75)
+    assert (front, back) == pytest.approx((1.3359, -1.3090), abs=1e-4)
+    robot.motor("front wheel rotation").set_position(front)
+    robot.motor("back wheel rotation").set_position(back)
+    sim.run(100)                                            # the hinges turn; the wheels hold
+    assert robot.motor("front wheel rotation").position == pytest.approx(front, abs=1e-12)
+    set_shrimp(robot, 127, -75)
+    sim.run(1)
+    drive = w.world.robots[0].steered_drive
+    by_name = {f"wheel motor 0{i}": s for i, s in enumerate(speeds)}
+    _, _, wz = fit_twist(drive.wheels, by_name, {"front wheel rotation": front, "back wheel rotation": back})
+    assert robot.drive.velocity()[5] == pytest.approx(wz, abs=1e-12)
+    assert wz == pytest.approx(1.3268, abs=1e-4)             # 6 % under the controller's 1.409: its
+    assert wz == pytest.approx(6.0883 * SHRIMP_R / 0.25054, rel=0.06)   # 0.242 and unsteered bogies
+    sim.run(62)                                              # 1.008 s in all at that rate
+    yaw = math.atan2(robot.pose.rotation[1, 0], robot.pose.rotation[0, 0])
+    assert yaw == pytest.approx(wz * 63 * 0.016, abs=1e-9)
+
+
+# NEX Robotics' Fire Bird 6: two wheels of radius 0.046 m, 0.3 m apart, their hinges anchored on the
+# body's centre line at x 0.07 (the end points at y ±0.15), eight sonars ps0..ps7 reading metres.
+FB6 = "Fire Bird 6"
+FB6_R, FB6_STEP = 0.046, 64
+
+
+def fb6_world():
+    w = load_world(DATA / "fire_bird_6.wbt")
+    sim = Simulation(w, "fast")
+    return w, sim, sim.robot(FB6)
+
+
+def test_the_fire_bird_6_keeps_its_two_wheel_drive_about_its_axle() -> None:
+    """Both wheel hinges are anchored at (0.07, 0, -0.08), on the centre line: the wheels' places are
+    their end points', 0.3 m apart, the axle's centre 0.07 m ahead of the origin. Every device the
+    obstacle-avoidance controller asks for is there."""
+    w, _, _ = fb6_world()
+    assert not [x for x in w.warnings if "will not move" in x], w.warnings
+    drive = w.world.robots[0].differential_drive
+    assert drive is not None
+    assert (drive.wheel_radius, drive.axle_length, tuple(drive.axle_center)) == (FB6_R, 0.3, (0.07, 0.0))
+    names = {d.name for d in w.world.robots[0].devices}
+    assert {f"ps{i}" for i in range(8)} | {"left wheel motor", "right wheel motor"} <= names
+
+
+def test_the_fire_bird_6_obstacle_avoidance_stops_its_run_at_the_wall_by_its_sonar() -> None:
+    """fire_bird_6_obstacle_avoidance's rule, step by step at its 64 ms: both wheels at 1 rad/s
+    (0.046 m/s, 2.944 mm a step) until ps2 (at x 0.15, reading metres) reads under 0.25, then left 0,
+    right -1. The wall's face is at x 1.45, so ps2 reads 1.30 - 0.002944·(k - 1) at step k (the speed
+    set one step after the reading): under 0.25 first at k = 358 (22.912 s), the robot 1.051008 m on."""
+    _, sim, robot = fb6_world()
+    ps = [sim.device(f"{FB6}/ps{i}") for i in range(8)]
+    for p in ps:
+        p.enable(FB6_STEP)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    for k in range(1, 400):
+        for _ in range(FB6_STEP // 16):
+            sim.step()
+        v = [float(p.value) for p in ps]
+        assert v[2] == pytest.approx(1.30 - FB6_R * FB6_STEP / 1000 * max(k - 1, 0), abs=1e-6)   # rays cast in float32
+        if v[2] < 0.25:
+            break
+        assert min(v[0], v[1], v[3], v[4]) >= 0.25           # nothing beside it: straight on
+        left.set_velocity(1.0)
+        right.set_velocity(1.0)
+    assert k == 358
+    assert robot.pose.translation[:2] == pytest.approx([357 * FB6_R * 0.064, 0.0], abs=1e-9)
+
+
+def test_the_fire_bird_6_turns_about_its_axle_centre() -> None:
+    """The controller's 'turn right' (left 3, right -1 rad/s): ω = 0.046·(-1 - 3)/0.3 = -0.61333 rad/s
+    about the axle's centre, which moves on at 0.046·(3 - 1)/2 = 0.046 m/s along the heading."""
+    _, sim, robot = fb6_world()
+    for name, s in (("left wheel motor", 3.0), ("right wheel motor", -1.0)):
+        robot.motor(name).set_position(math.inf)
+        robot.motor(name).set_velocity(s)
+    sim.run(64)                                              # 1.024 s
+    rot = robot.pose.rotation
+    yaw = math.atan2(rot[1, 0], rot[0, 0])
+    wz, v, t = FB6_R * -4 / 0.3, FB6_R, 1.024
+    assert yaw == pytest.approx(wz * t, abs=1e-9)
+    centre = robot.pose.translation[:2] + rot[:2, :2] @ np.array([0.07, 0.0])
+    # the axle's centre on its arc from (0.07, 0): radius v/|ω|, turning right
+    expect = [0.07 + v / wz * math.sin(wz * t), v / wz * (1 - math.cos(wz * t))]
+    assert centre == pytest.approx(expect, abs=1e-9)
