@@ -207,3 +207,68 @@ def test_the_fire_bird_6_turns_about_its_axle_centre() -> None:
     # the axle's centre on its arc from (0.07, 0): radius v/|ω|, turning right
     expect = [0.07 + v / wz * math.sin(wz * t), v / wz * (1 - math.cos(wz * t))]
     assert centre == pytest.approx(expect, abs=1e-9)
+
+
+# The Surveyor SRV-1: ten wheels of radius 0.014 m (wheel_motor00..04 on its left, 05..09 on its
+# right, 0.0788 m apart), all about -y: a negative speed rolls it forward (+x), as its controller's
+# protocol drives it.
+SRV = "SurveyorSrv1"
+SRV_R, SRV_TRACK = 0.014, 0.0788
+
+
+def srv_world():
+    w = load_world(DATA / "srv-1.wbt")
+    sim = Simulation(w, "fast")
+    return w, sim, sim.robot(SRV)
+
+
+def srv_set(robot, left: float, right: float) -> None:
+    for i in range(10):
+        m = robot.motor(f"wheel_motor0{i}")
+        m.set_position(math.inf)
+        m.set_velocity(left if i < 5 else right)
+
+
+def test_the_surveyor_keeps_its_ten_wheels_as_a_skid_steer_driven_backwards_by_positive_speeds() -> None:
+    """Its ten wheels turn about -y: a skid-steer drive whose forward is -x (positive speeds roll it
+    back), every wheel kept. Every device surveyor_init asks for is there (camera, ten motors and
+    sensors, ds0..ds3)."""
+    w, _, _ = srv_world()
+    assert not [x for x in w.warnings if "will not move" in x], w.warnings
+    drive = w.world.robots[0].differential_drive
+    assert drive is not None and drive.skid_steer is not None
+    assert (drive.wheel_radius, drive.axle_length, tuple(drive.forward)) == (SRV_R, SRV_TRACK, (-1.0, 0.0))
+    assert {drive.left_motor, drive.right_motor, *drive.skid_steer.left, *drive.skid_steer.right} == {
+        f"wheel_motor0{i}" for i in range(10)}
+    names = {d.name for d in w.world.robots[0].devices}
+    assert {"camera", "ds0", "ds1", "ds2", "ds3"} | {f"wheel_sensor0{i}" for i in range(10)} <= names
+
+
+@pytest.mark.parametrize(("command", "left_power"), [("8 forward", 0.5), ("7 drift left", 0.4), ("9 drift right", 0.6)])
+def test_the_surveyor_protocol_commands_drive_it_by_the_closed_form(command: str, left_power: float) -> None:
+    """Its protocol's forward and drift commands at the initial 0.3 m/s: each left wheel at
+    -(p/0.5)·0.3/0.014 rad/s, each right one at -((1 - p)/0.5)·0.3/0.014, so the sides roll at
+    0.6·p and 0.6·(1 - p) m/s: 0.3 m/s ahead, turning at (0.6 - 1.2·p)/0.0788 rad/s (drift left
+    1.5228, right -1.5228) about its centre."""
+    _, sim, robot = srv_world()
+    v_left, v_right = 0.6 * left_power, 0.6 * (1 - left_power)
+    srv_set(robot, -v_left / SRV_R, -v_right / SRV_R)
+    sim.run(64)                                               # 1.024 s
+    t, v, wz = 1.024, 0.3, (v_right - v_left) / SRV_TRACK
+    rot = robot.pose.rotation
+    assert math.atan2(rot[1, 0], rot[0, 0]) == pytest.approx(wz * t, abs=1e-9)
+    expect = [v * t, 0.0] if wz == 0 else [v / wz * math.sin(wz * t), v / wz * (1 - math.cos(wz * t))]
+    assert robot.pose.translation[:2] == pytest.approx(expect, abs=1e-9)
+
+
+def test_the_surveyor_spins_20_degrees_in_200_ms_at_the_kinematic_rate() -> None:
+    """The protocol's '0' (turn 20° left): left wheels +0.3/0.014, right -0.3/0.014 for 200 ms (its
+    clock counts 16 ms steps: 13 of them). Here the skid-steer turns at 0.6/0.0788 = 7.614 rad/s, 1.58
+    rad in those 208 ms, in place; Webots' tracks slip in the turn (the protocol's 20° is the real
+    robot's figure) -- a departure the README says."""
+    _, sim, robot = srv_world()
+    srv_set(robot, 0.3 / SRV_R, -0.3 / SRV_R)
+    sim.run(13)
+    rot = robot.pose.rotation
+    assert math.atan2(rot[1, 0], rot[0, 0]) == pytest.approx(0.6 / SRV_TRACK * 0.208, abs=1e-9)
+    assert robot.pose.translation[:2] == pytest.approx([0.0, 0.0], abs=1e-12)
