@@ -5,10 +5,12 @@ its Webots sample controller makes, checked against closed forms."""
 from __future__ import annotations
 
 import math
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _serve import child_env, sensorium
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
@@ -272,3 +274,46 @@ def test_the_surveyor_spins_20_degrees_in_200_ms_at_the_kinematic_rate() -> None
     rot = robot.pose.rotation
     assert math.atan2(rot[1, 0], rot[0, 0]) == pytest.approx(0.6 / SRV_TRACK * 0.208, abs=1e-9)
     assert robot.pose.translation[:2] == pytest.approx([0.0, 0.0], abs=1e-12)
+
+
+FB6_CONTROLLER = '''
+from controller import Robot
+
+robot = Robot()
+print("Fire Bird 6 controller for obstacle avoidance")
+ps = [robot.getDevice(f"ps{i}") for i in range(8)]
+for p in ps:
+    p.enable(64)
+left, right = robot.getDevice("left wheel motor"), robot.getDevice("right wheel motor")
+for m in (left, right):
+    m.setPosition(float("inf"))
+    m.setVelocity(0.0)
+while robot.step(64) != -1:
+    v = [p.getValue() for p in ps]
+    front = v[2] < 0.25
+    ls, rs = (0.0, -1.0) if front else (3.0, -1.0) if v[0] < 0.25 or v[1] < 0.25 else (
+        -1.0, 3.0) if v[3] < 0.25 or v[4] < 0.25 else (1.0, 1.0)
+    if front:
+        print(f"front {robot.getTime():.3f} {v[2]:.5f}", flush=True)
+        break
+    left.setVelocity(ls)
+    right.setVelocity(rs)
+'''
+
+
+@pytest.mark.slow
+def test_the_fire_bird_6_controller_runs_under_sensorium_run(tmp_path: Path) -> None:
+    """A Python controller of ours making fire_bird_6_obstacle_avoidance's calls (its devices, its
+    64 ms step, its rule), started by ``sensorium run`` from the project's controllers/ folder: its
+    sonar ps2 sees the wall under 0.25 m first at 22.912 s (the closed form above), reading 0.24899."""
+    (tmp_path / "worlds").mkdir()
+    (tmp_path / "worlds" / "fire_bird_6.wbt").write_text((DATA / "fire_bird_6.wbt").read_text())
+    folder = tmp_path / "controllers" / "fire_bird_6_obstacle_avoidance"
+    folder.mkdir(parents=True)
+    (folder / "fire_bird_6_obstacle_avoidance.py").write_text(FB6_CONTROLLER)
+    done = subprocess.run(sensorium("run", str(tmp_path / "worlds" / "fire_bird_6.wbt"), "--until", "23500",
+                                    "--rpc", "tcp://127.0.0.1:0", "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "Fire Bird 6 controller for obstacle avoidance" in done.stdout, done.stderr
+    assert "front 22.912 0.24899" in done.stdout, (done.stdout, done.stderr)
