@@ -317,3 +317,38 @@ def test_the_fire_bird_6_controller_runs_under_sensorium_run(tmp_path: Path) -> 
     assert done.returncode == 0, done.stderr
     assert "Fire Bird 6 controller for obstacle avoidance" in done.stdout, done.stderr
     assert "front 22.912 0.24899" in done.stdout, (done.stdout, done.stderr)
+
+
+def test_the_scara_t6_example_reaches_its_targets_and_carries_the_shaft_there() -> None:
+    """scara's calls (Epson's SCARA T6, our stand-in): base_arm_motor to 0.5, arm_motor to 0.14,
+    shaft_linear_motor to -0.1, the LED toggled each second. Each joint moves kinematically and
+    holds its target; the shaft, 0.2615 m past the arm's hinge at (0.37, 0.005), which is 0.31 m
+    past the base hinge at (0.06, 0), stands where the two turns put it (closed form below), 0.1 m
+    lower. The robot has no wheel: one line per joint says it moves kinematically, no drive is missed."""
+    w = load_world(DATA / "scara_t6.wbt")
+    assert not [x for x in w.warnings if "will not move" in x], w.warnings
+    sim = Simulation(w, "fast")
+    robot = sim.robot("ScaraT6")
+    sensors = {n: sim.device(f"ScaraT6/{n}") for n in ("base_arm_position", "arm_position")}
+    for s in sensors.values():
+        s.enable(16)
+    led = sim.device("ScaraT6/epson_led")
+    led.set(1, sim.time_ms)
+    robot.motor("arm_motor").set_position(0.14)
+    robot.motor("base_arm_motor").set_position(0.5)
+    robot.motor("shaft_linear_motor").set_position(-0.1)
+    sim.run(63)                                               # 1.008 s
+    assert float(sensors["base_arm_position"].value) == pytest.approx(0.5, abs=1e-12)
+    assert float(sensors["arm_position"].value) == pytest.approx(0.14, abs=1e-12)
+
+    def turn(a: float, p: np.ndarray) -> np.ndarray:
+        c, s = math.cos(a), math.sin(a)
+        return np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]])
+
+    p1, p2, p3 = np.array([0.06, 0.0]), np.array([0.37, 0.005]), np.array([0.6245, 0.0])
+    p2_now = p1 + turn(0.5, p2 - p1)
+    p3_now = p2_now + turn(0.64, p3 - p2)
+    shaft = robot.link_pose("shaft_linear_motor")
+    assert shaft is not None
+    at = shaft.rotation @ np.array([0.6245, 0.0, 0.256]) + shaft.translation
+    assert at == pytest.approx([*p3_now, 0.156], abs=1e-9)
