@@ -352,3 +352,29 @@ def test_the_scara_t6_example_reaches_its_targets_and_carries_the_shaft_there() 
     assert shaft is not None
     at = shaft.rotation @ np.array([0.6245, 0.0, 0.256]) + shaft.translation
     assert at == pytest.approx([*p3_now, 0.156], abs=1e-9)
+
+
+def test_the_p_rob3_moves_by_its_joints_accelerations_and_opens_its_coupled_gripper() -> None:
+    """p-rob3's first calls (F&P's P-Rob3 with its P-Grip, our stand-in): motor 5 to -1.95, then its
+    half-second wait (32 steps of 16 ms): the joint accelerates at its 3.49066 rad/s² (its
+    ``acceleration``), each step's speed a·dt, so it stands at -3.49066·0.016²·32·33/2 = -0.47183,
+    far from its target (2.79253 rad/s is never reached). Then motors 2 and 3 to 1.55 and 1.12 and
+    'gripper::right' to 0.5, which moves 'gripper::left' too (Webots couples 'NAME::x' motors), all
+    there within the controller's 2 s wait. Its close_gripper() is a torque, ignored here (the
+    client says so once): the fingers stay open, so the arm carries no can."""
+    w = load_world(DATA / "p-rob3.wbt")
+    assert not [x for x in w.warnings if "will not move" in x], w.warnings
+    names = {d.name for d in w.world.robots[0].devices}
+    assert {f"motor {i}" for i in range(1, 7)} | {"gripper::right", "gripper::left"} <= names
+    sim = Simulation(w, "fast")
+    robot = sim.robot("P-Rob3")
+    robot.motor("motor 5").set_position(-1.95)
+    sim.run(32)
+    assert robot.motor("motor 5").position == pytest.approx(-3.49066 * 0.016 ** 2 * 32 * 33 / 2, abs=1e-12)
+    robot.motor("motor 2").set_position(1.55)
+    robot.motor("motor 3").set_position(1.12)
+    robot.motor("gripper::right").set_position(0.5)
+    sim.run(125)
+    for name, target in (("motor 2", 1.55), ("motor 3", 1.12), ("motor 5", -1.95), ("gripper::right", 0.5),
+                         ("gripper::left", 0.5)):
+        assert robot.motor(name).position == pytest.approx(target, abs=1e-12), name
