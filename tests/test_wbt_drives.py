@@ -1033,3 +1033,32 @@ def test_a_spinning_lidar_head_steers_no_wheel(tmp_path: Path) -> None:
         r.motor(name).set_velocity(2.0)
     sim.run(100)
     assert r.pose.translation[0] == pytest.approx(R * 2.0 * 100 * 0.016, abs=1e-9)
+
+
+def test_two_steering_hinges_one_behind_the_other_make_a_steered_drive_not_a_car(tmp_path: Path) -> None:
+    """A steered front and a steered back wheel on the robot's x axis and two unsteered middle wheels
+    (a Shrimp's layout): the two steering hinges are on no front axle, so the robot is no car; it
+    gets the steered-wheel drive (before: 'no Ackermann drive (... not on one front axle ...); the
+    robot will not move'). Both steered a quarter turn, every wheel rolling at ω while the middle
+    ones are held: the fit moves it sideways at 2/4·r·ω (two wheels of four push it left)."""
+    robot = ('Robot { name "bogie" children [\n' + corner("front", 0.3, 0.0) + corner("back", -0.3, 0.0)
+             + wheel("middle left wheel", 0.0, 0.25) + wheel("middle right wheel", 0.0, -0.25)
+             + '] controller "<extern>" }\n')
+    w = load_world(write(tmp_path, robot))
+    assert not [x for x in w.warnings if "will not move" in x], w.warnings
+    drive = w.world.robots[0].steered_drive
+    assert drive is not None
+    assert {x.motor: (x.steer, x.position) for x in drive.wheels} == {
+        "front wheel": ("front arm", (0.3, 0.0)), "back wheel": ("back arm", (-0.3, 0.0)),
+        "middle left wheel": (None, (0.0, 0.25)), "middle right wheel": (None, (0.0, -0.25))}
+    sim = Simulation(w, "fast")
+    rover = sim.robot("bogie")
+    for k in ("front", "back"):
+        rover.motor(f"{k} arm").set_position(math.pi / 2)
+    sim.run(50)
+    for k in ("front", "back"):
+        rover.motor(f"{k} wheel").set_position(math.inf)
+        rover.motor(f"{k} wheel").set_velocity(4.0)
+    sim.run(1)
+    assert rover.drive.velocity()[:2] == pytest.approx([0.0, R * 4.0 / 2], abs=1e-12)
+    assert rover.drive.velocity()[5] == pytest.approx(0.0, abs=1e-12)

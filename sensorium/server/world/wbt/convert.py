@@ -1983,18 +1983,34 @@ class Converter:
                                  "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
-    def _steering_groups(self, wheels: list[dict]) -> list[tuple[dict | None, list[dict]]] | None:
+    def _steering_groups(self, wheels: list[dict], up: int) -> list[tuple[dict | None, list[dict]]] | None:
         """A base on more than two steering joints, each carrying driven wheels of its own (a PR2's four
-        casters, a rover's steered corners): each steering joint with the driven wheels it turns, then
-        (None, the driven wheels riding none); else None (a car steers two)."""
+        casters, a rover's steered corners), or on two that are no car's front axle, one behind the
+        other (a Shrimp's steered front and back wheels): each steering joint with the driven wheels it
+        turns, then (None, the driven wheels riding none); else None (a car steers two on one axle)."""
         steering = [w for w in wheels if w["steers"]]
         held = [self._inside(w["end"]) for w in steering]
         riding = [[w for w in wheels if not w["steers"] and id(w["node"]) in h] for h in held]
-        if len(steering) <= 2 or not all(riding):
+        if len(steering) < 2 or not all(riding) or (len(steering) == 2 and self._one_axle(steering, wheels, up)):
             return None
         carried = {id(w["node"]) for r in riding for w in r}
         free = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
         return [*zip(steering, riding), *([(None, free)] if free else [])]
+
+    def _one_axle(self, steering: list[dict], wheels: list[dict], up: int) -> bool:
+        """Whether two steering joints stand on one axle, as a car's front wheels do: the line between
+        their anchors, in the ground's plane, along the axis of the wheels riding no steering joint (the
+        robot's y when every wheel is steered)."""
+        from sensorium.server.world.wbt.drive import TOL
+
+        flat = [i for i in range(3) if i != up]
+        d = (np.asarray(steering[0]["anchor"], dtype=np.float64) - np.asarray(steering[1]["anchor"], dtype=np.float64))[flat]
+        carried: set[int] = set().union(*(self._inside(w["end"]) for w in steering))
+        free = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
+        axis = np.asarray(free[0]["axis"], dtype=np.float64)[flat] if free else np.array([0.0, 1.0])
+        if float(np.linalg.norm(axis)) <= TOL or float(np.linalg.norm(d)) <= TOL:
+            return True
+        return abs(float(d[0] * axis[1] - d[1] * axis[0])) <= TOL * float(np.linalg.norm(d) * np.linalg.norm(axis))
 
     def _grounded(self, groups: list[tuple[dict | None, list[dict]]], nowheel: list[tuple[Node, str, str, str]],
                   up: int) -> list[tuple[dict | None, list[dict]]]:
@@ -2410,7 +2426,7 @@ class Converter:
                 wheels = base
         else:
             turns = mecanum_turns(wheels, self)
-        groups = self._steering_groups(wheels) if turns is None else None
+        groups = self._steering_groups(wheels, up) if turns is None else None
         if groups is not None:                    # steered casters or corners: each wheel steered on its own
             groups = self._grounded(groups, nowheel, up)
             positions = {d["name"]: float(d.get("position", 0.0)) for d in robot.data["devices"]
