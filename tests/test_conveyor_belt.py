@@ -84,17 +84,26 @@ def test_a_stopped_belt_leaves_it_and_reverse_moves_it_back(tmp_path: Path) -> N
     assert at(sim) == pytest.approx([X0 - 0.1 + 0.05, 0.0, TOP + 0.05], abs=1e-12)
 
 
-def test_past_the_belts_end_it_lands_on_the_floor(tmp_path: Path) -> None:
-    sim = Simulation(load_world(world(tmp_path)))
+def _ride_off(sim: Simulation, x0: float, edge: float) -> float:
+    """At 0.2 m/s the box rides along the world's x from x0 at y 0, at x0 + 0.2 t every 10 ms step
+    (1e-12), until its origin passes ``edge``: there, within that step's 2 mm, it lands on the floor
+    (at its half height). Where it landed, x."""
     belt(sim, 0.2)
     steps = 0
-    while at(sim)[2] > 0.1:                       # carried until its origin passes x = 0.5
+    while at(sim)[2] > 0.1:
         sim.step()
         steps += 1
         assert steps < 1000
+        if at(sim)[2] > 0.1:
+            assert at(sim) == pytest.approx([x0 + 0.2 * 0.01 * steps, 0.0, TOP + 0.05], abs=1e-12)
     x = at(sim)[0]
-    assert x == pytest.approx(X0 + 0.2 * 0.01 * steps, abs=1e-12) and 0.5 < x <= 0.5 + 0.002 + 1e-12
-    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)     # on the floor at its half height
+    assert x == pytest.approx(x0 + 0.2 * 0.01 * steps, abs=1e-12) and edge < x <= edge + 0.002 + 1e-12
+    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+    return x
+
+def test_past_the_belts_end_it_lands_on_the_floor(tmp_path: Path) -> None:
+    sim = Simulation(load_world(world(tmp_path)))
+    x = _ride_off(sim, X0, 0.5)                    # carried until its origin passes x = 0.5
     sim.run(50)
     assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)     # off the belt: it stays
 
@@ -334,6 +343,7 @@ def test_a_box_tilted_inside_a_pose_carries_nothing_and_says_so(tmp_path: Path) 
     assert at(sim) == before
 
 
+
 def test_each_box_of_a_group_is_a_face_carrying_along_the_tracks_x(tmp_path: Path) -> None:
     """The Track's boundingObject a Group: a Pose holding a 0.5 m Box 0.25 m behind the Track's origin,
     and a Transform holding another 0.5 m Box 0.25 m ahead with a Cylinder (an end roller) beside it.
@@ -348,18 +358,7 @@ def test_each_box_of_a_group_is_a_face_carrying_along_the_tracks_x(tmp_path: Pat
     faces = w.world.robots[0].belts
     assert [(b.top, b.along, b.direction, b.length, b.width) for b in faces] == [
         ((-0.25, 0.0, TOP), (1.0, 0.0, 0.0), None, 0.5, 0.3), ((0.25, 0.0, TOP), (1.0, 0.0, 0.0), None, 0.5, 0.3)]
-    sim = Simulation(w)
-    belt(sim, 0.2)
-    steps = 0
-    while at(sim)[2] > 0.1:
-        sim.step()
-        steps += 1
-        assert steps < 1000
-        if at(sim)[2] > 0.1:
-            assert at(sim) == pytest.approx([X0 + 0.2 * 0.01 * steps, 0.0, TOP + 0.05], abs=1e-12)
-    x = at(sim)[0]
-    assert x == pytest.approx(X0 + 0.2 * 0.01 * steps, abs=1e-12) and 0.5 < x <= 0.5 + 0.002 + 1e-12
-    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+    _ride_off(Simulation(w), X0, 0.5)
 
 
 def test_a_box_turned_30_degrees_carries_along_the_tracks_x(tmp_path: Path) -> None:
@@ -374,18 +373,7 @@ def test_a_box_turned_30_degrees_carries_along_the_tracks_x(tmp_path: Path) -> N
     b = w.world.robots[0].belts[0]
     assert b.direction == (1.0, 0.0, 0.0)
     assert b.along == pytest.approx((math.sqrt(3) / 2, 0.5, 0.0), abs=1e-15)
-    sim = Simulation(w)
-    belt(sim, 0.2)
-    steps = 0
-    while at(sim)[2] > 0.1:
-        sim.step()
-        steps += 1
-        assert steps < 1000
-        if at(sim)[2] > 0.1:
-            assert at(sim) == pytest.approx([X1 + 0.2 * 0.01 * steps, 0.0, TOP + 0.05], abs=1e-12)
-    x = at(sim)[0]
-    assert x == pytest.approx(X1 + 0.2 * 0.01 * steps, abs=1e-12) and 0.3 < x <= 0.3 + 0.002 + 1e-12
-    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+    _ride_off(Simulation(w), X1, 0.3)
 
 
 def test_a_blocked_box_stops_with_its_face_on_the_walls(tmp_path: Path) -> None:

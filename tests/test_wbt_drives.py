@@ -407,10 +407,11 @@ def test_a_lone_motorised_turntable_is_no_failed_car(tmp_path: Path) -> None:
     assert ds.translation == pytest.approx([0.0, 0.05, 0.063], abs=1e-12)
 
 
-def _two_wheels_and_a_joint(tmp_path: Path, name: str, joint: str, motor: str) -> Simulation:
-    """A robot of two wheels and ``joint`` (a motorised vertical hinge, ``motor``, that must steer
-    nothing): loaded with its differential drive, no drive warning, the joint's one line, and the
-    simulation's drive and joints so."""
+def _two_wheels_and_a_joint(tmp_path: Path, name: str, joint: str, motor: str,
+                            why: str = "is no wheel and steers none (its end point holds no wheel)") -> Simulation:
+    """A robot of two wheels and ``joint`` (a motorised hinge, ``motor``, that must be no wheel and steer
+    nothing): loaded with its differential drive, no drive warning, the joint's one line (``why`` after
+    the motor's name), and the simulation's drive and joints so."""
     p = write(tmp_path, f'Robot {{ name "{name}" children [\n' + joint + wheel("left wheel", 0, Y)
               + wheel("right wheel", 0, -Y) + '] }\n')
     w = load_world(p)
@@ -419,9 +420,8 @@ def _two_wheels_and_a_joint(tmp_path: Path, name: str, joint: str, motor: str) -
         wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert not [x for x in w.warnings if "drive" in x], w.warnings
     assert [x.split(": ", 1)[1] for x in w.warnings if motor in x] == [
-        f"HingeJoint motor '{motor}' is no wheel and steers none (its end point holds no wheel): its joint moves "
-        "kinematically (Webots' rule without physics; its PositionSensor reads it), and the shapes and devices past "
-        "the joint with it"]
+        f"HingeJoint motor '{motor}' {why}: its joint moves kinematically (Webots' rule without physics; its "
+        "PositionSensor reads it), and the shapes and devices past the joint with it"]
     sim = Simulation(w)
     drive = sim.robot(name)
     assert sorted(drive.drive.motors) == ["left wheel", "right wheel"] and sorted(drive.joints) == [motor]
@@ -992,16 +992,8 @@ def test_a_camera_ball_on_a_tilt_hinge_is_no_wheel_of_a_two_wheel_or_omni_robot(
         head = (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor 0.05 0 0.3 }} device [ '
                 'RotationalMotor { name "tilt" } ] endPoint Solid { translation 0.05 0 0.3 children [ Shape { '
                 'geometry Sphere { radius 0.03 } } ] } }\n')
-        p = write(tmp_path, 'Robot { name "cam" children [\n' + wheel("left wheel", 0, 0.15)
-                  + wheel("right wheel", 0, -0.15) + head + '] }\n')
-        w = load_world(p)
-        assert w.world.robots[0].differential_drive == wm.DifferentialDrive(
-            wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
-        assert w.warnings == [
-            f"{p}:6:1: HingeJoint motor 'tilt' is no wheel (its round part's bottom is 0.27 m above the robot's lowest "
-            "wheels: it never touches the ground): its joint moves kinematically (Webots' rule without physics; its "
-            "PositionSensor reads it), and the shapes and devices past the joint with it"], axis
-        assert sorted(Simulation(w).robot("cam").joints) == ["tilt"]
+        _two_wheels_and_a_joint(tmp_path, "cam", head, "tilt", "is no wheel (its round part's bottom is 0.27 m above "
+                                "the robot's lowest wheels: it never touches the ground)")
 
 
 SPINNING_HEAD = ('HingeJoint { jointParameters HingeJointParameters { axis 0 0 1 anchor 0 0 0.3 } device [ '
@@ -1016,18 +1008,9 @@ def test_a_spinning_lidar_head_steers_no_wheel(tmp_path: Path) -> None:
     is no wheel and steers none (its one line says so), and the two wheels keep their drive. Before,
     the robot was taken for a car with one steering motor ('no Ackermann drive ...; the robot will not
     move'). A vertical hinge carrying a wheel's joint still steers (the cars' tests)."""
-    p = write(tmp_path, 'Robot { name "scan" children [\n' + wheel("left wheel", 0, 0.15)
-              + wheel("right wheel", 0, -0.15) + SPINNING_HEAD + '] }\n')
-    w = load_world(p)
-    assert w.world.robots[0].differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
-    assert w.warnings == [
-        f"{p}:6:1: HingeJoint motor 'spin' is no wheel and steers none (it spins its round part in place about its "
-        "own axis): its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
-        "the shapes and devices past the joint with it"]
-    sim = Simulation(w)
+    sim = _two_wheels_and_a_joint(tmp_path, "scan", SPINNING_HEAD, "spin", "is no wheel and steers none (it spins "
+                                  "its round part in place about its own axis)")
     r = sim.robot("scan")
-    assert sorted(r.joints) == ["spin"]
     for name in ("left wheel", "right wheel"):
         r.motor(name).set_position(math.inf)
         r.motor(name).set_velocity(2.0)
