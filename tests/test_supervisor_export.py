@@ -9,9 +9,12 @@ saved world loads again and gives the readings the running world gives."""
 from __future__ import annotations
 
 import math
+import os
+import sys
 from pathlib import Path
 
 import pytest
+from test_multiprocess import run_paused
 from test_supervisor_import import _wbt_world
 
 from sensorium.server.daemon import supervisor as sv
@@ -210,3 +213,57 @@ def test_remove_sf_on_a_robots_joint_end_point_is_read_only_here():
                  if sv.node_by_id(sim, c).type == "HingeJoint")
     with pytest.raises(ValueError, match="read-only here"):
         sv.remove_sf(sim, joint, "endPoint")
+
+
+# ---------------------------------------------------------------------- the clients (processes)
+
+EXPECTED_HEAD = ["DEF BOX Solid {", "  translation 1 0 0.1"]
+CLIENT_LINES = ["clone BOX box(1) 1 0 0.1", "save 0 0 1", "removed 1", "again 2", "inside ''"]
+
+
+def _client_check(ctl, saved: Path) -> None:
+    out, err = ctl.out, ctl.stderr()
+    assert out[:2] == EXPECTED_HEAD and "  rotation" not in out[2] and out[-5:] == CLIENT_LINES, out
+    assert "  children [" in out and '  name "box"' in out
+    errors = [line for line in err.splitlines() if line.startswith("Error")]
+    assert errors == [
+        "Error: wb_supervisor_world_save(): the world file is not overwritten here: name the file to write (a departure "
+        "from Webots, which overwrites the world file it loaded).",
+        "Error: the target file given to wb_supervisor_world_save() should have the '.wbt' extension.",
+        errors[2], errors[3], errors[4]], err
+    # (the C library writes the server's error code before its line)
+    assert errors[2].startswith("Error: wb_supervisor_field_remove_sf(): ") and "field_remove_sf: field 'appearance' " \
+        "(SFNode) of Shape 'DOTS'" in errors[2] and "is read-only here" in errors[2], err
+    assert errors[3] == "Error: wb_supervisor_field_remove_sf() called with wrong field type: SFVec3f.", err
+    assert errors[4].startswith("Error: wb_supervisor_node_export_string(): ") and "node_export_string: " \
+        "DistanceSensor 'ds'" in errors[4] and "is inside a robot or solid" in errors[4], err
+    again = _sim(saved)
+    assert [n.name for n in sv.root_children(again) if n.type == "Solid"] == ["box", "box(1)"]
+    assert sv.get_field(again, _node(again, "BOX"), "translation")["value"] == [1.0, 0.0, 0.1]
+    assert _ds(again) == pytest.approx(0.85, abs=1e-9)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_python_supervisor_exports_saves_and_removes_sf(tmp_path):
+    saved = tmp_path / "saved.wbt"
+    ctl = run_paused(WORLD, tmp_path, "supervisor_export.py", "probe", env={**os.environ, "EXPORT_SAVE": str(saved)})
+    _client_check(ctl, saved)
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")
+def test_a_c_supervisor_does_the_same(tmp_path, tmp_path_factory):
+    from test_c_client import sanitized_controller
+
+    exe = sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "supervisor_export.c")
+    saved = tmp_path / "saved.wbt"
+    ctl = run_paused(WORLD, tmp_path, exe, "probe", env={**os.environ, "EXPORT_SAVE": str(saved),
+                                                        "ASAN_OPTIONS": "detect_leaks=1:exitcode=86",
+                                                        "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"})
+    _client_check(ctl, saved)
+    py = tmp_path / "py"
+    py.mkdir()
+    assert ctl.out == run_paused(WORLD, py, "supervisor_export.py", "probe",
+                                 env={**os.environ, "EXPORT_SAVE": str(py / "saved.wbt")}).out
+    assert saved.read_text() == (py / "saved.wbt").read_text()
