@@ -45,7 +45,11 @@ def _read(text: str):
 
 
 def _ds(sim: Simulation) -> float:
-    ds = sim.device("probe/ds")
+    return _ds_of(sim, "probe/ds")
+
+
+def _ds_of(sim: Simulation, device: str = "r/ds") -> float:
+    ds = sim.device(device)
     ds.enable(16)
     sim.step()
     return float(ds.value)
@@ -133,6 +137,23 @@ def test_a_saved_world_loads_again_and_gives_the_same_readings(tmp_path):
     assert _ds(again) == pytest.approx(1.35, abs=1e-9)     # the turned cube's face at x = 1.4
     assert sv.get_field(again, _node(again, "BOX"), "translation")["value"] == [1.5, 0.0, 0.1]
     assert world_string(again) == world_string(sim)
+
+
+def test_shapes_outside_any_solid_are_saved_as_written_and_a_robot_without_controller_stays_so(tmp_path):
+    world = tmp_path / "shapes.wbt"
+    world.write_text(HEADER + "WorldInfo {\n}\nShape {\n  geometry Box {\n    size 0.2 4 1\n  }\n}\n"
+                     'Robot {\n  translation -1 0 0\n  name "r"\n  children [\n    DistanceSensor {\n      name "ds"\n'
+                     "      lookupTable [\n        0 0 0\n        5 5 0\n      ]\n    }\n  ]\n}\n")
+    sim = _sim(world)
+    assert [(n.type, n.name) for n in sv.root_children(sim)][2:] == [("Shape", ""), ("Robot", "r"), ("Solid", "shapes")]
+    text = world_string(sim)
+    assert text == HEADER + "\n" + world.read_text()[len(HEADER):].replace("WorldInfo {\n}\n", "WorldInfo {\n}\nViewpoint {\n}\n")
+    saved = tmp_path / "saved.wbt"
+    saved.write_text(text)
+    again = _sim(saved)
+    assert _ds_of(again) == _ds_of(sim) == 5.0     # a shape without boundingObject: no distance sensor meets it (Webots)
+    with pytest.raises(NotExported, match="shapes outside any solid"):
+        node_string(sim, sv.root_children(sim)[-1])
 
 
 def test_a_proto_instance_exports_as_the_instance_with_its_fields_now(tmp_path):

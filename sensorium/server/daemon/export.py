@@ -26,8 +26,10 @@ _POSE = {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 1.0, 0.0]}
 _LIGHT = {"on": True, "intensity": 1.0, "color": [1.0, 1.0, 1.0], "ambientIntensity": 0.0, "castShadows": False}
 _LOCAL = {"location": [0.0, 0.0, 0.0], "attenuation": [1.0, 0.0, 0.0], "radius": 100.0}
 DEFAULTS: dict[str, dict[str, Any]] = {
+    # a .wbt robot without a controller reads "<extern>" here (Webots' default is "<generic>"): one set to
+    # "<extern>" keeps its field written, and one never written stays unwritten
     "Robot": {**_POSE, "name": "robot", "model": "", "radarCrossSection": 0.0, "customData": "",
-              "controller": "<generic>", "supervisor": False, "synchronization": True},
+              "controller": "<extern>", "supervisor": False, "synchronization": True},
     "Solid": {**_POSE, "name": "solid", "model": "", "radarCrossSection": 0.0},
     "PointLight": {**_LIGHT, **_LOCAL},
     "SpotLight": {**_LIGHT, **_LOCAL, "direction": [0.0, 0.0, -1.0], "beamWidth": 1.570796, "cutOffAngle": 0.785398},
@@ -83,7 +85,8 @@ def _written(sim: Any, node: sv.Node) -> ParsedNode:
     else:
         wbt = _world_file(sim)
         at = sim.top_level.written.get(_place(sim, node)) if wbt is not None else None
-        written = None if at is None else wbt.nodes[at]
+        alone = at is not None and list(sim.top_level.written.values()).count(at) == 1
+        written = wbt.nodes[at] if wbt is not None and at is not None and alone else None
     if written is None:
         raise NotExported(f"{sv._what(node)} has no .wbt text here: {why}")
     return written
@@ -132,7 +135,7 @@ def node_string(sim: Any, node: sv.Node, writer: Writer | None = None) -> str:
         if name in fields:
             if _same(fields[name], now):
                 continue         # unchanged: as written (a rotation read back through its matrix differs in the last bits)
-            if node.interface or value != default:
+            if node.interface or value != default or name == "controller":
                 fields[name] = now
             else:
                 del fields[name]
@@ -157,9 +160,18 @@ def world_string(sim: Any) -> str:
     lines += [("IMPORTABLE " if d.importable else "") + f'EXTERNPROTO "{d.url}"' for d in wbt.declarations]
     lines.append("")
     writer = Writer()
+    places = sim.top_level.written
+    shared = {at for at in places.values() if list(places.values()).count(at) > 1}
+    imported = {n.id for n in sv._imported_nodes(sim, len(sv._loaded_nodes(sim))).every}
     for node in sv.root_children(sim):
-        if node.scenery and node.type in ("WorldInfo", "Viewpoint") and _place(sim, node) not in sim.top_level.written:
-            lines.append(f"{node.type} {{\n}}")        # one Webots adds where the file has none
+        at = None if node.id in imported else places.get(_place(sim, node))
+        if at in shared:            # one top-level node of the file that became several: written once, as written
+            if id(wbt.nodes[at]) not in writer.written_nodes:
+                lines.append(writer.node(wbt.nodes[at]))
             continue
+        if at is None and node.id not in imported:
+            if node.scenery:        # a WorldInfo or Viewpoint Webots adds where the file has none
+                lines.append(f"{node.type} {{\n}}")
+            continue                # the solid holding the file's shapes outside any solid: written as those shapes
         lines.append(node_string(sim, node, writer))
     return "\n".join(lines) + "\n"

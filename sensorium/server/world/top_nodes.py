@@ -51,7 +51,7 @@ class TopLevel:
                                                  # instance of (the top-level node it alone became)
     interfaces: dict = field(default_factory=dict)   # (kind, index) -> that instance's interface (wm.ProtoLevel each)
     written: dict = field(default_factory=dict)   # (kind, index) -> the place in file order of the top-level node it
-                                                  # alone became (a group: ("scenery", index)); a Supervisor's
+                                                  # came from (a group: ("scenery", index)); a Supervisor's
                                                   # exportString writes that node (daemon/export.py)
 
 
@@ -88,11 +88,10 @@ def top_level(world: wm.World) -> TopLevel:
                 and used[alone[0]] < sizes[alone[0]]:
             protos[(alone[0], used[alone[0]])] = node.proto
             interfaces[(alone[0], used[alone[0]])] = tuple(node.interface)
-        if sum(counts.values()) == 1 and used[alone[0]] < sizes[alone[0]]:
-            written[(alone[0], used[alone[0]])] = at
         for kind in KINDS:
             for _ in range(counts[kind]):
                 if used[kind] < sizes[kind]:
+                    written[(kind, used[kind])] = at
                     order.append((kind, used[kind]))
                     used[kind] += 1
     for kind in KINDS:        # what no top-level node accounts for (a YAML world; shapes outside any solid)

@@ -40,6 +40,7 @@ class Writer:
 
     def __init__(self) -> None:
         self.written: set[int] = set()        # ids of the DEF nodes written so far
+        self.written_nodes: set[int] = set()  # ids of the top-level nodes written so far (depth 0)
 
     def node(self, n: Node, depth: int = 0, fields: dict[str, Any] | None = None) -> str:
         """``n`` at ``depth`` levels of indent (its first line not indented: the caller places it);
@@ -48,6 +49,8 @@ class Writer:
             return f"USE {n.def_name}"
         if n.def_name:
             self.written.add(id(n))
+        if depth == 0:
+            self.written_nodes.add(id(n))
         head = f"DEF {n.def_name} {n.type}" if n.def_name else n.type
         lines = [head + " {"]
         pad = INDENT * (depth + 1)
