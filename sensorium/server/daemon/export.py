@@ -13,6 +13,7 @@ never writes a path a client names)."""
 from __future__ import annotations
 
 import math
+from collections import Counter
 from typing import Any
 
 from sensorium.server.daemon import supervisor as sv
@@ -85,11 +86,19 @@ def _written(sim: Any, node: sv.Node) -> ParsedNode:
     else:
         wbt = _world_file(sim)
         at = sim.top_level.written.get(_place(sim, node)) if wbt is not None else None
-        alone = at is not None and list(sim.top_level.written.values()).count(at) == 1
-        written = wbt.nodes[at] if wbt is not None and at is not None and alone else None
+        written = wbt.nodes[at] if wbt is not None and at is not None and _became(sim)[at] == 1 else None
     if written is None:
         raise NotExported(f"{sv._what(node)} has no .wbt text here: {why}")
     return written
+
+
+def _became(sim: Any) -> Counter[int]:
+    """How many robots, solids and lights each top-level node of the file became (counted once per layout)."""
+    places = sim.top_level.written
+    kept = getattr(sim, "_export_became", None)
+    if kept is None or kept[0] is not places:
+        kept = sim._export_became = (places, Counter(places.values()))
+    return kept[1]
 
 
 def _place(sim: Any, node: sv.Node) -> tuple[str, int]:
@@ -139,7 +148,7 @@ def node_string(sim: Any, node: sv.Node, writer: Writer | None = None) -> str:
                 fields[name] = now
             else:
                 del fields[name]
-        elif value != default and not _same(written_value(kind, default), now):
+        elif value != default and (default is None or not _same(written_value(kind, default), now)):
             fields = {name: now, **fields} if name in _FIRST else {**fields, name: now}
     if "rotation" in fields and "translation" in fields and list(fields).index("rotation") < list(fields).index(
             "translation"):
@@ -160,12 +169,11 @@ def world_string(sim: Any) -> str:
     lines += [("IMPORTABLE " if d.importable else "") + f'EXTERNPROTO "{d.url}"' for d in wbt.declarations]
     lines.append("")
     writer = Writer()
-    places = sim.top_level.written
-    shared = {at for at in places.values() if list(places.values()).count(at) > 1}
+    places, became = sim.top_level.written, _became(sim)
     imported = {n.id for n in sv._imported_nodes(sim, len(sv._loaded_nodes(sim))).every}
     for node in sv.root_children(sim):
         at = None if node.id in imported else places.get(_place(sim, node))
-        if at in shared:            # one top-level node of the file that became several: written once, as written
+        if at is not None and became[at] > 1:     # one top-level node of the file that became several: written once, as written
             if id(wbt.nodes[at]) not in writer.written_nodes:
                 lines.append(writer.node(wbt.nodes[at]))
             continue
