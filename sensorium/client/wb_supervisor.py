@@ -321,6 +321,17 @@ def wb_supervisor_node_get_center_of_mass(node: int | None) -> list[float]:
     return [math.nan] * 3 if got is None else [float(v) for v in got["value"]]
 
 
+def wb_supervisor_node_export_string(node: int | None) -> str:
+    """Webots' ``exportString``: a child of the root as ``.wbt`` text (``DEF NAME Type { ... }``), as its world
+    file or node string wrote it with the fields the server keeps as they are now (where it stands, its name,
+    custom data, a light's fields; README "Supervisor"), ready for ``importMFNodeFromString``. A node inside a
+    robot or solid, or of a YAML world, has no such text here: the server's one line and ""."""
+    func = "wb_supervisor_node_export_string"
+    r = _checked_node(node, func)
+    got = None if r is None else _answer(r, "node_export_string", {"node": int(node)}, func)  # type: ignore[arg-type]
+    return "" if got is None else str(got["value"])
+
+
 def wb_supervisor_node_remove(node: int | None) -> None:
     """Take a top-level solid or light out of the world for good: from the next step no sensor sees
     it and robots drive through where it stood; its id answers NULL from then on and is never reused;
@@ -1047,6 +1058,18 @@ def wb_supervisor_field_import_sf_node_from_string(field: Field | None, node_str
         print(f"Error: {func}(): {err.message}.", file=sys.stderr)
 
 
+def wb_supervisor_field_remove_sf(field: Field | None) -> None:
+    """Webots' ``removeSF``: served on the ``coord`` and ``color`` of an imported line or point set (the node
+    ``importSFNodeFromString`` put there leaves; the field is then empty and takes a node again); an empty
+    field stays empty; any other SFNode field is read-only here (the server's one line, nothing changed)."""
+    func = "wb_supervisor_field_remove_sf"
+    r = _field_robot(field, WB_SF_NODE, func)
+    if r is None:
+        return
+    assert field is not None
+    _answer(r, "field_remove_sf", _field_args(field), func)
+
+
 # ---------------------------------------------------------------------- the simulation
 
 def wb_supervisor_simulation_reset() -> None:
@@ -1122,6 +1145,47 @@ def wb_supervisor_world_reload() -> None:
     r = _supervisor(func)
     if r is not None:
         _launcher_call(r, "world_reload", None, func)
+
+
+def wb_supervisor_world_save(filename: str | None = None) -> bool:
+    """Webots' ``worldSave``: the world as it is now (README "Supervisor": what is written) saved as ``filename``
+    (a ``.wbt`` file; relative to the controller's folder, as every file a controller writes), through a
+    temporary file renamed onto it. Without a filename Webots overwrites the world file it loaded: here one
+    line and False (a headless server never overwrites its world file; name the file)."""
+    import os
+
+    func = "wb_supervisor_world_save"
+    r = _supervisor(func)
+    if r is None:
+        return False
+    if filename is None or filename == "":
+        print(f"Error: {func}(): the world file is not overwritten here: name the file to write (a departure from "
+              "Webots, which overwrites the world file it loaded).", file=sys.stderr)
+        return False
+    if not isinstance(filename, str | os.PathLike):
+        print(f"Error: {func}() called with an invalid 'filename' argument: {filename!r}.", file=sys.stderr)
+        return False
+    name = os.fspath(filename)
+    if not name.lower().endswith(".wbt"):
+        print(f"Error: the target file given to {func}() should have the '.wbt' extension.", file=sys.stderr)
+        return False
+    got = _answer(r, "world_save", None, func)
+    if got is None:
+        return False
+    folder, base = os.path.split(name)
+    tmp = os.path.join(folder, f".{base}.{os.getpid()}.tmp")
+    try:
+        with open(tmp, "w", encoding="utf-8", newline="\n") as out:
+            out.write(str(got["value"]))
+        os.replace(tmp, name)
+    except OSError as exc:
+        print(f"Error: {func}(): cannot write {name!r}: {exc.strerror or exc}.", file=sys.stderr)
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        return False
+    return True
 
 
 _unserved_warned: set[str] = set()

@@ -390,6 +390,8 @@ def node_by_id(sim: Any, node: int) -> Node:
     if node >= visuals.FIRST_ID:
         _all_nodes(sim)                  # (numbers the imports' visual nodes)
         v = _visuals(sim).nodes.get(node)
+        if v is None and node < _visuals(sim).next_id:       # (taken out of its field by removeSF)
+            raise ValueError(f"node {node} was removed")
         if v is None:
             raise ValueError(f"no node with id {node} ({_known_ids(sim)})")
         found = _visual_node(v)
@@ -1423,6 +1425,43 @@ def _set_label(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     return {"success": True}
 
 
+def remove_sf(sim: Any, node: Node, field: str, level: int = -1) -> None:
+    """Webots' ``removeSF``: the node in an SFNode field taken out, the field NULL. Served on the ``coord`` and
+    ``color`` of an imported line or point set (what ``importSFNodeFromString`` fills: the set then draws
+    nothing until a node is imported again); an empty field is left as it is (Webots); any other SFNode field
+    is read-only here (one line, nothing changed)."""
+    level = _level(node, level)
+    fields = _fields(sim, node, level)
+    entry = fields.get(field)
+    if entry is None or entry[0] != "SFNode":
+        kind = f" ({entry[0]})" if entry else ""
+        raise ValueError(f"field {field!r}{kind} of {_what(node)}: removeSF takes an SFNode field")
+    if not entry[1](sim, node):
+        return
+    if not (node.visual and node.id >= visuals.FIRST_ID):
+        raise ValueError(f"field {field!r} (SFNode) of {_what(node)} is read-only here: removeSF takes the node out of "
+                         "the coord or color of an imported line or point set only; nothing changed")
+    _visuals(sim).detach(_vnode(sim, node), field)
+
+
+def _remove_sf(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    remove_sf(sim, node_by_id(sim, a.node), a.field, a.level)
+    return {"success": True}
+
+
+def _export_string(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    from sensorium.server.daemon.export import node_string  # (export.py reads this module's nodes)
+
+    return {"value": node_string(sim, node_by_id(sim, a.node))}
+
+
+def _world_save(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    """The world as .wbt text; the client writes the file (the server never writes a path a client names)."""
+    from sensorium.server.daemon.export import world_string
+
+    return {"value": world_string(sim)}
+
+
 def _export_image(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     """The Viewpoint's picture (``viewshot.EXPORT_SIZE``) with the labels: pixels only, the client
     encodes and writes the file (the server never writes a path a client names)."""
@@ -1454,4 +1493,7 @@ HANDLERS = {
     "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},
     "set_label": _set_label,
     "export_image": _export_image,
+    "node_export_string": _export_string,
+    "world_save": _world_save,
+    "field_remove_sf": _remove_sf,
 }

@@ -179,6 +179,20 @@ class Store:
         parent.values[name] = child
         return child
 
+    def detach(self, parent: VNode, name: str) -> None:
+        """Webots' ``removeSF`` on the ``coord`` or ``color`` of an imported line or point set: its node and
+        those inside it leave (their ids read as removed, never given again), the slot is empty; ValueError
+        (one line, nothing changed) for any other field."""
+        if not (parent.inert and name in SF_SLOTS.get(parent.type, {})):
+            raise ValueError(f"field {name!r} of {what(parent)} is read-only here: removeSF takes the node out of the "
+                             "coord or color of an imported line or point set only; nothing changed")
+        child = parent.values.get(name, 0)
+        if not child:
+            return
+        for n in [self.nodes[child], *self.inside(child)]:
+            del self.nodes[n.id]
+        parent.values[name] = 0
+
     def inside(self, root_id: int) -> list[VNode]:
         """The nodes inside a root, depth first (its own fields' order)."""
         out: list[VNode] = []

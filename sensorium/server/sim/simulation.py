@@ -361,7 +361,7 @@ class Simulation:
         self.imported_protos: dict[str | int, str] = {}       # key -> the PROTO an imported node is an instance of
         self.imported_visuals: dict[str | int, Any] = {}      # key -> an imported Shape or Group (parsed; its solid's key)
         self.imported_interfaces: dict[str | int, tuple] = {}  # key -> that PROTO instance's interface fields
-        self.imported_written: dict[str | int, Any] = {}      # key -> an imported PROTO instance as written (parsed)
+        self.imported_written: dict[str | int, Any] = {}      # key -> an imported node as written (parsed)
         self.top_level = top_level(self.world)     # the root's children as loaded (world/top_nodes.py)
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
                                                             # a node was imported (None: the loaded order)
@@ -633,6 +633,7 @@ class Simulation:
             raise KeyError(f"no top-level light {index} (the world has {count}; removed: "
                            f"{sorted(self.scene.removed_lights) or 'none'})")
         self.scene.remove_top_light(index)
+        self.imported_written.pop(index, None)
 
     def next_node_id(self) -> int:
         """The Supervisor id the next imported node gets: after every node the world has had (robots,
@@ -679,7 +680,7 @@ class Simulation:
             self.imported_interfaces[key] = node.interface
             if node.visual is not None:
                 self.imported_visuals[key] = node.visual
-            if node.written is not None and node.proto:
+            if node.written is not None:       # (a PROTO instance's is built again from it; exportString writes it)
                 self.imported_written[key] = node.written
             out.append((node.type, key, node_id))
         return out

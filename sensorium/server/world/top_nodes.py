@@ -50,6 +50,9 @@ class TopLevel:
     protos: dict = field(default_factory=dict)   # (kind, index) -> the PROTO a robot, solid or light is an
                                                  # instance of (the top-level node it alone became)
     interfaces: dict = field(default_factory=dict)   # (kind, index) -> that instance's interface (wm.ProtoLevel each)
+    written: dict = field(default_factory=dict)   # (kind, index) -> the place in file order of the top-level node it
+                                                  # came from (a group: ("scenery", index)); a Supervisor's
+                                                  # exportString writes that node (daemon/export.py)
 
 
 def top_level(world: wm.World) -> TopLevel:
@@ -59,9 +62,11 @@ def top_level(world: wm.World) -> TopLevel:
     scenery: list[Scenery] = []
     protos: dict[tuple[str, int], str] = {}
     interfaces: dict[tuple[str, int], tuple] = {}
-    for node in world.top_nodes:
+    written: dict[tuple[str, int], int] = {}
+    for at, node in enumerate(world.top_nodes):
         counts = {"robots": node.robots, "solids": node.solids, "lights": node.lights}
         if not any(counts.values()):
+            written[("scenery", len(scenery))] = at
             order.append(("scenery", len(scenery)))
             scenery.append(Scenery(node.type, node.def_name or "", node.proto or "", dict(node.fields),
                                    tuple(node.interface)))
@@ -74,6 +79,7 @@ def top_level(world: wm.World) -> TopLevel:
                 take = min(counts[kind], sizes[kind] - used[kind])
                 members += [(kind, used[kind] + i) for i in range(take)]
                 used[kind] += take
+            written[("scenery", len(scenery))] = at
             order.append(("scenery", len(scenery)))
             scenery.append(Scenery(node.type, node.def_name or "", "", dict(node.fields), (), tuple(members)))
             continue
@@ -85,6 +91,7 @@ def top_level(world: wm.World) -> TopLevel:
         for kind in KINDS:
             for _ in range(counts[kind]):
                 if used[kind] < sizes[kind]:
+                    written[(kind, used[kind])] = at
                     order.append((kind, used[kind]))
                     used[kind] += 1
     for kind in KINDS:        # what no top-level node accounts for (a YAML world; shapes outside any solid)
@@ -93,4 +100,4 @@ def top_level(world: wm.World) -> TopLevel:
         if not any(s.type == kind for s in scenery):
             order.insert(min(place, len(order)), ("scenery", len(scenery)))
             scenery.append(Scenery(kind, ""))
-    return TopLevel(tuple(order), tuple(scenery), protos, interfaces)
+    return TopLevel(tuple(order), tuple(scenery), protos, interfaces, written)

@@ -4,6 +4,7 @@
  * call on the same node or field, as in Webots). Nodes are the root (id 0), robots, top-level solids
  * and top-level lights, and the nodes inside robots and solids (Solids, devices, Poses, Groups, joints);
  * a reply whose type is "" is Webots' NULL. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -493,6 +494,24 @@ void wb_supervisor_node_remove(WbNodeRef node) {
   sn_reply_free(&rep);
 }
 
+/* Webots' exportString: a child of the root as .wbt text, as its world file or node string wrote it with
+   the fields the server keeps as they are now. As libController, the library owns the string: it stays
+   valid until the next call (which frees it); "" after the server's line (a node inside a robot or solid,
+   a YAML world's node: no such text here). */
+const char *wb_supervisor_node_export_string(WbNodeRef node) {
+  static char *text;
+  const char *func = "wb_supervisor_node_export_string";
+  free(text);
+  text = NULL;
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/node_export_string", 1, args_node, &node->id, func, &rep) != 0)
+    return "";
+  text = sn_strdup_obj(sn_get(rep.result, "value"));
+  sn_reply_free(&rep);
+  return text != NULL ? text : "";
+}
+
 /* Webots' restartController and worldReload, served under `sensorium run` (which starts the
    controllers); under `sensorium serve` the server refuses them and one error line is printed. */
 void wb_supervisor_node_restart_controller(WbNodeRef node) {
@@ -511,6 +530,55 @@ void wb_supervisor_world_reload(void) {
   if (rb == NULL || sn_robot_call(rb, "robot/world_reload", 0, NULL, NULL, func, &rep) != 0)
     return;
   sn_reply_free(&rep);
+}
+
+/* Webots' worldSave: the world as it is now written to filename (a .wbt file, relative to the
+   controller's folder) through a temporary file beside it renamed onto it. Without a filename Webots
+   overwrites the world file it loaded: here one line and false (a headless server never overwrites its
+   world file). */
+static bool ends_with(const char *s, const char *suffix);
+
+bool wb_supervisor_world_save(const char *filename) {
+  const char *func = "wb_supervisor_world_save";
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return false;
+  if (filename == NULL || filename[0] == '\0') {
+    fprintf(stderr, "Error: %s(): the world file is not overwritten here: name the file to write (a departure from "
+                    "Webots, which overwrites the world file it loaded).\n", func);
+    return false;
+  }
+  if (!ends_with(filename, ".wbt")) {
+    fprintf(stderr, "Error: the target file given to %s() should have the '.wbt' extension.\n", func);
+    return false;
+  }
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/world_save", 0, NULL, NULL, func, &rep) != 0)
+    return false;
+  const msgpack_object *text = sn_get(rep.result, "value");
+  size_t n = strlen(filename) + 8;
+  char *tmp = malloc(n);
+  bool ok = text != NULL && text->type == MSGPACK_OBJECT_STR && tmp != NULL;
+  if (ok) {
+    snprintf(tmp, n, "%s.tmp", filename);
+    FILE *out = fopen(tmp, "wb");
+    ok = out != NULL && fwrite(text->via.str.ptr, 1, text->via.str.size, out) == text->via.str.size;
+    if (out != NULL && fclose(out) != 0)
+      ok = false;
+    if (ok && rename(tmp, filename) != 0)
+      ok = false;
+    if (!ok) {
+      fprintf(stderr, "Error: %s(): cannot write '%s': %s.\n", func, filename, strerror(errno));
+      remove(tmp);
+    }
+  }
+  free(tmp);
+  sn_reply_free(&rep);
+  return ok;
+}
+
+bool wb_supervisor_save_world(const char *filename) {
+  return wb_supervisor_world_save(filename);
 }
 
 typedef struct {
@@ -1528,6 +1596,20 @@ void wb_supervisor_field_import_sf_node_from_string(WbFieldRef field, const char
   import_args a = {field->node, field->name, 0, node_string};
   sn_reply rep;
   if (sn_robot_call(rb, "robot/import_node_from_string", 4, args_import, &a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
+/* Webots' removeSF: served on the coord and color of an imported line or point set (the node there
+   leaves, the field is empty and takes a node again); an empty field stays empty; any other SFNode field
+   is read-only here (the server's one line, nothing changed). */
+void wb_supervisor_field_remove_sf(WbFieldRef field) {
+  const char *func = "wb_supervisor_field_remove_sf";
+  sn_robot *rb = field_robot(field, WB_SF_NODE, func);
+  if (rb == NULL)
+    return;
+  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, field->level >= 0, field->level, 0, NULL};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/field_remove_sf", 2 + (field->level >= 0), args_field, &a, func, &rep) == 0)
     sn_reply_free(&rep);
 }
 

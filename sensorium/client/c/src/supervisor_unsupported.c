@@ -16,10 +16,6 @@ void wb_supervisor_world_load(const char *filename) {
   SN_UNSUPPORTED();
 }
 
-bool wb_supervisor_world_save(const char *filename) {
-  SN_UNSUPPORTED();
-  return false;
-}
 
 
 void wb_supervisor_movie_start_recording(const char *filename, int width, int height, int codec, int quality, int acceleration, bool caption) {
@@ -65,10 +61,6 @@ bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
 }
 
 
-const char *wb_supervisor_node_export_string(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return "";
-}
 
 void wb_supervisor_node_move_viewpoint(WbNodeRef node) {
   SN_UNSUPPORTED();
@@ -99,9 +91,6 @@ WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
 
 
 
-void wb_supervisor_field_remove_sf(WbFieldRef field) {
-  SN_UNSUPPORTED();
-}
 
 
 bool wb_supervisor_virtual_reality_headset_is_used(void) {
@@ -132,10 +121,6 @@ void wb_supervisor_load_world(const char *filename) {
   SN_UNSUPPORTED();
 }
 
-bool wb_supervisor_save_world(const char *filename) {
-  SN_UNSUPPORTED();
-  return false;
-}
 
 void wb_supervisor_field_remove_mf_node(WbFieldRef field, int position) {
   SN_UNSUPPORTED();

@@ -203,6 +203,9 @@ class Field:
     def importMFNodeFromString(self, position: int, nodeString: str) -> None:  # noqa: N803 - Webots' name
         wb.wb_supervisor_field_import_mf_node_from_string(self._ref, position, nodeString)
 
+    def removeSF(self) -> None:
+        wb.wb_supervisor_field_remove_sf(self._ref)
+
     _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_INT32: getSFInt32, wb.WB_SF_FLOAT: getSFFloat,
                 wb.WB_SF_STRING: getSFString, wb.WB_SF_VEC2F: getSFVec2f,
                 wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor,
@@ -359,6 +362,9 @@ class Node:
     def resetPhysics(self) -> None:
         wb.wb_supervisor_node_reset_physics(self._ref)
 
+    def exportString(self) -> str:
+        return wb.wb_supervisor_node_export_string(self._ref)
+
     def remove(self) -> None:
         wb.wb_supervisor_node_remove(self._ref)
 
@@ -506,6 +512,9 @@ class Supervisor(Robot):
     def simulationGetMode(self) -> int:
         return wb.wb_supervisor_simulation_get_mode()
 
+    def worldSave(self, filename: str | None = None) -> bool:
+        return wb.wb_supervisor_world_save(filename)
+
     def worldReload(self) -> None:
         wb.wb_supervisor_world_reload()
 
@@ -568,7 +577,7 @@ _NAN = math.nan
 _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
     Supervisor: {
         "getSelected": ("node_get_selected", None, ""),
-        "worldLoad": ("world_load", None, "filename"), "worldSave": ("world_save", False, "filename=None"),
+        "worldLoad": ("world_load", None, "filename"),
         "movieStartRecording": ("movie_start_recording", None,
                                 "filename, width, height, codec, quality, acceleration, caption"),
         "movieStopRecording": ("movie_stop_recording", None, ""), "movieIsReady": ("movie_is_ready", True, ""),
@@ -579,7 +588,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3, ""),
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9, "")},
     Node: {
-        "exportString": ("node_export_string", "", ""),
         "getStaticBalance": ("node_get_static_balance", False, ""),
         "moveViewpoint": ("node_move_viewpoint", None, ""),
         "setVisibility": ("node_set_visibility", None, "fromNode, visible"),
@@ -587,8 +595,7 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),
         "addTorque": ("node_add_torque", None, "torque, relative")},
     Field: {
-        "getActualField": ("field_get_actual_field", None, ""),
-        "removeSF": ("field_remove_sf", None, "")},
+        "getActualField": ("field_get_actual_field", None, "")},
 }
 for _cls, _methods in _UNSERVED.items():
     for _method, (_func, _value, _params) in _methods.items():
