@@ -175,6 +175,26 @@ def test_a_recording_holds_both_directions_in_order(tmp_path):
     assert [m.seq for m in msgs] == [0, 0, 1, 1]
 
 
+@pytest.mark.slow
+def test_a_replay_publishes_both_directions_in_order(tmp_path):
+    """`sensorium replay --topics /bot/robot_window` (a pattern taking both topics) and `sensorium echo`:
+    the dialogue as it was published, with its stamps."""
+    import json
+
+    from _serve import Served
+
+    path = tmp_path / "dialogue.mcap"
+    window_dialogue(path)
+    any_port = "tcp://127.0.0.1:*"
+    with Served(sensorium("replay", str(path), "--pub", any_port, "--rpc", any_port, "--rate", "0", "--wait",
+                          "--topics", "/bot/robot_window"), "sensorium: replaying").wait_ready() as replay:
+        with Proc(sensorium("echo", "/bot/", "--json", "--count", "4", "--url", replay.rpc)) as printer:
+            assert printer.wait(60) == 0, printer.stderr()
+        assert replay.wait(60) == 0, replay.stderr()
+    printed = [json.loads(line) for line in printer.stdout().splitlines()]
+    assert [(m["topic"], m["stamp_ns"], m["body"]["data"]) for m in printed] == DIALOGUE
+
+
 def test_foxglove_readers_decode_both_directions_in_order(tmp_path):
     """Foxglove's TypeScript MCAP reader (@mcap/core) and ROS 2 CDR decoder read the Foxglove-ready
     view of both topics, in the order they were published."""
