@@ -171,7 +171,10 @@ def test_layout_command(tmp_path):
     assert three_d["panelType"] == "ThreeDee" and three_d["config"]["fixedFrame"] == "world"
     assert set(three_d["config"]["topics"]) == {"/scene", "/bot/lidar/laser_scan", "/bot/lidar/point_cloud",
                                                 "/bot/lidar2/point_cloud"}
+    *side, windows = side                                       # last: the robots' windows, one tab each
     panels = {item["content"]["panelType"]: item["content"]["config"] for item in side}
+    assert [(t["title"], t["content"]["panelType"], t["content"]["config"]) for t in windows["content"]["tabs"]] == \
+        [(r, "RawMessages", {"topicPath": f"/{r}/robot_window"}) for r in ("bot", "bot2", "free", "rover")]
     assert [p["value"] for p in panels["Plot"]["paths"]] == ["/bot/ds/value.range", "/bot/ls/value.illuminance",
                                                              "/free/ls/value.illuminance"]
     assert panels["Image"]["imageMode"]["imageTopic"] == "/bot/lidar/range_image"

@@ -109,6 +109,108 @@ def test_a_recording_keeps_the_robot_window_texts_with_their_type(tmp_path):
                                                                (1, 64_000_000, {"data": "stop"})]
 
 
+def test_texts_sent_to_the_controller_are_published_on_their_own_topic_when_queued():
+    """``window_send`` publishes its text on ``/<robot>/robot_window/to_controller`` at once, stamped
+    with the simulated time it was queued, interleaved with the controller's own texts in the order
+    they came; a text the full queue refuses is not published."""
+    core, ctl = attached_core()
+    anyone = Client(core, OTHER)
+    core.subscription(b"\x01/bot/robot_window")         # a prefix: both directions
+    assert {"name": "/bot/robot_window/to_controller", "type": "std_msgs/msg/String"} in \
+        ctl.call("get_info")["result"]["topics"]
+    step(core, ctl, 96)
+    assert anyone.call("/bot/robot/window_send", {"text": "speed:2"})["result"]["queued"] == 1
+    assert ctl.call("/bot/robot/wwi_send", {"text": "ack"})["ok"]
+    assert anyone.call("/bot/robot/window_send", {"text": "é ✓\nline"})["ok"]
+    step(core, ctl, 32)                                    # the controller takes them; time 128 ms
+    assert anyone.call("/bot/robot/window_send", {"text": "later"})["ok"]
+    frames = core.topics.outbox
+    assert [(f[0], msgpack.unpackb(f[1]), f[2]) for f in frames] == [
+        (b"/bot/robot_window/to_controller\0", {"type": "std_msgs/msg/String", "seq": 0, "stamp_ns": 96_000_000},
+         pack({"data": "speed:2"})),
+        (b"/bot/robot_window\0", {"type": "std_msgs/msg/String", "seq": 0, "stamp_ns": 96_000_000}, pack({"data": "ack"})),
+        (b"/bot/robot_window/to_controller\0", {"type": "std_msgs/msg/String", "seq": 1, "stamp_ns": 96_000_000},
+         pack({"data": "é ✓\nline"})),
+        (b"/bot/robot_window/to_controller\0", {"type": "std_msgs/msg/String", "seq": 2, "stamp_ns": 128_000_000},
+         pack({"data": "later"})),
+    ]
+    core.topics.outbox = []
+    for k in range(S.MAX_WINDOW_QUEUE - 1):               # "later" waits already: fill the queue
+        assert anyone.call("/bot/robot/window_send", {"text": str(k)})["ok"]
+    assert len(core.topics.outbox) == S.MAX_WINDOW_QUEUE - 1
+    core.topics.outbox = []
+    assert anyone.call("/bot/robot/window_send", {"text": "refused"})["error"]["code"] == ErrorCode.WRONG_STATE
+    assert core.topics.outbox == []
+
+
+def window_dialogue(path: Path) -> None:
+    """A recording (every topic, as serve --record) of texts both ways over two steps."""
+    core, ctl = attached_core()
+    anyone = Client(core, OTHER)
+    rec = McapRecorder(path, world_text=WORLD.read_text(), world_name=WORLD.name, background_flush=False)
+    core.topics.set_recorder(rec)
+    step(core, ctl)
+    anyone.call("/bot/robot/window_send", {"text": "start"})
+    ctl.call("/bot/robot/wwi_send", {"text": "started"})
+    step(core, ctl)
+    ctl.call("/bot/robot/wwi_send", {"text": "score: 12"})
+    anyone.call("/bot/robot/window_send", {"text": "stop"})
+    core.topics.set_recorder(None)
+    rec.close()
+
+
+DIALOGUE = [("/bot/robot_window/to_controller", 32_000_000, "start"), ("/bot/robot_window", 32_000_000, "started"),
+            ("/bot/robot_window", 64_000_000, "score: 12"), ("/bot/robot_window/to_controller", 64_000_000, "stop")]
+
+
+def test_a_recording_holds_both_directions_in_order(tmp_path):
+    path = tmp_path / "dialogue.mcap"
+    window_dialogue(path)
+    with Recording(path) as r:
+        info = {t.topic: t for t in r.topics()}
+        assert info["/bot/robot_window/to_controller"].ros_type == "std_msgs/msg/String"
+        assert "foxglove_view_errors" not in r.metadata()
+        msgs = list(r.messages(["/bot/robot_window"]))   # a prefix: both directions, in publication order
+    assert [(m.topic, m.stamp_ns, m.decode()["data"]) for m in msgs] == DIALOGUE
+    assert [m.seq for m in msgs] == [0, 0, 1, 1]
+
+
+@pytest.mark.slow
+def test_a_replay_publishes_both_directions_in_order(tmp_path):
+    """`sensorium replay --topics /bot/robot_window` (a pattern taking both topics) and `sensorium echo`:
+    the dialogue as it was published, with its stamps."""
+    import json
+
+    from _serve import Served
+
+    path = tmp_path / "dialogue.mcap"
+    window_dialogue(path)
+    any_port = "tcp://127.0.0.1:*"
+    with Served(sensorium("replay", str(path), "--pub", any_port, "--rpc", any_port, "--rate", "0", "--wait",
+                          "--topics", "/bot/robot_window"), "sensorium: replaying").wait_ready() as replay:
+        with Proc(sensorium("echo", "/bot/", "--json", "--count", "4", "--url", replay.rpc)) as printer:
+            assert printer.wait(60) == 0, printer.stderr()
+        assert replay.wait(60) == 0, replay.stderr()
+    printed = [json.loads(line) for line in printer.stdout().splitlines()]
+    assert [(m["topic"], m["stamp_ns"], m["body"]["data"]) for m in printed] == DIALOGUE
+
+
+def test_foxglove_readers_decode_both_directions_in_order(tmp_path):
+    """Foxglove's TypeScript MCAP reader (@mcap/core) and ROS 2 CDR decoder read the Foxglove-ready
+    view of both topics, in the order they were published."""
+    from _node import require_node, run_script
+
+    require_node()
+    path = tmp_path / "dialogue.mcap"
+    window_dialogue(path)
+    got = run_script("read_mcap.js", str(path), "/bot/robot_window", "/bot/robot_window/to_controller")[0]
+    assert got["errors"] == []
+    channels = {c["topic"]: c for c in got["channels"]}
+    assert channels["/bot/robot_window/to_controller"]["schemaName"] == "std_msgs/msg/String"
+    assert [(m["topic"], m["log_time"], m["msg"]) for m in got["every"]] == \
+        [(topic, ns, {"data": text}) for topic, ns, text in DIALOGUE]
+
+
 def test_texts_sent_to_the_window_side_come_with_the_next_step_reply_in_order():
     core, ctl = attached_core()
     anyone = Client(core, OTHER)                         # any caller (open controls): the CLI's way
@@ -170,14 +272,20 @@ def test_wwi_receive_text_reads_a_steps_texts_one_per_call_and_the_next_step_dro
 @pytest.mark.slow
 def test_a_python_controller_talks_with_the_cli_through_its_robot_window(tmp_path):
     """`sensorium window ROBOT TEXT` reaches a Python controller's wwiReceiveText in order; its
-    wwiSendText answers are on /epuck/robot_window for a subscriber and in serve's recording."""
+    wwiSendText answers are on /epuck/robot_window for a subscriber and in serve's recording, the
+    texts sent to it on /epuck/robot_window/to_controller; `sensorium echo` of both topics prints the
+    dialogue in order."""
+    import json
+
     from sensorium.client.topics import Subscriber
 
     record = tmp_path / "window.mcap"
+    both = ["/epuck/robot_window", "/epuck/robot_window/to_controller"]
     with serve(ARENA, "--mode", "fast", "--record", str(record)) as server:
-        with Subscriber(server.pub, "/epuck/robot_window") as sub:
-            wait_until(lambda: b"/epuck/robot_window\0" in server.conn.call("get_counters")["subscriptions"],
-                       what="the subscription")
+        printer = Proc(sensorium("echo", *both, "--json", "--count", "7", "--url", server.rpc))
+        with printer, Subscriber(server.pub, "/epuck/robot_window") as sub:
+            wait_until(lambda: {b"/epuck/robot_window\0", b"/epuck/robot_window/to_controller\0"}
+                       <= set(server.conn.call("get_counters")["subscriptions"]), what="the subscriptions")
             ctl = Proc(sensorium("controller", str(REPO / "tests" / "controllers" / "window_echo.py"),
                                  "--url", server.url("epuck")))
             try:
@@ -194,6 +302,13 @@ def test_a_python_controller_talks_with_the_cli_through_its_robot_window(tmp_pat
             finally:
                 ctl.stop()
             assert ctl.stdout().splitlines() == ["received go|turn left|stop"]
+            assert printer.wait(60) == 0, printer.stderr()
+        dialogue = [("/epuck/robot_window", "ready")]
+        for text in ["go", "turn left", "stop"]:
+            dialogue += [("/epuck/robot_window/to_controller", text), ("/epuck/robot_window", f"echo:{text}")]
+        printed = [json.loads(line) for line in printer.stdout().splitlines()]
+        assert [(m["topic"], m["body"]["data"]) for m in printed] == dialogue
+        assert [m["seq"] for m in printed] == [0, 0, 1, 1, 2, 2, 3]
         # bad input: one line, exit 1
         done = subprocess.run(sensorium("window", "nobody", "hi", "--url", server.rpc), capture_output=True,
                               text=True, timeout=60, env=child_env())
@@ -201,5 +316,57 @@ def test_a_python_controller_talks_with_the_cli_through_its_robot_window(tmp_pat
         assert done.stderr.startswith("sensorium window: ") and "no robot 'nobody'" in done.stderr
         assert len(done.stderr.splitlines()) == 1, done.stderr
     with Recording(record) as r:
-        said = [m.decode()["data"] for m in r.messages(["/epuck/robot_window"])]
+        said = [m.decode()["data"] for m in r.messages(lambda topic: topic == "/epuck/robot_window")]
+        recorded = [(m.topic, m.decode()["data"]) for m in r.messages(both)]
     assert said == ["ready", "echo:go", "echo:turn left", "echo:stop"]
+    assert recorded == dialogue
+
+
+def window_panels(layout: str) -> list[tuple[str, str]]:
+    """The robot-window panels of a layout (the side column's last item): (tab or panel title, topic)."""
+    import json
+
+    last = json.loads(layout)["content"]["items"][1]["content"]["items"][-1]["content"]
+    if last.get("type") == "tabs":
+        return [(t["title"], t["content"]["config"]["topicPath"]) for t in last["tabs"]
+                if t["content"]["panelType"] == "RawMessages"]
+    if last.get("panelType") == "RawMessages" and last["config"]["topicPath"] != "/clock":
+        return [(last["title"], last["config"]["topicPath"])]
+    return []
+
+
+def test_the_layout_shows_the_robot_window_of_each_robot_with_a_controller_in_tabs(tmp_path):
+    """One panel whatever the number of robots: a tab per robot with a controller (``<none>`` has
+    none), at most MAX_WINDOW_TABS, the first by name; one robot: the panel itself."""
+    import json
+
+    pytest.importorskip("foxglove.layouts")
+    from sensorium.server.viewer.layout import MAX_WINDOW_TABS, layout_for
+
+    names = [f"r{k:02d}" for k in range(11)]
+    robots = [{"name": n, "controller": "<none>" if n == "r01" else "<extern>", "devices": []} for n in reversed(names)]
+    world = tmp_path / "many.json"
+    world.write_text(json.dumps({"world_info": {"basic_time_step": 16}, "robots": robots}))
+    shown = [n for n in names if n != "r01"][:MAX_WINDOW_TABS]
+    assert MAX_WINDOW_TABS == 8 and window_panels(layout_for(world)) == [(n, f"/{n}/robot_window") for n in shown]
+    world.write_text(json.dumps({"world_info": {"basic_time_step": 16}, "robots": robots[-2:]}))   # r01, r00
+    assert window_panels(layout_for(world)) == [("r00 robot window", "/r00/robot_window")]
+    world.write_text(json.dumps({"world_info": {"basic_time_step": 16}, "robots": robots[-2:-1]}))  # r01 alone
+    assert window_panels(layout_for(world)) == []
+
+
+def test_the_layout_of_a_recording_shows_the_windows_it_has_texts_of(tmp_path):
+    pytest.importorskip("foxglove.layouts")
+    from sensorium.server.viewer.layout import layout_for
+
+    path = tmp_path / "dialogue.mcap"
+    window_dialogue(path)                                # bot's texts both ways; bot2, free, rover said nothing
+    assert window_panels(layout_for(path)) == [("bot robot window", "/bot/robot_window")]
+    core, _ = attached_core()                            # a text only to a controller counts too
+    rec = McapRecorder(tmp_path / "to.mcap", world_text=WORLD.read_text(), world_name=WORLD.name,
+                       background_flush=False)
+    core.topics.set_recorder(rec)
+    Client(core, OTHER).call("/bot2/robot/window_send", {"text": "to bot2 only"})
+    core.topics.set_recorder(None)
+    rec.close()
+    assert window_panels(layout_for(tmp_path / "to.mcap")) == [("bot2 robot window", "/bot2/robot_window")]

@@ -47,9 +47,11 @@ def test_topic_names_and_types():
         ("/bot/lidar2/point_cloud", M.POINT_CLOUD),
         ("/bot/pose", M.POSE_STAMPED),                    # every robot: its pose after each basic step
         ("/bot/robot_window", M.STRING),                  # ... and what its controller sends its robot window
+        ("/bot/robot_window/to_controller", M.STRING),    # ... and what is sent to its controller from there
         ("/free/ls/value", M.ILLUMINANCE),
         ("/free/pose", M.POSE_STAMPED),
         ("/free/robot_window", M.STRING),
+        ("/free/robot_window/to_controller", M.STRING),
     ]
 
 
@@ -57,7 +59,10 @@ def test_topic_names_and_types():
     ([], set()),
     ([b""], {"/clock", "/bot/ls/value", "/bot/ds/value", "/bot/lidar/range_image", "/bot/lidar/laser_scan",
              "/bot/lidar/point_cloud", "/bot/lidar2/range_image", "/bot/lidar2/point_cloud", "/bot/pose",
-             "/bot/robot_window", "/free/ls/value", "/free/pose", "/free/robot_window"}),
+             "/bot/robot_window", "/bot/robot_window/to_controller", "/free/ls/value", "/free/pose",
+             "/free/robot_window", "/free/robot_window/to_controller"}),
+    ([b"/bot/robot_window\0"], {"/bot/robot_window"}),              # exact: not the other direction
+    ([b"/bot/robot_window"], {"/bot/robot_window", "/bot/robot_window/to_controller"}),
     ([b"/bot/pose\0"], {"/bot/pose"}),
     ([b"/bot/pose/"], set()),
     ([b"/bot/lidar/"], {"/bot/lidar/range_image", "/bot/lidar/laser_scan", "/bot/lidar/point_cloud"}),

@@ -92,12 +92,13 @@ def _controller_args(p: argparse.ArgumentParser) -> None:
                    "and '--' ends them")
 
 
-@command("echo", "print the messages of a topic (or of every topic under a PREFIX/) as YAML",
+@command("echo", "print the messages of topics (or of every topic under a PREFIX/) as YAML, in the order published",
          "sensorium.cli.topics:echo")
 def _echo_args(p: argparse.ArgumentParser) -> None:
     from sensorium.cli.topics import add_endpoint_args
 
-    p.add_argument("topic", help="topic, e.g. /epuck/ps0/value; a name ending in '/' is a prefix, '' is all")
+    p.add_argument("topics", nargs="+", metavar="TOPIC",
+                   help="topic, e.g. /epuck/ps0/value; a name ending in '/' is a prefix, '' is all")
     add_endpoint_args(p)
     p.add_argument("--count", type=at_least(1), metavar="N", help="stop after N messages")
     p.add_argument("--full", action="store_true", help="print arrays in full (default: summarised)")

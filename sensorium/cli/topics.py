@@ -189,7 +189,7 @@ def format_message(msg: Any, full: bool = False) -> str:
 
 
 def echo(args: argparse.Namespace) -> int:
-    setup = _setup("echo", [args.topic], args)
+    setup = _setup("echo", args.topics, args)
     if isinstance(setup, int):
         return setup
     view, url = setup
@@ -197,7 +197,7 @@ def echo(args: argparse.Namespace) -> int:
     count = 0
     noted = False
     last = time.monotonic()
-    sub = _subscribe("echo", url, [args.topic])
+    sub = _subscribe("echo", url, args.topics)      # one socket: several topics come in the order published
     if sub is None:
         return 1
     with sub:
@@ -207,7 +207,7 @@ def echo(args: argparse.Namespace) -> int:
             if msg is None:
                 idle = time.monotonic() - last
                 if limit is not None and idle >= limit:
-                    print(no_message("echo", repr(args.topic), url, limit, view), file=sys.stderr)
+                    print(no_message("echo", " or ".join(map(repr, args.topics)), url, limit, view), file=sys.stderr)
                     return 1
                 if not noted and count == 0 and view.info is not None and idle >= NOTE_AFTER_S:
                     view = ask_server(view.rpc) if view.info else view

@@ -25,9 +25,9 @@ def layout_cmd(args: argparse.Namespace) -> int:
         print(f"sensorium layout: {out} exists already; not overwriting (--force to replace it)", file=sys.stderr)
         return 1
     try:
-        from sensorium.server.viewer.layout import layout_json, topics_of
+        from sensorium.server.viewer.layout import layout_for
 
-        text = layout_json(topics_of(source))
+        text = layout_for(source)
     except WorldError as exc:
         print(str(exc), file=sys.stderr)
         return 1

@@ -1,9 +1,10 @@
 // Validate and decode a Sensorium recording with Foxglove's own TypeScript MCAP reader (@mcap/core)
 // and the independent decoders of decode.js. Prints one JSON object:
 //   {profile, channels: [{topic, schemaName, schemaEncoding, messageEncoding, count}], errors: [...],
-//    last: {topic: last decoded message}, messages}
-// Every chunk CRC is checked; every message of every channel is decoded.
-// Usage: node read_mcap.js FILE.mcap
+//    last: {topic: last decoded message}, messages, every: [{topic, log_time, msg}]}
+// Every chunk CRC is checked; every message of every channel is decoded. ``every`` lists the
+// messages of the TOPICs named after the file, each decoded, in the order the reader gives them.
+// Usage: node read_mcap.js FILE.mcap [TOPIC...]
 "use strict";
 const fs = require("fs");
 const { McapIndexedReader } = require("@mcap/core");
@@ -41,6 +42,8 @@ async function main() {
     }
   }
   const last = {};
+  const listed = new Set(process.argv.slice(3));
+  const every = [];
   let messages = 0;
   for await (const msg of reader.readMessages({ validateCrcs: true })) {
     const info = channels.get(msg.channelId);
@@ -51,11 +54,12 @@ async function main() {
     try {
       const value = decode(msg.data);
       last[info.topic] = { log_time: Number(msg.logTime), sequence: msg.sequence, msg: value };
+      if (listed.has(info.topic)) every.push({ topic: info.topic, log_time: Number(msg.logTime), msg: value });
     } catch (e) {
       if (errors.length < 50) errors.push({ topic: info.topic, log_time: Number(msg.logTime), error: `decode failed: ${e.message}` });
     }
   }
-  process.stdout.write(toJson({ profile: reader.header.profile, channels: [...channels.values()], errors, last, messages }) + "\n");
+  process.stdout.write(toJson({ profile: reader.header.profile, channels: [...channels.values()], errors, last, messages, every }) + "\n");
 }
 
 main().catch((e) => { process.stderr.write(String(e.stack || e) + "\n"); process.exit(1); });

@@ -806,7 +806,8 @@ class Core(DeviceServices):
     def _robot_window_send(self, c: Call) -> dict:
         """What a robot window's page sends its controller: queued for the controller's next step
         reply (wwiReceiveText reads them one per call), at most MAX_WINDOW_QUEUE texts and
-        MAX_WINDOW_QUEUE_CHARS characters waiting."""
+        MAX_WINDOW_QUEUE_CHARS characters waiting; published on ``/<robot>/robot_window/to_controller``
+        when queued (a refused one is not), stamped with the time then, so a recording has both sides."""
         q = self._window_inbox[c.robot]
         chars = self._window_chars[c.robot] + len(c.args.text)
         if len(q) >= S.MAX_WINDOW_QUEUE or chars > S.MAX_WINDOW_QUEUE_CHARS:
@@ -818,6 +819,7 @@ class Core(DeviceServices):
         q.append(c.args.text)
         self._window_chars[c.robot] = chars
         self._window_news.add(c.robot)
+        self.topics.robot_window(c.robot, c.args.text, self.sim.time_ms, to_controller=True)
         return {"queued": len(q)}
 
     # ------------------------------------------------------------------ supervisor services

@@ -14,8 +14,10 @@ device produced a new value (plus ``/clock``, each demanded ``/<robot>/pose`` an
 joints, ``/<robot>/joint_states``) as ready-to-send
 frames, calls the recorder (and the viewer sink, sensorium.server.viewer) with the very same bytes,
 and counts ``seq`` per topic. A text a controller sends its robot window (``wwi_send``) is published
-on ``/<robot>/robot_window`` when it arrives, not after a step: :meth:`Topics.robot_window` leaves its
-frames in :attr:`Topics.outbox`, which the transport sends after the requests it served. A robot's pose
+on ``/<robot>/robot_window`` when it arrives, not after a step, and a text sent to the window side
+for the controller (``window_send``) on ``/<robot>/robot_window/to_controller`` when it is queued:
+:meth:`Topics.robot_window` leaves their frames in :attr:`Topics.outbox`, which the transport sends
+after the requests it served. A robot's pose
 is read and packed only while its pose topic is demanded (``work["poses_built"]`` counts them).
 This module does no I/O.
 """
@@ -56,6 +58,7 @@ class Topic:
     name: str
     type: str
     kind: str                # value | range_image | laser_scan | point_cloud | clock | pose | joint_states | robot_window
+                             # | robot_window_to_controller
     path: str | None         # "robot/device"; the robot's name for pose; None for /clock
     frame: bytes             # name + NUL
 
@@ -222,6 +225,7 @@ class Topics:
         self.pose_topics: dict[str, Topic] = {}      # robot -> its /<robot>/pose topic
         self.joint_topics: dict[str, Topic] = {}     # robot with joints -> its /<robot>/joint_states topic
         self.window_topics: dict[str, Topic] = {}    # robot -> its /<robot>/robot_window topic
+        self.window_in_topics: dict[str, Topic] = {}  # robot -> its /<robot>/robot_window/to_controller topic
         world_info = getattr(getattr(sim, "world", None), "world_info", None)
         for robot_name, robot in sim.robots.items():
             for dev_name, dev in robot.devices.items():
@@ -244,6 +248,10 @@ class Topics:
             window_topic = Topic(name, msgs.STRING, "robot_window", robot_name, topic_frame(name))
             self.topics.append(window_topic)
             self.window_topics[robot_name] = window_topic
+            name = f"/{robot_name}/robot_window/to_controller"
+            window_in = Topic(name, msgs.STRING, "robot_window_to_controller", robot_name, topic_frame(name))
+            self.topics.append(window_in)
+            self.window_in_topics[robot_name] = window_in
         self.by_name = {t.name: t for t in self.topics}
         self.seq: dict[str, int] = {t.name: 0 for t in self.topics}
         self.prefixes: dict[bytes, int] = {}       # accepted subscription prefix -> subscriptions
@@ -432,10 +440,12 @@ class Topics:
                         self._emit(t, at, body, out)
         return out
 
-    def robot_window(self, robot: str, text: str, time_ms: int) -> None:
-        """A text the robot's controller sent its robot window: published now (subscribers get it
-        from :attr:`outbox`; the recorder and the viewer at once), stamped with the time it was sent."""
-        self._emit(self.window_topics[robot], time_ms, {"data": text}, self.outbox)
+    def robot_window(self, robot: str, text: str, time_ms: int, to_controller: bool = False) -> None:
+        """A text the robot's controller sent its robot window (``to_controller``: one sent to the
+        controller from the window side): published now (subscribers get it from :attr:`outbox`; the
+        recorder and the viewer at once), stamped with the time it was sent or queued."""
+        topic = (self.window_in_topics if to_controller else self.window_topics)[robot]
+        self._emit(topic, time_ms, {"data": text}, self.outbox)
 
     def _emit(self, t: Topic, ms: int, body: dict, out: list[list[bytes]]) -> None:
         seq = self.seq[t.name]

@@ -4,21 +4,27 @@ Foxglove *Layouts → Import from file*.
 Built with the SDK's layout types (``foxglove.layouts``), from the topics of a recording or a world
 file: a 3D panel (fixed frame ``world``; the scene, every laser scan and point cloud visible), a
 plot of every light sensor's illuminance and every distance sensor's range, an image panel on the
-first camera image (else the first lidar or range-finder range image), and a raw-messages panel on ``/clock``.
+first camera image (else the first lidar or range-finder range image), a raw-messages panel on ``/clock``
+and one on each robot's ``/<robot>/robot_window`` (the latest text its controller sent), for the
+robots with a controller (a world file) or whose window texts a recording holds: one tab each in one
+panel, at most :data:`MAX_WINDOW_TABS` (the first by name), so a world of many robots keeps its layout.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 
-__all__ = ["layout_json", "topics_of"]
+__all__ = ["layout_json", "layout_for"]
 
 MAX_PLOTTED = 16      # series per plot panel (a world with many sensors stays readable)
+MAX_WINDOW_TABS = 8   # robot-window tabs: more would not fit the tab bar of a side panel
+WINDOW = "/robot_window"
 
 
-def layout_json(topics: Mapping[str, str]) -> str:
-    """The layout (Foxglove's JSON) for ``topics`` (name → ROS type as published)."""
+def layout_json(topics: Mapping[str, str], windows: Iterable[str] = ()) -> str:
+    """The layout (Foxglove's JSON) for ``topics`` (name → ROS type as published) and the robots
+    whose ``/<robot>/robot_window`` it shows (``windows``)."""
     import foxglove.layouts as fl
 
     three_d: dict = {"/scene": fl.BaseRendererSceneUpdateTopicSettings(visible=True)}
@@ -43,6 +49,14 @@ def layout_json(topics: Mapping[str, str]) -> str:
             config=fl.ImageConfig(image_mode=fl.ImageModeConfig(image_topic=images[0])))))
     side.append(fl.SplitItem(content=fl.RawMessagesPanel(title="Raw messages",
                                                          config=fl.RawMessagesConfig(topic_path="/clock"))))
+    shown = sorted(set(windows))[:MAX_WINDOW_TABS]
+    panels = [fl.RawMessagesPanel(title=f"{r} robot window", config=fl.RawMessagesConfig(topic_path=f"/{r}{WINDOW}"))
+              for r in shown]
+    if len(panels) == 1:
+        side.append(fl.SplitItem(content=panels[0]))
+    elif panels:
+        side.append(fl.SplitItem(content=fl.TabContainer(tabs=[fl.TabItem(title=r, content=p)
+                                                               for r, p in zip(shown, panels)])))
     layout = fl.Layout(content=fl.SplitContainer(direction="row", items=[
         fl.SplitItem(proportion=2, content=fl.ThreeDeePanel(
             title="World", config=fl.ThreeDeeConfig(fixed_frame="world", follow_tf="world", topics=three_d))),
@@ -51,15 +65,22 @@ def layout_json(topics: Mapping[str, str]) -> str:
     return layout.to_json()
 
 
-def topics_of(source: str | Path) -> dict[str, str]:
-    """Topic → type of a recording (``.mcap``) or of the world a world file describes."""
+def layout_for(source: str | Path) -> str:
+    """The layout of a recording (``.mcap``: its topics; a robot window for each robot whose window
+    texts, either way, it holds) or of the world a world file describes (its topics; a robot window
+    for each robot with a controller, ``<none>`` having none)."""
     path = Path(source)
     if path.suffix == ".mcap":
         from sensorium.server.recording.reader import Recording
 
         with Recording(path) as rec:
-            return {t.topic: t.ros_type for t in rec.topics()}
+            infos = rec.topics()
+        said = {t.topic.removesuffix("/to_controller") for t in infos if t.count}
+        return layout_json({t.topic: t.ros_type for t in infos},
+                           [t[1:-len(WINDOW)] for t in said if t.startswith("/") and t.endswith(WINDOW)])
     from sensorium.server.daemon.topics import Topics
     from sensorium.server.sim.simulation import Simulation
 
-    return {t.name: t.type for t in Topics(Simulation.from_file(path, precision="fast")).topics}
+    sim = Simulation.from_file(path, precision="fast")
+    return layout_json({t.name: t.type for t in Topics(sim).topics},
+                       [name for name, robot in sim.robots.items() if robot.controller != "<none>"])
