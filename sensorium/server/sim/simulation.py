@@ -30,6 +30,7 @@ from sensorium.server.sim.belt import Belts
 from sensorium.server.sim.cameras import Camera
 from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
+from sensorium.server.sim.falling import Falls
 from sensorium.server.sim.ground import (
     Ground,
     GroundWarning,
@@ -410,6 +411,8 @@ class Simulation:
         # conveyor belts (sim/belt.py): none in most worlds, which then pay nothing for them
         self._belts = Belts(self, _TO_ENU[self.world.world_info.coordinate_system]) \
             if any(r.belts for r in self.world.robots) else None
+        # solids a VacuumGripper let go, falling under gravity (sim/falling.py): none, no work
+        self.falls = Falls(self, _TO_ENU[self.world.world_info.coordinate_system], self.world.world_info.gravity)
 
     def _warn_ground(self) -> None:
         """One GroundWarning per thing a driven robot will not ride on: a tilted terrain, a robot
@@ -508,6 +511,7 @@ class Simulation:
                 elif isinstance(dev, Camera):      # a zoomed camera: the world file's fieldOfView
                     dev.reset_fov()
         self.radio.reset()
+        self.falls.clear()
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
                 continue
@@ -832,6 +836,8 @@ class Simulation:
             self.scene.set_robot_pose(robot.index, pose)
         if self._belts is not None:   # belts carry what lies on them by their motors' travel this step
             self._belts.carry(dt * 0.001)
+        if self.falls:                # solids let go fall on before the grippers look (one may catch them)
+            self.falls.advance(now)
         for gripper in self._grippers:    # held solids follow their grippers; pumps on attach what they touch
             gripper.carry()
         for con in self._auto_locking:    # Webots attaches a locked auto-lock connector to a present peer
