@@ -52,28 +52,35 @@ class Falls:
     def __bool__(self) -> bool:
         return bool(self.falling)
 
-    def let_go(self, name: str, model: Any, start_ms: int) -> None:
-        """Solid ``name`` (world-file ``model``) let go at ``start_ms`` where it is now: it falls from
+    def let_go(self, name: str, model: Any, start_ms: int) -> Pose:
+        """Solid ``name`` (``model``) let go (or imported) at ``start_ms`` where it is now: it falls from
         there (and is put at its pose for the simulation's time now), or, already on or below its
-        support, is put on it at once; over no support, or with no gravity, it stays."""
+        support, is put on it at once; over no support, or with no gravity, it stays. Returns the pose
+        it comes to rest at."""
         sim = self._sim
         pose = sim.scene.solid_poses[name]
         self.falling.pop(name, None)
         landed = land_solid(model, pose, sim.loaded.base_dir, sim.landing_ground(name), self._to_enu)
         if landed is pose:
-            return
+            return pose
         base = sim.loaded.base_dir
         before, after = falling_span(model, base, self._to_enu, pose), falling_span(model, base, self._to_enu, landed)
         assert before is not None and after is not None      # land_solid moved it: it falls
         drop = before[0] - after[0]              # its lowest point now, less the top it comes to rest on
         if drop <= 0.0:                          # sunk into its support (or tipped up onto it): raised at once
             sim.place_solid(name, landed)
-            return
+            return landed
         if self.gravity <= 0.0:                  # no gravity: it floats where it was let go, as in Webots
-            return
+            return pose
         t = pose.translation if self._to_enu is None else self._to_enu @ pose.translation
         self.falling[name] = Fall(model, pose, int(start_ms), float(t[2]), drop, landed, pose)
         self._move(name, self.falling[name], sim.time_ms)
+        return landed
+
+    def resting(self, name: str, pose: Pose) -> Pose:
+        """Where solid ``name``, now at ``pose``, comes to rest: its fall's end if it falls, else ``pose``."""
+        fall = self.falling.get(name)
+        return pose if fall is None else fall.landed
 
     def advance(self, now_ms: int) -> None:
         """Every falling solid put where its fall has it at ``now_ms`` (a step's end)."""
