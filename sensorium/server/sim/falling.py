@@ -1,6 +1,7 @@
-"""Solids falling under the world's gravity after a VacuumGripper lets them go (Webots' physics drops them).
+"""Solids falling under the world's gravity after a VacuumGripper lets them go or a Supervisor imports
+them (Webots' physics drops them; settling at load and a PROTO rebuild stay instant: ground.py).
 
-A solid let go at simulated time ``t0`` (integer ms) from pose ``P0`` falls straight down the world's up
+A solid let go (or imported) at simulated time ``t0`` (integer ms) from pose ``P0`` falls straight down the world's up
 (ENU z; a NUE world's y), its x, y and rotation kept, no air drag and no spin: at each step's end ``t``
 its origin is ``g·(t − t0)²/2`` below ``P0``'s (``g``: ``WorldInfo.gravity``; float64), until its lowest
 point (``ground.falling_span`` at ``P0``) reaches the top it rests on, the lowest point of the pose
@@ -9,8 +10,9 @@ from that step on it is at exactly that pose, as it was put at once before. What
 once, when it is let go. Its velocity while it falls is ``−g·(t − t0)`` along the up, no rotation
 (:meth:`Falls.velocity`, a Supervisor's ``getVelocity``). A fall ends early, the solid staying where it
 is, when something else puts it somewhere (a Supervisor's move, a gripper holding it, a state loaded, a
-reset: its pose in the scene is then not the one the fall put) or when it is removed or rebuilt. Only
-falling solids cost work per step: none, nothing.
+reset: its pose in the scene is then not the one the fall put) or when it is removed or rebuilt. While
+it falls, it is support where it will rest (:meth:`Falls.resting`, read by ``Simulation.landing_ground``).
+Only falling solids cost work per step: none, nothing.
 """
 from __future__ import annotations
 
