@@ -60,6 +60,11 @@ def _released(sim: Simulation) -> Pose:
     assert g.held == "load"                                   # type: ignore[attr-defined]
     g.set_on(False)                                           # type: ignore[attr-defined]
     sim.step()
+    for _ in range(200):                                      # it falls (sim/falling.py) until it rests
+        if "load" not in sim.falls.falling:
+            break
+        sim.step()
+    assert "load" not in sim.falls.falling
     return sim.scene.solid_poses["load"]
 
 

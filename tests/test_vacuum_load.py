@@ -7,8 +7,8 @@ at (0.17, 0, 0.05). Wheels at 2.5 rad/s drive it 0.125 m/s: 0.3 m in 150 steps o
 contact would stop it at the parcel it holds; Webots' fixed joint makes the two one body.
 
 The crane: a robot without a drive whose gripper (a bounding cylinder, radius 0.05 m, 0.02 m tall)
-holds a 0.1 m parcel under it; turned off, the parcel lands at once, its bottom on the floor plane at
-z = 0.013 or on a table's top (a 0.6 x 0.6 x 0.4 m box centred at (1, 0, 0.2))."""
+holds a 0.1 m parcel under it; turned off, the parcel falls under gravity (sim/falling.py) until its
+bottom is on the floor plane at z = 0.013 or on a table's top (a 0.6 x 0.6 x 0.4 m box centred at (1, 0, 0.2))."""
 
 from __future__ import annotations
 
@@ -167,7 +167,17 @@ def _crane_world(parcel_bottom: float, x: float = 0.0, yaw: float = 0.4) -> Simu
                                    "robots": [crane]}), precision="exact")
 
 
-def test_a_parcel_let_go_above_the_floor_lands_on_it_at_the_end_of_that_step() -> None:
+def _fallen(sim: Simulation, name: str = "parcel") -> None:
+    """Steps until ``name`` has stopped falling (at most 2 s)."""
+    for _ in range(125):
+        sim.step()
+        if name not in sim.falls.falling:
+            return
+    raise AssertionError(f"{name} still falls")
+
+
+def test_a_parcel_let_go_above_the_floor_falls_onto_it() -> None:
+    """0.2 m of fall at 9.81 m/s²: sqrt(0.4 / 9.81) = 0.2019 s, at rest at the 13th step's end (0.208 s)."""
     sim = _crane_world(FLOOR_Z + 0.2)
     g = sim.device("crane/cup")
     sim.step()
@@ -175,8 +185,17 @@ def test_a_parcel_let_go_above_the_floor_lands_on_it_at_the_end_of_that_step() -
     before = sim.scene.solid_poses["parcel"]
     g.set_on(False)                                                     # type: ignore[attr-defined]
     assert sim.scene.solid_poses["parcel"] is before                    # let go where it is
+    z0 = float(before.translation[2])
+    for k in range(1, 13):
+        sim.step()
+        t = k * STEP / 1000.0
+        now = sim.scene.solid_poses["parcel"]
+        assert now.translation[2] == pytest.approx(z0 - 9.81 * t * t / 2.0, abs=1e-12), k
+        assert now.translation[:2].tolist() == before.translation[:2].tolist()
+        assert np.array_equal(now.rotation, before.rotation)
     sim.step()
     after = sim.scene.solid_poses["parcel"]
+    assert "parcel" not in sim.falls.falling
     assert after.translation[2] == pytest.approx(FLOOR_Z + 0.05, abs=1e-12)      # its bottom on the floor
     assert after.translation[:2].tolist() == before.translation[:2].tolist()
     assert np.array_equal(after.rotation, before.rotation)              # turned as it was
@@ -190,7 +209,7 @@ def test_a_parcel_let_go_over_the_table_lands_on_it_and_beside_it_on_the_floor()
         g = sim.device("crane/cup")
         sim.step()
         g.set_on(False)                                                 # type: ignore[attr-defined]
-        sim.step()
+        _fallen(sim)
         assert sim.scene.solid_poses["parcel"].translation[2] == pytest.approx(support + 0.05, abs=1e-12), x
 
 
@@ -201,7 +220,7 @@ def test_a_parcel_half_sunk_into_the_table_rises_onto_it_one_sunk_deeper_falls_t
         g = sim.device("crane/cup")
         sim.step()
         g.set_on(False)                                                 # type: ignore[attr-defined]
-        sim.step()
+        _fallen(sim)
         assert sim.scene.solid_poses["parcel"].translation[2] == pytest.approx(support + 0.05, abs=1e-12), bottom
 
 
@@ -288,7 +307,7 @@ def test_prism_depth_closed_forms() -> None:
     assert side is not None and prism_depth(cup, side) == pytest.approx(0.001, abs=1e-15)  # 1 mm into the disc
 
 
-def test_in_a_nue_world_it_lands_along_the_world_y() -> None:
+def test_in_a_nue_world_it_falls_along_the_world_y() -> None:
     """NUE (x north, y up, z east): the floor Plane turned so its normal is the world's y, at y = 0.2;
     the cup (a box thin along y) holds the parcel by its top at y = 0.9; let go, its y becomes 0.25."""
     floor = {"name": "floor", "pose": {"translation": [0.0, 0.2, 0.0], "rotation": [1, 0, 0, -math.pi / 2]},
@@ -305,6 +324,9 @@ def test_in_a_nue_world_it_lands_along_the_world_y() -> None:
     assert g.held == "parcel"                                           # type: ignore[attr-defined]
     g.set_on(False)                                                     # type: ignore[attr-defined]
     sim.step()
+    t = sim.scene.solid_poses["parcel"].translation                    # falling along -y: 0.6 m in 0.35 s
+    assert t[1] == pytest.approx(0.85 - 9.81 * 0.016 ** 2 / 2.0, abs=1e-12) and (t[0], t[2]) == (0.3, -0.2)
+    _fallen(sim)
     t = sim.scene.solid_poses["parcel"].translation
     assert t[1] == pytest.approx(0.2 + 0.05, abs=1e-12) and (t[0], t[2]) == (0.3, -0.2)
 

@@ -684,8 +684,9 @@ class Solid(Strict):
                                     "number there (InnerDef.scope)")
     physics: bool = Field(default=False, description="Webots: the solid has a Physics node. Nothing is pushed here "
                           "(no dynamics); a top-level solid with physics settles at load on what is under it (as "
-                          "Webots' physics drops it), a VacuumGripper carries only such a solid, and one it lets go "
-                          "lands at once on what is under it (no solid falls at any other time)")
+                          "Webots' physics drops it), a VacuumGripper carries only such a solid, and one it lets go or "
+                          "a Supervisor imports falls under the world's gravity onto what is under it over the next "
+                          "steps (no solid falls at any other time)")
     mass: Mass | None = Field(default=None, description=_MASS)
 
     _unit = field_validator("recognition_colors")(_unit_colors)

@@ -1173,14 +1173,18 @@ def center_of_mass(sim: Any, node: Node) -> list[float]:
 
 def node_velocity(sim: Any, node: Node) -> list[float]:
     """Webots' ``getVelocity``: a driven robot's from its kinematic drive's last step (world axes,
-    linear m/s then angular rad/s), a node inside it moving with it; anything else never moves by
-    itself: zeros."""
+    linear m/s then angular rad/s), a node inside it moving with it; a top-level solid falling after a
+    gripper let it go: −g·t along the up (sim/falling.py); anything else never moves by itself: zeros."""
     if node.nested:
         return nested.velocity(sim, _nested_of(sim, node))
     if node.type == "Robot":
         drive = sim.robots[node.key].drive
         if drive is not None:
             return drive.velocity()
+    elif node.type == "Solid" and not node.visual and sim.falls:
+        falling = sim.falls.velocity(node.key, sim.time_ms)
+        if falling is not None:
+            return falling
     return [0.0] * 6
 
 

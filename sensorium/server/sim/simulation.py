@@ -30,6 +30,7 @@ from sensorium.server.sim.belt import Belts
 from sensorium.server.sim.cameras import Camera
 from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
+from sensorium.server.sim.falling import Falls
 from sensorium.server.sim.ground import (
     Ground,
     GroundWarning,
@@ -410,6 +411,8 @@ class Simulation:
         # conveyor belts (sim/belt.py): none in most worlds, which then pay nothing for them
         self._belts = Belts(self, _TO_ENU[self.world.world_info.coordinate_system]) \
             if any(r.belts for r in self.world.robots) else None
+        # solids a VacuumGripper let go, falling under gravity (sim/falling.py): none, no work
+        self.falls = Falls(self, _TO_ENU[self.world.world_info.coordinate_system], self.world.world_info.gravity)
 
     def _warn_ground(self) -> None:
         """One GroundWarning per thing a driven robot will not ride on: a tilted terrain, a robot
@@ -451,14 +454,17 @@ class Simulation:
     def landing_ground(self, solid: str, carrier: int | None = None) -> Ground | None:
         """The ground a solid let go lands on (ground.land_solid): ground.settling_ground as the world is
         now, the other top-level solids where they are, the robots without a drive where they are with
-        their shapes where their joints hold them (a lift's cup that just let go of a parcel is above it).
+        their shapes where their joints hold them (a lift's cup that just let go of a parcel is above it),
+        a solid still falling where it will rest (sim/falling.py: a box let go over a falling one lands on it).
         ``carrier``: a robot (index) left out, the one holding the solid (one body with it)."""
         floors = [r for r in self.robots.values() if not r.model.drive_motors and r.index != carrier]
         alive = self.scene.solid_poses
         parts = [[(name, local if r.links is None or (j := getattr(shape, "on_joint", None)) not in r.links.poses
                    else r.links.poses[j].compose(local), shape) for name, local, shape in robot_parts(r.model)]
                  for r in floors]
-        return settling_ground([(s, alive[s.name]) for s in self.world.solids if s.name in alive and s.name != solid],
+        resting = self.falls.resting           # a solid still falling is taken where it will rest
+        return settling_ground([(s, resting(s.name, alive[s.name])) for s in self.world.solids
+                                if s.name in alive and s.name != solid],
                                [(r.model, self.scene.robot_poses[r.index]) for r in floors],
                                _TO_ENU[self.world.world_info.coordinate_system], parts)
 
@@ -508,6 +514,7 @@ class Simulation:
                 elif isinstance(dev, Camera):      # a zoomed camera: the world file's fieldOfView
                     dev.reset_fov()
         self.radio.reset()
+        self.falls.clear()
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
                 continue
@@ -669,8 +676,9 @@ class Simulation:
                 solid = node.model
                 self.world.solids.append(solid)
                 self._join_solid(solid, node_id, prep)
-                self._land(solid)      # with physics it drops onto what is under it, as Webots' does
-                self._imported_poses[solid.name] = self.scene.solid_poses[solid.name]
+                # with physics it falls onto what is under it from now, as Webots' does (sim/falling.py);
+                # its pose as imported is where it comes to rest (loadState("__init__") puts it there)
+                self._imported_poses[solid.name] = self.falls.let_go(solid.name, solid, self.time_ms)
                 key: str | int = solid.name
             else:
                 self.world.lights.append(node.model)
@@ -711,9 +719,9 @@ class Simulation:
             self.ground.add_solid(solid, pose)
 
     def _land(self, solid: wm.Solid) -> None:
-        """A top-level solid with physics just added (imported, or built again) lands at once on what is
-        under it now (ground.land_solid, the rule of a solid let go and of settle_world at load); any
-        other solid stays where it is."""
+        """A top-level solid with physics just built again (a PROTO field set) lands at once on what is
+        under it now (ground.land_solid, the rule of settle_world at load: it reads as the world file
+        written with that value); any other solid stays where it is."""
         to_enu = _TO_ENU[self.world.world_info.coordinate_system]
         pose = self.scene.solid_poses[solid.name]
         landed = land_solid(solid, pose, self.loaded.base_dir, self.landing_ground(solid.name), to_enu)
@@ -833,6 +841,8 @@ class Simulation:
             self.scene.set_robot_pose(robot.index, pose)
         if self._belts is not None:   # belts carry what lies on them by their motors' travel this step
             self._belts.carry(dt * 0.001)
+        if self.falls:                # solids let go fall on before the grippers look (one may catch them)
+            self.falls.advance(now)
         for gripper in self._grippers:    # held solids follow their grippers; pumps on attach what they touch
             gripper.carry()
         for con in self._auto_locking:    # Webots attaches a locked auto-lock connector to a present peer

@@ -24,10 +24,11 @@ bounds them. Robots are never attached, and no force breaks the hold (no physics
 A held solid is part of its carrier, as Webots' fixed joint makes the two one body: kinematic contact
 never stops the carrier at it nor do its bumpers touch it (``Contact.hold``/``let_go``), while it stops
 the other robots where it is. A solid let go (``turnOff``) is an obstacle to its carrier again at
-once and, at the end of that step, lands: ground.land_solid tips it onto the face
-under it (ground.resting_pose) and puts it straight down on the highest support under its origin (the settling ground without
-it: ``Simulation.landing_ground``), its lowest point on that support's top -- no flight time, bounce or
-rolling, where Webots' physics lets it fall over the next steps. While held, a load the kinematic
+once and falls from where it is, from the simulated time it is let go (sim/falling.py: straight down
+under the world's gravity, to the pose ground.land_solid gives -- tipped onto the face under it
+(ground.resting_pose), its lowest point on the highest support under its origin, the settling ground
+without it: ``Simulation.landing_ground`` -- which it takes at the step its lowest point reaches that
+support), with no bounce or rolling. While held, a load the kinematic
 carrier holds below the top of that support is raised onto it (:meth:`VacuumGripper._on_support`),
 where Webots' contact would push back on the load and, through the joint, on the arm.
 """
@@ -39,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.server.sim.contact import UPRIGHT, Obstacle, _closest_on_list, _hull, enu_pose, obstacle
-from sensorium.server.sim.ground import falling_shapes, land_solid, lift_pose, shapes_span
+from sensorium.server.sim.ground import falling_shapes, lift_pose, shapes_span
 from sensorium.server.sim.scene import primitive_from_model, solid_parts
 from sensorium.server.sim.sensors import Device
 from sensorium.server.world import geometry as geo
@@ -168,7 +169,7 @@ class VacuumGripper(Device):
         self.is_on = bool(self.config.is_on)
         self.value = 0.0                    # libController's presence before a value: false
         self.held: str | None = None
-        self._dropping: tuple[str, Any] | None = None     # (name, model) of a solid let go this step: it lands
+        self._dropping: tuple[str, Any, int] | None = None     # (name, model, time in ms) of a solid let go: it falls
         self._offset: Pose | None = None    # the held solid's pose in the gripper's frame
         self._held_model: Any = None        # its world-file model when attached (a rebuilt one is another)
         self._outline: tuple[str, Pose | None] | None = None     # (held, link pose) its outline was given at
@@ -197,11 +198,11 @@ class VacuumGripper(Device):
     def set_on(self, on: bool) -> None:
         """``wb_vacuum_gripper_turn_on`` (True: it attaches at the end of the next step) / ``turn_off``
         (False: what it holds is let go at once, where it is, as WbVacuumGripper::turnOff detaches, and
-        lands at the end of the step: :meth:`carry`)."""
+        falls from the simulation's time now: :meth:`carry`)."""
         self.is_on = bool(on)
         if not self.is_on:
             if self.held is not None:
-                self._dropping = (self.held, self._held_model)
+                self._dropping = (self.held, self._held_model, self._sim.time_ms)
             self.release()
 
     def release(self) -> None:
@@ -298,18 +299,15 @@ class VacuumGripper(Device):
         contact.hold(self._robot.index, self.held, parts)
         self._outline = (self.held, link)
 
-    def _land(self, name: str, model: Any) -> None:
-        """The solid let go this step put to rest on what is under it (ground.land_solid: tipped onto the
-        face under it, its lowest point on the highest support under its origin, at once), unless it is
-        gone, rebuilt, or held again (by another gripper)."""
+    def _land(self, name: str, model: Any, start_ms: int) -> None:
+        """The solid let go at ``start_ms`` starts falling onto what is under it (sim/falling.py:
+        ``Falls.let_go``, put where its fall has it at this step's end), unless it is gone, rebuilt, or
+        held again (by another gripper)."""
         sim = self._sim
         if self._model(name) is not model or any(
                 isinstance(d, VacuumGripper) and d.held == name for d in sim.all_devices()):
             return
-        pose = sim.scene.solid_poses[name]
-        landed = land_solid(model, pose, sim.loaded.base_dir, sim.landing_ground(name), self._robot.to_enu)
-        if landed is not pose:
-            sim.place_solid(name, landed)
+        sim.falls.let_go(name, model, start_ms)
 
     # -- touching
     def _model(self, name: str) -> Any:
