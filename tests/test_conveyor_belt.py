@@ -86,20 +86,34 @@ def test_a_stopped_belt_leaves_it_and_reverse_moves_it_back(tmp_path: Path) -> N
 
 def _ride_off(sim: Simulation, x0: float, edge: float) -> float:
     """At 0.2 m/s the box rides along the world's x from x0 at y 0, at x0 + 0.2 t every 10 ms step
-    (1e-12), until its origin passes ``edge``: there, within that step's 2 mm, it lands on the floor
-    (at its half height). Where it landed, x."""
+    (1e-12), until its origin passes ``edge`` (within that step's 2 mm); from there it falls onto the
+    floor (:func:`_falls_to_floor`). Where it landed, x."""
     belt(sim, 0.2)
     steps = 0
-    while at(sim)[2] > 0.1:
+    while at(sim)[0] <= edge:
         sim.step()
         steps += 1
         assert steps < 1000
-        if at(sim)[2] > 0.1:
-            assert at(sim) == pytest.approx([x0 + 0.2 * 0.01 * steps, 0.0, TOP + 0.05], abs=1e-12)
+        assert at(sim) == pytest.approx([x0 + 0.2 * 0.01 * steps, 0.0, TOP + 0.05], abs=1e-12)
     x = at(sim)[0]
-    assert x == pytest.approx(x0 + 0.2 * 0.01 * steps, abs=1e-12) and edge < x <= edge + 0.002 + 1e-12
-    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+    assert edge < x <= edge + 0.002 + 1e-12
+    _falls_to_floor(sim, x)
     return x
+
+
+def _falls_to_floor(sim: Simulation, x: float) -> None:
+    """The box, just past the belt's edge at height TOP + 0.05, falls straight down under gravity
+    (9.81 m/s², sim/falling.py): TOP + 0.05 - g t²/2 after each 10 ms step (1e-12), x and y kept, until
+    it rests on the floor at its half height, 0.05."""
+    k = 0
+    while at(sim)[2] > 0.05:
+        sim.step()
+        k += 1
+        assert k < 100
+        z = TOP + 0.05 - 0.5 * 9.81 * (0.01 * k) ** 2
+        assert at(sim) == pytest.approx([x, 0.0, max(z, 0.05)], abs=1e-12)
+    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+
 
 def test_past_the_belts_end_it_lands_on_the_floor(tmp_path: Path) -> None:
     sim = Simulation(load_world(world(tmp_path)))
@@ -307,18 +321,7 @@ def test_a_box_inside_a_pose_is_the_belts_face(tmp_path: Path) -> None:
     b = w.world.robots[0].belts[0]
     assert b.top == pytest.approx((0.2, 0.0, TOP), abs=1e-15)
     assert (b.along, b.length, b.width) == (pytest.approx((1.0, 0.0, 0.0), abs=1e-15), 1.0, 0.3)
-    sim = Simulation(w)
-    belt(sim, 0.2)
-    steps = 0
-    while at(sim)[2] > 0.1:
-        sim.step()
-        steps += 1
-        assert steps < 1000
-        if steps == 100:
-            assert at(sim) == pytest.approx([X0 + 0.2, 0.0, TOP + 0.05], abs=1e-12)
-    x = at(sim)[0]
-    assert x == pytest.approx(X0 + 0.2 * 0.01 * steps, abs=1e-12) and 0.7 < x <= 0.7 + 0.002 + 1e-12
-    assert at(sim) == pytest.approx([x, 0.0, 0.05], abs=1e-12)
+    _ride_off(Simulation(w), X0, 0.7)
 
 
 def test_a_box_turned_half_about_up_still_carries_along_the_tracks_x(tmp_path: Path) -> None:

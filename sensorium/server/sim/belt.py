@@ -2,7 +2,7 @@
 moves the belt): each basic step, a top-level solid with physics lying on a moving belt's top face -- its
 lowest point within contact.FLOOR of the face, its origin over the face -- moves along the belt by the
 motor's travel that step, as Webots' physics carries it on the Track's moving contact surface. Once its
-origin is past the face's edge it lands (ground.land_solid) on what is under it. A carried solid whose
+origin is past the face's edge it falls (sim/falling.py) onto what is under it. A carried solid whose
 move would put it into another solid or a robot's part (above the belt's face) goes as far as their faces
 meet, and the solids behind it on that belt as far as they meet it (a row stops together). A Track with
 several Boxes has a face for each, all moving along its +x; a solid moves once a step. Only a belt whose
@@ -17,7 +17,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import EPS, FLOOR
-from sensorium.server.sim.ground import GroundWarning, falling_shapes, land_solid, shapes_span
+from sensorium.server.sim.ground import GroundWarning, falling_shapes, shapes_span
 from sensorium.server.sim.scene import primitive_from_model, robot_parts, solid_parts
 from sensorium.server.world.poses import Pose
 
@@ -141,10 +141,10 @@ class Belts:
             moved = Pose(pose.rotation, np.asarray(pose.translation, dtype=np.float64) + world_step * part)
             offset = self._enu(np.asarray(moved.translation, dtype=np.float64)) - centre
             if abs(offset @ along) > belt.length / 2.0 or abs(offset @ across) > belt.width / 2.0:
-                # past the face's edge: it falls onto what is under it (landing_ground leaves the solid
-                # itself out: it need not be placed at ``moved`` first)
-                landed = land_solid(solid, moved, sim.loaded.base_dir, sim.landing_ground(solid.name), self._to_enu)
-                sim.place_solid(solid.name, landed)
+                # past the face's edge: from there it falls onto what is under it over the next steps
+                # (sim/falling.py), as a gripper's let-go solid does
+                sim.place_solid(solid.name, moved)
+                sim.falls.let_go(solid.name, solid, sim.time_ms)
                 continue
             sim.place_solid(solid.name, moved)
             lo, hi = spans[solid.name]
