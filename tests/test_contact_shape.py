@@ -745,3 +745,26 @@ def test_a_rod_turning_across_a_parallel_segment_is_stopped():
     assert C._gap(p, *C._grown(seg, rod, 0.0, p)) == pytest.approx(0.05, abs=1e-15)
     assert not C.turn_gap_holds(rod, 0.0, 0.5, seg, p, -C.EPS)
     assert C.turn_gap_holds(rod, 0.0, 0.16, seg, p, -C.EPS)      # 0.3 sin 0.16 = 0.0478 < 0.05
+
+
+@pytest.mark.parametrize("gap", [0.0, 0.0056])
+def test_a_box_robot_sliding_flush_along_boards_laid_end_to_end_passes_each_joint(gap):
+    # a wall of two 0.1 m thick boards end to end along x (Webots' maze blocks: abutting, or a few mm
+    # apart), their faces on y = 0.3; the 0.2 m square robot's left side lies on that line and it drives
+    # along +x at 1 m/s: it meets the second board's end face only at its corner, in line with the face it
+    # runs along, so nothing stops it (it stalled at x = 0.9 + gap, its corner on the joint)
+    first = block("first", 0.0, 1.0, 0.3, 0.4)
+    second = block("second", 1.0 + gap, 3.0, 0.3, 0.4)
+    sim = world([first, second], [box_robot("r", 0.3, 0.2, size=(0.2, 0.2))])
+    drive(sim, "r", 10.0)
+    for _ in range(100):
+        sim.step()
+    x, y = xy(sim, "r")
+    assert x == pytest.approx(0.3 + 100 * 0.032, abs=1e-9) and y == 0.2
+    assert sim.counters["contacts"] == 0
+    # a corner that reaches past the face line still meets the board's end: a robot 1 mm wider stops there
+    sim = world([first, second], [box_robot("r", 0.3, 0.2, size=(0.2, 0.202))])
+    drive(sim, "r", 10.0)
+    for _ in range(100):
+        sim.step()
+    assert xy(sim, "r")[0] == pytest.approx(0.9 + gap, abs=1e-9)

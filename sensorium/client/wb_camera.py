@@ -279,34 +279,40 @@ def wb_camera_set_exposure(tag: int, exposure: float) -> None:
     dev.desc["exposure"] = float(exposure)
 
 
+def _focus(tag: int, key: str, func: str) -> float:
+    """The camera's Focus value (0 without a Focus node, as in Webots)."""
+    return float(_cam(tag, func).desc.get(key, 0.0))
+
+
 def wb_camera_get_focal_length(tag: int) -> float:
-    """0: a camera without a Focus node (Webots)."""
-    _cam(tag, "wb_camera_get_focal_length")
-    return 0.0
+    return _focus(tag, "focal_length", "wb_camera_get_focal_length")
 
 
 def wb_camera_get_focal_distance(tag: int) -> float:
-    _cam(tag, "wb_camera_get_focal_distance")
-    return 0.0
+    return _focus(tag, "focal_distance", "wb_camera_get_focal_distance")
 
 
 def wb_camera_get_min_focal_distance(tag: int) -> float:
-    _cam(tag, "wb_camera_get_min_focal_distance")
-    return 0.0
+    return _focus(tag, "min_focal_distance", "wb_camera_get_min_focal_distance")
 
 
 def wb_camera_get_max_focal_distance(tag: int) -> float:
-    _cam(tag, "wb_camera_get_max_focal_distance")
-    return 0.0
+    return _focus(tag, "max_focal_distance", "wb_camera_get_max_focal_distance")
 
 
 def wb_camera_set_focal_distance(tag: int, focal_distance: float) -> None:
+    """Webots' checks (planar, then the Focus range, each its error line); the distance is kept here, as
+    Webots' library keeps it for getFocalDistance: the image shows no depth of field."""
     func = "wb_camera_set_focal_distance"
     dev = _cam(tag, func)
+    low, high = float(dev.desc.get("min_focal_distance", 0.0)), float(dev.desc.get("max_focal_distance", 0.0))
     if dev.desc.get("projection", "planar") != "planar":
         print(f"Error: {func}() can only be called on a planar camera.", file=sys.stderr)
-    elif focal_distance != 0.0:
-        print(f"Error: {func}() out of focus range [0.000000, 0.000000].", file=sys.stderr)
+    elif isinstance(focal_distance, bool) or not isinstance(focal_distance, (int, float)) \
+            or not low <= focal_distance <= high:
+        print(f"Error: {func}() out of focus range [{low:f}, {high:f}].", file=sys.stderr)
+    else:
+        dev.desc["focal_distance"] = float(focal_distance)
 
 
 def wb_camera_get_near(tag: int) -> float:

@@ -984,6 +984,17 @@ class Zoom(Strict):
         return self
 
 
+class Focus(Strict):
+    """Webots' Focus node in a Camera's ``focus`` field: its focal length and the focal distance a
+    controller's ``setFocalDistance`` may set within [min, max] (Webots' defaults 0); the image shows
+    no depth of field (one load warning: README "Cameras and range finders")."""
+
+    focal_distance: float = Field(default=0.0, ge=0.0, allow_inf_nan=False)
+    focal_length: float = Field(default=0.0, ge=0.0, allow_inf_nan=False)
+    min_focal_distance: float = Field(default=0.0, ge=0.0, allow_inf_nan=False)
+    max_focal_distance: float = Field(default=0.0, ge=0.0, allow_inf_nan=False)
+
+
 class Camera(_Imager):
     """Webots Camera: a ``width`` × ``height`` BGRA image by exact rays through the pixels (four per
     pixel with ``anti_aliasing``), shaded with the LightSensor's lighting, textures, transparency,
@@ -996,6 +1007,8 @@ class Camera(_Imager):
     noise: float = Field(default=0.0, ge=0.0, le=1.0, description="σ of the per-channel Gaussian noise, in [0, 1] units")
     recognition: Recognition | None = None
     zoom: Zoom | None = Field(default=None, description="Webots' Zoom node (NULL: none): the range setFov() may take")
+    focus: Focus | None = Field(default=None, description="Webots' Focus node (NULL: none): focal length, the range "
+                                "setFocalDistance() may take; no depth of field rendered")
     _what: ClassVar[str] = "camera"
 
 

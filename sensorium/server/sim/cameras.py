@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from sensorium.schemas import world as wm
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import blocks
@@ -389,7 +390,10 @@ class Camera(Device):
         rc = c.recognition
         zoom = c.zoom
         low, high = (self.fov, self.fov) if zoom is None else (zoom.min_field_of_view, zoom.max_field_of_view)
-        return {"width": int(c.width), "height": int(c.height), "fov": self.fov, "near": float(c.near),
+        focus = c.focus if c.focus is not None else wm.Focus()
+        return {"focal_length": focus.focal_length, "focal_distance": focus.focal_distance,
+                "min_focal_distance": focus.min_focal_distance, "max_focal_distance": focus.max_focal_distance,
+                "width": int(c.width), "height": int(c.height), "fov": self.fov, "near": float(c.near),
                 "min_fov": float(low), "max_fov": float(high),
                 "far": float(c.far), "exposure": float(self.exposure), "projection": c.projection,
                 "anti_aliasing": bool(c.anti_aliasing), "noise": float(c.noise),

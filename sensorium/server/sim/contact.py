@@ -678,15 +678,32 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
             s = _ray_circle(p, d, pts[i], rad, a)
             if s < best:
                 best, best_n = s, (p + s * d - pts[i]) / rad
-    for A, B, out, ax, ay, ox, oy in edges:          # a segment (n = 2) gets both sides: a→b and b→a
+    n_e = len(edges)
+    for k, (A, B, out, ax, ay, ox, oy) in enumerate(edges):   # a segment (n = 2) gets both sides: a→b and b→a
         if _edge_beyond(ax - px, ay - py, dx, dy, ox, oy):
             continue
         s = _ray_segment(p, d, A, B, out)
-        if s < best:
+        if s < best and not (rad == 0.0 and n_e >= 3 and _skims_past(p, d, s, edges[k - 1], edges[(k + 1) % n_e])):
             best, best_n = s, out.copy()
     if best > 1.0:
         return math.inf, None
     return best, best_n
+
+
+def _skims_past(p: np.ndarray, d: np.ndarray, s: float, before: tuple, after: tuple) -> bool:
+    """Whether a move meeting an edge at ``s`` meets it at an end only, running on along the line
+    of the edge there (``before`` or ``after``, the polygon's neighbouring edges) without going
+    in: from the meeting point to the move's end it stays within EPS outside that neighbour's
+    line, so it never enters the convex polygon. A robot sliding flush along a wall of boards laid
+    end to end (Webots' maze blocks) meets the next board's end face at its corner, in line with
+    the face it slides on: no impact, or it stalled at every joint."""
+    h = p + s * d
+    e = p + d
+    for nb in (before, after):
+        a, o = nb[0], nb[2]
+        if float((h - a) @ o) >= -EPS and float((e - a) @ o) >= -EPS:
+            return True
+    return False
 
 
 def _hull_data(ob: Obstacle, rad: float) -> tuple[list, list]:

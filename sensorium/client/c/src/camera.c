@@ -19,6 +19,7 @@ struct sn_imaging {
   int width, height;
   double fov, near, min_range, max_range;
   double min_fov, max_fov; /* camera: its Zoom's range (fov, fov without a Zoom) */
+  double focal_length, focal_distance, min_focal_distance, max_focal_distance; /* its Focus (0s without) */
   float *range;          /* range finder: height rows of width floats */
   unsigned char *image;  /* camera: BGRA, height rows of 4 * width bytes */
   double exposure;
@@ -52,6 +53,10 @@ int sn_imaging_describe(sn_device *d, const msgpack_object *desc) {
   im->exposure = sn_double_or(desc, "exposure", NAN);
   im->min_fov = sn_double_or(desc, "min_fov", im->fov);
   im->max_fov = sn_double_or(desc, "max_fov", im->fov);
+  im->focal_length = sn_double_or(desc, "focal_length", 0.0);
+  im->focal_distance = sn_double_or(desc, "focal_distance", 0.0);
+  im->min_focal_distance = sn_double_or(desc, "min_focal_distance", 0.0);
+  im->max_focal_distance = sn_double_or(desc, "max_focal_distance", 0.0);
   char *projection = sn_strdup_obj(sn_get(desc, "projection"));
   im->planar = projection == NULL || strcmp(projection, "planar") == 0;
   free(projection);
@@ -515,25 +520,25 @@ void wb_camera_set_exposure(WbDeviceTag tag, double exposure) {
   d->imaging->exposure = exposure;
 }
 
-/* a camera without a Focus node: Webots' zeros */
+/* the camera's Focus node (Webots' zeros without one) */
 double wb_camera_get_focal_length(WbDeviceTag tag) {
   CAMERA("wb_camera_get_focal_length");
-  return d ? 0.0 : NAN;
+  return d ? d->imaging->focal_length : NAN;
 }
 
 double wb_camera_get_focal_distance(WbDeviceTag tag) {
   CAMERA("wb_camera_get_focal_distance");
-  return d ? 0.0 : NAN;
+  return d ? d->imaging->focal_distance : NAN;
 }
 
 double wb_camera_get_max_focal_distance(WbDeviceTag tag) {
   CAMERA("wb_camera_get_max_focal_distance");
-  return d ? 0.0 : NAN;
+  return d ? d->imaging->max_focal_distance : NAN;
 }
 
 double wb_camera_get_min_focal_distance(WbDeviceTag tag) {
   CAMERA("wb_camera_get_min_focal_distance");
-  return d ? 0.0 : NAN;
+  return d ? d->imaging->min_focal_distance : NAN;
 }
 
 void wb_camera_set_focal_distance(WbDeviceTag tag, double focal_distance) {
@@ -543,8 +548,11 @@ void wb_camera_set_focal_distance(WbDeviceTag tag, double focal_distance) {
     return;
   if (!d->imaging->planar)
     fprintf(stderr, "Error: %s() can only be called on a planar camera.\n", func);
-  else if (focal_distance != 0.0)
-    fprintf(stderr, "Error: %s() out of focus range [0.000000, 0.000000].\n", func);
+  else if (!(focal_distance >= d->imaging->min_focal_distance && focal_distance <= d->imaging->max_focal_distance))
+    fprintf(stderr, "Error: %s() out of focus range [%f, %f].\n", func, d->imaging->min_focal_distance,
+            d->imaging->max_focal_distance);
+  else
+    d->imaging->focal_distance = focal_distance; /* kept here, as Webots' library: no depth of field drawn */
 }
 
 double wb_camera_get_near(WbDeviceTag tag) {

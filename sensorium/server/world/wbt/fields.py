@@ -281,6 +281,17 @@ def _zoom(f: Fields) -> dict | None:
     return {"min_field_of_view": low, "max_field_of_view": high}
 
 
+def _focus(f: Fields) -> dict | None:
+    """A Camera's Focus node (Webots' defaults 0), or None (NULL); a negative value is 0, as WbFocus resets it."""
+    ff = _child(f, "focus", "Focus")
+    if ff is None:
+        return None
+    return {"focal_distance": ff.non_negative("focalDistance", 0.0, 0.0),
+            "focal_length": ff.non_negative("focalLength", 0.0, 0.0),
+            "min_focal_distance": ff.non_negative("minFocalDistance", 0.0, 0.0),
+            "max_focal_distance": ff.non_negative("maxFocalDistance", 0.0, 0.0)}
+
+
 def _max_range(f: Fields, min_range: float, default: float) -> float:
     """A lidar's maxRange: one not above minRange is minRange + 1 (WbLidar::updateMaxRange)."""
     max_range = f.num("maxRange", default)
@@ -381,6 +392,9 @@ def device(node: Node, f: Fields) -> dict:
         zoom = _zoom(f)
         if zoom is not None:
             out["zoom"] = zoom
+        focus = _focus(f)
+        if focus is not None:
+            out["focus"] = focus
         return out
     if t == "PositionSensor":
         return {"device": t, "noise": f.num("noise", 0.0), "resolution": f.num("resolution", -1.0)}
