@@ -215,8 +215,7 @@ def write_stl(path, triangles) -> None:
         n = np.cross(tri[1] - tri[0], tri[2] - tri[0])
         lines += [f"facet normal {n[0]} {n[1]} {n[2]}", "outer loop", *(f"vertex {x} {y} {z}" for x, y, z in tri),
                   "endloop", "endfacet"]
-    (tmp := path).write_text("\n".join([*lines, "endsolid part", ""]))
-    assert tmp.stat().st_size > 0
+    path.write_text("\n".join([*lines, "endsolid part", ""]))
 
 
 def test_the_cube_is_wound_outward():
@@ -324,6 +323,20 @@ DEF BOT Robot {{
     assert com(lv, "LOAD") == pytest.approx([8.0, 1.0, 1.0], abs=1e-12)          # (1, 0, 0) turned a quarter
     assert com(lv, "PART") == pytest.approx([0.25, 0.25, 1.25], abs=1e-12)
     assert com(lv, "BOT") == pytest.approx([0.125, 0.125, 0.625], abs=1e-12)       # two equal masses
+
+
+def test_a_solid_a_supervisor_imports_weighs_its_mesh(tmp_path):
+    loaded = _mesh_world(tmp_path, 'DEF BOSS Robot { name "boss" supervisor TRUE controller "<extern>" }\n')
+    lv = Live(Simulation(loaded))
+    lv.ok(A, "attach", {"robot": "boss"})
+    lv.ok(A, "/boss/robot/import_node_from_string", {
+        "node": 0, "field": "children", "position": -1,
+        "node_string": 'DEF LOADED Solid { translation 5 0 0 name "l" boundingObject Pose { translation 0 0 1 '
+                       'children [ Mesh { url "tetra.obj" } ] } physics Physics { } }'})
+    lv.step(A, "boss")
+    node = lv.ok(A, "/boss/robot/get_from_def", {"name": "LOADED"})["node"]
+    assert lv.ok(A, "/boss/robot/get_node_center_of_mass", {"node": node})["value"] == \
+        pytest.approx([5.25, 0.25, 1.25], abs=1e-12)
 
 
 def test_the_import_records_what_the_loader_completes(tmp_path):

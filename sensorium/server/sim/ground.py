@@ -909,9 +909,9 @@ def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.nd
 
 def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.ndarray | None) -> Pose:
     """:func:`resting_pose` for a solid of several shapes, a mesh, a capsule or a cone: its shapes'
-    support points and centre of mass (its Physics' masses where the world gives them and no mesh file
-    is among its shapes, else uniform density over their volumes), placed at ``pose`` in ENU, tipped by
-    :func:`_hull_tip`."""
+    support points and centre of mass (its Physics' masses where the world gives them, mesh files'
+    volumes weighed by the loader, else uniform density over their volumes), placed at ``pose`` in ENU,
+    tipped by :func:`_hull_tip`."""
     shapes = falling_shapes(solid, base_dir)
     if shapes is None:
         return pose
