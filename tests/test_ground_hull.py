@@ -246,3 +246,30 @@ def test_a_physics_centre_of_mass_over_the_face_it_stands_on_keeps_the_l_standin
     assert pose.translation[2] == pytest.approx(0.3, abs=1e-12)
     tipped = _settled({"pose": turned, **L_SHAPE})
     assert abs(float(tipped.rotation[2, 0])) < 0.99      # without it: tipped onto the slanted face (above)
+
+
+def test_a_physics_centre_of_mass_keeps_an_l_with_a_mesh_standing(tmp_path) -> None:
+    """The same L, its upright bar a mesh file (a 0.2 × 0.2 × 0.6 box, wound outward): a solid with a mesh
+    tips about its Physics' centre of mass too, now that mesh volumes are weighed (given here: it stands)."""
+    corners = np.array([[x, y, z] for z in (-0.3, 0.3) for y in (-0.1, 0.1) for x in (-0.1, 0.1)])[[0, 1, 3, 2, 4, 5, 7, 6]]
+    quads = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    facets = []
+    for q in quads:
+        for k in (1, 2):
+            tri = corners[[q[0], q[k], q[k + 1]]]
+            facets += ["facet normal 0 0 0", "outer loop", *(f"vertex {x} {y} {z}" for x, y, z in tri), "endloop",
+                       "endfacet"]
+    (tmp_path / "bar.stl").write_text("\n".join(["solid bar", *facets, "endsolid bar", ""]))
+    bar = {"pose": {"translation": [-0.2, 0.0, 0.4]}, "geometry": {"type": "mesh", "url": "bar.stl"}}
+    turned = {"translation": [0.0, 0.0, 2.0], "rotation": _rotation((0, 1, 0), 90.0)}
+
+    def settled(extra: dict) -> Pose:
+        load = {"name": "load", "physics": True, "pose": turned, "geometry": L_SHAPE["geometry"], "shapes": [bar],
+                **extra}
+        loaded = parse_world({"solids": [FLOOR, load]}, source="w.yaml", base_dir=tmp_path)
+        return Simulation(loaded, precision="exact").scene.solid_poses["load"]
+
+    pose = settled({"mass": {"kg": 2.0, "center": [0.0, 0.0, 0.05]}})
+    np.testing.assert_allclose(pose.rotation, axis_angle_matrix((0.0, 1.0, 0.0), math.pi / 2.0), rtol=0, atol=1e-12)
+    assert pose.translation[2] == pytest.approx(0.3, abs=1e-12)
+    assert abs(float(settled({}).rotation[2, 0])) < 0.99      # uniform density: tipped onto the slanted face

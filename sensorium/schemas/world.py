@@ -642,8 +642,38 @@ class Mass(Strict):
     center: Vec3 = Field(default=(0.0, 0.0, 0.0), description="the centre of mass in the node's frame (m)")
 
 
+class MassMesh(Strict):
+    """A mesh file in the ``boundingObject`` of a Physics node: its volume and centroid count as Webots counts
+    them (ODE's dMassSetTrimesh on its triangles as the file winds them), read with the file by the loader."""
+
+    mesh: Mesh = Field(description="the file as a shape names it, its scale that of the Transforms above it")
+    pose: Pose = Field(default=Pose(), description="the mesh's frame in the node's frame")
+
+
+class PendingMass(Strict):
+    """A Physics node whose mass or centre of mass needs the volume of mesh files in its ``boundingObject``:
+    what the .wbt import knows of it. The loader reads the files and sets the node's ``mass`` from it by
+    Webots' rules (the same density over every bounding shape), then drops it."""
+
+    kg: float | None = Field(default=None, gt=0.0, description="Physics.mass when > 0; none: density × the "
+                             "bounding object's volume")
+    density: float = Field(default=1000.0, gt=0.0, description="Physics.density (kg/m³), used when kg is none")
+    center: Vec3 | None = Field(default=None, description="Physics.centerOfMass in the node's frame; none: the "
+                                "bounding object's centroid")
+    volume: float = Field(default=0.0, ge=0.0, description="the volume of its other bounding shapes (m³)")
+    centroid: Vec3 = Field(default=(0.0, 0.0, 0.0), description="their centroid in the node's frame (m)")
+    meshes: list[MassMesh] = Field(min_length=1, max_length=100_000, description="its mesh files")
+
+
 _MASS = ("Webots' Physics node: its mass and centre of mass (Supervisor getCenterOfMass: this node's and those "
          "of the nodes inside it with one, in world coordinates); none: no Physics (getCenterOfMass reads 0 0 0)")
+_PENDING_MASS = ("a Physics whose mass or centre needs the volume of mesh files (the .wbt import's): the loader "
+                 "reads them and sets `mass`; leave out `mass` with it")
+
+
+def _one_mass(mass: Mass | None, pending: PendingMass | None) -> None:
+    if mass is not None and pending is not None:
+        raise ValueError("pending_mass: give either mass or pending_mass (which the loader makes the mass), not both")
 
 
 class Solid(Strict):
@@ -688,11 +718,13 @@ class Solid(Strict):
                           "a Supervisor imports falls under the world's gravity onto what is under it over the next "
                           "steps (no solid falls at any other time)")
     mass: Mass | None = Field(default=None, description=_MASS)
+    pending_mass: PendingMass | None = Field(default=None, description=_PENDING_MASS)
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
     def _recognised_at_the_top(self) -> Solid:
+        _one_mass(self.mass, self.pending_mass)
         _check_cone_seen(self.geometry, self.seen_by)
         for i, con in enumerate(self.connectors):
             if con.on_joint is not None:
@@ -1764,6 +1796,12 @@ class NestedNode(Strict):
                                 "loads (its axis passes through it); none for other nodes")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
     mass: Mass | None = Field(default=None, description=_MASS + "; a Solid or device only")
+    pending_mass: PendingMass | None = Field(default=None, description=_PENDING_MASS)
+
+    @model_validator(mode="after")
+    def _one_physics(self) -> NestedNode:
+        _one_mass(self.mass, self.pending_mass)
+        return self
 
 
 class CarriedTarget(Strict):
@@ -1852,11 +1890,13 @@ class Robot(Strict):
     inner_defs: list[InnerDef] = Field(default=[], max_length=1024, description="the DEF names of its PROTO "
                                        "instances' bodies that name no node here, with why (InnerDef)")
     mass: Mass | None = Field(default=None, description=_MASS)
+    pending_mass: PendingMass | None = Field(default=None, description=_PENDING_MASS)
 
     _unit = field_validator("recognition_colors")(_unit_colors)
 
     @model_validator(mode="after")
     def _one_drive(self) -> Robot:
+        _one_mass(self.mass, self.pending_mass)
         given = [k for k in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive")
                  if getattr(self, k) is not None]
         if len(given) > 1:

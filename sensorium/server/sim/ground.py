@@ -909,9 +909,9 @@ def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.nd
 
 def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.ndarray | None) -> Pose:
     """:func:`resting_pose` for a solid of several shapes, a mesh, a capsule or a cone: its shapes'
-    support points and centre of mass (its Physics' masses where the world gives them and no mesh file
-    is among its shapes, else uniform density over their volumes), placed at ``pose`` in ENU, tipped by
-    :func:`_hull_tip`."""
+    support points and centre of mass (its Physics' masses where the world gives them, mesh files'
+    volumes weighed by the loader, else uniform density over their volumes), placed at ``pose`` in ENU,
+    tipped by :func:`_hull_tip`."""
     shapes = falling_shapes(solid, base_dir)
     if shapes is None:
         return pose
@@ -925,9 +925,9 @@ def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.n
     cloud = np.vstack(points)
     total = sum(volumes)
     centre = (sum(v * c for v, c in zip(volumes, centres)) / total) if total > 0.0 else cloud.mean(axis=0)
-    # its Physics' masses (the .wbt import's, Webots' rules) over uniform density, unless a mesh file is
-    # among its shapes (the import does not read the mesh, so its centre there would leave the mesh out)
-    weighed = None if any(isinstance(g, wm.Mesh) for _, _, g in shapes) else _mass_centre(solid)
+    # its Physics' masses (the .wbt import's and the loader's, Webots' rules, mesh files' volumes
+    # included) over uniform density
+    weighed = _mass_centre(solid)
     if weighed is not None:
         centre = enu_pose(pose, to_enu).rotation @ weighed + enu_pose(pose, to_enu).translation
     try:

@@ -323,8 +323,11 @@ def parse_world(data: Any, source: str = "<memory>", base_dir: Path | None = Non
                            asset_files=asset_files, textures=textures)
     if problems:
         raise WorldError(source, _named(data, problems))
+    world, weighed = complete_masses(world, base, limits=limits, allow_outside_meshes=allow_outside_meshes,
+                                     asset_files=asset_files)
     world, warnings = sanitize(world)
-    return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=warnings, textures=textures)
+    return LoadedWorld(world=world, source=source, base_dir=base, text=text, warnings=[*weighed, *warnings],
+                       textures=textures)
 
 
 def from_model(world: wm.World, base_dir: Path | None = None) -> LoadedWorld:
@@ -334,6 +337,7 @@ def from_model(world: wm.World, base_dir: Path | None = None) -> LoadedWorld:
     problems = check_world(world, base_dir or Path.cwd(), textures=textures)
     if problems:
         raise WorldError("<memory>", problems)
+    world, _ = complete_masses(world, base_dir or Path.cwd())
     world, _ = sanitize(world)
     return LoadedWorld(world=world, source="<memory>", base_dir=base_dir or Path.cwd(), textures=textures)
 
@@ -617,6 +621,61 @@ def _check_meshes_and_work(world: wm.World, base_dir: Path, limits: WorldLimits,
     for item in check_work(world, limits, lambda g: faces.get((g.url, tuple(g.scale), g.material_index, g.name), 0)):
         problems.append(Problem(*item) if isinstance(item, tuple) else Problem("", item))
     return problems
+
+
+def complete_masses(world: wm.World, base_dir: Path, *, limits: WorldLimits | None = None,
+                    allow_outside_meshes: bool = False, asset_files: frozenset[Path] = frozenset()
+                    ) -> tuple[wm.World, list[str]]:
+    """Every ``pending_mass`` (a Physics whose bounding object holds mesh files) made the node's ``mass``,
+    its files read as its shapes' are (checked already by ``check_world``; cached), each weighed as
+    Webots weighs it (``wbt.mass``); one warning per mesh Webots gives up on, which counts 1 kg at its
+    origin as there."""
+    if not has_pending_mass(world):
+        return world, []
+    from sensorium.server.world.meshes import load_mesh, resolve_mesh_url
+    from sensorium.server.world.poses import pose_from_model
+    from sensorium.server.world.wbt.mass import REFERENCE_DENSITY, completed_mass, trimesh_volume
+
+    limits = limits or WorldLimits()
+    warnings: list[str] = []
+
+    def weigh(path: str, node: Any) -> Any:
+        pending = node.pending_mass
+        if pending is None:
+            return node
+        volumes = []
+        for i, part in enumerate(pending.meshes):
+            g = part.mesh
+            file = resolve_mesh_url(g.url, base_dir, allow_outside=allow_outside_meshes,
+                                    max_bytes=limits.mesh_file_bytes, allowed=asset_files)
+            mesh = load_mesh(file, g.scale, display=g.url, memory=limits.mesh_load_bytes,
+                             max_triangles=limits.triangles, material=g.material_index, name=g.name)
+            at = pose_from_model(part.pose)
+            got = trimesh_volume(mesh.vertices, mesh.faces)
+            if got is None:
+                warnings.append(f"{path}.pending_mass.meshes[{i}]: mesh {g.url!r} in the boundingObject: Webots' mass "
+                                "properties of its triangles fail (no positive mass or inertia: open, or not all "
+                                "wound outward), so it counts 1 kg at its origin, as in Webots")
+                volumes.append((1.0 / REFERENCE_DENSITY, at.translation))
+            else:
+                volumes.append((got[0], at.rotation @ got[1] + at.translation))
+        return node.model_copy(update={"mass": wm.Mass(**completed_mass(pending, volumes)), "pending_mass": None})
+
+    def solid(path: str, s: wm.Solid) -> wm.Solid:
+        children = [solid(f"{path}.children[{i}]", c) for i, c in enumerate(s.children)]
+        return weigh(path, s.model_copy(update={"children": children}) if s.children else s)
+
+    solids = [solid(f"solids[{i}]", s) for i, s in enumerate(world.solids)]
+    robots = []
+    for r_i, r in enumerate(world.robots):
+        nodes = [weigh(f"robots[{r_i}].nodes[{n_i}]", n) for n_i, n in enumerate(r.nodes)]
+        robots.append(weigh(f"robots[{r_i}]", r.model_copy(update={"nodes": nodes}) if r.nodes else r))
+    return world.model_copy(update={"solids": solids, "robots": robots}), warnings
+
+
+def has_pending_mass(world: wm.World) -> bool:
+    return any(s.pending_mass is not None for _, s in all_solids(world)) or any(
+        r.pending_mass is not None or any(n.pending_mass is not None for n in r.nodes) for r in world.robots)
 
 
 def all_solids(world: wm.World) -> Iterator[tuple[str, wm.Solid]]:

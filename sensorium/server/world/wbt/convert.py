@@ -545,9 +545,8 @@ class Converter:
         entry: dict[str, Any] = {"type": t}
         if posed:
             entry["pose"] = self.child_frame(node, frame).pose()
-        mass = solid_mass(self, node) if posed and t not in ("Pose", "Transform") else None
-        if mass is not None:         # a Solid's or device's Physics (the Supervisor's getCenterOfMass)
-            entry["mass"] = mass
+        if posed and t not in ("Pose", "Transform"):    # a Solid's or device's Physics (getCenterOfMass)
+            entry.update(solid_mass(self, node))
         if t in ("HingeJoint", "SliderJoint"):
             parameters = self.fields(node).node_("jointParameters")
             if parameters is not None:
@@ -1389,9 +1388,7 @@ class Converter:
                             "top-level solid); ignored")
         if owner.kind != "world":       # a solid inside a top-level solid: a radar target of its own
             self.radar_cross_section(node, data)
-        mass = solid_mass(self, node)       # the Supervisor's getCenterOfMass
-        if mass is not None:
-            data["mass"] = mass
+        data.update(solid_mass(self, node))     # the Supervisor's getCenterOfMass
         if owner.kind == "world" and data["name"] != name:
             self.warn(node, f"solid name {name!r} used before: renamed {data['name']!r}")
         mine = Owner("solid", data, placed=owner.placed.compose(inner))
@@ -1514,9 +1511,7 @@ class Converter:
         if colors:
             data["recognition_colors"] = [list(c) for c in colors]
         self.radar_cross_section(node, data)
-        mass = solid_mass(self, node)       # the Supervisor's getCenterOfMass
-        if mass is not None:
-            data["mass"] = mass
+        data.update(solid_mass(self, node))     # the Supervisor's getCenterOfMass
         if f.flag("selfCollision", False):    # its generic, sonar and laser sensors see its own bounding objects
             data["self_collision"] = True
         battery = f.numbers("battery") if "battery" in node.fields else []
