@@ -250,6 +250,14 @@ def test_a_python_controllers_led_set_lights_the_sensor(tmp_path):
             led.set(0)
             robot.step(16)
             assert ls.getValue() == 0.0
+            # Webots' ctypes takes a bool as the C int 0 or 1 (its scara sample blinks its LED with
+            # set(True) / set(False)); refused before ('value must be an integer, got True')
+            led.set(True)
+            robot.step(16)
+            assert led.get() == 1 and ls.getValue() == pytest.approx(closed_form(COLORS[0]), rel=1e-12)
+            led.set(False)
+            robot.step(16)
+            assert led.get() == 0 and ls.getValue() == 0.0
         finally:
             wb.wb_robot_cleanup()
             from sensorium.client.webots.controller.robot import Robot as _R

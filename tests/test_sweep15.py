@@ -5,17 +5,20 @@ its Webots sample controller makes, checked against closed forms."""
 from __future__ import annotations
 
 import math
+import os
+import shutil
 import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
-from _serve import child_env, sensorium
+from _serve import REPO, child_env, sensorium
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 
 DATA = Path(__file__).parent / "data" / "sweep15"
+TESTS_C = Path(__file__).parent / "c"
 
 # BlueBotics' Shrimp III: six wheels of radius 0.058 m, the front and back ones on steering hinges
 # (front at x 0.271, back at -0.252), two per side on passive bogies at x ±0.089, y ±0.182.
@@ -378,3 +381,247 @@ def test_the_p_rob3_moves_by_its_joints_accelerations_and_opens_its_coupled_grip
     for name, target in (("motor 2", 1.55), ("motor 3", 1.12), ("motor 5", -1.95), ("gripper::right", 0.5),
                          ("gripper::left", 0.5)):
         assert robot.motor(name).position == pytest.approx(target, abs=1e-12), name
+
+
+# ---------------------------------------------------------------------- Webots' own controllers, unchanged
+
+# Webots' sample controllers are Webots' files, never this repository's: each test below copies one from
+# $WEBOTS_HOME (an installation or a source tree) into its temporary project, or, without it, our own
+# controller making the same calls (tests/c/, tests/controllers/), builds a C one against our
+# libController, and runs the world with `sensorium run`; a watcher of ours (a supervisor robot added to
+# the world's copy) prints the poses the closed forms are checked against.
+WATCHER = '''import math
+import sys
+
+from controller import Supervisor
+
+sup = Supervisor()
+every = int(sys.argv[1])
+nodes = [(name, sup.getFromDef(name)) for name in sys.argv[2:]]
+while sup.step(16) != -1:
+    t = round(sup.getTime() * 1000)
+    if t % every == 0:
+        for name, node in nodes:
+            p, r = node.getPosition(), node.getOrientation()
+            print(f"pose {t} {name} {p[0]:.9f} {p[1]:.9f} {p[2]:.9f} {math.atan2(r[3], r[0]):.9f} "
+                  f"{math.atan2(r[2], r[0]):.9f} {math.atan2(-r[5], r[4]):.9f}", flush=True)
+'''
+
+
+@pytest.fixture(scope="module")
+def clib(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
+    """Our libController built once for this file: (its build folder, the libraries to link)."""
+    if shutil.which("cc") is None or shutil.which("make") is None:
+        pytest.skip("needs a C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
+    build = tmp_path_factory.mktemp("cbuild")
+    make = ["make", "-s", "-C", str(REPO / "sensorium" / "client" / "c")]
+    done = subprocess.run([*make, f"BUILD={build}"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return build, subprocess.run([*make, "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+
+
+def sample_controller(tmp_path: Path, rel: str, ours: Path) -> tuple[Path, bool]:
+    """Webots' controller folder projects/robots/REL under $WEBOTS_HOME (an installation or a source
+    tree) and True; without it, a folder of that name holding ``ours`` (our own controller making the
+    same calls, renamed) and False."""
+    home = os.environ.get("WEBOTS_HOME")
+    folder = Path(home) / "projects" / "robots" / rel if home else None
+    if folder is not None and folder.is_dir():
+        return folder, True
+    name = rel.rsplit("/", 1)[-1]
+    folder = tmp_path / "ours" / name
+    folder.mkdir(parents=True)
+    shutil.copy(ours, folder / f"{name}{ours.suffix}")
+    return folder, False
+
+
+def webots_project(tmp_path: Path, world: str, controller: Path, watched: dict[str, str], every: int,
+                   extra: str = "", clib: tuple[Path, list[str]] | None = None) -> Path:
+    """worlds/WORLD.wbt: our stand-in with DEF names on the ``watched`` solids (DEF: the solid's name) and
+    the watcher printing their poses every ``every`` ms; controllers/: the Webots controller's copy (its
+    C files built into its executable against our libController) and the watcher."""
+    text = (DATA / f"{world}.wbt").read_text()
+    for def_name, solid in watched.items():
+        if def_name not in ("SHRIMP", "SRV1"):                 # the robots' own DEFs are in the file
+            at = text.rindex("Solid {", 0, text.index(f'name "{solid}"'))
+            text = f"{text[:at]}DEF {def_name} {text[at:]}"
+    args = " ".join(f'"{x}"' for x in (str(every), *watched))
+    text += f'{extra}\nRobot {{ name "watcher" supervisor TRUE controller "watcher" controllerArgs [ {args} ] }}\n'
+    (tmp_path / "worlds").mkdir()
+    (tmp_path / "worlds" / f"{world}.wbt").write_text(text)
+    (tmp_path / "controllers" / "watcher").mkdir(parents=True)
+    (tmp_path / "controllers" / "watcher" / "watcher.py").write_text(WATCHER)
+    folder = tmp_path / "controllers" / controller.name
+    shutil.copytree(controller, folder)
+    sources = sorted(str(x) for x in folder.glob("*.c"))
+    if sources:
+        assert clib is not None
+        build, libs = clib
+        done = subprocess.run(["cc", f"-I{REPO / 'sensorium' / 'client' / 'c' / 'include'}", *sources, "-o",
+                               str(folder / controller.name), str(build / "libController.a"), *libs, "-lm"],
+                              capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+    return tmp_path / "worlds" / f"{world}.wbt"
+
+
+def run_poses(world: Path, until_ms: int) -> tuple[dict[tuple[int, str], list[float]], subprocess.CompletedProcess]:
+    """``sensorium run`` until ``until_ms``: the watcher's poses by (ms, DEF) as [x, y, z, yaw, pitch,
+    roll], and the finished run."""
+    done = subprocess.run(sensorium("run", str(world), "--until", str(until_ms), "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=world.parent.parent, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "exited with status" not in done.stderr and "INVALID_ARGUMENT" not in done.stderr, done.stderr
+    poses = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("[watcher] pose "):
+            _, _, t, name, *values = line.split()
+            poses[int(t), name] = [float(v) for v in values]
+    return poses, done
+
+
+def turned(yaws: list[float]) -> float:
+    """The angle turned along a sampled yaw sequence (each sample within π of the last)."""
+    return sum(math.remainder(b - a, 2 * math.pi) for a, b in zip(yaws, yaws[1:]))
+
+
+@pytest.mark.slow
+def test_webots_shrimp_controller_runs_its_demo_by_the_closed_form(tmp_path: Path, clib) -> None:
+    """shrimp (Webots' C, unchanged; without it tests/c/shrimp_demo.c making its calls): command 95 straight, read wheel 00's encoder (16 counts a turn, rounded
+    up) each 64 ms until it passes 200, then 127 at -75° until it passes 270, then stop. Straight at
+    0.058·4.5543 m/s until 17.28 s (the count reaches 200 at 17.216 s, the command goes one step
+    later), then the turn: the hinges swing and the six wheels' fit turns it at 1.3268 rad/s (as the
+    in-process test above) until the count passes 270 at 21.312 s; it stands still from 21.376 s."""
+    controller, webots = sample_controller(tmp_path, "bluebotics/shrimp/controllers/shrimp", TESTS_C / "shrimp_demo.c")
+    world = webots_project(tmp_path, "shrimp", controller, {"SHRIMP": "Shrimp"}, 64, clib=clib)
+    poses, done = run_poses(world, 23000)
+    assert ("Select the 3D window and use the keyboard:" if webots else "demo done at 21.376 s") in done.stdout
+    straight, turn = abs(shrimp_command(95, 0)[0][0]), abs(shrimp_command(127, -75)[0][0])
+
+    def first_read(angle_at, counts: int, t: int) -> int:
+        """The first 64 ms read from ``t`` on at which ceil(angle / 2π · 16) reaches ``counts``."""
+        while math.ceil(angle_at(t) / (2 * math.pi) * 16) < counts:
+            t += 64
+        return t
+
+    t_turn = first_read(lambda t: straight * t / 1000, 200, 64) + 64
+    at_turn = straight * t_turn / 1000
+    t_stop = first_read(lambda t: at_turn + turn * (t - t_turn) / 1000, 270, t_turn + 64) + 64
+    assert (t_turn, t_stop) == (17280, 21376)
+    for t in range(64, t_turn + 1, 64):
+        x, y, _, yaw, _, _ = poses[t, "SHRIMP"]
+        assert x == pytest.approx(SHRIMP_R * straight * t / 1000, rel=1e-4), t   # the bogies' 3.1415
+        assert abs(y) < 2e-4 and abs(yaw) < 1e-4, t
+    assert poses[t_turn + 64, "SHRIMP"][3] > 0.04                                # turning left
+    drive = load_world(DATA / "shrimp.wbt").world.robots[0].steered_drive
+    assert drive is not None
+    speeds, front, back = shrimp_command(127, -75)
+    wz = fit_twist(drive.wheels, {f"wheel motor 0{i}": s for i, s in enumerate(speeds)},
+                   {"front wheel rotation": front, "back wheel rotation": back})[2]
+    steady = [poses[t, "SHRIMP"][3] for t in range(t_turn + 640, t_stop + 1, 64)]
+    assert turned(steady) == pytest.approx(wz * (t_stop - t_turn - 640) / 1000, abs=1e-6)
+    assert poses[t_stop - 64, "SHRIMP"] != poses[t_stop, "SHRIMP"]
+    assert all(poses[t, "SHRIMP"] == poses[t_stop, "SHRIMP"] for t in range(t_stop, 22976, 64))
+
+
+def p_rob3_waits(*seconds: float) -> list[int]:
+    """The times (ms) p-rob3's passive_wait()s end at, one after the other: each steps 16 ms while
+    start + seconds > the robot's time, in doubles as its C compares them (2.512 + 2.0 > 4.512: that
+    wait is one step longer)."""
+    ms, ends = 0, []
+    for wait in seconds:
+        start = ms / 1000
+        ms += 16
+        while start + wait > ms / 1000:
+            ms += 16
+        ends.append(ms)
+    return ends
+
+
+@pytest.mark.slow
+def test_webots_p_rob3_controller_moves_its_joints_by_their_accelerations(tmp_path: Path, clib) -> None:
+    """p-rob3 (Webots' C, unchanged; without it tests/c/p_rob3_moves.c), its links' turns read by the watcher: motor 5 at -0.47183 after the
+    first 0.512 s wait; then motors 2 and 3 at 1.55 and 1.12 and motor 5 at -1.95 (the links pitched
+    1.55, 2.67, 0.72), 'gripper::right' at 0.5 and its coupled 'gripper::left' with it; then motor 5 at
+    -1.09. close_gripper()'s torque is ignored (one warning): half a second later the fingers are still
+    open. Motors 2, 3, 5 then reach -0.92, 1.88, 1.5, and motor 1 starts its turn at its 2.61799
+    rad/s²: -2.61799·0.016²·32·33/2 = -0.35387 rad 32 steps later."""
+    links = {"L1": "motor 1 link", "L2": "motor 2 link", "L3": "motor 3 link", "L5": "motor 5 link",
+             "RF": "right finger", "LF": "left finger"}
+    controller, _ = sample_controller(tmp_path, "fp_robotics/p-rob3/controllers/p-rob3", TESTS_C / "p_rob3_moves.c")
+    world = webots_project(tmp_path, "p-rob3", controller, links, 16, clib=clib)
+    poses, done = run_poses(world, 8400)
+    pitch = {(t, k): v[4] for (t, k), v in poses.items()}
+    roll = {(t, k): v[5] for (t, k), v in poses.items()}
+    grasp, align, close, up, lift, rotate = p_rob3_waits(0.5, 2.0, 2.0, 0.5, 0.3, 2.0)
+    assert (grasp, align, close, up, lift, rotate) == (512, 2512, 4528, 5040, 5344, 7344)
+    assert pitch[grasp, "L5"] == pytest.approx(-3.49066 * 0.016 ** 2 * 32 * 33 / 2, abs=1e-8)
+    assert pitch[grasp, "L2"] == pitch[grasp, "L3"] == 0.0
+    for t in (align, close):
+        assert (pitch[t, "L2"], pitch[t, "L3"]) == pytest.approx((1.55, 2.67), abs=1e-8)
+        assert (roll[t, "RF"], roll[t, "LF"]) == pytest.approx((-0.5, 0.5), abs=1e-8)
+    assert pitch[align, "L5"] == pytest.approx(0.72, abs=1e-8)
+    assert pitch[align + 16, "L5"] == pytest.approx(0.72 + 3.49066 * 0.016 ** 2, abs=1e-8)   # its next move
+    assert pitch[close, "L5"] == pytest.approx(1.58, abs=1e-8)
+    assert (roll[up, "RF"], roll[up, "LF"]) == pytest.approx((-0.5, 0.5), abs=1e-8)
+    assert "wb_motor_set_torque(): RotationalMotor 'gripper::right' moves its joint kinematically" in done.stderr
+    assert (pitch[rotate, "L2"], pitch[rotate, "L3"], pitch[rotate, "L5"]) == pytest.approx((-0.92, 0.96, 2.46),
+                                                                                           abs=1e-8)
+    assert poses[rotate, "L1"][3] == 0.0
+    assert poses[rotate + 512, "L1"][3] == pytest.approx(-2.61799 * 0.016 ** 2 * 32 * 33 / 2, abs=1e-8)
+
+
+@pytest.mark.slow
+def test_webots_scara_controller_carries_the_shaft_where_its_two_turns_put_it(tmp_path: Path) -> None:
+    """scara (Webots' Python, unchanged; without it tests/controllers/scara_moves.py; it blinks the LED with set(True) / set(False), which Webots' ctypes takes
+    as 1 and 0): from its first step on it sets base 0.5, arm 0.14, shaft -0.1; the shaft's solid,
+    0.2545 m past the arm's hinge at (0.37, 0.005), itself 0.31 m past the base hinge at (0.06, 0),
+    stands where the two turns put it, 0.1 m lower, at 1.008 s and still at 2.096 s."""
+    controller, _ = sample_controller(tmp_path, "epson/scara_t6/controllers/scara",
+                                      Path(__file__).parent / "controllers" / "scara_moves.py")
+    world = webots_project(tmp_path, "scara_t6", controller, {"SHAFT": "shaft_solid"}, 16)
+    poses, _ = run_poses(world, 2100)
+    assert poses[16, "SHAFT"][:4] == pytest.approx([0.6245, 0.0, 0.256, 0.0], abs=1e-9)
+
+    def turn(a: float, p: np.ndarray) -> np.ndarray:
+        c, s = math.cos(a), math.sin(a)
+        return np.array([c * p[0] - s * p[1], s * p[0] + c * p[1]])
+
+    p1, p2, p3 = np.array([0.06, 0.0]), np.array([0.37, 0.005]), np.array([0.6245, 0.0])
+    p2_now = p1 + turn(0.5, p2 - p1)
+    shaft = p2_now + turn(0.64, p3 - p2)
+    for t in (1008, 2096):
+        assert poses[t, "SHAFT"][:4] == pytest.approx([*shaft, 0.156, 0.64], abs=1e-8), t
+
+
+SRV_WALL = '''
+Background { skyColor [ 0.4 0.7 1 ] }
+DirectionalLight { direction -1 0 -1 }
+Solid { translation 1.05 0 0.03 children [ Shape { geometry Box { size 0.1 3 0.06 } } ]
+  boundingObject Box { size 0.1 3 0.06 } name "wall" }
+'''
+
+
+@pytest.mark.slow
+def test_webots_surveyor_controller_wanders_by_its_camera_and_turns_at_the_wall(tmp_path: Path, clib) -> None:
+    """surveyor (Webots' C, unchanged; without it tests/c/surveyor_wander.c, whose simpler rule
+    spins right when the whole row is blocked, else goes straight on) starts in its wander mode: each step it compares the image with the
+    colours it sampled at its first step. Its scan is hard-wired for 80 × 64 pixels; on the 160 × 128
+    camera its bottom scan row is the right half of image row 31, whose pixel-centre rays rise at
+    atan(32.5/f) - 0.1742 = 0.04290 rad (f = 80/tan(0.994838/2), the camera pitched down 0.1742). It
+    goes straight at 0.3 m/s from 32 ms, until a wall of ours 0.06 m high with its face at x 1.0 (unlit,
+    black against the blue sky the scan sampled) fills that row: then all seven column groups are blocked and it spins right ('.': left wheels
+    -0.3/0.014 rad/s, right +0.3/0.014), -7.614 rad/s in place, the step after."""
+    controller, webots = sample_controller(tmp_path, "surveyor/controllers/surveyor", TESTS_C / "surveyor_wander.c")
+    world = webots_project(tmp_path, "srv-1", controller, {"SRV1": "SurveyorSrv1"}, 16, extra=SRV_WALL, clib=clib)
+    poses, done = run_poses(world, 2000)
+    assert not webots or "O (Wander on)\tP (Wander off)" in done.stdout
+    rise = math.atan(32.5 * math.tan(0.994838 / 2) / 80) - 0.1742
+    x = lambda t: 0.3 * max(t - 32, 0) / 1000                               # noqa: E731
+    seen = next(t for t in range(16, 2000, 16) if x(t) + 0.058 > 1.0 - (0.06 - 0.037) / math.tan(rise))
+    assert seen == 1392
+    for t in range(16, seen + 1, 16):
+        assert poses[t, "SRV1"][:2] + poses[t, "SRV1"][3:4] == pytest.approx([x(t), 0.0, 0.0], abs=1e-9), t
+    spun = poses[seen + 16, "SRV1"]
+    assert spun[:2] + spun[3:4] == pytest.approx([x(seen), 0.0, -0.6 / SRV_TRACK * 0.016], abs=1e-9)
+    assert poses[1984, "SRV1"][3] < -0.3 and poses[1984, "SRV1"][0] < 0.6         # turning away from it

@@ -291,7 +291,9 @@ def wb_led_set(tag: int, value: int) -> None:
     is printed and ignored (Webots)."""
     r = current()
     dev = _led(tag, "wb_led_set")
-    whole = integer(value)
+    # Webots' Python LED passes the value to C through ctypes, which takes a bool as the int 0 or 1:
+    # its own scara sample blinks the Epson's LED with set(True) / set(False)
+    whole = int(value) if isinstance(value, bool) else integer(value)
     if whole is None:
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_led_set(): value must be an integer, got {value!r}")
     value = whole
