@@ -455,6 +455,7 @@ class _Running:
     readers: list[threading.Thread] = field(default_factory=list)
     ending: bool = False       # ended by us (restart, reload, quit): no "exited" line of its own
     said_held: bool = False    # its pipes outlived its process group: said once
+    said_end: bool = False     # its "exited" line said (by the watcher or, at the run's end, by _end)
 
 
 class Launcher:
@@ -655,19 +656,32 @@ class Launcher:
 
     def _watch(self, run: _Running) -> None:
         code = run.proc.wait()
+        by_itself = not run.ending
         quitting = self._quitting()         # as it ended (the world may reach its end while its output drains)
-        if not run.ending:          # it may never have attached (a crash at start): not waited for any more
+        if by_itself:               # it may never have attached (a crash at start): not waited for any more
             self._starting.discard(run.spec.robot)
             self._wake_server()
         self._drain(run)
-        if not run.ending and not quitting:      # it ended by itself: the robot stays uncontrolled, the world goes on
-            self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}' {_describe(code)}")
+        # it ended by itself: the robot stays uncontrolled, the world goes on; a failure is said even when the
+        # world, left to itself, reached its end meanwhile (a clean end told by the world's end is not news)
+        if by_itself and (code != 0 or not quitting):
+            self._say_end(run, code)
+
+    def _say_end(self, run: _Running, code: int) -> None:
+        """Webots' line for a controller that ended by itself, once."""
+        with self._lock:
+            if run.said_end:
+                return
+            run.said_end = True
+        self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}' {_describe(code)}")
 
     def _end(self, run: _Running, grace_s: float) -> None:
         """End one controller: it was told (-1) by the server; after ``grace_s`` its process group
-        gets SIGTERM, then SIGKILL. Its output is read to the end."""
-        run.ending = True
+        gets SIGTERM, then SIGKILL. Its output is read to the end; one that had already failed by itself
+        (its watcher not yet there) has its line said here."""
         proc = run.proc
+        ended = proc.poll() if not run.ending else None
+        run.ending = True
         try:
             proc.wait(grace_s)
         except subprocess.TimeoutExpired:
@@ -691,6 +705,8 @@ class Launcher:
             run.said_held = True
             self.log(f"'{run.spec.name}' controller of robot '{run.spec.robot}': a process it started outside its "
                      "process group still holds its output: not read further, not ended")
+        if ended is not None and ended != 0:
+            self._say_end(run, ended)
 
     @staticmethod
     def _drain(run: _Running) -> bool:

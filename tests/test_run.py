@@ -242,6 +242,8 @@ def test_the_world_goes_on_to_until_when_every_started_controller_has_ended(tmp_
     assert proc.wait() == 0, proc.stderr()
     assert "[beta] done at 80" in proc.stdout().splitlines()
     assert "[alpha] no such device" in proc.stderr().splitlines()
+    # its end is said even when the world, left to itself, reaches --until before the process is reaped
+    assert "sensorium run: 'boom' controller of robot 'alpha' exited with status: 1." in proc.stderr()
     assert "sensorium: stopped at 800 ms after 50 steps" in proc.stderr().splitlines()
     assert "steps by itself" not in proc.stderr()            # serve's line, not run's: the world waited for both
 
