@@ -632,6 +632,24 @@ def wb_supervisor_field_get_name(field: Field | None) -> str:
     return "" if field is None else field[1]
 
 
+def wb_supervisor_field_get_actual_field(field: Field | None) -> Field | None:
+    """Webots' ``getActualField``: the node's own field (``getField``, what the scene tree shows) that
+    ``field`` takes its value from through IS -- a PROTO instance's base-node field or a field of a PROTO it
+    is built on gives the interface field passing straight to it; a node's own field is its own; None when
+    no interface field reaches it (README "Supervisor")."""
+    func = "wb_supervisor_field_get_actual_field"
+    r = _field_robot(field, None, func)
+    if r is None:
+        return None
+    assert field is not None
+    if len(field) == 3:                  # the node's own field already (getField)
+        return field
+    got = _answer(r, "get_actual_field", _field_args(field), func)
+    if got is None or not got["value"]:
+        return None
+    return (field[0], str(got["value"]), field[2])
+
+
 def _field_robot(field: Field | None, want: int | None, func: str):
     """The supervisor robot for a call on ``field`` of type ``want`` (None: any), or None after
     Webots' line for a NULL field or a wrong type."""

@@ -860,6 +860,26 @@ def get_field(sim: Any, node: Node, field: str, level: int = -1) -> dict:
         return {"type": entry[0], "value": [], "note": str(exc)}
 
 
+def actual_field(sim: Any, node: Node, field: str, level: int = -1) -> str:
+    """Webots' ``getActualField``: the name of the node's own field (``getField``, the one the scene tree
+    shows and a Supervisor sets) that the field ``field`` of ``level`` takes its value from; '' for Webots'
+    NULL. A node's own field is its own actual field. A PROTO instance's base-node field (level 0) or a field
+    of a PROTO it is built on (level >= 2) is linked to the interface field that passes through IS unchanged to
+    the same base-node field (``ProtoField.base``: the chain from the interface down to that field has one
+    field at each level, so the shared base names it); a field no interface field reaches that way is NULL."""
+    level = _level(node, level)
+    if field not in _fields(sim, node, level):
+        return ""
+    if level == 1 or not node.interface:
+        return field
+    if level == 0:
+        base: str | None = field
+    else:
+        base = next((f.base for f in node.interface[level - 1].fields if f.name == field), None)
+    own = node.interface[0].fields
+    return next((f.name for f in own if base is not None and f.base == base), "")
+
+
 _SOLID_ORDER = ("translation", "rotation", "scale", "children", "name", "model", "radarCrossSection", "controller",
                 "customData", "supervisor", "synchronization")
 _JOINT_ORDER = ("jointParameters", "jointParameters2", "jointParameters3", "device", "device2", "device3", "endPoint")
@@ -1479,6 +1499,8 @@ HANDLERS = {
     "get_from_id": lambda sim, ls, robot, a: node_ref(sim, node_from_id(sim, a.id)),
     "get_field": lambda sim, ls, robot, a: get_field(sim, node_by_id(sim, a.node), a.field, a.level),
     "get_proto": lambda sim, ls, robot, a: get_proto(sim, node_by_id(sim, a.node), a.level),
+    "get_actual_field": lambda sim, ls, robot, a: {"value": actual_field(sim, node_by_id(sim, a.node), a.field,
+                                                                         a.level)},
     "set_field": _set_field,
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},

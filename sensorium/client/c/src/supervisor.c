@@ -1071,6 +1071,26 @@ static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_
   return 0;
 }
 
+/* Webots' getActualField: the node's own field (getField: the scene tree's, the same ref) that `field` takes
+   its value from through IS; a node's own field is its own; NULL when no interface field reaches it */
+WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
+  const char *func = "wb_supervisor_field_get_actual_field";
+  sn_robot *rb = field_robot(field, WB_NO_FIELD, func);
+  if (rb == NULL)
+    return NULL;
+  if (field->level < 0)
+    return field;
+  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, true, field->level, 0, NULL};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/get_actual_field", 3, args_field, &a, func, &rep) != 0)
+    return NULL;
+  char *name = sn_strdup_obj(sn_get(rep.result, "value"));
+  sn_reply_free(&rep);
+  WbFieldRef actual = name != NULL && *name != '\0' ? field_at(node_ref(rb, field->node), name, -1, func) : NULL;
+  free(name);
+  return actual;
+}
+
 int wb_supervisor_field_get_count(WbFieldRef field) {
   sn_reply rep;
   const msgpack_object *v;

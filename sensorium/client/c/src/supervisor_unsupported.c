@@ -82,10 +82,6 @@ void wb_supervisor_node_add_torque(WbNodeRef node, const double torque[3], bool 
   SN_UNSUPPORTED();
 }
 
-WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
 
 
 

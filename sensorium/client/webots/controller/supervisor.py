@@ -206,6 +206,10 @@ class Field:
     def removeSF(self) -> None:
         wb.wb_supervisor_field_remove_sf(self._ref)
 
+    def getActualField(self) -> Field | None:
+        ref = wb.wb_supervisor_field_get_actual_field(self._ref)
+        return None if ref is None else Field(ref)
+
     _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_INT32: getSFInt32, wb.WB_SF_FLOAT: getSFFloat,
                 wb.WB_SF_STRING: getSFString, wb.WB_SF_VEC2F: getSFVec2f,
                 wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor,
@@ -594,8 +598,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "addForce": ("node_add_force", None, "force, relative"),
         "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),
         "addTorque": ("node_add_torque", None, "torque, relative")},
-    Field: {
-        "getActualField": ("field_get_actual_field", None, "")},
 }
 for _cls, _methods in _UNSERVED.items():
     for _method, (_func, _value, _params) in _methods.items():
