@@ -1145,6 +1145,32 @@ def _launcher_call(r: RobotClient, item: str, args: dict | None, func: str) -> N
         print(f"Error: {func}(): {err.message}.", file=sys.stderr)
 
 
+_SEEING = frozenset({"Camera", "Lidar", "RangeFinder", "Viewpoint"})
+
+
+def wb_supervisor_node_set_visibility(node: int | None, from_node: int | None, visible: bool) -> None:
+    """Webots' setVisibility: ``node`` (and what is inside it) hidden from, or shown again to, one Camera,
+    Lidar or RangeFinder (``from_node``, its node) or the Viewpoint (exportImage); the other devices keep
+    seeing it (README "Supervisor")."""
+    func = "wb_supervisor_node_set_visibility"
+    if _live_node_info(node, func) is None:
+        return
+    r = current()
+    if from_node is None or isinstance(from_node, bool) or not isinstance(from_node, int) or from_node < 0:
+        print(f"Error: {func}() called with a NULL or invalid 'from' argument.", file=sys.stderr)
+        return
+    seer = _call(r, "get_from_id", {"id": from_node})
+    if not seer.get("type"):
+        print(f"Error: {func}() called with a NULL or invalid 'from' argument.", file=sys.stderr)
+        return
+    if seer["type"] not in _SEEING:
+        print(f"Error: {func}() called with a 'from' argument which is not the viewpoint or a camera, lidar or "
+              "range-finder device.", file=sys.stderr)
+        return
+    _answer(r, "set_visibility", {"node": int(node), "from_node": from_node, "visible": bool(visible)},  # type: ignore[arg-type]
+            func)
+
+
 def wb_supervisor_node_restart_controller(node: int | None) -> None:
     """Webots' restartController, under ``sensorium run``: the robot's controller ends (its steps
     return -1; killed after a grace period) and starts again from its file. Under ``sensorium serve``

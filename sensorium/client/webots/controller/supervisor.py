@@ -375,6 +375,9 @@ class Node:
     def restartController(self) -> None:
         wb.wb_supervisor_node_restart_controller(self._ref)
 
+    def setVisibility(self, fromNode: Node | None, visible: bool) -> None:  # noqa: N803 - Webots' parameter name
+        wb.wb_supervisor_node_set_visibility(self._ref, None if fromNode is None else fromNode._ref, visible)
+
     def setJointPosition(self, position: float, index: int = 1) -> None:
         """Webots' ``setJointPosition``: the joint (this node) at ``position`` on its axis ``index`` at
         once, its motor targeting it (README "Supervisor": resets)."""
@@ -594,7 +597,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
     Node: {
         "getStaticBalance": ("node_get_static_balance", False, ""),
         "moveViewpoint": ("node_move_viewpoint", None, ""),
-        "setVisibility": ("node_set_visibility", None, "fromNode, visible"),
         "addForce": ("node_add_force", None, "force, relative"),
         "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),
         "addTorque": ("node_add_torque", None, "torque, relative")},
