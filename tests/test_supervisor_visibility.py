@@ -88,6 +88,16 @@ def test_a_node_hidden_from_one_device_is_seen_through_by_it_only(precision):
         np.testing.assert_array_equal(again[device], before[device])
 
 
+def test_a_shape_inside_a_solid_hidden_is_hidden_as_its_solid():
+    lv = _live()
+    shape = boss(lv, "get_field", {"node": CRATE, "field": "children"})["value"][0]
+    assert boss(lv, "get_from_id", {"id": shape})["type"] == "Shape"
+    hide(lv, shape, "cam")
+    np.testing.assert_array_equal(readings(lv)["cam"], without_crate("exact")["cam"])
+    hide(lv, WALL, "cam")               # the wall too: the blue sky (BGRA) in every pixel
+    assert (readings(lv)["cam"] == np.array([255, 0, 0, 255], dtype=np.uint8)).all()
+
+
 @pytest.mark.parametrize("precision", ["exact", "fast"])
 def test_a_robot_hidden_from_its_own_devices_keeps_its_body_out_of_their_view(precision):
     """tests/worlds/supervisor_visibility_self.yaml: the devices inside the robot's body box."""
