@@ -632,6 +632,24 @@ def wb_supervisor_field_get_name(field: Field | None) -> str:
     return "" if field is None else field[1]
 
 
+def wb_supervisor_field_get_actual_field(field: Field | None) -> Field | None:
+    """Webots' ``getActualField``: the node's own field (``getField``, what the scene tree shows) that
+    ``field`` takes its value from through IS -- a PROTO instance's base-node field or a field of a PROTO it
+    is built on gives the interface field passing straight to it; a node's own field is its own; None when
+    no interface field reaches it (README "Supervisor")."""
+    func = "wb_supervisor_field_get_actual_field"
+    r = _field_robot(field, None, func)
+    if r is None:
+        return None
+    assert field is not None
+    if len(field) == 3:                  # the node's own field already (getField)
+        return field
+    got = _answer(r, "get_actual_field", _field_args(field), func)
+    if got is None or not got["value"]:
+        return None
+    return (field[0], str(got["value"]), field[2])
+
+
 def _field_robot(field: Field | None, want: int | None, func: str):
     """The supervisor robot for a call on ``field`` of type ``want`` (None: any), or None after
     Webots' line for a NULL field or a wrong type."""
@@ -1125,6 +1143,32 @@ def _launcher_call(r: RobotClient, item: str, args: dict | None, func: str) -> N
         if err.code not in (ErrorCode.INVALID_ARGUMENT, ErrorCode.WRONG_STATE):
             raise
         print(f"Error: {func}(): {err.message}.", file=sys.stderr)
+
+
+_SEEING = frozenset({"Camera", "Lidar", "RangeFinder", "Viewpoint"})
+
+
+def wb_supervisor_node_set_visibility(node: int | None, from_node: int | None, visible: bool) -> None:
+    """Webots' setVisibility: ``node`` (and what is inside it) hidden from, or shown again to, one Camera,
+    Lidar or RangeFinder (``from_node``, its node) or the Viewpoint (exportImage); the other devices keep
+    seeing it (README "Supervisor")."""
+    func = "wb_supervisor_node_set_visibility"
+    if _live_node_info(node, func) is None:
+        return
+    r = current()
+    if from_node is None or isinstance(from_node, bool) or not isinstance(from_node, int) or from_node < 0:
+        print(f"Error: {func}() called with a NULL or invalid 'from' argument.", file=sys.stderr)
+        return
+    seer = _call(r, "get_from_id", {"id": from_node})
+    if not seer.get("type"):
+        print(f"Error: {func}() called with a NULL or invalid 'from' argument.", file=sys.stderr)
+        return
+    if seer["type"] not in _SEEING:
+        print(f"Error: {func}() called with a 'from' argument which is not the viewpoint or a camera, lidar or "
+              "range-finder device.", file=sys.stderr)
+        return
+    _answer(r, "set_visibility", {"node": int(node), "from_node": from_node, "visible": bool(visible)},  # type: ignore[arg-type]
+            func)
 
 
 def wb_supervisor_node_restart_controller(node: int | None) -> None:

@@ -369,6 +369,13 @@ class ProtoArgs(Args):
                        "(its base type name and the fields served here, in Webots' declaration order)")
 
 
+class SetVisibilityArgs(Args):
+    node: NodeId = Field(description="the node to hide or show, with what is inside it (a robot, a solid, a Shape, ...)")
+    from_node: NodeId = Field(description="the Camera, Lidar or RangeFinder node (a robot's device) or the Viewpoint "
+                              "it is hidden from or shown to")
+    visible: bool
+
+
 class SetJointPositionArgs(Args):
     node: NodeId = Field(description="a joint node inside a robot: HingeJoint, SliderJoint, Hinge2Joint, BallJoint")
     position: float = Field(description="the joint's new position (rad, or m on a slider): a finite number")
@@ -1099,6 +1106,8 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_field", "robot", FieldArgs, FieldValueResult, attached=True, supervisor=True),
     ServiceSpec("set_field", "robot", SetFieldArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("get_proto", "robot", ProtoArgs, ProtoResult, attached=True, supervisor=True),
+    ServiceSpec("get_actual_field", "robot", FieldArgs, StringValue, attached=True, supervisor=True),
+    ServiceSpec("set_visibility", "robot", SetVisibilityArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("get_node_center_of_mass", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),

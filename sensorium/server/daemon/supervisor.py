@@ -860,6 +860,86 @@ def get_field(sim: Any, node: Node, field: str, level: int = -1) -> dict:
         return {"type": entry[0], "value": [], "note": str(exc)}
 
 
+MAX_HIDDEN = 4096
+"""(node, device) pairs a Supervisor may keep hidden at once (setVisibility), Viewpoint included."""
+_SEEING = frozenset({"Camera", "Lidar", "RangeFinder"})
+
+
+def _node_shapes(sim: Any, node: Node) -> frozenset[int]:
+    """The scene's shapes of ``node`` and of what is inside it: every shape of a robot or top-level solid
+    (the solids inside it too), the Shape nodes at or under a node inside one, every shape for the root."""
+    scene = sim.scene
+    if node.id == 0:
+        return frozenset(range(len(scene.shapes)))
+    if node.type == "Robot" and not node.nested:
+        return frozenset(scene.target_shapes(sim.robots[node.key].index))
+    if node.type == "Solid" and not (node.nested or node.scenery or node.visual):
+        return frozenset(scene.target_shapes(node.key))
+    if not node.nested:
+        return frozenset()
+    table = _table(sim)
+    out: set[int] = set()
+    todo = [_nested_of(sim, node)]
+    while todo:
+        n = todo.pop()
+        if n.shape is not None and n.shape.role == "Shape":
+            out.update(n.shape.peers)
+        todo.extend(table.by_parent.get(n.id, ()))
+    return frozenset(out)
+
+
+def set_visibility(sim: Any, node: Node, viewer: Node, visible: bool) -> None:
+    """Webots' ``setVisibility``: ``node``'s shapes (and those inside it) left out of, or put back into, what
+    one Camera, Lidar or RangeFinder sees (its pixel rays, beams, the rays past semi-transparent
+    surfaces) or the Viewpoint's pictures (exportImage, snapshots). Shadows and other devices keep them."""
+    if viewer.scenery and viewer.type == "Viewpoint":
+        hidden = sim.viewpoint_hidden
+    else:
+        n = _nested_of(sim, viewer) if viewer.nested else None
+        device = None if n is None or not n.device or n.owner_kind != "Robot" else \
+            sim.robots[n.owner_key].devices.get(n.device)
+        if device is None or device.kind not in _SEEING:
+            raise ValueError(f"'from' ({_what(viewer)}) is not the viewpoint or a camera, lidar or range-finder device")
+        hidden = device.hidden
+    if visible:
+        hidden.pop(node.id, None)
+        return
+    shapes = _node_shapes(sim, node)
+    if not shapes:          # nothing of it is seen (a light, a device without shapes): nothing to hide
+        hidden.pop(node.id, None)
+        return
+    pairs = len(sim.viewpoint_hidden) + sum(len(d.hidden) for r in sim.robots.values() for d in r.devices.values())
+    if node.id not in hidden and pairs >= MAX_HIDDEN:
+        raise ValueError(f"{MAX_HIDDEN} nodes are hidden from devices already (at most {MAX_HIDDEN} pairs): "
+                         f"{_what(node)} not hidden; show one again first")
+    hidden[node.id] = shapes
+
+
+def _set_visibility(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    set_visibility(sim, node_by_id(sim, a.node), node_by_id(sim, a.from_node), a.visible)
+    return {"success": True}
+
+
+def actual_field(sim: Any, node: Node, field: str, level: int = -1) -> str:
+    """Webots' ``getActualField``: the name of the node's own field (``getField``, the one the scene tree
+    shows and a Supervisor sets) that the field ``field`` of ``level`` takes its value from; '' for Webots'
+    NULL. A node's own field is its own actual field. A PROTO instance's base-node field (level 0) or a field
+    of a PROTO it is built on (level >= 2) is linked to the interface field that passes through IS unchanged to
+    the same base-node field (``ProtoField.base``: the chain from the interface down to that field has one
+    field at each level, so the shared base names it); a field no interface field reaches that way is NULL."""
+    level = _level(node, level)
+    if field not in _fields(sim, node, level):
+        return ""
+    if level == 1 or not node.interface:
+        return field
+    if level == 0:
+        base: str | None = field
+    else:
+        base = next((f.base for f in node.interface[level - 1].fields if f.name == field), None)
+    own = node.interface[0].fields
+    return next((f.name for f in own if base is not None and f.base == base), "")
+
+
 _SOLID_ORDER = ("translation", "rotation", "scale", "children", "name", "model", "radarCrossSection", "controller",
                 "customData", "supervisor", "synchronization")
 _JOINT_ORDER = ("jointParameters", "jointParameters2", "jointParameters3", "device", "device2", "device3", "endPoint")
@@ -1483,6 +1563,9 @@ HANDLERS = {
     "get_from_id": lambda sim, ls, robot, a: node_ref(sim, node_from_id(sim, a.id)),
     "get_field": lambda sim, ls, robot, a: get_field(sim, node_by_id(sim, a.node), a.field, a.level),
     "get_proto": lambda sim, ls, robot, a: get_proto(sim, node_by_id(sim, a.node), a.level),
+    "set_visibility": _set_visibility,
+    "get_actual_field": lambda sim, ls, robot, a: {"value": actual_field(sim, node_by_id(sim, a.node), a.field,
+                                                                         a.level)},
     "set_field": _set_field,
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},

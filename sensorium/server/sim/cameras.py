@@ -94,6 +94,9 @@ def _cast_pixels(device: Any, rays: MountedRays, pose: Pose, limits: tuple[Any, 
     engine = device._scene.engine
     dirs, dirs32 = rays.at(pose.rotation, engine.threads)
     origins = np.broadcast_to(pose.translation, dirs.shape)
+    if device.hidden:     # a Supervisor hid nodes from it (setVisibility): a plain cast, on past them
+        return cast_skipping(engine, origins, dirs, *limits, device.own_shapes | device.hidden_shapes,
+                             directions32=dirs32)
     if rays.own is not None:
         return rays.own.cast(engine, origins, dirs, device.carrier_rotation(device._robot.pose), dirs32,
                              distance_only)
@@ -592,8 +595,8 @@ class Camera(Device):
             counters["rays_camera"] += len(D)
             counters["cast_calls"] += 1
             O = np.broadcast_to(origin, D.shape)
-            if self.own_shapes:
-                return cast_skipping(engine, O, D, tn, tf, self.own_shapes)
+            if self.own_shapes or self.hidden:
+                return cast_skipping(engine, O, D, tn, tf, self.own_shapes | self.hidden_shapes)
             return engine.cast(O, D, tn, tf, kind=RayKind.VISUAL, exclude_owner=-1)
 
         def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:

@@ -111,6 +111,25 @@ def cast_skipping(engine, origins: np.ndarray, directions: np.ndarray, t_near, t
     return _skipping(cast, len(origins), t_near, t_far, mine)
 
 
+def cast_past(engine, origins: np.ndarray, directions: np.ndarray, t_near, t_far, first: RayHits,
+              skip: frozenset[int], kind: RayKind = RayKind.VISUAL) -> RayHits:
+    """``first`` (a plain world cast of these rays, shapes kept) with each ray whose hit is one of ``skip``
+    cast on from just past it, blind to ``skip``: the shapes a Supervisor hid from a device (setVisibility)
+    and its own. Only the rays that met such a shape are cast again."""
+    ids = np.fromiter(skip, dtype=np.int64, count=len(skip))
+    rows = np.flatnonzero(np.isin(first.shape, ids))
+    if not len(rows):
+        return first
+    n = len(first.distance)
+    far = np.broadcast_to(np.asarray(t_far, dtype=np.float64), (n,))[rows]
+    near = np.nextafter(first.distance[rows], np.inf)
+    h = cast_skipping(engine, np.ascontiguousarray(origins[rows]), np.ascontiguousarray(directions[rows]), near, far,
+                      skip, kind)
+    distance, normal, shape = first.distance.copy(), np.array(first.normal, copy=True), first.shape.copy()
+    distance[rows], normal[rows], shape[rows] = h.distance, h.normal, h.shape
+    return RayHits(distance, normal, shape)
+
+
 class OwnBodyRays:
     """An image device's pixel rays (directions in its frame) when it has shapes of its own: cast
     mounted on its robot's body, which the world cast then skips, and nearer hits on that body

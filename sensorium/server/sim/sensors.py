@@ -27,7 +27,7 @@ from sensorium.server.devices.lookup import RESOLUTION_OFF, LookupTable, quantiz
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.raycast import blocks, packets
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
-from sensorium.server.sim.own_shapes import cast_local_skipping
+from sensorium.server.sim.own_shapes import cast_local_skipping, cast_past
 from sensorium.server.sim.scene import primitive_from_model
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import matrix_quaternion, pose_from_model
@@ -91,6 +91,8 @@ class Device:
     measured_at_ms: int = -1        # simulated time of the latest value
     _rng: np.random.Generator | None = None
     own_shapes: frozenset[int] = frozenset()   # its own Solid's shapes: its visual rays do not see them (own_shapes.py)
+    # shapes a Supervisor hid from it (setVisibility), by the node hidden: its visual rays pass through them
+    hidden: dict[int, frozenset[int]] = field(default_factory=dict)
 
     tracks_motion: ClassVar[bool] = False
     """The step calls ``track()`` after every basic step while the device is enabled."""
@@ -168,6 +170,11 @@ class Device:
     def step_reading(self) -> dict:
         """What a step reply carries for the device (PROTOCOL §3.6)."""
         return {"value": float(self.value)}  # type: ignore[attr-defined]
+
+    @property
+    def hidden_shapes(self) -> frozenset[int]:
+        """The shapes of every node hidden from it (empty for a device no Supervisor hid anything from)."""
+        return frozenset().union(*self.hidden.values()) if self.hidden else frozenset()
 
     def bind(self, robot: Any) -> None:
         """Called once with the device's ``RobotState`` (motors, drive, pose) when the robot is made."""
@@ -271,8 +278,12 @@ class Lidar(Device):
         # mounted on that body, which they also see (Mount(own=True): which beams can reach it is
         # decided once)
         self._mount: tuple[int, Mount] | None = None
+        self._scene: Any = None
+        # this step's beams while a Supervisor hides shapes from it: (origins, directions, far), cast again past them
+        self._past: tuple[np.ndarray, np.ndarray, Any] | None = None
 
     def bind(self, robot: Any) -> None:
+        self._scene = robot.scene       # (its engine, for beams past the shapes a Supervisor hid from it)
         if self.own_shapes:
             scene = robot.scene
             body = scene.device_body(self.robot_index, self.on_joint)
@@ -372,6 +383,9 @@ class Lidar(Device):
         """The rays of this step's measurement; ``body``: the engine body of the robot carrying the
         lidar (None: it has none), which a fixed lidar's rays are mounted on."""
         pose = self.world_pose(robot_pose)
+        self._past = None
+        if self.hidden:
+            return self._plan_past_hidden(pose, now_ms, dt_ms)
         if self.rotating:
             # only the sector the head sweeps during this step (devices.md §4.9)
             self._sweep = lmath.rotating_sweep(self.params, self.head_angle, self.frequency, dt_ms, now_ms / 1000.0)
@@ -408,10 +422,32 @@ class Lidar(Device):
         return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
                            distance_only=True)]
 
+    def _plan_past_hidden(self, pose: Pose, now_ms: int, dt_ms: int) -> list[RayRequest]:
+        """The beams as one plain world cast (its robot's body in it, nothing mounted), their shapes kept:
+        ``finish`` casts again, from just past it, each beam whose hit is a hidden or own shape."""
+        if self.rotating:
+            self._sweep = lmath.rotating_sweep(self.params, self.head_angle, self.frequency, dt_ms, now_ms / 1000.0)
+            cols = self._sweep.columns
+            if cols.size == 0:
+                return []
+            dirs = _rotate(pose.rotation, self._all_dirs[:, cols, :].reshape(-1, 3))
+            t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far[:, cols].reshape(-1)
+        else:
+            dirs = _rotate(pose.rotation, self._all_dirs.reshape(-1, 3))
+            t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far.reshape(-1)
+        origins = np.broadcast_to(pose.translation, dirs.shape)
+        self._past = (origins, dirs, t_far)
+        return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar")]
+
     def finish(self, hits: list[RayHits], now_ms: int, counters: dict[str, int], threads: int = 1) -> None:
         """Range image and point cloud from this step's hits; ``threads``: the point coordinates of a
         large scan are made in blocks on that many threads (the same values)."""
         L = self.config.number_of_layers
+        if self._past is not None:      # a Supervisor hid shapes from it: past them (and its own shapes)
+            origins, dirs, t_far = self._past
+            hits = [cast_past(self._scene.engine, origins, dirs, self.params.near, t_far, hits[0],
+                              self.own_shapes | self.hidden_shapes)]
+        own_body = None if self._past is not None else self._own_body
         if self.rotating:
             sweep = self._sweep
             self.head_angle = sweep.head_angle_after
@@ -419,7 +455,7 @@ class Lidar(Device):
             if cols.size == 0:
                 return
             dist = hits[0].distance.reshape(L, cols.size)
-            if self._own_body is not None:
+            if own_body is not None:
                 dist = np.minimum(dist, self._own_distances()[:, cols])
             ranges = lmath.ranges_from_hits(self.params, dist, self._all_dirs[:, cols, :], self._noise_rng())
             self.range_image[:, cols] = ranges
@@ -434,7 +470,7 @@ class Lidar(Device):
         else:
             W = self.config.horizontal_resolution
             dist = hits[0].distance.reshape(L, W)
-            if self._own_body is not None:
+            if own_body is not None:
                 dist = np.minimum(dist, self._own_distances())
             xyz = np.empty((L * W, 3), dtype=np.float32) if self.point_cloud_enabled else None
             ranges = np.empty((L, W), dtype=np.float32)

@@ -364,6 +364,8 @@ class Simulation:
         self.imported_interfaces: dict[str | int, tuple] = {}  # key -> that PROTO instance's interface fields
         self.imported_written: dict[str | int, Any] = {}      # key -> an imported node as written (parsed)
         self.top_level = top_level(self.world)     # the root's children as loaded (world/top_nodes.py)
+        # the shapes a Supervisor hid from the Viewpoint (setVisibility), by the node hidden: viewshot's pictures
+        self.viewpoint_hidden: dict[int, frozenset[int]] = {}
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
                                                             # a node was imported (None: the loaded order)
         self._import_protos: Any = None                     # the world's EXTERNPROTO declarations, read once

@@ -35,6 +35,7 @@ import numpy as np
 from sensorium.server.devices import imaging, shading
 from sensorium.server.sim import display
 from sensorium.server.sim.cameras import Camera, MountedRays
+from sensorium.server.sim.sensors import Device
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["EXPORT_SIZE", "MAX_PIXELS", "MAX_SIDE", "MAX_LABELS", "MAX_TEXT", "MAX_LABEL_ID", "Label", "Labels",
@@ -118,13 +119,15 @@ class _Eye:
     shapes of its own, the scene's lights and background."""
 
     own_shapes: frozenset[int] = frozenset()
+    hidden_shapes = Device.hidden_shapes      # the Viewpoint's: those a Supervisor hid from it
     _rays: Any = None          # (its rays are render()'s; its shadow buffers made per picture)
     _shadow_out: Any = None
     _render = Camera._render
     _shadows = Camera._shadows
     _light_arrays = Camera._light_arrays
 
-    def __init__(self, scene: Any, limits: tuple[Any, Any]):
+    def __init__(self, scene: Any, limits: tuple[Any, Any], hidden: dict[int, frozenset[int]]):
+        self.hidden = hidden
         self._scene = scene
         self._background = scene.background
         self._limits = limits
@@ -147,7 +150,7 @@ def render(sim: Any, width: int, height: int) -> np.ndarray:
     dirs = imaging.pixel_directions(g)[0]
     factors = imaging.depth_factors(g, dirs)
     limits = imaging.clip_limits(g, factors, vp.near, vp.far if vp.far > 0.0 else math.inf)
-    eye = _Eye(sim.scene, limits)
+    eye = _Eye(sim.scene, limits, getattr(sim, "viewpoint_hidden", {}))
     L = eye._render(vp.pose(), MountedRays(dirs), Counter())
     v = shading.tone_map(L, vp.exposure).reshape(height, width, 3)
     return shading.to_bytes(v)

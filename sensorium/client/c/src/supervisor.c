@@ -523,6 +523,45 @@ void wb_supervisor_node_restart_controller(WbNodeRef node) {
   sn_reply_free(&rep);
 }
 
+typedef struct {
+  int64_t node, from;
+  bool visible;
+} visibility_args;
+
+static void args_visibility(sn_req *r, const void *arg) {
+  const visibility_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "from_node");
+  msgpack_pack_int64(&r->pk, a->from);
+  sn_req_key(r, "visible");
+  sn_arg_bool(r, &a->visible);
+}
+
+/* Webots' setVisibility: `node` (and what is inside it) hidden from, or shown again to, one Camera, Lidar or
+   RangeFinder (`from`, its node) or the Viewpoint; the other devices keep seeing it */
+void wb_supervisor_node_set_visibility(WbNodeRef node, WbNodeRef from, bool visible) {
+  const char *func = "wb_supervisor_node_set_visibility";
+  if (live_node(node, func) == NULL)
+    return;
+  sn_robot *rb = supervisor(func);
+  sn_reply rep;
+  if (from == NULL || sn_robot_call(rb, "robot/get_from_id", 1, args_id, &from->id, func, &rep) != 0 ||
+      node_from_reply(rb, &rep) == NULL) {
+    fprintf(stderr, "Error: %s() called with a NULL or invalid 'from' argument.\n", func);
+    return;
+  }
+  const char *t = from->type_name;
+  if (strcmp(t, "Camera") != 0 && strcmp(t, "Lidar") != 0 && strcmp(t, "RangeFinder") != 0 && strcmp(t, "Viewpoint") != 0) {
+    fprintf(stderr, "Error: %s() called with a 'from' argument which is not the viewpoint or a camera, lidar or "
+                    "range-finder device.\n", func);
+    return;
+  }
+  visibility_args a = {node->id, from->id, visible};
+  if (sn_robot_call(rb, "robot/set_visibility", 3, args_visibility, &a, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
 void wb_supervisor_world_reload(void) {
   const char *func = "wb_supervisor_world_reload";
   sn_robot *rb = supervisor(func);
@@ -1069,6 +1108,26 @@ static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_
   }
   *value = sn_get(rep->result, "value");
   return 0;
+}
+
+/* Webots' getActualField: the node's own field (getField: the scene tree's, the same ref) that `field` takes
+   its value from through IS; a node's own field is its own; NULL when no interface field reaches it */
+WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
+  const char *func = "wb_supervisor_field_get_actual_field";
+  sn_robot *rb = field_robot(field, WB_NO_FIELD, func);
+  if (rb == NULL)
+    return NULL;
+  if (field->level < 0)
+    return field;
+  field_args a = {field->node, field->name, 0, false, 0.0, NULL, 0, true, field->level, 0, NULL};
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/get_actual_field", 3, args_field, &a, func, &rep) != 0)
+    return NULL;
+  char *name = sn_strdup_obj(sn_get(rep.result, "value"));
+  sn_reply_free(&rep);
+  WbFieldRef actual = name != NULL && *name != '\0' ? field_at(node_ref(rb, field->node), name, -1, func) : NULL;
+  free(name);
+  return actual;
 }
 
 int wb_supervisor_field_get_count(WbFieldRef field) {

@@ -66,9 +66,6 @@ void wb_supervisor_node_move_viewpoint(WbNodeRef node) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_node_set_visibility(WbNodeRef node, WbNodeRef from, bool visible) {
-  SN_UNSUPPORTED();
-}
 
 void wb_supervisor_node_add_force(WbNodeRef node, const double force[3], bool relative) {
   SN_UNSUPPORTED();
@@ -82,10 +79,6 @@ void wb_supervisor_node_add_torque(WbNodeRef node, const double torque[3], bool 
   SN_UNSUPPORTED();
 }
 
-WbFieldRef wb_supervisor_field_get_actual_field(WbFieldRef field) {
-  SN_UNSUPPORTED();
-  return NULL;
-}
 
 
 

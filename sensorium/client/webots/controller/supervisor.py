@@ -206,6 +206,10 @@ class Field:
     def removeSF(self) -> None:
         wb.wb_supervisor_field_remove_sf(self._ref)
 
+    def getActualField(self) -> Field | None:
+        ref = wb.wb_supervisor_field_get_actual_field(self._ref)
+        return None if ref is None else Field(ref)
+
     _GETTERS = {wb.WB_SF_BOOL: getSFBool, wb.WB_SF_INT32: getSFInt32, wb.WB_SF_FLOAT: getSFFloat,
                 wb.WB_SF_STRING: getSFString, wb.WB_SF_VEC2F: getSFVec2f,
                 wb.WB_SF_VEC3F: getSFVec3f, wb.WB_SF_ROTATION: getSFRotation, wb.WB_SF_COLOR: getSFColor,
@@ -370,6 +374,9 @@ class Node:
 
     def restartController(self) -> None:
         wb.wb_supervisor_node_restart_controller(self._ref)
+
+    def setVisibility(self, fromNode: Node | None, visible: bool) -> None:  # noqa: N803 - Webots' parameter name
+        wb.wb_supervisor_node_set_visibility(self._ref, None if fromNode is None else fromNode._ref, visible)
 
     def setJointPosition(self, position: float, index: int = 1) -> None:
         """Webots' ``setJointPosition``: the joint (this node) at ``position`` on its axis ``index`` at
@@ -590,12 +597,9 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
     Node: {
         "getStaticBalance": ("node_get_static_balance", False, ""),
         "moveViewpoint": ("node_move_viewpoint", None, ""),
-        "setVisibility": ("node_set_visibility", None, "fromNode, visible"),
         "addForce": ("node_add_force", None, "force, relative"),
         "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),
         "addTorque": ("node_add_torque", None, "torque, relative")},
-    Field: {
-        "getActualField": ("field_get_actual_field", None, "")},
 }
 for _cls, _methods in _UNSERVED.items():
     for _method, (_func, _value, _params) in _methods.items():
