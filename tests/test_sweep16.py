@@ -164,3 +164,69 @@ def test_the_sick_point_cloud_controller_counts_the_cans_under_sensorium_run(tmp
     assert "resolution 170 layers 8" in done.stdout, (done.stdout, done.stderr)
     seen = [int(x.rsplit(" ", 1)[1]) for x in done.stdout.splitlines() if "I see " in x]
     assert seen == SICK_PRINTS, (done.stdout, done.stderr)
+
+
+# sick: the tricycle's Sick LMS 291 (180 columns over 3.14159 rad, one layer, maxRange 80) at z 0.57,
+# the 46 obstacles (cylinders of radius 0.5 m) and the arena's walls (inner faces at ±50 m) around it
+def sick_obstacles() -> list[tuple[float, float]]:
+    text = (DATA / "sick.wbt").read_text()
+    out = []
+    for line in text.splitlines():
+        if line.startswith("Solid { translation ") and 'name "obstacle ' in line:
+            x, y = line.split()[3:5]
+            out.append((float(x), float(y)))
+    return out
+
+
+def lms291_closed_form(obstacles: list[tuple[float, float]]) -> np.ndarray:
+    """The 180 ranges from the origin: column j's beam at θ_j = Φ/2 - (j + ½)·Φ/180 (Φ = 3.14159) to
+    the nearest obstacle's circle or the wall it meets first."""
+    fov, w = 3.14159, 180
+    out = np.empty(w)
+    for j in range(w):
+        th = fov / 2 - (j + 0.5) * fov / w
+        d = np.array([math.cos(th), math.sin(th)])
+        best = min(50.0 / abs(d[0]) if abs(d[0]) > 1e-12 else math.inf,
+                   50.0 / abs(d[1]) if abs(d[1]) > 1e-12 else math.inf)
+        for cx, cy in obstacles:
+            c = np.array([cx, cy])
+            b = float(c @ d)
+            disc = b * b - (float(c @ c) - 0.25)
+            if disc >= 0 and b - math.sqrt(disc) > 0:
+                best = min(best, b - math.sqrt(disc))
+        out[j] = best
+    return out
+
+
+def braitenberg_obstacle(ranges: np.ndarray, max_range: float = 80.0) -> float:
+    """The sick controller's sum: Gaussian weights (mean 90, sigma 5, its integer divisions) times
+    1 - range / maxRange (an infinite range counted as maxRange)."""
+    i = np.arange(len(ranges), dtype=float)
+    g = np.exp(-((i - 90) ** 2) / 50.0) / (5 * math.sqrt(2 * math.pi))
+    v = np.where(np.isinf(ranges), max_range, ranges)
+    return float(np.sum(g * (1.0 - v / max_range)))
+
+
+def test_the_sick_tricycle_is_refused_and_its_lms_291_reads_the_closed_form() -> None:
+    """sick (Webots' LMS 291 on a tricycle): its back wheels are driven, its front wheel turns freely
+    on a steering hinge ('direction'); no drive here steers on one wheel, so the load says so in one
+    line and the robot stays. Its lidar's 180 ranges are the closed form's to the 46 obstacles and the
+    walls (1e-5 m relative, float32), and the controller's Braitenberg sum over them is 0.413814
+    (as Webots' controller printed it under `sensorium run`: speed 100·(0.99 - 0.413814) = 57.62 rad/s,
+    direction 0.007182 rad)."""
+    w = load_world(DATA / "sick.wbt")
+    assert any("robot 'robot': no Ackermann drive" in x and "it has 1 steering motor(s) ('direction')" in x
+               and "the robot will not move" in x for x in w.warnings), w.warnings
+    sim = Simulation(w, "exact")
+    sick = sim.device("robot/Sick LMS 291")
+    sick.enable(32)
+    sim.run(2)
+    got = np.asarray(sick.range_image, dtype=float).reshape(-1)
+    obstacles = sick_obstacles()
+    assert len(obstacles) == 46
+    want = lms291_closed_form(obstacles)
+    assert got == pytest.approx(want, rel=1e-6)
+    obstacle = braitenberg_obstacle(got)
+    assert obstacle == pytest.approx(0.413814, abs=5e-7)
+    speed = 100.0 * (0.99 - obstacle)
+    assert (speed, obstacle / speed) == pytest.approx((57.618592, 0.007182), abs=5e-6)
