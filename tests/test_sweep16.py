@@ -77,7 +77,7 @@ def test_the_ld_mrs_middle_layer_counts_the_cans_the_closed_form_counts() -> Non
     Webots' controller under `sensorium run` did (3 cans, then 4 … 8 as the belt brings them into
     the field of view, one too many or too few while two cans 0.1 m apart merge at the field's
     edge, 0 once all have fallen off the belt's end). The cans, placed 8.9 mm above the belt as in
-    Webots' world, settle on it at load (their origins' z 1.22 to 1.2111, a warning each under `sensorium run`)."""
+    Webots' world, settle on it at load (their origins' z 1.22 to 1.2111; `sensorium run` warns of it)."""
     w = load_world(DATA / "sick_point_cloud.wbt")
     assert any("its belt carries the solids" in x for x in w.warnings), w.warnings
     sim = Simulation(w, "exact")
