@@ -118,6 +118,12 @@ def test_skipped_nodes_summarised_once(tmp_path: Path) -> None:
     world.write_text(HEADER + "WorldInfo {}\nBackground { }\nBackground { }\n")
     summary = [x for x in load_world(world).warnings if "skipped nodes that do not matter" in x]
     assert summary == [f"{world}: skipped nodes that do not matter to these sensors: Background x2"]
+    # a sky colour is read (cameras see it past everything): only the rest of that Background is skipped
+    world.write_text(HEADER + "WorldInfo {}\nBackground { skyColor [ 0.2 0.3 0.4 ] }\n")
+    w = load_world(world)
+    assert w.world.background.sky_color == (0.2, 0.3, 0.4)
+    assert [x for x in w.warnings if "skipped nodes that do not matter" in x] == [
+        f"{world}: skipped nodes that do not matter to these sensors: Background (all but its skyColor)"]
 
 
 def test_convert_round_trip(tmp_path: Path, capsys) -> None:

@@ -636,7 +636,7 @@ class Converter:
             self.note_image_lighting(node)
             sky = f.colors("skyColor", [(0.0, 0.0, 0.0)])
             self.world["background"] = {"sky_color": list(sky[0]) if sky else [0.0, 0.0, 0.0]}
-            self.skipped[t] += 1     # its other fields (textures, luminosity) are not read
+            self.skipped["Background (all but its skyColor)"] += 1     # its textures, luminosity are not read
         elif t == "Fog":                 # cameras blend it in
             if top:
                 self.fog(node, f)
