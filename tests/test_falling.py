@@ -147,16 +147,35 @@ def test_in_a_nue_world_it_falls_down_the_world_y() -> None:
     assert sim.scene.solid_poses["load"].translation[1] == pytest.approx(0.05, abs=1e-12) and not sim.falls
 
 
-def test_a_supervisor_move_ends_the_fall_where_it_puts_the_box() -> None:
+def test_a_supervisor_move_mid_fall_starts_it_over_from_rest_where_it_puts_the_box() -> None:
+    """Moved to (0.3, 0, 1) after 5 steps of its fall, it falls from there from rest (its bottom 0.95 m
+    over the floor: 28 steps), its rotation kept, and rests on the floor."""
     sim = _world()
     _let_go(sim)
     for _ in range(5):
         sim.step()
+    start = sim.scene.solid_poses["load"]
     sim.set_solid_pose("load", [0.3, 0.0, 1.0])
-    for _ in range(30):
+    node = _node(sim, "load")
+    assert node_velocity(sim, node) == [0.0] * 6                        # type: ignore[arg-type]
+    n = _touch_steps(0.95)
+    for k in range(1, n):
         sim.step()
-    assert sim.scene.solid_poses["load"].translation.tolist() == [0.3, 0.0, 1.0] and not sim.falls
-    assert node_velocity(sim, _node(sim, "load")) == [0.0] * 6          # type: ignore[arg-type]
+        t = k * STEP / 1000.0
+        now = sim.scene.solid_poses["load"]
+        assert now.translation.tolist() == pytest.approx([0.3, 0.0, 1.0 - 9.81 * t * t / 2.0], abs=1e-12), k
+        assert np.array_equal(now.rotation, start.rotation)
+    sim.step()
+    assert sim.scene.solid_poses["load"].translation.tolist() == pytest.approx([0.3, 0.0, 0.05], abs=1e-12) and not sim.falls
+    assert node_velocity(sim, node) == [0.0] * 6                        # type: ignore[arg-type]
+
+
+def test_a_box_a_gripper_holds_does_not_fall_when_a_supervisor_moves_it() -> None:
+    sim = _world()
+    sim.step()
+    assert sim.device("crane/cup").held == "load"                       # type: ignore[attr-defined]
+    sim.set_solid_pose("load", [0.0, 0.0, 0.8])
+    assert not sim.falls
 
 
 def test_a_gripper_beside_its_path_catches_it_mid_fall() -> None:

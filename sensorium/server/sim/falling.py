@@ -1,5 +1,6 @@
-"""Solids falling under the world's gravity after a VacuumGripper lets them go or a Supervisor imports
-them (Webots' physics drops them; settling at load and a PROTO rebuild stay instant: ground.py).
+"""Solids falling under the world's gravity after a VacuumGripper lets them go, a Supervisor imports
+them or moves them into the air, or a belt carries them past its edge (Webots' physics drops them;
+settling at load and a PROTO rebuild stay instant: ground.py).
 
 A solid let go (or imported) at simulated time ``t0`` (integer ms) from pose ``P0`` falls straight down the world's up
 (ENU z; a NUE world's y), its x, y and rotation kept, no air drag and no spin: at each step's end ``t``
@@ -9,8 +10,9 @@ point (``ground.falling_span`` at ``P0``) reaches the top it rests on, the lowes
 from that step on it is at exactly that pose, as it was put at once before. What is under it is judged
 once, when it is let go. Its velocity while it falls is ``−g·(t − t0)`` along the up, no rotation
 (:meth:`Falls.velocity`, a Supervisor's ``getVelocity``). A fall ends early, the solid staying where it
-is, when something else puts it somewhere (a Supervisor's move, a gripper holding it, a state loaded, a
-reset: its pose in the scene is then not the one the fall put) or when it is removed or rebuilt. While
+is, when something else puts it somewhere (a gripper holding it, a state loaded, a reset: its pose in
+the scene is then not the one the fall put) or when it is removed or rebuilt; a Supervisor's move
+starts it over, from rest, from the pose it puts (``Simulation.set_solid_pose`` calls :meth:`Falls.let_go`). While
 it falls, it is support where it will rest (:meth:`Falls.resting`, read by ``Simulation.landing_ground``).
 Only falling solids cost work per step: none, nothing.
 """

@@ -573,11 +573,18 @@ class Simulation:
 
     def set_solid_pose(self, name: str, translation, rotation=None, quaternion=None) -> None:
         """Move a solid (as ``RobotState.set_pose``: non-finite values or a translation beyond
-        ``limits.MAX_COORDINATE_M`` raise ValueError and it stays)."""
+        ``limits.MAX_COORDINATE_M`` raise ValueError and it stays). One with physics put in the air
+        falls from there from rest (sim/falling.py), as Webots' physics drops it."""
         if name not in self.scene.solid_poses:
             raise KeyError(f"no solid {name!r}")
         check_pose(translation, rotation, quaternion)
         self.place_solid(name, moved_pose(self.scene.solid_poses[name], translation, rotation, quaternion))
+        # with physics, one put in the air falls from there, from rest, as Webots' physics drops it (a
+        # fall it was in ends: it starts over); onto its support it stays, sunk into it it is raised at
+        # once (sim/falling.py); one a gripper holds stays with the gripper
+        model = next((s for s in self.world.solids if s.name == name), None)
+        if model is not None and model.physics and not any(g.held == name for g in self._grippers):
+            self.falls.let_go(name, model, self.time_ms)
 
     def place_solid(self, name: str, pose: Pose) -> None:
         """Put a top-level solid at ``pose`` (checked by the caller): the sensors, kinematic contact
