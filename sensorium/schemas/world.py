@@ -1677,7 +1677,9 @@ class SteeredWheel(Strict):
     up axis (none: it keeps its heading), where it touches the ground and its radius (in the robot's frame:
     x forward, y left, z up; with the drive's ``forward`` another direction, along it and its left)."""
 
-    motor: str = Field(min_length=1, description="its rolling RotationalMotor's name")
+    motor: str | None = Field(default=None, min_length=1, description="its rolling RotationalMotor's name; none: a "
+                              "free wheel (a tricycle's steered front wheel, a caster) that rolls with the robot and "
+                              "only keeps it from sliding across its heading")
     steer: str | None = Field(default=None, min_length=1, description="the RotationalMotor of the hinge that "
                               "steers it (one of the robot's devices, moved as any joint is); none: its heading "
                               "is fixed")
@@ -1698,7 +1700,11 @@ class SteeredDrive(Strict):
     step) turning at ω_i moves its ground point at r_i·ω_i·(cos h_i, sin h_i). The body twist (vx, vy, ωz)
     over a step is the least-squares fit of those velocities to v + ωz × p_i (the 2N rows (1, 0, -y_i) and
     (0, 1, x_i)): exact when the wheels agree with one twist, their best fit when they do not (a real
-    robot's wheels would slip or scuff). The wheels must stand at two places at least."""
+    robot's wheels would slip or scuff). A free wheel (no ``motor``) only forbids sliding across its heading:
+    with free wheels the body moves along the twists every wheel's no-slip-across row allows (one line of
+    twists, as a tricycle's), at the speed where the driven wheels' rims' speeds along their headings sum to
+    their motors' (a tricycle: the bicycle model, v = r·ω and ωz = v·tan δ / L about the rear axle's centre).
+    The wheels must stand at two places at least, one of them driven."""
 
     wheels: list[SteeredWheel] = Field(min_length=2, max_length=16)
     wheel_bottom: float | None = _wheel_bottom_field()
@@ -1713,11 +1719,13 @@ class SteeredDrive(Strict):
     def motor_fields(self) -> list[tuple[str, str]]:
         """(field, motor name) of the rolling motors, in the wheels' order (the steering motors are the
         robot's joint motors, not the drive's)."""
-        return [(f"wheels[{i}].motor", w.motor) for i, w in enumerate(self.wheels)]
+        return [(f"wheels[{i}].motor", w.motor) for i, w in enumerate(self.wheels) if w.motor is not None]
 
     @model_validator(mode="after")
     def _valid(self) -> SteeredDrive:
-        names = [w.motor for w in self.wheels]
+        names = [w.motor for w in self.wheels if w.motor is not None]
+        if not names:
+            raise ValueError("no wheel has a motor: a steered drive needs one driven wheel at least")
         if len(set(names)) != len(names):
             raise ValueError(f"every wheel motor needs its own name, got {names}")
         _check_motor_max_speeds(self.motor_max_speeds, names, "drive's wheel motors")
