@@ -222,7 +222,8 @@ def tricycle(sign: int = 1) -> dict:
                 {"motor": "rr wheel", "position": [0.0, -B], "radius": R},
                 {"steer": "fr steer", "position": [L, 0.0], "radius": 0.03, "steer_sign": sign}]},
             "devices": [{"device": "RotationalMotor", "name": "fr steer", "axis": [0.0, 0.0, float(sign)],
-                         "anchor": [L, 0.0, 0.0], "max_velocity": 100.0}]}
+                         "anchor": [L, 0.0, 0.0], "max_velocity": 100.0},
+                        {"device": "PositionSensor", "name": "front encoder", "free_wheel": 2, "position": 0.5}]}
 
 
 def test_a_tricycle_s_free_wheel_gives_the_bicycle_twist() -> None:
@@ -270,4 +271,34 @@ def test_a_steered_drive_without_a_driven_wheel_is_one_line() -> None:
     for wheel in robot["steered_drive"]["wheels"]:
         wheel.pop("motor", None)
     with pytest.raises(WorldError, match="no wheel has a motor: a steered drive needs one driven wheel"):
+        sim_of(robot)
+
+
+def test_a_tricycle_s_free_wheel_encoder_reads_what_it_rolled() -> None:
+    """The free front wheel's PositionSensor (``free_wheel: 2``) reads its start position plus its
+    ground point's travel along its heading over its radius: r·ω·t / 0.03 straight, then the bicycle's
+    front wheel speed v / cos δ at δ = 0.3; back to its start on reset."""
+    sim = sim_of(tricycle())
+    enc = sim.robot("sw").devices["front encoder"]
+    enc.enable(16)
+    roll(sim, {"rl": 4.0, "rr": 4.0})
+    sim.run(50)
+    straight = R * 4.0 * 0.8 / 0.03
+    assert enc.value == pytest.approx(0.5 + straight, abs=1e-12)
+    roll(sim, {"rl": 0.0, "rr": 0.0})
+    sim.robot("sw").motor("fr steer").set_position(0.3)
+    sim.run(60)
+    assert enc.value == pytest.approx(0.5 + straight, abs=1e-12)
+    roll(sim, {"rl": 4.0, "rr": 4.0})
+    sim.run(100)
+    assert enc.value == pytest.approx(0.5 + straight + R * 4.0 / math.cos(0.3) * 1.6 / 0.03, abs=1e-9)
+    sim.reset()
+    sim.run(1)
+    assert enc.value == 0.5
+
+
+def test_a_free_wheel_encoder_on_a_driven_wheel_is_one_line() -> None:
+    robot = tricycle()
+    robot["devices"][1]["free_wheel"] = 0
+    with pytest.raises(WorldError, match="PositionSensor 'front encoder': free_wheel 0 is no wheel without motor"):
         sim_of(robot)

@@ -810,9 +810,10 @@ class PositionSensor(_Device):
                             description="without a motor: the joint's position it reads (Webots jointParameters "
                                         "position: rad, m on a slider), a free wheel's at the start; unused with a "
                                         "motor (the motor's own)")
-    free_wheel: Literal["right_front", "left_front", "right_rear", "left_rear"] | None = Field(
+    free_wheel: Literal["right_front", "left_front", "right_rear", "left_rear"] | int | None = Field(
         default=None, description="the encoder of a wheel of the robot's ackermann_drive that has no motor (Webots' "
-        "Car: the front wheels of a propulsion car, the rear ones of a traction car): it reads ``position`` plus the "
+        "Car: the front wheels of a propulsion car, the rear ones of a traction car), or the index of a free wheel "
+        "(no motor) in its steered_drive's wheels (a tricycle's front wheel): it reads ``position`` plus the "
         "angle the wheel has rolled, its contact point's travel along its rolling direction over its radius")
     free_wheel_sign: Literal[1, -1] = Field(
         default=1, description="1: the wheel's joint axis is the car's left, so rolling forward reads increasing; "
@@ -1922,7 +1923,17 @@ class Robot(Strict):
                 raise ValueError(f"radar_targets[{i}] ({t.name}): shape index {bad[0]} is past the robot's "
                                  f"{len(self.shapes)} shapes")
         for d in self.devices:
-            if isinstance(d, PositionSensor) and d.free_wheel is not None:
+            if isinstance(d, PositionSensor) and isinstance(d.free_wheel, int):
+                steered = self.steered_drive
+                if steered is None:
+                    raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel} needs the robot's "
+                                     "steered_drive")
+                if d.motor is not None:
+                    raise ValueError(f"PositionSensor {d.name!r}: give motor or free_wheel, not both")
+                if not 0 <= d.free_wheel < len(steered.wheels) or steered.wheels[d.free_wheel].motor is not None:
+                    raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel} is no wheel without motor "
+                                     f"in the steered_drive's {len(steered.wheels)} wheels")
+            elif isinstance(d, PositionSensor) and d.free_wheel is not None:
                 car = self.ackermann_drive
                 if car is None:
                     raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel!r} needs the robot's "

@@ -509,6 +509,8 @@ class SteeredDrive(HolonomicDrive):
             self.places.append((px, py))
         self.has_free = any(m is None for m, *_ in self.wheels)
         """Free wheels make the fit depend on the headings: :meth:`constrained_twist` each step."""
+        self.free_turned: dict[int, float] = {i: 0.0 for i, (m, *_) in enumerate(self.wheels) if m is None}
+        """Each free wheel's rolled angle (rad, along its heading positive) since the start, by wheel index."""
         solve = np.linalg.pinv(np.array(rows, dtype=np.float64))
         """3 × 2N: the wheels' ground velocities (u_ix, u_iy, ...) to the body twist (vx, vy, ωz)."""
         self.columns = [(tuple(float(v) for v in solve[:, 2 * i]), tuple(float(v) for v in solve[:, 2 * i + 1]))
@@ -546,7 +548,20 @@ class SteeredDrive(HolonomicDrive):
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
         dt = dt_ms / 1000.0
         speeds = [m.advance(dt) if m is not None else 0.0 for m, *_ in self.wheels]
+        if self.has_free and any(u != 0.0 for u in speeds):
+            self.roll_free(speeds, dt)
         return self.roll(speeds, dt)
+
+    def roll_free(self, speeds: list[float], dt: float) -> None:
+        """Turn the free wheels by the step's twist: each ground point's velocity v + ωz × p along the
+        wheel's heading, times dt over its radius."""
+        vx, vy, w = self.twist(speeds)
+        headings = self.headings()
+        for i in self.free_turned:
+            px, py = self.places[i]
+            h = headings[i]
+            along = (vx - w * py) * math.cos(h) + (vy + w * px) * math.sin(h)
+            self.free_turned[i] += along * dt / self.wheels[i][1]
 
     def constrained_twist(self, speeds: list[float]) -> tuple[float, float, float]:
         """The twist of a drive with free wheels, from its headings now. No wheel slides across its
