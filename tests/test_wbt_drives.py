@@ -1052,7 +1052,8 @@ def tricycle_wbt(steered_x: float, passive_hinge: bool) -> str:
     at x ``steered_x`` holding a free wheel of radius 0.08 -- in a passive HingeJoint (no device) or as
     the steering end point's own round part."""
     round_part = ('children [ DEF F Shape { geometry Cylinder { radius 0.08 height 0.04 } } ] boundingObject USE F')
-    held = (f'children [ HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 }} endPoint Solid {{ '
+    held = (f'children [ HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 -1 0 }} '
+            f'device [ PositionSensor {{ name "front encoder" }} ] endPoint Solid {{ '
             f'rotation 1 0 0 1.5708 {round_part} }} }} ]' if passive_hinge else f'rotation 1 0 0 1.5708 {round_part}')
     return ('Robot { name "trike" children [\n'
             '  Pose { translation 0 0 0.2 children [ Shape { geometry Box { size 0.3 0.3 0.1 } } ] }\n'
@@ -1086,3 +1087,9 @@ def test_two_driven_wheels_and_a_steered_free_wheel_make_a_tricycle(tmp_path: Pa
     sim.run(1)
     heading = 0.3 + wheels[2].heading
     assert sim.robot("trike").drive.velocity()[5] == pytest.approx(R * 5.0 * math.tan(heading) / steered_x, abs=1e-12)
+    if passive_hinge:               # its encoder (hinge axis the robot's right: rolling forward reads decreasing)
+        enc = sim.robot("trike").devices["front encoder"]
+        assert (enc.config.free_wheel, enc.config.free_wheel_sign) == (2, -1)
+        enc.enable(16)
+        sim.run(9)                  # 10 steps rolled: the front wheel's ground speed R·ω / cos δ
+        assert enc.value == pytest.approx(-R * 5.0 / math.cos(heading) * 0.16 / 0.08, abs=1e-9)

@@ -2493,6 +2493,17 @@ class Converter:
             # the steering hinge stays a joint; a motorised hinge of the free wheel stays one too (its motor,
             # never commanded by a tricycle's controller, moves that joint, not the drive)
             self._drive_wheels(node, robot, tricycle[0][1])
+            # an encoder on the free wheel's passive hinge reads what the wheel rolls (positive: rolling forward
+            # turns the hinge about its axis, the robot's left at steering 0)
+            held = tricycle[1][1][0]["end"]
+            for free in robot.free:
+                if free["end"] is held and free["sensors"]:
+                    left = np.array([0.0, 1.0, 0.0]) if up == 2 else np.array([0.0, 0.0, -1.0])
+                    for sensor in free["sensors"]:
+                        sensor["free_wheel"] = len(tricycle[0][1])
+                        if float(np.dot(free["axis"], left)) < 0.0:
+                            sensor["free_wheel_sign"] = -1
+                    free["line"] = None
             return
         if turns is None and any(w["steers"] for w in wheels):      # a car
             casters = self._one_steered_wheel(wheels)
