@@ -207,3 +207,98 @@ def test_strafing_sideways_up_a_ramp_covers_r_omega_t_along_the_ground() -> None
     d = sim.robot("sw").pose.translation - start
     dist = R * 4.0 * 0.96
     assert list(d) == pytest.approx([dist * math.cos(A), 0.0, dist * math.sin(A)], abs=1e-9)
+
+
+# A tricycle of ours: two driven rear wheels on one axle (the robot's origin at its centre), one free
+# front wheel on a steering hinge L ahead (Webots' sick sample and forklifts are built this way).
+L, B = 0.5, 0.2                        # wheelbase, half the rear track
+
+
+def tricycle(sign: int = 1) -> dict:
+    return {"name": "sw", "pose": {"translation": [0.0, 0.0, 0.1]},
+            "body": {"geometry": {"type": "box", "size": [0.6, 0.4, 0.1]}},
+            "steered_drive": {"max_wheel_speed": 20.0, "wheels": [
+                {"motor": "rl wheel", "position": [0.0, B], "radius": R},
+                {"motor": "rr wheel", "position": [0.0, -B], "radius": R},
+                {"steer": "fr steer", "position": [L, 0.0], "radius": 0.03, "steer_sign": sign}]},
+            "devices": [{"device": "RotationalMotor", "name": "fr steer", "axis": [0.0, 0.0, float(sign)],
+                         "anchor": [L, 0.0, 0.0], "max_velocity": 100.0},
+                        {"device": "PositionSensor", "name": "front encoder", "free_wheel": 2, "position": 0.5}]}
+
+
+def test_a_tricycle_s_free_wheel_gives_the_bicycle_twist() -> None:
+    """Rear wheels at one speed, the free front wheel at δ: v = r·ω and ωz = v·tan δ / L about the rear
+    axle's centre (the drive's origin), no sideways slip, to 1e-12."""
+    config = wm.SteeredDrive.model_validate(tricycle()["steered_drive"])
+
+    class Hinge:
+        position = 0.0
+
+    drive = SteeredDrive(config, Pose.identity())
+    hinge = Hinge()
+    drive.bind({"fr steer": hinge})
+    for delta, omega in ((0.0, 3.0), (0.3, 3.0), (-0.7, -2.0), (1.2, 5.5)):
+        hinge.position = delta
+        vx, vy, w = drive.twist([omega, omega, 0.0])
+        assert (vx, vy, w) == pytest.approx((R * omega, 0.0, R * omega * math.tan(delta) / L), abs=1e-12)
+    hinge.position = math.pi / 2                # the front wheel across: the rear wheels turn it about its axle
+    assert drive.twist([-1.0, 1.0, 0.0]) == pytest.approx((0.0, 0.0, R * 2.0 / (2 * B)), abs=1e-12)
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+def test_a_tricycle_drives_straight_then_on_the_bicycle_arc(sign: int) -> None:
+    sim = sim_of(tricycle(sign))
+    roll(sim, {"rl": 4.0, "rr": 4.0})
+    sim.run(50)                                 # 0.8 s straight
+    assert pose2d(sim) == pytest.approx((R * 4.0 * 0.8, 0.0, 0.0), abs=1e-12)
+    sim.robot("sw").motor("fr steer").set_position(0.3)
+    roll(sim, {"rl": 0.0, "rr": 0.0})
+    sim.run(60)                                 # steering alone does not move it
+    assert sim.robot("sw").motor("fr steer").position == 0.3
+    assert pose2d(sim) == pytest.approx((R * 4.0 * 0.8, 0.0, 0.0), abs=1e-12)
+    roll(sim, {"rl": 4.0, "rr": 4.0})
+    sim.run(100)                                # 1.6 s on the circle of radius L / tan 0.3 about (x0, ±radius)
+    v, delta = R * 4.0, 0.3 * sign
+    w = v * math.tan(delta) / L
+    x0, t = R * 4.0 * 0.8, 1.6
+    expected = (x0 + v / w * math.sin(w * t), v / w * (1.0 - math.cos(w * t)), w * t)
+    assert pose2d(sim) == pytest.approx(expected, abs=1e-9)
+    assert sim.robot("sw").drive.velocity()[5] == pytest.approx(w, abs=1e-12)
+
+
+def test_a_steered_drive_without_a_driven_wheel_is_one_line() -> None:
+    robot = tricycle()
+    for wheel in robot["steered_drive"]["wheels"]:
+        wheel.pop("motor", None)
+    with pytest.raises(WorldError, match="no wheel has a motor: a steered drive needs one driven wheel"):
+        sim_of(robot)
+
+
+def test_a_tricycle_s_free_wheel_encoder_reads_what_it_rolled() -> None:
+    """The free front wheel's PositionSensor (``free_wheel: 2``) reads its start position plus its
+    ground point's travel along its heading over its radius: r·ω·t / 0.03 straight, then the bicycle's
+    front wheel speed v / cos δ at δ = 0.3; back to its start on reset."""
+    sim = sim_of(tricycle())
+    enc = sim.robot("sw").devices["front encoder"]
+    enc.enable(16)
+    roll(sim, {"rl": 4.0, "rr": 4.0})
+    sim.run(50)
+    straight = R * 4.0 * 0.8 / 0.03
+    assert enc.value == pytest.approx(0.5 + straight, abs=1e-12)
+    roll(sim, {"rl": 0.0, "rr": 0.0})
+    sim.robot("sw").motor("fr steer").set_position(0.3)
+    sim.run(60)
+    assert enc.value == pytest.approx(0.5 + straight, abs=1e-12)
+    roll(sim, {"rl": 4.0, "rr": 4.0})
+    sim.run(100)
+    assert enc.value == pytest.approx(0.5 + straight + R * 4.0 / math.cos(0.3) * 1.6 / 0.03, abs=1e-9)
+    sim.reset()
+    sim.run(1)
+    assert enc.value == 0.5
+
+
+def test_a_free_wheel_encoder_on_a_driven_wheel_is_one_line() -> None:
+    robot = tricycle()
+    robot["devices"][1]["free_wheel"] = 0
+    with pytest.raises(WorldError, match="PositionSensor 'front encoder': free_wheel 0 is no wheel without motor"):
+        sim_of(robot)

@@ -207,16 +207,19 @@ def braitenberg_obstacle(ranges: np.ndarray, max_range: float = 80.0) -> float:
     return float(np.sum(g * (1.0 - v / max_range)))
 
 
-def test_the_sick_tricycle_is_refused_and_its_lms_291_reads_the_closed_form() -> None:
+def test_the_sick_tricycle_loads_as_a_tricycle_and_its_lms_291_reads_the_closed_form() -> None:
     """sick (Webots' LMS 291 on a tricycle): its back wheels are driven, its front wheel turns freely
-    on a steering hinge ('direction'); no drive here steers on one wheel, so the load says so in one
-    line and the robot stays. Its lidar's 180 ranges are the closed form's to the 46 obstacles and the
+    on a steering hinge ('direction'): a steered drive with that free wheel, no load line. Its lidar's
+    180 ranges are the closed form's to the 46 obstacles and the
     walls (1e-5 m relative, float32), and the controller's Braitenberg sum over them is 0.413814
     (as Webots' controller printed it under `sensorium run`: speed 100·(0.99 - 0.413814) = 57.62 rad/s,
     direction 0.007182 rad)."""
     w = load_world(DATA / "sick.wbt")
-    assert any("robot 'robot': no Ackermann drive" in x and "it has 1 steering motor(s) ('direction')" in x
-               and "the robot will not move" in x for x in w.warnings), w.warnings
+    assert w.warnings == []
+    wheels = w.world.robots[0].steered_drive.wheels
+    assert [(x.motor, x.steer, x.position, x.radius) for x in wheels] == [
+        ("back_right_wheel", None, (-0.4, -0.2), 0.17), ("back_left_wheel", None, (-0.4, 0.2), 0.17),
+        (None, "direction", (0.4, 0.0), 0.17)]
     sim = Simulation(w, "exact")
     sick = sim.device("robot/Sick LMS 291")
     sick.enable(32)
@@ -230,3 +233,50 @@ def test_the_sick_tricycle_is_refused_and_its_lms_291_reads_the_closed_form() ->
     assert obstacle == pytest.approx(0.413814, abs=5e-7)
     speed = 100.0 * (0.99 - obstacle)
     assert (speed, obstacle / speed) == pytest.approx((57.618592, 0.007182), abs=5e-6)
+
+
+def test_the_sick_controller_s_calls_drive_the_tricycle_on_the_bicycle_model() -> None:
+    """The sick controller's calls in process (32 ms steps: back wheels at 100·(0.99 - obstacle) rad/s,
+    'direction' at obstacle / speed) for 3 s: the rear axle's centre (0.4 m behind the origin) follows
+    the bicycle model step by step, v = 0.17·ω and ωz = v·tan δ / 0.8 with δ the steering joint's
+    position that step plus the front wheel's heading as loaded (-5.9e-8 rad: the sample's rounded
+    rotations), 1e-9 m and rad; the rear axle has gone 22.8 m (its speed falls as the obstacles near)."""
+    loaded = load_world(DATA / "sick.wbt")
+    h0 = loaded.world.robots[0].steered_drive.wheels[2].heading
+    assert abs(h0) < 1e-7
+    sim = Simulation(loaded, "exact")
+    robot = sim.robot("robot")
+    lms = sim.device("robot/Sick LMS 291")
+    lms.enable(32)
+    left, right, direction = robot.motor("back_left_wheel"), robot.motor("back_right_wheel"), robot.motor("direction")
+    left.set_position(math.inf)
+    right.set_position(math.inf)
+
+    def axle() -> tuple[float, float, float]:
+        p = robot.pose
+        yaw = math.atan2(p.rotation[1, 0], p.rotation[0, 0])
+        return float(p.translation[0]) - 0.4 * math.cos(yaw), float(p.translation[1]) - 0.4 * math.sin(yaw), yaw
+
+    x, y, yaw = axle()
+    speed = 100.0                 # Webots' motor after setPosition(inf): its maxVelocity until set
+    dt = 0.032
+    for _ in range(94):
+        sim.run(1)
+        delta = direction.position + h0
+        v = 0.17 * speed
+        w = v * math.tan(delta) / 0.8
+        if w == 0.0:
+            x, y = x + v * dt * math.cos(yaw), y + v * dt * math.sin(yaw)
+        else:
+            x, y = (x + v / w * (math.sin(yaw + w * dt) - math.sin(yaw)),
+                    y - v / w * (math.cos(yaw + w * dt) - math.cos(yaw)))
+            yaw = math.remainder(yaw + w * dt, 2 * math.pi)
+        gx, gy, gyaw = axle()
+        assert (gx, gy, gyaw) == pytest.approx((x, y, yaw), abs=1e-9)
+        obstacle = braitenberg_obstacle(np.asarray(lms.range_image, dtype=float).reshape(-1))
+        speed = 100.0 * (0.99 - obstacle)
+        direction.set_position(obstacle / speed)
+        left.set_velocity(speed)
+        right.set_velocity(speed)
+    assert math.hypot(gx, gy) == pytest.approx(22.8167, abs=1e-3)
+    assert abs(gyaw) > 1e-3                  # it steered

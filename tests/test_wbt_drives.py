@@ -1045,3 +1045,51 @@ def test_two_steering_hinges_one_behind_the_other_make_a_steered_drive_not_a_car
     sim.run(1)
     assert rover.drive.velocity()[:2] == pytest.approx([0.0, R * 4.0 / 2], abs=1e-12)
     assert rover.drive.velocity()[5] == pytest.approx(0.0, abs=1e-12)
+
+
+def tricycle_wbt(steered_x: float, passive_hinge: bool) -> str:
+    """Our tricycle: two driven wheels on the axle at x 0 (y ±Y), a steering hinge ('steer', about z)
+    at x ``steered_x`` holding a free wheel of radius 0.08 -- in a passive HingeJoint (no device) or as
+    the steering end point's own round part."""
+    round_part = ('children [ DEF F Shape { geometry Cylinder { radius 0.08 height 0.04 } } ] boundingObject USE F')
+    held = (f'children [ HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 -1 0 }} '
+            f'device [ PositionSensor {{ name "front encoder" }} ] endPoint Solid {{ '
+            f'rotation 1 0 0 1.5708 {round_part} }} }} ]' if passive_hinge else f'rotation 1 0 0 1.5708 {round_part}')
+    return ('Robot { name "trike" children [\n'
+            '  Pose { translation 0 0 0.2 children [ Shape { geometry Box { size 0.3 0.3 0.1 } } ] }\n'
+            + wheel("left wheel", 0.0, Y) + wheel("right wheel", 0.0, -Y)
+            + f'  HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 0 1 anchor {steered_x} 0 0.08 }} '
+              f'device [ RotationalMotor {{ name "steer" maxVelocity 100 }} ] '
+              f'endPoint Solid {{ translation {steered_x} 0 0.08 {held} }} }}\n'
+            '] }\n')
+
+
+@pytest.mark.parametrize("steered_x, passive_hinge", [(0.5, True), (-0.4, False)])
+def test_two_driven_wheels_and_a_steered_free_wheel_make_a_tricycle(tmp_path: Path, steered_x: float,
+                                                                     passive_hinge: bool) -> None:
+    """Two driven wheels on one axle and one steering hinge holding a free wheel (a passive hinge's
+    or the end point's own round part), ahead of the axle or behind it: a steered drive with that free
+    wheel, no load line; driven at ω with the steering at 0.3 it turns at ωz = R·ω·tan 0.3 / L (L the
+    signed distance from the axle to the steering axis: behind it, the other way)."""
+    loaded = load_world(write(tmp_path, tricycle_wbt(steered_x, passive_hinge)))
+    assert loaded.warnings == []
+    wheels = loaded.world.robots[0].steered_drive.wheels
+    assert [(w.motor, w.steer, w.position) for w in wheels] == [
+        ("left wheel", None, (0.0, Y)), ("right wheel", None, (0.0, -Y)), (None, "steer", (steered_x, 0.0))]
+    assert wheels[2].radius == pytest.approx(0.08, abs=1e-12)
+    sim = Simulation(loaded)
+    sim.robot("trike").motor("steer").set_position(0.3)
+    sim.run(60)
+    for name in ("left wheel", "right wheel"):
+        m = sim.robot("trike").motor(name)
+        m.set_position(math.inf)
+        m.set_velocity(5.0)
+    sim.run(1)
+    heading = 0.3 + wheels[2].heading
+    assert sim.robot("trike").drive.velocity()[5] == pytest.approx(R * 5.0 * math.tan(heading) / steered_x, abs=1e-12)
+    if passive_hinge:               # its encoder (hinge axis the robot's right: rolling forward reads decreasing)
+        enc = sim.robot("trike").devices["front encoder"]
+        assert (enc.config.free_wheel, enc.config.free_wheel_sign) == (2, -1)
+        enc.enable(16)
+        sim.run(9)                  # 10 steps rolled: the front wheel's ground speed R·ω / cos δ
+        assert enc.value == pytest.approx(-R * 5.0 / math.cos(heading) * 0.16 / 0.08, abs=1e-9)

@@ -810,9 +810,10 @@ class PositionSensor(_Device):
                             description="without a motor: the joint's position it reads (Webots jointParameters "
                                         "position: rad, m on a slider), a free wheel's at the start; unused with a "
                                         "motor (the motor's own)")
-    free_wheel: Literal["right_front", "left_front", "right_rear", "left_rear"] | None = Field(
+    free_wheel: Literal["right_front", "left_front", "right_rear", "left_rear"] | int | None = Field(
         default=None, description="the encoder of a wheel of the robot's ackermann_drive that has no motor (Webots' "
-        "Car: the front wheels of a propulsion car, the rear ones of a traction car): it reads ``position`` plus the "
+        "Car: the front wheels of a propulsion car, the rear ones of a traction car), or the index of a free wheel "
+        "(no motor) in its steered_drive's wheels (a tricycle's front wheel): it reads ``position`` plus the "
         "angle the wheel has rolled, its contact point's travel along its rolling direction over its radius")
     free_wheel_sign: Literal[1, -1] = Field(
         default=1, description="1: the wheel's joint axis is the car's left, so rolling forward reads increasing; "
@@ -1677,7 +1678,9 @@ class SteeredWheel(Strict):
     up axis (none: it keeps its heading), where it touches the ground and its radius (in the robot's frame:
     x forward, y left, z up; with the drive's ``forward`` another direction, along it and its left)."""
 
-    motor: str = Field(min_length=1, description="its rolling RotationalMotor's name")
+    motor: str | None = Field(default=None, min_length=1, description="its rolling RotationalMotor's name; none: a "
+                              "free wheel (a tricycle's steered front wheel, a caster) that rolls with the robot and "
+                              "only keeps it from sliding across its heading")
     steer: str | None = Field(default=None, min_length=1, description="the RotationalMotor of the hinge that "
                               "steers it (one of the robot's devices, moved as any joint is); none: its heading "
                               "is fixed")
@@ -1698,7 +1701,11 @@ class SteeredDrive(Strict):
     step) turning at ω_i moves its ground point at r_i·ω_i·(cos h_i, sin h_i). The body twist (vx, vy, ωz)
     over a step is the least-squares fit of those velocities to v + ωz × p_i (the 2N rows (1, 0, -y_i) and
     (0, 1, x_i)): exact when the wheels agree with one twist, their best fit when they do not (a real
-    robot's wheels would slip or scuff). The wheels must stand at two places at least."""
+    robot's wheels would slip or scuff). A free wheel (no ``motor``) only forbids sliding across its heading:
+    with free wheels the body moves along the twists every wheel's no-slip-across row allows (one line of
+    twists, as a tricycle's), at the speed where the driven wheels' rims' speeds along their headings sum to
+    their motors' (a tricycle: the bicycle model, v = r·ω and ωz = v·tan δ / L about the rear axle's centre).
+    The wheels must stand at two places at least, one of them driven."""
 
     wheels: list[SteeredWheel] = Field(min_length=2, max_length=16)
     wheel_bottom: float | None = _wheel_bottom_field()
@@ -1713,11 +1720,13 @@ class SteeredDrive(Strict):
     def motor_fields(self) -> list[tuple[str, str]]:
         """(field, motor name) of the rolling motors, in the wheels' order (the steering motors are the
         robot's joint motors, not the drive's)."""
-        return [(f"wheels[{i}].motor", w.motor) for i, w in enumerate(self.wheels)]
+        return [(f"wheels[{i}].motor", w.motor) for i, w in enumerate(self.wheels) if w.motor is not None]
 
     @model_validator(mode="after")
     def _valid(self) -> SteeredDrive:
-        names = [w.motor for w in self.wheels]
+        names = [w.motor for w in self.wheels if w.motor is not None]
+        if not names:
+            raise ValueError("no wheel has a motor: a steered drive needs one driven wheel at least")
         if len(set(names)) != len(names):
             raise ValueError(f"every wheel motor needs its own name, got {names}")
         _check_motor_max_speeds(self.motor_max_speeds, names, "drive's wheel motors")
@@ -1914,7 +1923,17 @@ class Robot(Strict):
                 raise ValueError(f"radar_targets[{i}] ({t.name}): shape index {bad[0]} is past the robot's "
                                  f"{len(self.shapes)} shapes")
         for d in self.devices:
-            if isinstance(d, PositionSensor) and d.free_wheel is not None:
+            if isinstance(d, PositionSensor) and isinstance(d.free_wheel, int):
+                steered = self.steered_drive
+                if steered is None:
+                    raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel} needs the robot's "
+                                     "steered_drive")
+                if d.motor is not None:
+                    raise ValueError(f"PositionSensor {d.name!r}: give motor or free_wheel, not both")
+                if not 0 <= d.free_wheel < len(steered.wheels) or steered.wheels[d.free_wheel].motor is not None:
+                    raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel} is no wheel without motor "
+                                     f"in the steered_drive's {len(steered.wheels)} wheels")
+            elif isinstance(d, PositionSensor) and d.free_wheel is not None:
                 car = self.ackermann_drive
                 if car is None:
                     raise ValueError(f"PositionSensor {d.name!r}: free_wheel {d.free_wheel!r} needs the robot's "

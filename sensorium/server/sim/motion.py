@@ -497,13 +497,20 @@ class SteeredDrive(HolonomicDrive):
 
     def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
         rows = []
-        # each wheel: its motor, radius, fixed heading, steer sign, steering motor's name (None: fixed)
-        self.wheels: list[tuple[WheelMotor, float, float, float, str | None]] = []
+        # each wheel: its motor (None: a free wheel), radius, fixed heading, steer sign, steering motor's
+        # name (None: fixed)
+        self.wheels: list[tuple[WheelMotor | None, float, float, float, str | None]] = []
+        self.places: list[tuple[float, float]] = []
         for w in config.wheels:
             px, py = float(w.position[0]), float(w.position[1])
             rows += [(1.0, 0.0, -py), (0.0, 1.0, px)]
-            self.wheels.append((WheelMotor(w.motor, wheel_max_speed(config, w.motor)), float(w.radius),
-                                float(w.heading), float(w.steer_sign), w.steer))
+            motor = WheelMotor(w.motor, wheel_max_speed(config, w.motor)) if w.motor is not None else None
+            self.wheels.append((motor, float(w.radius), float(w.heading), float(w.steer_sign), w.steer))
+            self.places.append((px, py))
+        self.has_free = any(m is None for m, *_ in self.wheels)
+        """Free wheels make the fit depend on the headings: :meth:`constrained_twist` each step."""
+        self.free_turned: dict[int, float] = {i: 0.0 for i, (m, *_) in enumerate(self.wheels) if m is None}
+        """Each free wheel's rolled angle (rad, along its heading positive) since the start, by wheel index."""
         solve = np.linalg.pinv(np.array(rows, dtype=np.float64))
         """3 × 2N: the wheels' ground velocities (u_ix, u_iy, ...) to the body twist (vx, vy, ωz)."""
         self.columns = [(tuple(float(v) for v in solve[:, 2 * i]), tuple(float(v) for v in solve[:, 2 * i + 1]))
@@ -518,7 +525,7 @@ class SteeredDrive(HolonomicDrive):
 
     @property
     def motors(self) -> dict[str, WheelMotor]:
-        return {m.name: m for m, *_ in self.wheels}
+        return {m.name: m for m, *_ in self.wheels if m is not None}
 
     def headings(self) -> list[float]:
         """Each wheel's heading now (rad, from forward towards the left)."""
@@ -528,7 +535,9 @@ class SteeredDrive(HolonomicDrive):
     def twist(self, speeds: list[float]) -> tuple[float, float, float]:
         """(vx, vy, ωz) in the robot's frame for the wheels' speeds (rad/s, the wheels' order) at their
         headings now: the pseudo-inverse's columns times the wheels' ground velocities, summed wheel by
-        wheel in plain float64."""
+        wheel in plain float64. With free wheels: :meth:`constrained_twist`."""
+        if self.has_free:
+            return self.constrained_twist(speeds)
         vx = vy = w = 0.0
         for u, (_, r, _, _, _), h, (a, b) in zip(speeds, self.wheels, self.headings(), self.columns):
             ux, uy = u * r * math.cos(h), u * r * math.sin(h)
@@ -538,8 +547,64 @@ class SteeredDrive(HolonomicDrive):
     def step(self, dt_ms: int) -> Pose | None:
         """Advance one basic step; the new pose, or None when the wheels did not turn."""
         dt = dt_ms / 1000.0
-        speeds = [m.advance(dt) for m, *_ in self.wheels]
+        speeds = [m.advance(dt) if m is not None else 0.0 for m, *_ in self.wheels]
+        if self.has_free and any(u != 0.0 for u in speeds):
+            self.roll_free(speeds, dt)
         return self.roll(speeds, dt)
+
+    def roll_free(self, speeds: list[float], dt: float) -> None:
+        """Turn the free wheels by the step's twist: each ground point's velocity v + ωz × p along the
+        wheel's heading, times dt over its radius."""
+        vx, vy, w = self.twist(speeds)
+        headings = self.headings()
+        for i in self.free_turned:
+            px, py = self.places[i]
+            h = headings[i]
+            along = (vx - w * py) * math.cos(h) + (vy + w * px) * math.sin(h)
+            self.free_turned[i] += along * dt / self.wheels[i][1]
+
+    def constrained_twist(self, speeds: list[float]) -> tuple[float, float, float]:
+        """The twist of a drive with free wheels, from its headings now. No wheel slides across its
+        heading h_i: n_i · (v + ωz × p_i) = 0 with n_i = (-sin h_i, cos h_i), the row (-sin h_i, cos h_i,
+        x_i cos h_i + y_i sin h_i). When those rows leave one line of twists d (rank 2: a tricycle's
+        rear axle and steered wheel; d the cross product of the two rows farthest from parallel, in
+        plain float64), the body moves at s·d with s = Σ r_i·ω_i / Σ a_i over the driven wheels, a_i =
+        d's velocity of wheel i's ground point along its heading: the driven rims' speeds sum to the
+        ground's (the rear axle's centre of a tricycle moves at the mean rim speed, AckermannDrive's
+        rule), so the bicycle model comes out: v = r·ω, ωz = v·tan δ / L; when the a_i cancel (the front
+        wheel across, the rear wheels turning the robot about their axle's centre) s is their least-squares
+        Σ a_i·r_i·ω_i / Σ a_i². Rows of any other rank (the
+        wheels' lines not meeting in one turn centre, or all parallel) fall back to the least-squares
+        fit of every driven wheel's ground velocity and every wheel's no-slip-across row."""
+        rows, along, rims = [], [], []
+        for u, (motor, r, _, _, _), h, (px, py) in zip(speeds, self.wheels, self.headings(), self.places):
+            c, s = math.cos(h), math.sin(h)
+            rows.append((-s, c, px * c + py * s))
+            if motor is not None:
+                along.append((c, s, py * -c + px * s))          # (cos h, sin h) · (v + ωz × p)
+                rims.append(u * r)
+        best, d = 0.0, (0.0, 0.0, 0.0)
+        for i, a in enumerate(rows):
+            for b in rows[i + 1:]:
+                cross = (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+                size = math.sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2])
+                if size > best:
+                    best, d = size, cross
+        scale = sum(abs(v) for row in rows for v in row)
+        if best > 1e-12 * scale * scale and all(
+                abs(row[0] * d[0] + row[1] * d[1] + row[2] * d[2]) <= 1e-9 * best * scale for row in rows):
+            speeds_of_d = [a[0] * d[0] + a[1] * d[1] + a[2] * d[2] for a in along]
+            total, size = sum(speeds_of_d), sum(abs(a) for a in speeds_of_d)
+            if size > 0.0:
+                if abs(total) > 1e-9 * size:
+                    k = sum(rims) / total
+                else:                   # the driven wheels' a_i cancel (a turn about the axle's centre)
+                    k = sum(a * u for a, u in zip(speeds_of_d, rims)) / sum(a * a for a in speeds_of_d)
+                return k * d[0], k * d[1], k * d[2]
+        fit = np.array(rows + along, dtype=np.float64)
+        target = np.array([0.0] * len(rows) + rims, dtype=np.float64)
+        vx, vy, w = np.linalg.lstsq(fit, target, rcond=None)[0].tolist()
+        return float(vx), float(vy), float(w)
 
 
 def ackermann_angles(steering_angle: float, wheelbase: float, track_front: float) -> tuple[float, float]:

@@ -495,6 +495,8 @@ class Simulation:
                     m.target_position, m.velocity, m.position = 0.0, m.max_velocity, 0.0
                 if isinstance(robot.drive, AckermannDrive):     # free wheels back at their world-file angles
                     robot.drive.free_turned = dict.fromkeys(robot.drive.free, 0.0)
+                elif isinstance(robot.drive, SteeredDrive):
+                    robot.drive.free_turned = dict.fromkeys(robot.drive.free_turned, 0.0)
                 robot.drive.reset(pose)
                 pose = robot.drive.placed(pose)
             for joint in robot.joints.values():

@@ -41,7 +41,7 @@ class Scope:
 class State:
     pose: Pose | None             # the robot's or solid's (None: the node has none of its own)
     positions: tuple[float, ...]  # the joints' positions, in the scope's motor order
-    free_wheels: dict[str, float] | None = None  # a car's free wheels' rolled angles (the robot's state)
+    free_wheels: dict[str | int, float] | None = None  # free wheels' rolled angles: a car's by key, a tricycle's by index
 
 
 class States:

@@ -33,11 +33,11 @@ def device_line(d) -> str:
 def drive_line(r: wm.Robot) -> str:
     """How the robot moves: its drive, what the .wbt import made of its wheels (or none)."""
     if r.omni_drive is not None:
-        wheels = ", ".join(f"{w.motor} at ({w.position[0]:g}, {w.position[1]:g}) m about ({w.axis[0]:g}, "
+        wheels = ", ".join(f"{w.motor or 'free wheel'} at ({w.position[0]:g}, {w.position[1]:g}) m about ({w.axis[0]:g}, "
                            f"{w.axis[1]:g}), radius {w.radius:g} m" for w in r.omni_drive.wheels)
         return f"omni wheels, {len(r.omni_drive.wheels)}: {wheels}"
     if r.steered_drive is not None:
-        wheels = ", ".join(f"{w.motor} at ({w.position[0]:g}, {w.position[1]:g}) m"
+        wheels = ", ".join(f"{w.motor or 'free wheel'} at ({w.position[0]:g}, {w.position[1]:g}) m"
                            + (f" steered by {w.steer}" if w.steer is not None else f" heading {w.heading:g} rad")
                            + f", radius {w.radius:g} m" for w in r.steered_drive.wheels)
         return f"steered wheels, {len(r.steered_drive.wheels)}: {wheels}"

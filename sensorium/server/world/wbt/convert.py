@@ -1992,6 +1992,50 @@ class Converter:
         free = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
         return [*zip(steering, riding), *([(None, free)] if free else [])]
 
+    def _tricycle(self, wheels: list[dict], up: int) -> list[tuple[dict | None, list[dict]]] | None:
+        """A tricycle's (a forklift's) steering groups: one steering joint holding a wheel that no motor
+        drives the robot with (a passive hinge's wheel, or its end point's round part) and two driven
+        wheels or more riding no steering joint, on one axle (coaxial, in the ground's plane), the
+        steered wheel ahead of it or behind it. [(None, the driven wheels), (the steering joint, [the
+        free wheel, marked "free"])]; else None (a car steers two; a BB-8's driven ball rides its only
+        steering joint: :meth:`_one_steered_wheel`)."""
+        from sensorium.server.world.wbt.drive import AXIS_TOL, TOL, held_wheel, holds_wheel
+
+        steering = [w for w in wheels if w["steers"]]
+        if len(steering) != 1 or steering[0]["node"].type != "HingeJoint" or not holds_wheel(steering[0]["end"], self):
+            return None                           # a Hinge2Joint's wheel is a car's (ackermann_drive says why not)
+        turn = np.asarray(steering[0]["axis"], dtype=np.float64)
+        if float(np.linalg.norm(np.delete(turn, up))) > AXIS_TOL * float(np.linalg.norm(turn)):
+            return None                           # no vertical steering axis
+        carried = self._inside(steering[0]["end"])
+        riding = [w for w in wheels if not w["steers"] and id(w["node"]) in carried]
+        driven = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
+        if len(driven) < 2 or len(riding) > 1:
+            return None
+        flat = [i for i in range(3) if i != up]
+        axis = np.asarray(driven[0]["axis"], dtype=np.float64)[flat]
+        if float(np.linalg.norm(axis)) <= TOL:
+            return None
+        axis /= np.linalg.norm(axis)
+        base = np.asarray(driven[0]["anchor"], dtype=np.float64)[flat]
+        for w in driven[1:]:
+            other = np.asarray(w["axis"], dtype=np.float64)[flat]
+            off = np.asarray(w["anchor"], dtype=np.float64)[flat] - base
+            if abs(float(other[0] * axis[1] - other[1] * axis[0])) > TOL * float(np.linalg.norm(other)) or \
+                    abs(float(off[0] * axis[1] - off[1] * axis[0])) > TOL:
+                return None                       # not on one axle
+        ahead = np.asarray(steering[0]["anchor"], dtype=np.float64)[flat] - base
+        if abs(float(ahead[0] * axis[1] - ahead[1] * axis[0])) <= TOL:
+            return None                           # the steered wheel on the axle's line: no wheelbase
+        if riding:
+            free = {**riding[0], "free": True}
+        else:                                     # a passive hinge or the end point's round part: it rolls along
+            end = held_wheel(steering[0]["end"], self)      # forward at steering position 0
+            if end is None:
+                return None
+            free = {"end": end, "axis": None, "free": True}
+        return [(None, driven), (steering[0], [free])]
+
     def _one_axle(self, steering: list[dict], wheels: list[dict], up: int) -> bool:
         """Whether two steering joints stand on one axle, as a car's front wheels do: the line between
         their anchors, in the ground's plane, along the axis of the wheels riding no steering joint (the
@@ -2436,6 +2480,31 @@ class Converter:
             # reads their positions); the rolling wheels are the drive's
             self._drive_wheels(node, robot, [w for _, riding in groups for w in riding])
             return
+        tricycle = self._tricycle(wheels, up) if turns is None else None
+        if tricycle is not None:                  # two driven wheels and a steered free one (Webots' sick sample)
+            positions = {d["name"]: float(d.get("position", 0.0)) for d in robot.data["devices"]
+                         if d.get("device") == "RotationalMotor"}
+            drive, why = steered_drive(tricycle, positions, self, up)
+            if drive is None:
+                self.warn(node, f"robot {robot.data['name']!r}: no steered-wheel drive ({why}); the robot will not "
+                                "move")
+                return
+            robot.data["steered_drive"] = drive
+            # the steering hinge stays a joint; a motorised hinge of the free wheel stays one too (its motor,
+            # never commanded by a tricycle's controller, moves that joint, not the drive)
+            self._drive_wheels(node, robot, tricycle[0][1])
+            # an encoder on the free wheel's passive hinge reads what the wheel rolls (positive: rolling forward
+            # turns the hinge about its axis, the robot's left at steering 0)
+            held = tricycle[1][1][0]["end"]
+            for free in robot.free:
+                if free["end"] is held and free["sensors"]:
+                    left = np.array([0.0, 1.0, 0.0]) if up == 2 else np.array([0.0, 0.0, -1.0])
+                    for sensor in free["sensors"]:
+                        sensor["free_wheel"] = len(tricycle[0][1])
+                        if float(np.dot(free["axis"], left)) < 0.0:
+                            sensor["free_wheel_sign"] = -1
+                    free["line"] = None
+            return
         if turns is None and any(w["steers"] for w in wheels):      # a car
             casters = self._one_steered_wheel(wheels)
             if casters:
@@ -2544,7 +2613,7 @@ def drive_motor_names(robot: dict) -> list[str]:
     motors += [v for k, v in (robot.get("ackermann_drive") or {}).items() if k.endswith(("_steer", "_wheel"))]
     motors += [v for k, v in (robot.get("mecanum_drive") or {}).items() if k.endswith("_motor")]
     motors += [w["motor"] for w in (robot.get("omni_drive") or {}).get("wheels", ())]
-    motors += [w["motor"] for w in (robot.get("steered_drive") or {}).get("wheels", ())]
+    motors += [w["motor"] for w in (robot.get("steered_drive") or {}).get("wheels", ()) if "motor" in w]
     return [m for m in motors if isinstance(m, str)]
 
 

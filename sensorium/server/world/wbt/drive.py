@@ -159,6 +159,33 @@ def spins_in_place(w: dict, conv) -> bool:
     return rolls_about_its_axis(w, conv) and not _holds_wheel_joint(w["end"], conv)
 
 
+def held_wheel(end: Node | None, conv) -> Node | None:
+    """The node whose round part is the wheel a steering hinge's end point holds: the end point of the
+    first hinge inside it with something round there (a tricycle's passive front wheel hinge), else the
+    end point itself when its own round part is a wheel (:func:`holds_wheel`), else None."""
+    def find(node: Node | None) -> Node | None:
+        if node is None:
+            return None
+        conv.walk(node)
+        nf = conv.fields(node)
+        if node.type in ("HingeJoint", "Hinge2Joint"):
+            held = nf.node_("endPoint")
+            return held if wheel_radius(held, conv) is not None else None
+        if node.type in ("Pose", "Transform", "Group", "Solid", "Slot"):
+            kids = [nf.node_("endPoint")] if node.type == "Slot" else nf.nodes("children")
+            for child in kids:
+                found = find(child)
+                if found is not None:
+                    return found
+        return None
+
+    found = find(end)
+    if found is not None:
+        return found
+    part = _round_part(end, conv)
+    return end if part is not None and part[2] <= 4.0 * part[1] else None
+
+
 def _holds_wheel_joint(end: Node | None, conv) -> bool:
     """Whether an end point holds a hinge whose end point has something round (a car's knuckle holding
     its wheel's joint)."""
@@ -858,7 +885,9 @@ def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions:
     axis × up, less the hinge's turn as loaded; a hinge about up turns it left as its position grows
     (``steer_sign`` 1), one about down right (-1). ``up``: the robot's up axis (2 its z; 1 its y, a
     robot built y-up, whose places and headings are taken along its x and its left, y × x = -z, its
-    drive's ``forward`` its x, (1, 0, 0), as :func:`omni_drive` takes them)."""
+    drive's ``forward`` its x, (1, 0, 0), as :func:`omni_drive` takes them). A wheel marked ``"free"``
+    (a tricycle's steered front wheel) becomes a wheel without motor; without an ``axis`` (no hinge of
+    its own, its round part on the steering joint's end point) it rolls along the robot's forward."""
     frame = None if up == 2 else drive_axes((1.0, 0.0, 0.0), up)
     out = []
     rolling = []
@@ -866,16 +895,19 @@ def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions:
         for w in riding:
             radius = wheel_radius(w["end"], conv)
             if radius is None:
-                return None, (f"wheel {w['motor']!r}: its end point has no cylinder or sphere to take the wheel "
-                              "radius from")
-            axis = np.asarray(w["axis"], dtype=np.float64)
+                return None, (f"wheel {w.get('motor') or 'free'!r}: its end point has no cylinder or sphere to take "
+                              "the wheel radius from")
+            # a free wheel (a tricycle's front wheel, "free": True) with no hinge of its own rolls along forward
+            axis = np.asarray(w["axis"] if w.get("axis") is not None else
+                              (frame.T @ np.array([0.0, 1.0, 0.0]) if frame is not None else [0.0, 1.0, 0.0]),
+                              dtype=np.float64)
             if frame is not None:
                 axis = frame @ axis
             if abs(float(axis[2])) > AXIS_TOL * float(np.linalg.norm(axis)):
                 return None, (f"wheel axis of motor {w['motor']!r} is {np.round(w['axis'], 6).tolist()}, not "
                               f"horizontal in the robot's frame (perpendicular to its {'xyz'[up]}): a steered wheel "
                               "rolls about a horizontal axis")
-            wheel: dict = {"motor": w["motor"], "radius": float(radius)}
+            wheel: dict = {"radius": float(radius)} if w.get("free") else {"motor": w["motor"], "radius": float(radius)}
             heading = math.atan2(-float(axis[0]), float(axis[1]))      # axis × up: (a_y, -a_x)
             if steering is None:
                 at = _on_axis(w, conv)
@@ -892,7 +924,8 @@ def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions:
             if heading != 0.0:
                 wheel["heading"] = math.remainder(heading, 2.0 * math.pi)
             out.append(wheel)
-            rolling.append(w)
+            if not w.get("free"):
+                rolling.append(w)
     if len({tuple(w["position"]) for w in out}) < 2:
         return None, "the wheels all stand at one place"
     drive: dict = {"wheels": out, **_wheel_speeds(rolling, conv)}
