@@ -137,6 +137,14 @@ def finish(p: subprocess.Popen, timeout: float = 120.0) -> tuple[int, list[str],
     return p.returncode, out.splitlines(), err
 
 
+def sanitized_run(tmp_path_factory, src: Path, world: Path, robot: str) -> tuple[int, list[str], str]:
+    """``src`` built by :func:`sanitized_controller`, run as ``robot``'s controller against ``sensorium
+    serve WORLD`` (sanitizers on) until it ends: :func:`finish`'s (code, stdout lines, stderr)."""
+    exe = sanitized_controller(tmp_path_factory, src)
+    with serve(world, env=SAN_ENV) as server:
+        return finish(start([exe], server.url(robot)))
+
+
 def run(cmd: list[str], url: str | None = None, **env: str) -> list[str]:
     code, out, err = finish(start(cmd, url, **env))
     assert code == 0, f"{cmd[0]} exited {code}:\n{err}"

@@ -69,14 +69,8 @@ def test_the_python_client_reads_and_sets_the_focus(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_the_c_client_reads_and_sets_the_focus_as_the_python_client(tmp_path, tmp_path_factory):
-    import subprocess
-
-    from _serve import serve
-    from test_c_client import REPO, SAN_ENV, finish, sanitized_controller, start
-    exe = sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "focus.c")
-    with serve(world_file(tmp_path), env=SAN_ENV) as server:
-        p: subprocess.Popen = start([exe], server.url("r"))
-        code, out, err = finish(p)
+    from test_c_client import REPO, sanitized_run
+    code, out, err = sanitized_run(tmp_path_factory, REPO / "tests" / "c" / "focus.c", world_file(tmp_path), "r")
     assert code == 0, err
     assert out == EXPECTED
     assert [x for x in err.splitlines() if x.startswith("Error")] == REFUSALS
