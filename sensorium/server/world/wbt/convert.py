@@ -2036,6 +2036,22 @@ class Converter:
             free = {"end": end, "axis": None, "free": True}
         return [(None, driven), (steering[0], [free])]
 
+    def _steered(self, node: Node, robot: Any, groups: list, driven: list[dict], up: int) -> bool:
+        """The steered-wheel drive of ``groups`` (steering joint, the wheels it turns) made the robot's, its
+        ``driven`` wheels the drive's (the steering hinges stay joints, moved as Webots' kinematic motor
+        control moves them; the drive reads their positions); False, with one line, when there is none."""
+        from sensorium.server.world.wbt.drive import steered_drive
+
+        positions = {d["name"]: float(d.get("position", 0.0)) for d in robot.data["devices"]
+                     if d.get("device") == "RotationalMotor"}
+        drive, why = steered_drive(groups, positions, self, up)
+        if drive is None:
+            self.warn(node, f"robot {robot.data['name']!r}: no steered-wheel drive ({why}); the robot will not move")
+            return False
+        robot.data["steered_drive"] = drive
+        self._drive_wheels(node, robot, driven)
+        return True
+
     def _one_axle(self, steering: list[dict], wheels: list[dict], up: int) -> bool:
         """Whether two steering joints stand on one axle, as a car's front wheels do: the line between
         their anchors, in the ground's plane, along the axis of the wheels riding no steering joint (the
@@ -2347,7 +2363,6 @@ class Converter:
             omni_wheels,
             rolls_about_its_axis,
             spins_in_place,
-            steered_drive,
             wheel_radius,
         )
 
@@ -2468,31 +2483,14 @@ class Converter:
         groups = self._steering_groups(wheels, up) if turns is None else None
         if groups is not None:                    # steered casters or corners: each wheel steered on its own
             groups = self._grounded(groups, nowheel, up)
-            positions = {d["name"]: float(d.get("position", 0.0)) for d in robot.data["devices"]
-                         if d.get("device") == "RotationalMotor"}
-            drive, why = steered_drive(groups, positions, self, up)
-            if drive is None:
-                self.warn(node, f"robot {robot.data['name']!r}: no steered-wheel drive ({why}); the robot will not "
-                                "move")
-                return
-            robot.data["steered_drive"] = drive
-            # the steering hinges stay joints (moved as Webots' kinematic motor control moves them; the drive
-            # reads their positions); the rolling wheels are the drive's
-            self._drive_wheels(node, robot, [w for _, riding in groups for w in riding])
+            self._steered(node, robot, groups, [w for _, riding in groups for w in riding], up)
             return
         tricycle = self._tricycle(wheels, up) if turns is None else None
         if tricycle is not None:                  # two driven wheels and a steered free one (Webots' sick sample)
-            positions = {d["name"]: float(d.get("position", 0.0)) for d in robot.data["devices"]
-                         if d.get("device") == "RotationalMotor"}
-            drive, why = steered_drive(tricycle, positions, self, up)
-            if drive is None:
-                self.warn(node, f"robot {robot.data['name']!r}: no steered-wheel drive ({why}); the robot will not "
-                                "move")
+            # a motorised hinge of the free wheel stays a joint too (its motor, never commanded by a
+            # tricycle's controller, moves that joint, not the drive)
+            if not self._steered(node, robot, tricycle, tricycle[0][1], up):
                 return
-            robot.data["steered_drive"] = drive
-            # the steering hinge stays a joint; a motorised hinge of the free wheel stays one too (its motor,
-            # never commanded by a tricycle's controller, moves that joint, not the drive)
-            self._drive_wheels(node, robot, tricycle[0][1])
             # an encoder on the free wheel's passive hinge reads what the wheel rolls (positive: rolling forward
             # turns the hinge about its axis, the robot's left at steering 0)
             held = tricycle[1][1][0]["end"]
