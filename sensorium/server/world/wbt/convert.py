@@ -2036,7 +2036,7 @@ class Converter:
             free = {"end": end, "axis": None, "free": True}
         return [(None, driven), (steering[0], [free])]
 
-    def _steered(self, node: Node, robot: Any, groups: list, driven: list[dict], up: int) -> bool:
+    def _steered(self, node: Node, robot: Owner, groups: list, driven: list[dict], up: int) -> bool:
         """The steered-wheel drive of ``groups`` (steering joint, the wheels it turns) made the robot's, its
         ``driven`` wheels the drive's (the steering hinges stay joints, moved as Webots' kinematic motor
         control moves them; the drive reads their positions); False, with one line, when there is none."""
