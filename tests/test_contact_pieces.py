@@ -99,18 +99,25 @@ def test_a_post_in_line_with_a_finger_stops_its_tip():
 
 
 def test_a_post_in_the_notch_is_never_swept_through_by_a_finger():
-    # the post against the body's front face, the robot spun both ways: its fingers meet the post and
-    # the turn is cut short, never into it (the hull, overlapping the post, would not see it)
+    # the post against the body's front face, the robot spun both ways: a finger turning into the post
+    # pushes the robot off it (the pieces' push), so the post ends in the notch's inner corner, touching
+    # the body's front face and that finger's inner face, at (FRONT + POST, -/+(GAP / 2 - POST)) in the
+    # robot's frame, and the robot pivots about it keeping its whole turn; no finger ever enters it
+    # (the hull, overlapping the post, would not see it)
     sim = world([post(1.0)], [u_robot("r", 1.0 - POST - FRONT - 1e-6, 0.0)])
     ob = next(o for o in sim.contact._obs if o.name == "post")
     for w in (3.0, -3.0, 3.0):
         drive(sim, "r", -w, w)
         for _ in range(40):
+            before = heading(sim, "r")
             sim.step()
             assert min(piece_gaps(sim, "r", ob)) >= -1e-9
-    # the post stays between the fingers: the heading is bounded by the fingers' inner faces
-    # (a finger's inner corner at (0.1, 0.05) swings onto the post's side within atan(...) of 0)
-    assert abs(heading(sim, "r")) < 0.5 and sim.counters["contacts"] > 0
+            turned = math.remainder(heading(sim, "r") - before, math.tau)
+            assert turned == pytest.approx(math.copysign(2.0 * 0.1 * 3.0 / 0.3 * STEP / 1000.0, w), abs=1e-12)
+        h, (x, y) = heading(sim, "r"), np.array([1.0, 0.0]) - xy(sim, "r")      # to the post, seen from r
+        assert x * math.cos(h) + y * math.sin(h) == pytest.approx(FRONT + POST, abs=1e-9)
+        assert -x * math.sin(h) + y * math.cos(h) == pytest.approx(-math.copysign(GAP / 2 - POST, w), abs=1e-9)
+    assert sim.counters["contacts"] > 0
 
 
 def test_a_u_robot_flat_against_a_wall_is_pushed_off_as_it_turns():
@@ -178,3 +185,69 @@ def test_the_batched_engine_moves_pieces_robots_as_the_single_simulation_bit_for
             drive_randomly(bs, singles, rng)
         _step_both(bs, singles, step)
     assert bs.counters["contacts"] == sum(s.counters["contacts"] for s in singles) > 50
+
+
+def _spin_once(sim, turn):
+    """Robot r's wheels set to turn it in place by ``turn`` rad in one step, and that step run."""
+    w = turn * 0.3 / (2 * 0.1 * STEP / 1000.0)
+    drive(sim, "r", -w, w)
+    sim.step()
+
+
+@pytest.mark.parametrize("turn", [0.2, -0.25])
+def test_a_finger_turned_into_a_post_in_the_notch_is_pushed_off_it_by_its_depth(turn):
+    # the post centred in the notch 0.05 m ahead of the body's front face (x 0.15), the robot turned
+    # in place by `turn` in one step: a finger's inner face (|y| = 0.05 in the robot's frame) swings
+    # into the post; the pieces' push moves the centre along that face's normal by the finger's
+    # depth in the post, 0.15 |sin turn| - 0.025, so the face touches it and the post stays in the
+    # notch (before: the turn was cut short where the face first touched, asin(0.025 / 0.15))
+    sim = world([post(0.15)], [u_robot("r", 0.0, 0.0)])
+    ob = next(o for o in sim.contact._obs if o.name == "post")
+    _spin_once(sim, turn)
+    depth = 0.15 * abs(math.sin(turn)) - POST
+    side = math.copysign(1.0, turn)          # turning left, the right finger comes: pushed to its right
+    x, y = xy(sim, "r")
+    assert heading(sim, "r") == pytest.approx(turn, abs=1e-12)
+    assert x == pytest.approx(depth * abs(math.sin(turn)), abs=1e-9)
+    assert y == pytest.approx(-side * depth * math.cos(turn), abs=1e-9)
+    assert 0.0 <= min(piece_gaps(sim, "r", ob)) <= 1e-9                  # touching, not farther off
+    assert sim.counters["contacts"] == 1
+
+
+def test_a_u_robot_with_a_post_in_its_notch_turning_into_a_wall_is_pushed_off_the_wall_alone():
+    # its left side flush with a wall and a post in its notch (x 0.2): turning left by 0.1 rad, the
+    # body's front-left corner (0.1, 0.15) swings 0.1 sin 0.1 + 0.15 cos 0.1 - 0.15 into the wall;
+    # the pieces are pushed straight off the wall by that much and the post stays where it was in
+    # the notch (before: the hull's push was refused, as the hull overlaps the post, and so was the turn)
+    sim = world([post(0.2), block("wall", -2.0, 2.0, 0.15, 0.5)], [u_robot("r", 0.0, 0.0)])
+    _spin_once(sim, 0.1)
+    x, y = xy(sim, "r")
+    assert heading(sim, "r") == pytest.approx(0.1, abs=1e-12)
+    assert x == 0.0 and y == pytest.approx(-(0.1 * math.sin(0.1) + 0.15 * math.cos(0.1) - 0.15), abs=1e-9)
+    gaps = {o.name: min(piece_gaps(sim, "r", o)) for o in sim.contact._obs if o.name in ("post", "wall")}
+    assert 0.0 <= gaps["wall"] <= 1e-9 and gaps["post"] > 0.01
+
+
+def test_an_arm_swung_into_the_notch_stops_the_robot_earlier_by_its_reach():
+    # an arm 0.3 x 0.05 m on a hinge about z through the origin, at load behind the body (x -0.4 to
+    # -0.1): a piece of its own. Swung half a turn it lies in the notch and reaches 0.4 ahead, 0.15
+    # past the fingers' tips: the robot driven at a wall stops with the arm's tip on it, 0.15 m
+    # earlier than with the arm behind (the tips on it)
+    wall = block("wall", 1.0, 1.2, -2.0, 2.0)
+    for swung in (False, True):
+        robot = u_robot("r", 0.0, 0.0)
+        robot["shapes"].append({"name": "arm", "on_joint": "hinge", "pose": {"translation": [-0.25, 0.0, 0.0]},
+                                "geometry": {"type": "box", "size": [0.3, 0.05, 0.1]}})
+        robot["devices"] = [{"device": "RotationalMotor", "name": "hinge", "max_velocity": 100.0,
+                             "max_torque": 1e5, "axis": [0, 0, 1]}]
+        sim = world([wall], [robot])
+        assert sim.contact.feet[0].pieces is not None and len(sim.contact.feet[0].pieces) == 4
+        if swung:
+            sim.robot("r").motor("hinge").set_position(math.pi)
+            sim.step()
+            assert float(max(pc.points[:, 0].max() for pc in sim.contact.feet[0].pieces)) == pytest.approx(0.4, abs=1e-12)
+        drive(sim, "r", 5.0)
+        sim.run(100)
+        reach = 0.4 if swung else TIP
+        x, y = xy(sim, "r")
+        assert x == pytest.approx(1.0 - reach, abs=1e-9) and x <= 1.0 - reach and y == 0.0

@@ -330,6 +330,9 @@ def test_a_sliver_robot_far_from_the_origin_curving_into_a_box_stays_out() -> No
     assert max(_overlap(pts, rnd, box, 0.0) for pts, rnd in pieces) <= 1e-9
 
 
+# the examples that had a turn refused outright (9 to 12 of 25 once; 0 to 1 now that most turns into
+# something are pushed off it, a concave body's by its pieces too: too few drawn to count on, so
+# tests/test_contact_shape.py holds the fixed cases of refused and pushed turns)
 STUCK_TURNS: list[int] = []
 
 
@@ -369,11 +372,3 @@ def test_a_turn_cut_short_by_a_corner_can_turn_back(me, yaw, spin, gap, offset, 
     check(sim, ["r0"], offset, nue)
     turned = (float(sim.contact.yaw[0]) - before + math.pi) % (2 * math.pi) - math.pi
     assert turned * spin < 0, (before, turned)
-
-
-def test_the_turn_fuzz_cut_turns_short() -> None:
-    """The examples above are not vacuous: many robots (5 at least) had a turn refused before turning back."""
-    # (how many examples had a turn refused varies with the examples drawn, 9 to 12 of 25 seen: most
-    # turns into something are pushed off it now; tests/test_contact_shape.py holds the fixed cases)
-    if STUCK_TURNS:
-        assert len(STUCK_TURNS) >= 5, STUCK_TURNS

@@ -13,7 +13,8 @@ Robots move in the world xy-plane, so contact is solved in 2D within each robot'
   (``Footprint.radius``) is the broad phase's. A concave body -- its hull's area more than CONCAVE
   (1 %) over its shapes' union -- is its convex pieces (``Footprint.pieces``: the shapes grouped at
   load while a group's hull adds under 1 %), each in its own band, any of them stopping it
-  (:meth:`Contact._clip_pieces`; its turn pushed as its hull's push, :meth:`Contact._push_pieces`);
+  (:meth:`Contact._clip_pieces`; its turn pushed off by its pieces, :meth:`Contact._push_by_pieces`,
+  else as its hull's push, :meth:`Contact._push_pieces`);
 * an obstacle is a convex 2D set ``hull(points) ⊕ disc(radius)``: an upright box is its 4
   corners, an upright cylinder or capsule a point with its radius, a sphere a point with the
   radius of its widest section inside the band, anything else the convex hull of its projected
@@ -1714,8 +1715,8 @@ class Contact:
         :attr:`Footprint.pieces`, and what it carries), at height ``h``: :meth:`_clip_carrying`'s rule,
         every piece against the solids ``solids`` (indices) and the robots' obstacles ``robot_obs`` in
         its own height band. ``hull``: a concave body's own footprint (its pieces' hull, nothing
-        carried): a turn the pieces cannot make in place pushes the robot off as its hull would be
-        pushed (:meth:`_push_pieces`) before it is cut short."""
+        carried): a turn the pieces cannot make in place pushes the robot off (:meth:`_push_pieces`:
+        by its pieces, else as its hull) before it is cut short."""
         pieces: list[tuple[Footprint, list[Obstacle]]] = []
         for piece in set_:
             lo, hi = h + piece.z_low, h + piece.z_high
@@ -1780,11 +1781,16 @@ class Contact:
                      robot_obs: list[Obstacle], h: float, p: np.ndarray, yaw: float, yaw1: float,
                      turn: float) -> np.ndarray | None:
         """Where a concave body whose pieces' turn in place would go into something is pushed, or None:
-        :meth:`_push` of its hull (the pieces lie in it, so the hull turned and pushed clear of a
-        candidate leaves every piece clear of it) among the candidates in the whole body's band,
-        taken only where every piece at the pushed centre, turned to ``yaw1``, is no deeper in any of
-        its candidates than it was at ``p`` before the turn (an obstacle in a notch, which the hull
-        overlaps already, may not be swept through by a piece)."""
+        the pieces' own push (:meth:`_push_by_pieces`, the least one that clears them); where that does
+        not hold through the turn (a corner passing the peak of its reach within the step), :meth:`_push`
+        of its hull (the pieces lie in it, so the hull turned and pushed clear of a candidate leaves
+        every piece clear of it) among the candidates in the whole body's band, taken only where every
+        piece at the pushed centre, turned to ``yaw1``, is no deeper in any of its candidates than it
+        was at ``p`` before the turn (an obstacle in a notch, which the hull overlaps already, may not
+        be swept through by a piece)."""
+        q = self._push_by_pieces(pieces, hull.radius * min(abs(turn), 2.0), p, yaw, yaw1, turn)
+        if q is not None:
+            return q
         assert hull.points is not None
         lo, hi = h + hull.z_low, h + hull.z_high
         cands = [self._in_band(self._obs[j], lo, hi) for j in solids] + robot_obs
@@ -1803,6 +1809,75 @@ class Contact:
                 if _gap(q, *_grown(ob, after, piece.round, q)) < min(_gap(p, *_grown(ob, before, piece.round, p)), 0.0) - EPS:
                     return None
         return q
+
+    def _push_by_pieces(self, pieces: list[tuple[Footprint, list[Obstacle]]], limit: float, p: np.ndarray,
+                        yaw: float, yaw1: float, turn: float) -> np.ndarray | None:
+        """The least push of a concave body's centre off what its pieces, turned in place from ``yaw``
+        to ``yaw1`` at ``p``, go into, or None: each candidate a piece enters, grown by that piece turned
+        (:func:`_grown`, convex: the way out along its nearest feature's outward normal is exact), gives
+        a push out of it, and each two such give the move meeting both pushes along their normals (a
+        piece in a corner, or two pieces in two things); the shortest of these is taken that leaves
+        every piece at the pushed centre, turned, no deeper in any candidate than it was at ``p`` (an
+        obstacle in a notch stays in it), whose path meets no candidate it did not push off, that is
+        not back toward the side the robot came from, no longer than ``limit`` (what the broad phase
+        grew the move by), and from where every piece's whole turn is clear (:meth:`_turn_clear`).
+        So a post in a U-shaped robot's notch that a finger turns into pushes the robot off it by the
+        finger's depth in it, as Webots' bodies collide piece by piece, not out of the notch."""
+        grow = 1.0 + min(abs(turn), 2.0)
+        tests = []          # (piece, candidate, grown by the piece at yaw, at yaw1, distance at yaw)
+        for piece, cands in pieces:
+            assert piece.points is not None
+            near = _in_reach(cands, p, _STILL, piece.radius * grow)
+            if near:
+                here, after = _turned(piece.points, yaw), _turned(piece.points, yaw1)
+                for ob in near:
+                    g0 = _grown(ob, here, piece.round, p)
+                    tests.append((piece, ob, g0, _grown(ob, after, piece.round, p), _gap(p, *g0)))
+        tries = []
+        for k, (_, _, g0, g1, before) in enumerate(tests):
+            self.checks += 1
+            gap, normal = _gap_normal(p, *g1)
+            target = min(before, 0.0)
+            if gap < target - EPS and float(normal @ _gap_normal(p, *g0)[1]) > 0.0:
+                tries.append((target - gap, k, normal))
+        if not tries:
+            return None
+        moves = [(t + BACK_OFF, ((t + BACK_OFF) * n, (k,))) for t, k, n in sorted(tries, key=lambda a: (a[0], a[1]))]
+        for a, (ta, ka, na) in enumerate(tries):
+            for tb, kb, nb in tries[a + 1:]:
+                det = float(na[0] * nb[1] - na[1] * nb[0])
+                if abs(det) < 1e-9:
+                    continue
+                ua, ub = ta + BACK_OFF, tb + BACK_OFF
+                s = np.array([ua * nb[1] - ub * na[1], ub * na[0] - ua * nb[0]]) / det
+                moves.append((float(np.hypot(*s)), (s, (ka, kb))))
+        for size, (step, into) in sorted(moves, key=lambda m: (m[0], m[1][1])):
+            if size > limit:
+                break
+            q = p + step
+            ok = True
+            for k, (_, _, _, g1, before) in enumerate(tests):
+                self.checks += 1
+                if _gap(q, *g1) < min(before, 0.0) - EPS or (k not in into and time_of_impact(p, step, *g1)[1] is not None):
+                    ok = False
+                    break
+            if ok and self._pieces_turn_clear(tests, q, yaw, turn):
+                return q
+        return None
+
+    def _pieces_turn_clear(self, tests: list, q: np.ndarray, yaw: float, turn: float) -> bool:
+        """Whether every piece of :meth:`_push_by_pieces`' ``tests``, at ``q`` heading ``yaw``, is no
+        deeper in its candidates than at the start and turns by ``turn`` clear of them (:meth:`_turn_clear`)."""
+        by_piece: dict[int, tuple[Footprint, list[Obstacle], list[float]]] = {}
+        for piece, ob, _, _, before in tests:
+            assert piece.points is not None
+            now = _gap(q, *_grown(ob, _turned(piece.points, yaw), piece.round, q))
+            if now < min(before, 0.0) - EPS:
+                return False
+            entry = by_piece.setdefault(id(piece), (piece, [], []))
+            entry[1].append(ob)
+            entry[2].append(now)
+        return all(self._turn_clear(piece, q, yaw, turn, obs, now) for piece, obs, now in by_piece.values())
 
     def _clip_shaped(self, foot: Footprint, p: np.ndarray, d: np.ndarray, yaw: float, yaw1: float,
                      cands: list[Obstacle]) -> tuple[np.ndarray, bool, float]:
