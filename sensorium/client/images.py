@@ -77,6 +77,23 @@ def write_file(func: str, filename: str, data: bytes) -> int:
     return 0
 
 
+def install(func: str, tmp: str, filename: str) -> bool:
+    """``tmp``, written in full, renamed onto ``filename`` (no reader ever sees half a file); on failure
+    Webots' kind of line, ``tmp`` removed and False."""
+    import os
+
+    try:
+        os.replace(tmp, filename)
+    except OSError as exc:
+        print(f"Error: {func}(): cannot write {filename!r}: {exc.strerror or exc}", file=sys.stderr)
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        return False
+    return True
+
+
 def save_rgb(func: str, filename: str, quality: int, rgb: bytes, width: int, height: int) -> int:
     """Webots' checks and formats: ``.png``, ``.jpg``/``.jpeg`` (quality 1..100); -1 with Webots'
     message on a bad argument, an unknown extension or a file that cannot be written."""

@@ -1218,18 +1218,18 @@ def wb_supervisor_world_save(filename: str | None = None) -> bool:
         return False
     folder, base = os.path.split(name)
     tmp = os.path.join(folder, f".{base}.{os.getpid()}.tmp")
+    import contextlib
+
+    from sensorium.client import images
     try:
         with open(tmp, "w", encoding="utf-8", newline="\n") as out:
             out.write(str(got["value"]))
-        os.replace(tmp, name)
     except OSError as exc:
-        print(f"Error: {func}(): cannot write {name!r}: {exc.strerror or exc}.", file=sys.stderr)
-        try:
+        print(f"Error: {func}(): cannot write {name!r}: {exc.strerror or exc}", file=sys.stderr)
+        with contextlib.suppress(OSError):      # a part written: not left behind
             os.unlink(tmp)
-        except OSError:
-            pass
         return False
-    return True
+    return images.install(func, tmp, name)
 
 
 _unserved_warned: set[str] = set()
@@ -1320,11 +1320,4 @@ def wb_supervisor_export_image(filename: str, quality: int) -> None:
     tmp = os.path.join(folder, f".{base}.{os.getpid()}.tmp{ext}")
     if images.save_rgb(func, tmp, quality, bytes(reply["data"]), int(reply["width"]), int(reply["height"])) != 0:
         return
-    try:
-        os.replace(tmp, name)
-    except OSError as exc:
-        print(f"Error: {func}(): cannot write {name!r}: {exc.strerror or exc}", file=sys.stderr)
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+    images.install(func, tmp, name)
