@@ -75,7 +75,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_pose, obstacle, ramp_top, robot_footprint
-from sensorium.server.sim.hull import FlatPoints, convex_hull, extreme_points, hull_tolerance
+from sensorium.server.sim.hull import FlatPoints, convex_hull, enclosed, extreme_points, hull_tolerance
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
@@ -792,11 +792,9 @@ def _volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
     assert isinstance(prim, geo.Mesh)
     v = np.asarray(prim.vertices, dtype=np.float64)
     if prim.closed and len(prim.faces):
-        a, b, c = (v[prim.faces[:, k]] for k in range(3))
-        six = np.einsum("ij,ij->i", a, np.cross(b, c))
-        total = float(six.sum())
-        if total != 0.0:
-            return abs(total) / 6.0, (six[:, None] * (a + b + c)).sum(axis=0) / (4.0 * total)
+        six, centre = enclosed(v, prim.faces)
+        if six != 0.0:
+            return abs(six) / 6.0, centre
     try:
         return convex_hull(extreme_points(v)).volume_centroid()
     except FlatPoints:
@@ -915,21 +913,24 @@ def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.n
     shapes = falling_shapes(solid, base_dir)
     if shapes is None:
         return pose
+    # its Physics' masses (the .wbt import's and the loader's, Webots' rules, mesh files' volumes
+    # included) over uniform density: the shapes' volumes are weighed only without them
+    weighed = _mass_centre(solid)
     points, volumes, centres = [], [], []
     for local, prim, g in shapes:
         at = enu_pose(pose.compose(local), to_enu)
         points.append(_support_points(g, prim) @ at.rotation.T + at.translation)
-        volume, centre = _volume_centre(g, prim)
-        volumes.append(volume)
-        centres.append(at.rotation @ centre + at.translation)
+        if weighed is None:
+            volume, centre = _volume_centre(g, prim)
+            volumes.append(volume)
+            centres.append(at.rotation @ centre + at.translation)
     cloud = np.vstack(points)
-    total = sum(volumes)
-    centre = (sum(v * c for v, c in zip(volumes, centres)) / total) if total > 0.0 else cloud.mean(axis=0)
-    # its Physics' masses (the .wbt import's and the loader's, Webots' rules, mesh files' volumes
-    # included) over uniform density
-    weighed = _mass_centre(solid)
     if weighed is not None:
-        centre = enu_pose(pose, to_enu).rotation @ weighed + enu_pose(pose, to_enu).translation
+        placed = enu_pose(pose, to_enu)
+        centre = placed.rotation @ weighed + placed.translation
+    else:
+        total = sum(volumes)
+        centre = (sum(v * c for v, c in zip(volumes, centres)) / total) if total > 0.0 else cloud.mean(axis=0)
     try:
         got = _hull_tip(extreme_points(cloud), centre)
     except FlatPoints as flat:

@@ -18,7 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["FlatPoints", "Hull", "MAX_POINTS", "beyond", "convex_hull", "extreme_points", "hull_tolerance"]
+__all__ = ["FlatPoints", "Hull", "MAX_POINTS", "beyond", "convex_hull", "enclosed", "extreme_points",
+           "hull_tolerance"]
 
 _RELATIVE_TOL = 1e-10
 
@@ -80,13 +81,20 @@ class Hull:
 
     def volume_centroid(self) -> tuple[float, np.ndarray]:
         """The hull's volume and the centre of that volume (tetrahedra from one hull vertex)."""
-        p = self.points
-        apex = p[self.vertices[0]]
-        a, b, c = (p[self.faces[:, k]] - apex for k in range(3))
-        six = np.einsum("ij,ij->i", a, np.cross(b, c))          # 6 × each tetrahedron's volume
-        volume = float(six.sum()) / 6.0
-        centroid = apex + (six[:, None] * (a + b + c)).sum(axis=0) / (4.0 * float(six.sum()))
-        return volume, centroid
+        six, centroid = enclosed(self.points, self.faces, self.points[self.vertices[0]])
+        return six / 6.0, centroid
+
+
+def enclosed(points: np.ndarray, faces: np.ndarray, apex: np.ndarray | None = None) -> tuple[float, np.ndarray]:
+    """Six times the signed volume that triangles ``faces`` (indices into ``points``, wound outward
+    counter-clockwise) enclose, and the centre of that volume: tetrahedra from ``apex`` (the origin when
+    None) to each triangle. The centre is NaN when the volume is 0."""
+    a, b, c = (points[faces[:, k]] if apex is None else points[faces[:, k]] - apex for k in range(3))
+    six = np.einsum("ij,ij->i", a, np.cross(b, c))          # 6 × each tetrahedron's volume
+    total = float(six.sum())
+    with np.errstate(divide="ignore", invalid="ignore"):
+        centre = (six[:, None] * (a + b + c)).sum(axis=0) / (4.0 * total)
+    return total, centre if apex is None else apex + centre
 
 
 def hull_tolerance(points: np.ndarray) -> float:
