@@ -163,23 +163,7 @@ def held_wheel(end: Node | None, conv) -> Node | None:
     """The node whose round part is the wheel a steering hinge's end point holds: the end point of the
     first hinge inside it with something round there (a tricycle's passive front wheel hinge), else the
     end point itself when its own round part is a wheel (:func:`holds_wheel`), else None."""
-    def find(node: Node | None) -> Node | None:
-        if node is None:
-            return None
-        conv.walk(node)
-        nf = conv.fields(node)
-        if node.type in ("HingeJoint", "Hinge2Joint"):
-            held = nf.node_("endPoint")
-            return held if wheel_radius(held, conv) is not None else None
-        if node.type in ("Pose", "Transform", "Group", "Solid", "Slot"):
-            kids = [nf.node_("endPoint")] if node.type == "Slot" else nf.nodes("children")
-            for child in kids:
-                found = find(child)
-                if found is not None:
-                    return found
-        return None
-
-    found = find(end)
+    found = _wheel_joint_end(end, conv)
     if found is not None:
         return found
     part = _round_part(end, conv)
@@ -189,19 +173,25 @@ def held_wheel(end: Node | None, conv) -> Node | None:
 def _holds_wheel_joint(end: Node | None, conv) -> bool:
     """Whether an end point holds a hinge whose end point has something round (a car's knuckle holding
     its wheel's joint)."""
-    def find(node: Node | None) -> bool:
-        if node is None:
-            return False
-        conv.walk(node)
-        nf = conv.fields(node)
-        if node.type in ("HingeJoint", "Hinge2Joint"):
-            return wheel_radius(nf.node_("endPoint"), conv) is not None
-        if node.type in ("Pose", "Transform", "Group", "Solid", "Slot"):
-            kids = [nf.node_("endPoint")] if node.type == "Slot" else nf.nodes("children")
-            return any(find(child) for child in kids)
-        return False
+    return _wheel_joint_end(end, conv) is not None
 
-    return find(end)
+
+def _wheel_joint_end(node: Node | None, conv) -> Node | None:
+    """The end point of the first hinge at or inside ``node`` (through Poses, Transforms, Groups, Solids
+    and Slots, not past a hinge) whose end point has something round (:func:`wheel_radius`), else None."""
+    if node is None:
+        return None
+    conv.walk(node)
+    nf = conv.fields(node)
+    if node.type in ("HingeJoint", "Hinge2Joint"):
+        held = nf.node_("endPoint")
+        return held if wheel_radius(held, conv) is not None else None
+    if node.type in ("Pose", "Transform", "Group", "Solid", "Slot"):
+        for child in [nf.node_("endPoint")] if node.type == "Slot" else nf.nodes("children"):
+            found = _wheel_joint_end(child, conv)
+            if found is not None:
+                return found
+    return None
 
 
 def _axis_off_y(wheels: list[dict], tol: float, why: str) -> str:
