@@ -17,10 +17,9 @@ from collections import Counter
 from typing import Any
 
 from sensorium.server.daemon import supervisor as sv
-from sensorium.server.sim.regenerate import written_value
-from sensorium.server.world.limits import ProtoLimits
+from sensorium.server.sim.regenerate import reparsed_world, written_value
 from sensorium.server.world.wbt.parser import Node as ParsedNode
-from sensorium.server.world.wbt.parser import WbtFile, WbtSyntaxError, parse_wbt
+from sensorium.server.world.wbt.parser import WbtFile
 from sensorium.server.world.wbt.write import Writer
 
 _POSE = {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 1.0, 0.0]}
@@ -51,16 +50,8 @@ def _world_file(sim: Any) -> WbtFile | None:
     kept = getattr(sim, "_export_world", None)
     if kept is not None:
         return kept or None
-    loaded = sim.loaded
-    if not loaded.source.lower().endswith(".wbt") or not loaded.text:
-        sim._export_world = ()
-        return None
-    text = loaded.text.removeprefix(b"\xef\xbb\xbf").decode("utf-8", errors="replace")
-    try:
-        wbt = parse_wbt(text, loaded.source, ProtoLimits.matching(sim.limits))
-    except WbtSyntaxError as exc:
-        raise NotExported(f"{loaded.source}: the world file does not parse again: {exc.message}") from None
-    sim._export_world = wbt
+    wbt = reparsed_world(sim, NotExported)
+    sim._export_world = wbt if wbt is not None else ()
     return wbt
 
 

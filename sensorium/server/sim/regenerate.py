@@ -38,21 +38,29 @@ def written_value(kind: str, value: Any) -> Any:
     return [float(v) for item in value for v in item]          # MFVec2f, MFVec3f, MFColor, MFRotation
 
 
+def reparsed_world(sim: Any, refused: type[ValueError]) -> WbtFile | None:
+    """The world file parsed again from the bytes it loaded from (within the world's PROTO limits); None
+    for a world not loaded from a ``.wbt`` file; ``refused`` (one line) if it does not parse."""
+    loaded = sim.loaded
+    if not loaded.source.lower().endswith(".wbt") or not loaded.text:
+        return None
+    text = loaded.text.removeprefix(b"\xef\xbb\xbf").decode("utf-8", errors="replace")
+    try:
+        return parse_wbt(text, loaded.source, ProtoLimits.matching(sim.limits))
+    except WbtSyntaxError as exc:
+        raise refused(f"{loaded.source}: the world file does not parse again: {exc.message}") from None
+
+
 def _world_instances(sim: Any) -> tuple[WbtFile, dict[str, ParsedNode]]:
     """The world file's declarations and PROTOs, and its top-level PROTO instances that became one top-level
     solid each (by the solid's name): the file parsed again once, at the first set, the rest dropped."""
     kept = getattr(sim, "_regen_world", None)
     if kept is not None:
         return kept
-    loaded = sim.loaded
-    if not loaded.source.lower().endswith(".wbt") or not loaded.text:
-        kept = (WbtFile("", [], [], loaded.source), {})
+    wbt = reparsed_world(sim, ImportRefused)
+    if wbt is None:
+        kept = (WbtFile("", [], [], sim.loaded.source), {})
     else:
-        text = loaded.text.removeprefix(b"\xef\xbb\xbf").decode("utf-8", errors="replace")
-        try:
-            wbt = parse_wbt(text, loaded.source, ProtoLimits.matching(sim.limits))
-        except WbtSyntaxError as exc:       # the file changed on disk since it loaded? it loaded from these bytes
-            raise ImportRefused(f"{loaded.source}: the world file does not parse again: {exc.message}") from None
         instances: dict[str, ParsedNode] = {}
         solids = 0
         faces = sim.top_level.interfaces
