@@ -1244,8 +1244,8 @@ def center_of_mass(sim: Any, node: Node) -> list[float]:
     pose = nested.world_pose(sim, me) if node.nested else _pose(sim, node)
     weighted = [(own.kg, pose.rotation @ np.asarray(own.center) + pose.translation)]
     for n in inside:
-        at = nested.world_pose(sim, n) if n.mass is not None else None
-        if n.mass is not None and at is not None:
+        at = None if n.mass is None else nested.world_pose(sim, n)
+        if at is not None:
             weighted.append((n.mass.kg, at.rotation @ np.asarray(n.mass.center) + at.translation))
     total = sum(kg for kg, _ in weighted)
     return [float(v) for v in sum(kg * p for kg, p in weighted) / total]

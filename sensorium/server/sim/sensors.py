@@ -387,14 +387,10 @@ class Lidar(Device):
         if self.hidden:
             return self._plan_past_hidden(pose, now_ms, dt_ms)
         if self.rotating:
-            # only the sector the head sweeps during this step (devices.md §4.9)
-            self._sweep = lmath.rotating_sweep(self.params, self.head_angle, self.frequency, dt_ms, now_ms / 1000.0)
-            cols = self._sweep.columns
-            if cols.size == 0:
+            swept = self._swept(pose, now_ms, dt_ms)
+            if swept is None:
                 return []
-            dirs_local = self._all_dirs[:, cols, :]
-            t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far[:, cols].reshape(-1)
-            dirs = _rotate(pose.rotation, dirs_local.reshape(-1, 3))
+            dirs, t_far = swept
             if self._own_body is not None:
                 return [RayRequest(np.broadcast_to(pose.translation, dirs.shape), dirs, self.params.near, t_far,
                                    RayKind.VISUAL, -1, tag="lidar", distance_only=True,
@@ -422,16 +418,24 @@ class Lidar(Device):
         return [RayRequest(origins, dirs, self.params.near, t_far, RayKind.VISUAL, -1, tag="lidar",
                            distance_only=True)]
 
+    def _swept(self, pose: Pose, now_ms: int, dt_ms: int) -> tuple[np.ndarray, Any] | None:
+        """A rotating head's beams this step: only the sector it sweeps (devices.md §4.9), their world
+        directions and far limits; None when it sweeps no column."""
+        self._sweep = lmath.rotating_sweep(self.params, self.head_angle, self.frequency, dt_ms, now_ms / 1000.0)
+        cols = self._sweep.columns
+        if cols.size == 0:
+            return None
+        t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far[:, cols].reshape(-1)
+        return _rotate(pose.rotation, self._all_dirs[:, cols, :].reshape(-1, 3)), t_far
+
     def _plan_past_hidden(self, pose: Pose, now_ms: int, dt_ms: int) -> list[RayRequest]:
         """The beams as one plain world cast (its robot's body in it, nothing mounted), their shapes kept:
         ``finish`` casts again, from just past it, each beam whose hit is a hidden or own shape."""
         if self.rotating:
-            self._sweep = lmath.rotating_sweep(self.params, self.head_angle, self.frequency, dt_ms, now_ms / 1000.0)
-            cols = self._sweep.columns
-            if cols.size == 0:
+            swept = self._swept(pose, now_ms, dt_ms)
+            if swept is None:
                 return []
-            dirs = _rotate(pose.rotation, self._all_dirs[:, cols, :].reshape(-1, 3))
-            t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far[:, cols].reshape(-1)
+            dirs, t_far = swept
         else:
             dirs = _rotate(pose.rotation, self._all_dirs.reshape(-1, 3))
             t_far = self._t_far if not isinstance(self._t_far, np.ndarray) else self._t_far.reshape(-1)
