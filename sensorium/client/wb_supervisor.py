@@ -1196,7 +1196,10 @@ def wb_supervisor_world_save(filename: str | None = None) -> bool:
     (a ``.wbt`` file; relative to the controller's folder, as every file a controller writes), through a
     temporary file renamed onto it. Without a filename Webots overwrites the world file it loaded: here one
     line and False (a headless server never overwrites its world file; name the file)."""
+    import contextlib
     import os
+
+    from sensorium.client import images
 
     func = "wb_supervisor_world_save"
     r = _supervisor(func)
@@ -1218,9 +1221,6 @@ def wb_supervisor_world_save(filename: str | None = None) -> bool:
         return False
     folder, base = os.path.split(name)
     tmp = os.path.join(folder, f".{base}.{os.getpid()}.tmp")
-    import contextlib
-
-    from sensorium.client import images
     try:
         with open(tmp, "w", encoding="utf-8", newline="\n") as out:
             out.write(str(got["value"]))
