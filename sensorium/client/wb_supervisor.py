@@ -414,14 +414,21 @@ def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
 
 
 def wb_supervisor_node_reset_physics(node: int | None) -> None:
-    """Webots zeroes the node's velocities and keeps the motors' commands; without physics there is no
-    momentum to clear (a robot's motion is its wheels' commands): nothing to do."""
-    _checked_node(node, "wb_supervisor_node_reset_physics")
+    """Webots' ``resetPhysics``: the velocities of the node and the Solids under it zeroed. A top-level solid
+    falling (README "Falling") falls again from rest from where it is, onto the same support; a robot keeps
+    its motors' commands (its motion here), so nothing else changes. The root's: every falling solid's."""
+    func = "wb_supervisor_node_reset_physics"
+    r = _checked_node(node, func)
+    if r is not None:
+        _answer(r, "reset_physics", {"node": int(node)}, func)  # type: ignore[arg-type]
 
 
 def wb_supervisor_simulation_reset_physics() -> None:
-    """As ``wb_supervisor_node_reset_physics`` for every node: nothing to clear without physics."""
-    _supervisor("wb_supervisor_simulation_reset_physics")
+    """Webots' ``simulationResetPhysics``: the root's ``resetPhysics``, every falling solid falls again from rest."""
+    func = "wb_supervisor_simulation_reset_physics"
+    r = _supervisor(func)
+    if r is not None:
+        _answer(r, "reset_physics", {"node": 0}, func)
 
 
 # ---------------------------------------------------------------------- fields

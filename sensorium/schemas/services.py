@@ -1117,6 +1117,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("load_node_state", "robot", NodeStateArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("import_node_from_string", "robot", ImportNodeArgs, IntArrayValue, attached=True, supervisor=True),
     ServiceSpec("simulation_reset", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("reset_physics", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("restart_controller", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("world_reload", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_quit", "robot", SimulationQuitArgs, SuccessResult, attached=True, supervisor=True),

@@ -1495,6 +1495,19 @@ def _reset(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     return {"success": True}
 
 
+def _reset_physics(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    """Webots' ``resetPhysics``: the velocities of the node and the Solids under it zeroed. The ones that
+    have a velocity here of their own are the top-level solids falling (sim/falling.py): the root's
+    reset (``simulationResetPhysics``) stops them all, a top-level solid's itself; a robot keeps its
+    motors' commands (Webots), and nothing inside a robot or solid moves by itself."""
+    node = node_by_id(sim, a.node)
+    if node is ROOT:
+        sim.reset_physics()
+    elif node.type == "Solid" and not (node.nested or node.visual or node.scenery):
+        sim.reset_physics(str(node.key))
+    return {"success": True}
+
+
 def _set_mode(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     ls.set_mode(MODES[a.mode])
     return {"success": True}
@@ -1576,6 +1589,7 @@ HANDLERS = {
     "load_node_state": _load_state,
     "import_node_from_string": _import,
     "simulation_reset": _reset,
+    "reset_physics": _reset_physics,
     "simulation_set_mode": _set_mode,
     "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},
     "set_label": _set_label,

@@ -12,7 +12,9 @@ once, when it is let go. Its velocity while it falls is ``−g·(t − t0)`` alo
 (:meth:`Falls.velocity`, a Supervisor's ``getVelocity``). A fall ends early, the solid staying where it
 is, when something else puts it somewhere (a gripper holding it, a state loaded, a reset: its pose in
 the scene is then not the one the fall put) or when it is removed or rebuilt; a Supervisor's move
-starts it over, from rest, from the pose it puts (``Simulation.set_solid_pose`` calls :meth:`Falls.let_go`). While
+starts it over, from rest, from the pose it puts (``Simulation.set_solid_pose`` calls :meth:`Falls.let_go`); a
+Supervisor's ``resetPhysics`` zeroes its velocity: it falls again from rest from where it is, onto the support
+and into the pose judged when it was let go (:meth:`Falls.stop`). While
 it falls, it is support where it will rest (:meth:`Falls.resting`, read by ``Simulation.landing_ground``).
 Only falling solids cost work per step: none, nothing.
 """
@@ -81,6 +83,22 @@ class Falls:
         self._move(name, self.falling[name], sim.time_ms)
         return landed
 
+    def stop(self, name: str, now_ms: int) -> None:
+        """Webots' ``resetPhysics`` on solid ``name``: a falling one's velocity zeroed at ``now_ms``, so it
+        falls again from rest from where it is now (its height then less ``g·(t − now)²/2``), onto the
+        same support, coming to the same resting pose; one not falling is left as it is."""
+        fall = self.falling.get(name)
+        if fall is None:
+            return
+        if not self._still(name, fall):          # put elsewhere since: that fall is over
+            del self.falling[name]
+            return
+        here = fall.placed                       # where the fall has it now (put there at the last step's end)
+        t = here.translation if self._to_enu is None else self._to_enu @ here.translation
+        height = float(t[2])
+        drop = fall.drop - (fall.start_height - height)      # what is left of the way down (> 0: not landed)
+        fall.start, fall.start_ms, fall.start_height, fall.drop = here, int(now_ms), height, drop
+
     def resting(self, name: str, pose: Pose) -> Pose:
         """Where solid ``name``, now at ``pose``, comes to rest: its fall's end if it falls, else ``pose``."""
         fall = self.falling.get(name)
@@ -122,7 +140,7 @@ class Falls:
         fall = self.falling.get(name)
         if fall is None:
             return None
-        v = -self.gravity * (now_ms - fall.start_ms) * 0.001 * self._up
+        v = -self.gravity * (now_ms - fall.start_ms) * 0.001 * self._up + 0.0     # (+ 0.0: no -0.0 at rest)
         return [float(v[0]), float(v[1]), float(v[2]), 0.0, 0.0, 0.0]
 
     def clear(self) -> None:

@@ -588,6 +588,13 @@ class Simulation:
         if model is not None and model.physics and not any(g.held == name for g in self._grippers):
             self.falls.let_go(name, model, self.time_ms)
 
+    def reset_physics(self, solid: str | None = None) -> None:
+        """Webots' ``resetPhysics`` on top-level solid ``solid`` (None: every one, ``simulationResetPhysics``):
+        velocities zeroed, so a falling one falls again from rest from where it is now (sim/falling.py,
+        ``Falls.stop``); nothing else here has a velocity that is not its motors' commands."""
+        for name in list(self.falls.falling) if solid is None else [solid]:
+            self.falls.stop(name, self.time_ms)
+
     def place_solid(self, name: str, pose: Pose) -> None:
         """Put a top-level solid at ``pose`` (checked by the caller): the sensors, kinematic contact
         and the terrains see it there from the next measurement."""

@@ -731,18 +731,30 @@ void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
                   "their wheels' commands, solids are static).\n");
 }
 
-/* Webots zeroes the node's velocities and keeps the motors' commands; without physics there is no
-   momentum to clear: nothing to do. */
+/* Webots' resetPhysics: the velocities of the node and the Solids under it zeroed. A top-level solid
+   falling falls again from rest from where it is; a robot keeps its motors' commands. The root's (node
+   0, simulationResetPhysics): every falling solid's. */
+static void reset_physics(sn_robot *rb, int64_t node, const char *func) {
+  sn_reply rep;
+  if (rb != NULL && sn_robot_call(rb, "robot/reset_physics", 1, args_node, &node, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
 void wb_supervisor_node_reset_physics(WbNodeRef node) {
-  supervisor_node(node, "wb_supervisor_node_reset_physics");
+  const char *func = "wb_supervisor_node_reset_physics";
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb != NULL)
+    reset_physics(rb, node->id, func);
 }
 
 void wb_supervisor_simulation_reset_physics(void) {
-  supervisor("wb_supervisor_simulation_reset_physics");
+  const char *func = "wb_supervisor_simulation_reset_physics";
+  reset_physics(supervisor(func), 0, func);
 }
 
 void wb_supervisor_simulation_physics_reset(void) {
-  supervisor("wb_supervisor_simulation_physics_reset");
+  const char *func = "wb_supervisor_simulation_physics_reset";
+  reset_physics(supervisor(func), 0, func);
 }
 
 /* ------------------------------------------------------------------ fields */
