@@ -404,13 +404,14 @@ _set_velocity_warned: list[bool] = []
 
 
 def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
-    """No physics: a robot moves only by its wheels (which keep their commands), so a velocity set
-    from outside has nothing to act on; one warning line, ignored."""
+    """No physics engine: a robot moves only by its wheels (which keep their commands) and a solid only falls
+    straight down from rest (README "Falling"), so a velocity set from outside has nothing to act on; one
+    warning line, ignored."""
     if _checked_node(node, "wb_supervisor_node_set_velocity") is None or _set_velocity_warned:
         return
     _set_velocity_warned.append(True)
-    print("Warning: wb_supervisor_node_set_velocity(): ignored: Sensorium has no physics (robots move by their "
-          "wheels' commands, solids are static).", file=sys.stderr)
+    print("Warning: wb_supervisor_node_set_velocity(): ignored: Sensorium has no physics engine (robots move by "
+          "their wheels' commands, solids only fall straight down from rest).", file=sys.stderr)
 
 
 def wb_supervisor_node_reset_physics(node: int | None) -> None:

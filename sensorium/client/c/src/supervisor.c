@@ -719,16 +719,16 @@ void wb_supervisor_node_load_state(WbNodeRef node, const char *state_name) {
   node_state(node, state_name, "robot/load_node_state", "wb_supervisor_node_load_state");
 }
 
-/* No physics: a robot moves by its wheels (which keep their commands), solids are static; a velocity
-   set from outside has nothing to act on: one warning, ignored. */
+/* No physics engine: a robot moves by its wheels (which keep their commands), a solid only falls straight
+   down from rest; a velocity set from outside has nothing to act on: one warning, ignored. */
 void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
   (void)velocity;
   static bool warned;
   if (supervisor_node(node, "wb_supervisor_node_set_velocity") == NULL || warned)
     return;
   warned = true;
-  fprintf(stderr, "Warning: wb_supervisor_node_set_velocity(): ignored: Sensorium has no physics (robots move by "
-                  "their wheels' commands, solids are static).\n");
+  fprintf(stderr, "Warning: wb_supervisor_node_set_velocity(): ignored: Sensorium has no physics engine (robots move "
+                  "by their wheels' commands, solids only fall straight down from rest).\n");
 }
 
 /* Webots' resetPhysics: the velocities of the node and the Solids under it zeroed. A top-level solid
