@@ -648,7 +648,8 @@ class Camera(Device):
     def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
                  counters: Any) -> np.ndarray:
         """(S, n) False where a shadow-casting light is hidden from the point by a visible shape
-        (its segment to the light, 1000 m towards a directional one); only lit, facing pairs cast.
+        (its segment to the light, 1000 m towards a directional one), not one a Supervisor hid from
+        this camera (``hidden_shapes``); only lit, facing pairs cast.
         Which pairs cast and their segments come from :func:`shadow_rays` (row blocks on the
         engine's threads); each light's rays are then one cast, as one batch."""
         lit = np.ones((len(P), len(lights)), dtype=bool)
@@ -663,8 +664,13 @@ class Camera(Device):
             for k, (j, (i, unit, length)) in enumerate(rays.items()):
                 if len(i) == 0:
                     continue
-                hits = engine.cast(out.origins(k, P, i), unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1,
-                                   distance_only=True)
+                if self.hidden:    # a node hidden from this camera casts no shadow in its image (Webots
+                    # sets it invisible for the camera's render, and WREN's shadow volumes are its visible nodes')
+                    hits = cast_skipping(engine, out.origins(k, P, i), unit, 0.0, length, self.hidden_shapes,
+                                         kind=RayKind.SHADOW)
+                else:
+                    hits = engine.cast(out.origins(k, P, i), unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1,
+                                       distance_only=True)
                 counters["rays_camera"] += len(i)
                 counters["cast_calls"] += 1
                 lit[i, j] = ~(hits.distance <= length)
