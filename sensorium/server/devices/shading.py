@@ -338,10 +338,10 @@ def apply_noise_mask(bgra: np.ndarray, width: int, height: int, mask: np.ndarray
                      factor: tuple[float, float]) -> None:
     """Webots' noise mask over an image of ``width`` × ``height`` BGRA pixels (M, 4) uint8, in place:
     each pixel's RGB ``c`` (bytes / 255) becomes ``c·(1 − a) + m·a`` of the mask's RGBA ``(m, a)``
-    (``mask``: (h, w, 4) float64 in [0, 1], RGBA, top row first) read bilinearly with the mask
-    repeated, at ``(centre + offset)·factor`` in texture units (``u = (i + ½)/W``, ``v = (j + ½)/H``,
+    (``mask``: (4, h, w) float64 planes R, G, B, A in [0, 1], top row first) read bilinearly with the
+    mask repeated, at ``(centre + offset)·factor`` in texture units (``u = (i + ½)/W``, ``v = (j + ½)/H``,
     rows from the top), then ``⌊255·x + ½⌋``."""
-    th, tw = mask.shape[:2]
+    th, tw = mask.shape[1:]
     u = (np.arange(width) + 0.5) / width
     v = (np.arange(height) + 0.5) / height
 
@@ -354,19 +354,30 @@ def apply_noise_mask(bgra: np.ndarray, width: int, height: int, mask: np.ndarray
 
     x0, x1, fx = taps(u, offset[0], factor[0], tw)
     y0, y1, fy = taps(v, offset[1], factor[1], th)
-    fx, fy = fx[None, :, None], fy[:, None, None]
-    a0, b0 = mask[y0][:, x0], mask[y0][:, x1]        # each tap as a + (b − a)·f: equal texels give theirs
-    top = a0 + (b0 - a0) * fx
-    a1, b1 = mask[y1][:, x0], mask[y1][:, x1]
-    bottom = a1 + (b1 - a1) * fx
-    m = (top + (bottom - top) * fy).reshape(-1, 4)            # (H·W, RGBA)
-    a = m[:, 3:4]
-    rgb = bgra[:, 2::-1].astype(np.float64) / 255.0          # BGR -> RGB
-    x = rgb * (1.0 - a) + m[:, :3] * a
-    np.clip(x, 0.0, 1.0, out=x)
-    x *= 255.0
-    x += 0.5
-    bgra[:, 2::-1] = np.floor(x)
+    planes = mask.reshape(4, -1)
+
+    def texel(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:     # (4, H·W): one gather per corner
+        return np.take(planes, (rows[:, None] * tw + cols[None, :]).reshape(-1), axis=1)
+
+    fx = np.broadcast_to(fx[None, :], (height, width)).reshape(-1)
+    fy = np.broadcast_to(fy[:, None], (height, width)).reshape(-1)
+    top = texel(y0, x0)                   # each tap as a + (b − a)·f: equal texels give theirs
+    top += (texel(y0, x1) - top) * fx
+    bottom = texel(y1, x0)
+    bottom += (texel(y1, x1) - bottom) * fx
+    bottom -= top
+    bottom *= fy
+    top += bottom                         # (R, G, B, A) planes of the H·W pixels
+    a = top[3]
+    keep = 1.0 - a
+    for ch in range(3):                   # RGB channel ch is BGRA column 2 − ch
+        x = bgra[:, 2 - ch] / 255.0
+        x *= keep
+        x += top[ch] * a
+        np.clip(x, 0.0, 1.0, out=x)
+        x *= 255.0
+        x += 0.5
+        bgra[:, 2 - ch] = np.floor(x)
 
 
 # Rows of (n, 3) float64 arrays, as an image's shading gathers and scatters them: numpy's fancy

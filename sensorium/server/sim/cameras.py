@@ -382,7 +382,7 @@ class Camera(Device):
         self._image_at = self._segmentation_at = -1      # the measurement that made the latest of each
         self._seg_bytes: tuple[int, bytes] = (-1, b"")
         self._blurred: np.ndarray | None = None     # motion blur: the last image's mixed radiance (M, 3)
-        self._mask: np.ndarray | None = None        # the noise mask's texels (h, w, RGBA) in [0, 1]
+        self._mask: np.ndarray | None = None        # the noise mask's texels (RGBA, h, w) in [0, 1]
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
@@ -391,9 +391,9 @@ class Camera(Device):
         url = self.config.noise_mask_url
         if url:           # the image the world's check read (world/textures.py), as a shape's texture
             rgb, alpha, _ = self._scene.images[url][1]
-            mask = np.empty((*rgb.shape[:2], 4))
-            mask[..., :3] = rgb
-            mask[..., 3] = 255.0 if alpha is None else alpha
+            mask = np.empty((4, *rgb.shape[:2]))      # R, G, B, A planes (shading.apply_noise_mask)
+            mask[:3] = np.moveaxis(rgb, 2, 0)
+            mask[3] = 255.0 if alpha is None else alpha
             mask /= 255.0
             self._mask = mask
 
@@ -598,7 +598,7 @@ class Camera(Device):
                                     blur)
         if self._mask is not None:         # shifted by two uniform draws of the camera's stream per image
             offset = self.rng.random(2)
-            th, tw = self._mask.shape[:2]
+            th, tw = self._mask.shape[1:]
             shading.apply_noise_mask(bgra, c.width, c.height, self._mask, (float(offset[0]), float(offset[1])),
                                      shading.noise_mask_factor(c.width, c.height, tw, th))
         self.image = bgra.reshape(c.height, c.width, 4)
