@@ -261,3 +261,9 @@ def test_a_wbt_camera_keeps_motion_blur_and_its_noise_mask(tmp_path):
     assert cams[1].noise_mask_url == ""
     assert not [w for w in loaded.warnings if "not rendered here" in w and ("motionBlur" in w or "noiseMask" in w)]
     assert [w for w in loaded.warnings if "noise mask to planar cameras only" in w]
+    # `sensorium convert` writing the world elsewhere names the mask relative to where it is written
+    from sensorium.server.world.wbt.emit import converted_world
+
+    (tmp_path / "out").mkdir()
+    data = converted_world(tmp_path / "w.wbt", tmp_path / "out")
+    assert data["robots"][0]["devices"][0]["noise_mask_url"] == "../noise.png"
