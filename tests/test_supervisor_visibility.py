@@ -181,3 +181,50 @@ def test_a_c_supervisor_hides_the_crate_the_same_way(tmp_path, tmp_path_factory)
     ctl = run_paused(WORLD, tmp_path, exe, "boss", env=SAN_ENV)
     assert ctl.out == EXPECTED
     assert ctl.stderr().count("Error:") == 1 and "Sanitizer" not in ctl.stderr(), ctl.stderr()
+
+
+@pytest.mark.parametrize("precision", ["exact", "fast"])
+def test_a_node_hidden_from_a_camera_casts_no_shadow_in_its_image(precision, tmp_path):
+    """Webots sets a hidden node invisible for that camera's render, and WREN builds its shadow volumes
+    from the visible nodes only: the crate hidden from ``cam`` leaves no shadow on the wall in cam's
+    image -- the image of the world without the crate -- while ``other`` still sees the crate and, past
+    its edges, its shadow (the sun behind the devices, along +x, casting shadows)."""
+    import yaml
+
+    data = yaml.safe_load(WORLD.read_text())
+    data["lights"][0]["cast_shadows"] = True
+    path = tmp_path / "shadows.yaml"
+    path.write_text(yaml.safe_dump(data))
+
+    def live() -> Live:
+        lv = Live(Simulation(load_world(path), precision=precision))
+        lv.ok(A, "attach", {"robot": "boss"})
+        for name in ("cam", "other"):
+            lv.sim.device(f"boss/{name}").enable(16)
+        return lv
+
+    def images(lv: Live) -> tuple[np.ndarray, np.ndarray]:
+        lv.step(A, "boss", {"duration": 16})
+        return lv.sim.device("boss/cam").image.copy(), lv.sim.device("boss/other").image.copy()
+
+    lv = live()
+    cam0, other0 = images(lv)
+    gone = live()
+    boss(gone, "remove_node", {"node": CRATE})
+    cam_gone, _ = images(gone)
+    hide(lv, CRATE, "cam")
+    cam1, other1 = images(lv)
+    np.testing.assert_array_equal(cam1, cam_gone)          # the wall fully lit: no shadow of the hidden crate
+    np.testing.assert_array_equal(other1, other0)          # the other camera: the crate, and its shadow
+    # the shadow was there to leave out: the wall's pixels behind the crate's edge are darker with it
+    assert (other1[:, :, :3].astype(int).sum(axis=2) < cam1[:, :, :3].astype(int).sum(axis=2)).any()
+    hide(lv, CRATE, "cam", visible=True)
+    cam2, _ = images(lv)
+    np.testing.assert_array_equal(cam2, cam0)
+    # the Viewpoint's picture alike: hidden from it, the crate and its shadow are out of the picture
+    shown = viewshot.render(lv.sim, 32, 24)
+    viewpoint = next(n["node"] for n in (boss(lv, "get_from_id", {"id": i}) for i in range(4, 8))
+                     if n["type"] == "Viewpoint")
+    assert boss(lv, "set_visibility", {"node": CRATE, "from_node": viewpoint, "visible": False}) == {"success": True}
+    np.testing.assert_array_equal(viewshot.render(lv.sim, 32, 24), viewshot.render(gone.sim, 32, 24))
+    assert not np.array_equal(viewshot.render(lv.sim, 32, 24), shown)

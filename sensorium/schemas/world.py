@@ -1042,7 +1042,20 @@ class Camera(_Imager):
     zoom: Zoom | None = Field(default=None, description="Webots' Zoom node (NULL: none): the range setFov() may take")
     focus: Focus | None = Field(default=None, description="Webots' Focus node (NULL: none): focal length, the range "
                                 "setFocalDistance() may take; no depth of field rendered")
+    motion_blur: float = Field(default=0.0, ge=0.0, description="ms a pixel takes to reach 99.5% of a new colour "
+                               "(Webots' motionBlur): each image mixes its radiance with the previous image's, the "
+                               "previous one weighing 0.005^(sampling period / motion_blur); 0: off")
+    noise_mask_url: str = Field(default="", description="Webots' noiseMaskUrl: a PNG or JPEG (relative to the world "
+                                "file) mixed over each image by its alpha, shifted by a random offset per image "
+                                "(planar cameras only); empty: none")
     _what: ClassVar[str] = "camera"
+
+    @model_validator(mode="after")
+    def _noise_mask_planar(self) -> Camera:
+        if self.noise_mask_url and self.projection != "planar":
+            raise ValueError(f"noise_mask_url: Webots applies a noise mask to planar cameras only, this one is "
+                             f"{self.projection}")
+        return self
 
 
 def _minus_one_or_positive(name: str, v: float) -> float:

@@ -28,6 +28,15 @@ the fog colour (sRGB to linear) in the HDR buffer, before the resolve and the no
 (the length of its view-space position: Webots' "point" depth, not the planar depth), ``V`` the
 visibility range: ``f = 1 − d/V`` (LINEAR), ``exp(−d/V)`` (EXPONENTIAL), ``exp(−(d/V)²)``
 (EXPONENTIAL2), clamped to [0, 1]. The background is not fogged (Webots' sky is drawn without it).
+
+Motion blur (Webots' ``motionBlur``, ``motion_blur.frag`` before ``hdr_resolve``): each image's
+pixel radiance ``L`` (the samples' mean) is mixed with the previous image's mixed radiance ``R``,
+``R ← L·(1 − w) + R·w``, ``w = 0.005^(period/motionBlur)`` (:func:`motion_blur_weight`; the pixel
+reaches 99.5% of a new colour after ``motionBlur`` ms); the first image is ``L`` itself. The noise
+mask (Webots' ``noiseMaskUrl``, ``noise_mask.frag``, after the colour noise, on the 8-bit image):
+each byte ``c`` becomes ``⌊255·((c/255)(1 − a) + m·a) + ½⌋`` of the mask's texel colour ``m`` and
+alpha ``a``, the mask read bilinearly, repeated, at the pixel's centre shifted by a random offset per
+image (:func:`apply_noise_mask`).
 """
 
 from __future__ import annotations
@@ -40,7 +49,8 @@ from .light import LightArrays, LightKind
 from .noise import gaussian
 
 __all__ = ["GAMMA", "FOG_TYPES", "background_radiance", "srgb_to_linear", "radiance", "within_radius", "fog_weight", "fog",
-           "tone_map", "to_bytes", "resolve_bgra", "take_rows", "add_to_rows", "set_rows", "scaled_rows"]
+           "tone_map", "to_bytes", "resolve_bgra", "motion_blur_weight", "noise_mask_factor", "apply_noise_mask",
+           "take_rows", "add_to_rows", "set_rows", "scaled_rows"]
 
 GAMMA = 2.2
 """Webots' ``hdr_resolve.frag`` gamma."""
@@ -255,13 +265,22 @@ def to_bytes(values: np.ndarray, noise: float = 0.0, rng: np.random.Generator | 
     return np.floor(x, out=x).astype(np.uint8)
 
 
+def motion_blur_weight(period_ms: int, motion_blur_ms: float) -> float:
+    """The previous image's weight in a new one (Webots' ``WbAbstractCamera::applyMotionBlurToWren``):
+    ``0.005^(period/motionBlur)``, so that a pixel is within 0.5% of a new colour ``motionBlur`` ms
+    after it appeared."""
+    return 0.005 ** (float(period_ms) / float(motion_blur_ms))
+
+
 def resolve_bgra(radiance: np.ndarray, exposure: float, noise: float = 0.0, rng: np.random.Generator | None = None,
-                 samples: int = 1) -> np.ndarray:
+                 samples: int = 1, blur: tuple[np.ndarray, float] | None = None) -> np.ndarray:
     """A camera's pixels (M, 4) BGRA uint8 (alpha 255) from the radiance (samples·M, 3) of its
     rays (sample-major, as ``pixel_directions`` makes them): the samples' mean, :func:`tone_map`,
     :func:`to_bytes`, on blocks of pixels that stay in the CPU's cache: the same operations per
     value in the same order, so the same bytes as those calls on the whole image (the noise drawn
-    first, all of it, in C order as ``to_bytes`` draws it)."""
+    first, all of it, in C order as ``to_bytes`` draws it). ``blur``: motion blur, ``(R, w)``: the
+    previous image's mixed radiance (M, 3), replaced in place by this one's, and its weight ``w``
+    (0 for the first image: ``L`` itself), mixed in before the tone mapping."""
     L = np.asarray(radiance, dtype=np.float64).reshape(samples, -1, 3)
     M = L.shape[1]
     draws = float(noise) * gaussian(rng, M * 3).reshape(M, 3) if noise > 0.0 and rng is not None else None
@@ -280,6 +299,12 @@ def resolve_bgra(radiance: np.ndarray, exposure: float, noise: float = 0.0, rng:
                 np.maximum(v, 0.0, out=v)
             else:
                 np.maximum(L[0, a:b], 0.0, out=v)
+            if blur is not None:             # motion_blur.frag's mix(L, R, w), kept as the next R
+                last, w = blur[0][a:b], float(blur[1])
+                v *= 1.0 - w
+                last *= w
+                v += last
+                last[...] = v
             np.negative(v, out=v)            # tone_map
             v *= float(exposure)
             np.exp(v, out=v)
@@ -295,6 +320,64 @@ def resolve_bgra(radiance: np.ndarray, exposure: float, noise: float = 0.0, rng:
             for ch in range(3):              # RGB → BGR
                 out[a:b, 2 - ch] = v[:, ch]
     return out
+
+
+def noise_mask_factor(width: int, height: int, mask_width: int, mask_height: int) -> tuple[float, float]:
+    """How many mask widths and heights one image spans (Webots' ``WbWrenCamera::setNoiseMask``): a
+    mask at least as large as the image is read one texel per pixel, ``(W/w, H/h)``; a smaller one
+    spans the image once along one axis and keeps its texels square along the other (the axis the
+    mask falls shorter on relative to the image keeps 1)."""
+    dw, dh = mask_width - width, mask_height - height
+    if dw < 0 or dh < 0:
+        ratio = width / height
+        return (ratio, 1.0) if dw > dh else (1.0, 1.0 / ratio)
+    return width / mask_width, height / mask_height
+
+
+def apply_noise_mask(bgra: np.ndarray, width: int, height: int, mask: np.ndarray, offset: tuple[float, float],
+                     factor: tuple[float, float]) -> None:
+    """Webots' noise mask over an image of ``width`` × ``height`` BGRA pixels (M, 4) uint8, in place:
+    each pixel's RGB ``c`` (bytes / 255) becomes ``c·(1 − a) + m·a`` of the mask's RGBA ``(m, a)``
+    (``mask``: (4, h, w) float64 planes R, G, B, A in [0, 1], top row first) read bilinearly with the
+    mask repeated, at ``(centre + offset)·factor`` in texture units (``u = (i + ½)/W``, ``v = (j + ½)/H``,
+    rows from the top), then ``⌊255·x + ½⌋``."""
+    th, tw = mask.shape[1:]
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+
+    def taps(t: np.ndarray, shift: float, scale: float, size: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        x = (t + shift) * scale * size - 0.5            # texel coordinate; texel k's centre at k
+        k0 = np.floor(x)
+        f = x - k0
+        k0 = k0.astype(np.int64) % size
+        return k0, (k0 + 1) % size, f
+
+    x0, x1, fx = taps(u, offset[0], factor[0], tw)
+    y0, y1, fy = taps(v, offset[1], factor[1], th)
+    planes = mask.reshape(4, -1)
+
+    def texel(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:     # (4, H·W): one gather per corner
+        return np.take(planes, (rows[:, None] * tw + cols[None, :]).reshape(-1), axis=1)
+
+    fx = np.broadcast_to(fx[None, :], (height, width)).reshape(-1)
+    fy = np.broadcast_to(fy[:, None], (height, width)).reshape(-1)
+    top = texel(y0, x0)                   # each tap as a + (b − a)·f: equal texels give theirs
+    top += (texel(y0, x1) - top) * fx
+    bottom = texel(y1, x0)
+    bottom += (texel(y1, x1) - bottom) * fx
+    bottom -= top
+    bottom *= fy
+    top += bottom                         # (R, G, B, A) planes of the H·W pixels
+    a = top[3]
+    keep = 1.0 - a
+    for ch in range(3):                   # RGB channel ch is BGRA column 2 − ch
+        x = bgra[:, 2 - ch] / 255.0
+        x *= keep
+        x += top[ch] * a
+        np.clip(x, 0.0, 1.0, out=x)
+        x *= 255.0
+        x += 0.5
+        bgra[:, 2 - ch] = np.floor(x)
 
 
 # Rows of (n, 3) float64 arrays, as an image's shading gathers and scatters them: numpy's fancy

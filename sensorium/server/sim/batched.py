@@ -428,6 +428,14 @@ class BatchedSimulation:
                                f"simulation lays no ink, so {readers[0][0]}/{readers[0][1]} would not see it (use "
                                "Simulation, or the pen's write: false)")
 
+        # a camera's image effects that carry state from image to image (its previous image, its
+        # stream's offsets) are the single simulation's: the batched camera does not draw them
+        effects = [(r.name, d.name, f) for r in w.robots for d in r.devices if d.device == "Camera"
+                   for f, on in (("motion_blur", d.motion_blur > 0), ("noise_mask_url", bool(d.noise_mask_url))) if on]
+        if effects:
+            raise BatchedError(f"{self.loaded.source}: robot {effects[0][0]!r}: camera {effects[0][1]!r} sets "
+                               f"{effects[0][2]}, which the batched simulation does not draw (use Simulation)")
+
     def _build_devices(self) -> None:
         C = self.copies
         self.refs: dict[tuple[int, str], DeviceRef] = {}

@@ -381,11 +381,21 @@ class Camera(Device):
         self._centre_rays: MountedRays | None = None
         self._image_at = self._segmentation_at = -1      # the measurement that made the latest of each
         self._seg_bytes: tuple[int, bytes] = (-1, b"")
+        self._blurred: np.ndarray | None = None     # motion blur: the last image's mixed radiance (M, 3)
+        self._mask: np.ndarray | None = None        # the noise mask's texels (RGBA, h, w) in [0, 1]
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
         self._scene = robot.scene
         self._background = self._scene.background
+        url = self.config.noise_mask_url
+        if url:           # the image the world's check read (world/textures.py), as a shape's texture
+            rgb, alpha, _ = self._scene.images[url][1]
+            mask = np.empty((4, *rgb.shape[:2]))      # R, G, B, A planes (shading.apply_noise_mask)
+            mask[:3] = np.moveaxis(rgb, 2, 0)
+            mask[3] = 255.0 if alpha is None else alpha
+            mask /= 255.0
+            self._mask = mask
 
     # -- controller API
     def describe(self) -> dict:
@@ -575,8 +585,22 @@ class Camera(Device):
         rays = self._prepare()
         L = self._render(pose, rays, counters)
         c = self.config
-        # supersampling: the mean radiance of the pixel's rays; then the resolve, the noise, BGRA
-        bgra = shading.resolve_bgra(L, self.exposure, c.noise, self.rng if c.noise > 0 else None, len(self._samples))
+        # supersampling: the mean radiance of the pixel's rays; then the motion blur, the resolve, the
+        # noise, BGRA, the noise mask (Webots' order of passes)
+        blur = None
+        if c.motion_blur > 0:
+            if self._blurred is None:      # the first image: itself (motion_blur.frag's firstRender)
+                self._blurred = np.zeros((c.height * c.width, 3))
+                blur = (self._blurred, 0.0)
+            else:
+                blur = (self._blurred, shading.motion_blur_weight(self.schedule.period_ms, c.motion_blur))
+        bgra = shading.resolve_bgra(L, self.exposure, c.noise, self.rng if c.noise > 0 else None, len(self._samples),
+                                    blur)
+        if self._mask is not None:         # shifted by two uniform draws of the camera's stream per image
+            offset = self.rng.random(2)
+            th, tw = self._mask.shape[1:]
+            shading.apply_noise_mask(bgra, c.width, c.height, self._mask, (float(offset[0]), float(offset[1])),
+                                     shading.noise_mask_factor(c.width, c.height, tw, th))
         self.image = bgra.reshape(c.height, c.width, 4)
 
     def _render(self, pose: Pose, rays: MountedRays, counters: Any) -> np.ndarray:
@@ -624,7 +648,8 @@ class Camera(Device):
     def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
                  counters: Any) -> np.ndarray:
         """(S, n) False where a shadow-casting light is hidden from the point by a visible shape
-        (its segment to the light, 1000 m towards a directional one); only lit, facing pairs cast.
+        (its segment to the light, 1000 m towards a directional one), not one a Supervisor hid from
+        this camera (``hidden_shapes``); only lit, facing pairs cast.
         Which pairs cast and their segments come from :func:`shadow_rays` (row blocks on the
         engine's threads); each light's rays are then one cast, as one batch."""
         lit = np.ones((len(P), len(lights)), dtype=bool)
@@ -639,8 +664,13 @@ class Camera(Device):
             for k, (j, (i, unit, length)) in enumerate(rays.items()):
                 if len(i) == 0:
                     continue
-                hits = engine.cast(out.origins(k, P, i), unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1,
-                                   distance_only=True)
+                if self.hidden:    # a node hidden from this camera casts no shadow in its image (Webots
+                    # sets it invisible for the camera's render, and WREN's shadow volumes are its visible nodes')
+                    hits = cast_skipping(engine, out.origins(k, P, i), unit, 0.0, length, self.hidden_shapes,
+                                         kind=RayKind.SHADOW)
+                else:
+                    hits = engine.cast(out.origins(k, P, i), unit, 0.0, length, kind=RayKind.SHADOW, exclude_owner=-1,
+                                       distance_only=True)
                 counters["rays_camera"] += len(i)
                 counters["cast_calls"] += 1
                 lit[i, j] = ~(hits.distance <= length)

@@ -308,7 +308,28 @@ def check_textures(world: wm.World, base_dir: Path, limits: Any, allow_outside: 
                     images[tex.url] = (file, seen[file])
             except TextureFileError as exc:
                 problems.append((where, str(exc)))
+    for where, url in _noise_masks(world):     # a camera's noise mask: an image read as the others are
+        try:
+            file = resolve_texture_url(url, base_dir, allow_outside=allow_outside, max_bytes=limits.texture_file_bytes,
+                                       allowed=allowed)
+            if file not in seen:
+                file, pixels, seen[file] = read_checked_image(url, base_dir, limits, allow_outside=allow_outside,
+                                                              allowed=allowed, pixels_before=total)
+                total += pixels
+            if images is not None:
+                images[url] = (file, seen[file])
+        except TextureFileError as exc:
+            problems.append((where, str(exc)))
     return problems
+
+
+def _noise_masks(world: wm.World) -> Iterator[tuple[str, str]]:
+    """(path, url) of every camera's noise mask (Webots' ``noiseMaskUrl``)."""
+    for r_i, robot in enumerate(world.robots):
+        for d_i, dev in enumerate(robot.devices):
+            url = getattr(dev, "noise_mask_url", "")
+            if url:
+                yield f"robots[{r_i}].devices[{d_i}].noise_mask_url", url
 
 
 def _check_tex_coords(g: wm.Triangles, path: str) -> list[tuple[str, str]]:

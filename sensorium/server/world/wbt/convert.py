@@ -1603,6 +1603,16 @@ class Converter:
             self.device_where[id(data)] = self.where(node)
             if node.type == "Lidar" and f.node_("rotatingHead") is not None:
                 self.skipped["Lidar.rotatingHead"] += 1
+            mask = f.string("noiseMaskUrl", "") if node.type == "Camera" else ""
+            if mask and data.get("projection", "planar") != "planar":   # WbWrenCamera::setNoiseMask's refusal
+                self.warn(node, f"Camera {data['name']!r}: noiseMaskUrl: Webots applies a noise mask to planar "
+                                "cameras only; this spherical camera has none")
+            elif mask:
+                url, why = self.asset(node, mask, "texture")
+                if url is None:
+                    self.warn(node, f"Camera {data['name']!r}: noiseMaskUrl: {why}")
+                else:
+                    data["noise_mask_url"] = url
             for name, what in unread_image_fields(node.type, node.fields):
                 self.warn(node, f"{node.type} {data['name']!r} of robot {owner.data['name']!r}: {name} ({what}) is "
                                 "not rendered here; the image is Webots' without it")

@@ -36,6 +36,8 @@ def _rebase(data: Any, src_dir: Path, out_dir: Path) -> Any:
     if isinstance(data, dict):
         if data.get("type") == "mesh" and isinstance(data.get("url"), str):
             return {**data, "url": _relative(data["url"], src_dir, out_dir)}
+        if data.get("device") == "Camera" and isinstance(data.get("noise_mask_url"), str):    # an image file too
+            data = {**data, "noise_mask_url": _relative(data["noise_mask_url"], src_dir, out_dir)}
         return {k: _rebase_texture(v, src_dir, out_dir) if k in TEXTURE_KEYS else _rebase(v, src_dir, out_dir)
                 for k, v in data.items()}
     if isinstance(data, list):

@@ -381,7 +381,8 @@ def device(node: Node, f: Fields) -> dict:
     if t == "Camera":
         out = {"device": t, **_image(f, "spherical"),
                "far": f.non_negative("far", 0.0, 0.0), "exposure": f.non_negative("exposure", 1.0, 1.0),
-               "anti_aliasing": f.flag("antiAliasing", False), "noise": f.non_negative("noise", 0.0, 0.0)}
+               "anti_aliasing": f.flag("antiAliasing", False), "noise": f.non_negative("noise", 0.0, 0.0),
+               "motion_blur": f.non_negative("motionBlur", 0.0, 0.0)}
         rec = f.node_("recognition")
         if rec is not None:
             rf = f.sub(rec)

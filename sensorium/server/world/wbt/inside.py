@@ -33,8 +33,7 @@ EPS = 1e-9
 # field -> (Webots' default, what it does there); a Node-valued field's default is None (NULL)
 UNREAD_IMAGE_FIELDS = {
     "Camera": {"focus": (None, "depth of field"),
-               "lensFlare": (None, "lens flares"), "motionBlur": (0.0, "motion blur"),
-               "noiseMaskUrl": ("", "a noise mask image"), "bloomThreshold": (-1.0, "bloom"),
+               "lensFlare": (None, "lens flares"), "bloomThreshold": (-1.0, "bloom"),
                "ambientOcclusionRadius": (0.0, "ambient occlusion")},
     "RangeFinder": {"motionBlur": (0.0, "motion blur")},
 }

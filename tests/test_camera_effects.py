@@ -1,0 +1,269 @@
+"""A Camera's motion blur (Webots' ``motionBlur``) and noise mask (``noiseMaskUrl``) against closed
+forms: a static scene is a fixed point of the blur, a light switched on and off gives the blend
+sequence ``R ← L(1 − w) + R w`` with ``w = 0.005^(period/motionBlur)``, a uniform mask mixes its colour
+over every pixel by its alpha, a checker mask is read bilinearly at the offsets the camera's stream
+draws; a bad mask file is one problem naming the field; the batched camera refuses both."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from sensorium.schemas import world as wm
+from sensorium.server.devices.noise import device_rng
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import WorldError, parse_world
+
+WALL = {"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
+        "appearance": {"base_color": [0.8, 0.5, 0.2]}}
+ALBEDO = np.array([0.8, 0.5, 0.2])
+SUN = {"type": "DirectionalLight", "direction": [1.0, 0.0, 0.0], "intensity": 1.5}   # head-on: cos 1 on the wall
+
+
+def world_dict(cam: dict, lights=(SUN,)) -> dict:
+    return {"world_info": {"basic_time_step": 16, "random_seed": 5}, "solids": [WALL], "lights": list(lights),
+            "robots": [{"name": "r", "devices": [{"device": "Camera", "name": "cam", "width": 6, "height": 4,
+                                                  "field_of_view": 0.8, **cam}]}]}
+
+
+def sim_of(cam: dict, base_dir: Path | None = None, lights=(SUN,)) -> Simulation:
+    d = world_dict(cam, lights)
+    if base_dir is None:
+        return Simulation(wm.World.model_validate(d))
+    return Simulation(parse_world(d, base_dir=base_dir))
+
+
+def to_byte(x: np.ndarray) -> np.ndarray:
+    return np.floor(255.0 * np.asarray(x) + 0.5).astype(np.int64)
+
+
+def resolved(L: np.ndarray) -> np.ndarray:
+    """Webots' HDR resolve and byte of a radiance (exposure 1)."""
+    return to_byte((1.0 - np.exp(-np.asarray(L))) ** (1.0 / 2.2))
+
+
+def rgb(image: np.ndarray) -> np.ndarray:
+    return image[:, :, [2, 1, 0]].astype(np.int64)
+
+
+# ------------------------------------------------------------------------------------ motion blur
+
+def test_a_static_scene_is_a_fixed_point_of_the_motion_blur():
+    plain, blurred = sim_of({}), sim_of({"motion_blur": 300.0})
+    for s in (plain, blurred):
+        s.device("r/cam").enable(16)
+    for _ in range(12):
+        plain.run(1)
+        blurred.run(1)
+        a, b = plain.device("r/cam").image, blurred.device("r/cam").image
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(rgb(b), np.broadcast_to(resolved(ALBEDO * 1.5), (4, 6, 3)))
+
+
+def test_a_light_switched_on_and_off_gives_the_blend_sequence():
+    # the wall lit head-on (L = albedo · 1.5) or black (L = 0), switched at each image; every image is
+    # R_n = L_n (1 − w) + R_{n−1} w, R_0 = L_0, with w = 0.005^(16 / 100)
+    sim = sim_of({"motion_blur": 100.0})
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    on = sim.scene.top_lights()[0]
+    off = on.model_copy(update={"on": False})
+    w = 0.005 ** (16 / 100.0)
+    lit = ALBEDO * 1.5
+    R = None
+    pattern = [1, 0, 0, 1, 1, 1, 0, 1, 0, 0, 1, 1]
+    for k, state in enumerate(pattern):
+        sim.scene.set_top_light(0, on if state else off)
+        sim.run(1)
+        L = lit if state else np.zeros(3)
+        R = L if R is None else L * (1.0 - w) + R * w
+        got = rgb(cam.image)
+        assert np.all(got == got[0, 0]), k               # uniform: the blur is per pixel
+        np.testing.assert_array_equal(got[0, 0], resolved(R), err_msg=f"image {k}")
+    assert len({tuple(resolved(x)) for x in (lit, np.zeros(3))}) == 2
+
+
+def test_motion_blur_reaches_99_5_percent_after_motion_blur_ms():
+    # Webots' definition: 160 ms at a 16 ms period is 10 images; a step from black to lit is then at
+    # 1 − w^10 = 0.995 of the lit radiance
+    sim = sim_of({"motion_blur": 160.0}, lights=[{**SUN, "intensity": 0.2}])
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    on = sim.scene.top_lights()[0]
+    sim.scene.set_top_light(0, on.model_copy(update={"on": False}))
+    sim.run(1)
+    sim.scene.set_top_light(0, on)
+    sim.run(10)
+    from sensorium.server.devices.shading import motion_blur_weight
+
+    w = motion_blur_weight(16, 160.0)
+    assert abs(w ** 10 - 0.005) < 1e-15
+    R = np.zeros(3)
+    for _ in range(10):
+        R = ALBEDO * 0.2 * (1.0 - w) + R * w
+    np.testing.assert_allclose(R, ALBEDO * 0.2 * 0.995, rtol=1e-12)
+    np.testing.assert_array_equal(rgb(cam.image)[0, 0], resolved(R))
+
+
+def test_motion_blur_weight_follows_the_sampling_period():
+    # the same scene sampled every 32 ms: w = 0.005^(32/100)
+    sim = sim_of({"motion_blur": 100.0})
+    cam = sim.device("r/cam")
+    cam.enable(32)
+    on = sim.scene.top_lights()[0]
+    sim.run(2)
+    sim.scene.set_top_light(0, on.model_copy(update={"on": False}))
+    sim.run(2)
+    w = 0.005 ** (32 / 100.0)
+    np.testing.assert_array_equal(rgb(cam.image)[0, 0], resolved(ALBEDO * 1.5 * w))
+
+
+# ------------------------------------------------------------------------------------ noise mask
+
+def _mask(tmp_path: Path, name: str, texels: np.ndarray) -> str:
+    mode = "RGBA" if texels.shape[-1] == 4 else "RGB"
+    Image.fromarray(texels.astype(np.uint8), mode).save(tmp_path / name)
+    return name
+
+
+def test_a_uniform_noise_mask_mixes_its_colour_over_every_pixel_by_its_alpha(tmp_path):
+    plain = sim_of({})
+    plain.device("r/cam").enable(16)
+    plain.run(1)
+    c = rgb(plain.device("r/cam").image)
+    assert np.all(c == resolved(ALBEDO * 1.5))
+    texel = np.array([30, 200, 90, 100])
+    url = _mask(tmp_path, "mask.png", np.broadcast_to(texel, (8, 8, 4)))
+    sim = sim_of({"noise_mask_url": url}, tmp_path)
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    a = texel[3] / 255.0
+    want = to_byte((c / 255.0) * (1.0 - a) + (texel[:3] / 255.0) * a)
+    for _ in range(3):                    # every image (each at its own offset): the same uniform mix
+        sim.run(1)
+        np.testing.assert_array_equal(rgb(cam.image), want)
+        assert np.all(cam.image[:, :, 3] == 255)
+    assert not np.array_equal(want, c)
+    # an opaque mask (an RGB file: alpha 1) replaces the image; a clear one leaves it
+    for texels, expect in ((np.broadcast_to([30, 200, 90], (4, 4, 3)), np.broadcast_to([30, 200, 90], c.shape)),
+                           (np.broadcast_to([30, 200, 90, 0], (4, 4, 4)), c)):
+        url = _mask(tmp_path, f"m{texels.shape[-1]}.png", np.array(texels))
+        sim = sim_of({"noise_mask_url": url}, tmp_path)
+        sim.device("r/cam").enable(16)
+        sim.run(1)
+        np.testing.assert_array_equal(rgb(sim.device("r/cam").image), expect)
+
+
+def test_a_checker_mask_is_read_bilinearly_at_the_offsets_the_camera_stream_draws(tmp_path):
+    # a 2 x 2 mask (smaller than the 6 x 4 image: it spans the image's height once, square texels
+    # across, factor (1, 4/6)), alpha 255 so the image is the mask; its offsets are the camera's own
+    # stream's first draws (no colour noise draws before them)
+    texels = np.array([[[255, 0, 0, 255], [0, 0, 255, 255]], [[0, 255, 0, 255], [255, 255, 255, 255]]])
+    url = _mask(tmp_path, "checker.png", texels)
+    sim = sim_of({"noise_mask_url": url}, tmp_path)
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    rng = device_rng(5, "r/cam")
+    colours = texels[..., :3] / 255.0
+    seen = []
+    for _ in range(3):
+        sim.run(1)
+        ox, oy = rng.random(2)
+        fx, fy = 1.0, 4 / 6
+        want = np.zeros((4, 6, 3))
+        for j in range(4):
+            for i in range(6):
+                x = ((i + 0.5) / 6 + ox) * fx * 2 - 0.5
+                y = ((j + 0.5) / 4 + oy) * fy * 2 - 0.5
+                x0, y0 = int(np.floor(x)), int(np.floor(y))
+                tx, ty = x - x0, y - y0
+                c = sum(colours[(y0 + dy) % 2, (x0 + dx) % 2] * (tx if dx else 1 - tx) * (ty if dy else 1 - ty)
+                        for dx in (0, 1) for dy in (0, 1))
+                want[j, i] = c
+        got = rgb(cam.image)
+        assert np.abs(got - to_byte(want)).max() <= 1      # the bilinear sums' order: at most one step
+        assert np.mean(got == to_byte(want)) > 0.9
+        seen.append(got)
+    assert not np.array_equal(seen[0], seen[1])            # a new offset per image: the noise flickers
+    again = sim_of({"noise_mask_url": url}, tmp_path)      # the same seed: the same images
+    again.device("r/cam").enable(16)
+    again.run(1)
+    np.testing.assert_array_equal(rgb(again.device("r/cam").image), seen[0])
+
+
+def test_noise_mask_factor_is_webots():
+    from sensorium.server.devices.shading import noise_mask_factor
+
+    assert noise_mask_factor(64, 48, 128, 128) == (0.5, 0.375)       # larger: one texel per pixel
+    assert noise_mask_factor(64, 48, 32, 32) == (1.0, 0.75)          # smaller: the height once, square across
+    assert noise_mask_factor(48, 64, 32, 32) == (0.75, 1.0)
+    assert noise_mask_factor(64, 48, 100, 40) == (64 / 48, 1.0)      # only its height short
+
+
+def test_a_bad_noise_mask_file_is_one_problem_naming_the_field(tmp_path):
+    (tmp_path / "notimage.png").write_text("hello")
+    (tmp_path / "sub").mkdir()
+    cases = {"missing.png": "not found", "notimage.png": "is not a PNG or JPEG image",
+             "../outside.png": "leaves the world's folder"}
+    for url, why in cases.items():
+        with pytest.raises(WorldError) as exc:
+            parse_world(world_dict({"noise_mask_url": url}), base_dir=tmp_path / ("sub" if url.startswith("..") else ""))
+        (problem,) = exc.value.problems
+        assert problem.path == "robots[0].devices[0].noise_mask_url" and why in problem.message, (url, problem)
+        assert "\n" not in str(problem)
+    with pytest.raises(ValueError, match="noise_mask_url: Webots applies a noise mask to planar cameras only"):
+        wm.World.model_validate(world_dict({"noise_mask_url": "m.png", "projection": "spherical"}))
+    with pytest.raises(ValueError, match="greater than or equal to 0"):
+        wm.World.model_validate(world_dict({"motion_blur": -1}))
+
+
+@pytest.mark.slow
+def test_the_cli_names_a_bad_noise_mask_in_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    import yaml
+
+    path = tmp_path / "w.yaml"
+    path.write_text(yaml.safe_dump(world_dict({"noise_mask_url": "nope.png"})))
+    out = subprocess.run([sys.executable, "-m", "sensorium", "validate", str(path)], capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode != 0
+    lines = [ln for ln in (out.stdout + out.stderr).splitlines() if "noise_mask_url" in ln]
+    assert len(lines) == 1 and "nope.png" in lines[0] and "not found" in lines[0], out
+    assert "Traceback" not in out.stderr
+
+
+def test_the_batched_simulation_refuses_them_in_one_line(tmp_path):
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+
+    url = _mask(tmp_path, "m.png", np.zeros((2, 2, 4)))
+    for cam, field in (({"motion_blur": 50.0}, "motion_blur"), ({"noise_mask_url": url}, "noise_mask_url")):
+        w = parse_world(world_dict(cam), base_dir=tmp_path)
+        with pytest.raises(BatchedError, match=f"camera 'cam' sets {field}, which the batched simulation does not draw"):
+            BatchedSimulation(w, copies=2)
+
+
+def test_a_wbt_camera_keeps_motion_blur_and_its_noise_mask(tmp_path):
+    from sensorium.server.world.loader import load_world
+
+    Image.new("RGBA", (4, 4), (10, 20, 30, 40)).save(tmp_path / "noise.png")
+    (tmp_path / "w.wbt").write_text(
+        "#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\nViewpoint { }\n"
+        'Robot { name "r" children [ Camera { name "cam" motionBlur 200 noiseMaskUrl "noise.png" } ] }\n'
+        'Robot { name "s" children [ Camera { name "cam" spherical TRUE noiseMaskUrl "noise.png" } ] }\n')
+    loaded = load_world(tmp_path / "w.wbt")
+    cams = [r.devices[0] for r in loaded.world.robots]
+    assert (cams[0].motion_blur, cams[0].noise_mask_url) == (200.0, "noise.png")
+    assert cams[1].noise_mask_url == ""
+    assert not [w for w in loaded.warnings if "not rendered here" in w and ("motionBlur" in w or "noiseMask" in w)]
+    assert [w for w in loaded.warnings if "noise mask to planar cameras only" in w]
+    # `sensorium convert` writing the world elsewhere names the mask relative to where it is written
+    from sensorium.server.world.wbt.emit import converted_world
+
+    (tmp_path / "out").mkdir()
+    data = converted_world(tmp_path / "w.wbt", tmp_path / "out")
+    assert data["robots"][0]["devices"][0]["noise_mask_url"] == "../noise.png"
