@@ -1,0 +1,155 @@
+"""Sweep 17: Webots' sample controllers not run before, each on a stand-in world of ours
+(tests/data/sweep17/: the sample's poses and sizes and its PROTO's device names, places and tables, our
+own text) driven by the calls its sample controller makes, checked against closed forms."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _serve import child_env, sensorium
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+DATA = Path(__file__).parent / "data" / "sweep17"
+
+# pioneer3dx_collision_avoidance: the Pioneer 3-DX (wheels of radius 0.0975 m at y ±0.165) and its 16
+# sonars (x, y, heading in degrees; all at z 0.114 above the origin, itself 0.0975 m up) in the 12 x 12 m
+# arena with six 0.6 m boxes; its controller's rule (MAX_SPEED 5.24, 0.7 of it to turn, weights, 100).
+P3DX = "Pioneer 3-DX"
+P3DX_R, P3DX_AXLE, P3DX_STEP = 0.0975, 0.33, 8
+SONARS = [(0.061, 0.1402, 90), (0.1103, 0.1223, 50), (0.1455, 0.0801, 30), (0.1642, 0.0285, 10),
+          (0.1642, -0.0264, -10), (0.1455, -0.078, -30), (0.1103, -0.1201, -50), (0.061, -0.1381, -90),
+          (-0.1549, -0.1373, -90), (-0.2041, -0.1194, -130), (-0.2392, -0.0774, -150), (-0.2578, -0.0259, -170),
+          (-0.2578, 0.0289, 170), (-0.2392, 0.0804, 150), (-0.2041, 0.1224, 130), (-0.1549, 0.1403, 90)]
+WEIGHTS = [(150, 0), (200, 0), (300, 0), (600, 0), (0, 600), (0, 300), (0, 200), (0, 150)] + [(0, 0)] * 8
+BOXES = [(-0.201269, 4.94642), (0.225428, -5.08162), (4.01933, -3.31136), (3.98789, 3.08066),
+         (-4.22157, -3.54663), (-4.21065, 2.89465)]
+
+
+def p3dx_world(tmp_path: Path, noise: bool = False):
+    """The stand-in loaded, its sonars' 1 % noise taken out unless ``noise``: (simulation, robot)."""
+    text = (DATA / "pioneer3dx_collision_avoidance.wbt").read_text()
+    if not noise:
+        text = text.replace("lookupTable [ 0 1024 0.01, 5 0 0.01 ]", "lookupTable [ 0 1024 0, 5 0 0 ]")
+    path = tmp_path / "pioneer3dx_collision_avoidance.wbt"
+    path.write_text(text)
+    sim = Simulation(load_world(path), "exact")
+    return sim, sim.robot(P3DX)
+
+
+def sonar_closed_form(x: float, y: float, heading: float) -> float:
+    """A sonar's reading from (x, y) along ``heading``: the nearest of the arena's inner wall faces
+    (x, y = ±6) and the boxes' faces (0.6 m cubes, taller than the sonars' 0.2115 m) its ray meets,
+    1024·(1 - d/5) if the ray meets it within 5 m at no more than π/8 from the face's normal (a sonar
+    hears no echo past that), else 0 (the table's far end)."""
+    dx, dy = math.cos(heading), math.sin(heading)
+    rects = [(-6.0, -6.0, 6.0, 6.0, True)] + [(bx - 0.3, by - 0.3, bx + 0.3, by + 0.3, False) for bx, by in BOXES]
+    best, best_cos = math.inf, 0.0
+    for x0, y0, x1, y1, inside in rects:
+        faces = []
+        if abs(dx) > 1e-15:
+            for fx, nx in ((x0, -1.0), (x1, 1.0)):
+                t = (fx - x) / dx
+                if t > 0 and y0 <= y + t * dy <= y1 and (dx * nx > 0) == inside:
+                    faces.append((t, abs(dx)))
+        if abs(dy) > 1e-15:
+            for fy, ny in ((y0, -1.0), (y1, 1.0)):
+                t = (fy - y) / dy
+                if t > 0 and x0 <= x + t * dx <= x1 and (dy * ny > 0) == inside:
+                    faces.append((t, abs(dy)))
+        for t, c in faces:
+            if t < best:
+                best, best_cos = t, c
+    if best >= 5.0 or best_cos < math.cos(math.pi / 8):
+        return 0.0
+    return 1024.0 * (1.0 - best / 5.0)
+
+
+def collision_avoidance_rule(values: list[float], state: str) -> tuple[float, float, str]:
+    """pioneer3dx_collision_avoidance's step: each sonar's distance 5·(1 - v/1024) under 1 m weighs
+    (1 - d) on each wheel; over 100 on the left (right) wheel's sum it turns right (left) in place at
+    0.7·5.24 rad/s and keeps turning while either sum is over 100, else drives on at 5.24 rad/s."""
+    total = [0.0, 0.0]
+    for v, w in zip(values, WEIGHTS):
+        d = 5.0 * (1.0 - v / 1024.0)
+        m = 0.0 if v == 0.0 or d >= 1.0 else 1.0 - d
+        total[0] += w[0] * m
+        total[1] += w[1] * m
+    if state == "forward":
+        if total[0] > 100:
+            return 0.7 * 5.24, -0.7 * 5.24, "left"
+        if total[1] > 100:
+            return -0.7 * 5.24, 0.7 * 5.24, "right"
+        return 5.24, 5.24, "forward"
+    if total[0] > 100 or total[1] > 100:
+        return (0.7 * 5.24, -0.7 * 5.24, state) if state == "left" else (-0.7 * 5.24, 0.7 * 5.24, state)
+    return 5.24, 5.24, "forward"
+
+
+def yaw_of(robot) -> float:
+    r = robot.pose.rotation
+    return math.atan2(r[1, 0], r[0, 0])
+
+
+def test_the_pioneer_3dx_stand_in_loads_with_its_drive_sonars_and_leds(tmp_path: Path) -> None:
+    """The stand-in loads with no line; its wheels (radius 0.0975 m, 0.33 m apart, both hinges on the
+    axle through the origin) are a two-wheel drive, and every device the controller asks for is there."""
+    w = load_world(DATA / "pioneer3dx_collision_avoidance.wbt")
+    assert w.warnings == []
+    robot = w.world.robots[0]
+    drive = robot.differential_drive
+    assert drive is not None
+    assert (drive.wheel_radius, drive.axle_length, tuple(drive.axle_center)) == (P3DX_R, P3DX_AXLE, (0.0, 0.0))
+    names = {d.name for d in robot.devices}
+    assert {f"so{i}" for i in range(16)} | {"left wheel", "right wheel", "red led 1", "red led 2", "red led 3"} <= names
+
+
+def test_the_pioneer_3dx_sonars_read_the_closed_form_and_its_rule_drives_it_so(tmp_path: Path) -> None:
+    """pioneer3dx_collision_avoidance's calls in process, its 8 ms step, the sonars' noise taken out, for
+    24 s: every step the 16 sonars read the closed form's echo from the walls and boxes (1e-6 of 1024:
+    the rays are cast in float32), and the controller's rule on them drives the robot: straight on at
+    5.24 × 0.0975 = 0.5109 m/s, turning in place about its axle's centre at 0.7 × 5.24 × 2 × 0.0975 /
+    0.33 = 2.1675 rad/s, the pose the closed form's step by step (1e-9). It drives 5.4687 m (10.704 s from
+    its first step's command) towards the north wall and first turns right, its front sonars so2 and
+    so3 hearing the wall within 1 m, at 10.712 s; one 8 ms step of turning brings the sums under 100
+    again, so it turns in short bursts; by 24 s it has turned at the north and east walls."""
+    sim, robot = p3dx_world(tmp_path)
+    sonars = [sim.device(f"{P3DX}/so{i}") for i in range(16)]
+    for s in sonars:
+        s.enable(P3DX_STEP)
+    left, right = robot.motor("left wheel"), robot.motor("right wheel")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    x, y = (float(v) for v in robot.pose.translation[:2])
+    yaw = yaw_of(robot)
+    state, wl, wr, dt = "forward", 0.0, 0.0, P3DX_STEP / 1000
+    turns = []
+    for k in range(1, 3001):
+        sim.step()
+        v_, w_ = P3DX_R * (wl + wr) / 2, P3DX_R * (wr - wl) / P3DX_AXLE
+        if w_ == 0.0:
+            x, y = x + v_ * dt * math.cos(yaw), y + v_ * dt * math.sin(yaw)
+        else:                                          # a turn in place: v is 0
+            yaw = math.remainder(yaw + w_ * dt, 2 * math.pi)
+        assert [float(v) for v in robot.pose.translation[:2]] == pytest.approx([x, y], abs=1e-9), k
+        assert math.remainder(yaw_of(robot) - yaw, 2 * math.pi) == pytest.approx(0.0, abs=1e-9), k
+        values = [float(s.value) for s in sonars]
+        want = [sonar_closed_form(x + math.cos(yaw) * sx - math.sin(yaw) * sy,
+                                  y + math.sin(yaw) * sx + math.cos(yaw) * sy, yaw + math.radians(deg))
+                for sx, sy, deg in SONARS]
+        assert values == pytest.approx(want, abs=1e-6 * 1024), k
+        wl, wr, new_state = collision_avoidance_rule(values, state)
+        if new_state != state and new_state != "forward":
+            turns.append((k * P3DX_STEP, new_state, round(x, 4), round(y, 4)))
+        state = new_state
+        left.set_velocity(wl)
+        right.set_velocity(wr)
+    assert turns[0] == (10712, "left", 1.5704, 4.9672)
+    assert math.hypot(1.5704 + 0.613659, 4.9672 + 0.0464224) == pytest.approx(5.24 * P3DX_R * 10.704, abs=1e-4)
+    assert any(t > 18000 and px > 4.5 for t, _, px, _ in turns)      # the east wall
