@@ -8,7 +8,6 @@ import math
 import subprocess
 from pathlib import Path
 
-import numpy as np
 import pytest
 from _serve import child_env, sensorium
 
@@ -153,3 +152,93 @@ def test_the_pioneer_3dx_sonars_read_the_closed_form_and_its_rule_drives_it_so(t
     assert turns[0] == (10712, "left", 1.5704, 4.9672)
     assert math.hypot(1.5704 + 0.613659, 4.9672 + 0.0464224) == pytest.approx(5.24 * P3DX_R * 10.704, abs=1e-4)
     assert any(t > 18000 and px > 4.5 for t, _, px, _ in turns)      # the east wall
+
+
+# Webots' controller is Webots' file, never this repository's: the run below uses our own Python
+# controller making its calls (under `sensorium run`, Webots' C one, built against our libController,
+# printed the same poses: README, sweep 17), and a watcher of ours printing the robot's pose.
+P3DX_CONTROLLER = '''\
+import math
+
+from controller import Robot
+
+WEIGHTS = [(150, 0), (200, 0), (300, 0), (600, 0), (0, 600), (0, 300), (0, 200), (0, 150)] + [(0, 0)] * 8
+robot = Robot()
+step = int(robot.getBasicTimeStep())
+left, right = robot.getDevice("left wheel"), robot.getDevice("right wheel")
+leds = [robot.getDevice(f"red led {i}") for i in (1, 2, 3)]
+sonars = [robot.getDevice(f"so{i}") for i in range(16)]
+for s in sonars:
+    s.enable(step)
+for m in (left, right):
+    m.setPosition(math.inf)
+    m.setVelocity(0.0)
+state, led, delay = "forward", 0, 0
+while robot.step(step) != -1:
+    total = [0.0, 0.0]
+    for s, w in zip(sonars, WEIGHTS):
+        v = s.getValue()
+        d = 5.0 * (1.0 - v / 1024)
+        m = 0.0 if v == 0.0 or d >= 1.0 else 1.0 - d
+        total = [total[0] + w[0] * m, total[1] + w[1] * m]
+    near = total[0] > 100 or total[1] > 100
+    if state == "forward" and near:
+        state = "left" if total[0] > 100 else "right"
+        print(f"turn {state} at {round(robot.getTime() * 1000)}", flush=True)
+    elif state != "forward" and not near:
+        state = "forward"
+    speed = {"forward": (5.24, 5.24), "left": (3.668, -3.668), "right": (-3.668, 3.668)}[state]
+    delay += 1
+    if delay == 70:
+        leds[led].set(0)
+        led = (led + 1) % 3
+        leds[led].set(1)
+        delay = 0
+    left.setVelocity(speed[0])
+    right.setVelocity(speed[1])
+'''
+
+WATCHER = '''\
+import math
+
+from controller import Supervisor
+
+sup = Supervisor()
+node = sup.getFromDef("PIONEER_3DX")
+while sup.step(8) != -1:
+    p, r = node.getPosition(), node.getOrientation()
+    print(f"pose {round(sup.getTime() * 1000)} {p[0]:.9f} {p[1]:.9f} {math.atan2(r[3], r[0]):.9f}", flush=True)
+'''
+
+
+@pytest.mark.slow
+def test_the_collision_avoidance_calls_under_sensorium_run_turn_at_the_closed_form_step(tmp_path: Path) -> None:
+    """Our Python controller making pioneer3dx_collision_avoidance's calls (the 16 sonars, the rule, the
+    LEDs every 70 steps), the sonars' noise taken out, under ``sensorium run`` for 12 s: it prints its
+    first turn at 10.712 s, where the robot is 0.5109 × 10.704 m on from its start (1e-6), and the next
+    step it has turned 0.7 × 5.24 × 2 × 0.0975 / 0.33 × 0.008 rad in place."""
+    text = (DATA / "pioneer3dx_collision_avoidance.wbt").read_text()
+    text = text.replace("lookupTable [ 0 1024 0.01, 5 0 0.01 ]", "lookupTable [ 0 1024 0, 5 0 0 ]")
+    text += 'Robot { name "watcher" supervisor TRUE controller "watcher" }\n'
+    (tmp_path / "worlds").mkdir()
+    world = tmp_path / "worlds" / "pioneer3dx_collision_avoidance.wbt"
+    world.write_text(text)
+    for name, source in (("pioneer3dx_collision_avoidance", P3DX_CONTROLLER), ("watcher", WATCHER)):
+        (tmp_path / "controllers" / name).mkdir(parents=True)
+        (tmp_path / "controllers" / name / f"{name}.py").write_text(source)
+    done = subprocess.run(sensorium("run", str(world), "--until", "12000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    turns = [x.split("] ", 1)[1] for x in done.stdout.splitlines() if " turn " in x]
+    assert turns[0] == "turn left at 10712", done.stdout[-2000:]
+    poses = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("[watcher] pose "):
+            t, *values = line.split()[2:]
+            poses[int(t)] = [float(v) for v in values]
+    x0, y0, yaw0 = -0.613659, -0.0464224, math.remainder(-5.12323, 2 * math.pi)
+    on = 5.24 * P3DX_R * 10.704
+    assert poses[10712] == pytest.approx([x0 + on * math.cos(yaw0), y0 + on * math.sin(yaw0), yaw0], abs=1e-6)
+    turned = 0.7 * 5.24 * 2 * P3DX_R / P3DX_AXLE * P3DX_STEP / 1000
+    assert poses[10720] == pytest.approx([*poses[10712][:2], yaw0 - turned], abs=1e-6)
