@@ -355,3 +355,45 @@ def test_the_braitenberg_controller_drives_the_pioneer_2_on_its_closed_form_arcs
     assert first_seen == (16832, [13], 1.7303, 1.5861)
     assert held[0] == (563, -0.002082, 0.0)             # the east wall (x 1.99) holds its 16-gon's corner
     assert 100 < len(held) < 400                        # it meets walls again as it roams
+
+
+def test_the_motor_sample_s_turntable_follows_its_staircase_by_the_kinematic_rule() -> None:
+    """motor (Webots' device sample): each 8 ms step the controller sets the turntable's target, 0 for
+    51 steps, then π/4 more every 51 steps. Its hinge starts at 1.5708 and moves kinematically (one load
+    line: forces are ignored, so the client's torque feedback reads NaN; the robot's battery is one more
+    line, its sensor NaN): its speed grows by maxTorque × dt = 20 × 0.008 rad/s a step up to
+    maxVelocity 2 rad/s towards the target and it stops on it the step it would pass it. Every step's
+    angle is that rule's (1e-12): down from 1.5708 towards 0 at 2 rad/s, it meets the next target π/4
+    on its way at 0.448 s and stops there; it rests until π/2 is set, and from then on, a π/4 step in
+    0.408 s being 0.39 s at full speed, it lags the staircase (5.4828 rad at 3.28 s, the target 2π)."""
+    w = load_world(DATA / "motor.wbt")
+    assert any("battery 3600, 36000, 5 is not simulated here" in x for x in w.warnings), w.warnings
+    assert any("HingeJoint motor 'motor' is no wheel" in x for x in w.warnings), w.warnings
+    sim = Simulation(w, "exact")
+    motor = sim.robot(w.world.robots[0].name).motor("motor")
+    x, v, dt = 1.5708, 0.0, 0.008
+    assert motor.position == pytest.approx(x, abs=1e-12)
+    target, counter, rested = 0.0, 0, []
+    target_set: float | None = None
+    for k in range(1, 411):
+        sim.run(1)
+        if target_set is not None:                     # the rule on the target set after the step before
+            to = target_set - x
+            if to == 0.0:
+                v = 0.0
+            else:
+                v = math.copysign(min(abs(v) + 20 * dt, 2.0), to) if v * to >= 0 else math.copysign(20 * dt, to)
+                if abs(v * dt) >= abs(to):
+                    x, v = target_set, 0.0
+                    rested.append(k)
+                else:
+                    x += v * dt
+        assert motor.position == pytest.approx(x, abs=1e-12), k
+        motor.set_position(target)
+        target_set = target
+        if counter == 50:
+            target += math.pi / 4
+            counter = 0
+        else:
+            counter += 1
+    assert rested[0] == 56 and x == pytest.approx(5.482831, abs=1e-6)
