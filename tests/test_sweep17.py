@@ -397,3 +397,35 @@ def test_the_motor_sample_s_turntable_follows_its_staircase_by_the_kinematic_rul
         else:
             counter += 1
     assert rested[0] == 56 and x == pytest.approx(5.482831, abs=1e-6)
+
+
+def test_the_position_sensor_sample_s_pole_stands_and_its_pid_asks_nothing() -> None:
+    """position_sensor (Webots' device sample, an inverted pendulum balanced by a PID on the pole's
+    hinge): the hinge's sensor, unnamed in the world, is "position sensor" as in Webots; the pole's free
+    hinge is moved by nothing without physics (one load line), so it reads 0 at every step, the PID's
+    speed KP·0 + KI·0 + KD·0 is 0 and MyBot stays where it stands (1e-12 after 10 s), where Webots'
+    physics tips the pole and the robot drives to catch it."""
+    w = load_world(DATA / "position_sensor.wbt")
+    assert any("PositionSensor on a joint without a motor" in x for x in w.warnings), w.warnings
+    robot_node = w.world.robots[0]
+    assert "position sensor" in {d.name for d in robot_node.devices}
+    sim = Simulation(w, "exact")
+    robot = sim.robot("MyBot")
+    sensor = sim.device("MyBot/position sensor")
+    sensor.enable(16)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    start = [float(c) for c in robot.pose.translation]
+    previous, integral = 0.0, 0.0
+    for _ in range(625):
+        sim.run(1)
+        position = float(sensor.value)
+        assert position == 0.0
+        integral += (position + previous) * 0.5
+        speed = max(-100.0, min(100.0, 35 * position + 5 * integral + 28.9 * (position - previous)))
+        left.set_velocity(-speed)
+        right.set_velocity(-speed)
+        previous = position
+    assert [float(c) for c in robot.pose.translation] == pytest.approx(start, abs=1e-12)
