@@ -30,11 +30,10 @@ BOXES = [(-0.201269, 4.94642), (0.225428, -5.08162), (4.01933, -3.31136), (3.987
          (-4.22157, -3.54663), (-4.21065, 2.89465)]
 
 
-def p3dx_world(tmp_path: Path, noise: bool = False):
-    """The stand-in loaded, its sonars' 1 % noise taken out unless ``noise``: (simulation, robot)."""
+def p3dx_world(tmp_path: Path):
+    """The stand-in loaded, its sonars' 1 % noise taken out: (simulation, robot)."""
     text = (DATA / "pioneer3dx_collision_avoidance.wbt").read_text()
-    if not noise:
-        text = text.replace("lookupTable [ 0 1024 0.01, 5 0 0.01 ]", "lookupTable [ 0 1024 0, 5 0 0 ]")
+    text = text.replace("lookupTable [ 0 1024 0.01, 5 0 0.01 ]", "lookupTable [ 0 1024 0, 5 0 0 ]")
     path = tmp_path / "pioneer3dx_collision_avoidance.wbt"
     path.write_text(text)
     sim = Simulation(load_world(path), "exact")
@@ -95,7 +94,7 @@ def yaw_of(robot) -> float:
     return math.atan2(r[1, 0], r[0, 0])
 
 
-def test_the_pioneer_3dx_stand_in_loads_with_its_drive_sonars_and_leds(tmp_path: Path) -> None:
+def test_the_pioneer_3dx_stand_in_loads_with_its_drive_sonars_and_leds() -> None:
     """The stand-in loads with no line; its wheels (radius 0.0975 m, 0.33 m apart, both hinges on the
     axle through the origin) are a two-wheel drive, and every device the controller asks for is there."""
     w = load_world(DATA / "pioneer3dx_collision_avoidance.wbt")
