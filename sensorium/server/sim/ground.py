@@ -80,8 +80,9 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "placing_ceiling", "resting_pose", "ride_height",
-           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling"]
+__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "over_support", "placing_ceiling", "resting_pose",
+           "ride_height", "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling",
+           "support_points", "volume_centre"]
 
 UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
@@ -757,7 +758,7 @@ def _dome(radius: float, z: float, sign: float) -> np.ndarray:
                       [[0.0, 0.0, z + sign * radius]]])
 
 
-def _support_points(g: object, prim: object) -> np.ndarray:
+def support_points(g: object, prim: object) -> np.ndarray:
     """Points (local frame) whose convex hull is the shape's, curved ones sampled (above)."""
     if isinstance(g, wm.Box):
         hx, hy, hz = (float(v) / 2.0 for v in g.size)
@@ -775,7 +776,7 @@ def _support_points(g: object, prim: object) -> np.ndarray:
     return np.asarray(prim.vertices, dtype=np.float64)
 
 
-def _volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
+def volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
     """A shape's volume and the centre of that volume (local frame), for uniform density: a closed
     mesh's own (signed tetrahedra), an open one's convex hull's, a flat one none."""
     r = float(getattr(g, "radius", 0.0))
@@ -842,17 +843,24 @@ def _tipping_edge(poly: np.ndarray, q: np.ndarray, tol: float) -> tuple[np.ndarr
     return None if best is None else (best[1], best[2])
 
 
-def _balanced(corners: np.ndarray, centre: np.ndarray, tol: float) -> bool:
-    """Whether the centre is over (within ``tol`` of) what the lowest corners span seen from above: a
-    face, an edge or a point it stands on as it is (an upright capsule on its pole, Webots' balance)."""
-    low = corners[corners[:, 2] <= float(corners[:, 2].min()) + tol][:, :2]
-    poly, q = _polygon(low), centre[:2]
+def over_support(xy: np.ndarray, q: np.ndarray, tol: float) -> bool:
+    """Whether the point ``q`` (x, y) is over (within ``tol`` of) what the points ``xy`` span seen from
+    above: their convex polygon, or the segment or point they make (the Supervisor's static balance,
+    sim/balance.py, and :func:`_balanced`)."""
+    poly = _polygon(xy)
     if len(poly) >= 3:
         return _tipping_edge(poly, q, tol) is None
     a, b = poly[0], poly[-1]
     d = b - a
     t = 0.0 if len(poly) == 1 else min(max(float((q - a) @ d) / float(d @ d), 0.0), 1.0)
     return float(np.hypot(*(q - a - t * d))) <= tol
+
+
+def _balanced(corners: np.ndarray, centre: np.ndarray, tol: float) -> bool:
+    """Whether the centre is over (within ``tol`` of) what the lowest corners span seen from above: a
+    face, an edge or a point it stands on as it is (an upright capsule on its pole, Webots' balance)."""
+    low = corners[corners[:, 2] <= float(corners[:, 2].min()) + tol][:, :2]
+    return over_support(low, centre[:2], tol)
 
 
 def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
@@ -919,9 +927,9 @@ def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.n
     points, volumes, centres = [], [], []
     for local, prim, g in shapes:
         at = enu_pose(pose.compose(local), to_enu)
-        points.append(_support_points(g, prim) @ at.rotation.T + at.translation)
+        points.append(support_points(g, prim) @ at.rotation.T + at.translation)
         if weighed is None:
-            volume, centre = _volume_centre(g, prim)
+            volume, centre = volume_centre(g, prim)
             volumes.append(volume)
             centres.append(at.rotation @ centre + at.translation)
     cloud = np.vstack(points)
