@@ -169,6 +169,14 @@ def test_a_two_wheel_robot_stands_on_its_wheels_and_caster(tmp_path):
     assert balance(lv, "STEADY") is True             # its centre at x ≈ -0.03 over the triangle
     assert balance(lv, "TWOWHEEL") is False          # two wheels alone: a line its centre is off
     assert balance(lv, "HEAVY") is False             # its centre at x ≈ -0.3, behind the caster
+    robot = lv.sim.robot("steady")
+    for name, speed in (("left wheel", 4.0), ("right wheel", 3.0)):     # driving a curve, its wheels turning
+        robot.motor(name).set_position(math.inf)
+        robot.motor(name).set_velocity(speed)
+    for _ in range(10):
+        lv.step(A, "sup")
+    assert sup(lv, "get_node_pose", {"node": node(lv, "STEADY")})["position"][0] > 0.02      # 0.175 m/s for 0.16 s
+    assert balance(lv, "STEADY") is True
     sup(lv, "set_field", {"node": node(lv, "STEADY"), "field": "translation", "value": [5.0, 5.0, 0.0]})
     assert balance(lv, "STEADY") is True             # put elsewhere on the floor: it still stands
     sup(lv, "set_field", {"node": node(lv, "STEADY"), "field": "rotation", "value": [1.0, 0.0, 0.0, 0.3]})
@@ -196,3 +204,19 @@ def test_a_c_controller_reads_the_balance(tmp_path_factory):
     assert code == 0, err
     assert out == EXPECTED
     assert "Error: wb_supervisor_node_get_static_balance(): " in err and ROOT_LINE in err
+
+
+NUE = ('#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 coordinateSystem "NUE" }\n'
+       'Solid { rotation 1 0 0 -1.5707963267948966 name "floor" boundingObject Plane { size 20 20 } }\n'
+       + "".join(f'DEF {name} Solid {{ translation {x} 0.05 0 name "{name.lower()}" boundingObject Box {{ size 0.1 0.1 0.1 }} '
+                 f'physics Physics {{ mass 1 centerOfMass [ {cx} 0 {cz} ] }} }}\n'
+                 for name, x, cx, cz in (("INSIDE", 0, 0.049, -0.049), ("OUTSIDE", 1, 0, 0.051)))
+       + SUPERVISOR.replace("translation 9 9 0", "translation 9 0 9"))
+
+
+def test_a_nue_world_judges_along_its_up_y(tmp_path):
+    lv = _live(NUE, tmp_path)
+    assert balance(lv, "INSIDE") is True             # 1 mm inside along x and z, the horizontal axes
+    assert balance(lv, "OUTSIDE") is False           # 1 mm beyond along z
+    sup(lv, "set_field", {"node": node(lv, "INSIDE"), "field": "translation", "value": [0.0, 0.3, 0.0]})
+    assert balance(lv, "INSIDE") is False            # lifted along y, the up: in the air
