@@ -116,6 +116,25 @@ def test_two_boxes_overhanging_a_table_balance_on_their_foot_alone(tmp_path):
     assert balance(lv, "RESTING") is True
 
 
+def _plank(name: str, y: float, x: float) -> str:
+    return (f'DEF {name.upper()} Solid {{ translation {x!r} {y} 0.525 name "{name}" boundingObject Box {{ size 1 0.1 0.05 }} '
+            'physics Physics { } }\n')
+
+
+PLANKS = (HEAD + 'Solid { translation -1 0 0.25 name "table" boundingObject Box { size 2 40 0.5 } }\n'
+          + _plank("held", 0.0, -0.001) + _plank("over", 1.0, 0.001) + _plank("along", 2.0, -0.45) + SUPERVISOR)
+
+
+def test_a_plank_over_a_table_edge_is_held_up_to_that_edge(tmp_path):
+    lv = _live(PLANKS, tmp_path)
+    # a 1 m plank touches the table top over x in [x - 0.5, 0]: balanced while its centre x <= 0
+    assert balance(lv, "HELD") is True               # 1 mm on the table's side of its edge
+    assert balance(lv, "OVER") is False              # 1 mm beyond it (over no ground at its origin: it stays)
+    assert balance(lv, "ALONG") is True
+    # its corners over the table are at x = -0.501 alone: the table's edge holds the rest
+    assert sup(lv, "get_node_pose", {"node": node(lv, "HELD")})["position"] == pytest.approx([-0.001, 0.0, 0.525], abs=1e-15)
+
+
 def _on_ramp(name: str, y: float, tilt: float, width: float, height: float) -> str:
     """A ramp rising along x at ``tilt`` (rad) around y, and a width x width x height box of uniform density
     lying on its top face; the box's Solid origin is 3 m aside, over no ground (it stays as the file puts it)."""
@@ -220,3 +239,17 @@ def test_a_nue_world_judges_along_its_up_y(tmp_path):
     assert balance(lv, "OUTSIDE") is False           # 1 mm beyond along z
     sup(lv, "set_field", {"node": node(lv, "INSIDE"), "field": "translation", "value": [0.0, 0.3, 0.0]})
     assert balance(lv, "INSIDE") is False            # lifted along y, the up: in the air
+
+
+def test_clip_keeps_the_part_of_a_face_a_line_or_a_point_inside_an_outline():
+    from sensorium.server.sim.balance import clip
+
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    shifted = square + [0.5, 0.25]
+    got = clip(shifted, square)                      # the overlap: [0.5, 1] x [0.25, 1]
+    assert sorted(map(tuple, got.round(15))) == [(0.5, 0.25), (0.5, 1.0), (1.0, 0.25), (1.0, 1.0)]
+    line = clip(np.array([[-1.0, 0.5], [2.0, 0.5]]), square)
+    assert line.tolist() == [[0.0, 0.5], [1.0, 0.5]]
+    assert clip(np.array([[0.5, 0.5]]), square).tolist() == [[0.5, 0.5]]
+    assert clip(np.array([[1.5, 0.5]]), square).shape == (0, 2)
+    assert clip(square + [3.0, 0.0], square).shape == (0, 2)

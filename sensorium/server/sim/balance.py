@@ -9,7 +9,9 @@ sphere's or capsule's lowest point, a cylinder's lowest rim points and its end r
 among them; any other shape's support points, ground.support_points) that lie within CONTACT_TOL of the
 ground under them, that ground being the one a let-go solid lands on (``Simulation.landing_ground``:
 floors, terrains, ramps' top faces, box and cylinder tops not above the point, the other solids where
-they are). A solid touching nothing (in the air) has no contact point and is not balanced.
+they are); and where a shape's points at a box or cylinder top's height span a face, a line or a point,
+the part of it over that top (:func:`clip`), so a face over a table's edge is held up to the edge. A
+solid touching nothing (in the air) has no contact point and is not balanced.
 """
 
 from __future__ import annotations
@@ -20,11 +22,11 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.contact import FLOOR, enu_pose
-from sensorium.server.sim.ground import Ground, over_support, support_points, volume_centre
+from sensorium.server.sim.ground import Ground, hull_2d, over_support, support_points, volume_centre
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "contact_points", "lowest_points", "robot_balance", "shapes_centre",
+__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "lowest_points", "robot_balance", "shapes_centre",
            "solid_balance"]
 
 CONTACT_TOL = FLOOR
@@ -64,25 +66,79 @@ def lowest_points(g: object, prim: object, at: Pose) -> np.ndarray:
     return np.vstack([lowest, support_points(g, prim) @ r.T + c])
 
 
-def _points(parts: list[tuple[Pose, Any]], pose: Pose, base_dir: Any, to_enu: np.ndarray | None) -> np.ndarray:
-    """:func:`lowest_points` of every bounding shape of ``parts`` ((pose in the owner's frame, shape)),
+def _points(parts: list[tuple[Pose, Any]], pose: Pose, base_dir: Any, to_enu: np.ndarray | None) -> list[np.ndarray]:
+    """:func:`lowest_points` of each bounding shape of ``parts`` ((pose in the owner's frame, shape)),
     the owner at ``pose``; Planes and ElevationGrids are ground, not something that rests."""
     from sensorium.server.sim.scene import primitive_from_model
 
-    points = [lowest_points(shape.geometry, primitive_from_model(shape.geometry, base_dir),
-                            enu_pose(pose.compose(local), to_enu))
-              for local, shape in parts if shape.seen_by in ("both", "bounding")
-              and not isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid))]
-    return np.vstack(points) if points else np.zeros((0, 3))
+    return [lowest_points(shape.geometry, primitive_from_model(shape.geometry, base_dir),
+                          enu_pose(pose.compose(local), to_enu))
+            for local, shape in parts if shape.seen_by in ("both", "bounding")
+            and not isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid))]
 
 
-def contact_points(points: np.ndarray, ground: Ground | None) -> np.ndarray:
-    """The ``points`` (ENU) within CONTACT_TOL of the ground under each (``Ground.under``, taking no
-    box top or ramp above the point + CONTACT_TOL)."""
-    if ground is None or not len(points):
+def _inside(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """How far ``p`` (x, y) is on the inner (left) side of the edge from ``a`` to ``b`` (m)."""
+    e = b - a
+    return float(e[0] * (p[1] - a[1]) - e[1] * (p[0] - a[0])) / float(np.hypot(e[0], e[1]))
+
+
+def clip(face: np.ndarray, outline: np.ndarray) -> np.ndarray:
+    """The part of ``face`` (x, y: a convex polygon counter-clockwise, a segment or a point, as
+    ground's hull gives them) inside the convex counter-clockwise ``outline`` (within EDGE_TOL), its
+    corners: Sutherland-Hodgman, each edge of the outline cutting it in turn (a segment as a polygon of
+    two corners that does not close)."""
+    pts = [np.asarray(p, dtype=np.float64) for p in face]
+    closed = len(pts) >= 3
+    for k in range(len(outline)):
+        a, b = outline[k], outline[(k + 1) % len(outline)]
+        kept: list[np.ndarray] = []
+        ends = len(pts) if closed else len(pts) - 1
+        if len(pts) == 1:
+            kept = pts if _inside(pts[0], a, b) >= -EDGE_TOL else []
+        for i in range(max(ends, 0)):
+            p, q = pts[i], pts[(i + 1) % len(pts)]
+            dp, dq = _inside(p, a, b), _inside(q, a, b)
+            if dp >= -EDGE_TOL and (not kept or not np.array_equal(kept[-1], p)):
+                kept.append(p)
+            if (dp < -EDGE_TOL) != (dq < -EDGE_TOL):            # the edge crosses the line: its crossing
+                kept.append(p + (dp / (dp - dq)) * (q - p))
+            if not closed and dq >= -EDGE_TOL:
+                kept.append(q)
+        pts = kept
+        if not pts:
+            break
+    return np.array(pts, dtype=np.float64).reshape(-1, 2)
+
+
+def contact_points(shapes: list[np.ndarray], ground: Ground | None) -> np.ndarray:
+    """The contact points (ENU) of shapes whose :func:`lowest_points` are ``shapes`` (one array each):
+    those points within CONTACT_TOL of the ground under each (``Ground.under``, taking no box top or
+    ramp above the point + CONTACT_TOL), and where a shape's points at a box or cylinder top's height
+    (within CONTACT_TOL) span a face, a line or a point, the part of it over that top (:func:`clip`):
+    a face over a top's edge is held up to that edge."""
+    if ground is None or not shapes:
         return np.zeros((0, 3))
+    points = np.vstack(shapes)
     found, z, _, _ = ground.under(points[:, 0], points[:, 1], points[:, 2] + CONTACT_TOL)
-    return points[found & (np.abs(points[:, 2] - z) <= CONTACT_TOL)]
+    contacts = [points[found & (np.abs(points[:, 2] - z) <= CONTACT_TOL)]]
+    tops = ground.tops()
+    if tops:
+        heights = np.array([h for h, _ in tops])
+        lows = np.array([o.min(axis=0) for _, o in tops])
+        highs = np.array([o.max(axis=0) for _, o in tops])
+        for shape in shapes:
+            # the tops at its points' heights whose outline's box meets its own, seen from above
+            lo, hi = shape.min(axis=0), shape.max(axis=0)
+            near_tops = ((heights >= lo[2] - CONTACT_TOL) & (heights <= hi[2] + CONTACT_TOL)
+                         & (lows <= hi[:2]).all(axis=1) & (highs >= lo[:2]).all(axis=1))
+            for k in near_tops.nonzero()[0]:
+                height, outline = tops[k]
+                near = shape[np.abs(shape[:, 2] - height) <= CONTACT_TOL]
+                if len(near):
+                    held = clip(hull_2d(near[:, :2]), outline)
+                    contacts.append(np.column_stack([held, np.full(len(held), height)]))
+    return np.vstack(contacts)
 
 
 def balanced(contacts: np.ndarray, centre: np.ndarray) -> bool:

@@ -80,7 +80,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "over_support", "placing_ceiling", "resting_pose",
+__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "hull_2d", "land_pose", "land_solid", "lift_pose", "over_support", "placing_ceiling", "resting_pose",
            "ride_height", "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling",
            "support_points", "volume_centre"]
 
@@ -179,6 +179,7 @@ class Ground:
         self._surfaces = surfaces
         self._boxes: tuple[np.ndarray, ...] | None = None      # _box_table's, made again when stale
         self._boxes_stale = True
+        self._tops: tuple[tuple[np.ndarray, ...], list[tuple[float, np.ndarray]]] | None = None   # tops()'s
         self._to_enu = to_enu
         self._poses = dict(poses)
         for s in surfaces:
@@ -373,6 +374,33 @@ class Ground:
             self._boxes = None if not rows else (np.array([r[0] for r in rows], dtype=np.int64),
                                                  *np.array([r[1:] for r in rows], dtype=np.float64).T)
         return self._boxes
+
+    def tops(self) -> list[tuple[float, np.ndarray]]:
+        """The upright box and cylinder tops as (height, their outline seen from above: x, y corners
+        counter-clockwise; a cylinder's disc a 64-gon inscribed in it), for the Supervisor's static balance
+        (sim/balance.py: where a flat face over a top's edge is held)."""
+        boxes = self._box_table()
+        if boxes is None:
+            return []
+        if self._tops is None or self._tops[0] is not boxes:    # made again with the box table
+            self._tops = (boxes, self._outlines(boxes))
+        return self._tops[1]
+
+    @staticmethod
+    def _outlines(boxes: tuple[np.ndarray, ...]) -> list[tuple[float, np.ndarray]]:
+        disc = np.arange(64) * (2.0 * math.pi / 64)
+        out = []
+        for _, tx, ty, tz, a, b, c, d, hu, hv, rr in zip(*boxes):
+            if math.isinf(rr):        # a box: its corners at ±hu along (a, b), ±hv along (c, d)
+                corners = [(su * hu, sv * hv) for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+                outline = np.array([[tx + u * a + v * c, ty + u * b + v * d] for u, v in corners])
+                if a * d - b * c < 0.0:          # a mirrored frame: keep them counter-clockwise
+                    outline = outline[::-1]
+            else:
+                radius = math.sqrt(rr)
+                outline = np.column_stack([tx + radius * np.cos(disc), ty + radius * np.sin(disc)])
+            out.append((float(tz), outline))
+        return out
 
     def at(self, x: float, y: float, ceiling: float = math.inf) -> tuple[float, float, float] | None:
         """:meth:`under` at one point: ``(z, gx, gy)`` or None (the same arithmetic, so the same bits)."""
@@ -802,7 +830,7 @@ def volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
         return 0.0, v.mean(axis=0)
 
 
-def _polygon(xy: np.ndarray) -> np.ndarray:
+def hull_2d(xy: np.ndarray) -> np.ndarray:
     """The 2-D convex hull of points, counter-clockwise, no collinear corners (Andrew's monotone chain)."""
     pts = sorted({(float(x), float(y)) for x, y in xy})
     if len(pts) <= 2:
@@ -847,7 +875,7 @@ def over_support(xy: np.ndarray, q: np.ndarray, tol: float) -> bool:
     """Whether the point ``q`` (x, y) is over (within ``tol`` of) what the points ``xy`` span seen from
     above: their convex polygon, or the segment or point they make (the Supervisor's static balance,
     sim/balance.py, and :func:`_balanced`)."""
-    poly = _polygon(xy)
+    poly = hull_2d(xy)
     if len(poly) >= 3:
         return _tipping_edge(poly, q, tol) is None
     a, b = poly[0], poly[-1]
@@ -892,7 +920,7 @@ def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.nd
     for _ in range(2 * len(corners) + 2):
         at = corners @ turn.T + shift
         ground = float(at[:, 2].min())
-        poly = _polygon(at[at[:, 2] <= ground + tol][:, :2])
+        poly = hull_2d(at[at[:, 2] <= ground + tol][:, :2])
         if len(poly) < 3:
             break
         edge = _tipping_edge(poly, (turn @ centre + shift)[:2], tol)
