@@ -321,6 +321,16 @@ def wb_supervisor_node_get_center_of_mass(node: int | None) -> list[float]:
     return [math.nan] * 3 if got is None else [float(v) for v in got["value"]]
 
 
+def wb_supervisor_node_get_static_balance(node: int | None) -> bool:
+    """Whether a top-level solid's or robot's centre of mass, seen from above, is over the support polygon
+    of where its bounding shapes touch the ground now (README "Supervisor"); false without physics or
+    touching nothing, and after the server's line for a node that is no top-level Solid (Webots)."""
+    func = "wb_supervisor_node_get_static_balance"
+    r = _checked_node(node, func)
+    got = None if r is None else _answer(r, "get_node_static_balance", {"node": int(node)}, func)  # type: ignore[arg-type]
+    return False if got is None else bool(got["value"])
+
+
 def wb_supervisor_node_export_string(node: int | None) -> str:
     """Webots' ``exportString``: a child of the root as ``.wbt`` text (``DEF NAME Type { ... }``), as its world
     file or node string wrote it with the fields the server keeps as they are now (where it stands, its name,

@@ -890,6 +890,10 @@ class FloatArrayValue(Result):
     value: list[float]
 
 
+class BoolValue(Result):
+    value: bool
+
+
 class DeviceListResult(Result):
     list: list[str]
 
@@ -1111,6 +1115,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("get_node_center_of_mass", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
+    ServiceSpec("get_node_static_balance", "robot", NodeArgs, BoolValue, attached=True, supervisor=True),
     ServiceSpec("remove_node", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("set_joint_position", "robot", SetJointPositionArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("save_node_state", "robot", NodeStateArgs, SuccessResult, attached=True, supervisor=True),

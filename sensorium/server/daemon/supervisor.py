@@ -35,7 +35,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.daemon import appearance, nested, visuals
 from sensorium.server.daemon.mf_items import item_position
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
-from sensorium.server.sim import states, viewshot
+from sensorium.server.sim import balance, states, viewshot
 from sensorium.server.world.limits import RAISE, custom_data_chars
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion, pose_from_model
 from sensorium.server.world.top_nodes import Scenery
@@ -1251,6 +1251,22 @@ def center_of_mass(sim: Any, node: Node) -> list[float]:
     return [float(v) for v in sum(kg * p for kg, p in weighted) / total]
 
 
+def static_balance(sim: Any, node: Node) -> bool:
+    """Webots' ``getStaticBalance`` of a top-level solid or robot (sim/balance.py): with physics, whether
+    its centre of mass (:func:`center_of_mass`; a solid given no mass: its shapes' volumes') seen from
+    above is over the support polygon of where its bounding shapes touch the ground now; False without
+    physics or touching nothing. Anything else: Webots' warning as the one line (the client answers
+    false, as Webots' does)."""
+    if node.nested or node.visual or node.type not in ("Robot", "Solid"):
+        raise ValueError("it can exclusively be used with a top Solid, not " + ("the root" if node.id == 0 else _what(node)))
+    if node.type == "Robot":
+        state = sim.robots[node.key]
+        return state.model.mass is not None and balance.robot_balance(sim, state, center_of_mass(sim, node))
+    model = next(s for s in sim.world.solids if s.name == node.key)
+    return model.physics and balance.solid_balance(sim, node.key, None if model.mass is None
+                                                   else center_of_mass(sim, node))
+
+
 def node_velocity(sim: Any, node: Node) -> list[float]:
     """Webots' ``getVelocity``: a driven robot's from its kinematic drive's last step (world axes,
     linear m/s then angular rad/s), a node inside it moving with it; a top-level solid falling after a
@@ -1583,6 +1599,7 @@ HANDLERS = {
     "get_node_pose": lambda sim, ls, robot, a: node_pose(sim, node_by_id(sim, a.node)),
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},
     "get_node_center_of_mass": lambda sim, ls, robot, a: {"value": center_of_mass(sim, node_by_id(sim, a.node))},
+    "get_node_static_balance": lambda sim, ls, robot, a: {"value": static_balance(sim, node_by_id(sim, a.node))},
     "remove_node": _remove,
     "set_joint_position": _set_joint_position,
     "save_node_state": _save_state,

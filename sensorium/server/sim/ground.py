@@ -80,8 +80,9 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "land_pose", "land_solid", "lift_pose", "placing_ceiling", "resting_pose", "ride_height",
-           "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling"]
+__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "hull_2d", "land_pose", "land_solid", "lift_pose", "over_support", "placing_ceiling", "resting_pose",
+           "ride_height", "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling",
+           "support_points", "volume_centre"]
 
 UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from the world's up still taken as upright
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
@@ -178,6 +179,7 @@ class Ground:
         self._surfaces = surfaces
         self._boxes: tuple[np.ndarray, ...] | None = None      # _box_table's, made again when stale
         self._boxes_stale = True
+        self._tops: tuple[tuple[np.ndarray, ...], list[tuple[float, np.ndarray]]] | None = None   # tops()'s
         self._to_enu = to_enu
         self._poses = dict(poses)
         for s in surfaces:
@@ -372,6 +374,33 @@ class Ground:
             self._boxes = None if not rows else (np.array([r[0] for r in rows], dtype=np.int64),
                                                  *np.array([r[1:] for r in rows], dtype=np.float64).T)
         return self._boxes
+
+    def tops(self) -> list[tuple[float, np.ndarray]]:
+        """The upright box and cylinder tops as (height, their outline seen from above: x, y corners
+        counter-clockwise; a cylinder's disc a 64-gon inscribed in it), for the Supervisor's static balance
+        (sim/balance.py: where a flat face over a top's edge is held)."""
+        boxes = self._box_table()
+        if boxes is None:
+            return []
+        if self._tops is None or self._tops[0] is not boxes:    # made again with the box table
+            self._tops = (boxes, self._outlines(boxes))
+        return self._tops[1]
+
+    @staticmethod
+    def _outlines(boxes: tuple[np.ndarray, ...]) -> list[tuple[float, np.ndarray]]:
+        disc = np.arange(64) * (2.0 * math.pi / 64)
+        out = []
+        for _, tx, ty, tz, a, b, c, d, hu, hv, rr in zip(*boxes):
+            if math.isinf(rr):        # a box: its corners at ±hu along (a, b), ±hv along (c, d)
+                corners = [(su * hu, sv * hv) for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+                outline = np.array([[tx + u * a + v * c, ty + u * b + v * d] for u, v in corners])
+                if a * d - b * c < 0.0:          # a mirrored frame: keep them counter-clockwise
+                    outline = outline[::-1]
+            else:
+                radius = math.sqrt(rr)
+                outline = np.column_stack([tx + radius * np.cos(disc), ty + radius * np.sin(disc)])
+            out.append((float(tz), outline))
+        return out
 
     def at(self, x: float, y: float, ceiling: float = math.inf) -> tuple[float, float, float] | None:
         """:meth:`under` at one point: ``(z, gx, gy)`` or None (the same arithmetic, so the same bits)."""
@@ -757,7 +786,7 @@ def _dome(radius: float, z: float, sign: float) -> np.ndarray:
                       [[0.0, 0.0, z + sign * radius]]])
 
 
-def _support_points(g: object, prim: object) -> np.ndarray:
+def support_points(g: object, prim: object) -> np.ndarray:
     """Points (local frame) whose convex hull is the shape's, curved ones sampled (above)."""
     if isinstance(g, wm.Box):
         hx, hy, hz = (float(v) / 2.0 for v in g.size)
@@ -775,7 +804,7 @@ def _support_points(g: object, prim: object) -> np.ndarray:
     return np.asarray(prim.vertices, dtype=np.float64)
 
 
-def _volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
+def volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
     """A shape's volume and the centre of that volume (local frame), for uniform density: a closed
     mesh's own (signed tetrahedra), an open one's convex hull's, a flat one none."""
     r = float(getattr(g, "radius", 0.0))
@@ -801,7 +830,7 @@ def _volume_centre(g: object, prim: object) -> tuple[float, np.ndarray]:
         return 0.0, v.mean(axis=0)
 
 
-def _polygon(xy: np.ndarray) -> np.ndarray:
+def hull_2d(xy: np.ndarray) -> np.ndarray:
     """The 2-D convex hull of points, counter-clockwise, no collinear corners (Andrew's monotone chain)."""
     pts = sorted({(float(x), float(y)) for x, y in xy})
     if len(pts) <= 2:
@@ -842,17 +871,24 @@ def _tipping_edge(poly: np.ndarray, q: np.ndarray, tol: float) -> tuple[np.ndarr
     return None if best is None else (best[1], best[2])
 
 
-def _balanced(corners: np.ndarray, centre: np.ndarray, tol: float) -> bool:
-    """Whether the centre is over (within ``tol`` of) what the lowest corners span seen from above: a
-    face, an edge or a point it stands on as it is (an upright capsule on its pole, Webots' balance)."""
-    low = corners[corners[:, 2] <= float(corners[:, 2].min()) + tol][:, :2]
-    poly, q = _polygon(low), centre[:2]
+def over_support(xy: np.ndarray, q: np.ndarray, tol: float) -> bool:
+    """Whether the point ``q`` (x, y) is over (within ``tol`` of) what the points ``xy`` span seen from
+    above: their convex polygon, or the segment or point they make (the Supervisor's static balance,
+    sim/balance.py, and :func:`_balanced`)."""
+    poly = hull_2d(xy)
     if len(poly) >= 3:
         return _tipping_edge(poly, q, tol) is None
     a, b = poly[0], poly[-1]
     d = b - a
     t = 0.0 if len(poly) == 1 else min(max(float((q - a) @ d) / float(d @ d), 0.0), 1.0)
     return float(np.hypot(*(q - a - t * d))) <= tol
+
+
+def _balanced(corners: np.ndarray, centre: np.ndarray, tol: float) -> bool:
+    """Whether the centre is over (within ``tol`` of) what the lowest corners span seen from above: a
+    face, an edge or a point it stands on as it is (an upright capsule on its pole, Webots' balance)."""
+    low = corners[corners[:, 2] <= float(corners[:, 2].min()) + tol][:, :2]
+    return over_support(low, centre[:2], tol)
 
 
 def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
@@ -884,7 +920,7 @@ def _hull_tip(points: np.ndarray, centre: np.ndarray) -> tuple[np.ndarray, np.nd
     for _ in range(2 * len(corners) + 2):
         at = corners @ turn.T + shift
         ground = float(at[:, 2].min())
-        poly = _polygon(at[at[:, 2] <= ground + tol][:, :2])
+        poly = hull_2d(at[at[:, 2] <= ground + tol][:, :2])
         if len(poly) < 3:
             break
         edge = _tipping_edge(poly, (turn @ centre + shift)[:2], tol)
@@ -919,9 +955,9 @@ def _hull_resting_pose(solid: wm.Solid, pose: Pose, base_dir: Path, to_enu: np.n
     points, volumes, centres = [], [], []
     for local, prim, g in shapes:
         at = enu_pose(pose.compose(local), to_enu)
-        points.append(_support_points(g, prim) @ at.rotation.T + at.translation)
+        points.append(support_points(g, prim) @ at.rotation.T + at.translation)
         if weighed is None:
-            volume, centre = _volume_centre(g, prim)
+            volume, centre = volume_centre(g, prim)
             volumes.append(volume)
             centres.append(at.rotation @ centre + at.translation)
     cloud = np.vstack(points)

@@ -482,6 +482,24 @@ const double *wb_supervisor_node_get_center_of_mass(WbNodeRef node) {
   return ok ? node->center_of_mass : sn_no_values();
 }
 
+/* whether a top-level solid's or robot's centre of mass, seen from above, is over the support polygon of
+   where its bounding shapes touch the ground now; false without physics or touching nothing, and after
+   the server's line for a node that is no top-level Solid (Webots) */
+bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
+  const char *func = "wb_supervisor_node_get_static_balance";
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  if (rb == NULL || sn_robot_call(rb, "robot/get_node_static_balance", 1, args_node, &node->id, func, &rep) != 0)
+    return false;
+  const msgpack_object *value = sn_get(rep.result, "value");
+  bool ok = value != NULL && value->type == MSGPACK_OBJECT_BOOLEAN;
+  bool balanced = ok && value->via.boolean;
+  sn_reply_free(&rep);
+  if (!ok)
+    fprintf(stderr, "Error: %s(): malformed reply\n", func);
+  return balanced;
+}
+
 /* Webots' node.remove() for a top-level solid or light: no sensor sees it from the next step and its
    id answers NULL from then on (never reused); the root and robots are refused with the server's one
    line (a departure from Webots, which removes robots too). The node's record stays until cleanup. */

@@ -55,13 +55,6 @@ WbNodeRef wb_supervisor_node_get_selected(void) {
 
 
 
-bool wb_supervisor_node_get_static_balance(WbNodeRef node) {
-  SN_UNSUPPORTED();
-  return false;
-}
-
-
-
 void wb_supervisor_node_move_viewpoint(WbNodeRef node) {
   SN_UNSUPPORTED();
 }

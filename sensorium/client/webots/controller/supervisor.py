@@ -360,6 +360,9 @@ class Node:
     def getCenterOfMass(self) -> list[float]:
         return wb.wb_supervisor_node_get_center_of_mass(self._ref)
 
+    def getStaticBalance(self) -> bool:
+        return wb.wb_supervisor_node_get_static_balance(self._ref)
+
     def setVelocity(self, velocity: list[float]) -> None:
         wb.wb_supervisor_node_set_velocity(self._ref, velocity)
 
@@ -595,7 +598,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3, ""),
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9, "")},
     Node: {
-        "getStaticBalance": ("node_get_static_balance", False, ""),
         "moveViewpoint": ("node_move_viewpoint", None, ""),
         "addForce": ("node_add_force", None, "force, relative"),
         "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),

@@ -1,0 +1,198 @@
+"""Webots' static balance (the Supervisor's ``getStaticBalance``) without physics.
+
+Webots takes the contact points its physics found under a top-level solid (and the solids inside it)
+in the last step, their convex hull seen along gravity (its support polygon), and answers whether the
+solid's centre of mass, seen the same way, is over that polygon, its edges included. Here nothing
+collides, so the contact points are where the solid's bounding shapes touch the ground under them now:
+the points of each shape that can touch a ground below it (:func:`lowest_points`: a box's corners, a
+sphere's or capsule's lowest point, a cylinder's lowest rim points and its end rims, a wheel's bottom
+among them; any other shape's support points, ground.support_points) that lie within CONTACT_TOL of the
+ground under them, that ground being the one a let-go solid lands on (``Simulation.landing_ground``:
+floors, terrains, ramps' top faces, box and cylinder tops not above the point, the other solids where
+they are); and where a shape's points at a box or cylinder top's height span a face, a line or a point,
+the part of it over that top (:func:`clip`), so a face over a table's edge is held up to the edge. A
+solid touching nothing (in the air) has no contact point and is not balanced.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.contact import FLOOR, enu_pose
+from sensorium.server.sim.ground import Ground, hull_2d, over_support, support_points, volume_centre
+from sensorium.server.sim.motion import _TO_ENU
+from sensorium.server.world.geometry import Pose
+
+__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "lowest_points", "robot_balance", "shapes_centre",
+           "solid_balance"]
+
+CONTACT_TOL = FLOOR
+"""m: a bounding shape's point at most this far above or below the ground under it touches it (kinematic
+contact's floor tolerance)."""
+EDGE_TOL = 1e-9
+"""m: a centre of mass this close to the support polygon's edge is over it (Webots counts the edges in)."""
+
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+def lowest_points(g: object, prim: object, at: Pose) -> np.ndarray:
+    """The points (ENU) of a bounding shape at ENU pose ``at`` that may touch a ground under it: a
+    sphere's lowest point; a capsule's lowest point of each end; a cylinder's lowest rim point of each
+    end (on its side it touches along the line between them), a cone's lowest base rim point and its
+    apex, and their end rims too when the bottom rim lies within CONTACT_TOL of level (standing on an
+    end it touches all round; its rim's points near the bottom are never taken for a side's line); a
+    box's corners; any other shape's support points (ground.support_points)."""
+    r, c = at.rotation, at.translation
+    if isinstance(g, wm.Sphere):
+        return (c - float(g.radius) * _UP)[None]
+    if not isinstance(g, (wm.Capsule, wm.Cylinder, wm.Cone)):
+        return support_points(g, prim) @ r.T + c
+    axis = r[:, 2]
+    half = float(g.height) / 2.0
+    ends = np.array([c + half * axis, c - half * axis])
+    if isinstance(g, wm.Capsule):
+        return ends - float(g.radius) * _UP
+    radius = float(g.bottom_radius if isinstance(g, wm.Cone) else g.radius)
+    side = _UP - float(_UP @ axis) * axis         # the up without its part along the axis
+    n = float(np.linalg.norm(side))               # sin of the axis's tilt from the vertical
+    lowest = ends if n == 0.0 else ends - (radius / n) * side
+    if isinstance(g, wm.Cone):                    # its apex, the top end's centre
+        lowest = np.array([ends[0], lowest[1]])
+    if 2.0 * radius * n > CONTACT_TOL:
+        return lowest
+    return np.vstack([lowest, support_points(g, prim) @ r.T + c])
+
+
+def _points(parts: list[tuple[Pose, Any]], pose: Pose, base_dir: Any, to_enu: np.ndarray | None) -> list[np.ndarray]:
+    """:func:`lowest_points` of each bounding shape of ``parts`` ((pose in the owner's frame, shape)),
+    the owner at ``pose``; Planes and ElevationGrids are ground, not something that rests."""
+    from sensorium.server.sim.scene import primitive_from_model
+
+    return [lowest_points(shape.geometry, primitive_from_model(shape.geometry, base_dir),
+                          enu_pose(pose.compose(local), to_enu))
+            for local, shape in parts if shape.seen_by in ("both", "bounding")
+            and not isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid))]
+
+
+def _inside(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """How far ``p`` (x, y) is on the inner (left) side of the edge from ``a`` to ``b`` (m)."""
+    e = b - a
+    return float(e[0] * (p[1] - a[1]) - e[1] * (p[0] - a[0])) / float(np.hypot(e[0], e[1]))
+
+
+def clip(face: np.ndarray, outline: np.ndarray) -> np.ndarray:
+    """The part of ``face`` (x, y: a convex polygon counter-clockwise, a segment or a point, as
+    ground's hull gives them) inside the convex counter-clockwise ``outline`` (within EDGE_TOL), its
+    corners: Sutherland-Hodgman, each edge of the outline cutting it in turn (a segment as a polygon of
+    two corners that does not close)."""
+    pts = [np.asarray(p, dtype=np.float64) for p in face]
+    closed = len(pts) >= 3
+    for k in range(len(outline)):
+        a, b = outline[k], outline[(k + 1) % len(outline)]
+        kept: list[np.ndarray] = []
+        ends = len(pts) if closed else len(pts) - 1
+        if len(pts) == 1:
+            kept = pts if _inside(pts[0], a, b) >= -EDGE_TOL else []
+        for i in range(max(ends, 0)):
+            p, q = pts[i], pts[(i + 1) % len(pts)]
+            dp, dq = _inside(p, a, b), _inside(q, a, b)
+            if dp >= -EDGE_TOL and (not kept or not np.array_equal(kept[-1], p)):
+                kept.append(p)
+            if (dp < -EDGE_TOL) != (dq < -EDGE_TOL):            # the edge crosses the line: its crossing
+                kept.append(p + (dp / (dp - dq)) * (q - p))
+            if not closed and dq >= -EDGE_TOL:
+                kept.append(q)
+        pts = kept
+        if not pts:
+            break
+    return np.array(pts, dtype=np.float64).reshape(-1, 2)
+
+
+def contact_points(shapes: list[np.ndarray], ground: Ground | None) -> np.ndarray:
+    """The contact points (ENU) of shapes whose :func:`lowest_points` are ``shapes`` (one array each):
+    those points within CONTACT_TOL of the ground under each (``Ground.under``, taking no box top or
+    ramp above the point + CONTACT_TOL), and where a shape's points at a box or cylinder top's height
+    (within CONTACT_TOL) span a face, a line or a point, the part of it over that top (:func:`clip`):
+    a face over a top's edge is held up to that edge."""
+    if ground is None or not shapes:
+        return np.zeros((0, 3))
+    points = np.vstack(shapes)
+    found, z, _, _ = ground.under(points[:, 0], points[:, 1], points[:, 2] + CONTACT_TOL)
+    contacts = [points[found & (np.abs(points[:, 2] - z) <= CONTACT_TOL)]]
+    tops = ground.tops()
+    if tops:
+        heights = np.array([h for h, _ in tops])
+        lows = np.array([o.min(axis=0) for _, o in tops])
+        highs = np.array([o.max(axis=0) for _, o in tops])
+        for shape in shapes:
+            # the tops at its points' heights whose outline's box meets its own, seen from above
+            lo, hi = shape.min(axis=0), shape.max(axis=0)
+            near_tops = ((heights >= lo[2] - CONTACT_TOL) & (heights <= hi[2] + CONTACT_TOL)
+                         & (lows <= hi[:2]).all(axis=1) & (highs >= lo[:2]).all(axis=1))
+            for k in near_tops.nonzero()[0]:
+                height, outline = tops[k]
+                near = shape[np.abs(shape[:, 2] - height) <= CONTACT_TOL]
+                if len(near):
+                    held = clip(hull_2d(near[:, :2]), outline)
+                    contacts.append(np.column_stack([held, np.full(len(held), height)]))
+    return np.vstack(contacts)
+
+
+def balanced(contacts: np.ndarray, centre: np.ndarray) -> bool:
+    """Whether the centre of mass (ENU) is over (within EDGE_TOL of) the support polygon of ``contacts``
+    (ENU) seen from above: their convex hull, or the segment or point they make; False without any."""
+    return bool(len(contacts)) and over_support(contacts[:, :2], np.asarray(centre, dtype=np.float64)[:2], EDGE_TOL)
+
+
+def shapes_centre(parts: list[tuple[Pose, Any]], pose: Pose, base_dir: Any, to_enu: np.ndarray | None) -> np.ndarray:
+    """The centre (ENU) of the bounding shapes' volumes of a solid with physics but no mass given (a YAML
+    world's ``physics: true``), uniform density, as its landing weighs it (ground.volume_centre)."""
+    from sensorium.server.sim.scene import primitive_from_model
+
+    weighed = []
+    for local, shape in parts:
+        if shape.seen_by in ("both", "bounding") and not isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid)):
+            at = enu_pose(pose.compose(local), to_enu)
+            volume, centre = volume_centre(shape.geometry, primitive_from_model(shape.geometry, base_dir))
+            weighed.append((volume, at.rotation @ centre + at.translation))
+    total = sum(v for v, _ in weighed)
+    if total > 0.0:
+        return sum(v * c for v, c in weighed) / total
+    return enu_pose(pose, to_enu).translation
+
+
+def _enu(point: Any, to_enu: np.ndarray | None) -> np.ndarray:
+    p = np.asarray(point, dtype=np.float64)
+    return p if to_enu is None else to_enu @ p
+
+
+def solid_balance(sim: Any, name: str, centre: Any) -> bool:
+    """A top-level solid with physics: whether ``centre`` (its centre of mass, world axes; None for a
+    solid given no mass: its shapes' volumes', :func:`shapes_centre`) is over its contact points on the
+    ground a let-go solid lands on, itself left out (:func:`balanced`)."""
+    from sensorium.server.sim.scene import solid_parts
+
+    model = next(s for s in sim.world.solids if s.name == name)
+    parts = [(local, shape) for _, local, shape in solid_parts(model, Pose.identity())]
+    pose = sim.scene.solid_poses[name]
+    to_enu = _TO_ENU[sim.world.world_info.coordinate_system]
+    base = sim.loaded.base_dir
+    contacts = contact_points(_points(parts, pose, base, to_enu), sim.landing_ground(name))
+    return balanced(contacts, shapes_centre(parts, pose, base, to_enu) if centre is None else _enu(centre, to_enu))
+
+
+def robot_balance(sim: Any, state: Any, centre: Any) -> bool:
+    """A robot with physics: whether ``centre`` (its centre of mass, world axes) is over its contact
+    points: its bounding shapes where its joints hold them now (its wheels among them) on the ground a
+    let-go solid lands on, its own shapes left out (:func:`balanced`)."""
+    from sensorium.server.sim.scene import robot_parts
+
+    links = state.links
+    parts = [(local if links is None or (j := getattr(shape, "on_joint", None)) not in links.poses
+              else links.poses[j].compose(local), shape) for _, local, shape in robot_parts(state.model)]
+    ground = sim.landing_ground("\0" + state.model.name, carrier=state.index)
+    contacts = contact_points(_points(parts, state.pose, sim.loaded.base_dir, state.to_enu), ground)
+    return balanced(contacts, _enu(centre, state.to_enu))
