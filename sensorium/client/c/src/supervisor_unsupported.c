@@ -12,9 +12,6 @@
 /* every function here ignores its arguments (it answers Webots' "no value") */
 #pragma GCC diagnostic ignored "-Wunused-parameter"
 
-void wb_supervisor_world_load(const char *filename) {
-  SN_UNSUPPORTED();
-}
 
 
 
@@ -110,9 +107,6 @@ void wb_supervisor_simulation_revert(void) {
   SN_UNSUPPORTED();
 }
 
-void wb_supervisor_load_world(const char *filename) {
-  SN_UNSUPPORTED();
-}
 
 
 void wb_supervisor_field_remove_mf_node(WbFieldRef field, int position) {
