@@ -420,12 +420,14 @@ def clib(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
     return build, libs
 
 
-def compile_controller(clib: tuple[Path, list[str]], folder: Path, name: str, source: str) -> None:
-    """controllers/NAME/NAME.c compiled to controllers/NAME/NAME against our libController."""
+def compile_controller(clib: tuple[Path, list[str]], folder: Path, name: str, source: str, language: str = "c") -> None:
+    """controllers/NAME/NAME.c (``language`` "cpp": NAME.cpp, our C++ layer) compiled to
+    controllers/NAME/NAME against our libController."""
     build, libs = clib
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / f"{name}.c").write_text(source)
-    done = subprocess.run(["cc", "-std=c99", "-Wall", "-Werror", f"-I{CLIB / 'include'}", str(folder / f"{name}.c"),
+    (folder / f"{name}.{language}").write_text(source)
+    compiler = ["c++", "-std=c++11"] if language == "cpp" else ["cc", "-std=c99"]
+    done = subprocess.run([*compiler, "-Wall", "-Werror", f"-I{CLIB / 'include'}", str(folder / f"{name}.{language}"),
                            "-o", str(folder / name), str(build / "libController.a"), *libs, "-lm"],
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
@@ -545,14 +547,34 @@ int main(void) {
 '''
 
 
-def test_c_world_load_starts_the_named_worlds_controllers(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:
+CPP_LOADER = r'''#include <cmath>
+#include <cstdio>
+#include <webots/Supervisor.hpp>
+
+int main() {
+  webots::Supervisor boss;
+  boss.worldLoad("");
+  while (boss.step(16) != -1) {
+    if (std::lround(boss.getTime() * 1000) == 320)
+      boss.worldLoad("../../worlds/b.wbt");
+  }
+  std::printf("C++ boss ends at %ld\n", std::lround(boss.getTime() * 1000));
+  return 0;
+}
+'''
+
+
+@pytest.mark.parametrize("language", ["c", "cpp"])
+def test_c_and_cpp_world_load_start_the_named_worlds_controllers(tmp_path: Path, clib: tuple[Path, list[str]],
+                                                                 language: str) -> None:
     world = project(tmp_path, 'Robot { name "boss" controller "boss" supervisor TRUE }', {})
-    compile_controller(clib, tmp_path / "controllers" / "boss", "boss", C_LOADER)
+    compile_controller(clib, tmp_path / "controllers" / "boss", "boss", C_LOADER if language == "c" else CPP_LOADER,
+                       language)
     world_b(tmp_path)
     proc = run(world, "--until", "640")
     assert proc.wait() == 0, proc.stderr()
     out = proc.stdout().splitlines()
-    assert "[boss] C boss ends at 320" in out
+    assert f"[boss] {'C' if language == 'c' else 'C++'} boss ends at 320" in out
     assert "[beta] only world b has beta at 0.0" in out and "[beta] beta stepped 40 until 640" in out
     # Webots' line for an empty name, nothing done
     assert "[boss] Error: wb_supervisor_world_load() called with NULL or empty 'filename' argument." in \
