@@ -1,6 +1,7 @@
 """``sensorium run``: open a Webots project headless, the way Webots does: serve the world and start
 every robot's controller named in it, print their output with the robot's name, restart them on
-``restartController``, reload the world on ``worldReload``, end them all at the end.
+``restartController``, reload the world on ``worldReload`` (load another on ``worldLoad``), end them all
+at the end.
 
 Where a controller is found, as Webots' WbController does for a project: ``controllers/NAME/`` next to
 the world's ``worlds/`` folder (then the robot's PROTO's project, for a PROTO the world declares by
@@ -417,12 +418,49 @@ def after_run(reload_requested: bool, interrupted: bool, quit_status: int | None
     return reload_requested and not interrupted and quit_status is None
 
 
-def exit_status(quit_status: int | None, missing: bool = False) -> int:
+def exit_status(quit_status: int | None, missing: bool = False, load_refused: bool = False) -> int:
     """``run``'s exit status: ``simulationQuit(status)``'s low 8 bits, as Webots exits, when not 0;
     else 1 when a robot ran without the controller its world names (``missing``: a CI job must not
-    pass by a run that was not the one its world describes); else 0."""
+    pass by a run that was not the one its world describes) or a ``worldLoad`` named no world it could
+    load (``load_refused``); else 0."""
     status = 0 if quit_status is None else quit_status & 0xFF
-    return status or (1 if missing else 0)
+    return status or (1 if missing or load_refused else 0)
+
+
+WORLD_SUFFIXES = (".wbt", ".yaml", ".yml", ".json")    # the world files `run` loads (Webots': .wbt only)
+
+
+def world_to_load(filename: str, folder: Path | None, worlds: Path) -> Path:
+    """The world file a Supervisor's ``worldLoad(filename)`` names: relative to its controller's
+    ``folder``, as Webots takes it (None: a controller ``run`` did not start, which has none here),
+    symbolic links followed; it must lie in ``worlds``, the folder of the world ``run`` was started
+    with (a world from elsewhere would start the controllers of another project), exist and be a
+    world file. Raises :class:`LaunchError` saying why (one line)."""
+    if not filename or "\0" in filename:
+        raise LaunchError("no file named" if not filename else "a NUL byte in the file name")
+    path = Path(filename)
+    if not path.is_absolute():
+        if folder is None:
+            raise LaunchError("a relative name is taken from the controller's folder, and this robot's controller "
+                              "was not started by `sensorium run`: give the world file's absolute path")
+        path = folder / path
+    try:
+        resolved = path.resolve()
+    except (OSError, RuntimeError) as exc:          # a symbolic link loop
+        raise LaunchError(f"{path} cannot be resolved: {exc}") from None
+    root = worlds.resolve()
+    if not resolved.is_relative_to(root):
+        raise LaunchError(f"{resolved} is outside {root}, the folder of the world `sensorium run` started with "
+                          "(a world from elsewhere would start another project's controllers)")
+    try:
+        found = resolved.is_file()
+    except OSError as exc:               # a folder on the way that may not be read
+        raise LaunchError(f"{resolved} cannot be read: {exc.strerror or exc}") from None
+    if not found:
+        raise LaunchError(f"no world file {resolved}")
+    if resolved.suffix.lower() not in WORLD_SUFFIXES:
+        raise LaunchError(f"{resolved} is not a world file (.wbt; YAML or JSON: .yaml, .yml, .json)")
+    return resolved
 
 
 def _describe(code: int) -> str:
@@ -486,7 +524,10 @@ class Launcher:
         self._wake = threading.Event()
         self._closed = False
         self.reload_requested = False
-        self.on_reload: Callable[[], None] | None = None     # stops the server (run's loop reloads)
+        self.world_requested: Path | None = None     # worldLoad's world (None: worldReload's, the same file)
+        self.worlds: Path | None = None               # where worldLoad may load from (run's first world's folder)
+        self.load_refused = False                     # a worldLoad named no world to load: the run ended (exit 1)
+        self.stop_server: Callable[[], None] | None = None     # the server stops (run's loop then reloads or ends)
         # (robot, controller name) -> the controller to start (run's find_controller for this world), or LaunchError
         self.find: Callable[[str, str], ControllerSpec] | None = None
         self._starting: set[str] = set()         # the lockstep's: the world waits until these attach
@@ -780,9 +821,30 @@ class Launcher:
     def reload(self) -> None:
         """worldReload: stop the server (every step -1); ``run`` then reloads and starts all again."""
         self.reload_requested = True
+        self._stop()
+
+    def load(self, robot: str, filename: str) -> None:
+        """worldLoad: stop the server (every step -1); ``run`` then loads ``filename``
+        (:func:`world_to_load`: from the robot's controller folder, within :attr:`worlds`) and starts
+        its controllers. A name that gives no world to load is one line and the run ends (exit 1): Webots
+        opens an empty world then, where nothing runs."""
+        spec = self.specs.get(robot)
+        try:
+            if self.worlds is None:
+                raise LaunchError("no world folder to load from")
+            self.world_requested = world_to_load(filename, spec.folder if spec else None, self.worlds)
+        except LaunchError as exc:
+            self.log(f"robot '{robot}': worldLoad({filename!r}): {exc}: the simulation ends (Webots opens an empty "
+                     "world)")
+            self.load_refused = True
+            self._stop()
+            return
+        self.reload()
+
+    def _stop(self) -> None:
         self.quit()
-        if self.on_reload is not None:
-            self.on_reload()
+        if self.stop_server is not None:
+            self.stop_server()
 
     def quit(self) -> None:
         """simulationQuit (and a reload's first half): the server stops (every step -1); every
@@ -949,6 +1011,7 @@ class ProjectRun:
                             attach_timeout_s=self.options.attach_timeout_s,
                             robot_window_log=self.options.robot_window_log)
         self._server = server
+        worlds = self.world.resolve().parent      # worldLoad loads from here (the first world's folder)
         old_handlers = {}
         if signals and threading.current_thread() is threading.main_thread():    # Python's signals: main thread only
             old_handlers = {sig: signal.signal(sig, lambda signum, frame: self.stop())
@@ -964,15 +1027,22 @@ class ProjectRun:
                 launcher.bind(lockstep.starting, server.transport.wake, partial(getattr, lockstep, "shutting_down"))
                 lockstep.starting.update(world_plan.extern_waited)
                 lockstep.extern_synchronous = list(world_plan.extern_synchronous)
-                launcher.on_reload = server.stop
+                launcher.stop_server = server.stop
                 launcher.find = self._find
+                launcher.worlds = worlds
                 print(server.ready_line, file=self.out, flush=True)
                 launcher.start_all()
                 server.run(signals=False)
                 launcher.end_all()
-                if not after_run(launcher.reload_requested, self.interrupted, server.core.quit_status):
+                if launcher.load_refused or not after_run(launcher.reload_requested, self.interrupted,
+                                                          server.core.quit_status):
                     break
                 launcher.reload_requested = False          # worldReload: the same file, time 0, the same endpoints
+                loaded = launcher.world_requested          # worldLoad: another file, its project's controllers
+                launcher.world_requested = None
+                if loaded is not None:
+                    self.world = loaded
+                    self.dirs = controller_dirs(self.world, list(self.options.controllers_dirs), self.projects)
                 again = dataclasses.replace(self.options.serve, rpc=server.transport.rpc_endpoint,
                                             pub=server.transport.pub_endpoint)
                 reopened = self._open(again)
@@ -982,7 +1052,7 @@ class ProjectRun:
                 if world_plan is None:
                     return 1
                 launcher.replan(list(world_plan.specs))
-                launcher.log(f"world reloaded from {self.world}")
+                launcher.log(f"world {'loaded' if loaded is not None else 'reloaded'} from {self.world}")
                 server = self._server = reopened
         finally:
             launcher.close()
@@ -991,7 +1061,7 @@ class ProjectRun:
         core = server.core
         self._say(f"sensorium: stopped at {core.sim.time_ms} ms after {core.lockstep.steps} steps")
         missing = {**self.missing, **launcher.failed}
-        status = exit_status(core.quit_status, bool(missing))
+        status = exit_status(core.quit_status, bool(missing), launcher.load_refused)
         if missing:
             names = ", ".join(f"'{robot}' ('{name}')" for robot, name in missing.items())
             self._say(f"sensorium run: {len(missing)} robot{'s' if len(missing) > 1 else ''} ran without the "

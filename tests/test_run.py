@@ -1,7 +1,7 @@
 """``sensorium run WORLD``: a Webots project of our own (worlds/ and controllers/ in a tmp folder)
 runs with one command: its named controllers are found and started as Webots starts them (their
 folder, their controllerArgs), their lines come out as ``[ROBOT] ...``, the world ends at ``--until``
-with every controller gone; restartController and worldReload restart them."""
+with every controller gone; restartController and worldReload restart them, worldLoad starts another world's."""
 
 from __future__ import annotations
 
@@ -145,6 +145,45 @@ def test_after_a_server_stops_the_run_reloads_or_ends_with_a_status(reload: bool
     assert launch.after_run(reload, interrupted, quit_status) is again
     assert launch.exit_status(quit_status) == status
     assert launch.exit_status(quit_status, missing=True) == status_missing
+    assert launch.exit_status(quit_status, load_refused=True) == status_missing
+
+
+def test_world_load_names_a_world_from_the_controllers_folder_inside_the_first_worlds_folder(tmp_path: Path) -> None:
+    """Webots takes worldLoad's relative name from the Supervisor's controller folder; `run` also keeps
+    the new world in the folder of the world it started with (a world from elsewhere would start
+    another project's controllers), and it must exist and be a world file."""
+    worlds = tmp_path / "worlds"
+    (worlds / "more").mkdir(parents=True)
+    folder = tmp_path / "controllers" / "boss"
+    folder.mkdir(parents=True)
+    for name in ("b.wbt", "more/c.yaml", "notes.txt"):
+        (worlds / name).write_text("")
+    elsewhere = tmp_path / "other" / "worlds"
+    elsewhere.mkdir(parents=True)
+    (elsewhere / "x.wbt").write_text("")
+    (worlds / "link.wbt").symlink_to(elsewhere / "x.wbt")
+    assert launch.world_to_load("../../worlds/b.wbt", folder, worlds) == worlds / "b.wbt"
+    assert launch.world_to_load(str(worlds / "more" / "c.yaml"), folder, worlds) == worlds / "more" / "c.yaml"
+    assert launch.world_to_load(str(worlds / "b.wbt"), None, worlds) == worlds / "b.wbt"   # an <extern> one: absolute
+    refused = {
+        "b.wbt": f"{folder / 'b.wbt'} is outside {worlds}, the folder of the world `sensorium run` started with (a "
+                 "world from elsewhere would start another project's controllers)",    # taken from the controller's
+        "../../worlds/gone.wbt": f"no world file {worlds / 'gone.wbt'}",
+        "../../worlds/notes.txt": f"{worlds / 'notes.txt'} is not a world file (.wbt; YAML or JSON: .yaml, .yml, .json)",
+        "../../other/worlds/x.wbt": f"{elsewhere / 'x.wbt'} is outside {worlds}, the folder of the world `sensorium "
+                                    "run` started with (a world from elsewhere would start another project's controllers)",
+        "../../worlds/link.wbt": f"{elsewhere / 'x.wbt'} is outside {worlds}, the folder of the world `sensorium "
+                                 "run` started with (a world from elsewhere would start another project's controllers)",
+        "": "no file named",
+    }
+    for name, why in refused.items():
+        with pytest.raises(LaunchError) as info:
+            launch.world_to_load(name, folder, worlds)
+        assert str(info.value) == why, name
+    with pytest.raises(LaunchError, match=r"^a relative name is taken from the controller's folder, and this robot's "
+                                          r"controller was not started by `sensorium run`: give the world file's "
+                                          r"absolute path$"):
+        launch.world_to_load("../../worlds/b.wbt", None, worlds)
 
 
 # ---------------------------------------------------------------------- running a project
@@ -381,12 +420,14 @@ def clib(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
     return build, libs
 
 
-def compile_controller(clib: tuple[Path, list[str]], folder: Path, name: str, source: str) -> None:
-    """controllers/NAME/NAME.c compiled to controllers/NAME/NAME against our libController."""
+def compile_controller(clib: tuple[Path, list[str]], folder: Path, name: str, source: str, language: str = "c") -> None:
+    """controllers/NAME/NAME.c (``language`` "cpp": NAME.cpp, our C++ layer) compiled to
+    controllers/NAME/NAME against our libController."""
     build, libs = clib
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / f"{name}.c").write_text(source)
-    done = subprocess.run(["cc", "-std=c99", "-Wall", "-Werror", f"-I{CLIB / 'include'}", str(folder / f"{name}.c"),
+    (folder / f"{name}.{language}").write_text(source)
+    compiler = ["c++", "-std=c++11"] if language == "cpp" else ["cc", "-std=c99"]
+    done = subprocess.run([*compiler, "-Wall", "-Werror", f"-I{CLIB / 'include'}", str(folder / f"{name}.{language}"),
                            "-o", str(folder / name), str(build / "libController.a"), *libs, "-lm"],
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
@@ -405,6 +446,139 @@ def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path, cli
     assert [line for line in proc.stdout().splitlines() if line.startswith("[boss]")] == [
         "[boss] boss starts (in C) at 0", "[boss] boss ends at 960", "[boss] boss starts (in C) at 0 after the reload",
         "[boss] boss ends at 1200"]
+
+
+LOADER = '''import os
+from controller import Supervisor
+boss = Supervisor()
+print("boss starts at", boss.getTime())
+os.chdir("/")          # Webots takes worldLoad's relative name from the controller's folder, not its cwd
+while boss.step(16) != -1:
+    if round(boss.getTime() * 1000) == 320:
+        boss.worldLoad({name!r})
+print("boss ends at", round(boss.getTime() * 1000))
+'''
+
+ONLY_B = '''from controller import Robot
+robot = Robot()
+print("only world b has", robot.getName(), "at", robot.getTime())
+steps = 0
+while robot.step(16) != -1:
+    steps += 1
+print(robot.getName(), "stepped", steps, "until", round(robot.getTime() * 1000))
+'''
+
+
+def world_b(tmp_path: Path, text: str = 'Robot { name "beta" controller "only_b" }') -> Path:
+    """worlds/b.wbt beside the project's w.wbt, its robot's controller only it names."""
+    path = tmp_path / "worlds" / "b.wbt"
+    path.write_text(WORLD.replace("{robots}", text))
+    (tmp_path / "controllers" / "only_b").mkdir(parents=True, exist_ok=True)
+    (tmp_path / "controllers" / "only_b" / "only_b.py").write_text(ONLY_B)
+    return path
+
+
+def test_world_load_ends_every_controller_and_starts_the_named_worlds(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\n'
+                              'Robot { name "boss" controller "boss" supervisor TRUE }',
+                    {"a.py": COUNTER.replace("{step}", "16"), "boss.py": LOADER.format(name="../../worlds/b.wbt")})
+    b = world_b(tmp_path)
+    proc = run(world, "--until", "640")
+    assert proc.wait() == 0, proc.stderr()
+    out = proc.stdout().splitlines()
+    # world w's controllers end at 320 (their next step answers -1); world b starts at time 0, its controller runs
+    assert "[boss] boss ends at 320" in out and "[alpha] alpha stepped 20 until 320" in out
+    assert "[beta] only world b has beta at 0.0" in out and "[beta] beta stepped 40 until 640" in out
+    assert [line.split(" rpc=")[0] for line in out if line.startswith("sensorium: serving world")] == [
+        "sensorium: serving world 'w'", "sensorium: serving world 'b'"]
+    # the same endpoints: an <extern> controller's URL stays good
+    assert len({line.split(" rpc=")[1] for line in out if line.startswith("sensorium: serving world")}) == 1
+    assert sum(line.startswith("[boss] boss starts") for line in out) == 1       # w's controllers do not start again
+    assert f"sensorium run: world loaded from {b}" in proc.stderr().splitlines()
+    assert proc.stderr().splitlines()[-1] == "sensorium: stopped at 640 ms after 40 steps"
+    for pid in pids(tmp_path / "controllers" / "a", "alpha"):
+        assert not alive(pid)
+
+
+def test_a_world_load_that_names_no_world_is_one_line_and_the_run_ends_with_1(tmp_path: Path) -> None:
+    """As Webots opens an empty world when worldLoad's file cannot be opened, where nothing runs: one
+    line naming the file and why, every controller ends, exit status 1."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\n'
+                              'Robot { name "boss" controller "boss" supervisor TRUE }',
+                    {"a.py": COUNTER.replace("{step}", "16"), "boss.py": LOADER.format(name="../../worlds/gone.wbt")})
+    proc = run(world, "--until", "640")
+    assert proc.wait() == 1, proc.stderr()
+    assert "[boss] boss ends at 320" in proc.stdout().splitlines()
+    err = [line for line in proc.stderr().splitlines() if "Traceback" in line or "worldLoad" in line]
+    assert err == [f"sensorium run: robot 'boss': worldLoad('../../worlds/gone.wbt'): no world file "
+                   f"{tmp_path / 'worlds' / 'gone.wbt'}: the simulation ends (Webots opens an empty world)"]
+    assert proc.stderr().splitlines()[-1] == "sensorium: stopped at 320 ms after 20 steps"
+    assert sum(line.startswith("sensorium: serving world") for line in proc.stdout().splitlines()) == 1
+
+
+def test_a_world_load_of_a_file_that_does_not_load_is_its_line_and_exit_1(tmp_path: Path) -> None:
+    world = project(tmp_path, 'Robot { name "boss" controller "boss" supervisor TRUE }',
+                    {"boss.py": LOADER.format(name="../../worlds/b.wbt")})
+    b = world_b(tmp_path, 'Robot { name "beta" controller "only_b"')       # its closing brace missing
+    proc = run(world, "--until", "640")
+    assert proc.wait() == 1, proc.stderr()
+    assert "[boss] boss ends at 320" in proc.stdout().splitlines()
+    assert proc.stderr().splitlines()[-1] == (f"{b}: line 4, column 1: expected a field name or '}}' in Robot (line 3), "
+                                              "found end of file")
+    assert "Traceback" not in proc.stderr() and "[beta]" not in proc.stdout()
+
+
+C_LOADER = r'''#include <math.h>
+#include <stdio.h>
+#include <webots/robot.h>
+#include <webots/supervisor.h>
+
+int main(void) {
+  wb_robot_init();
+  wb_supervisor_world_load("");
+  while (wb_robot_step(16) != -1) {
+    if (lround(wb_robot_get_time() * 1000) == 320)
+      wb_supervisor_world_load("../../worlds/b.wbt");
+  }
+  printf("C boss ends at %ld\n", lround(wb_robot_get_time() * 1000));
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+CPP_LOADER = r'''#include <cmath>
+#include <cstdio>
+#include <webots/Supervisor.hpp>
+
+int main() {
+  webots::Supervisor boss;
+  boss.worldLoad("");
+  while (boss.step(16) != -1) {
+    if (std::lround(boss.getTime() * 1000) == 320)
+      boss.worldLoad("../../worlds/b.wbt");
+  }
+  std::printf("C++ boss ends at %ld\n", std::lround(boss.getTime() * 1000));
+  return 0;
+}
+'''
+
+
+@pytest.mark.parametrize("language", ["c", "cpp"])
+def test_c_and_cpp_world_load_start_the_named_worlds_controllers(tmp_path: Path, clib: tuple[Path, list[str]],
+                                                                 language: str) -> None:
+    world = project(tmp_path, 'Robot { name "boss" controller "boss" supervisor TRUE }', {})
+    compile_controller(clib, tmp_path / "controllers" / "boss", "boss", C_LOADER if language == "c" else CPP_LOADER,
+                       language)
+    world_b(tmp_path)
+    proc = run(world, "--until", "640")
+    assert proc.wait() == 0, proc.stderr()
+    out = proc.stdout().splitlines()
+    assert f"[boss] {'C' if language == 'c' else 'C++'} boss ends at 320" in out
+    assert "[beta] only world b has beta at 0.0" in out and "[beta] beta stepped 40 until 640" in out
+    # Webots' line for an empty name, nothing done
+    assert "[boss] Error: wb_supervisor_world_load() called with NULL or empty 'filename' argument." in \
+        proc.stderr().splitlines()
 
 
 C_NAMER = r'''#include <stdio.h>
@@ -497,12 +671,13 @@ boss = Supervisor()
 boss.step(16)
 boss.getFromDef("ALPHA").restartController()
 boss.worldReload()
+boss.worldLoad("w.wbt")
 boss.getSelf().restartController()
 print("still at", round(boss.getTime() * 1000))
 '''
 
 
-def test_under_serve_restart_and_reload_are_one_line_each_and_change_nothing(tmp_path: Path) -> None:
+def test_under_serve_restart_reload_and_load_are_one_line_each_and_change_nothing(tmp_path: Path) -> None:
     """Controllers you start yourself (`sensorium serve`) cannot be started again by the server."""
     world = project(tmp_path, 'DEF ALPHA Robot { name "alpha" controller "a" }\n'
                               'Robot { name "boss" controller "<extern>" supervisor TRUE }', {"boss.py": UNDER_SERVE})
@@ -514,6 +689,8 @@ def test_under_serve_restart_and_reload_are_one_line_each_and_change_nothing(tmp
         "an <extern> controller is restarted by whoever started it.",
         "Error: wb_supervisor_world_reload(): world_reload: only `sensorium run` reloads a world (it starts the "
         "controllers again).",
+        "Error: wb_supervisor_world_load(): world_load: only `sensorium run` loads another world (it starts the "
+        "new world's controllers).",
         "Error: wb_supervisor_node_restart_controller(): restart_controller: only `sensorium run` starts controllers; "
         "an <extern> controller is restarted by whoever started it."]
 

@@ -1,6 +1,7 @@
 """``sensorium run WORLD``: the argparse shell over :mod:`sensorium.launch`: serve the world and start
 every robot's named controller with it, as Webots opens a project; restart them on
-``restartController``, reload on ``worldReload``; end them all at ``--until``, Ctrl-C or SIGTERM."""
+``restartController``, reload on ``worldReload``, load another world on ``worldLoad``; end them all at
+``--until``, Ctrl-C or SIGTERM."""
 
 from __future__ import annotations
 

@@ -1209,6 +1209,23 @@ def wb_supervisor_world_reload() -> None:
         _launcher_call(r, "world_reload", None, func)
 
 
+def wb_supervisor_world_load(filename: str) -> None:
+    """Webots' worldLoad, under ``sensorium run``: the simulation ends (every controller's steps, this
+    one's too, return -1), ``filename`` loads (relative to this controller's folder, as in Webots; within
+    the folder of the world ``run`` started with) and its controllers start. A name that gives no world
+    is one line of ``run``'s and the run ends (exit 1). Under ``sensorium serve`` one error line, nothing done."""
+    import os
+
+    func = "wb_supervisor_world_load"
+    r = _supervisor(func)
+    if r is None:
+        return
+    if not filename or not isinstance(filename, str | os.PathLike):
+        print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
+        return
+    _launcher_call(r, "world_load", {"filename": os.fspath(filename)}, func)
+
+
 def wb_supervisor_world_save(filename: str | None = None) -> bool:
     """Webots' ``worldSave``: the world as it is now (README "Supervisor": what is written) saved as ``filename``
     (a ``.wbt`` file; relative to the controller's folder, as every file a controller writes), through a

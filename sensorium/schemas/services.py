@@ -414,6 +414,14 @@ class SimulationQuitArgs(Args):
     status: int = Field(ge=-2**31, le=2**31 - 1, description="the exit status of `sensorium run`/`serve` (Webots': its own)")
 
 
+class WorldLoadArgs(Args):
+    """``wb_supervisor_world_load``: the world ``sensorium run`` loads next."""
+
+    filename: str = Field(min_length=1, max_length=4096, description=(
+        "the world file, relative to the calling controller's folder (Webots' rule); within the folder of the world "
+        "`sensorium run` was started with"))
+
+
 class SetLabelArgs(Args):
     """``wb_supervisor_set_label``: a text over the exported picture (README 'Supervisor')."""
 
@@ -1125,6 +1133,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("reset_physics", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("restart_controller", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("world_reload", "robot", NoArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("world_load", "robot", WorldLoadArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_quit", "robot", SimulationQuitArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_set_mode", "robot", SimulationModeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),

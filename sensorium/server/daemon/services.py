@@ -119,7 +119,8 @@ class Core(DeviceServices):
         self.pub_endpoint = pub_endpoint
         self.max_request = max_request
         self.open_controls = open_controls       # world-wide controls for any caller (roles.py)
-        # ``sensorium run``'s controller launcher (restart(robot), reload()): restartController and worldReload
+        # ``sensorium run``'s controller launcher (restart(robot), reload(), load(robot, filename)):
+        # restartController, worldReload and worldLoad
         self.launcher: Any = None
         # simulationQuit: its status (the server's exit status; the first call counts) and how the
         # server is stopped (Server sets it to its transport's stop)
@@ -854,6 +855,15 @@ class Core(DeviceServices):
             raise ServiceError(ErrorCode.WRONG_STATE, "world_reload: only `sensorium run` reloads a world (it "
                                                       "starts the controllers again)")
         self.launcher.reload()
+        return {"success": True}
+
+    def _robot_world_load(self, c: Call) -> dict:
+        """Webots' worldLoad: ``sensorium run`` stops this simulation (every step answers -1), loads the
+        named world (or says in one line why it cannot and ends) and starts its controllers."""
+        if self.launcher is None:
+            raise ServiceError(ErrorCode.WRONG_STATE, "world_load: only `sensorium run` loads another world (it "
+                                                      "starts the new world's controllers)")
+        self.launcher.load(c.robot, c.args.filename)
         return {"success": True}
 
     def _robot_simulation_quit(self, c: Call) -> dict:

@@ -589,6 +589,33 @@ void wb_supervisor_world_reload(void) {
   sn_reply_free(&rep);
 }
 
+static void args_filename(sn_req *r, const void *arg) {
+  sn_req_key(r, "filename");
+  sn_req_str(r, (const char *)arg);
+}
+
+/* Webots' worldLoad, served under `sensorium run`: the simulation ends (every step -1) and run loads
+   filename (relative to the controller's folder, as in Webots) and starts its controllers; a name that
+   gives no world is one line of run's and the run ends (exit 1). */
+void wb_supervisor_world_load(const char *filename) {
+  const char *func = "wb_supervisor_world_load";
+  sn_robot *rb = supervisor(func);
+  if (rb == NULL)
+    return;
+  if (filename == NULL || filename[0] == '\0') {
+    fprintf(stderr, "Error: %s() called with NULL or empty 'filename' argument.\n", func);
+    return;
+  }
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/world_load", 1, args_filename, filename, func, &rep) != 0)
+    return;
+  sn_reply_free(&rep);
+}
+
+void wb_supervisor_load_world(const char *filename) {
+  wb_supervisor_world_load(filename);
+}
+
 /* Webots' worldSave: the world as it is now written to filename (a .wbt file, relative to the
    controller's folder) through a temporary file beside it renamed onto it. Without a filename Webots
    overwrites the world file it loaded: here one line and false (a headless server never overwrites its

@@ -12,12 +12,6 @@
 /* every function here ignores its arguments (it answers Webots' "no value") */
 #pragma GCC diagnostic ignored "-Wunused-parameter"
 
-void wb_supervisor_world_load(const char *filename) {
-  SN_UNSUPPORTED();
-}
-
-
-
 void wb_supervisor_movie_start_recording(const char *filename, int width, int height, int codec, int quality, int acceleration, bool caption) {
   SN_UNSUPPORTED();
 }
@@ -102,11 +96,6 @@ int wb_supervisor_movie_get_status(void) {
 void wb_supervisor_simulation_revert(void) {
   SN_UNSUPPORTED();
 }
-
-void wb_supervisor_load_world(const char *filename) {
-  SN_UNSUPPORTED();
-}
-
 
 void wb_supervisor_field_remove_mf_node(WbFieldRef field, int position) {
   SN_UNSUPPORTED();

@@ -528,6 +528,9 @@ class Supervisor(Robot):
     def worldReload(self) -> None:
         wb.wb_supervisor_world_reload()
 
+    def worldLoad(self, filename: str) -> None:
+        wb.wb_supervisor_world_load(filename)
+
     simulation_mode = property(simulationGetMode, simulationSetMode)
 
     def simulationQuit(self, status: int) -> None:
@@ -587,7 +590,6 @@ _NAN = math.nan
 _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
     Supervisor: {
         "getSelected": ("node_get_selected", None, ""),
-        "worldLoad": ("world_load", None, "filename"),
         "movieStartRecording": ("movie_start_recording", None,
                                 "filename, width, height, codec, quality, acceleration, caption"),
         "movieStopRecording": ("movie_stop_recording", None, ""), "movieIsReady": ("movie_is_ready", True, ""),
