@@ -101,6 +101,67 @@ def test_every_copy_captures_its_cameras_as_the_single_simulation(precision: str
     assert len({img.tobytes() for img in eye}) == len(seeds)
 
 
+def _effects(seed: int, base: Path) -> LoadedWorld:
+    """The camera world with motion blur and noise masks: the planar "eye" (noise, anti-aliasing)
+    both, the housed one a mask only (no colour noise: its stream draws only the offsets), the
+    cylindrical and spherical ones blur only (Webots masks planar cameras only); the mask a seeded
+    5 x 7 RGBA image of varied alpha written next to the world (given unchecked, as the other
+    textures here: each camera reads and checks it when built, cameras.noise_mask_planes)."""
+    from PIL import Image
+
+    texels = np.random.default_rng(11).integers(0, 256, (7, 5, 4), dtype=np.uint8)
+    Image.fromarray(texels, "RGBA").save(base / "noise_mask.png")
+    lw = _world(seed, base)
+    fx = {"eye": {"motion_blur": 100.0, "noise_mask_url": "noise_mask.png"}, "housed": {"noise_mask_url": "noise_mask.png"},
+          "pano": {"motion_blur": 60.0}, "dome": {"motion_blur": 30.0}}
+    robots = [r.model_copy(update={"devices": [d.model_copy(update=fx[d.name]) for d in r.devices]})
+              for r in lw.world.robots]
+    w = wm.World.model_validate(lw.world.model_copy(update={"robots": robots}).model_dump())
+    return LoadedWorld(world=w, source=lw.source, base_dir=base)     # unchecked: the cameras read the mask
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_every_copy_blurs_and_masks_its_cameras_as_the_single_simulation(precision: str, texture_dir: Path):
+    """The driving copies with motion blur and noise masks: each copy keeps its own last mixed
+    radiance (its first image, and its first after a reset, itself), mixes at the weight of its own
+    sampling period (copy 2's eye changes period on the way), and draws its mask's two offsets per
+    image from its own camera stream after its image's colour noise: after every basic step every
+    image of every copy equals its Simulation's, byte for byte."""
+    seeds = [5, 6, 7]
+
+    def make(seed: int) -> LoadedWorld:
+        return _effects(seed, texture_dir)
+
+    bs, sims = copies_and_singles(make, seeds, precision, PERIODS)
+    rng = np.random.default_rng(4)
+    for step in range(60):
+        if step % 10 == 0:
+            steer_randomly(bs, sims, rng, PERIODS)
+        if step == 20:
+            bs.enable(bs.device("rover", "eye"), 48, copies=[2])
+            sims[2].robot("rover").device("eye").enable(48)
+        if step == 35:                          # copy 1 as a new world with another seed
+            reseed_copy(bs, sims, make, 1, 42, precision, PERIODS)
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot, names in PERIODS.items():
+                for n in names:
+                    want = s.robot(robot).device(n).image
+                    got = bs.image(bs.device(robot, n))[c]
+                    assert want.tobytes() == got.tobytes(), (step, c, robot, n, np.abs(want.astype(int) - got).max())
+    # the effects are there: the same copy's images without them differ (mask offsets: every image)
+    plain = Simulation(_world(5, texture_dir), precision=precision)
+    masked = Simulation(make(5), precision=precision)
+    for s in (plain, masked):
+        s.robot("rover").device("housed").enable(16)
+        s.step()
+    assert plain.robot("rover").device("housed").image.tobytes() != masked.robot("rover").device("housed").image.tobytes()
+    # each copy's mask offsets are its own stream's: the housed (noiseless) camera differs between copies
+    housed = bs.image(bs.device("rover", "housed"))
+    assert len({img.tobytes() for img in housed}) == len(seeds)
+
+
 def test_the_rays_skipping_their_robot_never_meet_it(texture_dir: Path):
     """batched_depth.may_meet_parts (a camera's rays that may meet one of its robot's shapes; the
     others skip that robot in every copy's cast): 4,000 random rays from inside the rover's box (its

@@ -65,6 +65,46 @@ def test_every_copy_captures_its_range_finders_as_the_single_simulation(precisio
     assert len({img.tobytes() for img in depth}) == len(seeds)
 
 
+def _blurred(seed: int) -> LoadedWorld:
+    """depth.yaml with motion blur on every range finder (the rover's planar one also noisy and
+    quantised, its cylindrical and housed ones, the scout's spherical one), at different lengths."""
+    lw = _world(seed)
+    blur = {"depth": 60.0, "wide": 200.0, "housed": 40.0, "eye": 100.0}
+    robots = [r.model_copy(update={"devices": [d.model_copy(update={"motion_blur": blur[d.name]}) for d in r.devices]})
+              for r in lw.world.robots]
+    return LoadedWorld(world=lw.world.model_copy(update={"robots": robots}), source=lw.source, base_dir=lw.base_dir)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_every_copy_blurs_its_range_images_as_the_single_simulation(precision: str):
+    """The driving copies with motion blur on every range finder: each copy keeps its own blurred
+    values (+inf before its first image and again after its reset) and mixes them at the weight of
+    its own sampling period (copy 2's planar one changes period on the way), before its own noise:
+    after every basic step every image of every copy equals its Simulation's, bit for bit."""
+    seeds = [5, 6, 7]
+    bs, sims = copies_and_singles(_blurred, seeds, precision, PERIODS)
+    rng = np.random.default_rng(2)
+    moved = 0
+    for step in range(70):
+        if step % 10 == 0:
+            steer_randomly(bs, sims, rng, PERIODS)
+        if step == 25:                          # one copy's planar range finder at another period
+            bs.enable(bs.device("rover", "depth"), 48, copies=[2])
+            sims[2].robot("rover").device("depth").enable(48)
+        if step == 40:                          # copy 1 as a new world with another seed
+            reseed_copy(bs, sims, _blurred, 1, 42, precision, PERIODS)
+        bs.step()
+        for c, s in enumerate(sims):
+            s.step()
+            for robot, names in PERIODS.items():
+                for n in names:
+                    want = s.robot(robot).device(n).range_image
+                    got = bs.range_image(bs.device(robot, n))[c]
+                    assert want.tobytes() == got.tobytes(), (step, c, robot, n)
+            moved += int(np.isfinite(s.robot("rover").device("wide")._blurred).any())
+    assert moved > 100          # (the single devices blur: a batched copy that did not would differ)
+
+
 def _facing(d: list[float], projection: str, noise: float = 0.0) -> wm.World:
     """A robot without a body whose range finder (11 x 5 pixels, at the robot's origin, 0.1 m up)
     faces a wide wall whose face is the plane x = 2."""

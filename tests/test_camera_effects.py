@@ -2,10 +2,14 @@
 forms: a static scene is a fixed point of the blur, a light switched on and off gives the blend
 sequence ``R ← L(1 − w) + R w`` with ``w = 0.005^(period/motionBlur)``, a uniform mask mixes its colour
 over every pixel by its alpha, a checker mask is read bilinearly at the offsets the camera's stream
-draws; a bad mask file is one problem naming the field; the batched camera refuses both."""
+draws; a bad mask file is one problem naming the field. A RangeFinder's motion blur: a wall that
+jumps from d1 to d2 gives the blend sequence on the depths, an infinite value (new or last) is not
+mixed, the noise is drawn after the blur and never fed back. The batched simulation's copies with
+either effect: tests/test_batched_camera.py and test_batched_depth.py."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -237,16 +241,6 @@ def test_the_cli_names_a_bad_noise_mask_in_one_line(tmp_path):
     assert "Traceback" not in out.stderr
 
 
-def test_the_batched_simulation_refuses_them_in_one_line(tmp_path):
-    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
-
-    url = _mask(tmp_path, "m.png", np.zeros((2, 2, 4)))
-    for cam, field in (({"motion_blur": 50.0}, "motion_blur"), ({"noise_mask_url": url}, "noise_mask_url")):
-        w = parse_world(world_dict(cam), base_dir=tmp_path)
-        with pytest.raises(BatchedError, match=f"camera 'cam' sets {field}, which the batched simulation does not draw"):
-            BatchedSimulation(w, copies=2)
-
-
 def test_a_wbt_camera_keeps_motion_blur_and_its_noise_mask(tmp_path):
     from sensorium.server.world.loader import load_world
 
@@ -267,3 +261,92 @@ def test_a_wbt_camera_keeps_motion_blur_and_its_noise_mask(tmp_path):
     (tmp_path / "out").mkdir()
     data = converted_world(tmp_path / "w.wbt", tmp_path / "out")
     assert data["robots"][0]["devices"][0]["noise_mask_url"] == "../noise.png"
+
+
+# ------------------------------------------------------------------ a range finder's motion blur
+
+def ranging(rf: dict, twin: dict | None = None) -> Simulation:
+    """A robot at the origin whose planar range finder "rf" (5 x 3 pixels, max_range 5) faces the
+    wall's near face, the plane x = 1.95; ``twin``: a second one, "twin", beside it."""
+    devs = [{"device": "RangeFinder", "name": "rf", "width": 5, "height": 3, "field_of_view": 0.6, "max_range": 5.0,
+             **rf}]
+    if twin is not None:
+        devs.append({**devs[0], "name": "twin", **twin})
+    return Simulation(wm.World.model_validate(
+        {"world_info": {"basic_time_step": 16, "random_seed": 5}, "solids": [WALL],
+         "robots": [{"name": "r", "devices": devs}]}))
+
+
+def test_a_range_finder_seeing_a_wall_jump_gives_the_blend_sequence():
+    # planar depth: every pixel reads the wall's distance, 1.95 m, then 1.2 m once the robot is put
+    # 0.75 m nearer: B <- d2 (1 - w) + B w from B = d1, w = 0.005^(16/100) per 16 ms image
+    sim = ranging({"motion_blur": 100.0})
+    rf = sim.device("r/rf")
+    rf.enable(16)
+    sim.run(1)
+    np.testing.assert_allclose(rf.range_image, 1.95, rtol=1e-6)          # the first image: itself
+    sim.robot("r").set_pose([0.75, 0.0, 0.0])
+    w = 0.005 ** (16 / 100)
+    B = 1.95
+    for k in range(12):
+        sim.run(1)
+        B = 1.2 * (1 - w) + B * w
+        np.testing.assert_allclose(rf.range_image, np.full((3, 5), B), rtol=1e-6, err_msg=str(k))
+    assert abs(B - 1.2) < 0.01 * 0.75                 # within 1% of the jump after 12 images (> 100 ms)
+    # back: the sequence from where it stands towards d1
+    sim.robot("r").set_pose([0.0, 0.0, 0.0])
+    sim.run(1)
+    np.testing.assert_allclose(rf.range_image, 1.95 * (1 - w) + B * w, rtol=1e-6)
+
+
+def test_an_infinite_range_is_not_mixed_by_the_motion_blur():
+    # a twin without blur gives the exact values; facing away (nothing within max_range: +inf) the
+    # blurred image is +inf at once, and facing the wall again it is the wall's depth at once, bit for
+    # bit the twin's (motion_blur.frag passes an infinite value, new or last, through as the new one)
+    sim = ranging({"motion_blur": 500.0}, twin={"motion_blur": 0.0})
+    rf, twin = sim.device("r/rf"), sim.device("r/twin")
+    rf.enable(16)
+    twin.enable(16)
+    sim.run(3)
+    assert rf.range_image.tobytes() == twin.range_image.tobytes()
+    sim.robot("r").set_pose([0.75, 0.0, 0.0])
+    sim.run(1)
+    assert (rf.range_image > twin.range_image).all()          # blurred: between 1.95 and 1.2
+    sim.robot("r").set_pose(rotation=[0, 0, 1, math.pi])
+    sim.run(1)
+    assert np.isposinf(rf.range_image).all() and np.isposinf(twin.range_image).all()
+    sim.robot("r").set_pose(rotation=[0, 0, 1, 0.0])
+    sim.run(1)
+    assert rf.range_image.tobytes() == twin.range_image.tobytes()
+    np.testing.assert_allclose(rf.range_image, 1.2, rtol=1e-6)
+
+
+def test_the_range_noise_is_drawn_after_the_blur_and_not_fed_back():
+    # a static wall with noise (sigma 0.02 x 5 m): the blurred values stay the wall's depth (a fixed
+    # point), so each image is that depth plus the device's own stream's draws, as without the blur
+    # (the same seed and device name); noise fed back into the blur would move them by ~0.1 m
+    blurred, plain = ranging({"motion_blur": 300.0, "noise": 0.02}), ranging({"noise": 0.02})
+    for s in (blurred, plain):
+        s.device("r/rf").enable(16)
+    rng = device_rng(5, "r/rf")
+    for _ in range(6):
+        blurred.run(1)
+        plain.run(1)
+        a, b = blurred.device("r/rf").range_image, plain.device("r/rf").range_image
+        np.testing.assert_allclose(a, b, rtol=1e-6)
+        np.testing.assert_allclose(a, 1.95 + 0.1 * rng.standard_normal(15).reshape(3, 5), rtol=1e-6)
+    assert np.std(a) > 0.02
+
+
+def test_a_wbt_range_finder_keeps_its_motion_blur(tmp_path):
+    from sensorium.server.world.loader import load_world
+
+    (tmp_path / "w.wbt").write_text(
+        "#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\nViewpoint { }\n"
+        'Robot { name "r" children [ RangeFinder { name "rf" motionBlur 40 } ] }\n')
+    loaded = load_world(tmp_path / "w.wbt")
+    assert loaded.world.robots[0].devices[0].motion_blur == 40.0
+    assert not [w for w in loaded.warnings if "motionBlur" in w]
+    with pytest.raises(ValueError, match="greater than or equal to 0"):
+        wm.World.model_validate({"robots": [{"name": "r", "devices": [{"device": "RangeFinder", "name": "rf",
+                                                                        "motion_blur": -5}]}]})

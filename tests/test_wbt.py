@@ -1109,17 +1109,18 @@ def test_camera_fields_the_renderer_uses_and_rays_do_not_are_said(tmp_path: Path
     """Motion blur and the other image effects of Webots' renderer (README: what a rasterising GPU
     gives that this does not) were dropped from a .wbt camera without a word; each one a world
     writes (with a value that does something in Webots) is now one warning. The lens is read
-    (tests/test_lens.py), not said, and so is a camera's motion blur (tests/test_camera_effects.py);
-    a range finder's is said."""
+    (tests/test_lens.py), not said, and so is a camera's and a range finder's motion blur
+    (tests/test_camera_effects.py); a camera's bloom is said."""
     p = write(tmp_path, 'Robot { name "r" children [\n'
               'Camera { lens Lens { radialCoefficients 0.2 0 } motionBlur 100 bloomThreshold -1 zoom NULL }\n'
-              'RangeFinder { motionBlur 40 }\n] }\n')
+              'RangeFinder { motionBlur 40 }\n'
+              'Camera { name "bright" bloomThreshold 10 }\n] }\n')
     w = load_world(p)
     assert w.warnings == [
-        f"{p}:4:1: RangeFinder 'range-finder' of robot 'r': {field} is not rendered here; the image is Webots' "
-        "without it" for field in ("motionBlur (motion blur)",)]
+        f"{p}:5:1: Camera 'bright' of robot 'r': {field} is not rendered here; the image is Webots' "
+        "without it" for field in ("bloomThreshold (bloom)",)]
     assert w.world.robots[0].devices[0].lens == wm.Lens(radial_coefficients=(0.2, 0.0))
-    assert w.world.robots[0].devices[0].motion_blur == 100.0
+    assert [d.motion_blur for d in w.world.robots[0].devices] == [100.0, 40.0, 0.0]
 
 
 def test_a_robots_battery_and_a_charger_are_said(tmp_path: Path) -> None:

@@ -986,6 +986,10 @@ class RangeFinder(_Imager):
     max_range: float = Field(default=1.0, gt=0.0)
     noise: float = Field(default=0.0, ge=0.0, description="σ of the Gaussian noise as a fraction of max_range")
     resolution: float = -1.0
+    motion_blur: float = Field(default=0.0, ge=0.0, description="ms a pixel takes to reach 99.5% of a new range "
+                               "(Webots' motionBlur): each image mixes its values with the previous image's, the "
+                               "previous one weighing 0.005^(sampling period / motion_blur), before the noise; an "
+                               "infinite value (new or previous) is not mixed; 0: off")
     _what: ClassVar[str] = "range finder"
 
 

@@ -49,7 +49,10 @@ Range values (``range_image``)
     ``planar``: the depth along +x (the distance to the plane x = 0 of the device, Webots' reference
     page), i.e. ``t·cos`` of the ray with +x; the other projections: the distance ``t`` along the
     ray (the merge shader's depth/cosine). Then Webots' steps, as for the lidar: no hit,
-    ``v < minRange`` or ``v >= maxRange`` → ``+inf``; Gaussian noise σ = ``noise·maxRange``
+    ``v < minRange`` or ``v >= maxRange`` → ``+inf``; with ``motionBlur`` (Webots' motion blur pass,
+    before the noise): ``B ← v·(1 − w) + B·w``, ``w = 0.005^(period/motionBlur)``, where both ``v``
+    and the last image's ``B`` are finite, else ``B ← v`` (the pass lets an infinite value, new or
+    last, through as the new one: the first image is itself); Gaussian noise σ = ``noise·maxRange``
     (reference manual) on each finite value; ``resolution`` rounding ``floor(v/res + ½)·res``; the
     bounds again (noise or rounding can push a value out, never in); float32.
 """
@@ -58,6 +61,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -298,10 +302,14 @@ def clip_limits(g: ImageGeometry, factors: np.ndarray | None, near: float, far: 
 
 
 def range_values(distances: np.ndarray, factors: np.ndarray | None, min_range: float, max_range: float,
-                 noise: float, resolution: float, rng: np.random.Generator | None) -> np.ndarray:
+                 noise: float, resolution: float, rng: np.random.Generator | None,
+                 blur: tuple[np.ndarray, Any] | None = None) -> np.ndarray:
     """The range image (float32, shape of ``distances``) from the hit distances (``+inf`` = no hit)
-    and :func:`depth_factors` (module docstring: validity, noise σ = ``noise·max_range``, resolution,
-    bounds). ``rng`` None: no noise."""
+    and :func:`depth_factors` (module docstring: validity, motion blur, noise σ = ``noise·max_range``,
+    resolution, bounds). ``rng`` None: no noise. ``blur``: motion blur, ``(B, w)``: the last image's
+    blurred values (float64, shape of ``distances``; ``+inf`` before the first image), replaced in
+    place by this one's, and the last image's weight ``w`` (a number, or one per leading row that
+    broadcasts: a batch of copies' images)."""
     d = np.asarray(distances, dtype=np.float64)
     with np.errstate(invalid="ignore"):
         v = d if factors is None else d * np.asarray(factors).reshape(d.shape)
@@ -309,6 +317,12 @@ def range_values(distances: np.ndarray, factors: np.ndarray | None, min_range: f
     noisy = noise > 0.0 and rng is not None
     with np.errstate(invalid="ignore", over="ignore"):
         valid = np.isfinite(v) & (v >= lo) & (v < hi)
+        if blur is not None:       # motion_blur.frag on the depth texture: a mix where both are finite
+            last, w = blur
+            v = np.where(valid, v, np.inf)
+            mixed = v * (1.0 - w) + last * w
+            v = np.where(valid & np.isfinite(last), mixed, v)
+            last[...] = v
         if not noisy and resolution == RESOLUTION_OFF:
             out = v.astype(np.float32)
             out[~valid | (out >= np.float32(hi))] = np.inf     # a value just below maxRange may round up to it

@@ -222,6 +222,17 @@ class NoiseStreams:
             k += m
         return out
 
+    def stream(self, c: int, d: int) -> np.random.Generator:
+        """The (copy, device) stream itself, for a device that draws other numbers between its
+        normals (a camera's noise-mask offsets, uniforms): created without a block drawn ahead, so
+        that :func:`batched_depth.draw` then takes every normal from it directly, in the single
+        device's order. It must be the stream's first use since a reseed, or all its uses such."""
+        rng = self.rngs[c][d]
+        if rng is None:
+            rng = self.rngs[c][d] = device_rng(self.seeds[c], self.paths[d])
+        assert self.cursor[c, d] >= self.block, "a stream drawn ahead cannot interleave other draws"
+        return rng
+
 
 class BatchedSimulation:
     """``copies`` independent copies of a world stepped together (see the module docstring)."""
@@ -428,14 +439,6 @@ class BatchedSimulation:
                                f"simulation lays no ink, so {readers[0][0]}/{readers[0][1]} would not see it (use "
                                "Simulation, or the pen's write: false)")
 
-        # a camera's image effects that carry state from image to image (its previous image, its
-        # stream's offsets) are the single simulation's: the batched camera does not draw them
-        effects = [(r.name, d.name, f) for r in w.robots for d in r.devices if d.device == "Camera"
-                   for f, on in (("motion_blur", d.motion_blur > 0), ("noise_mask_url", bool(d.noise_mask_url))) if on]
-        if effects:
-            raise BatchedError(f"{self.loaded.source}: robot {effects[0][0]!r}: camera {effects[0][1]!r} sets "
-                               f"{effects[0][2]}, which the batched simulation does not draw (use Simulation)")
-
     def _build_devices(self) -> None:
         C = self.copies
         self.refs: dict[tuple[int, str], DeviceRef] = {}
@@ -480,7 +483,7 @@ class BatchedSimulation:
             for k, d in enumerate(devs):
                 table = getattr(d, "table", None)
                 if ((table is not None and table.has_noise) or float(getattr(d.config, "noise", 0.0) or 0.0) > 0.0
-                        or kin.draws_noise(d.config)):
+                        or kin.draws_noise(d.config) or bool(getattr(d.config, "noise_mask_url", ""))):
                     cols[k] = self._noise_col[(kind_name, k)] = len(paths)
                     paths.append(d.path)
             self._noise_of[kind_name] = cols

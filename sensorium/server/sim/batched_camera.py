@@ -22,7 +22,9 @@ with semi-transparent surfaces each copy's image is composited as the single cam
 (``Camera._render``'s layers, from the copies' first cast): the rays going on past a surface are
 cast for that copy alone, from its camera with per-ray limits. Noise: each (copy, camera) draws its
 own stream (``device_rng(seed, "robot/camera")``), one standard normal per byte of RGB in C order,
-as ``shading.to_bytes`` draws it.
+as ``shading.to_bytes`` draws it. Motion blur and a noise mask (``_finish_copies``): each copy keeps
+its own last mixed radiance and draws its mask's offsets from its own camera stream after its
+image's noise, as the single camera does; such a camera's images are resolved copy by copy.
 
 A textured robot body's texels are looked up per copy at that copy's pose of the shape
 (batched_textures.py). Lights carried by robots (batched_lights.py) light only their own copy: in such a world each copy's
@@ -44,7 +46,7 @@ from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
-from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite
+from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite, masked, noise_mask_planes
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import _base_color, receives_shadows, robot_parts, surface_colors, surface_opacity
 
@@ -113,6 +115,9 @@ class _Device:
         self.own: OwnBodyRays | None = None
         self.skip: np.ndarray | int | None = None
         self.plan: tuple | None = None
+        self.mask: np.ndarray | None = None          # the noise mask's planes (cameras.noise_mask_planes)
+        self.blurred: np.ndarray | None = None       # motion blur: each copy's last mixed radiance (C, M, 3)
+        self.started = np.zeros(0, dtype=bool)       # ... and whether it has made its first image
 
 
 def own_body_hits(pixels: PixelDevices, col: int, copies: np.ndarray, h: RayHits) -> RayHits:
@@ -145,6 +150,12 @@ class CameraDevices(PixelDevices):
     def __init__(self, sim: Any, devices: list[BatchedCamera]):
         super().__init__(sim, [_Device(d) for d in devices])
         self.images = [np.zeros((sim.copies, d.height, d.width, 4), dtype=np.uint8) for d in self.devices]
+        for d in self.devices:      # the effects carried from image to image: each copy's own (_finish_copies)
+            cfg = d.template.config
+            d.mask = noise_mask_planes(sim.scene, cfg.noise_mask_url)
+            if cfg.motion_blur > 0:
+                d.blurred = np.zeros((sim.copies, d.height * d.width, 3))
+                d.started = np.zeros(sim.copies, dtype=bool)
         for img in self.images:
             img[..., 3] = 255
         scene = sim.scene
@@ -177,6 +188,10 @@ class CameraDevices(PixelDevices):
         for img in self.images:
             img[idx] = 0
             img[idx, :, :, 3] = 255
+        for d in self.devices:
+            if d.blurred is not None:      # the next image is the first again: itself
+                d.blurred[idx] = 0.0
+                d.started[idx] = False
 
     # -- planning: each due camera's rays of every copy, cast in finish
     def plan(self, copies: np.ndarray, cols: np.ndarray) -> tuple[dict, list]:
@@ -413,8 +428,37 @@ class CameraDevices(PixelDevices):
         if S > 1:     # supersampling, per copy as the single camera averages its image's rays
             per = out.reshape(k, S * dev.height * dev.width, 3)
             out = np.concatenate([per[q].reshape(S, -1, 3).mean(axis=0) for q in range(k)])
+        if dev.blurred is not None or dev.mask is not None:
+            self._finish_copies(col, copies, out)
+            return
         rng = None
         if cfg.noise > 0:
             rng = _Draws(sim.noise, copies.tolist(), sim._noise_col[("Camera", col)], [dev.height * dev.width * 3] * k)
         bgra = shading.resolve_bgra(out, dev.exposure, cfg.noise, rng)      # type: ignore[arg-type]
         self.images[col][copies] = bgra.reshape(k, dev.height, dev.width, 4)
+
+    def _finish_copies(self, col: int, copies: np.ndarray, out: np.ndarray) -> None:
+        """The resolve of a camera with motion blur or a noise mask, copy by copy as the single
+        camera makes its image: its own last mixed radiance and the weight of its own sampling
+        period, then its colour noise and its mask's two uniform offsets from its own stream, in
+        that order (the stream taken whole: ``NoiseStreams.stream``, nothing drawn ahead)."""
+        sim = self.sim
+        dev = self.devices[col]
+        cfg = dev.template.config
+        M = dev.height * dev.width
+        column = sim._noise_col.get(("Camera", col), -1)
+        for q, cc in enumerate(copies.tolist()):
+            stream = sim.noise.stream(cc, column) if dev.mask is not None else None
+            rng = _Draws(sim.noise, [cc], column, [M * 3]) if cfg.noise > 0 else None
+            blur = None
+            if dev.blurred is not None:     # the first image: itself (Camera._capture_image)
+                w = shading.motion_blur_weight(int(sim.period["Camera"][cc, col]), cfg.motion_blur) \
+                    if dev.started[cc] else 0.0
+                dev.started[cc] = True
+                blur = (dev.blurred[cc], w)
+            bgra = shading.resolve_bgra(out[q * M:(q + 1) * M], dev.exposure, cfg.noise, rng, 1,  # type: ignore[arg-type]
+                                        blur)
+            if dev.mask is not None:
+                assert stream is not None
+                masked(bgra, cfg, dev.mask, stream)
+            self.images[col][cc] = bgra.reshape(dev.height, dev.width, 4)

@@ -24,7 +24,10 @@ lidar's way (``BatchedSimulation._plan_lidars``):
 * noise: each (copy, device) draws from its own stream (``device_rng(seed, "robot/device")``), one
   standard normal per valid pixel, in the image's order, as the single device does; a copy's block
   is taken from the bank's buffer and then straight from the stream (:func:`draw`), the same
-  numbers in the same order whatever the block sizes.
+  numbers in the same order whatever the block sizes;
+* motion blur: each copy keeps its own last blurred values (``+inf`` before its first image and
+  after a reset) and mixes at the weight of its own sampling period, in the same ``range_values``
+  call (the mix is elementwise too).
 
 What range finders and cameras (batched_camera.py) share -- the pixel rays of every capturing copy,
 their rows and the mount -- is :class:`PixelDevices`.
@@ -37,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import world as wm
-from sensorium.server.devices import imaging
+from sensorium.server.devices import imaging, shading
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.cameras import RangeFinder
@@ -216,11 +219,17 @@ class DepthDevices(PixelDevices):
     def __init__(self, sim: Any, devices: list[RangeFinder]):
         super().__init__(sim, [_Device(d) for d in devices])
         self.images = [np.zeros((sim.copies, d.height, d.width), dtype=np.float32) for d in self.devices]
+        # motion blur: each copy's last blurred values (+inf before its first image), as the single device's
+        self.blurred = [np.full((sim.copies, d.height, d.width), np.inf) if d.template.config.motion_blur > 0 else None
+                        for d in self.devices]
 
     def reset(self, idx: np.ndarray) -> None:
         """Zeros before the first image (Webots), as a freshly built device."""
         for img in self.images:
             img[idx] = 0.0
+        for b in self.blurred:
+            if b is not None:
+                b[idx] = np.inf
 
     # -- planning: every copy's pixel rays of each due device
     def plan(self, copies: np.ndarray, cols: np.ndarray) -> tuple[dict, list]:
@@ -265,8 +274,15 @@ class DepthDevices(PixelDevices):
             if cfg.noise > 0:
                 rng = _Draws(sim.noise, c.tolist(), sim._noise_col[("RangeFinder", col)],
                              self._valid_counts(dist, factors, cfg.min_range, cfg.max_range))
+            blur = None
+            blurred = self.blurred[col]
+            if blurred is not None:      # each copy's weight from its own sampling period (RangeFinder.capture)
+                w = [shading.motion_blur_weight(int(p), cfg.motion_blur) for p in sim.period["RangeFinder"][c, col]]
+                blur = (blurred[c], np.array(w).reshape(k, 1, 1))
             self.images[col][c] = imaging.range_values(dist, factors, cfg.min_range, cfg.max_range, cfg.noise,
-                                                       cfg.resolution, rng)    # type: ignore[arg-type]
+                                                       cfg.resolution, rng, blur)    # type: ignore[arg-type]
+            if blur is not None and blurred is not None:
+                blurred[c] = blur[0]
             sim.last["RangeFinder"][c, col] = sim.time_ms[c]
             sim.counters["measurements"] += k
 

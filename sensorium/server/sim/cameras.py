@@ -29,7 +29,7 @@ from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["Camera", "RangeFinder", "MountedRays", "ShadowBuffers", "camera_lights", "camera_info", "composite",
-           "lens_of"]
+           "lens_of", "noise_mask_planes"]
 
 
 class MountedRays:
@@ -129,6 +129,27 @@ def lens_of(config: Any) -> imaging.Lens | None:
     return imaging.Lens(tuple(lens.center), tuple(lens.radial_coefficients), tuple(lens.tangential_coefficients))
 
 
+def noise_mask_planes(scene: Any, url: str) -> np.ndarray | None:
+    """A camera's noise mask (None without one): the image the world's check read
+    (world/textures.py; the ``scene``'s images), as a shape's texture (read and checked here when a
+    world was given unchecked), as R, G, B, A planes (4, h, w) in [0, 1]
+    (``shading.apply_noise_mask``). The single and the batched camera share it."""
+    if not url:
+        return None
+    if url in scene.images:
+        rgb, alpha, _ = scene.images[url][1]
+    else:
+        from sensorium.server.world.limits import WorldLimits
+        from sensorium.server.world.textures import read_checked_image
+
+        rgb, alpha, _ = read_checked_image(url, scene.base_dir, WorldLimits(), allow_outside=True)[2]
+    mask = np.empty((4, *rgb.shape[:2]))
+    mask[:3] = np.moveaxis(rgb, 2, 0)
+    mask[3] = 255.0 if alpha is None else alpha
+    mask /= 255.0
+    return mask
+
+
 def camera_info(geometry: imaging.ImageGeometry) -> dict:
     """The fields of a ``sensor_msgs/CameraInfo`` after its header (a planar image's exact pinhole).
     ``d`` stays zeros with a lens: Webots' distortion is not OpenCV's plumb_bob (image units per
@@ -159,6 +180,8 @@ class RangeFinder(Device):
         self._limits: tuple[Any, Any] = (0.0, 0.0)
         self._robot: Any = None
         self._scene: Any = None
+        # motion blur: the last image's blurred values (+inf before the first: that one is itself)
+        self._blurred: np.ndarray | None = None
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
@@ -196,9 +219,14 @@ class RangeFinder(Device):
         counters["rays_range_finder"] += len(rays)
         counters["cast_calls"] += 1
         c = self.config
+        blur = None
+        if c.motion_blur > 0:
+            if self._blurred is None:
+                self._blurred = np.full((c.height, c.width), np.inf)
+            blur = (self._blurred, shading.motion_blur_weight(self.schedule.period_ms, c.motion_blur))
         self.range_image = imaging.range_values(
             hits.distance.reshape(c.height, c.width), self._factors, c.min_range, c.max_range, c.noise,
-            c.resolution, self.rng if c.noise > 0 else None)
+            c.resolution, self.rng if c.noise > 0 else None, blur)
         self.schedule.last_update_ms = now_ms
         self._mark(now_ms)
 
@@ -388,14 +416,7 @@ class Camera(Device):
         self._robot = robot
         self._scene = robot.scene
         self._background = self._scene.background
-        url = self.config.noise_mask_url
-        if url:           # the image the world's check read (world/textures.py), as a shape's texture
-            rgb, alpha, _ = self._scene.images[url][1]
-            mask = np.empty((4, *rgb.shape[:2]))      # R, G, B, A planes (shading.apply_noise_mask)
-            mask[:3] = np.moveaxis(rgb, 2, 0)
-            mask[3] = 255.0 if alpha is None else alpha
-            mask /= 255.0
-            self._mask = mask
+        self._mask = noise_mask_planes(self._scene, self.config.noise_mask_url)
 
     # -- controller API
     def describe(self) -> dict:
@@ -596,11 +617,8 @@ class Camera(Device):
                 blur = (self._blurred, shading.motion_blur_weight(self.schedule.period_ms, c.motion_blur))
         bgra = shading.resolve_bgra(L, self.exposure, c.noise, self.rng if c.noise > 0 else None, len(self._samples),
                                     blur)
-        if self._mask is not None:         # shifted by two uniform draws of the camera's stream per image
-            offset = self.rng.random(2)
-            th, tw = self._mask.shape[1:]
-            shading.apply_noise_mask(bgra, c.width, c.height, self._mask, (float(offset[0]), float(offset[1])),
-                                     shading.noise_mask_factor(c.width, c.height, tw, th))
+        if self._mask is not None:
+            masked(bgra, c, self._mask, self.rng)
         self.image = bgra.reshape(c.height, c.width, 4)
 
     def _render(self, pose: Pose, rays: MountedRays, counters: Any) -> np.ndarray:
@@ -677,6 +695,16 @@ class Camera(Device):
         finally:
             self._shadow_out = out
         return lit
+
+
+def masked(bgra: np.ndarray, config: Any, mask: np.ndarray, rng: np.random.Generator) -> None:
+    """A camera's noise mask over its image's BGRA pixels (M, 4), in place, shifted by two uniform
+    draws of its stream (``rng``) per image, after the image's colour noise draws (Webots' order).
+    The single and the batched camera (per copy) share it."""
+    offset = rng.random(2)
+    th, tw = mask.shape[1:]
+    shading.apply_noise_mask(bgra, config.width, config.height, mask, (float(offset[0]), float(offset[1])),
+                             shading.noise_mask_factor(config.width, config.height, tw, th))
 
 
 class ShadowBuffers:

@@ -377,7 +377,8 @@ def device(node: Node, f: Fields) -> dict:
     if t == "RangeFinder":
         return {"device": t, **_image(f, "cylindrical"),
                 "min_range": f.positive("minRange", 0.01, 0.01), "max_range": f.num("maxRange", 1.0),
-                "noise": f.non_negative("noise", 0.0, 0.0), "resolution": f.num("resolution", -1.0)}
+                "noise": f.non_negative("noise", 0.0, 0.0), "resolution": f.num("resolution", -1.0),
+                "motion_blur": f.non_negative("motionBlur", 0.0, 0.0)}
     if t == "Camera":
         out = {"device": t, **_image(f, "spherical"),
                "far": f.non_negative("far", 0.0, 0.0), "exposure": f.non_negative("exposure", 1.0, 1.0),

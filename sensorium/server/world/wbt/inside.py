@@ -35,7 +35,6 @@ UNREAD_IMAGE_FIELDS = {
     "Camera": {"focus": (None, "depth of field"),
                "lensFlare": (None, "lens flares"), "bloomThreshold": (-1.0, "bloom"),
                "ambientOcclusionRadius": (0.0, "ambient occlusion")},
-    "RangeFinder": {"motionBlur": (0.0, "motion blur")},
 }
 
 
