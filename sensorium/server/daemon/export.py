@@ -51,6 +51,9 @@ _FIRST = ("translation", "rotation")      # Webots declares them first: a pose f
 _IN_PARENT = frozenset({"jointParameters", "appearance", "material", "texture", "baseColorMap", "geometry"})
 """The SF fields whose nested node is found in its parent's written node (it has no place of its own)."""
 
+_PLACES_KEPT = 256
+"""The most written top-level nodes whose places are kept (each one's table made again when dropped)."""
+
 _NESTED_POSE = {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 1.0, 0.0]}
 
 
@@ -122,7 +125,7 @@ def _owner_places(sim: Any, owner: int) -> dict[tuple[int, ...], ParsedNode]:
         wbt = _world_file(sim)
         roots = list(wbt.nodes) if wbt is not None else []
     kept = getattr(sim, "_export_places", None)
-    if kept is None:
+    if kept is None or len(kept) > _PLACES_KEPT:       # (imports and rebuilds for days: bounded)
         kept = sim._export_places = {}
     out: dict[tuple[int, ...], ParsedNode] = {}
     for root in roots:
@@ -170,19 +173,20 @@ def _nested_written(sim: Any, table: nested.Table, n: nested.Nested) -> ParsedNo
 def _nested_now(sim: Any, table: nested.Table, n: nested.Nested) -> list[tuple[str, str, Any, Any]]:
     """(field, type, value now, Webots' default or None) of the fields of nested node ``n`` the server changed:
     an end point's pose its joint moved, a JointParameters' ``position``, a shape's fields a Supervisor set."""
-    node = sv._nested_node(n)
-    base = sv._base_fields(sim, node)
     out: list[tuple[str, str, Any, Any]] = []
     if n.shape is not None:
-        changed = sim.scene.appearance_values.get(n.shape.index, {})
-        for key in changed:
-            role, name = key.split(".", 1)
-            if role == n.shape.role and name in base:
-                out.append((name, base[name][0], base[name][1](sim, node), None))
+        changed = [key.split(".", 1)[1] for key in sim.scene.appearance_values.get(n.shape.index, {})
+                   if key.split(".", 1)[0] == n.shape.role]
+        if changed:
+            node = sv._nested_node(n)
+            base = sv._base_fields(sim, node)
+            out += [(name, base[name][0], base[name][1](sim, node), None) for name in changed if name in base]
         return out
     if n.motor:
         out.append(("position", "SFFloat", nested.joint_position(sim, n), 0.0))
     if n.own is not None and _moved(n.own, nested.own_pose(sim, table, n)):
+        node = sv._nested_node(n)
+        base = sv._base_fields(sim, node)
         out += [(name, base[name][0], base[name][1](sim, node), default) for name, default in _NESTED_POSE.items()]
     if n.interface:        # an instance's fields passing straight through IS to those
         face = n.interface[0].fields
@@ -219,14 +223,14 @@ def _pose_first(fields: dict[str, Any]) -> dict[str, Any]:
     return fields
 
 
-def _nested_fields(sim: Any) -> dict[int, dict[str, Any]]:
-    """id() of each nested node's written node -> its fields as they are now, for the nested nodes the server
-    changed (a top-level node's text and worldSave write them so)."""
+def _nested_fields(sim: Any, owner: int | None) -> dict[int, dict[str, Any]]:
+    """id() of each nested node's written node -> its fields as they are now, for the nested nodes inside
+    top-level node ``owner`` (None: every one) the server changed (a top-level node's text and worldSave write
+    them so)."""
     table = sv._table(sim)
     out: dict[int, dict[str, Any]] = {}
-    for n in list(table.nodes) + list(table.added.values()):
-        if n.id in table.forgotten or n.owner not in table.by_owner:
-            continue
+    inside = table.by_owner.get(owner, ()) if owner is not None else [n for v in table.by_owner.values() for n in v]
+    for n in inside:
         now = _nested_now(sim, table, n)
         if not now:
             continue
@@ -240,9 +244,9 @@ def _nested_fields(sim: Any) -> dict[int, dict[str, Any]]:
     return out
 
 
-def _writer(sim: Any) -> Writer:
-    """A writer of top-level nodes writing the nested nodes inside them as they are now."""
-    changed = _nested_fields(sim)
+def _writer(sim: Any, owner: int | None = None) -> Writer:
+    """A writer of top-level node ``owner`` (None: every one) writing the nested nodes inside as they are now."""
+    changed = _nested_fields(sim, owner)
     return Writer(lambda written: changed.get(id(written)))
 
 
@@ -292,12 +296,12 @@ def _same(written: Any, now: Any) -> bool:
 def node_string(sim: Any, node: sv.Node, writer: Writer | None = None) -> str:
     """Webots' ``exportString``: the node as ``.wbt`` text (NotExported: one line)."""
     written = _written(sim, node)
-    writer = writer or _writer(sim)
     if node.nested:
         table = sv._table(sim)
         n = table.get(node.id)
         assert n is not None
-        return writer.node(written, 0, _overlay(written, _nested_now(sim, table, n)))
+        return (writer or _writer(sim, n.owner)).node(written, 0, _overlay(written, _nested_now(sim, table, n)))
+    writer = writer or _writer(sim, node.id)
     fields = dict(written.fields)
     for name, kind, value, default in _now(sim, node):
         now = written_value(kind, value)
