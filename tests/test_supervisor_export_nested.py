@@ -56,6 +56,13 @@ def _as_written(world: Path, def_name: str) -> Node:
     raise AssertionError(def_name)
 
 
+def _save(sim: Simulation, folder: Path) -> Path:
+    """worldSave's text written in ``folder``, its EXTERNPROTO url made absolute."""
+    saved = folder / "saved.wbt"
+    saved.write_text(world_string(sim).replace('"../protos/', f'"{REPO / "tests" / "protos"}/'))
+    return saved
+
+
 def _same_tree(a: Node, b: Node) -> bool:
     """Two parsed nodes with the same type, DEF and fields, nodes inside compared alike."""
     def same(x, y) -> bool:
@@ -116,9 +123,7 @@ def test_a_joint_turned_back_exports_as_written():
 def test_a_saved_world_loads_the_arm_as_it_stood(tmp_path):
     sim = _sim()
     sv.set_field(sim, _parameters(sim), "position", 0.75)
-    saved = tmp_path / "saved.wbt"
-    saved.write_text(world_string(sim))
-    again = _sim(saved)
+    again = _sim(_save(sim, tmp_path))
     assert sv.get_field(again, _parameters(again), "position")["value"] == 0.75
     for name in ("LINK", "TOOL"):
         now, loaded = sv.node_pose(sim, _node(sim, name)), sv.node_pose(again, _node(again, name))
@@ -174,3 +179,25 @@ def test_a_nested_node_of_a_yaml_world_is_one_line():
                               if sv.node_from_id(sim, i) is not None) if n.nested)
     with pytest.raises(NotExported, match=r"has no \.wbt text here: the world was not loaded from a \.wbt file$"):
         node_string(sim, inside)
+
+
+def test_a_robots_material_a_supervisor_set_is_exported_and_saved(tmp_path):
+    sim = _sim()
+    sv.set_field(sim, _node(sim, "STEEL"), "diffuseColor", [0.25, 0.5, 0.75])
+    shape = _read(node_string(sim, _node(sim, "LINK_SHAPE")))
+    assert shape.fields["appearance"].fields["material"].fields == {"diffuseColor": (0.25, 0.5, 0.75)}
+    assert _read(node_string(sim, _node(sim, "STEEL"))).fields == {"diffuseColor": (0.25, 0.5, 0.75)}
+    again = _sim(_save(sim, tmp_path))
+    assert sv.get_field(again, _node(again, "STEEL"), "diffuseColor")["value"] == [0.25, 0.5, 0.75]
+
+
+def test_a_node_in_a_proto_instances_field_exports_as_written_after_the_instance_is_built_again():
+    sim = _sim()
+    assert _same_tree(_read(node_string(sim, _node(sim, "POST"))), _as_written(WORLD, "POST"))
+    holder = _node(sim, "HOLDER")
+    sv.set_field(sim, holder, "side", 0.5)                     # the instance built again (a new POST node)
+    post = _node(sim, "POST")
+    assert _same_tree(_read(node_string(sim, post)), _as_written(WORLD, "POST"))
+    assert sv.node_pose(sim, post)["position"] == pytest.approx([-2.0, 0.0, 0.8], abs=1e-15)
+    instance = _read(node_string(sim, holder))
+    assert instance.fields["side"] == 0.5 and _same_tree(instance.fields["slot"][0], _as_written(WORLD, "POST"))
