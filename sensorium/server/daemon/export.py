@@ -149,22 +149,25 @@ def _maker(sim: Any, table: nested.Table, n: nested.Nested) -> str:
     return f"PROTO {proto}" if proto else "a PROTO"
 
 
+def _found(sim: Any, table: nested.Table, n: nested.Nested) -> ParsedNode | None:
+    """A nested node as its owner's file writes it: at its place (``Nested.at``), or in its parent's field;
+    None when no file writes it."""
+    if n.at:
+        return _owner_places(sim, n.owner).get(n.at)
+    parent = table.get(n.parent) if n.field in _IN_PARENT else None
+    above = None if parent is None else _found(sim, table, parent)
+    value = None if above is None else above.fields.get(n.field)
+    return value if isinstance(value, ParsedNode) else None
+
+
 def _nested_written(sim: Any, table: nested.Table, n: nested.Nested) -> ParsedNode:
-    """A nested node as its owner's file writes it: at its place (``Nested.at``), or in its parent's field."""
+    """A nested node as its owner's file writes it (NotExported: one line)."""
     if _world_file(sim) is None and n.owner not in table.segments:
         raise NotExported(f"{sv._what(sv._nested_node(n))} has no .wbt text here: the world was not loaded from a "
                           ".wbt file")
-    if n.at:
-        found = _owner_places(sim, n.owner).get(n.at)
-        if found is not None:
-            return found
-    elif n.field in _IN_PARENT and (parent := table.get(n.parent)) is not None:
-        try:
-            value = _nested_written(sim, table, parent).fields.get(n.field)
-        except NotExported:
-            value = None
-        if isinstance(value, ParsedNode):
-            return value
+    found = _found(sim, table, n)
+    if found is not None:
+        return found
     raise NotExported(f"{sv._what(sv._nested_node(n))} is made by the body of {_maker(sim, table, n)}, not written "
                       "in the world file: exportString writes the nodes a world file or node string writes here "
                       "(Webots writes the node as the PROTO made it; that text is not kept here)")
@@ -230,13 +233,13 @@ def _nested_fields(sim: Any, owner: int | None) -> dict[int, dict[str, Any]]:
     table = sv._table(sim)
     out: dict[int, dict[str, Any]] = {}
     inside = table.by_owner.get(owner, ()) if owner is not None else [n for v in table.by_owner.values() for n in v]
+    changed_shapes = sim.scene.appearance_values
     for n in inside:
+        if not (n.motor or n.joint or n.shape is not None and n.shape.index in changed_shapes):
+            continue             # nothing the server changes
         now = _nested_now(sim, table, n)
-        if not now:
-            continue
-        try:
-            written = _nested_written(sim, table, n)
-        except NotExported:
+        written = _found(sim, table, n) if now else None
+        if written is None:
             continue
         fields = _overlay(written, now)
         if fields != written.fields:
