@@ -332,10 +332,10 @@ def wb_supervisor_node_get_static_balance(node: int | None) -> bool:
 
 
 def wb_supervisor_node_export_string(node: int | None) -> str:
-    """Webots' ``exportString``: a child of the root as ``.wbt`` text (``DEF NAME Type { ... }``), as its world
-    file or node string wrote it with the fields the server keeps as they are now (where it stands, its name,
-    custom data, a light's fields; README "Supervisor"), ready for ``importMFNodeFromString``. A node inside a
-    robot or solid, or of a YAML world, has no such text here: the server's one line and ""."""
+    """Webots' ``exportString``: a node as ``.wbt`` text (``DEF NAME Type { ... }``), as its world file or node
+    string wrote it with the fields the server keeps as they are now (where it stands, its name, custom data, a
+    light's fields, a joint's position; README "Supervisor"), ready for ``importMFNodeFromString``. A node a
+    PROTO's body made, or of a YAML world, has no such text here: the server's one line and ""."""
     func = "wb_supervisor_node_export_string"
     r = _checked_node(node, func)
     got = None if r is None else _answer(r, "node_export_string", {"node": int(node)}, func)  # type: ignore[arg-type]

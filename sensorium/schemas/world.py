@@ -439,6 +439,14 @@ class InnerDef(Strict):
 
 _INNER_DEFS = "the DEF names of PROTO bodies this node answers getFromProtoDef for (see InnerDef)"
 
+_WRITTEN_AT = ("where the world file (or the node string it was imported from) writes this node: [line, column] (a "
+               "PROTO instance: where the instance is written); none for a node a PROTO's body made. A Supervisor's "
+               "exportString finds its text there")
+
+
+def _written_at() -> Any:
+    return Field(default=None, min_length=2, max_length=2, description=_WRITTEN_AT)
+
 
 class ShapeNode(Strict):
     """A ``.wbt`` Shape as a Supervisor serves it (README "Supervisor"): its DEFs, its appearance
@@ -470,6 +478,7 @@ class ShapeNode(Strict):
     values: dict[str, NodeValue] = Field(default={}, max_length=64, description="the written values: "
                                          "'<node>.<field>' (node: appearance, material, texture, geometry)")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
+    written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
     piece: bool = Field(default=False, description="a further piece of the shape before it: a mesh the .wbt import "
                         "split around its robot's devices (README 'Worlds') is one Shape node to a "
                         "Supervisor, its first piece's")
@@ -712,6 +721,7 @@ class Solid(Strict):
                                        "solid, those of its PROTO instances' DEFs that name no node here (`why`)")
     proto_scope: int | None = Field(default=None, ge=0, description="a PROTO instance inside a top-level solid: its "
                                     "number there (InnerDef.scope)")
+    written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
     physics: bool = Field(default=False, description="Webots: the solid has a Physics node. Nothing is pushed here "
                           "(no dynamics); a top-level solid with physics settles at load on what is under it (as "
                           "Webots' physics drops it), a VacuumGripper carries only such a solid, and one it lets go or "
@@ -1821,6 +1831,7 @@ class NestedNode(Strict):
     anchor: Vec3 | None = Field(default=None, description="a HingeJoint's anchor in the robot's frame as the world "
                                 "loads (its axis passes through it); none for other nodes")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
+    written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
     mass: Mass | None = Field(default=None, description=_MASS + "; a Solid or device only")
     pending_mass: PendingMass | None = Field(default=None, description=_PENDING_MASS)
 

@@ -1,8 +1,9 @@
 /* exportString, worldSave and removeSF from C (tests/worlds/export_world.wbt): the box moved and exported, its
  * text imported again, the world saved where $EXPORT_SAVE names, an imported point set's coord taken out and
- * filled again; refusals one line each. The same stdout as tests/controllers/supervisor_export.py. */
+ * filled again, the robot's distance sensor exported; refusals one line each. The same stdout as tests/controllers/supervisor_export.py. */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <webots/robot.h>
 #include <webots/supervisor.h>
@@ -35,7 +36,8 @@ int main(void) {
   printf("again %d\n", wb_supervisor_field_get_count(wb_supervisor_node_get_field(wb_supervisor_field_get_sf_node(coord), "point")));
   wb_supervisor_field_remove_sf(wb_supervisor_node_get_field(wb_supervisor_node_get_from_def("DOTS"), "appearance"));
   wb_supervisor_field_remove_sf(wb_supervisor_node_get_field(box, "translation"));
-  printf("inside '%s'\n", wb_supervisor_node_export_string(wb_supervisor_node_get_from_device(wb_robot_get_device("ds"))));
+  const char *inside = wb_supervisor_node_export_string(wb_supervisor_node_get_from_device(wb_robot_get_device("ds")));
+  printf("inside %.*s\n", (int)strcspn(inside, "\n"), inside); /* its first line */
   wb_robot_step(step);
   wb_robot_cleanup();
   return 0;

@@ -6,8 +6,12 @@ and ``rotation`` (where it drove or a Supervisor put it), ``name``, ``customData
 ``radarCrossSection``; a light's fields; a PROTO instance's fields that pass through IS to those (its
 other fields as last set: a set builds the solid again from its written node, sim/regenerate.py). A field
 whose value is Webots' default is left out, as Webots writes only the fields that differ from it.
-What is inside a robot or solid is written as the file wrote it (a joint's position, a shape's colour
-set since are not: README "Supervisor"). Text only: the client writes ``worldSave``'s file (the server
+A node inside a robot or solid (nested.py) is found where its owner's file writes it (``Nested.at``, the
+import's line and column; a joint's ``jointParameters`` and a shape's appearance, material, texture and
+geometry in their parent's field) and written so, with what the server changed since: an end point's pose
+its joint moved, a joint's ``position``, a shape's fields a Supervisor set; exportString answers it alone,
+and the top-level node and ``worldSave`` holding it write it so too. A node a PROTO's body made is written
+nowhere here: one line. Text only: the client writes ``worldSave``'s file (the server
 never writes a path a client names)."""
 
 from __future__ import annotations
@@ -16,6 +20,9 @@ import math
 from collections import Counter
 from typing import Any
 
+import numpy as np
+
+from sensorium.server.daemon import nested
 from sensorium.server.daemon import supervisor as sv
 from sensorium.server.sim.regenerate import reparsed_world, written_value
 from sensorium.server.world.wbt.parser import Node as ParsedNode
@@ -41,6 +48,15 @@ default is not written."""
 _FIRST = ("translation", "rotation")      # Webots declares them first: a pose field not written goes first
 
 
+_IN_PARENT = frozenset({"jointParameters", "appearance", "material", "texture", "baseColorMap", "geometry"})
+"""The SF fields whose nested node is found in its parent's written node (it has no place of its own)."""
+
+_PLACES_KEPT = 256
+"""The most written top-level nodes whose places are kept (each one's table made again when dropped)."""
+
+_NESTED_POSE = {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 1.0, 0.0]}
+
+
 class NotExported(ValueError):
     """A node with no ``.wbt`` text here: one line, what and why."""
 
@@ -60,8 +76,10 @@ def _written(sim: Any, node: sv.Node) -> ParsedNode:
     why = "the world was not loaded from a .wbt file" if _world_file(sim) is None else \
         "it is not one top-level node of the world file (a node it became among others, or shapes outside any solid)"
     if node.nested:
-        raise NotExported(f"{sv._what(node)} is inside a robot or solid: exportString serves the root's children "
-                          "here (export the top-level node holding it)")
+        table = sv._table(sim)
+        n = table.get(node.id)
+        assert n is not None
+        return _nested_written(sim, table, n)
     if node.visual and node.id >= sv.visuals.FIRST_ID:
         raise NotExported(f"{sv._what(node)} is inside an imported Shape or Group: exportString serves the root's "
                           "children here")
@@ -81,6 +99,158 @@ def _written(sim: Any, node: sv.Node) -> ParsedNode:
     if written is None:
         raise NotExported(f"{sv._what(node)} has no .wbt text here: {why}")
     return written
+
+
+def _places(root: ParsedNode) -> dict[tuple[int, ...], ParsedNode]:
+    """Every node written inside ``root`` (itself included) by its (line, column)."""
+    out: dict[tuple[int, ...], ParsedNode] = {}
+    todo: list[Any] = [root]
+    while todo:
+        v = todo.pop()
+        if isinstance(v, ParsedNode):
+            if (v.line, v.col) not in out:
+                out[(v.line, v.col)] = v
+                todo.extend(v.fields.values())
+        elif isinstance(v, list):
+            todo.extend(v)
+    return out
+
+
+def _owner_places(sim: Any, owner: int) -> dict[tuple[int, ...], ParsedNode]:
+    """The nodes written inside the top-level node ``owner`` as written (the whole world file's when it is no one
+    top-level node of it), by (line, column); kept per written node."""
+    try:
+        roots = [_written(sim, sv.node_by_id(sim, owner))]
+    except NotExported:
+        wbt = _world_file(sim)
+        roots = list(wbt.nodes) if wbt is not None else []
+    kept = getattr(sim, "_export_places", None)
+    if kept is None or len(kept) > _PLACES_KEPT:       # (imports and rebuilds for days: bounded)
+        kept = sim._export_places = {}
+    out: dict[tuple[int, ...], ParsedNode] = {}
+    for root in roots:
+        if id(root) not in kept or kept[id(root)][0] is not root:
+            kept[id(root)] = (root, _places(root))
+        out.update(kept[id(root)][1])
+    return out
+
+
+def _maker(sim: Any, table: nested.Table, n: nested.Nested) -> str:
+    """The PROTO instance written in the file whose body (or a PROTO's inside it) made nested node ``n``: the
+    nearest written instance holding it."""
+    above: nested.Nested | None = n
+    while above is not None:
+        if above.proto and above.at:
+            return f"PROTO {above.proto}"
+        if above.parent == above.owner:
+            break
+        above = table.get(above.parent)
+    proto = sv.node_by_id(sim, n.owner).proto
+    return f"PROTO {proto}" if proto else "a PROTO"
+
+
+def _found(sim: Any, table: nested.Table, n: nested.Nested) -> ParsedNode | None:
+    """A nested node as its owner's file writes it: at its place (``Nested.at``), or in its parent's field;
+    None when no file writes it."""
+    if n.at:
+        return _owner_places(sim, n.owner).get(n.at)
+    parent = table.get(n.parent) if n.field in _IN_PARENT else None
+    above = None if parent is None else _found(sim, table, parent)
+    value = None if above is None else above.fields.get(n.field)
+    return value if isinstance(value, ParsedNode) else None
+
+
+def _nested_written(sim: Any, table: nested.Table, n: nested.Nested) -> ParsedNode:
+    """A nested node as its owner's file writes it (NotExported: one line)."""
+    if _world_file(sim) is None and n.owner not in table.segments:
+        raise NotExported(f"{sv._what(sv._nested_node(n))} has no .wbt text here: the world was not loaded from a "
+                          ".wbt file")
+    found = _found(sim, table, n)
+    if found is not None:
+        return found
+    raise NotExported(f"{sv._what(sv._nested_node(n))} is made by the body of {_maker(sim, table, n)}, not written "
+                      "in the world file: exportString writes the nodes a world file or node string writes here "
+                      "(Webots writes the node as the PROTO made it; that text is not kept here)")
+
+
+def _nested_now(sim: Any, table: nested.Table, n: nested.Nested) -> list[tuple[str, str, Any, Any]]:
+    """(field, type, value now, Webots' default or None) of the fields of nested node ``n`` the server changed:
+    an end point's pose its joint moved, a JointParameters' ``position``, a shape's fields a Supervisor set."""
+    out: list[tuple[str, str, Any, Any]] = []
+    if n.shape is not None:
+        changed = [key.split(".", 1)[1] for key in sim.scene.appearance_values.get(n.shape.index, {})
+                   if key.split(".", 1)[0] == n.shape.role]
+        if changed:
+            node = sv._nested_node(n)
+            base = sv._base_fields(sim, node)
+            out += [(name, base[name][0], base[name][1](sim, node), None) for name in changed if name in base]
+        return out
+    if n.motor:
+        out.append(("position", "SFFloat", nested.joint_position(sim, n), 0.0))
+    if n.own is not None and _moved(n.own, nested.own_pose(sim, table, n)):
+        node = sv._nested_node(n)
+        base = sv._base_fields(sim, node)
+        out += [(name, base[name][0], base[name][1](sim, node), default) for name, default in _NESTED_POSE.items()]
+    if n.interface:        # an instance's fields passing straight through IS to those
+        face = n.interface[0].fields
+        out = [(f.name, f.type, value, f.value) for name, kind, value, _ in out for f in face
+               if f.base == name and f.type == kind]
+    return out
+
+
+def _moved(loaded: Any, now: Any) -> bool:
+    """Whether a nested node's pose now is not the pose it loaded at (a rotation is compared as a matrix: its
+    axis and angle read back may be written otherwise)."""
+    return now is not loaded and not (np.allclose(now.translation, loaded.translation, rtol=0.0, atol=1e-12)
+                                      and np.allclose(now.rotation, loaded.rotation, rtol=0.0, atol=1e-12))
+
+
+def _overlay(written: ParsedNode, now: list[tuple[str, str, Any, Any]]) -> dict[str, Any]:
+    """``written``'s fields with the values ``now`` where they differ (a field at ``default`` not added)."""
+    fields = dict(written.fields)
+    for name, kind, value, default in now:
+        v = written_value(kind, value)
+        if name in fields:
+            if not _same(fields[name], v):
+                fields[name] = v
+        elif default is None or not _same(written_value(kind, default), v):
+            fields = {name: v, **fields} if name in _FIRST else {**fields, name: v}
+    return _pose_first(fields)
+
+
+def _pose_first(fields: dict[str, Any]) -> dict[str, Any]:
+    """``fields`` with ``translation`` before ``rotation`` (Webots' order) when both are written."""
+    names = list(fields)
+    if "rotation" in fields and "translation" in fields and names.index("rotation") < names.index("translation"):
+        return {"translation": fields.pop("translation"), **fields}
+    return fields
+
+
+def _nested_fields(sim: Any, owner: int | None) -> dict[int, dict[str, Any]]:
+    """id() of each nested node's written node -> its fields as they are now, for the nested nodes inside
+    top-level node ``owner`` (None: every one) the server changed (a top-level node's text and worldSave write
+    them so)."""
+    table = sv._table(sim)
+    out: dict[int, dict[str, Any]] = {}
+    inside = table.by_owner.get(owner, ()) if owner is not None else [n for v in table.by_owner.values() for n in v]
+    changed_shapes = sim.scene.appearance_values
+    for n in inside:
+        if not (n.motor or n.joint or n.shape is not None and n.shape.index in changed_shapes):
+            continue             # nothing the server changes
+        now = _nested_now(sim, table, n)
+        written = _found(sim, table, n) if now else None
+        if written is None:
+            continue
+        fields = _overlay(written, now)
+        if fields != written.fields:
+            out[id(written)] = fields
+    return out
+
+
+def _writer(sim: Any, owner: int | None = None) -> Writer:
+    """A writer of top-level node ``owner`` (None: every one) writing the nested nodes inside as they are now."""
+    changed = _nested_fields(sim, owner)
+    return Writer(lambda written: changed.get(id(written)))
 
 
 def _became(sim: Any) -> Counter[int]:
@@ -129,6 +299,12 @@ def _same(written: Any, now: Any) -> bool:
 def node_string(sim: Any, node: sv.Node, writer: Writer | None = None) -> str:
     """Webots' ``exportString``: the node as ``.wbt`` text (NotExported: one line)."""
     written = _written(sim, node)
+    if node.nested:
+        table = sv._table(sim)
+        n = table.get(node.id)
+        assert n is not None
+        return (writer or _writer(sim, n.owner)).node(written, 0, _overlay(written, _nested_now(sim, table, n)))
+    writer = writer or _writer(sim, node.id)
     fields = dict(written.fields)
     for name, kind, value, default in _now(sim, node):
         now = written_value(kind, value)
@@ -141,10 +317,7 @@ def node_string(sim: Any, node: sv.Node, writer: Writer | None = None) -> str:
                 del fields[name]
         elif value != default and (default is None or not _same(written_value(kind, default), now)):
             fields = {name: now, **fields} if name in _FIRST else {**fields, name: now}
-    if "rotation" in fields and "translation" in fields and list(fields).index("rotation") < list(fields).index(
-            "translation"):
-        fields = {"translation": fields.pop("translation"), **fields}
-    return (writer or Writer()).node(written, 0, fields)
+    return writer.node(written, 0, _pose_first(fields))
 
 
 def world_string(sim: Any) -> str:
@@ -159,7 +332,7 @@ def world_string(sim: Any) -> str:
     lines = [f"#VRML_SIM {wbt.version} utf8"]
     lines += [("IMPORTABLE " if d.importable else "") + f'EXTERNPROTO "{d.url}"' for d in wbt.declarations]
     lines.append("")
-    writer = Writer()
+    writer = _writer(sim)
     places, became = sim.top_level.written, _became(sim)
     imported = {n.id for n in sv._imported_nodes(sim, len(sv._loaded_nodes(sim))).every}
     for node in sv.root_children(sim):

@@ -87,6 +87,8 @@ class Nested:
     order: float = 0.0    # its place among its parent's children (file order: Shapes between the others)
     shape: Any = None     # a Shape or a node inside it: its appearance.ShapeRef (appearance.py serves its fields)
     mass: wm.Mass | None = None   # a Solid's or device's Physics (supervisor.center_of_mass)
+    at: tuple[int, ...] = ()      # (line, column) where its owner's file writes it (() none: a PROTO body's, or a node
+                                  # in its parent's SF field, found there: export.py)
 
 
 @dataclass(slots=True)
@@ -261,7 +263,8 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
         me = first + len(added)
         added.append(Nested(me, "Shape", "", (node.def_name if node else None) or "", "", parent, "children", None,
                             None, "", owner, kind, key, order=order,
-                            shape=appearance.ShapeRef(k, node, "Shape", "Shape", whole)))
+                            shape=appearance.ShapeRef(k, node, "Shape", "Shape", whole),
+                            at=tuple(node.written_at or ()) if node is not None else ()))
         above = {"appearance": me, "geometry": me}
         ids = {"": me}
         for role, type_, def_name, field in appearance.inside(shape, k):
@@ -298,7 +301,8 @@ def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Ne
             own = pose_from_model(child.pose)
             local = own if at is None else at.compose(own)
             node = Nested(first + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
-                          local, own, "", owner, "Solid", key, order=float(k), mass=child.mass)
+                          local, own, "", owner, "Solid", key, order=float(k), mass=child.mass,
+                          at=tuple(child.written_at or ()))
             out.append(node)
             solid_ids[id(child)] = node.id
             if child.proto_scope is not None:
@@ -351,7 +355,8 @@ def build(sim: Any, loaded_solids: int) -> Table:
             out.append(Nested(first + k, e.type, e.proto or "", e.def_name or "", e.name or "",
                               owner if e.parent < 0 else first + e.parent, e.field, local, _own(local, above),
                               e.device or "", owner, "Robot", name, joints[k], above_id,
-                              interface=tuple(e.interface), order=float(k), mass=e.mass))
+                              interface=tuple(e.interface), order=float(k), mass=e.mass,
+                              at=tuple(e.written_at or ())))
     solid_ids: dict[int, int] = {}          # id(nested solid model) -> its node id
     for j in range(loaded_solids):
         _solid_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], FIRST_ID, out, solid_ids,

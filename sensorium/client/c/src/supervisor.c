@@ -512,10 +512,10 @@ void wb_supervisor_node_remove(WbNodeRef node) {
   sn_reply_free(&rep);
 }
 
-/* Webots' exportString: a child of the root as .wbt text, as its world file or node string wrote it with
-   the fields the server keeps as they are now. As libController, the library owns the string: it stays
-   valid until the next call (which frees it); "" after the server's line (a node inside a robot or solid,
-   a YAML world's node: no such text here). */
+/* Webots' exportString: a node as .wbt text, as its world file or node string wrote it with the fields
+   the server keeps as they are now. As libController, the library owns the string: it stays valid until
+   the next call (which frees it); "" after the server's line (a node a PROTO's body made, a YAML world's
+   node: no such text here). */
 const char *wb_supervisor_node_export_string(WbNodeRef node) {
   static char *text;
   const char *func = "wb_supervisor_node_export_string";

@@ -588,6 +588,7 @@ class Converter:
         tags = self.inner_defs(node)
         if tags:
             entry["inner_defs"] = tags[:64]
+        self.written_at(node, entry)
         self.tree.append(entry)
 
     def nested_def(self, node: Node) -> bool:
@@ -597,6 +598,14 @@ class Converter:
             return False
         self.nested_defs.add(id(node))
         return True
+
+    def written_at(self, node: Node, entry: dict) -> None:
+        """``entry``'s ``written_at``: where the world file writes ``node`` (a PROTO instance: the instance),
+        for a Supervisor's exportString; nothing for a node a PROTO's body made."""
+        if node.instance_at is not None and node.instance_at[0] == self.source:
+            entry["written_at"] = [node.instance_at[1], node.instance_at[2]]
+        elif node.instance_at is None and (node.source or self.source) == self.source:
+            entry["written_at"] = [node.line, node.col]
 
     def written(self, node: Node) -> bool:
         """Whether the world file writes ``node`` (or the PROTO instance it is): a node of a PROTO's
@@ -988,6 +997,7 @@ class Converter:
             tags += self.inner_defs(self.fields(node).node_("geometry"), "geometry")
         if tags:
             out["inner_defs"] = tags[:64]
+        self.written_at(node, out)
         app = self.fields(node).node_("appearance")
         if app is not None and app.proto and "appearance" in out:     # an appearance PROTO (PaintedWood, ...)
             out["appearance_proto"] = app.proto
@@ -1374,6 +1384,7 @@ class Converter:
             tags = self.inner_defs(node)
             if tags:
                 data["inner_defs"] = tags[:64]
+            self.written_at(node, data)
         if owner.kind == "world":
             colors = f.colors("recognitionColors", [])        # what cameras with a Recognition node report
             if colors:

@@ -10,6 +10,7 @@ a ``lookupTable``, ...), else all on one line, comma-separated (Webots' layout o
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from sensorium.server.world.wbt.parser import Node
@@ -36,9 +37,12 @@ def string(s: str) -> str:
 
 
 class Writer:
-    """Nodes to text; a DEF node met again in the same writer is written ``USE NAME`` (Webots' rule)."""
+    """Nodes to text; a DEF node met again in the same writer is written ``USE NAME`` (Webots' rule).
+    ``fields_of(node)``: the values to write in place of a node's own fields (None: its own), for every node
+    written without ``fields`` given (the nodes inside one too)."""
 
-    def __init__(self) -> None:
+    def __init__(self, fields_of: Callable[[Node], dict[str, Any] | None] | None = None) -> None:
+        self.fields_of = fields_of
         self.written: set[int] = set()        # ids of the DEF nodes written so far
         self.written_nodes: set[int] = set()  # ids of the top-level nodes written so far (depth 0)
 
@@ -51,6 +55,8 @@ class Writer:
             self.written.add(id(n))
         if depth == 0:
             self.written_nodes.add(id(n))
+        if fields is None and self.fields_of is not None:
+            fields = self.fields_of(n)
         head = f"DEF {n.def_name} {n.type}" if n.def_name else n.type
         lines = [head + " {"]
         pad = INDENT * (depth + 1)
