@@ -323,7 +323,7 @@ def project(tmp_path: Path, text: str, world: str, rel: str, ours: Path, clib: t
     return path, webots
 
 
-def run(world: Path, until_ms: int, *extra: str) -> subprocess.CompletedProcess:
+def run_world(world: Path, until_ms: int, *extra: str) -> subprocess.CompletedProcess:
     done = subprocess.run(sensorium("run", str(world), "--until", str(until_ms), "--rpc", "tcp://127.0.0.1:0",
                                     "--pub", "tcp://127.0.0.1:0", *extra),
                           env=child_env(), cwd=world.parent.parent, capture_output=True, text=True, timeout=600)
@@ -340,7 +340,7 @@ def test_thymio2_demo_sends_the_ground_readings_to_its_robot_window(tmp_path: Pa
     every LED value it sets is accepted (no error line)."""
     text = (thymio_world(tmp_path).read_text())
     world, _ = project(tmp_path, text, "thymio2", "mobsya/thymio/controllers/thymio2_demo", TESTS_C / "thymio_window.c", clib)
-    done = run(world, 1000, "--robot-window-log")
+    done = run_world(world, 1000, "--robot-window-log")
     sent = [x.split("robot window: ", 1)[1] for x in done.stderr.splitlines() if x.startswith("[Thymio II] robot window: ")]
     assert sent == ["0 0 0 0 0 0 0 83 83"] * 100, done.stderr[-2000:]
     assert "Error" not in done.stdout + done.stderr, done.stdout[-2000:] + done.stderr
@@ -357,7 +357,7 @@ def test_rover_controller_follows_the_line_as_the_closed_form(tmp_path: Path, cl
     world, _ = project(tmp_path, text, "rover", "lego/mindstorms/controllers/Rover", TESTS_C / "rover_edge.c", clib, extra)
     (tmp_path / "controllers" / "watcher").mkdir()
     (tmp_path / "controllers" / "watcher" / "watcher.py").write_text(WATCHER)
-    done = run(world, 20000)
+    done = run_world(world, 20000)
     poses = {}
     for line in done.stdout.splitlines():
         if line.startswith("[watcher] pose "):
@@ -367,3 +367,154 @@ def test_rover_controller_follows_the_line_as_the_closed_form(tmp_path: Path, cl
     assert len(poses) == 312
     for k, (x, y, yaw, _) in enumerate(want, 1):
         assert poses[64 * k] == pytest.approx([x, y, yaw], abs=1e-8), k
+
+
+# ----------------------------------------------------------------------------------------- Boe-Bot
+# boebot (parallax/boebot): 64 ms steps; its two infra-red sensors lds and rds (0.05 m ahead, 0.028 m either
+# side, turned 0.5 and -0.4 rad) read their table 0 up to 0.1 m, 1 from 0.101 m; each reading truncated to
+# an int makes a two-bit state: both clear (3) forward at 8 rad/s; one sees (1: lds, 2: rds) a turn in place
+# at 10 rad/s away from it; both (0) back off at (-10, -20) rad/s for 11 steps. Wheels of radius 0.034 m at
+# y 0.0468861 and -0.046, their hinges 0.025 m ahead of the origin.
+BOE = "BoeBot"
+BOE_R, BOE_CX, BOE_CY = 0.034, 0.025, (0.0468861 - 0.046) / 2
+BOE_AXLE = 0.0468861 + 0.046
+BOE_BOXES = [(-0.683174, 0.2, 0.5), (0.35, 0.75, 4.96782), (-0.35471, -0.5, 5.36782), (0.36, 0.3, 5.36782),
+             (-0.66, 0.65, 5.36782)]
+BOE_SENSORS = [(0.05, 0.028, 0.500004), (0.05, -0.028, 5.88319)]        # lds, rds: x, y, heading
+
+
+def boe_ray(x: float, y: float, heading: float) -> float:
+    """The distance along ``heading`` from (x, y) to the nearest face the sensors' rays (0.0892 m up, under
+    every top) meet: the arena's inner walls (x, y = ±1) and the 0.1 m wooden boxes, each turned by θ."""
+    dx, dy = math.cos(heading), math.sin(heading)
+    best = min([(1 - x) / dx if dx > 0 else math.inf, (-1 - x) / dx if dx < 0 else math.inf,
+                (1 - y) / dy if dy > 0 else math.inf, (-1 - y) / dy if dy < 0 else math.inf])
+    for bx, by, th in BOE_BOXES:
+        a, b = (math.cos(th), math.sin(th)), (-math.sin(th), math.cos(th))
+        px, py = (x - bx) * a[0] + (y - by) * a[1], (x - bx) * b[0] + (y - by) * b[1]
+        ux, uy = dx * a[0] + dy * a[1], dx * b[0] + dy * b[1]
+        lo, hi = -math.inf, math.inf
+        for p, u in ((px, ux), (py, uy)):
+            if abs(u) < 1e-15:
+                if abs(p) > 0.05:
+                    lo, hi = math.inf, -math.inf
+                continue
+            t0, t1 = sorted(((-0.05 - p) / u, (0.05 - p) / u))
+            lo, hi = max(lo, t0), min(hi, t1)
+        if lo <= hi and 0 < lo < best:
+            best = lo
+    return best
+
+
+def boe_reading(d: float) -> float:
+    """The table at d (the walls and the stand-in boxes have no appearance: white, infra-red at d itself)."""
+    return 0.0 if d <= 0.1 else 1.0 if d >= 0.101 else (d - 0.1) / 0.001
+
+
+def boe_move(x: float, y: float, yaw: float, wl: float, wr: float, dt: float) -> tuple[float, float, float]:
+    """One step of the drive: the wheels' centre (0.025, 0.00044) in the robot's frame on the arc of the wheel
+    speeds, the origin carried with it."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    cx, cy = x + c * BOE_CX - s * BOE_CY, y + s * BOE_CX + c * BOE_CY
+    v, w = BOE_R * (wl + wr) / 2, BOE_R * (wr - wl) / BOE_AXLE
+    if w == 0.0:
+        cx, cy = cx + v * dt * c, cy + v * dt * s
+    else:
+        cx, cy = cx + v / w * (math.sin(yaw + w * dt) - s), cy - v / w * (math.cos(yaw + w * dt) - c)
+        yaw = math.remainder(yaw + w * dt, 2 * math.pi)
+    c, s = math.cos(yaw), math.sin(yaw)
+    return cx - (c * BOE_CX - s * BOE_CY), cy - (s * BOE_CX + c * BOE_CY), yaw
+
+
+def boe_rule(left: float, right: float, back: int) -> tuple[float, float, int]:
+    """boebot.c's step on the two readings: (left, right, backward counter)."""
+    state = (int(left) << 1 | int(right)) if back == 0 else 0
+    if state == 0:
+        return -10.0, -20.0, (10 if back == 0 else back - 1)
+    return {1: (10.0, -10.0), 2: (-10.0, 10.0), 3: (8.0, 8.0)}[state] + (back,)
+
+
+def boe_run(sim: Simulation, steps: int) -> tuple[list[tuple[float, float, float]], list[tuple[int, float]]]:
+    """boebot.c's calls in process for ``steps`` 64 ms steps: each step the readings are checked against the
+    closed form from the pose and the pose against the arc of the wheel speeds from the last one; returns the
+    poses and the steps where the arc was cut short (a part of the robot met a wall: (step, shortfall))."""
+    robot = sim.robot(BOE)
+    sensors = [sim.device(f"{BOE}/lds"), sim.device(f"{BOE}/rds")]
+    for s in sensors:
+        s.enable(64)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    x, y, yaw = 0.0, 0.0, 1.8318
+    wl = wr = 0.0
+    back, poses, held = 0, [], []
+    for k in range(1, steps + 1):
+        x, y, yaw = boe_move(x, y, yaw, wl, wr, 0.064)
+        sim.run(2)
+        gx, gy, gyaw = float(robot.pose.translation[0]), float(robot.pose.translation[1]), yaw_of(robot)
+        if math.hypot(gx - x, gy - y) > 1e-9 or abs(math.remainder(gyaw - yaw, 2 * math.pi)) > 1e-9:
+            held.append((k, math.hypot(gx - x, gy - y)))
+            x, y, yaw = gx, gy, gyaw
+        poses.append((x, y, yaw))
+        got = [float(s.value) for s in sensors]
+        want = [boe_reading(boe_ray(x + math.cos(yaw) * sx - math.sin(yaw) * sy, y + math.sin(yaw) * sx + math.cos(yaw) * sy,
+                                    yaw + h)) for sx, sy, h in BOE_SENSORS]
+        assert got == pytest.approx(want, abs=1e-6), k
+        wl, wr, back = boe_rule(got[0], got[1], back)
+        left.set_velocity(wl)
+        right.set_velocity(wr)
+    return poses, held
+
+
+def test_the_boebot_stand_in_loads_with_its_drive_ahead_of_its_origin() -> None:
+    """The Boe-Bot stand-in: its wheels (radius 0.034 m, 0.0928861 m apart) are a two-wheel drive whose
+    centre is 0.025 m ahead of the origin and 0.44 mm to its left; put at z 0.038, it settles at load onto its
+    wheels at 0.0392 (their bottom 0.0392 under the origin)."""
+    w = load_world(DATA / "boebot.wbt")
+    assert len(w.warnings) == 1 and "RectangleArena, WoodenBox" in w.warnings[0], w.warnings
+    drive = w.world.robots[0].differential_drive
+    assert drive is not None and drive.wheel_radius == BOE_R
+    assert drive.axle_length == pytest.approx(BOE_AXLE, abs=1e-15)
+    assert drive.axle_center == pytest.approx((BOE_CX, BOE_CY), abs=1e-15)
+    sim = Simulation(w, "exact")
+    assert float(sim.robot(BOE).pose.translation[2]) == pytest.approx(0.0392, abs=1e-15)
+
+
+def test_the_boebot_avoids_the_walls_by_its_closed_form_readings_and_arcs() -> None:
+    """boebot.c's calls in process for 60 s: every step both sensors read the closed form's table (the
+    nearest wall or box face along their rays) and the pose is the arc of the wheel speeds set the step
+    before (1e-9), but for one step: turning in place beside the west wall at 6.016 s, its footprint (the
+    whiskers reach 0.127 m ahead) would sweep into the wall, and it is pushed 4.4 mm off it (Kinematic
+    contact), its turn kept. It drives at 8 × 0.034 = 0.272 m/s and turns at 10 × 2 × 0.034 / 0.0928861 =
+    7.32 rad/s, from wall to wall; at 59.968 s it is at (0.5205, 0.8842), heading −0.00034."""
+    poses, held = boe_run(Simulation(load_world(DATA / "boebot.wbt"), "exact"), 937)
+    first = poses[14]                  # 0.96 s: 14 steps straight on at 0.272 m/s (the first step's speeds 0)
+    assert (first[0], first[1]) == pytest.approx((8 * BOE_R * 0.896 * math.cos(1.8318), 8 * BOE_R * 0.896 * math.sin(1.8318)), abs=1e-12)
+    assert [k for k, _ in held] == [94] and held[0][1] == pytest.approx(0.00438, abs=1e-5)
+    assert poses[-1] == pytest.approx((0.520491, 0.884204, -0.000343), abs=1e-6)
+
+
+BOE_WATCHER = WATCHER.replace('"ROVER"', '"BOEBOT"')
+
+
+@pytest.mark.slow
+def test_boebot_controller_drives_as_the_in_process_closed_form(tmp_path: Path, clib) -> None:
+    """boebot (Webots' C, unchanged; without it tests/c/boebot_states.c) under ``sensorium run`` for 30 s with
+    a watcher printing the robot's pose each 64 ms: every pose is the in-process run's (boe_run: the closed
+    form's readings and arcs, the one push off the west wall), 1e-8."""
+    want, _ = boe_run(Simulation(load_world(DATA / "boebot.wbt"), "exact"), 468)
+    extra = 'Robot { name "watcher" supervisor TRUE controller "watcher" }\n'
+    world, _ = project(tmp_path, (DATA / "boebot.wbt").read_text(), "boebot", "parallax/boebot/controllers/boebot",
+                       TESTS_C / "boebot_states.c", clib, extra)
+    (tmp_path / "controllers" / "watcher").mkdir()
+    (tmp_path / "controllers" / "watcher" / "watcher.py").write_text(BOE_WATCHER)
+    done = run_world(world, 30000)
+    poses = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("[watcher] pose "):
+            t, *values = line.split()[2:]
+            poses[int(t)] = [float(v) for v in values]
+    assert len(poses) == 469                                   # 30 s: 469 steps of 64 ms, to 30.016 s
+    for k, pose in enumerate(want, 1):
+        assert poses[64 * k] == pytest.approx(list(pose), abs=1e-8), k
