@@ -68,8 +68,8 @@ from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
 from sensorium.server.sim import batched_camera as cam
 from sensorium.server.sim import batched_depth as depth
+from sensorium.server.sim import batched_joints, batched_lidar
 from sensorium.server.sim import batched_kinematic as kin
-from sensorium.server.sim import batched_lidar
 from sensorium.server.sim import batched_recognition as recog
 from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batched_holonomic import twist_steps
@@ -386,6 +386,8 @@ class BatchedSimulation:
             self._footless = any(f is None for f in feet)
             self._bounds: list = []                # _solid_bounds' answer and the obstacle list it is for
             self._bounds_of: list | None = None
+        # joint motors (every motor but the drives'): their state per copy and what rides them (batched_joints.py)
+        self.joints = batched_joints.BatchedJoints(w, C)
         # -- devices: one template object per device (its constants); values per copy
         self._build_devices()
         self.counters = {"steps": 0, "copy_steps": 0, "measurements": 0, "resets": 0, "contacts": 0}
@@ -406,12 +408,25 @@ class BatchedSimulation:
         if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "
                                "carries solids; the batched simulation moves no belt (use Simulation)")
-        for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
-            drive = {m for _, m in r.drive_motors}
-            joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]
-            if joints:
-                raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: motor {joints[0]!r} moves a joint; the "
-                                   "batched simulation moves drive wheels only (use Simulation)")
+        for r in w.robots:            # joints move per copy (batched_joints.py); of what rides them, only devices
+            riding = [(f"shape {x.name!r}" if x.name else f"shapes[{i}]", x.on_joint) for i, x in enumerate(r.shapes)]
+            riding += [(f"lights[{i}]", x.on_joint) for i, x in enumerate(r.lights)]
+            for what, joint in riding:    # the copies' robots are one rigid body each: no link moves in the cast
+                if joint is not None:
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {what} rides joint {joint!r}; "
+                                       "the batched simulation moves no link's shapes or lights (use Simulation)")
+            for d in r.devices:
+                joint = getattr(d, "on_joint", None)
+                if joint is None:
+                    continue
+                if d.device not in batched_joints.RIDING_KINDS:
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
+                                       f"{joint!r}; the batched simulation moves distance sensors and fixed lidars "
+                                       "on joints only (use Simulation)")
+                if d.device == "Lidar" and d.type == "rotating":    # batched_lidar.py's heads turn on the body
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: rotating lidar {d.name!r} rides joint "
+                                       f"{joint!r}; the batched simulation moves fixed lidars on joints only "
+                                       "(use Simulation)")
         # a VacuumGripper is not stepped here (no service turns its pump on): one on at load would carry a
         # solid in Simulation that stays put here, so it is refused rather than silently different
         pumps = [(r.name, d.name) for r in w.robots for d in r.devices if d.device == "VacuumGripper" and d.is_on]
@@ -464,7 +479,14 @@ class BatchedSimulation:
                 dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
                                         world_seed=0, clock=lambda: 0,
                                         own_shapes=self._own_shapes.get((slot, d.name), frozenset()))
-                if d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
+                riding = dev.on_joint is not None and d.device in ("DistanceSensor", "Lidar")
+                if riding:
+                    # on a link without shapes (batched.py refuses links with shapes): its rays are
+                    # mounted on no body, as the single simulation's (Scene.device_body is None);
+                    # each copy's local pose is the joints' (batched_joints.py)
+                    dev.move_with(Pose.identity())
+                    self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose)
+                elif d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
                     # its beams meet its own robot's body once, in the body frame, blind to its own
                     # shapes (Lidar._own_distances, on the movers' engine)
                     dev._own_body = (_OnEngine(self.rays.movers), self.rays.slot_body[slot], None)
@@ -539,6 +561,10 @@ class BatchedSimulation:
             self._d_tables = [(table, np.array([self._d_col[id(self._d_plan.devices[i])] for i in idx.tolist()],
                                                dtype=np.int64)) for table, idx in self._d_plan.tables]
             self._d_table_of = _table_of(self._d_tables, len(self.distance))
+            # per plan index: the distance column of a sensor riding a joint (its local pose per copy), else -1
+            self._d_riding = np.array([self._d_col[id(d)] if ("DistanceSensor", self._d_col[id(d)]) in self.joints.riders
+                                       else -1 for d in self._d_plan.devices], dtype=np.int64)
+            self._d_any_riding = bool((self._d_riding >= 0).any())
             self._own_kept: dict[int, tuple] = {}   # per group: its due sensors' own-body hits (_own_rows)
             self._combine_kept: dict[int, tuple] = {}   # per group: its due sensors' CombinePlan
             self._d_rows: list | None = None             # the due sensors' rows (_distance_rows)
@@ -673,6 +699,7 @@ class BatchedSimulation:
             self.mecanum.reset(idx)
         if self.omni is not None:
             self.omni.reset(idx)
+        self.joints.reset(idx)
         self.pressing[idx] = False
         self.led_value[idx] = 0                 # LEDs off, their lights too (WbLed::reset)
         if self.carried is not None:
@@ -812,6 +839,7 @@ class BatchedSimulation:
             self.time_ms[live] += dt
         self.counters["steps"] += 1
         self.counters["copy_steps"] += len(live)
+        self.joints.step(live, dt * 0.001)       # joints first, as Simulation.step moves them (and their links)
         self._drive(live, dt)
         self._measure_positions(live)
         self.kinematic.measure(live)
@@ -1281,6 +1309,7 @@ class BatchedSimulation:
             self.mecanum.read_encoders(self.position, copies, cols, v)
         if self.omni is not None:     # an omni wheel's encoder
             self.omni.read_encoders(self.position, copies, cols, v)
+        self.joints.read_encoders(self.position, copies, cols, v)   # a joint motor's
         plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself
         for k in (~plain).nonzero()[0].tolist():
             col = int(cols[k])
@@ -1462,14 +1491,17 @@ class BatchedSimulation:
         reqs: list[_Rays] = []
         groups = self._distance_rows(copies, cols)
         state["kept"] = self._d_rows
-        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy, native in groups:
+        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy, native, local in groups:
             n = g.n
             if native is not None:   # packets.sensor_rays of these sensors
                 positions, origins, dirs = native()
             else:
                 rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
-                rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
-                                         np.ascontiguousarray(plan.local_pos_t[:, pi]))
+                if local is None:
+                    lrot_t, lpos_t = plan.local_rot_t[:, :, pi], plan.local_pos_t[:, pi]
+                else:               # (rows' own local poses: sensors on joints)
+                    lrot_t, lpos_t = local[0].transpose(1, 2, 0), local[1].T
+                rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(lrot_t), np.ascontiguousarray(lpos_t))
                 positions = pos_t.T + self.pos[c, slot]
                 dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
                 origins = np.repeat(positions, n, axis=0)
@@ -1484,7 +1516,8 @@ class BatchedSimulation:
         and copy, their world rays' C pass or None), kept while the same sensors of the same copies
         are due (step after step)."""
         kept = self._d_rows
-        if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols):
+        if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols) \
+                and not self._d_any_riding:     # (sensors on joints: their copies' local poses, made each step)
             return kept[2]
         plan = self._d_plan
         out = []
@@ -1504,9 +1537,19 @@ class BatchedSimulation:
                 mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             t_far = g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1)
-            native = packets.sensor_rays_of(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k,
-                                            g.local_dirs)
-            out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n), native))
+            local_rot, local_pos = plan.local_rot, plan.local_pos
+            riding = self._d_riding[pi]
+            if self._d_any_riding and (riding >= 0).any():
+                # one local pose per row: the plan's, or the copy's for a sensor riding a joint
+                local_rot, local_pos = plan.local_rot[pi], plan.local_pos[pi]
+                for col in np.unique(riding[riding >= 0]).tolist():
+                    m = (riding == col).nonzero()[0]
+                    local_rot[m] = self.joints.local_rot[("DistanceSensor", col)][c[m]]
+                    local_pos[m] = self.joints.local_pos[("DistanceSensor", col)][c[m]]
+                pi = np.arange(len(pi))
+            native = packets.sensor_rays_of(c, slot, self.rot, self.pos, pi, local_rot, local_pos, k, g.local_dirs)
+            out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n), native,
+                        None if local_rot is plan.local_rot else (local_rot, local_pos)))
         self._d_rows = [copies.copy(), cols.copy(), out, None]    # (the outputs: _distance_outputs)
         return out
 
@@ -1625,8 +1668,13 @@ class BatchedSimulation:
             lid = self.lidar[col]
             slot = lid.robot_index
             rr = self.rot[c, slot]
-            rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
-            org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
+            rider = ("Lidar", col)
+            if rider in self.joints.riders:     # on a joint: each copy's local pose (batched_joints.py)
+                rot = np.matmul(rr, self.joints.local_rot[rider][c])
+                org = np.matmul(rr, self.joints.local_pos[rider][c][:, :, None])[:, :, 0] + self.pos[c, slot]
+            else:
+                rot = np.matmul(rr, lid.local_pose.rotation)                    # Pose.compose, stacked
+                org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
             W = len(lid._dir_columns[0])
             got = packets.lidar_beams(rot, org, lid._dir_columns, self._lidar_buffers(col, len(c) * W))
             origins, d, d32 = got if got is not None else _lidar_beams(rot, org, lid._dir_columns)
@@ -1686,6 +1734,8 @@ class BatchedSimulation:
         (a Webots lidar sees its own robot, so the others are paired with it every scan; a fixed
         lidar's beams never move in the body frame), else -1. Decided once."""
         got = self._lidar_skips.get(col)
+        if got is None and ("Lidar", col) in self.joints.riders:   # on a joint: its beams move in the body frame
+            got = self._lidar_skips[col] = np.full(len(self.lidar[col]._dir_columns[0]), -1, dtype=np.int64)
         if got is None:
             lid = self.lidar[col]
             slot = lid.robot_index
