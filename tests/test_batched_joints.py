@@ -209,3 +209,22 @@ def test_bad_joint_commands_name_the_motor():
         batched.joints.command(slot, "tilt", acceleration=-2.0)
     with pytest.raises(KeyError, match="no joint motor 'nope'"):
         batched.joints.command(slot, "nope", position=0.0)
+
+
+def test_a_task_callable_commands_a_copys_joint_through_its_view():
+    """The gym's view of copy 1 (what task callables get): its joint motor takes setPosition in that
+    copy alone, coupled motors following (arm::b at -0.5 times arm::a's target); a negative velocity
+    in position control is ignored, as the single motor ignores it."""
+    from sensorium.gym.views import CopySim
+
+    batched = BatchedSimulation(jointed_world(), 2)
+    view = CopySim(batched, 1).robot("lift")
+    view.motor("arm::a").set_position(0.8)
+    slot = batched.slot("lift")
+    a, b = batched.joints.of(slot, "arm::a"), batched.joints.of(slot, "arm::b")
+    assert batched.joints.target[:, a].tolist() == [0.0, 0.8] and batched.joints.target[:, b].tolist() == [0.0, -0.4]
+    view.motor("arm::a").set_velocity(-1.0)
+    assert view.motor("arm::a").velocity == 2.0
+    batched.run(40)
+    assert view.motor("arm::a").position == 0.8 and view.motor("arm::b").position == -0.4
+    assert batched.joints.position[0, a] == 0.0
