@@ -485,7 +485,7 @@ class BatchedSimulation:
                     # mounted on no body, as the single simulation's (Scene.device_body is None);
                     # each copy's local pose is the joints' (batched_joints.py)
                     dev.move_with(Pose.identity())
-                    self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose)
+                    self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose, dev.local_pose)
                 elif d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
                     # its beams meet its own robot's body once, in the body frame, blind to its own
                     # shapes (Lidar._own_distances, on the movers' engine)
