@@ -43,6 +43,11 @@ as DifferentialDrive.step), the others by their arcs, both in the C drive pass (
 path's operations); in a world with car-like, mecanum or omni-wheel robots those take the numpy
 drive and the two-wheel robots' wheels and moves are C passes within it.
 
+Joint motors (every motor that is no drive's wheel) move per copy by :mod:`~sensorium.server.sim.batched_joints`
+(``sim.joints.command``), before the drives as in Simulation.step; the distance sensors and fixed lidars
+riding them cast from each copy's link. A link's shapes or lights, other devices on a joint, rotating
+lidars on one, steered drives and belts are refused (BatchedError, one line).
+
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
 worlds take the numpy drive pass (the C pass writes ENU poses).
