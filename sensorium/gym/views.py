@@ -210,7 +210,7 @@ class CopyRobot:
         else:           # a mecanum or omni-wheel robot: its wheels; any other robot: no motors
             self.drive = None
             self.motors = {}
-            for drives in (sim.mecanum, sim.omni):
+            for drives in (sim.mecanum, sim.omni, sim.steered):
                 if drives is not None and slot in drives.of:
                     self.motors = {name: _Motor.holonomic(drives, copy, slot, name)
                                    for name in drives.columns[drives.of[slot]]}

@@ -81,6 +81,7 @@ from sensorium.server.sim.batched_holonomic import twist_steps
 from sensorium.server.sim.batched_lights import CarriedLights, has_carried_lights
 from sensorium.server.sim.batched_mecanum import MecanumDrives
 from sensorium.server.sim.batched_omni import OmniDrives
+from sensorium.server.sim.batched_steered import SteeredDrives
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import (
@@ -111,6 +112,7 @@ from sensorium.server.sim.motion import (
     MecanumDrive,
     OmniDrive,
     PlanarState,
+    SteeredDrive,
     _rz,
 )
 from sensorium.server.sim.scene import (
@@ -333,16 +335,24 @@ class BatchedSimulation:
                               band_low=float(self.band_low[i])) if r.mecanum_drive
             else OmniDrive(r.omni_drive, self.initial[i], up=up, ground=self.ground,
                            band_low=float(self.band_low[i])) if r.omni_drive
+            else SteeredDrive(r.steered_drive, self.initial[i], up=up, ground=self.ground,
+                              band_low=float(self.band_low[i])) if r.steered_drive
             else None for i, r in enumerate(w.robots)]
+        # joint motors (every motor but the drives'): their state per copy and what rides them (batched_joints.py)
+        self.joints = batched_joints.BatchedJoints(w, C)
         # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
         self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
         # mecanum robots: their four wheels and body twist (batched_mecanum.py), None in a world without one
         self.mecanum = (MecanumDrives(self._templates, C) if any(r.mecanum_drive for r in w.robots) else None)
         # omni-wheel robots: their wheels and body twist (batched_omni.py), None in a world without one
         self.omni = OmniDrives(self._templates, C) if any(r.omni_drive for r in w.robots) else None
+        # steered-wheel robots: their wheels and body twist at each copy's steering joints (batched_steered.py)
+        self.steered = (SteeredDrives(self._templates, C, self.joints) if any(r.steered_drive for r in w.robots)
+                        else None)
         # the drives the C drive pass does not step (it moves two-wheel robots by arcs about their
         # origin, or by their origin's twist when their wheels' centre is off it)
         self._numpy_drives = (self.cars is not None or self.mecanum is not None or self.omni is not None
+                              or self.steered is not None
                               or self.to_enu is not None)
         # -- per copy state
         self.time_ms = np.zeros(C, dtype=np.int64)
@@ -368,7 +378,7 @@ class BatchedSimulation:
         use_contact = w.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = None
         if use_contact and (self.has_drive.any() or self.cars is not None or self.mecanum is not None
-                            or self.omni is not None):
+                            or self.omni is not None or self.steered is not None):
             solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
@@ -391,8 +401,6 @@ class BatchedSimulation:
             self._footless = any(f is None for f in feet)
             self._bounds: list = []                # _solid_bounds' answer and the obstacle list it is for
             self._bounds_of: list | None = None
-        # joint motors (every motor but the drives'): their state per copy and what rides them (batched_joints.py)
-        self.joints = batched_joints.BatchedJoints(w, C)
         # -- devices: one template object per device (its constants); values per copy
         self._build_devices()
         self.counters = {"steps": 0, "copy_steps": 0, "measurements": 0, "resets": 0, "contacts": 0}
@@ -404,11 +412,12 @@ class BatchedSimulation:
         if w.world_info.coordinate_system not in _TO_ENU:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
-        steered = [r.name for r in w.robots if r.steered_drive is not None]
-        if steered:                   # its fit is not written for the copies' arrays
-            raise BatchedError(f"{self.loaded.source}: robot {steered[0]!r} has a steered_drive; the batched "
-                               "simulation drives two-wheel, skid-steer, car-like, mecanum and omni-wheel robots "
-                               "only (use Simulation)")
+        free = [r.name for r in w.robots if r.steered_drive is not None
+                and any(wheel.motor is None for wheel in r.steered_drive.wheels)]
+        if free:                      # their constrained fit is not written for the copies' arrays
+            raise BatchedError(f"{self.loaded.source}: robot {free[0]!r} has a steered_drive with free wheels (no "
+                               "motor); the batched simulation drives steered wheels that all have motors "
+                               "(use Simulation)")
         belts = [(r.name, b.motor) for r in w.robots for b in r.belts]
         if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "
@@ -704,6 +713,8 @@ class BatchedSimulation:
             self.mecanum.reset(idx)
         if self.omni is not None:
             self.omni.reset(idx)
+        if self.steered is not None:
+            self.steered.reset(idx)
         self.joints.reset(idx)
         self.pressing[idx] = False
         self.led_value[idx] = 0                 # LEDs off, their lights too (WbLed::reset)
@@ -801,6 +812,11 @@ class BatchedSimulation:
             n = int(self.omni.count[self.omni.of[slot]])
             raise ValueError(f"{self.robot_names[slot]}: an omni-wheel robot has no left and right wheels: "
                              f"command it with omni.command(slot, speeds) (copies, {n})")
+        if self.steered is not None and slot in self.steered.of:
+            n = int(self.steered.count[self.steered.of[slot]])
+            raise ValueError(f"{self.robot_names[slot]}: a steered-wheel robot has no left and right wheels: "
+                             f"command it with steered.command(slot, speeds) (copies, {n}) and its steering "
+                             "joints with joints.command")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         vmax = self.max_wheel[slot]
         left = np.asarray(left, dtype=np.float64)
@@ -943,7 +959,8 @@ class BatchedSimulation:
                              if self.cars.offset else _arc_steps(x0, y0, yaw0, v, w, dt))   # offset: origin off the rear axle
                 moves.append((copies, slots, x0, y0, yaw0, x, y, yaw))
         # the mecanum and omni-wheel robots' body twists, in one twist_steps call
-        twists = [t for t in (d.step(live, dt) for d in (self.mecanum, self.omni) if d is not None) if len(t[0])]
+        twists = [t for t in (d.step(live, dt) for d in (self.mecanum, self.omni, self.steered) if d is not None)
+                  if len(t[0])]
         if twists:
             copies, slots, vx, vy, w = (np.concatenate(col) if len(twists) > 1 else col[0] for col in zip(*twists))
             vx, vy, w = self._twist_over_ground(copies, slots, vx, vy, w)
@@ -1314,6 +1331,8 @@ class BatchedSimulation:
             self.mecanum.read_encoders(self.position, copies, cols, v)
         if self.omni is not None:     # an omni wheel's encoder
             self.omni.read_encoders(self.position, copies, cols, v)
+        if self.steered is not None:  # a steered wheel's encoder
+            self.steered.read_encoders(self.position, copies, cols, v)
         self.joints.read_encoders(self.position, copies, cols, v)   # a joint motor's
         plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself
         for k in (~plain).nonzero()[0].tolist():
