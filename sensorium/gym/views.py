@@ -20,7 +20,8 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
   side share one state, so commanding one of them commands its side. A car-like robot has
   ``motors`` (its steering and driven wheels) and no ``drive``; so have a mecanum robot (its four
-  wheels, batched_mecanum.MecanumDrives) and an omni-wheel robot (its wheels, batched_omni.OmniDrives).
+  wheels, batched_mecanum.MecanumDrives), an omni-wheel robot (its wheels, batched_omni.OmniDrives) and a
+  steered-wheel robot (its rolling wheels, batched_steered.SteeredDrives).
   A robot's joint motors are in its ``motors`` too (batched_joints.BatchedJoints).
 
 Anything else a callable reaches for raises AttributeError naming the view.

@@ -45,8 +45,10 @@ drive and the two-wheel robots' wheels and moves are C passes within it.
 
 Joint motors (every motor that is no drive's wheel) move per copy by :mod:`~sensorium.server.sim.batched_joints`
 (``sim.joints.command``), before the drives as in Simulation.step; the distance sensors and fixed lidars
-riding them cast from each copy's link. A link's shapes or lights, other devices on a joint, rotating
-lidars on one, steered drives and belts are refused (BatchedError, one line).
+riding them cast from each copy's link. Steered-wheel robots (``steered_drive``) are driven by
+:mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``) at each copy's steering joints.
+A link's shapes or lights, other devices on a joint, rotating lidars on one, steered drives with free
+wheels and belts are refused (BatchedError, one line).
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
