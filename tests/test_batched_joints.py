@@ -203,7 +203,7 @@ lookup table gives 1000 per metre)."""
     (lambda r: r["devices"].append({"device": "Lidar", "name": "spin", "on_joint": "tilt", "type": "rotating",
                                     "horizontal_resolution": 8, "field_of_view": 6.28}),
      "robot 'lift': rotating lidar 'spin' rides joint 'tilt'; the batched simulation moves fixed lidars on joints"),
-])
+], ids=["link shape", "camera", "rotating lidar"])
 def test_what_rides_a_joint_and_is_not_simulated_is_refused_in_one_line(change, message):
     lift = lift_robot()
     change(lift)
@@ -220,6 +220,8 @@ def test_bad_joint_commands_name_the_motor():
         batched.joints.command(slot, "tilt", position=math.nan)
     with pytest.raises(ValueError, match="motor 'tilt': acceleration must be >= 0"):
         batched.joints.command(slot, "tilt", acceleration=-2.0)
+    with pytest.raises(ValueError, match=r"motor 'tilt': velocity must be a number or one per copy \(2\), got \(3,\)"):
+        batched.joints.command(slot, "tilt", velocity=[1.0, 2.0, 3.0])
     with pytest.raises(KeyError, match="no joint motor 'nope'"):
         batched.joints.command(slot, "nope", position=0.0)
 

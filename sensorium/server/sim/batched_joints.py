@@ -170,7 +170,11 @@ class BatchedJoints:
         n = len(idx)
 
         def values(v, what: str) -> np.ndarray:
-            a = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+            try:
+                a = np.broadcast_to(np.asarray(v, dtype=np.float64), (n,))
+            except (TypeError, ValueError):
+                raise ValueError(f"motor {name!r}: {what} must be a number or one per copy ({n}), got "
+                                 f"{np.shape(v)}") from None
             if np.isnan(a).any():
                 raise ValueError(f"motor {name!r}: {what} must be a number, got NaN")
             return a
