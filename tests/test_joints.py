@@ -242,14 +242,29 @@ def test_wbt_robot_keeps_its_drive_bit_identical_and_its_arm_joint_moves(tmp_pat
     assert got[steps - 1:] == [0.5] * (12 - steps + 1)
 
 
-def test_the_batched_simulation_refuses_a_joint_in_one_line() -> None:
+def test_the_batched_simulation_moves_a_joint_as_the_single_one() -> None:
+    """Each copy's joint and its encoder as the single simulation's (tests/test_batched_joints.py has
+    the full comparison); a link carrying a shape is refused in one line."""
     from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 
     world = parse_world({"world_info": {"basic_time_step": DT_MS},
-                         "robots": [{"name": "arm", "devices": _hinge()}]})
-    with pytest.raises(BatchedError, match="robot 'arm': motor 'shoulder' moves a joint; the batched simulation "
-                                           r"moves drive wheels only \(use Simulation\)"):
-        BatchedSimulation(world, 2)
+                         "robots": [{"name": "arm", "devices": _hinge(max_velocity=2.0)}]})
+    batched, single = BatchedSimulation(world, 2), Simulation(world)
+    ref = batched.device("arm", "shoulder sensor")
+    batched.enable(ref, DT_MS)
+    batched.joints.command(0, "shoulder", position=0.5, copies=[1])
+    single.robot("arm").motor("shoulder").set_position(0.5)
+    single.device("arm/shoulder sensor").enable(DT_MS)
+    got = _readings(single, "arm/shoulder sensor", 12)
+    assert 0.0 < got[0] < got[-1] < 0.5          # ramped up at maxTorque 10 rad/s², not there yet
+    for want in got:
+        batched.step()
+        assert batched.value(ref).tolist() == [0.0, want]
+    carried = {"name": "arm", "devices": _hinge(), "shapes": [{"on_joint": "shoulder", "geometry": {
+        "type": "box", "size": [0.1, 0.1, 0.1]}}]}
+    with pytest.raises(BatchedError, match=r"robot 'arm': shapes\[0\] rides joint 'shoulder'; the batched simulation "
+                                           r"moves no link's shapes or lights \(use Simulation\)"):
+        BatchedSimulation(parse_world({"world_info": {"basic_time_step": DT_MS}, "robots": [carried]}), 2)
 
 
 def test_a_drive_motor_entry_with_joint_fields_is_refused_in_one_line() -> None:

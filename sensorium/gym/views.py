@@ -20,7 +20,9 @@ and its ``RobotState``. The vector environment hands them these views of one cop
   The batched simulation drives a skid-steer robot's wheels of one side together: its wheels of a
   side share one state, so commanding one of them commands its side. A car-like robot has
   ``motors`` (its steering and driven wheels) and no ``drive``; so have a mecanum robot (its four
-  wheels, batched_mecanum.MecanumDrives) and an omni-wheel robot (its wheels, batched_omni.OmniDrives).
+  wheels, batched_mecanum.MecanumDrives), an omni-wheel robot (its wheels, batched_omni.OmniDrives) and a
+  steered-wheel robot (its rolling wheels, batched_steered.SteeredDrives).
+  A robot's joint motors are in its ``motors`` too (batched_joints.BatchedJoints).
 
 Anything else a callable reaches for raises AttributeError naming the view.
 """
@@ -97,6 +99,36 @@ class _Motor:
         if velocity_accepted(self.name, value, self.target_position, self.velocity):
             self._velocity[self._i] = float(min(max(value, -self.max_velocity), self.max_velocity))
 
+class _JointMotor:
+    """A joint motor in one copy (batched_joints.BatchedJoints): ``position``, ``target_position``,
+    ``velocity``, ``max_velocity``, ``set_position``, ``set_velocity`` (the single JointMotor's rules:
+    coupled motors, multiplier, limits, a negative velocity in position control ignored)."""
+
+    def __init__(self, sim: BatchedSimulation, copy: int, slot: int, name: str):
+        self._joints, self._c, self._slot, self.name = sim.joints, copy, slot, name
+        self._j = sim.joints.of(slot, name)
+        self.max_velocity = float(sim.joints.max_velocity[self._j])
+
+    @property
+    def position(self) -> float:
+        return float(self._joints.position[self._c, self._j])
+
+    @property
+    def target_position(self) -> float:
+        return float(self._joints.target[self._c, self._j])
+
+    @property
+    def velocity(self) -> float:
+        return float(self._joints.velocity[self._c, self._j])
+
+    def set_position(self, value: float) -> None:
+        self._joints.command(self._slot, self.name, position=value, copies=[self._c])
+
+    def set_velocity(self, value: float) -> None:
+        if velocity_accepted(self.name, value, self.target_position, self.velocity):
+            self._joints.command(self._slot, self.name, velocity=value, copies=[self._c])
+
+
 class _Drive:
     def __init__(self, sim: BatchedSimulation, copy: int, slot: int):
         left, right = sim.world.robots[slot].differential_drive.motor_names
@@ -169,19 +201,22 @@ class CopyRobot:
         self.index = slot
         self.name = sim.robot_names[slot]
         self.model = sim.world.robots[slot]
+        self.motors: dict[str, _Motor | _JointMotor]
         if sim.has_drive[slot]:
             self.drive: _Drive | None = _Drive(sim, copy, slot)
-            self.motors: dict[str, _Motor] = dict(self.drive.motors)
+            self.motors = dict(self.drive.motors)
         elif sim.cars is not None and slot in sim.cars.car_of:     # a car: its motors (no drive view)
             self.drive = None
             self.motors = {name: _Motor.car(sim, copy, slot, name) for name in sim.cars.columns[sim.cars.car_of[slot]]}
         else:           # a mecanum or omni-wheel robot: its wheels; any other robot: no motors
             self.drive = None
             self.motors = {}
-            for drives in (sim.mecanum, sim.omni):
+            for drives in (sim.mecanum, sim.omni, sim.steered):
                 if drives is not None and slot in drives.of:
                     self.motors = {name: _Motor.holonomic(drives, copy, slot, name)
                                    for name in drives.columns[drives.of[slot]]}
+        # its joint motors (every motor but the drive's): batched_joints.py
+        self.motors.update({name: _JointMotor(sim, copy, slot, name) for name in sim.joints.slot_joints.get(slot, {})})
 
     @property
     def pose(self):
@@ -190,7 +225,7 @@ class CopyRobot:
     def set_pose(self, translation=None, rotation=None, quaternion=None) -> None:
         self._s.set_pose(self._c, self.index, translation, rotation, quaternion)
 
-    def motor(self, name: str) -> _Motor:
+    def motor(self, name: str) -> _Motor | _JointMotor:
         try:
             return self.motors[name]
         except KeyError:

@@ -43,6 +43,13 @@ as DifferentialDrive.step), the others by their arcs, both in the C drive pass (
 path's operations); in a world with car-like, mecanum or omni-wheel robots those take the numpy
 drive and the two-wheel robots' wheels and moves are C passes within it.
 
+Joint motors (every motor that is no drive's wheel) move per copy by :mod:`~sensorium.server.sim.batched_joints`
+(``sim.joints.command``), before the drives as in Simulation.step; the distance sensors and fixed lidars
+riding them cast from each copy's link. Steered-wheel robots (``steered_drive``) are driven by
+:mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``) at each copy's steering joints.
+A link's shapes or lights, other devices on a joint, rotating lidars on one, steered drives with free
+wheels and belts are refused (BatchedError, one line).
+
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
 worlds take the numpy drive pass (the C pass writes ENU poses).
@@ -68,14 +75,15 @@ from sensorium.server.raycast.copies import CopyRays
 from sensorium.server.raycast.engine import Precision, RayEngine, RayHits, RayKind
 from sensorium.server.sim import batched_camera as cam
 from sensorium.server.sim import batched_depth as depth
+from sensorium.server.sim import batched_joints, batched_lidar
 from sensorium.server.sim import batched_kinematic as kin
-from sensorium.server.sim import batched_lidar
 from sensorium.server.sim import batched_recognition as recog
 from sensorium.server.sim.batched_car import CarDrives
 from sensorium.server.sim.batched_holonomic import twist_steps
 from sensorium.server.sim.batched_lights import CarriedLights, has_carried_lights
 from sensorium.server.sim.batched_mecanum import MecanumDrives
 from sensorium.server.sim.batched_omni import OmniDrives
+from sensorium.server.sim.batched_steered import SteeredDrives
 from sensorium.server.sim.batched_textures import RobotTextures, textured_robot
 from sensorium.server.sim.batches import DistancePlan, _frames_t, _rotate_t, compose_rotations, joined, split_hits
 from sensorium.server.sim.contact import (
@@ -106,6 +114,7 @@ from sensorium.server.sim.motion import (
     MecanumDrive,
     OmniDrive,
     PlanarState,
+    SteeredDrive,
     _rz,
 )
 from sensorium.server.sim.scene import (
@@ -339,16 +348,24 @@ class BatchedSimulation:
                               band_low=float(self.band_low[i])) if r.mecanum_drive
             else OmniDrive(r.omni_drive, self.initial[i], up=up, ground=self.ground,
                            band_low=float(self.band_low[i])) if r.omni_drive
+            else SteeredDrive(r.steered_drive, self.initial[i], up=up, ground=self.ground,
+                              band_low=float(self.band_low[i])) if r.steered_drive
             else None for i, r in enumerate(w.robots)]
+        # joint motors (every motor but the drives'): their state per copy and what rides them (batched_joints.py)
+        self.joints = batched_joints.BatchedJoints(w, C)
         # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
         self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
         # mecanum robots: their four wheels and body twist (batched_mecanum.py), None in a world without one
         self.mecanum = (MecanumDrives(self._templates, C) if any(r.mecanum_drive for r in w.robots) else None)
         # omni-wheel robots: their wheels and body twist (batched_omni.py), None in a world without one
         self.omni = OmniDrives(self._templates, C) if any(r.omni_drive for r in w.robots) else None
+        # steered-wheel robots: their wheels and body twist at each copy's steering joints (batched_steered.py)
+        self.steered = (SteeredDrives(self._templates, C, self.joints) if any(r.steered_drive for r in w.robots)
+                        else None)
         # the drives the C drive pass does not step (it moves two-wheel robots by arcs about their
         # origin, or by their origin's twist when their wheels' centre is off it)
         self._numpy_drives = (self.cars is not None or self.mecanum is not None or self.omni is not None
+                              or self.steered is not None
                               or self.to_enu is not None)
         # -- per copy state
         self.time_ms = np.zeros(C, dtype=np.int64)
@@ -374,7 +391,7 @@ class BatchedSimulation:
         use_contact = w.world_info.contact if contact is None else bool(contact)
         self.contact: Contact | None = None
         if use_contact and (self.has_drive.any() or self.cars is not None or self.mecanum is not None
-                            or self.omni is not None):
+                            or self.omni is not None or self.steered is not None):
             solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
@@ -408,21 +425,35 @@ class BatchedSimulation:
         if w.world_info.coordinate_system not in _TO_ENU:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
-        steered = [r.name for r in w.robots if r.steered_drive is not None]
-        if steered:                   # its fit is not written for the copies' arrays
-            raise BatchedError(f"{self.loaded.source}: robot {steered[0]!r} has a steered_drive; the batched "
-                               "simulation drives two-wheel, skid-steer, car-like, mecanum and omni-wheel robots "
-                               "only (use Simulation)")
+        free = [r.name for r in w.robots if r.steered_drive is not None
+                and any(wheel.motor is None for wheel in r.steered_drive.wheels)]
+        if free:                      # their constrained fit is not written for the copies' arrays
+            raise BatchedError(f"{self.loaded.source}: robot {free[0]!r} has a steered_drive with free wheels (no "
+                               "motor); the batched simulation drives steered wheels that all have motors "
+                               "(use Simulation)")
         belts = [(r.name, b.motor) for r in w.robots for b in r.belts]
         if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "
                                "carries solids; the batched simulation moves no belt (use Simulation)")
-        for r in w.robots:            # a joint's motor (sim/joints.py) is not stepped here: refused, not frozen
-            drive = {m for _, m in r.drive_motors}
-            joints = [d.name for d in r.devices if isinstance(d, wm.Motor) and d.name not in drive]
-            if joints:
-                raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: motor {joints[0]!r} moves a joint; the "
-                                   "batched simulation moves drive wheels only (use Simulation)")
+        for r in w.robots:            # joints move per copy (batched_joints.py); of what rides them, only devices
+            riding = [(f"shape {x.name!r}" if x.name else f"shapes[{i}]", x.on_joint) for i, x in enumerate(r.shapes)]
+            riding += [(f"lights[{i}]", x.on_joint) for i, x in enumerate(r.lights)]
+            for what, joint in riding:    # the copies' robots are one rigid body each: no link moves in the cast
+                if joint is not None:
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {what} rides joint {joint!r}; "
+                                       "the batched simulation moves no link's shapes or lights (use Simulation)")
+            for d in r.devices:
+                joint = getattr(d, "on_joint", None)
+                if joint is None:
+                    continue
+                if d.device not in batched_joints.RIDING_KINDS:
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
+                                       f"{joint!r}; the batched simulation moves distance sensors and fixed lidars "
+                                       "on joints only (use Simulation)")
+                if d.device == "Lidar" and d.type == "rotating":    # batched_lidar.py's heads turn on the body
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: rotating lidar {d.name!r} rides joint "
+                                       f"{joint!r}; the batched simulation moves fixed lidars on joints only "
+                                       "(use Simulation)")
         # a VacuumGripper is not stepped here (no service turns its pump on): one on at load would carry a
         # solid in Simulation that stays put here, so it is refused rather than silently different
         pumps = [(r.name, d.name) for r in w.robots for d in r.devices if d.device == "VacuumGripper" and d.is_on]
@@ -467,7 +498,14 @@ class BatchedSimulation:
                 dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
                                         world_seed=0, clock=lambda: 0,
                                         own_shapes=self._own_shapes.get((slot, d.name), frozenset()))
-                if d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
+                riding = dev.on_joint is not None and d.device in ("DistanceSensor", "Lidar")
+                if riding:
+                    # on a link without shapes (batched.py refuses links with shapes): its rays are
+                    # mounted on no body, as the single simulation's (Scene.device_body is None);
+                    # each copy's local pose is the joints' (batched_joints.py)
+                    dev.move_with(Pose.identity())
+                    self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose, dev.local_pose)
+                elif d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
                     # its beams meet its own robot's body once, in the body frame, blind to its own
                     # shapes (Lidar._own_distances, on the movers' engine)
                     dev._own_body = (_OnEngine(self.rays.movers), self.rays.slot_body[slot], None)
@@ -542,6 +580,10 @@ class BatchedSimulation:
             self._d_tables = [(table, np.array([self._d_col[id(self._d_plan.devices[i])] for i in idx.tolist()],
                                                dtype=np.int64)) for table, idx in self._d_plan.tables]
             self._d_table_of = _table_of(self._d_tables, len(self.distance))
+            # per plan index: the distance column of a sensor riding a joint (its local pose per copy), else -1
+            self._d_riding = np.array([self._d_col[id(d)] if ("DistanceSensor", self._d_col[id(d)]) in self.joints.riders
+                                       else -1 for d in self._d_plan.devices], dtype=np.int64)
+            self._d_any_riding = bool((self._d_riding >= 0).any())
             self._own_kept: dict[int, tuple] = {}   # per group: its due sensors' own-body hits (_own_rows)
             self._combine_kept: dict[int, tuple] = {}   # per group: its due sensors' CombinePlan
             self._d_rows: list | None = None             # the due sensors' rows (_distance_rows)
@@ -676,6 +718,9 @@ class BatchedSimulation:
             self.mecanum.reset(idx)
         if self.omni is not None:
             self.omni.reset(idx)
+        if self.steered is not None:
+            self.steered.reset(idx)
+        self.joints.reset(idx)
         self.pressing[idx] = False
         self.led_value[idx] = 0                 # LEDs off, their lights too (WbLed::reset)
         if self.carried is not None:
@@ -772,6 +817,11 @@ class BatchedSimulation:
             n = int(self.omni.count[self.omni.of[slot]])
             raise ValueError(f"{self.robot_names[slot]}: an omni-wheel robot has no left and right wheels: "
                              f"command it with omni.command(slot, speeds) (copies, {n})")
+        if self.steered is not None and slot in self.steered.of:
+            n = int(self.steered.count[self.steered.of[slot]])
+            raise ValueError(f"{self.robot_names[slot]}: a steered-wheel robot has no left and right wheels: "
+                             f"command it with steered.command(slot, speeds) (copies, {n}) and its steering "
+                             "joints with joints.command")
         idx = slice(None) if copies is None else np.asarray(copies, dtype=np.int64)
         vmax = self.max_wheel[slot]
         left = np.asarray(left, dtype=np.float64)
@@ -815,6 +865,7 @@ class BatchedSimulation:
             self.time_ms[live] += dt
         self.counters["steps"] += 1
         self.counters["copy_steps"] += len(live)
+        self.joints.step(live, dt * 0.001)       # joints first, as Simulation.step moves them (and their links)
         self._drive(live, dt)
         self._measure_positions(live)
         self.kinematic.measure(live)
@@ -913,7 +964,8 @@ class BatchedSimulation:
                              if self.cars.offset else _arc_steps(x0, y0, yaw0, v, w, dt))   # offset: origin off the rear axle
                 moves.append((copies, slots, x0, y0, yaw0, x, y, yaw))
         # the mecanum and omni-wheel robots' body twists, in one twist_steps call
-        twists = [t for t in (d.step(live, dt) for d in (self.mecanum, self.omni) if d is not None) if len(t[0])]
+        twists = [t for t in (d.step(live, dt) for d in (self.mecanum, self.omni, self.steered) if d is not None)
+                  if len(t[0])]
         if twists:
             copies, slots, vx, vy, w = (np.concatenate(col) if len(twists) > 1 else col[0] for col in zip(*twists))
             vx, vy, w = self._twist_over_ground(copies, slots, vx, vy, w)
@@ -1284,6 +1336,9 @@ class BatchedSimulation:
             self.mecanum.read_encoders(self.position, copies, cols, v)
         if self.omni is not None:     # an omni wheel's encoder
             self.omni.read_encoders(self.position, copies, cols, v)
+        if self.steered is not None:  # a steered wheel's encoder
+            self.steered.read_encoders(self.position, copies, cols, v)
+        self.joints.read_encoders(self.position, copies, cols, v)   # a joint motor's
         plain = self._p_plain[cols]           # no noise, no resolution: the wheel angle itself
         for k in (~plain).nonzero()[0].tolist():
             col = int(cols[k])
@@ -1465,14 +1520,17 @@ class BatchedSimulation:
         reqs: list[_Rays] = []
         groups = self._distance_rows(copies, cols)
         state["kept"] = self._d_rows
-        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy, native in groups:
+        for g, rows, k, pi, c, slot, exclude, mount, t_far, ray_copy, native, local in groups:
             n = g.n
             if native is not None:   # packets.sensor_rays of these sensors
                 positions, origins, dirs = native()
             else:
                 rr_t = np.ascontiguousarray(self.rot[c, slot].transpose(1, 2, 0))
-                rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(plan.local_rot_t[:, :, pi]),
-                                         np.ascontiguousarray(plan.local_pos_t[:, pi]))
+                if local is None:
+                    lrot_t, lpos_t = plan.local_rot_t[:, :, pi], plan.local_pos_t[:, pi]
+                else:               # (rows' own local poses: sensors on joints)
+                    lrot_t, lpos_t = local[0].transpose(1, 2, 0), local[1].T
+                rot_t, pos_t = _frames_t(rr_t, np.ascontiguousarray(lrot_t), np.ascontiguousarray(lpos_t))
                 positions = pos_t.T + self.pos[c, slot]
                 dirs = _rotate_t(rot_t, np.ascontiguousarray(g.local_dirs_t[:, :, k]))
                 origins = np.repeat(positions, n, axis=0)
@@ -1487,7 +1545,8 @@ class BatchedSimulation:
         and copy, their world rays' C pass or None), kept while the same sensors of the same copies
         are due (step after step)."""
         kept = self._d_rows
-        if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols):
+        if kept is not None and np.array_equal(kept[0], copies) and np.array_equal(kept[1], cols) \
+                and not self._d_any_riding:     # (sensors on joints: their copies' local poses, made each step)
             return kept[2]
         plan = self._d_plan
         out = []
@@ -1507,9 +1566,19 @@ class BatchedSimulation:
                 mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             t_far = g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1)
-            native = packets.sensor_rays_of(c, slot, self.rot, self.pos, pi, plan.local_rot, plan.local_pos, k,
-                                            g.local_dirs)
-            out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n), native))
+            local_rot, local_pos = plan.local_rot, plan.local_pos
+            riding = self._d_riding[pi]
+            if self._d_any_riding and (riding >= 0).any():
+                # one local pose per row: the plan's, or the copy's for a sensor riding a joint
+                local_rot, local_pos = plan.local_rot[pi], plan.local_pos[pi]
+                for col in np.unique(riding[riding >= 0]).tolist():
+                    m = (riding == col).nonzero()[0]
+                    local_rot[m] = self.joints.local_rot[("DistanceSensor", col)][c[m]]
+                    local_pos[m] = self.joints.local_pos[("DistanceSensor", col)][c[m]]
+                pi = np.arange(len(pi))
+            native = packets.sensor_rays_of(c, slot, self.rot, self.pos, pi, local_rot, local_pos, k, g.local_dirs)
+            out.append((g, rows, k, pi, c, slot, exclude, mount, t_far, np.repeat(c, n), native,
+                        None if local_rot is plan.local_rot else (local_rot, local_pos)))
         self._d_rows = [copies.copy(), cols.copy(), out, None]    # (the outputs: _distance_outputs)
         return out
 
@@ -1628,8 +1697,13 @@ class BatchedSimulation:
             lid = self.lidar[col]
             slot = lid.robot_index
             rr = self.rot[c, slot]
-            rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
-            org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
+            rider = ("Lidar", col)
+            if rider in self.joints.riders:     # on a joint: each copy's local pose (batched_joints.py)
+                rot = np.matmul(rr, self.joints.local_rot[rider][c])
+                org = np.matmul(rr, self.joints.local_pos[rider][c][:, :, None])[:, :, 0] + self.pos[c, slot]
+            else:
+                rot = np.matmul(rr, lid.local_pose.rotation)                    # Pose.compose, stacked
+                org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + self.pos[c, slot]
             W = len(lid._dir_columns[0])
             got = packets.lidar_beams(rot, org, lid._dir_columns, self._lidar_buffers(col, len(c) * W))
             origins, d, d32 = got if got is not None else _lidar_beams(rot, org, lid._dir_columns)
@@ -1689,6 +1763,8 @@ class BatchedSimulation:
         (a Webots lidar sees its own robot, so the others are paired with it every scan; a fixed
         lidar's beams never move in the body frame), else -1. Decided once."""
         got = self._lidar_skips.get(col)
+        if got is None and ("Lidar", col) in self.joints.riders:   # on a joint: its beams move in the body frame
+            got = self._lidar_skips[col] = np.full(len(self.lidar[col]._dir_columns[0]), -1, dtype=np.int64)
         if got is None:
             lid = self.lidar[col]
             slot = lid.robot_index

@@ -63,9 +63,11 @@ class HolonomicDrives:
         """Robot row k's wheels in the order :meth:`command` takes their speeds, for messages."""
         return ", ".join(self.columns[k])
 
-    def twist(self, rows: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def twist(self, rows: np.ndarray, u: np.ndarray, copies: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The body twists (vx, vy, ωz) of robot ``rows`` turning their wheels at ``u`` (n, width)
-        rad/s: the single drive's ``twist``, element by element the same float64 operations."""
+        rad/s (``copies``: each row's copy, for a twist that depends on the copy's joints): the single
+        drive's ``twist``, element by element the same float64 operations."""
         raise NotImplementedError
 
     # ------------------------------------------------------------------ control
@@ -117,7 +119,7 @@ class HolonomicDrives:
         else:
             self.angle[live] = ang + u * dt
         ci, ri = (u != 0.0).any(axis=2).nonzero()
-        return (live[ci], self.slots[ri], *self.twist(ri, u[ci, ri]))
+        return (live[ci], self.slots[ri], *self.twist(ri, u[ci, ri], live[ci]))
 
     # ------------------------------------------------------------------ encoders
     def read_encoders(self, positions: list, copies: np.ndarray, cols: np.ndarray, values: np.ndarray) -> None:

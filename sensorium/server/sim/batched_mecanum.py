@@ -43,7 +43,8 @@ class MecanumDrives(HolonomicDrives):
     def order(self, k: int) -> str:
         return "front left, front right, rear left, rear right"
 
-    def twist(self, rows: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def twist(self, rows: np.ndarray, u: np.ndarray, copies: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         r, s, c = self.radius[rows], self.sign[rows], self.c[rows]
         # MecanumDrive.twist: Python's sum (0 + a + b ...) in wheel order, then r * sum / 4 (or / 4c²)
         tot, ts, tc = 0.0 + u[:, 0], 0.0 + s[:, 0] * u[:, 0], 0.0 + c[:, 0] * u[:, 0]

@@ -39,7 +39,8 @@ class OmniDrives(HolonomicDrives):
     def wheel_motors(self, drive) -> list[WheelMotor]:
         return [m for m, _ in drive.wheels]
 
-    def twist(self, rows: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def twist(self, rows: np.ndarray, u: np.ndarray, copies: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         rim = u * self.radius[rows]
         a = self.solve[rows]
         # OmniDrive.twist: from 0, wheel by wheel, each column times its rim's speed

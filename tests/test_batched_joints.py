@@ -1,0 +1,245 @@
+"""Joint motors in the batched simulation (batched_joints.py): every copy's joints move by Webots'
+kinematic motor control and the distance sensors and fixed lidars riding them cast from each copy's
+link, bit for bit as the copy's own Simulation (a pan hinge carrying a distance sensor and a lidar on
+a driving robot, a slider carrying an infra-red sensor and a nested tilt hinge carrying another,
+coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
+copy). Closed form: a pan turned a quarter makes its sensor read the side wall. What is not
+simulated is refused in one line (a link's shapes, a camera on a joint, a rotating lidar on one)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import parse_world
+
+STEP = 16
+
+
+def wall(name: str, x: float, y: float, sx: float, sy: float) -> dict:
+    return {"name": name, "pose": {"translation": [x, y, 0.5]}, "geometry": {"type": "box", "size": [sx, sy, 1.0]},
+            "appearance": {"base_color": [0.8, 0.5, 0.2]}}
+
+
+def laser(name: str, on_joint: str, translation, kind: str = "laser", noise: float = 0.0) -> dict:
+    return {"device": "DistanceSensor", "name": name, "type": kind, "on_joint": on_joint,
+            "pose": {"translation": translation},
+            "lookup_table": [[0, 0, 0], [3.0, 3000, noise]]}
+
+
+def pan_robot() -> dict:
+    """A two-wheel robot with a pan hinge (axis z through (0.05, 0, 0), acceleration-limited) carrying
+    a distance sensor and a fixed 3-layer lidar, and an encoder on the pan."""
+    return {"name": "pan", "pose": {"translation": [-0.3, 0.1, 0.05]},
+            "body": {"geometry": {"type": "cylinder", "radius": 0.1, "height": 0.1}},
+            "differential_drive": {"wheel_radius": 0.03, "axle_length": 0.15, "max_wheel_speed": 10.0},
+            "devices": [{"device": "RotationalMotor", "name": "pan motor", "axis": [0, 0, 1], "anchor": [0.05, 0, 0],
+                         "max_velocity": 3.0, "acceleration": 20.0, "max_torque": 50.0},
+                        {"device": "PositionSensor", "name": "pan enc", "motor": "pan motor", "noise": 0.001},
+                        laser("pan ds", "pan motor", [0.12, 0.0, 0.1], noise=0.02),
+                        {"device": "Lidar", "name": "pan lidar", "on_joint": "pan motor",
+                         "pose": {"translation": [0.1, 0.0, 0.15]}, "horizontal_resolution": 32,
+                         "field_of_view": 1.5, "number_of_layers": 3, "vertical_field_of_view": 0.2,
+                         "min_range": 0.05, "max_range": 3.0, "noise": 0.01}]}
+
+
+def lift_robot() -> dict:
+    """A robot without a drive: a slider (axis z, 0 .. 0.4 m) carrying an infra-red sensor and a tilt
+    hinge (axis y) riding the slider with a laser on it; two coupled hinges (``arm::a`` and ``arm::b``,
+    multiplier -0.5) each carrying a sensor."""
+    return {"name": "lift", "pose": {"translation": [0.4, -0.3, 0.05], "rotation": [0, 0, 1, 0.6]},
+            "body": {"geometry": {"type": "box", "size": [0.2, 0.2, 0.1]}},
+            "devices": [{"device": "LinearMotor", "name": "lift motor", "axis": [0, 0, 1], "max_velocity": 0.5,
+                         "min_position": 0.0, "max_position": 0.4, "max_force": 100.0},
+                        {"device": "RotationalMotor", "name": "tilt", "axis": [0, 1, 0], "anchor": [0, 0, 0.2],
+                         "on_joint": "lift motor", "max_velocity": 2.0, "min_position": -0.6, "max_position": 0.6},
+                        {"device": "RotationalMotor", "name": "arm::a", "axis": [0, 0, 1], "max_velocity": 2.0},
+                        {"device": "RotationalMotor", "name": "arm::b", "axis": [0, 0, 1], "max_velocity": 2.0,
+                         "multiplier": -0.5},
+                        {"device": "PositionSensor", "name": "lift enc", "motor": "lift motor"},
+                        {"device": "PositionSensor", "name": "b enc", "motor": "arm::b", "resolution": 0.01},
+                        laser("lift ir", "lift motor", [0.11, 0.0, 0.1], kind="infra-red"),
+                        laser("tilt ds", "tilt", [0.11, 0.0, 0.2]),
+                        laser("a ds", "arm::a", [0.0, 0.11, 0.05]),
+                        laser("b ds", "arm::b", [0.0, -0.11, 0.05]),
+                        laser("fixed ds", "lift motor", [-0.11, 0.0, 0.1])]}
+
+
+def jointed_world(seed: int = 3):
+    return parse_world({"world_info": {"basic_time_step": STEP, "contact": True, "random_seed": seed},
+                        "solids": [wall("north", 0, 1.2, 2.6, 0.2), wall("south", 0, -1.2, 2.6, 0.2),
+                                   wall("east", 1.2, 0, 0.2, 2.2), wall("west", -1.2, 0, 0.2, 2.2),
+                                   wall("block", 0.3, 0.5, 0.3, 0.3)],
+                        "robots": [pan_robot(), lift_robot()]})
+
+
+MOTORS = {"pan": ["pan motor"], "lift": ["lift motor", "tilt", "arm::a"]}
+
+
+def random_commands(rng: np.random.Generator) -> dict:
+    """Per motor: (position, velocity, acceleration, available force), any of them None."""
+    out = {}
+    for robot, names in MOTORS.items():
+        for name in names:
+            mode = rng.integers(4)
+            position = math.inf if mode == 0 else float(rng.uniform(-2.5, 2.5))      # limits clamp some
+            velocity = float(rng.uniform(-3.0, 3.0)) if mode == 0 else float(rng.uniform(0.1, 4.0))
+            acceleration = None if mode < 2 else (-1.0 if mode == 2 else float(rng.uniform(0.5, 30.0)))
+            force = float(rng.uniform(1.0, 200.0)) if mode == 3 else None
+            out[(robot, name)] = (position, velocity, acceleration, force)
+    return out
+
+
+@pytest.mark.parametrize("precision", ["exact", "fast"])
+def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for_bit(precision):
+    """Three copies and a Simulation per copy (world seeds 3, 4, 5), 300 steps; every 25 steps each
+    copy's motors get new random commands and its wheels new speeds; copy 1 reset at step 160 against
+    a fresh Simulation: every joint position, every encoder, distance sensor and lidar image and every
+    robot pose the same bits every step."""
+    w = jointed_world()
+    seeds = (3, 4, 5)
+    n = len(seeds)
+    batched = BatchedSimulation(w, n, precision=precision)
+    batched.reset(np.arange(n), list(seeds))
+    devices = {"pan": ["pan enc", "pan ds", "pan lidar"],
+               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "a ds", "b ds", "fixed ds"]}
+    for robot, names in devices.items():
+        for name in names:
+            batched.enable(batched.device(robot, name), 32)
+    rng = np.random.default_rng(11)
+    pan = batched.slot("pan")
+    moved = set()
+    def single(seed: int) -> Simulation:
+        sim = Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
+            update={"random_seed": seed})}), precision=precision)
+        for robot, names in devices.items():
+            for name in names:
+                sim.device(f"{robot}/{name}").enable(32)
+        return sim
+
+    singles = [single(s) for s in seeds]
+    for t in range(300):
+        if t == 160:                    # copy 1 reset: a freshly built world, its joints where the file has them
+            batched.reset([1], [seeds[1]])
+            for robot, names in devices.items():
+                for name in names:
+                    batched.enable(batched.device(robot, name), 32, copies=[1])
+            singles[1] = single(seeds[1])
+        if t % 25 == 0:
+            for c in range(n):
+                for (robot, name), (p, v, a, f) in random_commands(rng).items():
+                    singles[c].robot(robot).motor(name).command(p, v, a, f)
+                    batched.joints.command(batched.slot(robot), name, p, v, a, f, copies=[c])
+            wheels = rng.uniform(-6.0, 6.0, size=(n, 2))
+            batched.set_wheels(pan, wheels[:, 0], wheels[:, 1])
+            for c in range(n):
+                motors = singles[c].robot("pan").drive.motors
+                for side, m in zip(wheels[c], ("left wheel motor", "right wheel motor")):
+                    motors[m].set_position(math.inf)
+                    motors[m].set_velocity(float(side))
+        for s in singles:
+            s.step()
+        batched.step()
+        for c, s in enumerate(singles):
+            for robot in ("pan", "lift"):
+                slot = batched.slot(robot)
+                for name, motor in s.robot(robot).joints.items():
+                    got = batched.joints.position[c, batched.joints.of(slot, name)]
+                    assert got.tobytes() == np.float64(motor.position).tobytes(), (t, c, robot, name)
+                    if motor.position != motor.initial_position:
+                        moved.add(name)
+                pose = s.robot(robot).pose
+                assert batched.pose(c, slot).translation.tobytes() == pose.translation.tobytes(), (t, c, robot)
+                for name in devices[robot]:
+                    ref = batched.device(robot, name)
+                    dev = s.device(f"{robot}/{name}")
+                    if name.endswith("lidar"):
+                        assert batched.range_image(ref)[c].tobytes() == dev.range_image.tobytes(), (t, c, name)
+                    else:
+                        got = batched.value(ref)[c]
+                        assert np.float64(got).tobytes() == np.float64(dev.value).tobytes(), (t, c, name, got,
+                                                                                           dev.value)
+    assert moved == {"pan motor", "lift motor", "tilt", "arm::a", "arm::b"}
+    # the joints' sensors did read different things in different copies (each its own link)
+    assert len({float(v) for v in batched.value(batched.device("pan", "pan ds"))}) == n
+
+
+def test_a_pan_turned_a_quarter_reads_the_side_wall_in_that_copy_only():
+    """A robot at the origin, its sensor 0.1 m ahead of the pan axis, facing a wall whose near face
+    is at x = 1 and with one at y = 0.5 to its left. In copy 1 the pan turns to pi/2: the sensor sits
+    at (0, 0.1) looking along +y and reads 0.5 - 0.1 = 0.4 m; copy 0 still reads 1 - 0.1 = 0.9 m (the
+lookup table gives 1000 per metre)."""
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": False},
+                     "solids": [wall("front", 1.05, 0, 0.1, 8), wall("left", 0, 0.55, 8, 0.1)],
+                     "robots": [{"name": "r", "devices": [
+                         {"device": "RotationalMotor", "name": "pan", "axis": [0, 0, 1], "max_velocity": 100.0,
+                          "max_torque": 1e5},
+                         laser("ds", "pan", [0.1, 0.0, 0.3])]}]})
+    batched = BatchedSimulation(w, 2)
+    ref = batched.device("r", "ds")
+    batched.enable(ref, STEP)
+    batched.step()
+    assert batched.value(ref) == pytest.approx([900.0, 900.0], abs=1e-6)
+    batched.joints.command(0, "pan", position=math.pi / 2, copies=[1])
+    batched.step()
+    assert batched.joints.position[:, 0].tolist() == [0.0, math.pi / 2]
+    assert batched.value(ref) == pytest.approx([900.0, 400.0], abs=1e-6)
+    batched.reset([1], [0])             # back at its initial position: the front wall again
+    batched.enable(ref, STEP, copies=[1])
+    batched.step()
+    assert batched.value(ref) == pytest.approx([900.0, 900.0], abs=1e-6)
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda r: r.setdefault("shapes", []).append(
+        {"name": "cup", "on_joint": "lift motor", "geometry": {"type": "box", "size": [0.05, 0.05, 0.05]}}),
+     "robot 'lift': shape 'cup' rides joint 'lift motor'; the batched simulation moves no link's shapes"),
+    (lambda r: r["devices"].append({"device": "Camera", "name": "cam", "on_joint": "tilt", "width": 4, "height": 4}),
+     "robot 'lift': Camera 'cam' rides joint 'tilt'; the batched simulation moves distance sensors and fixed lidars"),
+    (lambda r: r["devices"].append({"device": "Lidar", "name": "spin", "on_joint": "tilt", "type": "rotating",
+                                    "horizontal_resolution": 8, "field_of_view": 6.28}),
+     "robot 'lift': rotating lidar 'spin' rides joint 'tilt'; the batched simulation moves fixed lidars on joints"),
+], ids=["link shape", "camera", "rotating lidar"])
+def test_what_rides_a_joint_and_is_not_simulated_is_refused_in_one_line(change, message):
+    lift = lift_robot()
+    change(lift)
+    w = parse_world({"world_info": {"basic_time_step": STEP}, "robots": [lift]})
+    with pytest.raises(BatchedError) as err:
+        BatchedSimulation(w, 2)
+    assert message in str(err.value) and "(use Simulation)" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_bad_joint_commands_name_the_motor():
+    batched = BatchedSimulation(jointed_world(), 2)
+    slot = batched.slot("lift")
+    with pytest.raises(ValueError, match="motor 'tilt': position must be a number"):
+        batched.joints.command(slot, "tilt", position=math.nan)
+    with pytest.raises(ValueError, match="motor 'tilt': acceleration must be >= 0"):
+        batched.joints.command(slot, "tilt", acceleration=-2.0)
+    with pytest.raises(ValueError, match=r"motor 'tilt': velocity must be a number or one per copy \(2\), got \(3,\)"):
+        batched.joints.command(slot, "tilt", velocity=[1.0, 2.0, 3.0])
+    with pytest.raises(KeyError, match="no joint motor 'nope'"):
+        batched.joints.command(slot, "nope", position=0.0)
+
+
+def test_a_task_callable_commands_a_copys_joint_through_its_view():
+    """The gym's view of copy 1 (what task callables get): its joint motor takes setPosition in that
+    copy alone, coupled motors following (arm::b at -0.5 times arm::a's target); a negative velocity
+    in position control is ignored, as the single motor ignores it."""
+    from sensorium.gym.views import CopySim
+
+    batched = BatchedSimulation(jointed_world(), 2)
+    view = CopySim(batched, 1).robot("lift")
+    view.motor("arm::a").set_position(0.8)
+    slot = batched.slot("lift")
+    a, b = batched.joints.of(slot, "arm::a"), batched.joints.of(slot, "arm::b")
+    assert batched.joints.target[:, a].tolist() == [0.0, 0.8] and batched.joints.target[:, b].tolist() == [0.0, -0.4]
+    view.motor("arm::a").set_velocity(-1.0)
+    assert view.motor("arm::a").velocity == 2.0
+    batched.run(40)
+    assert view.motor("arm::a").position == 0.8 and view.motor("arm::b").position == -0.4
+    assert batched.joints.position[0, a] == 0.0
