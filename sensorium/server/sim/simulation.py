@@ -17,6 +17,7 @@ import warnings
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any, cast
 
@@ -33,6 +34,7 @@ from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.falling import Falls
 from sensorium.server.sim.ground import (
     Ground,
+    GroundPieces,
     GroundWarning,
     band_low,
     land_solid,
@@ -410,6 +412,7 @@ class Simulation:
                          "radar_targets": dict(self.scene.radar_targets)}
         self._imported_poses: dict[str, Pose] = {}      # each imported solid's pose as imported
         self._settling = SettlingGrounds(_TO_ENU[self.world.world_info.coordinate_system])
+        self._pieces = GroundPieces(_TO_ENU[self.world.world_info.coordinate_system])    # landing_ground's
         # conveyor belts (sim/belt.py): none in most worlds, which then pay nothing for them
         self._belts = Belts(self, _TO_ENU[self.world.world_info.coordinate_system]) \
             if any(r.belts for r in self.world.robots) else None
@@ -459,16 +462,19 @@ class Simulation:
         their shapes where their joints hold them (a lift's cup that just let go of a parcel is above it),
         a solid still falling where it will rest (sim/falling.py: a box let go over a falling one lands on it).
         ``carrier``: a robot (index) left out, the one holding the solid (one body with it)."""
-        floors = [r for r in self.robots.values() if not r.model.drive_motors and r.index != carrier]
+        def parts(r: RobotState) -> list:
+            return [(name, local if r.links is None or (j := getattr(shape, "on_joint", None)) not in r.links.poses
+                     else r.links.poses[j].compose(local), shape) for name, local, shape in robot_parts(r.model)]
+
+        floors = [(r.model, self.scene.robot_poses[r.index],
+                   (r.model, *(() if r.links is None else r.links.poses.values())), partial(parts, r))
+                  for r in self.robots.values() if not r.model.drive_motors and r.index != carrier]
         alive = self.scene.solid_poses
-        parts = [[(name, local if r.links is None or (j := getattr(shape, "on_joint", None)) not in r.links.poses
-                   else r.links.poses[j].compose(local), shape) for name, local, shape in robot_parts(r.model)]
-                 for r in floors]
         resting = self.falls.resting           # a solid still falling is taken where it will rest
-        return settling_ground([(s, resting(s.name, alive[s.name])) for s in self.world.solids
-                                if s.name in alive and s.name != solid],
-                               [(r.model, self.scene.robot_poses[r.index]) for r in floors],
-                               _TO_ENU[self.world.world_info.coordinate_system], parts)
+        # the pieces of each solid and robot kept while it stays as it is (ground.GroundPieces): the ground
+        # settling_ground would build, bit for bit
+        return self._pieces.ground([(s, resting(s.name, alive[s.name])) for s in self.world.solids
+                                    if s.name in alive and s.name != solid], floors)
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
