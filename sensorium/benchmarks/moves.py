@@ -2,13 +2,15 @@
 
 ``python -m sensorium.benchmarks.moves [--solids 10,50] [--rounds 5] [--compare TREE]``
 
-A generated world: a floor plane, a table (a 1 m box, 0.8 m tall), a drum (an upright cylinder) and ``N`` boxes
-with physics in a grid beside them. In process (the Supervisor's own calls, no sockets), the median CPU time of:
+A generated world: a floor plane, a table (a 1 m box, 0.8 m tall), a drum (an upright cylinder), a two-wheel
+robot with physics and ``N`` boxes with physics in a grid beside them. In process (the Supervisor's own calls, no sockets), the median CPU time of:
 
 * ``move``: ``Simulation.set_solid_pose`` putting one box 1.7 m up over the table, then back on the floor (it
   falls: what it lands on is judged at once, on the ground the other solids make, ``Simulation.landing_ground``);
 * ``balance``: ``getStaticBalance`` of a box on the floor (sim/balance.py: its contacts on that same ground);
-* ``landing ground``: ``Simulation.landing_ground`` alone.
+* ``landing ground``: ``Simulation.landing_ground`` alone;
+* ``robot move``: a box put back where it was (no fall), then a two-wheel robot with physics put 0.5 m over the
+  table (it settles at once on the ground as the world is then, ``Simulation.settled``): the robot's move timed.
 
 Each measurement runs in a fresh interpreter with one source tree on its path; ``--compare TREE`` measures
 another tree (say a checkout of the base) too, the two trees' children interleaved round by round, and
@@ -48,6 +50,18 @@ out = {}
 out["move"] = cpu(lambda k: sim.set_solid_pose("b0", [0.1 * (k % 3), 0.0, 1.7] if k % 2 == 0 else [1.5, 0.0, 0.05]))
 out["balance"] = cpu(lambda k: balance.solid_balance(sim, "b1", None))
 out["landing ground"] = cpu(lambda k: sim.landing_ground("b1"))
+robot = sim.robot("bot")
+
+def timed_robot_move():
+    times = []
+    for k in range(reps):
+        sim.set_solid_pose("b1", [1.8, 0.0, 0.05 + 1e-6 * (k % 2)])     # a solid moved: the settling ground is stale
+        t = time.process_time()
+        robot.set_pose([0.1 * (k % 3), 0.2, 1.3])
+        times.append(time.process_time() - t)
+    return float(np.median(times)) * 1e3
+
+out["robot move"] = timed_robot_move()
 print(json.dumps(out))
 """
 
@@ -58,6 +72,13 @@ def world_text(solids: int) -> str:
             'Solid { name "floor" boundingObject Plane { size 40 40 } }\n'
             'Solid { translation 0 0 0.4 name "table" boundingObject Box { size 1 1 0.8 } }\n'
             'Solid { translation 0 -2 0.25 name "drum" boundingObject Cylinder { radius 0.3 height 0.5 } }\n')
+    wheels = "".join(
+        f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0.03 }} '
+        f'device [ RotationalMotor {{ name "{side} wheel motor" maxVelocity 10 }} ] '
+        f'endPoint Solid {{ translation 0 {y} 0.03 rotation 1 0 0 1.5707963267948966 name "{side} wheel" '
+        'boundingObject Cylinder { radius 0.025 height 0.01 } physics Physics { } } }\n'
+        for side, y in (("left", 0.05), ("right", -0.05)))
+    text += f'Robot {{ translation 0 -4 0 name "bot" controller "<extern>" children [\n{wheels}] physics Physics {{ }} }}\n'
     for i in range(solids):
         text += (f'Solid {{ translation {1.5 + (i % 10) * 0.3} {(i // 10) * 0.3} 0.05 name "b{i}" '
                  'boundingObject Box { size 0.1 0.1 0.1 } physics Physics { } }\n')
@@ -98,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
             for _ in range(args.rounds):
                 for name, tree in trees.items():
                     samples.setdefault((name, n), []).append(child(world, tree, args.reps))
-    print("| tree | solids | " + " | ".join(f"{k} (ms CPU)" for k in ("move", "balance", "landing ground"))
+    print("| tree | solids | " + " | ".join(f"{k} (ms CPU)" for k in ("move", "balance", "landing ground", "robot move"))
           + (" | ratio this/other |" if args.compare else " |"))
     for n in counts:
         for name in trees:

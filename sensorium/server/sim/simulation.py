@@ -41,7 +41,6 @@ from sensorium.server.sim.ground import (
     settle_pose,
     settle_world,
     settles,
-    settling_ground,
 )
 from sensorium.server.sim.joints import JointMotor, Links
 from sensorium.server.sim.motion import (
@@ -96,12 +95,14 @@ class SettlingGrounds:
     the robots without a drive (``floors``: (model, pose) each) where they are -- with settle_world's
     arithmetic (ground.settle_pose); any other robot keeps its pose. The ground is built once for
     what it is made of (the scene's solids' and shapes' versions, the floors' poses), at most
-    ``size`` of them kept (one per batched copy)."""
+    ``size`` of them kept (one per batched copy), from each solid's and floor's pieces kept while it stays
+    as it is (ground.GroundPieces)."""
 
     def __init__(self, to_enu: np.ndarray | None, size: int = 1):
         self.to_enu = to_enu
         self.size = size
         self._grounds: dict[tuple, Ground | None] = {}
+        self._pieces = GroundPieces(to_enu)
 
     def settled(self, model: wm.Robot, pose: Pose, solids: list[wm.Solid], scene: Scene,
                 floors: Callable[[], list[tuple[wm.Robot, Pose]]]) -> Pose:
@@ -114,8 +115,10 @@ class SettlingGrounds:
             if len(self._grounds) >= self.size:
                 self._grounds.clear()
             alive = scene.solid_poses
-            self._grounds[key] = settling_ground([(s, alive[s.name]) for s in solids if s.name in alive], under,
-                                                 self.to_enu)
+            # of the pieces kept (ground.GroundPieces): a solid's made again only once it changed, so a move
+            # after a solid's (an RL reset) does not read every solid again; settling_ground's ground, bit for bit
+            self._grounds[key] = self._pieces.ground([(s, alive[s.name]) for s in solids if s.name in alive],
+                                                     [(r, p, (r,), partial(robot_parts, r)) for r, p in under])
         return settle_pose(model, pose, self._grounds[key], self.to_enu)
 
 
