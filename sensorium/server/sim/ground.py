@@ -67,8 +67,8 @@ from __future__ import annotations
 
 import math
 import warnings
-from collections.abc import Collection
-from dataclasses import dataclass
+from collections.abc import Callable, Collection, Iterable, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -80,7 +80,7 @@ from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
 
-__all__ = ["Ground", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "hull_2d", "land_pose", "land_solid", "lift_pose", "over_support", "placing_ceiling", "resting_pose",
+__all__ = ["Ground", "GroundPieces", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "hull_2d", "land_pose", "land_solid", "lift_pose", "over_support", "placing_ceiling", "resting_pose",
            "ride_height", "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling",
            "support_points", "volume_centre"]
 
@@ -135,6 +135,8 @@ class _Surface:
     # a box that is a ramp (contact.ramp_top; set by Ground.place): its top face's centre (cx, cy, cz),
     # slope (gx, gy), in-face axes and half sizes (ai, hi), (aj, hj), and low edge
     ramp: tuple | None = None
+    # an upright box's or cylinder's top seen from above (Ground.tops), made once per placing
+    outline: np.ndarray | None = None
 
 
 def _is_upright(r: np.ndarray) -> bool:
@@ -172,18 +174,100 @@ def _parts_surfaces(owner: str, parts) -> list[_Surface]:
     return surfaces
 
 
+def _place_surface(s: _Surface, pose: Pose, to_enu: np.ndarray | None) -> None:
+    """Surface ``s`` of a solid or robot at ``pose`` placed in the world (ENU axes)."""
+    s.outline = None
+    pose = pose.compose(s.local)
+    r, t = pose.rotation, pose.translation
+    if to_enu is not None:
+        r, t = to_enu @ r, to_enu @ t
+    if s.half is not None:
+        _place_box(s, r, t)
+    elif s.disc is not None:
+        _place_disc(s, r, t)
+    else:
+        s.upright = _is_upright(r)
+        s.tx, s.ty, s.tz = (float(v) for v in t)
+        s.r00, s.r01, s.r10, s.r11 = float(r[0, 0]), float(r[0, 1]), float(r[1, 0]), float(r[1, 1])
+
+
+def _place_box(s: _Surface, r: np.ndarray, t: np.ndarray) -> None:
+    """A box's top and footprint: ground only if one of its local axes is the world's up (its
+    faces horizontal and vertical). Its top is the highest of its corners' heights computed as
+    contact.obstacle computes them (``corners @ r.T + t``), so both judge the same number."""
+    assert s.half is not None
+    up = [k for k in range(3) if abs(r[0, k]) <= UPRIGHT_TOL and abs(r[1, k]) <= UPRIGHT_TOL
+          and all(abs(r[2, j]) <= UPRIGHT_TOL for j in range(3) if j != k)]
+    s.upright = bool(up)
+    s.ramp = None
+    if not up:
+        ramp = ramp_top(r, t, s.half)
+        if ramp is not None:
+            k, sign, _, low = ramp
+            i, j = (a for a in range(3) if a != k)
+            n = sign * r[:, k]
+            c = t + (sign * s.half[k]) * r[:, k]
+            s.ramp = (float(c[0]), float(c[1]), float(c[2]), float(-n[0] / n[2]), float(-n[1] / n[2]),
+                      *(float(v) for v in r[:, i]), s.half[i], *(float(v) for v in r[:, j]), s.half[j], low)
+        return
+    i, j = (a for a in range(3) if a != up[0])
+    hx, hy, hz = s.half
+    corners = np.array([[x, y, z] for x in (-hx, hx) for y in (-hy, hy) for z in (-hz, hz)])
+    s.tx, s.ty = float(t[0]), float(t[1])
+    s.tz = float((corners @ r.T + t)[:, 2].max())
+    s.r00, s.r10, s.r01, s.r11 = float(r[0, i]), float(r[1, i]), float(r[0, j]), float(r[1, j])
+    s.hu, s.hv = s.half[i], s.half[j]
+
+
+def _place_disc(s: _Surface, r: np.ndarray, t: np.ndarray) -> None:
+    """A cylinder's top disc: ground only if its axis (local z) is the world's up or down. Its
+    top is its centre's height plus half its height, as contact.obstacle takes an upright
+    cylinder's, and its disc its radius about its axis, so both judge the same numbers."""
+    assert s.disc is not None
+    s.upright = (abs(r[0, 2]) <= UPRIGHT_TOL and abs(r[1, 2]) <= UPRIGHT_TOL
+                 and abs(r[2, 0]) <= UPRIGHT_TOL and abs(r[2, 1]) <= UPRIGHT_TOL)
+    if not s.upright:
+        return
+    s.tx, s.ty = float(t[0]), float(t[1])
+    s.tz = float(t[2] + s.disc[1])
+
+
+_DISC = np.arange(64) * (2.0 * math.pi / 64)
+
+
+def _outline(s: _Surface) -> np.ndarray:
+    """An upright box's or cylinder's top seen from above: x, y corners counter-clockwise (a cylinder's disc
+    a 64-gon inscribed in it), kept on the surface until it is placed again (read only: shared)."""
+    if s.outline is None:
+        if s.disc is None:       # a box: its corners at ±hu along (r00, r10), ±hv along (r01, r11)
+            corners = [(su * s.hu, sv * s.hv) for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+            outline = np.array([[s.tx + u * s.r00 + v * s.r01, s.ty + u * s.r10 + v * s.r11] for u, v in corners])
+            if s.r00 * s.r11 - s.r10 * s.r01 < 0.0:          # a mirrored frame: keep them counter-clockwise
+                outline = outline[::-1]
+        else:
+            radius = math.sqrt(s.disc[0] * s.disc[0])
+            outline = np.column_stack([s.tx + radius * np.cos(_DISC), s.ty + radius * np.sin(_DISC)])
+        outline.flags.writeable = False
+        s.outline = outline
+    return s.outline
+
+
 class Ground:
     """The world's ground (see the module docstring); :meth:`under` samples it at points."""
 
-    def __init__(self, surfaces: list[_Surface], poses: dict[str, Pose], to_enu: np.ndarray | None):
+    def __init__(self, surfaces: list[_Surface], poses: dict[str, Pose], to_enu: np.ndarray | None,
+                 placed: bool = False):
+        """``placed``: the surfaces are placed at ``poses`` already (:class:`GroundPieces`' ones, shared with
+        other grounds: :meth:`update_solid` places copies of them)."""
         self._surfaces = surfaces
         self._boxes: tuple[np.ndarray, ...] | None = None      # _box_table's, made again when stale
         self._boxes_stale = True
         self._tops: tuple[tuple[np.ndarray, ...], list[tuple[float, np.ndarray]]] | None = None   # tops()'s
         self._to_enu = to_enu
         self._poses = dict(poses)
-        for s in surfaces:
-            self._place(s)
+        if not placed:
+            for s in surfaces:
+                self._place(s)
 
     @classmethod
     def from_world(cls, world: wm.World, solid_poses: dict[str, Pose], to_enu: np.ndarray | None) -> Ground | None:
@@ -211,70 +295,17 @@ class Ground:
         return [s.solid for s in self._surfaces if s.grid is not None and not s.upright]
 
     def _place(self, s: _Surface) -> None:
-        pose = self._poses[s.solid].compose(s.local)
-        r, t = pose.rotation, pose.translation
-        if self._to_enu is not None:
-            r, t = self._to_enu @ r, self._to_enu @ t
-        if s.half is not None:
-            self._place_box(s, r, t)
-            self._boxes_stale = True
-            return
-        if s.disc is not None:
-            self._place_disc(s, r, t)
-            self._boxes_stale = True
-            return
-        s.upright = _is_upright(r)
-        s.tx, s.ty, s.tz = (float(v) for v in t)
-        s.r00, s.r01, s.r10, s.r11 = float(r[0, 0]), float(r[0, 1]), float(r[1, 0]), float(r[1, 1])
-
-    @staticmethod
-    def _place_box(s: _Surface, r: np.ndarray, t: np.ndarray) -> None:
-        """A box's top and footprint: ground only if one of its local axes is the world's up (its
-        faces horizontal and vertical). Its top is the highest of its corners' heights computed as
-        contact.obstacle computes them (``corners @ r.T + t``), so both judge the same number."""
-        assert s.half is not None
-        up = [k for k in range(3) if abs(r[0, k]) <= UPRIGHT_TOL and abs(r[1, k]) <= UPRIGHT_TOL
-              and all(abs(r[2, j]) <= UPRIGHT_TOL for j in range(3) if j != k)]
-        s.upright = bool(up)
-        s.ramp = None
-        if not up:
-            ramp = ramp_top(r, t, s.half)
-            if ramp is not None:
-                k, sign, _, low = ramp
-                i, j = (a for a in range(3) if a != k)
-                n = sign * r[:, k]
-                c = t + (sign * s.half[k]) * r[:, k]
-                s.ramp = (float(c[0]), float(c[1]), float(c[2]), float(-n[0] / n[2]), float(-n[1] / n[2]),
-                          *(float(v) for v in r[:, i]), s.half[i], *(float(v) for v in r[:, j]), s.half[j], low)
-            return
-        i, j = (a for a in range(3) if a != up[0])
-        hx, hy, hz = s.half
-        corners = np.array([[x, y, z] for x in (-hx, hx) for y in (-hy, hy) for z in (-hz, hz)])
-        s.tx, s.ty = float(t[0]), float(t[1])
-        s.tz = float((corners @ r.T + t)[:, 2].max())
-        s.r00, s.r10, s.r01, s.r11 = float(r[0, i]), float(r[1, i]), float(r[0, j]), float(r[1, j])
-        s.hu, s.hv = s.half[i], s.half[j]
-
-    @staticmethod
-    def _place_disc(s: _Surface, r: np.ndarray, t: np.ndarray) -> None:
-        """A cylinder's top disc: ground only if its axis (local z) is the world's up or down. Its
-        top is its centre's height plus half its height, as contact.obstacle takes an upright
-        cylinder's, and its disc its radius about its axis, so both judge the same numbers."""
-        assert s.disc is not None
-        s.upright = (abs(r[0, 2]) <= UPRIGHT_TOL and abs(r[1, 2]) <= UPRIGHT_TOL
-                     and abs(r[2, 0]) <= UPRIGHT_TOL and abs(r[2, 1]) <= UPRIGHT_TOL)
-        if not s.upright:
-            return
-        s.tx, s.ty = float(t[0]), float(t[1])
-        s.tz = float(t[2] + s.disc[1])
+        _place_surface(s, self._poses[s.solid], self._to_enu)
+        self._boxes_stale = True
 
     def update_solid(self, name: str, pose: Pose) -> None:
         """A solid moved (supervisor): its pieces of ground move with it."""
         if name not in self._poses:
             return
         self._poses[name] = pose
-        for s in self._surfaces:
+        for k, s in enumerate(self._surfaces):
             if s.solid == name:
+                self._surfaces[k] = s = replace(s)       # (the old one may be GroundPieces', shared)
                 self._place(s)
 
     def remove_solid(self, name: str) -> None:
@@ -383,24 +414,9 @@ class Ground:
         if boxes is None:
             return []
         if self._tops is None or self._tops[0] is not boxes:    # made again with the box table
-            self._tops = (boxes, self._outlines(boxes))
+            self._tops = (boxes, [(s.tz, _outline(s)) for s in self._surfaces
+                                  if (s.half is not None or s.disc is not None) and s.upright])
         return self._tops[1]
-
-    @staticmethod
-    def _outlines(boxes: tuple[np.ndarray, ...]) -> list[tuple[float, np.ndarray]]:
-        disc = np.arange(64) * (2.0 * math.pi / 64)
-        out = []
-        for _, tx, ty, tz, a, b, c, d, hu, hv, rr in zip(*boxes):
-            if math.isinf(rr):        # a box: its corners at ±hu along (a, b), ±hv along (c, d)
-                corners = [(su * hu, sv * hv) for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-                outline = np.array([[tx + u * a + v * c, ty + u * b + v * d] for u, v in corners])
-                if a * d - b * c < 0.0:          # a mirrored frame: keep them counter-clockwise
-                    outline = outline[::-1]
-            else:
-                radius = math.sqrt(rr)
-                outline = np.column_stack([tx + radius * np.cos(disc), ty + radius * np.sin(disc)])
-            out.append((float(tz), outline))
-        return out
 
     def at(self, x: float, y: float, ceiling: float = math.inf) -> tuple[float, float, float] | None:
         """:meth:`under` at one point: ``(z, gx, gy)`` or None (the same arithmetic, so the same bits)."""
@@ -587,6 +603,56 @@ def settling_ground(solids: list[tuple[wm.Solid, Pose]], floors: list[tuple[wm.R
     poses = {s.name: pose for s, pose in solids}
     poses.update({"\0" + r.name: pose for r, pose in floors})
     return Ground(surfaces, poses, to_enu)
+
+
+class GroundPieces:
+    """The pieces of ground of each top-level solid and robot, placed where it is, kept from one
+    ``Simulation.landing_ground`` to the next (a Supervisor moving, balancing or letting go solids among many
+    others builds again only what changed): an owner's pieces are read again from its model when the model
+    or its joints' displacements changed (a solid built again or imported under a name is a new model) and
+    placed again when its pose did -- models, poses and displacements are immutable objects, compared by
+    identity, so every path that changes one (a move, an import, a removal, a PROTO field set, a reset, a
+    gripper, a fall) changes what is compared. The same placing arithmetic as :class:`Ground`'s, so a ground
+    made of them is bit for bit the one :func:`settling_ground` builds; its surfaces are shared (read only)."""
+
+    def __init__(self, to_enu: np.ndarray | None):
+        self.to_enu = to_enu
+        # owner -> (what its pieces are read from, its unplaced pieces, the pose they are placed at, placed)
+        self._kept: dict[str, tuple[tuple, list[_Surface], Pose, list[_Surface]]] = {}
+
+    def pieces(self, owner: str, source: tuple, parts: Callable[[], Iterable], pose: Pose) -> list[_Surface]:
+        """Owner ``owner``'s pieces placed at ``pose``: ``source`` the objects its ``parts()`` (scene.solid_parts'
+        or robot_parts' (name, local pose, shape)) are made from, its model and displacements."""
+        kept = self._kept.get(owner)
+        if kept is not None and len(kept[0]) == len(source) and all(a is b for a, b in zip(kept[0], source)):
+            if kept[2] is pose:
+                return kept[3]
+            unplaced = kept[1]
+        else:
+            unplaced = _parts_surfaces(owner, parts())
+        placed = [replace(u) for u in unplaced]
+        for s in placed:
+            _place_surface(s, pose, self.to_enu)
+        self._kept[owner] = (source, unplaced, pose, placed)
+        return placed
+
+    def ground(self, solids: Sequence[tuple[wm.Solid, Pose]],
+               floors: Sequence[tuple[wm.Robot, Pose, tuple, Callable[[], Iterable]]]) -> Ground | None:
+        """:func:`settling_ground` of ``solids`` and ``floors`` ((model, pose, what its parts are made from: its
+        model and joint displacements, its parts where its joints hold them)) from the kept pieces."""
+        from sensorium.server.sim.scene import solid_parts
+
+        surfaces: list[_Surface] = []
+        poses: dict[str, Pose] = {}
+        for s, pose in solids:
+            surfaces += self.pieces(s.name, (s,), lambda s=s: solid_parts(s, Pose.identity()), pose)
+            poses[s.name] = pose
+        for r, pose, source, parts in floors:
+            surfaces += self.pieces("\0" + r.name, source, parts, pose)
+            poses["\0" + r.name] = pose
+        if len(self._kept) > 2 * len(poses) + 16:     # owners gone (removed solids): forgotten
+            self._kept = {k: v for k, v in self._kept.items() if k in poses}
+        return Ground(surfaces, poses, self.to_enu, placed=True) if surfaces else None
 
 
 def _settled(ground: Ground, bottoms: np.ndarray, axles: np.ndarray, xs: np.ndarray, ys: np.ndarray,

@@ -17,6 +17,7 @@ import warnings
 from collections import Counter
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any, cast
 
@@ -33,13 +34,13 @@ from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.falling import Falls
 from sensorium.server.sim.ground import (
     Ground,
+    GroundPieces,
     GroundWarning,
     band_low,
     land_solid,
     settle_pose,
     settle_world,
     settles,
-    settling_ground,
 )
 from sensorium.server.sim.joints import JointMotor, Links
 from sensorium.server.sim.motion import (
@@ -94,12 +95,14 @@ class SettlingGrounds:
     the robots without a drive (``floors``: (model, pose) each) where they are -- with settle_world's
     arithmetic (ground.settle_pose); any other robot keeps its pose. The ground is built once for
     what it is made of (the scene's solids' and shapes' versions, the floors' poses), at most
-    ``size`` of them kept (one per batched copy)."""
+    ``size`` of them kept (one per batched copy), from each solid's and floor's pieces kept while it stays
+    as it is (ground.GroundPieces)."""
 
     def __init__(self, to_enu: np.ndarray | None, size: int = 1):
         self.to_enu = to_enu
         self.size = size
         self._grounds: dict[tuple, Ground | None] = {}
+        self._pieces = GroundPieces(to_enu)
 
     def settled(self, model: wm.Robot, pose: Pose, solids: list[wm.Solid], scene: Scene,
                 floors: Callable[[], list[tuple[wm.Robot, Pose]]]) -> Pose:
@@ -112,8 +115,10 @@ class SettlingGrounds:
             if len(self._grounds) >= self.size:
                 self._grounds.clear()
             alive = scene.solid_poses
-            self._grounds[key] = settling_ground([(s, alive[s.name]) for s in solids if s.name in alive], under,
-                                                 self.to_enu)
+            # of the pieces kept (ground.GroundPieces): a solid's made again only once it changed, so a move
+            # after a solid's (an RL reset) does not read every solid again; settling_ground's ground, bit for bit
+            self._grounds[key] = self._pieces.ground([(s, alive[s.name]) for s in solids if s.name in alive],
+                                                     [(r, p, (r,), partial(robot_parts, r)) for r, p in under])
         return settle_pose(model, pose, self._grounds[key], self.to_enu)
 
 
@@ -410,6 +415,7 @@ class Simulation:
                          "radar_targets": dict(self.scene.radar_targets)}
         self._imported_poses: dict[str, Pose] = {}      # each imported solid's pose as imported
         self._settling = SettlingGrounds(_TO_ENU[self.world.world_info.coordinate_system])
+        self._pieces = GroundPieces(_TO_ENU[self.world.world_info.coordinate_system])    # landing_ground's
         # conveyor belts (sim/belt.py): none in most worlds, which then pay nothing for them
         self._belts = Belts(self, _TO_ENU[self.world.world_info.coordinate_system]) \
             if any(r.belts for r in self.world.robots) else None
@@ -459,16 +465,19 @@ class Simulation:
         their shapes where their joints hold them (a lift's cup that just let go of a parcel is above it),
         a solid still falling where it will rest (sim/falling.py: a box let go over a falling one lands on it).
         ``carrier``: a robot (index) left out, the one holding the solid (one body with it)."""
-        floors = [r for r in self.robots.values() if not r.model.drive_motors and r.index != carrier]
+        def parts(r: RobotState) -> list:
+            return [(name, local if r.links is None or (j := getattr(shape, "on_joint", None)) not in r.links.poses
+                     else r.links.poses[j].compose(local), shape) for name, local, shape in robot_parts(r.model)]
+
+        floors = [(r.model, self.scene.robot_poses[r.index],
+                   (r.model, *(() if r.links is None else r.links.poses.values())), partial(parts, r))
+                  for r in self.robots.values() if not r.model.drive_motors and r.index != carrier]
         alive = self.scene.solid_poses
-        parts = [[(name, local if r.links is None or (j := getattr(shape, "on_joint", None)) not in r.links.poses
-                   else r.links.poses[j].compose(local), shape) for name, local, shape in robot_parts(r.model)]
-                 for r in floors]
         resting = self.falls.resting           # a solid still falling is taken where it will rest
-        return settling_ground([(s, resting(s.name, alive[s.name])) for s in self.world.solids
-                                if s.name in alive and s.name != solid],
-                               [(r.model, self.scene.robot_poses[r.index]) for r in floors],
-                               _TO_ENU[self.world.world_info.coordinate_system], parts)
+        # the pieces of each solid and robot kept while it stays as it is (ground.GroundPieces): the ground
+        # settling_ground would build, bit for bit
+        return self._pieces.ground([(s, resting(s.name, alive[s.name])) for s in self.world.solids
+                                    if s.name in alive and s.name != solid], floors)
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
