@@ -64,9 +64,10 @@ def same(a: list, b: list) -> None:
 
 def test_full_wbt_is_its_yaml_twin_bit_for_bit() -> None:
     wbt, yml = load_world(HERE / "full.wbt"), load_world(HERE / "full.yaml")
-    # a YAML world has no file order, nor the nodes inside its robots a Supervisor walks, nor its Shape nodes
+    # a YAML world has no file order, nor the nodes inside its robots a Supervisor walks (nor the Solid among
+    # them a shape belongs to), nor its Shape nodes
     def bare(owner):
-        update = {"shapes": [p.model_copy(update={"node": None}) for p in owner.shapes]}
+        update = {"shapes": [p.model_copy(update={"node": None, "in_solid": -1}) for p in owner.shapes]}
         if hasattr(owner, "children"):
             update["children"] = [bare(c) for c in owner.children]
         return owner.model_copy(update=update)
