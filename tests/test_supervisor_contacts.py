@@ -8,6 +8,8 @@ nothing of its own body, a box in the air, on a table, in a NUE world. Webots' C
 from __future__ import annotations
 
 import math
+import shutil
+import subprocess
 
 import numpy as np
 import pytest
@@ -166,4 +168,27 @@ def test_a_c_controller_reads_the_contact_points(tmp_path_factory):
     assert code == 0, err
     assert out == EXPECTED
     assert [line for line in err.splitlines() if "deprecated" in line] == DEPRECATED
+    assert "Error: wb_supervisor_node_get_contact_points(): " in err and ROOT_LINE in err
+
+
+@pytest.mark.slow
+def test_a_cpp_controller_reads_the_contact_points(tmp_path_factory):
+    """Our C++ layer (webots::Node::getContactPoints and the deprecated per-index methods) over the same C calls."""
+    from _serve import serve
+    from test_c_client import CLIB, SAN_ENV, TESTS_C, _make, finish, start
+
+    if shutil.which("c++") is None:
+        pytest.skip("needs a C++ toolchain")
+    build = tmp_path_factory.mktemp("cppbuild")
+    _make(f"BUILD={build}", "SANITIZE=1")
+    exe = build / "contact_points_cpp"
+    done = subprocess.run(["c++", "-std=c++11", "-Wall", "-Wextra", "-Werror", "-g", "-fsanitize=address,undefined",
+                           f"-I{CLIB / 'include'}", str(TESTS_C / "contact_points_cpp.cpp"), "-o", str(exe),
+                           str(build / "libController.a"), *_make("libs").split()],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    with serve(E2E, env=SAN_ENV) as server:
+        code, out, err = finish(start([str(exe)], server.url("sup")))
+    assert code == 0, err
+    assert out == EXPECTED
     assert "Error: wb_supervisor_node_get_contact_points(): " in err and ROOT_LINE in err
