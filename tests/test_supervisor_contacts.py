@@ -103,6 +103,22 @@ def test_a_two_wheel_robot_touches_with_its_wheels_and_caster_only(tmp_path):
                           ((0.11, 5.0, 0.0), right), ((0.0, 4.9, 0.0), caster)])
 
 
+def test_a_driven_robot_s_contacts_move_with_it(tmp_path):
+    lv = _live(WORLD, tmp_path)
+    before, ids = contacts(lv, "CART", True)
+    robot = lv.sim.robot("cart")
+    for name in ("left wheel", "right wheel"):          # straight ahead, along the world's +y
+        robot.motor(name).set_position(math.inf)
+        robot.motor(name).set_velocity(4.0)
+    for _ in range(10):
+        lv.step(A, "sup")
+    moved = np.array(sup(lv, "get_node_pose", {"node": node(lv, "CART")})["position"]) - [0.0, 5.0, 0.0]
+    assert moved[1] > 0.02 and abs(moved[0]) < 1e-12 and moved[2] == 0.0
+    after, same_ids = contacts(lv, "CART", True)
+    assert same_ids == ids
+    assert after == pytest.approx(before + moved, abs=1e-12)
+
+
 def test_in_the_air_without_physics_or_no_top_solid(tmp_path):
     lv = _live(WORLD, tmp_path)
     assert contacts(lv, "BARE", True)[1] == []                  # no Physics: Webots' ODE makes no contact for it
