@@ -101,27 +101,6 @@ def test_vehicle_classes_import_with_webots_constants():
     assert issubclass(Car, Driver)
 
 
-def test_a_node_has_no_contact_points_in_python_either(capsys):
-    """No physics contacts (the C client answers the same: 0, NULL, a NaN vector), and the first query
-    says so in one line: a supervisor that waits for its robot to touch something (the robotbenchmark
-    obstacle-avoidance referee loops over a robot's contact points, which in Webots always hold its
-    wheels') would otherwise wait silently."""
-    from sensorium.client.webots.controller import ContactPoint, Node, supervisor
-
-    supervisor._contact_points_warned.clear()
-    node = Node(7, "Robot", "car")
-    node.enableContactPointsTracking(16, includeDescendants=True)
-    assert capsys.readouterr().err == ""                      # tracking alone reads nothing
-    assert node.getContactPoints() == [] and node.getContactPoints(True) == []
-    assert node.getNumberOfContactPoints(True) == 0 and node.getContactPointNode(0) is None
-    assert all(math.isnan(v) for v in node.getContactPoint(0)) and len(node.getContactPoint(0)) == 3
-    node.disableContactPointsTracking()
-    assert ContactPoint([1.0, 2.0, 3.0], 4).getNodeId() == 4
-    assert capsys.readouterr().err.splitlines() == [
-        "Warning: Node.getContactPoints(): Sensorium computes no contact points: every node touches nothing "
-        "(none, even on the ground)."]
-
-
 # Webots' Python controller modules (lib/controller/python/controller/*.py) with their main class; left
 # out: constants.py and wb.py (libController bindings, internal to Webots' package). Proto is not in
 # the package's names (as in Webots), only in its module.

@@ -448,6 +448,43 @@ def test_c_controllers_run_and_restart_through_the_c_library(tmp_path: Path, cli
         "[boss] boss ends at 1200"]
 
 
+C_REVERT = r'''#include <math.h>
+#include <stdio.h>
+#include <unistd.h>
+#include <webots/robot.h>
+#include <webots/supervisor.h>
+
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations" /* simulation_revert: Webots' deprecated name */
+
+int main(void) {
+  wb_robot_init();
+  int again = access("reverted", F_OK) == 0;
+  printf("boss starts at %g%s\n", wb_robot_get_time(), again ? " after the revert" : "");
+  fflush(stdout);
+  while (wb_robot_step(16) != -1)
+    if (lround(wb_robot_get_time() * 1000) == 320 && !again) {
+      fclose(fopen("reverted", "w"));
+      wb_supervisor_simulation_revert();
+    }
+  printf("boss ends at %ld\n", lround(wb_robot_get_time() * 1000));
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+def test_c_simulation_revert_reloads_the_world(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:
+    """Webots' deprecated wb_supervisor_simulation_revert is its worldReload: the simulation ends for
+    every controller and `run` loads the world again, its controllers from time 0."""
+    world = project(tmp_path, 'Robot { name "boss" controller "boss" supervisor TRUE }', {})
+    compile_controller(clib, tmp_path / "controllers" / "boss", "boss", C_REVERT)
+    proc = run(world, "--until", "640")
+    assert proc.wait() == 0, proc.stderr()
+    assert [line for line in proc.stdout().splitlines() if line.startswith("[boss]")] == [
+        "[boss] boss starts at 0", "[boss] boss ends at 320", "[boss] boss starts at 0 after the revert",
+        "[boss] boss ends at 640"]
+
+
 LOADER = '''import os
 from controller import Supervisor
 boss = Supervisor()

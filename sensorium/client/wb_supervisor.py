@@ -331,6 +331,91 @@ def wb_supervisor_node_get_static_balance(node: int | None) -> bool:
     return False if got is None else bool(got["value"])
 
 
+_contact_descendants: dict[int, bool] = {}       # node -> include_descendants of its last number query
+_contact_steps: dict[tuple[int, bool], tuple[int, dict]] = {}   # (node, descendants) -> (time ms, answer)
+_deprecation_warned: set[str] = set()
+
+
+def _contacts(r: RobotClient, node: int, descendants: bool, func: str) -> dict | None:
+    """The server's contact points of ``node``, asked at its first query in a step: as Webots' library,
+    the step's later queries answer that one's."""
+    key = (node, descendants)
+    kept = _contact_steps.get(key)
+    if kept is not None and kept[0] == r.time_ms:
+        return kept[1]
+    got = _answer(r, "get_node_contact_points", {"node": node, "include_descendants": descendants}, func)
+    if got is not None:
+        _contact_steps[key] = (r.time_ms, got)
+    return got
+
+
+def wb_supervisor_node_get_contact_points(node: int | None, include_descendants: bool = False) -> list[tuple[list[float], int]]:
+    """Where a top-level solid's or robot's bounding shapes (with ``include_descendants``, those of the
+    solids inside it too) touch the ground now (README "Supervisor"): each point in world coordinates
+    with the id of the Solid touching there; none without physics or touching nothing, and after the
+    server's line for a node that is no top-level Solid."""
+    func = "wb_supervisor_node_get_contact_points"
+    r = _checked_node(node, func)
+    got = None if r is None else _contacts(r, int(node), bool(include_descendants), func)  # type: ignore[arg-type]
+    if got is None:
+        return []
+    flat = [float(v) for v in got["points"]]
+    return [(flat[3 * k:3 * k + 3], int(n)) for k, n in enumerate(got["nodes"])]
+
+
+def _deprecated(func: str) -> None:
+    if func not in _deprecation_warned:          # Webots' line, once per function
+        _deprecation_warned.add(func)
+        print(f"Warning: {func}() is deprecated, use wb_supervisor_node_get_contact_points() instead.", file=sys.stderr)
+
+
+def wb_supervisor_node_get_number_of_contact_points(node: int | None, include_descendants: bool = False) -> int:
+    """Webots' deprecated count of :func:`wb_supervisor_node_get_contact_points`; -1 for a node that is
+    no top-level Solid. ``get_contact_point`` and ``get_contact_point_node`` then take the same
+    ``include_descendants``."""
+    func = "wb_supervisor_node_get_number_of_contact_points"
+    _deprecated(func)
+    r = _checked_node(node, func)
+    if r is None:
+        return -1
+    _contact_descendants[int(node)] = bool(include_descendants)  # type: ignore[arg-type]
+    got = _contacts(r, int(node), bool(include_descendants), func)  # type: ignore[arg-type]
+    return -1 if got is None else len(got["nodes"])
+
+
+def _contact_point(node: int | None, index: int, func: str) -> tuple[list[float], int] | None:
+    _deprecated(func)
+    r = _checked_node(node, func)
+    if r is None:
+        return None
+    got = _contacts(r, int(node), _contact_descendants.get(int(node), False), func)  # type: ignore[arg-type]
+    if got is None or isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < len(got["nodes"]):
+        return None
+    return [float(v) for v in got["points"][3 * index:3 * index + 3]], int(got["nodes"][index])
+
+
+def wb_supervisor_node_get_contact_point(node: int | None, index: int) -> list[float]:
+    """Webots' deprecated contact point ``index`` (NaNs past the last)."""
+    got = _contact_point(node, index, "wb_supervisor_node_get_contact_point")
+    return [math.nan] * 3 if got is None else got[0]
+
+
+def wb_supervisor_node_get_contact_point_node(node: int | None, index: int) -> int | None:
+    """Webots' deprecated Solid of contact point ``index`` (None past the last)."""
+    got = _contact_point(node, index, "wb_supervisor_node_get_contact_point_node")
+    return None if got is None else wb_supervisor_node_get_from_id(got[1])
+
+
+def wb_supervisor_node_enable_contact_points_tracking(node: int | None, sampling_period: int,
+                                                      include_descendants: bool = False) -> None:
+    """Accepted; every query computes the points of that moment (README "Supervisor")."""
+    _checked_node(node, "wb_supervisor_node_enable_contact_points_tracking")
+
+
+def wb_supervisor_node_disable_contact_points_tracking(node: int | None) -> None:
+    _checked_node(node, "wb_supervisor_node_disable_contact_points_tracking")
+
+
 def wb_supervisor_node_export_string(node: int | None) -> str:
     """Webots' ``exportString``: a node as ``.wbt`` text (``DEF NAME Type { ... }``), as its world file or node
     string wrote it with the fields the server keeps as they are now (where it stands, its name, custom data, a

@@ -341,6 +341,12 @@ _LEVEL = ("whose fields: -1 the node's (a PROTO instance's: its PROTO's interfac
           "is built on, ...: getProto().getField, getParent())")
 
 
+class ContactPointsArgs(Args):
+    node: NodeId = Field(description="a top-level robot or solid")
+    include_descendants: bool = Field(default=False, description="the solids inside it touch too (Webots' "
+                                      "includeDescendants): a robot's wheels, a nested solid")
+
+
 class FieldArgs(Args):
     node: NodeId
     field: FieldName
@@ -902,6 +908,12 @@ class BoolValue(Result):
     value: bool
 
 
+class ContactPointsResult(Result):
+    points: list[float] = Field(description="x, y, z (world, m) of each contact point, one after the other")
+    nodes: list[int] = Field(description="for each point, the id of the Solid whose bounding shape touches there "
+                             "(the node itself or, with include_descendants, a solid inside it)")
+
+
 class DeviceListResult(Result):
     list: list[str]
 
@@ -1124,6 +1136,8 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("get_node_center_of_mass", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("get_node_static_balance", "robot", NodeArgs, BoolValue, attached=True, supervisor=True),
+    ServiceSpec("get_node_contact_points", "robot", ContactPointsArgs, ContactPointsResult, attached=True,
+                supervisor=True),
     ServiceSpec("remove_node", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("set_joint_position", "robot", SetJointPositionArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("save_node_state", "robot", NodeStateArgs, SuccessResult, attached=True, supervisor=True),

@@ -524,6 +524,10 @@ class Part(Shape):
         default=None, min_length=1,
         description="on a robot: the device whose own Solid this shape belongs to (a sensor's housing); that "
                     "device's infra-red rays and lidar beams do not see it, as in Webots")
+    in_solid: int = Field(
+        default=-1, ge=-1, le=1 << 20,
+        description="on a robot: the index in the robot's `nodes` of the Solid (or device) this shape belongs to, "
+                    "the nearest one holding it (-1: the robot itself); the Supervisor's contact points name it")
     unseen_by: list[str] = Field(
         default=[], max_length=256,
         description="on a robot: devices whose visual rays (infra-red, lidar, camera, range finder) do not see this "

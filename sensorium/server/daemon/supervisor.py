@@ -1267,6 +1267,37 @@ def static_balance(sim: Any, node: Node) -> bool:
                                                    else center_of_mass(sim, node))
 
 
+def contact_points(sim: Any, node: Node, descendants: bool) -> dict:
+    """Webots' ``getContactPoints`` of a top-level solid or robot (sim/balance.py): where its bounding
+    shapes (with ``descendants``, the solids' inside it too) touch the ground now, in world axes, each
+    with the id of the Solid whose shape touches (a nested solid's from the nested table); none without
+    physics (Webots' physics makes no contact for a static solid). Anything else: one line."""
+    if node.nested or node.visual or node.type not in ("Robot", "Solid"):
+        raise ValueError("it can exclusively be used with a top Solid, not " + ("the root" if node.id == 0 else _what(node)))
+    inside = [n for n in _table(sim).by_owner.get(node.id, ()) if n.shape is None and n.field != "jointParameters"]
+    if node.type == "Robot":
+        state = sim.robots[node.key]
+        if state.model.mass is None:
+            return {"points": [], "nodes": []}
+        points, owners = balance.robot_contacts(sim, state, descendants)
+        ids = [node.id if k < 0 or k >= len(inside) else inside[k].id for k in owners]
+    else:
+        model = next(s for s in sim.world.solids if s.name == node.key)
+        if not model.physics:
+            return {"points": [], "nodes": []}
+        points, solids = balance.solid_contacts(sim, node.key, descendants)
+        order: list[wm.Solid] = []               # the nested solids depth first, as nested.py numbers them
+        stack = list(reversed(model.children))
+        while stack:
+            child = stack.pop()
+            order.append(child)
+            stack.extend(reversed(child.children))
+        nested_solids = [n.id for n in inside if n.type == "Solid"]
+        by_model = {id(m): i for m, i in zip(order, nested_solids, strict=False)}
+        ids = [by_model.get(id(s), node.id) for s in solids]
+    return {"points": [float(v) for v in points.reshape(-1)], "nodes": ids}
+
+
 def node_velocity(sim: Any, node: Node) -> list[float]:
     """Webots' ``getVelocity``: a driven robot's from its kinematic drive's last step (world axes,
     linear m/s then angular rad/s), a node inside it moving with it; a top-level solid falling after a
@@ -1600,6 +1631,7 @@ HANDLERS = {
     "get_node_velocity": lambda sim, ls, robot, a: {"value": node_velocity(sim, node_by_id(sim, a.node))},
     "get_node_center_of_mass": lambda sim, ls, robot, a: {"value": center_of_mass(sim, node_by_id(sim, a.node))},
     "get_node_static_balance": lambda sim, ls, robot, a: {"value": static_balance(sim, node_by_id(sim, a.node))},
+    "get_node_contact_points": lambda sim, ls, robot, a: contact_points(sim, node_by_id(sim, a.node), a.include_descendants),
     "remove_node": _remove,
     "set_joint_position": _set_joint_position,
     "save_node_state": _save_state,

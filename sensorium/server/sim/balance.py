@@ -26,8 +26,8 @@ from sensorium.server.sim.ground import Ground, hull_2d, over_support, support_p
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "lowest_points", "robot_balance", "shapes_centre",
-           "solid_balance"]
+__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "lowest_points", "robot_balance",
+           "robot_contacts", "shapes_centre", "solid_balance", "solid_contacts", "touching"]
 
 CONTACT_TOL = FLOOR
 """m: a bounding shape's point at most this far above or below the ground under it touches it (kinematic
@@ -73,8 +73,7 @@ def _points(parts: list[tuple[Pose, Any]], pose: Pose, base_dir: Any, to_enu: np
 
     return [lowest_points(shape.geometry, primitive_from_model(shape.geometry, base_dir),
                           enu_pose(pose.compose(local), to_enu))
-            for local, shape in parts if shape.seen_by in ("both", "bounding")
-            and not isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid))]
+            for local, shape in parts if _touches(shape)]
 
 
 def _inside(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
@@ -117,17 +116,25 @@ def contact_points(shapes: list[np.ndarray], ground: Ground | None) -> np.ndarra
     ramp above the point + CONTACT_TOL), and where a shape's points at a box or cylinder top's height
     (within CONTACT_TOL) span a face, a line or a point, the part of it over that top (:func:`clip`):
     a face over a top's edge is held up to that edge."""
+    return touching(shapes, ground)[0]
+
+
+def touching(shapes: list[np.ndarray], ground: Ground | None) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`contact_points` and, for each point, the index in ``shapes`` of the shape touching there."""
     if ground is None or not shapes:
-        return np.zeros((0, 3))
+        return np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
     points = np.vstack(shapes)
+    of = np.repeat(np.arange(len(shapes)), [len(p) for p in shapes])
     found, z, _, _ = ground.under(points[:, 0], points[:, 1], points[:, 2] + CONTACT_TOL)
-    contacts = [points[found & (np.abs(points[:, 2] - z) <= CONTACT_TOL)]]
+    on = found & (np.abs(points[:, 2] - z) <= CONTACT_TOL)
+    contacts = [points[on]]
+    owners = [of[on]]
     tops = ground.tops()
     if tops:
         heights = np.array([h for h, _ in tops])
         lows = np.array([o.min(axis=0) for _, o in tops])
         highs = np.array([o.max(axis=0) for _, o in tops])
-        for shape in shapes:
+        for index, shape in enumerate(shapes):
             # the tops at its points' heights whose outline's box meets its own, seen from above
             lo, hi = shape.min(axis=0), shape.max(axis=0)
             near_tops = ((heights >= lo[2] - CONTACT_TOL) & (heights <= hi[2] + CONTACT_TOL)
@@ -138,7 +145,8 @@ def contact_points(shapes: list[np.ndarray], ground: Ground | None) -> np.ndarra
                 if len(near):
                     held = clip(hull_2d(near[:, :2]), outline)
                     contacts.append(np.column_stack([held, np.full(len(held), height)]))
-    return np.vstack(contacts)
+                    owners.append(np.full(len(held), index))
+    return np.vstack(contacts), np.concatenate(owners)
 
 
 def balanced(contacts: np.ndarray, centre: np.ndarray) -> bool:
@@ -182,6 +190,52 @@ def solid_balance(sim: Any, name: str, centre: Any) -> bool:
     base = sim.loaded.base_dir
     contacts = contact_points(_points(parts, pose, base, to_enu), sim.landing_ground(name))
     return balanced(contacts, shapes_centre(parts, pose, base, to_enu) if centre is None else _enu(centre, to_enu))
+
+
+def _world(points: np.ndarray, to_enu: np.ndarray | None) -> np.ndarray:
+    """ENU points back in the world's axes (``to_enu`` is a permutation: its transpose undoes it)."""
+    return points if to_enu is None else points @ to_enu
+
+
+def solid_contacts(sim: Any, name: str, descendants: bool) -> tuple[np.ndarray, list[wm.Solid]]:
+    """Webots' ``getContactPoints`` of top-level solid ``name``: where its bounding shapes (and, with
+    ``descendants``, those of the solids inside it) touch the ground a let-go solid lands on now
+    (:func:`touching`), in world axes, and for each point the solid model (the top one or a nested
+    child) whose shape touches there."""
+    from sensorium.server.sim.scene import owned_solid_parts
+
+    model = next(s for s in sim.world.solids if s.name == name)
+    owned = [(owner, local, shape) for owner, _, local, shape in owned_solid_parts(model, Pose.identity())
+             if descendants or owner is model]
+    parts = [(local, shape) for _, local, shape in owned]
+    owners = [owner for owner, _, shape in owned if _touches(shape)]
+    to_enu = _TO_ENU[sim.world.world_info.coordinate_system]
+    points, of = touching(_points(parts, sim.scene.solid_poses[name], sim.loaded.base_dir, to_enu),
+                          sim.landing_ground(name))
+    return _world(points, to_enu), [owners[k] for k in of]
+
+
+def robot_contacts(sim: Any, state: Any, descendants: bool) -> tuple[np.ndarray, list[int]]:
+    """Webots' ``getContactPoints`` of a robot: where its bounding shapes touch the ground now, its
+    joints holding them where they are (:func:`robot_balance`'s points), in world axes, and for each
+    point the index in the robot's ``nodes`` of the Solid whose shape touches (``Part.in_solid``; -1:
+    the robot's own). Without ``descendants``, the robot's own shapes only."""
+    from sensorium.server.sim.scene import robot_parts
+
+    links = state.links
+    owned = [(getattr(shape, "in_solid", -1), local if links is None or (j := getattr(shape, "on_joint", None))
+              not in links.poses else links.poses[j].compose(local), shape) for _, local, shape in robot_parts(state.model)]
+    owned = [o for o in owned if descendants or o[0] < 0]
+    ground = sim.landing_ground("\0" + state.model.name, carrier=state.index)
+    points, of = touching(_points([(local, shape) for _, local, shape in owned], state.pose, sim.loaded.base_dir,
+                                  state.to_enu), ground)
+    owners = [solid for solid, _, shape in owned if _touches(shape)]
+    return _world(points, state.to_enu), [owners[k] for k in of]
+
+
+def _touches(shape: Any) -> bool:
+    """Whether :func:`_points` takes ``shape`` (a bounding shape that is no ground)."""
+    return shape.seen_by in ("both", "bounding") and not isinstance(shape.geometry, (wm.Plane, wm.ElevationGrid))
 
 
 def robot_balance(sim: Any, state: Any, centre: Any) -> bool:

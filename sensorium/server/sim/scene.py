@@ -125,12 +125,18 @@ def _entry(shape: wm.Shape | wm.Solid, base_dir: Path, local: Pose | None = None
 
 def solid_parts(solid: wm.Solid, frame: Pose) -> Iterator[tuple[str, Pose, wm.Shape | wm.Solid]]:
     """Every shape of a solid and its nested children: (name, pose in ``frame``'s parent, shape)."""
+    for _, name, pose, shape in owned_solid_parts(solid, frame):
+        yield name, pose, shape
+
+
+def owned_solid_parts(solid: wm.Solid, frame: Pose) -> Iterator[tuple[wm.Solid, str, Pose, wm.Shape | wm.Solid]]:
+    """:func:`solid_parts`, each with the solid (the top one or a nested child) whose shape it is."""
     if solid.geometry is not None:
-        yield solid.name, frame, solid
+        yield solid, solid.name, frame, solid
     for part in solid.shapes:
-        yield part.name or solid.name, frame.compose(pose_from_model(part.pose)), part
+        yield solid, part.name or solid.name, frame.compose(pose_from_model(part.pose)), part
     for child in solid.children:
-        yield from solid_parts(child, frame.compose(pose_from_model(child.pose)))
+        yield from owned_solid_parts(child, frame.compose(pose_from_model(child.pose)))
 
 
 def solid_lights(solid: wm.Solid, frame: Pose, nested: bool = False

@@ -27,6 +27,11 @@ struct WbNodeStructPrivate {
   double velocity[6];
   double center_of_mass[3];
   double pose[16];
+  WbContactPoint *contact_points[2]; /* its contact points without, with its descendants: the library's */
+  int n_contact_points[2];
+  int64_t contact_time[2]; /* the simulated time (ms) they were asked at */
+  bool contact_known[2];
+  bool contact_descendants; /* include_descendants of its last get_number_of_contact_points */
   struct WbNodeStructPrivate *next;
 };
 
@@ -64,6 +69,8 @@ void sn_supervisor_free(sn_robot *rb) {
     next = n->next;
     free(n->def_name);
     free(n->proto);
+    free(n->contact_points[0]);
+    free(n->contact_points[1]);
     free(n);
   }
   for (struct WbFieldStructPrivate *f = rb->fields, *next; f != NULL; f = next) {
@@ -587,6 +594,12 @@ void wb_supervisor_world_reload(void) {
   if (rb == NULL || sn_robot_call(rb, "robot/world_reload", 0, NULL, NULL, func, &rep) != 0)
     return;
   sn_reply_free(&rep);
+}
+
+/* Webots' deprecated simulation_revert is its worldReload (the C++ simulationRevert() calls that too) */
+void wb_supervisor_simulation_revert(void) {
+  if (supervisor("wb_supervisor_simulation_revert") != NULL)
+    wb_supervisor_world_reload();
 }
 
 static void args_filename(sn_req *r, const void *arg) {
@@ -1808,51 +1821,107 @@ WbSimulationMode wb_supervisor_simulation_get_mode(void) {
 }
 
 /* ------------------------------------------------------------------ contact points */
-/* No physics here: a node never touches anything, so every query answers "none". The supervisor check
- * still applies, as for every wb_supervisor_* function. In Webots a robot on the ground always has
- * contact points (its wheels'): a supervisor that waits for one (a benchmark's "has it touched
- * something?") would wait forever here without a word, so the first query says so, once. */
-static void contact_points_unsimulated(const char *func) {
-  static bool warned;
-  if (warned)
+/* Where a top-level solid's or robot's bounding shapes (with include_descendants, those of the solids
+ * inside it too) touch the ground now, each with the id of the Solid touching there (README
+ * "Supervisor"): asked of the server at a node's first query in a step; as in Webots' libController, the
+ * step's later queries answer that one's array, valid until the step ends (tracking changes nothing). */
+typedef struct {
+  int64_t node;
+  bool descendants;
+} contact_args;
+
+static void args_contacts(sn_req *r, const void *arg) {
+  const contact_args *a = arg;
+  sn_req_key(r, "node");
+  msgpack_pack_int64(&r->pk, a->node);
+  sn_req_key(r, "include_descendants");
+  sn_arg_bool(r, &a->descendants);
+}
+
+/* the node's contact points in its array for that flag (the library's until a query in a later step, or
+   cleanup): how many, -1 after the server's line (a node that is no top-level Solid) or a malformed reply */
+static int query_contacts(WbNodeRef node, bool descendants, const char *func) {
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb == NULL)
+    return -1;
+  int d = descendants ? 1 : 0;
+  if (node->contact_known[d] && node->contact_time[d] == rb->time_ms)
+    return node->n_contact_points[d];
+  sn_reply rep;
+  contact_args a = {node->id, descendants};
+  if (sn_robot_call(rb, "robot/get_node_contact_points", 2, args_contacts, &a, func, &rep) != 0)
+    return -1;
+  const msgpack_object *points = sn_get(rep.result, "points"), *ids = sn_get(rep.result, "nodes");
+  int n = -1;
+  if (points != NULL && ids != NULL && points->type == MSGPACK_OBJECT_ARRAY && ids->type == MSGPACK_OBJECT_ARRAY &&
+      points->via.array.size == 3 * ids->via.array.size) {
+    n = (int)ids->via.array.size;
+    WbContactPoint *out = n > 0 ? calloc((size_t)n, sizeof *out) : NULL;
+    bool ok = n == 0 || out != NULL;
+    for (int i = 0; ok && i < n; i++) {
+      int64_t id;
+      ok = sn_as_int64(&ids->via.array.ptr[i], &id);
+      out[i].node_id = (int)id;
+      for (int k = 0; ok && k < 3; k++)
+        ok = sn_as_double(&points->via.array.ptr[3 * i + k], &out[i].point[k]);
+    }
+    if (ok) {
+      free(node->contact_points[d]);
+      node->contact_points[d] = out;
+      node->n_contact_points[d] = n;
+      node->contact_time[d] = rb->time_ms;
+      node->contact_known[d] = true;
+    } else {
+      free(out);
+      n = -1;
+    }
+  }
+  sn_reply_free(&rep);
+  if (n < 0)
+    fprintf(stderr, "Error: %s(): malformed reply\n", func);
+  return n;
+}
+
+static void deprecated(const char *func, bool *warned) {
+  if (*warned)
     return;
-  warned = true;
-  fprintf(stderr, "Warning: %s(): Sensorium computes no contact points: every node touches nothing (none, even "
-                  "on the ground).\n", func);
-}
-
-const double *wb_supervisor_node_get_contact_point(WbNodeRef node, int index) {
-  (void)node;
-  (void)index;
-  if (supervisor("wb_supervisor_node_get_contact_point"))
-    contact_points_unsimulated("wb_supervisor_node_get_contact_point");
-  return sn_no_values();
-}
-
-WbNodeRef wb_supervisor_node_get_contact_point_node(WbNodeRef node, int index) {
-  (void)node;
-  (void)index;
-  if (supervisor("wb_supervisor_node_get_contact_point_node"))
-    contact_points_unsimulated("wb_supervisor_node_get_contact_point_node");
-  return NULL;
-}
-
-int wb_supervisor_node_get_number_of_contact_points(WbNodeRef node, bool include_descendants) {
-  (void)node;
-  (void)include_descendants;
-  if (supervisor("wb_supervisor_node_get_number_of_contact_points"))
-    contact_points_unsimulated("wb_supervisor_node_get_number_of_contact_points");
-  return 0;
+  *warned = true;
+  fprintf(stderr, "Warning: %s() is deprecated, use wb_supervisor_node_get_contact_points() instead.\n", func);
 }
 
 WbContactPoint *wb_supervisor_node_get_contact_points(WbNodeRef node, bool include_descendants, int *size) {
-  (void)node;
-  (void)include_descendants;
+  int n = query_contacts(node, include_descendants, "wb_supervisor_node_get_contact_points");
   if (size != NULL)
-    *size = 0;
-  if (supervisor("wb_supervisor_node_get_contact_points"))
-    contact_points_unsimulated("wb_supervisor_node_get_contact_points");
-  return NULL;
+    *size = n > 0 ? n : 0;
+  return n > 0 ? node->contact_points[include_descendants ? 1 : 0] : NULL;
+}
+
+/* Webots' deprecated functions: the count (-1 for a node that is no top-level Solid) sets the
+   include_descendants the point and node functions then take */
+int wb_supervisor_node_get_number_of_contact_points(WbNodeRef node, bool include_descendants) {
+  static bool warned;
+  deprecated("wb_supervisor_node_get_number_of_contact_points", &warned);
+  if (node != NULL)
+    node->contact_descendants = include_descendants;
+  return query_contacts(node, include_descendants, "wb_supervisor_node_get_number_of_contact_points");
+}
+
+const double *wb_supervisor_node_get_contact_point(WbNodeRef node, int index) {
+  static bool warned;
+  const char *func = "wb_supervisor_node_get_contact_point";
+  deprecated(func, &warned);
+  bool d = node != NULL && node->contact_descendants;
+  int n = query_contacts(node, d, func);
+  return index >= 0 && index < n ? node->contact_points[d][index].point : sn_no_values();
+}
+
+WbNodeRef wb_supervisor_node_get_contact_point_node(WbNodeRef node, int index) {
+  static bool warned;
+  const char *func = "wb_supervisor_node_get_contact_point_node";
+  deprecated(func, &warned);
+  bool d = node != NULL && node->contact_descendants;
+  int n = query_contacts(node, d, func);
+  return index >= 0 && index < n ? node_from_id(node->contact_points[d][index].node_id, func) : NULL;
 }
 
 void wb_supervisor_node_enable_contact_points_tracking(WbNodeRef node, int sampling_period, bool include_descendants) {

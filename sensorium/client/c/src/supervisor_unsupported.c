@@ -93,10 +93,6 @@ int wb_supervisor_movie_get_status(void) {
   return WB_SUPERVISOR_MOVIE_SIMULATION_ERROR;
 }
 
-void wb_supervisor_simulation_revert(void) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_field_remove_mf_node(WbFieldRef field, int position) {
   SN_UNSUPPORTED();
 }

@@ -257,17 +257,6 @@ class Field:
 
 
 
-_contact_points_warned: list[bool] = []
-
-
-def _contact_points_unsimulated(method: str) -> None:
-    """In Webots a robot on the ground always has contact points (its wheels'); here none: one line, once."""
-    if _contact_points_warned:
-        return
-    _contact_points_warned.append(True)
-    print(f"Warning: Node.{method}(): Sensorium computes no contact points: every node touches nothing (none, "
-          "even on the ground).", file=sys.stderr)
-
 class Node:
     """A node of the scene tree Sensorium has: the root (id 0), a robot, a top-level solid or light, a
     node inside a robot or solid (a Solid, device, Pose, Group, joint).
@@ -394,29 +383,24 @@ class Node:
         """Put back the state saved under ``stateName`` (``"__init__"``: as the world loaded)."""
         wb.wb_supervisor_node_load_state(self._ref, stateName)
 
-    # -- contact points: Sensorium has no physics contacts, so a node touches nothing (as in the C client);
-    # the first query says so once (a supervisor waiting for a contact would otherwise wait silently)
+    # -- contact points: where its bounding shapes touch the ground now (README "Supervisor")
     def getContactPoints(self, includeDescendants: bool = False) -> list[ContactPoint]:  # noqa: N803
-        _contact_points_unsimulated("getContactPoints")
-        return []
+        return [ContactPoint(point, node) for point, node in wb.wb_supervisor_node_get_contact_points(self._ref, includeDescendants)]
 
     def enableContactPointsTracking(self, samplingPeriod: int, includeDescendants: bool = False) -> None:  # noqa: N803
-        pass
+        wb.wb_supervisor_node_enable_contact_points_tracking(self._ref, samplingPeriod, includeDescendants)
 
     def disableContactPointsTracking(self, includeDescendants: bool = False) -> None:  # noqa: N803
-        pass
+        wb.wb_supervisor_node_disable_contact_points_tracking(self._ref)
 
     def getNumberOfContactPoints(self, includeDescendants: bool = False) -> int:  # noqa: N803
-        _contact_points_unsimulated("getNumberOfContactPoints")
-        return 0
+        return wb.wb_supervisor_node_get_number_of_contact_points(self._ref, includeDescendants)
 
     def getContactPoint(self, index: int) -> list[float]:
-        _contact_points_unsimulated("getContactPoint")
-        return [math.nan] * 3
+        return wb.wb_supervisor_node_get_contact_point(self._ref, index)
 
     def getContactPointNode(self, index: int) -> Node | None:
-        _contact_points_unsimulated("getContactPointNode")
-        return None
+        return _node_of(wb.wb_supervisor_node_get_contact_point_node(self._ref, index))
 
     id = property(getId)
     DEF = property(getDef)
@@ -456,9 +440,8 @@ for _name, _value in nodes.WEBOTS_NODE_TYPES.items():
 
 @dataclass
 class ContactPoint:
-    """Webots' contact point (``Node.getContactPoints``): Sensorium has no physics contacts, so no
-    function returns one (``getContactPoints()`` is ``[]``); the class exists for ``from controller
-    import ContactPoint``."""
+    """Webots' contact point (``Node.getContactPoints``): ``point`` in world coordinates (m) and the id of
+    the Solid touching there, ``node_id``."""
 
     point: list[float] = field(default_factory=lambda: [0.0, 0.0, 0.0])
     node_id: int = -1

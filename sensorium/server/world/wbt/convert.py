@@ -975,7 +975,19 @@ class Converter:
             owner.keys[key] = part
         part["_at"] = self.at(gnode)
         self.ride(part)
+        self.held_by_solid(part, owner)
         owner.parts.append(part)
+
+    def held_by_solid(self, part: dict, owner: Owner) -> None:
+        """A robot's shape names the nearest Solid (or device) of the robot's nodes holding it
+        (``in_solid``; none: the robot's own), which the Supervisor's contact points report."""
+        if owner.kind != "robot" or self.tree is None:
+            return
+        for _, k in reversed(self.tree_stack):
+            t = self.tree[k]["type"]
+            if t not in ("Pose", "Transform", "Group", "Slot") and t not in JOINTS:
+                part["in_solid"] = k
+                return
 
     def shape_node(self, node: Node, owner: Owner) -> dict:
         """The Supervisor's view of a Shape (schemas.world.ShapeNode): its DEFs and written fields, and

@@ -113,7 +113,7 @@ public:
   }
   const double *getCenterOfMass() const { return wb_supervisor_node_get_center_of_mass(ref_); }
 
-  // no physics contacts here: none
+  // where its bounding shapes touch the ground now (README "Supervisor")
   ContactPoint *getContactPoints(bool includeDescendants, int *size) const {
     return wb_supervisor_node_get_contact_points(ref_, includeDescendants, size);
   }

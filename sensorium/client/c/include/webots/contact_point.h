@@ -1,5 +1,5 @@
 /* Sensorium C controller library: WbContactPoint (supervisor.h's contact point functions), in its own
- * header as in Webots. Sensorium has no physics contacts: no function ever returns one. */
+ * header as in Webots. */
 #ifndef WB_CONTACT_POINT_H
 #define WB_CONTACT_POINT_H
 
