@@ -156,18 +156,37 @@ def test_a_controller_leaving_ends_its_movie() -> None:
 
 # ---------------------------------------------------------------------- the Python client, ffmpeg
 
-def _run(out: Path, env: dict[str, str | None] | None = None) -> tuple[list[str], str]:
-    from _serve import Proc, sensorium, serve
+def _python(url: str) -> list[str]:
+    from _serve import sensorium
+    return sensorium("controller", "--url", url, str(REPO / "tests" / "controllers" / "movie.py"))
+
+
+def _run(argv, out: Path, env: dict[str, str | None] | None = None) -> tuple[list[str], str]:
+    from _serve import Proc, serve
     with serve(WORLD, "--mode", "fast") as server:
         url = server.url("boss")
-        proc = Proc(sensorium("controller", "--url", url, str(REPO / "tests" / "controllers" / "movie.py")),
-                    env={**(env or {}), "MOVIE_OUT": str(out), "SENSORIUM_CONTROLLER_URL": url})
+        proc = Proc(argv(url), env={**(env or {}), "MOVIE_OUT": str(out), "SENSORIUM_CONTROLLER_URL": url})
         try:
             code = proc.wait(300)
         finally:
             proc.stop()
         assert code == 0, proc.stderr()
         return proc.stdout().splitlines(), proc.stderr()
+
+
+@pytest.fixture(scope="module")
+def c_movie(tmp_path_factory) -> str:
+    from test_c_client import sanitized_controller
+    return sanitized_controller(tmp_path_factory, REPO / "tests" / "c" / "movie.c")
+
+
+def _client(request, which: str):
+    """The controller's argv maker and environment: the Python client, or the C one (sanitizers on)."""
+    if which == "python":
+        return _python, {}
+    from test_c_client import SAN_ENV
+    exe = request.getfixturevalue("c_movie")
+    return (lambda url: [exe]), dict(SAN_ENV)
 
 
 def _decode(path: Path) -> np.ndarray:
@@ -185,8 +204,11 @@ REFUSED = ["Error: wb_supervisor_movie_start_recording(): movie recording has al
 
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("ffmpeg") is None or sys.platform == "win32", reason="needs ffmpeg (POSIX)")
-def test_the_python_client_writes_an_mp4_of_the_frames_with_webots_states_and_lines(tmp_path: Path) -> None:
-    lines, err = _run(tmp_path)
+@pytest.mark.parametrize("which", ["python", "c"])
+def test_the_client_writes_an_mp4_of_the_frames_with_webots_states_and_lines(tmp_path: Path, request, which) -> None:
+    argv, env = _client(request, which)
+    lines, err = _run(argv, tmp_path, env)
+    assert "Sanitizer" not in err and "runtime error" not in err, err
     assert lines == ["before True False", "recording False False", "stopped True False", "checked True False",
                      "odd True True", "folder True True", "done"], err
     errors = [line for line in err.splitlines() if line.startswith("Error")]
@@ -213,12 +235,14 @@ def test_the_python_client_writes_an_mp4_of_the_frames_with_webots_states_and_li
 
 @pytest.mark.slow
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX PATH")
-def test_without_ffmpeg_on_path_a_recording_fails_in_one_line(tmp_path: Path) -> None:
+@pytest.mark.parametrize("which", ["python", "c"])
+def test_without_ffmpeg_on_path_a_recording_fails_in_one_line(tmp_path: Path, request, which) -> None:
     empty = tmp_path / "bin"
     empty.mkdir()
     out = tmp_path / "out"
     out.mkdir()
-    lines, err = _run(out, {"PATH": str(empty)})
+    argv, env = _client(request, which)
+    lines, err = _run(argv, out, {**env, "PATH": str(empty)})
     assert lines[:3] == ["before True False", "recording True True", "stopped True True"], err
     errors = [line for line in err.splitlines() if "ffmpeg is not on PATH" in line]
     # each start past Webots' checks says so (run, again, the odd size: the client looks before the server)
