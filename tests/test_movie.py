@@ -234,6 +234,19 @@ def test_the_client_writes_an_mp4_of_the_frames_with_webots_states_and_lines(tmp
 
 
 @pytest.mark.slow
+@pytest.mark.skipif(shutil.which("ffmpeg") is None or sys.platform == "win32", reason="needs ffmpeg (POSIX)")
+@pytest.mark.parametrize("which", ["python", "c"])
+def test_a_controller_ending_while_recording_writes_the_movie_so_far(tmp_path: Path, request, which) -> None:
+    argv, env = _client(request, which)
+    lines, err = _run(argv, tmp_path, {**env, "MOVIE_LEAVE": "1"})
+    assert lines == ["left"] and "Error" not in err and "Sanitizer" not in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["left.mp4"]
+    frames = _decode(tmp_path / "left.mp4")
+    assert len(frames) == 5                              # 160 ms, a frame each 32 ms
+    assert np.abs(frames.reshape(5, -1, 3).mean(axis=1) - [FACE, 0, 0]).max() <= 6
+
+
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX PATH")
 @pytest.mark.parametrize("which", ["python", "c"])
 def test_without_ffmpeg_on_path_a_recording_fails_in_one_line(tmp_path: Path, request, which) -> None:

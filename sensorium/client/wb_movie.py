@@ -144,10 +144,11 @@ class Recorder:
     def stop(self, func: str) -> None:
         if self.status != RECORDING:
             return
-        self.take()
-        if self.status != RECORDING:
-            return
-        self._call("movie_stop")
+        if not self.robot.terminated:       # (the world ended: the frames taken so far are the movie)
+            self.take()
+            if self.status != RECORDING:
+                return
+            self._call("movie_stop")
         if self.frames == 0:
             self._abort(func, "nothing was recorded because the simulation did not run", SIMULATION_ERROR)
             return
@@ -186,13 +187,11 @@ class Recorder:
 
     def finish(self) -> None:
         """The controller ends: a movie still recording is stopped and its file completed."""
-        if self.status == RECORDING and not self.robot.conn.closed:
+        if self.status == RECORDING:
             try:
                 self.stop("wb_supervisor_movie_stop_recording")
             except SensoriumError:
                 self._abort("wb_supervisor_movie_stop_recording", "the server ended the movie", SIMULATION_ERROR)
-        elif self.status == RECORDING:
-            self._abort("wb_supervisor_movie_stop_recording", "the controller ended while recording", SIMULATION_ERROR)
         self.poll(FINISH_WAIT_S)
         if self.status == SAVING and self.process is not None:
             self.process.kill()

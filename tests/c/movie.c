@@ -1,6 +1,7 @@
 /* tests/controllers/movie.py in C (tests/test_movie.py, tests/worlds/movie.wbt): a movie of the wall
  * red for 20 basic steps, blue for 20 more, stopped and waited for; then the arguments Webots'
- * libController refuses and those Sensorium refuses beyond it, one line each. Prints the same lines. */
+ * libController refuses and those Sensorium refuses beyond it, one line each. Prints the same lines
+ * (with $MOVIE_LEAVE set: 10 steps of a movie, then the end without stopping it, "left"). */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -24,6 +25,17 @@ int main(void) {
   snprintf(bad, sizeof bad, "%s/bad.mp4", out);
   snprintf(folder, sizeof folder, "%s/no/such/folder.mp4", out);
   WbFieldRef colour = wb_supervisor_node_get_field(wb_supervisor_node_get_from_def("WALL_APP"), "baseColor");
+  if (getenv("MOVIE_LEAVE") != NULL) { /* ends while recording: the controller's end writes the movie */
+    char left[4096];
+    snprintf(left, sizeof left, "%s/left.mp4", out);
+    wb_supervisor_movie_start_recording(left, 160, 120, 0, 90, 1, false);
+    for (int i = 0; i < 10; i++)
+      wb_robot_step(16);
+    printf("left\n");
+    fflush(stdout);
+    wb_robot_cleanup();
+    return 0;
+  }
   states("before");
   wb_supervisor_movie_start_recording(run, 160, 120, 0, 90, 1, false);
   states("recording");

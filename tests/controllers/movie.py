@@ -10,6 +10,12 @@ from controller import Supervisor
 out = os.environ["MOVIE_OUT"]
 robot = Supervisor()
 colour = robot.getFromDef("WALL_APP").getField("baseColor")
+if os.environ.get("MOVIE_LEAVE"):         # ends while recording: the controller's end writes the movie
+    robot.movieStartRecording(os.path.join(out, "left.mp4"), 160, 120, 0, 90, 1, False)
+    for _ in range(10):
+        robot.step(16)
+    print("left")
+    raise SystemExit(0)
 print("before", robot.movieIsReady(), robot.movieFailed())
 robot.movieStartRecording(os.path.join(out, "run"), 160, 120, 0, 90, 1, False)      # ".mp4" added
 print("recording", robot.movieIsReady(), robot.movieFailed())

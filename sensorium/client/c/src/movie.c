@@ -263,10 +263,12 @@ void sn_movie_after_step(sn_robot *rb) {
 static void stop(sn_robot *rb, const char *func) {
   if (g_status != WB_SUPERVISOR_MOVIE_RECORDING)
     return;
-  sn_movie_after_step(rb);
-  if (g_status != WB_SUPERVISOR_MOVIE_RECORDING)
-    return;
-  server_stop(rb);
+  if (!rb->terminated) { /* (the world ended: the frames taken so far are the movie) */
+    sn_movie_after_step(rb);
+    if (g_status != WB_SUPERVISOR_MOVIE_RECORDING)
+      return;
+    server_stop(rb);
+  }
   if (g_frames == 0) {
     abort_movie(func, "nothing was recorded because the simulation did not run",
                 WB_SUPERVISOR_MOVIE_SIMULATION_ERROR);
@@ -309,10 +311,7 @@ static int poll_movie(int wait_ms) {
 /* the controller ends: a movie still recording is stopped and its file completed */
 void sn_movie_finish(sn_robot *rb) {
   const char *func = "wb_supervisor_movie_stop_recording";
-  if (g_status == WB_SUPERVISOR_MOVIE_RECORDING && !rb->terminated)
-    stop(rb, func);
-  else if (g_status == WB_SUPERVISOR_MOVIE_RECORDING)
-    abort_movie(func, "the controller ended while recording", WB_SUPERVISOR_MOVIE_SIMULATION_ERROR);
+  stop(rb, func);
   poll_movie(FINISH_WAIT_MS);
   if (g_status == WB_SUPERVISOR_MOVIE_SAVING)
     abort_movie(func, "ffmpeg did not finish the movie in time", WB_SUPERVISOR_MOVIE_ENCODING_ERROR);
