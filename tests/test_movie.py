@@ -262,3 +262,15 @@ def test_without_ffmpeg_on_path_a_recording_fails_in_one_line(tmp_path: Path, re
     assert errors == 3 * ["Error: wb_supervisor_movie_start_recording(): ffmpeg is not on PATH: Sensorium's movies "
                           "are encoded by ffmpeg (install it, e.g. apt-get install ffmpeg); nothing recorded."], err
     assert list(out.iterdir()) == []
+
+
+def test_a_frame_that_cannot_be_rendered_ends_the_movie_in_one_line_and_the_world_steps_on(monkeypatch) -> None:
+    lv, A = _live()
+    lv.ok(A, "/boss/robot/movie_start", {"width": 64, "height": 48, "acceleration": 1})
+
+    def broken(*a, **k):
+        raise RuntimeError("no picture")
+    monkeypatch.setattr(viewshot, "picture", broken)
+    assert lv.step(A, "boss", {"duration": 64})["time_ms"] == 64
+    got = lv.ok(A, "/boss/robot/movie_frames")
+    assert got["frames"] == [] and got["failed"] == "the frame at 32 ms could not be rendered: RuntimeError: no picture"

@@ -383,8 +383,11 @@ class Movie:
             over._by_id[CAPTION_ID] = self.caption
         try:
             rgb = picture(sim, self.width, self.height, over)
-        except ValueError as exc:
+        except ValueError as exc:            # a Viewpoint a Supervisor made unusable
             self.failed = str(exc)
+            return
+        except Exception as exc:  # noqa: BLE001 - a rendering bug ends the movie, never the world's step
+            self.failed = f"the frame at {now} ms could not be rendered: {type(exc).__name__}: {exc}"
             return
         self.queue.append(rgb.tobytes())
         self.queued += size
