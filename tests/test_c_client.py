@@ -316,7 +316,7 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
     assert len(warned) == 2 and "Microphone 'mic'" in warned[0] and "Radio 'radio'" in warned[1], err
     assert "Error: wb_microphone_enable(): device tag 3 is 'radio', a Radio" in err
     unserved = sorted(line.split("(")[0] for line in err.splitlines() if "not served by Sensorium" in line)
-    assert unserved == ["Error: wb_supervisor_" + f for f in ("movie_is_ready", "node_get_selected")], err
+    assert unserved == ["Error: wb_supervisor_" + f for f in ("node_get_selected", "virtual_reality_headset_is_used")], err
     assert "Error: wb_supervisor_node_export_string(): INVALID_ARGUMENT: node_export_string: Robot 'car' (node 1) has " \
         "no .wbt text here: the world was not loaded from a .wbt file" in err, err      # a YAML world: "" and one line
     # served for a PROTO's interface fields: Webots' line for the robot's SFRotation, 0; the robot (no PROTO)

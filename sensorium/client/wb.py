@@ -23,7 +23,7 @@ device print Webots' message to stderr once per disable. A velocity above ``maxV
 clamped here with Webots' warning (Webots clamps in the simulator).
 The functions live in ``wb_robot`` (session, robot, keyboard), ``wb_sensors`` (light, distance,
 lidar, encoders), ``wb_kinematic`` (GPS, InertialUnit, Compass, Accelerometer, Gyro, Altimeter,
-TouchSensor), ``wb_radio`` (Emitter, Receiver), ``wb_camera`` (RangeFinder, Camera, Recognition), ``wb_display``, ``wb_pen``, ``wb_radar``, ``wb_speaker``, ``wb_vacuum`` (VacuumGripper), ``wb_connector`` (Connector, Brake), ``wb_motor`` (motors, LEDs), ``wb_motion`` (motion files, ``wbu_motion_*``), ``wb_input``
+TouchSensor), ``wb_radio`` (Emitter, Receiver), ``wb_camera`` (RangeFinder, Camera, Recognition), ``wb_display``, ``wb_pen``, ``wb_radar``, ``wb_speaker``, ``wb_vacuum`` (VacuumGripper), ``wb_connector`` (Connector, Brake), ``wb_motor`` (motors, LEDs), ``wb_motion`` (motion files, ``wbu_motion_*``), ``wb_movie`` (a Supervisor's movies), ``wb_input``
 (joystick, mouse, waiting for user input, battery), ``wb_unsimulated`` (the devices Sensorium
 lists without simulating: Webots' "no value" with one warning per device) and ``wb_supervisor``;
 this module re-exports them all. One process drives one robot through
@@ -41,6 +41,7 @@ from sensorium.client import (
     wb_kinematic,
     wb_motion,
     wb_motor,
+    wb_movie,
     wb_pen,
     wb_radar,
     wb_radio,
@@ -67,6 +68,7 @@ from sensorium.client.wb_input import *  # noqa: F403
 from sensorium.client.wb_kinematic import *  # noqa: F403
 from sensorium.client.wb_motion import *  # noqa: F403
 from sensorium.client.wb_motor import *  # noqa: F403
+from sensorium.client.wb_movie import *  # noqa: F403
 from sensorium.client.wb_pen import *  # noqa: F403
 from sensorium.client.wb_radar import *  # noqa: F403
 from sensorium.client.wb_radio import *  # noqa: F403
@@ -90,7 +92,8 @@ from sensorium.client.wb_unsimulated import *  # noqa: F403
 from sensorium.client.wb_vacuum import *  # noqa: F403
 
 _MODULES = (wb_robot, wb_sensors, wb_kinematic, wb_radio, wb_camera, wb_display, wb_pen, wb_radar, wb_motor, wb_input,
-            wb_unsimulated, wb_supervisor, wb_speaker, wb_vacuum, wb_connector, wb_motion)
+            wb_unsimulated, wb_supervisor, wb_speaker, wb_vacuum, wb_connector, wb_motion,
+            wb_movie)
 globals().update({n: v for m in _MODULES for n, v in vars(m).items() if n.startswith(("wb_", "WB_", "wbu_"))})
 __all__ = sorted({n for m in _MODULES for n in vars(m) if n.startswith(("wb_", "WB_", "wbu_"))}
                  | {"SensoriumError", "RobotClient", "WbMouseState"})

@@ -287,6 +287,9 @@ class RobotClient:
         self.motor_commands: dict[str, dict[str, float]] = {}   # sent with the next step request
         # called with each step's duration before its request is built (wb_motion's playing motions)
         self.step_hooks: list[Callable[[int], None]] = []
+        # called after each step reply (a Supervisor's movie takes its frames) and before detaching
+        self.step_end_hooks: list[Callable[[], None]] = []
+        self.close_hooks: list[Callable[[], None]] = []
         self._prefix = f"/{self.name}/"
         self.conn.start_heartbeat(self.session, self.heartbeat_ms, lost_after_s)
 
@@ -400,6 +403,8 @@ class RobotClient:
             self.window_inbox.extend(str(t) for t in texts)
         if status == -1:
             self.terminated = True
+        for hook in self.step_end_hooks:
+            hook()
         return status
 
     def step(self, duration: int | None = None) -> int:
@@ -645,6 +650,8 @@ class RobotClient:
         if self.closed:
             return
         self.closed = True
+        for hook in self.close_hooks:
+            hook()
         self.conn.stop_heartbeat()
         if self.pending is not None:
             self.conn.discard(self.pending)

@@ -441,6 +441,15 @@ class SetLabelArgs(Args):
     font: str = Field(max_length=256, description="Webots' font name (kept; one bitmap font draws every label here)")
 
 
+class MovieStartArgs(Args):
+    """``wb_supervisor_movie_start_recording``: the movie's frames rendered on the server from now on."""
+
+    width: int = Field(ge=1, le=4096, description="frame width in pixels (even)")
+    height: int = Field(ge=1, le=4096, description="frame height in pixels (even)")
+    acceleration: int = Field(ge=1, le=10_000, description="simulated time per movie time (Webots' acceleration)")
+    caption: bool = Field(default=False, description="Webots' caption: the acceleration at the top right")
+
+
 # ---------------------------------------------------------------------- results
 
 class Empty(Result):
@@ -896,6 +905,23 @@ class ImageResult(Result):
     data: bytes = Field(description="width x height x 3 bytes (R, G, B), rows top first")
 
 
+class MovieStartResult(Result):
+    """``movie_start``: the simulated ms between two frames (the movie runs at acceleration × 1000 / step_ms fps)."""
+
+    step_ms: int = Field(ge=1)
+
+
+class MovieFramesResult(Result):
+    """``movie_frames``: the frames rendered since the last call, oldest first."""
+
+    frames: list[bytes] = Field(description="each width x height x 3 bytes (R, G, B), rows top first")
+    more: bool = Field(description="more frames wait: call again")
+    width: int = Field(ge=1)
+    height: int = Field(ge=1)
+    full: bool = Field(description="the movie reached its frame limit: no more frames are taken")
+    failed: str = Field(description="why the server stopped taking frames, or empty")
+
+
 class IntValue(Result):
     value: int
 
@@ -1153,6 +1179,9 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("simulation_get_mode", "robot", NoArgs, IntValue, attached=True, supervisor=True),
     ServiceSpec("set_label", "robot", SetLabelArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("export_image", "robot", NoArgs, ImageResult, attached=True, supervisor=True),
+    ServiceSpec("movie_start", "robot", MovieStartArgs, MovieStartResult, attached=True, supervisor=True),
+    ServiceSpec("movie_frames", "robot", NoArgs, MovieFramesResult, attached=True, supervisor=True),
+    ServiceSpec("movie_stop", "robot", NoArgs, IntValue, attached=True, supervisor=True),
     ServiceSpec("node_export_string", "robot", NodeArgs, StringValue, attached=True, supervisor=True),
     ServiceSpec("world_save", "robot", NoArgs, StringValue, attached=True, supervisor=True),
     ServiceSpec("field_remove_sf", "robot", FieldArgs, SuccessResult, attached=True, supervisor=True),

@@ -116,7 +116,7 @@ static void online(void) {
          wb_supervisor_node_get_id(self) > 0, wb_supervisor_field_get_type_name(rotation),
          wb_supervisor_field_get_count(rotation), wb_supervisor_node_get_number_of_fields(self),
          com[0], com[1], com[2], wb_supervisor_node_export_string(self),
-         (int)wb_supervisor_movie_is_ready(), (int)wb_supervisor_field_get_mf_int32(rotation, 0));
+         (int)!wb_supervisor_virtual_reality_headset_is_used(), (int)wb_supervisor_field_get_mf_int32(rotation, 0));
   wb_supervisor_simulation_quit(3);
   printf("after quit %d\n", wb_robot_step(16)); /* -1, then the next step ends the process (libController) */
   fflush(stdout);

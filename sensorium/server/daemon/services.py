@@ -404,6 +404,8 @@ class Core(DeviceServices):
             self.lockstep.set_mode("pause")
             return [self._reply_error(d, ErrorCode.INTERNAL, f"the world failed to step: {exc}")
                     for d in self.lockstep.cancel_pending()], []
+        if getattr(self.sim, "_movie", None) is not None:     # only a recording world renders frames
+            supervisor.movie_after_step(self.sim)
         done = self.lockstep.advanced(now)
         if self.sim.time_ms != self.lockstep.time_ms:
             raise RuntimeError(f"clock mismatch: simulation {self.sim.time_ms} ms, lockstep {self.lockstep.time_ms} ms")
@@ -442,6 +444,7 @@ class Core(DeviceServices):
         self._seen.pop(s.token, None)
         self._custom_sent.pop(s.token, None)
         self.topics.release_robot(s.robot)
+        supervisor.movie_released(self.sim, s.robot)
         # a robot without a controller stops: with no collision response it would otherwise
         # drive through walls while the world steps for the others (Webots keeps the commands)
         for motor in self.sim.robots[s.robot].motors.values():

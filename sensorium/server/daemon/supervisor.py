@@ -1614,6 +1614,51 @@ def _export_image(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     return {"width": w, "height": h, "data": rgb.tobytes()}
 
 
+def _movie_start(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    """A movie's frames rendered from now on (the client runs the encoder and writes the file)."""
+    movie = getattr(sim, "_movie", None)
+    if movie is not None:
+        raise ValueError(f"a movie is already being recorded (by robot {movie.robot!r}): stop it first")
+    movie = viewshot.Movie(robot, sim.time_ms, sim.basic_time_step, a.width, a.height, a.acceleration, a.caption)
+    viewshot.viewpoint_of(sim)       # a Viewpoint that makes no picture: said now, not at the first frame
+    sim._movie = movie
+    return {"step_ms": movie.step_ms}
+
+
+def _own_movie(sim: Any, robot: str) -> Any:
+    movie = getattr(sim, "_movie", None)
+    if movie is None or movie.robot != robot:
+        raise ValueError("no movie is being recorded by this robot")
+    return movie
+
+
+def _movie_frames(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    movie = _own_movie(sim, robot)
+    frames, more = movie.take()
+    return {"frames": frames, "more": more, "width": movie.width, "height": movie.height, "full": movie.full,
+            "failed": movie.failed}
+
+
+def _movie_stop(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    """The movie ends; frames not yet taken are dropped (the client takes them first)."""
+    movie = _own_movie(sim, robot)
+    sim._movie = None
+    return {"value": movie.frames}
+
+
+def movie_after_step(sim: Any) -> None:
+    """The daemon's call after each basic step: a recording movie's frame when it is due."""
+    movie = sim._movie
+    movie.after_step(sim, getattr(sim, "_labels", None))
+
+
+def movie_released(sim: Any, robot: str) -> None:
+    """A robot's controller went: its movie ends."""
+    movie = getattr(sim, "_movie", None)
+    if movie is not None and movie.robot == robot:
+        sim._movie = None
+
+
 HANDLERS = {
     "get_from_def": lambda sim, ls, robot, a: node_ref(sim, find_node(sim, a.name)),
     "get_from_proto_def": _from_proto_def,
@@ -1643,6 +1688,9 @@ HANDLERS = {
     "simulation_get_mode": lambda sim, ls, robot, a: {"value": MODES.index(ls.mode)},
     "set_label": _set_label,
     "export_image": _export_image,
+    "movie_start": _movie_start,
+    "movie_frames": _movie_frames,
+    "movie_stop": _movie_stop,
     "node_export_string": _export_string,
     "world_save": _world_save,
     "field_remove_sf": _remove_sf,

@@ -17,6 +17,10 @@ Pillow's small bitmap font, Webots' TrueType fonts are not here), each glyph pix
 square of ``max(1, round(size·H / line height))`` pixels, so ``size`` (a fraction of the height,
 Webots' unit) sets the text's height to the nearest whole multiple of the font's.
 
+A Supervisor's movie (:class:`Movie`) is the same picture rendered at Webots' frame times
+(:func:`movie_frame_step`) while it records, the frames kept until the recording controller takes
+them (its client pipes them into ffmpeg); a simulation without one renders nothing.
+
 The work is bounded: an image has at most :data:`MAX_PIXELS` pixels, a label's text
 :data:`MAX_TEXT` characters, a simulation :data:`MAX_LABELS` labels, and a label's glyph squares
 are cut to the image before they are filled (a label costs at most about the image's pixels).
@@ -40,7 +44,7 @@ from sensorium.server.world.geometry import Pose
 
 __all__ = ["EXPORT_SIZE", "MAX_PIXELS", "MAX_SIDE", "MAX_LABELS", "MAX_TEXT", "MAX_LABEL_ID", "Label", "Labels",
            "Viewpoint", "placed_viewpoint", "viewpoint_of", "render", "draw_labels", "picture", "parse_size", "FORMATS",
-           "image_format", "encode", "snapshot"]
+           "image_format", "encode", "snapshot", "Movie", "movie_frame_step"]
 
 EXPORT_SIZE = (640, 480)
 """The size of a Supervisor's ``exportImage`` (Webots': its 3D window's, which a server has not)."""
@@ -307,3 +311,94 @@ def snapshot(sim: Any, width: int, height: int, steps: int = 0) -> np.ndarray:
     for _ in range(steps):
         sim.step()
     return picture(sim, width, height)
+
+
+# ------------------------------------------------------------------------------ movies
+
+MOVIE_FRAME_MS = 40               # Webots' aim between two frames at acceleration 1 (25 fps)
+MOVIE_MAX_ACCELERATION = 10_000
+MOVIE_MAX_FRAMES = 1 << 20        # a movie's frames, at most (about 11.6 h at 25 fps)
+MOVIE_QUEUE_BYTES = 128 << 20     # frames waiting for the recording controller, at most
+MOVIE_REPLY_BYTES = 32 << 20      # frames handed over in one reply, at most (one frame always)
+CAPTION_ID = 65535                # Webots' movie caption label
+
+
+def movie_frame_step(basic_ms: int, acceleration: int) -> int:
+    """The simulated ms between two movie frames (Webots' WbVideoRecorder rule): a whole number
+    of basic steps near ``acceleration`` × 40 ms, the lower whole number unless it is 0 or the
+    upper one's step lies nearer 40 ms."""
+    refresh = acceleration * MOVIE_FRAME_MS / basic_ms
+    low, high = math.floor(refresh) * basic_ms, math.ceil(refresh) * basic_ms
+    if low == 0 or abs(low - MOVIE_FRAME_MS) > abs(high - MOVIE_FRAME_MS):
+        return int(high)
+    return int(low)
+
+
+class Movie:
+    """A Supervisor's movie on the server: the Viewpoint's picture (labels and caption over it)
+    rendered at every ``step_ms`` of simulated time after its start, kept until the recording
+    controller takes them (:meth:`take`). A simulation without a movie renders nothing."""
+
+    def __init__(self, robot: str, start_ms: int, basic_ms: int, width: Any, height: Any, acceleration: Any,
+                 caption: Any) -> None:
+        width, height = parse_size_values(width, height)
+        if width % 2 or height % 2:
+            raise ValueError(f"movie size {width}x{height}: width and height must be even (H.264, 4:2:0 colour)")
+        if (isinstance(acceleration, bool) or not isinstance(acceleration, int)
+                or not 1 <= acceleration <= MOVIE_MAX_ACCELERATION):
+            raise ValueError(f"movie acceleration must be an integer in 1..{MOVIE_MAX_ACCELERATION}, "
+                             f"got {acceleration!r}")
+        self.robot = robot
+        self.width, self.height = width, height
+        self.step_ms = movie_frame_step(basic_ms, acceleration)
+        self.next_ms = start_ms + self.step_ms
+        self.frames = 0                     # taken so far
+        self.full = False                   # MOVIE_MAX_FRAMES reached: no more frames taken
+        self.failed = ""                    # why the server stopped taking frames
+        self.queue: list[bytes] = []
+        self.queued = 0
+        self.caption: Label | None = None
+        if caption:
+            # Webots' caption: the acceleration ("4x") in white at the top right, 0.2 of the height
+            self.caption = Label(f"{acceleration}x", 1.0 - 0.227 * height / width, 0.025, 0.2, 0xFFFFFF, 0.0, "Arial")
+
+    def after_step(self, sim: Any, labels: Labels | None) -> None:
+        """Called after every basic step: the frame when its time has come."""
+        now = sim.time_ms
+        if now < self.next_ms or self.failed:
+            return
+        self.next_ms += self.step_ms        # (start and step are whole basic steps)
+        if self.frames >= MOVIE_MAX_FRAMES:
+            self.full = True
+            return
+        size = self.width * self.height * 3
+        if self.queued + size > MOVIE_QUEUE_BYTES:
+            self.failed = (f"the movie's frames not yet taken by the recording controller passed "
+                           f"{MOVIE_QUEUE_BYTES >> 20} MiB: step it more often, or record a smaller movie")
+            return
+        over = Labels()
+        if labels is not None:
+            over._by_id.update(labels._by_id)
+        if self.caption is not None:
+            over._by_id[CAPTION_ID] = self.caption
+        try:
+            rgb = picture(sim, self.width, self.height, over)
+        except ValueError as exc:            # a Viewpoint a Supervisor made unusable
+            self.failed = str(exc)
+            return
+        except Exception as exc:  # noqa: BLE001 - a rendering bug ends the movie, never the world's step
+            self.failed = f"the frame at {now} ms could not be rendered: {type(exc).__name__}: {exc}"
+            return
+        self.queue.append(rgb.tobytes())
+        self.queued += size
+        self.frames += 1
+
+    def take(self) -> tuple[list[bytes], bool]:
+        """The frames waiting (at most MOVIE_REPLY_BYTES of them, one at least) and whether more wait."""
+        out, n = [], 0
+        while self.queue and (not out or n + len(self.queue[0]) <= MOVIE_REPLY_BYTES):
+            frame = self.queue.pop(0)
+            out.append(frame)
+            n += len(frame)
+        self.queued -= n
+        return out, bool(self.queue)

@@ -274,6 +274,10 @@ int sn_device_call(sn_robot *rb, const sn_device *dev, const char *item, sn_arg_
 int sn_robot_call(sn_robot *rb, const char *item, uint32_t nargs, sn_arg_fn add_args, const void *arg,
                   const char *func, sn_reply *out);
 void sn_supervisor_free(sn_robot *rb);
+/* A Supervisor's movie (movie.c): its frames taken after each step reply; stopped and its file
+ * completed when the controller ends. */
+void sn_movie_after_step(sn_robot *rb);
+void sn_movie_finish(sn_robot *rb);
 void sn_arg_int(sn_req *r, const void *arg);
 void sn_arg_bool(sn_req *r, const void *arg);
 void sn_arg_double(sn_req *r, const void *arg);

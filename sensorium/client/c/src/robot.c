@@ -460,6 +460,7 @@ void wb_robot_cleanup(void) {
   sn_robot *rb = g_robot;
   if (rb == NULL)
     return;
+  sn_movie_finish(rb); /* (while its calls still reach the server) */
   g_robot = NULL;
   g_cleaned = rb->terminated ? 1 : 2;
   sn_conn_stop_heartbeat(rb->conn);
@@ -702,6 +703,7 @@ static int step_end(sn_robot *rb) {
   sn_reply_free(&rep);
   if (status == -1)
     rb->terminated = true;
+  sn_movie_after_step(rb);
   return status;
 }
 

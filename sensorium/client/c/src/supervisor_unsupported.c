@@ -12,24 +12,6 @@
 /* every function here ignores its arguments (it answers Webots' "no value") */
 #pragma GCC diagnostic ignored "-Wunused-parameter"
 
-void wb_supervisor_movie_start_recording(const char *filename, int width, int height, int codec, int quality, int acceleration, bool caption) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_movie_stop_recording(void) {
-  SN_UNSUPPORTED();
-}
-
-bool wb_supervisor_movie_is_ready(void) {
-  SN_UNSUPPORTED();
-  return true;
-}
-
-bool wb_supervisor_movie_failed(void) {
-  SN_UNSUPPORTED();
-  return true;
-}
-
 bool wb_supervisor_animation_start_recording(const char *filename) {
   SN_UNSUPPORTED();
   return false;
@@ -40,19 +22,14 @@ bool wb_supervisor_animation_stop_recording(void) {
   return false;
 }
 
-
-
 WbNodeRef wb_supervisor_node_get_selected(void) {
   SN_UNSUPPORTED();
   return NULL;
 }
 
-
-
 void wb_supervisor_node_move_viewpoint(WbNodeRef node) {
   SN_UNSUPPORTED();
 }
-
 
 void wb_supervisor_node_add_force(WbNodeRef node, const double force[3], bool relative) {
   SN_UNSUPPORTED();
@@ -65,13 +42,6 @@ void wb_supervisor_node_add_force_with_offset(WbNodeRef node, const double force
 void wb_supervisor_node_add_torque(WbNodeRef node, const double torque[3], bool relative) {
   SN_UNSUPPORTED();
 }
-
-
-
-
-
-
-
 
 bool wb_supervisor_virtual_reality_headset_is_used(void) {
   SN_UNSUPPORTED();
@@ -88,25 +58,6 @@ const double *wb_supervisor_virtual_reality_headset_get_orientation(void) {
   return sn_no_values();
 }
 
-int wb_supervisor_movie_get_status(void) {
-  SN_UNSUPPORTED();
-  return WB_SUPERVISOR_MOVIE_SIMULATION_ERROR;
-}
-
 void wb_supervisor_field_remove_mf_node(WbFieldRef field, int position) {
   SN_UNSUPPORTED();
-}
-
-
-void wb_supervisor_start_movie(const char *file, int width, int height, int codec, int quality, int acceleration, bool caption) {
-  SN_UNSUPPORTED();
-}
-
-void wb_supervisor_stop_movie(void) {
-  SN_UNSUPPORTED();
-}
-
-int wb_supervisor_get_movie_status(void) {
-  SN_UNSUPPORTED();
-  return WB_SUPERVISOR_MOVIE_SIMULATION_ERROR;
 }

@@ -493,6 +493,19 @@ class Supervisor(Robot):
     def exportImage(self, filename: str, quality: int) -> None:
         wb.wb_supervisor_export_image(filename, quality)
 
+    def movieStartRecording(self, filename: str, width: int, height: int, codec: int, quality: int,
+                            acceleration: int, caption: bool) -> None:
+        wb.wb_supervisor_movie_start_recording(filename, width, height, codec, quality, acceleration, caption)
+
+    def movieStopRecording(self) -> None:
+        wb.wb_supervisor_movie_stop_recording()
+
+    def movieIsReady(self) -> bool:
+        return wb.wb_supervisor_movie_is_ready()
+
+    def movieFailed(self) -> bool:
+        return wb.wb_supervisor_movie_failed()
+
     def simulationReset(self) -> None:
         wb.wb_supervisor_simulation_reset()
 
@@ -573,10 +586,6 @@ _NAN = math.nan
 _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
     Supervisor: {
         "getSelected": ("node_get_selected", None, ""),
-        "movieStartRecording": ("movie_start_recording", None,
-                                "filename, width, height, codec, quality, acceleration, caption"),
-        "movieStopRecording": ("movie_stop_recording", None, ""), "movieIsReady": ("movie_is_ready", True, ""),
-        "movieFailed": ("movie_failed", True, ""),
         "animationStartRecording": ("animation_start_recording", False, "filename"),
         "animationStopRecording": ("animation_stop_recording", False, ""),
         "virtualRealityHeadsetIsUsed": ("virtual_reality_headset_is_used", False, ""),

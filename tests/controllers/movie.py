@@ -1,0 +1,43 @@
+"""A Webots-style supervisor recording a movie (tests/test_movie.py, tests/worlds/movie.wbt):
+the wall red for 20 basic steps (320 ms), blue for 20 more, then the recording stopped and waited
+for; then the arguments Webots' libController refuses, and those Sensorium refuses beyond it, one
+line each. Prints the movie's states as it goes and "done"."""
+
+import os
+
+from controller import Supervisor
+
+out = os.environ["MOVIE_OUT"]
+robot = Supervisor()
+colour = robot.getFromDef("WALL_APP").getField("baseColor")
+if os.environ.get("MOVIE_LEAVE"):         # ends while recording: the controller's end writes the movie
+    robot.movieStartRecording(os.path.join(out, "left.mp4"), 160, 120, 0, 90, 1, False)
+    for _ in range(10):
+        robot.step(16)
+    print("left")
+    raise SystemExit(0)
+print("before", robot.movieIsReady(), robot.movieFailed())
+robot.movieStartRecording(os.path.join(out, "run"), 160, 120, 0, 90, 1, False)      # ".mp4" added
+print("recording", robot.movieIsReady(), robot.movieFailed())
+robot.movieStartRecording(os.path.join(out, "again.mp4"), 160, 120, 0, 90, 1, False)  # refused: one line
+for _ in range(20):
+    robot.step(16)
+colour.setSFColor([0, 0, 1])
+for _ in range(20):
+    robot.step(16)
+robot.movieStopRecording()
+while not robot.movieIsReady():
+    robot.step(16)
+print("stopped", robot.movieIsReady(), robot.movieFailed())
+# refused, one line each, nothing recorded
+robot.movieStartRecording("", 160, 120, 0, 90, 1, False)
+robot.movieStartRecording(os.path.join(out, "bad.mp4"), 0, 120, 0, 90, 1, False)
+robot.movieStartRecording(os.path.join(out, "bad.mp4"), 160, 120, 0, 0, 1, False)
+robot.movieStartRecording(os.path.join(out, "bad.mp4"), 160, 120, 0, 90, 0, False)
+print("checked", robot.movieIsReady(), robot.movieFailed())
+robot.movieStartRecording(os.path.join(out, "bad.mp4"), 161, 120, 0, 90, 1, False)     # the server's refusal
+print("odd", robot.movieIsReady(), robot.movieFailed())
+robot.movieStartRecording(os.path.join(out, "no", "such", "folder.mp4"), 160, 120, 0, 90, 1, False)
+print("folder", robot.movieIsReady(), robot.movieFailed())
+robot.step(16)
+print("done")
