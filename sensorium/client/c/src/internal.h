@@ -296,6 +296,8 @@ sn_device *sn_sensor_reading(WbDeviceTag tag, sn_kind kind, const char *func, co
 /* A device Sensorium lists but does not simulate: checks that tag is a device of node_type (else
  * Webots' error), prints one warning line per device, returns false. true if tag is simulated. */
 bool sn_unsimulated(WbDeviceTag tag, int node_type, const char *func);
+/* supervisor.c: the calling robot if it is a Supervisor, else Webots' two error lines for func and NULL. */
+sn_robot *sn_supervisor(const char *func);
 /* supervisor.c: a Supervisor function Sensorium does not serve: Webots' error in a Robot controller,
    else one line the first time (*warned) it is called. */
 void sn_supervisor_unsupported(const char *func, bool *warned);

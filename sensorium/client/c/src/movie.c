@@ -35,19 +35,6 @@ static char g_name[4096], g_tmp[4096 + 64];
 static long long g_frames;
 static bool g_said_full;
 
-static sn_robot *movie_supervisor(const char *func) {
-  sn_robot *rb = sn_robot_get(func);
-  if (!rb->supervisor) {
-    fprintf(stderr,
-            "Error: ignoring illegal call to %s() in a 'Robot' controller.\n"
-            "Error: this function can only be used in a 'Supervisor' controller (set 'supervisor: true' on robot "
-            "'%s' in the world file).\n",
-            func, rb->name);
-    return NULL;
-  }
-  return rb;
-}
-
 static void fail(const char *func, const char *why, int status) {
   fprintf(stderr, "Error: %s(): %s.\n", func, why);
   g_status = status;
@@ -321,7 +308,7 @@ void wb_supervisor_movie_start_recording(const char *filename, int width, int he
                                          int acceleration, bool caption) {
   const char *func = "wb_supervisor_movie_start_recording";
   (void)codec; /* ignored, as in Webots */
-  sn_robot *rb = movie_supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return;
   int status = poll_movie(0);
@@ -350,20 +337,20 @@ void wb_supervisor_movie_start_recording(const char *filename, int width, int he
 
 void wb_supervisor_movie_stop_recording(void) {
   const char *func = "wb_supervisor_movie_stop_recording";
-  sn_robot *rb = movie_supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb != NULL)
     stop(rb, func);
 }
 
 bool wb_supervisor_movie_is_ready(void) {
-  if (movie_supervisor("wb_supervisor_movie_is_ready") == NULL)
+  if (sn_supervisor("wb_supervisor_movie_is_ready") == NULL)
     return false;
   int status = poll_movie(0);
   return status == WB_SUPERVISOR_MOVIE_READY || status > WB_SUPERVISOR_MOVIE_SAVING;
 }
 
 bool wb_supervisor_movie_failed(void) {
-  if (movie_supervisor("wb_supervisor_movie_failed") == NULL)
+  if (sn_supervisor("wb_supervisor_movie_failed") == NULL)
     return true;
   return poll_movie(0) > WB_SUPERVISOR_MOVIE_SAVING;
 }
@@ -375,7 +362,7 @@ int wb_supervisor_movie_get_status(void) {
                     "instead.\n", __func__);
     warned = true;
   }
-  if (movie_supervisor(__func__) == NULL)
+  if (sn_supervisor(__func__) == NULL)
     return WB_SUPERVISOR_MOVIE_SIMULATION_ERROR;
   return poll_movie(0);
 }

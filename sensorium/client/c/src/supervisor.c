@@ -86,7 +86,7 @@ void sn_supervisor_free(sn_robot *rb) {
   rb->nodes = rb->fields = rb->protos = NULL;
 }
 
-static sn_robot *supervisor(const char *func) {
+sn_robot *sn_supervisor(const char *func) {
   sn_robot *rb = sn_robot_get(func);
   if (!rb->supervisor) {
     fprintf(stderr,
@@ -101,7 +101,7 @@ static sn_robot *supervisor(const char *func) {
 
 /* the supervisor's robot when node is a node; Webots' line for a NULL one */
 static sn_robot *supervisor_node(WbNodeRef node, const char *func) {
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb != NULL && node == NULL) {
     fprintf(stderr, "Error: %s() called with a NULL or invalid 'node' argument.\n", func);
     return NULL;
@@ -110,7 +110,7 @@ static sn_robot *supervisor_node(WbNodeRef node, const char *func) {
 }
 
 void sn_supervisor_unsupported(const char *func, bool *warned) {
-  if (supervisor(func) == NULL || *warned)
+  if (sn_supervisor(func) == NULL || *warned)
     return;
   *warned = true;
   fprintf(stderr,
@@ -221,7 +221,7 @@ static void args_name(sn_req *r, const void *arg) {
 
 WbNodeRef wb_supervisor_node_get_from_def(const char *def) {
   const char *func = "wb_supervisor_node_get_from_def";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return NULL;
   if (def == NULL || *def == '\0') {
@@ -235,7 +235,7 @@ WbNodeRef wb_supervisor_node_get_from_def(const char *def) {
 }
 
 static WbNodeRef node_without_args(const char *item, const char *func) {
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   sn_reply rep;
   if (rb == NULL || sn_robot_call(rb, item, 0, NULL, NULL, func, &rep) != 0)
     return NULL;
@@ -250,7 +250,7 @@ static void args_device(sn_req *r, const void *arg) {
 /* the node of one of this robot's devices (its parent, pose and fields as any node inside the robot) */
 WbNodeRef wb_supervisor_node_get_from_device(WbDeviceTag tag) {
   const char *func = "wb_supervisor_node_get_from_device";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return NULL;
   sn_device *d = sn_device_get(tag, SN_OTHER, func);
@@ -274,7 +274,7 @@ static void args_id(sn_req *r, const void *arg) {
 }
 
 static WbNodeRef node_from_id(int64_t id, const char *func) {
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return NULL;
   if (id < 0) {
@@ -569,7 +569,7 @@ void wb_supervisor_node_set_visibility(WbNodeRef node, WbNodeRef from, bool visi
   const char *func = "wb_supervisor_node_set_visibility";
   if (live_node(node, func) == NULL)
     return;
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   sn_reply rep;
   if (from == NULL || sn_robot_call(rb, "robot/get_from_id", 1, args_id, &from->id, func, &rep) != 0 ||
       node_from_reply(rb, &rep) == NULL) {
@@ -589,7 +589,7 @@ void wb_supervisor_node_set_visibility(WbNodeRef node, WbNodeRef from, bool visi
 
 void wb_supervisor_world_reload(void) {
   const char *func = "wb_supervisor_world_reload";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   sn_reply rep;
   if (rb == NULL || sn_robot_call(rb, "robot/world_reload", 0, NULL, NULL, func, &rep) != 0)
     return;
@@ -598,7 +598,7 @@ void wb_supervisor_world_reload(void) {
 
 /* Webots' deprecated simulation_revert is its worldReload (the C++ simulationRevert() calls that too) */
 void wb_supervisor_simulation_revert(void) {
-  if (supervisor("wb_supervisor_simulation_revert") != NULL)
+  if (sn_supervisor("wb_supervisor_simulation_revert") != NULL)
     wb_supervisor_world_reload();
 }
 
@@ -612,7 +612,7 @@ static void args_filename(sn_req *r, const void *arg) {
    gives no world is one line of run's and the run ends (exit 1). */
 void wb_supervisor_world_load(const char *filename) {
   const char *func = "wb_supervisor_world_load";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return;
   if (filename == NULL || filename[0] == '\0') {
@@ -637,7 +637,7 @@ static bool ends_with(const char *s, const char *suffix);
 
 bool wb_supervisor_world_save(const char *filename) {
   const char *func = "wb_supervisor_world_save";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return false;
   if (filename == NULL || filename[0] == '\0') {
@@ -807,12 +807,12 @@ void wb_supervisor_node_reset_physics(WbNodeRef node) {
 
 void wb_supervisor_simulation_reset_physics(void) {
   const char *func = "wb_supervisor_simulation_reset_physics";
-  reset_physics(supervisor(func), 0, func);
+  reset_physics(sn_supervisor(func), 0, func);
 }
 
 void wb_supervisor_simulation_physics_reset(void) {
   const char *func = "wb_supervisor_simulation_physics_reset";
-  reset_physics(supervisor(func), 0, func);
+  reset_physics(sn_supervisor(func), 0, func);
 }
 
 /* ------------------------------------------------------------------ fields */
@@ -992,7 +992,7 @@ WbProtoRef wb_supervisor_node_get_proto(WbNodeRef node) {
 
 /* the supervisor robot for a call on `proto`, or NULL after Webots' line */
 static sn_robot *proto_robot(WbProtoRef proto, const char *func) {
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return NULL;
   for (struct WbProtoInfoStructPrivate *p = rb->protos; proto != NULL && p != NULL; p = p->next)
@@ -1076,7 +1076,7 @@ static void args_proto_def(sn_req *r, const void *arg) {
    PROTO instance); the server's line when the DEF names a node Sensorium serves no Supervisor node for. */
 WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def) {
   const char *func = "wb_supervisor_node_get_from_proto_def";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return NULL;
   if (def == NULL || *def == '\0') {
@@ -1139,7 +1139,7 @@ const char *wb_supervisor_field_get_type_name(WbFieldRef field) {
 /* The supervisor robot for a call on `field` of `type` (WB_NO_FIELD: any), or NULL after Webots'
    line for a NULL field or a wrong type. */
 static sn_robot *field_robot(WbFieldRef field, WbFieldType type, const char *func) {
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return NULL;
   if (field == NULL) {
@@ -1750,7 +1750,7 @@ static void args_status(sn_req *r, const void *arg) {
 
 void wb_supervisor_simulation_quit(int status) {
   const char *func = "wb_supervisor_simulation_quit";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return;
   /* As Webots quits: the server stops, every controller's steps answer -1 (this one's next step at
@@ -1763,7 +1763,7 @@ void wb_supervisor_simulation_quit(int status) {
 
 void wb_supervisor_simulation_reset(void) {
   const char *func = "wb_supervisor_simulation_reset";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   sn_reply rep;
   if (rb == NULL || sn_robot_call(rb, "robot/simulation_reset", 0, NULL, NULL, func, &rep) != 0)
     return;
@@ -1796,7 +1796,7 @@ static void args_mode(sn_req *r, const void *arg) {
 
 void wb_supervisor_simulation_set_mode(WbSimulationMode mode) {
   const char *func = "wb_supervisor_simulation_set_mode";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return;
   int m = (int)mode;
@@ -1811,7 +1811,7 @@ void wb_supervisor_simulation_set_mode(WbSimulationMode mode) {
 
 WbSimulationMode wb_supervisor_simulation_get_mode(void) {
   const char *func = "wb_supervisor_simulation_get_mode";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   sn_reply rep;
   if (rb == NULL || sn_robot_call(rb, "robot/simulation_get_mode", 0, NULL, NULL, func, &rep) != 0)
     return WB_SUPERVISOR_SIMULATION_MODE_FAST;
@@ -1928,25 +1928,25 @@ void wb_supervisor_node_enable_contact_points_tracking(WbNodeRef node, int sampl
   (void)node;
   (void)sampling_period;
   (void)include_descendants;
-  supervisor("wb_supervisor_node_enable_contact_points_tracking");
+  sn_supervisor("wb_supervisor_node_enable_contact_points_tracking");
 }
 
 void wb_supervisor_node_disable_contact_points_tracking(WbNodeRef node) {
   (void)node;
-  supervisor("wb_supervisor_node_disable_contact_points_tracking");
+  sn_supervisor("wb_supervisor_node_disable_contact_points_tracking");
 }
 
 void wb_supervisor_node_enable_contact_point_tracking(WbNodeRef node, int sampling_period, bool include_descendants) {
   (void)node;
   (void)sampling_period;
   (void)include_descendants;
-  supervisor("wb_supervisor_node_enable_contact_point_tracking");
+  sn_supervisor("wb_supervisor_node_enable_contact_point_tracking");
 }
 
 void wb_supervisor_node_disable_contact_point_tracking(WbNodeRef node, bool include_descendants) {
   (void)node;
   (void)include_descendants;
-  supervisor("wb_supervisor_node_disable_contact_point_tracking");
+  sn_supervisor("wb_supervisor_node_disable_contact_point_tracking");
 }
 
 /* ------------------------------------------------------------------ labels and pictures */
@@ -1999,7 +1999,7 @@ void wb_supervisor_set_label(int id, const char *text, double x, double y, doubl
   if (!unit_arg(func, "x", x) || !unit_arg(func, "y", y) || !unit_arg(func, "size", size) ||
       !unit_arg(func, "transparency", transparency))
     return;
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return;
   if (text == NULL) {
@@ -2048,7 +2048,7 @@ static bool ends_with(const char *s, const char *suffix) {
    a temporary file beside it renamed onto it (Webots' way: never a half-written picture). */
 void wb_supervisor_export_image(const char *filename, int quality) {
   const char *func = "wb_supervisor_export_image";
-  sn_robot *rb = supervisor(func);
+  sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return;
   if (filename == NULL || filename[0] == '\0') {
