@@ -5,7 +5,7 @@ at least ``near + 1.05 r`` (WbViewpoint::moveViewpointToObject); at once here, w
 it over about a second. tests/worlds/move_viewpoint.wbt: the Viewpoint at the origin looks along +y
 (Φ = π/4); a white ball r = 0.5 at (2, 3, 1); two balls r = 0.5 at ±1 m along x of a solid at
 (−4, 6, 0.5) turned 0.3 rad about z (one sphere of radius 1.5 about the solid's origin); a Solid
-without shapes."""
+without shapes; a Solid without shapes inside the ball's (its nearest ancestor with shapes: the ball)."""
 
 from __future__ import annotations
 
@@ -82,7 +82,7 @@ def test_the_bounding_sphere_merges_the_shapes_and_a_nested_node_uses_its_own():
     np.testing.assert_allclose(position(lv), c - [0.0, distance(0.5), 0.0], atol=1e-9)
 
 
-def test_a_node_without_shapes_leaves_the_viewpoint_and_reset_restores_it():
+def test_a_node_without_shapes_leaves_the_viewpoint_or_frames_its_ancestor_and_reset_restores_it():
     lv = _live()
     for node in (EMPTY, BOSS):                                # Webots: an empty bounding sphere, no move
         assert boss(lv, "move_viewpoint", {"node": node}) == {"success": True}
@@ -91,6 +91,11 @@ def test_a_node_without_shapes_leaves_the_viewpoint_and_reset_restores_it():
     text = boss(lv, "node_export_string", {"node": VIEWPOINT})["value"]        # exportString writes where it went
     [line] = [ln.split()[1:] for ln in text.splitlines() if ln.split()[:1] == ["position"]]
     np.testing.assert_allclose([float(c) for c in line], [2.0, 3.0 - distance(0.5), 1.0], atol=1e-12)
+    mark = boss(lv, "get_field", {"node": BALL, "field": "children"})["value"][1]
+    boss(lv, "simulation_reset", {})
+    assert position(lv) == [0.0, 0.0, 0.0]
+    boss(lv, "move_viewpoint", {"node": mark})                # inside the ball's solid: its nearest sphere, the ball's
+    np.testing.assert_allclose(position(lv), [2.0, 3.0 - distance(0.5), 1.0], atol=1e-12)
     boss(lv, "simulation_reset", {})
     assert position(lv) == [0.0, 0.0, 0.0]
     assert not viewshot.render(lv.sim, 64, 48)[24].any()       # the centre row: sky again

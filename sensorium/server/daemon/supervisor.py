@@ -966,8 +966,13 @@ def move_viewpoint(sim: Any, node: Node) -> None:
     """Webots' ``moveViewpoint`` (WbViewpoint::moveViewpointToObject): the Viewpoint's position moved so
     that the node's bounding sphere fills the view (``viewshot.framing_position``), its orientation kept.
     Webots animates the move over about a second of wall time; headless it is there at once. A node
-    without shapes (Webots: an empty bounding sphere) leaves the Viewpoint where it is."""
+    inside a robot or solid without shapes frames its nearest ancestor with some, up to that top-level
+    node (WbNodeUtilities::boundingSphereAncestor); a top-level node without any (Webots: an empty
+    bounding sphere) leaves the Viewpoint where it is."""
     sphere = bounding_sphere(sim, node)
+    while sphere is None and node.nested:
+        node = node_by_id(sim, _nested_of(sim, node).parent)
+        sphere = bounding_sphere(sim, node)
     if sphere is None:
         return
     vp = next(s for s in _scenery(sim) if s.type == "Viewpoint")
