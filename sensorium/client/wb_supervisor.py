@@ -519,6 +519,16 @@ def wb_supervisor_node_reset_physics(node: int | None) -> None:
         _answer(r, "reset_physics", {"node": int(node)}, func)  # type: ignore[arg-type]
 
 
+def wb_supervisor_node_move_viewpoint(node: int | None) -> None:
+    """Webots' ``moveViewpoint``: the Viewpoint backed off along its view direction until the node's bounding
+    sphere fills the view, its orientation kept; at once (Webots animates it over about a second), seen by
+    its ``position`` field and the next exportImage or movie frame (README "Supervisor")."""
+    func = "wb_supervisor_node_move_viewpoint"
+    r = _checked_node(node, func)
+    if r is not None:
+        _answer(r, "move_viewpoint", {"node": int(node)}, func)  # type: ignore[arg-type]
+
+
 def wb_supervisor_simulation_reset_physics() -> None:
     """Webots' ``simulationResetPhysics``: the root's ``resetPhysics``, every falling solid falls again from rest."""
     func = "wb_supervisor_simulation_reset_physics"

@@ -1158,6 +1158,7 @@ SERVICES: tuple[ServiceSpec, ...] = (
     ServiceSpec("get_proto", "robot", ProtoArgs, ProtoResult, attached=True, supervisor=True),
     ServiceSpec("get_actual_field", "robot", FieldArgs, StringValue, attached=True, supervisor=True),
     ServiceSpec("set_visibility", "robot", SetVisibilityArgs, SuccessResult, attached=True, supervisor=True),
+    ServiceSpec("move_viewpoint", "robot", NodeArgs, SuccessResult, attached=True, supervisor=True),
     ServiceSpec("get_node_pose", "robot", NodeArgs, NodePoseResult, attached=True, supervisor=True),
     ServiceSpec("get_node_velocity", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),
     ServiceSpec("get_node_center_of_mass", "robot", NodeArgs, FloatArrayValue, attached=True, supervisor=True),

@@ -277,6 +277,9 @@ def _now(sim: Any, node: sv.Node) -> list[tuple[str, str, Any, Any]]:
     """(field as written, type, value now, the value not written) of the fields written from the server's state:
     a base node's at Webots' default; a PROTO instance's fields that pass straight through IS to those at the
     instance's value as it loaded (its PROTO's default when the instance does not write it)."""
+    if node.scenery and node.type == "Viewpoint" and getattr(sim, "viewpoint_loaded", None) is not None:
+        # moved by moveViewpoint: Webots' position field holds where it went, and its text writes it
+        return [("position", "SFVec3f", sv.SCENERY_FIELDS["Viewpoint"]["position"][1](sim, node), None)]
     defaults = DEFAULTS.get(node.type)
     if defaults is None or node.scenery or node.visual:
         return []

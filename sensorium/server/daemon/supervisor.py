@@ -640,7 +640,7 @@ SCENERY_FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
                   "gpsReference": ("SFVec3f", _info("gps_reference", lambda v: [float(c) for c in v]), None),
                   "inkEvaporation": ("SFFloat", _info("ink_evaporation", float), None)},
     # the world file's values (wbt/convert.SCENERY_VALUES), else Webots' defaults (a Viewpoint Webots adds, a
-    # YAML world's); read-only here: Sensorium has no 3D view for a Viewpoint to move nor a sky to recolour
+    # YAML world's); read-only here (but moveViewpoint's position: move_viewpoint): no sky to recolour
     "Viewpoint": {"fieldOfView": ("SFFloat", _written("fieldOfView", 0.785398), None),
                   "orientation": ("SFRotation", _written("orientation", [0.0, 0.0, 1.0, 0.0]), None),
                   "position": ("SFVec3f", _written("position", [-10.0, 0.0, 0.0]), None),
@@ -913,6 +913,76 @@ def set_visibility(sim: Any, node: Node, viewer: Node, visible: bool) -> None:
         raise ValueError(f"{MAX_HIDDEN} nodes are hidden from devices already (at most {MAX_HIDDEN} pairs): "
                          f"{_what(node)} not hidden; show one again first")
     hidden[node.id] = shapes
+
+
+def _enclose(a: tuple[np.ndarray, float] | None, centre: np.ndarray, radius: float) -> tuple[np.ndarray, float]:
+    """The smallest sphere holding sphere ``a`` and (``centre``, ``radius``) (WbBoundingSphere's merge)."""
+    if a is None:
+        return centre, radius
+    c, r = a
+    gap = float(np.linalg.norm(centre - c))
+    if gap + radius <= r:
+        return c, r
+    if gap + r <= radius:
+        return centre, radius
+    grown = (gap + r + radius) / 2.0
+    return c + (centre - c) * ((grown - r) / gap), grown
+
+
+def bounding_sphere(sim: Any, node: Node) -> tuple[np.ndarray, float] | None:
+    """A node's world bounding sphere as Webots merges it: each of its shapes' spheres (a primitive's
+    about its centre, ``textures.bounding_radius``; a mesh's Ritter sphere of its world corners)
+    enclosed one after the other, in shape order; None for a node without a (finite) shape."""
+    from sensorium.server.sim.scene import primitive_from_model
+    from sensorium.server.world.geometry import Mesh
+    from sensorium.server.world.textures import bounding_radius
+    scene = sim.scene
+    sphere: tuple[np.ndarray, float] | None = None
+    for shape in sorted(_node_shapes(sim, node) - scene.removed_shapes):
+        g = scene.shape_model(shape).geometry
+        pose = scene.shape_pose(shape)
+        if isinstance(g, wm.Mesh | wm.Triangles | wm.ElevationGrid):
+            prim = primitive_from_model(g, scene.base_dir)
+            pts = pose.apply(prim.vertices) if isinstance(prim, Mesh) else pose.apply(np.zeros((1, 3)))
+            a, b = _far_pair(pts)
+            own = ((pts[a] + pts[b]) / 2.0, float(np.linalg.norm(pts[a] - pts[b])) / 2.0)
+            for p in pts:
+                own = _enclose(own, p, 0.0)
+            sphere = _enclose(sphere, *own)
+            continue
+        radius = bounding_radius(g)
+        if math.isfinite(radius):
+            sphere = _enclose(sphere, pose.translation.astype(np.float64), radius)
+    return sphere
+
+
+def _far_pair(pts: np.ndarray) -> list[int]:
+    """Ritter's start: the corner farthest from the first one, then the one farthest from it."""
+    a = int(np.argmax(((pts - pts[0]) ** 2).sum(axis=1)))
+    return [a, int(np.argmax(((pts - pts[a]) ** 2).sum(axis=1)))]
+
+
+def move_viewpoint(sim: Any, node: Node) -> None:
+    """Webots' ``moveViewpoint`` (WbViewpoint::moveViewpointToObject): the Viewpoint's position moved so
+    that the node's bounding sphere fills the view (``viewshot.framing_position``), its orientation kept.
+    Webots animates the move over about a second of wall time; headless it is there at once. A node
+    inside a robot or solid without shapes frames its nearest ancestor with some, up to that top-level
+    node (WbNodeUtilities::boundingSphereAncestor); a top-level node without any (Webots: an empty
+    bounding sphere) leaves the Viewpoint where it is."""
+    sphere = bounding_sphere(sim, node)
+    while sphere is None and node.nested:
+        node = node_by_id(sim, _nested_of(sim, node).parent)
+        sphere = bounding_sphere(sim, node)
+    if sphere is None:
+        return
+    vp = next(s for s in _scenery(sim) if s.type == "Viewpoint")
+    sim.viewpoint_loaded = dict(vp.fields) if sim.viewpoint_loaded is None else sim.viewpoint_loaded
+    vp.fields["position"] = list(viewshot.framing_position(viewshot.viewpoint_of(sim), *sphere))
+
+
+def _move_viewpoint(sim: Any, ls: Any, robot: str, a: Any) -> dict:
+    move_viewpoint(sim, node_by_id(sim, a.node))
+    return {"success": True}
 
 
 def _set_visibility(sim: Any, ls: Any, robot: str, a: Any) -> dict:
@@ -1669,6 +1739,7 @@ HANDLERS = {
     "get_field": lambda sim, ls, robot, a: get_field(sim, node_by_id(sim, a.node), a.field, a.level),
     "get_proto": lambda sim, ls, robot, a: get_proto(sim, node_by_id(sim, a.node), a.level),
     "set_visibility": _set_visibility,
+    "move_viewpoint": _move_viewpoint,
     "get_actual_field": lambda sim, ls, robot, a: {"value": actual_field(sim, node_by_id(sim, a.node), a.field,
                                                                          a.level)},
     "set_field": _set_field,

@@ -371,6 +371,8 @@ class Simulation:
         self.top_level = top_level(self.world)     # the root's children as loaded (world/top_nodes.py)
         # the shapes a Supervisor hid from the Viewpoint (setVisibility), by the node hidden: viewshot's pictures
         self.viewpoint_hidden: dict[int, frozenset[int]] = {}
+        # the Viewpoint's fields as loaded, kept when a Supervisor's moveViewpoint first moves it (reset restores them)
+        self.viewpoint_loaded: dict | None = None
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
                                                             # a node was imported (None: the loaded order)
         self._import_protos: Any = None                     # the world's EXTERNPROTO declarations, read once
@@ -542,6 +544,11 @@ class Simulation:
                 self.scene.set_top_light(k, light)
         self.scene.clear_ink()          # WbPen::reset clears every paint texture
         self.scene.restore_appearances()     # colours a Supervisor set: as loaded
+        if self.viewpoint_loaded is not None:      # a Viewpoint moveViewpoint moved: where it was loaded
+            vp = next(s for s in self.top_level.scenery if s.type == "Viewpoint")
+            vp.fields.clear()
+            vp.fields.update(self.viewpoint_loaded)
+            self.viewpoint_loaded = None
         # radar cross sections a Supervisor set: back to the loaded ones (of the robots and solids still there)
         owners = {k: k[0] if isinstance(k, tuple) else k for k in self._initial["radar_targets"]}
         self.scene.radar_targets = {k: v for k, v in self._initial["radar_targets"].items()

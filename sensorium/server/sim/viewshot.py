@@ -43,7 +43,7 @@ from sensorium.server.sim.sensors import Device
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["EXPORT_SIZE", "MAX_PIXELS", "MAX_SIDE", "MAX_LABELS", "MAX_TEXT", "MAX_LABEL_ID", "Label", "Labels",
-           "Viewpoint", "placed_viewpoint", "viewpoint_of", "render", "draw_labels", "picture", "parse_size", "FORMATS",
+           "Viewpoint", "placed_viewpoint", "viewpoint_of", "framing_position", "render", "draw_labels", "picture", "parse_size", "FORMATS",
            "image_format", "encode", "snapshot", "Movie", "movie_frame_step"]
 
 EXPORT_SIZE = (640, 480)
@@ -116,6 +116,21 @@ def viewpoint_of(sim: Any) -> Viewpoint:
     if vp.near < 0.0 or vp.far < 0.0 or vp.exposure < 0.0:
         raise ValueError("Viewpoint near, far and exposure must be >= 0")
     return vp
+
+
+def framing_position(vp: Viewpoint, centre: np.ndarray, radius: float) -> tuple[float, float, float]:
+    """Where Webots' ``moveViewpoint`` puts the Viewpoint to frame a bounding sphere (WbViewpoint's
+    ``moveViewpointToObject``): its orientation kept, backed off from ``centre`` along its view
+    direction (+x of its frame) by ``d = 1.05 r / (sin(fov/2) * min(a, 1/a))``, at least
+    ``near + 1.05 r``. Webots' ``a`` is its 3D view's aspect; headless, the exportImage picture's
+    (``EXPORT_SIZE``)."""
+    w, h = EXPORT_SIZE
+    aspect = w / h
+    r = 1.05 * radius
+    d = max(r / (math.sin(vp.field_of_view / 2.0) * min(aspect, 1.0 / aspect)), vp.near + r)
+    forward = vp.pose().apply_dirs(np.array([[1.0, 0.0, 0.0]]))[0]
+    p = np.asarray(centre, dtype=np.float64) - d * forward
+    return (float(p[0]), float(p[1]), float(p[2]))
 
 
 class _Eye:

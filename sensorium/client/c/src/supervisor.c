@@ -805,6 +805,17 @@ void wb_supervisor_node_reset_physics(WbNodeRef node) {
     reset_physics(rb, node->id, func);
 }
 
+/* Webots' moveViewpoint: the Viewpoint backed off along its view direction until the node's bounding sphere
+   fills the view (its orientation kept); at once here, where Webots animates it over about a second */
+void wb_supervisor_node_move_viewpoint(WbNodeRef node) {
+  const char *func = "wb_supervisor_node_move_viewpoint";
+  sn_robot *rb = supervisor_node(node, func);
+  sn_reply rep;
+  int64_t id = rb != NULL ? node->id : 0;
+  if (rb != NULL && sn_robot_call(rb, "robot/move_viewpoint", 1, args_node, &id, func, &rep) == 0)
+    sn_reply_free(&rep);
+}
+
 void wb_supervisor_simulation_reset_physics(void) {
   const char *func = "wb_supervisor_simulation_reset_physics";
   reset_physics(sn_supervisor(func), 0, func);

@@ -27,10 +27,6 @@ WbNodeRef wb_supervisor_node_get_selected(void) {
   return NULL;
 }
 
-void wb_supervisor_node_move_viewpoint(WbNodeRef node) {
-  SN_UNSUPPORTED();
-}
-
 void wb_supervisor_node_add_force(WbNodeRef node, const double force[3], bool relative) {
   SN_UNSUPPORTED();
 }

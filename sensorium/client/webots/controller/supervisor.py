@@ -367,6 +367,9 @@ class Node:
     def restartController(self) -> None:
         wb.wb_supervisor_node_restart_controller(self._ref)
 
+    def moveViewpoint(self) -> None:
+        wb.wb_supervisor_node_move_viewpoint(self._ref)
+
     def setVisibility(self, fromNode: Node | None, visible: bool) -> None:  # noqa: N803 - Webots' parameter name
         wb.wb_supervisor_node_set_visibility(self._ref, None if fromNode is None else fromNode._ref, visible)
 
@@ -592,7 +595,6 @@ _UNSERVED: dict[type, dict[str, tuple[str, Any, str]]] = {
         "virtualRealityHeadsetGetPosition": ("virtual_reality_headset_get_position", [_NAN] * 3, ""),
         "virtualRealityHeadsetGetOrientation": ("virtual_reality_headset_get_orientation", [_NAN] * 9, "")},
     Node: {
-        "moveViewpoint": ("node_move_viewpoint", None, ""),
         "addForce": ("node_add_force", None, "force, relative"),
         "addForceWithOffset": ("node_add_force_with_offset", None, "force, offset, relative"),
         "addTorque": ("node_add_torque", None, "torque, relative")},
