@@ -430,6 +430,12 @@ def exit_status(quit_status: int | None, missing: bool = False, load_refused: bo
 WORLD_SUFFIXES = (".wbt", ".yaml", ".yml", ".json")    # the world files `run` loads (Webots': .wbt only)
 
 
+def _one_line(value: object) -> str:
+    """A path (or an OS error naming one) as text on one line: a control character a file name may hold
+    (a newline from a Supervisor's worldLoad argument) written as its escape, so the refusal stays one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(value))
+
+
 def world_to_load(filename: str, folder: Path | None, worlds: Path) -> Path:
     """The world file a Supervisor's ``worldLoad(filename)`` names: relative to its controller's
     ``folder``, as Webots takes it (None: a controller ``run`` did not start, which has none here),
@@ -447,19 +453,19 @@ def world_to_load(filename: str, folder: Path | None, worlds: Path) -> Path:
     try:
         resolved = path.resolve()
     except (OSError, RuntimeError) as exc:          # a symbolic link loop
-        raise LaunchError(f"{path} cannot be resolved: {exc}") from None
+        raise LaunchError(f"{_one_line(path)} cannot be resolved: {_one_line(exc)}") from None
     root = worlds.resolve()
     if not resolved.is_relative_to(root):
-        raise LaunchError(f"{resolved} is outside {root}, the folder of the world `sensorium run` started with "
-                          "(a world from elsewhere would start another project's controllers)")
+        raise LaunchError(f"{_one_line(resolved)} is outside {_one_line(root)}, the folder of the world `sensorium run` "
+                          "started with (a world from elsewhere would start another project's controllers)")
     try:
         found = resolved.is_file()
     except OSError as exc:               # a folder on the way that may not be read
-        raise LaunchError(f"{resolved} cannot be read: {exc.strerror or exc}") from None
+        raise LaunchError(f"{_one_line(resolved)} cannot be read: {_one_line(exc.strerror or exc)}") from None
     if not found:
-        raise LaunchError(f"no world file {resolved}")
+        raise LaunchError(f"no world file {_one_line(resolved)}")
     if resolved.suffix.lower() not in WORLD_SUFFIXES:
-        raise LaunchError(f"{resolved} is not a world file (.wbt; YAML or JSON: .yaml, .yml, .json)")
+        raise LaunchError(f"{_one_line(resolved)} is not a world file (.wbt; YAML or JSON: .yaml, .yml, .json)")
     return resolved
 
 

@@ -19,7 +19,7 @@ from PIL import Image
 from sensorium.schemas import world as wm
 from sensorium.server.devices.noise import device_rng
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import WorldError, parse_world
+from sensorium.server.world.loader import WorldError, load_world, parse_world
 
 WALL = {"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
         "appearance": {"base_color": [0.8, 0.5, 0.2]}}
@@ -159,6 +159,22 @@ def test_a_uniform_noise_mask_mixes_its_colour_over_every_pixel_by_its_alpha(tmp
         sim.device("r/cam").enable(16)
         sim.run(1)
         np.testing.assert_array_equal(rgb(sim.device("r/cam").image), expect)
+
+
+def test_a_one_texel_mask_is_a_uniform_mix_at_every_offset(tmp_path):
+    # the smallest mask: every bilinear corner is the one texel, so each image is the uniform mix whatever its offset
+    plain = sim_of({})
+    plain.device("r/cam").enable(16)
+    plain.run(1)
+    c = rgb(plain.device("r/cam").image)
+    texel = np.array([250, 10, 120, 77])
+    sim = sim_of({"noise_mask_url": _mask(tmp_path, "one.png", texel.reshape(1, 1, 4))}, tmp_path)
+    sim.device("r/cam").enable(16)
+    a = texel[3] / 255.0
+    for _ in range(4):
+        sim.run(1)
+        np.testing.assert_array_equal(rgb(sim.device("r/cam").image), to_byte((c / 255.0) * (1.0 - a)
+                                                                                + (texel[:3] / 255.0) * a))
 
 
 def test_a_checker_mask_is_read_bilinearly_at_the_offsets_the_camera_stream_draws(tmp_path):
@@ -350,3 +366,23 @@ def test_a_wbt_range_finder_keeps_its_motion_blur(tmp_path):
     with pytest.raises(ValueError, match="greater than or equal to 0"):
         wm.World.model_validate({"robots": [{"name": "r", "devices": [{"device": "RangeFinder", "name": "rf",
                                                                         "motion_blur": -5}]}]})
+
+
+@pytest.mark.parametrize("device", ["Camera", "RangeFinder"])
+@pytest.mark.parametrize(("value", "words"), [
+    ("nan", "column 71: number 'nan' is not finite"),
+    ("1e999", "column 71: number '1e999' is out of range"),
+    ("1e300", "the magnitude of 1e+300 exceeds the limit of 1e+09"),
+    ("4.9e-324", "5e-324 is too close to 0 (use 0, or a magnitude of at least 1e-30)"),
+    ("1e-310", "1e-310 is too close to 0"),
+    ("TRUE", "motionBlur: expected one number, got True"),
+])
+def test_a_hostile_motion_blur_is_one_line_naming_the_file_and_line(tmp_path, device, value, words):
+    # a denormal would make 0.005^(period/motionBlur) underflow silently, a huge one never change the image
+    world = tmp_path / "w.wbt"
+    world.write_text(f'#VRML_SIM R2023b utf8\nWorldInfo {{ basicTimeStep 16 }}\nRobot {{ children [ {device:<11} {{ '
+                     f'name "c" width 4 height 2 motionBlur {value} }} ] }}\n')
+    with pytest.raises(WorldError) as info:
+        load_world(world)
+    line = str(info.value)
+    assert line.startswith(f"{world}: line 3, column ") and words in line and "\n" not in line, line

@@ -274,3 +274,42 @@ def test_a_frame_that_cannot_be_rendered_ends_the_movie_in_one_line_and_the_worl
     assert lv.step(A, "boss", {"duration": 64})["time_ms"] == 64
     got = lv.ok(A, "/boss/robot/movie_frames")
     assert got["frames"] == [] and got["failed"] == "the frame at 32 ms could not be rendered: RuntimeError: no picture"
+
+
+class _FakeSupervisor:
+    """The client's view of a Supervisor: its calls packed as the connection packs them (msgpack), the
+    server's start answered, each call kept."""
+
+    def __init__(self) -> None:
+        import msgpack
+        self.name, self.calls, self.step_end_hooks, self.close_hooks = "boss", [], [], []
+        self.conn = self
+        self._pack = msgpack.packb
+
+    def call(self, service: str, args: dict | None = None) -> dict:
+        self._pack(args)
+        self.calls.append(service)
+        return {"step_ms": 32} if service.endswith("movie_start") else {"value": 0}
+
+
+@pytest.mark.parametrize(("filename", "width", "quality", "acceleration", "line"), [
+    ("a\0b.mp4", 160, 90, 1, "'filename' argument 'a\\x00b.mp4' holds a NUL byte."),
+    ("run.mp4", 1 << 70, 90, 1, "'width' argument (1180591620717411303424) is not a 32-bit whole number."),
+    ("run.mp4", 160, 90, 1 << 64, "'acceleration' argument (18446744073709551616) is not a 32-bit whole number."),
+    ("run.mp4", 160, -(1 << 64), 1, "'quality' argument (-18446744073709551616) must be between 1 and 100."),
+    ("run.mp4", 160, 90, 1 << 31, "'acceleration' argument (2147483648) is not a 32-bit whole number."),
+    (b"run.mp4", 160, 90, 1, None),
+])
+def test_a_filename_with_a_nul_or_a_number_past_a_c_int_is_one_line_and_asks_the_server_nothing(
+        tmp_path: Path, monkeypatch, capsys, filename, width, quality, acceleration, line) -> None:
+    from sensorium.client import wb_movie
+    fake = _FakeSupervisor()
+    monkeypatch.setattr(wb_movie, "_supervisor", lambda func: fake)
+    monkeypatch.setattr(wb_movie.shutil, "which", lambda name: "/bin/true")
+    monkeypatch.chdir(tmp_path)
+    wb_movie.wb_supervisor_movie_start_recording(filename, width, 120, 0, quality, acceleration, False)
+    err = capsys.readouterr().err
+    func = "wb_supervisor_movie_start_recording"
+    assert err == (f"Error: {func}() called with NULL or empty 'filename' argument.\n" if line is None
+                   else f"Error: {func}(): {line}\n")
+    assert fake.calls == [] and wb_movie.wb_supervisor_movie_get_status() == wb_movie.READY

@@ -186,6 +186,32 @@ def test_world_load_names_a_world_from_the_controllers_folder_inside_the_first_w
         launch.world_to_load("../../worlds/b.wbt", None, worlds)
 
 
+def test_world_load_refusals_stay_one_line_whatever_the_name_holds(tmp_path: Path) -> None:
+    """A Supervisor's worldLoad argument is any string: a newline, carriage return, tab or Unicode line
+    separator in it (or in a real file's name) is written as its escape in the refusal, never a second
+    line in `run`'s output; a symbolic link loop and a 4096-character name are one line too."""
+    worlds = tmp_path / "worlds"
+    worlds.mkdir()
+    folder = tmp_path / "controllers" / "boss"
+    folder.mkdir(parents=True)
+    (worlds / "a\nb.txt").write_text("")
+    (worlds / "loop1").symlink_to("loop2")
+    (worlds / "loop2").symlink_to("loop1")
+    refused = {
+        "../../worlds/a\nb.txt": f"{worlds}/a\\nb.txt is not a world file (.wbt; YAML or JSON: .yaml, .yml, .json)",
+        "../../worlds/gone\r\n[boss] fake.wbt": f"no world file {worlds}/gone\\r\\n[boss] fake.wbt",
+        "x\tq\u2028.wbt": f"{folder}/x\\tq\\u2028.wbt is outside {worlds}, the folder of the world `sensorium run` "
+                          "started with (a world from elsewhere would start another project's controllers)",
+    }
+    for name, why in refused.items():
+        with pytest.raises(LaunchError) as info:
+            launch.world_to_load(name, folder, worlds)
+        assert str(info.value) == why, name
+    for name in ("../../worlds/loop1", "../../worlds/" + "x" * 4083 + "\n"):
+        with pytest.raises(LaunchError) as info:
+            launch.world_to_load(name, folder, worlds)
+        assert str(info.value).isprintable(), (name[:20], str(info.value)[:200])
+
 # ---------------------------------------------------------------------- running a project
 
 def test_two_controllers_run_print_with_their_robot_and_end_at_until(tmp_path: Path) -> None:

@@ -208,3 +208,20 @@ def test_a_cpp_controller_reads_the_contact_points(tmp_path_factory):
     assert code == 0, err
     assert out == EXPECTED
     assert "Error: wb_supervisor_node_get_contact_points(): " in err and ROOT_LINE in err
+
+
+@pytest.mark.parametrize("node", [None, -1, True, 1.0, 1 << 31, 1 << 64, 1 << 70])
+def test_a_node_argument_that_is_no_id_is_one_line_and_asks_the_server_nothing(monkeypatch, capsys, node) -> None:
+    """Every node function's check (contact points, balance, resetPhysics among them): an id is a
+    non-negative 32-bit whole number; past 64 bits the request could not even be packed."""
+    from test_movie import _FakeSupervisor
+
+    from sensorium.client import wb_supervisor as ws
+    fake = _FakeSupervisor()
+    monkeypatch.setattr(ws, "_supervisor", lambda func: fake)
+    for func, call in (("wb_supervisor_node_get_contact_points", lambda: ws.wb_supervisor_node_get_contact_points(node)),
+                       ("wb_supervisor_node_get_static_balance", lambda: ws.wb_supervisor_node_get_static_balance(node)),
+                       ("wb_supervisor_node_reset_physics", lambda: ws.wb_supervisor_node_reset_physics(node))):
+        assert call() in ([], False, None)
+        assert capsys.readouterr().err == f"Error: {func}() called with a NULL or invalid 'node' argument.\n"
+    assert fake.calls == []

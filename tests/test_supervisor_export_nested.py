@@ -201,3 +201,29 @@ def test_a_node_in_a_proto_instances_field_exports_as_written_after_the_instance
     assert sv.node_pose(sim, post)["position"] == pytest.approx([-2.0, 0.0, 0.8], abs=1e-15)
     instance = _read(node_string(sim, holder))
     assert instance.fields["side"] == 0.5 and _same_tree(instance.fields["slot"][0], _as_written(WORLD, "POST"))
+
+
+def test_a_shape_a_supervisor_removed_is_left_out_of_the_text_and_of_a_saved_world(tmp_path):
+    # TOP out of TABLE's children (LEG stays, as written); LINK_SHAPE out of LINK's (TOOL stays); LINK's
+    # children then hold TOOL only, and a list a removal empties is Webots' default: not written
+    sim = _sim()
+    paint = _node(sim, "PAINT")
+    sv.remove_node(sim, _node(sim, "TOP"))
+    sv.remove_node(sim, _node(sim, "LINK_SHAPE"))
+    table = _read(node_string(sim, sv.find_node(sim, "TABLE")))
+    assert len(table.fields["children"]) == 1 and _same_tree(table.fields["children"][0], _as_written(WORLD, "LEG"))
+    link = _read(node_string(sim, _node(sim, "LINK")))
+    assert [c.def_name for c in link.fields["children"]] == ["TOOL"]
+    arm = _read(node_string(sim, _node(sim, "ARM")))
+    assert "LINK_SHAPE" not in node_string(sim, _node(sim, "ARM")) and arm.fields["name"] == "arm"
+    saved = _save(sim, tmp_path).read_text()
+    assert "DEF TOP" not in saved and "LINK_SHAPE" not in saved and "DEF LEG" in saved and "DEF TOOL" in saved
+    with pytest.raises(ValueError, match=rf"^node {paint.id} \(PBRAppearance 'PAINT'\) was removed$"):
+        sv.node_by_id(sim, paint.id)
+    # a solid whose only Shape was removed: its emptied children not written (Webots' default)
+    world = tmp_path / "one.wbt"
+    world.write_text(HEADER + "DEF ONE Solid {\n  translation 1 0 0\n  children [\n    DEF S Shape {\n      geometry "
+                     "Box {\n        size 1 1 1\n      }\n    }\n  ]\n  name \"one\"\n}\n")
+    one = _sim(world)
+    sv.remove_node(one, _node(one, "S"))
+    assert node_string(one, _node(one, "ONE")) == 'DEF ONE Solid {\n  translation 1 0 0\n  name "one"\n}'

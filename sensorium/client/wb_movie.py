@@ -226,8 +226,12 @@ def wb_supervisor_movie_start_recording(filename: str, width: int, height: int, 
     if rec.poll() in (RECORDING, SAVING):
         print(f"Error: {func}(): movie recording has already been started.", file=sys.stderr)
         return
-    if not filename or not isinstance(filename, str | os.PathLike):
+    name = os.fspath(filename) if isinstance(filename, str | os.PathLike) else None
+    if not name or not isinstance(name, str):
         print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
+        return
+    if "\0" in name:          # (ffmpeg's command line could not hold it)
+        print(f"Error: {func}(): 'filename' argument {name!r} holds a NUL byte.", file=sys.stderr)
         return
     if not _integer(width) or not _integer(height) or width <= 0 or height <= 0:
         print(f"Error: {func}(): 'width' and 'height' arguments must be postitive.", file=sys.stderr)
@@ -238,7 +242,11 @@ def wb_supervisor_movie_start_recording(filename: str, width: int, height: int, 
     if not _integer(acceleration) or acceleration < 1:
         print(f"Error: {func}(): 'acceleration' argument must be greater than or equal to 1.", file=sys.stderr)
         return
-    rec.start(func, os.fspath(filename), width, height, quality, acceleration, bool(caption))
+    for arg, value in (("width", width), ("height", height), ("acceleration", acceleration)):
+        if value >= 1 << 31:          # Webots' C ints (the request could not even hold one past 64 bits)
+            print(f"Error: {func}(): '{arg}' argument ({value!r}) is not a 32-bit whole number.", file=sys.stderr)
+            return
+    rec.start(func, name, width, height, quality, acceleration, bool(caption))
 
 
 def wb_supervisor_movie_stop_recording() -> None:

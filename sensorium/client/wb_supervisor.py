@@ -103,7 +103,7 @@ def _checked_node(node: Any, func: str) -> RobotClient | None:
     r = _supervisor(func)
     if r is None:
         return None
-    if node is None or isinstance(node, bool) or not isinstance(node, int) or node < 0:
+    if node is None or isinstance(node, bool) or not isinstance(node, int) or not 0 <= node < 1 << 31:   # (ids: int32)
         print(f"Error: {func}() called with a NULL or invalid 'node' argument.", file=sys.stderr)
         return None
     return r

@@ -248,9 +248,12 @@ def _nested_fields(sim: Any, owner: int | None) -> dict[int, dict[str, Any]]:
 
 
 def _writer(sim: Any, owner: int | None = None) -> Writer:
-    """A writer of top-level node ``owner`` (None: every one) writing the nested nodes inside as they are now."""
+    """A writer of top-level node ``owner`` (None: every one) writing the nested nodes inside as they are now (the
+    Shapes a Supervisor removed left out)."""
     changed = _nested_fields(sim, owner)
-    return Writer(lambda written: changed.get(id(written)))
+    table = sv._table(sim)
+    removed = (_found(sim, table, n) for n in table.removed_shapes.values() if owner is None or n.owner == owner)
+    return Writer(lambda written: changed.get(id(written)), frozenset(id(w) for w in removed if w is not None))
 
 
 def _became(sim: Any) -> Counter[int]:

@@ -101,6 +101,8 @@ class Table:
                                                 # it is no node here (getFromProtoDef: :func:`inner_defs`)
     added: dict[int, Nested] = dataclasses.field(default_factory=dict)  # the nodes of imported and rebuilt solids now there
     forgotten: set[int] = dataclasses.field(default_factory=set)        # world nodes whose solid was built again (removed)
+    removed_shapes: dict[int, Nested] = dataclasses.field(default_factory=dict)  # Shapes a Supervisor removed, and
+                                                # the nodes inside them (export leaves them out)
     segments: dict[int, str] = dataclasses.field(default_factory=dict)  # owner id -> its solid's name, for those in ``added``
     end: int = FIRST_ID                         # the next id to give (ids are never reused)
     imports_seen: int = 0                       # how many of the simulation's imports were looked at
@@ -432,6 +434,8 @@ def drop(table: Table, owner: int) -> None:
     if table.inner is not None:
         table.inner.pop(owner, None)
     table.segments.pop(owner, None)
+    for node_id in [k for k, n in table.removed_shapes.items() if n.owner == owner]:
+        del table.removed_shapes[node_id]
 
 
 def drop_shape(table: Table, shape: int) -> None:
@@ -445,6 +449,10 @@ def drop_shape(table: Table, shape: int) -> None:
             todo.append(c.id)
     n = table.get(shape)
     assert n is not None
+    for node_id in gone:
+        inner = table.get(node_id)
+        if inner is not None:
+            table.removed_shapes[node_id] = inner
     table.by_parent[n.parent] = tuple(c for c in table.by_parent.get(n.parent, ()) if c.id != shape)
     table.by_owner[n.owner] = tuple(c for c in table.by_owner.get(n.owner, ()) if c.id not in gone)
     for node_id in gone:

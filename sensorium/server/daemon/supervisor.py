@@ -407,6 +407,8 @@ def node_by_id(sim: Any, node: int) -> Node:
             raise ValueError(f"no node with id {node} ({_known_ids(sim)})")
         found = _nested_node(inner)
         if _removed(sim, found):
+            if node in table.removed_shapes:    # (by itself: remove_node)
+                raise ValueError(f"node {node} ({found.type} {found.def_name or found.name!r}) was removed")
             how = " when a PROTO field set built it again" if inner.owner_key in sim.scene.solid_poses else ""
             raise ValueError(f"node {node} ({found.type} {found.name!r}) was removed with {inner.owner_key!r}{how}")
         return found

@@ -39,10 +39,13 @@ def string(s: str) -> str:
 class Writer:
     """Nodes to text; a DEF node met again in the same writer is written ``USE NAME`` (Webots' rule).
     ``fields_of(node)``: the values to write in place of a node's own fields (None: its own), for every node
-    written without ``fields`` given (the nodes inside one too)."""
+    written without ``fields`` given (the nodes inside one too). ``left_out``: ids of nodes not written in a
+    list of nodes (a Shape a Supervisor removed)."""
 
-    def __init__(self, fields_of: Callable[[Node], dict[str, Any] | None] | None = None) -> None:
+    def __init__(self, fields_of: Callable[[Node], dict[str, Any] | None] | None = None,
+                 left_out: frozenset[int] = frozenset()) -> None:
         self.fields_of = fields_of
+        self.left_out = left_out
         self.written: set[int] = set()        # ids of the DEF nodes written so far
         self.written_nodes: set[int] = set()  # ids of the top-level nodes written so far (depth 0)
 
@@ -61,6 +64,8 @@ class Writer:
         lines = [head + " {"]
         pad = INDENT * (depth + 1)
         for name, value in (n.fields if fields is None else fields).items():
+            if isinstance(value, list) and value and all(id(x) in self.left_out for x in value):
+                continue                          # emptied: Webots' default, not written
             width = WIDTHS.get(f"{n.type}.{name}", WIDTHS.get(name))
             if width and isinstance(value, list) and value and all(_is_number(x) for x in value):
                 value = [tuple(value[k:k + width]) for k in range(0, len(value), width)]
@@ -80,6 +85,7 @@ class Writer:
         if isinstance(v, tuple):                  # an SF vector, rotation or colour: its numbers on one line
             return " ".join(number(x) for x in v)
         if isinstance(v, list):
+            v = [x for x in v if id(x) not in self.left_out]
             if not v:
                 return "[]"
             pad = INDENT * (depth + 1)
