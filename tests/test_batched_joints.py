@@ -1,9 +1,12 @@
 """Joint motors in the batched simulation (batched_joints.py): every copy's joints move by Webots'
-kinematic motor control and the distance sensors and fixed lidars riding them cast from each copy's
-link, bit for bit as the copy's own Simulation (a pan hinge carrying a distance sensor and a lidar on
-a driving robot, a slider carrying an infra-red sensor and a nested tilt hinge carrying another,
+kinematic motor control and the distance sensors, light sensors and fixed lidars riding them cast from
+each copy's link, bit for bit as the copy's own Simulation (a pan hinge carrying a distance sensor, a
+lidar and a light sensor on
+a driving robot, a slider carrying an infra-red sensor and a nested tilt hinge carrying another and a
+light sensor,
 coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
-copy). Closed form: a pan turned a quarter makes its sensor read the side wall. What is not
+copy). Closed form: a pan turned a quarter makes its sensor read the side wall, and its light
+sensor face a lamp. What is not
 simulated is refused in one line (a link's shapes, a camera on a joint, a rotating lidar on one)."""
 
 from __future__ import annotations
@@ -44,7 +47,10 @@ def pan_robot() -> dict:
                         {"device": "Lidar", "name": "pan lidar", "on_joint": "pan motor",
                          "pose": {"translation": [0.1, 0.0, 0.15]}, "horizontal_resolution": 32,
                          "field_of_view": 1.5, "number_of_layers": 3, "vertical_field_of_view": 0.2,
-                         "min_range": 0.05, "max_range": 3.0, "noise": 0.01}]}
+                         "min_range": 0.05, "max_range": 3.0, "noise": 0.01},
+                        {"device": "LightSensor", "name": "pan ls", "on_joint": "pan motor", "occlusion": True,
+                         "pose": {"translation": [0.1, 0.02, 0.12], "rotation": [0, 0, 1, 0.4]},
+                         "lookup_table": [[0, 0, 0], [10, 1000, 0.05]]}]}
 
 
 def lift_robot() -> dict:
@@ -64,6 +70,9 @@ def lift_robot() -> dict:
                         {"device": "PositionSensor", "name": "b enc", "motor": "arm::b", "resolution": 0.01},
                         laser("lift ir", "lift motor", [0.11, 0.0, 0.1], kind="infra-red"),
                         laser("tilt ds", "tilt", [0.11, 0.0, 0.2]),
+                        {"device": "LightSensor", "name": "tilt ls", "on_joint": "tilt", "occlusion": True,
+                         "pose": {"translation": [0.0, 0.11, 0.2], "rotation": [0, 1, 0, -0.5]},
+                         "lookup_table": [[0, 0, 0], [10, 1000, 0]]},
                         laser("a ds", "arm::a", [0.0, 0.11, 0.05]),
                         laser("b ds", "arm::b", [0.0, -0.11, 0.05]),
                         laser("fixed ds", "lift motor", [-0.11, 0.0, 0.1])]}
@@ -74,6 +83,8 @@ def jointed_world(seed: int = 3):
                         "solids": [wall("north", 0, 1.2, 2.6, 0.2), wall("south", 0, -1.2, 2.6, 0.2),
                                    wall("east", 1.2, 0, 0.2, 2.2), wall("west", -1.2, 0, 0.2, 2.2),
                                    wall("block", 0.3, 0.5, 0.3, 0.3)],
+                        "lights": [{"type": "PointLight", "location": [0.1, 0.2, 0.6], "intensity": 1.5,
+                                    "attenuation": [0, 0, 1]}],
                         "robots": [pan_robot(), lift_robot()]})
 
 
@@ -99,14 +110,15 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
     """Three copies and a Simulation per copy (world seeds 3, 4, 5), 300 steps; every 25 steps each
     copy's motors get new random commands and its wheels new speeds; copy 1 reset at step 160 against
     a fresh Simulation: every joint position, every encoder, distance sensor and lidar image and every
-    robot pose the same bits every step."""
+    robot pose the same bits every step (light sensors too, their occlusion rays cast from each
+    copy's link)."""
     w = jointed_world()
     seeds = (3, 4, 5)
     n = len(seeds)
     batched = BatchedSimulation(w, n, precision=precision)
     batched.reset(np.arange(n), list(seeds))
-    devices = {"pan": ["pan enc", "pan ds", "pan lidar"],
-               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "a ds", "b ds", "fixed ds"]}
+    devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls"],
+               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "tilt ls", "a ds", "b ds", "fixed ds"]}
     for robot, names in devices.items():
         for name in names:
             batched.enable(batched.device(robot, name), 32)
@@ -166,6 +178,8 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
     assert moved == {"pan motor", "lift motor", "tilt", "arm::a", "arm::b"}
     # the joints' sensors did read different things in different copies (each its own link)
     assert len({float(v) for v in batched.value(batched.device("pan", "pan ds"))}) == n
+    assert len({float(v) for v in batched.value(batched.device("pan", "pan ls"))}) == n
+    assert len({float(v) for v in batched.value(batched.device("lift", "tilt ls"))}) == n
 
 
 def test_a_pan_turned_a_quarter_reads_the_side_wall_in_that_copy_only():
@@ -194,12 +208,34 @@ lookup table gives 1000 per metre)."""
     assert batched.value(ref) == pytest.approx([900.0, 900.0], abs=1e-6)
 
 
+def test_a_light_sensor_on_a_pan_faces_the_lamp_in_the_copy_that_turned_it():
+    """A light sensor 0.1 m ahead of a pan axis at the origin, looking along +x; a point light
+    (intensity 0.8, attenuation 0 0 1, no ambient) 1 m to its left at its height. Copy 0 keeps the
+    lamp behind the sensor's plane (cos < 0: 0); copy 1 turns the pan a quarter, the sensor then
+    sits at (0, 0.1) facing the lamp 0.9 m away: 0.8 / 0.81 through the table (x 100)."""
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": False},
+                     "lights": [{"type": "PointLight", "location": [0, 1.0, 0.3], "intensity": 0.8,
+                                 "attenuation": [0, 0, 1]}],
+                     "robots": [{"name": "r", "devices": [
+                         {"device": "RotationalMotor", "name": "pan", "axis": [0, 0, 1], "max_velocity": 100.0,
+                          "max_torque": 1e5},
+                         {"device": "LightSensor", "name": "ls", "on_joint": "pan", "pose": {"translation": [0.1, 0, 0.3]},
+                          "lookup_table": [[0, 0, 0], [10, 1000, 0]]}]}]})
+    batched = BatchedSimulation(w, 2)
+    ref = batched.device("r", "ls")
+    batched.enable(ref, STEP)
+    batched.joints.command(0, "pan", position=math.pi / 2, copies=[1])
+    batched.step()
+    assert batched.value(ref) == pytest.approx([0.0, 100.0 * 0.8 / 0.81], abs=1e-9)
+
+
 @pytest.mark.parametrize("change, message", [
     (lambda r: r.setdefault("shapes", []).append(
         {"name": "cup", "on_joint": "lift motor", "geometry": {"type": "box", "size": [0.05, 0.05, 0.05]}}),
      "robot 'lift': shape 'cup' rides joint 'lift motor'; the batched simulation moves no link's shapes"),
     (lambda r: r["devices"].append({"device": "Camera", "name": "cam", "on_joint": "tilt", "width": 4, "height": 4}),
-     "robot 'lift': Camera 'cam' rides joint 'tilt'; the batched simulation moves distance sensors and fixed lidars"),
+     "robot 'lift': Camera 'cam' rides joint 'tilt'; the batched simulation moves distance sensors, light sensors "
+     "and fixed lidars"),
     (lambda r: r["devices"].append({"device": "Lidar", "name": "spin", "on_joint": "tilt", "type": "rotating",
                                     "horizontal_resolution": 8, "field_of_view": 6.28}),
      "robot 'lift': rotating lidar 'spin' rides joint 'tilt'; the batched simulation moves fixed lidars on joints"),

@@ -16,7 +16,8 @@ arithmetic (Pose.from_axis_angle on libm's cosine and sine, Pose.compose's stack
 device riding a moved link gets that copy's local pose, ``displacement ∘ mount`` (the single device's
 ``move_with``), in :attr:`BatchedJoints.local_rot` / ``local_pos``. (Measured: 256 copies, five joints
 on two robots, per-copy Links objects took 28 ms a step; the arrays take ~1 ms.) The batched
-simulation casts the rays of the distance sensors and fixed lidars riding joints from those poses;
+simulation casts the rays of the distance sensors and fixed lidars riding joints from those poses, and
+places the light sensors riding them there (their normals, their occlusion rays);
 it refuses what else rides a joint (batched.py's ``_check_supported``): a link's shapes or lights
 (the copies' robots are one rigid template body each) and other devices.
 """
@@ -36,9 +37,9 @@ __all__ = ["BatchedJoints", "RIDING_KINDS", "joint_motors"]
 _POSITION_THRESHOLD = 1e-6       # joints.py's (Webots' TARGET_POSITION_THRESHOLD)
 _VELOCITY_THRESHOLD = 1e-6
 
-RIDING_KINDS = ("DistanceSensor", "Lidar", "PositionSensor", "RotationalMotor", "LinearMotor")
-"""What may ride a joint (``on_joint``) in the batched simulation: the sensors whose rays start
-from each copy's link, encoders (which read a motor, wherever they sit) and the nested joints'
+RIDING_KINDS = ("DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "RotationalMotor", "LinearMotor")
+"""What may ride a joint (``on_joint``) in the batched simulation: the sensors whose rays (and a
+light sensor's normal) start from each copy's link, encoders (which read a motor, wherever they sit) and the nested joints'
 motors."""
 
 
