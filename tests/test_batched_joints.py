@@ -1,13 +1,13 @@
 """Joint motors in the batched simulation (batched_joints.py): every copy's joints move by Webots'
-kinematic motor control and the distance sensors, light sensors and fixed lidars riding them cast from
-each copy's link, bit for bit as the copy's own Simulation (a pan hinge carrying a distance sensor, a
-lidar and a light sensor on
-a driving robot, a slider carrying an infra-red sensor and a nested tilt hinge carrying another and a
-light sensor,
+kinematic motor control and the distance sensors, light sensors, cameras (images, recognition,
+segmentation), range finders and fixed lidars riding them cast from each copy's link, bit for bit as the
+copy's own Simulation (a pan hinge carrying a distance sensor, a lidar, a light sensor and a camera on
+a driving robot, a slider carrying an infra-red sensor and a nested tilt hinge carrying another, a
+light sensor, a range finder and a camera,
 coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
 copy). Closed form: a pan turned a quarter makes its sensor read the side wall, and its light
-sensor face a lamp. What is not
-simulated is refused in one line (a link's shapes, a camera on a joint, a rotating lidar on one)."""
+sensor face a lamp; a range finder turned back on its pan sees its own robot. What is not
+simulated is refused in one line (a link's shapes, a GPS on a joint, a rotating lidar on one)."""
 
 from __future__ import annotations
 
@@ -23,9 +23,9 @@ from sensorium.server.world.loader import parse_world
 STEP = 16
 
 
-def wall(name: str, x: float, y: float, sx: float, sy: float) -> dict:
+def wall(name: str, x: float, y: float, sx: float, sy: float, colour=(0.8, 0.5, 0.2)) -> dict:
     return {"name": name, "pose": {"translation": [x, y, 0.5]}, "geometry": {"type": "box", "size": [sx, sy, 1.0]},
-            "appearance": {"base_color": [0.8, 0.5, 0.2]}}
+            "appearance": {"base_color": list(colour)}, "recognition_colors": [list(colour)]}
 
 
 def laser(name: str, on_joint: str, translation, kind: str = "laser", noise: float = 0.0) -> dict:
@@ -50,7 +50,10 @@ def pan_robot() -> dict:
                          "min_range": 0.05, "max_range": 3.0, "noise": 0.01},
                         {"device": "LightSensor", "name": "pan ls", "on_joint": "pan motor", "occlusion": True,
                          "pose": {"translation": [0.1, 0.02, 0.12], "rotation": [0, 0, 1, 0.4]},
-                         "lookup_table": [[0, 0, 0], [10, 1000, 0.05]]}]}
+                         "lookup_table": [[0, 0, 0], [10, 1000, 0.05]]},
+                        {"device": "Camera", "name": "pan cam", "on_joint": "pan motor", "width": 12, "height": 8,
+                         "pose": {"translation": [0.11, 0.0, 0.14]}, "field_of_view": 1.2, "noise": 0.02,
+                         "recognition": {"occlusion": 1, "segmentation": True}}]}
 
 
 def lift_robot() -> dict:
@@ -73,6 +76,12 @@ def lift_robot() -> dict:
                         {"device": "LightSensor", "name": "tilt ls", "on_joint": "tilt", "occlusion": True,
                          "pose": {"translation": [0.0, 0.11, 0.2], "rotation": [0, 1, 0, -0.5]},
                          "lookup_table": [[0, 0, 0], [10, 1000, 0]]},
+                        {"device": "RangeFinder", "name": "tilt rf", "on_joint": "tilt", "width": 10, "height": 6,
+                         "pose": {"translation": [0.11, 0.0, 0.24]}, "field_of_view": 1.0, "max_range": 3.0,
+                         "noise": 0.01},
+                        {"device": "Camera", "name": "tilt cam", "on_joint": "tilt", "width": 8, "height": 6,
+                         "pose": {"translation": [0.11, 0.02, 0.24], "rotation": [0, 1, 0, 0.2]},
+                         "field_of_view": 0.9, "recognition": {"occlusion": 2}},
                         laser("a ds", "arm::a", [0.0, 0.11, 0.05]),
                         laser("b ds", "arm::b", [0.0, -0.11, 0.05]),
                         laser("fixed ds", "lift motor", [-0.11, 0.0, 0.1])]}
@@ -82,7 +91,8 @@ def jointed_world(seed: int = 3):
     return parse_world({"world_info": {"basic_time_step": STEP, "contact": True, "random_seed": seed},
                         "solids": [wall("north", 0, 1.2, 2.6, 0.2), wall("south", 0, -1.2, 2.6, 0.2),
                                    wall("east", 1.2, 0, 0.2, 2.2), wall("west", -1.2, 0, 0.2, 2.2),
-                                   wall("block", 0.3, 0.5, 0.3, 0.3)],
+                                   wall("block", 0.3, 0.5, 0.3, 0.3, (0.2, 0.4, 0.9)),
+                                   wall("post", -0.6, -0.6, 0.15, 0.15, (0.9, 0.9, 0.1))],
                         "lights": [{"type": "PointLight", "location": [0.1, 0.2, 0.6], "intensity": 1.5,
                                     "attenuation": [0, 0, 1]}],
                         "robots": [pan_robot(), lift_robot()]})
@@ -117,20 +127,33 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
     n = len(seeds)
     batched = BatchedSimulation(w, n, precision=precision)
     batched.reset(np.arange(n), list(seeds))
-    devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls"],
-               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "tilt ls", "a ds", "b ds", "fixed ds"]}
+
+    def recognise(copies: list[int]) -> None:
+        for (robot, name), segment in cameras.items():
+            batched.recognition_enable(batched.device(robot, name), 32, copies=copies)
+            batched.enable_segmentation(batched.device(robot, name), segment, copies=copies)
+
+    devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls", "pan cam"],
+               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "tilt ls", "tilt rf", "tilt cam", "a ds", "b ds",
+                        "fixed ds"]}
+    cameras = {("pan", "pan cam"): True, ("lift", "tilt cam"): False}     # recognition; segmentation
     for robot, names in devices.items():
         for name in names:
             batched.enable(batched.device(robot, name), 32)
+    recognise(list(range(n)))
     rng = np.random.default_rng(11)
     pan = batched.slot("pan")
     moved = set()
+    seen: set[int] = set()
     def single(seed: int) -> Simulation:
         sim = Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
             update={"random_seed": seed})}), precision=precision)
         for robot, names in devices.items():
             for name in names:
                 sim.device(f"{robot}/{name}").enable(32)
+        for (robot, name), segment in cameras.items():
+            sim.device(f"{robot}/{name}").recognition_enable(32)
+            sim.device(f"{robot}/{name}").enable_segmentation(segment)
         return sim
 
     singles = [single(s) for s in seeds]
@@ -140,6 +163,7 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
             for robot, names in devices.items():
                 for name in names:
                     batched.enable(batched.device(robot, name), 32, copies=[1])
+            recognise([1])
             singles[1] = single(seeds[1])
         if t % 25 == 0:
             for c in range(n):
@@ -169,8 +193,14 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
                 for name in devices[robot]:
                     ref = batched.device(robot, name)
                     dev = s.device(f"{robot}/{name}")
-                    if name.endswith("lidar"):
+                    if name.endswith("lidar") or name.endswith("rf"):
                         assert batched.range_image(ref)[c].tobytes() == dev.range_image.tobytes(), (t, c, name)
+                    elif name.endswith("cam"):
+                        assert batched.image(ref)[c].tobytes() == dev.image.tobytes(), (t, c, name)
+                        assert batched.recognition_objects(ref, c) == dev.objects, (t, c, name)
+                        if cameras[(robot, name)]:
+                            assert batched.segmentation_image(ref)[c].tobytes() == dev.segmentation_image.tobytes()
+                        seen |= {o.id for o in dev.objects}
                     else:
                         got = batched.value(ref)[c]
                         assert np.float64(got).tobytes() == np.float64(dev.value).tobytes(), (t, c, name, got,
@@ -180,6 +210,11 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
     assert len({float(v) for v in batched.value(batched.device("pan", "pan ds"))}) == n
     assert len({float(v) for v in batched.value(batched.device("pan", "pan ls"))}) == n
     assert len({float(v) for v in batched.value(batched.device("lift", "tilt ls"))}) == n
+    for name in ("pan cam", "tilt rf"):
+        ref = batched.device("pan" if name == "pan cam" else "lift", name)
+        got = batched.image(ref) if name == "pan cam" else batched.range_image(ref)
+        assert len({got[c].tobytes() for c in range(n)}) == n, name
+    assert len(seen) >= 2       # the cameras recognised walls
 
 
 def test_a_pan_turned_a_quarter_reads_the_side_wall_in_that_copy_only():
@@ -229,17 +264,40 @@ def test_a_light_sensor_on_a_pan_faces_the_lamp_in_the_copy_that_turned_it():
     assert batched.value(ref) == pytest.approx([0.0, 100.0 * 0.8 / 0.81], abs=1e-9)
 
 
+def test_a_range_finder_turned_back_on_its_pan_sees_its_own_robot():
+    """A one-pixel range finder 0.4 m ahead of a robot whose body is a 0.2 m box, on a pan hinge
+    through (0.3, 0, 0), looking along +x at a wall whose near face is at x = 1: 0.6 m. Copy 1 turns
+    the pan half a turn: the device sits at (0.2, 0) looking back along -x and sees its own robot's
+    face at x = 0.1 (0.1 m), not the wall behind it at x = -1 (a Webots range finder sees its robot;
+    its rays turn in the body frame, so none may skip the robot)."""
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": False},
+                     "solids": [wall("front", 1.05, 0, 0.1, 8), wall("back", -1.05, 0, 0.1, 8)],
+                     "robots": [{"name": "r", "body": {"geometry": {"type": "box", "size": [0.2, 0.2, 0.6]}},
+                                 "devices": [
+                         {"device": "RotationalMotor", "name": "pan", "axis": [0, 0, 1], "anchor": [0.3, 0, 0],
+                          "max_velocity": 100.0, "max_torque": 1e5},
+                         {"device": "RangeFinder", "name": "rf", "on_joint": "pan", "width": 1, "height": 1,
+                          "field_of_view": 0.1, "max_range": 3.0, "pose": {"translation": [0.4, 0, 0.1]}}]}]})
+    batched = BatchedSimulation(w, 2)
+    ref = batched.device("r", "rf")
+    batched.enable(ref, STEP)
+    batched.joints.command(0, "pan", position=math.pi, copies=[1])
+    batched.run(3)
+    assert batched.joints.position[:, 0].tolist() == [0.0, math.pi]
+    assert batched.range_image(ref)[:, 0, 0] == pytest.approx([0.6, 0.1], abs=1e-6)
+
+
 @pytest.mark.parametrize("change, message", [
     (lambda r: r.setdefault("shapes", []).append(
         {"name": "cup", "on_joint": "lift motor", "geometry": {"type": "box", "size": [0.05, 0.05, 0.05]}}),
      "robot 'lift': shape 'cup' rides joint 'lift motor'; the batched simulation moves no link's shapes"),
-    (lambda r: r["devices"].append({"device": "Camera", "name": "cam", "on_joint": "tilt", "width": 4, "height": 4}),
-     "robot 'lift': Camera 'cam' rides joint 'tilt'; the batched simulation moves distance sensors, light sensors "
-     "and fixed lidars"),
+    (lambda r: r["devices"].append({"device": "GPS", "name": "gps", "on_joint": "tilt"}),
+     "robot 'lift': GPS 'gps' rides joint 'tilt'; the batched simulation moves distance sensors, light sensors, "
+     "cameras, range finders and fixed lidars on joints only"),
     (lambda r: r["devices"].append({"device": "Lidar", "name": "spin", "on_joint": "tilt", "type": "rotating",
                                     "horizontal_resolution": 8, "field_of_view": 6.28}),
      "robot 'lift': rotating lidar 'spin' rides joint 'tilt'; the batched simulation moves fixed lidars on joints"),
-], ids=["link shape", "camera", "rotating lidar"])
+], ids=["link shape", "gps", "rotating lidar"])
 def test_what_rides_a_joint_and_is_not_simulated_is_refused_in_one_line(change, message):
     lift = lift_robot()
     change(lift)

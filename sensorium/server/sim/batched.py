@@ -44,9 +44,10 @@ path's operations); in a world with car-like, mecanum or omni-wheel robots those
 drive and the two-wheel robots' wheels and moves are C passes within it.
 
 Joint motors (every motor that is no drive's wheel) move per copy by :mod:`~sensorium.server.sim.batched_joints`
-(``sim.joints.command``), before the drives as in Simulation.step; the distance sensors, light sensors
-and fixed lidars riding them cast from each copy's link. Steered-wheel robots (``steered_drive``) are driven by
-:mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``) at each copy's steering joints.
+(``sim.joints.command``), before the drives as in Simulation.step; the distance sensors, light sensors,
+cameras, range finders and fixed lidars riding them cast from each copy's link. Steered-wheel robots
+(``steered_drive``) are driven by :mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``)
+at each copy's steering joints.
 A link's shapes or lights, other devices on a joint, rotating lidars on one, steered drives with free
 wheels and belts are refused (BatchedError, one line).
 
@@ -448,8 +449,8 @@ class BatchedSimulation:
                     continue
                 if d.device not in batched_joints.RIDING_KINDS:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
-                                       f"{joint!r}; the batched simulation moves distance sensors, light sensors "
-                                       "and fixed lidars on joints only (use Simulation)")
+                                       f"{joint!r}; the batched simulation moves distance sensors, light sensors, "
+                                       "cameras, range finders and fixed lidars on joints only (use Simulation)")
                 if d.device == "Lidar" and d.type == "rotating":    # batched_lidar.py's heads turn on the body
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: rotating lidar {d.name!r} rides joint "
                                        f"{joint!r}; the batched simulation moves fixed lidars on joints only "
@@ -498,7 +499,7 @@ class BatchedSimulation:
                 dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
                                         world_seed=0, clock=lambda: 0,
                                         own_shapes=self._own_shapes.get((slot, d.name), frozenset()))
-                riding = dev.on_joint is not None and d.device in ("DistanceSensor", "Lidar", "LightSensor")
+                riding = dev.on_joint is not None and d.device in batched_joints.PLACED_KINDS
                 if riding:
                     # on a link without shapes (batched.py refuses links with shapes): its rays are
                     # mounted on no body, as the single simulation's (Scene.device_body is None), and a

@@ -32,12 +32,15 @@ from sensorium.server.sim.joints import Links
 from sensorium.server.sim.simulation import couple, joint_motor
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["BatchedJoints", "RIDING_KINDS", "joint_motors"]
+__all__ = ["BatchedJoints", "PLACED_KINDS", "RIDING_KINDS", "joint_motors"]
 
 _POSITION_THRESHOLD = 1e-6       # joints.py's (Webots' TARGET_POSITION_THRESHOLD)
 _VELOCITY_THRESHOLD = 1e-6
 
-RIDING_KINDS = ("DistanceSensor", "LightSensor", "Lidar", "PositionSensor", "RotationalMotor", "LinearMotor")
+PLACED_KINDS = ("DistanceSensor", "LightSensor", "Lidar", "RangeFinder", "Camera")
+"""The devices riding a joint that the batched simulation places per copy (their local poses here)."""
+
+RIDING_KINDS = (*PLACED_KINDS, "PositionSensor", "RotationalMotor", "LinearMotor")
 """What may ride a joint (``on_joint``) in the batched simulation: the sensors whose rays (and a
 light sensor's normal) start from each copy's link, encoders (which read a motor, wherever they sit) and the nested joints'
 motors."""
