@@ -7,7 +7,7 @@ light sensor, a range finder and a camera,
 coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
 copy). Closed form: a pan turned a quarter makes its sensor read the side wall, and its light
 sensor face a lamp; a range finder turned back on its pan sees its own robot. What is not
-simulated is refused in one line (a link's shapes, a GPS on a joint, a rotating lidar on one)."""
+simulated is refused in one line (a link's shapes, a gyro on a joint, a rotating lidar on one)."""
 
 from __future__ import annotations
 
@@ -53,7 +53,11 @@ def pan_robot() -> dict:
                          "lookup_table": [[0, 0, 0], [10, 1000, 0.05]]},
                         {"device": "Camera", "name": "pan cam", "on_joint": "pan motor", "width": 12, "height": 8,
                          "pose": {"translation": [0.11, 0.0, 0.14]}, "field_of_view": 1.2, "noise": 0.02,
-                         "recognition": {"occlusion": 1, "segmentation": True}}]}
+                         "recognition": {"occlusion": 1, "segmentation": True}},
+                        {"device": "GPS", "name": "pan gps", "on_joint": "pan motor", "accuracy": 0.01,
+                         "noise_correlation": 0.5, "speed_noise": 0.02, "pose": {"translation": [0.12, 0.03, 0.1]}},
+                        {"device": "Compass", "name": "pan compass", "on_joint": "pan motor",
+                         "pose": {"rotation": [1, 0, 0, 0.3]}}]}
 
 
 def lift_robot() -> dict:
@@ -82,6 +86,10 @@ def lift_robot() -> dict:
                         {"device": "Camera", "name": "tilt cam", "on_joint": "tilt", "width": 8, "height": 6,
                          "pose": {"translation": [0.11, 0.02, 0.24], "rotation": [0, 1, 0, 0.2]},
                          "field_of_view": 0.9, "recognition": {"occlusion": 2}},
+                        {"device": "InertialUnit", "name": "tilt imu", "on_joint": "tilt", "noise": 0.001,
+                         "pose": {"translation": [0.05, 0.0, 0.25], "rotation": [0, 0, 1, 0.7]}},
+                        {"device": "Altimeter", "name": "lift alt", "on_joint": "lift motor", "accuracy": 0.005,
+                         "pose": {"translation": [0.0, 0.05, 0.12]}},
                         laser("a ds", "arm::a", [0.0, 0.11, 0.05]),
                         laser("b ds", "arm::b", [0.0, -0.11, 0.05]),
                         laser("fixed ds", "lift motor", [-0.11, 0.0, 0.1])]}
@@ -133,9 +141,9 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
             batched.recognition_enable(batched.device(robot, name), 32, copies=copies)
             batched.enable_segmentation(batched.device(robot, name), segment, copies=copies)
 
-    devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls", "pan cam"],
-               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "tilt ls", "tilt rf", "tilt cam", "a ds", "b ds",
-                        "fixed ds"]}
+    devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls", "pan cam", "pan gps", "pan compass"],
+               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "tilt ls", "tilt rf", "tilt cam", "tilt imu",
+                        "lift alt", "a ds", "b ds", "fixed ds"]}
     cameras = {("pan", "pan cam"): True, ("lift", "tilt cam"): False}     # recognition; segmentation
     for robot, names in devices.items():
         for name in names:
@@ -201,6 +209,15 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
                         if cameras[(robot, name)]:
                             assert batched.segmentation_image(ref)[c].tobytes() == dev.segmentation_image.tobytes()
                         seen |= {o.id for o in dev.objects}
+                    elif ref.kind in ("GPS", "Compass", "InertialUnit"):
+                        want = dev.roll_pitch_yaw if ref.kind == "InertialUnit" else dev.values
+                        assert batched.value(ref)[c].tobytes() == np.asarray(want).tobytes(), (t, c, name)
+                        if ref.kind == "GPS":
+                            for what in ("speed", "speed_vector"):
+                                want = np.float64(getattr(dev, what)) if what == "speed" else getattr(dev, what)
+                                assert batched.reading(ref, what)[c].tobytes() == np.asarray(want).tobytes()
+                        if ref.kind == "InertialUnit":
+                            assert batched.reading(ref, "quaternion")[c].tobytes() == dev.quaternion.tobytes()
                     else:
                         got = batched.value(ref)[c]
                         assert np.float64(got).tobytes() == np.float64(dev.value).tobytes(), (t, c, name, got,
@@ -215,6 +232,9 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
         got = batched.image(ref) if name == "pan cam" else batched.range_image(ref)
         assert len({got[c].tobytes() for c in range(n)}) == n, name
     assert len(seen) >= 2       # the cameras recognised walls
+    for name in ("tilt imu", "lift alt"):       # the lift robot never drives: its joints alone tell copies apart
+        got = batched.value(batched.device("lift", name))
+        assert len({got[c].tobytes() for c in range(n)}) == n, name
 
 
 def test_a_pan_turned_a_quarter_reads_the_side_wall_in_that_copy_only():
@@ -291,13 +311,13 @@ def test_a_range_finder_turned_back_on_its_pan_sees_its_own_robot():
     (lambda r: r.setdefault("shapes", []).append(
         {"name": "cup", "on_joint": "lift motor", "geometry": {"type": "box", "size": [0.05, 0.05, 0.05]}}),
      "robot 'lift': shape 'cup' rides joint 'lift motor'; the batched simulation moves no link's shapes"),
-    (lambda r: r["devices"].append({"device": "GPS", "name": "gps", "on_joint": "tilt"}),
-     "robot 'lift': GPS 'gps' rides joint 'tilt'; the batched simulation moves distance sensors, light sensors, "
-     "cameras, range finders and fixed lidars on joints only"),
+    (lambda r: r["devices"].append({"device": "Gyro", "name": "gyro", "on_joint": "tilt"}),
+     "robot 'lift': Gyro 'gyro' rides joint 'tilt'; the batched simulation moves distance sensors, light sensors, "
+     "cameras, range finders, fixed lidars, GPS, compasses, inertial units and altimeters on joints only"),
     (lambda r: r["devices"].append({"device": "Lidar", "name": "spin", "on_joint": "tilt", "type": "rotating",
                                     "horizontal_resolution": 8, "field_of_view": 6.28}),
      "robot 'lift': rotating lidar 'spin' rides joint 'tilt'; the batched simulation moves fixed lidars on joints"),
-], ids=["link shape", "gps", "rotating lidar"])
+], ids=["link shape", "gyro", "rotating lidar"])
 def test_what_rides_a_joint_and_is_not_simulated_is_refused_in_one_line(change, message):
     lift = lift_robot()
     change(lift)

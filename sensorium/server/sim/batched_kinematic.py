@@ -513,13 +513,23 @@ class KinematicDevices:
 
     def _frames(self, kind: str, copies: np.ndarray, cols: np.ndarray, translation: bool = True):
         """Device.world_pose of each due device: robot pose ∘ local pose, as Pose.compose computes it
-        (rotation R·Rl, translation R·tl + t), stacked."""
+        (rotation R·Rl, translation R·tl + t), stacked; a device riding a joint (GPS, Compass,
+        InertialUnit, Altimeter) at its copy's local pose (batched_joints.py)."""
         slot = self.slot[kind][cols]
         rr = np.ascontiguousarray(self.sim.rot[copies, slot])       # contiguous 3x3s, as a Pose holds them
-        rot = np.matmul(rr, self.local_rot[kind][cols])
+        local_rot, local_pos = self.local_rot[kind][cols], self.local_pos[kind][cols]
+        joints = self.sim.joints
+        riding = [col for col in np.unique(cols).tolist() if (kind, col) in joints.riders] if joints.riders else []
+        if riding:
+            local_rot, local_pos = local_rot.copy(), local_pos.copy()
+            for col in riding:
+                m = (cols == col).nonzero()[0]
+                local_rot[m] = joints.local_rot[(kind, col)][copies[m]]
+                local_pos[m] = joints.local_pos[(kind, col)][copies[m]]
+        rot = np.matmul(rr, local_rot)
         if not translation:
             return rot, None
-        return rot, np.matmul(rr, self.local_pos[kind][cols][:, :, None])[:, :, 0] + self.sim.pos[copies, slot]
+        return rot, np.matmul(rr, local_pos[:, :, None])[:, :, 0] + self.sim.pos[copies, slot]
 
     def _gauss(self, kind: str, copies: np.ndarray, cols: np.ndarray, count: int) -> np.ndarray:
         """(k, count) standard normals: ``count`` in order from each (copy, device) stream."""
