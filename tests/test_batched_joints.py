@@ -7,7 +7,7 @@ light sensor, a range finder and a camera,
 coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
 copy). Closed form: a pan turned a quarter makes its sensor read the side wall, and its light
 sensor face a lamp; a range finder turned back on its pan sees its own robot. What is not
-simulated is refused in one line (a link's shapes, a gyro on a joint, a rotating lidar on one)."""
+simulated is refused in one line (a link's shapes, a bumper on a joint, a rotating lidar on one)."""
 
 from __future__ import annotations
 
@@ -57,7 +57,12 @@ def pan_robot() -> dict:
                         {"device": "GPS", "name": "pan gps", "on_joint": "pan motor", "accuracy": 0.01,
                          "noise_correlation": 0.5, "speed_noise": 0.02, "pose": {"translation": [0.12, 0.03, 0.1]}},
                         {"device": "Compass", "name": "pan compass", "on_joint": "pan motor",
-                         "pose": {"rotation": [1, 0, 0, 0.3]}}]}
+                         "pose": {"rotation": [1, 0, 0, 0.3]}},
+                        {"device": "Gyro", "name": "pan gyro", "on_joint": "pan motor",
+                         "pose": {"translation": [0.1, 0, 0.1], "rotation": [0, 1, 0, 0.4]},
+                         "lookup_table": [[-100, -100, 0.01], [100, 100, 0.01]]},
+                        {"device": "Accelerometer", "name": "pan acc", "on_joint": "pan motor",
+                         "pose": {"translation": [0.12, 0.02, 0.1]}}]}
 
 
 def lift_robot() -> dict:
@@ -90,6 +95,9 @@ def lift_robot() -> dict:
                          "pose": {"translation": [0.05, 0.0, 0.25], "rotation": [0, 0, 1, 0.7]}},
                         {"device": "Altimeter", "name": "lift alt", "on_joint": "lift motor", "accuracy": 0.005,
                          "pose": {"translation": [0.0, 0.05, 0.12]}},
+                        {"device": "Accelerometer", "name": "tilt acc", "on_joint": "tilt",
+                         "pose": {"translation": [0.1, 0.0, 0.3]}},
+                        {"device": "Gyro", "name": "tilt gyro", "on_joint": "tilt"},
                         laser("a ds", "arm::a", [0.0, 0.11, 0.05]),
                         laser("b ds", "arm::b", [0.0, -0.11, 0.05]),
                         laser("fixed ds", "lift motor", [-0.11, 0.0, 0.1])]}
@@ -141,9 +149,10 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
             batched.recognition_enable(batched.device(robot, name), 32, copies=copies)
             batched.enable_segmentation(batched.device(robot, name), segment, copies=copies)
 
-    devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls", "pan cam", "pan gps", "pan compass"],
+    devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls", "pan cam", "pan gps", "pan compass", "pan gyro",
+                       "pan acc"],
                "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "tilt ls", "tilt rf", "tilt cam", "tilt imu",
-                        "lift alt", "a ds", "b ds", "fixed ds"]}
+                        "lift alt", "tilt acc", "tilt gyro", "a ds", "b ds", "fixed ds"]}
     cameras = {("pan", "pan cam"): True, ("lift", "tilt cam"): False}     # recognition; segmentation
     for robot, names in devices.items():
         for name in names:
@@ -209,7 +218,7 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
                         if cameras[(robot, name)]:
                             assert batched.segmentation_image(ref)[c].tobytes() == dev.segmentation_image.tobytes()
                         seen |= {o.id for o in dev.objects}
-                    elif ref.kind in ("GPS", "Compass", "InertialUnit"):
+                    elif ref.kind in ("GPS", "Compass", "InertialUnit", "Gyro", "Accelerometer"):
                         want = dev.roll_pitch_yaw if ref.kind == "InertialUnit" else dev.values
                         assert batched.value(ref)[c].tobytes() == np.asarray(want).tobytes(), (t, c, name)
                         if ref.kind == "GPS":
@@ -232,7 +241,7 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
         got = batched.image(ref) if name == "pan cam" else batched.range_image(ref)
         assert len({got[c].tobytes() for c in range(n)}) == n, name
     assert len(seen) >= 2       # the cameras recognised walls
-    for name in ("tilt imu", "lift alt"):       # the lift robot never drives: its joints alone tell copies apart
+    for name in ("tilt imu", "lift alt", "tilt acc", "tilt gyro"):       # the lift robot never drives: its joints alone tell copies apart
         got = batched.value(batched.device("lift", name))
         assert len({got[c].tobytes() for c in range(n)}) == n, name
 
@@ -311,13 +320,14 @@ def test_a_range_finder_turned_back_on_its_pan_sees_its_own_robot():
     (lambda r: r.setdefault("shapes", []).append(
         {"name": "cup", "on_joint": "lift motor", "geometry": {"type": "box", "size": [0.05, 0.05, 0.05]}}),
      "robot 'lift': shape 'cup' rides joint 'lift motor'; the batched simulation moves no link's shapes"),
-    (lambda r: r["devices"].append({"device": "Gyro", "name": "gyro", "on_joint": "tilt"}),
-     "robot 'lift': Gyro 'gyro' rides joint 'tilt'; the batched simulation moves distance sensors, light sensors, "
-     "cameras, range finders, fixed lidars, GPS, compasses, inertial units and altimeters on joints only"),
+    (lambda r: r["devices"].append({"device": "TouchSensor", "name": "bump", "on_joint": "tilt"}),
+     "robot 'lift': TouchSensor 'bump' rides joint 'tilt'; the batched simulation moves distance sensors, light "
+     "sensors, cameras, range finders, fixed lidars, GPS, compasses, inertial units, gyros, accelerometers and "
+     "altimeters on joints only"),
     (lambda r: r["devices"].append({"device": "Lidar", "name": "spin", "on_joint": "tilt", "type": "rotating",
                                     "horizontal_resolution": 8, "field_of_view": 6.28}),
      "robot 'lift': rotating lidar 'spin' rides joint 'tilt'; the batched simulation moves fixed lidars on joints"),
-], ids=["link shape", "gyro", "rotating lidar"])
+], ids=["link shape", "bumper", "rotating lidar"])
 def test_what_rides_a_joint_and_is_not_simulated_is_refused_in_one_line(change, message):
     lift = lift_robot()
     change(lift)

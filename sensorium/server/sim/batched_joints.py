@@ -18,7 +18,7 @@ device riding a moved link gets that copy's local pose, ``displacement ∘ mount
 on two robots, per-copy Links objects took 28 ms a step; the arrays take ~1 ms.) The batched
 simulation casts the rays of the distance sensors and fixed lidars riding joints from those poses, and
 places the light sensors, cameras and range finders riding them there (and measures the GPS,
-compasses, inertial units and altimeters riding them there: batched_kinematic.py);
+compasses, inertial units, gyros, accelerometers and altimeters riding them there: batched_kinematic.py);
 it refuses what else rides a joint (batched.py's ``_check_supported``): a link's shapes or lights
 (the copies' robots are one rigid template body each) and other devices.
 """
@@ -39,7 +39,7 @@ _POSITION_THRESHOLD = 1e-6       # joints.py's (Webots' TARGET_POSITION_THRESHOL
 _VELOCITY_THRESHOLD = 1e-6
 
 PLACED_KINDS = ("DistanceSensor", "LightSensor", "Lidar", "RangeFinder", "Camera", "GPS", "Compass", "InertialUnit",
-                "Altimeter")
+                "Gyro", "Accelerometer", "Altimeter")
 """The devices riding a joint that the batched simulation places per copy (their local poses here)."""
 
 RIDING_KINDS = (*PLACED_KINDS, "PositionSensor", "RotationalMotor", "LinearMotor")
