@@ -26,7 +26,8 @@ A gyro or an accelerometer differences the device's world poses after the last b
 it was enabled (_MotionSensor in sim/sensors.py): the copies' end-of-step robot poses of the last
 two steps are kept for every slot, and per device the robot's pose when it was enabled and how
 many poses it has seen since (1 at ``enable``, at most 3), so its poses are composed only when it
-is due.
+is due. A device riding a joint (``on_joint``) takes its copy's local pose from batched_joints.py;
+a gyro's or accelerometer's local poses at those times are kept per copy beside the robot's.
 
 A bumper keeps a touch until it is read, as the single TouchSensor (WbTouchSensor's flag): per copy
 and bumper a ``touched`` flag, or-ed after each step where an armed bumper (enabled at least once
