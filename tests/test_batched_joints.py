@@ -1,10 +1,13 @@
 """Joint motors in the batched simulation (batched_joints.py): every copy's joints move by Webots'
-kinematic motor control and the distance sensors and fixed lidars riding them cast from each copy's
-link, bit for bit as the copy's own Simulation (a pan hinge carrying a distance sensor and a lidar on
-a driving robot, a slider carrying an infra-red sensor and a nested tilt hinge carrying another,
+kinematic motor control and the distance sensors, light sensors, cameras (images, recognition,
+segmentation), range finders and fixed lidars riding them cast from each copy's link, bit for bit as the
+copy's own Simulation (a pan hinge carrying a distance sensor, a lidar, a light sensor and a camera on
+a driving robot, a slider carrying an infra-red sensor and a nested tilt hinge carrying another, a
+light sensor, a range finder and a camera,
 coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
-copy). Closed form: a pan turned a quarter makes its sensor read the side wall. What is not
-simulated is refused in one line (a link's shapes, a camera on a joint, a rotating lidar on one)."""
+copy). Closed form: a pan turned a quarter makes its sensor read the side wall, and its light
+sensor face a lamp; a range finder turned back on its pan sees its own robot. What is not
+simulated is refused in one line (a link's shapes, a bumper on a joint, a rotating lidar on one)."""
 
 from __future__ import annotations
 
@@ -20,9 +23,9 @@ from sensorium.server.world.loader import parse_world
 STEP = 16
 
 
-def wall(name: str, x: float, y: float, sx: float, sy: float) -> dict:
+def wall(name: str, x: float, y: float, sx: float, sy: float, colour=(0.8, 0.5, 0.2)) -> dict:
     return {"name": name, "pose": {"translation": [x, y, 0.5]}, "geometry": {"type": "box", "size": [sx, sy, 1.0]},
-            "appearance": {"base_color": [0.8, 0.5, 0.2]}}
+            "appearance": {"base_color": list(colour)}, "recognition_colors": [list(colour)]}
 
 
 def laser(name: str, on_joint: str, translation, kind: str = "laser", noise: float = 0.0) -> dict:
@@ -44,7 +47,22 @@ def pan_robot() -> dict:
                         {"device": "Lidar", "name": "pan lidar", "on_joint": "pan motor",
                          "pose": {"translation": [0.1, 0.0, 0.15]}, "horizontal_resolution": 32,
                          "field_of_view": 1.5, "number_of_layers": 3, "vertical_field_of_view": 0.2,
-                         "min_range": 0.05, "max_range": 3.0, "noise": 0.01}]}
+                         "min_range": 0.05, "max_range": 3.0, "noise": 0.01},
+                        {"device": "LightSensor", "name": "pan ls", "on_joint": "pan motor", "occlusion": True,
+                         "pose": {"translation": [0.1, 0.02, 0.12], "rotation": [0, 0, 1, 0.4]},
+                         "lookup_table": [[0, 0, 0], [10, 1000, 0.05]]},
+                        {"device": "Camera", "name": "pan cam", "on_joint": "pan motor", "width": 12, "height": 8,
+                         "pose": {"translation": [0.11, 0.0, 0.14]}, "field_of_view": 1.2, "noise": 0.02,
+                         "recognition": {"occlusion": 1, "segmentation": True}},
+                        {"device": "GPS", "name": "pan gps", "on_joint": "pan motor", "accuracy": 0.01,
+                         "noise_correlation": 0.5, "speed_noise": 0.02, "pose": {"translation": [0.12, 0.03, 0.1]}},
+                        {"device": "Compass", "name": "pan compass", "on_joint": "pan motor",
+                         "pose": {"rotation": [1, 0, 0, 0.3]}},
+                        {"device": "Gyro", "name": "pan gyro", "on_joint": "pan motor",
+                         "pose": {"translation": [0.1, 0, 0.1], "rotation": [0, 1, 0, 0.4]},
+                         "lookup_table": [[-100, -100, 0.01], [100, 100, 0.01]]},
+                        {"device": "Accelerometer", "name": "pan acc", "on_joint": "pan motor",
+                         "pose": {"translation": [0.12, 0.02, 0.1]}}]}
 
 
 def lift_robot() -> dict:
@@ -64,6 +82,22 @@ def lift_robot() -> dict:
                         {"device": "PositionSensor", "name": "b enc", "motor": "arm::b", "resolution": 0.01},
                         laser("lift ir", "lift motor", [0.11, 0.0, 0.1], kind="infra-red"),
                         laser("tilt ds", "tilt", [0.11, 0.0, 0.2]),
+                        {"device": "LightSensor", "name": "tilt ls", "on_joint": "tilt", "occlusion": True,
+                         "pose": {"translation": [0.0, 0.11, 0.2], "rotation": [0, 1, 0, -0.5]},
+                         "lookup_table": [[0, 0, 0], [10, 1000, 0]]},
+                        {"device": "RangeFinder", "name": "tilt rf", "on_joint": "tilt", "width": 10, "height": 6,
+                         "pose": {"translation": [0.11, 0.0, 0.24]}, "field_of_view": 1.0, "max_range": 3.0,
+                         "noise": 0.01},
+                        {"device": "Camera", "name": "tilt cam", "on_joint": "tilt", "width": 8, "height": 6,
+                         "pose": {"translation": [0.11, 0.02, 0.24], "rotation": [0, 1, 0, 0.2]},
+                         "field_of_view": 0.9, "recognition": {"occlusion": 2}},
+                        {"device": "InertialUnit", "name": "tilt imu", "on_joint": "tilt", "noise": 0.001,
+                         "pose": {"translation": [0.05, 0.0, 0.25], "rotation": [0, 0, 1, 0.7]}},
+                        {"device": "Altimeter", "name": "lift alt", "on_joint": "lift motor", "accuracy": 0.005,
+                         "pose": {"translation": [0.0, 0.05, 0.12]}},
+                        {"device": "Accelerometer", "name": "tilt acc", "on_joint": "tilt",
+                         "pose": {"translation": [0.1, 0.0, 0.3]}},
+                        {"device": "Gyro", "name": "tilt gyro", "on_joint": "tilt"},
                         laser("a ds", "arm::a", [0.0, 0.11, 0.05]),
                         laser("b ds", "arm::b", [0.0, -0.11, 0.05]),
                         laser("fixed ds", "lift motor", [-0.11, 0.0, 0.1])]}
@@ -73,7 +107,10 @@ def jointed_world(seed: int = 3):
     return parse_world({"world_info": {"basic_time_step": STEP, "contact": True, "random_seed": seed},
                         "solids": [wall("north", 0, 1.2, 2.6, 0.2), wall("south", 0, -1.2, 2.6, 0.2),
                                    wall("east", 1.2, 0, 0.2, 2.2), wall("west", -1.2, 0, 0.2, 2.2),
-                                   wall("block", 0.3, 0.5, 0.3, 0.3)],
+                                   wall("block", 0.3, 0.5, 0.3, 0.3, (0.2, 0.4, 0.9)),
+                                   wall("post", -0.6, -0.6, 0.15, 0.15, (0.9, 0.9, 0.1))],
+                        "lights": [{"type": "PointLight", "location": [0.1, 0.2, 0.6], "intensity": 1.5,
+                                    "attenuation": [0, 0, 1]}],
                         "robots": [pan_robot(), lift_robot()]})
 
 
@@ -99,26 +136,41 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
     """Three copies and a Simulation per copy (world seeds 3, 4, 5), 300 steps; every 25 steps each
     copy's motors get new random commands and its wheels new speeds; copy 1 reset at step 160 against
     a fresh Simulation: every joint position, every encoder, distance sensor and lidar image and every
-    robot pose the same bits every step."""
+    robot pose the same bits every step (light sensors too, their occlusion rays cast from each
+    copy's link)."""
     w = jointed_world()
     seeds = (3, 4, 5)
     n = len(seeds)
     batched = BatchedSimulation(w, n, precision=precision)
     batched.reset(np.arange(n), list(seeds))
-    devices = {"pan": ["pan enc", "pan ds", "pan lidar"],
-               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "a ds", "b ds", "fixed ds"]}
+
+    def recognise(copies: list[int]) -> None:
+        for (robot, name), segment in cameras.items():
+            batched.recognition_enable(batched.device(robot, name), 32, copies=copies)
+            batched.enable_segmentation(batched.device(robot, name), segment, copies=copies)
+
+    devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls", "pan cam", "pan gps", "pan compass", "pan gyro",
+                       "pan acc"],
+               "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "tilt ls", "tilt rf", "tilt cam", "tilt imu",
+                        "lift alt", "tilt acc", "tilt gyro", "a ds", "b ds", "fixed ds"]}
+    cameras = {("pan", "pan cam"): True, ("lift", "tilt cam"): False}     # recognition; segmentation
     for robot, names in devices.items():
         for name in names:
             batched.enable(batched.device(robot, name), 32)
+    recognise(list(range(n)))
     rng = np.random.default_rng(11)
     pan = batched.slot("pan")
     moved = set()
+    seen: set[int] = set()
     def single(seed: int) -> Simulation:
         sim = Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
             update={"random_seed": seed})}), precision=precision)
         for robot, names in devices.items():
             for name in names:
                 sim.device(f"{robot}/{name}").enable(32)
+        for (robot, name), segment in cameras.items():
+            sim.device(f"{robot}/{name}").recognition_enable(32)
+            sim.device(f"{robot}/{name}").enable_segmentation(segment)
         return sim
 
     singles = [single(s) for s in seeds]
@@ -128,6 +180,7 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
             for robot, names in devices.items():
                 for name in names:
                     batched.enable(batched.device(robot, name), 32, copies=[1])
+            recognise([1])
             singles[1] = single(seeds[1])
         if t % 25 == 0:
             for c in range(n):
@@ -157,8 +210,23 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
                 for name in devices[robot]:
                     ref = batched.device(robot, name)
                     dev = s.device(f"{robot}/{name}")
-                    if name.endswith("lidar"):
+                    if name.endswith("lidar") or name.endswith("rf"):
                         assert batched.range_image(ref)[c].tobytes() == dev.range_image.tobytes(), (t, c, name)
+                    elif name.endswith("cam"):
+                        assert batched.image(ref)[c].tobytes() == dev.image.tobytes(), (t, c, name)
+                        assert batched.recognition_objects(ref, c) == dev.objects, (t, c, name)
+                        if cameras[(robot, name)]:
+                            assert batched.segmentation_image(ref)[c].tobytes() == dev.segmentation_image.tobytes()
+                        seen |= {o.id for o in dev.objects}
+                    elif ref.kind in ("GPS", "Compass", "InertialUnit", "Gyro", "Accelerometer"):
+                        want = dev.roll_pitch_yaw if ref.kind == "InertialUnit" else dev.values
+                        assert batched.value(ref)[c].tobytes() == np.asarray(want).tobytes(), (t, c, name)
+                        if ref.kind == "GPS":
+                            for what in ("speed", "speed_vector"):
+                                want = np.float64(getattr(dev, what)) if what == "speed" else getattr(dev, what)
+                                assert batched.reading(ref, what)[c].tobytes() == np.asarray(want).tobytes()
+                        if ref.kind == "InertialUnit":
+                            assert batched.reading(ref, "quaternion")[c].tobytes() == dev.quaternion.tobytes()
                     else:
                         got = batched.value(ref)[c]
                         assert np.float64(got).tobytes() == np.float64(dev.value).tobytes(), (t, c, name, got,
@@ -166,6 +234,16 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
     assert moved == {"pan motor", "lift motor", "tilt", "arm::a", "arm::b"}
     # the joints' sensors did read different things in different copies (each its own link)
     assert len({float(v) for v in batched.value(batched.device("pan", "pan ds"))}) == n
+    assert len({float(v) for v in batched.value(batched.device("pan", "pan ls"))}) == n
+    assert len({float(v) for v in batched.value(batched.device("lift", "tilt ls"))}) == n
+    for name in ("pan cam", "tilt rf"):
+        ref = batched.device("pan" if name == "pan cam" else "lift", name)
+        got = batched.image(ref) if name == "pan cam" else batched.range_image(ref)
+        assert len({got[c].tobytes() for c in range(n)}) == n, name
+    assert len(seen) >= 2       # the cameras recognised walls
+    for name in ("tilt imu", "lift alt", "tilt acc", "tilt gyro"):       # the lift robot never drives: its joints alone tell copies apart
+        got = batched.value(batched.device("lift", name))
+        assert len({got[c].tobytes() for c in range(n)}) == n, name
 
 
 def test_a_pan_turned_a_quarter_reads_the_side_wall_in_that_copy_only():
@@ -194,16 +272,62 @@ lookup table gives 1000 per metre)."""
     assert batched.value(ref) == pytest.approx([900.0, 900.0], abs=1e-6)
 
 
+def test_a_light_sensor_on_a_pan_faces_the_lamp_in_the_copy_that_turned_it():
+    """A light sensor 0.1 m ahead of a pan axis at the origin, looking along +x; a point light
+    (intensity 0.8, attenuation 0 0 1, no ambient) 1 m to its left at its height. Copy 0 keeps the
+    lamp behind the sensor's plane (cos < 0: 0); copy 1 turns the pan a quarter, the sensor then
+    sits at (0, 0.1) facing the lamp 0.9 m away: 0.8 / 0.81 through the table (x 100)."""
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": False},
+                     "lights": [{"type": "PointLight", "location": [0, 1.0, 0.3], "intensity": 0.8,
+                                 "attenuation": [0, 0, 1]}],
+                     "robots": [{"name": "r", "devices": [
+                         {"device": "RotationalMotor", "name": "pan", "axis": [0, 0, 1], "max_velocity": 100.0,
+                          "max_torque": 1e5},
+                         {"device": "LightSensor", "name": "ls", "on_joint": "pan", "pose": {"translation": [0.1, 0, 0.3]},
+                          "lookup_table": [[0, 0, 0], [10, 1000, 0]]}]}]})
+    batched = BatchedSimulation(w, 2)
+    ref = batched.device("r", "ls")
+    batched.enable(ref, STEP)
+    batched.joints.command(0, "pan", position=math.pi / 2, copies=[1])
+    batched.step()
+    assert batched.value(ref) == pytest.approx([0.0, 100.0 * 0.8 / 0.81], abs=1e-9)
+
+
+def test_a_range_finder_turned_back_on_its_pan_sees_its_own_robot():
+    """A one-pixel range finder 0.4 m ahead of a robot whose body is a 0.2 m box, on a pan hinge
+    through (0.3, 0, 0), looking along +x at a wall whose near face is at x = 1: 0.6 m. Copy 1 turns
+    the pan half a turn: the device sits at (0.2, 0) looking back along -x and sees its own robot's
+    face at x = 0.1 (0.1 m), not the wall behind it at x = -1 (a Webots range finder sees its robot;
+    its rays turn in the body frame, so none may skip the robot)."""
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": False},
+                     "solids": [wall("front", 1.05, 0, 0.1, 8), wall("back", -1.05, 0, 0.1, 8)],
+                     "robots": [{"name": "r", "body": {"geometry": {"type": "box", "size": [0.2, 0.2, 0.6]}},
+                                 "devices": [
+                         {"device": "RotationalMotor", "name": "pan", "axis": [0, 0, 1], "anchor": [0.3, 0, 0],
+                          "max_velocity": 100.0, "max_torque": 1e5},
+                         {"device": "RangeFinder", "name": "rf", "on_joint": "pan", "width": 1, "height": 1,
+                          "field_of_view": 0.1, "max_range": 3.0, "pose": {"translation": [0.4, 0, 0.1]}}]}]})
+    batched = BatchedSimulation(w, 2)
+    ref = batched.device("r", "rf")
+    batched.enable(ref, STEP)
+    batched.joints.command(0, "pan", position=math.pi, copies=[1])
+    batched.run(3)
+    assert batched.joints.position[:, 0].tolist() == [0.0, math.pi]
+    assert batched.range_image(ref)[:, 0, 0] == pytest.approx([0.6, 0.1], abs=1e-6)
+
+
 @pytest.mark.parametrize("change, message", [
     (lambda r: r.setdefault("shapes", []).append(
         {"name": "cup", "on_joint": "lift motor", "geometry": {"type": "box", "size": [0.05, 0.05, 0.05]}}),
      "robot 'lift': shape 'cup' rides joint 'lift motor'; the batched simulation moves no link's shapes"),
-    (lambda r: r["devices"].append({"device": "Camera", "name": "cam", "on_joint": "tilt", "width": 4, "height": 4}),
-     "robot 'lift': Camera 'cam' rides joint 'tilt'; the batched simulation moves distance sensors and fixed lidars"),
+    (lambda r: r["devices"].append({"device": "TouchSensor", "name": "bump", "on_joint": "tilt"}),
+     "robot 'lift': TouchSensor 'bump' rides joint 'tilt'; the batched simulation moves distance sensors, light "
+     "sensors, cameras, range finders, fixed lidars, GPS, compasses, inertial units, gyros, accelerometers and "
+     "altimeters on joints only"),
     (lambda r: r["devices"].append({"device": "Lidar", "name": "spin", "on_joint": "tilt", "type": "rotating",
                                     "horizontal_resolution": 8, "field_of_view": 6.28}),
      "robot 'lift': rotating lidar 'spin' rides joint 'tilt'; the batched simulation moves fixed lidars on joints"),
-], ids=["link shape", "camera", "rotating lidar"])
+], ids=["link shape", "bumper", "rotating lidar"])
 def test_what_rides_a_joint_and_is_not_simulated_is_refused_in_one_line(change, message):
     lift = lift_robot()
     change(lift)

@@ -44,9 +44,11 @@ path's operations); in a world with car-like, mecanum or omni-wheel robots those
 drive and the two-wheel robots' wheels and moves are C passes within it.
 
 Joint motors (every motor that is no drive's wheel) move per copy by :mod:`~sensorium.server.sim.batched_joints`
-(``sim.joints.command``), before the drives as in Simulation.step; the distance sensors and fixed lidars
-riding them cast from each copy's link. Steered-wheel robots (``steered_drive``) are driven by
-:mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``) at each copy's steering joints.
+(``sim.joints.command``), before the drives as in Simulation.step; the distance sensors, light sensors,
+cameras, range finders and fixed lidars riding them cast from each copy's link, and the GPS, compasses,
+inertial units, gyros, accelerometers and altimeters riding them measure there. Steered-wheel robots
+(``steered_drive``) are driven by :mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``)
+at each copy's steering joints.
 A link's shapes or lights, other devices on a joint, rotating lidars on one, steered drives with free
 wheels and belts are refused (BatchedError, one line).
 
@@ -448,8 +450,9 @@ class BatchedSimulation:
                     continue
                 if d.device not in batched_joints.RIDING_KINDS:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
-                                       f"{joint!r}; the batched simulation moves distance sensors and fixed lidars "
-                                       "on joints only (use Simulation)")
+                                       f"{joint!r}; the batched simulation moves distance sensors, light sensors, "
+                                       "cameras, range finders, fixed lidars, GPS, compasses, inertial units, gyros, "
+                                       "accelerometers and altimeters on joints only (use Simulation)")
                 if d.device == "Lidar" and d.type == "rotating":    # batched_lidar.py's heads turn on the body
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: rotating lidar {d.name!r} rides joint "
                                        f"{joint!r}; the batched simulation moves fixed lidars on joints only "
@@ -498,10 +501,11 @@ class BatchedSimulation:
                 dev = classes[d.device](config=d, robot_index=slot, robot_name=r.name, self_collision=r.self_collision,
                                         world_seed=0, clock=lambda: 0,
                                         own_shapes=self._own_shapes.get((slot, d.name), frozenset()))
-                riding = dev.on_joint is not None and d.device in ("DistanceSensor", "Lidar")
+                riding = dev.on_joint is not None and d.device in batched_joints.PLACED_KINDS
                 if riding:
                     # on a link without shapes (batched.py refuses links with shapes): its rays are
-                    # mounted on no body, as the single simulation's (Scene.device_body is None);
+                    # mounted on no body, as the single simulation's (Scene.device_body is None), and a
+                    # light sensor's occlusion rays skip its robot as the single one's do (exclude_self);
                     # each copy's local pose is the joints' (batched_joints.py)
                     dev.move_with(Pose.identity())
                     self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose, dev.local_pose)
@@ -558,6 +562,7 @@ class BatchedSimulation:
             self._l_slot = np.array([d.robot_index for d in self.light], dtype=np.int64)
             self._l_rot = np.array([d.local_pose.rotation for d in self.light])
             self._l_pos = np.array([d.local_pose.translation for d in self.light])
+            self._l_riding = any(k == "LightSensor" for k, _ in self.joints.riders)
             self._l_filter = np.array([d.config.color_filter for d in self.light], dtype=np.float64)
             self._l_occl = np.array([d.config.occlusion for d in self.light], dtype=bool)
             self._l_excl = np.array([d.exclude_self() for d in self.light], dtype=np.int64)
@@ -1439,8 +1444,17 @@ class BatchedSimulation:
         slot = self._l_slot[cols]
         rr = self.rot[copies, slot]
         rt = self.pos[copies, slot]
-        rot = compose_rotations(rr, self._l_rot[cols])
-        positions = np.einsum("sij,sj->si", rr, self._l_pos[cols]) + rt
+        local_rot, local_pos = self._l_rot[cols], self._l_pos[cols]
+        if self._l_riding:     # a sensor riding a joint: its copy's local pose (batched_joints.py)
+            local_rot, local_pos = local_rot.copy(), local_pos.copy()
+            for col in np.unique(cols).tolist():
+                key = ("LightSensor", col)
+                if key in self.joints.riders:
+                    m = (cols == col).nonzero()[0]
+                    local_rot[m] = self.joints.local_rot[key][copies[m]]
+                    local_pos[m] = self.joints.local_pos[key][copies[m]]
+        rot = compose_rotations(rr, local_rot)
+        positions = np.einsum("sij,sj->si", rr, local_pos) + rt
         normals = rot[:, :, 0]
         # each row's copy's lights: the shared arrays, or with robots' lights at that copy's poses
         lights = self.lights if self.carried is None else self.carried.rows(self.rot, self.pos, copies)

@@ -147,6 +147,8 @@ def own_body_hits(pixels: PixelDevices, col: int, copies: np.ndarray, h: RayHits
 class CameraDevices(PixelDevices):
     """The batched simulation's cameras: constants per device, BGRA images per copy."""
 
+    kind = "Camera"
+
     def __init__(self, sim: Any, devices: list[BatchedCamera]):
         super().__init__(sim, [_Device(d) for d in devices])
         self.images = [np.zeros((sim.copies, d.height, d.width, 4), dtype=np.uint8) for d in self.devices]

@@ -149,6 +149,8 @@ class PixelDevices:
     device's constants (``devices[col]``) have ``template``, ``n`` (rays per image), ``dirs``,
     ``columns``, ``limits`` and the kept ``own``, ``skip``, ``plan``."""
 
+    kind = "RangeFinder"     # the devices' kind: a device riding a joint is (kind, column) in sim.joints
+
     def __init__(self, sim: Any, devices: list):
         self.sim = sim
         self.devices = devices
@@ -161,10 +163,15 @@ class PixelDevices:
         sim = self.sim
         dev = self.devices[col]
         slot = dev.template.robot_index
-        local = dev.template.local_pose
         rr = sim.rot[copies, slot]
-        rot = np.matmul(rr, local.rotation)                                  # Pose.compose, stacked
-        org = np.matmul(rr, local.translation[None, :, None])[:, :, 0] + sim.pos[copies, slot]
+        rider = (self.kind, col)
+        if rider in sim.joints.riders:        # on a joint: each copy's local pose (batched_joints.py)
+            rot = np.matmul(rr, sim.joints.local_rot[rider][copies])
+            org = np.matmul(rr, sim.joints.local_pos[rider][copies][:, :, None])[:, :, 0] + sim.pos[copies, slot]
+        else:
+            local = dev.template.local_pose
+            rot = np.matmul(rr, local.rotation)                              # Pose.compose, stacked
+            org = np.matmul(rr, local.translation[None, :, None])[:, :, 0] + sim.pos[copies, slot]
         got = packets.lidar_beams(rot, org, dev.columns, self._beam_buffers(col, len(copies) * dev.n))
         origins, d, d32 = got if got is not None else _lidar_beams(rot, org, dev.columns)
         return org, origins, d, d32
@@ -192,8 +199,12 @@ class PixelDevices:
     def _mount(self, col: int) -> np.ndarray | int:
         """The slot a device's pixel rays are never paired with in the world cast: its robot's, for
         a device with shapes of its own (that body is met apart, in the body frame: ``own``), else per
-        pixel its robot's where the ray can never meet that body, -1 where it may (it sees its robot)."""
+        pixel its robot's where the ray can never meet that body, -1 where it may (it sees its robot).
+        A device riding a joint (on a link without shapes: mounted on no body, as the single
+        device's ``device_body`` is None) turns in the body frame: every ray may meet its robot."""
         dev = self.devices[col]
+        if dev.skip is None and (self.kind, col) in self.sim.joints.riders:
+            dev.skip = -1
         if dev.skip is None:
             tpl = dev.template
             slot = tpl.robot_index

@@ -16,7 +16,9 @@ arithmetic (Pose.from_axis_angle on libm's cosine and sine, Pose.compose's stack
 device riding a moved link gets that copy's local pose, ``displacement ∘ mount`` (the single device's
 ``move_with``), in :attr:`BatchedJoints.local_rot` / ``local_pos``. (Measured: 256 copies, five joints
 on two robots, per-copy Links objects took 28 ms a step; the arrays take ~1 ms.) The batched
-simulation casts the rays of the distance sensors and fixed lidars riding joints from those poses;
+simulation casts the rays of the distance sensors and fixed lidars riding joints from those poses, and
+places the light sensors, cameras and range finders riding them there (and measures the GPS,
+compasses, inertial units, gyros, accelerometers and altimeters riding them there: batched_kinematic.py);
 it refuses what else rides a joint (batched.py's ``_check_supported``): a link's shapes or lights
 (the copies' robots are one rigid template body each) and other devices.
 """
@@ -31,14 +33,18 @@ from sensorium.server.sim.joints import Links
 from sensorium.server.sim.simulation import couple, joint_motor
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["BatchedJoints", "RIDING_KINDS", "joint_motors"]
+__all__ = ["BatchedJoints", "PLACED_KINDS", "RIDING_KINDS", "joint_motors"]
 
 _POSITION_THRESHOLD = 1e-6       # joints.py's (Webots' TARGET_POSITION_THRESHOLD)
 _VELOCITY_THRESHOLD = 1e-6
 
-RIDING_KINDS = ("DistanceSensor", "Lidar", "PositionSensor", "RotationalMotor", "LinearMotor")
-"""What may ride a joint (``on_joint``) in the batched simulation: the sensors whose rays start
-from each copy's link, encoders (which read a motor, wherever they sit) and the nested joints'
+PLACED_KINDS = ("DistanceSensor", "LightSensor", "Lidar", "RangeFinder", "Camera", "GPS", "Compass", "InertialUnit",
+                "Gyro", "Accelerometer", "Altimeter")
+"""The devices riding a joint that the batched simulation places per copy (their local poses here)."""
+
+RIDING_KINDS = (*PLACED_KINDS, "PositionSensor", "RotationalMotor", "LinearMotor")
+"""What may ride a joint (``on_joint``) in the batched simulation: the sensors whose rays (and a
+light sensor's normal) start from each copy's link, encoders (which read a motor, wherever they sit) and the nested joints'
 motors."""
 
 

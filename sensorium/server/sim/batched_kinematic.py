@@ -26,7 +26,8 @@ A gyro or an accelerometer differences the device's world poses after the last b
 it was enabled (_MotionSensor in sim/sensors.py): the copies' end-of-step robot poses of the last
 two steps are kept for every slot, and per device the robot's pose when it was enabled and how
 many poses it has seen since (1 at ``enable``, at most 3), so its poses are composed only when it
-is due.
+is due. A device riding a joint (``on_joint``) takes its copy's local pose from batched_joints.py;
+a gyro's or accelerometer's local poses at those times are kept per copy beside the robot's.
 
 A bumper keeps a touch until it is read, as the single TouchSensor (WbTouchSensor's flag): per copy
 and bumper a ``touched`` flag, or-ed after each step where an armed bumper (enabled at least once
@@ -410,6 +411,12 @@ class KinematicDevices:
         self.latching = False
         self.enable_rot = {k: np.zeros((C, len(self.devices[k]), 3, 3)) for k in MOTION}
         self.enable_pos = {k: np.zeros((C, len(self.devices[k]), 3)) for k in MOTION}
+        # a gyro or an accelerometer riding a joint: its local pose moves too, so per copy its local
+        # poses at enable and at the last two steps' ends are kept beside the robot's (batched_joints.py)
+        joints = sim.joints
+        self.motion_riders: dict[tuple[str, int], dict[str, tuple[np.ndarray, np.ndarray]]] = {
+            key: {when: (joints.local_rot[key].copy(), joints.local_pos[key].copy()) for when in ("enable", "last", "last2")}
+            for key in joints.riders if key[0] in MOTION}
 
     # ------------------------------------------------------------------ state
     def reset(self, idx: np.ndarray) -> None:
@@ -437,6 +444,11 @@ class KinematicDevices:
         if kind in MOTION:
             slot = self.slot[kind][column]
             self.seen[kind][idx, column] = 1
+            kept = self.motion_riders.get((kind, column))
+            if kept is not None:
+                joints = self.sim.joints
+                kept["enable"][0][idx] = joints.local_rot[(kind, column)][idx]
+                kept["enable"][1][idx] = joints.local_pos[(kind, column)][idx]
             self.enable_rot[kind][idx, column] = self.sim.rot[idx, slot]
             self.enable_pos[kind][idx, column] = self.sim.pos[idx, slot]
 
@@ -481,6 +493,11 @@ class KinematicDevices:
         self.last2_pos[live] = self.last_pos[live]
         self.last_pos[live] = sim.pos[live]
         self.last_rot[live] = sim.rot[live]
+        for key, kept in self.motion_riders.items():
+            for k in (0, 1):
+                kept["last2"][k][live] = kept["last"][k][live]
+            kept["last"][0][live] = sim.joints.local_rot[key][live]
+            kept["last"][1][live] = sim.joints.local_pos[key][live]
 
     def _poses(self, kind: str, copies: np.ndarray, cols: np.ndarray):
         """The device poses of a due gyro or accelerometer as its pose list holds them after this
@@ -503,23 +520,62 @@ class KinematicDevices:
         first_pos = np.where(older[:, None], self.last2_pos[copies, slot], e_pos)
         return n, (now_rot, now_pos), (prev_rot, prev_pos), (first_rot, first_pos)
 
-    def _compose(self, kind: str, cols: np.ndarray, rot: np.ndarray, pos: np.ndarray | None):
-        """Device.world_pose from robot poses (rotation R·Rl, translation R·tl + t; None: no translation)."""
+    def _motion_locals(self, kind: str, copies: np.ndarray, cols: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The device's local poses at the three poses :meth:`_poses` picks (now, previous, first),
+        chosen the same way: the file's for a device on the body, each copy's kept ones for a device
+        riding a joint (whose local pose moved with it)."""
+        fixed = (self.local_rot[kind][cols], self.local_pos[kind][cols])
+        out = [(fixed[0].copy(), fixed[1].copy()) for _ in range(3)]
+        riding = [col for col in np.unique(cols).tolist() if (kind, col) in self.motion_riders]
+        if not riding:
+            return out
+        before = self.seen[kind][copies, cols]
+        n = np.minimum(before + 1, 3)
+        joints = self.sim.joints
+        for col in riding:
+            m = (cols == col).nonzero()[0]
+            c = copies[m]
+            kept = self.motion_riders[(kind, col)]
+            now = (joints.local_rot[(kind, col)][c], joints.local_pos[(kind, col)][c])
+            one, two, older = (n[m] == 2), (n[m] >= 3), (before[m] >= 3)
+            e, last, last2 = [(kept[w][0][c], kept[w][1][c]) for w in ("enable", "last", "last2")]
+            prev = (np.where(two[:, None, None], last[0], np.where(one[:, None, None], e[0], now[0])),
+                    np.where(two[:, None], last[1], np.where(one[:, None], e[1], now[1])))
+            first = (np.where(older[:, None, None], last2[0], e[0]), np.where(older[:, None], last2[1], e[1]))
+            for i, (r, p) in enumerate((now, prev, first)):
+                out[i][0][m] = r
+                out[i][1][m] = p
+        return out
+
+    @staticmethod
+    def _compose(local: tuple[np.ndarray, np.ndarray], rot: np.ndarray, pos: np.ndarray | None):
+        """Device.world_pose from robot poses and the device's local poses ``local`` (rotation R·Rl,
+        translation R·tl + t; None: no translation)."""
         rr = np.ascontiguousarray(rot)
-        r = np.matmul(rr, self.local_rot[kind][cols])
+        r = np.matmul(rr, local[0])
         if pos is None:
             return r, None
-        return r, np.matmul(rr, self.local_pos[kind][cols][:, :, None])[:, :, 0] + pos
+        return r, np.matmul(rr, local[1][:, :, None])[:, :, 0] + pos
 
     def _frames(self, kind: str, copies: np.ndarray, cols: np.ndarray, translation: bool = True):
         """Device.world_pose of each due device: robot pose ∘ local pose, as Pose.compose computes it
-        (rotation R·Rl, translation R·tl + t), stacked."""
+        (rotation R·Rl, translation R·tl + t), stacked; a device riding a joint at its copy's local
+        pose (batched_joints.py)."""
         slot = self.slot[kind][cols]
         rr = np.ascontiguousarray(self.sim.rot[copies, slot])       # contiguous 3x3s, as a Pose holds them
-        rot = np.matmul(rr, self.local_rot[kind][cols])
+        local_rot, local_pos = self.local_rot[kind][cols], self.local_pos[kind][cols]
+        joints = self.sim.joints
+        riding = [col for col in np.unique(cols).tolist() if (kind, col) in joints.riders] if joints.riders else []
+        if riding:
+            local_rot, local_pos = local_rot.copy(), local_pos.copy()
+            for col in riding:
+                m = (cols == col).nonzero()[0]
+                local_rot[m] = joints.local_rot[(kind, col)][copies[m]]
+                local_pos[m] = joints.local_pos[(kind, col)][copies[m]]
+        rot = np.matmul(rr, local_rot)
         if not translation:
             return rot, None
-        return rot, np.matmul(rr, self.local_pos[kind][cols][:, :, None])[:, :, 0] + self.sim.pos[copies, slot]
+        return rot, np.matmul(rr, local_pos[:, :, None])[:, :, 0] + self.sim.pos[copies, slot]
 
     def _gauss(self, kind: str, copies: np.ndarray, cols: np.ndarray, count: int) -> np.ndarray:
         """(k, count) standard normals: ``count`` in order from each (copy, device) stream."""
@@ -598,17 +654,19 @@ class KinematicDevices:
     def _gyro(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Gyro.measure: the turn from the device's previous pose to this step's over one basic step."""
         n, (now_rot, _), (prev_rot, _), _ = self._poses("Gyro", copies, cols)
-        r1, _ = self._compose("Gyro", cols, now_rot, None)
-        r0, _ = self._compose("Gyro", cols, prev_rot, None)
+        now, prev, _ = self._motion_locals("Gyro", copies, cols)
+        r1, _ = self._compose(now, now_rot, None)
+        r0, _ = self._compose(prev, prev_rot, None)
         return self._through_tables("Gyro", copies, cols, angular_velocities(r0, r1, self.dt_s))
 
     def _accelerometer(self, copies: np.ndarray, cols: np.ndarray) -> np.ndarray:
         """Accelerometer.measure: the second difference of the device's last three positions (rest
         until three are known) plus gravity, in the device frame (specific_force)."""
         n, (now_rot, now_pos), (prev_rot, prev_pos), (first_rot, first_pos) = self._poses("Accelerometer", copies, cols)
-        rot, p2 = self._compose("Accelerometer", cols, now_rot, now_pos)
-        _, p1 = self._compose("Accelerometer", cols, prev_rot, prev_pos)
-        _, p0 = self._compose("Accelerometer", cols, first_rot, first_pos)
+        now, prev, first = self._motion_locals("Accelerometer", copies, cols)
+        rot, p2 = self._compose(now, now_rot, now_pos)
+        _, p1 = self._compose(prev, prev_rot, prev_pos)
+        _, p0 = self._compose(first, first_rot, first_pos)
         assert p0 is not None and p1 is not None and p2 is not None
         rest = (n < 3)[:, None]                          # fewer than three poses: p0 = p1 = p2
         p0, p1 = np.where(rest, p2, p0), np.where(rest, p2, p1)

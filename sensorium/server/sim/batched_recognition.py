@@ -85,6 +85,8 @@ class RecognitionDevices(PixelDevices):
     """The batched cameras' recognition (columns: the cameras' columns): schedules, objects and
     segmentation images per copy."""
 
+    kind = "Camera"
+
     def __init__(self, sim: Any, cameras: list):
         super().__init__(sim, [_Centres(d) for d in cameras])
         C = sim.copies
@@ -161,7 +163,7 @@ class RecognitionDevices(PixelDevices):
         seen = []
         for k, c in enumerate(copies.tolist()):
             self.scene.copy = c
-            pose = sim.pose(c, tpl.robot_index).compose(tpl.local_pose)      # Device.world_pose
+            pose = sim.pose(c, tpl.robot_index).compose(self._local_pose(col, c))      # Device.world_pose
             mine = None if pixels is None else pixels[k]
             seen.append((pose, rec.candidates(pose, mine)))
             if segment[k]:
@@ -172,6 +174,15 @@ class RecognitionDevices(PixelDevices):
         for c, (_, found) in zip(copies.tolist(), seen):
             self.objects[c][col] = rec.trim([o for _, o, _ in found])
         self.last[copies, col] = sim.time_ms[copies]
+
+    def _local_pose(self, col: int, copy: int) -> Pose:
+        """The camera's pose in its robot's frame in one copy: riding a joint, that copy's
+        (batched_joints.py: ``displacement ∘ mount``, as the single device's ``move_with``)."""
+        rider = (self.kind, col)
+        joints = self.sim.joints
+        if rider in joints.riders:
+            return Pose(joints.local_rot[rider][copy], joints.local_pos[rider][copy])
+        return self.devices[col].template.local_pose
 
     def _occlusion(self, col: int, copies: np.ndarray, rec: Recognizer, seen: list) -> list:
         """Occlusion 1 of every copy's candidates (Recognizer._origin_visible): their rays to the
