@@ -420,3 +420,22 @@ def test_the_center_of_mass_follows_a_turned_joint(tmp_path):
         pytest.approx([0.0, 0.15, 0.15], abs=1e-12)
     assert lv.ok(A, "/arm/robot/get_node_center_of_mass", {"node": link})["value"] == \
         pytest.approx([0.0, 0.2, 0.2], abs=1e-12)
+
+
+def test_a_bounding_sphere_of_radius_0_is_webots_unit_sphere_for_mass_and_fall(tmp_path):
+    """Webots resets a non-positive Sphere radius to 1 (the node's own rule, a bounding object too): the
+    solid weighs 1000 × 4/3 π, falls onto the floor like a unit ball and answers its centre."""
+    path = tmp_path / "radius0.wbt"
+    path.write_text('#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n'
+                    'Solid {\n  translation 0 0 -0.5\n  name "floor"\n  boundingObject Box { size 10 10 1 }\n}\n'
+                    'DEF BALL Solid {\n  translation 2 0 3\n  name "ball"\n'
+                    '  boundingObject Sphere { radius 0 }\n  physics Physics { }\n}\n'
+                    'Robot { translation -3 0 0 name "bot" supervisor TRUE controller "<extern>" }\n')
+    done = wbt_convert(path)
+    assert done.warnings == [f"{path}:11:27: Sphere.radius: 0 is not > 0; using 1 (as Webots does)"]
+    ball = {s.name: s for s in load_world(path).world.solids}["ball"]
+    assert ball.mass.kg == pytest.approx(1000 * 4 / 3 * math.pi, rel=1e-12)
+    assert tuple(ball.mass.center) == (0.0, 0.0, 0.0)
+    lv = _live(path)
+    lv.step(A, "bot")
+    assert com(lv, "BALL") == pytest.approx([2.0, 0.0, 1.0], abs=1e-12)    # resting on the floor's top, z = 0

@@ -162,18 +162,18 @@ def _parts(conv: Any, node: Node | None, rot: np.ndarray, at: np.ndarray, scale:
         return _parts(conv, f.node_("geometry"), rot, at, scale, meshes)
     s = np.broadcast_to(np.asarray(scale, dtype=np.float64), (3,))
     factor = float(abs(s[0] * s[1] * s[2]))     # a Transform's scale over a geometry (Webots keeps it uniform)
-    if t == "Box":
-        size = f.vec("size", (0.1, 0.1, 0.1))
-        return [(abs(size[0] * size[1] * size[2]) * factor, at)]
-    if t == "Sphere":
-        r = f.num("radius", 1.0)
-        return [(4.0 / 3.0 * math.pi * abs(r) ** 3 * factor, at)]
-    if t == "Cylinder":
-        r, h = f.num("radius", 1.0), f.num("height", 2.0)
-        return [(math.pi * r * r * abs(h) * factor, at)]
-    if t == "Capsule":
-        r, h = f.num("radius", 1.0), f.num("height", 2.0)
-        return [((math.pi * r * r * abs(h) + 4.0 / 3.0 * math.pi * abs(r) ** 3) * factor, at)]
+    if t in ("Box", "Sphere", "Cylinder", "Capsule"):
+        # the sizes the shape has: Webots' defaults, and its resets of a non-positive one (said at the field)
+        g, _ = conv.base_geometry(node, 1.0)
+        if t == "Box":
+            size = g["size"]
+            return [(size[0] * size[1] * size[2] * factor, at)]
+        r = g["radius"]
+        if t == "Sphere":
+            return [(4.0 / 3.0 * math.pi * r ** 3 * factor, at)]
+        h = g["height"]
+        cap = 4.0 / 3.0 * math.pi * r ** 3 if t == "Capsule" else 0.0
+        return [((math.pi * r * r * h + cap) * factor, at)]
     if t == "IndexedFaceSet":
         return _mesh_part(conv, node, rot, at, s)
     if t == "Mesh":
