@@ -132,6 +132,25 @@ def test_in_the_air_without_physics_or_no_top_solid(tmp_path):
         assert "exclusively be used with a top Solid" in message
 
 
+SHELF = (HEAD + FLOOR
+         + 'DEF SHELF Solid { translation 2 1 0.5 name "shelf" boundingObject Box { size 0.2 0.2 0.2 } children [ '
+         'DEF PUCK Solid { translation 0.5 0 -0.45 name "puck" boundingObject Sphere { radius 0.05 } physics Physics { } '
+         'children [ DEF PIN Solid { translation 0 0.3 -0.02 name "pin" boundingObject Sphere { radius 0.03 } } ] } '
+         'DEF PEG Solid { translation -0.5 0 -0.45 name "peg" boundingObject Sphere { radius 0.05 } } ] }\n'
+         + SUPERVISOR)
+
+
+def test_a_static_solid_touches_through_its_nested_solids_with_physics(tmp_path):
+    """Webots counts, with descendants, every contact of a body whose top solid is the one asked: a static
+    shelf's nested puck with Physics (and the pin merged into the puck's body) touch the floor, the shelf's
+    own box and its static peg never (ODE makes no contact between static geometries)."""
+    lv = _live(SHELF, tmp_path)
+    assert contacts(lv, "SHELF") == (pytest.approx(np.zeros((0, 3))), [])
+    points, ids = contacts(lv, "SHELF", True)
+    got = sorted((tuple(round(float(v), 12) + 0.0 for v in p), n) for p, n in zip(points, ids, strict=True))
+    assert got == sorted([((2.5, 1.0, 0.0), node(lv, "PUCK")), ((2.5, 1.3, 0.0), node(lv, "PIN"))])
+
+
 TABLE = (HEAD + 'Solid { translation 0 0 0.25 name "table" boundingObject Box { size 1 1 0.5 } }\n'
          + 'DEF PLANK Solid { translation 0.4 0 0.525 name "plank" boundingObject Box { size 0.4 0.1 0.05 } '
          'physics Physics { } }\n' + SUPERVISOR)

@@ -1342,8 +1342,10 @@ def static_balance(sim: Any, node: Node) -> bool:
 def contact_points(sim: Any, node: Node, descendants: bool) -> dict:
     """Webots' ``getContactPoints`` of a top-level solid or robot (sim/balance.py): where its bounding
     shapes (with ``descendants``, the solids' inside it too) touch the ground now, in world axes, each
-    with the id of the Solid whose shape touches (a nested solid's from the nested table); none without
-    physics (Webots' physics makes no contact for a static solid). Anything else: one line."""
+    with the id of the Solid whose shape touches (a nested solid's from the nested table); none from a static
+    solid's shapes (Webots' physics makes no contact between static geometries), but with ``descendants`` a
+    static top's nested solids with physics (and those inside them) touch as Webots' bodies do. Anything
+    else: one line."""
     if node.nested or node.visual or node.type not in ("Robot", "Solid"):
         raise ValueError("it can exclusively be used with a top Solid, not " + ("the root" if node.id == 0 else _what(node)))
     inside = [n for n in _table(sim).by_owner.get(node.id, ()) if n.shape is None and n.field != "jointParameters"]
@@ -1355,9 +1357,13 @@ def contact_points(sim: Any, node: Node, descendants: bool) -> dict:
         ids = [node.id if k < 0 or k >= len(inside) else inside[k].id for k in owners]
     else:
         model = next(s for s in sim.world.solids if s.name == node.key)
-        if not model.physics:
+        if not model.physics and not descendants:
             return {"points": [], "nodes": []}
         points, solids = balance.solid_contacts(sim, node.key, descendants)
+        if not model.physics:                   # a static top: only the nested solids physics moves touch
+            moving = balance.dynamic_solids(model)
+            keep = [k for k, s in enumerate(solids) if id(s) in moving]
+            points, solids = points.reshape(-1, 3)[keep], [solids[k] for k in keep]
         order: list[wm.Solid] = []               # the nested solids depth first, as nested.py numbers them
         stack = list(reversed(model.children))
         while stack:

@@ -26,7 +26,7 @@ from sensorium.server.sim.ground import Ground, hull_2d, over_support, support_p
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "lowest_points", "robot_balance",
+__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "dynamic_solids", "lowest_points", "robot_balance",
            "robot_contacts", "shapes_centre", "solid_balance", "solid_contacts", "touching"]
 
 CONTACT_TOL = FLOOR
@@ -213,6 +213,20 @@ def solid_contacts(sim: Any, name: str, descendants: bool) -> tuple[np.ndarray, 
     points, of = touching(_points(parts, sim.scene.solid_poses[name], sim.loaded.base_dir, to_enu),
                           sim.landing_ground(name))
     return _world(points, to_enu), [owners[k] for k in of]
+
+
+def dynamic_solids(model: wm.Solid) -> set[int]:
+    """The ids of the solids inside ``model`` that Webots' physics moves although ``model`` has no Physics:
+    each nested one with a Physics node (the import keeps a nested solid's Physics as its mass; one without
+    a volume to weigh has no shape that touches either) and every solid inside it (merged into its body)."""
+    moving: set[int] = set()
+    stack = [(child, False) for child in model.children]
+    while stack:
+        solid, inside_moving = stack.pop()
+        if inside_moving or solid.physics or solid.mass is not None or solid.pending_mass is not None:
+            moving.add(id(solid))
+        stack.extend((child, id(solid) in moving) for child in solid.children)
+    return moving
 
 
 def robot_contacts(sim: Any, state: Any, descendants: bool) -> tuple[np.ndarray, list[int]]:
