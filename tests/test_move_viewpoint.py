@@ -121,3 +121,31 @@ def test_a_c_supervisor_moves_the_viewpoint_the_same_way(tmp_path, tmp_path_fact
     assert ctl.out == ["before 0.000 0.000 0.000", f"after 2.000 {3 - distance(0.5):.3f} 1.000",
                        "reset 0.000 0.000 0.000"]
     assert "Error" not in ctl.stderr() and "Sanitizer" not in ctl.stderr(), ctl.stderr()
+
+
+def test_a_world_without_viewpoint_saves_the_moved_one_and_loads_it_back(tmp_path):
+    """Webots adds a default Viewpoint (at -10 0 0, looking along +x) to a file without one; moved by
+    moveViewpoint, worldSave writes where it went (its orientation, the default, left out) and the saved
+    world loads with the Viewpoint there: in front of the ball r = 0.5 at (2, 0, 1), d back along +x."""
+    from sensorium.server.daemon.export import world_string
+
+    path = tmp_path / "bare.wbt"
+    path.write_text('#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n'
+                    'Robot { name "boss" supervisor TRUE controller "<extern>" }\n'
+                    'DEF BALL Solid { translation 2 0 1 children [ Shape { geometry Sphere { radius 0.5 } } ] }\n')
+    lv = Live(Simulation(load_world(path)))
+    lv.ok(A, "attach", {"robot": "boss"})
+    assert "Viewpoint {\n}" in world_string(lv.sim)                       # not moved: Webots' empty node
+    ball = boss(lv, "get_from_def", {"name": "BALL"})["node"]
+    assert boss(lv, "move_viewpoint", {"node": ball}) == {"success": True}
+    moved = viewshot.viewpoint_of(lv.sim).position
+    np.testing.assert_allclose(moved, [2.0 - distance(0.5), 0.0, 1.0], atol=1e-6)   # the tessellated ball's sphere
+    saved = tmp_path / "saved.wbt"
+    saved.write_text(world_string(lv.sim))
+    text = saved.read_text()
+    assert "Viewpoint {\n  position " in text and "orientation" not in text
+    again = viewshot.viewpoint_of(Simulation(load_world(saved)))
+    assert tuple(again.position) == tuple(moved)                           # every bit: the shortest text of each
+    assert tuple(again.orientation) == (0.0, 0.0, 1.0, 0.0)
+    lv.sim.reset()                                                          # the reset: the added one as loaded
+    assert "Viewpoint {\n}" in world_string(lv.sim)

@@ -326,6 +326,16 @@ def node_string(sim: Any, node: sv.Node, writer: Writer | None = None) -> str:
     return writer.node(written, 0, _pose_first(fields))
 
 
+def _added_scenery(sim: Any, node: sv.Node, writer: Writer) -> str:
+    """A WorldInfo or Viewpoint Webots added where the file has none: the fields the server set on it since
+    it loaded (a Viewpoint moveViewpoint moved: its position; its orientation stays Webots' default, left
+    out as every default is), else an empty node."""
+    getters = sv.SCENERY_FIELDS.get(node.type, {})
+    fields = {name: written_value(getters[name][0], getters[name][1](sim, node))
+              for name in getters if name in sv._scenery(sim)[int(node.key)].fields}
+    return writer.node(ParsedNode(node.type, fields, 0, 0))
+
+
 def world_string(sim: Any) -> str:
     """Webots' ``worldSave``'s text: the header of the world file's version, its EXTERNPROTO declarations, then
     the root's children as :func:`node_string` writes them (NotExported: one line, nothing written)."""
@@ -349,7 +359,7 @@ def world_string(sim: Any) -> str:
             continue
         if at is None and node.id not in imported:
             if node.scenery:        # a WorldInfo or Viewpoint Webots adds where the file has none
-                lines.append(f"{node.type} {{\n}}")
+                lines.append(_added_scenery(sim, node, writer))
             continue                # the solid holding the file's shapes outside any solid: written as those shapes
         lines.append(node_string(sim, node, writer))
     return "\n".join(lines) + "\n"
