@@ -16,7 +16,8 @@ arithmetic (Pose.from_axis_angle on libm's cosine and sine, Pose.compose's stack
 device riding a moved link gets that copy's local pose, ``displacement ∘ mount`` (the single device's
 ``move_with``), in :attr:`BatchedJoints.local_rot` / ``local_pos``. (Measured: 256 copies, five joints
 on two robots, per-copy Links objects took 28 ms a step; the arrays take ~1 ms.) The batched
-simulation casts the rays of the distance sensors and fixed lidars riding joints from those poses, and
+simulation casts the rays of the distance sensors and lidars (a rotating one's sectors too: batched_lidar.py)
+riding joints from those poses, and
 places the light sensors, cameras and range finders riding them there (and measures the GPS,
 compasses, inertial units, gyros, accelerometers and altimeters riding them there: batched_kinematic.py);
 it refuses what else rides a joint (batched.py's ``_check_supported``): a link's shapes or lights
