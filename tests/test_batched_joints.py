@@ -1,13 +1,14 @@
 """Joint motors in the batched simulation (batched_joints.py): every copy's joints move by Webots'
 kinematic motor control and the distance sensors, light sensors, cameras (images, recognition,
-segmentation), range finders and fixed lidars riding them cast from each copy's link, bit for bit as the
+segmentation), range finders and lidars (fixed and rotating) riding them cast from each copy's link, bit for bit as the
 copy's own Simulation (a pan hinge carrying a distance sensor, a lidar, a light sensor and a camera on
 a driving robot, a slider carrying an infra-red sensor and a nested tilt hinge carrying another, a
 light sensor, a range finder and a camera,
 coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
 copy). Closed form: a pan turned a quarter makes its sensor read the side wall, and its light
 sensor face a lamp; a range finder turned back on its pan sees its own robot. What is not
-simulated is refused in one line (a link's shapes, a bumper on a joint, a rotating lidar on one)."""
+simulated is refused in one line (a link's shapes, a bumper's among them; an LED on a joint).
+A bumper on a joint without shapes reads its robot's contact, as in Simulation."""
 
 from __future__ import annotations
 
@@ -62,7 +63,8 @@ def pan_robot() -> dict:
                          "pose": {"translation": [0.1, 0, 0.1], "rotation": [0, 1, 0, 0.4]},
                          "lookup_table": [[-100, -100, 0.01], [100, 100, 0.01]]},
                         {"device": "Accelerometer", "name": "pan acc", "on_joint": "pan motor",
-                         "pose": {"translation": [0.12, 0.02, 0.1]}}]}
+                         "pose": {"translation": [0.12, 0.02, 0.1]}},
+                        {"device": "TouchSensor", "name": "pan bump", "on_joint": "pan motor"}]}
 
 
 def lift_robot() -> dict:
@@ -98,6 +100,11 @@ def lift_robot() -> dict:
                         {"device": "Accelerometer", "name": "tilt acc", "on_joint": "tilt",
                          "pose": {"translation": [0.1, 0.0, 0.3]}},
                         {"device": "Gyro", "name": "tilt gyro", "on_joint": "tilt"},
+                        {"device": "Lidar", "name": "tilt lidar", "on_joint": "tilt", "type": "rotating",
+                         "pose": {"translation": [0.05, 0.0, 0.3]}, "horizontal_resolution": 24,
+                         "field_of_view": 2 * math.pi, "number_of_layers": 2, "vertical_field_of_view": 0.2,
+                         "near": 0.01, "min_range": 0.05, "max_range": 3.0, "noise": 0.01,
+                         "default_frequency": 9.0, "min_frequency": 1.0, "max_frequency": 20.0},
                         laser("a ds", "arm::a", [0.0, 0.11, 0.05]),
                         laser("b ds", "arm::b", [0.0, -0.11, 0.05]),
                         laser("fixed ds", "lift motor", [-0.11, 0.0, 0.1])]}
@@ -150,9 +157,9 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
             batched.enable_segmentation(batched.device(robot, name), segment, copies=copies)
 
     devices = {"pan": ["pan enc", "pan ds", "pan lidar", "pan ls", "pan cam", "pan gps", "pan compass", "pan gyro",
-                       "pan acc"],
+                       "pan acc", "pan bump"],
                "lift": ["lift enc", "b enc", "lift ir", "tilt ds", "tilt ls", "tilt rf", "tilt cam", "tilt imu",
-                        "lift alt", "tilt acc", "tilt gyro", "a ds", "b ds", "fixed ds"]}
+                        "lift alt", "tilt acc", "tilt gyro", "a ds", "b ds", "fixed ds", "tilt lidar"]}
     cameras = {("pan", "pan cam"): True, ("lift", "tilt cam"): False}     # recognition; segmentation
     for robot, names in devices.items():
         for name in names:
@@ -162,6 +169,8 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
     pan = batched.slot("pan")
     moved = set()
     seen: set[int] = set()
+    bumped: set[int] = set()
+    pan_ls_apart = False
     def single(seed: int) -> Simulation:
         sim = Simulation(w.world.model_copy(update={"world_info": w.world.world_info.model_copy(
             update={"random_seed": seed})}), precision=precision)
@@ -187,7 +196,7 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
                 for (robot, name), (p, v, a, f) in random_commands(rng).items():
                     singles[c].robot(robot).motor(name).command(p, v, a, f)
                     batched.joints.command(batched.slot(robot), name, p, v, a, f, copies=[c])
-            wheels = rng.uniform(-6.0, 6.0, size=(n, 2))
+            wheels = rng.uniform(-2.0, 10.0, size=(n, 2))     # mostly ahead: the robots meet walls (bumper)
             batched.set_wheels(pan, wheels[:, 0], wheels[:, 1])
             for c in range(n):
                 motors = singles[c].robot("pan").drive.motors
@@ -229,14 +238,18 @@ def test_every_copy_moves_its_joints_and_their_sensors_as_its_simulation_bit_for
                             assert batched.reading(ref, "quaternion")[c].tobytes() == dev.quaternion.tobytes()
                     else:
                         got = batched.value(ref)[c]
+                        if name == "pan bump" and got == 1.0:
+                            bumped.add(c)
                         assert np.float64(got).tobytes() == np.float64(dev.value).tobytes(), (t, c, name, got,
                                                                                            dev.value)
+        pan_ls_apart |= len({float(v) for v in batched.value(batched.device("pan", "pan ls"))}) == n
     assert moved == {"pan motor", "lift motor", "tilt", "arm::a", "arm::b"}
+    assert bumped                 # the bumper on the pan did feel a wall in some copy
     # the joints' sensors did read different things in different copies (each its own link)
     assert len({float(v) for v in batched.value(batched.device("pan", "pan ds"))}) == n
-    assert len({float(v) for v in batched.value(batched.device("pan", "pan ls"))}) == n
+    assert pan_ls_apart            # at some step, each copy's its own value
     assert len({float(v) for v in batched.value(batched.device("lift", "tilt ls"))}) == n
-    for name in ("pan cam", "tilt rf"):
+    for name in ("pan cam", "tilt rf", "tilt lidar"):
         ref = batched.device("pan" if name == "pan cam" else "lift", name)
         got = batched.image(ref) if name == "pan cam" else batched.range_image(ref)
         assert len({got[c].tobytes() for c in range(n)}) == n, name
@@ -270,6 +283,59 @@ lookup table gives 1000 per metre)."""
     batched.enable(ref, STEP, copies=[1])
     batched.step()
     assert batched.value(ref) == pytest.approx([900.0, 900.0], abs=1e-6)
+
+
+def test_a_rotating_lidar_on_a_pan_turned_a_quarter_sees_the_side_wall_where_it_saw_the_front_one():
+    """A one-layer rotating lidar (8 columns round the circle) on a pan axis at the origin, a wall
+    whose near face is at x = 1 and one at y = 0.5. After full sweeps, copy 0 reads 1.0 m in the
+    column looking along +x; copy 1 turned its pan a quarter first: that column now looks along +y
+    and reads the side wall at 0.5 m, and the one that read 0.5 m in copy 0 looks along -x, where
+    nothing is within 3 m (inf)."""
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": False},
+                     "solids": [wall("front", 1.05, 0, 0.1, 8), wall("left", 0, 0.55, 8, 0.1)],
+                     "robots": [{"name": "r", "devices": [
+                         {"device": "RotationalMotor", "name": "pan", "axis": [0, 0, 1], "max_velocity": 100.0,
+                          "max_torque": 1e5},
+                         {"device": "Lidar", "name": "spin", "on_joint": "pan", "type": "rotating",
+                          "pose": {"translation": [0, 0, 0.3]}, "horizontal_resolution": 8,
+                          "number_of_layers": 1, "vertical_field_of_view": 0.0,
+                          "field_of_view": 2 * math.pi, "near": 0.01, "min_range": 0.01, "max_range": 3.0,
+                          "default_frequency": 10.0, "min_frequency": 1.0, "max_frequency": 20.0}]}]})
+    batched = BatchedSimulation(w, 2)
+    ref = batched.device("r", "spin")
+    batched.enable(ref, STEP)
+    batched.joints.command(0, "pan", position=math.pi / 2, copies=[1])
+    batched.run(30)                     # three turns of the head
+    assert batched.joints.position[:, 0].tolist() == [0.0, math.pi / 2]
+    img = batched.range_image(ref)[:, 0, :]
+    front = int(np.flatnonzero(np.isclose(img[0], 1.0))[0])
+    side = int(np.flatnonzero(np.isclose(img[0], 0.5))[0])
+    assert img[1, front] == pytest.approx(0.5, abs=1e-9)
+    assert np.isinf(img[1, side])
+
+
+def test_a_bumper_on_a_pan_reads_its_robots_contact_in_the_copy_that_drove_into_the_wall():
+    """A 0.1 m radius robot at the origin, a wall whose near face is at x = 0.3, a bumper without
+    shapes on its pan. Copy 0 drives at 0.3 m/s for 1.6 s: contact stops it at x = 0.2 and its
+    bumper reads 1; copy 1 stands still with its pan turned a quarter: 0."""
+    w = parse_world({"world_info": {"basic_time_step": STEP, "contact": True},
+                     "solids": [wall("front", 0.35, 0, 0.1, 8)],
+                     "robots": [{"name": "r", "body": {"geometry": {"type": "cylinder", "radius": 0.1, "height": 0.1}},
+                                 "differential_drive": {"wheel_radius": 0.03, "axle_length": 0.15,
+                                                        "max_wheel_speed": 10.0},
+                                 "devices": [
+                         {"device": "RotationalMotor", "name": "pan", "axis": [0, 0, 1], "max_velocity": 100.0,
+                          "max_torque": 1e5},
+                         {"device": "TouchSensor", "name": "bump", "on_joint": "pan"}]}]})
+    batched = BatchedSimulation(w, 2)
+    ref = batched.device("r", "bump")
+    batched.enable(ref, STEP)
+    batched.joints.command(0, "pan", position=math.pi / 2, copies=[1])
+    batched.set_wheels(0, np.array([10.0, 0.0]), np.array([10.0, 0.0]))
+    batched.run(100)
+    assert batched.pose(0, 0).translation[0] == pytest.approx(0.2, abs=2e-3)
+    assert batched.pose(1, 0).translation[0] == 0.0
+    assert batched.value(ref).tolist() == [1.0, 0.0]
 
 
 def test_a_light_sensor_on_a_pan_faces_the_lamp_in_the_copy_that_turned_it():
@@ -320,14 +386,15 @@ def test_a_range_finder_turned_back_on_its_pan_sees_its_own_robot():
     (lambda r: r.setdefault("shapes", []).append(
         {"name": "cup", "on_joint": "lift motor", "geometry": {"type": "box", "size": [0.05, 0.05, 0.05]}}),
      "robot 'lift': shape 'cup' rides joint 'lift motor'; the batched simulation moves no link's shapes"),
-    (lambda r: r["devices"].append({"device": "TouchSensor", "name": "bump", "on_joint": "tilt"}),
-     "robot 'lift': TouchSensor 'bump' rides joint 'tilt'; the batched simulation moves distance sensors, light "
-     "sensors, cameras, range finders, fixed lidars, GPS, compasses, inertial units, gyros, accelerometers and "
-     "altimeters on joints only"),
-    (lambda r: r["devices"].append({"device": "Lidar", "name": "spin", "on_joint": "tilt", "type": "rotating",
-                                    "horizontal_resolution": 8, "field_of_view": 6.28}),
-     "robot 'lift': rotating lidar 'spin' rides joint 'tilt'; the batched simulation moves fixed lidars on joints"),
-], ids=["link shape", "bumper", "rotating lidar"])
+    (lambda r: (r["devices"].append({"device": "TouchSensor", "name": "bump", "on_joint": "tilt"}),
+                r.setdefault("shapes", []).append({"name": "pad", "of_device": "bump", "on_joint": "tilt",
+                                                   "geometry": {"type": "box", "size": [0.02, 0.1, 0.05]}})),
+     "robot 'lift': shape 'pad' of 'bump' rides joint 'tilt'; the batched simulation moves no link's shapes"),
+    (lambda r: r["devices"].append({"device": "LED", "name": "lamp", "on_joint": "tilt"}),
+     "robot 'lift': LED 'lamp' rides joint 'tilt'; the batched simulation moves distance sensors, light "
+     "sensors, cameras, range finders, lidars, GPS, compasses, inertial units, gyros, accelerometers, "
+     "altimeters and bumpers without shapes on joints only"),
+], ids=["link shape", "bumper with shapes", "LED"])
 def test_what_rides_a_joint_and_is_not_simulated_is_refused_in_one_line(change, message):
     lift = lift_robot()
     change(lift)

@@ -45,11 +45,12 @@ drive and the two-wheel robots' wheels and moves are C passes within it.
 
 Joint motors (every motor that is no drive's wheel) move per copy by :mod:`~sensorium.server.sim.batched_joints`
 (``sim.joints.command``), before the drives as in Simulation.step; the distance sensors, light sensors,
-cameras, range finders and fixed lidars riding them cast from each copy's link, and the GPS, compasses,
-inertial units, gyros, accelerometers and altimeters riding them measure there. Steered-wheel robots
+cameras, range finders and lidars (rotating ones too) riding them cast from each copy's link, and the GPS, compasses,
+inertial units, gyros, accelerometers and altimeters riding them measure there (a bumper without shapes
+riding one reads its robot's contact). Steered-wheel robots
 (``steered_drive``) are driven by :mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``)
 at each copy's steering joints.
-A link's shapes or lights, other devices on a joint, rotating lidars on one, steered drives with free
+A link's shapes or lights, other devices on a joint, steered drives with free
 wheels and belts are refused (BatchedError, one line).
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
@@ -438,7 +439,8 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "
                                "carries solids; the batched simulation moves no belt (use Simulation)")
         for r in w.robots:            # joints move per copy (batched_joints.py); of what rides them, only devices
-            riding = [(f"shape {x.name!r}" if x.name else f"shapes[{i}]", x.on_joint) for i, x in enumerate(r.shapes)]
+            riding = [((f"shape {x.name!r}" if x.name else f"shapes[{i}]")
+                       + (f" of {x.of_device!r}" if x.of_device else ""), x.on_joint) for i, x in enumerate(r.shapes)]
             riding += [(f"lights[{i}]", x.on_joint) for i, x in enumerate(r.lights)]
             for what, joint in riding:    # the copies' robots are one rigid body each: no link moves in the cast
                 if joint is not None:
@@ -451,11 +453,8 @@ class BatchedSimulation:
                 if d.device not in batched_joints.RIDING_KINDS:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
                                        f"{joint!r}; the batched simulation moves distance sensors, light sensors, "
-                                       "cameras, range finders, fixed lidars, GPS, compasses, inertial units, gyros, "
-                                       "accelerometers and altimeters on joints only (use Simulation)")
-                if d.device == "Lidar" and d.type == "rotating":    # batched_lidar.py's heads turn on the body
-                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: rotating lidar {d.name!r} rides joint "
-                                       f"{joint!r}; the batched simulation moves fixed lidars on joints only "
+                                       "cameras, range finders, lidars, GPS, compasses, inertial units, gyros, "
+                                       "accelerometers, altimeters and bumpers without shapes on joints only "
                                        "(use Simulation)")
         # a VacuumGripper is not stepped here (no service turns its pump on): one on at load would carry a
         # solid in Simulation that stays put here, so it is refused rather than silently different

@@ -16,11 +16,12 @@ arithmetic (Pose.from_axis_angle on libm's cosine and sine, Pose.compose's stack
 device riding a moved link gets that copy's local pose, ``displacement ∘ mount`` (the single device's
 ``move_with``), in :attr:`BatchedJoints.local_rot` / ``local_pos``. (Measured: 256 copies, five joints
 on two robots, per-copy Links objects took 28 ms a step; the arrays take ~1 ms.) The batched
-simulation casts the rays of the distance sensors and fixed lidars riding joints from those poses, and
+simulation casts the rays of the distance sensors and lidars (a rotating one's sectors too: batched_lidar.py)
+riding joints from those poses, and
 places the light sensors, cameras and range finders riding them there (and measures the GPS,
 compasses, inertial units, gyros, accelerometers and altimeters riding them there: batched_kinematic.py);
 it refuses what else rides a joint (batched.py's ``_check_supported``): a link's shapes or lights
-(the copies' robots are one rigid template body each) and other devices.
+(the copies' robots are one rigid template body each: a bumper's own shapes among them) and other devices.
 """
 
 from __future__ import annotations
@@ -42,10 +43,11 @@ PLACED_KINDS = ("DistanceSensor", "LightSensor", "Lidar", "RangeFinder", "Camera
                 "Gyro", "Accelerometer", "Altimeter")
 """The devices riding a joint that the batched simulation places per copy (their local poses here)."""
 
-RIDING_KINDS = (*PLACED_KINDS, "PositionSensor", "RotationalMotor", "LinearMotor")
+RIDING_KINDS = (*PLACED_KINDS, "PositionSensor", "TouchSensor", "RotationalMotor", "LinearMotor")
 """What may ride a joint (``on_joint``) in the batched simulation: the sensors whose rays (and a
-light sensor's normal) start from each copy's link, encoders (which read a motor, wherever they sit) and the nested joints'
-motors."""
+light sensor's normal) start from each copy's link, encoders (which read a motor, wherever they sit),
+bumpers without shapes of their own (which read their robot's contact, wherever they sit: a bumper's
+shapes on a joint are a link's shapes, refused) and the nested joints' motors."""
 
 
 def joint_motors(robot: wm.Robot) -> list[wm.RotationalMotor | wm.LinearMotor]:

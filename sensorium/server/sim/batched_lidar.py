@@ -14,7 +14,8 @@ What the single device does, per copy:
   after a reset);
 * a sector's beams are the device's beams of those columns (layer-major, columns in sweep order),
   turned into the copy's world by the single ``_rotate``'s products and sums, from the stacked
-  ``Pose.compose`` the fixed lidars use; they go out as runs from one origin per copy, traced as
+  ``Pose.compose`` the fixed lidars use (a lidar riding a joint: its copy's local pose from
+  batched_joints.py, the head turning within it as in the single device); they go out as runs from one origin per copy, traced as
   coherent packets as the single device's one-origin cast is. Runs must have one length per cast,
   and a sector has one of two lengths (the sweep per step need not be a whole number of columns),
   so each length is a cast of its own (as range finders are: batched_depth.py);
@@ -115,8 +116,13 @@ class RotatingLidars:
         m = len(c)
         slot = lid.robot_index
         rr = sim.rot[c, slot]
-        rot = np.matmul(rr, lid.local_pose.rotation)                        # Pose.compose, stacked
-        org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + sim.pos[c, slot]
+        rider = ("Lidar", col)
+        if rider in sim.joints.riders:   # on a joint: each copy's local pose (batched_joints.py), the head
+            rot = np.matmul(rr, sim.joints.local_rot[rider][c])             # turning within it as in Simulation
+            org = np.matmul(rr, sim.joints.local_pos[rider][c][:, :, None])[:, :, 0] + sim.pos[c, slot]
+        else:
+            rot = np.matmul(rr, lid.local_pose.rotation)                    # Pose.compose, stacked
+            org = np.matmul(rr, lid.local_pose.translation[None, :, None])[:, :, 0] + sim.pos[c, slot]
         O, D, D32 = self._buffers(col, n, m * k)
         cuts = [0, *(np.flatnonzero(group[1:] != group[:-1]) + 1).tolist(), m]
         for a, b in zip(cuts[:-1], cuts[1:]):   # the copies of one sector: sensors._rotate's sums, in one pass
