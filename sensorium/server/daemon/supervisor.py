@@ -1323,14 +1323,19 @@ def center_of_mass(sim: Any, node: Node) -> list[float]:
     return [float(v) for v in sum(kg * p for kg, p in weighted) / total]
 
 
+def _top_solid(node: Node) -> None:
+    """Webots' refusal of a static-balance or contact-points query on anything but a top-level solid or robot."""
+    if node.nested or node.visual or node.type not in ("Robot", "Solid"):
+        raise ValueError("it can exclusively be used with a top Solid, not " + ("the root" if node.id == 0 else _what(node)))
+
+
 def static_balance(sim: Any, node: Node) -> bool:
     """Webots' ``getStaticBalance`` of a top-level solid or robot (sim/balance.py): with physics, whether
     its centre of mass (:func:`center_of_mass`; a solid given no mass: its shapes' volumes') seen from
     above is over the support polygon of where its bounding shapes touch the ground now; False without
     physics or touching nothing. Anything else: Webots' warning as the one line (the client answers
     false, as Webots' does)."""
-    if node.nested or node.visual or node.type not in ("Robot", "Solid"):
-        raise ValueError("it can exclusively be used with a top Solid, not " + ("the root" if node.id == 0 else _what(node)))
+    _top_solid(node)
     if node.type == "Robot":
         state = sim.robots[node.key]
         return state.model.mass is not None and balance.robot_balance(sim, state, center_of_mass(sim, node))
@@ -1346,8 +1351,7 @@ def contact_points(sim: Any, node: Node, descendants: bool) -> dict:
     solid's shapes (Webots' physics makes no contact between static geometries), but with ``descendants`` a
     static top's nested solids with physics (and those inside them) touch as Webots' bodies do. Anything
     else: one line."""
-    if node.nested or node.visual or node.type not in ("Robot", "Solid"):
-        raise ValueError("it can exclusively be used with a top Solid, not " + ("the root" if node.id == 0 else _what(node)))
+    _top_solid(node)
     inside = [n for n in _table(sim).by_owner.get(node.id, ()) if n.shape is None and n.field != "jointParameters"]
     if node.type == "Robot":
         state = sim.robots[node.key]

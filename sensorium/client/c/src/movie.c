@@ -74,10 +74,7 @@ static void args_start(sn_req *r, const void *arg) {
   sn_req_key(r, "acceleration");
   msgpack_pack_int(&r->pk, a->acceleration);
   sn_req_key(r, "caption");
-  if (a->caption)
-    msgpack_pack_true(&r->pk);
-  else
-    msgpack_pack_false(&r->pk);
+  sn_arg_bool(r, &a->caption);
 }
 
 static void server_stop(sn_robot *rb) {
