@@ -1,0 +1,198 @@
+"""Sweep 19: Webots' device samples for joints not run before (motor2, motor3, coupled_motors), each on a
+stand-in world of ours (tests/data/sweep19/: the sample's poses, sizes, joints and motors, our own text,
+PROTO shapes stood in for by plain ones) driven in process by the calls its controller makes and checked
+against closed forms: each motor by Webots' kinematic rule, each end point by its joint's turns."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_supervisor import A, Live
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+DATA = Path(__file__).parent / "data" / "sweep19"
+
+
+def rot(axis, angle: float) -> np.ndarray:
+    """Rodrigues: the rotation by ``angle`` about ``axis``."""
+    x, y, z = np.asarray(axis, dtype=np.float64) / np.linalg.norm(axis)
+    k = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
+    return np.eye(3) + math.sin(angle) * k + (1 - math.cos(angle)) * (k @ k)
+
+
+class KinematicMotor:
+    """Webots' kinematic motor control in position control (WbMotor::runKinematicControl), the closed
+    form a motor without physics follows: its speed (a magnitude) grows by a·dt a step up to maxVelocity,
+    a being maxTorque (the motor's acceleration is -1), and its position moves by speed·dt towards the
+    target, never past it; within 1e-6 of the target it rests and its speed drops to 0."""
+
+    def __init__(self, max_velocity: float, acceleration: float, position: float = 0.0):
+        self.v_max, self.a = max_velocity, acceleration
+        self.x, self.speed, self.target = position, 0.0, position
+
+    def step(self, dt: float) -> None:
+        to = self.target - self.x
+        if abs(to) < 1e-6:
+            self.speed = 0.0
+            return
+        if abs(self.v_max - self.speed) > 1e-6:
+            self.speed = min(self.speed + self.a * dt, self.v_max)
+        self.x = min(self.x + self.speed * dt, self.target) if to > 0 else max(self.x - self.speed * dt, self.target)
+
+
+def supervised(path: Path, tmp_path: Path) -> Live:
+    """The stand-in with ``supervisor TRUE`` on its robot (to read its end points' poses as Webots'
+    Supervisor does), attached."""
+    text = path.read_text().replace("DEF ROBOT Robot {", "DEF ROBOT Robot { supervisor TRUE name \"robot\"")
+    copy = tmp_path / path.name
+    copy.write_text(text)
+    lv = Live(Simulation(load_world(copy), "exact"))
+    lv.ok(A, "attach", {"robot": "robot"})
+    return lv
+
+
+def node_pose(lv: Live, name: str) -> tuple[np.ndarray, np.ndarray]:
+    node = lv.ok(A, "/robot/robot/get_from_def", {"name": name})["node"]
+    got = lv.ok(A, "/robot/robot/get_node_pose", {"node": node})
+    return np.array(got["position"]), np.array(got["orientation"]).reshape(3, 3)
+
+
+# ------------------------------------------------------------------------------------------ motor3
+# motor3: a BallJoint whose anchor is 0.11 m up, in a column turned -pi/2 about z: its axes (WbBallJoint:
+# jointParameters2's, jointParameters3's cross the first, jointParameters3's; Webots' defaults x, y, z)
+# are, in the world, Rz(-pi/2)·x = -y for "motor 3" (the joint's device), x for "motor 1" (device2) and z
+# for "motor 2" (device3). The bar's centre is 0.067 m above the anchor.
+M3_TURN = -1.570805
+M3_ANCHOR = np.array([0.0, 0.0, 0.11])
+M3_BAR = np.array([0.0, 0.0, 0.177])
+
+
+def motor3_targets(counter: int) -> dict[str, float]:
+    """What motor3.c asks at its step ``counter`` (after wb_robot_step)."""
+    fixed = {50: ("motor 1", 1.0), 100: ("motor 1", -1.0), 200: ("motor 1", 0.0), 300: ("motor 2", 1.0),
+             400: ("motor 2", -1.0), 500: ("motor 2", 0.0), 600: ("motor 3", 1.0), 700: ("motor 3", -1.0),
+             800: ("motor 3", 0.0)}
+    if counter in fixed:
+        name, q = fixed[counter]
+        return {name: q}
+    if counter > 900:
+        return {"motor 1": math.cos(0.01 * counter), "motor 2": math.sin(0.012 * counter),
+                "motor 3": math.cos(0.013 * counter)}
+    return {}
+
+
+def test_the_motor3_stand_in_loads_its_ball_joint_s_three_motors_on_webots_axes() -> None:
+    """The BallJoint's three motors load on WbBallJoint's axes turned with the column (-pi/2 about z):
+    "motor 3" about -y, "motor 1" about x riding on it, "motor 2" about z riding on "motor 1", all
+    through the anchor (0, 0, 0.11); one load line says the joint moves kinematically, and no drive is
+    looked for."""
+    w = load_world(DATA / "motor3.wbt")
+    assert len(w.warnings) == 1 and "BallJoint motor 'motor 3', 'motor 1', 'motor 2'" in w.warnings[0], w.warnings
+    robot = w.world.robots[0]
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    d = {m.name: m for m in robot.devices}
+    turn = rot((0, 0, 1), M3_TURN)
+    for name, axis, on in (("motor 3", (1, 0, 0), None), ("motor 1", (0, 1, 0), "motor 3"),
+                           ("motor 2", (0, 0, 1), "motor 1")):
+        assert d[name].axis == pytest.approx(turn @ axis, abs=1e-15), name
+        assert d[name].anchor == pytest.approx(M3_ANCHOR, abs=1e-15) and d[name].on_joint == on, name
+    assert (d["motor 1"].min_position, d["motor 1"].max_position) == (-math.pi / 2, math.pi / 2)
+
+
+def test_the_motor3_calls_turn_the_bar_about_the_ball_s_three_axes_by_the_kinematic_rule(tmp_path: Path) -> None:
+    """motor3.c's calls in process, 1200 steps of 32 ms (the world's default basic step): each motor
+    moves by Webots' kinematic rule (maxVelocity 1, maxTorque 10 as its acceleration), "motor 1" to 1,
+    −1 and 0 from step 50, "motor 2" from step 300, "motor 3" from 600, then all three following the
+    controller's cosines and sine from step 901 (1e-12). Each step the bar (DEF BAR, read as a Supervisor
+    reads it) is at anchor + R(a3, q3)·R(a1, q1)·R(z, q2)·(bar₀ − anchor), a3 and a1 Rz(−1.570805)·x ≈
+    −y and Rz(−1.570805)·y ≈ x, and turned by that rotation
+    (1e-12): the first axis carries the second, which carries the third, as WbBallJoint turns its end
+    point."""
+    lv = supervised(DATA / "motor3.wbt", tmp_path)
+    robot = lv.sim.robot("robot")
+    motors = {n: robot.motor(n) for n in ("motor 1", "motor 2", "motor 3")}
+    twin = {n: KinematicMotor(1.0, 10.0) for n in motors}
+    column = rot((0, 0, 1), M3_TURN)             # -pi/2 to 1e-5: the axes as the column turns them
+    axes = {"motor 3": column @ (1, 0, 0), "motor 1": column @ (0, 1, 0), "motor 2": (0.0, 0.0, 1.0)}
+    at0, turned0 = node_pose(lv, "BAR")
+    assert at0 == pytest.approx(M3_BAR, abs=1e-12)
+    assert turned0 == pytest.approx(rot((0, 0, 1), 2 * M3_TURN), abs=1e-12)
+    extremes = {n: [0.0, 0.0] for n in motors}
+    for counter in range(1, 1201):
+        lv.sim.step()
+        assert lv.sim.time_ms == 32 * counter
+        for n, m in twin.items():
+            m.step(0.032)
+            assert motors[n].position == pytest.approx(m.x, abs=1e-12), (counter, n)
+            extremes[n] = [min(extremes[n][0], m.x), max(extremes[n][1], m.x)]
+        turn = rot(axes["motor 3"], twin["motor 3"].x) @ rot(axes["motor 1"], twin["motor 1"].x) @ \
+            rot(axes["motor 2"], twin["motor 2"].x)
+        if counter % 10 == 0 or counter > 1150:
+            at, turned = node_pose(lv, "BAR")
+            assert at == pytest.approx(M3_ANCHOR + turn @ (M3_BAR - M3_ANCHOR), abs=1e-12), counter
+            assert turned == pytest.approx(turn @ turned0, abs=1e-12), counter
+        for n, q in motor3_targets(counter).items():
+            motors[n].set_position(q)
+            twin[n].target = q
+    # each fixed target is reached (1 rad at 1 rad/s after its 0.1 s ramp: within 50 steps of 32 ms)
+    assert all(e == [-1.0, 1.0] for e in extremes.values()), extremes
+
+
+# ------------------------------------------------------------------------------------------ motor2
+# motor2: a Hinge2Joint whose anchor is 0.13 m up, its first axis -x ("motor 1"), its second -y
+# ("motor 2", riding on the first); the block (DEF BLOCK) 0.026 m behind the head's axis.
+M2_ANCHOR = np.array([0.0, 0.0, 0.13])
+M2_HEAD = rot((0.5773509358554485, 0.5773489358556708, -0.5773509358554485), 2.0944)
+
+
+def motor2_targets(counter: int) -> dict[str, float]:
+    """What motor2.c asks at its step ``counter`` (after wb_robot_step)."""
+    fixed = {50: ("motor 1", 1.0), 100: ("motor 1", -1.0), 200: ("motor 1", 0.0), 300: ("motor 2", 1.0),
+             400: ("motor 2", -1.0)}
+    if counter in fixed:
+        name, q = fixed[counter]
+        return {name: q}
+    if counter > 500:
+        return {"motor 1": 0.5 * math.cos(0.01 * counter), "motor 2": 0.5 * math.sin(0.003 * counter)}
+    return {}
+
+
+def test_the_motor2_calls_turn_the_head_about_its_two_axes_by_the_kinematic_rule(tmp_path: Path) -> None:
+    """motor2.c's calls in process, 800 steps of 32 ms: the Hinge2Joint's motors (maxVelocity 1,
+    maxTorque 10) follow Webots' kinematic rule to each target (1e-12), "motor 2" held at −1 from step
+    400 until the controller's sines take both from step 501; the block is at anchor + R(−x, q1)·R(−y,
+    q2)·(block₀ − anchor), turned by R(−x, q1)·R(−y, q2) from where the file puts it (1e-12). The load
+    says each motor once (the robot's only motorised joint: no drive looked for)."""
+    w = load_world(DATA / "motor2.wbt")
+    assert len(w.warnings) == 2 and all("is no wheel (the robot's only motorised joint)" in x for x in w.warnings)
+    d = {m.name: m for m in w.world.robots[0].devices}
+    assert (d["motor 1"].axis, d["motor 2"].axis) == ((-1.0, 0.0, 0.0), (0.0, -1.0, 0.0))
+    assert d["motor 2"].on_joint == "motor 1" and d["motor 2"].anchor == pytest.approx(M2_ANCHOR)
+    lv = supervised(DATA / "motor2.wbt", tmp_path)
+    robot = lv.sim.robot("robot")
+    motors = {n: robot.motor(n) for n in ("motor 1", "motor 2")}
+    twin = {n: KinematicMotor(1.0, 10.0) for n in motors}
+    block0 = M2_ANCHOR + M2_HEAD @ np.array([-0.026, 0.0, 0.0])
+    at0, turned0 = node_pose(lv, "BLOCK")
+    assert at0 == pytest.approx(block0, abs=1e-12)
+    assert turned0 == pytest.approx(M2_HEAD @ rot((0, 0, 1), 3.14159), abs=1e-12)
+    for counter in range(1, 801):
+        lv.sim.step()
+        for n, m in twin.items():
+            m.step(0.032)
+            assert motors[n].position == pytest.approx(m.x, abs=1e-12), (counter, n)
+        turn = rot((-1, 0, 0), twin["motor 1"].x) @ rot((0, -1, 0), twin["motor 2"].x)
+        if counter % 10 == 0 or counter > 780:
+            at, turned = node_pose(lv, "BLOCK")
+            assert at == pytest.approx(M2_ANCHOR + turn @ (block0 - M2_ANCHOR), abs=1e-12), counter
+            assert turned == pytest.approx(turn @ turned0, abs=1e-12), counter
+        if counter == 500:
+            assert (twin["motor 1"].x, twin["motor 2"].x) == (0.0, -1.0)
+        for n, q in motor2_targets(counter).items():
+            motors[n].set_position(q)
+            twin[n].target = q
