@@ -6,6 +6,7 @@ against closed forms: each motor by Webots' kinematic rule, each end point by it
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -48,7 +49,7 @@ class KinematicMotor:
 def supervised(path: Path, tmp_path: Path) -> Live:
     """The stand-in with ``supervisor TRUE`` on its robot (to read its end points' poses as Webots'
     Supervisor does), attached."""
-    text = path.read_text().replace("DEF ROBOT Robot {", "DEF ROBOT Robot { supervisor TRUE name \"robot\"")
+    text = re.sub(r"(DEF \w+ Robot \{)", r'\1 supervisor TRUE name "robot"', path.read_text(), count=1)
     copy = tmp_path / path.name
     copy.write_text(text)
     lv = Live(Simulation(load_world(copy), "exact"))
@@ -196,3 +197,82 @@ def test_the_motor2_calls_turn_the_head_about_its_two_axes_by_the_kinematic_rule
         for n, q in motor2_targets(counter).items():
             motors[n].set_position(q)
             twin[n].target = q
+
+
+# ---------------------------------------------------------------------------------- coupled_motors
+# coupled_motors: the gripper at (0.2, 0.5, 0) climbs its rod on a SliderJoint (z); each actuated link
+# turns about z through (0, ∓0.008) on the carriage (0.01 m up at slider 0) and holds its finger's pivot
+# 0.0399 m away, at (0.02869, ∓0.02787) from its anchor, where the finger's origin is. 16 ms steps of the
+# controller over the world's basic 8 ms; its cycle: 50 steps, close (0.42), 50, climb to 0.14 at 0.1 m/s,
+# 100, open (0), 50, down to 0, 100.
+GRIPPER = np.array([0.2, 0.5, 0.0])
+FINGERS = {"LEFT_FINGER": (np.array([0.0, -0.008, 0.01]), np.array([0.02869, -0.02787, 0.0]), 1.5708),
+           "RIGHT_FINGER": (np.array([0.0, 0.008, 0.01]), np.array([0.02869, 0.02787, 0.0]), 0.0)}
+
+
+def test_the_coupled_motors_stand_in_says_its_open_loops_and_couples_its_fingers() -> None:
+    """The gripper loads with its three motors: the unnamed LinearMotor is "linear motor" (Webots'
+    default name), the fingers' "motor::left finger" and "motor::right finger" (multiplier −1) ride on it;
+    each passive link's pivot ends in a SolidReference naming the finger, the loop of a parallelogram,
+    which no physics closes here: one load line each names it. No drive is looked for."""
+    w = load_world(DATA / "coupled_motors.wbt")
+    loops = [x for x in w.warnings if "ending in SolidReference" in x]
+    assert [x.split(": ", 1)[1] for x in loops] == [
+        f"HingeJoint ending in SolidReference {n!r}: the loop it closes is not closed here (no physics); "
+        f"{n!r} moves with the joints it is written in only" for n in ("left_gripper", "right_gripper")]
+    assert len(w.warnings) == 5, w.warnings       # and one line for each of the three motors' joints
+    robot = w.world.robots[0]
+    assert robot.differential_drive is None and robot.ackermann_drive is None
+    d = {m.name: m for m in robot.devices}
+    assert set(d) == {"linear motor", "motor::left finger", "motor::right finger"}
+    assert (d["motor::left finger"].on_joint, d["motor::right finger"].on_joint) == ("linear motor",) * 2
+    assert (d["motor::left finger"].multiplier, d["motor::right finger"].multiplier) == (1.0, -1.0)
+
+
+def test_the_coupled_motors_calls_close_lift_open_and_lower_the_gripper_by_the_kinematic_rule(tmp_path: Path) -> None:
+    """coupled_motors.c's calls in process for two cycles (700 steps of 16 ms): only "motor::left finger"
+    is commanded, and its coupled right finger takes −1 times each target (Webots' coupling). Each
+    motor follows Webots' kinematic rule (the fingers at maxVelocity 10 with maxTorque 10 as their
+    acceleration: 0.42 in 36 basic steps, 0.288 s; the slider at the 0.1 m/s set, maxForce 15: 0.14 m in
+    1.4 s) (1e-12). Each finger's origin is at its link's pivot, carriage anchor + slider + Rz(±q)·pivot,
+    as in Webots (1e-12), but turned by ±q with its link, where Webots' closed parallelogram keeps it
+    parallel to the carriage; the red block, which Webots' fingers grip and lift, stays on the table
+    (the fingers pass through it)."""
+    lv = supervised(DATA / "coupled_motors.wbt", tmp_path)
+    robot = lv.sim.robot("robot")
+    slider, left, right = (robot.motor(n) for n in ("linear motor", "motor::left finger", "motor::right finger"))
+    twins = {"slider": KinematicMotor(10.0, 15.0), "left": KinematicMotor(10.0, 10.0),
+             "right": KinematicMotor(10.0, 10.0)}
+    block0, _ = node_pose(lv, "OBJECT")
+    assert block0 == pytest.approx([0.255, 0.49, 0.01], abs=1e-12)
+    plan = {50: ("finger", 0.42), 100: ("slider", 0.14), 200: ("finger", 0.0), 250: ("slider", 0.0)}
+    closed_at, top_at = None, None
+    for step in range(1, 701):
+        for _ in range(2):                         # 16 ms: two basic steps of 8 ms
+            lv.sim.step()
+            for m in twins.values():
+                m.step(0.008)
+            if closed_at is None and twins["left"].x == 0.42:
+                closed_at = lv.sim.time_ms
+            if top_at is None and abs(twins["slider"].x - 0.14) < 1e-6:     # 175 steps of 0.0008 m
+                top_at = lv.sim.time_ms
+        got = (slider.position, left.position, right.position)
+        want = (twins["slider"].x, twins["left"].x, twins["right"].x)
+        assert got == pytest.approx(want, abs=1e-12), step
+        if step % 5 == 0:
+            lift = np.array([0.0, 0.0, twins["slider"].x])
+            for name, q in (("LEFT_FINGER", twins["left"].x), ("RIGHT_FINGER", twins["right"].x)):
+                anchor, pivot, yaw0 = FINGERS[name]
+                at, turned = node_pose(lv, name)
+                assert at == pytest.approx(GRIPPER + anchor + lift + rot((0, 0, 1), q) @ pivot, abs=1e-12), step
+                assert turned == pytest.approx(rot((0, 0, 1), yaw0 + q), abs=1e-12), step
+            assert node_pose(lv, "OBJECT")[0] == pytest.approx(block0, abs=1e-12), step
+        kind, target = plan.get(step % 350, (None, 0.0))
+        if kind == "finger":
+            left.set_position(target)              # the controller's one call reaches both fingers
+            twins["left"].target, twins["right"].target = target, -target
+        elif kind == "slider":
+            slider.set_position(target)
+            slider.set_velocity(0.1)
+            twins["slider"].target, twins["slider"].v_max = target, 0.1
+    assert (closed_at, top_at) == (800 + 288, 1600 + 1400)

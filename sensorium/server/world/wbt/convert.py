@@ -1869,7 +1869,12 @@ class Converter:
             self.warn(node, f"PositionSensor on a joint without a motor: reads the joint's position, "
                             f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)")
         if end is not None:
-            if end.type == "SolidReference":
+            if end.type == "SolidReference":      # a closed chain (a parallel gripper's linkage): Webots'
+                # physics closes it; here the joint is left out, so the Solid named moves only with
+                # the joints it is written in (a parallelogram's finger turns with its driven link)
+                name = self.fields(end).string("solidName", "")
+                self.warn(node, f"{node.type} ending in SolidReference {name!r}: the loop it closes is not "
+                                f"closed here (no physics); {name!r} moves with the joints it is written in only")
                 return
             self.tree_field = "endPoint"
             if moving:          # what the end point holds rides on this joint (its innermost motor's)
