@@ -7,10 +7,12 @@ from __future__ import annotations
 
 import math
 import re
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _serve import child_env, sensorium
 from test_supervisor import A, Live
 
 from sensorium.server.sim.simulation import Simulation
@@ -276,3 +278,81 @@ def test_the_coupled_motors_calls_close_lift_open_and_lower_the_gripper_by_the_k
             slider.set_velocity(0.1)
             twins["slider"].target, twins["slider"].v_max = target, 0.1
     assert (closed_at, top_at) == (800 + 288, 1600 + 1400)
+
+
+COUPLED_CONTROLLER = '''\
+# Sensorium's test controller making coupled_motors.c's calls (Webots' sample), printing what it asked and
+# what the coupled right finger took.
+from controller import Robot
+
+robot = Robot()
+linear_motor = robot.getDevice("linear motor")
+motor = robot.getDevice("motor::left finger")
+right = robot.getDevice("motor::right finger")
+
+
+def wait(n):
+    for _ in range(n):
+        if robot.step(16) == -1:
+            raise SystemExit(0)
+
+
+while True:
+    wait(50)
+    motor.setPosition(0.42)
+    print(f"close {round(robot.getTime() * 1000)} right target {right.getTargetPosition():g}", flush=True)
+    wait(50)
+    linear_motor.setPosition(0.14)
+    linear_motor.setVelocity(0.1)
+    wait(100)
+    motor.setPosition(0)
+    print(f"open {round(robot.getTime() * 1000)} right target {right.getTargetPosition():g}", flush=True)
+    wait(50)
+    linear_motor.setPosition(0)
+    wait(100)
+'''
+
+FINGER_WATCHER = '''\
+import math
+from controller import Supervisor
+
+sup = Supervisor()
+fingers = [sup.getFromDef(n) for n in ("LEFT_FINGER", "RIGHT_FINGER")]
+while sup.step(8) != -1:
+    t = round(sup.getTime() * 1000)
+    if t in (1088, 3000, 3200, 3488, 5600):
+        for name, node in zip("LR", fingers):
+            p, r = node.getPosition(), node.getOrientation()
+            print(f"{name} {t} {p[0]:.9f} {p[1]:.9f} {p[2]:.9f} {math.atan2(r[3], r[0]):.9f}", flush=True)
+'''
+
+
+@pytest.mark.slow
+def test_the_coupled_motors_calls_under_sensorium_run_move_both_fingers_and_the_carriage(tmp_path: Path) -> None:
+    """Our Python controller making coupled_motors.c's calls under ``sensorium run`` for 6 s, a watcher
+    Supervisor printing the fingers' poses: the one command to "motor::left finger" gives the right
+    finger −0.42 (its getTargetPosition), and each finger is where the closed form puts it (1e-9): closed
+    at 1.088 s, carried 0.14 m up at 3.0 s, open again 0.288 s after 3.2 s, down by 5.6 s."""
+    (tmp_path / "worlds").mkdir()
+    world = tmp_path / "worlds" / "coupled_motors.wbt"
+    world.write_text((DATA / "coupled_motors.wbt").read_text() +
+                     'Robot { name "watcher" supervisor TRUE controller "watcher" }\n')
+    for name, source in (("coupled_motors", COUPLED_CONTROLLER), ("watcher", FINGER_WATCHER)):
+        (tmp_path / "controllers" / name).mkdir(parents=True)
+        (tmp_path / "controllers" / name / f"{name}.py").write_text(source)
+    done = subprocess.run(sensorium("run", str(world), "--until", "6000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    said = [x.split("] ", 1)[1] for x in done.stdout.splitlines() if x.startswith("[robot] ")]
+    assert said[:2] == ["close 800 right target -0.42", "open 3200 right target -0"], done.stdout[-2000:]
+    poses = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("[watcher] "):
+            name, t, *values = line.split("] ", 1)[1].split()
+            poses[name, int(t)] = [float(v) for v in values]
+    for t, q, lift in ((1088, 0.42, 0.0), (3000, 0.42, 0.14), (3488, 0.0, 0.14), (5600, 0.0, 0.0)):
+        for name, key, sign in (("L", "LEFT_FINGER", 1), ("R", "RIGHT_FINGER", -1)):
+            anchor, pivot, yaw0 = FINGERS[key]
+            at = GRIPPER + anchor + [0.0, 0.0, lift] + rot((0, 0, 1), sign * q) @ pivot
+            assert poses[name, t] == pytest.approx([*at, yaw0 + sign * q], abs=1e-9), (name, t)
