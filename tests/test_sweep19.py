@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import math
 import re
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -54,6 +55,7 @@ def supervised(path: Path, tmp_path: Path) -> Live:
     text = re.sub(r"(DEF \w+ Robot \{)", r'\1 supervisor TRUE name "robot"', path.read_text(), count=1)
     copy = tmp_path / path.name
     copy.write_text(text)
+    shutil.copytree(path.parent / "protos", tmp_path / "protos", dirs_exist_ok=True)   # its stand-in PROTOs
     lv = Live(Simulation(load_world(copy), "exact"))
     lv.ok(A, "attach", {"robot": "robot"})
     return lv
@@ -356,3 +358,68 @@ def test_the_coupled_motors_calls_under_sensorium_run_move_both_fingers_and_the_
             anchor, pivot, yaw0 = FINGERS[key]
             at = GRIPPER + anchor + [0.0, 0.0, lift] + rot((0, 0, 1), sign * q) @ pivot
             assert poses[name, t] == pytest.approx([*at, yaw0 + sign * q], abs=1e-9), (name, t)
+
+
+# ----------------------------------------------------------------------------- hinge_joint_with_backlash
+# hinge_joint_with_backlash: the rotor's hinge along x through (0.19, 0, 0) in our plain stand-in of the
+# HingeJointWithBacklash PROTO (tests/data/sweep19/protos/); the output's marker 0.005 m past the anchor,
+# 0.0075 m off the axis. The controller turns the rotor at ±0.2 rad/s, reversing once its sensor reads
+# past ±1.0471; its 16 ms steps are the world's 32 ms basic steps here (rounded up, as Webots does).
+BACKLASH_ANCHOR = np.array([0.19, 0.0, 0.0])
+
+
+class VelocityMotor:
+    """Webots' kinematic rule in velocity control (target +inf): the signed speed moves towards the
+    commanded velocity by at most a·dt a step (a: maxTorque 10 here), the position by speed·dt."""
+
+    def __init__(self, acceleration: float):
+        self.a, self.x, self.speed, self.velocity = acceleration, 0.0, 0.0, 0.0
+
+    def step(self, dt: float) -> None:
+        if abs(self.velocity - self.speed) > 1e-6:
+            self.speed = (min(self.speed + self.a * dt, self.velocity) if self.velocity > self.speed
+                          else max(self.speed - self.a * dt, self.velocity))
+        self.x += self.speed * dt
+
+
+def test_the_backlash_sample_s_rotor_swings_between_its_bounds_and_the_output_turns_with_it(tmp_path: Path) -> None:
+    """hinge_joint_with_backlash.c's calls in process for 60 s (1875 steps of 32 ms): the rotor reaches
+    0.2 rad/s in one step (maxTorque 10 as its acceleration: 0.32 rad/s a step), its sensor reads the
+    rule's angle at every step (1e-12) and the controller reverses it the step after it reads past
+    ±1.0471: first at 5.248 s (164 steps of 0.0064 rad: 1.0496), then every 10.528 s at −1.0534 and
+    1.0496 in turn (329 steps: the speed turns over in two, 0.2, −0.12, −0.2, then 328 of 0.0064 rad). The output (DEF OUTPUT) turns with the rotor about x
+    through the anchor (1e-12, as a Supervisor reads it): our stand-in PROTO's inner hinge stays at 0,
+    where Webots' physics lets the output lag up to the 0.4 rad backlash behind the rotor after each
+    reversal, pushed by the gear's stops."""
+    w = load_world(DATA / "hinge_joint_with_backlash.wbt")
+    assert len(w.warnings) == 1 and "HingeJoint motor 'rotor motor' is no wheel" in w.warnings[0], w.warnings
+    lv = supervised(DATA / "hinge_joint_with_backlash.wbt", tmp_path)
+    robot = lv.sim.robot("robot")
+    motor, sensor = robot.motor("rotor motor"), lv.sim.device("robot/rotor sensor")
+    sensor.enable(32)
+    motor.set_position(math.inf)
+    motor.set_velocity(0.2)
+    twin = VelocityMotor(10.0)
+    twin.velocity = 0.2
+    at0, turned0 = node_pose(lv, "OUTPUT")
+    assert at0 == pytest.approx([0.0, 0.0, 0.0], abs=1e-12) and turned0 == pytest.approx(np.eye(3), abs=1e-12)
+    reversals = []
+    for k in range(1, 1876):
+        lv.sim.step()
+        twin.step(0.032)
+        position = float(sensor.value)
+        assert position == pytest.approx(twin.x, abs=1e-12), k
+        if k % 25 == 0:
+            at, turned = node_pose(lv, "OUTPUT")
+            turn = rot((1, 0, 0), twin.x)
+            assert turned == pytest.approx(turn, abs=1e-12), k
+            assert at == pytest.approx(BACKLASH_ANCHOR - turn @ BACKLASH_ANCHOR, abs=1e-12), k
+        if position > 1.0471 and twin.velocity > 0 or position < -1.0471 and twin.velocity < 0:
+            reversals.append((lv.sim.time_ms, round(position, 4)))
+        if position > 1.0471:
+            motor.set_velocity(-0.2)
+            twin.velocity = -0.2
+        elif position < -1.0471:
+            motor.set_velocity(0.2)
+            twin.velocity = 0.2
+    assert reversals == [(5248 + 10528 * i, (1.0496, -1.0534)[i % 2]) for i in range(6)]
