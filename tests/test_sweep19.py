@@ -6,6 +6,7 @@ against closed forms: each motor by Webots' kinematic rule, each end point by it
 from __future__ import annotations
 
 import math
+import os
 import re
 import shutil
 import subprocess
@@ -316,6 +317,7 @@ while True:
 
 FINGER_WATCHER = '''\
 import math
+import os
 from controller import Supervisor
 
 sup = Supervisor()
@@ -423,3 +425,74 @@ def test_the_backlash_sample_s_rotor_swings_between_its_bounds_and_the_output_tu
             motor.set_velocity(0.2)
             twin.velocity = 0.2
     assert reversals == [(5248 + 10528 * i, (1.0496, -1.0534)[i % 2]) for i in range(6)]
+
+
+# ---------------------------------------------------------------------- motor3 under sensorium run
+# Webots' controller is Webots' file, never this repository's: the test copies it from $WEBOTS_HOME (an
+# installation or a source tree) into its temporary project, or, without it, our own C controller making
+# the same calls (tests/c/ball_joint_targets.c), builds it against our libController and runs the world.
+TESTS_C = Path(__file__).parent / "c"
+REPO = Path(__file__).resolve().parent.parent
+BAR_WATCHER = '''from controller import Supervisor
+
+sup = Supervisor()
+bar = sup.getFromDef("BAR")
+while sup.step(32) != -1:
+    t = round(sup.getTime() * 1000)
+    if t % 3200 == 0:
+        print(f"bar {t} " + " ".join(f"{v:.12f}" for v in bar.getPosition() + bar.getOrientation()), flush=True)
+'''
+
+
+@pytest.mark.slow
+def test_the_motor3_controller_under_sensorium_run_turns_the_bar_as_the_closed_form(tmp_path: Path) -> None:
+    """motor3 (Webots' C, unchanged, with WEBOTS_HOME; else tests/c/ball_joint_targets.c) built against our
+    libController, under ``sensorium run`` for 38.4 s with a watcher Supervisor: every 3.2 s the bar is where
+    the in-process closed form puts it (the kinematic rule on each motor, R(a3, q3)·R(a1, q1)·R(z, q2) about
+    the anchor; 1e-9)."""
+    if shutil.which("cc") is None or shutil.which("make") is None:
+        pytest.skip("needs a C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
+    build = tmp_path / "cbuild"
+    make = ["make", "-s", "-C", str(REPO / "sensorium" / "client" / "c")]
+    done = subprocess.run([*make, f"BUILD={build}"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    libs = subprocess.run([*make, "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+    folder = tmp_path / "controllers" / "motor3"
+    home = os.environ.get("WEBOTS_HOME")
+    webots = Path(home or "/nonexistent") / "projects" / "samples" / "devices" / "controllers" / "motor3" / "motor3.c"
+    folder.mkdir(parents=True)
+    shutil.copy(webots if webots.is_file() else TESTS_C / "ball_joint_targets.c", folder / "motor3.c")
+    done = subprocess.run(["cc", f"-I{REPO / 'sensorium' / 'client' / 'c' / 'include'}", str(folder / "motor3.c"),
+                           "-o", str(folder / "motor3"), str(build / "libController.a"), *libs, "-lm"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    (tmp_path / "controllers" / "watcher").mkdir()
+    (tmp_path / "controllers" / "watcher" / "watcher.py").write_text(BAR_WATCHER)
+    (tmp_path / "worlds").mkdir()
+    world = tmp_path / "worlds" / "motor3.wbt"
+    world.write_text((DATA / "motor3.wbt").read_text() + 'Robot { name "watcher" supervisor TRUE controller "watcher" }\n')
+    done = subprocess.run(sensorium("run", str(world), "--until", "38400", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    printed = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("[watcher] bar "):
+            t, *values = line.split()[2:]
+            printed[int(t)] = np.array([float(v) for v in values])
+    assert sorted(printed) == [3200 * i for i in range(1, 13)], done.stdout[-2000:]
+    column = rot((0, 0, 1), M3_TURN)
+    axes = {"motor 3": column @ (1, 0, 0), "motor 1": column @ (0, 1, 0), "motor 2": (0.0, 0.0, 1.0)}
+    twin = {n: KinematicMotor(1.0, 10.0) for n in axes}
+    turned0 = rot((0, 0, 1), 2 * M3_TURN)
+    for counter in range(1, 1201):
+        for m in twin.values():
+            m.step(0.032)
+        if 32 * counter in printed:
+            turn = rot(axes["motor 3"], twin["motor 3"].x) @ rot(axes["motor 1"], twin["motor 1"].x) @ \
+                rot(axes["motor 2"], twin["motor 2"].x)
+            got = printed[32 * counter]
+            assert got[:3] == pytest.approx(M3_ANCHOR + turn @ (M3_BAR - M3_ANCHOR), abs=1e-9), counter
+            assert got[3:].reshape(3, 3) == pytest.approx(turn @ turned0, abs=1e-9), counter
+        for n, q in motor3_targets(counter).items():
+            twin[n].target = q
