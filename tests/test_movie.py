@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_run import clib  # noqa: F401  (a fixture: our libController built once, for the C controllers)
 
 from sensorium.schemas.wire import ErrorCode
 from sensorium.server.daemon import supervisor as sv
@@ -283,6 +284,7 @@ class _FakeSupervisor:
     def __init__(self) -> None:
         import msgpack
         self.name, self.calls, self.step_end_hooks, self.close_hooks = "boss", [], [], []
+        self.terminated = False
         self.conn = self
         self._pack = msgpack.packb
 
@@ -313,3 +315,105 @@ def test_a_filename_with_a_nul_or_a_number_past_a_c_int_is_one_line_and_asks_the
     assert err == (f"Error: {func}() called with NULL or empty 'filename' argument.\n" if line is None
                    else f"Error: {func}(): {line}\n")
     assert fake.calls == [] and wb_movie.wb_supervisor_movie_get_status() == wb_movie.READY
+
+
+# ---------------------------------------------------------------------- a world reload while recording
+
+# `sensorium run`'s supervisor: records from 0, reloads the world at 320 ms (its first run); its steps answer -1,
+# the movie ends with the frames taken; with the argument "stay" it never leaves (killed 1 s on by `run`)
+RELOADER_PY = """import os, sys, time
+from controller import Supervisor
+boss = Supervisor()
+again = os.path.exists("reloaded")
+print("start", "again" if again else "first", boss.movieIsReady(), boss.movieFailed())
+if not again:
+    boss.movieStartRecording("m.mp4", 160, 120, 0, 90, 1, False)
+while boss.step(16) != -1:
+    if round(boss.getTime() * 1000) == 320 and not again:
+        open("reloaded", "w").close()
+        boss.worldReload()
+print("ended", round(boss.getTime() * 1000))
+if "stay" in sys.argv[1:] and not again:
+    while True:
+        time.sleep(0.05)
+while not boss.movieIsReady():          # (a step after -1 would end the process, as Webots' library does)
+    time.sleep(0.01)
+print("saved", boss.movieIsReady(), boss.movieFailed())
+"""
+
+RELOADER_C = r"""#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+#include <webots/robot.h>
+#include <webots/supervisor.h>
+
+int main(int argc, char **argv) {
+  wb_robot_init();
+  int again = access("reloaded", F_OK) == 0;
+  printf("start %s %s %s\n", again ? "again" : "first", wb_supervisor_movie_is_ready() ? "True" : "False",
+         wb_supervisor_movie_failed() ? "True" : "False");
+  if (!again)
+    wb_supervisor_movie_start_recording("m.mp4", 160, 120, 0, 90, 1, false);
+  while (wb_robot_step(16) != -1)
+    if (lround(wb_robot_get_time() * 1000) == 320 && !again) {
+      fclose(fopen("reloaded", "w"));
+      wb_supervisor_world_reload();
+    }
+  printf("ended %ld\n", lround(wb_robot_get_time() * 1000));
+  fflush(stdout);
+  struct timespec ts = {0, 10 * 1000 * 1000};
+  if (argc > 1 && strcmp(argv[1], "stay") == 0 && !again)
+    for (;;)
+      nanosleep(&ts, NULL);
+  while (!wb_supervisor_movie_is_ready())
+    nanosleep(&ts, NULL);
+  printf("saved %s %s\n", wb_supervisor_movie_is_ready() ? "True" : "False",
+         wb_supervisor_movie_failed() ? "True" : "False");
+  wb_robot_cleanup();
+  return 0;
+}
+"""
+
+ENDED_LINE = ("Warning: wb_supervisor_movie_start_recording(): the world ended while recording (a reload, a load, a "
+              "quit): the movie is written with its 10 frames; movieFailed() is then true, as Webots reports a "
+              "recording a world load cancels.")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("ffmpeg") is None or sys.platform == "win32", reason="needs ffmpeg (POSIX)")
+@pytest.mark.parametrize("stay", [False, True], ids=["leaves", "killed"])
+@pytest.mark.parametrize("which", ["python", "c"])
+def test_a_world_reload_while_recording_writes_the_movie_so_far_with_webots_status(tmp_path: Path, request, which,
+                                                                                  stay) -> None:
+    """Webots cancels a recording at a world (re)load (status SIMULATION_ERROR); here the frames taken until the
+    reload are the movie, complete and playable, and the status is Webots' once it is written: movieIsReady() and
+    movieFailed() true. A controller that never leaves after its -1 is killed by `sensorium run`; the movie is
+    still finished (the shell waiting for ffmpeg renames it). The reloaded world's controller starts idle."""
+    from test_run import compile_controller, project, run
+
+    text = WORLD.read_text().replace('controller "<extern>"', 'controller "boss"'
+                                           + (' controllerArgs [ "stay" ]' if stay else ""))
+    folder = tmp_path / "controllers" / "boss"
+    if which == "python":
+        world = project(tmp_path, "", {"boss.py": RELOADER_PY})
+    else:
+        world = project(tmp_path, "", {})
+        compile_controller(request.getfixturevalue("clib"), folder, "boss", RELOADER_C)
+    world.write_text(text)
+    proc = run(world, "--until", "640")
+    assert proc.wait(300) == 0, proc.stderr()
+    out = [line for line in proc.stdout().splitlines() if line.startswith("[boss]")]
+    first = ["[boss] start first True False", "[boss] ended 320"]
+    assert out == first + ([] if stay else ["[boss] saved True True"]) + [
+        "[boss] start again True False", "[boss] ended 640", "[boss] saved True False"], proc.stderr()
+    err = proc.stderr()
+    assert err.count(ENDED_LINE) == 1 and "Traceback" not in err and "Error" not in err, err
+    assert ("forced termination" in err) == stay, err
+    assert sorted(p.name for p in folder.iterdir() if p.suffix not in (".py", ".c") and p.name != "boss") == \
+        ["m.mp4", "reloaded"]                                   # no temporary left behind
+    frames = _decode(folder / "m.mp4")
+    assert len(frames) == 10                                    # 320 ms, a frame each 32 ms
+    assert np.abs(frames.reshape(10, -1, 3).mean(axis=1) - [FACE, 0, 0]).max() <= 6

@@ -151,6 +151,60 @@ def test_a_static_solid_touches_through_its_nested_solids_with_physics(tmp_path)
     assert got == sorted([((2.5, 1.0, 0.0), node(lv, "PUCK")), ((2.5, 1.3, 0.0), node(lv, "PIN"))])
 
 
+# a robot without Physics: its own box rests on the floor, a static foot beside it; its DEF ARM Solid with
+# Physics holds a box on the floor and, merged into its body, a HAND Solid without Physics holding a sphere
+ROVER = (HEAD + FLOOR
+         + 'DEF ROVER Robot { translation 2 3 0 name "rover" boundingObject Pose { translation 0 0 0.05 children [ '
+         'Box { size 0.1 0.1 0.1 } ] } children [ '
+         'DEF FOOT Solid { translation 0 -0.5 0.05 name "foot" boundingObject Box { size 0.1 0.1 0.1 } } '
+         'DEF ARM Solid { translation 0.5 0 0.05 name "arm" boundingObject Box { size 0.2 0.1 0.1 } physics Physics { } '
+         'children [ DEF HAND Solid { translation 0 0.3 -0.02 name "hand" boundingObject Sphere { radius 0.03 } } ] } ] }\n'
+         + SUPERVISOR)
+
+
+def test_a_robot_without_physics_touches_through_its_nested_solids_with_physics(tmp_path):
+    """Webots: a robot without Physics is static geometry (no contact with the floor, its static FOOT neither),
+    but its nested ARM with Physics is a body, the HAND merged into it: with descendants their contacts are the
+    robot's, named by the ids getFromDef gives them; the ARM's box's four bottom corners, the HAND's lowest point."""
+    lv = _live(ROVER, tmp_path)
+    assert contacts(lv, "ROVER") == (pytest.approx(np.zeros((0, 3))), [])
+    points, ids = contacts(lv, "ROVER", True)
+    arm, hand = node(lv, "ARM"), node(lv, "HAND")
+    got = sorted((tuple(round(float(v), 12) + 0.0 for v in p), n) for p, n in zip(points, ids, strict=True))
+    assert got == sorted([((2.5 + x, 3.0 + y, 0.0), arm) for x in (-0.1, 0.1) for y in (-0.05, 0.05)]
+                         + [((2.5, 3.3, 0.0), hand)])
+    assert sup(lv, "get_from_id", {"id": arm})["name"] == "arm"
+    assert sup(lv, "get_from_id", {"id": hand})["name"] == "hand"
+
+
+PAIR = (HEAD + FLOOR + "".join(
+    f'DEF {top} Solid {{ translation {x} 0 0.5 name "{top.lower()}" children [ '
+    f'DEF {top}_A Solid {{ translation 0.3 0 -0.45 name "a" boundingObject Sphere {{ radius 0.05 }} physics Physics {{ }} '
+    f'children [ DEF {top}_B Solid {{ translation 0 0.3 -0.02 name "b" boundingObject Sphere {{ radius 0.03 }} }} ] }} '
+    f'DEF {top}_C Solid {{ translation -0.3 0 -0.45 name "c" boundingObject Sphere {{ radius 0.05 }} physics Physics {{ }} }} ] }}\n'
+    for top, x in (("LEFT", 1), ("RIGHT", 3))) + SUPERVISOR)
+
+
+def test_nested_solids_are_named_by_the_ids_the_nested_table_gave_them_in_every_top_and_an_import(tmp_path):
+    """Two static tops with the same nested tree, then a third imported: each contact names the solid
+    getFromDef finds (its own top's, never the other's), an imported top's from the ids its import gave."""
+    lv = _live(PAIR, tmp_path)
+
+    def named(top: str) -> dict[tuple[float, ...], int]:
+        points, ids = contacts(lv, top, True)
+        return {tuple(round(float(v), 12) + 0.0 for v in p): n for p, n in zip(points, ids, strict=True)}
+
+    for top, x in (("LEFT", 1.0), ("RIGHT", 3.0)):
+        assert named(top) == {(x + 0.3, 0.0, 0.0): node(lv, f"{top}_A"), (x + 0.3, 0.3, 0.0): node(lv, f"{top}_B"),
+                              (x - 0.3, 0.0, 0.0): node(lv, f"{top}_C")}
+    text = PAIR.splitlines()[3].replace("LEFT", "THIRD").replace('"third"', '"third"').replace("translation 1 0 0.5",
+                                                                                              "translation 5 0 0.5")
+    sup(lv, "import_node_from_string", {"node": 0, "field": "children", "position": -1, "node_string": text})
+    assert named("THIRD") == {(5.3, 0.0, 0.0): node(lv, "THIRD_A"), (5.3, 0.3, 0.0): node(lv, "THIRD_B"),
+                              (4.7, 0.0, 0.0): node(lv, "THIRD_C")}
+    assert len({node(lv, f"{t}_A") for t in ("LEFT", "RIGHT", "THIRD")}) == 3
+
+
 TABLE = (HEAD + 'Solid { translation 0 0 0.25 name "table" boundingObject Box { size 1 1 0.5 } }\n'
          + 'DEF PLANK Solid { translation 0.4 0 0.525 name "plank" boundingObject Box { size 0.4 0.1 0.05 } '
          'physics Physics { } }\n' + SUPERVISOR)

@@ -1,14 +1,20 @@
 """A Supervisor's movies (``wb_supervisor_movie_*``): the server renders the Viewpoint's frames at
 the movie's frame times and this client pipes them, raw RGB, into an ``ffmpeg`` it starts (H.264 in
 an MP4 file, written to a temporary file beside the movie's and renamed onto it once complete: the
-server never writes a file a client names). ``ffmpeg`` is an optional system tool: without it on
-PATH a recording fails at its start with one line. Status values are Webots' (``WB_SUPERVISOR_MOVIE_*``).
+server never writes a file a client names). On POSIX a shell that waits for ffmpeg does the rename
+(:data:`FINISHER`), so a controller killed while ffmpeg completes the file (``sensorium run`` ends a
+controller 1 s after its last step) still leaves the movie. ``ffmpeg`` is an optional system tool:
+without it on PATH a recording fails at its start with one line. Status values are Webots'
+(``WB_SUPERVISOR_MOVIE_*``); the world ending while recording (a worldReload, a worldLoad, a quit: the
+step answers -1) ends the movie with the frames taken, its status Webots' for the recording its world
+load cancels (SIMULATION_ERROR) once the file is written.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from typing import Any
@@ -19,6 +25,11 @@ from sensorium.client.wb_supervisor import _supervisor
 
 READY, RECORDING, SAVING, WRITE_ERROR, ENCODING_ERROR, SIMULATION_ERROR = range(6)
 FINISH_WAIT_S = 600.0            # how long a controller ending waits for its movie's encoder
+FINISHER = ('f=$1 t=$2; shift 2; "$@" || { s=$?; rm -f -- "$t"; exit $s; }; '
+            'mv -f -- "$t" "$f" 2>/dev/null || { rm -f -- "$t"; exit 99; }')
+"""sh -c script run as ``FINISHER sh MOVIE TMP ffmpeg ARGS...``: ffmpeg, then TMP renamed onto MOVIE (exit 99: the
+rename failed; ffmpeg's own status when it failed), TMP removed unless renamed: whether or not the controller lives."""
+RENAME_FAILED = 99
 
 
 class Recorder:
@@ -32,6 +43,7 @@ class Recorder:
         self.tmp = ""
         self.frames = 0
         self.said_full = False
+        self.world_ended = False    # the world ended while recording: Webots' status for it once written
         robot.step_end_hooks.append(self.take)
         robot.close_hooks.append(self.finish)
 
@@ -67,10 +79,13 @@ class Recorder:
         self.filename = filename
         self.frames = 0
         self.said_full = False
+        self.world_ended = False
         command = [ffmpeg, "-hide_banner", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
                    "-s", f"{width}x{height}", "-framerate", f"{acceleration * 1000}/{step_ms}", "-i", "pipe:0",
                    "-an", "-c:v", "libx264", "-b:v", str(max(bitrate, 1000)), "-g", "132", "-pix_fmt", "yuv420p",
                    "-f", "mp4", self.tmp]
+        if os.name == "posix":
+            command = ["/bin/sh", "-c", FINISHER, "sh", self.filename, self.tmp, *command]
         try:
             self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                                             start_new_session=True)
@@ -86,6 +101,8 @@ class Recorder:
 
     def take(self) -> None:
         """After each step: the frames the server rendered, into the encoder."""
+        if self.status == RECORDING and self.robot.terminated:
+            self._end_with_world()
         if self.status != RECORDING or self.robot.terminated:
             return
         func = "wb_supervisor_movie_start_recording"
@@ -121,6 +138,18 @@ class Recorder:
         self.frames += 1
         return True
 
+    def _end_with_world(self) -> None:
+        """The world ended while recording (its step answered -1: a worldReload, a worldLoad, a quit): Webots
+        cancels the recording at a world load; here the frames taken so far are the movie, encoded at once
+        (while the controller is given its last second), its status Webots' once the file is written."""
+        self.world_ended = True
+        func = "wb_supervisor_movie_start_recording"
+        if self.frames:
+            print(f"Warning: {func}(): the world ended while recording (a reload, a load, a quit): the movie is "
+                  f"written with its {self.frames} frames; movieFailed() is then true, as Webots reports a recording "
+                  "a world load cancels.", file=sys.stderr)
+        self.stop(func)
+
     def _abort(self, func: str, why: str, status: int) -> None:
         """The recording ends without a movie: the encoder stopped, its file removed."""
         process, self.process = self.process, None
@@ -130,7 +159,13 @@ class Recorder:
                     process.stdin.close()
                 except OSError:
                     pass
-            process.kill()
+            try:
+                if os.name == "posix":      # its group: the shell that renames and ffmpeg
+                    os.killpg(process.pid, signal.SIGKILL)
+                else:
+                    process.kill()
+            except OSError:
+                pass
             process.wait()
         self._remove_tmp()
         self._fail(func, why, status)
@@ -143,6 +178,9 @@ class Recorder:
 
     def stop(self, func: str) -> None:
         if self.status != RECORDING:
+            return
+        if self.robot.terminated and not self.world_ended:
+            self._end_with_world()
             return
         if not self.robot.terminated:       # (the world ended: the frames taken so far are the movie)
             self.take()
@@ -162,6 +200,8 @@ class Recorder:
 
     def poll(self, wait: float | None = None) -> int:
         """Webots' status, the encoder's end looked at (waited for ``wait`` s when given)."""
+        if self.status == RECORDING and self.robot.terminated:
+            self._end_with_world()
         if self.status != SAVING or self.process is None:
             return self.status
         try:
@@ -171,14 +211,19 @@ class Recorder:
         if code is None:
             return self.status
         self.process = None
-        if code != 0:
+        if code == RENAME_FAILED and os.name == "posix":
+            self._remove_tmp()
+            self._fail("wb_supervisor_movie_stop_recording", f"cannot write {self.filename!r}: the encoded movie could "
+                       "not be renamed onto it", WRITE_ERROR)
+        elif code != 0:
             self._remove_tmp()
             self._fail("wb_supervisor_movie_stop_recording", f"ffmpeg failed to encode the movie (exit status {code})",
                        ENCODING_ERROR)
         else:
             try:
-                os.replace(self.tmp, self.filename)
-                self.status = READY
+                if os.path.exists(self.tmp):        # (no finisher shell: renamed here)
+                    os.replace(self.tmp, self.filename)
+                self.status = SIMULATION_ERROR if self.world_ended else READY
             except OSError as exc:
                 self._remove_tmp()
                 self._fail("wb_supervisor_movie_stop_recording",

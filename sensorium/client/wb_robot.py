@@ -368,12 +368,10 @@ class RobotClient:
             result = self.conn.wait(rid, timeout=None)
         except ConnectionLost as exc:
             print(f"sensorium: {exc}; ending the controller's steps", file=sys.stderr)
-            self.terminated = True
-            return -1
+            return self._steps_ended()
         except SensoriumError as exc:
             if exc.code == ErrorCode.SHUTTING_DOWN:
-                self.terminated = True
-                return -1
+                return self._steps_ended()
             if exc.code == ErrorCode.NOT_ATTACHED:
                 # the session was dropped (3 heartbeats of silence: a network stall, or this
                 # process was stopped); like a Webots extern controller whose simulation went
@@ -387,8 +385,7 @@ class RobotClient:
                                                  else "a network stall, or this process was stopped)"))
                 print(f"sensorium: {problem}; ending the controller's steps (start it again to re-attach)",
                       file=sys.stderr)
-                self.terminated = True
-                return -1
+                return self._steps_ended()
             raise
         status = int(result.get("status", 0))
         self.time_ms = int(result.get("time_ms", self.time_ms))
@@ -406,6 +403,13 @@ class RobotClient:
         for hook in self.step_end_hooks:
             hook()
         return status
+
+    def _steps_ended(self) -> int:
+        """The step answered no reply but the end of this controller's steps: -1, the hooks told (a movie ends)."""
+        self.terminated = True
+        for hook in self.step_end_hooks:
+            hook()
+        return -1
 
     def step(self, duration: int | None = None) -> int:
         if self.step_begin(duration) == -1:

@@ -89,6 +89,8 @@ class Nested:
     mass: wm.Mass | None = None   # a Solid's or device's Physics (supervisor.center_of_mass)
     at: tuple[int, ...] = ()      # (line, column) where its owner's file writes it (() none: a PROTO body's, or a node
                                   # in its parent's SF field, found there: export.py)
+    path: tuple[int, ...] = ()    # a top-level solid's nested Solid: its place among each parent's ``children`` from the
+                                  # top one down (wm.Solid.children indices): the key that names its model (contact points)
 
 
 @dataclass(slots=True)
@@ -208,12 +210,17 @@ Holder = tuple[Any, int, int, str, str]
 """A shape to number and where it is: (its model, its parent's id, its owner's id, "Robot" | "Solid", owner key)."""
 
 
-def _solid_holders(s: wm.Solid, holder: int, owner: int, key: str, solid_ids: dict[int, int]) -> list[Holder]:
+SolidIds = dict[tuple[int, tuple[int, ...]], int]
+"""(owner id, :attr:`Nested.path`) -> the nested solid's node id, as :func:`_solid_nodes` numbers them."""
+
+
+def _solid_holders(s: wm.Solid, holder: int, owner: int, key: str, solid_ids: SolidIds,
+                   path: tuple[int, ...] = ()) -> list[Holder]:
     """A top-level solid's shapes (``holder``: its id), then those of the solids inside it, depth first."""
     out: list[Holder] = [(shape, holder, owner, "Solid", key)
                          for shape in ([s] if s.geometry is not None else []) + list(s.shapes)]
-    for child in s.children:
-        out += _solid_holders(child, solid_ids[id(child)], owner, key, solid_ids)
+    for k, child in enumerate(s.children):
+        out += _solid_holders(child, solid_ids[owner, (*path, k)], owner, key, solid_ids, (*path, k))
     return out
 
 
@@ -292,27 +299,28 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
     return added
 
 
-def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Nested], solid_ids: dict[int, int],
+def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Nested], solid_ids: SolidIds,
                  tags: list[tuple[int, wm.InnerDef, int | str]], serials: dict[int, dict[int, int]]) -> None:
     """The solids inside top-level solid ``solid`` (node ``owner``, named ``key``) at any depth, appended to
-    ``out`` depth first, numbered from ``first`` on (``first + len(out)``); ``solid_ids`` gets each one's id
-    by ``id()`` of its model, ``tags`` the PROTO-body DEFs, ``serials`` the PROTO instances by number."""
+    ``out`` depth first, numbered from ``first`` on (``first + len(out)``), each with its :attr:`Nested.path`;
+    ``solid_ids`` gets each one's id by (owner, path), ``tags`` the PROTO-body DEFs, ``serials`` the PROTO
+    instances by number."""
 
-    def walk(s: wm.Solid, parent: int, at: Pose | None) -> None:
+    def walk(s: wm.Solid, parent: int, at: Pose | None, path: tuple[int, ...]) -> None:
         for k, child in enumerate(s.children):
             own = pose_from_model(child.pose)
             local = own if at is None else at.compose(own)
             node = Nested(first + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
                           local, own, "", owner, "Solid", key, order=float(k), mass=child.mass,
-                          at=tuple(child.written_at or ()))
+                          at=tuple(child.written_at or ()), path=(*path, k))
             out.append(node)
-            solid_ids[id(child)] = node.id
+            solid_ids[owner, node.path] = node.id
             if child.proto_scope is not None:
                 serials.setdefault(owner, {})[child.proto_scope] = node.id
             tags.extend((owner, t, node.id) for t in child.inner_defs)
-            walk(child, node.id, local)
+            walk(child, node.id, local, node.path)
 
-    walk(solid, owner, None)
+    walk(solid, owner, None, ())
     tags.extend((owner, t, t.why) for t in solid.inner_defs if t.why)
 
 
@@ -359,7 +367,7 @@ def build(sim: Any, loaded_solids: int) -> Table:
                               e.device or "", owner, "Robot", name, joints[k], above_id,
                               interface=tuple(e.interface), order=float(k), mass=e.mass,
                               at=tuple(e.written_at or ())))
-    solid_ids: dict[int, int] = {}          # id(nested solid model) -> its node id
+    solid_ids: SolidIds = {}
     for j in range(loaded_solids):
         _solid_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], FIRST_ID, out, solid_ids,
                      tags, serials)
@@ -400,7 +408,7 @@ def add_solid(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid) -> 
     and their nodes, with their PROTO-body DEFs), numbered from ``table.end`` on: new ids, never a removed
     node's. :func:`drop` takes them out when the solid goes."""
     out: list[Nested] = []
-    solid_ids: dict[int, int] = {}
+    solid_ids: SolidIds = {}
     tags: list[tuple[int, wm.InnerDef, int | str]] = []
     serials: dict[int, dict[int, int]] = {}
     _solid_nodes(solid, owner, key, table.end, out, solid_ids, tags, serials)

@@ -1347,36 +1347,35 @@ def static_balance(sim: Any, node: Node) -> bool:
 def contact_points(sim: Any, node: Node, descendants: bool) -> dict:
     """Webots' ``getContactPoints`` of a top-level solid or robot (sim/balance.py): where its bounding
     shapes (with ``descendants``, the solids' inside it too) touch the ground now, in world axes, each
-    with the id of the Solid whose shape touches (a nested solid's from the nested table); none from a static
-    solid's shapes (Webots' physics makes no contact between static geometries), but with ``descendants`` a
-    static top's nested solids with physics (and those inside them) touch as Webots' bodies do. Anything
-    else: one line."""
+    with the id of the Solid whose shape touches (a nested solid's as the nested table numbered it: a
+    robot's by its entry, a solid's by its path). Webots' physics makes no contact between static
+    geometries: a top without Physics touches through none of its own shapes, but with ``descendants``
+    through its nested solids with Physics (and those inside them, merged into their bodies), as Webots
+    counts every contact whose solid's top solid is the node. Anything else: one line."""
     _top_solid(node)
     inside = [n for n in _table(sim).by_owner.get(node.id, ()) if n.shape is None and n.field != "jointParameters"]
     if node.type == "Robot":
         state = sim.robots[node.key]
-        if state.model.mass is None:
+        static = state.model.mass is None
+        if static and not descendants:
             return {"points": [], "nodes": []}
         points, owners = balance.robot_contacts(sim, state, descendants)
+        if static:                              # only the nested solids physics moves touch
+            moving = balance.dynamic_entries(list(state.model.nodes))
+            keep = [k for k, owner in enumerate(owners) if owner in moving]
+            points, owners = points.reshape(-1, 3)[keep], [owners[k] for k in keep]
         ids = [node.id if k < 0 or k >= len(inside) else inside[k].id for k in owners]
     else:
         model = next(s for s in sim.world.solids if s.name == node.key)
         if not model.physics and not descendants:
             return {"points": [], "nodes": []}
-        points, solids = balance.solid_contacts(sim, node.key, descendants)
-        if not model.physics:                   # a static top: only the nested solids physics moves touch
-            moving = balance.dynamic_solids(model)
-            keep = [k for k, s in enumerate(solids) if id(s) in moving]
-            points, solids = points.reshape(-1, 3)[keep], [solids[k] for k in keep]
-        order: list[wm.Solid] = []               # the nested solids depth first, as nested.py numbers them
-        stack = list(reversed(model.children))
-        while stack:
-            child = stack.pop()
-            order.append(child)
-            stack.extend(reversed(child.children))
-        nested_solids = [n.id for n in inside if n.type == "Solid"]
-        by_model = {id(m): i for m, i in zip(order, nested_solids, strict=False)}
-        ids = [by_model.get(id(s), node.id) for s in solids]
+        points, paths = balance.solid_contacts(sim, node.key, descendants)
+        if not model.physics:
+            moving_paths = balance.dynamic_solids(model)
+            keep = [k for k, path in enumerate(paths) if path in moving_paths]
+            points, paths = points.reshape(-1, 3)[keep], [paths[k] for k in keep]
+        by_path = {n.path: n.id for n in inside if n.path}
+        ids = [by_path.get(path, node.id) for path in paths]
     return {"points": [float(v) for v in points.reshape(-1)], "nodes": ids}
 
 

@@ -26,8 +26,8 @@ from sensorium.server.sim.ground import Ground, hull_2d, over_support, support_p
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "dynamic_solids", "lowest_points", "robot_balance",
-           "robot_contacts", "shapes_centre", "solid_balance", "solid_contacts", "touching"]
+__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "dynamic_entries", "dynamic_solids",
+           "lowest_points", "robot_balance", "robot_contacts", "shapes_centre", "solid_balance", "solid_contacts", "touching"]
 
 CONTACT_TOL = FLOOR
 """m: a bounding shape's point at most this far above or below the ground under it touches it (kinematic
@@ -197,35 +197,46 @@ def _world(points: np.ndarray, to_enu: np.ndarray | None) -> np.ndarray:
     return points if to_enu is None else points @ to_enu
 
 
-def solid_contacts(sim: Any, name: str, descendants: bool) -> tuple[np.ndarray, list[wm.Solid]]:
+def solid_contacts(sim: Any, name: str, descendants: bool) -> tuple[np.ndarray, list[tuple[int, ...]]]:
     """Webots' ``getContactPoints`` of top-level solid ``name``: where its bounding shapes (and, with
     ``descendants``, those of the solids inside it) touch the ground a let-go solid lands on now
-    (:func:`touching`), in world axes, and for each point the solid model (the top one or a nested
-    child) whose shape touches there."""
+    (:func:`touching`), in world axes, and for each point the path of the solid whose shape touches there
+    (scene.owned_solid_parts: () the top one)."""
     from sensorium.server.sim.scene import owned_solid_parts
 
     model = next(s for s in sim.world.solids if s.name == name)
-    owned = [(owner, local, shape) for owner, _, local, shape in owned_solid_parts(model, Pose.identity())
-             if descendants or owner is model]
+    owned = [(path, local, shape) for path, _, local, shape in owned_solid_parts(model, Pose.identity())
+             if descendants or not path]
     parts = [(local, shape) for _, local, shape in owned]
-    owners = [owner for owner, _, shape in owned if _touches(shape)]
+    owners = [path for path, _, shape in owned if _touches(shape)]
     to_enu = _TO_ENU[sim.world.world_info.coordinate_system]
     points, of = touching(_points(parts, sim.scene.solid_poses[name], sim.loaded.base_dir, to_enu),
                           sim.landing_ground(name))
     return _world(points, to_enu), [owners[k] for k in of]
 
 
-def dynamic_solids(model: wm.Solid) -> set[int]:
-    """The ids of the solids inside ``model`` that Webots' physics moves although ``model`` has no Physics:
-    each nested one with a Physics node (the import keeps a nested solid's Physics as its mass; one without
-    a volume to weigh has no shape that touches either) and every solid inside it (merged into its body)."""
-    moving: set[int] = set()
-    stack = [(child, False) for child in model.children]
+def dynamic_solids(model: wm.Solid) -> set[tuple[int, ...]]:
+    """The paths (scene.owned_solid_parts) of the solids inside ``model`` that Webots' physics moves although
+    ``model`` has no Physics: each nested one with a Physics node (the import keeps a nested solid's Physics as
+    its mass; one without a volume to weigh has no shape that touches either) and every solid inside it (merged
+    into its body)."""
+    moving: set[tuple[int, ...]] = set()
+    stack: list[tuple[wm.Solid, tuple[int, ...], bool]] = [(child, (k,), False) for k, child in enumerate(model.children)]
     while stack:
-        solid, inside_moving = stack.pop()
+        solid, path, inside_moving = stack.pop()
         if inside_moving or solid.physics or solid.mass is not None or solid.pending_mass is not None:
-            moving.add(id(solid))
-        stack.extend((child, id(solid) in moving) for child in solid.children)
+            moving.add(path)
+        stack.extend((child, (*path, k), path in moving) for k, child in enumerate(solid.children))
+    return moving
+
+
+def dynamic_entries(nodes: list[wm.NestedNode]) -> set[int]:
+    """The indices in a robot's ``nodes`` of those Webots' physics moves although the robot has no Physics:
+    each with a Physics node (its mass) and every node inside one (a Solid there is merged into its body)."""
+    moving: set[int] = set()
+    for k, n in enumerate(nodes):          # (a parent is an earlier entry)
+        if n.mass is not None or n.pending_mass is not None or n.parent in moving:
+            moving.add(k)
     return moving
 
 

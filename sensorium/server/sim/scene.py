@@ -129,14 +129,16 @@ def solid_parts(solid: wm.Solid, frame: Pose) -> Iterator[tuple[str, Pose, wm.Sh
         yield name, pose, shape
 
 
-def owned_solid_parts(solid: wm.Solid, frame: Pose) -> Iterator[tuple[wm.Solid, str, Pose, wm.Shape | wm.Solid]]:
-    """:func:`solid_parts`, each with the solid (the top one or a nested child) whose shape it is."""
+def owned_solid_parts(solid: wm.Solid, frame: Pose, path: tuple[int, ...] = ()
+                      ) -> Iterator[tuple[tuple[int, ...], str, Pose, wm.Shape | wm.Solid]]:
+    """:func:`solid_parts`, each with the path of the solid whose shape it is: () the top one, a nested
+    child's its ``children`` index at each level (the Supervisor's nested table keys its nodes so)."""
     if solid.geometry is not None:
-        yield solid, solid.name, frame, solid
+        yield path, solid.name, frame, solid
     for part in solid.shapes:
-        yield solid, part.name or solid.name, frame.compose(pose_from_model(part.pose)), part
-    for child in solid.children:
-        yield from owned_solid_parts(child, frame.compose(pose_from_model(child.pose)))
+        yield path, part.name or solid.name, frame.compose(pose_from_model(part.pose)), part
+    for k, child in enumerate(solid.children):
+        yield from owned_solid_parts(child, frame.compose(pose_from_model(child.pose)), (*path, k))
 
 
 def solid_lights(solid: wm.Solid, frame: Pose, nested: bool = False

@@ -2,8 +2,11 @@
  * client's wb_movie.py. The server renders the Viewpoint's frames at the movie's frame times; this
  * library takes them after each step reply and writes them, raw RGB, into an ffmpeg it starts (H.264
  * in an MP4 file, written to a temporary file beside the movie's and renamed onto it once complete:
- * the server never writes a file a client names). Without ffmpeg on PATH a recording fails at its
- * start with one line. One robot per process, so the movie's state is this file's. */
+ * the server never writes a file a client names; a shell waiting for ffmpeg renames it, FINISHER, so a
+ * controller killed while ffmpeg completes the file still leaves the movie). The world ending while
+ * recording (the step answers -1) ends the movie with the frames taken, its status then Webots' for a
+ * recording its world load cancels. Without ffmpeg on PATH a recording fails at its start with one
+ * line. One robot per process, so the movie's state is this file's. */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <fcntl.h>
@@ -27,6 +30,12 @@
 extern char **environ;
 
 #define FINISH_WAIT_MS 600000 /* how long a controller ending waits for its movie's encoder */
+/* sh -c script run as FINISHER sh MOVIE TMP ffmpeg ARGS...: ffmpeg, then TMP renamed onto MOVIE (exit 99: the
+   rename failed; ffmpeg's own status when it failed), TMP removed unless renamed: whether or not we live */
+#define FINISHER                                                                                                     \
+  "f=$1 t=$2; shift 2; \"$@\" || { s=$?; rm -f -- \"$t\"; exit $s; }; "                                         \
+  "mv -f -- \"$t\" \"$f\" 2>/dev/null || { rm -f -- \"$t\"; exit 99; }"
+#define RENAME_FAILED 99
 
 static int g_status = WB_SUPERVISOR_MOVIE_READY;
 static pid_t g_encoder = -1;
@@ -34,6 +43,7 @@ static int g_pipe = -1;
 static char g_name[4096], g_tmp[4096 + 64];
 static long long g_frames;
 static bool g_said_full;
+static bool g_world_ended; /* the world ended while recording: Webots' status for it once written */
 
 static void fail(const char *func, const char *why, int status) {
   fprintf(stderr, "Error: %s(): %s.\n", func, why);
@@ -89,7 +99,7 @@ static void abort_movie(const char *func, const char *why, int status) {
     close(g_pipe);
   g_pipe = -1;
   if (g_encoder > 0) {
-    kill(g_encoder, SIGKILL);
+    kill(-g_encoder, SIGKILL); /* its group: the shell that renames and ffmpeg */
     waitpid(g_encoder, NULL, 0);
   }
   g_encoder = -1;
@@ -152,7 +162,8 @@ static void start(sn_robot *rb, const char *func, const char *filename, int widt
   snprintf(size, sizeof size, "%dx%d", width, height);
   snprintf(rate, sizeof rate, "%lld/%lld", (long long)acceleration * 1000, step_ms);
   snprintf(bits, sizeof bits, "%lld", bitrate);
-  char *argv[] = {ffmpeg, "-hide_banner", "-loglevel", "error", "-y", "-f", "rawvideo", "-pix_fmt", "rgb24",
+  char *argv[] = {"/bin/sh", "-c", FINISHER, "sh", g_name, g_tmp, ffmpeg, "-hide_banner", "-loglevel", "error", "-y",
+                  "-f", "rawvideo", "-pix_fmt", "rgb24",
                   "-s", size, "-framerate", rate, "-i", "pipe:0", "-an", "-c:v", "libx264", "-b:v", bits, "-g", "132",
                   "-pix_fmt", "yuv420p", "-f", "mp4", g_tmp, NULL};
   int fds[2];
@@ -172,7 +183,7 @@ static void start(sn_robot *rb, const char *func, const char *filename, int widt
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP); /* its own group: a Ctrl-C does not cut the file short */
   posix_spawnattr_setpgroup(&attr, 0);
   pid_t pid;
-  int rc = posix_spawn(&pid, ffmpeg, &actions, &attr, argv, environ);
+  int rc = posix_spawn(&pid, "/bin/sh", &actions, &attr, argv, environ);
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
   close(fds[0]);
@@ -191,6 +202,7 @@ static void start(sn_robot *rb, const char *func, const char *filename, int widt
   g_pipe = fds[1];
   g_frames = 0;
   g_said_full = false;
+  g_world_ended = false;
   g_status = WB_SUPERVISOR_MOVIE_RECORDING;
 }
 
@@ -207,10 +219,29 @@ static bool write_all(int fd, const char *p, size_t n) {
   return true;
 }
 
+static void stop(sn_robot *rb, const char *func);
+
+/* the world ended while recording (its step answered -1: a worldReload, a worldLoad, a quit): Webots cancels
+   the recording at a world load; here the frames taken so far are the movie, encoded at once (while the
+   controller is given its last second), its status Webots' once the file is written */
+static void end_with_world(sn_robot *rb) {
+  if (g_status != WB_SUPERVISOR_MOVIE_RECORDING || !rb->terminated || g_world_ended)
+    return;
+  g_world_ended = true;
+  const char *func = "wb_supervisor_movie_start_recording";
+  if (g_frames > 0)
+    fprintf(stderr,
+            "Warning: %s(): the world ended while recording (a reload, a load, a quit): the movie is written with its "
+            "%lld frames; movieFailed() is then true, as Webots reports a recording a world load cancels.\n",
+            func, g_frames);
+  stop(rb, func);
+}
+
 /* after each step reply: the frames the server rendered, into the encoder */
 void sn_movie_after_step(sn_robot *rb) {
   const char *func = "wb_supervisor_movie_start_recording";
   bool more = true;
+  end_with_world(rb);
   while (g_status == WB_SUPERVISOR_MOVIE_RECORDING && !rb->terminated && more) {
     sn_reply rep;
     if (sn_robot_call(rb, "robot/movie_frames", 0, NULL, NULL, func, &rep) != 0) {
@@ -247,6 +278,10 @@ void sn_movie_after_step(sn_robot *rb) {
 static void stop(sn_robot *rb, const char *func) {
   if (g_status != WB_SUPERVISOR_MOVIE_RECORDING)
     return;
+  if (rb->terminated && !g_world_ended) {
+    end_with_world(rb);
+    return;
+  }
   if (!rb->terminated) { /* (the world ended: the frames taken so far are the movie) */
     sn_movie_after_step(rb);
     if (g_status != WB_SUPERVISOR_MOVIE_RECORDING)
@@ -264,7 +299,8 @@ static void stop(sn_robot *rb, const char *func) {
 }
 
 /* Webots' status, the encoder's end looked at (waited for up to wait_ms) */
-static int poll_movie(int wait_ms) {
+static int poll_movie(sn_robot *rb, int wait_ms) {
+  end_with_world(rb);
   if (g_status != WB_SUPERVISOR_MOVIE_SAVING || g_encoder <= 0)
     return g_status;
   const char *func = "wb_supervisor_movie_stop_recording";
@@ -279,16 +315,16 @@ static int poll_movie(int wait_ms) {
     return g_status;
   g_encoder = -1;
   char why[8400];
-  if (done < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
+  if (done > 0 && WIFEXITED(st) && WEXITSTATUS(st) == RENAME_FAILED) {
+    remove(g_tmp);
+    snprintf(why, sizeof why, "cannot write '%s': the encoded movie could not be renamed onto it", g_name);
+    fail(func, why, WB_SUPERVISOR_MOVIE_WRITE_ERROR);
+  } else if (done < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
     remove(g_tmp);
     snprintf(why, sizeof why, "ffmpeg failed to encode the movie (exit status %d)", WIFEXITED(st) ? WEXITSTATUS(st) : -1);
     fail(func, why, WB_SUPERVISOR_MOVIE_ENCODING_ERROR);
-  } else if (rename(g_tmp, g_name) != 0) {
-    snprintf(why, sizeof why, "cannot write '%s': %s", g_name, strerror(errno));
-    remove(g_tmp);
-    fail(func, why, WB_SUPERVISOR_MOVIE_WRITE_ERROR);
   } else
-    g_status = WB_SUPERVISOR_MOVIE_READY;
+    g_status = g_world_ended ? WB_SUPERVISOR_MOVIE_SIMULATION_ERROR : WB_SUPERVISOR_MOVIE_READY;
   return g_status;
 }
 
@@ -296,7 +332,7 @@ static int poll_movie(int wait_ms) {
 void sn_movie_finish(sn_robot *rb) {
   const char *func = "wb_supervisor_movie_stop_recording";
   stop(rb, func);
-  poll_movie(FINISH_WAIT_MS);
+  poll_movie(rb, FINISH_WAIT_MS);
   if (g_status == WB_SUPERVISOR_MOVIE_SAVING)
     abort_movie(func, "ffmpeg did not finish the movie in time", WB_SUPERVISOR_MOVIE_ENCODING_ERROR);
 }
@@ -308,7 +344,7 @@ void wb_supervisor_movie_start_recording(const char *filename, int width, int he
   sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return;
-  int status = poll_movie(0);
+  int status = poll_movie(rb, 0);
   if (status == WB_SUPERVISOR_MOVIE_RECORDING || status == WB_SUPERVISOR_MOVIE_SAVING) {
     fprintf(stderr, "Error: %s(): movie recording has already been started.\n", func);
     return;
@@ -340,16 +376,18 @@ void wb_supervisor_movie_stop_recording(void) {
 }
 
 bool wb_supervisor_movie_is_ready(void) {
-  if (sn_supervisor("wb_supervisor_movie_is_ready") == NULL)
+  sn_robot *rb = sn_supervisor("wb_supervisor_movie_is_ready");
+  if (rb == NULL)
     return false;
-  int status = poll_movie(0);
+  int status = poll_movie(rb, 0);
   return status == WB_SUPERVISOR_MOVIE_READY || status > WB_SUPERVISOR_MOVIE_SAVING;
 }
 
 bool wb_supervisor_movie_failed(void) {
-  if (sn_supervisor("wb_supervisor_movie_failed") == NULL)
+  sn_robot *rb = sn_supervisor("wb_supervisor_movie_failed");
+  if (rb == NULL)
     return true;
-  return poll_movie(0) > WB_SUPERVISOR_MOVIE_SAVING;
+  return poll_movie(rb, 0) > WB_SUPERVISOR_MOVIE_SAVING;
 }
 
 int wb_supervisor_movie_get_status(void) {
@@ -359,9 +397,10 @@ int wb_supervisor_movie_get_status(void) {
                     "instead.\n", __func__);
     warned = true;
   }
-  if (sn_supervisor(__func__) == NULL)
+  sn_robot *rb = sn_supervisor(__func__);
+  if (rb == NULL)
     return WB_SUPERVISOR_MOVIE_SIMULATION_ERROR;
-  return poll_movie(0);
+  return poll_movie(rb, 0);
 }
 
 void wb_supervisor_start_movie(const char *file, int width, int height, int codec, int quality, int acceleration,

@@ -680,6 +680,7 @@ static int step_end(sn_robot *rb) {
   if (rc != 0 && rep.code == SN_CONNECTION_LOST) {
     fprintf(stderr, "sensorium: CONNECTION_LOST: %s; ending the controller's steps\n", rep.message);
     rb->terminated = true;
+    sn_movie_after_step(rb); /* (a movie recording ends with the world) */
     return -1;
   }
   if (rc != 0 || !rep.ok) {
@@ -688,6 +689,8 @@ static int step_end(sn_robot *rb) {
     else
       fprintf(stderr, "Error: wb_robot_step(): %s: %s\n", sn_error_name(rep.code), rep.message);
     sn_reply_free(&rep);
+    if (rb->terminated)
+      sn_movie_after_step(rb);
     return -1;
   }
   int status = (int)sn_int_or(rep.result, "status", 0);
