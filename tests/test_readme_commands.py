@@ -113,6 +113,13 @@ def _parse_error(argv: list[str]) -> str | None:
     return None
 
 
+def _passed_on(parser: argparse.ArgumentParser, before: list[str]) -> bool:
+    """Whether an option after these tokens belongs to a program the command starts: `sensorium
+    controller SCRIPT ARGS...` hands what follows SCRIPT to the script (`example:wanderer -v`)."""
+    takes_the_rest = any(a.nargs == argparse.REMAINDER for a in parser._actions)
+    return takes_the_rest and any(not t.startswith("-") for t in before)
+
+
 def command_problems(text: str) -> list[str]:
     problems: list[str] = []
     for line, name, rest in sensorium_commands(text):
@@ -128,12 +135,12 @@ def command_problems(text: str) -> list[str]:
             tokens = rest.split()
         for k, token in enumerate(tokens):
             flag = token.strip("[]").split("=")[0]
-            if not FLAG.fullmatch(flag):
+            if not (FLAG.fullmatch(flag) or re.fullmatch(r"-[a-zA-Z]", flag)):
                 continue
-            if flag not in options:
+            if flag not in options and not _passed_on(SUBCOMMANDS[name], tokens[:k]):
                 problems.append(f"README.md:{line}: `sensorium {name}` has no option {flag}")
                 continue
-            choices = options[flag].choices
+            choices = options[flag].choices if flag in options else None
             value = tokens[k + 1].strip("[]") if k + 1 < len(tokens) else ""
             if choices and value and not value.startswith("-") and not _placeholder(value):
                 bad = [v for v in value.split("|") if v not in choices]
@@ -285,6 +292,8 @@ def test_a_renamed_option_an_unknown_command_and_a_bad_choice_are_caught():
     assert any("`sensorium serv`: no such command" in p for p in problems)
     assert any("takes one of" in p and "not image" in p for p in problems)
     assert any("not slow" in p for p in problems)
+    assert command_problems("`sensorium controller -q example:wanderer --robot scout -v`") == [
+        "README.md:1: `sensorium controller` has no option -q"]
     assert command_problems("`sensorium probe arena --steps five`") == [
         "README.md:1: `sensorium probe arena --steps five` does not parse: "
         "argument --steps: invalid int value: 'five'"]
