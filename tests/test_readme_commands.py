@@ -227,16 +227,29 @@ def link_problems(name: str, text: str) -> list[str]:
 
 
 def path_problems(text: str) -> list[str]:
-    """Repository paths (sensorium/..., tests/..., docs/..., docker/...) the text names exist;
+    """Repository paths (sensorium/..., tests/..., docs/..., docker/..., .ci/...) the text names exist;
     gym ids (sensorium/ReachLight-v0) and build outputs are not files of the repository."""
     problems = []
     for i, line in enumerate(text.splitlines(), 1):
-        for m in re.finditer(r"(?<![\w./~$-])((?:sensorium|tests|docs|docker)/[\w./-]*[\w/])", line):
+        for m in re.finditer(r"(?<![\w./~$-])((?:sensorium|tests|docs|docker|\.ci)/[\w./-]*[\w/])", line):
             path = m.group(1)
             if (re.search(r"-v\d+$", path) or "/build" in path or path in EXAMPLE_PATHS
                     or (ROOT / path).exists()):
                 continue
             problems.append(f"line {i}: {path}: no such file or folder")
+    return problems
+
+
+def module_path_problems(text: str) -> list[str]:
+    """ARCHITECTURE.md and PROTOCOL.md name files by their path under the package or one of its
+    folders (`server/sim/scene.py`, `sim/motion.py`, `client/c/src/robot.c`): each is a file here."""
+    bases = [ROOT, ROOT / "sensorium", ROOT / "sensorium" / "server", ROOT / "sensorium" / "client"]
+    problems = []
+    for i, line in enumerate(text.splitlines(), 1):
+        for m in re.finditer(r"(?<![\w./~<$-])([\w-]+(?:/[\w.-]+)+\.(?:py|pyi|yaml|json|c|h|hpp|cpp|wbt|md|toml|js))\b",
+                             line):
+            if not any((base / m.group(1)).exists() for base in bases):
+                problems.append(f"line {i}: {m.group(1)}: no such file")
     return problems
 
 
@@ -277,6 +290,11 @@ def test_every_repository_path_the_readme_names_exists():
     assert path_problems(README.read_text()) == []
 
 
+@pytest.mark.parametrize("name", ["ARCHITECTURE.md", "PROTOCOL.md"])
+def test_every_file_architecture_and_protocol_name_exists(name):
+    assert module_path_problems((ROOT / name).read_text()) == []
+
+
 def test_python_snippets_compile():
     for line, code in python_snippets(README.read_text()):
         compile(code, f"README.md:{line}", "exec")
@@ -309,6 +327,8 @@ def test_a_missing_module_option_a_lone_option_a_link_and_a_path_are_caught():
     assert link_problems("README.md", "see [x](PROTOCOL.md#no-such-section) and [y](NOPE.md)") == [
         "README.md:1: link to PROTOCOL.md#no-such-section: no such heading in PROTOCOL.md",
         "README.md:1: link to NOPE.md: no such file"]
+    assert module_path_problems("2. `server/devices/compass.py`: the pure model") == [
+        "line 1: server/devices/compass.py: no such file"]
     assert path_problems("in `sensorium/worlds/no_such_world.yaml`") == [
         "line 1: sensorium/worlds/no_such_world.yaml: no such file or folder"]
     with pytest.raises(SyntaxError):
