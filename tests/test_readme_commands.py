@@ -1,13 +1,13 @@
 """What the docs name exists, so a reader who copies it is not stopped by a rename or a move.
 
-Every ``sensorium CMD ...`` the README shows (in a ``sh`` block or an inline code span) names a
-subcommand and only options that subcommand has, with values its choices allow, and parses when
-it has no placeholders; every ``python -m sensorium.MODULE --flag`` names a module that exists and
-an option it defines; every lone ```--flag``` span is an option of some sensorium command or module
-(or of the external tool the text names); every relative link of README.md, ARCHITECTURE.md and
-PROTOCOL.md points at a file that exists, and at a heading there when it has an anchor; every
-repository path the README names exists; every Python snippet compiles. Nothing is run:
-tests/test_readme.py runs the snippets and the offline commands."""
+Every ``sensorium CMD ...`` that README.md, ARCHITECTURE.md or PROTOCOL.md shows (in a ``sh`` block
+or an inline code span) names a subcommand and only options that subcommand has, with values its
+choices allow, and parses when it has no placeholders; every ``python -m sensorium.MODULE --flag``
+names a module that exists and an option it defines; every lone ```--flag``` span is an option of
+some sensorium command or module (or of the external tool the text names); every relative link
+points at a file that exists, and at a heading there when it has an anchor; every repository path
+the README names, and every file ARCHITECTURE.md and PROTOCOL.md name, exists; every README Python
+snippet compiles. Nothing is run: tests/test_readme.py runs the snippets and the offline commands."""
 
 from __future__ import annotations
 
@@ -120,12 +120,12 @@ def _passed_on(parser: argparse.ArgumentParser, before: list[str]) -> bool:
     return takes_the_rest and any(not t.startswith("-") for t in before)
 
 
-def command_problems(text: str) -> list[str]:
+def command_problems(text: str, doc: str = "README.md") -> list[str]:
     problems: list[str] = []
     for line, name, rest in sensorium_commands(text):
         found = len(problems)
         if name not in SUBCOMMANDS:
-            problems.append(f"README.md:{line}: `sensorium {name}`: no such command")
+            problems.append(f"{doc}:{line}: `sensorium {name}`: no such command")
             continue
         options = _options(SUBCOMMANDS[name]) | _options(PARSER)
         rest = rest.split(":")[0] if rest.startswith(":") else rest      # `sensorium run: ...` is its log line
@@ -138,21 +138,21 @@ def command_problems(text: str) -> list[str]:
             if not (FLAG.fullmatch(flag) or re.fullmatch(r"-[a-zA-Z]", flag)):
                 continue
             if flag not in options and not _passed_on(SUBCOMMANDS[name], tokens[:k]):
-                problems.append(f"README.md:{line}: `sensorium {name}` has no option {flag}")
+                problems.append(f"{doc}:{line}: `sensorium {name}` has no option {flag}")
                 continue
             choices = options[flag].choices if flag in options else None
             value = tokens[k + 1].strip("[]") if k + 1 < len(tokens) else ""
             if choices and value and not value.startswith("-") and not _placeholder(value):
                 bad = [v for v in value.split("|") if v not in choices]
                 if bad:
-                    problems.append(f"README.md:{line}: `sensorium {name} {flag}` takes one of "
+                    problems.append(f"{doc}:{line}: `sensorium {name} {flag}` takes one of "
                                     f"{', '.join(map(str, choices))}, not {bad[0]}")
         if tokens and len(problems) == found and not any(_placeholder(t) for t in tokens) and "|" not in rest:
             refused = _parse_error([name, *tokens])
             # a span that names a command with an option (`sensorium run --robot-window-log`) leaves
             # out its positional arguments; anything else argparse refuses is a wrong line
             if refused and not refused.startswith("the following arguments are required"):
-                problems.append(f"README.md:{line}: `sensorium {name}{rest}` does not parse: {refused}")
+                problems.append(f"{doc}:{line}: `sensorium {name}{rest}` does not parse: {refused}")
     return problems
 
 
@@ -168,15 +168,15 @@ def _defined_flags(source: str) -> set[str]:
     return set(re.findall(r"""["'](--[a-z][a-z0-9-]*)["']""", source))
 
 
-def module_problems(text: str) -> list[str]:
+def module_problems(text: str, doc: str = "README.md") -> list[str]:
     problems = []
     for line, module, rest in module_commands(text):
         path = _module_file(module)
         if path is None:
-            problems.append(f"README.md:{line}: `python -m {module}`: no such module")
+            problems.append(f"{doc}:{line}: `python -m {module}`: no such module")
             continue
         defined = _defined_flags(path.read_text())
-        problems += [f"README.md:{line}: `python -m {module}` has no option {flag}"
+        problems += [f"{doc}:{line}: `python -m {module}` has no option {flag}"
                      for flag in FLAG.findall(rest) if flag not in defined]
     return problems
 
@@ -188,10 +188,10 @@ def known_flags() -> set[str]:
     return flags | EXTERNAL_FLAGS
 
 
-def lone_flag_problems(text: str) -> list[str]:
+def lone_flag_problems(text: str, doc: str = "README.md") -> list[str]:
     """A span that is only options (```--compare```, ```--body box```) names an option that exists."""
     known = known_flags()
-    return [f"README.md:{line}: {flag} is no option of any sensorium command or module"
+    return [f"{doc}:{line}: {flag} is no option of any sensorium command or module"
             for line, snippet in code_snippets(text) if snippet.startswith("--")
             for flag in FLAG.findall(snippet) if flag not in known]
 
@@ -269,16 +269,19 @@ def test_the_readme_shows_commands_of_each_kind():
     assert len(python_snippets(text)) >= 6
 
 
-def test_every_sensorium_command_the_readme_shows_has_its_options():
-    assert command_problems(README.read_text()) == []
+@pytest.mark.parametrize("name", DOCS)
+def test_every_sensorium_command_shown_has_its_options(name):
+    assert command_problems((ROOT / name).read_text(), name) == []
 
 
-def test_every_python_module_the_readme_runs_exists_with_its_options():
-    assert module_problems(README.read_text()) == []
+@pytest.mark.parametrize("name", DOCS)
+def test_every_python_module_shown_exists_with_its_options(name):
+    assert module_problems((ROOT / name).read_text(), name) == []
 
 
-def test_every_option_named_alone_exists():
-    assert lone_flag_problems(README.read_text()) == []
+@pytest.mark.parametrize("name", DOCS)
+def test_every_option_named_alone_exists(name):
+    assert lone_flag_problems((ROOT / name).read_text(), name) == []
 
 
 @pytest.mark.parametrize("name", DOCS)
