@@ -21,8 +21,10 @@ from unittest import mock
 import pytest
 
 from sensorium.cli import build_parser
+from sensorium.worlds import names as bundled_worlds
 
 ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "sensorium" / "client" / "examples"
 README = ROOT / "README.md"
 DOCS = ("README.md", "ARCHITECTURE.md", "PROTOCOL.md")
 FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
@@ -156,6 +158,21 @@ def command_problems(text: str, doc: str = "README.md") -> list[str]:
     return problems
 
 
+def named_things_problems(text: str, doc: str = "README.md") -> list[str]:
+    """A bundled example controller (`example:NAME`) or bundled world (`sensorium serve NAME`, a bare
+    name where a command takes a world) the text names is bundled."""
+    problems = [f"{doc}:{text.count(chr(10), 0, m.start()) + 1}: example:{m.group(1)}: no such bundled controller"
+                for m in re.finditer(r"\bexample:([a-z_]+)", text)
+                if not (EXAMPLES / f"{m.group(1)}.py").exists()]
+    for line, name, rest in sensorium_commands(text):
+        parser = SUBCOMMANDS.get(name)
+        world = [a for a in parser._actions if a.dest in ("world", "path", "source") and not a.option_strings] if parser else []
+        tokens = [t for t in rest.split() if not t.startswith("-")]
+        if world and tokens and re.fullmatch(r"[a-z][a-z0-9_]*", tokens[0]) and tokens[0] not in bundled_worlds():
+            problems.append(f"{doc}:{line}: `sensorium {name} {tokens[0]}`: no bundled world {tokens[0]!r}")
+    return problems
+
+
 def _module_file(module: str) -> Path | None:
     path = ROOT.joinpath(*module.split("."))
     for candidate in (path.with_suffix(".py"), path / "__main__.py"):
@@ -275,6 +292,11 @@ def test_every_sensorium_command_shown_has_its_options(name):
 
 
 @pytest.mark.parametrize("name", DOCS)
+def test_every_bundled_controller_and_world_named_is_bundled(name):
+    assert named_things_problems((ROOT / name).read_text(), name) == []
+
+
+@pytest.mark.parametrize("name", DOCS)
 def test_every_python_module_shown_exists_with_its_options(name):
     assert module_problems((ROOT / name).read_text(), name) == []
 
@@ -330,6 +352,9 @@ def test_a_missing_module_option_a_lone_option_a_link_and_a_path_are_caught():
     assert link_problems("README.md", "see [x](PROTOCOL.md#no-such-section) and [y](NOPE.md)") == [
         "README.md:1: link to PROTOCOL.md#no-such-section: no such heading in PROTOCOL.md",
         "README.md:1: link to NOPE.md: no such file"]
+    assert named_things_problems("`sensorium serve arena_2` and `sensorium controller example:follower`") == [
+        "README.md:1: example:follower: no such bundled controller",
+        "README.md:1: `sensorium serve arena_2`: no bundled world 'arena_2'"]
     assert module_path_problems("2. `server/devices/compass.py`: the pure model") == [
         "line 1: server/devices/compass.py: no such file"]
     assert path_problems("in `sensorium/worlds/no_such_world.yaml`") == [
