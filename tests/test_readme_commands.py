@@ -362,3 +362,11 @@ def test_a_missing_module_option_a_lone_option_a_link_and_a_path_are_caught():
     with pytest.raises(SyntaxError):
         for line, code in python_snippets("```python\nprint(1\n```\n"):
             compile(code, f"README.md:{line}", "exec")
+
+
+def test_every_gymnasium_id_the_readme_names_is_registered():
+    gym = pytest.importorskip("gymnasium")
+    import sensorium.gym  # noqa: F401  (registers the ids)
+
+    named = set(re.findall(r"\bsensorium/[A-Za-z]+-v\d+\b", README.read_text()))
+    assert named and sorted(named - set(gym.registry)) == []
