@@ -146,7 +146,7 @@ def markdown(doc: dict) -> str:
     L.append("python -m pip install -e '.[bench-peers]'   # Open3D on Debian also needs: apt-get install libusb-1.0-0")
     L.append(doc.get("command", "sensorium bench --out docs/"))
     L.append("```\n")
-    L.append(f"`sensorium bench --quick` is a ~30 s smoke run; `--only SECTION` (repeatable: "
+    L.append(f"`sensorium bench --quick` is a smoke run (about 5 min on 2 cores); `--only SECTION` (repeatable: "
              f"{', '.join(ORDER)}) re-measures some sections and keeps the others of an existing report.\n")
     L.append(f"Measured {doc.get('generated', '?')} on {m.get('cpu', '?')}, {m.get('cpus', '?')} cores, Python "
              f"{m.get('python', '?')}, numpy {m.get('numpy', '?')}, embreex {m.get('embreex', '?')}, ZeroMQ {m.get('zmq', '?')}; "

@@ -11,7 +11,7 @@ from sensorium.benchmarks import SECTIONS
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--quick", action="store_true", help="smoke run (~30 s): fewer sizes and repeats")
+    p.add_argument("--quick", action="store_true", help="smoke run: fewer sizes and repeats (about 5 min on 2 cores)")
     p.add_argument("--out", default="docs", metavar="DIR",
                    help="where benchmarks.md, benchmarks.json and bench/*.png go (default: docs)")
     p.add_argument("--only", action="append", choices=SECTIONS, metavar="SECTION",
