@@ -486,3 +486,18 @@ def test_cli_record_sigint_finishes_and_reports(rec_path, ctx, tmp_path):
 def test_published_helper_is_deterministic():
     assert list(published(5)) == list(published(5))
     assert set(TOPICS) >= {t for t, *_ in published(4)}
+
+
+def test_cli_replay_stops_on_sigint_when_started_with_it_ignored(rec_path):
+    # a shell script's background job (`sensorium replay ... &`) starts with SIGINT ignored; `kill -INT`
+    # must still end the replay cleanly, as it ends `serve`
+    path, _items = rec_path
+    with Served(sensorium("replay", str(path), "--pub", ANY, "--rpc", ANY, "--loop"), "sensorium: replaying",
+                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN)).wait_ready() as proc:
+        proc.p.send_signal(signal.SIGINT)
+        try:
+            code = proc.p.wait(60)
+        except subprocess.TimeoutExpired:
+            code = None
+    assert code is not None, "replay ignored SIGINT"
+    assert "Traceback" not in proc.stderr(), proc.stderr()

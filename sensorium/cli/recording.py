@@ -38,14 +38,16 @@ def damage_printer(command: str, path: str | os.PathLike) -> Callable[[Damage], 
 
 
 @contextmanager
-def sigterm_as_interrupt():
-    """SIGTERM (and SIGHUP) raise KeyboardInterrupt like Ctrl-C, so files get finished."""
+def signals_as_interrupt():
+    """SIGTERM, SIGHUP and SIGINT raise KeyboardInterrupt, so files get finished. SIGINT too because a
+    shell script's background job starts with it ignored (``sensorium replay & ... kill -INT $!``
+    would do nothing), and ``serve`` answers it there as well."""
     previous: dict = {}
 
     def handler(signum, frame):
         raise KeyboardInterrupt
 
-    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None), signal.SIGINT):
         if sig is not None:
             try:
                 previous[sig] = signal.signal(sig, handler)
@@ -77,7 +79,7 @@ def record(args: argparse.Namespace) -> int:
     print(f"sensorium: recording {args.file} from pub={rec.pub_endpoint}"
           + (f" topics={' '.join(args.topics)}" if args.topics else ""), flush=True)
     try:
-        with sigterm_as_interrupt():
+        with signals_as_interrupt():
             rec.run(duration=args.duration, max_messages=args.max_messages)
     except KeyboardInterrupt:
         pass
@@ -132,7 +134,7 @@ def replay_cmd(args: argparse.Namespace) -> int:
                 print(f"sensorium: Foxglove web app: {viewer.app_url()}", file=sys.stderr, flush=True)
         interrupted = False
         try:                    # Ctrl-C from the announcement on (scripts send it once they read it)
-            with sigterm_as_interrupt():
+            with signals_as_interrupt():
                 print(r.announce(), flush=True)
                 if r.recording.truncated:
                     print("sensorium: warning: the recording is truncated; replaying up to its last complete "
@@ -221,7 +223,7 @@ def recover_cmd(args: argparse.Namespace) -> int:
     from sensorium.server.recording.recover import recover
 
     try:
-        with sigterm_as_interrupt():    # SIGTERM/SIGHUP too: OUT.part is removed, as for Ctrl-C
+        with signals_as_interrupt():    # SIGTERM/SIGHUP too: OUT.part is removed, as for Ctrl-C
             r = recover(args.file, args.out, overwrite=args.force, on_damage=damage_printer("recover", args.file))
     except (FileExistsError, ValueError) as exc:
         print(f"sensorium recover: {exc}", file=sys.stderr)
