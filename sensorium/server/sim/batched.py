@@ -50,8 +50,16 @@ inertial units, gyros, accelerometers and altimeters riding them measure there (
 riding one reads its robot's contact). Steered-wheel robots
 (``steered_drive``) are driven by :mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``)
 at each copy's steering joints.
-A link's shapes or lights, other devices on a joint, steered drives with free
-wheels and belts are refused (BatchedError, one line).
+A link's shapes (``on_joint``) are template bodies of their own in the copies' cast, owned by their
+robot (``CopyRays``' link slots), each copy's placed at its robot's pose ∘ its joint's displacement
+there as Simulation's scene places a link's body, and numbered as that scene numbers them
+(:func:`~sensorium.server.sim.scene.robot_bodies`): every ray of a copy meets its own links, a ray blind to
+its robot (``exclude_owner``) its robot's links too. Refused (BatchedError, one line): a light on a link,
+a plane, textured shape or bumper's shape on one, a link that bounds its robot while kinematic contact
+runs (its footprint would not follow the joint), a device that sees its own robot riding a link with
+shapes (lidars, cameras, range finders; distance and light sensors with self-collision), a camera's
+recognition in a world with link shapes; other devices on a joint, steered drives with free
+wheels and belts.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
@@ -127,8 +135,8 @@ from sensorium.server.sim.scene import (
     blind_devices,
     infra_red_terms,
     primitive_from_model,
-    robot_bounding_parts,
     robot_bodies,
+    robot_bounding_parts,
     solid_parts,
 )
 from sensorium.server.sim.sensors import LED, DistanceSensor, Lidar, LightSensor, PositionSensor
@@ -539,10 +547,11 @@ class BatchedSimulation:
                                         own_shapes=self._own_shapes.get((slot, d.name), frozenset()))
                 riding = dev.on_joint is not None and d.device in batched_joints.PLACED_KINDS
                 if riding:
-                    # on a link without shapes (batched.py refuses links with shapes): its rays are
-                    # mounted on no body, as the single simulation's (Scene.device_body is None), and a
-                    # light sensor's occlusion rays skip its robot as the single one's do (exclude_self);
-                    # each copy's local pose is the joints' (batched_joints.py)
+                    # its rays are mounted on no body: on a link without shapes as the single simulation's
+                    # (Scene.device_body is None); on one with shapes only if blind to its robot
+                    # (_check_supported), so its link is never met; a light sensor's occlusion rays
+                    # skip its robot as the single one's do (exclude_self); each copy's local pose is
+                    # the joints' (batched_joints.py)
                     dev.move_with(Pose.identity())
                     self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose, dev.local_pose)
                 elif d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
