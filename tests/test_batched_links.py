@@ -3,7 +3,9 @@ bodies of their own, posed in each copy from its robot's pose and its joints, so
 meets them where that copy's joints hold them, and no other copy's rays do. A robot with a swinging
 arm (a hinge carrying a bar, and a nested tilt hinge carrying a hand) in front of another robot's
 distance sensors, lidar, camera, range finder and a light sensor the arm shadows from a lamp, and
-the arm's own distance sensor and lidar (self-collision on) that see the bar: every copy, with its
+the arm's own distance sensor, lidar, camera and light sensor (self-collision on) that see the bar,
+and a flag on the other robot's own pan, which its generic distance sensor and light sensor are blind
+to (their robot excluded: its links too) and its infra-red sensor, lidar and camera see: every copy, with its
 own random joint commands, reads bit for bit what Simulation built with that copy's seed reads.
 Closed form: the bar swung by a (2.6 deg < a < 9.5 deg) shows its side face to a sensor on its
 pivot's axis at 0.025 / sin(a) from the pivot. What the copies cannot follow is refused in one
@@ -33,7 +35,8 @@ def wall(name: str, x: float, y: float, sx: float, sy: float) -> dict:
 def arm_robot(seen_by: str = "both") -> dict:
     """No drive: a hinge (axis z through its origin) carrying a bar from x = 0.15 to 0.55 (0.05 wide,
     0.1 high, its centre 0.15 above the origin), and a tilt hinge riding it at the bar's end carrying a
-    hand; its own distance sensor and lidar see the bar (self_collision)."""
+    hand; its own distance sensor, lidar, camera and light sensor (facing a lamp behind it) see the bar
+    (self_collision)."""
     return {"name": "arm", "pose": {"translation": [0.0, 0.0, 0.05]}, "self_collision": True,
             "body": {"geometry": {"type": "box", "size": [0.2, 0.2, 0.2]}},
             "shapes": [{"name": "bar", "on_joint": "swing", "seen_by": seen_by,
@@ -42,7 +45,7 @@ def arm_robot(seen_by: str = "both") -> dict:
                        {"name": "hand", "on_joint": "wrist", "seen_by": seen_by,
                         "pose": {"translation": [0.6, 0.0, 0.15]}, "geometry": {"type": "sphere", "radius": 0.04},
                         "appearance": {"base_color": [0.9, 0.1, 0.1]}}],
-            "devices": [{"device": "RotationalMotor", "name": "swing", "axis": [0, 0, 1], "max_velocity": 2.0},
+            "devices": [{"device": "RotationalMotor", "name": "swing", "axis": [0, 0, 1], "max_velocity": 8.0},
                         {"device": "RotationalMotor", "name": "wrist", "on_joint": "swing", "axis": [0, 1, 0],
                          "anchor": [0.55, 0.0, 0.15], "max_velocity": 3.0},
                         {"device": "DistanceSensor", "name": "own ds", "pose": {"translation": [0.11, 0.0, 0.12],
@@ -50,16 +53,27 @@ def arm_robot(seen_by: str = "both") -> dict:
                          "lookup_table": [[0, 0, 0], [2.0, 2.0, 0]]},
                         {"device": "Lidar", "name": "own lidar", "pose": {"translation": [0.0, 0.0, 0.2]},
                          "horizontal_resolution": 36, "field_of_view": 2 * math.pi, "number_of_layers": 2,
-                         "vertical_field_of_view": 0.3, "min_range": 0.05, "max_range": 2.0}]}
+                         "vertical_field_of_view": 0.3, "min_range": 0.05, "max_range": 2.0},
+                        {"device": "Camera", "name": "own cam", "pose": {"translation": [0.11, 0.0, 0.14]},
+                         "width": 12, "height": 8, "field_of_view": 1.4},
+                        {"device": "LightSensor", "name": "own ls", "occlusion": True,
+                         "pose": {"translation": [-0.11, 0.0, 0.15], "rotation": [0, 0, 1, math.pi]},
+                         "lookup_table": [[0, 0, 0], [10, 1000, 0]]}]}
 
 
-def watcher_robot() -> dict:
+def watcher_robot(seen_by: str = "both") -> dict:
     """Facing the arm (-x) from WATCHER_X: distance sensors (generic and infra-red, noisy), a lidar, a
-    camera, a range finder and a light sensor looking at a lamp behind the arm."""
+    camera, a range finder and a light sensor looking at a lamp behind the arm; a flag on a pan hinge
+    of its own, right in front of those sensors when the pan is at 0: they are blind to their robot
+    (no self-collision), so to its link too, but its camera is not."""
     ahead = {"translation": [0.09, 0.0, 0.15]}
     return {"name": "watcher", "pose": {"translation": [WATCHER_X, 0.0, 0.05], "rotation": [0, 0, 1, math.pi]},
             "body": {"geometry": {"type": "cylinder", "radius": 0.08, "height": 0.1}},
-            "devices": [{"device": "DistanceSensor", "name": "ds", "pose": ahead,
+            "shapes": [{"name": "flag", "on_joint": "flag pan", "seen_by": seen_by,
+                        "pose": {"translation": [0.16, 0.0, 0.15]}, "geometry": {"type": "box", "size": [0.02, 0.1, 0.1]},
+                        "appearance": {"base_color": [0.2, 0.2, 0.9]}}],
+            "devices": [{"device": "RotationalMotor", "name": "flag pan", "axis": [0, 0, 1], "max_velocity": 4.0},
+                        {"device": "DistanceSensor", "name": "ds", "pose": ahead,
                          "lookup_table": [[0, 0, 0], [2.0, 2.0, 0]]},
                         {"device": "DistanceSensor", "name": "noisy ds", "pose": {"translation": [0.09, 0.02, 0.15]},
                          "lookup_table": [[0, 0, 0], [2.0, 2000, 0.05]]},
@@ -86,7 +100,7 @@ def arm_world(seed: int = 3):
                         "robots": [arm_robot(), watcher_robot()]})
 
 
-DEVICES = {"arm": ["own ds", "own lidar"], "watcher": ["ds", "noisy ds", "ir", "lidar", "cam", "rf", "ls"]}
+DEVICES = {"arm": ["own ds", "own lidar", "own cam", "own ls"], "watcher": ["ds", "noisy ds", "ir", "lidar", "cam", "rf", "ls"]}
 
 
 def _single(world, seed: int, precision: str) -> Simulation:
@@ -110,8 +124,8 @@ def _reading(batched: BatchedSimulation, sim: Simulation, c: int, robot: str, na
 
 @pytest.mark.parametrize("precision", ["exact", "fast"])
 def test_every_copy_sees_its_own_links_as_its_simulation_bit_for_bit(precision):
-    """Three copies and a Simulation per copy (seeds 3, 4, 5), 160 steps; every 20 steps each copy's
-    swing and wrist get new random targets; copy 2 reset at step 90 against a fresh Simulation. Every
+    """Three copies and a Simulation per copy (seeds 3, 4, 5), 200 steps; every 40 steps each copy's
+    swing and wrist get new random targets; copy 2 reset at step 110 against a fresh Simulation. Every
     reading of both robots the same bits every step; the arm both hid the watcher's lamp and let
     it through, and the watcher's sensor saw the bar and saw past it."""
     world = arm_world()
@@ -127,19 +141,23 @@ def test_every_copy_sees_its_own_links_as_its_simulation_bit_for_bit(precision):
     rng = np.random.default_rng(7)
     ds_values: set[float] = set()
     light_values: set[float] = set()
-    for t in range(160):
-        if t == 90:
+    own_light: set[float] = set()
+    for t in range(200):
+        if t == 110:
             batched.reset([2], [seeds[2]])
             for robot, names in DEVICES.items():
                 for name in names:
                     batched.enable(batched.device(robot, name), STEP, copies=[2])
             singles[2] = _single(world, seeds[2], precision)
-        if t % 20 == 0:
+        if t % 40 == 0:
             for c in range(n):
-                for name, span in (("swing", math.pi), ("wrist", 1.2)):
-                    target = float(rng.uniform(-span, span))
-                    singles[c].robot("arm").motor(name).set_position(target)
-                    batched.joints.command(arm, name, position=target, copies=[c])
+                for robot, name, span in (("arm", "swing", math.pi), ("arm", "wrist", 1.2),
+                                          ("watcher", "flag pan", math.pi)):
+                    # (the swing now and then straight ahead or back: the bar between a lamp and a light sensor)
+                    pick = rng.integers(3) if name == "swing" else 2
+                    target = (0.0, math.pi, float(rng.uniform(-span, span)))[pick]
+                    singles[c].robot(robot).motor(name).set_position(target)
+                    batched.joints.command(batched.slot(robot), name, position=target, copies=[c])
         for s in singles:
             s.step()
         batched.step()
@@ -153,8 +171,10 @@ def test_every_copy_sees_its_own_links_as_its_simulation_bit_for_bit(precision):
                     assert got == want, (t, c, robot, name)
             ds_values.add(float(batched.value(batched.device("watcher", "ds"))[c]))
             light_values.add(float(batched.value(batched.device("watcher", "ls"))[c]))
+            own_light.add(float(batched.value(batched.device("arm", "own ls"))[c]))
     assert min(ds_values) < 0.3 and max(ds_values) > 1.5      # the bar in front of it, and out of the way
     assert min(light_values) == 0.0 < max(light_values)         # the lamp hidden by the bar, and not
+    assert min(own_light) == 0.0 < max(own_light)               # (the arm's own: the bar swung behind it)
 
 
 def test_a_bar_swung_by_a_shows_its_side_at_the_closed_form_distance_in_its_copy_only():
@@ -208,7 +228,7 @@ def test_what_a_link_cannot_carry_here_is_refused_in_one_line(world, message):
 def _changed(change, contact: bool = False, seen_by: str = "both"):
     """The arm world with ``change`` made to the arm; with ``contact``, the watcher on wheels (a
     driven robot: kinematic contact runs, every robot's footprint an obstacle)."""
-    w = {"world_info": {"basic_time_step": STEP, "contact": contact}, "robots": [arm_robot(seen_by), watcher_robot()]}
+    w = {"world_info": {"basic_time_step": STEP, "contact": contact}, "robots": [arm_robot(seen_by), watcher_robot(seen_by)]}
     change(w["robots"][0])
     if contact:
         w["robots"][1]["differential_drive"] = {"wheel_radius": 0.03, "axle_length": 0.15, "max_wheel_speed": 10.0}
@@ -223,9 +243,10 @@ def test_a_visual_only_link_runs_with_contact_and_recognition_is_refused():
     ref = batched.device("watcher", "ir")          # (infra-red: visual rays, which see the bar)
     batched.enable(ref, STEP)
     batched.joints.command(batched.slot("arm"), "swing", position=np.array([0.0, math.pi / 2]))
+    batched.joints.command(batched.slot("watcher"), "flag pan", position=2.0)    # (its own flag out of the way)
     batched.run(60)
     got = batched.value(ref)
-    assert got[0] < 600.0 < got[1]                  # the bar 0.26 m ahead in copy 0 only (2000 per 2 m)
+    assert got[0] < 600.0 and got[1] == 2000.0      # the hand 0.17 m ahead in copy 0; nothing in copy 1
     cam = batched.device("watcher", "cam")
     with pytest.raises(BatchedError, match="recognises nothing in a world with shapes on a link"):
         batched.recognition_enable(cam, STEP)
