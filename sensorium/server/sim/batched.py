@@ -54,8 +54,9 @@ A link's shapes (``on_joint``) are template bodies of their own in the copies' c
 robot (``CopyRays``' link slots), each copy's placed at its robot's pose ∘ its joint's displacement
 there as Simulation's scene places a link's body, and numbered as that scene numbers them
 (:func:`~sensorium.server.sim.scene.robot_bodies`): every ray of a copy meets its own links, a ray blind to
-its robot (``exclude_owner``) its robot's links too. Refused (BatchedError, one line): a light on a link,
-a plane, textured shape or bumper's shape on one, a link that bounds its robot while kinematic contact
+its robot (``exclude_owner``) its robot's links too; a robot's lights riding a joint are placed in each
+copy on its link (batched_lights.py). Refused (BatchedError, one line): a plane, textured shape or
+bumper's shape on a link, a link that bounds its robot while kinematic contact
 runs (its footprint would not follow the joint), a device that sees its own robot riding a link with
 shapes (lidars, cameras, range finders; distance and light sensors with self-collision), a camera's
 recognition in a world with link shapes; other devices on a joint, steered drives with free
@@ -374,6 +375,8 @@ class BatchedSimulation:
             else None for i, r in enumerate(w.robots)]
         # joint motors (every motor but the drives'): their state per copy and what rides them (batched_joints.py)
         self.joints = batched_joints.BatchedJoints(w, C)
+        if self.carried is not None:      # the lights riding joints: placed on each copy's links
+            self.carried.bind_joints(self.joints)
         # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
         self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
         # mecanum robots: their four wheels and body twist (batched_mecanum.py), None in a world without one
@@ -478,11 +481,6 @@ class BatchedSimulation:
                 if why:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {what} rides joint {x.on_joint!r}; "
                                        f"the batched simulation moves no {why} (use Simulation)")
-            for i, lt in enumerate(r.lights):
-                if lt.on_joint is not None:
-                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: lights[{i}] rides joint "
-                                       f"{lt.on_joint!r}; the batched simulation moves no light on a link "
-                                       "(use Simulation)")
             shaped = {x.on_joint for x in r.shapes if x.on_joint is not None}
             for d in r.devices:
                 joint = getattr(d, "on_joint", None)

@@ -20,9 +20,10 @@ simulation casts the rays of the distance sensors and lidars (a rotating one's s
 riding joints from those poses, and
 places the light sensors, cameras and range finders riding them there (and measures the GPS,
 compasses, inertial units, gyros, accelerometers and altimeters riding them there: batched_kinematic.py);
-the links' shapes are bodies of their own in the copies' cast, posed from ``link_rot`` / ``link_pos``
-(batched.py's ``_with_links``); it refuses what else rides a joint (batched.py's ``_check_supported``):
-a link's lights, a bumper's own shapes and other devices.
+the links' shapes are bodies of their own in the copies' cast and their lights are placed per copy,
+both from ``link_rot`` / ``link_pos`` (batched.py's ``_with_links``, batched_lights.py); it refuses
+what else rides a joint (batched.py's ``_check_supported``): a bumper's own shapes, planes, textured
+shapes and other devices.
 """
 
 from __future__ import annotations
