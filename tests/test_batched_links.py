@@ -72,7 +72,8 @@ def watcher_robot(seen_by: str = "both") -> dict:
     """Facing the arm (-x) from WATCHER_X: distance sensors (generic and infra-red, noisy), a lidar, a
     camera, a range finder and a light sensor looking at a lamp behind the arm; a flag on a pan hinge
     of its own, right in front of those sensors when the pan is at 0: they are blind to their robot
-    (no self-collision), so to its link too, but its camera is not."""
+    (no self-collision), so to its link too, but its camera is not; a distance sensor and a light
+    sensor ride the flag, blind to it."""
     ahead = {"translation": [0.09, 0.0, 0.15]}
     return {"name": "watcher", "pose": {"translation": [WATCHER_X, 0.0, 0.05], "rotation": [0, 0, 1, math.pi]},
             "body": {"geometry": {"type": "cylinder", "radius": 0.08, "height": 0.1}},
@@ -80,6 +81,10 @@ def watcher_robot(seen_by: str = "both") -> dict:
                         "pose": {"translation": [0.16, 0.0, 0.15]}, "geometry": {"type": "box", "size": [0.02, 0.1, 0.1]},
                         "appearance": {"base_color": [0.2, 0.2, 0.9]}}],
             "devices": [{"device": "RotationalMotor", "name": "flag pan", "axis": [0, 0, 1], "max_velocity": 4.0},
+                        {"device": "DistanceSensor", "name": "flag ds", "on_joint": "flag pan",
+                         "pose": {"translation": [0.18, 0.0, 0.15]}, "lookup_table": [[0, 0, 0], [2.0, 2.0, 0]]},
+                        {"device": "LightSensor", "name": "flag ls", "on_joint": "flag pan", "occlusion": True,
+                         "pose": {"translation": [0.18, 0.03, 0.15]}, "lookup_table": [[0, 0, 0], [10, 1000, 0]]},
                         {"device": "DistanceSensor", "name": "ds", "pose": ahead,
                          "lookup_table": [[0, 0, 0], [2.0, 2.0, 0]]},
                         {"device": "DistanceSensor", "name": "noisy ds", "pose": {"translation": [0.09, 0.02, 0.15]},
@@ -107,7 +112,8 @@ def arm_world(seed: int = 3, lights: bool = True):
                         "robots": [arm_robot(lights=lights), watcher_robot()]})
 
 
-DEVICES = {"arm": ["own ds", "own lidar", "own cam", "own ls"], "watcher": ["ds", "noisy ds", "ir", "lidar", "cam", "rf", "ls"]}
+DEVICES = {"arm": ["own ds", "own lidar", "own cam", "own ls"],
+           "watcher": ["ds", "noisy ds", "ir", "lidar", "cam", "rf", "ls", "flag ds", "flag ls"]}
 
 
 def _single(world, seed: int, precision: str) -> Simulation:
@@ -241,10 +247,14 @@ def test_a_light_on_a_link_lights_a_sensor_from_where_its_copy_holds_it():
     (lambda: _changed(lambda r: r["devices"].append(
         {"device": "Lidar", "name": "arm lidar", "on_joint": "swing", "pose": {"translation": [0.3, 0, 0.25]}})),
      "robot 'arm': Lidar 'arm lidar' rides joint 'swing', whose link has shapes it sees"),
+    (lambda: _changed(lambda r: (r.update(self_collision=False), r["devices"].append(
+        {"device": "DistanceSensor", "name": "tip ir", "type": "infra-red", "on_joint": "swing",
+         "pose": {"translation": [0.56, 0, 0.2]}}))),
+     "robot 'arm': DistanceSensor 'tip ir' rides joint 'swing', whose link has shapes it sees"),
     (lambda: _changed(lambda r: r["shapes"].append(
         {"name": "slab", "on_joint": "swing", "geometry": {"type": "plane", "size": [1, 1]}})),
      "robot 'arm': shape 'slab' rides joint 'swing'; the batched simulation moves no plane on a link"),
-], ids=["bounding link with contact", "lidar on its link", "plane on a link"])
+], ids=["bounding link with contact", "lidar on its link", "infra-red on its link", "plane on a link"])
 def test_what_a_link_cannot_carry_here_is_refused_in_one_line(world, message):
     with pytest.raises(BatchedError, match=re.escape(message)):
         BatchedSimulation(world(), 2)

@@ -58,7 +58,7 @@ its robot (``exclude_owner``) its robot's links too; a robot's lights riding a j
 copy on its link (batched_lights.py). Refused (BatchedError, one line): a plane, textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
 runs (its footprint would not follow the joint), a device that sees its own robot riding a link with
-shapes (lidars, cameras, range finders; distance and light sensors with self-collision), a camera's
+shapes (lidars, cameras, range finders, infra-red sensors; distance and light sensors with self-collision), a camera's
 recognition in a world with link shapes; other devices on a joint, steered drives with free
 wheels and belts.
 
@@ -489,7 +489,8 @@ class BatchedSimulation:
                 # a device that sees its own robot, on a link with shapes: the single simulation meets that
                 # link from the device's frame (its mount); the copies' casts would meet it from the world's
                 if joint in shaped and (d.device in ("Lidar", "Camera", "RangeFinder") or (
-                        d.device in ("DistanceSensor", "LightSensor") and r.self_collision)):
+                        d.device in ("DistanceSensor", "LightSensor") and r.self_collision)
+                        or (d.device == "DistanceSensor" and d.type == "infra-red")):    # (visual rays: see their robot)
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
                                        f"{joint!r}, whose link has shapes it sees; the batched simulation casts from "
                                        "a link with shapes only the rays blind to their own robot (use Simulation)")
