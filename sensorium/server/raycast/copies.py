@@ -4,7 +4,8 @@ N independent copies of a world (a batched training environment) share everythin
 moves, so that is built once: ``static`` is a :class:`~.engine.RayEngine` holding the world's
 solids (its static tier and planes). What moves -- the robots -- differs per copy, but every copy
 has the same *slots* (robot 0, robot 1, ...), each with the same shapes, so ``movers`` holds one
-template body per slot; a copy's robot is that template at the copy's pose. Copies overlap in
+template body per slot; a copy's robot is that template at the copy's pose (a robot's links, the
+shapes riding its joints, are slots of their own owned by it, posed per copy by ``expand``). Copies overlap in
 space (they all use the world's own coordinates, so a copy's rays see the static geometry exactly
 as the single world's rays do) and never see each other: a ray carries its copy, and it is paired
 only with the bodies of its own copy.
