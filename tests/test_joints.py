@@ -244,7 +244,7 @@ def test_wbt_robot_keeps_its_drive_bit_identical_and_its_arm_joint_moves(tmp_pat
 
 def test_the_batched_simulation_moves_a_joint_as_the_single_one() -> None:
     """Each copy's joint and its encoder as the single simulation's (tests/test_batched_joints.py has
-    the full comparison); a link carrying a shape is refused in one line."""
+    the full comparison); an LED on a joint is refused in one line."""
     from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 
     world = parse_world({"world_info": {"basic_time_step": DT_MS},
@@ -260,10 +260,9 @@ def test_the_batched_simulation_moves_a_joint_as_the_single_one() -> None:
     for want in got:
         batched.step()
         assert batched.value(ref).tolist() == [0.0, want]
-    carried = {"name": "arm", "devices": _hinge(), "shapes": [{"on_joint": "shoulder", "geometry": {
-        "type": "box", "size": [0.1, 0.1, 0.1]}}]}
-    with pytest.raises(BatchedError, match=r"robot 'arm': shapes\[0\] rides joint 'shoulder'; the batched simulation "
-                                           r"moves no link's shapes or lights \(use Simulation\)"):
+    carried = {"name": "arm", "devices": [*_hinge(), {"device": "LED", "name": "lamp", "on_joint": "shoulder"}]}
+    with pytest.raises(BatchedError, match=r"robot 'arm': LED 'lamp' rides joint 'shoulder'; the batched simulation "
+                                           r"moves distance sensors"):
         BatchedSimulation(parse_world({"world_info": {"basic_time_step": DT_MS}, "robots": [carried]}), 2)
 
 

@@ -4,7 +4,8 @@ N independent copies of a world (a batched training environment) share everythin
 moves, so that is built once: ``static`` is a :class:`~.engine.RayEngine` holding the world's
 solids (its static tier and planes). What moves -- the robots -- differs per copy, but every copy
 has the same *slots* (robot 0, robot 1, ...), each with the same shapes, so ``movers`` holds one
-template body per slot; a copy's robot is that template at the copy's pose. Copies overlap in
+template body per slot; a copy's robot is that template at the copy's pose (a robot's links, the
+shapes riding its joints, are slots of their own owned by it, posed per copy by ``expand``). Copies overlap in
 space (they all use the world's own coordinates, so a copy's rays see the static geometry exactly
 as the single world's rays do) and never see each other: a ray carries its copy, and it is paired
 only with the bodies of its own copy.
@@ -68,14 +69,27 @@ class CopyRays:
     for a robot without one; the body's owner is the slot). ``shape_offset``: the number of shapes
     of ``static``; a hit on a robot is reported as ``shape_offset`` + its shape index in ``movers``
     (with solids added before robots, as a world's scene does, these are the single world's shape
-    indices)."""
+    indices).
 
-    def __init__(self, static: RayEngine, movers: RayEngine, slot_body: Sequence[int | None], shape_offset: int):
+    ``owner``: each slot's robot (default: itself). A robot's links (the shapes riding its joints)
+    are slots of their own after the robots' (their owner the robot, as the single world's link
+    bodies are owned by their robot): a ray's ``exclude_slot`` drops its robot's links too, its
+    ``mount_slot`` only the robot's own body. ``expand``: with links, ``(rot, pos)`` of the robots
+    ``(C, robots, ...)`` -> every slot's ``(C, slots, ...)`` (the links' world poses per copy)."""
+
+    def __init__(self, static: RayEngine, movers: RayEngine, slot_body: Sequence[int | None], shape_offset: int,
+                 owner: Sequence[int] | None = None, expand=None):
         self.static = static
         self.movers = movers
         self.slot_body = list(slot_body)
         self.shape_offset = int(shape_offset)
         self.slots = len(self.slot_body)
+        self.owner = np.arange(self.slots, dtype=np.int64) if owner is None else np.asarray(owner, dtype=np.int64)
+        # the slots that are links (owned by another slot): their pairs with an excluded owner are dropped
+        self._links = bool((self.owner != np.arange(self.slots)).any())
+        self.expand = expand
+        # the order the engine takes bodies in (ties between bodies: the earlier body's hit)
+        self._body_rank = np.array([-1 if b is None else b for b in self.slot_body], dtype=np.int64)
         self._spheres: dict[str, tuple] = {}     # per variant: (tier per slot, anchor (R,3), r2 (R,), has body (R,))
         self.counters = {"casts": 0, "rays": 0, "mover_pairs": 0, "mover_traces": 0, "lean_casts": 0}
         self.lean = True     # FAST casts through sp_copy_cast where their data allows (False: the general path)
@@ -158,6 +172,8 @@ class CopyRays:
         t_near = _param(t_near, n, np.float64, float)     # uniform -> scalar, as the engine normalises it
         self.counters["casts"] += 1
         self.counters["rays"] += n
+        if self.expand is not None and rot.shape[1] != self.slots:    # the robots' poses -> their links' too
+            rot, pos = self.expand(rot, pos)
         # the robots' planes first, each ray against its own copy's (the single world casts its planes
         # before its tiers, every tier then up to the nearest plane hit): the static pass up to them
         planes = self._robot_plane_pass(O, D, n, t_near, t_far, kind, skip_transparent, copy, rot, pos, exclude_slot,
@@ -171,7 +187,9 @@ class CopyRays:
             hits, pr, pm, far = lean
             if planes is not None:
                 hits = self._with_planes(hits, planes)
-            if pr is None:
+            if pr is not None and self._links:
+                pr, pm = self._drop_owned(pr, pm, exclude_slot)
+            if pr is None or not len(pr):
                 return hits
             tiers = self._slot_tiers(self.movers._variant(kind, skip_transparent))[0]
             return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent, run)
@@ -200,9 +218,26 @@ class CopyRays:
             lo = np.broadcast_to(np.asarray(t_near, dtype=np.float64), (n,))
             got = _pairs(O, D, copy, centre, r2, present, lo, np.minimum(far, dist), excl, mnt)
         pr, pm = got
+        if self._links:
+            pr, pm = self._drop_owned(pr, pm, excl)
         if not len(pr):
             return hits
         return self._mover_pass(hits, O, D, t_near, far, pr, pm, tiers, rot, pos, distance_only, coherent, run)
+
+    def _drop_owned(self, pr: np.ndarray, pm: np.ndarray, exclude_slot) -> tuple[np.ndarray, np.ndarray]:
+        """The broad phase's pairs without those of a link whose owner is the ray's excluded slot
+        (the broad phase compares slots; a link's owner is another slot). Each pair is judged on its
+        own, so dropping one afterwards is the same as never pairing it."""
+        owner = self.owner.take(pm % self.slots)
+        link = owner != pm % self.slots
+        if isinstance(exclude_slot, (int, np.integer)):
+            drop = link & (owner == int(exclude_slot))
+        else:
+            drop = link & (owner == np.asarray(exclude_slot, dtype=np.int64).reshape(-1).take(pr))
+        if not drop.any():
+            return pr, pm
+        keep = ~drop
+        return pr[keep], pm[keep]
 
     def _robot_planes(self, variant: str) -> tuple | None:
         """The robots' planes ``variant`` sees, as the template bodies carry them: (the movers'
@@ -373,8 +408,8 @@ class CopyRays:
         win = (t_all < dist[pr]).nonzero()[0]
         if not len(win):
             return hits
-        # the nearest body per ray; equal distances: the lower slot (the engine takes bodies in order)
-        keep = np.lexsort((slot[win], t_all[win], pr[win]))
+        # the nearest body per ray; equal distances: the earlier body (the engine takes bodies in order)
+        keep = np.lexsort((self._body_rank.take(slot[win]), t_all[win], pr[win]))
         w = win[keep]
         first = np.ones(len(w), dtype=bool)
         first[1:] = pr[w][1:] != pr[w][:-1]

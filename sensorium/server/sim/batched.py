@@ -50,8 +50,17 @@ inertial units, gyros, accelerometers and altimeters riding them measure there (
 riding one reads its robot's contact). Steered-wheel robots
 (``steered_drive``) are driven by :mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``)
 at each copy's steering joints.
-A link's shapes or lights, other devices on a joint, steered drives with free
-wheels and belts are refused (BatchedError, one line).
+A link's shapes (``on_joint``) are template bodies of their own in the copies' cast, owned by their
+robot (``CopyRays``' link slots), each copy's placed at its robot's pose ∘ its joint's displacement
+there as Simulation's scene places a link's body, and numbered as that scene numbers them
+(:func:`~sensorium.server.sim.scene.robot_bodies`): every ray of a copy meets its own links, a ray blind to
+its robot (``exclude_owner``) its robot's links too; a robot's lights riding a joint are placed in each
+copy on its link (batched_lights.py). Refused (BatchedError, one line): a plane, textured shape or
+bumper's shape on a link, a link that bounds its robot while kinematic contact
+runs (its footprint would not follow the joint), a device that sees its own robot riding a link with
+shapes (lidars, cameras, range finders, infra-red sensors; distance and light sensors with self-collision), a camera's
+recognition in a world with link shapes; other devices on a joint, steered drives with free
+wheels and belts.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
@@ -127,8 +136,8 @@ from sensorium.server.sim.scene import (
     blind_devices,
     infra_red_terms,
     primitive_from_model,
+    robot_bodies,
     robot_bounding_parts,
-    robot_parts,
     solid_parts,
 )
 from sensorium.server.sim.sensors import LED, DistanceSensor, Lidar, LightSensor, PositionSensor
@@ -283,29 +292,39 @@ class BatchedSimulation:
         # the shapes of each device's own Solid (of_device), numbered as the movers' engine numbers
         # them: its visual rays do not see them (own_shapes.py), as in the single simulation
         self._own_shapes: dict[tuple[int, str], frozenset[int]] = {}
+        # a robot's links (the shapes riding a joint) are template bodies of their own, owned by the
+        # robot, added right after its body as the single scene adds them (so the shapes' numbers
+        # are that scene's): their slots follow the robots' (robot slot, joint, body)
+        link_slots: list[tuple[int, str, int]] = []
         first = 0
         for i, r in enumerate(w.robots):
-            parts = list(robot_parts(r))
-            if parts:
-                slot_body.append(movers.add_body([_entry(s, base, local) for _, local, s in parts],
-                                                 pose_from_model(r.pose), owner=i, movable=True))
-                owned: dict[str, set[int]] = {}
+            owned: dict[str, set[int]] = {}
+            slot_body.append(None)
+            for joint, parts in robot_bodies(r):
+                body = movers.add_body([_entry(s, base, local) for _, local, s in parts],
+                                       pose_from_model(r.pose), owner=i, movable=True)
+                if joint is None:
+                    slot_body[i] = body
+                else:
+                    link_slots.append((i, joint, body))
                 for k, (_, _, shape) in enumerate(parts):
                     for device in blind_devices(shape):
                         owned.setdefault(device, set()).add(first + k)
-                self._own_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
                 first += len(parts)
                 for name, _, shape in parts:
                     info = _shape_info(name, i, shape)
                     red.append(info.red)
                     rough.append(info.roughness)
-            else:
-                slot_body.append(None)
+            self._own_shapes.update({(i, d): frozenset(ids) for d, ids in owned.items()})
         if threads is not None:       # the cores a large cast may use (RayEngine.threads; same bits on any number)
             if int(threads) < 1:
                 raise BatchedError(f"threads must be >= 1, got {threads}")
             self.scene.engine.threads = movers.threads = int(threads)
-        self.rays = CopyRays(self.scene.engine, movers, slot_body, n_static)
+        self.link_slots = link_slots
+        self._link_cols: tuple[np.ndarray, np.ndarray] | None = None   # (robot slot, joint column) per link
+        self.rays = CopyRays(self.scene.engine, movers, slot_body + [b for _, _, b in link_slots], n_static,
+                             owner=[*range(R), *(i for i, _, _ in link_slots)],
+                             expand=self._with_links if link_slots else None)
         self.red = np.array(red + [1.0])              # per hit shape; -1 (no hit) reads the last entry
         self.roughness = np.array(rough + [0.0])
         self.n_static_shapes = n_static
@@ -356,6 +375,8 @@ class BatchedSimulation:
             else None for i, r in enumerate(w.robots)]
         # joint motors (every motor but the drives'): their state per copy and what rides them (batched_joints.py)
         self.joints = batched_joints.BatchedJoints(w, C)
+        if self.carried is not None:      # the lights riding joints: placed on each copy's links
+            self.carried.bind_joints(self.joints)
         # car-like robots: their motors and bicycle model (batched_car.py), None in a world without one
         self.cars = CarDrives(w, C) if any(r.ackermann_drive for r in w.robots) else None
         # mecanum robots: their four wheels and body twist (batched_mecanum.py), None in a world without one
@@ -398,6 +419,13 @@ class BatchedSimulation:
             solids = [(s.name, primitive_from_model(shape.geometry, base), local, self.scene.solid_poses[s.name],
                        shape.seen_by in ("both", "bounding"))
                       for s in w.solids for _, local, shape in solid_parts(s, Pose.identity())]
+            bound = [(r.name, f"shape {x.name!r}" if x.name else f"shapes[{i}]", x.on_joint) for r in w.robots
+                     for i, x in enumerate(r.shapes) if x.on_joint is not None and x.seen_by in ("both", "bounding")]
+            if bound:      # Simulation reshapes a robot's footprint as its joints move; the copies' stay as built
+                raise BatchedError(f"{self.loaded.source}: robot {bound[0][0]!r}: {bound[0][1]} rides "
+                                   f"joint {bound[0][2]!r} and bounds the robot; the batched simulation's kinematic "
+                                   "contact does not follow a link (use Simulation, contact: false, or the shape's "
+                                   "seen_by: visual)")
             self.contact = Contact(solids, [], self.to_enu)
             feet = [drive_footprint(robot_bounding_parts(r, base), self.initial[i], self.to_enu,
                                     None if (tpl := self._templates[i]) is None else tpl.yaw)
@@ -438,18 +466,34 @@ class BatchedSimulation:
         if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "
                                "carries solids; the batched simulation moves no belt (use Simulation)")
-        for r in w.robots:            # joints move per copy (batched_joints.py); of what rides them, only devices
-            riding = [((f"shape {x.name!r}" if x.name else f"shapes[{i}]")
-                       + (f" of {x.of_device!r}" if x.of_device else ""), x.on_joint) for i, x in enumerate(r.shapes)]
-            riding += [(f"lights[{i}]", x.on_joint) for i, x in enumerate(r.lights)]
-            for what, joint in riding:    # the copies' robots are one rigid body each: no link moves in the cast
-                if joint is not None:
-                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {what} rides joint {joint!r}; "
-                                       "the batched simulation moves no link's shapes or lights (use Simulation)")
+        for r in w.robots:            # joints move per copy (batched_joints.py): links' shapes and devices ride them
+            bumpers = {d.name for d in r.devices if d.device == "TouchSensor"}
+            for i, x in enumerate(r.shapes):
+                if x.on_joint is None:
+                    continue
+                what = (f"shape {x.name!r}" if x.name else f"shapes[{i}]") + (f" of {x.of_device!r}" if x.of_device
+                                                                            else "")
+                why = ("bumper's shapes on a link (its contact does not follow the joint here)"
+                       if x.of_device in bumpers else
+                       "plane on a link" if isinstance(x.geometry, wm.Plane) else
+                       "textured shape on a link" if textured_robot(r.model_copy(update={"body": None, "shapes": [x]}))
+                       else None)
+                if why:
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {what} rides joint {x.on_joint!r}; "
+                                       f"the batched simulation moves no {why} (use Simulation)")
+            shaped = {x.on_joint for x in r.shapes if x.on_joint is not None}
             for d in r.devices:
                 joint = getattr(d, "on_joint", None)
                 if joint is None:
                     continue
+                # a device that sees its own robot, on a link with shapes: the single simulation meets that
+                # link from the device's frame (its mount); the copies' casts would meet it from the world's
+                if joint in shaped and (d.device in ("Lidar", "Camera", "RangeFinder") or (
+                        d.device in ("DistanceSensor", "LightSensor") and r.self_collision)
+                        or (d.device == "DistanceSensor" and d.type == "infra-red")):    # (visual rays: see their robot)
+                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
+                                       f"{joint!r}, whose link has shapes it sees; the batched simulation casts from "
+                                       "a link with shapes only the rays blind to their own robot (use Simulation)")
                 if d.device not in batched_joints.RIDING_KINDS:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
                                        f"{joint!r}; the batched simulation moves distance sensors, light sensors, "
@@ -502,10 +546,11 @@ class BatchedSimulation:
                                         own_shapes=self._own_shapes.get((slot, d.name), frozenset()))
                 riding = dev.on_joint is not None and d.device in batched_joints.PLACED_KINDS
                 if riding:
-                    # on a link without shapes (batched.py refuses links with shapes): its rays are
-                    # mounted on no body, as the single simulation's (Scene.device_body is None), and a
-                    # light sensor's occlusion rays skip its robot as the single one's do (exclude_self);
-                    # each copy's local pose is the joints' (batched_joints.py)
+                    # its rays are mounted on no body: on a link without shapes as the single simulation's
+                    # (Scene.device_body is None); on one with shapes only if blind to its robot
+                    # (_check_supported), so its link is never met; a light sensor's occlusion rays
+                    # skip its robot as the single one's do (exclude_self); each copy's local pose is
+                    # the joints' (batched_joints.py)
                     dev.move_with(Pose.identity())
                     self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose, dev.local_pose)
                 elif d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
@@ -669,6 +714,9 @@ class BatchedSimulation:
     def recognition_enable(self, ref: DeviceRef, period_ms: int, copies=None) -> None:
         """A camera's ``recognition_enable(period)`` in the named copies (default: all), counted from
         each copy's clock (0 disables it, and the segmentation with it)."""
+        if self.link_slots and period_ms:     # (its objects are placed by their robots' poses, not their links')
+            raise BatchedError(f"{self.robot_names[ref.slot]}/{ref.name}: the batched simulation recognises "
+                               "nothing in a world with shapes on a link (use Simulation)")
         self.recognition.enable(self._camera_column(ref), period_ms, slice(None) if copies is None
                                 else np.asarray(copies, dtype=np.int64))
 
@@ -875,6 +923,27 @@ class BatchedSimulation:
         self.kinematic.measure(live)
         self._measure_rays(live, dt)
         self.recognition.measure(live)
+
+    def _with_links(self, rot: np.ndarray, pos: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Every template slot's pose per copy (CopyRays' ``expand``): the robots' (``rot``, ``pos``,
+        (C, R, ...)), then each link's, its robot's pose ∘ its joint's displacement in that copy as
+        the single scene places a link's body (Pose.compose: the same 3x3 products, stacked)."""
+        cols = self._link_cols
+        if cols is None:
+            cols = self._link_cols = (np.array([i for i, _, _ in self.link_slots], dtype=np.int64),
+                                      np.array([self.joints.of(i, j) for i, j, _ in self.link_slots], dtype=np.int64))
+        robot, joint = cols
+        C = len(rot)
+        rr = rot[:, robot]                                    # (C, L, 3, 3)
+        lr = self.joints.link_rot[:, joint]
+        lp = self.joints.link_pos[:, joint]
+        out_rot = np.empty((C, self.R + len(robot), 3, 3))
+        out_pos = np.empty((C, self.R + len(robot), 3))
+        out_rot[:, :self.R] = rot
+        out_pos[:, :self.R] = pos
+        out_rot[:, self.R:] = np.matmul(rr, lr)
+        out_pos[:, self.R:] = np.matmul(rr, lp[..., None])[..., 0] + pos[:, robot]
+        return out_rot, out_pos
 
     # -- motion
     def _drive(self, live: np.ndarray, dt_ms: int) -> None:

@@ -48,7 +48,7 @@ from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
 from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite, masked, noise_mask_planes
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import _base_color, receives_shadows, robot_parts, surface_colors, surface_opacity
+from sensorium.server.sim.scene import _base_color, receives_shadows, scene_robot_parts, surface_colors, surface_opacity
 
 __all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera", "own_body_hits"]
 
@@ -171,7 +171,7 @@ class CameraDevices(PixelDevices):
         # base colour a camera sees (a textured shape's texels come on top: _albedo) and the
         # transparency
         models = [scene.part(i)[2] for i in range(sim.n_static_shapes)]
-        models += [shape for r in sim.world.robots for _, _, shape in robot_parts(r)]
+        models += [shape for r in sim.world.robots for _, _, shape in scene_robot_parts(r)]
         self.colors = np.array([_base_color(m) for m in models] + [(1.0, 1.0, 1.0)], dtype=np.float64).reshape(-1, 3)
         self.transparency = np.array([m.appearance.transparency if m.appearance is not None else 0.0
                                       for m in models] + [0.0])

@@ -20,8 +20,10 @@ simulation casts the rays of the distance sensors and lidars (a rotating one's s
 riding joints from those poses, and
 places the light sensors, cameras and range finders riding them there (and measures the GPS,
 compasses, inertial units, gyros, accelerometers and altimeters riding them there: batched_kinematic.py);
-it refuses what else rides a joint (batched.py's ``_check_supported``): a link's shapes or lights
-(the copies' robots are one rigid template body each: a bumper's own shapes among them) and other devices.
+the links' shapes are bodies of their own in the copies' cast and their lights are placed per copy,
+both from ``link_rot`` / ``link_pos`` (batched.py's ``_with_links``, batched_lights.py); it refuses
+what else rides a joint (batched.py's ``_check_supported``): a bumper's own shapes, planes, textured
+shapes and other devices.
 """
 
 from __future__ import annotations
@@ -47,7 +49,7 @@ RIDING_KINDS = (*PLACED_KINDS, "PositionSensor", "TouchSensor", "RotationalMotor
 """What may ride a joint (``on_joint``) in the batched simulation: the sensors whose rays (and a
 light sensor's normal) start from each copy's link, encoders (which read a motor, wherever they sit),
 bumpers without shapes of their own (which read their robot's contact, wherever they sit: a bumper's
-shapes on a joint are a link's shapes, refused) and the nested joints' motors."""
+own shapes on a joint are refused) and the nested joints' motors."""
 
 
 def joint_motors(robot: wm.Robot) -> list[wm.RotationalMotor | wm.LinearMotor]:

@@ -6,7 +6,10 @@ lights that are on, robot after robot, each placed by ``place_light(model, robot
 Copy c's arrays are the same list with copy c's robot poses: the fixed lights shared by every copy,
 the carried ones placed per copy with the same numpy calls on stacks (``Pose.compose`` with the
 identity, then ``location @ R.T + t`` and ``direction @ R.T``, each a matmul of the same shapes), so
-the bits are the single simulation's.
+the bits are the single simulation's. A light riding a joint (``on_joint``) is placed on its copy's
+link: its robot's pose ∘ the joint's displacement there (batched_joints.py's ``link_rot`` /
+``link_pos``, Pose.compose's products stacked), then as above; a spot light's light-sensor axis there is
+turned by the displacement alone (scene.py's ``link_aimed``).
 
 A robot's LEDs' lights (``robot_led_lights``: in the robot's frame, listed after its own lights, as
 the single scene lists them) are carried the same way and are on in a copy exactly while that copy's
@@ -29,7 +32,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
-from sensorium.server.sim.scene import for_light_sensors, light_from_model, place_light, robot_led_lights
+from sensorium.server.sim.scene import for_light_sensors, light_from_model, link_aimed, place_light, robot_led_lights
 from sensorium.server.world.geometry import Pose
 
 __all__ = ["CarriedLights", "RowLights", "copy_world_lights", "has_carried_lights"]
@@ -103,6 +106,21 @@ class CarriedLights:
                                      dtype=bool)
         self._oriented = self.shared.kind != light_math.LightKind.POINT
         self._n_fixed = len(self._fixed)
+        # the joint each carried light rides (``on_joint``; None: its robot's body), its column once bound
+        self._joints = [getattr(m, "on_joint", None) for _, m in carried]
+        self._link: np.ndarray | None = None           # per carried light: its joint's column, -1 none
+        self._link_rot = self._link_pos = None          # (copies, joints, ...) displacements (batched_joints.py)
+        # on a link, a spot light's light-sensor axis turns with the joint (scene.link_aimed)
+        self._sensor_turned = np.array([m.type == "SpotLight" and m.light_sensor_direction is not None
+                                        and j is not None for (_, m), j in zip(carried, self._joints)], dtype=bool)
+
+    def bind_joints(self, joints) -> None:
+        """The copies' joints (:class:`~sensorium.server.sim.batched_joints.BatchedJoints`) whose links
+        carry lights: each such light is placed at its robot's pose ∘ its joint's displacement."""
+        if any(j is not None for j in self._joints):
+            self._link = np.array([-1 if j is None else joints.of(int(i), j) for i, j in zip(self.slots, self._joints)],
+                                  dtype=np.int64)
+            self._link_rot, self._link_pos = joints.link_rot, joints.link_pos
 
     # ------------------------------------------------------------------ LEDs
     def switch_led(self, slot: int, name: str, copies: np.ndarray, on: bool, color: tuple[float, float, float]) -> None:
@@ -157,7 +175,18 @@ class CarriedLights:
         k = len(copies)
         R = rot[copies[:, None], self.slots[None, :]]                 # (k, m, 3, 3)
         t = pos[copies[:, None], self.slots[None, :]]
-        Rc = np.matmul(R, _EYE)                                       # robot pose ∘ identity (Pose.compose)
+        linked = None
+        if self._link is not None:    # on a link: robot pose ∘ its displacement (Pose.compose), as the scene frames it
+            linked = np.flatnonzero(self._link >= 0)
+            cols = self._link[linked]
+            Ld = self._link_rot[copies[:, None], cols[None, :]]       # (k, m', 3, 3)
+            Lt = self._link_pos[copies[:, None], cols[None, :]]
+            Rr = R[:, linked]
+            R = R.copy()
+            t = t.copy()
+            R[:, linked] = np.matmul(Rr, Ld)
+            t[:, linked] = np.matmul(Rr, Lt[..., None])[..., 0] + t[:, linked]
+        Rc = np.matmul(R, _EYE)                                       # frame ∘ identity (Pose.compose)
         tc = np.matmul(R, _ZERO) + t
         Rt = Rc.transpose(0, 1, 3, 2)
         where = np.broadcast_to(self._local_pos[None, :, None, :], (k, self.count, 1, 3))
@@ -166,6 +195,12 @@ class CarriedLights:
         d = np.matmul(aim, Rt)[:, :, 0, :]                            # direction @ R.T (Pose.apply_dirs)
         p = np.where(self._located[None, :, None], p, self._local_pos[None])
         d = np.where(aimed[None, :, None], d, local_dir[None])
+        if sensors and linked is not None and self._sensor_turned.any():
+            # its light-sensor axis turned by the joint's displacement only (scene.link_aimed: apply_dirs)
+            turned = np.flatnonzero(self._sensor_turned[linked])
+            j = linked[turned]
+            axis = np.broadcast_to(local_dir[j][None, :, None, :], (k, len(j), 1, 3))
+            d[:, j] = np.matmul(axis, Ld[:, turned].transpose(0, 1, 3, 2))[:, :, 0, :]
         return p, d
 
     def rows(self, rot: np.ndarray, pos: np.ndarray, copies: np.ndarray) -> RowLights:
@@ -214,5 +249,13 @@ def copy_world_lights(sim, copy: int) -> list:
             models += [m.model_copy(update={"on": on, "color": color}) if on else m for m in lights]
         if models:
             frame = sim.pose(copy, slot).compose(Pose.identity())
-            out += [place_light(m, frame) for m in models]
+            for m in models:
+                joint = getattr(m, "on_joint", None)
+                if joint is None:
+                    out.append(place_light(m, frame))
+                    continue
+                k = sim.joints.of(slot, joint)     # on a link: where this copy's joint holds it (Scene.world_lights)
+                moved = Pose(sim.joints.link_rot[copy, k], sim.joints.link_pos[copy, k])
+                out.append(link_aimed(place_light(m, sim.pose(copy, slot).compose(moved).compose(Pose.identity())),
+                                      moved))
     return out

@@ -27,7 +27,7 @@ from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.batched_camera import own_body_hits
 from sensorium.server.sim.batched_depth import PixelDevices
 from sensorium.server.sim.recognition import RecognisedObject, Recognizer, occlusion_ray
-from sensorium.server.sim.scene import recognisable_owners, robot_parts
+from sensorium.server.sim.scene import recognisable_owners, scene_robot_parts
 from sensorium.server.sim.sensors import _check_period
 from sensorium.server.world.geometry import Pose
 
@@ -46,7 +46,7 @@ class _CopyScene:
         self.base_dir = scene.base_dir
         world = sim.world
         self._parts = [scene.part(i) for i in range(sim.n_static_shapes)]
-        self._parts += [(r, local, shape) for r, robot in enumerate(world.robots) for _, local, shape in robot_parts(robot)]
+        self._parts += [(r, local, shape) for r, robot in enumerate(world.robots) for _, local, shape in scene_robot_parts(robot)]
         self.shapes = self._parts                     # (a Recognizer counts them)
         self.recognisable = recognisable_owners(world)     # the single scene's Supervisor node ids
 
@@ -54,7 +54,7 @@ class _CopyScene:
         return self._parts[shape]
 
     def on_link(self, shape: int) -> bool:
-        return False                                  # (the batched simulation refuses joints)
+        return False                                  # (recognition is refused in a world with link shapes: batched.py)
 
     def owner_pose(self, key: str | int) -> Pose:
         if isinstance(key, str):

@@ -1,8 +1,8 @@
 """Textured robot bodies in the batched simulation: a camera's or an infra-red sensor's hit on a
 robot's textured shape reads its texel as the single simulation reads it.
 
-The single scene numbers its shapes solids first, then every robot's parts in world order; the
-copies' cast numbers a robot's hit ``shape_offset`` (the solids' count) + its part's index among
+The single scene numbers its shapes solids first, then every robot's parts in world order (its
+body's, then each link's: scene.robot_bodies); the copies' cast numbers a robot's hit ``shape_offset`` (the solids' count) + its part's index among
 all robots' parts: the same numbers. So one :class:`~sensorium.server.world.textures.TextureSampler`
 over the solids' and the robots' template shapes (the batched scene's, extended) serves every
 copy, and a copy's lookup differs from another's only in the shape's world-to-shape pose: the
@@ -17,7 +17,7 @@ from collections.abc import Callable
 from typing import Any
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.scene import robot_parts
+from sensorium.server.sim.scene import robot_parts, scene_robot_parts
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.textures import TextureSampler
 
@@ -42,7 +42,7 @@ class RobotTextures:
         self.sim = sim
         scene = sim.scene
         self.n_static = sim.n_static_shapes
-        parts = [(slot, local, shape) for slot, r in enumerate(sim.world.robots) for _, local, shape in robot_parts(r)]
+        parts = [(slot, local, shape) for slot, r in enumerate(sim.world.robots) for _, local, shape in scene_robot_parts(r)]
         self.parts: list[tuple[int, Pose]] = [(slot, local) for slot, local, _ in parts]
         models = [(shape.geometry, shape.appearance) for _, _, shape in parts]
         if scene.textures is None:

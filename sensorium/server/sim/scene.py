@@ -204,6 +204,22 @@ def robot_parts(robot: wm.Robot) -> Iterator[tuple[str, Pose, wm.Shape]]:
         yield f"{robot.name}/{part.name or 'body'}", pose_from_model(part.pose), part
 
 
+def robot_bodies(robot: wm.Robot) -> list[tuple[str | None, list[tuple[str, Pose, wm.Shape]]]]:
+    """A robot's shapes as the scene's bodies hold them: (None, the robot's own body's parts) first,
+    then (joint, the parts riding it: its link, ``on_joint``) in the order the joints first appear,
+    each group's parts in :func:`robot_parts` order. The scene numbers a robot's shapes in this order."""
+    groups: dict[str | None, list] = {}
+    for part in robot_parts(robot):
+        groups.setdefault(getattr(part[2], "on_joint", None), []).append(part)
+    return sorted(groups.items(), key=lambda kv: kv[0] is not None)
+
+
+def scene_robot_parts(robot: wm.Robot) -> list[tuple[str, Pose, wm.Shape]]:
+    """A robot's shapes in the scene's numbering (:func:`robot_bodies` flattened): :func:`robot_parts`'
+    order unless a shape rides a joint."""
+    return [part for _, group in robot_bodies(robot) for part in group]
+
+
 def robot_bounding_parts(robot: wm.Robot, base_dir: Path) -> list[tuple[Any, Pose]]:
     """A robot's shapes that bound it (``seen_by`` both or bounding) as (primitive, pose in the robot
     frame): what kinematic contact and the ground's support ceiling take its body to be."""
@@ -470,15 +486,11 @@ class Scene:
                 self._led_lights[(i, name)] = models
                 carrier = i if led_joint[name] is None else (i, led_joint[name])
                 self._lights += [(m, carrier, Pose.identity()) for m in models]
-            parts = list(robot_parts(r))
             # a joint's link (the shapes riding on it: ``on_joint``) is a movable body of its own, owned
             # by the robot; every other shape is the robot's body, as in a robot without joints
-            links: dict[str | None, list] = {}
-            for part in parts:
-                links.setdefault(getattr(part[2], "on_joint", None), []).append(part)
             owned: dict[str, set[int]] = {}
             placed: dict[int, int] = {}                      # id(shape model) -> its shape index
-            for joint, group in sorted(links.items(), key=lambda kv: kv[0] is not None):
+            for joint, group in robot_bodies(r):
                 first = len(self.shapes)
                 body = self._add_body(group, base_dir, pose, owner=i, movable=True, key=i)
                 if joint is None:
