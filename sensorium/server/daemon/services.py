@@ -793,6 +793,18 @@ class Core(DeviceServices):
         self._custom_sent[self._session(c).token] = c.args.value     # its controller has it (the field too)
         return {"success": True}
 
+    def _robot_battery_sensor_enable(self, c: Call) -> dict:
+        """Webots' wb_robot_battery_sensor_enable: its value (J) every period from now (NaN until the
+        first; -1 without a battery, as Webots); 0 disables it (the last value stays)."""
+        self.sim.enable_battery_sensor(self.sim.robots[c.robot], c.args.value)
+        return {"success": True}
+
+    def _robot_battery_sensor_get_sampling_period(self, c: Call) -> dict:
+        return {"value": self.sim.robots[c.robot].battery_schedule.period_ms}
+
+    def _robot_battery_sensor_get_value(self, c: Call) -> dict:
+        return {"value": self.sim.robots[c.robot].battery_value}
+
     def _robot_get_model(self, c: Call) -> dict:
         return {"value": self.sim.robots[c.robot].model.model}
 
