@@ -10,6 +10,7 @@ import math
 from pathlib import Path
 
 import pytest
+from test_run import clib, compile_controller, project, run  # noqa: F401  (clib: the fixture)
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import WorldError, load_world, parse_world
@@ -151,3 +152,51 @@ def test_the_wbt_import_reads_batteries_cpu_consumption_and_chargers(tmp_path: P
     sim = Simulation(w)
     sim.step()
     assert sim.robots["plain"].battery.energy == pytest.approx(80.0 - 2.5 * 0.032)
+
+
+PY_READER = '''from controller import Robot
+robot = Robot()
+robot.batterySensorEnable(32)
+while robot.step(16) != -1:
+    print(round(robot.getTime() * 1000), f"{robot.batterySensorGetValue():.6f}", robot.batterySensorGetSamplingPeriod())
+'''
+
+C_READER = r'''#include <math.h>
+#include <stdio.h>
+#include <webots/robot.h>
+
+int main(void) {
+  wb_robot_init();
+  wb_robot_battery_sensor_enable(32);
+  while (wb_robot_step(16) != -1) {
+    double v = wb_robot_battery_sensor_get_value();
+    if (isnan(v))
+      printf("%ld nan %d\n", lround(wb_robot_get_time() * 1000), wb_robot_battery_sensor_get_sampling_period());
+    else
+      printf("%ld %.6f %d\n", lround(wb_robot_get_time() * 1000), v, wb_robot_battery_sensor_get_sampling_period());
+    fflush(stdout);
+  }
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+@pytest.mark.slow
+def test_python_and_c_controllers_read_the_same_battery(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:  # noqa: F811
+    """0.5 J at 3 W, 16 ms steps, a 32 ms period: 0.5 - 0.003 t at t = 32, 64, ...; empty in the step
+    ending at 176 ms (0.5 / 0.048 J a step), read 0 at once."""
+    battery = "battery [ 0.5, 1, 1 ] cpuConsumption 3"
+    world = project(tmp_path, f'Robot {{ name "py" controller "py_reader" {battery} }}\n'
+                              f'Robot {{ name "c" controller "c_reader" {battery} }}', {"py_reader.py": PY_READER})
+    compile_controller(clib, tmp_path / "controllers" / "c_reader", "c_reader", C_READER)
+    proc = run(world, "--until", "224")
+    assert proc.wait() == 0, proc.stderr()
+    expected = []
+    for t in range(16, 225, 16):
+        sampled = t - t % 32
+        value = "nan" if sampled == 0 else f"{max(0.0, 0.5 - 3 * sampled / 1000) if t < 176 else 0.0:.6f}"
+        expected.append(f"{t} {value} 32")
+    out = proc.stdout().splitlines()
+    for robot in ("py", "c"):
+        assert [line.split("] ", 1)[1] for line in out if line.startswith(f"[{robot}]")] == expected, proc.stdout()
