@@ -200,3 +200,32 @@ def test_python_and_c_controllers_read_the_same_battery(tmp_path: Path, clib: tu
     out = proc.stdout().splitlines()
     for robot in ("py", "c"):
         assert [line.split("] ", 1)[1] for line in out if line.startswith(f"[{robot}]")] == expected, proc.stdout()
+
+
+def test_the_battery_services_serve_the_attached_controller_and_reset_when_it_leaves() -> None:
+    import msgpack
+
+    from sensorium.schemas import wire
+    from sensorium.server.daemon.services import Core
+
+    core = Core(world([{"name": "r", "battery": [10.0, 20.0, 1.0], "cpu_consumption": 2.0}]),
+                new_token=lambda: "s0", log=lambda *_: None)
+    rid = iter(range(1, 100))
+
+    def call(service: str, args: dict, who: bytes = b"A") -> dict:
+        (frames,) = core.handle([who, wire.pack({"id": next(rid), "service": service, "args": args})], 0.0)
+        return msgpack.unpackb(frames[-1])
+
+    assert call("attach", {"robot": "r"})["ok"] is True
+    refused = call("/r/robot/battery_sensor_enable", {"value": DT}, who=b"B")     # not its controller
+    assert refused["ok"] is False
+    assert call("/r/robot/battery_sensor_enable", {"value": DT})["result"] == {"success": True}
+    assert math.isnan(call("/r/robot/battery_sensor_get_value", {})["result"]["value"])
+    for _ in range(3):
+        assert core.handle([b"A", wire.pack({"id": next(rid), "service": "/r/robot/step", "args": {}})], 0.0) == []
+        core.step_once(0.0)
+    assert call("/r/robot/battery_sensor_get_value", {})["result"]["value"] == pytest.approx(10.0 - 2.0 * 0.096)
+    assert call("/r/robot/battery_sensor_get_sampling_period", {}, who=b"B")["result"]["value"] == DT
+    assert call("detach", {"session": "s0"})["ok"] is True
+    assert call("/r/robot/battery_sensor_get_sampling_period", {}, who=b"B")["result"]["value"] == 0
+    assert math.isnan(call("/r/robot/battery_sensor_get_value", {}, who=b"B")["result"]["value"])

@@ -17,6 +17,7 @@ that fails gets exactly one error reply with a protocol code; the core never rai
 
 from __future__ import annotations
 
+import math
 import sys
 import traceback
 from collections import deque
@@ -445,6 +446,9 @@ class Core(DeviceServices):
         self._custom_sent.pop(s.token, None)
         self.topics.release_robot(s.robot)
         supervisor.movie_released(self.sim, s.robot)
+        robot = self.sim.robots[s.robot]          # the next controller starts with its battery sensor off
+        self.sim.enable_battery_sensor(robot, 0)
+        robot.battery_value = math.nan
         # a robot without a controller stops: with no collision response it would otherwise
         # drive through walls while the world steps for the others (Webots keeps the commands)
         for motor in self.sim.robots[s.robot].motors.values():
