@@ -229,3 +229,28 @@ def test_the_battery_services_serve_the_attached_controller_and_reset_when_it_le
     assert call("detach", {"session": "s0"})["ok"] is True
     assert call("/r/robot/battery_sensor_get_sampling_period", {}, who=b"B")["result"]["value"] == 0
     assert math.isnan(call("/r/robot/battery_sensor_get_value", {}, who=b"B")["result"]["value"])
+
+
+def test_a_supervisor_reads_the_battery_field_with_its_present_energy() -> None:
+    import msgpack
+
+    from sensorium.schemas import wire
+    from sensorium.server.daemon.services import Core
+
+    sim = world([{"name": "r", "def_name": "R", "battery": [10.0, 20.0], "cpu_consumption": 2.0},
+                 {"name": "boss", "supervisor": True}])
+    core = Core(sim, new_token=lambda: "s0", log=lambda *_: None)
+    rid = iter(range(1, 100))
+
+    def call(service: str, args: dict) -> dict:
+        (frames,) = core.handle([b"A", wire.pack({"id": next(rid), "service": service, "args": args})], 0.0)
+        return msgpack.unpackb(frames[-1])["result"]
+
+    call("attach", {"robot": "boss"})
+    node = call("/boss/robot/get_from_def", {"name": "R"})["node"]
+    for _ in range(5):
+        sim.step()
+    # the world's two values, the first the energy now (Webots' WbRobot::setCurrentEnergy writes the field)
+    got = call("/boss/robot/get_field", {"node": node, "field": "battery"})
+    assert got["type"] == "MFFloat" and got["value"] == pytest.approx([10.0 - 2.0 * 0.16, 20.0], abs=1e-12)
+    assert call("/boss/robot/get_field", {"node": node, "field": "cpuConsumption"}) == {"type": "SFFloat", "value": 2.0}
