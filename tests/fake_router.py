@@ -9,6 +9,7 @@ Robot r2 also has two wheel motors; motor commands arrive in the step requests' 
 from __future__ import annotations
 
 import itertools
+import math
 import struct
 import threading
 import time
@@ -181,6 +182,10 @@ class FakeServer(threading.Thread):
             raise _Err(2, f"unknown service {service!r}")
         robot, dev_name, item = parts
         if dev_name == "robot":
+            if item == "battery_sensor_enable":          # the fake's robots have no battery: never a value
+                return {"success": True}
+            if item == "battery_sensor_get_value":
+                return {"value": math.nan}
             if item != "step":
                 raise _Err(2, service)
             if self.attached.get(robot, (None,))[0] != identity:

@@ -186,6 +186,9 @@ class FakeSim:
         self.robots = {r.name: FakeRobot(self, r) for r in world.robots}
         self.fail = False
 
+    def enable_battery_sensor(self, robot, period_ms):       # what Core calls when a controller leaves
+        robot.battery_period = period_ms
+
     def step(self):
         if self.fail:
             raise RuntimeError("boom")

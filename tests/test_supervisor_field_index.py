@@ -23,11 +23,11 @@ HARDEN = REPO / "tests" / "worlds" / "proto" / "supervisor_proto_harden.wbt"
 NESTED = REPO / "tests" / "worlds" / "nested_nodes.wbt"
 SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_on_error=1:print_stacktrace=1:exitcode=87"}
 SOLID = ["translation", "rotation", "children", "name", "model", "radarCrossSection"]
-ROBOT = SOLID + ["controller", "customData", "supervisor", "synchronization"]
+ROBOT = SOLID + ["controller", "customData", "supervisor", "synchronization", "battery", "cpuConsumption"]
 INFO = ["title", "gravity", "basicTimeStep", "inkEvaporation", "coordinateSystem", "gpsCoordinateSystem",
         "gpsReference", "randomSeed"]
 EXPECTED = [" ".join(["box", "6", *SOLID]), " ".join(["boxbase", "6", *SOLID]), " ".join(["info", "8", *INFO]),
-            " ".join(["keeper", "14", "10", *ROBOT]), "controller SFString <extern>", "translation -1 0 0.1", "bad 1 1", "protodef 1 1 1 1"]
+            " ".join(["keeper", "14", "12", *ROBOT]), "controller SFString <extern>", "translation -1 0 0.1", "bad 1 1", "protodef 1 1 1 1"]
 
 
 def _live(world=HARDEN) -> Live:

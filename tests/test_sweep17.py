@@ -360,13 +360,14 @@ def test_the_motor_sample_s_turntable_follows_its_staircase_by_the_kinematic_rul
     """motor (Webots' device sample): each 8 ms step the controller sets the turntable's target, 0 for
     51 steps, then π/4 more every 51 steps. Its hinge starts at 1.5708 and moves kinematically (one load
     line: forces are ignored, so the client's torque feedback reads NaN; the robot's battery is one more
-    line, its sensor NaN): its speed grows by maxTorque × dt = 20 × 0.008 rad/s a step up to
+    line: with physics and a consuming motor, it drains by cpuConsumption only here): its speed grows by maxTorque × dt = 20 × 0.008 rad/s a step up to
     maxVelocity 2 rad/s towards the target and it stops on it the step it would pass it. Every step's
     angle is that rule's (1e-12): down from 1.5708 towards 0 at 2 rad/s, it meets the next target π/4
     on its way at 0.448 s and stops there; it rests until π/2 is set, and from then on, a π/4 step in
     0.408 s being 0.39 s at full speed, it lags the staircase (5.4828 rad at 3.28 s, the target 2π)."""
     w = load_world(DATA / "motor.wbt")
-    assert any("battery 3600, 36000, 5 is not simulated here" in x for x in w.warnings), w.warnings
+    assert any("its battery drains by cpuConsumption only" in x for x in w.warnings), w.warnings
+    assert w.world.robots[0].battery == [3600.0, 36000.0, 5.0]
     assert any("HingeJoint motor 'motor' is no wheel" in x for x in w.warnings), w.warnings
     sim = Simulation(w, "exact")
     motor = sim.robot(w.world.robots[0].name).motor("motor")

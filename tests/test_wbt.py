@@ -1125,21 +1125,19 @@ def test_camera_fields_the_renderer_uses_and_rays_do_not_are_said(tmp_path: Path
     assert [d.motion_blur for d in w.world.robots[0].devices] == [100.0, 40.0, 0.0]
 
 
-def test_a_robots_battery_and_a_charger_are_said(tmp_path: Path) -> None:
+def test_a_robots_battery_and_a_charger_are_read(tmp_path: Path) -> None:
     """Webots' battery sample: a robot with a ``battery`` (its controller reads the battery sensor)
-    and Chargers around it. The battery was dropped without a word (its sensor reads NaN here) and
-    a Charger was called a device outside a robot; both are now one plain line, the Charger's shapes
-    kept as a solid."""
+    and Chargers around it. The battery was dropped without a word, then one line (its sensor read
+    NaN); both are now read (README "Battery and Charger"), without a line: the robot has no physics,
+    so its motors would consume nothing in Webots either; the Charger's shapes are kept as a solid."""
     p = write(tmp_path, 'Robot { name "r" battery [ 50, 100, 30 ] cpuConsumption 0.5 }\n'
               'Charger { name "charger0" battery [ 100, 100, 3 ] children [ Shape { geometry Cylinder { radius 0.1 '
               'height 0.3 } } ] }\n')
     w = load_world(p)
-    assert not w.report.losses
-    assert w.warnings == [
-        f"{p}:2:1: Robot 'r': battery 50, 100, 30 is not simulated here: its battery sensor reads NaN, as a Webots "
-        "robot without a battery",
-        f"{p}:3:1: Charger 'charger0': recharging is not simulated (robots have no battery here); its shapes and "
-        "lights are kept as a solid"]
+    assert not w.report.losses and w.warnings == []
+    (robot,) = w.world.robots
+    assert (robot.battery, robot.cpu_consumption) == ([50.0, 100.0, 30.0], 0.5)
+    assert w.world.chargers == [wm.Charger(solid="charger0", battery=[100.0, 100.0, 3.0], radius=0.04)]
     assert [(s.name, [x.geometry.type for x in s.shapes]) for s in w.world.solids] == [("charger0", ["cylinder"])]
 
 

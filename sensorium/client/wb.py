@@ -24,7 +24,7 @@ clamped here with Webots' warning (Webots clamps in the simulator).
 The functions live in ``wb_robot`` (session, robot, keyboard), ``wb_sensors`` (light, distance,
 lidar, encoders), ``wb_kinematic`` (GPS, InertialUnit, Compass, Accelerometer, Gyro, Altimeter,
 TouchSensor), ``wb_radio`` (Emitter, Receiver), ``wb_camera`` (RangeFinder, Camera, Recognition), ``wb_display``, ``wb_pen``, ``wb_radar``, ``wb_speaker``, ``wb_vacuum`` (VacuumGripper), ``wb_connector`` (Connector, Brake), ``wb_motor`` (motors, LEDs), ``wb_motion`` (motion files, ``wbu_motion_*``), ``wb_movie`` (a Supervisor's movies), ``wb_input``
-(joystick, mouse, waiting for user input, battery), ``wb_unsimulated`` (the devices Sensorium
+(joystick, mouse, waiting for user input, the battery sensor), ``wb_unsimulated`` (the devices Sensorium
 lists without simulating: Webots' "no value" with one warning per device) and ``wb_supervisor``;
 this module re-exports them all. One process drives one robot through
 these functions; :class:`RobotClient` is the same thing as

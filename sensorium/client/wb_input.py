@@ -1,6 +1,6 @@
 """Webots' user-input and robot extras on a headless server: ``wb_joystick_*`` (never connected),
 ``wb_mouse_*`` (no state: NaN), ``wb_robot_wait_for_user_input_event`` (no event ever comes: the
-simulation runs for the whole timeout), the battery (none: NaN), project/world paths (""), the URDF (the server's
+simulation runs for the whole timeout), the battery sensor (the server's ``battery_sensor_*``), project/world paths (""), the URDF (the server's
 ``get_urdf``), robot-window texts (sent to the server's ``wwi_send``, received with the step replies). The keyboard is in :mod:`sensorium.client.wb_robot`."""
 
 from __future__ import annotations
@@ -49,11 +49,16 @@ def wb_robot_wait_for_user_input_event(event_type: int, timeout: int) -> int:
 # ---------------------------------------------------------------------- battery, paths, windows
 
 def wb_robot_battery_sensor_enable(sampling_period: int) -> None:
-    _state.battery_period = _period(sampling_period, "wb_robot_battery_sensor_enable")
+    """The server samples the robot's battery every ``sampling_period`` ms from now (0 disables)."""
+    period = _period(sampling_period, "wb_robot_battery_sensor_enable")
+    r = current()
+    if not r.terminated:
+        r.conn.call(f"/{r.name}/robot/battery_sensor_enable", {"value": period})
+    _state.battery_period = period
 
 
 def wb_robot_battery_sensor_disable() -> None:
-    _state.battery_period = 0
+    wb_robot_battery_sensor_enable(0)
 
 
 def wb_robot_battery_sensor_get_sampling_period() -> int:
@@ -61,9 +66,12 @@ def wb_robot_battery_sensor_get_sampling_period() -> int:
 
 
 def wb_robot_battery_sensor_get_value() -> float:
-    """NaN: Sensorium robots have no battery."""
-    current()
-    return math.nan
+    """The battery's energy (J) at the latest sample: NaN before the first one, -1 for a robot
+    without a battery (Webots' values; README "Battery and Charger")."""
+    r = current()
+    if r.terminated:
+        return math.nan
+    return float(r.conn.call(f"/{r.name}/robot/battery_sensor_get_value", {})["value"])
 
 
 def wb_robot_get_project_path() -> str:

@@ -1896,6 +1896,12 @@ class Robot(Strict):
 
     synchronization: bool = True
     supervisor: bool = Field(default=False, description="its controller may use the Supervisor services (Webots)")
+    battery: list[Annotated[float, Field(ge=0.0, allow_inf_nan=False)]] = Field(
+        default=[], max_length=3, description="Webots battery: [current energy (J), maximum energy (J), recharge "
+        "speed (W)]; empty: no battery (its battery sensor reads NaN). The energy drops by cpu_consumption each "
+        "step (README 'Battery and Charger'); a Charger needs all three values")
+    cpu_consumption: float = Field(default=10.0, ge=0.0, allow_inf_nan=False,
+                                   description="Webots cpuConsumption (W): the battery's drain")
     custom_data: str = Field(default="", max_length=1 << 20, description="Webots customData (get/setCustomData)")
     model: str = Field(default="", max_length=4096, description="Webots model (getModel)")
     self_collision: bool = False
@@ -2065,6 +2071,18 @@ class TopNode(Strict):
     lights: int = Field(default=0, ge=0, description="top-level lights this node became")
 
 
+class Charger(Strict):
+    """Webots' Charger: the top-level solid ``solid`` (its position) recharges the battery of one robot at a
+    time whose position comes within ``radius`` of its own (README 'Battery and Charger')."""
+
+    solid: str = Field(min_length=1, description="the name of the top-level solid that is the Charger")
+    battery: list[Annotated[float, Field(ge=0.0, allow_inf_nan=False)]] = Field(
+        default=[], max_length=3, description="[current energy (J), maximum energy (J), energy upload speed (W)]; "
+        "fewer than three values: the Charger does nothing, as in Webots")
+    radius: float = Field(default=0.04, ge=0.0, allow_inf_nan=False,
+                          description="the distance (m) between its position and a robot's that starts a charge")
+
+
 class World(Strict):
     """A whole world file.
 
@@ -2076,6 +2094,7 @@ class World(Strict):
     solids: list[Solid] = []
     lights: list[Light] = []
     robots: list[Robot] = []
+    chargers: list[Charger] = Field(default=[], description="Webots' Charger nodes (each names its solid)")
     background: Background = Background()
     fog: Fog | None = Field(default=None, description="Webots' Fog node (the first one of a .wbt world)")
     top_nodes: list[TopNode] = Field(

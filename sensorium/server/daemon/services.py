@@ -17,6 +17,7 @@ that fails gets exactly one error reply with a protocol code; the core never rai
 
 from __future__ import annotations
 
+import math
 import sys
 import traceback
 from collections import deque
@@ -445,6 +446,9 @@ class Core(DeviceServices):
         self._custom_sent.pop(s.token, None)
         self.topics.release_robot(s.robot)
         supervisor.movie_released(self.sim, s.robot)
+        robot = self.sim.robots[s.robot]          # the next controller starts with its battery sensor off
+        self.sim.enable_battery_sensor(robot, 0)
+        robot.battery_value = math.nan
         # a robot without a controller stops: with no collision response it would otherwise
         # drive through walls while the world steps for the others (Webots keeps the commands)
         for motor in self.sim.robots[s.robot].motors.values():
@@ -792,6 +796,18 @@ class Core(DeviceServices):
         self.sim.robots[c.robot].custom_data = c.args.value
         self._custom_sent[self._session(c).token] = c.args.value     # its controller has it (the field too)
         return {"success": True}
+
+    def _robot_battery_sensor_enable(self, c: Call) -> dict:
+        """Webots' wb_robot_battery_sensor_enable: its value (J) every period from now (NaN until the
+        first; -1 without a battery, as Webots); 0 disables it (the last value stays)."""
+        self.sim.enable_battery_sensor(self.sim.robots[c.robot], c.args.value)
+        return {"success": True}
+
+    def _robot_battery_sensor_get_sampling_period(self, c: Call) -> dict:
+        return {"value": self.sim.robots[c.robot].battery_schedule.period_ms}
+
+    def _robot_battery_sensor_get_value(self, c: Call) -> dict:
+        return {"value": self.sim.robots[c.robot].battery_value}
 
     def _robot_get_model(self, c: Call) -> dict:
         return {"value": self.sim.robots[c.robot].model.model}

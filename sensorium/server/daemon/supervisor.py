@@ -590,6 +590,13 @@ def _set_custom_data(sim: Any, node: Node, value: str) -> None:
     sim.robots[node.key].custom_data = value
 
 
+def _battery(robot: Any) -> list[float]:
+    """A robot's ``battery`` as Webots' field holds it: its present energy first (sim/battery.py), then
+    the maximum and recharge speed as loaded; as many values as the world gives."""
+    b = robot.battery
+    return [b.energy, b.maximum, b.speed][:len(robot.model.battery)]
+
+
 def _set_controller(sim: Any, node: Node, value: str) -> None:
     """Webots' WbRobot::updateControllerDir: the value only; services.py ends the running controller and
     `sensorium run`'s launcher starts the named one (a Supervisor's set_field compares before and after)."""
@@ -611,6 +618,8 @@ FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
               "controller": ("SFString", lambda sim, n: sim.robots[n.key].controller, _set_controller),
               "supervisor": ("SFBool", lambda sim, n: bool(sim.robots[n.key].supervisor), None),
               "synchronization": ("SFBool", lambda sim, n: bool(sim.robots[n.key].synchronization), None),
+              "battery": ("MFFloat", lambda sim, n: _battery(sim.robots[n.key]), None),
+              "cpuConsumption": ("SFFloat", lambda sim, n: sim.robots[n.key].battery.cpu, None),
               **_RADAR_FIELD},
     "Solid": {**_POSE_FIELDS,
               "children": ("MFNode", _children, None),
@@ -1013,7 +1022,7 @@ def actual_field(sim: Any, node: Node, field: str, level: int = -1) -> str:
 
 
 _SOLID_ORDER = ("translation", "rotation", "scale", "children", "name", "model", "radarCrossSection", "controller",
-                "customData", "supervisor", "synchronization")
+                "customData", "supervisor", "synchronization", "battery", "cpuConsumption")
 _JOINT_ORDER = ("jointParameters", "jointParameters2", "jointParameters3", "device", "device2", "device3", "endPoint")
 _LIGHT_ORDER = ("ambientIntensity", "attenuation", "beamWidth", "color", "cutOffAngle", "direction", "intensity",
                 "location", "on", "radius", "castShadows")

@@ -27,6 +27,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast.engine import Mount, Precision, RayHits
 from sensorium.server.sim.batches import DistanceBatch, DistancePlan, LightBatch, joined, split_hits
+from sensorium.server.sim.battery import Battery, Charger
 from sensorium.server.sim.belt import Belts
 from sensorium.server.sim.cameras import Camera
 from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
@@ -73,6 +74,7 @@ from sensorium.server.sim.sensors import (
     Lidar,
     LightSensor,
     RayRequest,
+    Schedule,
     TouchSensor,
     device_class,
 )
@@ -242,6 +244,9 @@ class RobotState:
         self.pressing = False         # kinematic contact clipped the drive's motion in the last step
         self.custom_data = model.custom_data
         self.supervisor = model.supervisor
+        self.battery = Battery.from_model(model)
+        self.battery_schedule = Schedule()      # its battery sensor (Webots' wb_robot_battery_sensor_*)
+        self.battery_value = math.nan           # the sensor's latest value (J)
 
     @property
     def pose(self) -> Pose:
@@ -388,6 +393,10 @@ class Simulation:
         self._lights_version = self.scene.lights_version
         self.robots: dict[str, RobotState] = {r.name: RobotState(self, i, r) for i, r in enumerate(self.world.robots)}
         self._driven = [r for r in self.robots.values() if r.drive is not None]
+        self._batteries = [r.battery for r in self.robots.values()]
+        self._powered = [r for r in self.robots.values() if r.battery.present]
+        self.chargers = [c for c in map(Charger.from_model, self.world.chargers) if c is not None]
+        self._battery_sensing: list[RobotState] = []     # robots whose battery sensor is enabled
         self._jointed = [j for r in self.robots.values() for j in r.joints.values()]
         self._linked = [r for r in self.robots.values() if r.links is not None]
         if self.ground is not None:
@@ -495,12 +504,15 @@ class Simulation:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
         Supervisor imported removed (removed ones stay removed), wheel
         motors to their initial commands and angles, joints to their initial positions, top-level lights' fields as loaded, LEDs off, displays black (no image kept, no camera), pen ink cleared (the pens keep their
-        ``write`` and ink, as Webots' WbPen::reset), custom data, radar cross sections, vacuum grippers' pumps (nothing held) and connectors' lock states as in the world file, speakers silent, GPS and Radar speeds
+        ``write`` and ink, as Webots' WbPen::reset), custom data, batteries and Chargers' energies (Chargers idle), radar cross sections, vacuum grippers' pumps (nothing held) and connectors' lock states as in the world file, speakers silent, GPS and Radar speeds
         NaN at their next value (no previous position, as Webots' WbGps::reset and WbRadar::reset).
         The clock keeps running (the lockstep's time never goes back) and devices keep their
         sampling periods and last values."""
+        for charger in self.chargers:
+            charger.reset()
         for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):
             robot.custom_data = data
+            robot.battery.reset()
             if robot.drive is not None:
                 for m in robot.drive.motors.values():
                     m.target_position, m.velocity, m.position = 0.0, m.max_velocity, 0.0
@@ -823,6 +835,8 @@ class Simulation:
         radio = self.radio if self.radio else None
         if radio is not None:
             radio.forward()           # packets sent with the step requests leave before anything moves
+        if self.chargers:             # at the positions the step starts from (Webots' prePhysicsStep)
+            self._charge(dt)
         if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
@@ -885,6 +899,14 @@ class Simulation:
         poses = self.scene.robot_poses
         if radio is not None:
             radio.deliver(poses)      # range, cones, line of sight and readings at the end-of-step poses
+        emptied = [robot for robot in self._powered if robot.battery.drain(dt)]   # Webots' postPhysicsStep
+        for robot in self._battery_sensing:
+            s = robot.battery_schedule
+            # Webots refreshes the sensor when the battery empties: it reads 0 at once
+            if now - s.last_update_ms >= s.period_ms or robot in emptied:
+                # without a battery Webots' sensor reads -1 (WbRobot::currentEnergy)
+                robot.battery_value = robot.battery.energy if robot.battery.present else -1.0
+                s.last_update_ms = now
         if self._by_kind is None:   # devices never change after loading: sort them by kind once
             every = list(self.all_devices())
             self._by_kind = ([d for d in every if isinstance(d, LightSensor)],
@@ -954,6 +976,24 @@ class Simulation:
     def run(self, steps: int) -> None:
         for _ in range(steps):
             self.step()
+
+    def enable_battery_sensor(self, robot: RobotState, period_ms: int) -> None:
+        """Webots' wb_robot_battery_sensor_enable: a value every ``period_ms`` from now (0 disables;
+        the last value stays)."""
+        robot.battery_schedule.enable(period_ms, self.time_ms)
+        if period_ms > 0 and robot not in self._battery_sensing:
+            self._battery_sensing.append(robot)
+        elif period_ms == 0 and robot in self._battery_sensing:
+            self._battery_sensing.remove(robot)
+
+    def _charge(self, dt: int) -> None:
+        """Every Charger's step (sim/battery.py) at the robots' and its solid's present positions; a
+        Charger whose solid a Supervisor removed does nothing."""
+        positions = np.array([p.translation for p in self.scene.robot_poses], dtype=np.float64).reshape(-1, 3)
+        for charger in self.chargers:
+            own = self.scene.solid_poses.get(charger.solid)
+            if own is not None:
+                charger.step(self._batteries, positions, np.asarray(own.translation, dtype=np.float64), dt)
 
     def _distance_plan(self, distances: list[DistanceSensor]) -> DistancePlan:
         """The stacked constants of these sensors: built when the set of due sensors changes (a

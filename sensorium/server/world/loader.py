@@ -443,6 +443,11 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
         elif name.split("/")[0] == "robot":
             problems.append(Problem(path, f"name {name!r} is reserved (robot-level services live under /<robot>/robot/)"))
 
+    solid_names = {s.name for s in world.solids}
+    for i, c in enumerate(world.chargers):
+        if c.solid not in solid_names:
+            problems.append(Problem(f"chargers[{i}].solid", f"no top-level solid named {c.solid!r} (the Charger's "
+                                                            "body: its position)"))
     for i, r in enumerate(world.robots):
         name_ok(f"robots[{i}].name", r.name)
         for d_i, d in enumerate(r.devices):

@@ -1,5 +1,5 @@
 /* Sensorium C controller library: user input (joystick, mouse, wb_robot_wait_for_user_input_event),
- * the robot's battery and the image pixel helpers. A headless server has no user: no key, button,
+ * the robot's battery sensor and the image pixel helpers. A headless server has no user: no key, button,
  * axis or click ever happens, so waiting for one runs the simulation for the whole timeout. */
 #include <math.h>
 #include <stddef.h>
@@ -40,17 +40,34 @@ WbUserInputEvent wb_robot_wait_for_user_input_event(WbUserInputEvent event_type,
 }
 
 /* ------------------------------------------------------------------ battery */
+/* The server samples the robot's battery (Robot.battery, README "Battery and Charger"); the period is
+ * kept here too, for wb_robot_battery_sensor_get_sampling_period once the simulation ended. */
 void wb_robot_battery_sensor_enable(int sampling_period) {
-  sn_robot_get("wb_robot_battery_sensor_enable");
+  sn_robot *rb = sn_robot_get("wb_robot_battery_sensor_enable");
   int p = checked_period(sampling_period, "wb_robot_battery_sensor_enable");
-  if (p >= 0)
-    g_battery_period = p;
+  if (p < 0 || rb->terminated)
+    return;
+  sn_reply rep;
+  if (sn_device_call(rb, NULL, "robot/battery_sensor_enable", sn_arg_int, &p, "wb_robot_battery_sensor_enable",
+                     &rep) != 0)
+    return;
+  sn_reply_free(&rep);
+  g_battery_period = p;
 }
-void wb_robot_battery_sensor_disable(void) { g_battery_period = 0; }
+void wb_robot_battery_sensor_disable(void) { wb_robot_battery_sensor_enable(0); }
 int wb_robot_battery_sensor_get_sampling_period(void) { return g_battery_period; }
 double wb_robot_battery_sensor_get_value(void) {
-  sn_robot_get("wb_robot_battery_sensor_get_value");
-  return NAN; /* Sensorium robots have no battery */
+  sn_robot *rb = sn_robot_get("wb_robot_battery_sensor_get_value");
+  if (rb->terminated)
+    return NAN;
+  sn_reply rep;
+  if (sn_robot_call(rb, "robot/battery_sensor_get_value", 0, NULL, NULL, "wb_robot_battery_sensor_get_value", &rep) != 0)
+    return NAN;
+  double v = NAN;
+  if (!sn_as_double(sn_get(rep.result, "value"), &v))
+    v = NAN;
+  sn_reply_free(&rep);
+  return v;
 }
 
 /* ------------------------------------------------------------------ joystick */

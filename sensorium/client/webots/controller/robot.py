@@ -142,7 +142,7 @@ class Robot:
         return wb.wb_robot_battery_sensor_get_sampling_period()
 
     def batterySensorGetValue(self) -> float:
-        """NaN: Sensorium robots have no battery."""
+        """The battery's energy (J) at the latest sample (README "Battery and Charger")."""
         return wb.wb_robot_battery_sensor_get_value()
 
     def getProjectPath(self) -> str:

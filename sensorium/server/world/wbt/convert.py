@@ -667,10 +667,17 @@ class Converter:
                             "(no physics); its shapes are kept as a solid that cameras, lidars and infra-red sensors "
                             "see, its boundingObject (the fluid's volume) is no obstacle")
             self.solid(node, frame, owner, "fluid", bounding=False)
-        elif t == "Charger":             # a Solid that recharges robots' batteries (no battery here)
-            self.warn(node, f"Charger {f.string('name', 'solid')!r}: recharging is not simulated (robots have no "
-                            "battery here); its shapes and lights are kept as a solid")
-            self.solid(node, frame, owner, "solid")
+        elif t == "Charger":             # a Solid that recharges robots' batteries (README 'Battery and Charger')
+            entry = self.solid(node, frame, owner, "solid")
+            if owner.kind != "world" or entry is None:
+                self.warn(node, f"Charger {f.string('name', 'solid')!r}: only a top-level Charger recharges "
+                                "robots here; its shapes and lights are kept")
+            else:
+                charger: dict[str, Any] = {"solid": entry["name"], "radius": f.non_negative("radius", 0.04, 0.04)}
+                battery = self.battery_values(node, f"Charger {entry['name']!r}")
+                if battery:
+                    charger["battery"] = battery
+                self.world.setdefault("chargers", []).append(charger)
         elif t in OTHER_DEVICES:
             if owner.kind == "robot":
                 inner = self.child_frame(node, frame)
@@ -1371,6 +1378,20 @@ class Converter:
         return inside(children[0]) if children else []
 
     # ------------------------------------------------------------ solids and robots
+    def battery_values(self, node: Node, what: str) -> list[float]:
+        """A Robot's or Charger's battery field: its first three values (energy J, maximum J, speed W);
+        none when one of them is negative or not finite (one warning)."""
+        values = self.fields(node).numbers("battery") if "battery" in node.fields else []
+        if len(values) > 3:
+            self.warn(node, f"{what}: battery has {len(values)} values; the first three are used "
+                            "(energy, maximum energy, recharge speed)")
+            values = values[:3]
+        if any(not math.isfinite(v) or v < 0 for v in values):
+            self.warn(node, f"{what}: battery {', '.join(f'{v:g}' for v in values)} has a negative or infinite "
+                            "value; no battery")
+            return []
+        return values
+
     def solid(self, node: Node, frame: Frame, owner: Owner, default: str = "solid", bounding: bool = True) -> dict | None:
         """A Solid (``default``: its name when it has none: a device's default name); its entry (None
         when it is part of a robot's body). ``bounding`` False: its boundingObject is left out (a
@@ -1537,10 +1558,14 @@ class Converter:
         data.update(solid_mass(self, node))     # the Supervisor's getCenterOfMass
         if f.flag("selfCollision", False):    # its generic, sonar and laser sensors see its own bounding objects
             data["self_collision"] = True
-        battery = f.numbers("battery") if "battery" in node.fields else []
+        battery = self.battery_values(node, f"Robot {unique!r}")
         if battery:        # Webots: current energy, maximum, recharge speed; its battery sensor reads the first
-            self.warn(node, f"Robot {unique!r}: battery {', '.join(f'{v:g}' for v in battery)} is not simulated here: "
-                            "its battery sensor reads NaN, as a Webots robot without a battery")
+            data["battery"] = battery
+            if f.node_("physics") is not None and _consuming_motors(node):
+                self.warn(node, f"Robot {unique!r}: its motors' energy consumption (torque x consumptionFactor) is "
+                                "not simulated (no torques here): its battery drains by cpuConsumption only")
+        if "cpuConsumption" in node.fields:
+            data["cpu_consumption"] = f.non_negative("cpuConsumption", 10.0, 10.0)
         data["_at"] = self.at(node)
         mine = Owner("robot", data)
         self.riding = []
@@ -2770,3 +2795,19 @@ def strip_origins(data: Any, path: str, origin: dict[str, tuple[int, int, str]])
 def _flat(kinds: set[type]) -> bool:
     """No dict or list among these types (what strip_origins would walk into)."""
     return not any(issubclass(k, (dict, list)) for k in kinds)
+
+
+def _consuming_motors(node: Node) -> bool:
+    """Whether a motor inside ``node`` consumes energy in Webots (consumptionFactor > 0; 10 by default)."""
+    stack: list[Any] = list(node.fields.values())
+    while stack:
+        v = stack.pop()
+        if isinstance(v, list):
+            stack.extend(v)
+        elif isinstance(v, Node):
+            if v.type in ("RotationalMotor", "LinearMotor"):
+                factor = v.fields.get("consumptionFactor", 10.0)
+                if not isinstance(factor, (int, float)) or factor > 0:
+                    return True
+            stack.extend(v.fields.values())
+    return False

@@ -51,7 +51,8 @@ WbDeviceTag wb_robot_get_device_by_index(int index);     /* 0 if index is out of
  * when the simulation ends). */
 WbUserInputEvent wb_robot_wait_for_user_input_event(WbUserInputEvent event_type, int timeout);
 
-/* The robot's battery (Robot.battery): Sensorium does not simulate batteries; the value is NaN. */
+/* The robot's battery (Robot.battery): its energy (J) every sampling period, NaN before the first value, -1
+ * without a battery (README "Battery and Charger"). */
 void wb_robot_battery_sensor_enable(int sampling_period);
 void wb_robot_battery_sensor_disable(void);
 int wb_robot_battery_sensor_get_sampling_period(void);

@@ -1,0 +1,256 @@
+"""Robots' batteries and Webots' Chargers (README "Battery and Charger"): a battery [E0, Emax, r] with
+cpuConsumption P reads E0 - P t at its sensor's sample times, stops at 0 and reads 0 at once; a full
+Charger within its radius gives a robot r dt a step until its maximum, an idle one gathers its own
+speed, the robot leaving empties it; a robot away from it gets nothing; the .wbt import reads the
+fields; Python and C controllers under `sensorium run` read the same values."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+from test_run import clib, compile_controller, project, run  # noqa: F401  (clib: the fixture)
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import WorldError, load_world, parse_world
+
+DT = 32          # basic step (ms)
+
+
+def world(robots: list[dict], chargers: list[dict] = (), solids: list[dict] = ()) -> Simulation:  # type: ignore[assignment]
+    return Simulation(parse_world({"world_info": {"basic_time_step": DT}, "robots": robots,
+                                   "chargers": list(chargers), "solids": list(solids)}))
+
+
+def test_the_battery_reads_its_energy_less_cpu_consumption_at_each_sample() -> None:
+    e0, p = 100.0, 5.0
+    sim = world([{"name": "r", "battery": [e0, 200.0, 20.0], "cpu_consumption": p}])
+    r = sim.robots["r"]
+    sim.step()                                   # enabled at 32 ms with a 64 ms period: samples at 96, 160, ...
+    sim.enable_battery_sensor(r, 64)
+    seen = []
+    for _ in range(8):
+        sim.step()
+        seen.append((sim.time_ms, r.battery_value))
+    assert math.isnan(seen[0][1])                # before its first sample, as Webots
+    for t, v in seen:
+        last = t - (t - 32) % 64                 # the latest sample time
+        if last > 32:
+            assert v == pytest.approx(e0 - p * last / 1000, abs=1e-9)
+    assert r.battery.energy == pytest.approx(e0 - p * sim.time_ms / 1000, abs=1e-9)
+    sim.enable_battery_sensor(r, 0)              # disabled: the last value stays
+    last_value = r.battery_value
+    sim.step()
+    assert r.battery_value == last_value and r.battery_schedule.period_ms == 0
+
+
+def test_an_empty_battery_reads_zero_at_once_and_stays_empty() -> None:
+    # 1 J at 10 W (the default cpuConsumption): 0.32 J a step, empty in the 4th step (128 ms)
+    sim = world([{"name": "r", "battery": [1.0]}, {"name": "none"}])
+    r, none = sim.robots["r"], sim.robots["none"]
+    sim.enable_battery_sensor(r, 1000)
+    sim.enable_battery_sensor(none, DT)
+    for _ in range(3):
+        sim.step()
+    assert r.battery.energy == pytest.approx(1.0 - 10 * 0.096) and math.isnan(r.battery_value)
+    sim.step()
+    assert r.battery.energy == 0.0 and r.battery_value == 0.0 and sim.time_ms == 128   # refreshed when it emptied
+    for _ in range(40):
+        sim.step()
+    assert r.battery.energy == 0.0 and r.battery_value == 0.0
+    assert none.battery_value == -1.0            # a robot without a battery: Webots' -1
+    sim.reset()                                  # simulationReset: the battery as loaded
+    assert r.battery.energy == 1.0
+
+
+CHARGER = {"solid": "dock", "battery": [50.0, 50.0, 10.0], "radius": 0.2}
+DOCK = {"name": "dock", "pose": {"translation": [1.0, 0.0, 0.0]}}
+
+
+def test_a_full_charger_within_its_radius_charges_one_robot_until_its_maximum() -> None:
+    e0, emax, rate, p = 100.0, 103.0, 20.0, 5.0
+    sim = world([{"name": "r", "battery": [e0, emax, rate], "cpu_consumption": p,
+                  "pose": {"translation": [1.15, 0.0, 0.0]}},
+                 {"name": "q", "battery": [e0, emax, rate], "cpu_consumption": p,      # also within: second in line
+                  "pose": {"translation": [0.9, 0.0, 0.0]}}],
+                [CHARGER], [DOCK])
+    r, q, charger = sim.robots["r"], sim.robots["q"], sim.chargers[0]
+    net = (rate - p) * DT / 1000                 # 0.48 J a step
+    for k in range(1, 6):
+        sim.step()
+        assert r.battery.energy == pytest.approx(e0 + k * net, abs=1e-9)
+        assert q.battery.energy == pytest.approx(e0 - k * p * DT / 1000, abs=1e-9)
+        assert charger.energy == pytest.approx(50.0 - k * rate * DT / 1000, abs=1e-9)
+    sim.step()                                   # 103.36 > 103: the battery keeps its maximum, less this step's use
+    assert r.battery.energy == pytest.approx(emax - p * DT / 1000, abs=1e-9)
+    assert charger.energy == pytest.approx(50.0 - 6 * rate * DT / 1000, abs=1e-9)
+    for k in range(1, 4):                        # full: the Charger still gives, the energy is lost
+        sim.step()
+        assert r.battery.energy == pytest.approx(emax - (k + 1) * p * DT / 1000, abs=1e-9)
+        assert charger.energy == pytest.approx(50.0 - (6 + k) * rate * DT / 1000, abs=1e-9)
+    r.set_pose([1.21, 0.0, 0.0])                 # beyond the radius, within 1.1 radius: still held
+    sim.step()
+    assert charger.robot == 0
+    r.set_pose([3.0, 0.0, 0.0])                  # gone: the Charger is emptied, then gathers 10 W
+    sim.step()
+    assert charger.robot is None and charger.energy == pytest.approx(10.0 * DT / 1000, abs=1e-12)
+    before = q.battery.energy
+    sim.step()                                   # q within the radius is not taken: the Charger is not full
+    assert charger.robot is None and q.battery.energy == pytest.approx(before - p * DT / 1000, abs=1e-9)
+
+
+def test_a_robot_away_from_the_charger_gets_nothing_and_the_charger_gathers_up_to_its_maximum() -> None:
+    sim = world([{"name": "r", "battery": [100.0, 200.0, 20.0], "cpu_consumption": 0.0,
+                  "pose": {"translation": [1.25, 0.0, 0.0]}}],
+                [{**CHARGER, "battery": [49.0, 50.0, 10.0]}], [DOCK])
+    charger = sim.chargers[0]
+    for k in range(1, 5):
+        sim.step()
+        assert charger.energy == pytest.approx(min(50.0, 49.0 + k * 10.0 * DT / 1000), abs=1e-12)
+    assert sim.robots["r"].battery.energy == 100.0 and charger.robot is None
+
+
+def test_a_charger_names_a_top_level_solid() -> None:
+    with pytest.raises(WorldError, match=r"chargers\[0\]\.solid: no top-level solid named 'dock'"):
+        world([{"name": "r"}], [CHARGER])
+
+
+WBT = """#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 32 }
+Charger {
+  translation 1 0 0
+  children [ Shape { appearance Appearance { material Material { emissiveColor 0 1 0 } } geometry Box { size 0.1 0.1 0.1 } } ]
+  name "dock"
+  battery [ 40, 50, 10 ]
+  radius 0.3
+}
+Robot { name "plain" battery [ 80, 100, 5 ] cpuConsumption 2.5 }
+Robot {
+  name "heavy"
+  battery [ 10, 10, 1 ]
+  children [ HingeJoint { device [ RotationalMotor { name "m" } ] endPoint Solid { } } ]
+  physics Physics { }
+}
+Robot { name "thrifty" battery [ 10 ] physics Physics { }
+  children [ HingeJoint { device [ RotationalMotor { name "m" consumptionFactor 0 } ] endPoint Solid { } } ] }
+"""
+
+
+def test_the_wbt_import_reads_batteries_cpu_consumption_and_chargers(tmp_path: Path) -> None:
+    p = tmp_path / "w.wbt"
+    p.write_text(WBT)
+    w = load_world(p)
+    robots = {r.name: r for r in w.world.robots}
+    assert robots["plain"].battery == [80.0, 100.0, 5.0] and robots["plain"].cpu_consumption == 2.5
+    assert robots["heavy"].cpu_consumption == 10.0 and robots["thrifty"].battery == [10.0]
+    (charger,) = w.world.chargers
+    assert (charger.solid, charger.battery, charger.radius) == ("dock", [40.0, 50.0, 10.0], 0.3)
+    said = [x.split(": ", 1)[1] for x in w.warnings if "battery" in x or "Charger" in x]
+    assert said == ["Robot 'heavy': its motors' energy consumption (torque x consumptionFactor) is not simulated "
+                    "(no torques here): its battery drains by cpuConsumption only"]
+    sim = Simulation(w)
+    sim.step()
+    assert sim.robots["plain"].battery.energy == pytest.approx(80.0 - 2.5 * 0.032)
+
+
+PY_READER = '''from controller import Robot
+robot = Robot()
+robot.batterySensorEnable(32)
+while robot.step(16) != -1:
+    print(round(robot.getTime() * 1000), f"{robot.batterySensorGetValue():.6f}", robot.batterySensorGetSamplingPeriod())
+'''
+
+C_READER = r'''#include <math.h>
+#include <stdio.h>
+#include <webots/robot.h>
+
+int main(void) {
+  wb_robot_init();
+  wb_robot_battery_sensor_enable(32);
+  while (wb_robot_step(16) != -1) {
+    double v = wb_robot_battery_sensor_get_value();
+    if (isnan(v))
+      printf("%ld nan %d\n", lround(wb_robot_get_time() * 1000), wb_robot_battery_sensor_get_sampling_period());
+    else
+      printf("%ld %.6f %d\n", lround(wb_robot_get_time() * 1000), v, wb_robot_battery_sensor_get_sampling_period());
+    fflush(stdout);
+  }
+  wb_robot_cleanup();
+  return 0;
+}
+'''
+
+
+@pytest.mark.slow
+def test_python_and_c_controllers_read_the_same_battery(tmp_path: Path, clib: tuple[Path, list[str]]) -> None:  # noqa: F811
+    """0.5 J at 3 W, 16 ms steps, a 32 ms period: 0.5 - 0.003 t at t = 32, 64, ...; empty in the step
+    ending at 176 ms (0.5 / 0.048 J a step), read 0 at once."""
+    battery = "battery [ 0.5, 1, 1 ] cpuConsumption 3"
+    world = project(tmp_path, f'Robot {{ name "py" controller "py_reader" {battery} }}\n'
+                              f'Robot {{ name "c" controller "c_reader" {battery} }}', {"py_reader.py": PY_READER})
+    compile_controller(clib, tmp_path / "controllers" / "c_reader", "c_reader", C_READER)
+    proc = run(world, "--until", "224")
+    assert proc.wait() == 0, proc.stderr()
+    expected = []
+    for t in range(16, 225, 16):
+        sampled = t - t % 32
+        value = "nan" if sampled == 0 else f"{max(0.0, 0.5 - 3 * sampled / 1000) if t < 176 else 0.0:.6f}"
+        expected.append(f"{t} {value} 32")
+    out = proc.stdout().splitlines()
+    for robot in ("py", "c"):
+        assert [line.split("] ", 1)[1] for line in out if line.startswith(f"[{robot}]")] == expected, proc.stdout()
+
+
+def test_the_battery_services_serve_the_attached_controller_and_reset_when_it_leaves() -> None:
+    import msgpack
+
+    from sensorium.schemas import wire
+    from sensorium.server.daemon.services import Core
+
+    core = Core(world([{"name": "r", "battery": [10.0, 20.0, 1.0], "cpu_consumption": 2.0}]),
+                new_token=lambda: "s0", log=lambda *_: None)
+    rid = iter(range(1, 100))
+
+    def call(service: str, args: dict, who: bytes = b"A") -> dict:
+        (frames,) = core.handle([who, wire.pack({"id": next(rid), "service": service, "args": args})], 0.0)
+        return msgpack.unpackb(frames[-1])
+
+    assert call("attach", {"robot": "r"})["ok"] is True
+    refused = call("/r/robot/battery_sensor_enable", {"value": DT}, who=b"B")     # not its controller
+    assert refused["ok"] is False
+    assert call("/r/robot/battery_sensor_enable", {"value": DT})["result"] == {"success": True}
+    assert math.isnan(call("/r/robot/battery_sensor_get_value", {})["result"]["value"])
+    for _ in range(3):
+        assert core.handle([b"A", wire.pack({"id": next(rid), "service": "/r/robot/step", "args": {}})], 0.0) == []
+        core.step_once(0.0)
+    assert call("/r/robot/battery_sensor_get_value", {})["result"]["value"] == pytest.approx(10.0 - 2.0 * 0.096)
+    assert call("/r/robot/battery_sensor_get_sampling_period", {}, who=b"B")["result"]["value"] == DT
+    assert call("detach", {"session": "s0"})["ok"] is True
+    assert call("/r/robot/battery_sensor_get_sampling_period", {}, who=b"B")["result"]["value"] == 0
+    assert math.isnan(call("/r/robot/battery_sensor_get_value", {}, who=b"B")["result"]["value"])
+
+
+def test_a_supervisor_reads_the_battery_field_with_its_present_energy() -> None:
+    import msgpack
+
+    from sensorium.schemas import wire
+    from sensorium.server.daemon.services import Core
+
+    sim = world([{"name": "r", "def_name": "R", "battery": [10.0, 20.0], "cpu_consumption": 2.0},
+                 {"name": "boss", "supervisor": True}])
+    core = Core(sim, new_token=lambda: "s0", log=lambda *_: None)
+    rid = iter(range(1, 100))
+
+    def call(service: str, args: dict) -> dict:
+        (frames,) = core.handle([b"A", wire.pack({"id": next(rid), "service": service, "args": args})], 0.0)
+        return msgpack.unpackb(frames[-1])["result"]
+
+    call("attach", {"robot": "boss"})
+    node = call("/boss/robot/get_from_def", {"name": "R"})["node"]
+    for _ in range(5):
+        sim.step()
+    # the world's two values, the first the energy now (Webots' WbRobot::setCurrentEnergy writes the field)
+    got = call("/boss/robot/get_field", {"node": node, "field": "battery"})
+    assert got["type"] == "MFFloat" and got["value"] == pytest.approx([10.0 - 2.0 * 0.16, 20.0], abs=1e-12)
+    assert call("/boss/robot/get_field", {"node": node, "field": "cpuConsumption"}) == {"type": "SFFloat", "value": 2.0}
