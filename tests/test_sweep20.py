@@ -4,6 +4,7 @@ in process by the calls its controller makes and checked against closed forms.""
 
 from __future__ import annotations
 
+import math
 import shutil
 from pathlib import Path
 
@@ -18,10 +19,12 @@ from sensorium.server.world.loader import load_world
 DATA = Path(__file__).parent / "data" / "sweep20"
 
 
-def supervised(path: Path, tmp_path: Path, robot: str) -> Live:
+def supervised(path: Path, tmp_path: Path, robot: str, after: str | None = None) -> Live:
     """The stand-in with ``supervisor TRUE`` on the robot named ``robot`` (to read the end points' poses
-    as Webots' Supervisor does), attached to it."""
-    text = path.read_text().replace(f'  name "{robot}"\n', f'  name "{robot}"\n  supervisor TRUE\n', 1)
+    as Webots' Supervisor does), written after its line ``after`` (its name's line unless said), attached
+    to it."""
+    line = after or f'  name "{robot}"'
+    text = path.read_text().replace(line + "\n", line + "\n  supervisor TRUE\n", 1)
     assert "supervisor TRUE" in text
     copy = tmp_path / path.name
     copy.write_text(text)
@@ -32,8 +35,13 @@ def supervised(path: Path, tmp_path: Path, robot: str) -> Live:
     return lv
 
 
-def node_pose(lv: Live, robot: str, name: str) -> tuple[np.ndarray, np.ndarray]:
-    node = lv.ok(A, f"/{robot}/robot/get_from_def", {"name": name})["node"]
+def node_pose(lv: Live, robot: str, name: str, inside: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The pose of the node DEF ``name`` (in the PROTO instance DEF ``inside``: getFromProtoDef, as a
+    PROTO's own DEF names are hidden from getFromDef in Webots), read as a Supervisor reads it."""
+    node = lv.ok(A, f"/{robot}/robot/get_from_def", {"name": inside or name})["node"]
+    if inside is not None:
+        node = lv.ok(A, f"/{robot}/robot/get_from_proto_def", {"node": node, "name": name})["node"]
+    assert node != 0, (name, inside)
     got = lv.ok(A, f"/{robot}/robot/get_node_pose", {"node": node})
     return np.array(got["position"]), np.array(got["orientation"]).reshape(3, 3)
 
@@ -109,3 +117,135 @@ def test_both_heads_follow_the_motor2_calls_by_the_kinematic_rule(tmp_path: Path
             for n, q in motor2_targets(counter).items():
                 motors[n].set_position(q)
                 twin[n].target = q
+
+
+# ----------------------------------------------------------------------------------- khepera3_gripper
+# khepera3_gripper (k-team/khepera3): the Khepera III (wheels of 0.0212 m at y ±0.0458, turning about +y)
+# turned 2.87979 rad at the origin, 16 ms steps; its gripper in the turret slot: "horizontal_motor" turns
+# the driven arm about -y through (0.05, -0.028, 0.087) in the robot's frame (maxTorque 5: its
+# acceleration here), "finger_motor::left" and its coupled "finger_motor::right" (maxTorque 10) turn the
+# fingers' tip hinges. The controller's script: step(s) runs ⌈s / 0.016⌉ steps.
+K3 = "Khepera III"
+K3_R, K3_AXLE = 0.0212, 0.0916
+K3_YAW0 = 2.87979
+K3_ARM_ANCHOR = np.array([0.05, -0.028, 0.087])
+K3_ARM0 = rot((0.57735, -0.57735, -0.57735), 2.094395)
+
+
+def k3_script() -> list[tuple[dict[str, float], int]]:
+    """khepera3_gripper.c's calls before its Braitenberg loop: (the settings made, then the steps run)."""
+    def steps(seconds: float) -> int:
+        return math.ceil(seconds * 1000 / 16)
+
+    def wheels(left: float, right: float) -> dict[str, float]:
+        return {"left": left, "right": right}
+
+    return [(wheels(0, 0), steps(1.0)),                                   # stop(1.0)
+            ({**wheels(12.8, 12.8), "arm": -3.0}, steps(1.0)),           # moveForwards, moveArms(-3)
+            (wheels(0, 0), steps(1.0)),                                   # stop(1.0)
+            ({"fingers": 0.42}, steps(1.0)),
+            ({"arm": 0.0, **wheels(-12.8, -12.8)}, steps(1.0)),
+            (wheels(0, 0), steps(1.0)),
+            (wheels(-2.4, 2.4), steps(0.5)),                              # turn(-2.4): left about its axle
+            (wheels(12.8, 12.8), steps(0.6)),
+            (wheels(0, 0), steps(0.25)),
+            ({"arm": -1.6}, steps(1.5)),
+            ({"fingers": 0.0}, steps(1.0)),
+            ({"arm": 0.0, "fingers": 0.0}, steps(1.0)),
+            (wheels(-12.8, -12.8), steps(1.0)),
+            (wheels(-10.7, 10.7), steps(1.0))]
+
+
+def k3_move(x: float, y: float, yaw: float, wl: float, wr: float, dt: float) -> tuple[float, float, float]:
+    """One step of the two-wheel drive (the axle's centre at the origin): the arc of v = r(ωl + ωr)/2,
+    ω = r(ωr − ωl)/axle."""
+    v, w = K3_R * (wl + wr) / 2, K3_R * (wr - wl) / K3_AXLE
+    if w == 0.0:
+        return x + v * dt * math.cos(yaw), y + v * dt * math.sin(yaw), yaw
+    return (x + v / w * (math.sin(yaw + w * dt) - math.sin(yaw)), y - v / w * (math.cos(yaw + w * dt) - math.cos(yaw)),
+            math.remainder(yaw + w * dt, 2 * math.pi))
+
+
+def test_the_khepera3_gripper_stand_in_loads_its_sensors_drive_and_gripper_motors() -> None:
+    """The Khepera III loads with the devices its controllers ask for (ds0..ds10, us0..us4, both wheel
+    motors and sensors, the rs232 emitter and receiver, the gripper's three motors), a two-wheel drive
+    (radius 0.0212 m, axle 0.0916 m) settled from z 0 to −0.0033 (its wheels' bottom 3.3 mm above its
+    origin); each finger motor sits on the tip hinge that closes its finger's loop (a SolidReference to
+    the tip): one line says the loop is not closed (and one for each of the head's two), and the fingers'
+    motors ride on the arm's."""
+    w = load_world(DATA / "khepera3_gripper.wbt")
+    loops = [x.split(": ", 1)[1].split(":")[0] for x in w.warnings if "ending in SolidReference" in x]
+    assert sorted(loops) == ["HingeJoint ending in SolidReference 'gripper_head'"] * 2 + [
+        "HingeJoint ending in SolidReference 'left_finger_tip'", "HingeJoint ending in SolidReference 'right_finger_tip'"]
+    (robot,) = w.world.robots
+    names = {d.name for d in robot.devices}
+    assert names == {*(f"ds{k}" for k in range(11)), *(f"us{k}" for k in range(5)), "left wheel motor", "right wheel motor",
+                     "left wheel sensor", "right wheel sensor", "rs232_out", "rs232_in", "horizontal_motor",
+                     "finger_motor::left", "finger_motor::right"}
+    drive = robot.differential_drive
+    assert (drive.wheel_radius, drive.axle_length, drive.wheel_bottom) == pytest.approx((K3_R, K3_AXLE, 0.0033), abs=1e-15)
+    d = {m.name: m for m in robot.devices}
+    assert d["horizontal_motor"].axis == (0.0, -1.0, 0.0)
+    assert d["horizontal_motor"].anchor == pytest.approx(K3_ARM_ANCHOR, abs=1e-15)
+    assert d["finger_motor::left"].on_joint == d["finger_motor::right"].on_joint == "horizontal_motor"
+    sim = Simulation(w, "exact")
+    assert sim.robot(K3).pose.translation == pytest.approx([0.0, 0.0, -0.0033], abs=1e-15)
+
+
+def test_the_khepera3_gripper_script_drives_and_moves_the_gripper_by_the_closed_forms(tmp_path: Path) -> None:
+    """khepera3_gripper.c's script in process (810 steps of 16 ms, 12.96 s): the robot stays 1.008 s,
+    drives 12.8 × 0.0212 = 0.27136 m/s for 63 steps, backs the same, turns left in place at 2 × 2.4 ×
+    0.0212 / 0.0916 = 1.1109 rad/s for 32 steps, drives 38 steps, backs 63 and turns at 4.9528 rad/s for
+    63, its pose the arc of the wheel speeds each step (1e-9); nothing holds it (the boxes and the
+    cylinder are out of its way). The arm motor follows Webots' kinematic rule at the 2 rad/s set
+    (acceleration 5) to −3, 0, −1.6 and 0, the fingers' coupled pair at 2 rad/s (acceleration 10) to 0.42
+    and back, each step (1e-12); the gripper head (read by a Supervisor) turns rigidly with the arm about
+    its anchor (1e-9). Webots' parallelogram keeps the head level and its fingers close on the cylinder
+    and lift it; here the head tilts with the arm, the fingers' motors move nothing (their hinges end in
+    SolidReferences) and the cylinder stays where it stands."""
+    lv = supervised(DATA / "khepera3_gripper.wbt", tmp_path, K3, after='  controller "khepera3_gripper"')
+    sim = lv.sim
+    robot = sim.robot(K3)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    arm, finger, coupled = (robot.motor(n) for n in ("horizontal_motor", "finger_motor::left", "finger_motor::right"))
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    arm_twin, finger_twin = KinematicMotor(10.0, 5.0), KinematicMotor(10.0, 10.0)
+    x, y, yaw = 0.0, 0.0, K3_YAW0
+    load0, _ = node_pose(lv, K3, "CYLINDER_LOAD")
+    wl = wr = 0.0
+    counter = 0
+    for settings, steps in k3_script():
+        if "left" in settings:
+            wl, wr = settings["left"], settings["right"]
+            left.set_velocity(wl)
+            right.set_velocity(wr)
+        if "arm" in settings:
+            arm.set_velocity(2.0)
+            arm.set_position(settings["arm"])
+            arm_twin.v_max, arm_twin.target = 2.0, settings["arm"]
+        if "fingers" in settings:
+            finger.set_velocity(2.0)
+            finger.set_position(settings["fingers"])
+            finger_twin.v_max, finger_twin.target = 2.0, settings["fingers"]
+        for _ in range(steps):
+            sim.step()
+            counter += 1
+            x, y, yaw = k3_move(x, y, yaw, wl, wr, 0.016)
+            arm_twin.step(0.016)
+            finger_twin.step(0.016)
+            r = robot.pose.rotation
+            assert [*robot.pose.translation[:2], math.atan2(r[1][0], r[0][0])] == pytest.approx([x, y, yaw], abs=1e-9), counter
+            assert arm.position == pytest.approx(arm_twin.x, abs=1e-12), counter
+            assert finger.position == pytest.approx(finger_twin.x, abs=1e-12), counter
+            assert coupled.position == pytest.approx(finger_twin.x, abs=1e-12), counter
+            if counter % 8 == 0:
+                body = rot((0, 0, 1), yaw)
+                turn = rot((0, -1, 0), arm_twin.x)
+                head_at = np.array([x, y, -0.0033]) + body @ (K3_ARM_ANCHOR + turn @ (np.array([0, 0, 0.074]) - K3_ARM_ANCHOR))
+                at, turned = node_pose(lv, K3, "GRIPPER_HEAD", inside="BASE")
+                assert at == pytest.approx(head_at, abs=1e-9), counter
+                assert turned == pytest.approx(body @ turn @ K3_ARM0, abs=1e-9), counter
+    assert counter == 810
+    assert node_pose(lv, K3, "CYLINDER_LOAD")[0] == pytest.approx(load0, abs=1e-12)
