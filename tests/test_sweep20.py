@@ -6,10 +6,12 @@ from __future__ import annotations
 
 import math
 import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _serve import child_env, sensorium
 from test_supervisor import A, Live
 from test_sweep19 import KinematicMotor, motor2_targets, rot
 
@@ -171,12 +173,21 @@ def test_the_khepera3_gripper_stand_in_loads_its_sensors_drive_and_gripper_motor
     motors and sensors, the rs232 emitter and receiver, the gripper's three motors), a two-wheel drive
     (radius 0.0212 m, axle 0.0916 m) settled from z 0 to −0.0033 (its wheels' bottom 3.3 mm above its
     origin); each finger motor sits on the tip hinge that closes its finger's loop (a SolidReference to
-    the tip): one line says the loop is not closed (and one for each of the head's two), and the fingers'
-    motors ride on the arm's."""
+    the tip): one line says the loop is not closed (and one for each of the head's two), and the motor's
+    own line says it moves nothing (it said the shapes past its joint moved with it, and none are); the
+    fingers' motors ride on the arm's."""
     w = load_world(DATA / "khepera3_gripper.wbt")
     loops = [x.split(": ", 1)[1].split(":")[0] for x in w.warnings if "ending in SolidReference" in x]
     assert sorted(loops) == ["HingeJoint ending in SolidReference 'gripper_head'"] * 2 + [
         "HingeJoint ending in SolidReference 'left_finger_tip'", "HingeJoint ending in SolidReference 'right_finger_tip'"]
+    for side in ("left", "right"):         # a motor on a loop-closing joint: moved by the rule, moving nothing
+        (line,) = [x for x in w.warnings if f"motor 'finger_motor::{side}'" in x]
+        assert line.endswith(f"its joint moves kinematically (Webots' rule without physics; its PositionSensor reads "
+                             f"it), but moves nothing: its end point is SolidReference '{side}_finger_tip', whose "
+                             f"loop is not closed here"), line
+    (line,) = [x for x in w.warnings if "motor 'horizontal_motor'" in x]
+    assert line.endswith("and the shapes and devices past the joint with it"), line
+    assert len(w.warnings) == 7, w.warnings
     (robot,) = w.world.robots
     names = {d.name for d in robot.devices}
     assert names == {*(f"ds{k}" for k in range(11)), *(f"us{k}" for k in range(5)), "left wheel motor", "right wheel motor",
@@ -249,3 +260,115 @@ def test_the_khepera3_gripper_script_drives_and_moves_the_gripper_by_the_closed_
                 assert turned == pytest.approx(body @ turn @ K3_ARM0, abs=1e-9), counter
     assert counter == 810
     assert node_pose(lv, K3, "CYLINDER_LOAD")[0] == pytest.approx(load0, abs=1e-12)
+
+
+K3_CONTROLLER = '''\
+# Sensorium's test controller making khepera3_gripper.c's calls (Webots' sample): its script, then its
+# Braitenberg loop over ds0..ds8.
+import math
+from controller import Robot
+
+robot = Robot()
+step_ms = int(robot.getBasicTimeStep())
+sensors = [robot.getDevice(f"ds{k}") for k in range(9)]
+for s in sensors:
+    s.enable(step_ms)
+arm, fingers = robot.getDevice("horizontal_motor"), robot.getDevice("finger_motor::left")
+left, right = robot.getDevice("left wheel motor"), robot.getDevice("right wheel motor")
+for m in (left, right):
+    m.setPosition(math.inf)
+    m.setVelocity(0.0)
+print(f"The {robot.getName()} robot is initialized, it uses {len(sensors)} distance sensors", flush=True)
+MATRIX = [(-2.67, -2.67), (-10.86, 21.37), (-16.03, 26.71), (-37.4, 37.4), (37.4, -32.06), (26.71, -21.37),
+          (21.37, -10.86), (-2.67, -2.67), (-5.34, -5.34)]
+
+
+def wait(seconds):
+    elapsed = 0
+    while elapsed < seconds * 1000:
+        robot.step(step_ms)
+        elapsed += step_ms
+
+
+def wheels(l, r):
+    left.setVelocity(l)
+    right.setVelocity(r)
+
+
+def move(motor, q):
+    motor.setVelocity(2.0)
+    motor.setPosition(q)
+
+
+wheels(0, 0); wait(1.0)
+wheels(12.8, 12.8); move(arm, -3.0); wait(1.0)
+wheels(0, 0); wait(1.0)
+move(fingers, 0.42); wait(1.0)
+move(arm, 0.0); wheels(-12.8, -12.8); wait(1.0)
+wheels(0, 0); wait(1.0)
+wheels(-2.4, 2.4); wait(0.5)
+wheels(12.8, 12.8); wait(0.6)
+wheels(0, 0); wait(0.25)
+move(arm, -1.6); wait(1.5)
+move(fingers, 0.0); wait(1.0)
+move(arm, 0.0); move(fingers, 0.0); wait(1.0)
+wheels(-12.8, -12.8); wait(1.0)
+wheels(-10.7, 10.7); wait(1.0)
+while robot.step(step_ms) != -1:
+    values = [s.getValue() for s in sensors]
+    speed = [max(-19.1, min(19.1, sum(MATRIX[j][i] * (1.0 - values[j] / 2000.0) for j in range(9)))) for i in (0, 1)]
+    wheels(*speed)
+'''
+
+K3_WATCHER = '''\
+import math
+from controller import Supervisor
+
+sup = Supervisor()
+khepera = sup.getFromDef("KHEPERA")
+ends = {int(t) for t in "ENDS".split()}
+while sup.step(16) != -1:
+    t = round(sup.getTime() * 1000)
+    if t in ends:
+        p, r = khepera.getPosition(), khepera.getOrientation()
+        print(f"{t} {p[0]:.9f} {p[1]:.9f} {math.atan2(r[3], r[0]):.9f}", flush=True)
+'''
+
+
+@pytest.mark.slow
+def test_the_khepera3_gripper_calls_under_sensorium_run_drive_the_script_s_closed_form(tmp_path: Path) -> None:
+    """Our Python controller making khepera3_gripper.c's calls under ``sensorium run`` for 16 s, a watcher
+    Supervisor printing the Khepera's pose at the end of each scripted phase: it prints Webots' sample's
+    first line, and the robot is where the closed form of the script's wheel speeds puts it (1e-9) until
+    its Braitenberg loop takes over at 12.96 s."""
+    (tmp_path / "worlds").mkdir()
+    shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
+    ends, t, x, y, yaw, want = [], 0, 0.0, 0.0, K3_YAW0, {}
+    wl = wr = 0.0
+    for settings, steps in k3_script():
+        wl, wr = (settings["left"], settings["right"]) if "left" in settings else (wl, wr)
+        for _ in range(steps):
+            x, y, yaw = k3_move(x, y, yaw, wl, wr, 0.016)
+        t += 16 * steps
+        ends.append(t)
+        want[t] = (x, y, yaw)
+    world = tmp_path / "worlds" / "khepera3_gripper.wbt"
+    world.write_text((DATA / "khepera3_gripper.wbt").read_text() +
+                     'Robot { name "watcher" supervisor TRUE controller "watcher" }\n')
+    for name, source in (("khepera3_gripper", K3_CONTROLLER),
+                         ("watcher", K3_WATCHER.replace("ENDS", " ".join(map(str, ends))))):
+        (tmp_path / "controllers" / name).mkdir(parents=True)
+        (tmp_path / "controllers" / name / f"{name}.py").write_text(source)
+    done = subprocess.run(sensorium("run", str(world), "--until", "16000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert f"[{K3}] The {K3} robot is initialized, it uses 9 distance sensors" in done.stdout.splitlines(), done.stdout
+    got = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("[watcher] "):
+            t, *values = line.split("] ", 1)[1].split()
+            got[int(t)] = [float(v) for v in values]
+    assert sorted(got) == ends, done.stdout[-2000:]
+    for t in ends:
+        assert got[t] == pytest.approx(want[t], abs=1e-9), t

@@ -89,6 +89,10 @@ JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "m
 MANY_JOINTS = 4      # more motorised joints than this, none a wheel: one warning for the robot, naming the first few
 JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
                "the shapes and devices past the joint with it")
+# the same for a joint ending in a SolidReference (a linkage's loop-closing joint, driven: the Khepera III
+# gripper's fingers): nothing is past it here, as the loop is not closed
+JOINT_MOVES_NOTHING = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), "
+                       "but moves nothing: its end point is SolidReference {name!r}, whose loop is not closed here")
 # the fields every Solid has (a device's own fields are the others)
 SOLID_FIELDS = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
                 "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection",
@@ -2363,6 +2367,10 @@ class Converter:
     def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         if len(nowheel) <= MANY_JOINTS:
             for joint, _motor, line, _why in nowheel:
+                end = self.fields(joint).node_("endPoint")
+                if end is not None and end.type == "SolidReference" and line.endswith(JOINT_MOVES):
+                    name = self.fields(end).string("solidName", "")
+                    line = line[:-len(JOINT_MOVES)] + JOINT_MOVES_NOTHING.format(name=name)
                 self.warn(joint, line)
             return
         reasons: dict[str, int] = {}
