@@ -5,6 +5,7 @@ in process by the calls its controller makes and checked against closed forms.""
 from __future__ import annotations
 
 import math
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -159,9 +160,14 @@ def k3_script() -> list[tuple[dict[str, float], int]]:
 
 
 def k3_move(x: float, y: float, yaw: float, wl: float, wr: float, dt: float) -> tuple[float, float, float]:
-    """One step of the two-wheel drive (the axle's centre at the origin): the arc of v = r(ωl + ωr)/2,
+    return k3_move_on(x, y, yaw, wl, wr, dt, K3_R, K3_AXLE)
+
+
+def k3_move_on(x: float, y: float, yaw: float, wl: float, wr: float, dt: float, radius: float,
+               axle: float) -> tuple[float, float, float]:
+    """One step of a two-wheel drive (the axle's centre at the origin): the arc of v = r(ωl + ωr)/2,
     ω = r(ωr − ωl)/axle."""
-    v, w = K3_R * (wl + wr) / 2, K3_R * (wr - wl) / K3_AXLE
+    v, w = radius * (wl + wr) / 2, radius * (wr - wl) / axle
     if w == 0.0:
         return x + v * dt * math.cos(yaw), y + v * dt * math.sin(yaw), yaw
     return (x + v / w * (math.sin(yaw + w * dt) - math.sin(yaw)), y - v / w * (math.cos(yaw + w * dt) - math.cos(yaw)),
@@ -372,3 +378,140 @@ def test_the_khepera3_gripper_calls_under_sensorium_run_drive_the_script_s_close
     assert sorted(got) == ends, done.stdout[-2000:]
     for t in ends:
         assert got[t] == pytest.approx(want[t], abs=1e-9), t
+
+
+# ------------------------------------------------------------------------------------------- khepera4
+# khepera4 (k-team/khepera4): the Khepera IV (wheels of 0.021 m at y ±0.0527, turning about +y) turned
+# 0.261803 rad at the centre of the default CircleArena (radius 1 m), six boxes about it, 16 ms steps. Each
+# step its controller sets the wheels from three infra-red sensors: 0.2 (47.6 − 0.03 front) ± 0.03 (front
+# left − front right). An infra-red ray reads the PROTO's table at the distance to a box's face (white:
+# the distance itself), 120 past its 0.2 m.
+K4 = "Khepera IV"
+K4_R, K4_AXLE = 0.021, 0.1054
+K4_TURN = ((1.78221999971205e-05, -2.346349999620905e-06, 0.9999999998384319), 0.261803)
+K4_IR = {"front left infrared sensor": ((0.0495, 0.0495, 0.014), (0.862854, 0.357409, 0.357409), 1.717773),
+         "front infrared sensor": ((0.07, 0.0, 0.014), (-1.0, 0.0, 0.0), -1.570796),
+         "front right infrared sensor": ((0.0495, -0.0495, 0.014), (0.862857, -0.357406, -0.357406), 1.717771)}
+K4_TABLE = ([0, 0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08, 0.09, 0.1, 0.15, 0.2],
+            [1023, 1010, 1000, 990, 800, 500, 400, 350, 280, 250, 220, 180, 120])
+
+
+def k4_boxes() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The stand-in's boxes as the world file writes them: (centre, rotation, half sizes)."""
+    text = (DATA / "khepera4.wbt").read_text()
+    boxes = []
+    for t, r, s in re.findall(r"translation ([^\n]+)\n  rotation ([^\n]+)\n  children \[ DEF BOX\d_SHAPE Shape "
+                              r"\{ geometry Box \{ size ([^}]+) \}", text):
+        axis_angle = [float(v) for v in r.split()]
+        boxes.append((np.array([float(v) for v in t.split()]), rot(axis_angle[:3], axis_angle[3]),
+                      np.array([float(v) for v in s.split()]) / 2))
+    assert len(boxes) == 6
+    return boxes
+
+
+def ray_to_boxes(origin: np.ndarray, u: np.ndarray, boxes: list) -> float:
+    """The distance along the unit ray to the nearest box face it meets (slabs in each box's frame); inf
+    when it meets none."""
+    best = math.inf
+    for centre, turn, half in boxes:
+        p, d = turn.T @ (origin - centre), turn.T @ u
+        near, far = -math.inf, math.inf
+        for k in range(3):
+            if abs(d[k]) < 1e-15:
+                if abs(p[k]) > half[k]:
+                    break
+                continue
+            a, b = (-half[k] - p[k]) / d[k], (half[k] - p[k]) / d[k]
+            near, far = max(near, min(a, b)), min(far, max(a, b))
+        else:
+            if near <= far and near >= 0.0:
+                best = min(best, near)
+    return best
+
+
+def k4_reading(distance: float) -> float:
+    return float(np.interp(distance, *K4_TABLE)) if distance < 0.2 else 120.0
+
+
+def noiseless(path: Path, tmp_path: Path) -> Path:
+    """A copy of a stand-in (and its PROTOs) with every lookup table's noise column 0 (the rows of a table
+    between ``[`` and ``]``, or between a template's branch markers)."""
+    def quiet(rows: str) -> str:
+        return ", ".join(f"{a} {b} 0" for a, b, _ in (r.split() for r in rows.replace("\n", ",").split(",") if r.strip()))
+
+    shutil.copytree(path.parent / "protos", tmp_path / "protos", dirs_exist_ok=True)
+    for proto in (tmp_path / "protos").glob("Khepera4*.proto"):
+        text = re.sub(r"(lookupTable \[)([^\]%]*)(\])", lambda m: m.group(1) + quiet(m.group(2)) + m.group(3),
+                      proto.read_text())
+        text = re.sub(r"(>%\n)(\s*0 [^%]*?)(\n\s*%<)", lambda m: m.group(1) + quiet(m.group(2)) + m.group(3), text)
+        proto.write_text(text)
+    copy = tmp_path / path.name
+    copy.write_text(path.read_text())
+    return copy
+
+
+def test_the_khepera4_stand_in_loads_every_device_its_controller_asks_for() -> None:
+    """The Khepera IV loads with its 30 devices (the controller's five sonars, twelve infra-red sensors,
+    three LEDs, camera and wheel motors among them), a two-wheel drive (radius 0.021 m, axle 0.1054 m)
+    whose wheels touch the floor where the world puts it (no settling); its camera, inside the body's
+    cylinder, is said once (the cylinder is both the visual shape and the bounding object: it was said
+    twice)."""
+    w = load_world(DATA / "khepera4.wbt")
+    (line,) = w.warnings
+    assert "Camera 'camera' of robot 'Khepera IV' is inside the robot's cylinder" in line, w.warnings
+    (robot,) = w.world.robots
+    names = {d.name for d in robot.devices}
+    assert len(names) == 30 and {"camera", "rear led", "left ultrasonic sensor",
+                                 "ground right infrared sensor", *K4_IR} <= names
+    drive = robot.differential_drive
+    assert (drive.wheel_radius, drive.axle_length, drive.wheel_bottom) == pytest.approx((K4_R, K4_AXLE, 0.0), abs=1e-15)
+
+
+def test_the_khepera4_avoids_the_boxes_by_its_closed_form_readings_and_arcs(tmp_path: Path) -> None:
+    """khepera4.c's calls in process, its sensors' noise taken out, while the robot is more than 0.7 m
+    from the arena's centre (its rays, 0.2 m from 0.07 m out, cannot reach the wall): each 16 ms step the
+    three front infra-red sensors read the closed form (the table at the ray's distance to the nearest box
+    face; 120 past 0.2 m) and the pose is the arc of the wheel speeds the controller set from them (1e-9).
+    In open space it drives at 0.2 × (47.6 − 3.6) × 0.021 = 0.1848 m/s; the first box enters its front
+    sensor's ray at 1.328 s (the robot at (0.2342, 0.0628)), and it slows and turns left, its front right
+    sensor seeing the box too, until it leaves the 0.7 m disc at 4.672 s, at (0.3775, 0.5912) heading
+    1.5649. (Webots' wheels reach their speeds at their 130.45 rad/s² acceleration, which the kinematic
+    drive ignores: 0.07 s at the start, a step or two at each change.)"""
+    sim = Simulation(load_world(noiseless(DATA / "khepera4.wbt", tmp_path)), "exact")
+    robot = sim.robot(K4)
+    irs = {n: sim.device(f"{K4}/{n}") for n in K4_IR}
+    for d in irs.values():
+        d.enable(16)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    boxes = k4_boxes()
+    turn0 = rot(*K4_TURN)
+    yaw0 = math.atan2(turn0[1, 0], turn0[0, 0])
+    x, y, yaw, wl, wr = 0.0, 0.0, yaw0, 0.0, 0.0
+    seen, steps, first = set(), 0, None
+    while math.hypot(x, y) < 0.7 and steps < 2500:
+        sim.step()
+        steps += 1
+        x, y, yaw = k3_move_on(x, y, yaw, wl, wr, 0.016, K4_R, K4_AXLE)
+        body = rot((0, 0, 1), yaw - yaw0) @ turn0
+        assert np.asarray(robot.pose.rotation) == pytest.approx(body, abs=1e-9), steps
+        assert list(robot.pose.translation[:2]) == pytest.approx([x, y], abs=1e-9), steps
+        values = {}
+        for name, (at, axis, angle) in K4_IR.items():
+            origin = np.array([x, y, 0.0]) + body @ np.array(at)
+            distance = ray_to_boxes(origin, body @ rot(axis, angle) @ np.array([1.0, 0.0, 0.0]), boxes)
+            values[name] = k4_reading(distance)
+            if distance < 0.2:
+                seen.add(name)
+                first = first or (steps, name, x, y)
+            assert float(irs[name].value) == pytest.approx(values[name], abs=1e-9), (steps, name)
+        offset = 0.2 * (47.6 - 0.03 * values["front infrared sensor"])
+        delta = 0.03 * values["front left infrared sensor"] - 0.03 * values["front right infrared sensor"]
+        wl, wr = offset + delta, offset - delta
+        left.set_velocity(wl)
+        right.set_velocity(wr)
+    assert first is not None and first[:2] == (83, "front infrared sensor"), first
+    assert seen == {"front infrared sensor", "front right infrared sensor"} and steps == 292, (seen, steps)
+    assert [x, y, yaw] == pytest.approx([0.3775, 0.5912, 1.5649], abs=1e-4)

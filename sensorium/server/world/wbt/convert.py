@@ -1575,18 +1575,22 @@ class Converter:
     def devices_inside(self, robot: dict) -> None:
         """One warning for each visual device whose origin is inside one of its robot's closed
         primitives, which Webots never sees from there and rays here do (wbt/inside.py; a mesh is
-        split instead: turn_meshes_away)."""
+        split instead: turn_meshes_away). Said once for a primitive listed twice (a body's visual
+        shape and its bounding object, the same cylinder where the same line wrote them)."""
         for dev in robot["devices"]:
             where = self.device_where.get(id(dev))
             if where is None:
                 continue
+            said: set[str] = set()
             for part in enclosing_shapes(robot, dev):
                 line, col, _ = part.get("_at", (0, 0, ""))
                 at = f" (written at line {line}, column {col})" if line else ""
-                self.warnings.append(
-                    f"{where}: {dev['device']} {dev['name']!r} of robot {robot['name']!r} is inside the robot's "
-                    f"{part['geometry']['type']}{at}: its rays see that shape from inside, where Webots' never do "
-                    "(back faces culled); mount the device outside it or make the shape part of the device's Solid")
+                text = (f"{where}: {dev['device']} {dev['name']!r} of robot {robot['name']!r} is inside the robot's "
+                        f"{part['geometry']['type']}{at}: its rays see that shape from inside, where Webots' never do "
+                        "(back faces culled); mount the device outside it or make the shape part of the device's Solid")
+                if text not in said:
+                    said.add(text)
+                    self.warnings.append(text)
 
     def unique_devices(self, robot: dict) -> None:
         """Device names address topics and services, so a repeated one gets a suffix (Webots warns
