@@ -122,6 +122,81 @@ def test_both_heads_follow_the_motor2_calls_by_the_kinematic_rule(tmp_path: Path
                 twin[n].target = q
 
 
+
+MOTOR2_CONTROLLER = '''\
+# Sensorium's test controller making motor2.c's calls (Webots' sample): "motor 1" to 1, -1, 0 from step
+# 50, "motor 2" to 1, -1 from step 300, then both following cosines and sines from step 501.
+import math
+from controller import Robot
+
+robot = Robot()
+motors = {n: robot.getDevice(n) for n in ("motor 1", "motor 2")}
+print(f"{robot.getName()} runs", flush=True)
+fixed = {50: ("motor 1", 1.0), 100: ("motor 1", -1.0), 200: ("motor 1", 0.0), 300: ("motor 2", 1.0),
+         400: ("motor 2", -1.0)}
+counter = 0
+while robot.step(32) != -1:
+    counter += 1
+    if counter in fixed:
+        motors[fixed[counter][0]].setPosition(fixed[counter][1])
+    elif counter > 500:
+        motors["motor 1"].setPosition(0.5 * math.cos(0.01 * counter))
+        motors["motor 2"].setPosition(0.5 * math.sin(0.003 * counter))
+'''
+
+H2_WATCHER = '''\
+from controller import Supervisor
+
+sup = Supervisor()
+blocks = {tag: sup.getFromDef(f"BLOCK_{tag}") for tag in ("WITHOUT_BACKLASH", "WITH_BACKLASH")}
+while sup.step(32) != -1:
+    t = round(sup.getTime() * 1000)
+    if t in (6400, 16000, 25600):
+        for tag, node in blocks.items():
+            p = node.getPosition()
+            print(f"{tag} {t} {p[0]:.9f} {p[1]:.9f} {p[2]:.9f}", flush=True)
+'''
+
+
+@pytest.mark.slow
+def test_both_robots_run_motor2_under_sensorium_run_and_their_blocks_meet_the_closed_form(tmp_path: Path) -> None:
+    """Our Python controller making motor2.c's calls, named by both robots, under ``sensorium run`` for
+    26 s with a watcher Supervisor: each robot runs its own copy, and each block is where the kinematic
+    rule and the two turns put it at 6.4, 16 and 25.6 s (1e-9)."""
+    (tmp_path / "worlds").mkdir()
+    shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
+    world = tmp_path / "worlds" / "hinge_2_joint_with_backlash.wbt"
+    world.write_text((DATA / "hinge_2_joint_with_backlash.wbt").read_text() +
+                     'Robot { name "watcher" supervisor TRUE controller "watcher" }\n')
+    for name, source in (("motor2", MOTOR2_CONTROLLER), ("watcher", H2_WATCHER)):
+        (tmp_path / "controllers" / name).mkdir(parents=True)
+        (tmp_path / "controllers" / name / f"{name}.py").write_text(source)
+    done = subprocess.run(sensorium("run", str(world), "--until", "26000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    for name in H2_ROBOTS:
+        assert f"[{name}] {name} runs" in lines, done.stdout[-2000:]
+    got = {}
+    for line in lines:
+        if line.startswith("[watcher] "):
+            tag, t, *values = line.split("] ", 1)[1].split()
+            got[tag, int(t)] = [float(v) for v in values]
+    twin = {n: KinematicMotor(1.0, 10.0) for n in ("motor 1", "motor 2")}
+    for counter in range(1, 801):
+        for m in twin.values():
+            m.step(0.032)
+        if 32 * counter in (6400, 16000, 25600):
+            for tag, origin, yaw in H2_ROBOTS.values():
+                turn = rot((0, 0, 1), yaw)
+                anchor = origin + np.array([0.0, 0.0, 0.13])
+                block0 = anchor + turn @ H2_HEAD @ np.array([-0.026, 0.0, 0.0])
+                q = rot(turn @ (-1, 0, 0), twin["motor 1"].x) @ rot(turn @ (0, -1, 0), twin["motor 2"].x)
+                assert got[tag, 32 * counter] == pytest.approx(anchor + q @ (block0 - anchor), abs=1e-9), (tag, counter)
+        for n, target in motor2_targets(counter).items():
+            twin[n].target = target
+
 # ----------------------------------------------------------------------------------- khepera3_gripper
 # khepera3_gripper (k-team/khepera3): the Khepera III (wheels of 0.0212 m at y ±0.0458, turning about +y)
 # turned 2.87979 rad at the origin, 16 ms steps; its gripper in the turret slot: "horizontal_motor" turns
