@@ -590,3 +590,24 @@ def test_the_khepera4_avoids_the_boxes_by_its_closed_form_readings_and_arcs(tmp_
     assert first is not None and first[:2] == (83, "front infrared sensor"), first
     assert seen == {"front infrared sensor", "front right infrared sensor"} and steps == 292, (seen, steps)
     assert [x, y, yaw] == pytest.approx([0.3775, 0.5912, 1.5649], abs=1e-4)
+
+
+def test_a_wheel_whose_cylinder_lies_across_its_hinge_is_said(tmp_path: Path) -> None:
+    """A stand-in of this sweep first had its wheels' cylinders lying across their hinges (a Cylinder's
+    axis is its z since R2022a), and the robot drove on them, where Webots' would not roll: the drive
+    still takes such a wheel (its radius as the rolling one), and one load line now names it; the
+    other, turned onto the hinge's axis, is a wheel without a word."""
+    world = tmp_path / "discs.wbt"
+    wheel = ('HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0.02 }} '
+             'device [ RotationalMotor {{ name "{side} wheel motor" }} ] endPoint Solid {{ translation 0 {y} 0.02 '
+             'children [ Pose {{ {turn}children [ Shape {{ geometry Cylinder {{ height 0.003 radius 0.02 }} }} ] }} ] '
+             'name "{side} wheel" }} }}\n')
+    world.write_text('#VRML_SIM R2023b utf8\nWorldInfo { }\nRobot {\n  children [\n' +
+                     wheel.format(y=0.05, side="left", turn="rotation 1 0 0 1.5708 ") +
+                     wheel.format(y=-0.05, side="right", turn="") + '  ]\n  controller "<none>"\n}\n')
+    w = load_world(world)
+    assert w.warnings == [f"{world}:6:1: HingeJoint motor 'right wheel motor': its wheel's cylinder lies across the "
+                          "hinge's axis, not along it; taken as a wheel of radius 0.02 all the same, where Webots' "
+                          "would not roll on it"], w.warnings
+    drive = w.world.robots[0].differential_drive
+    assert (drive.wheel_radius, drive.axle_length) == (0.02, 0.1)

@@ -2597,6 +2597,12 @@ class Converter:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return
             robot.data["differential_drive"] = drive
+            for w in wheels:      # a wheel's cylinder lying across its hinge's axis: Webots' would not roll
+                if not rolls_about_its_axis(w, self, centred=False):
+                    self.warn(w["node"], f"HingeJoint motor {w['motor']!r}: its wheel's cylinder lies across the "
+                                         f"hinge's axis, not along it; taken as a wheel of radius "
+                                         f"{wheel_radius(w['end'], self):g} all the same, where Webots' would not "
+                                         "roll on it")
         self._drive_wheels(node, robot, wheels)
 
     def _drive_wheels(self, node: Node, robot: Owner, wheels: list[dict]) -> None:
