@@ -89,6 +89,10 @@ JOINT_KEYS = ("max_velocity", "min_position", "max_position", "acceleration", "m
 MANY_JOINTS = 4      # more motorised joints than this, none a wheel: one warning for the robot, naming the first few
 JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), and "
                "the shapes and devices past the joint with it")
+# the same for a joint ending in a SolidReference (a linkage's loop-closing joint, driven: the Khepera III
+# gripper's fingers): nothing is past it here, as the loop is not closed
+JOINT_MOVES_NOTHING = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), "
+                       "but moves nothing: its end point is SolidReference {name!r}, whose loop is not closed here")
 # the fields every Solid has (a device's own fields are the others)
 SOLID_FIELDS = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
                 "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection",
@@ -1596,18 +1600,22 @@ class Converter:
     def devices_inside(self, robot: dict) -> None:
         """One warning for each visual device whose origin is inside one of its robot's closed
         primitives, which Webots never sees from there and rays here do (wbt/inside.py; a mesh is
-        split instead: turn_meshes_away)."""
+        split instead: turn_meshes_away). Said once for a primitive listed twice (a body's visual
+        shape and its bounding object, the same cylinder where the same line wrote them)."""
         for dev in robot["devices"]:
             where = self.device_where.get(id(dev))
             if where is None:
                 continue
+            said: set[str] = set()
             for part in enclosing_shapes(robot, dev):
                 line, col, _ = part.get("_at", (0, 0, ""))
                 at = f" (written at line {line}, column {col})" if line else ""
-                self.warnings.append(
-                    f"{where}: {dev['device']} {dev['name']!r} of robot {robot['name']!r} is inside the robot's "
-                    f"{part['geometry']['type']}{at}: its rays see that shape from inside, where Webots' never do "
-                    "(back faces culled); mount the device outside it or make the shape part of the device's Solid")
+                text = (f"{where}: {dev['device']} {dev['name']!r} of robot {robot['name']!r} is inside the robot's "
+                        f"{part['geometry']['type']}{at}: its rays see that shape from inside, where Webots' never do "
+                        "(back faces culled); mount the device outside it or make the shape part of the device's Solid")
+                if text not in said:
+                    said.add(text)
+                    self.warnings.append(text)
 
     def unique_devices(self, robot: dict) -> None:
         """Device names address topics and services, so a repeated one gets a suffix (Webots warns
@@ -2388,6 +2396,10 @@ class Converter:
     def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         if len(nowheel) <= MANY_JOINTS:
             for joint, _motor, line, _why in nowheel:
+                end = self.fields(joint).node_("endPoint")
+                if end is not None and end.type == "SolidReference" and line.endswith(JOINT_MOVES):
+                    name = self.fields(end).string("solidName", "")
+                    line = line[:-len(JOINT_MOVES)] + JOINT_MOVES_NOTHING.format(name=name)
                 self.warn(joint, line)
             return
         reasons: dict[str, int] = {}
@@ -2610,6 +2622,12 @@ class Converter:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return
             robot.data["differential_drive"] = drive
+            for w in wheels:      # a wheel's cylinder lying across its hinge's axis: Webots' would not roll
+                if not rolls_about_its_axis(w, self, centred=False):
+                    self.warn(w["node"], f"HingeJoint motor {w['motor']!r}: its wheel's cylinder lies across the "
+                                         f"hinge's axis, not along it; taken as a wheel of radius "
+                                         f"{wheel_radius(w['end'], self):g} all the same, where Webots' would not "
+                                         "roll on it")
         self._drive_wheels(node, robot, wheels)
 
     def _drive_wheels(self, node: Node, robot: Owner, wheels: list[dict]) -> None:

@@ -106,12 +106,13 @@ def _round_part(end: Node | None, conv) -> tuple[str, float, float] | None:
     return bounding if bounding is not None and bounding[1] else find(end, 1.0)   # (a 0 radius: the visual's)
 
 
-def rolls_about_its_axis(w: dict, conv) -> bool:
+def rolls_about_its_axis(w: dict, conv, centred: bool = True) -> bool:
     """Whether a motorised hinge's end point turns something round as a wheel turns: its first
     cylinder or capsule (boundingObject first, as :func:`wheel_radius` looks) lies along the hinge's
     axis with its centre on it, or its first sphere is centred on the axis (within a quarter of the
     radius, 5° of tilt). An arm's link of a plain cylinder, standing across the axis or off it, does
-    not: a robot with such an arm beside its wheels keeps its drive."""
+    not: a robot with such an arm beside its wheels keeps its drive. ``centred`` False: the tilt
+    only (a wheel's place is its Solid's where the joint's anchor is left at its default)."""
     end = conv.slotted(w["end"])
     if end is None:
         return False
@@ -122,7 +123,7 @@ def rolls_about_its_axis(w: dict, conv) -> bool:
     def judge(kind: str, radius: float, frame) -> bool:
         centre = np.asarray(frame.translation, dtype=np.float64)
         off = (centre - anchor) - axis * float(np.dot(centre - anchor, axis))
-        if float(np.linalg.norm(off)) > 0.25 * radius:
+        if centred and float(np.linalg.norm(off)) > 0.25 * radius:
             return False
         if kind == "Sphere":
             return True
