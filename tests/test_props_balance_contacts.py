@@ -157,3 +157,21 @@ def test_a_box_on_a_ramp_is_balanced_iff_tan_tilt_is_at_most_width_over_height(e
             (math.tan(tilt), width / height)
 
     run()
+
+
+@pytest.mark.parametrize("height", [0.3, 0.001, 0.0005])
+@pytest.mark.parametrize("flip", [False, True])
+def test_a_standing_disc_touches_at_its_lower_end_s_centre_and_rim_only(height: float, flip: bool) -> None:
+    # a cylinder standing on an end: that end's centre and its 32 rim points (README), on the floor; a disc 1 mm
+    # thick or less has its upper end within the 1 mm tolerance too, and that end touches nothing
+    turn = " rotation 1 0 0 3.141592653589793" if flip else ""
+    lv = _live(HEAD + FLOOR + f'DEF DISC Solid {{ translation 2 3 {_r(height / 2.0)}{turn} name "disc" '
+               f'boundingObject Cylinder {{ radius 0.2 height {_r(height)} }} physics Physics {{ }} }}\n' + SUPERVISOR)
+    disc = _node(lv, "DISC")
+    got = _sup(lv, "get_node_contact_points", {"node": disc, "include_descendants": False})
+    points = np.array(got["points"]).reshape(-1, 3)
+    assert got["nodes"] == [disc] * 33
+    assert np.abs(points[:, 2]).max() <= 1e-15
+    radii = np.sort(np.hypot(points[:, 0] - 2.0, points[:, 1] - 3.0))
+    assert radii[0] <= 1e-15 and radii[1:] == pytest.approx([0.2] * 32, abs=1e-15)
+    assert _sup(lv, "get_node_static_balance", {"node": disc})["value"] is True

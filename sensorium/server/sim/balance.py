@@ -46,8 +46,8 @@ def lowest_points(g: object, prim: object, at: Pose) -> np.ndarray:
     """The points (ENU) of a bounding shape at ENU pose ``at`` that may touch a ground under it: a
     sphere's lowest point; a capsule's lowest point of each end; a cylinder's lowest rim point of each
     end (on its side it touches along the line between them), a cone's lowest base rim point and its
-    apex, and their end rims too when the bottom rim lies within CONTACT_TOL of level (standing on an
-    end it touches all round; its rim's points near the bottom are never taken for a side's line); a
+    apex, and, when the bottom rim lies within CONTACT_TOL of level, the end turned down alone with its
+    rim (standing on an end it touches all round; its rim's points near the bottom are never taken for a side's line); a
     box's corners on a face turned down (FACING_DOWN); any other shape's support points (ground.support_points)."""
     r, c = at.rotation, at.translation
     if isinstance(g, wm.Sphere):
@@ -73,7 +73,10 @@ def lowest_points(g: object, prim: object, at: Pose) -> np.ndarray:
         lowest = np.array([ends[0], lowest[1]])
     if 2.0 * radius * n > CONTACT_TOL:
         return lowest
-    return np.vstack([lowest, support_points(g, prim) @ r.T + c])
+    # level: the end turned down alone (a disc 1 mm thick or less has its top end within CONTACT_TOL too), its
+    # centre (any rim point is a lowest one: a tilt of 1e-16 would pick one of them) and its rim
+    rim = support_points(g, prim)
+    return np.vstack([ends[[axis[2] < 0.0, axis[2] > 0.0]], rim[np.sign(rim[:, 2]) * axis[2] < 0.0] @ r.T + c])
 
 
 def _points(parts: list[tuple[Pose, Any]], pose: Pose, base_dir: Any, to_enu: np.ndarray | None) -> list[np.ndarray]:
