@@ -4,7 +4,8 @@ cut, spliced with huge, tiny, NaN and infinite numbers, nested deeper than allow
 Every request gets one reply; a refusal is one line with a protocol code other than INTERNAL; an import
 that is taken exports as text again, and the world keeps answering (a step, the contact points and
 balance of the first box). A world file whose bounding object's volume overflows (a sphere of radius 1e308)
-is refused at load in lines naming where, not with an OverflowError or a numpy warning."""
+is refused at load in lines naming where, not with an OverflowError or a numpy warning; a joint ending in a
+SolidReference is one load line saying what it names (a Solid, the static environment, nothing)."""
 
 from __future__ import annotations
 
@@ -105,3 +106,22 @@ def test_a_bounding_object_whose_volume_overflows_is_refused_where_it_is(tmp_pat
     lines = str(info.value).splitlines()
     assert lines and all(line.startswith(f"{path}: line 2, column ") for line in lines), lines
     assert any("solids[0].mass.kg): expected a finite number, got inf" in line for line in lines), lines
+
+
+@pytest.mark.parametrize(("reference", "line"), [
+    ('solidName "finger"', "HingeJoint ending in SolidReference 'finger': the loop it closes is not closed here "
+                           "(no physics); 'finger' moves with the joints it is written in only"),
+    ('solidName "<static environment>"', "HingeJoint ending in SolidReference '<static environment>': the Solid "
+                                         "above it is not tied to the world here (no physics); the joint is left out"),
+    ("", "HingeJoint ending in a SolidReference without a solidName: it names no Solid; the joint is left out"),
+    ('solidName "a\\"b\\nc"', "HingeJoint ending in SolidReference 'a\"bnc': the loop it closes is not closed here "
+                              "(no physics); 'a\"bnc' moves with the joints it is written in only")])
+def test_a_joint_ending_in_a_solid_reference_is_one_load_line_saying_what_it_ties(tmp_path, reference: str,
+                                                                                  line: str) -> None:
+    # Webots' solidName: a Solid's name, or <static environment> (the Solid above the joint tied to the world)
+    path = tmp_path / "w.wbt"
+    robot = ('Robot { name "arm" children [ HingeJoint { endPoint Solid { name "link" '
+             f'children [ HingeJoint {{ endPoint SolidReference {{ {reference} }} }} ] }} }} ] }}\n')
+    path.write_text("#VRML_SIM R2023b utf8\n" + robot)
+    warnings = [w for w in load_world(path).warnings if "SolidReference" in w]
+    assert warnings == [f"{path}:2:{robot.rindex('HingeJoint') + 1}: {line}"], warnings
