@@ -236,3 +236,37 @@ def test_an_exported_solid_imported_again_exports_the_same_text(examples: int) -
         assert _sup(empty, "node_export_string", {"node": again})["value"] == first
 
     run()
+
+
+@pytest.mark.parametrize("examples", example_counts(80))
+def test_a_box_reset_at_any_steps_falls_from_rest_at_each_reset_and_lands_on_the_floor(examples: int) -> None:
+    """resetPhysics (sim/falling.py Falls.stop) at random steps of a fall from a random height: between resets the
+    box's centre is at z_r - g (t - t_r)^2 / 2 (z_r its height at the last reset t_r, the lift a reset at 0); from
+    the first step whose end is past the remaining drop's time it rests with its bottom on the floor (z = 0.05)."""
+    from test_reset_physics import STEP, G, _lift, _node, _reset, _world
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.floats(0.06, 30.0).map(lambda v: round(v, 9)), st.lists(st.integers(1, 400), max_size=4, unique=True))
+    def run(height, resets):
+        sim = _world()
+        _lift(sim, [0.3, -0.2, height])
+        z_r, k_r, landed = height, 0, False
+        for k in range(1, 500):
+            if k - 1 in resets and not landed:
+                _reset(sim, _node(sim))
+                z_r, k_r = sim.scene.solid_poses["load"].translation[2], k - 1
+            sim.step()
+            t = (k - k_r) * STEP / 1000.0
+            closed = z_r - G * t * t / 2.0
+            z = sim.scene.solid_poses["load"].translation
+            assume(abs(closed - 0.05) > 1e-9)        # (touching within rounding: either answer is right)
+            if closed > 0.05:
+                assert z.tolist() == pytest.approx([0.3, -0.2, closed], abs=1e-9 * max(height, 1.0)), (k, resets)
+            else:
+                assert z.tolist() == pytest.approx([0.3, -0.2, 0.05], abs=1e-12), (k, resets)
+                assert not sim.falls
+                landed = True
+                break
+        assert landed
+
+    run()
