@@ -59,9 +59,9 @@ boxes = st.tuples(size, size, size, st.floats(-math.pi, math.pi),     # width (x
                   st.floats(-1.5, 1.5), st.floats(-1.5, 1.5), st.floats(-1.0, 1.0))   # com in units of half sides
 
 
-def _footprint_case(box: tuple, at: tuple[float, float]) -> tuple[str, bool, np.ndarray] | None:
-    """The box's world text, whether its centre of mass is over its footprint, its bottom corners (None for a
-    centre within EDGE of the footprint's edge)."""
+def _footprint_case(box: tuple, at: tuple[float, float], base: float = 0.0) -> tuple[str, bool, np.ndarray] | None:
+    """The box's world text (its bottom at height ``base``), whether its centre of mass is over its footprint,
+    its bottom corners (None for a centre within EDGE of the footprint's edge)."""
     # rounded: a world's numbers below 1e-30 in magnitude are refused at load (world/limits.py)
     w, d, h, yaw, u, v, k = (round(x, 12) for x in box)
     cx, cy, cz = u * w / 2.0, v * d / 2.0, k * h / 2.0
@@ -69,20 +69,25 @@ def _footprint_case(box: tuple, at: tuple[float, float]) -> tuple[str, bool, np.
         return None
     inside = abs(cx) < w / 2.0 and abs(cy) < d / 2.0
     c, s = math.cos(yaw), math.sin(yaw)
-    corners = np.array([(at[0] + c * x - s * y, at[1] + s * x + c * y, 0.0)
+    corners = np.array([(at[0] + c * x - s * y, at[1] + s * x + c * y, base)
                         for x in (-w / 2.0, w / 2.0) for y in (-d / 2.0, d / 2.0)])
-    text = (f'DEF BOX Solid {{ translation {_r(at[0])} {_r(at[1])} {_r(h / 2.0)} rotation 0 0 1 {_r(yaw)} name "box" '
+    text = (f'DEF BOX Solid {{ translation {_r(at[0])} {_r(at[1])} {_r(base + h / 2.0)} rotation 0 0 1 {_r(yaw)} name "box" '
             f'boundingObject Box {{ size {_r(w)} {_r(d)} {_r(h)} }} '
             f'physics Physics {{ mass 1 centerOfMass [ {_r(cx)} {_r(cy)} {_r(cz)} ] }} }}\n')
     return text, inside, corners
 
 
-def _check_footprint(box: tuple, at: tuple[float, float]) -> None:
-    case = _footprint_case(box, at)
+def _table(at: tuple[float, float]) -> str:
+    """A table 0.5 m high and 6 m square centred under ``at``, no floor."""
+    return f'Solid {{ translation {_r(at[0])} {_r(at[1])} 0.25 name "table" boundingObject Box {{ size 6 6 0.5 }} }}\n'
+
+
+def _check_footprint(box: tuple, at: tuple[float, float], table: bool = False) -> None:
+    case = _footprint_case(box, at, 0.5 if table else 0.0)
     assume(case is not None)
     assert case is not None
     text, inside, corners = case
-    lv = _live(HEAD + FLOOR + text + SUPERVISOR)
+    lv = _live(HEAD + (_table(at) if table else FLOOR) + text + SUPERVISOR)
     box_id = _node(lv, "BOX")
     assert _sup(lv, "get_node_static_balance", {"node": box_id})["value"] is inside
     got = _sup(lv, "get_node_contact_points", {"node": box_id, "include_descendants": False})
@@ -93,7 +98,7 @@ def _check_footprint(box: tuple, at: tuple[float, float]) -> None:
     # each corner matched by one point (order is the shape's own)
     for corner in corners:
         assert np.min(np.max(np.abs(points - corner), axis=1)) <= tol, (corner, points)
-    assert np.all(np.abs(points[:, 2]) <= tol)
+    assert np.all(np.abs(points[:, 2] - corners[0, 2]) <= tol)
 
 
 @pytest.mark.parametrize("examples", example_counts(200))
@@ -107,13 +112,15 @@ def test_a_box_on_the_floor_is_balanced_iff_its_centre_is_over_its_turned_footpr
 
 
 @pytest.mark.parametrize("examples", example_counts(200))
-def test_the_same_answers_far_from_the_origin(examples: int) -> None:
+def test_the_same_answers_far_from_the_origin_and_on_a_table(examples: int) -> None:
+    # on a table's top its corners are found on the ground under them and as its face's corners over the top:
+    # each counted once
     far = st.floats(-1e5, 1e5) | st.sampled_from([1e5, -1e5, 99999.999])
 
     @settings(SETTINGS, max_examples=examples)
-    @given(boxes, st.tuples(far, far))
-    def run(box, at):
-        _check_footprint(box, (round(at[0], 9), round(at[1], 9)))
+    @given(boxes, st.tuples(far, far), st.booleans())
+    def run(box, at, table):
+        _check_footprint(box, (round(at[0], 9), round(at[1], 9)), table)
 
     run()
 
@@ -270,3 +277,19 @@ def test_a_box_reset_at_any_steps_falls_from_rest_at_each_reset_and_lands_on_the
         assert landed
 
     run()
+
+
+@pytest.mark.parametrize(("shape", "count"), [("Sphere { radius 0.1 }", 1), ("Cylinder { radius 0.1 height 0.2 }", 33),
+                                              ("Capsule { radius 0.1 height 0.2 }", 1)])
+def test_a_shape_on_a_table_touches_at_each_point_once(shape: str, count: int) -> None:
+    # standing (a capsule upright: its lower end's lowest point), its lowest points on the table's top at z = 0.5
+    half = {"Sphere": 0.1, "Cylinder": 0.1, "Capsule": 0.2}[shape.split()[0]]
+    lv = _live(HEAD + _table((2.0, 1.0)) + f'DEF S Solid {{ translation 2.3 0.8 {_r(0.5 + half)} name "s" '
+               f'boundingObject {shape} physics Physics {{ }} }}\n' + SUPERVISOR)
+    s = _node(lv, "S")
+    got = _sup(lv, "get_node_contact_points", {"node": s, "include_descendants": False})
+    points = np.array(got["points"]).reshape(-1, 3)
+    assert got["nodes"] == [s] * count and len({(x, y) for x, y, _ in points}) == count
+    assert np.abs(points[:, 2] - 0.5).max() <= 1e-15
+    radii = np.sort(np.hypot(points[:, 0] - 2.3, points[:, 1] - 0.8))       # its centre's, then its rim's
+    assert radii.tolist() == pytest.approx([0.0] + [0.1] * (count - 1), abs=1e-15)

@@ -133,7 +133,8 @@ def contact_points(shapes: list[np.ndarray], ground: Ground | None) -> np.ndarra
 
 
 def touching(shapes: list[np.ndarray], ground: Ground | None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`contact_points` and, for each point, the index in ``shapes`` of the shape touching there."""
+    """:func:`contact_points` and, for each point, the index in ``shapes`` of the shape touching there; a
+    shape's points at the same place seen from above counted once."""
     if ground is None or not shapes:
         return np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
     points = np.vstack(shapes)
@@ -159,7 +160,14 @@ def touching(shapes: list[np.ndarray], ground: Ground | None) -> tuple[np.ndarra
                     held = clip(hull_2d(near[:, :2]), outline)
                     contacts.append(np.column_stack([held, np.full(len(held), height)]))
                     owners.append(np.full(len(held), index))
-    return np.vstack(contacts), np.concatenate(owners)
+    points, of = np.vstack(contacts), np.concatenate(owners)
+    if len(contacts) > 1:
+        # a point over a top is found twice: on the ground under it and as a corner of its face held by the
+        # top (clip keeps the hull's own coordinates): once per shape, the first kept, in order
+        _, first = np.unique(np.column_stack([of.astype(np.float64), points[:, :2]]), axis=0, return_index=True)
+        first.sort()
+        points, of = points[first], of[first]
+    return points, of
 
 
 def balanced(contacts: np.ndarray, centre: np.ndarray) -> bool:
