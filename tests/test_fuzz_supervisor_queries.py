@@ -1,12 +1,13 @@
 """Hypothesis fuzz of this round's Supervisor services on the sans-IO core, on
 tests/worlds/contact_points.wbt (a box and a ball with physics, a two-wheel robot with nested solids):
 reset_physics, get_node_static_balance, get_node_contact_points (with and without descendants),
-node_export_string of top-level and nested nodes, movie_start/frames/stop and world_load, with node ids
+node_export_string of top-level and nested nodes, move_viewpoint, movie_start/frames/stop and world_load, with node ids
 of the root, of nested nodes, of removed nodes, out of range and of every wrong type, movie sizes and
 accelerations at and past their bounds, interleaved with steps, a node's removal, a simulation reset
 and a world reload. Every request gets one reply; a refusal is one line with a protocol code other
 than INTERNAL and leaves the movie as it was; contact points come as finite (x, y, z) triples, one
-node id each, balance as a bool, export text as text; every frame is width x height x 3 bytes."""
+node id each, balance as a bool, export text as text; every frame is width x height x 3 bytes; the
+Viewpoint's position stays finite."""
 
 from __future__ import annotations
 
@@ -18,6 +19,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from test_fuzz_core import SETTINGS, Fuzzed
 from test_fuzz_new_devices import send, values
+
+from sensorium.server.sim import viewshot
 
 R = "/sup/robot/"
 DEFS = ("BOX", "BALL", "CART", "LEFT", "RIGHT", "CASTER")
@@ -45,7 +48,7 @@ def test_the_rounds_supervisor_services_answer_or_refuse_in_one_line(examples: i
     side = st.sampled_from([2, 4, 16]) | st.sampled_from([2, 4, 16, 1, 3, 0, -2, 4097, 1 << 40, 2.0, math.nan]) | values
     acceleration = st.sampled_from([1, 2, 7, 10_000]) | st.sampled_from([0, -1, 10_001, 1.5, math.inf, True]) | values
     requests = st.one_of(
-        st.tuples(st.sampled_from(["reset_physics", "get_node_static_balance", "node_export_string"]),
+        st.tuples(st.sampled_from(["reset_physics", "get_node_static_balance", "node_export_string", "move_viewpoint"]),
                   st.fixed_dictionaries({"node": node})),
         st.tuples(st.just("get_node_contact_points"),
                   st.fixed_dictionaries({"node": node}, optional={"include_descendants": st.booleans() | values})),
@@ -76,6 +79,7 @@ def test_the_rounds_supervisor_services_answer_or_refuse_in_one_line(examples: i
             got = reply.get("result")
             if not reply["ok"]:
                 assert _movie(f) == movie, (item, args, reply)
+                assert "\n" not in reply["error"]["message"], (item, args, reply)
             elif item == "get_node_contact_points":
                 points, nodes = got["points"], got["nodes"]
                 assert len(points) == 3 * len(nodes) and all(math.isfinite(v) for v in points), got
@@ -86,6 +90,9 @@ def test_the_rounds_supervisor_services_answer_or_refuse_in_one_line(examples: i
                 assert isinstance(got["value"], str) and got["value"], got
             elif item == "movie_frames":
                 assert all(len(b) == got["width"] * got["height"] * 3 for b in got["frames"]), got["width"]
+            elif item == "move_viewpoint":
+                assert got == {"success": True}, got
+            assert all(math.isfinite(v) for v in viewshot.viewpoint_of(f.sim).position), (item, args)
             f.assert_healthy()
         f.steps()
         f.assert_healthy()

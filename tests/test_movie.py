@@ -237,12 +237,15 @@ def test_the_client_writes_an_mp4_of_the_frames_with_webots_states_and_lines(tmp
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("ffmpeg") is None or sys.platform == "win32", reason="needs ffmpeg (POSIX)")
 @pytest.mark.parametrize("which", ["python", "c"])
-def test_a_controller_ending_while_recording_writes_the_movie_so_far(tmp_path: Path, request, which) -> None:
+@pytest.mark.parametrize("name", ["left.mp4", "l" * 247 + ".mp4", "é" * 123 + "l.mp4"])
+def test_a_controller_ending_while_recording_writes_the_movie_so_far(tmp_path: Path, request, which, name) -> None:
+    # a name of 251 bytes (255 the file system's limit) leaves no room for a temporary named after it whole:
+    # the temporary takes its first wb_movie.TMP_BASE bytes
     argv, env = _client(request, which)
-    lines, err = _run(argv, tmp_path, {**env, "MOVIE_LEAVE": "1"})
+    lines, err = _run(argv, tmp_path, {**env, "MOVIE_LEAVE": "1", "MOVIE_LEFT_NAME": name})
     assert lines == ["left"] and "Error" not in err and "Sanitizer" not in err, err
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["left.mp4"]
-    frames = _decode(tmp_path / "left.mp4")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]
+    frames = _decode(tmp_path / name)
     assert len(frames) == 5                              # 160 ms, a frame each 32 ms
     assert np.abs(frames.reshape(5, -1, 3).mean(axis=1) - [FACE, 0, 0]).max() <= 6
 

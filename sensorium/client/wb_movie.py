@@ -30,6 +30,16 @@ FINISHER = ('f=$1 t=$2; shift 2; "$@" || { s=$?; rm -f -- "$t"; exit $s; }; '
 """sh -c script run as ``FINISHER sh MOVIE TMP ffmpeg ARGS...``: ffmpeg, then TMP renamed onto MOVIE (exit 99: the
 rename failed; ffmpeg's own status when it failed), TMP removed unless renamed: whether or not the controller lives."""
 RENAME_FAILED = 99
+TMP_BASE = 192
+"""Bytes of the movie's name kept in its temporary's: a name near the 255-byte limit of a file name leaves
+room for the dot, the process id and the suffix."""
+
+
+def temporary(folder: str, base: str, pid: int) -> str:
+    """The temporary file beside the movie ``base`` in ``folder`` that ffmpeg writes: hidden, the name cut
+    to TMP_BASE bytes (as the C client cuts it: within a character, the bytes kept as they are)."""
+    cut = os.fsdecode(os.fsencode(base)[:TMP_BASE])
+    return os.path.join(folder, f".{cut}.{pid}.tmp.mp4")
 
 
 class Recorder:
@@ -75,7 +85,7 @@ class Recorder:
         step_ms = int(reply["step_ms"])
         # Webots' bit rate: quality x fps x pixels / 256; its frame rate: acceleration x 1000 / step_ms
         bitrate = quality * acceleration * 1000 * width * height // (256 * step_ms)
-        self.tmp = os.path.join(folder, f".{base}.{os.getpid()}.tmp.mp4")
+        self.tmp = temporary(folder, base, os.getpid())
         self.filename = filename
         self.frames = 0
         self.said_full = False

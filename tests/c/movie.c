@@ -1,7 +1,8 @@
 /* tests/controllers/movie.py in C (tests/test_movie.py, tests/worlds/movie.wbt): a movie of the wall
  * red for 20 basic steps, blue for 20 more, stopped and waited for; then the arguments Webots'
  * libController refuses and those Sensorium refuses beyond it, one line each. Prints the same lines
- * (with $MOVIE_LEAVE set: 10 steps of a movie, then the end without stopping it, "left"). */
+ * (with $MOVIE_LEAVE set: 10 steps of a movie, $MOVIE_LEFT_NAME else left.mp4, then the end without stopping
+ * it, "left"). */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -27,7 +28,8 @@ int main(void) {
   WbFieldRef colour = wb_supervisor_node_get_field(wb_supervisor_node_get_from_def("WALL_APP"), "baseColor");
   if (getenv("MOVIE_LEAVE") != NULL) { /* ends while recording: the controller's end writes the movie */
     char left[4096];
-    snprintf(left, sizeof left, "%s/left.mp4", out);
+    const char *name = getenv("MOVIE_LEFT_NAME");
+    snprintf(left, sizeof left, "%s/%s", out, name != NULL ? name : "left.mp4");
     wb_supervisor_movie_start_recording(left, 160, 120, 0, 90, 1, false);
     for (int i = 0; i < 10; i++)
       wb_robot_step(16);

@@ -1,7 +1,8 @@
 """A Webots-style supervisor recording a movie (tests/test_movie.py, tests/worlds/movie.wbt):
 the wall red for 20 basic steps (320 ms), blue for 20 more, then the recording stopped and waited
 for; then the arguments Webots' libController refuses, and those Sensorium refuses beyond it, one
-line each. Prints the movie's states as it goes and "done"."""
+line each. Prints the movie's states as it goes and "done". With $MOVIE_LEAVE set: 10 steps of a movie
+($MOVIE_LEFT_NAME, else left.mp4), then the end without stopping it, "left"."""
 
 import os
 
@@ -11,7 +12,8 @@ out = os.environ["MOVIE_OUT"]
 robot = Supervisor()
 colour = robot.getFromDef("WALL_APP").getField("baseColor")
 if os.environ.get("MOVIE_LEAVE"):         # ends while recording: the controller's end writes the movie
-    robot.movieStartRecording(os.path.join(out, "left.mp4"), 160, 120, 0, 90, 1, False)
+    robot.movieStartRecording(os.path.join(out, os.environ.get("MOVIE_LEFT_NAME", "left.mp4")), 160, 120, 0, 90, 1,
+                              False)
     for _ in range(10):
         robot.step(16)
     print("left")

@@ -26,7 +26,7 @@ from sensorium.server.sim.ground import Ground, hull_2d, over_support, support_p
 from sensorium.server.sim.motion import _TO_ENU
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["CONTACT_TOL", "EDGE_TOL", "balanced", "clip", "contact_points", "dynamic_entries", "dynamic_solids",
+__all__ = ["CONTACT_TOL", "EDGE_TOL", "FACING_DOWN", "balanced", "clip", "contact_points", "dynamic_entries", "dynamic_solids",
            "lowest_points", "robot_balance", "robot_contacts", "shapes_centre", "solid_balance", "solid_contacts", "touching"]
 
 CONTACT_TOL = FLOOR
@@ -35,6 +35,10 @@ contact's floor tolerance)."""
 EDGE_TOL = 1e-9
 """m: a centre of mass this close to the support polygon's edge is over it (Webots counts the edges in)."""
 
+FACING_DOWN = 1e-9
+"""A box face's outward normal's vertical part below minus this faces down (a face turned level by a
+rotation's rounding, some 1e-16, does not)."""
+
 _UP = np.array([0.0, 0.0, 1.0])
 
 
@@ -42,12 +46,18 @@ def lowest_points(g: object, prim: object, at: Pose) -> np.ndarray:
     """The points (ENU) of a bounding shape at ENU pose ``at`` that may touch a ground under it: a
     sphere's lowest point; a capsule's lowest point of each end; a cylinder's lowest rim point of each
     end (on its side it touches along the line between them), a cone's lowest base rim point and its
-    apex, and their end rims too when the bottom rim lies within CONTACT_TOL of level (standing on an
-    end it touches all round; its rim's points near the bottom are never taken for a side's line); a
-    box's corners; any other shape's support points (ground.support_points)."""
+    apex, and, when the bottom rim lies within CONTACT_TOL of level, the end turned down alone with its
+    rim (standing on an end it touches all round; its rim's points near the bottom are never taken for a side's line); a
+    box's corners on a face turned down (FACING_DOWN); any other shape's support points (ground.support_points)."""
     r, c = at.rotation, at.translation
     if isinstance(g, wm.Sphere):
         return (c - float(g.radius) * _UP)[None]
+    if isinstance(g, wm.Box):
+        # the corners on a face turned down: a top corner is the box's own height above the bottom one under
+        # it, which a box 1 mm high or less would put within CONTACT_TOL of the ground too
+        corners = support_points(g, prim)
+        down = (np.sign(corners) * r[2]).min(axis=1) < -FACING_DOWN
+        return corners[down] @ r.T + c
     if not isinstance(g, (wm.Capsule, wm.Cylinder, wm.Cone)):
         return support_points(g, prim) @ r.T + c
     axis = r[:, 2]
@@ -63,7 +73,10 @@ def lowest_points(g: object, prim: object, at: Pose) -> np.ndarray:
         lowest = np.array([ends[0], lowest[1]])
     if 2.0 * radius * n > CONTACT_TOL:
         return lowest
-    return np.vstack([lowest, support_points(g, prim) @ r.T + c])
+    # level: the end turned down alone (a disc 1 mm thick or less has its top end within CONTACT_TOL too), its
+    # centre (any rim point is a lowest one: a tilt of 1e-16 would pick one of them) and its rim
+    rim = support_points(g, prim)
+    return np.vstack([ends[[axis[2] < 0.0, axis[2] > 0.0]], rim[np.sign(rim[:, 2]) * axis[2] < 0.0] @ r.T + c])
 
 
 def _points(parts: list[tuple[Pose, Any]], pose: Pose, base_dir: Any, to_enu: np.ndarray | None) -> list[np.ndarray]:
@@ -120,7 +133,8 @@ def contact_points(shapes: list[np.ndarray], ground: Ground | None) -> np.ndarra
 
 
 def touching(shapes: list[np.ndarray], ground: Ground | None) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`contact_points` and, for each point, the index in ``shapes`` of the shape touching there."""
+    """:func:`contact_points` and, for each point, the index in ``shapes`` of the shape touching there; a
+    shape's points at the same place seen from above counted once."""
     if ground is None or not shapes:
         return np.zeros((0, 3)), np.zeros(0, dtype=np.int64)
     points = np.vstack(shapes)
@@ -146,7 +160,14 @@ def touching(shapes: list[np.ndarray], ground: Ground | None) -> tuple[np.ndarra
                     held = clip(hull_2d(near[:, :2]), outline)
                     contacts.append(np.column_stack([held, np.full(len(held), height)]))
                     owners.append(np.full(len(held), index))
-    return np.vstack(contacts), np.concatenate(owners)
+    points, of = np.vstack(contacts), np.concatenate(owners)
+    if len(contacts) > 1:
+        # a point over a top is found twice: on the ground under it and as a corner of its face held by the
+        # top (clip keeps the hull's own coordinates): once per shape, the first kept, in order
+        _, first = np.unique(np.column_stack([of.astype(np.float64), points[:, :2]]), axis=0, return_index=True)
+        first.sort()
+        points, of = points[first], of[first]
+    return points, of
 
 
 def balanced(contacts: np.ndarray, centre: np.ndarray) -> bool:

@@ -41,6 +41,7 @@ static int g_status = WB_SUPERVISOR_MOVIE_READY;
 static pid_t g_encoder = -1;
 static int g_pipe = -1;
 static char g_name[4096], g_tmp[4096 + 64];
+#define TMP_BASE 192 /* bytes of the movie's name in its temporary's (wb_movie.TMP_BASE) */
 static long long g_frames;
 static bool g_said_full;
 static bool g_world_ended; /* the world ended while recording: Webots' status for it once written */
@@ -157,7 +158,8 @@ static void start(sn_robot *rb, const char *func, const char *filename, int widt
   long long bitrate = (long long)quality * acceleration * 1000 * width * height / (256 * step_ms);
   if (bitrate < 1000)
     bitrate = 1000;
-  snprintf(g_tmp, sizeof g_tmp, "%s/.%s.%ld.tmp.mp4", folder, base, (long)getpid());
+  /* the movie's name cut to TMP_BASE bytes: a name near the 255-byte limit would leave none for the rest */
+  snprintf(g_tmp, sizeof g_tmp, "%s/.%.*s.%ld.tmp.mp4", folder, TMP_BASE, base, (long)getpid());
   char size[64], rate[64], bits[32];
   snprintf(size, sizeof size, "%dx%d", width, height);
   snprintf(rate, sizeof rate, "%lld/%lld", (long long)acceleration * 1000, step_ms);

@@ -1906,8 +1906,15 @@ class Converter:
                 # physics closes it; here the joint is left out, so the Solid named moves only with
                 # the joints it is written in (a parallelogram's finger turns with its driven link)
                 name = self.fields(end).string("solidName", "")
-                self.warn(node, f"{node.type} ending in SolidReference {name!r}: the loop it closes is not "
-                                f"closed here (no physics); {name!r} moves with the joints it is written in only")
+                if name == "<static environment>":      # Webots ties the Solid above the joint to the world
+                    self.warn(node, f"{node.type} ending in SolidReference {name!r}: the Solid above it is not tied "
+                                    "to the world here (no physics); the joint is left out")
+                elif not name:
+                    self.warn(node, f"{node.type} ending in a SolidReference without a solidName: it names no Solid; "
+                                    "the joint is left out")
+                else:
+                    self.warn(node, f"{node.type} ending in SolidReference {name!r}: the loop it closes is not "
+                                    f"closed here (no physics); {name!r} moves with the joints it is written in only")
                 return
             self.tree_field = "endPoint"
             if moving:          # what the end point holds rides on this joint (its innermost motor's)

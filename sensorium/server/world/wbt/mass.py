@@ -138,7 +138,8 @@ def _volume(conv: Any, node: Node | None, rot: np.ndarray, at: np.ndarray, scale
     total = sum(v for v, _ in parts)
     if total <= 0:
         return 0.0, (0.0, 0.0, 0.0)
-    c = sum(v * np.asarray(p) for v, p in parts) / total
+    with np.errstate(invalid="ignore", over="ignore"):      # an infinite volume: a mass the load refuses
+        c = sum(v * np.asarray(p) for v, p in parts) / total
     return total, tuple(float(x) for x in c)
 
 
@@ -169,10 +170,11 @@ def _parts(conv: Any, node: Node | None, rot: np.ndarray, at: np.ndarray, scale:
             size = g["size"]
             return [(size[0] * size[1] * size[2] * factor, at)]
         r = g["radius"]
+        cube = r * r * r        # (not r ** 3: a radius of 1e308 overflows to inf, refused as the mass, not raised)
         if t == "Sphere":
-            return [(4.0 / 3.0 * math.pi * r ** 3 * factor, at)]
+            return [(4.0 / 3.0 * math.pi * cube * factor, at)]
         h = g["height"]
-        cap = 4.0 / 3.0 * math.pi * r ** 3 if t == "Capsule" else 0.0
+        cap = 4.0 / 3.0 * math.pi * cube if t == "Capsule" else 0.0
         return [((math.pi * r * r * h + cap) * factor, at)]
     if t == "IndexedFaceSet":
         return _mesh_part(conv, node, rot, at, s)
