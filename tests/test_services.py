@@ -471,3 +471,25 @@ def test_motor_routes_counted():
     assert set(core.routes) == set(names)
     assert {n for n in names if n.startswith(f"/bot/{LEFT}/")} == {
         f"/bot/{LEFT}/{i}" for i in ("set_position", "set_velocity", "get_velocity", "get_max_velocity", "get_target_position")}
+
+
+def test_a_union_arguments_refusal_is_one_short_line():
+    # SetFieldArgs.value takes one of several types: pydantic reports every member's mismatch, each echoing
+    # the value; the line names the argument once, with what was really wrong, the value shortened
+    from pydantic import ValidationError
+
+    from sensorium.server.daemon.services import _arg_errors
+
+    def line(value):
+        with pytest.raises(ValidationError) as e:
+            S.SetFieldArgs.model_validate({"node": 1, "field": "translation", "value": value})
+        return _arg_errors(e.value, S.SetFieldArgs)
+
+    assert line(math.nan) == "argument 'value': Input should be a finite number (got nan)"
+    assert line([1.0, math.inf]) == "argument 'value.1': Input should be a finite number (got inf)"
+    assert line([1.0, "a"]) == "argument 'value.1': Input should be a valid number (got 'a')"
+    assert line([1.0]).startswith("argument 'value': List should have at least 2 items")
+    assert line({"a": 1}) == "argument 'value': Input should be one of bool, int, float, list[float], str (got {'a': 1})"
+    long = line("x" * 5000)
+    assert long.startswith("argument 'value': String should have at most 4096 characters (got 'xxx")
+    assert long.endswith("...)") and len(long) < 200 and long.count("argument") == 1

@@ -279,3 +279,15 @@ def test_info_summary_names_an_encoder_on_a_joint_nothing_turns():
 
     assert device_line(wm.PositionSensor(device="PositionSensor", name="arm sensor")) == \
         "PositionSensor on a joint nothing turns here (present, reads its position, 0)"
+
+
+def test_a_refused_set_field_value_is_one_short_line():
+    # the value's union of types: one complaint naming the argument once (each member's mismatch echoed
+    # the value, and the 512-character cut left only the first: "should be a valid boolean"), shortened
+    live = Live()
+    live.ok(A, "attach", {"robot": "pioneer"})
+    for value, said in [("x" * 5000, "String should have at most 4096 characters"),
+                        (float("nan"), "Input should be a finite number (got nan)")]:
+        message = live.err(A, "/pioneer/robot/set_field", {"node": 1, "field": "translation", "value": value},
+                           ErrorCode.INVALID_ARGUMENT)
+        assert message.count("argument 'value'") == 1 and said in message and len(message) < 200, message

@@ -24,9 +24,11 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
-from typing import Any, cast
+from types import UnionType
+from typing import Any, Union, cast, get_args, get_origin
 
 from pydantic import ValidationError
+from pydantic_core import ErrorDetails
 
 from sensorium.schemas import services as S
 from sensorium.schemas.devices import KINDS
@@ -92,16 +94,59 @@ ARG_CACHE_KEYS = 4            # argument maps of at most this many int/str value
 ARG_CACHE_SIZE = 1024         # validated argument maps kept
 
 
-def _arg_errors(exc: ValidationError) -> str:
-    parts = []
+# pydantic's errors that only say "not this member's type": in a union (SetFieldArgs.value) one comes per
+# member; the line keeps the member errors that say more ("should be a finite number", a list's length)
+_TYPE_MISMATCH = frozenset({"bool_type", "bool_parsing", "int_type", "int_parsing", "int_from_float", "float_type",
+                            "float_parsing", "list_type", "string_type", "dict_type", "model_type", "none_required"})
+_SHOWN_INPUT = 80             # characters of a refused value echoed back (a 4 KiB string is not sent back 5 times)
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= _SHOWN_INPUT else text[:_SHOWN_INPUT - 3] + "..."
+
+
+def _union_fields(model: Any) -> frozenset[str]:
+    """The arguments of ``model`` that take one of several types (pydantic reports each member's error)."""
+    names = []
+    for name, info in getattr(model, "model_fields", {}).items():
+        if get_origin(info.annotation) in (Union, UnionType):
+            if sum(1 for a in get_args(info.annotation) if a is not type(None)) > 1:
+                names.append(name)
+    return frozenset(names)
+
+
+def _arg_errors(exc: ValidationError, model: Any = None) -> str:
+    """One line for a request's refused arguments: each named once, a long value shortened."""
+    unions = _union_fields(model)
+    parts: list[str] = []
+    members: dict[str, list[ErrorDetails]] = {}     # a union argument -> its members' errors, in order
     for e in exc.errors(include_url=False):
         loc = ".".join(str(x) for x in e["loc"]) or "args"
         if e["type"] == "extra_forbidden":
             parts.append(f"unknown argument {loc!r}")
         elif e["type"] == "missing":
             parts.append(f"missing argument {loc!r}")
+        elif len(e["loc"]) >= 2 and e["loc"][0] in unions:
+            name = str(e["loc"][0])
+            if name not in members:
+                parts.append(name)          # placeholder: its line goes where it first failed
+            members.setdefault(name, []).append(e)
         else:
-            parts.append(f"argument {loc!r}: {e['msg']} (got {e.get('input')!r})")
+            parts.append(f"argument {loc!r}: {e['msg']} (got {_shown(e.get('input'))})")
+    for name, errors in members.items():
+        # a member's own complaint (not finite, too long, a list's length, a list's item)
+        said = [e for e in errors if e["type"] not in _TYPE_MISMATCH or len(e["loc"]) > 2]
+        if said:
+            lines: dict[str, None] = {}
+            for m in said:                  # its path without the member's type tag (value.1, not value.list[float].1)
+                where = ".".join(str(x) for x in (m["loc"][0], *m["loc"][2:]))
+                lines.setdefault(f"argument {where!r}: {m['msg']} (got {_shown(m.get('input'))})", None)
+            line = "; ".join(lines)
+        else:
+            kinds = ", ".join(dict.fromkeys(str(e["loc"][1]).removeprefix("constrained-") for e in errors))
+            line = f"argument {name!r}: Input should be one of {kinds} (got {_shown(errors[0].get('input'))})"
+        parts[parts.index(name)] = line
     return "; ".join(parts)
 
 
@@ -346,7 +391,7 @@ class Core(DeviceServices):
         try:
             args = model.model_validate(raw)  # type: ignore[attr-defined]
         except ValidationError as exc:
-            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{service}: {_arg_errors(exc)}") from None
+            raise ServiceError(ErrorCode.INVALID_ARGUMENT, f"{service}: {_arg_errors(exc, model)}") from None
         if key is not None:
             if len(self._arg_cache) >= ARG_CACHE_SIZE:
                 self._arg_cache.clear()               # bounded: a client varying its values only evicts
