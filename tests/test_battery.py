@@ -357,3 +357,21 @@ def test_an_empty_battery_holds_the_robots_joints_where_they_are() -> None:
     sim.set_solid_pose("dock", [0.0, 0.0, 0.0])
     sim.step()
     assert pan.position == pytest.approx(4 * 0.064, abs=1e-12)
+
+
+def test_the_batched_simulation_refuses_a_battery_that_can_empty_in_one_line() -> None:
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+
+    def batched(robot: dict, chargers: list[dict] = ()) -> BatchedSimulation:  # type: ignore[assignment]
+        return BatchedSimulation(parse_world({"world_info": {"basic_time_step": DT}, "robots": [robot],
+                                              "chargers": list(chargers), "solids": [DOCK]}), 2)
+
+    with pytest.raises(BatchedError) as err:
+        batched({"name": "r", "battery": [5.0, 10.0], "cpu_consumption": 2.0})
+    assert str(err.value).endswith("robot 'r': its battery (5 J, cpu_consumption 2 W) can empty and power it off; "
+                                   "the batched simulation drains no battery (use Simulation, or cpu_consumption: 0)")
+    with pytest.raises(BatchedError, match="can empty"):      # empty now, but a Charger could fill it
+        batched({"name": "r", "battery": [0.0, 10.0, 1.0], "cpu_consumption": 2.0}, [CHARGER])
+    # nothing a battery changes: none drawn, or an empty one nothing fills (Webots keeps such a robot on)
+    assert batched({"name": "r", "battery": [5.0, 10.0], "cpu_consumption": 0.0}, [CHARGER]).copies == 2
+    assert batched({"name": "r", "battery": [0.0], "cpu_consumption": 2.0}).copies == 2
