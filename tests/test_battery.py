@@ -254,3 +254,124 @@ def test_a_supervisor_reads_the_battery_field_with_its_present_energy() -> None:
     got = call("/boss/robot/get_field", {"node": node, "field": "battery"})
     assert got["type"] == "MFFloat" and got["value"] == pytest.approx([10.0 - 2.0 * 0.16, 20.0], abs=1e-12)
     assert call("/boss/robot/get_field", {"node": node, "field": "cpuConsumption"}) == {"type": "SFFloat", "value": 2.0}
+
+
+# an empty battery powers its robot off (WbRobot::powerOn(false)) until a Charger gives it energy
+DRAIN = 31.25            # W: 1.0 J a 32 ms step, exactly
+FACE = 0.95              # the wall's face (m) ahead of the robot's distance sensor
+
+
+def powered_world(e0: float) -> Simulation:
+    """A robot at the origin driving +x at 0.1 m/s (wheels 0.05 m at 2 rad/s) towards a wall, its
+    distance sensor reading the range (table 0..2 m), and a full Charger's solid far away."""
+    sim = world([{"name": "r", "battery": [e0, 100.0, 62.5], "cpu_consumption": DRAIN,
+                  "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.1},
+                  "devices": [{"device": "DistanceSensor", "name": "d", "lookup_table": [[0, 0, 0], [2, 2, 0]]},
+                              {"device": "PositionSensor", "name": "enc", "motor": "left wheel motor"}]}],
+                [{**CHARGER, "battery": [50.0, 50.0, 10.0], "radius": 0.2}],
+                [{"name": "dock", "pose": {"translation": [5.0, 3.0, 0.0]}},
+                 {"name": "wall", "pose": {"translation": [1.0, 0, 0]}, "geometry": {"type": "box", "size": [0.1, 4, 1]}}])
+    for m in sim.robots["r"].motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(2.0)
+    sim.device("r/d").enable(DT)
+    sim.device("r/enc").enable(DT)
+    return sim
+
+
+def test_an_empty_battery_stops_the_robot_at_v_e0_over_p_and_freezes_its_sensors_until_a_charger_refills_it() -> None:
+    e0, v = 5.0, 0.1
+    sim = powered_world(e0)
+    r, d, enc = sim.robots["r"], sim.device("r/d"), sim.device("r/enc")
+    for k in range(1, 5):
+        sim.step()
+        assert r.pose.translation[0] == pytest.approx(v * k * DT / 1000, abs=1e-12)
+        assert d.value == pytest.approx(FACE - v * k * DT / 1000, abs=1e-12)
+    sim.step()                        # the 5th step empties it: it moved, its sensors did not refresh (Webots)
+    stop = v * e0 / DRAIN             # 0.016 m
+    assert r.battery.energy == 0.0 and not r.battery.powered
+    assert r.pose.translation[0] == pytest.approx(stop, abs=1e-12)
+    assert d.value == pytest.approx(FACE - v * 4 * DT / 1000, abs=1e-12)
+    assert enc.value == pytest.approx(2.0 * 4 * DT / 1000, abs=1e-12)
+    for _ in range(20):               # off: no motion, the last values kept
+        sim.step()
+    assert r.pose.translation[0] == pytest.approx(stop, abs=1e-12)
+    assert d.value == pytest.approx(FACE - v * 4 * DT / 1000, abs=1e-12)
+    assert enc.value == pytest.approx(2.0 * 4 * DT / 1000, abs=1e-12) and d.schedule.last_update_ms == 4 * DT
+    sim.set_solid_pose("dock", [stop, 0.0, 0.0])       # the Charger comes: 62.5 W gives 2 J a step
+    sim.step()                        # energy at the step's start: on again, it drives and samples this step
+    assert r.battery.powered and r.battery.energy == pytest.approx(2.0 - 1.0, abs=1e-12)
+    assert r.pose.translation[0] == pytest.approx(stop + v * DT / 1000, abs=1e-12)
+    assert d.value == pytest.approx(FACE - stop - v * DT / 1000, abs=1e-12)
+    assert enc.value == pytest.approx(2.0 * 6 * DT / 1000, abs=1e-12)    # the wheel turned 5 + 1 steps
+    sim.reset()                       # simulationReset: as loaded, powered
+    assert r.battery.powered and r.battery.energy == e0
+
+
+def test_a_robot_loaded_with_an_empty_battery_is_powered_as_in_webots() -> None:
+    # Webots powers a robot off only when a step empties its battery; one loaded with 0 J runs
+    sim = powered_world(0.0)
+    sim.run(3)
+    assert sim.robots["r"].pose.translation[0] == pytest.approx(0.1 * 3 * DT / 1000, abs=1e-12)
+
+
+def test_an_empty_battery_turns_the_leds_and_their_lights_off_while_get_reads_the_set_value() -> None:
+    from test_led_lights import COLORS, FILTER, D, I, closed_form
+
+    sim = world([{"name": "eye", "devices": [{"device": "LightSensor", "name": "ls", "color_filter": list(FILTER)}]},
+                 {"name": "r", "battery": [2.0, 10.0, 62.5], "cpu_consumption": DRAIN,
+                  "pose": {"translation": [D, 0.0, 0.0]},
+                  "devices": [{"device": "LED", "name": "led", "color": [list(c) for c in COLORS],
+                               "lights": [{"type": "PointLight", "intensity": I, "attenuation": [0, 0, 1]}]}]}],
+                [{**CHARGER, "radius": 0.1}], [{"name": "dock", "pose": {"translation": [9.0, 0.0, 0.0]}}])
+    ls, led = sim.device("eye/ls"), sim.device("r/led")
+    ls.enable(DT)
+    led.set(2, sim.time_ms)
+    sim.step()
+    assert ls.value == pytest.approx(closed_form(COLORS[1]), rel=1e-12)
+    sim.step()                        # empty (2 J at 1 J a step): WbLed::powerOn(false) sets its value 0
+    assert ls.value == 0.0 and led.rgb() == (0.0, 0.0, 0.0)
+    assert led.value == 2             # what wb_led_get reads: libController's last set
+    sim.set_solid_pose("dock", [D, 0.0, 0.0])
+    sim.step()                        # powered again: Webots' LED stays off until the controller sets it
+    assert sim.robots["r"].battery.powered and ls.value == 0.0
+    led.set(2, sim.time_ms)
+    sim.step()
+    assert ls.value == pytest.approx(closed_form(COLORS[1]), rel=1e-12)
+
+
+def test_an_empty_battery_holds_the_robots_joints_where_they_are() -> None:
+    # a hinge at 2 rad/s (1e6 N m available: WbMotor's kinematic control reaches it in a step) turns
+    # 0.064 rad a step for the 3 steps the 3 J last, then holds; a Charger's energy starts it again
+    sim = world([{"name": "r", "battery": [3.0, 10.0, 62.5], "cpu_consumption": DRAIN,
+                  "devices": [{"device": "RotationalMotor", "name": "pan", "axis": [0, 0, 1], "max_velocity": 2.0,
+                               "max_torque": 1e6}]}],
+                [CHARGER], [{"name": "dock", "pose": {"translation": [9.0, 0.0, 0.0]}}])
+    pan = sim.robots["r"].motor("pan")
+    pan.set_position(math.inf)
+    pan.set_velocity(2.0)
+    sim.run(3)
+    assert pan.position == pytest.approx(3 * 0.064, abs=1e-12)
+    sim.run(10)
+    assert pan.position == pytest.approx(3 * 0.064, abs=1e-12) and pan.speed == 0.0
+    sim.set_solid_pose("dock", [0.0, 0.0, 0.0])
+    sim.step()
+    assert pan.position == pytest.approx(4 * 0.064, abs=1e-12)
+
+
+def test_the_batched_simulation_refuses_a_battery_that_can_empty_in_one_line() -> None:
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+
+    def batched(robot: dict, chargers: list[dict] = ()) -> BatchedSimulation:  # type: ignore[assignment]
+        return BatchedSimulation(parse_world({"world_info": {"basic_time_step": DT}, "robots": [robot],
+                                              "chargers": list(chargers), "solids": [DOCK]}), 2)
+
+    with pytest.raises(BatchedError) as err:
+        batched({"name": "r", "battery": [5.0, 10.0], "cpu_consumption": 2.0})
+    assert str(err.value).endswith("robot 'r': its battery (5 J, cpu_consumption 2 W) can empty and power it off; "
+                                   "the batched simulation drains no battery (use Simulation, or cpu_consumption: 0)")
+    with pytest.raises(BatchedError, match="can empty"):      # empty now, but a Charger could fill it
+        batched({"name": "r", "battery": [0.0, 10.0, 1.0], "cpu_consumption": 2.0}, [CHARGER])
+    # nothing a battery changes: none drawn, or an empty one nothing fills (Webots keeps such a robot on)
+    assert batched({"name": "r", "battery": [5.0, 10.0], "cpu_consumption": 0.0}, [CHARGER]).copies == 2
+    assert batched({"name": "r", "battery": [0.0], "cpu_consumption": 2.0}).copies == 2

@@ -462,6 +462,14 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: robot {free[0]!r} has a steered_drive with free wheels (no "
                                "motor); the batched simulation drives steered wheels that all have motors "
                                "(use Simulation)")
+        # batteries are not drained here: one that can empty (cpuConsumption > 0 and energy now, or a
+        # Charger to give it some) would power its robot off in Simulation, so it is refused
+        draining = [r for r in w.robots if r.battery and r.cpu_consumption > 0.0 and (r.battery[0] > 0.0 or w.chargers)]
+        if draining:
+            r = draining[0]
+            raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: its battery ({r.battery[0]:g} J, "
+                               f"cpu_consumption {r.cpu_consumption:g} W) can empty and power it off; the batched "
+                               "simulation drains no battery (use Simulation, or cpu_consumption: 0)")
         belts = [(r.name, b.motor) for r in w.robots for b in r.belts]
         if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "

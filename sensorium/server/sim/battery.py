@@ -5,8 +5,9 @@ a full Charger takes the first robot with a 3-value battery whose position comes
 while it holds one (within 1.1 radius) it gives min(robot's recharge speed x dt, its energy) a step,
 the robot's battery keeping at most its maximum (what is beyond is lost); an idle Charger gathers its
 own upload speed x dt up to its maximum; the robot leaving empties it. Then every battery with energy
-loses cpuConsumption x dt (WbRobot::postPhysicsStep), stopping at 0. Energies in J, powers in W, the
-step in integer ms."""
+loses cpuConsumption x dt (WbRobot::postPhysicsStep), stopping at 0. A battery emptying powers its
+robot off (WbRobot::powerOn(false)) until a Charger gives it energy (Battery.powered). Energies in J,
+powers in W, the step in integer ms."""
 
 from __future__ import annotations
 
@@ -30,6 +31,8 @@ class Battery:
     speed: float
     cpu: float
     initial: float
+    powered: bool = True    # Webots' mPowerOn: off only once a step empties the battery (a robot
+                            # loaded with 0 J is on), on again when a Charger gives it energy
 
     @classmethod
     def from_model(cls, robot: wm.Robot) -> Battery:
@@ -37,7 +40,14 @@ class Battery:
         return cls(float(b[0]), float(b[1]), float(b[2]), float(robot.cpu_consumption), float(b[0]))
 
     def reset(self) -> None:
-        self.energy = self.initial
+        self.energy, self.powered = self.initial, True
+
+    def power_back(self) -> bool:
+        """True when the robot was off and its battery holds energy again (a Charger's): it powers on."""
+        if self.powered or not self.energy > 0.0:
+            return False
+        self.powered = True
+        return True
 
     @property
     def present(self) -> bool:
@@ -53,7 +63,7 @@ class Battery:
             return False
         self.energy -= self.cpu * dt_ms * 0.001
         if self.energy <= 0.0:
-            self.energy = 0.0
+            self.energy, self.powered = 0.0, False
             return True
         return False
 

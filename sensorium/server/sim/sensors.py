@@ -630,11 +630,14 @@ class LED(Device):
     ``color`` list is empty, else an intensity 0..255 of its first colour (WbLed's monochrome LED). Its
     ``lights`` (if any) are on exactly while the value is not 0, in its colour (``light_color``), and
     light sensors and cameras see them then. Each ``set`` counts as a new measurement (its topic
-    publishes it)."""
+    publishes it). Its robot's battery emptying turns it off (``dark``, WbLed::powerOn(false) setting
+    Webots' own value to 0) while ``value``, what ``get`` reads, keeps the controller's last set, as
+    libController's; it stays off when power returns, until the next ``set``."""
 
     def __post_init__(self) -> None:
         super().__post_init__()
         self.value = 0
+        self.dark = False
         self._switch: Callable[[bool, tuple[float, float, float]], None] | None = None
 
     def bind(self, robot: Any) -> None:
@@ -652,15 +655,22 @@ class LED(Device):
                 f"0 (off) or a colour index 1..{len(c.color)}"
             raise ValueError(f"LED {self.name!r}: value {value} is not {what}")
         self.value = int(value)
+        self.dark = False
         self._mark(now_ms)
         if self._switch is not None:
             self._switch(self.value != 0, self.light_color())
+
+    def power_off(self) -> None:
+        """Its robot's battery emptied: off, lights too (``get`` still reads ``value``)."""
+        self.dark = True
+        if self._switch is not None:
+            self._switch(False, (0.0, 0.0, 0.0))
 
     def light_color(self) -> tuple[float, float, float]:
         """The colour its lights take: ``rgb`` as ``WbLed::setMaterialsAndLightsColor`` computes it, in
         single precision (its ``float r, g, b``: an RGB LED's byte / 255.0f; a monochrome one's
         intensity value / 255.0f times its colour; a colour of the list rounded to float)."""
-        v, c = self.value, self.config
+        v, c = (0 if self.dark else self.value), self.config
         if v != 0 and c.gradual:
             if not c.color:
                 return tuple(float(np.float32((v >> s) & 255) / np.float32(255.0))   # type: ignore[return-value]
@@ -671,7 +681,7 @@ class LED(Device):
 
     def rgb(self) -> tuple[float, float, float]:
         """The colour shown (0, 0, 0 when off)."""
-        v, c = self.value, self.config
+        v, c = (0 if self.dark else self.value), self.config
         if v == 0:
             return (0.0, 0.0, 0.0)
         if c.gradual and not c.color:

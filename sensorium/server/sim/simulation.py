@@ -398,6 +398,7 @@ class Simulation:
         self.chargers = [c for c in map(Charger.from_model, self.world.chargers) if c is not None]
         self._battery_sensing: list[RobotState] = []     # robots whose battery sensor is enabled
         self._jointed = [j for r in self.robots.values() for j in r.joints.values()]
+        self._joint_robot = [r.index for r in self.robots.values() for _ in r.joints.values()]
         self._linked = [r for r in self.robots.values() if r.links is not None]
         if self.ground is not None:
             self._warn_ground()
@@ -527,7 +528,7 @@ class Simulation:
             self.joints_moved(robot)
             self.place_robot(robot, pose)
             for dev in robot.devices.values():
-                if isinstance(dev, LED) and dev.value != 0:
+                if isinstance(dev, LED) and (dev.value != 0 or dev.dark):
                     dev.set(0, self.time_ms)
                 elif isinstance(dev, (GPS, Radar)):      # no previous position: the next speeds are NaN
                     dev.restart()
@@ -837,6 +838,9 @@ class Simulation:
             radio.forward()           # packets sent with the step requests leave before anything moves
         if self.chargers:             # at the positions the step starts from (Webots' prePhysicsStep)
             self._charge(dt)
+        # robots whose battery emptied: no motion, no new sample until a Charger gives energy (Webots'
+        # WbRobot::powerOn(false): motors without torque, sensors not refreshed)
+        off = {r.index for r in self._powered if not r.battery.powered} if self._powered else set()
         if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
@@ -846,8 +850,11 @@ class Simulation:
                          tuple[float, float], Pose]] = []
         if self._jointed:             # joints move kinematically (sim/joints.py), and what rides on them
             dt_s = dt * 0.001
-            for joint in self._jointed:
-                joint.advance(dt_s)
+            for joint, owner in zip(self._jointed, self._joint_robot):
+                if owner in off:      # no torque: it holds where it is (README 'Battery and Charger')
+                    joint.speed = joint.rate = 0.0
+                else:
+                    joint.advance(dt_s)
             moved_links = False
             for linked in self._linked:
                 moved_links = linked.move_links() or moved_links
@@ -858,6 +865,8 @@ class Simulation:
             drive = robot.drive
             assert drive is not None
             robot.pressing = False
+            if robot.index in off:    # its wheels' motors have no torque: the robot stays
+                continue
             start = (drive.x, drive.y)
             yaw0 = drive.yaw
             pose = drive.step(dt)
@@ -900,6 +909,11 @@ class Simulation:
         if radio is not None:
             radio.deliver(poses)      # range, cones, line of sight and readings at the end-of-step poses
         emptied = [robot for robot in self._powered if robot.battery.drain(dt)]   # Webots' postPhysicsStep
+        for robot in emptied:         # powered off: its LEDs go dark, its sensors keep their last values
+            off.add(robot.index)
+            for dev in robot.devices.values():
+                if isinstance(dev, LED):
+                    dev.power_off()
         for robot in self._battery_sensing:
             s = robot.battery_schedule
             # Webots refreshes the sensor when the battery empties: it reads 0 at once
@@ -919,10 +933,18 @@ class Simulation:
             self._capturing = sorted((d for d in every if getattr(d, "captures", False)),
                                      key=lambda d: d.kind == "Display")
         all_lights, all_distances, all_lidars, all_kinematic = self._by_kind
+        capturing, bumpers = self._capturing, self._bumpers
+        if off:                       # a powered-off robot's sensors are not refreshed (WbDevice::isPowerOn)
+            all_lights = [d for d in all_lights if d.robot_index not in off]
+            all_distances = [d for d in all_distances if d.robot_index not in off]
+            all_lidars = [d for d in all_lidars if d.robot_index not in off]
+            all_kinematic = [d for d in all_kinematic if d.robot_index not in off]
+            capturing = [d for d in capturing if d.robot_index not in off]
+            bumpers = [d for d in bumpers if d.robot_index not in off]
         for dev in self._tracking:    # devices that read the motion keep its last poses while enabled
             if dev.enabled:
                 dev.track()           # type: ignore[attr-defined]
-        for bumper in self._bumpers:  # a bumper remembers a touch until its next reading (WbTouchSensor)
+        for bumper in bumpers:        # a bumper remembers a touch until its next reading (WbTouchSensor)
             if bumper.armed and not bumper.touched and not bumper.schedule.due(now):
                 bumper.sample()
         # Schedule.due inlined (a step of 1,000 robots asks 8,000 sensors)
@@ -937,7 +959,7 @@ class Simulation:
                 enc.measure(now)      # type: ignore[attr-defined]
                 enc.schedule.last_update_ms = now
                 encoders += 1
-        for cam in self._capturing:   # cameras and range finders: their own casts (sim/cameras.py)
+        for cam in capturing:         # cameras and range finders: their own casts (sim/cameras.py)
             if cam.due(now):
                 cam.capture(now, self._counters)
                 encoders += 1
@@ -994,6 +1016,8 @@ class Simulation:
             own = self.scene.solid_poses.get(charger.solid)
             if own is not None:
                 charger.step(self._batteries, positions, np.asarray(own.translation, dtype=np.float64), dt)
+        for robot in self._powered:   # energy again: powered on (WbRobot::setCurrentEnergy)
+            robot.battery.power_back()
 
     def _distance_plan(self, distances: list[DistanceSensor]) -> DistancePlan:
         """The stacked constants of these sensors: built when the set of due sensors changes (a
