@@ -24,7 +24,11 @@ One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
   pair into the body's frame with the same float64 products the single world's engine uses for
   one mover (``(O - T) @ R`` in the engine's summation order, ``exact._to_frame``, for all pairs at once, so the bits are the engine's), and traces all
   pairs of one template tier in ONE call -- a hundred robots' pairs cost one Embree call, not a
-  hundred.
+  hundred. Coherent runs (every copy's lidar meeting a robot or a link) too: each copy's pairs with
+  one body are packed as the single world packs its lidar's pairs with that body (a coherent
+  packet's lane can change with its other lanes), by the C pass itself (``seg_end``: packets never
+  span two runs), in one call for the runs that start inside the tier's sphere and one for those
+  that start outside it (their rays then start at the sphere, per row, as the single world's do).
 
 A FAST cast whose data allows it takes a lean path (:meth:`CopyRays._lean_cast`): the planes (one
 axis-aligned plane, a floor), the static tier and the broad phase in ONE C call (``sp_copy_cast``)
@@ -356,7 +360,7 @@ class CopyRays:
         """The mover pass of :meth:`cast` over the broad phase's (ray, copy * R + slot) pairs: each
         pair into its body's frame, one trace per template tier, the nearest body hit per ray where
         it is nearer than the static one (``hits``). Coherent runs (``run`` > 0): each body's pairs
-        of one copy are a trace of their own (:meth:`_trace_bodies`)."""
+        of one copy are packed on their own (:meth:`_trace_bodies`)."""
         R = self.slots
         dist = hits.distance
         lim = np.minimum(far, dist)
