@@ -54,7 +54,8 @@ A link's shapes (``on_joint``) are template bodies of their own in the copies' c
 robot (``CopyRays``' link slots), each copy's placed at its robot's pose ∘ its joint's displacement
 there as Simulation's scene places a link's body, and numbered as that scene numbers them
 (:func:`~sensorium.server.sim.scene.robot_bodies`): every ray of a copy meets its own links, a ray blind to
-its robot (``exclude_owner``) its robot's links too; a robot's lights riding a joint are placed in each
+its robot (``exclude_owner``) its robot's links too (every copy's lidar beams meeting a link: one C
+pass for all copies, each copy's packed as its own lidar's); a robot's lights riding a joint are placed in each
 copy on its link (batched_lights.py). Refused (BatchedError, one line): a plane, textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
 runs (its footprint would not follow the joint), a device that sees its own robot riding a link with
