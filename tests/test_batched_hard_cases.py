@@ -656,3 +656,41 @@ def test_the_c_passes_under_address_and_undefined_behaviour_sanitizers_on_edge_i
     angle = math.acos(((0.0 + 0.0 + 1.0) - 1.0) / 2.0)        # a quarter turn: 2 (pi/2) / (2 sin(pi/2)) / dt
     same("gyro", [0.0, 0.0, 0.0, 0.0, 0.0, 2.0 * (angle / (2.0 * math.sin(angle))) / 60.0])
     same("gyro_tiny", [0.0, 0.0, 0.0, 0.0, 0.0, math.inf])
+
+
+@needs_c
+@pytest.mark.parametrize("threads", [1, 2])
+def test_coherent_runs_of_any_length_in_one_pass_are_each_runs_own_trace(threads):
+    """A lidar's beams that may meet a body come in runs of any length, one per copy (the copies'
+    pairs with their links, CopyRays._trace_runs): 200 such runs from origins around x = 1e5 m
+    (float32 ~8 mm apart), 1 to 360 beams each, traced in one pass with ``seg_end`` on one thread
+    or two: every beam's answer is its run's own one-origin trace's, bit for bit (packed without
+    the runs' ends, beams of two runs share packets and some answers change)."""
+    bs = BatchedSimulation(counterweighted(1), 1, precision="fast")
+    static = bs.rays.static
+    static.threads = threads
+    tier = static._static_tier(bs.rays.movers._variant(RayKind.VISUAL, False))
+    rng = np.random.default_rng(11)
+    k, W = 200, 360
+    rows = np.column_stack([1e5 + rng.uniform(-1.9, 1.9, k), rng.uniform(-1.9, 1.9, k), np.full(k, 0.15)])
+    a = np.pi - (np.arange(W) + 0.5) * (2 * np.pi / W)
+    dirs = np.column_stack([np.cos(a), np.sin(a), np.zeros(W)])
+    runs = [np.sort(rng.choice(W, int(rng.integers(1, W + 1)), replace=False)) for _ in range(k)]
+    O = np.concatenate([np.repeat(rows[j:j + 1], len(r), axis=0) for j, r in enumerate(runs)])
+    D = np.concatenate([dirs[r] for r in runs])
+    ends = np.cumsum([len(r) for r in runs])
+    seg_end = np.repeat(ends, [len(r) for r in runs]).astype(np.int64)
+    eps64 = 1e-9 + 1e-14 * float(np.abs(O).max())
+    lim = np.full(len(O), 6.0)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
+        every = static._trace(tier, O, D, 0.02, lim, -1, eps64, False, None, True, coherent=True,
+                              seg_end=seg_end)[0]
+        mixed = static._trace(tier, O, D, 0.02, lim, -1, eps64, False, None, True, coherent=True)[0]
+        for j, r in enumerate(runs):
+            got = every[ends[j] - len(r):ends[j]]
+            one = static._trace(tier, np.broadcast_to(rows[j], (len(r), 3)), dirs[r], 0.02, np.full(len(r), 6.0),
+                                -1, eps64, False, None, True)
+            one = np.full(len(r), np.inf) if one is None else one[0]
+            assert one.tobytes() == got.tobytes(), (j, np.flatnonzero(one != got))
+    assert np.isfinite(every).mean() > 0.9
+    assert (mixed != every).any()       # the runs' ends matter here: this test would see them ignored

@@ -9,7 +9,8 @@ to (their robot excluded: its links too) and its infra-red sensor, lidar and cam
 own random joint commands, reads bit for bit what Simulation built with that copy's seed reads.
 Closed form: the bar swung by a (2.6 deg < a < 9.5 deg) shows its side face to a sensor on its
 pivot's axis at 0.025 / sin(a) from the pivot; a light on the swing lights a sensor by 1/d² from
-where each copy's joint holds it. What the copies cannot follow is refused in one line."""
+where each copy's joint holds it. A camera recognises the arm with its links where each copy holds
+them. What the copies cannot follow is refused in one line."""
 
 from __future__ import annotations
 
@@ -270,9 +271,8 @@ def _changed(change, contact: bool = False, seen_by: str = "both"):
     return parse_world(w)
 
 
-def test_a_visual_only_link_runs_with_contact_and_recognition_is_refused():
-    """A link seen only by visual rays does not bound the robot: a world with contact runs it; a
-    camera's recognition (objects placed by their robots' poses, not their links') is refused."""
+def test_a_visual_only_link_runs_with_contact():
+    """A link seen only by visual rays does not bound the robot: a world with contact runs it."""
     batched = BatchedSimulation(_changed(lambda r: None, contact=True, seen_by="visual"), 2)
     assert batched.contact is not None
     ref = batched.device("watcher", "ir")          # (infra-red: visual rays, which see the bar)
@@ -282,6 +282,57 @@ def test_a_visual_only_link_runs_with_contact_and_recognition_is_refused():
     batched.run(60)
     got = batched.value(ref)
     assert got[0] < 600.0 and got[1] == 2000.0      # the hand 0.17 m ahead in copy 0; nothing in copy 1
+
+
+def _recognising(seed: int) -> object:
+    """The arm world with the arm recognisable and the watcher's camera recognising (segmentation on)."""
+    def change(w):
+        w["robots"][0]["recognition_colors"] = [[0.1, 0.7, 0.3]]
+        cam = next(d for d in w["robots"][1]["devices"] if d["name"] == "cam")
+        cam["recognition"] = {"segmentation": True, "max_range": 3.0}
+    w = {"world_info": {"basic_time_step": STEP, "contact": False, "random_seed": seed},
+         "robots": [arm_robot(), watcher_robot()]}
+    change(w)
+    return parse_world(w)
+
+
+def test_a_camera_recognises_a_robot_with_its_links_where_each_copy_holds_them():
+    """The watcher's camera recognises the arm (its box the union of its body, bar and hand where the
+    copy's joints hold them) and segments it: three copies with their own random swings, 120 steps,
+    every copy's objects and segmentation image those of its Simulation, bit for bit (copy 0's links
+    unmoved for 30 steps, carried by its robot's pose alone as the single scene carries them; the objects'
+    sizes change as the bar swings, and differ between copies)."""
+    seeds = (3, 4, 5)
+    n = len(seeds)
+    batched = BatchedSimulation(_recognising(seeds[0]), n)
+    batched.reset(np.arange(n), list(seeds))
     cam = batched.device("watcher", "cam")
-    with pytest.raises(BatchedError, match="recognises nothing in a world with shapes on a link"):
-        batched.recognition_enable(cam, STEP)
+    batched.enable(cam, STEP)
+    batched.recognition_enable(cam, STEP)
+    batched.enable_segmentation(cam, True)
+    singles = [Simulation(_recognising(s).world) for s in seeds]
+    for s in singles:
+        dev = s.device("watcher/cam")
+        dev.enable(STEP)
+        dev.recognition_enable(STEP)
+        dev.enable_segmentation(True)
+    arm = batched.slot("arm")
+    rng = np.random.default_rng(5)
+    sizes: set[tuple] = set()
+    for t in range(120):
+        if t % 30 == 0:
+            for c in range(0 if t else 1, n):     # (copy 0's links unmoved until step 30: carried by its robot)
+                for name, span in (("swing", 1.2), ("wrist", 1.2)):
+                    target = float(rng.uniform(-span, span))
+                    singles[c].robot("arm").motor(name).set_position(target)
+                    batched.joints.command(arm, name, position=target, copies=[c])
+        for s in singles:
+            s.step()
+        batched.step()
+        for c, s in enumerate(singles):
+            dev = s.device("watcher/cam")
+            got = batched.recognition_objects(cam, c)
+            assert got == dev.objects and repr(got) == repr(dev.objects), (t, c)
+            assert batched.segmentation_image(cam)[c].tobytes() == dev.segmentation_image.tobytes(), (t, c)
+            sizes.update(tuple(o.size) for o in got)
+    assert len(sizes) > 10          # the arm's box follows its links

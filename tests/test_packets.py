@@ -349,7 +349,7 @@ def test_a_large_fast_cast_is_split_over_threads_inside_the_c_pass(monkeypatch):
     real = lib.sp_fast_pass
 
     def spy(*args):
-        asked.append((args[2], args[-2]))      # (rays, threads; then run)
+        asked.append((args[2], args[-3]))      # (rays, threads; then run and seg_end)
         return real(*args)
 
     monkeypatch.setattr(lib, "sp_fast_pass", spy)

@@ -24,7 +24,11 @@ One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
   pair into the body's frame with the same float64 products the single world's engine uses for
   one mover (``(O - T) @ R`` in the engine's summation order, ``exact._to_frame``, for all pairs at once, so the bits are the engine's), and traces all
   pairs of one template tier in ONE call -- a hundred robots' pairs cost one Embree call, not a
-  hundred.
+  hundred. Coherent runs (every copy's lidar meeting a robot or a link) too: each copy's pairs with
+  one body are packed as the single world packs its lidar's pairs with that body (a coherent
+  packet's lane can change with its other lanes), by the C pass itself (``seg_end``: packets never
+  span two runs), in one call for the runs that start inside the tier's sphere and one for those
+  that start outside it (their rays then start at the sphere, per row, as the single world's do).
 
 A FAST cast whose data allows it takes a lean path (:meth:`CopyRays._lean_cast`): the planes (one
 axis-aligned plane, a floor), the static tier and the broad phase in ONE C call (``sp_copy_cast``)
@@ -52,7 +56,7 @@ import numpy as np
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.blocks import MIN_RAYS, in_block
 from sensorium.server.raycast.engine import RayEngine
-from sensorium.server.raycast.exact import _CHUNK, _INF, _PRUNE, _SMALL, _param, _take
+from sensorium.server.raycast.exact import _CHUNK, _INF, _PRUNE, _SMALL, _dot, _minus, _param, _take
 from sensorium.server.raycast.kinds import Precision, RayHits, RayKind
 from sensorium.server.raycast.planes import plane_terms
 from sensorium.server.raycast.trace import shell_spheres
@@ -93,6 +97,7 @@ class CopyRays:
         self._spheres: dict[str, tuple] = {}     # per variant: (tier per slot, anchor (R,3), r2 (R,), has body (R,))
         self.counters = {"casts": 0, "rays": 0, "mover_pairs": 0, "mover_traces": 0, "lean_casts": 0}
         self.lean = True     # FAST casts through sp_copy_cast where their data allows (False: the general path)
+        self.segmented = True   # coherent runs' mover pairs in one C pass per group (False: one trace per run)
         self._local = threading.local()   # per thread: the lean path's job struct and scratch buffers
         self._static_kept: dict[str, tuple] = {}   # per variant: the lean job's static fields (_static_fields)
         self._planes: dict[str, tuple | None] = {}   # per variant: the robots' planes (_robot_planes)
@@ -355,7 +360,7 @@ class CopyRays:
         """The mover pass of :meth:`cast` over the broad phase's (ray, copy * R + slot) pairs: each
         pair into its body's frame, one trace per template tier, the nearest body hit per ray where
         it is nearer than the static one (``hits``). Coherent runs (``run`` > 0): each body's pairs
-        of one copy are a trace of their own (:meth:`_trace_bodies`)."""
+        of one copy are packed on their own (:meth:`_trace_bodies`)."""
         R = self.slots
         dist = hits.distance
         lim = np.minimum(far, dist)
@@ -450,10 +455,15 @@ class CopyRays:
 
     def _trace_bodies(self, tier, ob, db, tn, lm, pm: np.ndarray, eps64: float, exact: bool, distance_only: bool):
         """:meth:`_trace_pairs` of coherent runs (a lidar's beams in every copy): each body's pairs
-        of one copy (``pm``: copy * R + slot, in blocks, rays in order) traced on their own, as the
+        of one copy (``pm``: copy * R + slot, in blocks, rays in order) packed on their own, as the
         single world traces one lidar's pairs with one body (a coherent packet's traversal can
-        change a lane's answer with the packet's other rays: packets never mix two copies' beams)."""
+        change a lane's answer with the packet's other rays: packets never mix two copies' beams).
+        With the packet helper all copies' runs go in one call per group (:meth:`_trace_runs`), else
+        one trace per run."""
         cuts = (np.flatnonzero(pm[1:] != pm[:-1]) + 1).tolist()
+        if self.segmented and self.movers.native and tier.native(False) is not None:
+            return self._trace_runs(tier, ob, db, tn, lm, np.array([0, *cuts], dtype=np.int64),
+                                    np.array([*cuts, len(ob)], dtype=np.int64), eps64, distance_only)
         t = np.full(len(ob), _INF)
         s = None if distance_only else np.full(len(ob), -1, dtype=np.int64)
         nrm = None if distance_only else np.zeros((len(ob), 3))
@@ -469,6 +479,63 @@ class CopyRays:
             t[rows] = res[0]
             if not distance_only:
                 s[rows], nrm[rows] = res[1], res[2]
+        return (None, (t, s, nrm)) if hit else None
+
+    def _trace_runs(self, tier, ob, db, tn, lm, a: np.ndarray, b: np.ndarray, eps64: float, distance_only: bool):
+        """The runs ``[a[k], b[k])`` of :meth:`_trace_bodies` (FAST, each run's rows one origin in the
+        body frame), each answered as its own trace answers it, in one C pass per group: each run of
+        :data:`_PRUNE` pairs or more first pruned by the tier's bound (a per-row test, as its own
+        trace prunes it), then the runs whose origin lies outside the tier's sphere (their own
+        traces start each ray at the sphere, per row) apart from those inside (their traces keep one
+        start): a group's pass packs each run on its own (``seg_end``) and starts every ray as its
+        run's trace does, so every row gets that trace's bits."""
+        m = len(ob)
+        size = b - a
+        keep = np.ones(m, dtype=bool)
+        big = (size >= _PRUNE).nonzero()[0]
+        if len(big):
+            rows = np.concatenate([np.arange(a[k], b[k]) for k in big.tolist()])
+            keep[rows] = tier.may_hit(ob[rows], db[rows], _take(tn, rows) if isinstance(tn, np.ndarray) else tn,
+                                      lm[rows])
+        run = np.repeat(np.arange(len(a)), size)
+        # each row's origin outside the tier's sphere, as _trace_fast tests each row; a run is in
+        # one group when all its rows are (a run of two origins, partly outside: a trace of its own)
+        o32 = (_minus(ob, tier.anchor) if tier.anchored else ob).astype(np.float32)
+        far = _dot(o32, o32) > np.float32(tier.radius * tier.radius)
+        n_far = np.bincount(run, weights=far, minlength=len(a))
+        t = np.full(m, _INF)
+        s = None if distance_only else np.full(m, -1, dtype=np.int64)
+        nrm = None if distance_only else np.zeros((m, 3))
+        hit = False
+        for k in ((n_far > 0) & (n_far < size)).nonzero()[0].tolist():
+            got = self._trace_pairs(tier, ob[a[k]:b[k]], db[a[k]:b[k]], tn[a[k]:b[k]] if isinstance(tn, np.ndarray)
+                                    else tn, lm[a[k]:b[k]], eps64, False, distance_only, True)
+            if got is not None:
+                hit = True
+                rows = np.arange(a[k], b[k]) if got[0] is None else a[k] + got[0]
+                t[rows] = got[1][0]
+                if not distance_only:
+                    s[rows], nrm[rows] = got[1][1], got[1][2]
+        for group in (n_far == 0, n_far == size):
+            sel = (keep & group[run]).nonzero()[0]
+            if not len(sel):
+                continue
+            r = run[sel]
+            ends = np.ones(len(sel), dtype=bool)      # a row ends its run's kept rows
+            ends[:-1] = r[1:] != r[:-1]
+            last = ends.nonzero()[0] + 1
+            seg_end = np.repeat(last, np.diff(np.concatenate([[0], last]))).astype(np.int64)
+            self.counters["mover_traces"] += 1
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
+                res = self.movers._trace(tier, ob[sel], db[sel], _take(tn, sel) if isinstance(tn, np.ndarray) else tn,
+                                         lm[sel], -1, eps64, False, None, distance_only, coherent=True,
+                                         seg_end=seg_end)
+            if res is None:
+                continue
+            hit = True
+            t[sel] = res[0]
+            if not distance_only:
+                s[sel], nrm[sel] = res[1], res[2]
         return (None, (t, s, nrm)) if hit else None
 
     def _lean_cast(self, O: np.ndarray, D: np.ndarray, n: int, t_near, t_far, kind: RayKind, copy, rot, pos,

@@ -655,7 +655,7 @@ struct fast_job {
   int far_none; const double* Ot; size_t ot_stride; const double* origin; const double* D;
   const double* start; double start_value; const double* lim; double lim_value; int lim_min;
   const int64_t* excl; int64_t excl_value; int has_excl; int distance_only; double* t_out;
-  int64_t* s_out; double* n_out; uint8_t* special; size_t run;
+  int64_t* s_out; double* n_out; uint8_t* special; size_t run; const int64_t* seg_end;
 };
 
 /* A part of a FAST pass: the rays [a0, a1) (a0 a multiple of 16, or of the run: every packet holds
@@ -676,6 +676,7 @@ static void* fast_range(void* arg) {
   const int distance_only = J->distance_only; double* t_out = J->t_out; int64_t* s_out = J->s_out;
   double* n_out = J->n_out; uint8_t* special = J->special;
   const size_t run = coherent ? J->run : 0;
+  const int64_t* seg_end = coherent ? J->seg_end : NULL;
   const size_t m = P->a1;
   struct ray_hit16 r;
   struct intersect_args args;
@@ -691,6 +692,7 @@ static void* fast_range(void* arg) {
        packet's other rays (seen far from the origin, where float32 is coarse) */
     next = a + 16 < m ? a + 16 : m;
     if (run > 0 && (a / run + 1) * run < next) next = (a / run + 1) * run;
+    if (seg_end && (size_t)seg_end[a] < next) next = (size_t)seg_end[a];
     int mk = (int)(next - a);
     for (int k = 0; k < 16; k++) {
       size_t i = a + (k < mk ? (size_t)k : 0);
@@ -813,16 +815,19 @@ int sp_probe_worker_cpus(void) {
  * `threads` > 1 and enough rays, the rays are split in `threads` parts traced side by side (POSIX
  * threads; the caller takes the first part): every ray's answer is the one a single pass gives.
  * `run` > 0 with `coherent`: the rays come in runs of `run` from one origin each (a batched world's
- * lidars), each packed from its own first ray, as its one-origin cast packs it. */
+ * lidars), each packed from its own first ray, as its one-origin cast packs it. `seg_end` (NULL:
+ * none) with `coherent`: runs of any length, seg_end[i] the end of ray i's run (every copy's pairs
+ * with one body, as copies.py traces them): packed and split between threads the same way. */
 size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent, const float* o32, size_t o_stride,
                     const float* o1, int shifted, float start32, const float* d32, const float* far, float far_value,
                     int far_none, const double* Ot, size_t ot_stride, const double* origin, const double* D,
                     const double* start, double start_value, const double* lim, double lim_value, int lim_min,
                     const int64_t* excl, int64_t excl_value, int has_excl, int distance_only, double* t_out,
-                    int64_t* s_out, double* n_out, uint8_t* special, int threads, size_t run) {
+                    int64_t* s_out, double* n_out, uint8_t* special, int threads, size_t run,
+                    const int64_t* seg_end) {
   struct fast_job J = {scene, T, m, coherent, o32, o_stride, o1, shifted, start32, d32, far, far_value, far_none, Ot,
                        ot_stride, origin, D, start, start_value, lim, lim_value, lim_min, excl, excl_value, has_excl,
-                       distance_only, t_out, s_out, n_out, special, run};
+                       distance_only, t_out, s_out, n_out, special, run, seg_end};
   enum { MAX_THREADS = 64, MIN_PART = 4096 };
   if (threads > MAX_THREADS) threads = MAX_THREADS;
   if (threads > 1 && m / (size_t)threads < MIN_PART) threads = (int)(m / MIN_PART);
@@ -838,6 +843,13 @@ size_t sp_fast_pass(void* scene, const struct sp_tier* T, size_t m, int coherent
     parts[k].a1 = k + 1 == threads ? m : unit * (packs * (size_t)(k + 1) / (size_t)threads);
     parts[k].n_hit = 0;
   }
+  if (coherent && seg_end)   /* a part starts where a run starts: at the end of the run it would cut */
+    for (int k = 1; k < threads; k++) {
+      size_t b = parts[k].a0;
+      if (b > 0 && b < m && (size_t)seg_end[b - 1] > b) b = (size_t)seg_end[b - 1];
+      if (b < parts[k - 1].a0) b = parts[k - 1].a0;
+      parts[k - 1].a1 = parts[k].a0 = b;
+    }
   for (int k = 1; k < threads; k++)   /* a thread that cannot start: its part is traced here below */
     started[k] = pthread_create(&tid[k], NULL, fast_thread, &parts[k]) == 0;
   fast_range(&parts[0]);
@@ -1027,7 +1039,7 @@ int64_t sp_copy_cast(struct sp_copy_job* J) {
   J->n_hit = (int64_t)sp_fast_pass(J->scene, T, n, (int)J->coherent, NULL, 0, NULL, shifted, shifted ? (float)J->near : 0.0f,
                                    d32, far32, far_value32, far_none, J->O, 3, J->O, J->D, NULL, J->near, lim,
                                    lim ? 0.0 : lim_value, lim_min, NULL, 0, 0, (int)J->distance_only, tt, ss, nn,
-                                   J->special, (int)J->threads, (size_t)J->run);
+                                   J->special, (int)J->threads, (size_t)J->run, NULL);
   int64_t sp = 0;
   for (size_t i = 0; i < n; i++) sp += J->special[i];
   J->n_special = sp;

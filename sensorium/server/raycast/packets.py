@@ -169,7 +169,7 @@ def _load() -> None:
     lib.sp_fast_pass.restype = sz
     f, i64 = ctypes.c_float, ctypes.c_int64
     lib.sp_fast_pass.argtypes = [vp, vp, sz, i, vp, sz, vp, i, f, vp, vp, f, i, vp, sz, vp, vp, vp, d, vp, d, i, vp, i64,
-                                 i, i, vp, vp, vp, vp, i, sz]
+                                 i, i, vp, vp, vp, vp, i, sz, vp]
     lib.sp_set_worker_cpus.restype = i
     lib.sp_set_worker_cpus.argtypes = [sz, vp]
     lib.sp_probe_worker_cpus.restype = i

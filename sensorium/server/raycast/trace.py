@@ -96,7 +96,8 @@ class TierTracer(Refiner):
         return scene.run(o32, d32, far, output=1)
 
     def _trace(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, exact: bool, big: float | None = None,
-               distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None, run: int = 0):
+               distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None, run: int = 0,
+               seg_end=None):
         """Nearest accepted hit in one tier.  O, D in the tier's parent frame; returns (t, shape,
         normal oriented toward the origin) with normal in the parent frame's orientation, or None
         when no ray hits.  ``big``: max |coordinate| of O when already known (saves two reductions
@@ -108,7 +109,9 @@ class TierTracer(Refiner):
         curved-shell pre-pass takes the (min, max) per column of O from it when given (the values
         it would find; an unanchored tier); ``rows``: O's distinct rows (every ray's origin is one
         of them), whose distance to the curved shells can rule the pre-pass out. ``run`` > 0 with
-        ``coherent``: the runs' length (each run's packets are its own one-origin cast's)."""
+        ``coherent``: the runs' length (each run's packets are its own one-origin cast's); ``seg_end``
+        ((m,) int64, with ``coherent``): runs of any length, each ray's run ending before
+        ``seg_end[i]`` (the C pass only: packets never span two runs)."""
         if exact:
             res = self._trace_loop(tier, O, D, t_near, lim, excl, eps64, exact=True, distance_only=distance_only,
                                    d32_all=d32)
@@ -116,11 +119,11 @@ class TierTracer(Refiner):
                 return None
             return (res[0], None, None) if distance_only else res
         return self._trace_fast(tier, O, D, t_near, lim, excl, eps64, big, distance_only, d32, coherent, box, rows,
-                                run)
+                                run, seg_end)
 
     def _trace_fast(self, tier: _Tier, O, D, t_near, lim, excl, eps64: float, big: float | None = None,
                     distance_only: bool = False, d32=None, coherent: bool = False, box=None, rows=None,
-                    run: int = 0):
+                    run: int = 0, seg_end=None):
         """FAST: one Embree call and vectorised gathers; the rare rays needing judgement (possible
         self-hits, shells left from inside, excluded owners) are redone by the general loop.
         Mostly-missing batches (short sensor rays) work on the hit rows only, mostly-hitting ones
@@ -213,7 +216,8 @@ class TierTracer(Refiner):
                 far = float(far)
         if native:   # traversal and judging in one C call (the same values)
             n_hit, t, shape, normal, redo = self._fast_native(tier, Ot, D, o32, o1, shifted, d32, far, one or coherent,
-                                                              start, lim, excl, distance_only, 0 if one else run)
+                                                              start, lim, excl, distance_only, 0 if one else run,
+                                                              None if one else seg_end)
             if n_hit == 0 and pre is None:
                 return None
         else:
@@ -275,7 +279,7 @@ class TierTracer(Refiner):
         return t, shape, normal
 
     def _fast_native(self, tier: _Tier, Ot, D, o32, o1, shifted: bool, d32, far, coherent: bool, start, lim, excl,
-                     distance_only: bool, run: int = 0):
+                     distance_only: bool, run: int = 0, seg_end=None):
         """FAST's Embree call and judging (``_judge_fast``, ``_special``) in one call of packets.c:
         (hits, t, shape, normal, redo mask or None), the values of the numpy path. ``o32`` None: one
         origin ``o1``, shifted by ``start`` along each ray when ``shifted``; ``o32`` and ``o1`` None:
@@ -336,7 +340,8 @@ class TierTracer(Refiner):
             0.0 if lim_arr is not None else lim, 1 if isinstance(lim, np.ndarray) or lim != _INF else 0,
             None if ex_arr is None else ex_arr.ctypes.data, 0 if ex_arr is not None or not has_excl else excl,
             1 if has_excl else 0, 1 if distance_only else 0, p_t, p_s, p_n, p_sp,
-            self.threads if m >= MIN_RAYS and not in_block() else 1, max(0, int(run)))
+            self.threads if m >= MIN_RAYS and not in_block() else 1, max(0, int(run)),
+            None if seg_end is None else seg_end.ctypes.data)
         if small:
             t = sc.t[:m].copy()
             shape = None if distance_only else sc.s[:m].copy()

@@ -54,12 +54,13 @@ A link's shapes (``on_joint``) are template bodies of their own in the copies' c
 robot (``CopyRays``' link slots), each copy's placed at its robot's pose ∘ its joint's displacement
 there as Simulation's scene places a link's body, and numbered as that scene numbers them
 (:func:`~sensorium.server.sim.scene.robot_bodies`): every ray of a copy meets its own links, a ray blind to
-its robot (``exclude_owner``) its robot's links too; a robot's lights riding a joint are placed in each
+its robot (``exclude_owner``) its robot's links too (every copy's lidar beams meeting a link: one C
+pass for all copies, each copy's packed as its own lidar's); a robot's lights riding a joint are placed in each
 copy on its link (batched_lights.py). Refused (BatchedError, one line): a plane, textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
 runs (its footprint would not follow the joint), a device that sees its own robot riding a link with
-shapes (lidars, cameras, range finders, infra-red sensors; distance and light sensors with self-collision), a camera's
-recognition in a world with link shapes; other devices on a joint, steered drives with free
+shapes (lidars, cameras, range finders, infra-red sensors; distance and light sensors with self-collision);
+other devices on a joint, steered drives with free
 wheels and belts.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
@@ -722,9 +723,6 @@ class BatchedSimulation:
     def recognition_enable(self, ref: DeviceRef, period_ms: int, copies=None) -> None:
         """A camera's ``recognition_enable(period)`` in the named copies (default: all), counted from
         each copy's clock (0 disables it, and the segmentation with it)."""
-        if self.link_slots and period_ms:     # (its objects are placed by their robots' poses, not their links')
-            raise BatchedError(f"{self.robot_names[ref.slot]}/{ref.name}: the batched simulation recognises "
-                               "nothing in a world with shapes on a link (use Simulation)")
         self.recognition.enable(self._camera_column(ref), period_ms, slice(None) if copies is None
                                 else np.asarray(copies, dtype=np.int64))
 

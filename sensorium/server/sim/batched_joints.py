@@ -119,6 +119,9 @@ class BatchedJoints:
         self.link_rot = np.broadcast_to(np.eye(3), (C, J, 3, 3)).copy()
         self.link_pos = np.zeros((C, J, 3))
         self._at = np.broadcast_to(self.initial, (C, J)).copy()     # the positions the links were made at
+        # a link displaced since the copy's reset (Links.poses holds it then, and the scene composes its
+        # robot's pose with it; before, it is where the robot is: recognition's carrier)
+        self.placed = np.zeros((C, J), dtype=bool)
         # devices riding joints: (kind, column) -> (slot, joint, mount pose), their local poses per copy
         self.riders: dict[tuple[str, int], tuple[int, str, Pose]] = {}
         self._rider_of: dict[int, dict[tuple[str, int], Pose]] = {}    # joint column -> its riders' mounts
@@ -161,6 +164,7 @@ class BatchedJoints:
         self.link_rot[idx] = np.eye(3)
         self.link_pos[idx] = 0.0
         self._at[idx] = self.initial
+        self.placed[idx] = False
         for key, local in self._loaded.items():
             self.local_rot[key][idx] = local.rotation
             self.local_pos[key][idx] = local.translation
@@ -286,6 +290,7 @@ class BatchedJoints:
                 rot, pos = np.matmul(prot, rot), np.matmul(prot, pos[:, :, None])[:, :, 0] + self.link_pos[c, parent]
             self.link_rot[c, j] = rot
             self.link_pos[c, j] = pos
+            self.placed[c, j] = True
             for key, mount in self._rider_of.get(j, {}).items():
                 self.local_rot[key][c] = np.matmul(self.link_rot[c, j], mount.rotation)
                 self.local_pos[key][c] = np.matmul(self.link_rot[c, j], mount.translation) + self.link_pos[c, j]

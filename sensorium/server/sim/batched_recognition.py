@@ -9,7 +9,9 @@ every due copy are one cast of their own, as the batched camera's image rays are
 the same stacked ``Pose.compose``, its robot's body met apart for a housed camera), meeting only that
 copy's robots. The objects are the single Recognizer's, run per copy on :class:`_CopyScene`: the
 world's shapes numbered as the single scene numbers them (solids, then the robots'), the Supervisor's
-node ids (robots 1..R, then the top-level solids), each robot's pose in that copy. The occlusion rays
+node ids (robots 1..R, then the top-level solids), each robot's pose in that copy, a shape riding a
+joint carried by its robot's pose ∘ that copy's link displacement (once the joint has moved since the
+copy's reset: the single scene's ``carrier``). The occlusion rays
 (occlusion 1: one per candidate object, to its origin) of every due copy of a camera are one cast,
 each ray meeting only its copy's world, its camera's robot excluded, as the single camera casts it
 alone.
@@ -27,7 +29,7 @@ from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.batched_camera import own_body_hits
 from sensorium.server.sim.batched_depth import PixelDevices
 from sensorium.server.sim.recognition import RecognisedObject, Recognizer, occlusion_ray
-from sensorium.server.sim.scene import recognisable_owners, scene_robot_parts
+from sensorium.server.sim.scene import recognisable_owners, robot_bodies, scene_robot_parts
 from sensorium.server.sim.sensors import _check_period
 from sensorium.server.world.geometry import Pose
 
@@ -49,12 +51,30 @@ class _CopyScene:
         self._parts += [(r, local, shape) for r, robot in enumerate(world.robots) for _, local, shape in scene_robot_parts(robot)]
         self.shapes = self._parts                     # (a Recognizer counts them)
         self.recognisable = recognisable_owners(world)     # the single scene's Supervisor node ids
+        # the shapes riding a joint (the scene's numbering): shape -> that joint's column
+        self._link: dict[int, int] = {}
+        k = sim.n_static_shapes
+        for r, robot in enumerate(world.robots):
+            for joint, group in robot_bodies(robot):
+                if joint is not None:
+                    self._link.update((k + q, sim.joints.of(r, joint)) for q in range(len(group)))
+                k += len(group)
 
     def part(self, shape: int) -> tuple:
         return self._parts[shape]
 
     def on_link(self, shape: int) -> bool:
-        return False                                  # (recognition is refused in a world with link shapes: batched.py)
+        return shape in self._link
+
+    def carrier(self, shape: int) -> Pose:
+        """Scene.carrier in this copy: its robot's pose, composed with its link's displacement
+        once its joint has moved since the copy's reset (as the single scene holds one then)."""
+        owner = self.sim.pose(self.copy, self._parts[shape][0])
+        j = self._link[shape]
+        joints = self.sim.joints
+        if not joints.placed[self.copy, j]:
+            return owner
+        return owner.compose(Pose._owned(joints.link_rot[self.copy, j].copy(), joints.link_pos[self.copy, j].copy()))
 
     def owner_pose(self, key: str | int) -> Pose:
         if isinstance(key, str):
