@@ -80,6 +80,28 @@ def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
     return (1.0, 1.0, 1.0) if a is None else tuple(float(v) for v in a.base_color)  # type: ignore[return-value]
 
 
+def emissive_of(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
+    """The radiance a shape's surface sends whatever the lights: its emissive colour times its
+    intensity (Webots' Phong and PBR shaders add it to the lit colour)."""
+    a = shape.appearance
+    if a is None:
+        return (0.0, 0.0, 0.0)
+    return tuple(float(v) * a.emissive_intensity for v in a.emissive_color)  # type: ignore[return-value]
+
+
+def emissive_rows(emissive: np.ndarray | None, shape: np.ndarray) -> np.ndarray | None:
+    """The emissive radiance (n, 3) of the hit shapes, or None in a world where nothing glows
+    (``emissive`` None: nothing is added or computed)."""
+    return None if emissive is None else np.take(emissive, shape, axis=0)
+
+
+def emissive_array(colors: list[tuple[float, float, float]]) -> np.ndarray | None:
+    """Per shape (and a trailing 0 for no hit) the emissive radiance, or None when none glows."""
+    if not any(any(c) for c in colors):
+        return None
+    return np.array(list(colors) + [(0.0, 0.0, 0.0)], dtype=np.float64).reshape(-1, 3)
+
+
 def _maps(a: wm.Appearance) -> tuple:
     """What of an appearance the texture sampler reads."""
     return a.texture, a.roughness_map, a.occlusion_map, a.texture_transform
@@ -556,6 +578,7 @@ class Scene:
         # cameras read these (sim/cameras.py): base colour (white without appearance) and transparency
         self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
         self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
+        self.emissive = emissive_array([emissive_of(shape) for _, _, shape in self._parts])
 
     def set_appearance(self, shape: int, appearance: wm.Appearance) -> None:
         """A Supervisor's new colour, roughness or transparency for one shape (Webots' Material and
@@ -631,6 +654,13 @@ class Scene:
         self.shapes[shape] = info
         self.red[shape], self.roughness[shape], self.transparency[shape] = info.red, info.roughness, info.transparency
         self.colors[shape] = _base_color(model)
+        glow = emissive_of(model)
+        if self.emissive is not None:
+            self.emissive[shape] = glow
+            if not self.emissive.any():
+                self.emissive = None
+        elif any(glow):
+            self.emissive = emissive_array([emissive_of(m) for _, _, m in self._parts])
 
     def shape_model(self, shape: int) -> wm.Shape | wm.Solid:
         """A shape's model now (its appearance as a Supervisor last set it)."""
@@ -781,6 +811,7 @@ class Scene:
             self.roughness = np.append(self.roughness[:n], self.roughness[-1])
             self.colors = np.concatenate([self.colors[:n], self.colors[-1:]])
             self.transparency = np.append(self.transparency[:n], self.transparency[-1])
+            self.emissive = emissive_array([emissive_of(m) for _, _, m in self._parts])
             self.shapes_version += 1
 
     def solid_entries(self, solid: wm.Solid) -> tuple[list, list[ShapeEntry]]:
