@@ -483,9 +483,11 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
                                "transparency": f.within("transparency", 0.0, 0.0, 1.0, 0.0),
                                "roughness": f.within("roughness", 0.0, 0.0, 1.0, 0.0)}
         emissive = f.color("emissiveColor", (0.0, 0.0, 0.0))
-        if any(emissive):          # (the model's default otherwise: a world without glow dumps as before)
+        intensity = f.non_negative("emissiveIntensity", 1.0, 1.0)
+        if any(emissive):          # (the model's defaults otherwise: a world without glow dumps as before)
             out["emissive_color"] = list(emissive)
-            out["emissive_intensity"] = f.non_negative("emissiveIntensity", 1.0, 1.0)
+        if intensity != 1.0:       # (kept for a colour a Supervisor sets)
+            out["emissive_intensity"] = intensity
         base = image_texture(f.node_("baseColorMap"), source, warn, resolve)
         if base is not None:
             out["texture"] = base
