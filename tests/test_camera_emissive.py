@@ -123,3 +123,81 @@ def test_every_copy_draws_emissive_colours_as_the_single_simulation(precision: s
     for c in range(len(x)):
         L = np.asarray(DIFFUSE) * (0.3 + 0.6) + 1.2 * np.asarray(GLOW)
         np.testing.assert_array_equal(centre[c], byte(L), err_msg=str(c))
+
+
+# ---------------------------------------------------------------------------------- a Charger's glow
+
+def _charger_world(gradual: bool, initial=(0.0, 0.0, 0.2)) -> wm.World:
+    """A camera in the dark facing a Charger's box (its own emissive colour ``initial``): the Charger
+    starts empty and gathers 10 W up to 1 J, full after 100 ms; a second shape of its solid does not
+    glow (glow_shapes 1)."""
+    dock = {"name": "dock", "pose": {"translation": [2.0, 0.0, 0.0]},
+            "shapes": [{"geometry": {"type": "box", "size": [0.1, 20, 20]},
+                        "appearance": {"base_color": [0.5, 0.5, 0.5], "emissive_color": list(initial)}},
+                       {"pose": {"translation": [0.0, 0.0, 30.0]}, "geometry": {"type": "box", "size": [0.1, 1, 1]},
+                        "appearance": {"emissive_color": [0.1, 0.1, 0.1]}}]}
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16}, "solids": [dock],
+        "chargers": [{"solid": "dock", "battery": [0.0, 1.0, 10.0], "emissive_color": [1.0, 0.5, 0.0],
+                      "gradual": gradual}],
+        "robots": [{"name": "r", "devices": [{"device": "Camera", "name": "cam", **CAM}]}]})
+
+
+@pytest.mark.parametrize("gradual", [True, False])
+def test_a_chargers_first_shape_glows_with_its_energy(gradual: bool):
+    """Webots' WbCharger: full, the emissiveColor; else, gradual, initial + (emissiveColor − initial)·E/Emax;
+    not gradual, the shape's own colour. The image after each step reads the energy of that step."""
+    sim = Simulation(_charger_world(gradual))
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    initial, full = np.array([0.0, 0.0, 0.2]), np.array([1.0, 0.5, 0.0])
+    seen = set()
+    for step in range(1, 10):
+        sim.run(1)
+        energy = min(10.0 * 0.016 * step, 1.0)
+        assert sim.chargers[0].energy == pytest.approx(energy, abs=1e-12)
+        e = full if energy >= 1.0 else (initial + (full - initial) * energy if gradual else initial)
+        got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+        np.testing.assert_array_equal(got, np.broadcast_to(byte(e), got.shape), err_msg=str(step))
+        seen.add(got.tobytes())
+    assert len(seen) == (7 if gradual else 2)          # 0.16 J a step: full from the 7th
+    assert sim.scene.emissive[1].tolist() == [0.1, 0.1, 0.1]       # the second shape keeps its own
+    sim.reset()                                      # the loaded energy (0 J): the initial colour again
+    sim.run(1)
+    e = initial + (full - initial) * 0.16 if gradual else initial
+    np.testing.assert_array_equal(cam.image[2, 4, 2::-1].astype(np.int64), byte(e))
+
+
+CHARGER_WBT = """#VRML_SIM R2023b utf8
+WorldInfo {{ basicTimeStep 16 }}
+Charger {{
+  translation 2 0 0
+  children [
+    Pose {{ children [ Shape {{ appearance PBRAppearance {{ baseColor 0.5 0.5 0.5 emissiveColor 0 0 0.2 }}
+                               geometry Box {{ size 0.1 20 20 }} }} ] }}
+    Shape {{ appearance Appearance {{ material Material {{ emissiveColor 0.1 0.1 0.1 }} }} geometry Box {{ size 0.1 1 1 }} }}
+  ]
+  name "dock"
+  battery [ 0, 1, 10 ]
+  emissiveColor 1 0.5 0
+  gradual {gradual}
+}}
+Robot {{ children [ Camera {{ name "cam" width 9 height 7 fieldOfView 1 }} ] controller "<none>" }}
+"""
+
+
+@pytest.mark.parametrize("gradual", ["TRUE", "FALSE"])
+def test_a_wbt_chargers_first_child_glows(tmp_path: Path, gradual: str):
+    path = tmp_path / "dock.wbt"
+    path.write_text(CHARGER_WBT.format(gradual=gradual))
+    lw = load_world(path)
+    charger = lw.world.chargers[0]
+    assert (charger.glow_shapes, charger.gradual, charger.emissive_color) == (1, gradual == "TRUE", (1.0, 0.5, 0.0))
+    sim = Simulation(lw)
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    sim.run(3)
+    e = np.array([0.0, 0.0, 0.2]) + (np.array([1.0, 0.5, 0.0]) - [0.0, 0.0, 0.2]) * 0.48 if gradual == "TRUE" \
+        else np.array([0.0, 0.0, 0.2])
+    np.testing.assert_array_equal(cam.image[3, 4, 2::-1].astype(np.int64), byte(e))
+    assert sim.scene.emissive[1].tolist() == [0.1, 0.1, 0.1]

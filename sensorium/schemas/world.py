@@ -2085,6 +2085,14 @@ class Charger(Strict):
         "fewer than three values: the Charger does nothing, as in Webots")
     radius: float = Field(default=0.04, ge=0.0, allow_inf_nan=False,
                           description="the distance (m) between its position and a robot's that starts a charge")
+    emissive_color: Vec3 = Field(default=(0.0, 1.0, 0.0), description="the emissive colour its glowing shapes "
+                                 "take when it is full (Webots' Charger.emissiveColor)")
+    gradual: bool = Field(default=True, description="true: the glowing shapes' emissive colour goes from their own "
+                          "to emissive_color with the energy; false: their own until full, then emissive_color")
+    glow_shapes: int = Field(default=1, ge=0, description="how many of its solid's first shapes glow so (a .wbt "
+                             "Charger: the shapes of its first child, as Webots)")
+
+    _unit = field_validator("emissive_color")(_unit_colors)
 
 
 class World(Strict):
