@@ -201,3 +201,14 @@ def test_a_wbt_chargers_first_child_glows(tmp_path: Path, gradual: str):
         else np.array([0.0, 0.0, 0.2])
     np.testing.assert_array_equal(cam.image[3, 4, 2::-1].astype(np.int64), byte(e))
     assert sim.scene.emissive[1].tolist() == [0.1, 0.1, 0.1]
+
+
+def test_the_batched_simulation_refuses_a_glow_a_camera_sees_in_one_line():
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+    lw = LoadedWorld(world=_charger_world(True), source="<dock>", base_dir=Path.cwd())
+    with pytest.raises(BatchedError, match=r"^<dock>: Charger 'dock': its shapes glow with its energy, which camera "
+                                           r"r/cam sees; .*glow_shapes: 0\)$"):
+        BatchedSimulation(lw, 2)
+    w = lw.world
+    calm = w.model_copy(update={"chargers": [w.chargers[0].model_copy(update={"glow_shapes": 0})]})
+    BatchedSimulation(LoadedWorld(world=calm, source="<dock>", base_dir=Path.cwd()), 2)      # accepted
