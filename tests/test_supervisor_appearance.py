@@ -156,11 +156,31 @@ def test_refusals_name_the_field_and_change_nothing():
     with pytest.raises(ValueError, match="'IBLStrength' .* read-only"):
         sv.set_field(sim, app, "IBLStrength", 0.5)
     assert np.array_equal(_shot(sim)[0], before[0])
-    # metalness and emissive colours are kept and read back (cameras here render neither, as for the world file)
+    # metalness is kept and read back (cameras here do not render it, as for the world file)
     sv.set_field(sim, app, "metalness", 0.7)
-    sv.set_field(sim, app, "emissiveColor", [0.2, 0.0, 0.0])
-    assert (field(sim, app, "metalness"), field(sim, app, "emissiveColor")) == (0.7, [0.2, 0.0, 0.0])
+    assert field(sim, app, "metalness") == 0.7
     assert np.array_equal(_shot(sim)[0], before[0])
+
+
+def test_an_emissive_colour_set_glows_as_if_the_world_file_said_it(tmp_path):
+    """Every pixel of the ambient-lit wall reads 0.5·albedo + emissive (Webots' shaders add it); a
+    PBRAppearance's emissiveIntensity (world file: 2) scales a colour set later too."""
+    sim = _sim()
+    app = sv.find_node(sim, "WALL_APP")
+    sv.set_field(sim, app, "emissiveColor", [0.2, 0.0, 0.1])
+    assert field(sim, app, "emissiveColor") == [0.2, 0.0, 0.1]
+    img, _ = _shot(sim)
+    L = AMBIENT * np.array([0.8, 0.5, 0.2]) + [0.2, 0.0, 0.1]
+    assert img[2, 2, [2, 1, 0]].tolist() == np.floor(255.0 * (1.0 - np.exp(-L)) ** (1.0 / 2.2) + 0.5).astype(int).tolist()
+    ref, _ = _shot(_sim(_variant(tmp_path, "roughness 0.3", "roughness 0.3 emissiveColor 0.2 0 0.1")))
+    assert np.array_equal(img, ref)
+    sim = _sim(_variant(tmp_path, "roughness 0.3", "roughness 0.3 emissiveIntensity 2"))
+    sv.set_field(sim, sv.find_node(sim, "WALL_APP"), "emissiveColor", [0.2, 0.0, 0.1])
+    L = AMBIENT * np.array([0.8, 0.5, 0.2]) + [0.4, 0.0, 0.2]
+    img, _ = _shot(sim)
+    assert img[2, 2, [2, 1, 0]].tolist() == np.floor(255.0 * (1.0 - np.exp(-L)) ** (1.0 / 2.2) + 0.5).astype(int).tolist()
+    sv.set_field(sim, sv.find_node(sim, "WALL_APP"), "emissiveColor", [0.0, 0.0, 0.0])     # back to no glow
+    assert np.array_equal(_shot(sim)[0], _shot(_sim())[0]) and sim.scene.emissive is None
 
 
 def test_a_simulation_reset_brings_the_loaded_colours_back():

@@ -403,9 +403,13 @@ class Appearance(Strict):
     With a ``texture`` the colour is ``base_color × (1 − transparency) × texel`` (Webots multiplies
     a PBRAppearance's baseColor by its baseColorMap; a textured Appearance's diffuse colour is
     replaced by white). ``roughness_map``/``occlusion_map`` (red channel) are read only where
-    ``texture`` is set, as in Webots."""
+    ``texture`` is set, as in Webots. Cameras add ``emissive_color × emissive_intensity`` to the
+    light a surface sends (Webots' Material ``emissiveColor``, intensity 1; a PBRAppearance's
+    ``emissiveColor`` and ``emissiveIntensity``)."""
 
     base_color: Vec3 = (1.0, 1.0, 1.0)
+    emissive_color: Vec3 = (0.0, 0.0, 0.0)
+    emissive_intensity: float = Field(default=1.0, ge=0.0, allow_inf_nan=False)
     transparency: float = Field(default=0.0, ge=0.0, le=1.0)
     roughness: float = Field(default=0.0, ge=0.0, le=1.0)
     texture: TextureField = None
@@ -413,7 +417,7 @@ class Appearance(Strict):
     occlusion_map: TextureField = None
     texture_transform: TextureTransform | None = None
 
-    _unit = field_validator("base_color")(_unit_colors)
+    _unit = field_validator("base_color", "emissive_color")(_unit_colors)
 
 
 SeenBy = Literal["both", "bounding", "visual"]
@@ -2081,6 +2085,14 @@ class Charger(Strict):
         "fewer than three values: the Charger does nothing, as in Webots")
     radius: float = Field(default=0.04, ge=0.0, allow_inf_nan=False,
                           description="the distance (m) between its position and a robot's that starts a charge")
+    emissive_color: Vec3 = Field(default=(0.0, 1.0, 0.0), description="the emissive colour its glowing shapes "
+                                 "take when it is full (Webots' Charger.emissiveColor)")
+    gradual: bool = Field(default=True, description="true: the glowing shapes' emissive colour goes from their own "
+                          "to emissive_color with the energy; false: their own until full, then emissive_color")
+    glow_shapes: int = Field(default=1, ge=0, description="how many of its solid's first shapes glow so (a .wbt "
+                             "Charger: the shapes of its first child, as Webots)")
+
+    _unit = field_validator("emissive_color")(_unit_colors)
 
 
 class World(Strict):

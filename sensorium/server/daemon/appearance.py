@@ -165,7 +165,9 @@ def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
                 update["base_color"] = tuple(float(v) for v in values)
             elif name == "roughness":
                 update["roughness"] = float(value)
-            if update and current is not None:      # (metalness, emissive colours: not rendered here, kept)
+            elif name == "emissiveColor":
+                update["emissive_color"] = tuple(float(v) for v in values)
+            if update and current is not None:      # (metalness: not rendered here, kept)
                 scene.set_appearance(k, current.model_copy(update=update))
             scene.appearance_values.setdefault(k, {})[f"{ref.role}.{name}"] = \
                 [float(v) for v in values] if kind == "SFColor" else float(value)

@@ -48,7 +48,16 @@ from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
 from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite, masked, noise_mask_planes
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import _base_color, receives_shadows, scene_robot_parts, surface_colors, surface_opacity
+from sensorium.server.sim.scene import (
+    _base_color,
+    emissive_array,
+    emissive_of,
+    emissive_rows,
+    receives_shadows,
+    scene_robot_parts,
+    surface_colors,
+    surface_opacity,
+)
 
 __all__ = ["KINDS", "CLASSES", "CameraDevices", "BatchedCamera", "own_body_hits"]
 
@@ -175,6 +184,7 @@ class CameraDevices(PixelDevices):
         self.colors = np.array([_base_color(m) for m in models] + [(1.0, 1.0, 1.0)], dtype=np.float64).reshape(-1, 3)
         self.transparency = np.array([m.appearance.transparency if m.appearance is not None else 0.0
                                       for m in models] + [0.0])
+        self.emissive = emissive_array([emissive_of(m) for m in models])
         self.clear = bool((self.transparency > 0.0).any())     # semi-transparent surfaces: layers per copy
 
     def _lights_of(self, copy: int) -> light_math.LightArrays:
@@ -330,6 +340,9 @@ class CameraDevices(PixelDevices):
                     on = (~translucent[s]).nonzero()[0]
                     lit[on] = self._shadows(P[on], N[on], row_copy[on], copies)
             L = self._shade_copies(P, N, albedo, lit, row_copy, copies)
+            glow = emissive_rows(self.emissive, s)
+            if glow is not None:       # as Camera's surface
+                L += glow
             if scene.fog is not None:
                 L = shading.fog(L, tk, *scene.fog)
             share = weight[kk] * (1.0 - np.zeros(len(kk)))   # (opaque: transparency 0, as the single's share)
@@ -405,7 +418,11 @@ class CameraDevices(PixelDevices):
                 on = receives_shadows(self.transparency, translucent, s).nonzero()[0]   # (this camera's numbering)
                 lit[on] = self._shadows(P[on], N[on], zeros[on], copy)
             lights = self._lights_of(int(copy[0]))
-            return _shade(P, N, albedo, lights, None if lit is None else lit[:, :lights.count], scene.engine.threads)
+            L = _shade(P, N, albedo, lights, None if lit is None else lit[:, :lights.count], scene.engine.threads)
+            glow = emissive_rows(self.emissive, s)
+            if glow is not None:       # as Camera's surface
+                L += glow
+            return L
 
         alpha = None
         if alpha_shapes is not None:

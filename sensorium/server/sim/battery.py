@@ -78,6 +78,9 @@ class Charger:
     initial: float
     robot: int | None = None       # the index of the robot it charges
     done: bool = True              # that robot's battery is full: what the Charger still gives is lost
+    emissive: tuple[float, float, float] = (0.0, 1.0, 0.0)
+    gradual: bool = True
+    glow_shapes: int = 0           # how many of its solid's first shapes glow with its energy
 
     @classmethod
     def from_model(cls, c: wm.Charger) -> Charger | None:
@@ -85,7 +88,18 @@ class Charger:
         if len(c.battery) < 3:
             return None
         e, m, s = (float(v) for v in c.battery)
-        return cls(c.solid, float(c.radius), e, m, s, e)
+        return cls(c.solid, float(c.radius), e, m, s, e, emissive=tuple(float(v) for v in c.emissive_color),  # type: ignore[arg-type]
+                   gradual=c.gradual, glow_shapes=c.glow_shapes)
+
+    def glow(self, initial: tuple[float, float, float]) -> tuple[float, float, float]:
+        """The emissive colour of a glowing shape whose own is ``initial`` (WbCharger::updateMaterialsAndLights):
+        ``emissive`` when full; else, ``gradual``, ``initial + (emissive − initial)·E/Emax``, or ``initial``."""
+        if self.energy >= self.maximum:          # (a maximum of 0: full)
+            return self.emissive
+        if not self.gradual:
+            return initial
+        r = self.energy / self.maximum
+        return tuple((e - i) * r + i for e, i in zip(self.emissive, initial))  # type: ignore[return-value]
 
     def reset(self) -> None:
         self.energy, self.robot, self.done = self.initial, None, True

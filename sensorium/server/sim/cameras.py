@@ -23,7 +23,7 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import blocks
 from sensorium.server.raycast.engine import RayHits, RayKind, Riding
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import light_from_model
+from sensorium.server.sim.scene import emissive_rows, light_from_model
 from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
@@ -651,7 +651,11 @@ class Camera(Device):
                 else:
                     lit = np.ones((len(s), len(shadows)), dtype=bool)
                     lit[on] = self._shadows(P[on], N[on], lights, shadows, counters)
-            return _shade(P, N, albedo, lights, lit, engine.threads)
+            L = _shade(P, N, albedo, lights, lit, engine.threads)
+            glow = emissive_rows(scene.emissive, s)
+            if glow is not None:       # Webots' shaders add the emissive colour to the lit one
+                L += glow
+            return L
 
         alpha = None
         shapes = scene.alpha_shapes              # None unless an image has transparent texels

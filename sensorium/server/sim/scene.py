@@ -80,6 +80,28 @@ def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
     return (1.0, 1.0, 1.0) if a is None else tuple(float(v) for v in a.base_color)  # type: ignore[return-value]
 
 
+def emissive_of(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
+    """The radiance a shape's surface sends whatever the lights: its emissive colour times its
+    intensity (Webots' Phong and PBR shaders add it to the lit colour)."""
+    a = shape.appearance
+    if a is None:
+        return (0.0, 0.0, 0.0)
+    return tuple(float(v) * a.emissive_intensity for v in a.emissive_color)  # type: ignore[return-value]
+
+
+def emissive_rows(emissive: np.ndarray | None, shape: np.ndarray) -> np.ndarray | None:
+    """The emissive radiance (n, 3) of the hit shapes, or None in a world where nothing glows
+    (``emissive`` None: nothing is added or computed)."""
+    return None if emissive is None else np.take(emissive, shape, axis=0)
+
+
+def emissive_array(colors: list[tuple[float, float, float]]) -> np.ndarray | None:
+    """Per shape (and a trailing 0 for no hit) the emissive radiance, or None when none glows."""
+    if not any(any(c) for c in colors):
+        return None
+    return np.array(list(colors) + [(0.0, 0.0, 0.0)], dtype=np.float64).reshape(-1, 3)
+
+
 def _maps(a: wm.Appearance) -> tuple:
     """What of an appearance the texture sampler reads."""
     return a.texture, a.roughness_map, a.occlusion_map, a.texture_transform
@@ -528,6 +550,7 @@ class Scene:
         self.removed_lights: set[int] = set()   # top-level lights a Supervisor removed (their indices)
         self.shapes_version = 0        # changes whenever a Supervisor adds shapes (cameras' recognition rebuilds)
         self.appearance_version = 0    # changes whenever a shape's appearance changes or a reset restores it (Foxglove's scene)
+        self._glow: dict[int, tuple[float, float, float]] = {}    # shape -> a Charger's emissive colour for it
         self._shape_arrays()
         # what cameras see past everything: the HDR radiance Webots clears with (shows as the sky colour)
         self.background = background_radiance(world.background.sky_color)
@@ -556,6 +579,35 @@ class Scene:
         # cameras read these (sim/cameras.py): base colour (white without appearance) and transparency
         self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
         self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
+        self.emissive = emissive_array([self._emissive_now(k, shape) for k, (_, _, shape) in enumerate(self._parts)])
+
+    def _emissive_now(self, shape: int, model: wm.Shape | wm.Solid) -> tuple[float, float, float]:
+        """:func:`emissive_of` a shape, its colour a Charger's glow (``set_glow``) where it has one."""
+        glow = self._glow.get(shape)
+        a = model.appearance
+        if glow is None or a is None:
+            return emissive_of(model)
+        return tuple(float(v) * a.emissive_intensity for v in glow)  # type: ignore[return-value]
+
+    def solid_shapes(self, name: str) -> list[int]:
+        """The shapes of top-level solid ``name`` (its own, then its nested solids'), in order."""
+        return [k for k, (key, _, _) in enumerate(self._parts) if key == name]
+
+    def set_glow(self, shape: int, color: tuple[float, float, float]) -> None:
+        """A Charger's glowing shape's emissive colour now (WbCharger sets its Material's or
+        PBRAppearance's ``emissiveColor``): cameras add it, times the appearance's intensity, from the
+        next image; the shape's model keeps the world file's colour."""
+        if self._glow.get(shape) == color:
+            return
+        self._glow[shape] = color
+        glow = self._emissive_now(shape, self._parts[shape][2])
+        if self.emissive is None:
+            if any(glow):
+                self.emissive = emissive_array([self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)])
+            return
+        self.emissive[shape] = glow
+        if not self.emissive.any():
+            self.emissive = None
 
     def set_appearance(self, shape: int, appearance: wm.Appearance) -> None:
         """A Supervisor's new colour, roughness or transparency for one shape (Webots' Material and
@@ -631,6 +683,13 @@ class Scene:
         self.shapes[shape] = info
         self.red[shape], self.roughness[shape], self.transparency[shape] = info.red, info.roughness, info.transparency
         self.colors[shape] = _base_color(model)
+        glow = self._emissive_now(shape, model)
+        if self.emissive is not None:
+            self.emissive[shape] = glow
+            if not self.emissive.any():
+                self.emissive = None
+        elif any(glow):
+            self.emissive = emissive_array([self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)])
 
     def shape_model(self, shape: int) -> wm.Shape | wm.Solid:
         """A shape's model now (its appearance as a Supervisor last set it)."""
@@ -777,10 +836,12 @@ class Scene:
             self.textures.forget(kept, n)
         if n < len(self.shapes):
             del self.shapes[n:], self._parts[n:]
+            self._glow = {k: c for k, c in self._glow.items() if k < n}
             self.red = np.append(self.red[:n], self.red[-1])
             self.roughness = np.append(self.roughness[:n], self.roughness[-1])
             self.colors = np.concatenate([self.colors[:n], self.colors[-1:]])
             self.transparency = np.append(self.transparency[:n], self.transparency[-1])
+            self.emissive = emissive_array([self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)])
             self.shapes_version += 1
 
     def solid_entries(self, solid: wm.Solid) -> tuple[list, list[ShapeEntry]]:

@@ -396,6 +396,10 @@ class Simulation:
         self._batteries = [r.battery for r in self.robots.values()]
         self._powered = [r for r in self.robots.values() if r.battery.present]
         self.chargers = [c for c in map(Charger.from_model, self.world.chargers) if c is not None]
+        # each Charger's glowing shapes (its solid's first glow_shapes with an appearance) and their own colours
+        self._glowing = [(c, [(k, self.scene.loaded_model(k).appearance.emissive_color)    # type: ignore[union-attr]
+                              for k in self.scene.solid_shapes(c.solid)[:c.glow_shapes]
+                              if self.scene.loaded_model(k).appearance is not None]) for c in self.chargers]
         self._battery_sensing: list[RobotState] = []     # robots whose battery sensor is enabled
         self._jointed = [j for r in self.robots.values() for j in r.joints.values()]
         self._joint_robot = [r.index for r in self.robots.values() for _ in r.joints.values()]
@@ -557,6 +561,8 @@ class Simulation:
                 self.scene.set_top_light(k, light)
         self.scene.clear_ink()          # WbPen::reset clears every paint texture
         self.scene.restore_appearances()     # colours a Supervisor set: as loaded
+        if self.chargers:
+            self._glow()                     # the Chargers' energies as loaded (WbCharger::reset)
         if self.viewpoint_loaded is not None:      # a Viewpoint moveViewpoint moved: where it was loaded
             vp = next(s for s in self.top_level.scenery if s.type == "Viewpoint")
             vp.fields.clear()
@@ -1018,6 +1024,15 @@ class Simulation:
                 charger.step(self._batteries, positions, np.asarray(own.translation, dtype=np.float64), dt)
         for robot in self._powered:   # energy again: powered on (WbRobot::setCurrentEnergy)
             robot.battery.power_back()
+        self._glow()
+
+    def _glow(self) -> None:
+        """Each Charger's glowing shapes take the emissive colour of its energy now (Webots updates them
+        at each Charger step and at a reset)."""
+        for charger, shapes in self._glowing:
+            if charger.solid in self.scene.solid_poses:
+                for k, initial in shapes:
+                    self.scene.set_glow(k, charger.glow(initial))
 
     def _distance_plan(self, distances: list[DistanceSensor]) -> DistancePlan:
         """The stacked constants of these sensors: built when the set of due sensors changes (a

@@ -673,11 +673,15 @@ class Converter:
             self.solid(node, frame, owner, "fluid", bounding=False)
         elif t == "Charger":             # a Solid that recharges robots' batteries (README 'Battery and Charger')
             entry = self.solid(node, frame, owner, "solid")
+            glow = entry.pop("_glow_shapes", 0) if entry is not None else 0
             if owner.kind != "world" or entry is None:
                 self.warn(node, f"Charger {f.string('name', 'solid')!r}: only a top-level Charger recharges "
                                 "robots here; its shapes and lights are kept")
             else:
-                charger: dict[str, Any] = {"solid": entry["name"], "radius": f.non_negative("radius", 0.04, 0.04)}
+                charger: dict[str, Any] = {"solid": entry["name"], "radius": f.non_negative("radius", 0.04, 0.04),
+                                           "emissive_color": list(f.color("emissiveColor", (0.0, 1.0, 0.0))),
+                                           "gradual": f.flag("gradual", True),
+                                           "glow_shapes": glow}
                 battery = self.battery_values(node, f"Charger {entry['name']!r}")
                 if battery:
                     charger["battery"] = battery
@@ -1506,8 +1510,10 @@ class Converter:
 
     def solid_contents(self, node: Node, frame: Frame, owner: Owner, bounding: bool = True) -> None:
         f = self.fields(node)
-        for child in f.nodes("children"):
+        for k, child in enumerate(f.nodes("children")):
             self.visit(child, frame, owner)
+            if k == 0 and node.type == "Charger" and owner.kind == "solid":   # its first child's shapes glow
+                owner.data["_glow_shapes"] = len(owner.parts)
         if bounding:
             self.bounding(f.node_("boundingObject"), frame, owner)
 

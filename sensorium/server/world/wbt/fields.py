@@ -482,6 +482,12 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
         out: dict[str, Any] = {"base_color": list(f.color("baseColor", (1.0, 1.0, 1.0))),
                                "transparency": f.within("transparency", 0.0, 0.0, 1.0, 0.0),
                                "roughness": f.within("roughness", 0.0, 0.0, 1.0, 0.0)}
+        emissive = f.color("emissiveColor", (0.0, 0.0, 0.0))
+        intensity = f.non_negative("emissiveIntensity", 1.0, 1.0)
+        if any(emissive):          # (the model's defaults otherwise: a world without glow dumps as before)
+            out["emissive_color"] = list(emissive)
+        if intensity != 1.0:       # (kept for a colour a Supervisor sets)
+            out["emissive_intensity"] = intensity
         base = image_texture(f.node_("baseColorMap"), source, warn, resolve)
         if base is not None:
             out["texture"] = base
@@ -502,6 +508,9 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
             if texture is None:
                 out["base_color"] = list(diffuse)
             out["transparency"] = m.within("transparency", 0.0, 0.0, 1.0, 0.5)
+            emissive = m.color("emissiveColor", (0.0, 0.0, 0.0))
+            if any(emissive):
+                out["emissive_color"] = list(emissive)
         if texture is not None:
             out["texture"] = texture
         if f.node_("texture") is not None:           # (kept for a url a Supervisor sets)

@@ -1,0 +1,214 @@
+"""Emissive colours in camera images, as Webots' shaders add them: WREN's phong.frag writes
+``emissive + ambient + diffuse (+ specular)`` and pbr.frag adds the emissive colour to the lit one,
+so a surface of albedo d, emissive colour e (a PBRAppearance's times its ``emissiveIntensity``)
+sends ``d·Σ lights + e`` into the HDR buffer, and glows with ``e`` alone where no light reaches.
+
+Closed forms: a camera at the origin looking along +x at a flat wall (face x = 1.95) lit by an
+ambient-only directional light (0.3) and a point light at the camera (0.8, so ``0.8·cos`` of the
+pixel's ray): each pixel reads Webots' resolve of ``d·(0.3 + 0.8·cos) + e``; in a world with no
+light an emissive box reads the resolve of ``e`` and a plain one black. The batched camera gives
+every copy the single simulation's bytes. A world where nothing glows adds nothing (no array)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.schemas import world as wm
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import LoadedWorld, load_world
+from tests.test_batched_camera import images_with_robot_placed
+from tests.test_camera_light_radius import AMBIENT, BOTH, CAM, byte, point, rays, shoot
+
+DIFFUSE, GLOW = [0.6, 0.3, 0.15], [0.05, 0.4, 0.7]
+
+
+def wall(appearance: dict) -> dict:
+    return {"name": "wall", "pose": {"translation": [2.0, 0.0, 0.0]}, "geometry": {"type": "box", "size": [0.1, 20, 20]},
+            "appearance": appearance}
+
+
+def world(lights, appearance: dict, robot_extra: dict | None = None) -> wm.World:
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16, "random_seed": 5}, "solids": [wall(appearance)], "lights": list(lights),
+        "robots": [{"name": "r", "devices": [{"device": "Camera", "name": "cam", **CAM}], **(robot_extra or {})}]})
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_lit_face_reads_its_lit_colour_plus_its_emissive_colour(precision: str):
+    _, cos = rays()
+    lit = np.asarray(DIFFUSE) * (0.3 + 0.8 * cos)[..., None]
+    plain = shoot(world([AMBIENT, point(None)], {"base_color": DIFFUSE}), precision)
+    np.testing.assert_array_equal(plain, byte(lit))
+    got = shoot(world([AMBIENT, point(None)], {"base_color": DIFFUSE, "emissive_color": GLOW}), precision)
+    np.testing.assert_array_equal(got, byte(lit + np.asarray(GLOW)))
+    # a PBRAppearance's emissiveIntensity scales it
+    twice = shoot(world([AMBIENT, point(None)], {"base_color": DIFFUSE, "emissive_color": GLOW,
+                                                 "emissive_intensity": 1.5}), precision)
+    np.testing.assert_array_equal(twice, byte(lit + 1.5 * np.asarray(GLOW)))
+    assert (twice > got).any() and (got > plain).all()
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_an_emissive_box_glows_in_a_world_without_light(precision: str):
+    got = shoot(world([], {"base_color": DIFFUSE, "emissive_color": GLOW}), precision)
+    np.testing.assert_array_equal(got, np.broadcast_to(byte(np.asarray(GLOW)), got.shape))
+    dark = shoot(world([], {"base_color": DIFFUSE}), precision)
+    assert not dark.any()
+
+
+def test_nothing_is_added_where_nothing_glows():
+    sim = Simulation(world([AMBIENT], {"base_color": DIFFUSE}))
+    assert sim.scene.emissive is None
+    sim = Simulation(world([AMBIENT], {"base_color": DIFFUSE, "emissive_color": GLOW}))
+    assert sim.scene.emissive is not None and sim.scene.emissive[0].tolist() == GLOW
+    assert sim.scene.emissive[-1].tolist() == [0.0, 0.0, 0.0]           # no hit: the sky adds nothing
+
+
+WBT = """#VRML_SIM R2023b utf8
+WorldInfo {{ basicTimeStep 16 }}
+DirectionalLight {{ direction 1 0 0 intensity 0 ambientIntensity 0.3 }}
+Solid {{
+  translation 2 0 0
+  children [ Shape {{ appearance {appearance} geometry Box {{ size 0.1 20 20 }} }} ]
+}}
+Robot {{ children [ Camera {{ name "cam" width 9 height 7 fieldOfView 1 }} ] controller "<none>" }}
+"""
+
+
+@pytest.mark.parametrize("appearance, glow", [
+    ("Appearance { material Material { diffuseColor 0.6 0.3 0.15 emissiveColor 0.05 0.4 0.7 } }", GLOW),
+    ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 emissiveIntensity 0.5 }",
+     [0.025, 0.2, 0.35]),
+    ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 emissiveIntensity -2 }", GLOW),
+])
+def test_a_world_files_emissive_colours_are_drawn(tmp_path: Path, appearance: str, glow):
+    """A Material's emissiveColor; a PBRAppearance's times its emissiveIntensity (a negative one
+    is reset to 1 with a warning)."""
+    path = tmp_path / "glow.wbt"
+    path.write_text(WBT.format(appearance=appearance))
+    sim = Simulation(load_world(path))
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    sim.run(1)
+    got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+    np.testing.assert_array_equal(got, np.broadcast_to(byte(0.3 * np.asarray(DIFFUSE) + np.asarray(glow)), got.shape))
+
+
+def _facing(glass: bool) -> LoadedWorld:
+    """A bodiless robot whose camera faces a wall that glows and a box that does not (or, ``glass``,
+    a semi-transparent one that glows too), under the ambient light and a point light it carries."""
+    dev = {"device": "Camera", "name": "cam", "width": 11, "height": 5, "field_of_view": 1.0}
+    box = {"name": "box", "pose": {"translation": [1.5, 0.4, 0.0]}, "geometry": {"type": "box", "size": [0.2, 0.2, 0.2]},
+           "appearance": {"base_color": [0.9, 0.9, 0.2]}}
+    if glass:
+        box["appearance"] = {"base_color": [0.9, 0.9, 0.2], "transparency": 0.5, "emissive_color": [0.3, 0.0, 0.1]}
+    w = wm.World.model_validate({
+        "world_info": {"basic_time_step": 8, "contact": False}, "lights": [AMBIENT],
+        "solids": [wall({"base_color": DIFFUSE, "emissive_color": GLOW, "emissive_intensity": 1.2}), box],
+        "robots": [{"name": "bot", "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2,
+                                                          "max_wheel_speed": 10.0},
+                    "lights": [point(None, intensity=0.6)], "devices": [dev]}]})
+    return LoadedWorld(world=w, source="<test>", base_dir=Path.cwd())
+
+
+@pytest.mark.parametrize("glass", [False, True])
+@pytest.mark.parametrize("precision", BOTH)
+def test_every_copy_draws_emissive_colours_as_the_single_simulation(precision: str, glass: bool):
+    x = [1.4, 0.9, -1.0]
+    img = images_with_robot_placed(_facing(glass), precision, "bot", [[xc, 0.0, 0.0] for xc in x])
+    centre = img[:, 2, 5, 2::-1].astype(np.int64)          # its ray along +x meets the wall face on
+    for c in range(len(x)):
+        L = np.asarray(DIFFUSE) * (0.3 + 0.6) + 1.2 * np.asarray(GLOW)
+        np.testing.assert_array_equal(centre[c], byte(L), err_msg=str(c))
+
+
+# ---------------------------------------------------------------------------------- a Charger's glow
+
+def _charger_world(gradual: bool, initial=(0.0, 0.0, 0.2)) -> wm.World:
+    """A camera in the dark facing a Charger's box (its own emissive colour ``initial``): the Charger
+    starts empty and gathers 10 W up to 1 J, full after 100 ms; a second shape of its solid does not
+    glow (glow_shapes 1)."""
+    dock = {"name": "dock", "pose": {"translation": [2.0, 0.0, 0.0]},
+            "shapes": [{"geometry": {"type": "box", "size": [0.1, 20, 20]},
+                        "appearance": {"base_color": [0.5, 0.5, 0.5], "emissive_color": list(initial)}},
+                       {"pose": {"translation": [0.0, 0.0, 30.0]}, "geometry": {"type": "box", "size": [0.1, 1, 1]},
+                        "appearance": {"emissive_color": [0.1, 0.1, 0.1]}}]}
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16}, "solids": [dock],
+        "chargers": [{"solid": "dock", "battery": [0.0, 1.0, 10.0], "emissive_color": [1.0, 0.5, 0.0],
+                      "gradual": gradual}],
+        "robots": [{"name": "r", "devices": [{"device": "Camera", "name": "cam", **CAM}]}]})
+
+
+@pytest.mark.parametrize("gradual", [True, False])
+def test_a_chargers_first_shape_glows_with_its_energy(gradual: bool):
+    """Webots' WbCharger: full, the emissiveColor; else, gradual, initial + (emissiveColor − initial)·E/Emax;
+    not gradual, the shape's own colour. The image after each step reads the energy of that step."""
+    sim = Simulation(_charger_world(gradual))
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    initial, full = np.array([0.0, 0.0, 0.2]), np.array([1.0, 0.5, 0.0])
+    seen = set()
+    for step in range(1, 10):
+        sim.run(1)
+        energy = min(10.0 * 0.016 * step, 1.0)
+        assert sim.chargers[0].energy == pytest.approx(energy, abs=1e-12)
+        e = full if energy >= 1.0 else (initial + (full - initial) * energy if gradual else initial)
+        got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+        np.testing.assert_array_equal(got, np.broadcast_to(byte(e), got.shape), err_msg=str(step))
+        seen.add(got.tobytes())
+    assert len(seen) == (7 if gradual else 2)          # 0.16 J a step: full from the 7th
+    assert sim.scene.emissive[1].tolist() == [0.1, 0.1, 0.1]       # the second shape keeps its own
+    sim.reset()                                      # the loaded energy (0 J): the initial colour again
+    sim.run(1)
+    e = initial + (full - initial) * 0.16 if gradual else initial
+    np.testing.assert_array_equal(cam.image[2, 4, 2::-1].astype(np.int64), byte(e))
+
+
+CHARGER_WBT = """#VRML_SIM R2023b utf8
+WorldInfo {{ basicTimeStep 16 }}
+Charger {{
+  translation 2 0 0
+  children [
+    Pose {{ children [ Shape {{ appearance PBRAppearance {{ baseColor 0.5 0.5 0.5 emissiveColor 0 0 0.2 }}
+                               geometry Box {{ size 0.1 20 20 }} }} ] }}
+    Shape {{ appearance Appearance {{ material Material {{ emissiveColor 0.1 0.1 0.1 }} }} geometry Box {{ size 0.1 1 1 }} }}
+  ]
+  name "dock"
+  battery [ 0, 1, 10 ]
+  emissiveColor 1 0.5 0
+  gradual {gradual}
+}}
+Robot {{ children [ Camera {{ name "cam" width 9 height 7 fieldOfView 1 }} ] controller "<none>" }}
+"""
+
+
+@pytest.mark.parametrize("gradual", ["TRUE", "FALSE"])
+def test_a_wbt_chargers_first_child_glows(tmp_path: Path, gradual: str):
+    path = tmp_path / "dock.wbt"
+    path.write_text(CHARGER_WBT.format(gradual=gradual))
+    lw = load_world(path)
+    charger = lw.world.chargers[0]
+    assert (charger.glow_shapes, charger.gradual, charger.emissive_color) == (1, gradual == "TRUE", (1.0, 0.5, 0.0))
+    sim = Simulation(lw)
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    sim.run(3)
+    e = np.array([0.0, 0.0, 0.2]) + (np.array([1.0, 0.5, 0.0]) - [0.0, 0.0, 0.2]) * 0.48 if gradual == "TRUE" \
+        else np.array([0.0, 0.0, 0.2])
+    np.testing.assert_array_equal(cam.image[3, 4, 2::-1].astype(np.int64), byte(e))
+    assert sim.scene.emissive[1].tolist() == [0.1, 0.1, 0.1]
+
+
+def test_the_batched_simulation_refuses_a_glow_a_camera_sees_in_one_line():
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+    lw = LoadedWorld(world=_charger_world(True), source="<dock>", base_dir=Path.cwd())
+    with pytest.raises(BatchedError, match=r"^<dock>: Charger 'dock': its shapes glow with its energy, which camera "
+                                           r"r/cam sees; .*glow_shapes: 0\)$"):
+        BatchedSimulation(lw, 2)
+    w = lw.world
+    calm = w.model_copy(update={"chargers": [w.chargers[0].model_copy(update={"glow_shapes": 0})]})
+    BatchedSimulation(LoadedWorld(world=calm, source="<dock>", base_dir=Path.cwd()), 2)      # accepted
