@@ -1,6 +1,6 @@
 """Emissive colours in camera images, as Webots' shaders add them: WREN's phong.frag writes
 ``emissive + ambient + diffuse (+ specular)`` and pbr.frag adds the emissive colour to the lit one,
-so a surface of albedo d, emissive colour e (a PBRAppearance's times its ``emissiveIntensity``)
+so a surface of albedo d, emissive colour e (a PBRAppearance's ``emissiveIntensity`` left out, as WREN's shader leaves it out)
 sends ``d·Σ lights + e`` into the HDR buffer, and glows with ``e`` alone where no light reaches.
 
 Closed forms: a camera at the origin looking along +x at a flat wall (face x = 1.95) lit by an
@@ -44,11 +44,7 @@ def test_a_lit_face_reads_its_lit_colour_plus_its_emissive_colour(precision: str
     np.testing.assert_array_equal(plain, byte(lit))
     got = shoot(world([AMBIENT, point(None)], {"base_color": DIFFUSE, "emissive_color": GLOW}), precision)
     np.testing.assert_array_equal(got, byte(lit + np.asarray(GLOW)))
-    # a PBRAppearance's emissiveIntensity scales it
-    twice = shoot(world([AMBIENT, point(None)], {"base_color": DIFFUSE, "emissive_color": GLOW,
-                                                 "emissive_intensity": 1.5}), precision)
-    np.testing.assert_array_equal(twice, byte(lit + 1.5 * np.asarray(GLOW)))
-    assert (twice > got).any() and (got > plain).all()
+    assert (got > plain).all()
 
 
 @pytest.mark.parametrize("precision", BOTH)
@@ -80,13 +76,13 @@ Robot {{ children [ Camera {{ name "cam" width 9 height 7 fieldOfView 1 }} ] con
 
 @pytest.mark.parametrize("appearance, glow", [
     ("Appearance { material Material { diffuseColor 0.6 0.3 0.15 emissiveColor 0.05 0.4 0.7 } }", GLOW),
-    ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 emissiveIntensity 0.5 }",
-     [0.025, 0.2, 0.35]),
+    ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 }", GLOW),
+    ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 emissiveIntensity 0.5 }", GLOW),
     ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 emissiveIntensity -2 }", GLOW),
 ])
 def test_a_world_files_emissive_colours_are_drawn(tmp_path: Path, appearance: str, glow):
-    """A Material's emissiveColor; a PBRAppearance's times its emissiveIntensity (a negative one
-    is reset to 1 with a warning)."""
+    """A Material's emissiveColor; a PBRAppearance's, whatever its emissiveIntensity (WREN's PBR shader
+    applies the intensity in wireframe rendering only, and Webots resets no negative one)."""
     path = tmp_path / "glow.wbt"
     path.write_text(WBT.format(appearance=appearance))
     sim = Simulation(load_world(path))
@@ -107,7 +103,7 @@ def _facing(glass: bool) -> LoadedWorld:
         box["appearance"] = {"base_color": [0.9, 0.9, 0.2], "transparency": 0.5, "emissive_color": [0.3, 0.0, 0.1]}
     w = wm.World.model_validate({
         "world_info": {"basic_time_step": 8, "contact": False}, "lights": [AMBIENT],
-        "solids": [wall({"base_color": DIFFUSE, "emissive_color": GLOW, "emissive_intensity": 1.2}), box],
+        "solids": [wall({"base_color": DIFFUSE, "emissive_color": GLOW}), box],
         "robots": [{"name": "bot", "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.2,
                                                           "max_wheel_speed": 10.0},
                     "lights": [point(None, intensity=0.6)], "devices": [dev]}]})
@@ -121,7 +117,7 @@ def test_every_copy_draws_emissive_colours_as_the_single_simulation(precision: s
     img = images_with_robot_placed(_facing(glass), precision, "bot", [[xc, 0.0, 0.0] for xc in x])
     centre = img[:, 2, 5, 2::-1].astype(np.int64)          # its ray along +x meets the wall face on
     for c in range(len(x)):
-        L = np.asarray(DIFFUSE) * (0.3 + 0.6) + 1.2 * np.asarray(GLOW)
+        L = np.asarray(DIFFUSE) * (0.3 + 0.6) + np.asarray(GLOW)
         np.testing.assert_array_equal(centre[c], byte(L), err_msg=str(c))
 
 

@@ -403,13 +403,12 @@ class Appearance(Strict):
     With a ``texture`` the colour is ``base_color × (1 − transparency) × texel`` (Webots multiplies
     a PBRAppearance's baseColor by its baseColorMap; a textured Appearance's diffuse colour is
     replaced by white). ``roughness_map``/``occlusion_map`` (red channel) are read only where
-    ``texture`` is set, as in Webots. Cameras add ``emissive_color × emissive_intensity`` to the
-    light a surface sends (Webots' Material ``emissiveColor``, intensity 1; a PBRAppearance's
-    ``emissiveColor`` and ``emissiveIntensity``)."""
+    ``texture`` is set, as in Webots. Cameras add ``emissive_color`` to the light a surface sends
+    (Webots' Material ``emissiveColor``; a PBRAppearance's ``emissiveColor``, whose
+    ``emissiveIntensity`` Webots' renderer applies in wireframe rendering only)."""
 
     base_color: Vec3 = (1.0, 1.0, 1.0)
     emissive_color: Vec3 = (0.0, 0.0, 0.0)
-    emissive_intensity: float = Field(default=1.0, ge=0.0, allow_inf_nan=False)
     transparency: float = Field(default=0.0, ge=0.0, le=1.0)
     roughness: float = Field(default=0.0, ge=0.0, le=1.0)
     texture: TextureField = None

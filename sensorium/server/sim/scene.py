@@ -81,12 +81,12 @@ def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
 
 
 def emissive_of(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
-    """The radiance a shape's surface sends whatever the lights: its emissive colour times its
-    intensity (Webots' Phong and PBR shaders add it to the lit colour)."""
+    """The radiance a shape's surface sends whatever the lights: its emissive colour (Webots' Phong
+    and PBR shaders add it to the lit colour; a PBRAppearance's emissiveIntensity only in wireframe)."""
     a = shape.appearance
     if a is None:
         return (0.0, 0.0, 0.0)
-    return tuple(float(v) * a.emissive_intensity for v in a.emissive_color)  # type: ignore[return-value]
+    return tuple(float(v) for v in a.emissive_color)  # type: ignore[return-value]
 
 
 def emissive_rows(emissive: np.ndarray | None, shape: np.ndarray) -> np.ndarray | None:
@@ -584,10 +584,9 @@ class Scene:
     def _emissive_now(self, shape: int, model: wm.Shape | wm.Solid) -> tuple[float, float, float]:
         """:func:`emissive_of` a shape, its colour a Charger's glow (``set_glow``) where it has one."""
         glow = self._glow.get(shape)
-        a = model.appearance
-        if glow is None or a is None:
+        if glow is None or model.appearance is None:
             return emissive_of(model)
-        return tuple(float(v) * a.emissive_intensity for v in glow)  # type: ignore[return-value]
+        return tuple(float(v) for v in glow)  # type: ignore[return-value]
 
     def solid_shapes(self, name: str) -> list[int]:
         """The shapes of top-level solid ``name`` (its own, then its nested solids'), in order."""

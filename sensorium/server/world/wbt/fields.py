@@ -482,12 +482,11 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
         out: dict[str, Any] = {"base_color": list(f.color("baseColor", (1.0, 1.0, 1.0))),
                                "transparency": f.within("transparency", 0.0, 0.0, 1.0, 0.0),
                                "roughness": f.within("roughness", 0.0, 0.0, 1.0, 0.0)}
+        # emissiveIntensity is not read: WREN's PBR shader applies it in wireframe rendering only, and
+        # WbPbrAppearance passes emissiveColor unscaled (nor does it reset a negative intensity)
         emissive = f.color("emissiveColor", (0.0, 0.0, 0.0))
-        intensity = f.non_negative("emissiveIntensity", 1.0, 1.0)
         if any(emissive):          # (the model's defaults otherwise: a world without glow dumps as before)
             out["emissive_color"] = list(emissive)
-        if intensity != 1.0:       # (kept for a colour a Supervisor sets)
-            out["emissive_intensity"] = intensity
         base = image_texture(f.node_("baseColorMap"), source, warn, resolve)
         if base is not None:
             out["texture"] = base
