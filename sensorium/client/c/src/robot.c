@@ -403,7 +403,8 @@ int wb_robot_init(void) {
   sn_reply rep;
   if (call(c, &r, id, g_timeout_ms, &rep) != 0) {
     char msg[700];
-    snprintf(msg, sizeof msg, "attaching to robot '%s' at %s: %s", name ? name : "", sn_conn_endpoint(c), rep.message);
+    snprintf(msg, sizeof msg, "attaching to robot '%s' at %s: %s", sn_shown(name ? name : ""), sn_conn_endpoint(c),
+             rep.message);
     fatal("wb_robot_init", rep.code, msg);
   }
   sn_robot *rb = calloc(1, sizeof *rb);

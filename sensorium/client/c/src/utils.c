@@ -104,14 +104,18 @@ const char *sn_shown(const char *s) {
       snprintf(piece, sizeof piece, "\\%c", *p == '\n' ? 'n' : *p == '\t' ? 't' : 'r');
     else if (*p < 0x20 || *p == 0x7f)
       snprintf(piece, sizeof piece, "\\x%02x", *p);
-    else
-      piece[0] = (char)*p, piece[1] = '\0';
+    else {
+      piece[0] = (char)*p;
+      piece[1] = '\0';
+    }
     size_t len = strlen(piece);
     if (n + len > SN_SHOWN_MAX) {
-      while (n > 0 && ((unsigned char)out[n - 1] & 0xC0) == 0x80) /* no UTF-8 character cut in two */
-        n--;
-      if (n > 0 && (unsigned char)out[n - 1] >= 0xC0)
-        n--;
+      if ((*p & 0xC0) == 0x80) { /* the cut is inside a UTF-8 character: its first bytes go too */
+        while (n > 0 && ((unsigned char)out[n - 1] & 0xC0) == 0x80)
+          n--;
+        if (n > 0 && (unsigned char)out[n - 1] >= 0xC0)
+          n--;
+      }
       memcpy(out + n, "...", 4);
       return out;
     }
