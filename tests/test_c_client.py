@@ -308,7 +308,7 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
                       "wwi (null) (null) 0",                 # no robot window
                       "default window (null)",               # its default window's functions: compile, run, no effect
                       "step 0",
-                      "supervisor NULL 1 SFRotation -1 10 0 0 0  1 0",   # beyond the subset: "no value"; 10 fields;
+                      "supervisor NULL 1 SFRotation -1 12 0 0 0  1 0",   # beyond the subset: "no value"; 12 fields;
                       # getCenterOfMass served: 0 0 0 for a robot without Physics (Webots)
                       "after quit -1"]     # the simulation ended for this controller: the next step ends it
     warned = [line for line in err.splitlines() if "does not simulate" in line]
@@ -320,7 +320,7 @@ def test_microphone_radio_contact_points_robot_window_and_unserved_supervisor_fu
     assert "Error: wb_supervisor_node_export_string(): INVALID_ARGUMENT: node_export_string: Robot 'car' (node 1) has " \
         "no .wbt text here: the world was not loaded from a .wbt file" in err, err      # a YAML world: "" and one line
     # served for a PROTO's interface fields: Webots' line for the robot's SFRotation, 0; the robot (no PROTO)
-    # counts the 10 fields served for a Robot
+    # counts the 12 fields served for a Robot (battery and cpuConsumption among them)
     assert "Error: wb_supervisor_field_get_mf_int32() called with wrong field type: SFRotation." in err
     assert "simulation_quit" not in err
     contacts = sorted(line for line in err.splitlines() if "contact" in line)   # Webots' deprecation lines, once each
@@ -1019,11 +1019,33 @@ def test_heartbeat_keeps_a_computing_c_controller_attached(cbin, servers):
     ("tcp://127.0.0.1:99999/epuck", ["BAD_URL", "bad port '99999'"]),
     ("tcp:///epuck", ["BAD_URL", "no host"]),
     ("epuck/left", ["BAD_URL", "contains '/'"]),
+    # a line break and a tab in the URL are shown escaped: the line stays one line
+    ("tcp://127.0.0.1:9\n9/e\tpuck", ["BAD_URL", "controller URL 'tcp://127.0.0.1:9\\n9/e\\tpuck': bad port '9\\n9'"]),
 ])
 def test_bad_urls_give_one_clear_line(cbin, url, words):
     code, out, err = finish(start([cbin["script"], "step", "32", "1"], url))
     assert code == 1 and out == []
     assert len(err.strip().splitlines()) == 1 and all(w in err for w in words), err
+
+
+def test_a_callers_string_shows_in_an_error_line_escaped_and_bounded(tmp_path):
+    """sn_shown (src/utils.c, compiled into tests/c/shown_names.c): control characters as the Python client's
+    repr shows them, other bytes as they are; past 4096 bytes cut with "...", never inside a UTF-8 character."""
+    exe = tmp_path / "shown_names"
+    done = subprocess.run(["cc", "-std=c99", "-D_POSIX_C_SOURCE=200809L", "-Wall", "-Wextra", "-Werror", "-g",
+                           "-fsanitize=address,undefined", "-fno-sanitize-recover=undefined", f"-I{CLIB / 'include'}",
+                           f"-I{CLIB / 'src'}", str(TESTS_C / "shown_names.c"), "-o", str(exe)],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    done = subprocess.run([str(exe)], capture_output=True, timeout=60)
+    assert done.returncode == 0 and done.stderr == b"", done.stderr
+    assert done.stdout.decode().splitlines() == [
+        "[a\\nb\\tc\\rd\\x01e\\x7ff\\n \u00e9]",    # a backslash as it is (the Python client's repr doubles it)
+        "[4098 xxx...]",                           # 4095 x: the é cut after its first byte goes whole
+        "[4099 xxx...]",                           # 4096 x, the next cut
+        "[4096 xxy]",                              # a line break and 4094 more bytes: 4096, not cut
+        "[(null)]",
+        "[1\\n 2\\t 3\\r 4\\x1b]"]                   # four in one printf: each its own buffer
 
 
 def test_url_forms_and_variables(cbin, servers, tmp_path):

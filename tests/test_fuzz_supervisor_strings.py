@@ -5,7 +5,8 @@ Every request gets one reply; a refusal is one line with a protocol code other t
 that is taken exports as text again, and the world keeps answering (a step, the contact points and
 balance of the first box). A world file whose bounding object's volume overflows (a sphere of radius 1e308)
 is refused at load in lines naming where, not with an OverflowError or a numpy warning; a joint ending in a
-SolidReference is one load line saying what it names (a Solid, the static environment, nothing)."""
+SolidReference is one load line saying what it names (a Solid, the static environment, nothing, a name no
+Solid bears)."""
 
 from __future__ import annotations
 
@@ -115,13 +116,30 @@ def test_a_bounding_object_whose_volume_overflows_is_refused_where_it_is(tmp_pat
                                          "above it is not tied to the world here (no physics); the joint is left out"),
     ("", "HingeJoint ending in a SolidReference without a solidName: it names no Solid; the joint is left out"),
     ('solidName "a\\"b\\nc"', "HingeJoint ending in SolidReference 'a\"bnc': the loop it closes is not closed here "
-                              "(no physics); 'a\"bnc' moves with the joints it is written in only")])
+                              "(no physics); 'a\"bnc' moves with the joints it is written in only"),
+    # no Solid of the robot bears the name (Webots refuses the reference)
+    ('solidName "fingers"', "HingeJoint ending in SolidReference 'fingers': no Solid is named 'fingers' in the robot "
+                            "or solid it is written in (Webots refuses the reference); the joint is left out")])
 def test_a_joint_ending_in_a_solid_reference_is_one_load_line_saying_what_it_ties(tmp_path, reference: str,
                                                                                   line: str) -> None:
     # Webots' solidName: a Solid's name, or <static environment> (the Solid above the joint tied to the world)
     path = tmp_path / "w.wbt"
-    robot = ('Robot { name "arm" children [ HingeJoint { endPoint Solid { name "link" '
-             f'children [ HingeJoint {{ endPoint SolidReference {{ {reference} }} }} ] }} }} ] }}\n')
+    robot = ('Robot { name "arm" children [ HingeJoint { endPoint Solid { name "link" children [ Solid { name "finger" } '
+             'Solid { name "a\\"b\\nc" } RotationalMotor { name "fingers" } '
+             f'HingeJoint {{ endPoint SolidReference {{ {reference} }} }} ] }} }} ] }}\n')
     path.write_text("#VRML_SIM R2023b utf8\n" + robot)
     warnings = [w for w in load_world(path).warnings if "SolidReference" in w]
     assert warnings == [f"{path}:2:{robot.rindex('HingeJoint') + 1}: {line}"], warnings
+
+
+@pytest.mark.parametrize(("name", "says"), [("grip", "whose loop is not closed here"), ("grips", "which names no Solid")])
+def test_a_motor_on_a_joint_ending_in_a_solid_reference_says_whether_it_names_a_solid(tmp_path, name: str,
+                                                                                      says: str) -> None:
+    path = tmp_path / "w.wbt"
+    robot = ('Robot { name "arm" children [ Solid { name "grip" } HingeJoint { device [ RotationalMotor { name "m" } ] '
+             f'endPoint SolidReference {{ solidName "{name}" }} }} ] }}\n')
+    path.write_text("#VRML_SIM R2023b utf8\n" + robot)
+    motor = [w for w in load_world(path).warnings if "motor 'm'" in w]
+    assert motor == [f"{path}:2:{robot.index('HingeJoint') + 1}: HingeJoint motor 'm' is no wheel (its end point has no "
+                     "cylinder or sphere to roll on): its joint moves kinematically (Webots' rule without physics; its "
+                     f"PositionSensor reads it), but moves nothing: its end point is SolidReference '{name}', {says}"], motor

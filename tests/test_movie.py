@@ -217,7 +217,10 @@ def test_the_client_writes_an_mp4_of_the_frames_with_webots_states_and_lines(tmp
     assert "must be even" in errors[5] and errors[5].startswith("Error: wb_supervisor_movie_start_recording(): ")
     assert errors[6].startswith("Error: wb_supervisor_movie_start_recording(): cannot write the movie ") \
         and "no folder" in errors[6], err
-    assert len(errors) == 7 and "not served" not in err, err
+    # a name's line break and tab are shown escaped: its error stays one line
+    assert errors[7] == (f"Error: wb_supervisor_movie_start_recording(): cannot write the movie "
+                         f"'{tmp_path}/no\\nsuch/a\\tb.mp4': no folder '{tmp_path}/no\\nsuch'."), err
+    assert len(errors) == 8 and "not served" not in err, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.mp4"]      # no temporary left behind
     probe = json.loads(subprocess.run(["ffprobe", "-v", "error", "-select_streams", "v:0", "-show_entries",
                                        "stream=codec_name,width,height,r_frame_rate,nb_frames", "-of", "json",

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "motion.c"
+#include "utils.c" /* sn_shown, for its error lines */
 
 /* what motion.c calls outside parsing; never reached here */
 sn_robot *sn_robot_get(const char *func) {

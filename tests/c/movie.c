@@ -20,11 +20,12 @@ static void states(const char *what) {
 int main(void) {
   wb_robot_init();
   const char *out = getenv("MOVIE_OUT");
-  char run[4096], again[4096], bad[4096], folder[4096];
+  char run[4096], again[4096], bad[4096], folder[4096], controls[4096];
   snprintf(run, sizeof run, "%s/run", out); /* ".mp4" added */
   snprintf(again, sizeof again, "%s/again.mp4", out);
   snprintf(bad, sizeof bad, "%s/bad.mp4", out);
   snprintf(folder, sizeof folder, "%s/no/such/folder.mp4", out);
+  snprintf(controls, sizeof controls, "%s/no\nsuch/a\tb.mp4", out);
   WbFieldRef colour = wb_supervisor_node_get_field(wb_supervisor_node_get_from_def("WALL_APP"), "baseColor");
   if (getenv("MOVIE_LEAVE") != NULL) { /* ends while recording: the controller's end writes the movie */
     char left[4096];
@@ -61,6 +62,7 @@ int main(void) {
   states("odd");
   wb_supervisor_movie_start_recording(folder, 160, 120, 0, 90, 1, false);
   states("folder");
+  wb_supervisor_movie_start_recording(controls, 160, 120, 0, 90, 1, false); /* one line */
   wb_robot_step(16);
   printf("done\n");
   fflush(stdout);

@@ -41,5 +41,6 @@ robot.movieStartRecording(os.path.join(out, "bad.mp4"), 161, 120, 0, 90, 1, Fals
 print("odd", robot.movieIsReady(), robot.movieFailed())
 robot.movieStartRecording(os.path.join(out, "no", "such", "folder.mp4"), 160, 120, 0, 90, 1, False)
 print("folder", robot.movieIsReady(), robot.movieFailed())
+robot.movieStartRecording(os.path.join(out, "no\nsuch", "a\tb.mp4"), 160, 120, 0, 90, 1, False)  # one line
 robot.step(16)
 print("done")

@@ -337,11 +337,11 @@ static int save_rgb(const char *func, const char *filename, int quality, const u
     return -1;
   size_t n = strlen(filename);
   if (n < 4 || (strcmp(filename + n - 4, ".png") != 0 && strcmp(filename + n - 4, ".PNG") != 0)) {
-    fprintf(stderr, "Error: %s(): only .png images can be saved by this library ('%s').\n", func, filename);
+    fprintf(stderr, "Error: %s(): only .png images can be saved by this library ('%s').\n", func, sn_shown(filename));
     return -1;
   }
   if (write_png(filename, rgb, w, h) != 0) {
-    fprintf(stderr, "Error: %s(): cannot write '%s'.\n", func, filename);
+    fprintf(stderr, "Error: %s(): cannot write '%s'.\n", func, sn_shown(filename));
     return -1;
   }
   return 0;
@@ -426,7 +426,7 @@ int wb_range_finder_save_image(WbDeviceTag tag, const char *filename, int qualit
   if (hdr) {
     ret = write_hdr(filename, grey, im->width, im->height);
     if (ret != 0)
-      fprintf(stderr, "Error: %s(): cannot write '%s'.\n", func, filename);
+      fprintf(stderr, "Error: %s(): cannot write '%s'.\n", func, sn_shown(filename));
   } else
     ret = save_rgb(func, filename, quality, rgb, im->width, im->height);
   free(grey);

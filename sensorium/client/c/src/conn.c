@@ -57,8 +57,10 @@ static int robot_part(const char *url, const char *part, size_t n, char **robot,
   if (n == 0)
     return 0;
   if (memchr(part, '/', n) != NULL) {
-    snprintf(err, errlen, "controller URL '%s': robot name '%.*s' contains '/'; percent-encode it (%%2F)", url,
-             (int)n, part);
+    char name[512];
+    snprintf(name, sizeof name, "%.*s", (int)n, part);
+    snprintf(err, errlen, "controller URL '%s': robot name '%s' contains '/'; percent-encode it (%%2F)", sn_shown(url),
+             sn_shown(name));
     return -1;
   }
   char *out = malloc(n + 1);
@@ -105,7 +107,8 @@ int sn_parse_url(const char *url_in, sn_url *out, char *err, size_t errlen) {
     size_t slen = (size_t)(sep - url);
     char scheme[16] = {0};
     if (slen >= sizeof scheme) {
-      snprintf(err, errlen, "controller URL '%s': unsupported scheme (use tcp://, ipc:// or a robot name)", url);
+      snprintf(err, errlen, "controller URL '%s': unsupported scheme (use tcp://, ipc:// or a robot name)",
+               sn_shown(url));
       free(url);
       return -1;
     }
@@ -121,7 +124,7 @@ int sn_parse_url(const char *url_in, sn_url *out, char *err, size_t errlen) {
       if (hlen > 0 && rest[0] == '[') { /* IPv6 literal: [::1]:5560 */
         const char *close = memchr(rest, ']', hlen);
         if (close == NULL) {
-          snprintf(err, errlen, "controller URL '%s': unterminated IPv6 address", url);
+          snprintf(err, errlen, "controller URL '%s': unterminated IPv6 address", sn_shown(url));
           rc = -1;
         } else {
           host_len = (size_t)(close - rest) + 1;
@@ -141,7 +144,7 @@ int sn_parse_url(const char *url_in, sn_url *out, char *err, size_t errlen) {
         }
       }
       if (rc == 0 && host_len == 0) {
-        snprintf(err, errlen, "controller URL '%s': no host", url);
+        snprintf(err, errlen, "controller URL '%s': no host", sn_shown(url));
         rc = -1;
       }
       long portnum = DEFAULT_PORT;
@@ -151,7 +154,9 @@ int sn_parse_url(const char *url_in, sn_url *out, char *err, size_t errlen) {
           digits = isdigit((unsigned char)port[i]) != 0;
         portnum = digits ? strtol(port, NULL, 10) : -1;
         if (!digits || portnum <= 0 || portnum >= 65536) {
-          snprintf(err, errlen, "controller URL '%s': bad port '%.*s'", url, (int)port_len, port);
+          char shown[64];
+          snprintf(shown, sizeof shown, "%.*s", (int)port_len, port);
+          snprintf(err, errlen, "controller URL '%s': bad port '%s'", sn_shown(url), sn_shown(shown));
           rc = -1;
         }
       }
@@ -165,7 +170,7 @@ int sn_parse_url(const char *url_in, sn_url *out, char *err, size_t errlen) {
     } else if (strcmp(scheme, "ipc") == 0 || strcmp(scheme, "inproc") == 0) {
       size_t rlen = strlen(rest);
       if (rlen == 0) {
-        snprintf(err, errlen, "controller URL '%s': no path", url);
+        snprintf(err, errlen, "controller URL '%s': no path", sn_shown(url));
         rc = -1;
       } else if (rest[rlen - 1] == '/') {
         while (rlen > 0 && rest[rlen - 1] == '/')
@@ -189,8 +194,8 @@ int sn_parse_url(const char *url_in, sn_url *out, char *err, size_t errlen) {
         }
       }
     } else {
-      snprintf(err, errlen, "controller URL '%s': unsupported scheme '%s' (use tcp://, ipc:// or a robot name)", url,
-               scheme);
+      snprintf(err, errlen, "controller URL '%s': unsupported scheme '%s' (use tcp://, ipc:// or a robot name)",
+               sn_shown(url), sn_shown(scheme));
       rc = -1;
     }
   }

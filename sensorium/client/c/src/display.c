@@ -439,7 +439,7 @@ WbImageRef wb_display_image_load(WbDeviceTag tag, const char *filename) {
   unsigned char *rgba;
   char why[256];
   if (read_image(filename, &width, &height, &rgba, why, sizeof why) != 0) {
-    fprintf(stderr, "Error: %s(): the \"%s\" image is unreadable (%s).\n", func, filename, why);
+    fprintf(stderr, "Error: %s(): the \"%s\" image is unreadable (%s).\n", func, sn_shown(filename), why);
     return NULL;
   }
   WbImageRef ir = image_new(func, tag, width, height, rgba, WB_IMAGE_RGBA);
@@ -567,7 +567,7 @@ void wb_display_image_save(WbDeviceTag tag, WbImageRef ir, const char *filename)
   if (data == NULL || data->type != MSGPACK_OBJECT_BIN || w < 1 || h < 1 ||
       data->via.bin.size != 4 * (size_t)w * (size_t)h) {
     fprintf(stderr, "Error: %s(): image %d of Display '%s' holds no pixels (a copy outside the display, or "
-                    "deleted): '%s' is not written.\n", func, id, d->name, filename);
+                    "deleted): '%s' is not written.\n", func, id, d->name, sn_shown(filename));
     sn_reply_free(&rep);
     return;
   }
@@ -587,7 +587,7 @@ void wb_display_image_save(WbDeviceTag tag, WbImageRef ir, const char *filename)
     char why[256] = "";
     const int rc = jpeg ? sn_write_jpeg(filename, out, w, h, 100, why, sizeof why) : sn_write_png(filename, out, w, h, 4);
     if (rc != 0)
-      fprintf(stderr, "Error: %s(): cannot write '%s'%s%s%s.\n", func, filename, why[0] ? " (" : "", why,
+      fprintf(stderr, "Error: %s(): cannot write '%s'%s%s%s.\n", func, sn_shown(filename), why[0] ? " (" : "", why,
               why[0] ? ")" : "");
     free(out);
   }

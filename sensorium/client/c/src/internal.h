@@ -48,6 +48,15 @@ enum {
 };
 const char *sn_error_name(int code);
 
+/* ------------------------------------------------------------------ utils.c */
+/* s as it may show inside one error line: control characters as \n, \t, \r or \xNN (the Python
+ * side's repr escapes), other bytes (UTF-8 included) as they are, cut with "..." past SN_SHOWN_MAX
+ * bytes; NULL as "(null)". The text lives in one of SN_SHOWN_SLOTS buffers of the calling thread, reused
+ * in turn: up to that many may be shown in one fprintf. */
+#define SN_SHOWN_MAX 4096
+#define SN_SHOWN_SLOTS 4
+const char *sn_shown(const char *s);
+
 /* ------------------------------------------------------------------ wire.c */
 typedef struct {
   msgpack_sbuffer buf;

@@ -59,7 +59,7 @@ static int read_line(reader *r) {
   bool nul = false;
   while ((c = getc(r->f)) != EOF && c != '\n') {
     if (n == MAX_LINE) {
-      fprintf(stderr, "Error: " NEW "(): file '%s', line %d: longer than %d characters.\n", r->filename,
+      fprintf(stderr, "Error: " NEW "(): file '%s', line %d: longer than %d characters.\n", sn_shown(r->filename),
               r->number + 1, MAX_LINE);
       return -1;
     }
@@ -67,7 +67,7 @@ static int read_line(reader *r) {
     r->buf[n++] = (char)c;
   }
   if (c == EOF && ferror(r->f)) { /* a folder, a read error: what the Python client says for its OSError */
-    fprintf(stderr, "Error: " NEW "(): could not open '%s' file.\n", r->filename);
+    fprintf(stderr, "Error: " NEW "(): could not open '%s' file.\n", sn_shown(r->filename));
     return -1;
   }
   if (c == EOF && n == 0)
@@ -75,7 +75,7 @@ static int read_line(reader *r) {
   r->buf[n] = '\0';
   r->number++;
   if (nul) {
-    fprintf(stderr, "Error: " NEW "(): file '%s', line %d: holds a NUL character.\n", r->filename, r->number);
+    fprintf(stderr, "Error: " NEW "(): file '%s', line %d: holds a NUL character.\n", sn_shown(r->filename), r->number);
     return -1;
   }
   return 1;
@@ -178,14 +178,14 @@ static char *copy(const char *s) {
 
 #define FAIL(...)                                                                                   \
   do {                                                                                              \
-    fprintf(stderr, "Error: " NEW "(): file '%s', line %d: ", r->filename, r->number);              \
+    fprintf(stderr, "Error: " NEW "(): file '%s', line %d: ", sn_shown(r->filename), r->number);           \
     fprintf(stderr, __VA_ARGS__);                                                                   \
     fprintf(stderr, ".\n");                                                                         \
     return false;                                                                                   \
   } while (0)
 
 static bool out_of_memory(const reader *r) {
-  fprintf(stderr, "Error: " NEW "(): file '%s': out of memory.\n", r->filename);
+  fprintf(stderr, "Error: " NEW "(): file '%s': out of memory.\n", sn_shown(r->filename));
   return false;
 }
 
@@ -195,7 +195,7 @@ static bool parse(reader *r, WbMotionRef m) {
   if (got < 0)
     return false;
   if (got == 0) {
-    fprintf(stderr, "Error: " NEW "(): file '%s' is empty.\n", r->filename);
+    fprintf(stderr, "Error: " NEW "(): file '%s' is empty.\n", sn_shown(r->filename));
     return false;
   }
   split(r);
@@ -221,7 +221,7 @@ static bool parse(reader *r, WbMotionRef m) {
         split(r);
         if (r->n_tokens > 0) {
           fprintf(stderr, "Warning: " NEW "(): file '%s', line %d: ignored with every line after the empty line %d "
-                  "(an empty line ends the poses, as in Webots).\n", r->filename, r->number, empty);
+                  "(an empty line ends the poses, as in Webots).\n", sn_shown(r->filename), r->number, empty);
           break;
         }
       }
@@ -269,7 +269,7 @@ static bool parse(reader *r, WbMotionRef m) {
   if (got < 0)
     return false;
   if (m->n_poses == 0) {
-    fprintf(stderr, "Error: " NEW "(): file '%s' has no pose.\n", r->filename);
+    fprintf(stderr, "Error: " NEW "(): file '%s' has no pose.\n", sn_shown(r->filename));
     return false;
   }
   return true;
@@ -346,13 +346,13 @@ WbMotionRef wbu_motion_new(const char *filename) {
   sn_robot *rb = sn_robot_get(NEW);
   FILE *f = fopen(filename, "rb");
   if (f == NULL) {
-    fprintf(stderr, "Error: " NEW "(): could not open '%s' file.\n", filename);
+    fprintf(stderr, "Error: " NEW "(): could not open '%s' file.\n", sn_shown(filename));
     return NULL;
   }
   reader *r = calloc(1, sizeof *r);
   WbMotionRef m = calloc(1, sizeof *m);
   if (r == NULL || m == NULL) {
-    fprintf(stderr, "Error: " NEW "(): file '%s': out of memory.\n", filename);
+    fprintf(stderr, "Error: " NEW "(): file '%s': out of memory.\n", sn_shown(filename));
     free(r);
     free(m);
     fclose(f);
@@ -364,7 +364,7 @@ WbMotionRef wbu_motion_new(const char *filename) {
   fclose(f);
   free(r);
   if (ok && ((m->filename = copy(filename)) == NULL || (m->tags = calloc((size_t)m->n_motors, sizeof *m->tags)) == NULL)) {
-    fprintf(stderr, "Error: " NEW "(): file '%s': out of memory.\n", filename);
+    fprintf(stderr, "Error: " NEW "(): file '%s': out of memory.\n", sn_shown(filename));
     ok = false;
   }
   if (!ok) {
@@ -378,10 +378,10 @@ WbMotionRef wbu_motion_new(const char *filename) {
         d = &rb->devices[i];
     if (d == NULL)
       fprintf(stderr, "Warning: " NEW "(): ignoring motor '%s' of file '%s': robot '%s' has no such device.\n",
-              m->motors[j], filename, rb->name);
+              sn_shown(m->motors[j]), sn_shown(filename), rb->name);
     else if (d->node_type != WB_NODE_ROTATIONAL_MOTOR && d->node_type != WB_NODE_LINEAR_MOTOR)
-      fprintf(stderr, "Warning: " NEW "(): ignoring '%s' of file '%s': it is a %s, not a motor.\n", m->motors[j],
-              filename, d->type_name);
+      fprintf(stderr, "Warning: " NEW "(): ignoring '%s' of file '%s': it is a %s, not a motor.\n",
+              sn_shown(m->motors[j]), sn_shown(filename), d->type_name);
     else
       m->tags[j] = d->tag;
   }

@@ -127,9 +127,9 @@ static void start(sn_robot *rb, const char *func, const char *filename, int widt
   char why[8400];
   if (is_dir(g_name) || !is_dir(folder)) {
     if (is_dir(g_name))
-      snprintf(why, sizeof why, "cannot write the movie '%s': it is a folder", g_name);
+      snprintf(why, sizeof why, "cannot write the movie '%s': it is a folder", sn_shown(g_name));
     else
-      snprintf(why, sizeof why, "cannot write the movie '%s': no folder '%s'", g_name, folder);
+      snprintf(why, sizeof why, "cannot write the movie '%s': no folder '%s'", sn_shown(g_name), sn_shown(folder));
     fail(func, why, WB_SUPERVISOR_MOVIE_SIMULATION_ERROR);
     return;
   }
@@ -319,7 +319,7 @@ static int poll_movie(sn_robot *rb, int wait_ms) {
   char why[8400];
   if (done > 0 && WIFEXITED(st) && WEXITSTATUS(st) == RENAME_FAILED) {
     remove(g_tmp);
-    snprintf(why, sizeof why, "cannot write '%s': the encoded movie could not be renamed onto it", g_name);
+    snprintf(why, sizeof why, "cannot write '%s': the encoded movie could not be renamed onto it", sn_shown(g_name));
     fail(func, why, WB_SUPERVISOR_MOVIE_WRITE_ERROR);
   } else if (done < 0 || !WIFEXITED(st) || WEXITSTATUS(st) != 0) {
     remove(g_tmp);

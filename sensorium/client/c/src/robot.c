@@ -47,7 +47,7 @@ static int timeout_from_env(void) {
   char *end;
   double v = strtod(s, &end);
   if (*end != '\0' || !(v > 0) || v > 86400) {
-    fprintf(stderr, "Error: wb_robot_init(): SENSORIUM_CONTROLLER_TIMEOUT='%s' is not a number of seconds > 0\n", s);
+    fprintf(stderr, "Error: wb_robot_init(): SENSORIUM_CONTROLLER_TIMEOUT='%s' is not a number of seconds > 0\n", sn_shown(s));
     exit(1);
   }
   return (int)(v * 1000);
@@ -403,7 +403,8 @@ int wb_robot_init(void) {
   sn_reply rep;
   if (call(c, &r, id, g_timeout_ms, &rep) != 0) {
     char msg[700];
-    snprintf(msg, sizeof msg, "attaching to robot '%s' at %s: %s", name ? name : "", sn_conn_endpoint(c), rep.message);
+    snprintf(msg, sizeof msg, "attaching to robot '%s' at %s: %s", sn_shown(name ? name : ""), sn_conn_endpoint(c),
+             rep.message);
     fatal("wb_robot_init", rep.code, msg);
   }
   sn_robot *rb = calloc(1, sizeof *rb);
@@ -777,7 +778,7 @@ WbDeviceTag wb_robot_get_device(const char *name) {
     if (strcmp(rb->devices[i].name, name) == 0)
       return rb->devices[i].tag;
   /* Webots warns too: a misspelt name would otherwise only show as a later "invalid device tag 0" */
-  fprintf(stderr, "Warning: wb_robot_get_device(): robot \"%s\" has no device \"%s\".\n", rb->name, name);
+  fprintf(stderr, "Warning: wb_robot_get_device(): robot \"%s\" has no device \"%s\".\n", rb->name, sn_shown(name));
   return 0;
 }
 

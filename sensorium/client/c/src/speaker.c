@@ -133,12 +133,12 @@ static void play(sn_device *d, const char *sound, double volume, double pitch, d
     int got = wav_length(sound, &frames, &rate);
     if (got == -1) {
       fprintf(stderr, "Warning: %s(): Sound file '%s' not found. The sound file should be defined relatively to the "
-              "controller, the PROTO or absolutely.\n", func, sound);
+              "controller, the PROTO or absolutely.\n", func, sn_shown(sound));
       return;
     }
     if (got != 0) {
       fprintf(stderr, "Warning: %s(): Impossible to play '%s'. Make sure the file format is supported (8 or 16 bits, "
-              "mono or stereo wave).\n", func, sound);
+              "mono or stereo wave).\n", func, sn_shown(sound));
       return;
     }
     size_t n = strlen(sound) + 1;
@@ -271,7 +271,7 @@ bool wb_speaker_set_language(WbDeviceTag tag, const char *language) {
       l[3] > 'Z' || l[4] < 'A' || l[4] > 'Z') {
     fprintf(stderr, "Error: %s() called with an invalid 'language' argument: \"%s\". 'language' should follow the "
             "\"ll-CC\" format where ll is the ISO 639-1 language code and CC is the ISO 3166 country code, for example, "
-            "\"en-US\" or \"fr-FR\"; the \"%s\" engine speaks ", func, l, d->engine);
+            "\"en-US\" or \"fr-FR\"; the \"%s\" engine speaks ", func, sn_shown(l), d->engine);
     for (size_t i = 0; i < N_LANGUAGES; i++)
       fprintf(stderr, "\"%s\"%s", LANGUAGES[i], i + 1 < N_LANGUAGES ? ", " : ".\n");
     return false;

@@ -665,7 +665,7 @@ bool wb_supervisor_world_save(const char *filename) {
     if (ok && rename(tmp, filename) != 0)
       ok = false;
     if (!ok) {
-      fprintf(stderr, "Error: %s(): cannot write '%s': %s.\n", func, filename, strerror(errno));
+      fprintf(stderr, "Error: %s(): cannot write '%s': %s.\n", func, sn_shown(filename), strerror(errno));
       remove(tmp);
     }
   }
@@ -910,7 +910,7 @@ static WbFieldRef field_at(WbNodeRef node, const char *field_name, int level, co
     return NULL;
   if (t == WB_NO_FIELD) {
     fprintf(stderr, "Error: %s(): node %d (%s) has no field '%s' in Sensorium (README \"Supervisor\" lists the fields "
-                    "of each node kind).\n", func, (int)node->id, node->type_name, field_name);
+                    "of each node kind).\n", func, (int)node->id, node->type_name, sn_shown(field_name));
     return NULL;
   }
   struct WbFieldStructPrivate *f = calloc(1, sizeof *f);
@@ -2073,7 +2073,7 @@ void wb_supervisor_export_image(const char *filename, int quality) {
   const bool png = ends_with(filename, ".png");
   const char *ext = png ? ".png" : ends_with(filename, ".jpg") ? ".jpg" : ends_with(filename, ".jpeg") ? ".jpeg" : NULL;
   if (ext == NULL) {
-    fprintf(stderr, "Error: %s(): unsupported image format of '%s' (use .png, .jpg or .jpeg).\n", func, filename);
+    fprintf(stderr, "Error: %s(): unsupported image format of '%s' (use .png, .jpg or .jpeg).\n", func, sn_shown(filename));
     return;
   }
   sn_reply rep;
@@ -2083,7 +2083,7 @@ void wb_supervisor_export_image(const char *filename, int quality) {
   int w = (int)sn_int_or(rep.result, "width", 0), h = (int)sn_int_or(rep.result, "height", 0);
   if (data == NULL || data->type != MSGPACK_OBJECT_BIN || w < 1 || h < 1 ||
       data->via.bin.size != 3 * (size_t)w * (size_t)h) {
-    fprintf(stderr, "Error: %s(): the server sent no picture: '%s' is not written.\n", func, filename);
+    fprintf(stderr, "Error: %s(): the server sent no picture: '%s' is not written.\n", func, sn_shown(filename));
     sn_reply_free(&rep);
     return;
   }
@@ -2101,7 +2101,7 @@ void wb_supervisor_export_image(const char *filename, int quality) {
   if (rc == 0 && rename(tmp, filename) != 0)
     rc = -1;
   if (rc != 0) {
-    fprintf(stderr, "Error: %s(): cannot write '%s'%s%s%s.\n", func, filename, why[0] ? " (" : "", why, why[0] ? ")" : "");
+    fprintf(stderr, "Error: %s(): cannot write '%s'%s%s%s.\n", func, sn_shown(filename), why[0] ? " (" : "", why, why[0] ? ")" : "");
     remove(tmp);
   }
   free(tmp);

@@ -1,6 +1,6 @@
 /* Sensorium C controller library: console printing (console.h) and Webots' system and string helpers
- * (utils/system.h, utils/string.h). None of them talks to the server. Written from Webots' documented
- * behaviour. */
+ * (utils/system.h, utils/string.h), and how the library shows a caller's string in an error line. None of
+ * them talks to the server. Written from Webots' documented behaviour. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -8,6 +8,8 @@
 #include <webots/console.h>
 #include <webots/utils/string.h>
 #include <webots/utils/system.h>
+
+#include "internal.h"
 
 /* ------------------------------------------------------------------ console */
 void wb_console_print(const char *text, int stream) {
@@ -84,5 +86,42 @@ char *wbu_string_replace(char *value, const char *before, const char *after) {
     r = p + nb;
   }
   strcpy(w, r);
+  return out;
+}
+
+/* ------------------------------------------------------------------ names in error lines */
+const char *sn_shown(const char *s) {
+  static _Thread_local char slots[SN_SHOWN_SLOTS][SN_SHOWN_MAX + 8];
+  static _Thread_local int next = 0;
+  char *out = slots[next];
+  next = (next + 1) % SN_SHOWN_SLOTS;
+  if (s == NULL)
+    return "(null)";
+  size_t n = 0;
+  for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+    char piece[5];
+    if (*p == '\n' || *p == '\t' || *p == '\r')
+      snprintf(piece, sizeof piece, "\\%c", *p == '\n' ? 'n' : *p == '\t' ? 't' : 'r');
+    else if (*p < 0x20 || *p == 0x7f)
+      snprintf(piece, sizeof piece, "\\x%02x", *p);
+    else {
+      piece[0] = (char)*p;
+      piece[1] = '\0';
+    }
+    size_t len = strlen(piece);
+    if (n + len > SN_SHOWN_MAX) {
+      if ((*p & 0xC0) == 0x80) { /* the cut is inside a UTF-8 character: its first bytes go too */
+        while (n > 0 && ((unsigned char)out[n - 1] & 0xC0) == 0x80)
+          n--;
+        if (n > 0 && (unsigned char)out[n - 1] >= 0xC0)
+          n--;
+      }
+      memcpy(out + n, "...", 4);
+      return out;
+    }
+    memcpy(out + n, piece, len);
+    n += len;
+  }
+  out[n] = '\0';
   return out;
 }

@@ -93,6 +93,8 @@ JOINT_MOVES = ("its joint moves kinematically (Webots' rule without physics; its
 # gripper's fingers): nothing is past it here, as the loop is not closed
 JOINT_MOVES_NOTHING = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), "
                        "but moves nothing: its end point is SolidReference {name!r}, whose loop is not closed here")
+JOINT_MOVES_NO_SOLID = ("its joint moves kinematically (Webots' rule without physics; its PositionSensor reads it), "
+                        "but moves nothing: its end point is SolidReference {name!r}, which names no Solid")
 # the fields every Solid has (a device's own fields are the others)
 SOLID_FIELDS = {"translation", "rotation", "children", "name", "model", "description", "contactMaterial",
                 "immersionProperties", "boundingObject", "physics", "locked", "radarCrossSection",
@@ -191,6 +193,34 @@ def _scope_defs(root: Node) -> dict[str, tuple[int, str]]:
     return found
 
 
+# nodes that take a name but are no Solid: a SolidReference cannot name them
+_NAMED_NOT_SOLID = frozenset({"RotationalMotor", "LinearMotor", "PositionSensor", "Brake", "Skin"})
+
+
+def _solid_names(root: Node) -> set[str] | None:
+    """The names of the Solids under the top-level node ``root`` (``root`` too): those a SolidReference
+    inside it may name (Webots: a Solid with a common upper Solid). A Solid written without a name is
+    "solid". None when the subtree is over :data:`SCOPE_NODES` nodes (not searched: nothing is refused)."""
+    names: set[str] = set()
+    stack, seen = [root], set()
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if len(seen) > SCOPE_NODES:
+            return None
+        name = node.fields.get("name")
+        if isinstance(name, list) and len(name) == 1:
+            name = name[0]
+        if isinstance(name, str) and node.type not in _NAMED_NOT_SOLID:
+            names.add(name)
+        elif name is None and node.type == "Solid":
+            names.add("solid")
+        stack += _sub_nodes(node)
+    return names
+
+
 _PHYSICS_ONLY = frozenset({"Physics", "Damping", "ContactProperties", "ImmersionProperties", "Fluid", "Muscle"})
 
 
@@ -257,6 +287,9 @@ class Converter:
         # getFromProtoDef: the PROTO instances being walked (innermost last), the robot or top-level solid whose
         # entries are being made, and the number the next PROTO instance nested in a top-level solid gets
         self.scopes: list[_Scope] = []
+        self.top_walked: Node | None = None          # the top-level node being walked
+        self.top_solid_names: set[str] | None = None   # its Solids' names, once a SolidReference asks (_solid_names)
+        self.top_names_read = False
         self.inner_owner: dict | None = None
         self.scope_serial = 0
         self.lights_seen = 0               # lights on, or an LED's, anywhere (the world's, solids', robots')
@@ -474,6 +507,8 @@ class Converter:
 
     # ------------------------------------------------------------ the walk
     def visit(self, node: Node, frame: Frame, owner: Owner, top: bool = False) -> None:
+        if top:
+            self.top_walked, self.top_names_read = node, False
         pushed = self.tree_node(node, frame, owner)
         try:
             if node.proto is not None and node.instance_at is not None:
@@ -1918,6 +1953,10 @@ class Converter:
                 elif not name:
                     self.warn(node, f"{node.type} ending in a SolidReference without a solidName: it names no Solid; "
                                     "the joint is left out")
+                elif not self.names_a_solid(name):
+                    self.warn(node, f"{node.type} ending in SolidReference {name!r}: no Solid is named {name!r} in "
+                                    "the robot or solid it is written in (Webots refuses the reference); the joint "
+                                    "is left out")
                 else:
                     self.warn(node, f"{node.type} ending in SolidReference {name!r}: the loop it closes is not "
                                     f"closed here (no physics); {name!r} moves with the joints it is written in only")
@@ -1930,6 +1969,14 @@ class Converter:
             finally:
                 if moving:
                     self.riding.pop()
+
+    def names_a_solid(self, name: str) -> bool:
+        """Whether a Solid of the top-level node being walked is named ``name`` (true when not searched)."""
+        if self.top_walked is None:
+            return True
+        if not self.top_names_read:
+            self.top_solid_names, self.top_names_read = _solid_names(self.top_walked), True
+        return self.top_solid_names is None or name in self.top_solid_names
 
     def slotted(self, end: Node | None) -> Node | None:
         """A joint's end point, through the Slots that hold it (a Slot adds no frame)."""
@@ -2412,7 +2459,8 @@ class Converter:
                 end = self.fields(joint).node_("endPoint")
                 if end is not None and end.type == "SolidReference" and line.endswith(JOINT_MOVES):
                     name = self.fields(end).string("solidName", "")
-                    line = line[:-len(JOINT_MOVES)] + JOINT_MOVES_NOTHING.format(name=name)
+                    nothing = JOINT_MOVES_NOTHING if self.names_a_solid(name) else JOINT_MOVES_NO_SOLID
+                    line = line[:-len(JOINT_MOVES)] + nothing.format(name=name)
                 self.warn(joint, line)
             return
         reasons: dict[str, int] = {}
