@@ -88,6 +88,7 @@ from sensorium.server.world.report import warn_losses
 from sensorium.server.world.top_nodes import top_level
 
 _REMOVED = wm.Solid.model_construct(name="", def_name="")   # a removed imported solid's model: its name and DEF
+_NOBODY: frozenset[int] = frozenset()   # no robot powered off (a world without batteries)
 
 
 class SettlingGrounds:
@@ -846,7 +847,7 @@ class Simulation:
             self._charge(dt)
         # robots whose battery emptied: no motion, no new sample until a Charger gives energy (Webots'
         # WbRobot::powerOn(false): motors without torque, sensors not refreshed)
-        off = {r.index for r in self._powered if not r.battery.powered} if self._powered else set()
+        off = {r.index for r in self._powered if not r.battery.powered} if self._powered else _NOBODY
         if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
@@ -857,7 +858,7 @@ class Simulation:
         if self._jointed:             # joints move kinematically (sim/joints.py), and what rides on them
             dt_s = dt * 0.001
             for joint, owner in zip(self._jointed, self._joint_robot):
-                if owner in off:      # no torque: it holds where it is (README 'Battery and Charger')
+                if off and owner in off:      # no torque: it holds where it is (README 'Battery and Charger')
                     joint.speed = joint.rate = 0.0
                 else:
                     joint.advance(dt_s)
@@ -871,7 +872,7 @@ class Simulation:
             drive = robot.drive
             assert drive is not None
             robot.pressing = False
-            if robot.index in off:    # its wheels' motors have no torque: the robot stays
+            if off and robot.index in off:    # its wheels' motors have no torque: the robot stays
                 continue
             start = (drive.x, drive.y)
             yaw0 = drive.yaw
@@ -914,9 +915,10 @@ class Simulation:
         poses = self.scene.robot_poses
         if radio is not None:
             radio.deliver(poses)      # range, cones, line of sight and readings at the end-of-step poses
-        emptied = [robot for robot in self._powered if robot.battery.drain(dt)]   # Webots' postPhysicsStep
+        # Webots' postPhysicsStep (a world without batteries pays nothing here)
+        emptied = [robot for robot in self._powered if robot.battery.drain(dt)] if self._powered else ()
         for robot in emptied:         # powered off: its LEDs go dark, its sensors keep their last values
-            off.add(robot.index)
+            off = off | {robot.index}
             for dev in robot.devices.values():
                 if isinstance(dev, LED):
                     dev.power_off()
