@@ -579,7 +579,23 @@ class Scene:
         # cameras read these (sim/cameras.py): base colour (white without appearance) and transparency
         self.colors = np.array([_base_color(shape) for _, _, shape in self._parts] + [(1.0, 1.0, 1.0)]).reshape(-1, 3)
         self.transparency = np.array([s.transparency for s in self.shapes] + [0.0])
-        self.emissive = emissive_array([self._emissive_now(k, shape) for k, (_, _, shape) in enumerate(self._parts)])
+        self._rebuild_emissive()
+
+    def _rebuild_emissive(self) -> None:
+        """Every shape's emissive row now (None when nothing glows)."""
+        self.emissive = emissive_array([self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)])
+
+    def _refresh_emissive(self, shape: int) -> None:
+        """One shape's emissive row after its model or glow changed: the array built when it is the first
+        to glow, dropped when it was the last."""
+        glow = self._emissive_now(shape, self._parts[shape][2])
+        if self.emissive is None:
+            if any(glow):
+                self._rebuild_emissive()
+            return
+        self.emissive[shape] = glow
+        if not self.emissive.any():
+            self.emissive = None
 
     def _emissive_now(self, shape: int, model: wm.Shape | wm.Solid) -> tuple[float, float, float]:
         """:func:`emissive_of` a shape, its colour a Charger's glow (``set_glow``) where it has one."""
@@ -594,19 +610,12 @@ class Scene:
 
     def set_glow(self, shape: int, color: tuple[float, float, float]) -> None:
         """A Charger's glowing shape's emissive colour now (WbCharger sets its Material's or
-        PBRAppearance's ``emissiveColor``): cameras add it, times the appearance's intensity, from the
-        next image; the shape's model keeps the world file's colour."""
+        PBRAppearance's ``emissiveColor``): cameras add it from the next image; the shape's model keeps
+        the world file's colour."""
         if self._glow.get(shape) == color:
             return
         self._glow[shape] = color
-        glow = self._emissive_now(shape, self._parts[shape][2])
-        if self.emissive is None:
-            if any(glow):
-                self.emissive = emissive_array([self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)])
-            return
-        self.emissive[shape] = glow
-        if not self.emissive.any():
-            self.emissive = None
+        self._refresh_emissive(shape)
 
     def set_appearance(self, shape: int, appearance: wm.Appearance) -> None:
         """A Supervisor's new colour, roughness or transparency for one shape (Webots' Material and
@@ -682,13 +691,7 @@ class Scene:
         self.shapes[shape] = info
         self.red[shape], self.roughness[shape], self.transparency[shape] = info.red, info.roughness, info.transparency
         self.colors[shape] = _base_color(model)
-        glow = self._emissive_now(shape, model)
-        if self.emissive is not None:
-            self.emissive[shape] = glow
-            if not self.emissive.any():
-                self.emissive = None
-        elif any(glow):
-            self.emissive = emissive_array([self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)])
+        self._refresh_emissive(shape)
 
     def shape_model(self, shape: int) -> wm.Shape | wm.Solid:
         """A shape's model now (its appearance as a Supervisor last set it)."""
@@ -840,7 +843,7 @@ class Scene:
             self.roughness = np.append(self.roughness[:n], self.roughness[-1])
             self.colors = np.concatenate([self.colors[:n], self.colors[-1:]])
             self.transparency = np.append(self.transparency[:n], self.transparency[-1])
-            self.emissive = emissive_array([self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)])
+            self._rebuild_emissive()
             self.shapes_version += 1
 
     def solid_entries(self, solid: wm.Solid) -> tuple[list, list[ShapeEntry]]:
