@@ -1353,6 +1353,12 @@ def static_balance(sim: Any, node: Node) -> bool:
                                                    else center_of_mass(sim, node))
 
 
+def _touching_through(points: np.ndarray, tags: list, moving: set) -> tuple[np.ndarray, list]:
+    """The contact points (flat or (n, 3)) whose solid's tag is in ``moving``, and their tags."""
+    keep = [k for k, tag in enumerate(tags) if tag in moving]
+    return points.reshape(-1, 3)[keep], [tags[k] for k in keep]
+
+
 def contact_points(sim: Any, node: Node, descendants: bool) -> dict:
     """Webots' ``getContactPoints`` of a top-level solid or robot (sim/balance.py): where its bounding
     shapes (with ``descendants``, the solids' inside it too) touch the ground now, in world axes, each
@@ -1370,9 +1376,7 @@ def contact_points(sim: Any, node: Node, descendants: bool) -> dict:
             return {"points": [], "nodes": []}
         points, owners = balance.robot_contacts(sim, state, descendants)
         if static:                              # only the nested solids physics moves touch
-            moving = balance.dynamic_entries(list(state.model.nodes))
-            keep = [k for k, owner in enumerate(owners) if owner in moving]
-            points, owners = points.reshape(-1, 3)[keep], [owners[k] for k in keep]
+            points, owners = _touching_through(points, owners, balance.dynamic_entries(list(state.model.nodes)))
         ids = [node.id if k < 0 or k >= len(inside) else inside[k].id for k in owners]
     else:
         model = next(s for s in sim.world.solids if s.name == node.key)
@@ -1380,9 +1384,7 @@ def contact_points(sim: Any, node: Node, descendants: bool) -> dict:
             return {"points": [], "nodes": []}
         points, paths = balance.solid_contacts(sim, node.key, descendants)
         if not model.physics:
-            moving_paths = balance.dynamic_solids(model)
-            keep = [k for k, path in enumerate(paths) if path in moving_paths]
-            points, paths = points.reshape(-1, 3)[keep], [paths[k] for k in keep]
+            points, paths = _touching_through(points, paths, balance.dynamic_solids(model))
         by_path = {n.path: n.id for n in inside if n.path}
         ids = [by_path.get(path, node.id) for path in paths]
     return {"points": [float(v) for v in points.reshape(-1)], "nodes": ids}
