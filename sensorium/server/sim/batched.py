@@ -955,8 +955,7 @@ class BatchedSimulation:
         out_pos = np.empty((C, self.R + len(robot), 3))
         out_rot[:, :self.R] = rot
         out_pos[:, :self.R] = pos
-        out_rot[:, self.R:] = np.matmul(rr, lr)
-        out_pos[:, self.R:] = np.matmul(rr, lp[..., None])[..., 0] + pos[:, robot]
+        out_rot[:, self.R:], out_pos[:, self.R:] = batched_joints.compose_stacked(rr, pos[:, robot], lr, lp)
         return out_rot, out_pos
 
     # -- motion

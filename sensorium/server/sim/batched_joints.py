@@ -36,7 +36,7 @@ from sensorium.server.sim.joints import Links
 from sensorium.server.sim.simulation import couple, joint_motor
 from sensorium.server.world.geometry import Pose
 
-__all__ = ["BatchedJoints", "PLACED_KINDS", "RIDING_KINDS", "joint_motors"]
+__all__ = ["BatchedJoints", "PLACED_KINDS", "RIDING_KINDS", "compose_stacked", "joint_motors"]
 
 _POSITION_THRESHOLD = 1e-6       # joints.py's (Webots' TARGET_POSITION_THRESHOLD)
 _VELOCITY_THRESHOLD = 1e-6
@@ -50,6 +50,12 @@ RIDING_KINDS = (*PLACED_KINDS, "PositionSensor", "TouchSensor", "RotationalMotor
 light sensor's normal) start from each copy's link, encoders (which read a motor, wherever they sit),
 bumpers without shapes of their own (which read their robot's contact, wherever they sit: a bumper's
 own shapes on a joint are refused) and the nested joints' motors."""
+
+
+def compose_stacked(rot: np.ndarray, pos: np.ndarray, rot2: np.ndarray, pos2: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Frames (``rot`` (..., 3, 3), ``pos`` (..., 3)) composed with others, stacked: Pose.compose's
+    products (``rot @ rot2``, ``rot @ pos2 + pos``), so each frame's bits are the single simulation's."""
+    return np.matmul(rot, rot2), np.matmul(rot, pos2[..., None])[..., 0] + pos
 
 
 def joint_motors(robot: wm.Robot) -> list[wm.RotationalMotor | wm.LinearMotor]:
@@ -286,8 +292,7 @@ class BatchedJoints:
                 rot = np.broadcast_to(np.eye(3), (len(c), 3, 3))
                 pos = axis * delta[:, None]
             if parent >= 0:              # the parent's displacement ∘ its own (Pose.compose)
-                prot = self.link_rot[c, parent]
-                rot, pos = np.matmul(prot, rot), np.matmul(prot, pos[:, :, None])[:, :, 0] + self.link_pos[c, parent]
+                rot, pos = compose_stacked(self.link_rot[c, parent], self.link_pos[c, parent], rot, pos)
             self.link_rot[c, j] = rot
             self.link_pos[c, j] = pos
             self.placed[c, j] = True

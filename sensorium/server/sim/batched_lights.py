@@ -32,6 +32,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import light as light_math
+from sensorium.server.sim.batched_joints import compose_stacked
 from sensorium.server.sim.scene import for_light_sensors, light_from_model, link_aimed, place_light, robot_led_lights
 from sensorium.server.world.geometry import Pose
 
@@ -181,11 +182,9 @@ class CarriedLights:
             cols = self._link[linked]
             Ld = self._link_rot[copies[:, None], cols[None, :]]       # (k, m', 3, 3)
             Lt = self._link_pos[copies[:, None], cols[None, :]]
-            Rr = R[:, linked]
             R = R.copy()
             t = t.copy()
-            R[:, linked] = np.matmul(Rr, Ld)
-            t[:, linked] = np.matmul(Rr, Lt[..., None])[..., 0] + t[:, linked]
+            R[:, linked], t[:, linked] = compose_stacked(R[:, linked], t[:, linked], Ld, Lt)
         Rc = np.matmul(R, _EYE)                                       # frame ∘ identity (Pose.compose)
         tc = np.matmul(R, _ZERO) + t
         Rt = Rc.transpose(0, 1, 3, 2)
