@@ -97,7 +97,6 @@ class CopyRays:
         self._spheres: dict[str, tuple] = {}     # per variant: (tier per slot, anchor (R,3), r2 (R,), has body (R,))
         self.counters = {"casts": 0, "rays": 0, "mover_pairs": 0, "mover_traces": 0, "lean_casts": 0}
         self.lean = True     # FAST casts through sp_copy_cast where their data allows (False: the general path)
-        self.segmented = True   # coherent runs' mover pairs in one C pass per group (False: one trace per run)
         self._local = threading.local()   # per thread: the lean path's job struct and scratch buffers
         self._static_kept: dict[str, tuple] = {}   # per variant: the lean job's static fields (_static_fields)
         self._planes: dict[str, tuple | None] = {}   # per variant: the robots' planes (_robot_planes)
@@ -461,7 +460,7 @@ class CopyRays:
         With the packet helper all copies' runs go in one call per group (:meth:`_trace_runs`), else
         one trace per run."""
         cuts = (np.flatnonzero(pm[1:] != pm[:-1]) + 1).tolist()
-        if self.segmented and self.movers.native and tier.native(False) is not None:
+        if self.movers.native and tier.native(False) is not None:
             return self._trace_runs(tier, ob, db, tn, lm, np.array([0, *cuts], dtype=np.int64),
                                     np.array([*cuts, len(ob)], dtype=np.int64), eps64, distance_only)
         t = np.full(len(ob), _INF)
