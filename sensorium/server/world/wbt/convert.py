@@ -2878,15 +2878,12 @@ def _flat(kinds: set[type]) -> bool:
 
 def _consuming_motors(node: Node) -> bool:
     """Whether a motor inside ``node`` consumes energy in Webots (consumptionFactor > 0; 10 by default)."""
-    stack: list[Any] = list(node.fields.values())
+    stack = _sub_nodes(node)
     while stack:
         v = stack.pop()
-        if isinstance(v, list):
-            stack.extend(v)
-        elif isinstance(v, Node):
-            if v.type in ("RotationalMotor", "LinearMotor"):
-                factor = v.fields.get("consumptionFactor", 10.0)
-                if not isinstance(factor, (int, float)) or factor > 0:
-                    return True
-            stack.extend(v.fields.values())
+        if v.type in ("RotationalMotor", "LinearMotor"):
+            factor = v.fields.get("consumptionFactor", 10.0)
+            if not isinstance(factor, (int, float)) or factor > 0:
+                return True
+        stack += _sub_nodes(v)
     return False
