@@ -50,9 +50,9 @@ from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composit
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import (
     _base_color,
+    add_emissive,
     emissive_array,
     emissive_of,
-    emissive_rows,
     receives_shadows,
     scene_robot_parts,
     surface_colors,
@@ -340,9 +340,7 @@ class CameraDevices(PixelDevices):
                     on = (~translucent[s]).nonzero()[0]
                     lit[on] = self._shadows(P[on], N[on], row_copy[on], copies)
             L = self._shade_copies(P, N, albedo, lit, row_copy, copies)
-            glow = emissive_rows(self.emissive, s)
-            if glow is not None:       # as Camera's surface
-                L += glow
+            add_emissive(L, self.emissive, s)      # as Camera's surface
             if scene.fog is not None:
                 L = shading.fog(L, tk, *scene.fog)
             share = weight[kk] * (1.0 - np.zeros(len(kk)))   # (opaque: transparency 0, as the single's share)
@@ -419,9 +417,7 @@ class CameraDevices(PixelDevices):
                 lit[on] = self._shadows(P[on], N[on], zeros[on], copy)
             lights = self._lights_of(int(copy[0]))
             L = _shade(P, N, albedo, lights, None if lit is None else lit[:, :lights.count], scene.engine.threads)
-            glow = emissive_rows(self.emissive, s)
-            if glow is not None:       # as Camera's surface
-                L += glow
+            add_emissive(L, self.emissive, s)      # as Camera's surface
             return L
 
         alpha = None

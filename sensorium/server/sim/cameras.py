@@ -23,7 +23,7 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import blocks
 from sensorium.server.raycast.engine import RayHits, RayKind, Riding
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import emissive_rows, light_from_model
+from sensorium.server.sim.scene import add_emissive, light_from_model
 from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
@@ -652,9 +652,7 @@ class Camera(Device):
                     lit = np.ones((len(s), len(shadows)), dtype=bool)
                     lit[on] = self._shadows(P[on], N[on], lights, shadows, counters)
             L = _shade(P, N, albedo, lights, lit, engine.threads)
-            glow = emissive_rows(scene.emissive, s)
-            if glow is not None:       # Webots' shaders add the emissive colour to the lit one
-                L += glow
+            add_emissive(L, scene.emissive, s)     # Webots' shaders add the emissive colour to the lit one
             return L
 
         alpha = None

@@ -89,10 +89,11 @@ def emissive_of(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
     return tuple(float(v) for v in a.emissive_color)  # type: ignore[return-value]
 
 
-def emissive_rows(emissive: np.ndarray | None, shape: np.ndarray) -> np.ndarray | None:
-    """The emissive radiance (n, 3) of the hit shapes, or None in a world where nothing glows
-    (``emissive`` None: nothing is added or computed)."""
-    return None if emissive is None else np.take(emissive, shape, axis=0)
+def add_emissive(radiance: np.ndarray, emissive: np.ndarray | None, shape: np.ndarray) -> None:
+    """Adds the hit shapes' emissive radiance to ``radiance`` (n, 3) in place, as Webots' shaders add
+    it to the lit colour; nothing in a world where nothing glows (``emissive`` None)."""
+    if emissive is not None:
+        radiance += np.take(emissive, shape, axis=0)
 
 
 def emissive_array(colors: list[tuple[float, float, float]]) -> np.ndarray | None:
