@@ -65,6 +65,14 @@ from sensorium.server.world.geometry import Plane, Pose
 __all__ = ["CopyRays"]
 
 
+def _no_hits(n: int, distance_only: bool) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """``n`` rays' answers before any hit: distances inf, shapes -1, normals 0 (the last two None
+    when only distances are asked)."""
+    if distance_only:
+        return np.full(n, _INF), None, None
+    return np.full(n, _INF), np.full(n, -1, dtype=np.int64), np.zeros((n, 3))
+
+
 class CopyRays:
     """Casts for ``copies`` copies of a world (see the module docstring).
 
@@ -304,9 +312,7 @@ class CopyRays:
         excl = None if isinstance(exclude_slot, (int, np.integer)) and exclude_slot < 0 else (
             int(exclude_slot) if isinstance(exclude_slot, (int, np.integer)) else
             np.broadcast_to(np.asarray(exclude_slot, dtype=np.int64).reshape(-1), (n,)))
-        dist = np.full(n, _INF)
-        shape = None if distance_only else np.full(n, -1, dtype=np.int64)
-        normal = None if distance_only else np.zeros((n, 3))
+        dist, shape, normal = _no_hits(n, distance_only)
         hit = False
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
             for a in range(0, n, _CHUNK):
@@ -377,9 +383,7 @@ class CopyRays:
         x = D.take(pr, axis=0)
         Db = (x[:, 0:1] * Rg[:, 0] + x[:, 1:2] * Rg[:, 1]) + x[:, 2:3] * Rg[:, 2]
         slot = pm % R
-        t_all = np.full(len(pr), _INF)
-        s_all = None if distance_only else np.full(len(pr), -1, dtype=np.int64)
-        n_all = None if distance_only else np.zeros((len(pr), 3))
+        t_all, s_all, n_all = _no_hits(len(pr), distance_only)
         exact = self.movers.precision is Precision.EXACT
         big = max(float(O.max()), -float(O.min()))     # max |coordinate| (no |O| temporary: 0.5 MB for a lidar)
         eps64 = 1e-9 + 1e-14 * big          # the engine's float64 self-hit threshold for this cast
@@ -463,9 +467,7 @@ class CopyRays:
         if self.movers.native and tier.native(False) is not None:
             return self._trace_runs(tier, ob, db, tn, lm, np.array([0, *cuts], dtype=np.int64),
                                     np.array([*cuts, len(ob)], dtype=np.int64), eps64, distance_only)
-        t = np.full(len(ob), _INF)
-        s = None if distance_only else np.full(len(ob), -1, dtype=np.int64)
-        nrm = None if distance_only else np.zeros((len(ob), 3))
+        t, s, nrm = _no_hits(len(ob), distance_only)
         hit = False
         for a, b in zip([0, *cuts], [*cuts, len(ob)]):
             got = self._trace_pairs(tier, ob[a:b], db[a:b], tn[a:b] if isinstance(tn, np.ndarray) else tn, lm[a:b],
@@ -502,9 +504,7 @@ class CopyRays:
         o32 = (_minus(ob, tier.anchor) if tier.anchored else ob).astype(np.float32)
         far = _dot(o32, o32) > np.float32(tier.radius * tier.radius)
         n_far = np.bincount(run, weights=far, minlength=len(a))
-        t = np.full(m, _INF)
-        s = None if distance_only else np.full(m, -1, dtype=np.int64)
-        nrm = None if distance_only else np.zeros((m, 3))
+        t, s, nrm = _no_hits(m, distance_only)
         hit = False
         for k in ((n_far > 0) & (n_far < size)).nonzero()[0].tolist():
             got = self._trace_pairs(tier, ob[a[k]:b[k]], db[a[k]:b[k]], tn[a[k]:b[k]] if isinstance(tn, np.ndarray)
