@@ -42,12 +42,10 @@ class Battery:
     def reset(self) -> None:
         self.energy, self.powered = self.initial, True
 
-    def power_back(self) -> bool:
-        """True when the robot was off and its battery holds energy again (a Charger's): it powers on."""
-        if self.powered or not self.energy > 0.0:
-            return False
-        self.powered = True
-        return True
+    def power_back(self) -> None:
+        """A robot off whose battery holds energy again (a Charger's) powers on."""
+        if self.energy > 0.0:
+            self.powered = True
 
     @property
     def present(self) -> bool:
