@@ -229,7 +229,23 @@ def _closed_forms(out: dict) -> None:
         t = k * STEP / 1000.0
         assert b["z"][k - 1] == pytest.approx(z1 - G * t * t / 2.0, abs=1e-12), k
     assert b["z"][n - 1:] == [pytest.approx(0.05, abs=1e-12)] * (29 - n + 1)
+    c = out["c"]                                # setVelocity(0) is resetPhysics; NaN and sideways change nothing
+    z1 = 1.0 - G * 0.08 ** 2 / 2.0
+    assert c["z1"] == pytest.approx(z1, abs=1e-12)
+    assert c["v1"] == [0.0] * 6
+    n = _touch_steps(z1 - 0.05)
+    assert n == 28                              # lands in the last two of the 29 steps
+    for k in range(1, n):
+        t = k * STEP / 1000.0
+        assert c["z"][k - 1] == pytest.approx(z1 - G * t * t / 2.0, abs=1e-12), k
+    assert c["z"][n - 1:] == [pytest.approx(0.05, abs=1e-12)] * (29 - n + 1)
     assert out["xy"] == [0.2, 0.1] and out["floor"] == "Solid"
+
+
+SET_VELOCITY_LINES = ["Error: wb_supervisor_node_set_velocity() called with a NaN or infinite value.",
+                      "Warning: wb_supervisor_node_set_velocity(): a velocity other than zero is ignored: Sensorium "
+                      "has no physics engine (robots move by their wheels' commands, solids only fall straight down "
+                      "from rest)."]
 
 
 @pytest.mark.slow
@@ -239,6 +255,7 @@ def test_a_python_supervisor_stops_a_falling_box_and_sees_it_fall_again(tmp_path
 
     ctl = run_paused(WORLD, tmp_path, "reset_falls.py", "boss")
     _closed_forms(json.loads(ctl.out[-1]))
+    assert [line for line in ctl.stderr().splitlines() if "set_velocity" in line] == SET_VELOCITY_LINES
 
 
 @pytest.mark.slow
@@ -249,3 +266,30 @@ def test_a_c_supervisor_stops_a_falling_box_and_sees_it_fall_again(tmp_path_fact
     code, out, err = sanitized_run(tmp_path_factory, REPO / "tests" / "c" / "reset_falls.c", WORLD, "boss")
     assert code == 0, err
     _closed_forms(json.loads(out[-1]))
+    assert [line for line in err.splitlines() if "set_velocity" in line] == SET_VELOCITY_LINES
+
+
+def test_set_velocity_zero_asks_reset_physics_and_anything_else_is_one_line(monkeypatch, capsys) -> None:
+    """The Python client's ``setVelocity`` without a server: zero (any zeros: ints, -0.0) is the node's
+    ``reset_physics`` request; a velocity that is not 6 finite numbers is refused with its line; another
+    velocity prints the warning once and asks nothing."""
+    from test_movie import _FakeSupervisor
+
+    from sensorium.client import wb_supervisor as ws
+    fake = _FakeSupervisor()
+    monkeypatch.setattr(ws, "_supervisor", lambda func: fake)
+    monkeypatch.setattr(ws, "_set_velocity_warned", [])
+    func = "wb_supervisor_node_set_velocity"
+    ws.wb_supervisor_node_set_velocity(7, [0, 0, 0, -0.0, 0.0, 0])
+    assert fake.calls == ["/boss/robot/reset_physics"] and capsys.readouterr().err == ""
+    for bad, line in (([0.0] * 5, "expected 6 numbers, got 5."), ([0.0] * 7, "expected 6 numbers, got 7."),
+                      (None, "expected 6 numbers, got None."), (["x"] * 6, "expected 6 numbers, got ['x', 'x', "
+                                                                          "'x', 'x', 'x', 'x']."),
+                      ([0.0] * 5 + [math.inf], None), ([math.nan] + [0.0] * 5, None)):
+        ws.wb_supervisor_node_set_velocity(7, bad)
+        want = f"Error: {func}(): {line}" if line else f"Error: {func}() called with a NaN or infinite value."
+        assert capsys.readouterr().err == want + "\n"
+    for _ in range(2):
+        ws.wb_supervisor_node_set_velocity(7, [0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
+    assert capsys.readouterr().err == SET_VELOCITY_LINES[1] + "\n"
+    assert fake.calls == ["/boss/robot/reset_physics"]

@@ -499,14 +499,35 @@ _set_velocity_warned: list[bool] = []
 
 
 def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
-    """No physics engine: a robot moves only by its wheels (which keep their commands) and a solid only falls
-    straight down from rest (README "Falling"), so a velocity set from outside has nothing to act on; one
-    warning line, ignored."""
-    if _checked_node(node, "wb_supervisor_node_set_velocity") is None or _set_velocity_warned:
+    """Webots' ``setVelocity`` (linear then angular, world axes). Zero is served: it is ``resetPhysics``
+    here (the one velocity of its own a node can have is a top-level solid's fall, which then starts
+    again from rest; a robot keeps its motors' commands), the usual call after a supervisor moves a
+    solid. Any other velocity has nothing to act on without a physics engine (a robot moves only by its
+    wheels, a solid only falls straight down): one warning, ignored. Webots' check first: 6 finite
+    numbers."""
+    func = "wb_supervisor_node_set_velocity"
+    r = _checked_node(node, func)
+    if r is None:
+        return
+    try:
+        wire = [float(v) for v in velocity]
+    except (TypeError, ValueError):
+        print(f"Error: {func}(): expected 6 numbers, got {velocity!r}.", file=sys.stderr)
+        return
+    if len(wire) != 6:
+        print(f"Error: {func}(): expected 6 numbers, got {len(wire)}.", file=sys.stderr)
+        return
+    if not all(math.isfinite(v) for v in wire):
+        print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
+        return
+    if not any(wire):
+        _answer(r, "reset_physics", {"node": int(node)}, func)  # type: ignore[arg-type]
+        return
+    if _set_velocity_warned:
         return
     _set_velocity_warned.append(True)
-    print("Warning: wb_supervisor_node_set_velocity(): ignored: Sensorium has no physics engine (robots move by "
-          "their wheels' commands, solids only fall straight down from rest).", file=sys.stderr)
+    print(f"Warning: {func}(): a velocity other than zero is ignored: Sensorium has no physics engine (robots move "
+          "by their wheels' commands, solids only fall straight down from rest).", file=sys.stderr)
 
 
 def wb_supervisor_node_reset_physics(node: int | None) -> None:

@@ -1,6 +1,7 @@
 /* The C twin of tests/controllers/reset_falls.py (tests/worlds/reset_falls.wbt, tests/test_reset_physics.py):
  * a falling box stopped by wb_supervisor_node_reset_physics and wb_supervisor_simulation_reset_physics falls
  * again from rest. Prints the same JSON line (numbers as %.17g). */
+#include <math.h>
 #include <stdio.h>
 
 #include <webots/robot.h>
@@ -55,6 +56,25 @@ int main(void) {
     wb_robot_step(dt);
     zb[k] = wb_supervisor_field_get_sf_vec3f(translation)[2];
   }
+  double v1c[6], zc[29];
+  wb_supervisor_field_set_sf_vec3f(translation, up);
+  for (int k = 0; k < 5; k++)
+    wb_robot_step(dt);
+  double z1c = wb_supervisor_field_get_sf_vec3f(translation)[2];
+  const double zero[6] = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+  wb_supervisor_node_set_velocity(box, zero);
+  v = wb_supervisor_node_get_velocity(box);
+  for (int i = 0; i < 6; i++)
+    v1c[i] = v[i];
+  for (int k = 0; k < 29; k++) {
+    if (k == 3) {
+      const double bad[6] = {NAN, 0.0, 0.0, 0.0, 0.0, 0.0}, sideways[6] = {0.5, 0.0, 0.0, 0.0, 0.0, 0.0};
+      wb_supervisor_node_set_velocity(box, bad);
+      wb_supervisor_node_set_velocity(box, sideways);
+    }
+    wb_robot_step(dt);
+    zc[k] = wb_supervisor_field_get_sf_vec3f(translation)[2];
+  }
   const double *at = wb_supervisor_field_get_sf_vec3f(translation);
   printf("{\"a\": {\"z1\": %.17g, ", z1a);
   list("v1", v1a, 6, ", ");
@@ -65,6 +85,9 @@ int main(void) {
   printf("\"z1\": %.17g, ", z1b);
   list("v1", v1b, 6, ", ");
   list("z", zb, 29, "}, ");
+  printf("\"c\": {\"z1\": %.17g, ", z1c);
+  list("v1", v1c, 6, ", ");
+  list("z", zc, 29, "}, ");
   printf("\"xy\": [%.17g, %.17g], \"floor\": \"%s\"}\n", at[0], at[1], wb_supervisor_node_get_type_name(floor));
   fflush(stdout);
   wb_robot_cleanup();

@@ -45,4 +45,18 @@ b["z"] = []
 for _ in range(29):
     robot.step(step)
     b["z"].append(translation.getSFVec3f()[2])
-print(json.dumps({"a": a, "b": b, "xy": translation.getSFVec3f()[:2], "floor": floor.getTypeName()}))
+
+translation.setSFVec3f([0.2, 0.1, 1.0])
+for _ in range(5):
+    robot.step(step)
+c = {"z1": translation.getSFVec3f()[2]}
+box.setVelocity([0.0] * 6)
+c["v1"] = box.getVelocity()
+c["z"] = []
+for k in range(29):
+    if k == 3:
+        box.setVelocity([float("nan"), 0.0, 0.0, 0.0, 0.0, 0.0])
+        box.setVelocity([0.5, 0.0, 0.0, 0.0, 0.0, 0.0])
+    robot.step(step)
+    c["z"].append(translation.getSFVec3f()[2])
+print(json.dumps({"a": a, "b": b, "c": c, "xy": translation.getSFVec3f()[:2], "floor": floor.getTypeName()}))

@@ -777,18 +777,6 @@ void wb_supervisor_node_load_state(WbNodeRef node, const char *state_name) {
   node_state(node, state_name, "robot/load_node_state", "wb_supervisor_node_load_state");
 }
 
-/* No physics engine: a robot moves by its wheels (which keep their commands), a solid only falls straight
-   down from rest; a velocity set from outside has nothing to act on: one warning, ignored. */
-void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
-  (void)velocity;
-  static bool warned;
-  if (supervisor_node(node, "wb_supervisor_node_set_velocity") == NULL || warned)
-    return;
-  warned = true;
-  fprintf(stderr, "Warning: wb_supervisor_node_set_velocity(): ignored: Sensorium has no physics engine (robots move "
-                  "by their wheels' commands, solids only fall straight down from rest).\n");
-}
-
 /* Webots' resetPhysics: the velocities of the node and the Solids under it zeroed. A top-level solid
    falling falls again from rest from where it is; a robot keeps its motors' commands. The root's (node
    0, simulationResetPhysics): every falling solid's. */
@@ -803,6 +791,39 @@ void wb_supervisor_node_reset_physics(WbNodeRef node) {
   sn_robot *rb = supervisor_node(node, func);
   if (rb != NULL)
     reset_physics(rb, node->id, func);
+}
+
+/* Webots' setVelocity (linear then angular, world axes), after Webots' checks (NULL, NaN, infinite).
+   Zero is served: it is resetPhysics here (the one velocity of its own a node can have is a top-level
+   solid's fall, which starts again from rest; a robot keeps its motors' commands). Any other velocity has
+   nothing to act on without a physics engine: one warning, ignored. */
+void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
+  static const char *func = "wb_supervisor_node_set_velocity";
+  static bool warned;
+  sn_robot *rb = supervisor_node(node, func);
+  if (rb == NULL)
+    return;
+  if (velocity == NULL) {
+    fprintf(stderr, "Error: %s() called with NULL argument.\n", func);
+    return;
+  }
+  bool zero = true;
+  for (int i = 0; i < 6; i++) {
+    if (!isfinite(velocity[i])) {
+      fprintf(stderr, "Error: %s() called with a NaN or infinite value.\n", func);
+      return;
+    }
+    zero = zero && velocity[i] == 0.0;
+  }
+  if (zero) {
+    reset_physics(rb, node->id, func);
+    return;
+  }
+  if (warned)
+    return;
+  warned = true;
+  fprintf(stderr, "Warning: %s(): a velocity other than zero is ignored: Sensorium has no physics engine (robots move "
+                  "by their wheels' commands, solids only fall straight down from rest).\n", func);
 }
 
 /* Webots' moveViewpoint: the Viewpoint backed off along its view direction until the node's bounding sphere
