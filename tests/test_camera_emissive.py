@@ -1,6 +1,7 @@
 """Emissive colours in camera images, as Webots' shaders add them: WREN's phong.frag writes
 ``emissive + ambient + diffuse (+ specular)`` and pbr.frag adds the emissive colour to the lit one,
-so a surface of albedo d, emissive colour e (a PBRAppearance's ``emissiveIntensity`` left out, as WREN's shader leaves it out)
+so a surface of albedo d, emissive colour e (a PBRAppearance's ``emissiveIntensity`` left out, as WREN's
+shadow-volume shader leaves it out; its forward shader would apply it: a departure, README)
 sends ``d·Σ lights + e`` into the HDR buffer, and glows with ``e`` alone where no light reaches.
 
 Closed forms: a camera at the origin looking along +x at a flat wall (face x = 1.95) lit by an
@@ -81,8 +82,8 @@ Robot {{ children [ Camera {{ name "cam" width 9 height 7 fieldOfView 1 }} ] con
     ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 emissiveIntensity -2 }", GLOW),
 ])
 def test_a_world_files_emissive_colours_are_drawn(tmp_path: Path, appearance: str, glow):
-    """A Material's emissiveColor; a PBRAppearance's, whatever its emissiveIntensity (WREN's PBR shader
-    applies the intensity in wireframe rendering only, and Webots resets no negative one)."""
+    """A Material's emissiveColor; a PBRAppearance's, whatever its emissiveIntensity (left out, as WREN's
+    shadow-volume shader leaves it out outside wireframe rendering; Webots resets no negative one)."""
     path = tmp_path / "glow.wbt"
     path.write_text(WBT.format(appearance=appearance))
     sim = Simulation(load_world(path))
@@ -208,3 +209,135 @@ def test_the_batched_simulation_refuses_a_glow_a_camera_sees_in_one_line():
     w = lw.world
     calm = w.model_copy(update={"chargers": [w.chargers[0].model_copy(update={"glow_shapes": 0})]})
     BatchedSimulation(LoadedWorld(world=calm, source="<dock>", base_dir=Path.cwd()), 2)      # accepted
+
+
+# ------------------------------------------------------------------- a texture's colour on the glow
+
+TEXEL = (200, 100, 50)
+
+
+def _linear(byte_value: int) -> float:
+    """The sRGB decoding WREN's shaders apply to a texel (SRGBtoLINEAR)."""
+    c = byte_value / 255.0
+    return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+
+@pytest.fixture
+def texel_dir(tmp_path: Path) -> Path:
+    from PIL import Image
+    Image.fromarray(np.full((2, 2, 3), TEXEL, dtype=np.uint8), "RGB").save(tmp_path / "t.png")
+    return tmp_path
+
+
+@pytest.mark.parametrize("phong", [True, False])
+@pytest.mark.parametrize("precision", BOTH)
+def test_a_phong_surfaces_glow_is_multiplied_by_its_texel(texel_dir: Path, precision: str, phong: bool):
+    """WREN's phong.frag writes ``texel·(emissive + ambient + diffuse)``: a flat-lit textured face of
+    texel t, colour d, emissive e reads ``d·t·(0.3 + 0.8·cos) + e·t``; its PBR shader adds e as it is."""
+    _, cos = rays()
+    t = np.array([_linear(v) for v in TEXEL])
+    appearance = {"base_color": DIFFUSE, "texture": "t.png", "emissive_color": GLOW, "phong": phong}
+    sim = Simulation(world([AMBIENT, point(None)], appearance), precision=precision, base_dir=texel_dir)
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    sim.run(1)
+    got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+    glow = np.asarray(GLOW) * t if phong else np.asarray(GLOW)
+    np.testing.assert_array_equal(got, byte(np.asarray(DIFFUSE) * t * (0.3 + 0.8 * cos)[..., None] + glow))
+    assert (sim.scene.emissive_texel is not None) == phong
+
+
+@pytest.mark.parametrize("appearance, textured_glow", [
+    ('Appearance { material Material { emissiveColor 0.05 0.4 0.7 } texture ImageTexture { url "t.png" } }', True),
+    ('PBRAppearance { metalness 0 emissiveColor 0.05 0.4 0.7 baseColorMap ImageTexture { url "t.png" } }', False),
+])
+def test_a_world_files_textured_appearance_multiplies_its_glow(texel_dir: Path, appearance: str, textured_glow: bool):
+    """An Appearance's texture replaces its diffuse colour by white and multiplies its emissive colour
+    (Phong); a PBRAppearance's baseColorMap does not touch its emissive colour."""
+    path = texel_dir / "glow.wbt"
+    path.write_text(WBT.format(appearance=appearance))
+    sim = Simulation(load_world(path))
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    sim.run(1)
+    t = np.array([_linear(v) for v in TEXEL])
+    glow = np.asarray(GLOW) * (t if textured_glow else 1.0)
+    got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+    np.testing.assert_array_equal(got, np.broadcast_to(byte(0.3 * t + glow), got.shape))
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_every_copy_multiplies_a_phong_glow_by_its_texel_as_the_single_simulation(texel_dir: Path, precision: str):
+    lw = _facing(False)
+    w = lw.world
+    textured = w.solids[0].model_copy(update={"appearance": wm.Appearance.model_validate(
+        {"base_color": DIFFUSE, "texture": "t.png", "emissive_color": GLOW, "phong": True})})
+    lw = LoadedWorld(world=w.model_copy(update={"solids": [textured, *w.solids[1:]]}), source="<test>",
+                     base_dir=texel_dir)
+    x = [1.4, 0.9, -1.0]
+    img = images_with_robot_placed(lw, precision, "bot", [[xc, 0.0, 0.0] for xc in x])
+    t = np.array([_linear(v) for v in TEXEL])
+    centre = img[:, 2, 5, 2::-1].astype(np.int64)
+    for c in range(len(x)):
+        np.testing.assert_array_equal(centre[c], byte(np.asarray(DIFFUSE) * t * (0.3 + 0.6) + np.asarray(GLOW) * t),
+                                      err_msg=str(c))
+
+
+# ------------------------------------------------------------------------------ an emissive map
+
+MAP_TEXEL = (30, 180, 90)
+
+
+@pytest.fixture
+def map_dir(texel_dir: Path) -> Path:
+    from PIL import Image
+    Image.fromarray(np.full((2, 2, 3), MAP_TEXEL, dtype=np.uint8), "RGB").save(texel_dir / "m.png")
+    return texel_dir
+
+
+@pytest.mark.parametrize("colour", [[0.0, 0.0, 0.0], GLOW])
+@pytest.mark.parametrize("precision", BOTH)
+def test_an_emissive_mapped_box_in_the_dark_reads_its_map(map_dir: Path, precision: str, colour):
+    """WREN's PBR shaders take the emissiveColorMap's texel, as stored, for the emissive colour (it
+    replaces emissiveColor): in the dark the box reads the resolve of ``texel / 255``, whatever its
+    own colour, with or without a base texture (``t.png`` does not touch the glow)."""
+    want = byte(np.asarray(MAP_TEXEL) / 255.0)
+    for extra in ({}, {"texture": "t.png"}):
+        appearance = {"base_color": DIFFUSE, "emissive_color": colour, "emissive_map": "m.png", **extra}
+        sim = Simulation(world([], appearance), precision=precision, base_dir=map_dir)
+        cam = sim.device("r/cam")
+        cam.enable(16)
+        sim.run(1)
+        got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+        np.testing.assert_array_equal(got, np.broadcast_to(want, got.shape), err_msg=str(extra))
+
+
+def test_a_world_files_emissive_color_map_is_drawn(map_dir: Path):
+    path = map_dir / "glow.wbt"
+    path.write_text(WBT.format(appearance='PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 '
+                                          '0.7 emissiveColorMap ImageTexture { url "m.png" } }'))
+    lw = load_world(path)
+    assert lw.world.solids[0].shapes[0].appearance.emissive_map.url == "m.png"      # type: ignore[union-attr]
+    sim = Simulation(lw)
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    sim.run(1)
+    got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+    want = byte(0.3 * np.asarray(DIFFUSE) + np.asarray(MAP_TEXEL) / 255.0)
+    np.testing.assert_array_equal(got, np.broadcast_to(want, got.shape))
+
+
+@pytest.mark.parametrize("precision", BOTH)
+def test_every_copy_reads_an_emissive_map_as_the_single_simulation(map_dir: Path, precision: str):
+    lw = _facing(False)
+    w = lw.world
+    mapped = w.solids[0].model_copy(update={"appearance": wm.Appearance.model_validate(
+        {"base_color": DIFFUSE, "emissive_map": "m.png"})})
+    lw = LoadedWorld(world=w.model_copy(update={"solids": [mapped, *w.solids[1:]]}), source="<test>",
+                     base_dir=map_dir)
+    x = [1.4, 0.9, -1.0]
+    img = images_with_robot_placed(lw, precision, "bot", [[xc, 0.0, 0.0] for xc in x])
+    centre = img[:, 2, 5, 2::-1].astype(np.int64)
+    for c in range(len(x)):
+        np.testing.assert_array_equal(centre[c], byte(np.asarray(DIFFUSE) * (0.3 + 0.6) + np.asarray(MAP_TEXEL) / 255),
+                                      err_msg=str(c))
