@@ -204,7 +204,7 @@ def test_the_batched_simulation_refuses_a_glow_a_camera_sees_in_one_line():
     from sensorium.server.sim.batched import BatchedError, BatchedSimulation
     lw = LoadedWorld(world=_charger_world(True), source="<dock>", base_dir=Path.cwd())
     with pytest.raises(BatchedError, match=r"^<dock>: Charger 'dock': its shapes glow with its energy, which camera "
-                                           r"r/cam sees; .*glow_shapes: 0\)$"):
+                                           r"r/cam sees; .*glow_shapes: 0 and glow_solids: 0\)$"):
         BatchedSimulation(lw, 2)
     w = lw.world
     calm = w.model_copy(update={"chargers": [w.chargers[0].model_copy(update={"glow_shapes": 0})]})
@@ -341,3 +341,105 @@ def test_every_copy_reads_an_emissive_map_as_the_single_simulation(map_dir: Path
     for c in range(len(x)):
         np.testing.assert_array_equal(centre[c], byte(np.asarray(DIFFUSE) * (0.3 + 0.6) + np.asarray(MAP_TEXEL) / 255),
                                       err_msg=str(c))
+
+
+# ------------------------------------------------------------- a Charger's lights and nested solids
+
+LIGHT0, FULL = np.array([0.2, 0.4, 1.0]), np.array([1.0, 0.5, 0.0])
+
+
+def _lamp_world(nested_glow: bool) -> wm.World:
+    """A camera facing a wall lit only by the ambient term (0.3) of a light the Charger's solid holds
+    (colour LIGHT0); ``nested_glow``: the wall is a solid nested in the Charger's (glow_solids: 1), its
+    emissive colour (0, 0, 0.2) following the energy too, else a solid of its own and only the light
+    follows (glow_lights: 1). The Charger starts empty and gathers 0.16 J a step up to 1 J."""
+    lamp = {"type": "DirectionalLight", "direction": [1, 0, 0], "intensity": 0.0, "ambient_intensity": 0.3,
+            "color": LIGHT0.tolist()}
+    glowing_wall = {**wall({"base_color": DIFFUSE, "emissive_color": [0.0, 0.0, 0.2]}), "name": "inner"}
+    dock = {"name": "dock", "pose": {"translation": [-5.0, 0.0, 0.0]}, "lights": [lamp]}
+    if nested_glow:
+        dock["children"] = [{**glowing_wall, "pose": {"translation": [7.0, 0.0, 0.0]}}]
+        solids = [dock]
+        charger = {"glow_shapes": 0, "glow_solids": 1}
+    else:
+        solids = [dock, wall({"base_color": DIFFUSE})]
+        charger = {"glow_shapes": 0, "glow_lights": 1}
+    return wm.World.model_validate({
+        "world_info": {"basic_time_step": 16}, "solids": solids,
+        "chargers": [{"solid": "dock", "battery": [0.0, 1.0, 10.0], "emissive_color": FULL.tolist(), **charger}],
+        "robots": [{"name": "r", "devices": [{"device": "Camera", "name": "cam", **CAM}]}]})
+
+
+@pytest.mark.parametrize("nested_glow", [False, True])
+def test_a_chargers_light_and_nested_solid_follow_its_energy(nested_glow: bool):
+    """WbCharger::updateMaterialsAndLights: a light's colour takes the rule of the emissive colour,
+    c0 + (emissiveColor − c0)·E/Emax (full: emissiveColor); a solid inside its first child is searched as
+    a group, so its shapes glow so too. The wall reads ``0.3·light·d (+ glow)`` after each step."""
+    sim = Simulation(_lamp_world(nested_glow))
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    own = np.array([0.0, 0.0, 0.2])
+    seen = set()
+    for step in range(1, 9):
+        sim.run(1)
+        energy = min(0.16 * step, 1.0)
+        light = FULL if energy >= 1.0 else LIGHT0 + (FULL - LIGHT0) * energy
+        L = 0.3 * light * np.asarray(DIFFUSE)
+        if nested_glow:          # the light is not in its first child: its own colour
+            L = 0.3 * LIGHT0 * np.asarray(DIFFUSE) + (FULL if energy >= 1.0 else own + (FULL - own) * energy)
+        got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+        np.testing.assert_array_equal(got, np.broadcast_to(byte(L), got.shape), err_msg=str(step))
+        seen.add(got.tobytes())
+    assert len(seen) == 7                # full from the 7th step
+    sim.reset()                          # the loaded energy (0 J): the light's own colour again
+    sim.run(1)
+    light = LIGHT0 if nested_glow else LIGHT0 + (FULL - LIGHT0) * 0.16
+    glow = own + (FULL - own) * 0.16 if nested_glow else 0.0
+    np.testing.assert_array_equal(cam.image[3, 4, 2::-1].astype(np.int64), byte(0.3 * light * np.asarray(DIFFUSE) + glow))
+
+
+LAMP_WBT = """#VRML_SIM R2023b utf8
+WorldInfo {{ basicTimeStep 16 }}
+Charger {{
+  translation -5 0 0
+  children [
+    Group {{ children [
+      DirectionalLight {{ direction 1 0 0 intensity 0 ambientIntensity 0.3 color 0.2 0.4 1 }}
+      Solid {{ translation 7 0 0 name "inner"
+               children [ Shape {{ appearance PBRAppearance {{ baseColor 0.6 0.3 0.15 metalness 0
+                                                               emissiveColor 0 0 0.2 }}
+                                   geometry Box {{ size 0.1 20 20 }} }} ] }}
+    ] }}
+    DirectionalLight {{ direction 1 0 0 intensity 0 ambientIntensity 0.1 }}
+  ]
+  name "dock"
+  battery [ 0, 1, 10 ]
+  emissiveColor 1 0.5 0
+}}
+Robot {{ children [ Camera {{ name "cam" width 9 height 7 fieldOfView 1 }} ] controller "<none>" }}
+"""
+
+
+def test_a_wbt_chargers_first_child_lights_and_solids_follow_its_energy(tmp_path: Path):
+    """The first child (a Group) holds a light and a Solid: both follow the energy; the second light
+    keeps its white colour."""
+    path = tmp_path / "lamp.wbt"
+    path.write_text(LAMP_WBT.format())
+    lw = load_world(path)
+    charger = lw.world.chargers[0]
+    assert (charger.glow_shapes, charger.glow_lights, charger.glow_solids) == (0, 1, 1)
+    sim = Simulation(lw)
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    sim.run(3)
+    own = np.array([0.0, 0.0, 0.2])
+    L = (0.3 * (LIGHT0 + (FULL - LIGHT0) * 0.48) + 0.1) * np.asarray(DIFFUSE) + own + (FULL - own) * 0.48
+    np.testing.assert_array_equal(cam.image[3, 4, 2::-1].astype(np.int64), byte(L))
+
+
+def test_the_batched_simulation_refuses_a_chargers_light_a_sensor_sees_in_one_line():
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+    lw = LoadedWorld(world=_lamp_world(False), source="<dock>", base_dir=Path.cwd())
+    with pytest.raises(BatchedError, match=r"^<dock>: Charger 'dock': its lights' colour follows its energy, which "
+                                           r"r/cam sees; .*glow_lights: 0 and glow_solids: 0\)$"):
+        BatchedSimulation(lw, 2)

@@ -2096,6 +2096,11 @@ class Charger(Strict):
                           "to emissive_color with the energy; false: their own until full, then emissive_color")
     glow_shapes: int = Field(default=1, ge=0, description="how many of its solid's first shapes glow so (a .wbt "
                              "Charger: the shapes of its first child, as Webots)")
+    glow_lights: int = Field(default=0, ge=0, description="how many of its solid's first lights take that colour as "
+                             "their color (a .wbt Charger: the lights of its first child, as Webots)")
+    glow_solids: int = Field(default=0, ge=0, description="how many of its solid's first children solids glow so, "
+                             "every shape and light in them (a .wbt Charger: the solids in its first child, which "
+                             "Webots searches as groups)")
 
     _unit = field_validator("emissive_color")(_unit_colors)
 

@@ -203,6 +203,21 @@ def solid_lights(solid: wm.Solid, frame: Pose, nested: bool = False
         yield from solid_lights(child, frame.compose(pose_from_model(child.pose)), True)
 
 
+def charger_glow(solid: wm.Solid, shapes: int, lights: int, solids: int) -> tuple[list[int], list[int]]:
+    """A Charger's glowing shapes and lights, as indices among its solid's (:func:`solid_parts` and
+    :func:`solid_lights` order): its first ``shapes`` shapes and ``lights`` own lights, and every shape
+    and light of its first ``solids`` children (WbCharger searches the solids in its first child as
+    it searches groups)."""
+    all_shapes = len(list(solid_parts(solid, Pose.identity())))
+    own_shapes = (solid.geometry is not None) + len(solid.shapes)
+    nested = solid.children[:solids]
+    nested_shapes = sum(len(list(solid_parts(c, Pose.identity()))) for c in nested)
+    nested_lights = sum(len(list(solid_lights(c, Pose.identity()))) for c in nested)
+    glowing = sorted({*range(min(shapes, all_shapes)), *range(own_shapes, own_shapes + nested_shapes)})
+    own_lights = len(solid.lights)
+    return glowing, [*range(min(lights, own_lights)), *range(own_lights, own_lights + nested_lights)]
+
+
 def sensor_aimed(model, own: Pose):
     """A spot light of a nested solid with the beam axis Webots' LightSensor uses: ``direction``
     turned by that solid's own rotation only (``WbLightSensor::computeLightMeasurement`` turns it by
@@ -823,6 +838,25 @@ class Scene:
         swap = {id(a): b for a, b in zip(old, new)}
         self._lights = [(swap.get(id(m), m), owner, local) for m, owner, local in self._lights]
         self._led_lights[(robot, led)] = new
+        self.lights_version += 1
+
+    def solid_light_slots(self, name: str) -> list[int]:
+        """Where top-level solid ``name``'s lights (its own, then its nested solids', as
+        :func:`solid_lights`) are among the scene's lights, for :meth:`set_light_color`."""
+        return [k for k, (_, owner, _) in enumerate(self._lights) if owner == name]
+
+    def light_model(self, slot: int) -> Any:
+        """A light's model now (``slot``: see :meth:`solid_light_slots`)."""
+        return self._lights[slot][0]
+
+    def set_light_color(self, slot: int, color: tuple[float, float, float]) -> None:
+        """A light's colour now (a Charger's, ``WbLight::setColor``): light sensors and cameras
+        recompute their light arrays at their next measurement (``lights_version``); nothing changes
+        when it is the same."""
+        model, owner, local = self._lights[slot]
+        if tuple(model.color) == tuple(color):
+            return
+        self._lights[slot] = (model.model_copy(update={"color": tuple(color)}), owner, local)
         self.lights_version += 1
 
     def top_lights(self) -> list:
