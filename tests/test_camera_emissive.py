@@ -247,6 +247,35 @@ def test_a_phong_surfaces_glow_is_multiplied_by_its_texel(texel_dir: Path, preci
     assert (sim.scene.emissive_texel is not None) == phong
 
 
+@pytest.mark.parametrize("precision", BOTH)
+def test_ink_on_a_phong_surface_mixes_into_its_glow(texel_dir: Path, precision: str):
+    """WREN's Phong shader mixes the pen's ink into the texture colour before multiplying: in the dark
+    a glowing textured box top reads ``e·((1 − c)·t + c·ink)``: ``e·t`` where no ink is, black under a
+    stroke of black ink of density 1 (the pen test's stroke: a disc around the image's middle; the paint
+    texture takes the image's size, so a 128-texel image keeps the disc as fine as there)."""
+    import math
+
+    from PIL import Image
+
+    from tests.test_pen import pen
+    Image.fromarray(np.full((128, 128, 3), TEXEL, dtype=np.uint8), "RGB").save(texel_dir / "fine.png")
+    box = {"name": "box", "pose": {"translation": [0.0, 0.0, 0.1]}, "geometry": {"type": "box", "size": [0.4, 0.4, 0.2]},
+           "appearance": {"texture": "fine.png", "emissive_color": GLOW, "phong": True}}
+    down = [-1.0, 1.0, 1.0, 2.0 * math.pi / 3.0]     # +x to world -z
+    cam = {"device": "Camera", "name": "cam", "width": 33, "height": 33, "field_of_view": 0.5,
+           "pose": {"translation": [0.0, 0.0, 1.0], "rotation": down}}
+    w = wm.World.model_validate({"world_info": {"contact": False}, "solids": [box], "robots": [
+        {"name": "r", "devices": [pen(z=0.5, ink_density=1.0, lead_size=0.03), cam]}]})
+    sim = Simulation(w, precision=precision, base_dir=texel_dir)
+    sim.device("r/cam").enable(16)
+    sim.step()
+    assert sim.scene.textures.ink[0].density.max() == 1.0
+    img = sim.device("r/cam").image[:, :, [2, 1, 0]].astype(np.int64)
+    t = np.array([_linear(v) for v in TEXEL])
+    assert img[16, 16].tolist() == [0, 0, 0]
+    np.testing.assert_array_equal(img[2, 2], byte(np.asarray(GLOW) * t))
+
+
 @pytest.mark.parametrize("appearance, textured_glow", [
     ('Appearance { material Material { emissiveColor 0.05 0.4 0.7 } texture ImageTexture { url "t.png" } }', True),
     ('PBRAppearance { metalness 0 emissiveColor 0.05 0.4 0.7 baseColorMap ImageTexture { url "t.png" } }', False),
