@@ -245,6 +245,8 @@ def test_a_phong_surfaces_glow_is_multiplied_by_its_texel(texel_dir: Path, preci
     glow = np.asarray(GLOW) * t if phong else np.asarray(GLOW)
     np.testing.assert_array_equal(got, byte(np.asarray(DIFFUSE) * t * (0.3 + 0.8 * cos)[..., None] + glow))
     assert (sim.scene.emissive_texel is not None) == phong
+    calm = Simulation(world([AMBIENT], {**appearance, "emissive_color": [0.0, 0.0, 0.0]}), base_dir=texel_dir)
+    assert calm.scene.emissive is None and calm.scene.emissive_texel is None     # nothing glows: nothing computed
 
 
 @pytest.mark.parametrize("precision", BOTH)
