@@ -404,8 +404,8 @@ class Appearance(Strict):
     a PBRAppearance's baseColor by its baseColorMap; a textured Appearance's diffuse colour is
     replaced by white). ``roughness_map``/``occlusion_map`` (red channel) are read only where
     ``texture`` is set, as in Webots. Cameras add ``emissive_color`` to the light a surface sends
-    (Webots' Material ``emissiveColor``; a PBRAppearance's ``emissiveColor``, whose
-    ``emissiveIntensity`` Webots' renderer applies in wireframe rendering only)."""
+    (Webots' Material ``emissiveColor``; a PBRAppearance's ``emissiveColor``, its ``emissiveIntensity``
+    left out: WREN applies it in its forward shader only, not in the shadow-volume one)."""
 
     base_color: Vec3 = (1.0, 1.0, 1.0)
     emissive_color: Vec3 = (0.0, 0.0, 0.0)
@@ -415,6 +415,12 @@ class Appearance(Strict):
     roughness_map: TextureField = None
     occlusion_map: TextureField = None
     texture_transform: TextureTransform | None = None
+    emissive_map: TextureField = Field(default=None, description="Webots' PBRAppearance emissiveColorMap: cameras "
+                                       "take its texel, as stored (no sRGB decoding), for the emissive colour, as "
+                                       "WREN's PBR shaders do; read with or without a texture")
+    phong: bool = Field(default=False, description="drawn as Webots draws an Appearance node (its Phong shader): "
+                        "cameras multiply the emissive colour by the texture's colour too (a PBRAppearance's "
+                        "emissive colour is added as it is)")
 
     _unit = field_validator("base_color", "emissive_color")(_unit_colors)
 
@@ -2090,6 +2096,11 @@ class Charger(Strict):
                           "to emissive_color with the energy; false: their own until full, then emissive_color")
     glow_shapes: int = Field(default=1, ge=0, description="how many of its solid's first shapes glow so (a .wbt "
                              "Charger: the shapes of its first child, as Webots)")
+    glow_lights: int = Field(default=0, ge=0, description="how many of its solid's first lights take that colour as "
+                             "their color (a .wbt Charger: the lights of its first child, as Webots)")
+    glow_solids: int = Field(default=0, ge=0, description="how many of its solid's first children solids glow so, "
+                             "every shape and light in them (a .wbt Charger: the solids in its first child, which "
+                             "Webots searches as groups)")
 
     _unit = field_validator("emissive_color")(_unit_colors)
 

@@ -135,6 +135,7 @@ from sensorium.server.sim.scene import (
     _entry,
     _shape_info,
     blind_devices,
+    charger_glow,
     infra_red_terms,
     primitive_from_model,
     robot_bodies,
@@ -471,14 +472,25 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: its battery ({r.battery[0]:g} J, "
                                f"cpu_consumption {r.cpu_consumption:g} W) can empty and power it off; the batched "
                                "simulation drains no battery (use Simulation, or cpu_consumption: 0)")
-        glowing = [c.solid for c in w.chargers if len(c.battery) == 3 and c.glow_shapes > 0 and any(
-            shape.appearance is not None for s in w.solids if s.name == c.solid
-            for _, _, shape in list(solid_parts(s, Pose.identity()))[:c.glow_shapes])]
+        glowing, lit = [], []         # Chargers whose shapes glow, whose lights change colour, with their energy
+        for c in w.chargers:
+            for s in (s for s in w.solids if s.name == c.solid and len(c.battery) == 3):
+                shapes, lights = charger_glow(s, c.glow_shapes, c.glow_lights, c.glow_solids)
+                parts = [shape for _, _, shape in solid_parts(s, Pose.identity())]
+                if any(parts[i].appearance is not None for i in shapes):
+                    glowing.append(c.solid)
+                if lights:
+                    lit.append(c.solid)
         cameras = [(r.name, d.name) for r in w.robots for d in r.devices if d.device == "Camera"]
         if glowing and cameras:       # no Charger runs here: its glow (sim/battery.py) would not follow its energy
             raise BatchedError(f"{self.loaded.source}: Charger {glowing[0]!r}: its shapes glow with its energy, which "
                                f"camera {cameras[0][0]}/{cameras[0][1]} sees; the batched simulation runs no Charger "
-                               "(use Simulation, or glow_shapes: 0)")
+                               "(use Simulation, or glow_shapes: 0 and glow_solids: 0)")
+        seeing = [(r.name, d.name) for r in w.robots for d in r.devices if d.device in ("Camera", "LightSensor")]
+        if lit and seeing:
+            raise BatchedError(f"{self.loaded.source}: Charger {lit[0]!r}: its lights' colour follows its energy, which "
+                               f"{seeing[0][0]}/{seeing[0][1]} sees; the batched simulation runs no Charger (use "
+                               "Simulation, or glow_lights: 0 and glow_solids: 0)")
         belts = [(r.name, b.motor) for r in w.robots for b in r.belts]
         if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "

@@ -50,9 +50,9 @@ from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composit
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import (
     _base_color,
-    add_emissive,
-    emissive_array,
+    emissive_arrays,
     emissive_of,
+    emissive_rows,
     receives_shadows,
     scene_robot_parts,
     surface_colors,
@@ -184,7 +184,7 @@ class CameraDevices(PixelDevices):
         self.colors = np.array([_base_color(m) for m in models] + [(1.0, 1.0, 1.0)], dtype=np.float64).reshape(-1, 3)
         self.transparency = np.array([m.appearance.transparency if m.appearance is not None else 0.0
                                       for m in models] + [0.0])
-        self.emissive = emissive_array([emissive_of(m) for m in models])
+        self.emissive, self.emissive_texel = emissive_arrays([emissive_of(m) for m in models], models)
         self.clear = bool((self.transparency > 0.0).any())     # semi-transparent surfaces: layers per copy
 
     def _lights_of(self, copy: int) -> light_math.LightArrays:
@@ -229,34 +229,41 @@ class CameraDevices(PixelDevices):
         return own_body_hits(self, col, copies, h)
 
     def _albedo(self, shape: np.ndarray, org: np.ndarray, row_copy: np.ndarray, D: np.ndarray,
-                t: np.ndarray, copies: np.ndarray) -> np.ndarray:
+                t: np.ndarray, copies: np.ndarray, glow: np.ndarray | None = None) -> np.ndarray:
         """``Scene.surface_colors`` of hits of every copy: base colours by shape; a textured shape's
         texels per copy (a solid's, or a robot body's at that copy's pose: batched_textures.py), on the
-        rows the single camera would pass (its image's hits)."""
+        rows the single camera would pass (its image's hits). ``glow``: the hits' emissive rows, a
+        Phong shape's multiplied in place by its texture's colour (``surface_colors``' ``glow``)."""
         col = np.take(self.colors, shape, axis=0)
         sim = self.sim
         scene = sim.scene
         sampler = scene.textures
         if sampler is None:
             return col
+        texel = self.emissive_texel if glow is not None else None
         robots = sim.robot_textures
         textured = np.zeros(len(shape), dtype=bool)
+        flags = sampler.textured if texel is None or not sampler.has_emissive_map else \
+            sampler.textured | sampler.emissive_mapped         # (an emissive map is read on those rows too)
         if robots is not None:        # the sampler numbers every shape, robots' included
-            textured = sampler.textured[shape]
+            textured = flags[shape]
         else:
             static = shape < sim.n_static_shapes
-            textured[static] = sampler.textured[shape[static]]
+            textured[static] = flags[shape[static]]
         rows = textured.nonzero()[0]
         of = row_copy[rows]                  # nondecreasing: the hits come copy after copy
         cuts = np.flatnonzero(of[1:] != of[:-1]) + 1
         for rq in np.split(rows, cuts) if len(rows) else ():
             q = int(row_copy[rq[0]])
             o = np.broadcast_to(org[q], (len(rq), 3))
+            g = None if texel is None else (glow[rq], texel)     # type: ignore[index]
             if robots is None:
-                col[rq] = scene.surface_colors(shape[rq], o, D[rq], t[rq])
+                col[rq] = scene.surface_colors(shape[rq], o, D[rq], t[rq], g)
             else:
                 col[rq] = surface_colors(self.colors, sampler, robots.world_to_shape(int(copies[q])), shape[rq], o,
-                                         D[rq], t[rq])
+                                         D[rq], t[rq], g)
+            if g is not None:
+                glow[rq] = g[0]          # type: ignore[index]
         return col
 
     def _shadows(self, P: np.ndarray, N: np.ndarray, row_copy: np.ndarray, copies: np.ndarray) -> np.ndarray:
@@ -329,7 +336,8 @@ class CameraDevices(PixelDevices):
                 bk = back.nonzero()[0]
                 N[bk] = np.negative(shading.take_rows(N, bk))
             s = shape.take(kk)
-            albedo = self._albedo(s, org, row_copy, Dk, tk, copies)
+            glow = emissive_rows(self.emissive, s)
+            albedo = self._albedo(s, org, row_copy, Dk, tk, copies, glow)
             lit = None
             if self.shadows.any():
                 translucent = self._translucent_shapes()
@@ -340,7 +348,8 @@ class CameraDevices(PixelDevices):
                     on = (~translucent[s]).nonzero()[0]
                     lit[on] = self._shadows(P[on], N[on], row_copy[on], copies)
             L = self._shade_copies(P, N, albedo, lit, row_copy, copies)
-            add_emissive(L, self.emissive, s)      # as Camera's surface
+            if glow is not None:                   # as Camera's surface
+                L += glow
             if scene.fog is not None:
                 L = shading.fog(L, tk, *scene.fog)
             share = weight[kk] * (1.0 - np.zeros(len(kk)))   # (opaque: transparency 0, as the single's share)
@@ -409,7 +418,8 @@ class CameraDevices(PixelDevices):
 
         def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
             zeros = np.zeros(len(s), dtype=np.int64)
-            albedo = self._albedo(s, origin[None, :], zeros, D, t, copy)
+            glow = emissive_rows(self.emissive, s)
+            albedo = self._albedo(s, origin[None, :], zeros, D, t, copy, glow)
             lit = None
             if self.shadows.any():    # on opaque surfaces only, as Camera's surface
                 lit = np.ones((len(s), len(self.shadows)), dtype=bool)
@@ -417,7 +427,8 @@ class CameraDevices(PixelDevices):
                 lit[on] = self._shadows(P[on], N[on], zeros[on], copy)
             lights = self._lights_of(int(copy[0]))
             L = _shade(P, N, albedo, lights, None if lit is None else lit[:, :lights.count], scene.engine.threads)
-            add_emissive(L, self.emissive, s)      # as Camera's surface
+            if glow is not None:                   # as Camera's surface
+                L += glow
             return L
 
         alpha = None

@@ -25,11 +25,11 @@ __all__ = ["RobotTextures", "textured_robot"]
 
 
 def textured_robot(robot: wm.Robot) -> bool:
-    """Whether a robot's shapes carry a texture, a roughness map or an occlusion map."""
+    """Whether a robot's shapes carry a texture, a roughness, occlusion or emissive map."""
     for _, _, shape in robot_parts(robot):
         a = shape.appearance
         if a is not None and (getattr(a, "texture", None) or getattr(a, "roughness_map", None)
-                              or getattr(a, "occlusion_map", None)):
+                              or getattr(a, "occlusion_map", None) or getattr(a, "emissive_map", None)):
             return True
     return False
 

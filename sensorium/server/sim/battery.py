@@ -79,6 +79,8 @@ class Charger:
     emissive: tuple[float, float, float] = (0.0, 1.0, 0.0)
     gradual: bool = True
     glow_shapes: int = 0           # how many of its solid's first shapes glow with its energy
+    glow_lights: int = 0           # how many of its solid's first lights take that colour
+    glow_solids: int = 0           # how many of its solid's first children glow, all their shapes and lights
 
     @classmethod
     def from_model(cls, c: wm.Charger) -> Charger | None:
@@ -87,10 +89,11 @@ class Charger:
             return None
         e, m, s = (float(v) for v in c.battery)
         return cls(c.solid, float(c.radius), e, m, s, e, emissive=tuple(float(v) for v in c.emissive_color),  # type: ignore[arg-type]
-                   gradual=c.gradual, glow_shapes=c.glow_shapes)
+                   gradual=c.gradual, glow_shapes=c.glow_shapes, glow_lights=c.glow_lights, glow_solids=c.glow_solids)
 
     def glow(self, initial: tuple[float, float, float]) -> tuple[float, float, float]:
-        """The emissive colour of a glowing shape whose own is ``initial`` (WbCharger::updateMaterialsAndLights):
+        """The emissive colour of a glowing shape (or the colour of a light) whose own is ``initial``
+        (WbCharger::updateMaterialsAndLights, one rule for both):
         ``emissive`` when full; else, ``gradual``, ``initial + (emissive − initial)·E/Emax``, or ``initial``."""
         if self.energy >= self.maximum:          # (a maximum of 0: full)
             return self.emissive

@@ -23,7 +23,7 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import blocks
 from sensorium.server.raycast.engine import RayHits, RayKind, Riding
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import add_emissive, light_from_model
+from sensorium.server.sim.scene import emissive_rows, light_from_model
 from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
@@ -642,7 +642,10 @@ class Camera(Device):
             return engine.cast(O, D, tn, tf, kind=RayKind.VISUAL, exclude_owner=-1)
 
         def surface(s: np.ndarray, P: np.ndarray, N: np.ndarray, D: np.ndarray, t: np.ndarray) -> np.ndarray:
-            albedo = scene.surface_colors(s, np.broadcast_to(origin, (len(s), 3)), D, t)
+            glow = emissive_rows(scene.emissive, s)
+            texel = scene.emissive_texel
+            albedo = scene.surface_colors(s, np.broadcast_to(origin, (len(s), 3)), D, t,
+                                          None if glow is None or texel is None else (glow, texel))
             lit = None
             if shadows.any():    # shadows fall on opaque surfaces only (Webots' translucent ones take none)
                 on = scene.receives_shadows(s).nonzero()[0]
@@ -652,7 +655,8 @@ class Camera(Device):
                     lit = np.ones((len(s), len(shadows)), dtype=bool)
                     lit[on] = self._shadows(P[on], N[on], lights, shadows, counters)
             L = _shade(P, N, albedo, lights, lit, engine.threads)
-            add_emissive(L, scene.emissive, s)     # Webots' shaders add the emissive colour to the lit one
+            if glow is not None:       # Webots' shaders add the emissive colour to the lit one
+                L += glow
             return L
 
         alpha = None

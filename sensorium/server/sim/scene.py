@@ -82,30 +82,58 @@ def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
 
 def emissive_of(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
     """The radiance a shape's surface sends whatever the lights: its emissive colour (Webots' Phong
-    and PBR shaders add it to the lit colour; a PBRAppearance's emissiveIntensity only in wireframe)."""
+    and PBR shaders add it to the lit colour; a PBRAppearance's emissiveIntensity is left out)."""
     a = shape.appearance
     if a is None:
         return (0.0, 0.0, 0.0)
     return tuple(float(v) for v in a.emissive_color)  # type: ignore[return-value]
 
 
-def add_emissive(radiance: np.ndarray, emissive: np.ndarray | None, shape: np.ndarray) -> None:
-    """Adds the hit shapes' emissive radiance to ``radiance`` (n, 3) in place, as Webots' shaders add
-    it to the lit colour; nothing in a world where nothing glows (``emissive`` None)."""
-    if emissive is not None:
-        radiance += np.take(emissive, shape, axis=0)
+def emissive_rows(emissive: np.ndarray | None, shape: np.ndarray) -> np.ndarray | None:
+    """The hit shapes' emissive radiance (n, 3), which Webots' shaders add to the lit colour (where
+    a texture changes it, changed by :func:`surface_colors`' ``glow``); None in a world where
+    nothing glows (``emissive`` None)."""
+    return None if emissive is None else np.take(emissive, shape, axis=0)
 
 
-def emissive_array(colors: list[tuple[float, float, float]]) -> np.ndarray | None:
-    """Per shape (and a trailing 0 for no hit) the emissive radiance, or None when none glows."""
-    if not any(any(c) for c in colors):
-        return None
-    return np.array(list(colors) + [(0.0, 0.0, 0.0)], dtype=np.float64).reshape(-1, 3)
+TIMES_TEXEL, FROM_MAP = 1, 2
+"""What :func:`emissive_texels` says of a shape's emissive colour besides 0 (the colour as it is)."""
+
+
+def _emissive_texel(model: wm.Shape | wm.Solid) -> int:
+    a = model.appearance
+    if a is None:
+        return 0
+    if a.emissive_map is not None:
+        return FROM_MAP
+    return TIMES_TEXEL if a.phong and a.texture is not None else 0
+
+
+def emissive_texels(models: list[wm.Shape | wm.Solid]) -> np.ndarray | None:
+    """Per shape (and a trailing 0 for no hit) how a texture makes its emissive colour, or None when
+    no shape's does: ``TIMES_TEXEL``, an ``Appearance`` node's with an image is multiplied by the
+    texture's colour (WREN's Phong shader multiplies the sum of emissive and lit colours by the
+    texel; its PBR shader adds a PBRAppearance's as it is); ``FROM_MAP``, a PBRAppearance's
+    emissiveColorMap gives it (its texel replaces the colour in WREN's PBR shaders)."""
+    codes = [_emissive_texel(m) for m in models]
+    return np.array(codes + [0], dtype=np.int8) if any(codes) else None
+
+
+def emissive_arrays(colors: list[tuple[float, float, float]], models: list[wm.Shape | wm.Solid]
+                    ) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """Per shape (and a trailing 0 for no hit) the emissive radiance, and :func:`emissive_texels`: both
+    None when nothing glows (no emissive colour, no emissive map), the second None too when no
+    texture changes a glow."""
+    texel = emissive_texels(models)
+    mapped = texel is not None and bool((texel == FROM_MAP).any())
+    if not mapped and not any(any(c) for c in colors):
+        return None, None
+    return np.array(list(colors) + [(0.0, 0.0, 0.0)], dtype=np.float64).reshape(-1, 3), texel
 
 
 def _maps(a: wm.Appearance) -> tuple:
     """What of an appearance the texture sampler reads."""
-    return a.texture, a.roughness_map, a.occlusion_map, a.texture_transform
+    return a.texture, a.roughness_map, a.occlusion_map, a.emissive_map, a.texture_transform
 
 
 def translucent(appearance: wm.Appearance | None, base_dir: Path, images: Checked | None = None) -> bool:
@@ -173,6 +201,21 @@ def solid_lights(solid: wm.Solid, frame: Pose, nested: bool = False
         yield (lt if own is None else sensor_aimed(lt, own)), frame
     for child in solid.children:
         yield from solid_lights(child, frame.compose(pose_from_model(child.pose)), True)
+
+
+def charger_glow(solid: wm.Solid, shapes: int, lights: int, solids: int) -> tuple[list[int], list[int]]:
+    """A Charger's glowing shapes and lights, as indices among its solid's (:func:`solid_parts` and
+    :func:`solid_lights` order): its first ``shapes`` shapes and ``lights`` own lights, and every shape
+    and light of its first ``solids`` children (WbCharger searches the solids in its first child as
+    it searches groups)."""
+    all_shapes = len(list(solid_parts(solid, Pose.identity())))
+    own_shapes = (solid.geometry is not None) + len(solid.shapes)
+    nested = solid.children[:solids]
+    nested_shapes = sum(len(list(solid_parts(c, Pose.identity()))) for c in nested)
+    nested_lights = sum(len(list(solid_lights(c, Pose.identity()))) for c in nested)
+    glowing = sorted({*range(min(shapes, all_shapes)), *range(own_shapes, own_shapes + nested_shapes)})
+    own_lights = len(solid.lights)
+    return glowing, [*range(min(lights, own_lights)), *range(own_lights, own_lights + nested_lights)]
 
 
 def sensor_aimed(model, own: Pose):
@@ -283,12 +326,17 @@ def light_from_model(m) -> light_math.Light:
 
 
 def surface_colors(colors: np.ndarray, sampler: TextureSampler | None, world_to_shape: Callable[[int], Pose],
-                   shape: np.ndarray, origins: np.ndarray, directions: np.ndarray, distance: np.ndarray) -> np.ndarray:
+                   shape: np.ndarray, origins: np.ndarray, directions: np.ndarray, distance: np.ndarray,
+                   glow: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): the base colour,
     times the texel of a textured shape converted from sRGB to linear (Webots' shaders;
     where picking fails, 1), blended with a pen's ink (``(1 − c)·colour + c·ink``) read where the
     pen painted it (texture set 1, as Webots' shaders; infra-red reads it at set 0). ``colors``: base colours per shape (a trailing white for −1);
-    ``world_to_shape``: a shape's world-to-shape pose now."""
+    ``world_to_shape``: a shape's world-to-shape pose now. ``glow``: the hits' emissive rows (n, 3)
+    and the per-shape flags of :func:`emissive_texels`: a flagged shape's rows are multiplied in
+    place by the texture's colour read here (``(1 − c)·texel + c·ink``), as WREN's Phong shader
+    multiplies its emissive colour; an emissive-mapped shape's rows become its map's texel (where
+    picking fails, the colour stays), as WREN's PBR shaders take it."""
     col = np.take(colors, shape, axis=0)   # (faster than fancy indexing of (n, 3) rows)
     if sampler is None:
         return col
@@ -296,15 +344,24 @@ def surface_colors(colors: np.ndarray, sampler: TextureSampler | None, world_to_
                                                    directions, distance):
         sampler.lookups += len(rows)
         base = col[rows]
+        texel = None
         if s in sampler.shapes:
-            texel = srgb_to_linear(sampler.texels(s, uv, "base"))
-            base = base * np.where(picked[:, None], texel, 1.0)
+            texel = np.where(picked[:, None], srgb_to_linear(sampler.texels(s, uv, "base")), 1.0)
+            base = base * texel
         layer = sampler.ink.get(s)
+        ink = None
         if layer is not None:     # the paint texture as Webots' shaders sample it: at texture set 1
             ink, c = layer.pick(np.where(picked[:, None], sampler.ink_uv(s, o, d, distance[rows], uv), 0.0))
             c = np.where(picked, c.astype(np.float64), 0.0)[:, None]
             base = (1.0 - c) * base + c * ink
         col[rows] = base
+        if glow is not None and glow[1][s] == TIMES_TEXEL and texel is not None:
+            glow[0][rows] *= texel if ink is None else (1.0 - c) * texel + c * ink
+    if glow is not None and sampler.has_emissive_map:      # an emissive map's texel replaces the colour
+        for s, rows, _, _, uv, picked in _texel_coords(sampler, sampler.emissive_mapped, world_to_shape, shape,
+                                                       origins, directions, distance):
+            sampler.lookups += len(rows)
+            glow[0][rows] = np.where(picked[:, None], sampler.emissive_texels(s, uv), glow[0][rows])
     return col
 
 
@@ -583,20 +640,28 @@ class Scene:
         self._rebuild_emissive()
 
     def _rebuild_emissive(self) -> None:
-        """Every shape's emissive row now (None when nothing glows)."""
-        self.emissive = emissive_array([self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)])
+        """Every shape's emissive row now and how a texture makes it (``emissive_texel``, see
+        :func:`emissive_arrays`: both None when nothing glows)."""
+        self.emissive, self.emissive_texel = emissive_arrays(
+            [self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)], [m for _, _, m in self._parts])
 
     def _refresh_emissive(self, shape: int) -> None:
-        """One shape's emissive row after its model or glow changed: the array built when it is the first
-        to glow, dropped when it was the last."""
-        glow = self._emissive_now(shape, self._parts[shape][2])
-        if self.emissive is None:
-            if any(glow):
+        """One shape's emissive row after its model or glow changed: the arrays built when it is the first
+        to glow (or to have a texture make its glow), dropped when it was the last."""
+        model = self._parts[shape][2]
+        glow = self._emissive_now(shape, model)
+        code = _emissive_texel(model)
+        if self.emissive is None or (self.emissive_texel is None and code):
+            if any(glow) or code:
                 self._rebuild_emissive()
             return
         self.emissive[shape] = glow
-        if not self.emissive.any():
-            self.emissive = None
+        if self.emissive_texel is not None:
+            self.emissive_texel[shape] = code
+            if not self.emissive_texel.any():
+                self.emissive_texel = None
+        if not self.emissive.any() and (self.emissive_texel is None or not (self.emissive_texel == FROM_MAP).any()):
+            self.emissive = self.emissive_texel = None
 
     def _emissive_now(self, shape: int, model: wm.Shape | wm.Solid) -> tuple[float, float, float]:
         """:func:`emissive_of` a shape, its colour a Charger's glow (``set_glow``) where it has one."""
@@ -677,7 +742,8 @@ class Scene:
         whose pixel format has alpha makes the shape cast none (:meth:`_seen_again`)."""
         if shape in self.removed_shapes:
             return
-        if self.textures is None and appearance.texture is not None:     # (no shape textured until now)
+        if self.textures is None and (appearance.texture is not None or appearance.emissive_map is not None):
+            # (no shape textured until now)
             self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
                                            ink_evaporation=self._ink_evaporation, given=self.images)
         self._take_appearance(shape, appearance)
@@ -772,6 +838,25 @@ class Scene:
         swap = {id(a): b for a, b in zip(old, new)}
         self._lights = [(swap.get(id(m), m), owner, local) for m, owner, local in self._lights]
         self._led_lights[(robot, led)] = new
+        self.lights_version += 1
+
+    def solid_light_slots(self, name: str) -> list[int]:
+        """Where top-level solid ``name``'s lights (its own, then its nested solids', as
+        :func:`solid_lights`) are among the scene's lights, for :meth:`set_light_color`."""
+        return [k for k, (_, owner, _) in enumerate(self._lights) if owner == name]
+
+    def light_model(self, slot: int) -> Any:
+        """A light's model now (``slot``: see :meth:`solid_light_slots`)."""
+        return self._lights[slot][0]
+
+    def set_light_color(self, slot: int, color: tuple[float, float, float]) -> None:
+        """A light's colour now (a Charger's, ``WbLight::setColor``): light sensors and cameras
+        recompute their light arrays at their next measurement (``lights_version``); nothing changes
+        when it is the same."""
+        model, owner, local = self._lights[slot]
+        if tuple(model.color) == tuple(color):
+            return
+        self._lights[slot] = (model.model_copy(update={"color": tuple(color)}), owner, local)
         self.lights_version += 1
 
     def top_lights(self) -> list:
@@ -884,7 +969,7 @@ class Scene:
             models = [(shape.geometry, shape.appearance) for _, _, shape in parts]
             if self.textures is not None:
                 self.textures.extend(models)
-            elif any(a is not None and a.texture is not None for _, a in models):
+            elif any(a is not None and (a.texture is not None or a.emissive_map is not None) for _, a in models):
                 self.textures = TextureSampler([(s.geometry, s.appearance) for _, _, s in self._parts], self._base_dir,
                                                ink_evaporation=self._ink_evaporation, given=self.images)
             self.shapes_version += 1
@@ -1035,10 +1120,11 @@ class Scene:
         return tuple(i for i in range(len(self.shapes)) if self._parts[i][0] == key)
 
     def surface_colors(self, shape: np.ndarray, origins: np.ndarray, directions: np.ndarray,
-                       distance: np.ndarray) -> np.ndarray:
+                       distance: np.ndarray, glow: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """The albedo (n, 3) a camera sees at hits (world frame; shape −1: white): see
-        :func:`surface_colors`."""
-        return surface_colors(self.colors, self.textures, self._world_to_shape, shape, origins, directions, distance)
+        :func:`surface_colors` (``glow`` too)."""
+        return surface_colors(self.colors, self.textures, self._world_to_shape, shape, origins, directions, distance,
+                              glow)
 
     def receives_shadows(self, shape: np.ndarray) -> np.ndarray:
         """:func:`receives_shadows` of hits on this scene's shapes."""

@@ -58,6 +58,7 @@ from sensorium.server.sim.radar import Radar
 from sensorium.server.sim.radio import Emitter, Radio, Receiver
 from sensorium.server.sim.scene import (
     Scene,
+    charger_glow,
     light_from_model,
     primitive_from_model,
     robot_bounding_parts,
@@ -397,10 +398,18 @@ class Simulation:
         self._batteries = [r.battery for r in self.robots.values()]
         self._powered = [r for r in self.robots.values() if r.battery.present]
         self.chargers = [c for c in map(Charger.from_model, self.world.chargers) if c is not None]
-        # each Charger's glowing shapes (its solid's first glow_shapes with an appearance) and their own colours
-        self._glowing = [(c, [(k, self.scene.loaded_model(k).appearance.emissive_color)    # type: ignore[union-attr]
-                              for k in self.scene.solid_shapes(c.solid)[:c.glow_shapes]
-                              if self.scene.loaded_model(k).appearance is not None]) for c in self.chargers]
+        # each Charger's glowing shapes (those of charger_glow with an appearance) and their own colours, and its
+        # glowing lights (their places among its solid's lights) and their own colours
+        self._glowing: list[tuple[Charger, list[tuple[int, tuple]], list[tuple[int, tuple]]]] = []
+        solids = {s.name: s for s in self.world.solids}
+        for c in self.chargers:
+            solid = solids.get(c.solid)
+            shapes, lights = charger_glow(solid, c.glow_shapes, c.glow_lights, c.glow_solids) if solid else ([], [])
+            mine = self.scene.solid_shapes(c.solid)
+            slots = self.scene.solid_light_slots(c.solid)
+            self._glowing.append((c, [(mine[i], self.scene.loaded_model(mine[i]).appearance.emissive_color)  # type: ignore[union-attr]
+                                      for i in shapes if i < len(mine) and self.scene.loaded_model(mine[i]).appearance],
+                                  [(i, tuple(self.scene.light_model(slots[i]).color)) for i in lights if i < len(slots)]))
         self._battery_sensing: list[RobotState] = []     # robots whose battery sensor is enabled
         self._jointed = [j for r in self.robots.values() for j in r.joints.values()]
         self._joint_robot = [r.index for r in self.robots.values() for _ in r.joints.values()]
@@ -1031,10 +1040,14 @@ class Simulation:
     def _glow(self) -> None:
         """Each Charger's glowing shapes take the emissive colour of its energy now (Webots updates them
         at each Charger step and at a reset)."""
-        for charger, shapes in self._glowing:
+        for charger, shapes, lights in self._glowing:
             if charger.solid in self.scene.solid_poses:
                 for k, initial in shapes:
                     self.scene.set_glow(k, charger.glow(initial))
+                if lights:         # (their places now: another solid's removal moves them)
+                    slots = self.scene.solid_light_slots(charger.solid)
+                    for i, initial in lights:
+                        self.scene.set_light_color(slots[i], charger.glow(initial))
 
     def _distance_plan(self, distances: list[DistanceSensor]) -> DistancePlan:
         """The stacked constants of these sensors: built when the set of due sensors changes (a

@@ -207,7 +207,7 @@ def texture_urls(appearance: wm.Appearance | None) -> Iterator[tuple[str, wm.Tex
     """(field name, texture) of every image an appearance names."""
     if appearance is None:
         return
-    for name in ("texture", "roughness_map", "occlusion_map"):
+    for name in ("texture", "roughness_map", "occlusion_map", "emissive_map"):
         t = getattr(appearance, name)
         if t is not None:
             yield name, t
@@ -814,6 +814,10 @@ class TextureSampler:
         self.has_alpha = False
         self.translucent = np.zeros(1, dtype=bool)
         self.has_translucent = False
+        # a PBRAppearance's emissiveColorMap, read whether or not a base image is (cameras only)
+        self.emissive: dict[int, TextureImage] = {}
+        self.emissive_mapped = np.zeros(1, dtype=bool)
+        self.has_emissive_map = False
         self.extend(shapes)
         self.lookups = 0
 
@@ -860,6 +864,10 @@ class TextureSampler:
                 assert base is not None
                 self.shapes[i] = ShapeTexture(base, self._image(app.roughness_map, given=self._given),
                                               self._image(app.occlusion_map, given=self._given), app.texture_transform)
+            if app is not None and app.emissive_map is not None:
+                glow = self._image(app.emissive_map, given=self._given)
+                assert glow is not None
+                self.emissive[i] = glow
         textured = np.zeros(len(self.models) + 1, dtype=bool)
         textured[:first] = self.textured[:first]        # the trailing "no hit" entry stays False
         textured[list(self.shapes)] = True
@@ -876,6 +884,10 @@ class TextureSampler:
         translucent[[s for s, st in self.shapes.items() if st.base.translucent]] = True
         self.translucent = translucent
         self.has_translucent = bool(translucent.any())
+        mapped = np.zeros(len(self.models) + 1, dtype=bool)
+        mapped[list(self.emissive)] = True
+        self.emissive_mapped = mapped
+        self.has_emissive_map = bool(mapped.any())
 
     def forget(self, shapes: Collection[int], count: int) -> None:
         """Shapes of a body a Supervisor removed let go: ``shapes`` (numbers kept) hold nothing any more
@@ -887,6 +899,7 @@ class TextureSampler:
         layers = {id(self.ink[s]) for s in gone if s in self.ink}
         for s in gone:
             self.shapes.pop(s, None)
+            self.emissive.pop(s, None)
             self.ink.pop(s, None)
             self.ink_refused.discard(s)
             self._locators.pop(s, None)
@@ -897,7 +910,7 @@ class TextureSampler:
             self._evaporating = [layer for layer in self._evaporating if id(layer) not in layers]
         shorter = count < len(self.models)
         self.models = [m if i not in gone else (None, None) for i, m in enumerate(self.models[:count])]
-        for name in ("textured", "alpha", "translucent"):
+        for name in ("textured", "alpha", "translucent", "emissive_mapped"):
             flags = getattr(self, name)
             if shorter:           # new arrays (the scene tells their holders: shapes_version)
                 flags = np.append(flags[:count], False)
@@ -905,6 +918,7 @@ class TextureSampler:
             flags[[s for s in shapes if s < count]] = False     # in place
         self.has_alpha = bool(self.alpha.any())
         self.has_translucent = bool(self.translucent.any())
+        self.has_emissive_map = bool(self.emissive_mapped.any())
         self._let_go_unused()
 
     def set_shape(self, shape: int, appearance: wm.Appearance | None,
@@ -923,6 +937,13 @@ class TextureSampler:
                                               appearance.texture_transform)
         else:
             self.shapes.pop(shape, None)
+        glow = None if appearance is None else self._image(appearance.emissive_map, keep=False, given=given)
+        if glow is not None:
+            self.emissive[shape] = glow
+        else:
+            self.emissive.pop(shape, None)
+        self.emissive_mapped[shape] = glow is not None
+        self.has_emissive_map = bool(self.emissive_mapped.any())
         st = self.shapes.get(shape)
         self.textured[shape] = st is not None or shape in self.ink
         self.alpha[shape] = st is not None and st.base.alpha is not None
@@ -934,17 +955,19 @@ class TextureSampler:
     def _let_go_unused(self) -> None:
         """Images no shape shows any more, but the world's own (a reset brings them back), let go."""
         used = {id(img.rgb) for st in self.shapes.values() for img in (st.base, st.roughness, st.occlusion)
-                if img is not None}
+                if img is not None} | {id(img.rgb) for img in self.emissive.values()}
         self._images = {p: v for p, v in self._images.items() if p in self._kept or id(v[0]) in used}
 
     def pixels(self, without: Collection[int] = ()) -> int:
         """The pixels of the distinct images the shapes use (but those of the shapes ``without``)."""
         seen = {id(img.rgb): img.rgb.shape[0] * img.rgb.shape[1] for k, st in self.shapes.items() if k not in without
                 for img in (st.base, st.roughness, st.occlusion) if img is not None}
+        seen.update({id(img.rgb): img.rgb.shape[0] * img.rgb.shape[1] for k, img in self.emissive.items()
+                     if k not in without})
         return sum(seen.values())
 
     def __bool__(self) -> bool:
-        return bool(self.shapes) or bool(self.ink)
+        return bool(self.shapes) or bool(self.ink) or bool(self.emissive)
 
     # ---- texture coordinates
 
@@ -1008,6 +1031,14 @@ class TextureSampler:
         if img is None:
             raise KeyError(f"shape {shape} has no {which} map")
         return img.texels(transform_uv(np.asarray(uv, dtype=np.float64).reshape(-1, 2), st.transform), channel)
+
+    def emissive_texels(self, shape: int, uv: np.ndarray) -> np.ndarray:
+        """Colours ``(n, 3)`` of ``shape``'s emissive map at ``uv`` (its appearance's TextureTransform
+        applied, then the wrap, nearest texel, as :meth:`texels`), as stored: WREN's PBR shaders take
+        them for the emissive colour without sRGB decoding."""
+        appearance = self.models[shape][1]
+        transform = None if appearance is None else appearance.texture_transform
+        return self.emissive[shape].texels(transform_uv(np.asarray(uv, dtype=np.float64).reshape(-1, 2), transform))
 
     def opacity(self, shape: int, uv: np.ndarray) -> np.ndarray:
         """The alpha ``(n,)`` in [0, 1] of ``shape``'s base image at ``uv`` (the TextureTransform

@@ -709,6 +709,8 @@ class Converter:
         elif t == "Charger":             # a Solid that recharges robots' batteries (README 'Battery and Charger')
             entry = self.solid(node, frame, owner, "solid")
             glow = entry.pop("_glow_shapes", 0) if entry is not None else 0
+            glow_lights = entry.pop("_glow_lights", 0) if entry is not None else 0
+            glow_solids = entry.pop("_glow_solids", 0) if entry is not None else 0
             if owner.kind != "world" or entry is None:
                 self.warn(node, f"Charger {f.string('name', 'solid')!r}: only a top-level Charger recharges "
                                 "robots here; its shapes and lights are kept")
@@ -717,6 +719,10 @@ class Converter:
                                            "emissive_color": list(f.color("emissiveColor", (0.0, 1.0, 0.0))),
                                            "gradual": f.flag("gradual", True),
                                            "glow_shapes": glow}
+                if glow_lights:         # (the model's defaults otherwise: a Charger without them dumps as before)
+                    charger["glow_lights"] = glow_lights
+                if glow_solids:
+                    charger["glow_solids"] = glow_solids
                 battery = self.battery_values(node, f"Charger {entry['name']!r}")
                 if battery:
                     charger["battery"] = battery
@@ -1548,7 +1554,9 @@ class Converter:
         for k, child in enumerate(f.nodes("children")):
             self.visit(child, frame, owner)
             if k == 0 and node.type == "Charger" and owner.kind == "solid":   # its first child's shapes glow
-                owner.data["_glow_shapes"] = len(owner.parts)
+                owner.data["_glow_shapes"] = len(owner.parts)          # (and its lights, and the solids in it)
+                owner.data["_glow_lights"] = len(owner.data.get("lights", []))
+                owner.data["_glow_solids"] = len(owner.data.get("children", []))
         if bounding:
             self.bounding(f.node_("boundingObject"), frame, owner)
 

@@ -29,7 +29,7 @@ def dump_yaml(data: Any) -> str:
     return yaml.dump(data, Dumper=_Dumper, sort_keys=False, width=120)
 
 
-TEXTURE_KEYS = ("texture", "roughness_map", "occlusion_map")     # an appearance's image files
+TEXTURE_KEYS = ("texture", "roughness_map", "occlusion_map", "emissive_map")     # an appearance's image files
 
 
 def _rebase(data: Any, src_dir: Path, out_dir: Path) -> Any:

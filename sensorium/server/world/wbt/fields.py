@@ -482,8 +482,8 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
         out: dict[str, Any] = {"base_color": list(f.color("baseColor", (1.0, 1.0, 1.0))),
                                "transparency": f.within("transparency", 0.0, 0.0, 1.0, 0.0),
                                "roughness": f.within("roughness", 0.0, 0.0, 1.0, 0.0)}
-        # emissiveIntensity is not read: WREN's PBR shader applies it in wireframe rendering only, and
-        # WbPbrAppearance passes emissiveColor unscaled (nor does it reset a negative intensity)
+        # emissiveIntensity is not read: WREN's shadow-volume shader applies it in wireframe rendering only,
+        # its forward shader (no light casting shadows, translucent shapes) always (a departure: README)
         emissive = f.color("emissiveColor", (0.0, 0.0, 0.0))
         if any(emissive):          # (the model's defaults otherwise: a world without glow dumps as before)
             out["emissive_color"] = list(emissive)
@@ -494,7 +494,10 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
                 extra = image_texture(f.node_(field), source, warn, resolve)
                 if extra is not None:
                     out[key] = extra
-        if f.node_("baseColorMap") is not None:      # (kept for a url a Supervisor sets)
+        glow_map = image_texture(f.node_("emissiveColorMap"), source, warn, resolve)
+        if glow_map is not None:
+            out["emissive_map"] = glow_map
+        if f.node_("baseColorMap") is not None or glow_map is not None:      # (kept for a url a Supervisor sets)
             _texture_transform(f, source, out)
         return out
     if node.type == "Appearance":
@@ -514,6 +517,7 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
             out["texture"] = texture
         if f.node_("texture") is not None:           # (kept for a url a Supervisor sets)
             _texture_transform(f, source, out)
+            out["phong"] = True        # its emissive colour times the texel (only a textured one differs)
         return out
     warn(node, f"appearance {node.type}: not built in (a PROTO?); taken as white")
     return None
