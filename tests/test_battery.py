@@ -483,3 +483,20 @@ def test_a_battery_write_out_of_its_values_is_one_line_and_changes_nothing(args:
     assert got["ok"] is False and says in got["error"]["message"] and "\n" not in got["error"]["message"]
     b = sim.robots["r"].battery
     assert (b.energy, b.maximum, b.speed) == (5.0, 10.0, 1.0)
+
+
+def test_a_proto_robots_battery_field_passing_through_is_is_written_the_same_way() -> None:
+    # tests/protos/battery/Cell.proto: battery IS battery ([5, 10, 1]), cpuConsumption IS cpu (31.25 W: 1 J a step)
+    from sensorium.server.daemon import supervisor as sv
+
+    sim = Simulation(load_world(Path(__file__).parent / "worlds" / "battery_proto.wbt"))
+    cell, r = sv.find_node(sim, "CELL"), sim.robots["cell"]
+    assert sv.change_item(sim, cell, "battery", "set", 0, 3.5) == []
+    sim.run(2)
+    assert r.battery.energy == pytest.approx(1.5, abs=1e-12)
+    assert sv.get_field(sim, cell, "battery")["value"] == pytest.approx([1.5, 10.0, 1.0], abs=1e-12)
+    assert sv.set_field(sim, cell, "cpu", 0.0) == []
+    sim.run(2)
+    assert r.battery.energy == pytest.approx(1.5, abs=1e-12)
+    with pytest.raises(ValueError, match="PROTO internal field"):     # its base node's field: read-only, as Webots
+        sv.change_item(sim, cell, "battery", "set", 0, 3.0, 0)

@@ -306,3 +306,17 @@ def test_a_shape_a_supervisor_removed_is_left_out_of_the_text_and_of_a_saved_wor
     one = _sim(world)
     sv.remove_node(one, _node(one, "S"))
     assert node_string(one, _node(one, "ONE")) == 'DEF ONE Solid {\n  translation 1 0 0\n  name "one"\n}'
+
+
+def test_a_body_node_of_a_solid_built_again_or_imported_names_its_new_values():
+    # a set of TALL's height builds it again (sim/regenerate.py): its CAP at the new height; an imported
+    # Post's CAP at the height its node string gives
+    sim = _sim(BODY)
+    assert sv.set_field(sim, _node(sim, "TALL"), "height", 3.0, 1) == []
+    cap = _read(node_string(sim, _made(sim, "TALL", "CAP")))
+    assert cap.fields["translation"] == (0.0, 0.0, 3.0)
+    assert cap.fields["children"][0].fields["geometry"].fields == {"radius": 0.3}
+    sv.import_nodes(sim, sv.ROOT, "children", -1, 'DEF IMP Post { translation 0 5 0 name "imp" height 4 }')
+    cap = _read(node_string(sim, _made(sim, "IMP", "CAP")))
+    assert cap.fields["translation"] == (0.0, 0.0, 4.0)
+    assert cap.fields["children"][0].fields["appearance"].fields["baseColor"] == (1.0, 0.0, 0.0)
