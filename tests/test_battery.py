@@ -473,8 +473,9 @@ def test_a_written_maximum_and_recharge_speed_are_what_a_charger_gives_to() -> N
     ({"index": 3, "op": "set", "value": 1.0}, "out-of-bound index 3 (should be between -3 and 2)"),
     ({"index": 0, "op": "insert", "value": 1.0}, "its values are set here, not inserted or removed"),
     ({"index": 0, "op": "remove"}, "its values are set here, not inserted or removed"),
-    ({"index": 0, "op": "set", "value": -1.0}, "takes a value >= 0"),
-    ({"index": 0, "op": "set", "value": "full"}, "takes a finite number"),
+    ({"index": 0, "op": "set", "value": -1.0}, "item 0 takes a finite number >= 0 (J), got -1.0; nothing changed"),
+    ({"index": 2, "op": "set", "value": math.inf}, "should be a finite number (got inf)"),     # (the wire refuses it)
+    ({"index": 0, "op": "set", "value": "full"}, "item 0 takes a finite number >= 0 (J), got 'full'"),
 ])
 def test_a_battery_write_out_of_its_values_is_one_line_and_changes_nothing(args: dict, says: str) -> None:
     sim, call, node = supervised(world([{"name": "r", "def_name": "R", "battery": [5.0, 10.0, 1.0]},

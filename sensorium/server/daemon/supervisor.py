@@ -610,9 +610,9 @@ def _set_battery_item(sim: Any, node: Node, where: str, op: str, index: Any, val
         raise ValueError(f"{where}: its values are set here, not inserted or removed (the world gives "
                          f"{len(robot.model.battery)}); nothing changed")
     at = item_position(where, op, index, len(robot.model.battery))
-    _check_value("battery", "SFFloat", value)
-    if value < 0.0:
-        raise ValueError(f"{where}: takes a value >= 0 (J, J, W), got {value!r}; nothing changed")
+    if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value < math.inf:
+        raise ValueError(f"{where}: item {index} takes a finite number >= 0 ({('J', 'J', 'W')[at]}), got {value!r}; "
+                         "nothing changed")
     setattr(robot.battery, _BATTERY_ITEMS[at], float(value))
 
 
