@@ -320,3 +320,20 @@ def test_a_body_node_of_a_solid_built_again_or_imported_names_its_new_values():
     cap = _read(node_string(sim, _made(sim, "IMP", "CAP")))
     assert cap.fields["translation"] == (0.0, 0.0, 4.0)
     assert cap.fields["children"][0].fields["appearance"].fields["baseColor"] == (1.0, 0.0, 0.0)
+
+
+def test_a_body_node_whose_proto_file_is_gone_since_the_load_is_one_line(tmp_path):
+    # the PROTOs are read again from their files for such an export: one gone is one line naming it
+    (tmp_path / "protos").mkdir()
+    for name in ("Post.proto", "Holder.proto"):
+        (tmp_path / "protos" / name).write_text((REPO / "tests" / "protos" / "export" / name).read_text())
+    world = tmp_path / "body.wbt"
+    world.write_text(BODY.read_text().replace("../protos/export/Post.proto", "protos/Post.proto"))
+    sim = _sim(world)
+    cap = _made(sim, "TALL", "CAP")
+    (tmp_path / "protos" / "Post.proto").unlink()
+    with pytest.raises(NotExported) as err:
+        node_string(sim, cap)
+    line = str(err.value)
+    assert line.startswith("Solid 'cap'") and "made by the body of PROTO Post" in line and "Post.proto" in line
+    assert "\n" not in line

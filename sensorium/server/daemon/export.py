@@ -170,11 +170,15 @@ def _nested_written(sim: Any, table: nested.Table, n: nested.Nested) -> ParsedNo
     found = _found(sim, table, n)
     if found is not None:
         return found
-    made = _made(sim, table, n, {})
+    what = f"{sv._what(sv._nested_node(n))} is made by the body of {_maker(sim, table, n)}"
+    try:
+        made = _made(sim, table, n, {})
+    except NotExported as exc:
+        raise NotExported(f"{what}: {exc}") from None
     if made is not None:
         return made
-    raise NotExported(f"{sv._what(sv._nested_node(n))} is made by the body of {_maker(sim, table, n)}, and that "
-                      "body's node is not found where the world's PROTOs make it again here: it has no .wbt text here")
+    raise NotExported(f"{what}, and that body's node is not found where the world's PROTOs make it again here: it "
+                      "has no .wbt text here")
 
 
 def _made_string(sim: Any, table: nested.Table, n: nested.Nested) -> str:
