@@ -261,13 +261,15 @@ DRAIN = 31.25            # W: 1.0 J a 32 ms step, exactly
 FACE = 0.95              # the wall's face (m) ahead of the robot's distance sensor
 
 
-def powered_world(e0: float) -> Simulation:
+def powered_world(e0: float, boss: bool = False) -> Simulation:
     """A robot at the origin driving +x at 0.1 m/s (wheels 0.05 m at 2 rad/s) towards a wall, its
-    distance sensor reading the range (table 0..2 m), and a full Charger's solid far away."""
-    sim = world([{"name": "r", "battery": [e0, 100.0, 62.5], "cpu_consumption": DRAIN,
+    distance sensor reading the range (table 0..2 m), and a full Charger's solid far away (``boss``: the
+    robot DEF R, and a supervisor robot 'boss')."""
+    sim = world([{"name": "r", "def_name": "R", "battery": [e0, 100.0, 62.5], "cpu_consumption": DRAIN,
                   "differential_drive": {"wheel_radius": 0.05, "axle_length": 0.1},
                   "devices": [{"device": "DistanceSensor", "name": "d", "lookup_table": [[0, 0, 0], [2, 2, 0]]},
-                              {"device": "PositionSensor", "name": "enc", "motor": "left wheel motor"}]}],
+                              {"device": "PositionSensor", "name": "enc", "motor": "left wheel motor"}]},
+                 *([{"name": "boss", "supervisor": True}] if boss else [])],
                 [{**CHARGER, "battery": [50.0, 50.0, 10.0], "radius": 0.2}],
                 [{"name": "dock", "pose": {"translation": [5.0, 3.0, 0.0]}},
                  {"name": "wall", "pose": {"translation": [1.0, 0, 0]}, "geometry": {"type": "box", "size": [0.1, 4, 1]}}])
@@ -375,3 +377,127 @@ def test_the_batched_simulation_refuses_a_battery_that_can_empty_in_one_line() -
     # nothing a battery changes: none drawn, or an empty one nothing fills (Webots keeps such a robot on)
     assert batched({"name": "r", "battery": [5.0, 10.0], "cpu_consumption": 0.0}, [CHARGER]).copies == 2
     assert batched({"name": "r", "battery": [0.0], "cpu_consumption": 2.0}).copies == 2
+
+
+# a Supervisor's setMFFloat on a robot's battery: Webots' WbRobot reads the field's items live
+def supervised(sim: Simulation) -> tuple[Simulation, object, int]:
+    """``sim`` with a supervisor robot attached through the server's services: (sim, call, node of 'r')."""
+    import msgpack
+
+    from sensorium.schemas import wire
+    from sensorium.server.daemon.services import Core
+
+    core = Core(sim, new_token=lambda: "s0", log=lambda *_: None)
+    rid = iter(range(1, 1000))
+
+    def call(service: str, args: dict) -> dict:
+        (frames,) = core.handle([b"A", wire.pack({"id": next(rid), "service": service, "args": args})], 0.0)
+        return msgpack.unpackb(frames[-1])
+
+    assert call("attach", {"robot": "boss"})["ok"] is True
+    node = call("/boss/robot/get_from_def", {"name": "R"})["result"]["node"]
+    return sim, call, node
+
+
+def test_a_supervisor_write_of_the_energy_drains_from_there_and_an_empty_battery_powers_off_until_a_refill() -> None:
+    # 1 J a step (DRAIN): written 4.5 J it reads 4.5 - n after n steps, empties in the 5th (off: no motion, no
+    # sample); 2.5 J written then: the next step drains 1 J and leaves 1.5: on at its end (WbRobot::setCurrentEnergy
+    # in the post-physics step), sampling then, driving from the step after
+    v = 0.1
+    sim, call, node = supervised(powered_world(7.0, boss=True))
+    r, d = sim.robots["r"], sim.device("r/d")
+    sim.enable_battery_sensor(r, DT)
+    sim.step()
+    assert r.battery_value == pytest.approx(6.0, abs=1e-12)
+    write = {"node": node, "field": "battery", "index": 0, "op": "set"}
+    assert call("/boss/robot/set_field", {**write, "value": 4.5})["ok"] is True
+    got = call("/boss/robot/get_field", {"node": node, "field": "battery"})["result"]
+    assert got["value"] == pytest.approx([4.5, 100.0, 62.5], abs=0.0)        # the field holds it at once
+    assert r.battery_value == pytest.approx(6.0, abs=1e-12)                   # the sensor: at its next sample
+    for n in range(1, 5):
+        sim.step()
+        assert r.battery.energy == pytest.approx(4.5 - n, abs=1e-12) and r.battery_value == r.battery.energy
+    sim.step()
+    assert r.battery.energy == 0.0 and not r.battery.powered and r.battery_value == 0.0
+    stop = r.pose.translation[0]
+    assert stop == pytest.approx(v * 6 * DT / 1000, abs=1e-12)               # it moved in the step it emptied
+    sensed = d.value
+    for _ in range(3):
+        sim.step()
+    assert r.pose.translation[0] == stop and d.value == sensed
+    assert call("/boss/robot/set_field", {**write, "value": 2.5})["ok"] is True
+    sim.step()                        # off through the motion, on at the post-physics step: samples, no motion
+    assert r.battery.powered and r.battery.energy == pytest.approx(1.5, abs=1e-12) and r.battery_value == 1.5
+    assert r.pose.translation[0] == stop
+    assert d.value == pytest.approx(FACE - stop, abs=1e-12)
+    sim.step()                        # powered from the step's start: it drives
+    assert r.pose.translation[0] == pytest.approx(stop + v * DT / 1000, abs=1e-12)
+    assert r.battery.energy == pytest.approx(0.5, abs=1e-12)
+    sim.step()                        # 0.5 J: empty again
+    assert not r.battery.powered
+    assert call("/boss/robot/set_field", {**write, "value": 0.5})["ok"] is True
+    sim.step()                        # less than a step's drain: it empties in that step and stays off
+    assert not r.battery.powered and r.battery.energy == 0.0
+    sim.reset()                       # simulationReset: the world's battery, powered
+    assert r.battery.powered and r.battery.energy == 7.0
+
+
+def test_a_written_maximum_and_recharge_speed_are_what_a_charger_gives_to() -> None:
+    # the dock under the robot: 62.5 W gives 2 J a step against 1 J drained: +1 J a step up to the maximum;
+    # written speed 93.75 W: 3 J a step, +2 J a step; written maximum 12 J: it stops there (Charger's rule)
+    sim, call, node = supervised(world(
+        [{"name": "r", "def_name": "R", "battery": [5.0, 100.0, 62.5], "cpu_consumption": DRAIN},
+         {"name": "boss", "supervisor": True}],
+        [{"solid": "dock", "battery": [500.0, 500.0, 0.0], "radius": 0.2}], [{"name": "dock"}]))
+    r = sim.robots["r"]
+    sim.step()
+    assert r.battery.energy == pytest.approx(6.0, abs=1e-12)
+    write = {"node": node, "field": "battery", "op": "set"}
+    assert call("/boss/robot/set_field", {**write, "index": 2, "value": 93.75})["ok"] is True
+    assert call("/boss/robot/set_field", {**write, "index": -2, "value": 12.0})["ok"] is True   # from the end, as Webots
+    for n in range(1, 3):
+        sim.step()
+        assert r.battery.energy == pytest.approx(6.0 + 2.0 * n, abs=1e-12)
+    sim.step()                        # 13 J capped at 12 J by the Charger, then the step's drain
+    assert r.battery.energy == pytest.approx(11.0, abs=1e-12)
+    assert call("/boss/robot/get_field", {"node": node, "field": "battery"})["result"]["value"] == \
+        pytest.approx([11.0, 12.0, 93.75], abs=1e-12)
+    assert call("/boss/robot/set_field", {"node": node, "field": "cpuConsumption", "value": 0.0})["ok"] is True
+    sim.run(3)                        # no drain now, and the Charger holds a full robot: nothing more given
+    assert r.battery.energy == 11.0
+    sim.reset()                       # the world's values again
+    assert (r.battery.energy, r.battery.maximum, r.battery.speed, r.battery.cpu) == (5.0, 100.0, 62.5, DRAIN)
+
+
+@pytest.mark.parametrize(("args", "says"), [
+    ({"index": 3, "op": "set", "value": 1.0}, "out-of-bound index 3 (should be between -3 and 2)"),
+    ({"index": 0, "op": "insert", "value": 1.0}, "its values are set here, not inserted or removed"),
+    ({"index": 0, "op": "remove"}, "its values are set here, not inserted or removed"),
+    ({"index": 0, "op": "set", "value": -1.0}, "item 0 takes a finite number >= 0 (J), got -1.0; nothing changed"),
+    ({"index": 2, "op": "set", "value": math.inf}, "should be a finite number (got inf)"),     # (the wire refuses it)
+    ({"index": 0, "op": "set", "value": "full"}, "item 0 takes a finite number >= 0 (J), got 'full'"),
+])
+def test_a_battery_write_out_of_its_values_is_one_line_and_changes_nothing(args: dict, says: str) -> None:
+    sim, call, node = supervised(world([{"name": "r", "def_name": "R", "battery": [5.0, 10.0, 1.0]},
+                                        {"name": "boss", "supervisor": True}]))
+    got = call("/boss/robot/set_field", {"node": node, "field": "battery", **args})
+    assert got["ok"] is False and says in got["error"]["message"] and "\n" not in got["error"]["message"]
+    b = sim.robots["r"].battery
+    assert (b.energy, b.maximum, b.speed) == (5.0, 10.0, 1.0)
+
+
+def test_a_proto_robots_battery_field_passing_through_is_is_written_the_same_way() -> None:
+    # tests/protos/battery/Cell.proto: battery IS battery ([5, 10, 1]), cpuConsumption IS cpu (31.25 W: 1 J a step)
+    from sensorium.server.daemon import supervisor as sv
+
+    sim = Simulation(load_world(Path(__file__).parent / "worlds" / "battery_proto.wbt"))
+    cell, r = sv.find_node(sim, "CELL"), sim.robots["cell"]
+    assert sv.change_item(sim, cell, "battery", "set", 0, 3.5) == []
+    sim.run(2)
+    assert r.battery.energy == pytest.approx(1.5, abs=1e-12)
+    assert sv.get_field(sim, cell, "battery")["value"] == pytest.approx([1.5, 10.0, 1.0], abs=1e-12)
+    assert sv.set_field(sim, cell, "cpu", 0.0) == []
+    sim.run(2)
+    assert r.battery.energy == pytest.approx(1.5, abs=1e-12)
+    with pytest.raises(ValueError, match="PROTO internal field"):     # its base node's field: read-only, as Webots
+        sv.change_item(sim, cell, "battery", "set", 0, 3.0, 0)

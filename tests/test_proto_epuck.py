@@ -46,10 +46,11 @@ def run(sim: Simulation, steps: int = 50) -> list:
 
 
 def _unplaced(world) -> dict:
-    """The world as data without ``written_at`` (where its file writes each node)."""
+    """The world as data without ``written_at`` and ``made_at`` (where its file or a PROTO's body writes each
+    node)."""
     def strip(v):
         if isinstance(v, dict):
-            return {k: strip(x) for k, x in v.items() if k != "written_at"}
+            return {k: strip(x) for k, x in v.items() if k not in ("written_at", "made_at")}
         return [strip(x) for x in v] if isinstance(v, list) else v
     return strip(world.model_dump())
 

@@ -153,16 +153,95 @@ def test_a_node_in_a_proto_instances_field_exports_as_written():
 
 @pytest.mark.parametrize("instance, name, proto", [
     ("ROVER", "EYE", "Rover"), ("ROVER", "ARM", "Rover"), ("ROVER", "TOOL", "Rover"), ("ROVER", "PAINT", "Rover"),
-    ("SHELF", "BOARD", "Shelf"), ("SHELF", "WOOD", "Shelf"),
+    ("ROVER", "CHASSIS", "Rover"), ("SHELF", "BOARD", "Shelf"), ("SHELF", "WOOD", "Shelf"), ("BIG", "BOARD", "Shelf"),
 ])
-def test_a_node_a_proto_body_made_is_one_line(instance, name, proto):
+def test_a_node_a_proto_body_made_exports_as_the_body_writes_it(instance, name, proto):
+    # Webots writes a PROTO's internal node as that node: here the bodies have no IS in these nodes and no
+    # template, so the text is the PROTO file's node; a PROTO instance in a body (ARM) as that instance
     sim = _sim(PROTOS)
     node, why = sv.from_proto_def(sim, _node(sim, instance), name)
     assert node is not None, why
-    with pytest.raises(NotExported) as err:
-        node_string(sim, node)
-    line = str(err.value)
-    assert f"is made by the body of PROTO {proto}, not written in the world file" in line and "\n" not in line
+    got = _read(node_string(sim, node))
+    assert _same_tree(got, _in_body(REPO / "tests" / "protos" / "protodef" / f"{proto}.proto", name))
+
+
+def _in_body(proto: Path, def_name: str) -> Node:
+    """The node of that DEF as the PROTO file's body writes it (our parser on the body's text)."""
+    from sensorium.server.world.wbt.parser import Parser, Tokens
+
+    text = proto.read_text()
+    body = text[text.index("\n]\n{") + 4:text.rindex("}")]
+    todo: list = [Parser(Tokens(body, str(proto)), str(proto), proto_body=True).node(0)]
+    while todo:
+        v = todo.pop()
+        if isinstance(v, Node):
+            if v.def_name == def_name:
+                return v
+            todo.extend(v.fields.values())
+        elif isinstance(v, list):
+            todo.extend(v)
+    raise AssertionError(def_name)
+
+
+BODY = REPO / "tests" / "worlds" / "export_body.wbt"
+
+
+def _made(sim: Simulation, instance: str, name: str) -> sv.Node:
+    node, why = sv.from_proto_def(sim, _node(sim, instance), name)
+    assert node is not None, why
+    return node
+
+
+@pytest.mark.parametrize("instance, height, color", [("TALL", 2.0, (0.0, 0.0, 1.0)), ("SHORT", 1.0, (1.0, 0.0, 0.0))])
+def test_a_template_bodys_node_names_the_values_its_instance_made(instance, height, color):
+    # Post's body (tests/protos/export/Post.proto): CAP at z = height, its sphere height/10, its paint the
+    # instance's color through IS, BASE a Holder instance of side height/4 (its other fields at their defaults)
+    sim = _sim(BODY)
+    cap = _read(node_string(sim, _made(sim, instance, "CAP")))
+    assert (cap.type, cap.def_name) == ("Solid", "CAP")
+    assert cap.fields["translation"] == (0.0, 0.0, height) and cap.fields["name"] == "cap"
+    (shape,) = cap.fields["children"]
+    assert shape.fields["appearance"].def_name == "CAP_PAINT"
+    assert shape.fields["appearance"].fields == {"baseColor": color, "roughness": 1.0}
+    assert (shape.fields["geometry"].type, shape.fields["geometry"].fields) == ("Sphere", {"radius": height / 10})
+    paint = _read(node_string(sim, _made(sim, instance, "CAP_PAINT")))
+    assert (paint.type, paint.fields) == ("PBRAppearance", {"baseColor": color, "roughness": 1.0})
+    base = _read(node_string(sim, _made(sim, instance, "BASE")))
+    assert (base.type, base.def_name, base.fields) == ("Holder", "BASE", {"side": height / 4})
+
+
+def test_a_body_nodes_export_writes_what_a_supervisor_set_inside_it():
+    sim = _sim(BODY)
+    paint = _made(sim, "TALL", "CAP_PAINT")
+    sv.set_field(sim, paint, "baseColor", [0.0, 1.0, 0.0])
+    cap = _read(node_string(sim, _made(sim, "TALL", "CAP")))
+    assert cap.fields["children"][0].fields["appearance"].fields["baseColor"] == (0.0, 1.0, 0.0)
+    assert _read(node_string(sim, paint)).fields["baseColor"] == (0.0, 1.0, 0.0)
+    short = _read(node_string(sim, _made(sim, "SHORT", "CAP_PAINT")))      # the other instance's: its own
+    assert short.fields["baseColor"] == (1.0, 0.0, 0.0)
+
+
+def test_exported_proto_instances_read_again_make_the_same_world(tmp_path):
+    # the instances as written (their PROTO and fields), in a world of their own, load to the same solids
+    sim = _sim(BODY)
+    text = "\n".join(node_string(sim, _node(sim, name)) for name in ("TALL", "SHORT"))
+    assert text.startswith("DEF TALL Post {\n  translation 1 0 0\n  name \"tall\"\n  height 2\n  color 0 0 1\n}")
+    again = tmp_path / "again.wbt"
+    again.write_text(f'{HEADER}EXTERNPROTO "{REPO / "tests" / "protos" / "export" / "Post.proto"}"\n'
+                     f"WorldInfo {{\n  basicTimeStep 16\n}}\n{text}\n")
+    was, now = load_world(BODY).world, load_world(again).world
+
+    def plain(solid) -> object:
+        def strip(v):
+            if isinstance(v, dict):
+                return {k: strip(x) for k, x in v.items() if k != "written_at"}     # (its lines differ)
+            return [strip(x) for x in v] if isinstance(v, list) else v
+        return strip(solid.model_dump(mode="json"))
+
+    assert len(now.solids) == len(was.solids) == 2
+    assert [plain(s) for s in now.solids] == [plain(s) for s in was.solids]
+    cap = _read(node_string(Simulation(load_world(again)), _made(Simulation(load_world(again)), "TALL", "CAP")))
+    assert cap.fields["translation"] == (0.0, 0.0, 2.0)
 
 
 def test_a_node_inside_an_imported_solid_exports_as_its_string_writes_it():
@@ -227,3 +306,34 @@ def test_a_shape_a_supervisor_removed_is_left_out_of_the_text_and_of_a_saved_wor
     one = _sim(world)
     sv.remove_node(one, _node(one, "S"))
     assert node_string(one, _node(one, "ONE")) == 'DEF ONE Solid {\n  translation 1 0 0\n  name "one"\n}'
+
+
+def test_a_body_node_of_a_solid_built_again_or_imported_names_its_new_values():
+    # a set of TALL's height builds it again (sim/regenerate.py): its CAP at the new height; an imported
+    # Post's CAP at the height its node string gives
+    sim = _sim(BODY)
+    assert sv.set_field(sim, _node(sim, "TALL"), "height", 3.0, 1) == []
+    cap = _read(node_string(sim, _made(sim, "TALL", "CAP")))
+    assert cap.fields["translation"] == (0.0, 0.0, 3.0)
+    assert cap.fields["children"][0].fields["geometry"].fields == {"radius": 0.3}
+    sv.import_nodes(sim, sv.ROOT, "children", -1, 'DEF IMP Post { translation 0 5 0 name "imp" height 4 }')
+    cap = _read(node_string(sim, _made(sim, "IMP", "CAP")))
+    assert cap.fields["translation"] == (0.0, 0.0, 4.0)
+    assert cap.fields["children"][0].fields["appearance"].fields["baseColor"] == (1.0, 0.0, 0.0)
+
+
+def test_a_body_node_whose_proto_file_is_gone_since_the_load_is_one_line(tmp_path):
+    # the PROTOs are read again from their files for such an export: one gone is one line naming it
+    (tmp_path / "protos").mkdir()
+    for name in ("Post.proto", "Holder.proto"):
+        (tmp_path / "protos" / name).write_text((REPO / "tests" / "protos" / "export" / name).read_text())
+    world = tmp_path / "body.wbt"
+    world.write_text(BODY.read_text().replace("../protos/export/Post.proto", "protos/Post.proto"))
+    sim = _sim(world)
+    cap = _made(sim, "TALL", "CAP")
+    (tmp_path / "protos" / "Post.proto").unlink()
+    with pytest.raises(NotExported) as err:
+        node_string(sim, cap)
+    line = str(err.value)
+    assert line.startswith("Solid 'cap'") and "made by the body of PROTO Post" in line and "Post.proto" in line
+    assert "\n" not in line

@@ -457,6 +457,15 @@ def _written_at() -> Any:
     return Field(default=None, min_length=2, max_length=2, description=_WRITTEN_AT)
 
 
+_MADE_AT = ("where the PROTO body that made this node writes it: [line, column] in that body's text (as its template "
+            "generated it; a PROTO instance inside a body: where the instance is written there); none for a node the "
+            "world file writes. A Supervisor's exportString finds its text there")
+
+
+def _made_at() -> Any:
+    return Field(default=None, min_length=2, max_length=2, description=_MADE_AT)
+
+
 class ShapeNode(Strict):
     """A ``.wbt`` Shape as a Supervisor serves it (README "Supervisor"): its DEFs, its appearance
     node's type, and the written values of its appearance's, material's, texture's and geometry's
@@ -488,6 +497,7 @@ class ShapeNode(Strict):
                                          "'<node>.<field>' (node: appearance, material, texture, geometry)")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
     written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
+    made_at: list[Annotated[int, Field(ge=1)]] | None = _made_at()
     piece: bool = Field(default=False, description="a further piece of the shape before it: a mesh the .wbt import "
                         "split around its robot's devices (README 'Worlds') is one Shape node to a "
                         "Supervisor, its first piece's")
@@ -735,6 +745,7 @@ class Solid(Strict):
     proto_scope: int | None = Field(default=None, ge=0, description="a PROTO instance inside a top-level solid: its "
                                     "number there (InnerDef.scope)")
     written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
+    made_at: list[Annotated[int, Field(ge=1)]] | None = _made_at()
     physics: bool = Field(default=False, description="Webots: the solid has a Physics node. Nothing is pushed here "
                           "(no dynamics); a top-level solid with physics settles at load on what is under it (as "
                           "Webots' physics drops it), a VacuumGripper carries only such a solid, and one it lets go or "
@@ -1845,6 +1856,7 @@ class NestedNode(Strict):
                                 "loads (its axis passes through it); none for other nodes")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
     written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
+    made_at: list[Annotated[int, Field(ge=1)]] | None = _made_at()
     mass: Mass | None = Field(default=None, description=_MASS + "; a Solid or device only")
     pending_mass: PendingMass | None = Field(default=None, description=_PENDING_MASS)
 

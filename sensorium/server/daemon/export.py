@@ -10,8 +10,9 @@ A node inside a robot or solid (nested.py) is found where its owner's file write
 import's line and column; a joint's ``jointParameters`` and a shape's appearance, material, texture and
 geometry in their parent's field) and written so, with what the server changed since: an end point's pose
 its joint moved, a joint's ``position``, a shape's fields a Supervisor set; exportString answers it alone,
-and the top-level node and ``worldSave`` holding it write it so too. A node a PROTO's body made is written
-nowhere here: one line. Text only: the client writes ``worldSave``'s file (the server
+and the top-level node and ``worldSave`` holding it write it so too. A node a PROTO's body made is found in
+its top-level node written, its PROTOs expanded again (``Nested.made``: its place in that body) and written as
+Webots writes it: as the body writes it, a PROTO instance in it as that instance. Text only: the client writes ``worldSave``'s file (the server
 never writes a path a client names)."""
 
 from __future__ import annotations
@@ -25,8 +26,9 @@ import numpy as np
 from sensorium.server.daemon import nested
 from sensorium.server.daemon import supervisor as sv
 from sensorium.server.sim.regenerate import reparsed_world, written_value
+from sensorium.server.world.limits import ProtoLimits
 from sensorium.server.world.wbt.parser import Node as ParsedNode
-from sensorium.server.world.wbt.parser import WbtFile
+from sensorium.server.world.wbt.parser import WbtFile, WbtSyntaxError
 from sensorium.server.world.wbt.write import Writer
 
 _POSE = {"translation": [0.0, 0.0, 0.0], "rotation": [0.0, 0.0, 1.0, 0.0]}
@@ -168,9 +170,159 @@ def _nested_written(sim: Any, table: nested.Table, n: nested.Nested) -> ParsedNo
     found = _found(sim, table, n)
     if found is not None:
         return found
-    raise NotExported(f"{sv._what(sv._nested_node(n))} is made by the body of {_maker(sim, table, n)}, not written "
-                      "in the world file: exportString writes the nodes a world file or node string writes here "
-                      "(Webots writes the node as the PROTO made it; that text is not kept here)")
+    what = f"{sv._what(sv._nested_node(n))} is made by the body of {_maker(sim, table, n)}"
+    try:
+        made = _made(sim, table, n, {})
+    except NotExported as exc:
+        raise NotExported(f"{what}: {exc}") from None
+    if made is not None:
+        return made
+    raise NotExported(f"{what}, and that body's node is not found where the world's PROTOs make it again here: it "
+                      "has no .wbt text here")
+
+
+def _made_string(sim: Any, table: nested.Table, n: nested.Nested) -> str:
+    """A PROTO body's node ``n`` as text (:func:`_made`), with what the server changed in it and the nodes
+    inside it (an end point's pose its joint moved, a joint's ``position``, a shape's fields a Supervisor set)."""
+    memo: dict[int, ParsedNode | None] = {}
+    found = _made_node(sim, table, n, memo)
+    assert found is not None            # (_written found it)
+    done: dict[int, ParsedNode] = {}
+    out = _as_webots_writes(found, done)
+    changed: dict[int, dict[str, Any]] = {}
+    for m in table.by_owner.get(n.owner, ()):
+        if not (m.motor or m.joint or m.shape is not None and m.shape.index in sim.scene.appearance_values):
+            continue             # nothing the server changes
+        now = _nested_now(sim, table, m)
+        at = _made_node(sim, table, m, memo) if now else None
+        mine = None if at is None else done.get(id(at))
+        if mine is not None:
+            changed[id(mine)] = _overlay(mine, now)
+    return Writer(lambda w: changed.get(id(w))).node(out, 0, changed.get(id(out)))
+
+
+def _expanded(sim: Any, owner: int) -> tuple[ParsedNode, str]:
+    """Top-level node ``owner`` as written, its PROTO instances expanded again (the load's expansion: templates
+    run within the world's PROTO limits), and the file it is written in (its ``source``); kept per written node."""
+    from sensorium.server.sim.imports import string_file, world_protos
+    from sensorium.server.world.proto import ProtoError, ProtoSearch, expand
+
+    node = sv.node_by_id(sim, owner)
+    written = _written(sim, node)
+    kept = getattr(sim, "_export_expanded", None)
+    if kept is None or len(kept) > _PLACES_KEPT:
+        kept = sim._export_expanded = {}
+    if id(written) in kept and kept[id(written)][0] is written:
+        return kept[id(written)][1]
+    if not node.scenery and node.key in getattr(sim, "imported_written", {}):
+        if sim._import_protos is None:
+            sim._import_protos = world_protos(sim.loaded, ProtoLimits.matching(sim.limits))
+        file = string_file(sim.loaded, sim._import_protos)
+    else:
+        wbt = _world_file(sim)
+        assert wbt is not None          # (_written found the node in it)
+        file = wbt
+    one = WbtFile(file.version, [written], [], file.source, list(file.declarations), list(file.protos))
+    try:
+        (root,) = expand(one, ProtoSearch.create(sim.loaded.base_dir), ProtoLimits.matching(sim.limits)).nodes
+    except (ProtoError, WbtSyntaxError) as exc:
+        raise NotExported(f"{sv._what(node)}: its PROTOs do not expand again: {exc.message}") from None
+    kept[id(written)] = (written, (root, file.source))
+    return root, file.source
+
+
+def _made(sim: Any, table: nested.Table, n: nested.Nested, memo: dict[int, ParsedNode | None]) -> ParsedNode | None:
+    """Nested node ``n`` as the PROTO body that made it writes it, as Webots writes such a node (its fields as
+    the body gives them, its IS fields at the instance's values; a PROTO instance in it as that instance, its
+    fields at other than their defaults); None when not found (:func:`_made_node`)."""
+    found = _made_node(sim, table, n, memo)
+    return None if found is None else _as_webots_writes(found, {})
+
+
+def _made_node(sim: Any, table: nested.Table, n: nested.Nested, memo: dict[int, ParsedNode | None]) -> ParsedNode | None:
+    """``n``'s node in its owner expanded again (:func:`_expanded`): found in its parent's, at its place in the
+    world file (``Nested.at``) or in the body that made it (``Nested.made``); None when not found."""
+    if n.id not in memo:
+        if n.parent == n.owner:
+            above: ParsedNode | None = _expanded(sim, n.owner)[0]
+        else:
+            parent = table.get(n.parent)
+            above = None if parent is None else _made_node(sim, table, parent, memo)
+        memo[n.id] = None if above is None else _in_expanded(above, n, _expanded(sim, n.owner)[1])
+    return memo[n.id]
+
+
+_SEARCHED = 100_000
+"""The most nodes searched below a parent for a nested node's place (a body shares nodes: DEF/USE)."""
+
+
+def _in_expanded(above: ParsedNode, n: nested.Nested, top: str) -> ParsedNode | None:
+    """The node of ``above``'s expanded tree that ``n`` is: its SF field's node (a shape's appearance, ...), or
+    the shallowest node at ``n``'s place (written in the file ``top``: ``n.at``; made by a body: ``n.made``)."""
+    if n.field in _IN_PARENT:
+        v = above.fields.get(n.field)
+        return v if isinstance(v, ParsedNode) else None
+    if not (n.at or n.made):
+        return None
+
+    def here(v: ParsedNode) -> bool:
+        if v.instance_at is not None:
+            return (v.instance_at[0] == top, tuple(v.instance_at[1:])) in ((True, n.at), (False, n.made))
+        return ((v.source or top) == top, (v.line, v.col)) in ((True, n.at), (False, n.made))
+
+    level: list[Any] = list(above.fields.values())
+    seen: set[int] = set()
+    while level and len(seen) < _SEARCHED:
+        below: list[Any] = []
+        for v in level:
+            if isinstance(v, list):
+                below.extend(v)
+            elif isinstance(v, ParsedNode) and id(v) not in seen:
+                seen.add(id(v))
+                if here(v):
+                    return v
+                below.extend(v.fields.values())
+        level = below
+    return None
+
+
+def _as_webots_writes(node: ParsedNode, done: dict[int, ParsedNode]) -> ParsedNode:
+    """An expanded node as Webots writes it: a base node with its fields (the nodes in them so too), a PROTO
+    instance as the instance (its fields whose values are not its PROTO's defaults; those values as given,
+    unexpanded); a node met again is the same node (the writer's USE)."""
+    if id(node) in done:
+        return done[id(node)]
+    face = node.__dict__.get("interface") if node.proto is not None else None
+    if face is not None:
+        proto, values = face[0], face[1]
+        fields = {name: values[name] for name, decl in proto.fields.items()
+                  if name in values and not _same_value(values[name], decl.default)}
+        out = ParsedNode(proto.name, fields, node.line, node.col, node.def_name, source=node.source)
+    else:
+        out = ParsedNode(node.type, {}, node.line, node.col, node.def_name, source=node.source)
+        done[id(node)] = out
+        out.fields.update({name: _webots_value(v, done) for name, v in node.fields.items()})
+    done[id(node)] = out
+    return out
+
+
+def _webots_value(v: Any, done: dict[int, ParsedNode]) -> Any:
+    if isinstance(v, ParsedNode):
+        return _as_webots_writes(v, done)
+    if isinstance(v, list):
+        return [_webots_value(x, done) for x in v]
+    return v
+
+
+def _same_value(a: Any, b: Any) -> bool:
+    """Whether a PROTO field's value is its default (numbers compared as floats, lists item by item)."""
+    if isinstance(a, list | tuple) and isinstance(b, list | tuple):
+        return len(a) == len(b) and all(_same_value(x, y) for x, y in zip(a, b))
+    if isinstance(a, ParsedNode) or isinstance(b, ParsedNode):
+        return a is b
+    if isinstance(a, int | float) and isinstance(b, int | float) and not isinstance(a, bool) and not isinstance(b, bool):
+        return float(a) == float(b)
+    return bool(a == b)
 
 
 def _nested_now(sim: Any, table: nested.Table, n: nested.Nested) -> list[tuple[str, str, Any, Any]]:
@@ -309,6 +461,8 @@ def node_string(sim: Any, node: sv.Node, writer: Writer | None = None) -> str:
         table = sv._table(sim)
         n = table.get(node.id)
         assert n is not None
+        if _found(sim, table, n) is None:     # a PROTO body's node (:func:`_made`)
+            return _made_string(sim, table, n)
         return (writer or _writer(sim, n.owner)).node(written, 0, _overlay(written, _nested_now(sim, table, n)))
     writer = writer or _writer(sim, node.id)
     fields = dict(written.fields)

@@ -89,6 +89,7 @@ class Nested:
     mass: wm.Mass | None = None   # a Solid's or device's Physics (supervisor.center_of_mass)
     at: tuple[int, ...] = ()      # (line, column) where its owner's file writes it (() none: a PROTO body's, or a node
                                   # in its parent's SF field, found there: export.py)
+    made: tuple[int, ...] = ()    # (line, column) where the PROTO body that made it writes it (export.py)
     path: tuple[int, ...] = ()    # a top-level solid's nested Solid: its place among each parent's ``children`` from the
                                   # top one down (wm.Solid.children indices): the key that names its model (contact points)
 
@@ -273,7 +274,8 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
         added.append(Nested(me, "Shape", "", (node.def_name if node else None) or "", "", parent, "children", None,
                             None, "", owner, kind, key, order=order,
                             shape=appearance.ShapeRef(k, node, "Shape", "Shape", whole),
-                            at=tuple(node.written_at or ()) if node is not None else ()))
+                            at=tuple(node.written_at or ()) if node is not None else (),
+                            made=tuple(node.made_at or ()) if node is not None else ()))
         above = {"appearance": me, "geometry": me}
         ids = {"": me}
         for role, type_, def_name, field in appearance.inside(shape, k):
@@ -312,7 +314,7 @@ def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Ne
             local = own if at is None else at.compose(own)
             node = Nested(first + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
                           local, own, "", owner, "Solid", key, order=float(k), mass=child.mass,
-                          at=tuple(child.written_at or ()), path=(*path, k))
+                          at=tuple(child.written_at or ()), made=tuple(child.made_at or ()), path=(*path, k))
             out.append(node)
             solid_ids[owner, node.path] = node.id
             if child.proto_scope is not None:
@@ -366,7 +368,7 @@ def build(sim: Any, loaded_solids: int) -> Table:
                               owner if e.parent < 0 else first + e.parent, e.field, local, _own(local, above),
                               e.device or "", owner, "Robot", name, joints[k], above_id,
                               interface=tuple(e.interface), order=float(k), mass=e.mass,
-                              at=tuple(e.written_at or ())))
+                              at=tuple(e.written_at or ()), made=tuple(e.made_at or ())))
     solid_ids: SolidIds = {}
     for j in range(loaded_solids):
         _solid_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], FIRST_ID, out, solid_ids,

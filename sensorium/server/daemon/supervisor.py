@@ -597,6 +597,32 @@ def _battery(robot: Any) -> list[float]:
     return [b.energy, b.maximum, b.speed][:len(robot.model.battery)]
 
 
+_BATTERY_ITEMS = ("energy", "maximum", "speed")     # Webots' CURRENT_ENERGY, MAX_ENERGY, ENERGY_UPLOAD_SPEED
+
+
+def _set_battery_item(sim: Any, node: Node, where: str, op: str, index: Any, value: Any) -> None:
+    """Webots' ``setMFFloat`` on a robot's ``battery``: WbRobot reads the field's items live, so a write of the
+    energy (0) is what the battery holds now: its sensor reads it at its next sample, the step's drain takes
+    from it and powers the robot off at 0 or (a robot off) on again with energy left; the maximum (1) caps
+    what a Charger gives, the speed (2) is what it gives. The number of values is the world's (one line)."""
+    robot = sim.robots[node.key]
+    if op != "set":
+        raise ValueError(f"{where}: its values are set here, not inserted or removed (the world gives "
+                         f"{len(robot.model.battery)}); nothing changed")
+    at = item_position(where, op, index, len(robot.model.battery))
+    if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value < math.inf:
+        raise ValueError(f"{where}: item {index} takes a finite number >= 0 ({('J', 'J', 'W')[at]}), got {value!r}; "
+                         "nothing changed")
+    setattr(robot.battery, _BATTERY_ITEMS[at], float(value))
+
+
+def _set_cpu_consumption(sim: Any, node: Node, value: float) -> None:
+    """Webots' WbRobot reads ``cpuConsumption`` at each step's drain: the next step drains at the new power."""
+    if value < 0.0:
+        raise ValueError(f"field 'cpuConsumption' takes a value >= 0 (W), got {value!r}; nothing changed")
+    sim.robots[node.key].battery.cpu = float(value)
+
+
 def _set_controller(sim: Any, node: Node, value: str) -> None:
     """Webots' WbRobot::updateControllerDir: the value only; services.py ends the running controller and
     `sensorium run`'s launcher starts the named one (a Supervisor's set_field compares before and after)."""
@@ -619,7 +645,7 @@ FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
               "supervisor": ("SFBool", lambda sim, n: bool(sim.robots[n.key].supervisor), None),
               "synchronization": ("SFBool", lambda sim, n: bool(sim.robots[n.key].synchronization), None),
               "battery": ("MFFloat", lambda sim, n: _battery(sim.robots[n.key]), None),
-              "cpuConsumption": ("SFFloat", lambda sim, n: sim.robots[n.key].battery.cpu, None),
+              "cpuConsumption": ("SFFloat", lambda sim, n: sim.robots[n.key].battery.cpu, _set_cpu_consumption),
               **_RADAR_FIELD},
     "Solid": {**_POSE_FIELDS,
               "children": ("MFNode", _children, None),
@@ -1106,6 +1132,9 @@ def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: An
     kind = entry[0]
     if not kind.startswith("MF"):
         raise ValueError(f"field {field!r} of {what} is an {kind}, not a list: set it as a whole")
+    if _battery_field(node, level, field):
+        _set_battery_item(sim, node, f"field {field!r} ({kind}) of {what}", op, index, value)
+        return []
     if level == 1 and _rebuilds(node):
         return _regenerate(sim, node, field, kind, _changed_items(sim, node, field, kind, entry, op, index, value))
     if level >= 1:
@@ -1127,6 +1156,17 @@ def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: An
                          "the items of an imported line or point set's fields only); nothing changed")
     visuals.change(_vnode(sim, node), field, op, index, value)
     return []
+
+
+def _battery_field(node: Node, level: int, field: str) -> bool:
+    """Whether ``field`` at ``level`` is a top-level robot's ``battery``: its own, or its PROTO's field passing
+    straight through IS to it."""
+    if node.type != "Robot" or node.nested or node.scenery or node.visual:
+        return False
+    if level == 0:
+        return field == "battery" and not node.interface
+    return level == 1 and any(f.name == field and f.base == "battery" and f.type == "MFFloat"
+                              for f in node.interface[0].fields)
 
 
 _ITEM_SIZES = {"MFVec2f": 2, "MFVec3f": 3, "MFColor": 3, "MFRotation": 4}

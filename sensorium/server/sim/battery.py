@@ -6,8 +6,8 @@ while it holds one (within 1.1 radius) it gives min(robot's recharge speed x dt,
 the robot's battery keeping at most its maximum (what is beyond is lost); an idle Charger gathers its
 own upload speed x dt up to its maximum; the robot leaving empties it. Then every battery with energy
 loses cpuConsumption x dt (WbRobot::postPhysicsStep), stopping at 0. A battery emptying powers its
-robot off (WbRobot::powerOn(false)) until a Charger gives it energy (Battery.powered). Energies in J,
-powers in W, the step in integer ms."""
+robot off (WbRobot::powerOn(false)) until a Charger gives it energy (Battery.powered), or a Supervisor
+writes some that outlasts a step's drain. Energies in J, powers in W, the step in integer ms."""
 
 from __future__ import annotations
 
@@ -63,6 +63,7 @@ class Battery:
         if self.energy <= 0.0:
             self.energy, self.powered = 0.0, False
             return True
+        self.powered = True     # energy left: on (a Supervisor's refill of a robot off; WbRobot::setCurrentEnergy)
         return False
 
 

@@ -528,6 +528,8 @@ class Simulation:
         for robot, (pose, data) in zip(self.robots.values(), self._initial["robots"]):
             robot.custom_data = data
             robot.battery.reset()
+            loaded = Battery.from_model(robot.model)     # what a Supervisor wrote: as loaded
+            robot.battery.maximum, robot.battery.speed, robot.battery.cpu = loaded.maximum, loaded.speed, loaded.cpu
             if robot.drive is not None:
                 for m in robot.drive.motors.values():
                     m.target_position, m.velocity, m.position = 0.0, m.max_velocity, 0.0
@@ -926,8 +928,9 @@ class Simulation:
             radio.deliver(poses)      # range, cones, line of sight and readings at the end-of-step poses
         # Webots' postPhysicsStep (a world without batteries pays nothing here)
         emptied = [robot for robot in self._powered if robot.battery.drain(dt)] if self._powered else ()
+        if off or emptied:            # emptied: off; refilled by a Supervisor and left energy: on, sampling now
+            off = {r.index for r in self._powered if not r.battery.powered}
         for robot in emptied:         # powered off: its LEDs go dark, its sensors keep their last values
-            off = off | {robot.index}
             for dev in robot.devices.values():
                 if isinstance(dev, LED):
                     dev.power_off()
@@ -1033,8 +1036,9 @@ class Simulation:
             own = self.scene.solid_poses.get(charger.solid)
             if own is not None:
                 charger.step(self._batteries, positions, np.asarray(own.translation, dtype=np.float64), dt)
-        for robot in self._powered:   # energy again: powered on (WbRobot::setCurrentEnergy)
-            robot.battery.power_back()
+        for charger in self.chargers:   # the robot it gave energy: powered on (WbRobot::setCurrentEnergy); one a
+            if charger.robot is not None:  # Supervisor refilled is at its post-physics step (Battery.drain)
+                self._batteries[charger.robot].power_back()
         self._glow()
 
     def _glow(self) -> None:

@@ -640,11 +640,15 @@ class Converter:
 
     def written_at(self, node: Node, entry: dict) -> None:
         """``entry``'s ``written_at``: where the world file writes ``node`` (a PROTO instance: the instance),
-        for a Supervisor's exportString; nothing for a node a PROTO's body made."""
+        for a Supervisor's exportString; for a node a PROTO's body made, ``made_at``: where that body writes it."""
         if node.instance_at is not None and node.instance_at[0] == self.source:
             entry["written_at"] = [node.instance_at[1], node.instance_at[2]]
         elif node.instance_at is None and (node.source or self.source) == self.source:
             entry["written_at"] = [node.line, node.col]
+        elif node.instance_at is not None:
+            entry["made_at"] = [node.instance_at[1], node.instance_at[2]]
+        elif node.line >= 1 and node.col >= 1:
+            entry["made_at"] = [node.line, node.col]
 
     def written(self, node: Node) -> bool:
         """Whether the world file writes ``node`` (or the PROTO instance it is): a node of a PROTO's
