@@ -376,16 +376,10 @@ def test_the_soccer_stand_in_loads_its_six_players_and_the_referee() -> None:
     assert [d.name for d in robots["robot"].devices] == ["emitter"]
 
 
-def test_the_referee_and_players_calls_drive_them_by_the_closed_form() -> None:
-    """The referee's and the six players' calls in process for 19.2 s (300 steps of 64 ms, basic step 32).
-    Each step the referee reads the players' and the ball's translations (the rotations read once, at the
-    start), sends them and sets its clock label, and each player reads that packet one step later, bit for
-    bit. Each player moves on the arc of its wheel speeds (1e-9) until that arc would take its square into
-    the ball, a wall or another player: B1 (at 0.2 m/s along -x from 128 ms) then stops with its face on
-    the ball (x = -0.182283 + 0.021 + 0.0375), 1e-9, in the step its arc would enter it (576 ms), Y1 on the
-    ball at 832 ms, Y2 on Y1 at 7.552 s, B2 on a wall at 14.656 s; the ball, which Webots' players
-    push, stays. The goalkeepers follow the ball's y all along: B3 backs along +y until its packet's y is
-    past 0.16 (0.1739), Y3 (its wheels named the other way round, no matter at equal speeds) to 0.1787."""
+def soccer_in_process(steps: int) -> tuple[dict, dict[int, dict[str, tuple[float, float, float]]], dict]:
+    """The referee's and the players' calls in process for ``steps`` steps of 64 ms, checked as they go
+    (see the test below): the contacts met (player: (step, what)), each step's closed-form poses of the
+    players not yet stopped, and the last poses."""
     lv = Live(Simulation(load_world(DATA / "soccer.wbt"), "exact"))
     sim = lv.sim
     lv.ok(A, "attach", {"robot": "robot"})
@@ -413,7 +407,8 @@ def test_the_referee_and_players_calls_drive_them_by_the_closed_form() -> None:
     ball = tuple(field(ball_node, "translation")[:2])
     met = {}
     previous = None
-    for step in range(1, 301):
+    arcs = {}
+    for step in range(1, steps + 1):
         sim.run(2)
         assert sim.time_ms == 64 * step
         now = {}
@@ -431,10 +426,13 @@ def test_the_referee_and_players_calls_drive_them_by_the_closed_form() -> None:
             if hit:
                 p["met"] = met[name] = (step, hit)
                 assert meets(now[name], ball, {n: pose for n, pose in now.items() if n != name}) is None, name
+                if hit == "ball":                   # stopped with its face on it
+                    assert gap_to_ball(*now[name], ball) == pytest.approx(0.0, abs=1e-9), name
                 continue
             assert now[name][:2] == pytest.approx(arc[:2], abs=1e-9), (name, step)
             assert math.remainder(now[name][2] - arc[2], 2 * math.pi) == pytest.approx(0.0, abs=1e-9), (name, step)
             p["pose"] = arc
+            arcs.setdefault(step, {})[name] = arc
         packet = []
         for i, node in enumerate(nodes):
             t = field(node, "translation")
@@ -460,7 +458,194 @@ def test_the_referee_and_players_calls_drive_them_by_the_closed_form() -> None:
                 m.set_velocity(v)
             p["speeds"] = speeds
         previous = packet
+    return met, arcs, {name: p["pose"] for name, p in players.items()}
+
+
+def test_the_referee_and_players_calls_drive_them_by_the_closed_form() -> None:
+    """The referee's and the six players' calls in process for 19.2 s (300 steps of 64 ms, basic step 32).
+    Each step the referee reads the players' and the ball's translations (the rotations read once, at the
+    start), sends them and sets its clock label, and each player reads that packet one step later, bit for
+    bit. Each player moves on the arc of its wheel speeds (1e-9) until that arc would take its square into
+    the ball, a wall or another player: B1 (at 0.2 m/s along -x from 128 ms) then stops with its face on
+    the ball (x = -0.182283 + 0.021 + 0.0375), 1e-9, in the step its arc would enter it (576 ms), Y1 on the
+    ball at 832 ms, Y2 on Y1 at 7.552 s, B2 on a wall at 14.656 s; the ball, which Webots' players
+    push, stays. The goalkeepers follow the ball's y all along: B3 backs along +y until its packet's y is
+    past 0.16 (0.1739), Y3 (its wheels named the other way round, no matter at equal speeds) to 0.1787."""
+    met, _, last = soccer_in_process(300)
     assert met == {"b1": (9, "ball"), "y1": (13, "ball"), "y2": (118, "y1"), "b2": (229, "wall")}
-    assert gap_to_ball(*players["b1"]["pose"], ball) >= 0
     for name, y in (("b3", 0.1739), ("y3", 0.1787)):
-        assert players[name]["pose"][1] == pytest.approx(y, abs=5e-5), name
+        assert last[name][1] == pytest.approx(y, abs=5e-5), name
+
+
+
+def test_a_goal_scores_and_the_referee_puts_the_ball_and_players_back_three_seconds_later() -> None:
+    """The referee's goal rule in process: the ball, put by hand (another Supervisor call) into the blue
+    goal at (0.8, 0, 0.05), falls there (the field's Plane is infinite to physics, as in Webots) and, its x
+    past 0.745, scores for blue: label 0 reads "1" in blue; 47 steps later (3 s counted down by 0.064 s) the
+    referee sets the ball's and the six players' translations and rotations back to what it read at the
+    start, and B1, driven at 10 rad/s all along, is back there and one step further on its heading."""
+    lv = Live(Simulation(load_world(DATA / "soccer.wbt"), "exact"))
+    sim = lv.sim
+    lv.ok(A, "attach", {"robot": "robot"})
+    call = lambda service, args: lv.ok(A, f"/robot/robot/{service}", args)  # noqa: E731
+    nodes = [call("get_from_def", {"name": n.upper()})["node"] for n in PLAYERS]
+    ball = call("get_from_def", {"name": "BALL"})["node"]
+    field = lambda node, f: call("get_field", {"node": node, "field": f})["value"]  # noqa: E731
+    start = {n: (field(n, "translation"), field(n, "rotation")) for n in nodes}
+    ball0 = field(ball, "translation")
+    b1 = sim.robot("b1")
+    for m in (b1.motor("left wheel motor"), b1.motor("right wheel motor")):
+        m.set_position(math.inf)
+        m.set_velocity(10.0)
+    score = [0, 0]
+
+    def scores() -> None:
+        for i, (text, x, colour) in enumerate(((str(score[0]), 0.92, 0x0000FF), (str(score[1]), 0.05, 0xFFFF00))):
+            call("set_label", {"id": i, "text": text, "x": x, "y": 0.01, "size": 0.1, "color": colour,
+                               "transparency": 0.0, "font": "Arial"})
+
+    scores()
+    timer, scored_at, reset_at = 0.0, None, None
+    for step in range(1, 61):
+        sim.run(2)
+        if step == 5:
+            call("set_field", {"node": ball, "field": "translation", "value": [0.8, 0.0, 0.05]})
+        at = field(ball, "translation")
+        if timer == 0:
+            if at[0] > 0.745:
+                score[0] += 1
+                scores()
+                timer, scored_at = 3.0, step
+            elif at[0] < -0.745:
+                score[1] += 1
+                scores()
+                timer = 3.0
+        else:
+            timer -= 0.064
+            if timer <= 0:
+                timer, reset_at = 0.0, step
+                call("set_field", {"node": ball, "field": "translation", "value": ball0})
+                for n, (t, r) in start.items():
+                    call("set_field", {"node": n, "field": "translation", "value": t})
+                    call("set_field", {"node": n, "field": "rotation", "value": r})
+                for n, (t, r) in start.items():
+                    assert (field(n, "translation"), field(n, "rotation")) == (t, r)
+            if reset_at and step == reset_at + 1:
+                assert field(ball, "translation") == ball0
+                for n, (t, r) in list(start.items())[1:]:
+                    assert field(n, "translation") == pytest.approx(t, abs=1e-12) and \
+                        field(n, "rotation") == pytest.approx(r, abs=1e-12)
+                moved = field(nodes[0], "translation")
+                assert moved == pytest.approx([start[nodes[0]][0][0] - 0.2 * 0.064, start[nodes[0]][0][1],
+                                               start[nodes[0]][0][2]], abs=1e-9)
+        if step == 6:
+            assert at[:2] == [0.8, 0.0] and at[2] < 0.05          # falling in the goal
+    assert (scored_at, reset_at) == (5, 5 + 47)
+    assert field(ball, "translation") == ball0
+    labels = dict(sim._labels.items())
+    assert (labels[0].text, labels[0].color, labels[1].text, labels[1].color) == ("1", 0x0000FF, "0", 0xFFFF00)
+
+
+PLAYER_CONTROLLER = '''\
+# Sensorium's test controller making soccer_player.c's calls (Webots' demo), glibc's srand and rand
+# through ctypes as the C controller calls them.
+import ctypes
+import math
+import struct
+from controller import Robot
+
+libc = ctypes.CDLL("libc.so.6")
+robot = Robot()
+name = robot.getName()
+team, player = name[0], name[1]
+receiver = robot.getDevice("receiver")
+left, right = robot.getDevice("left wheel motor"), robot.getDevice("right wheel motor")
+for m in (left, right):
+    m.setPosition(math.inf)
+    m.setVelocity(0.0)
+libc.srand(ord(team) + ord(player))
+receiver.enable(64)
+counter, top = 0, 50
+while robot.step(64) != -1:
+    speeds = (0, 0)
+    while receiver.getQueueLength() > 0:
+        packet = struct.unpack("<20d", receiver.getBytes())
+        if player in "12":
+            counter += 1
+            speeds = (10, 10) if counter < top else (-10, 10)
+            if counter == 100:
+                counter = 0
+                top = 30 + libc.rand() // (2147483647 // 70)
+        else:
+            me = 3 * (int(player) - 1 + (3 if team == "y" else 0))
+            y = packet[me + 1]
+            d = y - packet[19]
+            if d > 0.01 and y > -0.16:
+                speeds = (10, 10)
+            elif d < -0.01 and y < 0.16:
+                speeds = (-10, -10)
+        receiver.nextPacket()
+    left.setVelocity(speeds[0])
+    right.setVelocity(speeds[1])
+'''
+
+REFEREE_CONTROLLER = '''\
+# Sensorium's test controller making soccer_referee_supervisor.c's calls (Webots' demo), printing the
+# players' packet positions at three times.
+import struct
+from controller import Supervisor
+
+sup = Supervisor()
+emitter = sup.getDevice("emitter")
+names = ("B1", "B2", "B3", "Y1", "Y2", "Y3")
+translations = [sup.getFromDef(n).getField("translation") for n in names]
+rotations = [sup.getFromDef(n).getField("rotation").getSFRotation() for n in names]
+ball = sup.getFromDef("BALL").getField("translation")
+sup.setLabel(0, "0", 0.92, 0.01, 0.1, 0x0000FF, 0.0, "Arial")
+sup.setLabel(1, "0", 0.05, 0.01, 0.1, 0xFFFF00, 0.0, "Arial")
+clock = 600.0
+while sup.step(64) != -1:
+    packet = []
+    for t, r in zip(translations, rotations):
+        x, y, _ = t.getSFVec3f()
+        packet += [x, y, r[3] if r[2] > 0 else -r[3]]
+    packet += ball.getSFVec3f()[:2]
+    emitter.send(struct.pack("<20d", *packet))
+    clock -= 0.064
+    sup.setLabel(2, "%02d:%02d" % (int(clock / 60), int(clock) % 60), 0.45, 0.01, 0.1, 0x000000, 0.0, "Arial")
+    t = round(sup.getTime() * 1000)
+    if t in (3200, 6400, 12800):
+        print(t, " ".join(f"{v:.9f}" for v in packet), flush=True)
+'''
+
+
+@pytest.mark.slow
+def test_the_soccer_demo_runs_under_sensorium_run_as_in_process(tmp_path: Path) -> None:
+    """Our Python controllers making soccer_player.c's and soccer_referee_supervisor.c's calls under
+    ``sensorium run`` for 13 s: the referee's packets at 3.2, 6.4 and 12.8 s carry the positions the
+    closed form gives each player not yet stopped (1e-9): the goalkeepers, B2, and Y2 before it meets Y1."""
+    (tmp_path / "worlds").mkdir()
+    shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
+    world = tmp_path / "worlds" / "soccer.wbt"
+    shutil.copy(DATA / "soccer.wbt", world)
+    for name, source in (("soccer_player", PLAYER_CONTROLLER), ("soccer_referee_supervisor", REFEREE_CONTROLLER)):
+        (tmp_path / "controllers" / name).mkdir(parents=True)
+        (tmp_path / "controllers" / name / f"{name}.py").write_text(source)
+    done = subprocess.run(sensorium("run", str(world), "--until", "13000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    got = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("[robot] "):
+            t, *values = line.split("] ", 1)[1].split()
+            got[int(t)] = [float(v) for v in values]
+    assert sorted(got) == [3200, 6400, 12800], done.stdout[-2000:]
+    _, arcs, _ = soccer_in_process(200)
+    checked = 0
+    for t, packet in got.items():
+        for i, name in enumerate(PLAYERS):
+            if name in arcs[t // 64]:
+                assert packet[3 * i:3 * i + 2] == pytest.approx(list(arcs[t // 64][name][:2]), abs=1e-9), (name, t)
+                checked += 1
+    assert checked == 3 * 3 + 2       # b2, b3, y3 each time; y2 until it meets y1
