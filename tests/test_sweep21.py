@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 from _serve import child_env, sensorium
 from test_supervisor import A, Live
-from test_sweep19 import rot
+from test_sweep19 import KinematicMotor, rot
 from test_sweep20 import k3_move_on
 
 from sensorium.server.sim.simulation import Simulation
@@ -82,7 +82,6 @@ class GantryTwin:
     motors follow Webots' kinematic rule, their acceleration their maxTorque or maxForce."""
 
     def __init__(self) -> None:
-        from test_sweep19 import KinematicMotor
         self.wheel, self.wheel_target = 0.0, 0.0
         self.joints = {4: KinematicMotor(1.0, 100.0), 5: KinematicMotor(3.14, 100.0), 6: KinematicMotor(1.0, 400.0),
                        7: KinematicMotor(10.0, 200.0), 8: KinematicMotor(10.0, 200.0)}
