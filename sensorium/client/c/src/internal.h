@@ -56,6 +56,9 @@ const char *sn_error_name(int code);
 #define SN_SHOWN_MAX 4096
 #define SN_SHOWN_SLOTS 4
 const char *sn_shown(const char *s);
+/* sn_shown of the n bytes at s, which need no NUL (a msgpack string of a reply); a NUL byte among them
+ * shows as \x00. */
+const char *sn_shown_n(const char *s, size_t n);
 
 /* ------------------------------------------------------------------ wire.c */
 typedef struct {
