@@ -651,7 +651,8 @@ int wb_robot_step_begin(int duration) {
   if (rc != 0) {
     fprintf(stderr, "sensorium: cannot send the step request to %s; ending the controller's steps\n",
             sn_conn_endpoint(rb->conn));
-    rb->terminated = rb->quit_returned = true;
+    sn_steps_ended(rb);
+    rb->quit_returned = true;
     return -1;
   }
   rb->pending = id;
@@ -659,6 +660,11 @@ int wb_robot_step_begin(int duration) {
 }
 
 static int step_end(sn_robot *rb);
+
+void sn_steps_ended(sn_robot *rb) {
+  rb->terminated = true;
+  sn_movie_after_step(rb); /* (a movie recording ends with the world) */
+}
 
 int wb_robot_step_end(void) {
   sn_robot *rb = sn_robot_get("wb_robot_step_end");
@@ -680,18 +686,16 @@ static int step_end(sn_robot *rb) {
   int rc = sn_conn_wait(rb->conn, id, -1, &rep);
   if (rc != 0 && rep.code == SN_CONNECTION_LOST) {
     fprintf(stderr, "sensorium: CONNECTION_LOST: %s; ending the controller's steps\n", rep.message);
-    rb->terminated = true;
-    sn_movie_after_step(rb); /* (a movie recording ends with the world) */
+    sn_steps_ended(rb);
     return -1;
   }
   if (rc != 0 || !rep.ok) {
-    if (rep.code == SN_SHUTTING_DOWN)
-      rb->terminated = true;
-    else
+    const bool ended = rep.code == SN_SHUTTING_DOWN;
+    if (!ended)
       fprintf(stderr, "Error: wb_robot_step(): %s: %s\n", sn_error_name(rep.code), rep.message);
     sn_reply_free(&rep);
-    if (rb->terminated)
-      sn_movie_after_step(rb);
+    if (ended)
+      sn_steps_ended(rb);
     return -1;
   }
   int status = (int)sn_int_or(rep.result, "status", 0);

@@ -1769,7 +1769,7 @@ void wb_supervisor_simulation_quit(int status) {
   sn_reply rep;
   if (sn_robot_call(rb, "robot/simulation_quit", 1, args_status, &status, func, &rep) == 0)
     sn_reply_free(&rep);
-  rb->terminated = true;
+  sn_steps_ended(rb);
 }
 
 void wb_supervisor_simulation_reset(void) {
