@@ -38,7 +38,7 @@ ENCODERS_PY = REPO / "tests" / "controllers" / "encoders.py"
 CONTROLLERS = ["script", "light_sequence", "proximity", "lidar_reader", "braitenberg", "encoders", "supervisor_check",
                "wire_vectors", "every_device", "headers", "car_driver", "car_lights", "car_hostile", "supervisor_scene",
                "supervisor_remove", "supervisor_import", "ignores_minus_one", "root_children", "supervisor_protos",
-               "nested_nodes", "top_groups", "robot_window", "window_echo"]
+               "nested_nodes", "top_groups", "robot_window", "window_echo", "world_names"]
 API_TESTS = ["motion_sensors", "emitter_receiver", "robot_devices"]      # tests/c/api: Webots-style API tests
 C_API_WORLD = REPO / "tests" / "worlds" / "c_api.yaml"
 HEADERS_WORLD = REPO / "tests" / "worlds" / "headers.yaml"
@@ -50,6 +50,7 @@ ROOT_WORLD = REPO / "tests" / "worlds" / "root_children.wbt"
 PROTOS_WORLD = REPO / "tests" / "worlds" / "proto" / "supervisor_protos.wbt"
 NESTED_WORLD = REPO / "tests" / "worlds" / "nested_nodes.wbt"
 GROUPS_WORLD = REPO / "tests" / "worlds" / "top_groups.wbt"
+CONTROL_NAMES_WORLD = REPO / "tests" / "worlds" / "control_names.yaml"
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32" or shutil.which("cc") is None,
                                 reason="needs a POSIX C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev)")
@@ -1021,11 +1022,35 @@ def test_heartbeat_keeps_a_computing_c_controller_attached(cbin, servers):
     ("epuck/left", ["BAD_URL", "contains '/'"]),
     # a line break and a tab in the URL are shown escaped: the line stays one line
     ("tcp://127.0.0.1:9\n9/e\tpuck", ["BAD_URL", "controller URL 'tcp://127.0.0.1:9\\n9/e\\tpuck': bad port '9\\n9'"]),
+    ("tcp://127.0.0\n.1:9/epuck", ["BAD_URL", "cannot connect to tcp://127.0.0\\n.1:9: "]),     # ZeroMQ's refusal
 ])
 def test_bad_urls_give_one_clear_line(cbin, url, words):
     code, out, err = finish(start([cbin["script"], "step", "32", "1"], url))
     assert code == 1 and out == []
     assert len(err.strip().splitlines()) == 1 and all(w in err for w in words), err
+
+
+def test_names_from_the_world_and_the_servers_error_texts_show_escaped_on_one_line(cbin, servers):
+    """A robot named "tab\\there\\nline" and its LED "led\\nlamp" (tests/worlds/control_names.yaml): the
+    library's lines naming them (a device's, a robot's) and the server's error text that lists the robots
+    each stay one line, the control characters escaped as the Python client's repr shows them."""
+    server = servers(CONTROL_NAMES_WORLD)
+    code, out, err = finish(start([cbin["world_names"]], server.url("tab%09here%0Aline")))
+    assert code == 0 and out == ["done"], err
+    assert err.splitlines() == [
+        "Error: wb_led_set(): value 5 out of range [0, 1] for LED 'led\\nlamp'.",
+        "Error: wb_distance_sensor_get_value(): device tag 1 is 'led\\nlamp', a LED",
+        'Warning: wb_robot_get_device(): robot "tab\\there\\nline" has no device "none".',
+        "Warning: the step duration 20 ms of robot 'tab\\there\\nline' is not a multiple of the basic time step "
+        "(16 ms); the server rounds it up."], err
+    code, out, err = finish(start([cbin["world_names"]], server.url("nobody")))      # the server's text
+    assert code == 1 and out == [] and err.splitlines() == [
+        f"Error: wb_robot_init(): UNKNOWN_ROBOT: attaching to robot 'nobody' at {server.rpc}: no robot 'nobody' "
+        "(robots: tab\\there\\nline, plain)"], err
+    code, out, err = finish(start([cbin["world_names"]], server.rpc))                 # the names the server lists
+    assert code == 1 and out == [] and err.splitlines() == [
+        f"Error: wb_robot_init(): BAD_URL: the controller URL names no robot and the world at {server.rpc} has 2 "
+        "(tab\\there\\nline, plain): add '/ROBOT' to the URL"], err
 
 
 def test_a_callers_string_shows_in_an_error_line_escaped_and_bounded(tmp_path):
@@ -1045,7 +1070,8 @@ def test_a_callers_string_shows_in_an_error_line_escaped_and_bounded(tmp_path):
         "[4099 xxx...]",                           # 4096 x, the next cut
         "[4096 xxy]",                              # a line break and 4094 more bytes: 4096, not cut
         "[(null)]",
-        "[1\\n 2\\t 3\\r 4\\x1b]"]                   # four in one printf: each its own buffer
+        "[1\\n 2\\t 3\\r 4\\x1b]",                  # four in one printf: each its own buffer
+        "[a\\x00b\\nc]"]                             # sn_shown_n: a length, not a NUL, ends the string
 
 
 def test_url_forms_and_variables(cbin, servers, tmp_path):

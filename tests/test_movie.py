@@ -254,6 +254,25 @@ def test_a_controller_ending_while_recording_writes_the_movie_so_far(tmp_path: P
 
 
 @pytest.mark.slow
+@pytest.mark.skipif(shutil.which("ffmpeg") is None or sys.platform == "win32", reason="needs ffmpeg (POSIX)")
+@pytest.mark.parametrize("which", ["python", "c"])
+def test_a_quit_while_recording_writes_the_movie_so_far_with_webots_status(tmp_path: Path, request, which) -> None:
+    """simulationQuit while recording ends the movie at once, as a world reload does (the quit runs the same
+    end-of-world path as a step answering -1): its 5 frames written, the status Webots' (ready and failed) once
+    it is; a movie started after the end records nothing, in one line."""
+    argv, env = _client(request, which)
+    lines, err = _run(argv, tmp_path, {**env, "MOVIE_QUIT": "1"})
+    assert lines == ["quit -1", "saved True True", "late True True"], err
+    assert err.splitlines() == [ENDED_LINE.replace("its 10 frames", "its 5 frames"),
+                                "Error: wb_supervisor_movie_start_recording(): nothing was recorded because the "
+                                "simulation did not run."], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["quit.mp4"]     # no temporary left behind
+    frames = _decode(tmp_path / "quit.mp4")
+    assert len(frames) == 5                              # 160 ms, a frame each 32 ms
+    assert np.abs(frames.reshape(5, -1, 3).mean(axis=1) - [FACE, 0, 0]).max() <= 6
+
+
+@pytest.mark.slow
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX PATH")
 @pytest.mark.parametrize("which", ["python", "c"])
 def test_without_ffmpeg_on_path_a_recording_fails_in_one_line(tmp_path: Path, request, which) -> None:

@@ -256,3 +256,63 @@ def test_sigkill_truncation_without_flush_calls(tmp_path):
         assert rec.truncated
     total = sum(1 for _ in published(400))
     assert 0.8 * total < n < total
+
+
+@pytest.mark.parametrize("signals", [1, 2])
+def test_record_stopped_by_a_signal_between_a_write_and_its_count_says_what_the_file_holds(tmp_path, monkeypatch,
+                                                                                        capsys, signals):
+    """``sensorium record`` and SIGINT raised right after the 5th message is written, before the recorder
+    counts it (where a KeyboardInterrupt made the summary one short of the file): the first signal is
+    latched, the run stops once that message is counted, the summary says 5 as the file does. A second
+    one at the same point ends the run at once (for a run stuck in a write): the file is finished still,
+    the summary one short of it."""
+    import threading
+
+    import zmq
+
+    from sensorium.cli import main
+    from sensorium.server.recording import live
+
+    pub_url = f"ipc://{tmp_path}/pub"
+    ctx = zmq.Context()
+    pub = ctx.socket(zmq.PUB)
+    pub.setsockopt(zmq.LINGER, 0)
+    pub.bind(pub_url)
+    monkeypatch.setattr(live, "rpc_call", lambda *a, **k: {"pub_endpoint": pub_url})    # the server's get_info
+    done = threading.Event()
+
+    def publish() -> None:      # until the test ends: the subscription joins at some point
+        while not done.is_set():
+            for topic, _type, envelope, body, _stamp, _seq in published(200):
+                pub.send_multipart([topic.encode() + b"\0", envelope, body])
+                if done.is_set():
+                    return
+
+    written = 0
+    write = McapRecorder.record
+
+    def write_then_signal(self, *item) -> None:
+        nonlocal written
+        write(self, *item)
+        written += 1
+        if written == 5:
+            for _ in range(signals):
+                signal.raise_signal(signal.SIGINT)      # its handler runs here, before the count
+
+    monkeypatch.setattr(McapRecorder, "record", write_then_signal)
+    publisher = threading.Thread(target=publish, daemon=True)
+    publisher.start()
+    path = tmp_path / "rec.mcap"
+    try:
+        assert main(["record", str(path), "--url", "ipc:///nowhere", "--json"]) == 0
+    finally:
+        done.set()
+        publisher.join(timeout=60)
+        pub.close()
+        ctx.term()
+    summary = json.loads(capsys.readouterr().out.splitlines()[-1])
+    with Recording(path) as rec:
+        assert not rec.truncated
+        in_file = sum(1 for _ in rec.messages())
+        assert rec.summary()["messages"] == in_file == written == 5
+    assert summary["received"] == (5 if signals == 1 else 4)

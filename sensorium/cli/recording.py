@@ -38,15 +38,11 @@ def damage_printer(command: str, path: str | os.PathLike) -> Callable[[Damage], 
 
 
 @contextmanager
-def signals_as_interrupt():
-    """SIGTERM, SIGHUP and SIGINT raise KeyboardInterrupt, so files get finished. SIGINT too because a
-    shell script's background job starts with it ignored (``sensorium replay & ... kill -INT $!``
-    would do nothing), and ``serve`` answers it there as well."""
+def _stop_signals(handler: Callable[[int, object], None]):
+    """``handler`` for SIGTERM, SIGHUP and SIGINT in the block, the previous handlers put back after. SIGINT
+    too because a shell script's background job starts with it ignored (``sensorium replay & ... kill
+    -INT $!`` would do nothing), and ``serve`` answers it there as well."""
     previous: dict = {}
-
-    def handler(signum, frame):
-        raise KeyboardInterrupt
-
     for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None), signal.SIGINT):
         if sig is not None:
             try:
@@ -58,6 +54,35 @@ def signals_as_interrupt():
     finally:
         for sig, h in previous.items():
             signal.signal(sig, h)
+
+
+@contextmanager
+def signals_as_interrupt():
+    """SIGTERM, SIGHUP and SIGINT raise KeyboardInterrupt, so files get finished."""
+    def handler(signum, frame):
+        raise KeyboardInterrupt
+
+    with _stop_signals(handler):
+        yield
+
+
+@contextmanager
+def signals_as_stop(stop: Callable[[], None]):
+    """SIGTERM, SIGHUP and SIGINT latched: the first calls ``stop`` and the loop ends at its next safe
+    point, so a message it wrote is also counted (a KeyboardInterrupt landing between the write and the
+    count made ``sensorium record``'s summary one short of its file); a second one raises
+    KeyboardInterrupt, for a loop that reaches no safe point (a write that blocks)."""
+    stopping = False
+
+    def handler(signum, frame):
+        nonlocal stopping
+        if stopping:
+            raise KeyboardInterrupt
+        stopping = True
+        stop()
+
+    with _stop_signals(handler):
+        yield
 
 
 def record(args: argparse.Namespace) -> int:
@@ -79,7 +104,7 @@ def record(args: argparse.Namespace) -> int:
     print(f"sensorium: recording {args.file} from pub={rec.pub_endpoint}"
           + (f" topics={' '.join(args.topics)}" if args.topics else ""), flush=True)
     try:
-        with signals_as_interrupt():
+        with signals_as_stop(rec.stop):     # it stops between two messages (LiveRecorder.run's safe points)
             rec.run(duration=args.duration, max_messages=args.max_messages)
     except KeyboardInterrupt:
         pass

@@ -74,6 +74,9 @@ class Recorder:
             self._fail(func, "ffmpeg is not on PATH: Sensorium's movies are encoded by ffmpeg (install it, e.g. "
                        "apt-get install ffmpeg); nothing recorded", ENCODING_ERROR)
             return
+        if self.robot.terminated:       # the world ended before: a movie that ends with it, without a frame
+            self._fail(func, "nothing was recorded because the simulation did not run", SIMULATION_ERROR)
+            return
         try:
             reply = self._call("movie_start", {"width": width, "height": height, "acceleration": acceleration,
                                                "caption": bool(caption)})
@@ -110,7 +113,8 @@ class Recorder:
         self.status = status
 
     def take(self) -> None:
-        """After each step: the frames the server rendered, into the encoder."""
+        """After each step: the frames the server rendered, into the encoder. Also the one place the world's
+        end is seen: every way this controller's steps end runs it (RobotClient.end_steps)."""
         if self.status == RECORDING and self.robot.terminated:
             self._end_with_world()
         if self.status != RECORDING or self.robot.terminated:
@@ -189,9 +193,6 @@ class Recorder:
     def stop(self, func: str) -> None:
         if self.status != RECORDING:
             return
-        if self.robot.terminated and not self.world_ended:
-            self._end_with_world()
-            return
         if not self.robot.terminated:       # (the world ended: the frames taken so far are the movie)
             self.take()
             if self.status != RECORDING:
@@ -210,8 +211,6 @@ class Recorder:
 
     def poll(self, wait: float | None = None) -> int:
         """Webots' status, the encoder's end looked at (waited for ``wait`` s when given)."""
-        if self.status == RECORDING and self.robot.terminated:
-            self._end_with_world()
         if self.status != SAVING or self.process is None:
             return self.status
         try:

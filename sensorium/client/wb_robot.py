@@ -368,10 +368,10 @@ class RobotClient:
             result = self.conn.wait(rid, timeout=None)
         except ConnectionLost as exc:
             print(f"sensorium: {exc}; ending the controller's steps", file=sys.stderr)
-            return self._steps_ended()
+            return self.end_steps()
         except SensoriumError as exc:
             if exc.code == ErrorCode.SHUTTING_DOWN:
-                return self._steps_ended()
+                return self.end_steps()
             if exc.code == ErrorCode.NOT_ATTACHED:
                 # the session was dropped (3 heartbeats of silence: a network stall, or this
                 # process was stopped); like a Webots extern controller whose simulation went
@@ -385,7 +385,7 @@ class RobotClient:
                                                  else "a network stall, or this process was stopped)"))
                 print(f"sensorium: {problem}; ending the controller's steps (start it again to re-attach)",
                       file=sys.stderr)
-                return self._steps_ended()
+                return self.end_steps()
             raise
         status = int(result.get("status", 0))
         self.time_ms = int(result.get("time_ms", self.time_ms))
@@ -404,8 +404,10 @@ class RobotClient:
             hook()
         return status
 
-    def _steps_ended(self) -> int:
-        """The step answered no reply but the end of this controller's steps: -1, the hooks told (a movie ends)."""
+    def end_steps(self) -> int:
+        """The end of this controller's steps without a step's answer (the server quit, stopped or went away;
+        this Supervisor's own quit): terminated, the step-end hooks told as after a step answering -1 (a movie
+        ends with the world); -1."""
         self.terminated = True
         for hook in self.step_end_hooks:
             hook()

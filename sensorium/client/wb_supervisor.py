@@ -1265,7 +1265,7 @@ def wb_supervisor_simulation_quit(status: int) -> None:
     if r is None:
         return
     _call(r, "simulation_quit", {"status": max(-2**31, min(2**31 - 1, int(status)))})
-    r.terminated = True
+    r.end_steps()
 
 
 def _launcher_call(r: RobotClient, item: str, args: dict | None, func: str) -> None:

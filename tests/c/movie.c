@@ -2,9 +2,12 @@
  * red for 20 basic steps, blue for 20 more, stopped and waited for; then the arguments Webots'
  * libController refuses and those Sensorium refuses beyond it, one line each. Prints the same lines
  * (with $MOVIE_LEAVE set: 10 steps of a movie, $MOVIE_LEFT_NAME else left.mp4, then the end without stopping
- * it, "left"). */
+ * it, "left"; with $MOVIE_QUIT set: 10 steps of a movie, then simulation_quit while recording, the states once
+ * it is written, then a movie started after the end). */
+#define _POSIX_C_SOURCE 200809L
 #include <stdio.h>
 #include <stdlib.h>
+#include <time.h>
 
 #include <webots/robot.h>
 #include <webots/supervisor.h>
@@ -35,6 +38,25 @@ int main(void) {
     for (int i = 0; i < 10; i++)
       wb_robot_step(16);
     printf("left\n");
+    fflush(stdout);
+    wb_robot_cleanup();
+    return 0;
+  }
+  if (getenv("MOVIE_QUIT") != NULL) { /* the world quits while recording: the frames so far are the movie */
+    char name[4096];
+    snprintf(name, sizeof name, "%s/quit.mp4", out);
+    wb_supervisor_movie_start_recording(name, 160, 120, 0, 90, 1, false);
+    for (int i = 0; i < 10; i++)
+      wb_robot_step(16);
+    wb_supervisor_simulation_quit(0);
+    printf("quit %d\n", wb_robot_step(16));
+    struct timespec ts = {0, 10 * 1000 * 1000};
+    while (!wb_supervisor_movie_is_ready()) /* (a step after -1 would end the process, as Webots' library does) */
+      nanosleep(&ts, NULL);
+    states("saved");
+    snprintf(name, sizeof name, "%s/late.mp4", out);
+    wb_supervisor_movie_start_recording(name, 160, 120, 0, 90, 1, false); /* one line */
+    states("late");
     fflush(stdout);
     wb_robot_cleanup();
     return 0;

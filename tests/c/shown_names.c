@@ -1,7 +1,8 @@
 /* A test harness, no controller: the C library's sn_shown (src/utils.c, included whole), the form a
  * caller's string takes in an error line. Prints each case's result on its own line between [ ]:
  * control characters, UTF-8 and a backslash; strings cut past SN_SHOWN_MAX bytes (plain, and inside a
- * 2-byte UTF-8 character); NULL; SN_SHOWN_SLOTS results used in one printf. */
+ * 2-byte UTF-8 character); NULL; SN_SHOWN_SLOTS results used in one printf; sn_shown_n's bytes, a NUL
+ * among them. */
 #include <string.h>
 
 #include "utils.c"
@@ -24,5 +25,6 @@ int main(void) {
   printf("[%zu %s]\n", strlen(cut), cut + SN_SHOWN_MAX - 3);
   printf("[%s]\n", sn_shown(NULL));
   printf("[%s %s %s %s]\n", sn_shown("1\n"), sn_shown("2\t"), sn_shown("3\r"), sn_shown("4\x1b"));
+  printf("[%s]\n", sn_shown_n("a\0b\ncdef", 5));
   return 0;
 }

@@ -2,9 +2,11 @@
 the wall red for 20 basic steps (320 ms), blue for 20 more, then the recording stopped and waited
 for; then the arguments Webots' libController refuses, and those Sensorium refuses beyond it, one
 line each. Prints the movie's states as it goes and "done". With $MOVIE_LEAVE set: 10 steps of a movie
-($MOVIE_LEFT_NAME, else left.mp4), then the end without stopping it, "left"."""
+($MOVIE_LEFT_NAME, else left.mp4), then the end without stopping it, "left". With $MOVIE_QUIT set: 10 steps of a
+movie, then simulationQuit while recording, the states once it is written; then a movie started after the end."""
 
 import os
+import time
 
 from controller import Supervisor
 
@@ -17,6 +19,18 @@ if os.environ.get("MOVIE_LEAVE"):         # ends while recording: the controller
     for _ in range(10):
         robot.step(16)
     print("left")
+    raise SystemExit(0)
+if os.environ.get("MOVIE_QUIT"):          # the world quits while recording: the frames so far are the movie
+    robot.movieStartRecording(os.path.join(out, "quit.mp4"), 160, 120, 0, 90, 1, False)
+    for _ in range(10):
+        robot.step(16)
+    robot.simulationQuit(0)
+    print("quit", robot.step(16))
+    while not robot.movieIsReady():     # (a step after -1 would end the process, as Webots' library does)
+        time.sleep(0.01)
+    print("saved", robot.movieIsReady(), robot.movieFailed())
+    robot.movieStartRecording(os.path.join(out, "late.mp4"), 160, 120, 0, 90, 1, False)     # one line
+    print("late", robot.movieIsReady(), robot.movieFailed())
     raise SystemExit(0)
 print("before", robot.movieIsReady(), robot.movieFailed())
 robot.movieStartRecording(os.path.join(out, "run"), 160, 120, 0, 90, 1, False)      # ".mp4" added

@@ -151,6 +151,8 @@ class LiveRecorder:
         self._rec_args: tuple = ()
 
     def stop(self) -> None:
+        """End :meth:`run` at its next safe point: once the message being stored is counted too, or
+        within 100 ms while it waits for one (a signal handler may call it)."""
         self._stop = True
 
     def open(self) -> None:

@@ -111,7 +111,7 @@ static void read_ints(const msgpack_object *arr, int *out, int n) {
 static void read_objects(sn_device *d, const msgpack_object *list) {
   struct sn_imaging *im = d->imaging;
   if (list->type != MSGPACK_OBJECT_ARRAY || list->via.array.size > (1u << 20)) {
-    fprintf(stderr, "Warning: camera '%s': recognition objects that are not a list: ignored\n", d->name);
+    fprintf(stderr, "Warning: camera '%s': recognition objects that are not a list: ignored\n", sn_shown(d->name));
     return;
   }
   free_objects(im);
@@ -172,7 +172,7 @@ void sn_imaging_apply(sn_device *d, const msgpack_object *reading) {
     if (bgra != NULL && bgra->type == MSGPACK_OBJECT_BIN && bgra->via.bin.size == 4 * n)
       memcpy(im->image, bgra->via.bin.ptr, 4 * n);
     else if (bgra != NULL)
-      fprintf(stderr, "Warning: camera '%s': image of %u bytes, expected %zu: ignored\n", d->name,
+      fprintf(stderr, "Warning: camera '%s': image of %u bytes, expected %zu: ignored\n", sn_shown(d->name),
               bgra->type == MSGPACK_OBJECT_BIN ? bgra->via.bin.size : 0u, 4 * n);
     const msgpack_object *seg = sn_get(reading, "segmentation_image");
     if (seg != NULL && seg->type == MSGPACK_OBJECT_BIN && seg->via.bin.size == 4 * n)
@@ -189,7 +189,7 @@ void sn_imaging_apply(sn_device *d, const msgpack_object *reading) {
     for (size_t j = 0; j < n; j++)
       im->range[j] = le_float(p + 4 * j);
   } else if (img != NULL)
-    fprintf(stderr, "Warning: range finder '%s': range image of %u bytes, expected %zu: ignored\n", d->name,
+    fprintf(stderr, "Warning: range finder '%s': range image of %u bytes, expected %zu: ignored\n", sn_shown(d->name),
             img->type == MSGPACK_OBJECT_BIN ? img->via.bin.size : 0u, 4 * n);
 }
 

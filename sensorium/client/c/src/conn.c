@@ -260,7 +260,7 @@ static int decode_reply(char *data, size_t size, sn_reply *out, uint64_t *id_out
     out->code = (int)sn_int_or(e, "code", SN_INTERNAL);
     const msgpack_object *m = sn_get(e, "message");
     if (m != NULL && m->type == MSGPACK_OBJECT_STR)
-      snprintf(out->message, sizeof out->message, "%.*s", (int)m->via.str.size, m->via.str.ptr);
+      snprintf(out->message, sizeof out->message, "%s", sn_shown_n(m->via.str.ptr, m->via.str.size));
     else if (e == NULL)
       out->code = SN_BAD_REPLY, snprintf(out->message, sizeof out->message, "error reply without an error map");
   }
@@ -279,6 +279,7 @@ struct sn_conn {
   void *ctx;
   void *sock;
   char *endpoint;
+  char *shown_endpoint; /* endpoint as its lines show it (sn_shown): the URL may hold a line break */
   uint64_t next_id;
   uint64_t *outstanding;
   size_t n_out, cap_out;
@@ -446,9 +447,10 @@ sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen) {
   c->ctx = zmq_ctx_new();
   c->sock = c->ctx ? zmq_socket(c->ctx, ZMQ_DEALER) : NULL;
   c->endpoint = strdup(endpoint);
+  c->shown_endpoint = strdup(sn_shown(endpoint));
   c->next_id = 1;
   pthread_mutex_init(&c->hb_lock, NULL);
-  if (c->sock == NULL || c->endpoint == NULL) {
+  if (c->sock == NULL || c->endpoint == NULL || c->shown_endpoint == NULL) {
     snprintf(err, errlen, "cannot create a ZeroMQ socket: %s", zmq_strerror(zmq_errno()));
     sn_conn_close(c);
     return NULL;
@@ -481,14 +483,14 @@ sn_conn *sn_conn_open(const char *endpoint, char *err, size_t errlen) {
   if (strncmp(endpoint, "tcp://", 6) == 0)
     start_monitor(c);
   if (zmq_connect(c->sock, endpoint) != 0) {
-    snprintf(err, errlen, "cannot connect to %s: %s", endpoint, zmq_strerror(zmq_errno()));
+    snprintf(err, errlen, "cannot connect to %s: %s", c->shown_endpoint, zmq_strerror(zmq_errno()));
     sn_conn_close(c);
     return NULL;
   }
   return c;
 }
 
-const char *sn_conn_endpoint(const sn_conn *c) { return c->endpoint; }
+const char *sn_conn_endpoint(const sn_conn *c) { return c->shown_endpoint; }
 
 void sn_conn_close(sn_conn *c) {
   if (c == NULL)
@@ -505,6 +507,7 @@ void sn_conn_close(sn_conn *c) {
   free(c->stash);
   free(c->outstanding);
   free(c->endpoint);
+  free(c->shown_endpoint);
   pthread_mutex_destroy(&c->hb_lock);
   free(c);
 }
@@ -588,7 +591,7 @@ static char *heartbeat_problem(sn_conn *c, char *buf, size_t len) {
   int64_t down = now - (int64_t)atomic_load(&c->hb_down_since);
   if (down <= c->hb_down_grace_ms)
     return NULL;
-  snprintf(buf, len, "no answer from %s for %.1f s and no connection to it for %.1f s (server gone?)", c->endpoint,
+  snprintf(buf, len, "no answer from %s for %.1f s and no connection to it for %.1f s (server gone?)", c->shown_endpoint,
            (double)silent / 1000.0, (double)down / 1000.0);
   return buf;
 }
@@ -616,13 +619,13 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
         forget(c, id);
         const char *refused = sn_conn_handshake_problem(c);
         if (refused != NULL) {
-          client_error(out, SN_TIMEOUT, "no reply from %s: %s", c->endpoint, refused);
+          client_error(out, SN_TIMEOUT, "no reply from %s: %s", c->shown_endpoint, refused);
           return -1;
         }
         char t[32];
         snprintf(t, sizeof t, "%g", timeout_ms / 1000.0);
         client_error(out, SN_TIMEOUT, "no reply from %s within %s s (is `sensorium serve` running there?)",
-                     c->endpoint, t);
+                     c->shown_endpoint, t);
         return -1;
       }
       if (left < slice)
@@ -634,7 +637,7 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
       if (zmq_errno() == EINTR)
         continue;
       forget(c, id);
-      client_error(out, SN_CONNECTION_LOST, "polling %s: %s", c->endpoint, zmq_strerror(zmq_errno()));
+      client_error(out, SN_CONNECTION_LOST, "polling %s: %s", c->shown_endpoint, zmq_strerror(zmq_errno()));
       return -1;
     }
     if (n == 0) {
@@ -646,7 +649,7 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
           forget(c, id);
           const char *refused = sn_conn_handshake_problem(c);
           if (refused != NULL) { /* libzmq gave up reconnecting after the handshake failed */
-            client_error(out, SN_TIMEOUT, "no reply from %s: %s", c->endpoint, refused);
+            client_error(out, SN_TIMEOUT, "no reply from %s: %s", c->shown_endpoint, refused);
             return -1;
           }
           char limit[32];
@@ -654,7 +657,7 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
           client_error(out, SN_CONNECTION_LOST,
                        "ZeroMQ closed the connection to %s for good while a reply was due: a reply larger than "
                        "this client's limit of %s (or not ZeroMQ) ends it; the Sensorium server sends no larger one",
-                       c->endpoint, limit);
+                       c->shown_endpoint, limit);
           return -1;
         }
         c->retry_sent_ms = now_ms();
@@ -728,14 +731,14 @@ int sn_conn_wait(sn_conn *c, uint64_t id, int timeout_ms, sn_reply *out) {
 int sn_conn_wait_any(sn_conn *c, int timeout_ms, sn_reply *out) {
   zmq_pollitem_t item = {c->sock, 0, ZMQ_POLLIN, 0};
   if (zmq_poll(&item, 1, timeout_ms) <= 0) {
-    client_error(out, SN_TIMEOUT, "no reply from %s%s", c->endpoint, "");
+    client_error(out, SN_TIMEOUT, "no reply from %s%s", c->shown_endpoint, "");
     return -1;
   }
   zmq_msg_t msg;
   zmq_msg_init(&msg);
   if (zmq_msg_recv(&msg, c->sock, 0) < 0) {
     zmq_msg_close(&msg);
-    client_error(out, SN_CONNECTION_LOST, "receiving from %s%s", c->endpoint, "");
+    client_error(out, SN_CONNECTION_LOST, "receiving from %s%s", c->shown_endpoint, "");
     return -1;
   }
   size_t size = zmq_msg_size(&msg);

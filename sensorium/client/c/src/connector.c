@@ -38,7 +38,7 @@ static void locking(WbDeviceTag tag, bool lock, const char *func) {
   if (d == NULL)
     return;
   if (d->connector_passive) { /* Webots' message; the state stays unlocked */
-    fprintf(stderr, "Warning: %s(): connector '%s': passive connectors cannot lock.\n", func, d->name);
+    fprintf(stderr, "Warning: %s(): connector '%s': passive connectors cannot lock.\n", func, sn_shown(d->name));
     return;
   }
   sn_robot *rb = sn_robot_get(func);
@@ -75,7 +75,7 @@ void wb_brake_set_damping_constant(WbDeviceTag tag, double damping_constant) {
   if (!d->warned_damping) {
     d->warned_damping = true;
     fprintf(stderr, "Warning: %s(): brake '%s': Sensorium has no physics, the damping constant has no effect (its "
-                    "joint moves as its motor drives it).\n", func, d->name);
+                    "joint moves as its motor drives it).\n", func, sn_shown(d->name));
   }
 }
 

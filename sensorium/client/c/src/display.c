@@ -41,7 +41,7 @@ static sn_device *display(WbDeviceTag tag, const char *func, bool drawing) {
   if (d == NULL)
     return NULL;
   if (d->node_type != WB_NODE_DISPLAY) {
-    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
+    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, sn_shown(d->name), d->type_name);
     return NULL;
   }
   if (!drawing)
@@ -567,7 +567,7 @@ void wb_display_image_save(WbDeviceTag tag, WbImageRef ir, const char *filename)
   if (data == NULL || data->type != MSGPACK_OBJECT_BIN || w < 1 || h < 1 ||
       data->via.bin.size != 4 * (size_t)w * (size_t)h) {
     fprintf(stderr, "Error: %s(): image %d of Display '%s' holds no pixels (a copy outside the display, or "
-                    "deleted): '%s' is not written.\n", func, id, d->name, sn_shown(filename));
+                    "deleted): '%s' is not written.\n", func, id, sn_shown(d->name), sn_shown(filename));
     sn_reply_free(&rep);
     return;
   }

@@ -62,7 +62,7 @@ void wb_led_set(WbDeviceTag tag, int value) {
   /* a gradual LED: 0xRRGGBB without a colour, else an intensity 0..255 of its colour (Webots' LED page) */
   int hi = d->led_gradual ? (d->led_colors == 0 ? 0xFFFFFF : 255) : d->led_colors;
   if (value < 0 || value > hi) {
-    fprintf(stderr, "Error: wb_led_set(): value %d out of range [0, %d] for LED '%s'.\n", value, hi, d->name);
+    fprintf(stderr, "Error: wb_led_set(): value %d out of range [0, %d] for LED '%s'.\n", value, hi, sn_shown(d->name));
     return;
   }
   if (!sn_device_set(d, "set", sn_arg_int, &value, "wb_led_set"))

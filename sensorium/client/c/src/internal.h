@@ -56,6 +56,9 @@ const char *sn_error_name(int code);
 #define SN_SHOWN_MAX 4096
 #define SN_SHOWN_SLOTS 4
 const char *sn_shown(const char *s);
+/* sn_shown of the n bytes at s, which need no NUL (a msgpack string of a reply); a NUL byte among them
+ * shows as \x00. */
+const char *sn_shown_n(const char *s, size_t n);
 
 /* ------------------------------------------------------------------ wire.c */
 typedef struct {
@@ -287,6 +290,9 @@ void sn_supervisor_free(sn_robot *rb);
  * completed when the controller ends. */
 void sn_movie_after_step(sn_robot *rb);
 void sn_movie_finish(sn_robot *rb);
+/* The end of the controller's steps without a step's answer (the server quit, stopped or went away; this
+ * Supervisor's own quit): terminated, and sn_movie_after_step as after a step answering -1 (robot.c). */
+void sn_steps_ended(sn_robot *rb);
 void sn_arg_int(sn_req *r, const void *arg);
 void sn_arg_bool(sn_req *r, const void *arg);
 void sn_arg_double(sn_req *r, const void *arg);

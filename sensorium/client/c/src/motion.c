@@ -378,7 +378,7 @@ WbMotionRef wbu_motion_new(const char *filename) {
         d = &rb->devices[i];
     if (d == NULL)
       fprintf(stderr, "Warning: " NEW "(): ignoring motor '%s' of file '%s': robot '%s' has no such device.\n",
-              sn_shown(m->motors[j]), sn_shown(filename), rb->name);
+              sn_shown(m->motors[j]), sn_shown(filename), sn_shown(rb->name));
     else if (d->node_type != WB_NODE_ROTATIONAL_MOTOR && d->node_type != WB_NODE_LINEAR_MOTOR)
       fprintf(stderr, "Warning: " NEW "(): ignoring '%s' of file '%s': it is a %s, not a motor.\n",
               sn_shown(m->motors[j]), sn_shown(filename), d->type_name);

@@ -28,10 +28,10 @@ static void position_warning(const sn_device *m, double position) {
   if (!m->joint || m->min_position == m->max_position || isinf(position))
     return;
   if (target > m->max_position)
-    fprintf(stderr, "WARNING: %s \"%s\": too big requested position: %g > %g\n", m->type_name, m->name, position,
+    fprintf(stderr, "WARNING: %s \"%s\": too big requested position: %g > %g\n", m->type_name, sn_shown(m->name), position,
             m->max_position);
   else if (target < m->min_position)
-    fprintf(stderr, "WARNING: %s \"%s\": too low requested position: %g < %g\n", m->type_name, m->name, position,
+    fprintf(stderr, "WARNING: %s \"%s\": too low requested position: %g < %g\n", m->type_name, sn_shown(m->name), position,
             m->min_position);
 }
 
@@ -64,7 +64,7 @@ static double scaled_velocity(const sn_device *m, double velocity) {
   double wanted = velocity * m->multiplier;
   if (fabs(wanted) > m->max_velocity) {
     fprintf(stderr, "WARNING: %s \"%s\": The requested velocity %g exceeds 'maxVelocity' = %g.\n", m->type_name,
-            m->name, wanted, m->max_velocity);
+            sn_shown(m->name), wanted, m->max_velocity);
     wanted = copysign(m->max_velocity, wanted);
   }
   return wanted;
@@ -126,7 +126,7 @@ WbJointType wb_motor_get_type(WbDeviceTag tag) {
   if (d == NULL)
     return WB_ROTATIONAL;
   if (d->node_type != WB_NODE_ROTATIONAL_MOTOR && d->node_type != WB_NODE_LINEAR_MOTOR) {
-    fprintf(stderr, "Error: wb_motor_get_type(): device tag %u is '%s', a %s\n", (unsigned)tag, d->name, d->type_name);
+    fprintf(stderr, "Error: wb_motor_get_type(): device tag %u is '%s', a %s\n", (unsigned)tag, sn_shown(d->name), d->type_name);
     return WB_ROTATIONAL;
   }
   return d->node_type == WB_NODE_LINEAR_MOTOR ? WB_LINEAR : WB_ROTATIONAL;
@@ -162,10 +162,10 @@ static sn_device *physics(WbDeviceTag tag, const char *func) {
     d->warned_physics = true;
     if (d->joint)
       fprintf(stderr, "Warning: %s(): %s '%s' moves its joint kinematically (no physics): PID gains, forces and "
-              "torques are ignored, force and torque feedback read NaN.\n", func, d->type_name, d->name);
+              "torques are ignored, force and torque feedback read NaN.\n", func, d->type_name, sn_shown(d->name));
     else
       fprintf(stderr, "Warning: %s(): %s '%s' is a kinematic wheel: accelerations, forces, torques and PID gains "
-              "are ignored, force and torque feedback read NaN.\n", func, d->type_name, d->name);
+              "are ignored, force and torque feedback read NaN.\n", func, d->type_name, sn_shown(d->name));
   }
   return d;
 }

@@ -141,6 +141,10 @@ static void start(sn_robot *rb, const char *func, const char *filename, int widt
          WB_SUPERVISOR_MOVIE_ENCODING_ERROR);
     return;
   }
+  if (rb->terminated) { /* the world ended before: a movie that ends with it, without a frame */
+    fail(func, "nothing was recorded because the simulation did not run", WB_SUPERVISOR_MOVIE_SIMULATION_ERROR);
+    return;
+  }
   start_args a = {width, height, acceleration, caption};
   sn_reply rep;
   if (sn_robot_call(rb, "robot/movie_start", 4, args_start, &a, func, &rep) != 0) {
@@ -239,7 +243,8 @@ static void end_with_world(sn_robot *rb) {
   stop(rb, func);
 }
 
-/* after each step reply: the frames the server rendered, into the encoder */
+/* after each step reply: the frames the server rendered, into the encoder. Also the one place the world's end is
+   seen: every way the controller's steps end calls it (sn_steps_ended) */
 void sn_movie_after_step(sn_robot *rb) {
   const char *func = "wb_supervisor_movie_start_recording";
   bool more = true;
@@ -280,10 +285,6 @@ void sn_movie_after_step(sn_robot *rb) {
 static void stop(sn_robot *rb, const char *func) {
   if (g_status != WB_SUPERVISOR_MOVIE_RECORDING)
     return;
-  if (rb->terminated && !g_world_ended) {
-    end_with_world(rb);
-    return;
-  }
   if (!rb->terminated) { /* (the world ended: the frames taken so far are the movie) */
     sn_movie_after_step(rb);
     if (g_status != WB_SUPERVISOR_MOVIE_RECORDING)
@@ -301,8 +302,7 @@ static void stop(sn_robot *rb, const char *func) {
 }
 
 /* Webots' status, the encoder's end looked at (waited for up to wait_ms) */
-static int poll_movie(sn_robot *rb, int wait_ms) {
-  end_with_world(rb);
+static int poll_movie(int wait_ms) {
   if (g_status != WB_SUPERVISOR_MOVIE_SAVING || g_encoder <= 0)
     return g_status;
   const char *func = "wb_supervisor_movie_stop_recording";
@@ -334,7 +334,7 @@ static int poll_movie(sn_robot *rb, int wait_ms) {
 void sn_movie_finish(sn_robot *rb) {
   const char *func = "wb_supervisor_movie_stop_recording";
   stop(rb, func);
-  poll_movie(rb, FINISH_WAIT_MS);
+  poll_movie(FINISH_WAIT_MS);
   if (g_status == WB_SUPERVISOR_MOVIE_SAVING)
     abort_movie(func, "ffmpeg did not finish the movie in time", WB_SUPERVISOR_MOVIE_ENCODING_ERROR);
 }
@@ -346,7 +346,7 @@ void wb_supervisor_movie_start_recording(const char *filename, int width, int he
   sn_robot *rb = sn_supervisor(func);
   if (rb == NULL)
     return;
-  int status = poll_movie(rb, 0);
+  int status = poll_movie(0);
   if (status == WB_SUPERVISOR_MOVIE_RECORDING || status == WB_SUPERVISOR_MOVIE_SAVING) {
     fprintf(stderr, "Error: %s(): movie recording has already been started.\n", func);
     return;
@@ -381,7 +381,7 @@ bool wb_supervisor_movie_is_ready(void) {
   sn_robot *rb = sn_supervisor("wb_supervisor_movie_is_ready");
   if (rb == NULL)
     return false;
-  int status = poll_movie(rb, 0);
+  int status = poll_movie(0);
   return status == WB_SUPERVISOR_MOVIE_READY || status > WB_SUPERVISOR_MOVIE_SAVING;
 }
 
@@ -389,7 +389,7 @@ bool wb_supervisor_movie_failed(void) {
   sn_robot *rb = sn_supervisor("wb_supervisor_movie_failed");
   if (rb == NULL)
     return true;
-  return poll_movie(rb, 0) > WB_SUPERVISOR_MOVIE_SAVING;
+  return poll_movie(0) > WB_SUPERVISOR_MOVIE_SAVING;
 }
 
 int wb_supervisor_movie_get_status(void) {
@@ -402,7 +402,7 @@ int wb_supervisor_movie_get_status(void) {
   sn_robot *rb = sn_supervisor(__func__);
   if (rb == NULL)
     return WB_SUPERVISOR_MOVIE_SIMULATION_ERROR;
-  return poll_movie(rb, 0);
+  return poll_movie(0);
 }
 
 void wb_supervisor_start_movie(const char *file, int width, int height, int codec, int quality, int acceleration,

@@ -17,7 +17,7 @@ static sn_device *pen(WbDeviceTag tag, const char *func) {
   if (d == NULL)
     return NULL;
   if (d->node_type != WB_NODE_PEN) {
-    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
+    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, sn_shown(d->name), d->type_name);
     return NULL;
   }
   if (!d->simulated) { /* a server that lists pens only */

@@ -14,7 +14,8 @@ void sn_radar_apply(sn_device *dev, const msgpack_object *targets) {
     return;
   uint32_t n = targets->via.array.size / 4;
   if (targets->via.array.size % 4)
-    fprintf(stderr, "Warning: radar '%s': %u target values, not a multiple of 4: the last ones ignored\n", dev->name,
+    fprintf(stderr, "Warning: radar '%s': %u target values, not a multiple of 4: the last ones ignored\n",
+            sn_shown(dev->name),
             targets->via.array.size);
   free(dev->radar_targets); /* Webots' libController keeps a new array per measurement too */
   dev->radar_targets = NULL;

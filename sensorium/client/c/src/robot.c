@@ -355,8 +355,8 @@ static char *only_robot(sn_conn *c) {
     for (uint32_t i = 0; i < n; i++) {
       const msgpack_object *nm = sn_get(&robots->via.array.ptr[i], "name");
       if (nm && nm->type == MSGPACK_OBJECT_STR)
-        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%.*s", i ? ", " : "",
-                 (int)nm->via.str.size, nm->via.str.ptr);
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", i ? ", " : "",
+                 sn_shown_n(nm->via.str.ptr, nm->via.str.size));
     }
     char msg[600];
     snprintf(msg, sizeof msg, "the controller URL names no robot and the world at %s has %u (%s): add '/ROBOT' to the URL",
@@ -546,7 +546,7 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
       for (size_t j = 0; j < n; j++)
         dev->range_image[j] = le_float(p + 4 * j);
     } else if (img != NULL)
-      fprintf(stderr, "Warning: lidar '%s': range image of %u bytes, expected %zu: ignored\n", dev->name,
+      fprintf(stderr, "Warning: lidar '%s': range image of %u bytes, expected %zu: ignored\n", sn_shown(dev->name),
               img->type == MSGPACK_OBJECT_BIN ? img->via.bin.size : 0u, 4 * n);
     const msgpack_object *pc = sn_get(v, "point_cloud");
     if (pc != NULL && pc->type == MSGPACK_OBJECT_BIN && pc->via.bin.size == 20 * n) {
@@ -561,7 +561,7 @@ static void apply_values(sn_robot *rb, const msgpack_object *values) {
         q->time = le_float(p + 16);
       }
     } else if (pc != NULL)
-      fprintf(stderr, "Warning: lidar '%s': point cloud of %u bytes, expected %zu: ignored\n", dev->name,
+      fprintf(stderr, "Warning: lidar '%s': point cloud of %u bytes, expected %zu: ignored\n", sn_shown(dev->name),
               pc->type == MSGPACK_OBJECT_BIN ? pc->via.bin.size : 0u, 20 * n);
   }
 }
@@ -589,7 +589,7 @@ int wb_robot_step_begin(int duration) {
     /* Webots warns once and wakes the controller at the first basic step that ends after it */
     rb->warned_duration = true;
     fprintf(stderr, "Warning: the step duration %d ms of robot '%s' is not a multiple of the basic time step (%d ms); "
-            "the server rounds it up.\n", duration, rb->name, rb->basic_time_step);
+            "the server rounds it up.\n", duration, sn_shown(rb->name), rb->basic_time_step);
   }
   sn_motion_step_all(duration); /* the playing motions set their motors' positions (motion.c) */
   rb->wwi_fresh = true;         /* what is left of the robot-window batch being read is dropped */
@@ -651,7 +651,8 @@ int wb_robot_step_begin(int duration) {
   if (rc != 0) {
     fprintf(stderr, "sensorium: cannot send the step request to %s; ending the controller's steps\n",
             sn_conn_endpoint(rb->conn));
-    rb->terminated = rb->quit_returned = true;
+    sn_steps_ended(rb);
+    rb->quit_returned = true;
     return -1;
   }
   rb->pending = id;
@@ -659,6 +660,11 @@ int wb_robot_step_begin(int duration) {
 }
 
 static int step_end(sn_robot *rb);
+
+void sn_steps_ended(sn_robot *rb) {
+  rb->terminated = true;
+  sn_movie_after_step(rb); /* (a movie recording ends with the world) */
+}
 
 int wb_robot_step_end(void) {
   sn_robot *rb = sn_robot_get("wb_robot_step_end");
@@ -680,18 +686,16 @@ static int step_end(sn_robot *rb) {
   int rc = sn_conn_wait(rb->conn, id, -1, &rep);
   if (rc != 0 && rep.code == SN_CONNECTION_LOST) {
     fprintf(stderr, "sensorium: CONNECTION_LOST: %s; ending the controller's steps\n", rep.message);
-    rb->terminated = true;
-    sn_movie_after_step(rb); /* (a movie recording ends with the world) */
+    sn_steps_ended(rb);
     return -1;
   }
   if (rc != 0 || !rep.ok) {
-    if (rep.code == SN_SHUTTING_DOWN)
-      rb->terminated = true;
-    else
+    const bool ended = rep.code == SN_SHUTTING_DOWN;
+    if (!ended)
       fprintf(stderr, "Error: wb_robot_step(): %s: %s\n", sn_error_name(rep.code), rep.message);
     sn_reply_free(&rep);
-    if (rb->terminated)
-      sn_movie_after_step(rb);
+    if (ended)
+      sn_steps_ended(rb);
     return -1;
   }
   int status = (int)sn_int_or(rep.result, "status", 0);
@@ -778,7 +782,7 @@ WbDeviceTag wb_robot_get_device(const char *name) {
     if (strcmp(rb->devices[i].name, name) == 0)
       return rb->devices[i].tag;
   /* Webots warns too: a misspelt name would otherwise only show as a later "invalid device tag 0" */
-  fprintf(stderr, "Warning: wb_robot_get_device(): robot \"%s\" has no device \"%s\".\n", rb->name, sn_shown(name));
+  fprintf(stderr, "Warning: wb_robot_get_device(): robot \"%s\" has no device \"%s\".\n", sn_shown(rb->name), sn_shown(name));
   return 0;
 }
 
@@ -829,17 +833,17 @@ bool sn_unsimulated(WbDeviceTag tag, int node_type, const char *func) {
   }
   sn_device *d = &rb->devices[tag - 1];
   if (d->node_type != node_type && !(node_type == WB_NODE_ROTATIONAL_MOTOR && d->node_type == WB_NODE_LINEAR_MOTOR)) {
-    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
+    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, sn_shown(d->name), d->type_name);
     return false;
   }
   if (!d->warned_unsimulated) {
     d->warned_unsimulated = true;
     if (d->simulated) /* the server measures it; this library does not read those readings yet */
       fprintf(stderr, "Warning: %s(): the C client does not read %s '%s' yet (its services and topics do): its functions "
-              "answer Webots' \"no value\" (NaN, NULL, 0).\n", func, d->type_name, d->name);
+              "answer Webots' \"no value\" (NaN, NULL, 0).\n", func, d->type_name, sn_shown(d->name));
     else
       fprintf(stderr, "Warning: %s(): Sensorium does not simulate %s '%s': its functions answer Webots' \"no value\" "
-              "(NaN, NULL, 0).\n", func, d->type_name, d->name);
+              "(NaN, NULL, 0).\n", func, d->type_name, sn_shown(d->name));
   }
   return false;
 }
@@ -861,7 +865,7 @@ sn_device *sn_device_get(WbDeviceTag tag, sn_kind kind, const char *func) {
       sn_unsimulated(tag, d->node_type, func);
       return NULL;
     }
-    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, d->name, d->type_name);
+    fprintf(stderr, "Error: %s(): device tag %u is '%s', a %s\n", func, (unsigned)tag, sn_shown(d->name), d->type_name);
     return NULL;
   }
   fprintf(stderr, "Error: %s(): invalid device tag %u\n", func, (unsigned)tag);

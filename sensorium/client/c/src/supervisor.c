@@ -93,7 +93,7 @@ sn_robot *sn_supervisor(const char *func) {
             "Error: ignoring illegal call to %s() in a 'Robot' controller.\n"
             "Error: this function can only be used in a 'Supervisor' controller (set 'supervisor: true' on robot "
             "'%s' in the world file).\n",
-            func, rb->name);
+            func, sn_shown(rb->name));
     return NULL;
   }
   return rb;
@@ -1127,7 +1127,7 @@ WbNodeRef wb_supervisor_node_get_from_proto_def(WbNodeRef node, const char *def)
     return NULL;
   const msgpack_object *note = sn_get(rep.result, "note");
   if (note != NULL && note->type == MSGPACK_OBJECT_STR && note->via.str.size > 0)
-    fprintf(stderr, "Error: %s(): %.*s.\n", func, (int)note->via.str.size, note->via.str.ptr);
+    fprintf(stderr, "Error: %s(): %s.\n", func, sn_shown_n(note->via.str.ptr, note->via.str.size));
   return node_from_reply(rb, &rep);
 }
 
@@ -1204,7 +1204,7 @@ static int field_value(WbFieldRef field, WbFieldType type, const char *func, sn_
     return -1;
   const msgpack_object *note = sn_get(rep->result, "note"); /* a value the server does not serve: its line */
   if (note != NULL && note->type == MSGPACK_OBJECT_STR && note->via.str.size > 0) {
-    fprintf(stderr, "Error: %s(): %.*s.\n", func, (int)note->via.str.size, note->via.str.ptr);
+    fprintf(stderr, "Error: %s(): %s.\n", func, sn_shown_n(note->via.str.ptr, note->via.str.size));
     sn_reply_free(rep);
     return -1;
   }
@@ -1790,7 +1790,7 @@ void wb_supervisor_simulation_quit(int status) {
   sn_reply rep;
   if (sn_robot_call(rb, "robot/simulation_quit", 1, args_status, &status, func, &rep) == 0)
     sn_reply_free(&rep);
-  rb->terminated = true;
+  sn_steps_ended(rb);
 }
 
 void wb_supervisor_simulation_reset(void) {

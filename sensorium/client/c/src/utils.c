@@ -90,7 +90,9 @@ char *wbu_string_replace(char *value, const char *before, const char *after) {
 }
 
 /* ------------------------------------------------------------------ names in error lines */
-const char *sn_shown(const char *s) {
+const char *sn_shown(const char *s) { return s == NULL ? "(null)" : sn_shown_n(s, strlen(s)); }
+
+const char *sn_shown_n(const char *s, size_t size) {
   static _Thread_local char slots[SN_SHOWN_SLOTS][SN_SHOWN_MAX + 8];
   static _Thread_local int next = 0;
   char *out = slots[next];
@@ -98,7 +100,7 @@ const char *sn_shown(const char *s) {
   if (s == NULL)
     return "(null)";
   size_t n = 0;
-  for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+  for (const unsigned char *p = (const unsigned char *)s, *end = p + size; p < end; p++) {
     char piece[5];
     if (*p == '\n' || *p == '\t' || *p == '\r')
       snprintf(piece, sizeof piece, "\\%c", *p == '\n' ? 'n' : *p == '\t' ? 't' : 'r');

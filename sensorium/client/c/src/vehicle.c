@@ -128,7 +128,7 @@ static void car_init(const char *func) {
             "Error: %s(): robot '%s' has no ackermann_drive: Sensorium's vehicle library drives a car-like robot whose "
             "world entry has one (README \"World files\"; a .wbt car is mapped when its steering and wheel joints "
             "are a car's).\n",
-            func, rb->name);
+            func, sn_shown(rb->name));
     fflush(stderr);
     exit(1);
   }
