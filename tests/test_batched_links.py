@@ -245,17 +245,18 @@ def test_a_light_on_a_link_lights_a_sensor_from_where_its_copy_holds_it():
 @pytest.mark.parametrize("world, message", [
     (lambda: _changed(lambda r: None, contact=True), "robot 'arm': shape 'bar' rides joint 'swing' and bounds the "
      "robot; the batched simulation's kinematic contact does not follow a link"),
-    (lambda: _changed(lambda r: r["devices"].append(
-        {"device": "Lidar", "name": "arm lidar", "on_joint": "swing", "pose": {"translation": [0.3, 0, 0.25]}})),
+    (lambda: _changed(lambda r: (r["devices"].append(
+        {"device": "Lidar", "name": "arm lidar", "on_joint": "swing", "pose": {"translation": [0.3, 0, 0.25]}}),
+        r["shapes"].append({"name": "housing", "of_device": "arm lidar", "on_joint": "swing",
+                            "pose": {"translation": [0.3, 0, 0.25]}, "geometry": {"type": "sphere", "radius": 0.01}}))),
      "robot 'arm': Lidar 'arm lidar' rides joint 'swing', whose link has shapes it sees"),
-    (lambda: _changed(lambda r: (r.update(self_collision=False), r["devices"].append(
-        {"device": "DistanceSensor", "name": "tip ir", "type": "infra-red", "on_joint": "swing",
-         "pose": {"translation": [0.56, 0, 0.2]}}))),
-     "robot 'arm': DistanceSensor 'tip ir' rides joint 'swing', whose link has shapes it sees"),
+    (lambda: _changed(lambda r: r["devices"].append(
+        {"device": "RangeFinder", "name": "tip rf", "on_joint": "swing", "pose": {"translation": [0.56, 0, 0.2]}})),
+     "robot 'arm': RangeFinder 'tip rf' rides joint 'swing', whose link has shapes it sees"),
     (lambda: _changed(lambda r: r["shapes"].append(
         {"name": "slab", "on_joint": "swing", "geometry": {"type": "plane", "size": [1, 1]}})),
      "robot 'arm': shape 'slab' rides joint 'swing'; the batched simulation moves no plane on a link"),
-], ids=["bounding link with contact", "lidar on its link", "infra-red on its link", "plane on a link"])
+], ids=["bounding link with contact", "housed lidar on its link", "range finder on its link", "plane on a link"])
 def test_what_a_link_cannot_carry_here_is_refused_in_one_line(world, message):
     with pytest.raises(BatchedError, match=re.escape(message)):
         BatchedSimulation(world(), 2)
@@ -336,3 +337,105 @@ def test_a_camera_recognises_a_robot_with_its_links_where_each_copy_holds_them()
             assert batched.segmentation_image(cam)[c].tobytes() == dev.segmentation_image.tobytes(), (t, c)
             sizes.update(tuple(o.size) for o in got)
     assert len(sizes) > 10          # the arm's box follows its links
+
+
+# sensors riding the swing, which see the bar they ride (self-collision; infra-red sees its robot anyway)
+TIP_BAR_DROP = 0.05       # the sensors sit 0.25 above the arm's origin, the bar's top face 0.2
+TIP_DS_TILT = 1.2         # the tip sensor's ray: pitched down by this, onto the bar's top face ahead of it
+TIP = [{"device": "DistanceSensor", "name": "tip ds", "on_joint": "swing", "lookup_table": [[0, 0, 0], [2.0, 2.0, 0]],
+        "pose": {"translation": [0.3, 0, 0.25], "rotation": [0, 1, 0, TIP_DS_TILT]}},
+       {"device": "DistanceSensor", "name": "tip ir", "type": "infra-red", "on_joint": "swing",
+        "pose": {"translation": [0.45, 0, 0.25], "rotation": [0, 1, 0, 1.0]}, "lookup_table": [[0, 0, 0], [2.0, 2000, 0.02]]},
+       {"device": "DistanceSensor", "name": "tip sonar", "type": "sonar", "on_joint": "swing", "number_of_rays": 4,
+        "aperture": 0.5, "pose": {"translation": [0.5, 0, 0.25], "rotation": [0, 1, 0, 0.9]},
+        "lookup_table": [[0, 0, 0], [2.0, 2000, 0]]},
+       {"device": "DistanceSensor", "name": "tip fan", "on_joint": "swing", "number_of_rays": 3, "aperture": 0.3,
+        "pose": {"translation": [0.3, 0, 0.25], "rotation": [0, 1, 0, 0.6]}, "lookup_table": [[0, 0, 0], [2.0, 2.0, 0]]},
+       {"device": "LightSensor", "name": "tip ls", "on_joint": "swing", "occlusion": True,
+        "pose": {"translation": [0.3, 0, 0.05], "rotation": [0, 0, 1, math.pi]}, "lookup_table": [[0, 0, 0], [10, 1000, 0]]},
+       {"device": "Lidar", "name": "tip lidar", "on_joint": "swing", "pose": {"translation": [0.3, 0, 0.25]},
+        "horizontal_resolution": 64, "field_of_view": 2 * math.pi, "number_of_layers": 4, "vertical_field_of_view": 1.2,
+        "min_range": 0.02, "max_range": 2.5, "noise": 0.01},
+       {"device": "Lidar", "name": "tip sweep", "type": "rotating", "on_joint": "swing", "default_frequency": 7.0,
+        "pose": {"translation": [0.35, 0, 0.25]}, "horizontal_resolution": 48, "field_of_view": 2 * math.pi,
+        "number_of_layers": 3, "vertical_field_of_view": 1.2, "min_range": 0.02, "max_range": 2.5}]
+TIP_DEVICES = {"arm": ["tip ds", "tip ir", "tip sonar", "tip fan", "tip ls", "tip lidar", "tip sweep", "own ds"],
+               "watcher": ["ds", "ir", "lidar"]}
+
+
+def _tip_world(seed: int, lidar_noise: bool = True):
+    w = arm_world(seed, lights=False).world.model_dump(mode="json", exclude_defaults=True)
+    w["robots"][0]["devices"] += [d if lidar_noise or d["name"] != "tip lidar" else {**d, "noise": 0.0} for d in TIP]
+    return parse_world(w)
+
+
+def _tip_single(seed: int, precision: str) -> Simulation:
+    sim = Simulation(_tip_world(seed).world, precision=precision)
+    for robot, names in TIP_DEVICES.items():
+        for name in names:
+            sim.device(f"{robot}/{name}").enable(STEP)
+    return sim
+
+
+@pytest.mark.parametrize("precision", ["exact", "fast"])
+def test_sensors_riding_a_link_see_its_shapes_as_their_simulation_bit_for_bit(precision):
+    """Distance sensors (generic, multi-ray, infra-red, sonar), a light sensor, a fixed and a rotating
+    lidar riding the swing, which they see (its bar below them, the hand on the wrist beyond): three
+    copies with their own random swings and wrists, copy 2 reset at step 110 against a fresh Simulation,
+    200 steps: every reading the same bits as the copy's Simulation. (A distance sensor's hits on its
+    own link are made from its mount, as the single simulation's: met from the world's frame instead,
+    EXACT readings differ in the last bits; the sonar's echo reads the hit's normal, turned by the
+    copy's link.)"""
+    seeds = (3, 4, 5)
+    n = len(seeds)
+    batched = BatchedSimulation(_tip_world(seeds[0]), n, precision=precision)
+    batched.reset(np.arange(n), list(seeds))
+    for robot, names in TIP_DEVICES.items():
+        for name in names:
+            batched.enable(batched.device(robot, name), STEP)
+    singles = [_tip_single(s, precision) for s in seeds]
+    arm = batched.slot("arm")
+    rng = np.random.default_rng(11)
+    echoes: set[float] = set()
+    for t in range(200):
+        if t == 110:
+            batched.reset([2], [seeds[2]])
+            for robot, names in TIP_DEVICES.items():
+                for name in names:
+                    batched.enable(batched.device(robot, name), STEP, copies=[2])
+            singles[2] = _tip_single(seeds[2], precision)
+        if t % 40 == 0:
+            for c in range(n):
+                for robot, name, span in (("arm", "swing", math.pi), ("arm", "wrist", 1.2),
+                                          ("watcher", "flag pan", math.pi)):
+                    target = float(rng.uniform(-span, span))
+                    singles[c].robot(robot).motor(name).set_position(target)
+                    batched.joints.command(batched.slot(robot), name, position=target, copies=[c])
+        for s in singles:
+            s.step()
+        batched.step()
+        for c, s in enumerate(singles):
+            for name in ("swing", "wrist"):
+                got = batched.joints.position[c, batched.joints.of(arm, name)]
+                assert got.tobytes() == np.float64(s.robot("arm").joints[name].position).tobytes(), (t, c, name)
+            for robot, names in TIP_DEVICES.items():
+                for name in names:
+                    got, want = _reading(batched, s, c, robot, name)
+                    assert got == want, (t, c, robot, name)
+            echoes.add(float(batched.value(batched.device("arm", "tip sonar"))[c]))
+    assert min(echoes) < 100.0 and max(echoes) == 2000.0      # the sonar met the hand, and missed it
+
+
+def test_sensors_riding_a_link_read_its_shape_at_the_closed_form_distance_in_every_copy():
+    """Whatever the swing, the bar's top face is TIP_BAR_DROP below the sensors riding it: the tip
+    sensor's ray pitched down by TIP_DS_TILT meets it at TIP_BAR_DROP / sin(TIP_DS_TILT), and the tip
+    lidar's lowest layer (pitched down by half its vertical field, 0.6; noise off) at TIP_BAR_DROP / sin(0.6),
+    its nearest range (float32)."""
+    batched = BatchedSimulation(_tip_world(3, lidar_noise=False), 3, precision="exact")
+    ds, lidar = batched.device("arm", "tip ds"), batched.device("arm", "tip lidar")
+    batched.enable(ds, STEP)
+    batched.enable(lidar, STEP)
+    batched.joints.command(batched.slot("arm"), "swing", position=np.array([0.0, 1.0, -2.5]))
+    batched.run(60)
+    assert batched.value(ds) == pytest.approx([TIP_BAR_DROP / math.sin(TIP_DS_TILT)] * 3, abs=1e-12)
+    assert batched.range_image(lidar).min(axis=(1, 2)) == pytest.approx([TIP_BAR_DROP / math.sin(0.6)] * 3, rel=1e-6)

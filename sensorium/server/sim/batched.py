@@ -322,6 +322,7 @@ class BatchedSimulation:
                 raise BatchedError(f"threads must be >= 1, got {threads}")
             self.scene.engine.threads = movers.threads = int(threads)
         self.link_slots = link_slots
+        self._link_body = {(i, joint): body for i, joint, body in link_slots}   # (robot slot, joint) -> body
         self._link_cols: tuple[np.ndarray, np.ndarray] | None = None   # (robot slot, joint column) per link
         self.rays = CopyRays(self.scene.engine, movers, slot_body + [b for _, _, b in link_slots], n_static,
                              owner=[*range(R), *(i for i, _, _ in link_slots)],
@@ -504,13 +505,18 @@ class BatchedSimulation:
                 if joint is None:
                     continue
                 # a device that sees its own robot, on a link with shapes: the single simulation meets that
-                # link from the device's frame (its mount); the copies' casts would meet it from the world's
-                if joint in shaped and (d.device in ("Lidar", "Camera", "RangeFinder") or (
-                        d.device in ("DistanceSensor", "LightSensor") and r.self_collision)
-                        or (d.device == "DistanceSensor" and d.type == "infra-red")):    # (visual rays: see their robot)
+                # link from the device's frame (its mount). A distance sensor's own-body hits are made
+                # so here too (on the link's template body); a lidar's beams (Mount(own=True) on the
+                # link) move into its frame by the world's round trip there as here; a light sensor's
+                # rays are mounted on nothing in either (tests/test_batched_links.py). A lidar with
+                # shapes of its own meets its link once from its mount, blind to them; cameras and
+                # range finders from their mount: refused
+                housed = d.device == "Lidar" and any(d.name in blind_devices(x) for x in r.shapes)
+                if joint in shaped and (d.device in ("Camera", "RangeFinder") or housed):
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
-                                       f"{joint!r}, whose link has shapes it sees; the batched simulation casts from "
-                                       "a link with shapes only the rays blind to their own robot (use Simulation)")
+                                       f"{joint!r}, whose link has shapes it sees; the batched simulation casts no "
+                                       "camera, range finder or lidar with shapes of its own from a link with shapes "
+                                       "(use Simulation)")
                 if d.device not in batched_joints.RIDING_KINDS:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
                                        f"{joint!r}; the batched simulation moves distance sensors, light sensors, "
@@ -564,11 +570,14 @@ class BatchedSimulation:
                 riding = dev.on_joint is not None and d.device in batched_joints.PLACED_KINDS
                 if riding:
                     # its rays are mounted on no body: on a link without shapes as the single simulation's
-                    # (Scene.device_body is None); on one with shapes only if blind to its robot
-                    # (_check_supported), so its link is never met; a light sensor's occlusion rays
-                    # skip its robot as the single one's do (exclude_self); each copy's local pose is
-                    # the joints' (batched_joints.py)
+                    # (Scene.device_body is None); a distance sensor on one with shapes is mounted on
+                    # that link's template body (its own-body hits made from its mount, as
+                    # DistanceBatch's), a lidar's beams meet it in the cast (_check_supported); a
+                    # light sensor's occlusion rays are mounted on nothing in either; each copy's
+                    # local pose is the joints' (batched_joints.py)
                     dev.move_with(Pose.identity())
+                    if d.device == "DistanceSensor":   # on a link with shapes: mounted on it, as Simulation's
+                        dev.link_body = self._link_body.get((slot, dev.on_joint))
                     self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose, dev.local_pose)
                 elif d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
                     # its beams meet its own robot's body once, in the body frame, blind to its own
@@ -634,6 +643,18 @@ class BatchedSimulation:
         if self.distance:
             bodies = [self.rays.slot_body[s] for s in range(self.R)]
             self._d_plan = DistancePlan(self.distance, bodies)
+            # per engine body (index -1: the last entry, -1): the slot a sensor mounted on it skips in the
+            # cast (its robot's, or its link's: its own-body hits are made apart) and the joint column
+            # turning a link body (-1: a robot's)
+            self._d_mount_slot = np.full(max((b for b in self.rays.slot_body if b is not None), default=0) + 2, -1,
+                                         dtype=np.int64)
+            self._d_link_joint = self._d_mount_slot.copy()
+            for s, b in enumerate(self.rays.slot_body):
+                if b is not None:
+                    self._d_mount_slot[b] = s
+            for i, joint, b in self.link_slots:
+                self._d_link_joint[b] = self.joints.of(i, joint)
+            self._d_on_link = any(d.link_body is not None for d in self.distance)
             self._d_col = {id(d): k for k, d in enumerate(self.distance)}
             self._d_empty = np.array([not d.config.lookup_table for d in self.distance], dtype=bool)
             self._d_slot = np.array([d.robot_index for d in self.distance], dtype=np.int64)
@@ -1658,7 +1679,7 @@ class BatchedSimulation:
             n = g.n
             mount: np.ndarray | int = -1
             if g.mount is not None:
-                mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
+                mount = np.repeat(self._d_mount_slot[g.mount.reshape(-1, n)[k, 0]], n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             t_far = g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1)
             local_rot, local_pos = plan.local_rot, plan.local_pos
@@ -1684,7 +1705,7 @@ class BatchedSimulation:
         for (g, rows, k, c, slot, positions, dirs), h in zip(state["groups"], hits):
             S, n = dirs.shape[:2]
             dist, shape, normal = h.distance, h.shape, h.normal
-            own = g.own_hits(self.rays.movers, plan.local_rot, plan.local_pos) if g.mount is not None else None
+            own = g.own_hits(self.rays.movers, plan.mount_rot, plan.mount_pos) if g.mount is not None else None
             if own is not None:   # the nearer of the cast and the ray's own-body hit (decided once)
                 od, osh, onr = self._own_rows(g, own, k)
                 win = (od < dist).nonzero()[0]
@@ -1693,7 +1714,13 @@ class BatchedSimulation:
                     dist[win] = od[win]
                     shape[win] = np.where(osh[win] >= 0, osh[win] + self.n_static_shapes, -1)
                     rr = np.repeat(np.arange(S), n)[win]
-                    normal[win] = np.einsum("sij,sj->si", self.rot[c[rr], slot[rr]], onr[win])
+                    carrier = self.rot[c[rr], slot[rr]]
+                    if self._d_on_link:   # mounted on a link: its copy's displacement turns it too (DistanceBatch)
+                        joint = self._d_link_joint[g.mount.reshape(-1, n)[k[rr], 0]]
+                        on = (joint >= 0).nonzero()[0]
+                        if len(on):
+                            carrier[on] = carrier[on] @ self.joints.link_rot[c[rr[on]], joint[on]]
+                    normal[win] = np.einsum("sij,sj->si", carrier, onr[win])
             dist = dist.reshape(S, n)
             reflection = None
             if g.kind == RayKind.VISUAL:
