@@ -56,10 +56,13 @@ there as Simulation's scene places a link's body, and numbered as that scene num
 (:func:`~sensorium.server.sim.scene.robot_bodies`): every ray of a copy meets its own links, a ray blind to
 its robot (``exclude_owner``) its robot's links too (every copy's lidar beams meeting a link: one C
 pass for all copies, each copy's packed as its own lidar's); a robot's lights riding a joint are placed in each
-copy on its link (batched_lights.py). Refused (BatchedError, one line): a plane, textured shape or
+copy on its link (batched_lights.py). A distance sensor riding a link with shapes is mounted on that
+link's template body (its hits on it made once from its mount, as DistanceBatch's own-body hits); the
+other devices riding one meet it in the copies' cast, through the world's frame as the single ones do.
+Refused (BatchedError, one line): a plane, textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
-runs (its footprint would not follow the joint), a device that sees its own robot riding a link with
-shapes (lidars, cameras, range finders, infra-red sensors; distance and light sensors with self-collision);
+runs (its footprint would not follow the joint), a lidar, camera or range finder with shapes of its own
+riding a link with shapes (the single device meets that link once from its mount, blind to them);
 other devices on a joint, steered drives with free
 wheels and belts.
 
@@ -504,15 +507,15 @@ class BatchedSimulation:
                 joint = getattr(d, "on_joint", None)
                 if joint is None:
                     continue
-                # a device that sees its own robot, on a link with shapes: the single simulation meets that
-                # link from the device's frame (its mount). A distance sensor's own-body hits are made
-                # so here too (on the link's template body); a lidar's beams (Mount(own=True) on the
-                # link) move into its frame by the world's round trip there as here; a light sensor's
-                # rays are mounted on nothing in either (tests/test_batched_links.py). A lidar with
-                # shapes of its own meets its link once from its mount, blind to them; cameras and
-                # range finders from their mount: refused
-                housed = d.device == "Lidar" and any(d.name in blind_devices(x) for x in r.shapes)
-                if joint in shaped and (d.device in ("Camera", "RangeFinder") or housed):
+                # a device that sees its own robot, on a link with shapes: the single distance sensor meets
+                # that link from its frame (its mount), as it does here (on the link's template body); a
+                # lidar's beams (Mount(own=True) on the link) and a camera's or range finder's pixels
+                # (Riding) move into its frame by the world's round trip there as here; a light sensor's
+                # rays are mounted on nothing in either (tests/test_batched_links.py). One with shapes of
+                # its own meets its link once from its mount, blind to them: refused
+                housed = d.device in ("Lidar", "Camera", "RangeFinder") and any(d.name in blind_devices(x)
+                                                                                for x in r.shapes)
+                if joint in shaped and housed:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
                                        f"{joint!r}, whose link has shapes it sees; the batched simulation casts no "
                                        "camera, range finder or lidar with shapes of its own from a link with shapes "

@@ -200,8 +200,9 @@ class PixelDevices:
         """The slot a device's pixel rays are never paired with in the world cast: its robot's, for
         a device with shapes of its own (that body is met apart, in the body frame: ``own``), else per
         pixel its robot's where the ray can never meet that body, -1 where it may (it sees its robot).
-        A device riding a joint (on a link without shapes: mounted on no body, as the single
-        device's ``device_body`` is None) turns in the body frame: every ray may meet its robot."""
+        A device riding a joint turns in the body frame: every ray may meet its robot (on a link
+        without shapes the single device is mounted on no body; on one with shapes its rays ride
+        that link, meeting it through the world's frame as any ray does: ``Riding``)."""
         dev = self.devices[col]
         if dev.skip is None and (self.kind, col) in self.sim.joints.riders:
             dev.skip = -1
