@@ -57,11 +57,13 @@ there as Simulation's scene places a link's body, and numbered as that scene num
 its robot (``exclude_owner``) its robot's links too (every copy's lidar beams meeting a link: one C
 pass for all copies, each copy's packed as its own lidar's); a robot's lights riding a joint are placed in each
 copy on its link (batched_lights.py). A distance sensor riding a link with shapes is mounted on that
-link's template body (its hits on it made once from its mount, as DistanceBatch's own-body hits); the
-other devices riding one meet it in the copies' cast, through the world's frame as the single ones do.
+link's template body (its hits on it made once from its mount, as DistanceBatch's own-body hits), and
+so is a lidar with shapes of its own (its hits on it made once from its mount, blind to them, as
+Lidar._own_distances); the other devices riding one meet it in the copies' cast, through the world's
+frame as the single ones do.
 Refused (BatchedError, one line): a plane, textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
-runs (its footprint would not follow the joint), a lidar, camera or range finder with shapes of its own
+runs (its footprint would not follow the joint), a camera or range finder with shapes of its own
 riding a link with shapes (the single device meets that link once from its mount, blind to them);
 other devices on a joint, steered drives with free
 wheels and belts.
@@ -511,14 +513,14 @@ class BatchedSimulation:
                 # that link from its frame (its mount), as it does here (on the link's template body); a
                 # lidar's beams (Mount(own=True) on the link) and a camera's or range finder's pixels
                 # (Riding) move into its frame by the world's round trip there as here; a light sensor's
-                # rays are mounted on nothing in either (tests/test_batched_links.py). One with shapes of
-                # its own meets its link once from its mount, blind to them: refused
-                housed = d.device in ("Lidar", "Camera", "RangeFinder") and any(d.name in blind_devices(x)
-                                                                                for x in r.shapes)
+                # rays are mounted on nothing in either; a lidar with shapes of its own meets its link
+                # once from its mount, blind to them, in both (tests/test_batched_links.py). A camera
+                # or range finder with shapes of its own does too there (OwnBodyRays): refused
+                housed = d.device in ("Camera", "RangeFinder") and any(d.name in blind_devices(x) for x in r.shapes)
                 if joint in shaped and housed:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
                                        f"{joint!r}, whose link has shapes it sees; the batched simulation casts no "
-                                       "camera, range finder or lidar with shapes of its own from a link with shapes "
+                                       "camera or range finder with shapes of its own from a link with shapes "
                                        "(use Simulation)")
                 if d.device not in batched_joints.RIDING_KINDS:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
@@ -579,8 +581,13 @@ class BatchedSimulation:
                     # light sensor's occlusion rays are mounted on nothing in either; each copy's
                     # local pose is the joints' (batched_joints.py)
                     dev.move_with(Pose.identity())
+                    link = self._link_body.get((slot, dev.on_joint))
                     if d.device == "DistanceSensor":   # on a link with shapes: mounted on it, as Simulation's
-                        dev.link_body = self._link_body.get((slot, dev.on_joint))
+                        dev.link_body = link
+                    elif d.device == "Lidar" and dev.own_shapes and link is not None:
+                        # its beams meet its link once, in the link's frame from its mount, blind to its
+                        # own shapes (Lidar._own_distances, on the movers' engine), the cast skipping it
+                        dev._own_body = (_OnEngine(self.rays.movers), link, None)
                     self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose, dev.local_pose)
                 elif d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
                     # its beams meet its own robot's body once, in the body frame, blind to its own
@@ -1875,13 +1882,19 @@ class BatchedSimulation:
         ray_copy = np.repeat(copies, W)
         skip = self._lidar_skip(col)
         if lid._own_body is not None:
-            mount: np.ndarray | int = lid.robot_index
+            mount: np.ndarray | int = self.own_body_slot(lid)
         elif len(skip) and (skip == skip[0]).all():   # every beam alike: one value (the pairing skips the
             mount = int(skip[0])                       # slot without reading a value per ray)
         else:
             mount = np.tile(skip, len(copies))
         self._lidar_plan[col] = (copies.copy(), ray_copy, mount)
         return ray_copy, mount
+
+    def own_body_slot(self, lid: Lidar) -> int:
+        """The slot of the body a lidar with shapes of its own meets apart (``_own_body``): its
+        robot's, or the link's it rides."""
+        assert lid._own_body is not None
+        return self.rays.slot_body.index(lid._own_body[1])
 
     def _lidar_skip(self, col: int) -> np.ndarray:
         """Per beam: the lidar's own robot slot where the beam can never meet that robot's body
