@@ -10,7 +10,7 @@ own random joint commands, reads bit for bit what Simulation built with that cop
 Closed form: the bar swung by a (2.6 deg < a < 9.5 deg) shows its side face to a sensor on its
 pivot's axis at 0.025 / sin(a) from the pivot; a light on the swing lights a sensor by 1/d² from
 where each copy's joint holds it. A camera recognises the arm with its links where each copy holds
-them. Distance sensors, a light sensor, lidars (two in domes of their own), a camera and a range finder
+them. Distance sensors, a light sensor, lidars, cameras and range finders (some in domes of their own)
 riding the swing see its bar as their Simulation does (closed form: the bar's top face below them at 0.05 / sin of a ray's
 pitch). What the copies cannot follow is refused in one line."""
 
@@ -247,20 +247,10 @@ def test_a_light_on_a_link_lights_a_sensor_from_where_its_copy_holds_it():
 @pytest.mark.parametrize("world, message", [
     (lambda: _changed(lambda r: None, contact=True), "robot 'arm': shape 'bar' rides joint 'swing' and bounds the "
      "robot; the batched simulation's kinematic contact does not follow a link"),
-    (lambda: _changed(lambda r: (r["devices"].append(
-        {"device": "RangeFinder", "name": "arm rf", "on_joint": "swing", "pose": {"translation": [0.3, 0, 0.25]}}),
-        r["shapes"].append({"name": "housing", "of_device": "arm rf", "on_joint": "swing",
-                            "pose": {"translation": [0.3, 0, 0.25]}, "geometry": {"type": "sphere", "radius": 0.01}}))),
-     "robot 'arm': RangeFinder 'arm rf' rides joint 'swing', whose link has shapes it sees"),
-    (lambda: _changed(lambda r: (r["devices"].append(
-        {"device": "Camera", "name": "tip cam", "on_joint": "swing", "pose": {"translation": [0.56, 0, 0.2]}}),
-        r["shapes"].append({"name": "lens", "of_device": "tip cam", "on_joint": "swing",
-                            "pose": {"translation": [0.56, 0, 0.2]}, "geometry": {"type": "sphere", "radius": 0.01}}))),
-     "robot 'arm': Camera 'tip cam' rides joint 'swing', whose link has shapes it sees"),
     (lambda: _changed(lambda r: r["shapes"].append(
         {"name": "slab", "on_joint": "swing", "geometry": {"type": "plane", "size": [1, 1]}})),
      "robot 'arm': shape 'slab' rides joint 'swing'; the batched simulation moves no plane on a link"),
-], ids=["bounding link with contact", "housed range finder on its link", "housed camera on its link", "plane on a link"])
+], ids=["bounding link with contact", "plane on a link"])
 def test_what_a_link_cannot_carry_here_is_refused_in_one_line(world, message):
     with pytest.raises(BatchedError, match=re.escape(message)):
         BatchedSimulation(world(), 2)
@@ -377,14 +367,28 @@ HOUSED = [{"device": "Lidar", "name": "housed", "on_joint": "swing", "pose": {"t
           {"device": "Lidar", "name": "housed sweep", "type": "rotating", "on_joint": "swing", "default_frequency": 7.0,
            "pose": {"translation": [0.4, 0, 0.25]}, "horizontal_resolution": 48, "field_of_view": 2 * math.pi,
            "number_of_layers": 3, "vertical_field_of_view": 1.2, "min_range": 0.02, "max_range": 2.5, "noise": 0.01}]
-DOMES = [{"name": f"dome {k}", "of_device": d["name"], "on_joint": "swing", "pose": d["pose"],
-          "geometry": {"type": "sphere", "radius": 0.03}, "appearance": {"base_color": [0.5, 0.5, 0.5]}}
-         for k, d in enumerate(HOUSED)]
-RECOGNISING = {"tip cam"}
+# a recognising camera beside the bar looking at its side face (its normal turned by the swing) and a
+# range finder looking down on it, each in a hood of its own it does not see
+HOUSED_PIXELS = [{"device": "Camera", "name": "housed cam", "on_joint": "swing", "width": 24, "height": 16,
+                  "field_of_view": 1.4, "noise": 0.02, "recognition": {"segmentation": True, "max_range": 3.0},
+                  "pose": {"translation": [0.35, 0.12, 0.22], "rotation": [0, 0, 1, -math.pi / 2]}},
+                 {"device": "RangeFinder", "name": "housed rf", "on_joint": "swing", "width": 20, "height": 12,
+                  "field_of_view": 1.3, "max_range": 3.0, "pose": {"translation": [0.35, 0, 0.28], "rotation": [0, 1, 0, 0.5]}}]
+
+
+def _domes(devices: list[dict]) -> list[dict]:
+    """A sphere of radius 0.03 around each device, its own (``of_device``), riding the swing."""
+    return [{"name": f"dome of {d['name']}", "of_device": d["name"], "on_joint": "swing", "pose": d["pose"],
+             "geometry": {"type": "sphere", "radius": 0.03}, "appearance": {"base_color": [0.5, 0.5, 0.5]}}
+            for d in devices]
+
+
+RECOGNISING = {"tip cam", "housed cam"}
 STEADY = {"tip ds", "tip fan"}     # their rays meet the bar below them whatever the swing: one reading
-RIDERS = {"sensors": (TIP, [], ["tip ds", "tip ir", "tip sonar", "tip fan", "tip ls", "tip lidar", "tip sweep", "own ds"]),
+RIDERS = {"sensors": (TIP, _domes(TIP[1:2]), ["tip ds", "tip ir", "tip sonar", "tip fan", "tip ls", "tip lidar", "tip sweep", "own ds"]),
           "pixels": (TIP_PIXELS, [], ["tip cam", "tip rf", "own cam"]),
-          "housed lidars": (HOUSED, DOMES, ["housed", "housed sweep", "own lidar"])}
+          "housed lidars": (HOUSED, _domes(HOUSED), ["housed", "housed sweep", "own lidar"]),
+          "housed pixels": (HOUSED_PIXELS, _domes(HOUSED_PIXELS), ["housed cam", "housed rf"])}
 
 
 def _riders_world(seed: int, case: str, lidar_noise: bool = True):
@@ -413,14 +417,14 @@ def _riders_single(seed: int, case: str, precision: str) -> Simulation:
 @pytest.mark.parametrize("case", list(RIDERS))
 def test_devices_riding_a_link_see_its_shapes_as_their_simulation_bit_for_bit(case, precision):
     """Devices riding the swing, which they see (its bar below them, the hand on the wrist beyond):
-    distance sensors (generic, 3-ray, infra-red, sonar), a light sensor, a noisy fixed and a rotating
+    distance sensors (generic, 3-ray, infra-red in a dome of its own, sonar), a light sensor, a noisy fixed and a rotating
     lidar; a noisy recognising camera and a range finder; a fixed and a noisy rotating lidar in domes
-    of their own. Three copies with their own random swings and wrists, copy 2 reset at step 110
+    of their own; a recognising camera (seeing the bar's side) and a range finder in domes of their own. Three copies with their own random swings and wrists, copy 2 reset at step 110
     against a fresh Simulation, 200 steps: every reading (value, image, range image, recognised
     objects, segmentation image) the same bits as the copy's Simulation. (A distance sensor's hits on
     its own link are made from its mount, as the single simulation's: met from the world's frame
-    instead, EXACT readings differ in the last bits; the sonar's echo reads the hit's normal, turned by
-    the copy's link.) The sensors whose rays all meet the bar read one value throughout, the range
+    instead, EXACT readings differ in the last bits; the sonar's echo and the housed camera's shading read
+    the hit's normal, turned by the copy's link: unturned, the camera's images differ.) The sensors whose rays all meet the bar read one value throughout, the range
     finder's and the housed lidar's nearest ranges too (the bar, or the other lidar's dome, never its
     own); every other reading changes as the arm moves."""
     seeds = (3, 4, 5)
@@ -477,10 +481,10 @@ def test_devices_riding_a_link_see_its_shapes_as_their_simulation_bit_for_bit(ca
                     objects_seen += len(objects)
     counts = {name: len(v) for name, v in readings.items()}
     assert all(counts[name] == 1 if name in STEADY else counts[name] > 10 for name in names), counts
-    for name in ("tip rf", "housed"):   # the bar below it, or the other lidar's dome: never its own (0.03)
+    for name in ("tip rf", "housed", "housed rf"):   # the bar below it, or the other lidar's dome: never its own
         if name in nearest:
             assert len(nearest[name]) == 1 and min(nearest[name]) > 0.06, (name, nearest[name])
-    assert case != "pixels" or objects_seen > 0
+    assert "pixels" not in case or objects_seen > 0
 
 
 def test_sensors_riding_a_link_read_its_shape_at_the_closed_form_distance_in_every_copy():

@@ -58,14 +58,13 @@ its robot (``exclude_owner``) its robot's links too (every copy's lidar beams me
 pass for all copies, each copy's packed as its own lidar's); a robot's lights riding a joint are placed in each
 copy on its link (batched_lights.py). A distance sensor riding a link with shapes is mounted on that
 link's template body (its hits on it made once from its mount, as DistanceBatch's own-body hits), and
-so is a lidar with shapes of its own (its hits on it made once from its mount, blind to them, as
-Lidar._own_distances); the other devices riding one meet it in the copies' cast, through the world's
-frame as the single ones do.
+so is a lidar, camera or range finder with shapes of its own (its hits on it made once from its mount,
+blind to them, as Lidar._own_distances and OwnBodyRays; a hit's normal turned by the copy's robot and
+link); the other devices riding one meet it in the copies' cast, through the world's frame as the
+single ones do.
 Refused (BatchedError, one line): a plane, textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
-runs (its footprint would not follow the joint), a camera or range finder with shapes of its own
-riding a link with shapes (the single device meets that link once from its mount, blind to them);
-other devices on a joint, steered drives with free
+runs (its footprint would not follow the joint); other devices on a joint, steered drives with free
 wheels and belts.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
@@ -504,24 +503,13 @@ class BatchedSimulation:
                 if why:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {what} rides joint {x.on_joint!r}; "
                                        f"the batched simulation moves no {why} (use Simulation)")
-            shaped = {x.on_joint for x in r.shapes if x.on_joint is not None}
+            # a device riding a link with shapes meets it as the single one does: a distance sensor, or
+            # one with shapes of its own, from its mount (on the link's template body), the others
+            # through the world's frame (a lidar's Mount, a camera's Riding: the same products)
             for d in r.devices:
                 joint = getattr(d, "on_joint", None)
                 if joint is None:
                     continue
-                # a device that sees its own robot, on a link with shapes: the single distance sensor meets
-                # that link from its frame (its mount), as it does here (on the link's template body); a
-                # lidar's beams (Mount(own=True) on the link) and a camera's or range finder's pixels
-                # (Riding) move into its frame by the world's round trip there as here; a light sensor's
-                # rays are mounted on nothing in either; a lidar with shapes of its own meets its link
-                # once from its mount, blind to them, in both (tests/test_batched_links.py). A camera
-                # or range finder with shapes of its own does too there (OwnBodyRays): refused
-                housed = d.device in ("Camera", "RangeFinder") and any(d.name in blind_devices(x) for x in r.shapes)
-                if joint in shaped and housed:
-                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
-                                       f"{joint!r}, whose link has shapes it sees; the batched simulation casts no "
-                                       "camera or range finder with shapes of its own from a link with shapes "
-                                       "(use Simulation)")
                 if d.device not in batched_joints.RIDING_KINDS:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
                                        f"{joint!r}; the batched simulation moves distance sensors, light sensors, "
@@ -1882,7 +1870,7 @@ class BatchedSimulation:
         ray_copy = np.repeat(copies, W)
         skip = self._lidar_skip(col)
         if lid._own_body is not None:
-            mount: np.ndarray | int = self.own_body_slot(lid)
+            mount: np.ndarray | int = self.slot_of_body(lid._own_body[1])
         elif len(skip) and (skip == skip[0]).all():   # every beam alike: one value (the pairing skips the
             mount = int(skip[0])                       # slot without reading a value per ray)
         else:
@@ -1890,11 +1878,11 @@ class BatchedSimulation:
         self._lidar_plan[col] = (copies.copy(), ray_copy, mount)
         return ray_copy, mount
 
-    def own_body_slot(self, lid: Lidar) -> int:
-        """The slot of the body a lidar with shapes of its own meets apart (``_own_body``): its
-        robot's, or the link's it rides."""
-        assert lid._own_body is not None
-        return self.rays.slot_body.index(lid._own_body[1])
+    def slot_of_body(self, body: int) -> int:
+        """The slot of a template body (a robot's, or a link's): the slot the rays of a device
+        meeting that body apart skip in the cast (a housed lidar's ``_own_body``, a housed camera's
+        ``own``)."""
+        return self.rays.slot_body.index(body)
 
     def _lidar_skip(self, col: int) -> np.ndarray:
         """Per beam: the lidar's own robot slot where the beam can never meet that robot's body

@@ -136,7 +136,7 @@ class RotatingLidars:
             t_far = np.concatenate([sectors[int(g)].t_far for g in group.tolist()])
         mount: np.ndarray | int
         if lid._own_body is not None:   # its robot's body (or link) met apart, in the body frame (finish)
-            mount = sim.own_body_slot(lid)
+            mount = sim.slot_of_body(lid._own_body[1])
         elif all(isinstance(sectors[int(g)].skip, int) for g in group.tolist()) and \
                 len({sectors[int(g)].skip for g in group.tolist()}) == 1:
             mount = sectors[int(group[0])].skip   # type: ignore[assignment]
