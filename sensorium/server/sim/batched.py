@@ -326,7 +326,7 @@ class BatchedSimulation:
                 raise BatchedError(f"threads must be >= 1, got {threads}")
             self.scene.engine.threads = movers.threads = int(threads)
         self.link_slots = link_slots
-        self._link_body = {(i, joint): body for i, joint, body in link_slots}   # (robot slot, joint) -> body
+        self.link_bodies = {(i, joint): body for i, joint, body in link_slots}   # (robot slot, joint) -> body
         self._link_cols: tuple[np.ndarray, np.ndarray] | None = None   # (robot slot, joint column) per link
         self.rays = CopyRays(self.scene.engine, movers, slot_body + [b for _, _, b in link_slots], n_static,
                              owner=[*range(R), *(i for i, _, _ in link_slots)],
@@ -569,7 +569,7 @@ class BatchedSimulation:
                     # light sensor's occlusion rays are mounted on nothing in either; each copy's
                     # local pose is the joints' (batched_joints.py)
                     dev.move_with(Pose.identity())
-                    link = self._link_body.get((slot, dev.on_joint))
+                    link = self.link_bodies.get((slot, dev.on_joint))
                     if d.device == "DistanceSensor":   # on a link with shapes: mounted on it, as Simulation's
                         dev.link_body = link
                     elif d.device == "Lidar" and dev.own_shapes and link is not None:

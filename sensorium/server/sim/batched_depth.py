@@ -209,7 +209,7 @@ class PixelDevices:
         rider = self.sim.joints.riders.get((self.kind, col))
         if dev.skip is None and rider is not None:
             tpl = dev.template
-            link = self.sim._link_body.get((rider[0], rider[1]))
+            link = self.sim.link_bodies.get((rider[0], rider[1]))
             if tpl.own_shapes and link is not None:   # (its mount: its pose in the link's frame)
                 dev.own = OwnBodyRays(link, tpl.mount_pose, dev.dirs, *dev.limits, tpl.own_shapes)
                 dev.own_joint = self.sim.joints.of(rider[0], rider[1])
