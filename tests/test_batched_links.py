@@ -11,7 +11,7 @@ Closed form: the bar swung by a (2.6 deg < a < 9.5 deg) shows its side face to a
 pivot's axis at 0.025 / sin(a) from the pivot; a light on the swing lights a sensor by 1/d² from
 where each copy's joint holds it. A camera recognises the arm with its links where each copy holds
 them. Distance sensors, a light sensor, lidars, cameras and range finders (some in domes of their own)
-riding the swing see its bar as their Simulation does (closed form: the bar's top face below them at 0.05 / sin of a ray's
+riding the swing see its bar (and planes riding the links) as their Simulation does (closed form: the bar's top face below them at 0.05 / sin of a ray's
 pitch). What the copies cannot follow is refused in one line."""
 
 from __future__ import annotations
@@ -247,10 +247,11 @@ def test_a_light_on_a_link_lights_a_sensor_from_where_its_copy_holds_it():
 @pytest.mark.parametrize("world, message", [
     (lambda: _changed(lambda r: None, contact=True), "robot 'arm': shape 'bar' rides joint 'swing' and bounds the "
      "robot; the batched simulation's kinematic contact does not follow a link"),
-    (lambda: _changed(lambda r: r["shapes"].append(
-        {"name": "slab", "on_joint": "swing", "geometry": {"type": "plane", "size": [1, 1]}})),
-     "robot 'arm': shape 'slab' rides joint 'swing'; the batched simulation moves no plane on a link"),
-], ids=["bounding link with contact", "plane on a link"])
+    (lambda: _changed(lambda r: (r["devices"].append({"device": "TouchSensor", "name": "bump", "on_joint": "swing"}),
+                                 r["shapes"].append({"name": "pad", "of_device": "bump", "on_joint": "swing",
+                                                     "geometry": {"type": "box", "size": [0.02, 0.1, 0.05]}}))),
+     "robot 'arm': shape 'pad' of 'bump' rides joint 'swing'; the batched simulation moves no bumper's shapes on a link"),
+], ids=["bounding link with contact", "bumper's shapes on a link"])
 def test_what_a_link_cannot_carry_here_is_refused_in_one_line(world, message):
     with pytest.raises(BatchedError, match=re.escape(message)):
         BatchedSimulation(world(), 2)
@@ -383,29 +384,54 @@ def _domes(devices: list[dict]) -> list[dict]:
             for d in devices]
 
 
+# planes on links: a panel on the swing (facing the watcher; a distance sensor riding the swing meets
+# its back, and a lidar its edge-on sides), and one on the watcher's flag, facing its sensors: blind to
+# their robot, its generic sensors never see it (as bounding rays, an infinite plane), its infra-red
+# sensor, lidar and camera do
+PANELS = [{"device": "DistanceSensor", "name": "panel ds", "on_joint": "swing", "pose": {"translation": [0.3, 0, 0.25]},
+           "lookup_table": [[0, 0, 0], [2.0, 2.0, 0]]},
+          {"device": "Lidar", "name": "panel lidar", "on_joint": "swing", "pose": {"translation": [0.3, 0, 0.3]},
+           "horizontal_resolution": 64, "field_of_view": 2 * math.pi, "number_of_layers": 2,
+           "vertical_field_of_view": 0.4, "min_range": 0.02, "max_range": 2.5}]
+PANEL_SHAPES = {0: [{"name": "panel", "on_joint": "swing", "geometry": {"type": "plane", "size": [0.2, 0.3]},
+                     "pose": {"translation": [0.45, 0, 0.25], "rotation": [0, 1, 0, math.pi / 2]},
+                     "appearance": {"base_color": [0.3, 0.3, 0.3]}}],
+                1: [{"name": "flag panel", "on_joint": "flag pan", "geometry": {"type": "plane", "size": [0.1, 0.1]},
+                     "pose": {"translation": [0.145, 0, 0.15], "rotation": [0, 1, 0, -math.pi / 2]},
+                     "appearance": {"base_color": [0.3, 0.3, 0.3]}}]}
 RECOGNISING = {"tip cam", "housed cam"}
 STEADY = {"tip ds", "tip fan"}     # their rays meet the bar below them whatever the swing: one reading
-RIDERS = {"sensors": (TIP, _domes(TIP[1:2]), ["tip ds", "tip ir", "tip sonar", "tip fan", "tip ls", "tip lidar", "tip sweep", "own ds"]),
-          "pixels": (TIP_PIXELS, [], ["tip cam", "tip rf", "own cam"]),
-          "housed lidars": (HOUSED, _domes(HOUSED), ["housed", "housed sweep", "own lidar"]),
-          "housed pixels": (HOUSED_PIXELS, _domes(HOUSED_PIXELS), ["housed cam", "housed rf"])}
+RIDERS = {"sensors": (TIP, {0: _domes(TIP[1:2])}, ["tip ds", "tip ir", "tip sonar", "tip fan", "tip ls", "tip lidar", "tip sweep", "own ds"]),
+          "pixels": (TIP_PIXELS, {}, ["tip cam", "tip rf", "own cam"]),
+          "housed lidars": (HOUSED, {0: _domes(HOUSED)}, ["housed", "housed sweep", "own lidar"]),
+          "housed pixels": (HOUSED_PIXELS, {0: _domes(HOUSED_PIXELS)}, ["housed cam", "housed rf"]),
+          "planes": (PANELS, PANEL_SHAPES, ["panel ds", "panel lidar", "own ds", "own lidar", "own cam", "watcher/ds",
+                                            "watcher/noisy ds", "watcher/ir", "watcher/lidar", "watcher/cam", "watcher/rf"])}
+
+
+def _at(entry: str) -> tuple[str, str]:
+    """(robot, device) of a RIDERS entry: ``robot/device``, or a device of the arm."""
+    robot, _, name = entry.rpartition("/")
+    return robot or "arm", name
 
 
 def _riders_world(seed: int, case: str, lidar_noise: bool = True):
-    """The arm world (no lights on the arm) with ``case``'s devices and shapes on the arm; the watcher
-    recognisable."""
+    """The arm world (no lights on the arm) with ``case``'s devices on the arm and shapes on its robots;
+    the watcher recognisable."""
     devices, shapes, _ = RIDERS[case]
     w = arm_world(seed, lights=False).world.model_dump(mode="json", exclude_defaults=True)
     w["robots"][0]["devices"] += [d if lidar_noise or d["device"] != "Lidar" else {**d, "noise": 0.0} for d in devices]
-    w["robots"][0]["shapes"] += shapes
+    for robot, more in shapes.items():
+        w["robots"][robot]["shapes"] += more
     w["robots"][1]["recognition_colors"] = [[0.2, 0.2, 0.9]]
     return parse_world(w)
 
 
 def _riders_single(seed: int, case: str, precision: str) -> Simulation:
     sim = Simulation(_riders_world(seed, case).world, precision=precision)
-    for name in RIDERS[case][2]:
-        dev = sim.device(f"arm/{name}")
+    for entry in RIDERS[case][2]:
+        robot, name = _at(entry)
+        dev = sim.device(f"{robot}/{name}")
         dev.enable(STEP)
         if name in RECOGNISING:
             dev.recognition_enable(STEP)
@@ -419,7 +445,8 @@ def test_devices_riding_a_link_see_its_shapes_as_their_simulation_bit_for_bit(ca
     """Devices riding the swing, which they see (its bar below them, the hand on the wrist beyond):
     distance sensors (generic, 3-ray, infra-red in a dome of its own, sonar), a light sensor, a noisy fixed and a rotating
     lidar; a noisy recognising camera and a range finder; a fixed and a noisy rotating lidar in domes
-    of their own; a recognising camera (seeing the bar's side) and a range finder in domes of their own. Three copies with their own random swings and wrists, copy 2 reset at step 110
+    of their own; a recognising camera (seeing the bar's side) and a range finder in domes of their own;
+    planes on the swing and on the watcher's flag (PANELS), seen or not by both robots' devices. Three copies with their own random swings and wrists, copy 2 reset at step 110
     against a fresh Simulation, 200 steps: every reading (value, image, range image, recognised
     objects, segmentation image) the same bits as the copy's Simulation. (A distance sensor's hits on
     its own link are made from its mount, as the single simulation's: met from the world's frame
@@ -432,7 +459,7 @@ def test_devices_riding_a_link_see_its_shapes_as_their_simulation_bit_for_bit(ca
     names = RIDERS[case][2]
     batched = BatchedSimulation(_riders_world(seeds[0], case), n, precision=precision)
     batched.reset(np.arange(n), list(seeds))
-    refs = {name: batched.device("arm", name) for name in names}
+    refs = {name: batched.device(*_at(name)) for name in names}
 
     def enable(copies=None):
         for name, ref in refs.items():
@@ -468,13 +495,13 @@ def test_devices_riding_a_link_see_its_shapes_as_their_simulation_bit_for_bit(ca
                 got = batched.joints.position[c, batched.joints.of(arm, name)]
                 assert got.tobytes() == np.float64(s.robot("arm").joints[name].position).tobytes(), (t, c, name)
             for name, ref in refs.items():
-                got, want = _reading(batched, s, c, "arm", name)
+                got, want = _reading(batched, s, c, *_at(name))
                 assert got == want, (t, c, name)
                 readings[name].add(got)
                 if ref.kind in ("Lidar", "RangeFinder") and t >= 20:   # (a rotating head swept once by then)
                     nearest[name].add(float(batched.range_image(ref)[c].min()))
                 if name in RECOGNISING:
-                    dev = s.device(f"arm/{name}")
+                    dev = s.device("{}/{}".format(*_at(name)))
                     objects = batched.recognition_objects(ref, c)
                     assert objects == dev.objects and repr(objects) == repr(dev.objects), (t, c)
                     assert batched.segmentation_image(ref)[c].tobytes() == dev.segmentation_image.tobytes(), (t, c)

@@ -62,7 +62,7 @@ so is a lidar, camera or range finder with shapes of its own (its hits on it mad
 blind to them, as Lidar._own_distances and OwnBodyRays; a hit's normal turned by the copy's robot and
 link); the other devices riding one meet it in the copies' cast, through the world's frame as the
 single ones do.
-Refused (BatchedError, one line): a plane, textured shape or
+Refused (BatchedError, one line): a textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
 runs (its footprint would not follow the joint); other devices on a joint, steered drives with free
 wheels and belts.
@@ -497,7 +497,6 @@ class BatchedSimulation:
                                                                             else "")
                 why = ("bumper's shapes on a link (its contact does not follow the joint here)"
                        if x.of_device in bumpers else
-                       "plane on a link" if isinstance(x.geometry, wm.Plane) else
                        "textured shape on a link" if textured_robot(r.model_copy(update={"body": None, "shapes": [x]}))
                        else None)
                 if why:
