@@ -7,7 +7,7 @@ light sensor, a range finder and a camera,
 coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
 copy). Closed form: a pan turned a quarter makes its sensor read the side wall, and its light
 sensor face a lamp; a range finder turned back on its pan sees its own robot. What is not
-simulated is refused in one line (a plane on a link, a bumper's shapes on one; an LED on a joint;
+simulated is refused in one line (a bumper's shapes on a link; an LED on a joint;
 a link's shapes and lights themselves: tests/test_batched_links.py).
 A bumper on a joint without shapes reads its robot's contact, as in Simulation."""
 
