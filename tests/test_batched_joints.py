@@ -7,7 +7,7 @@ light sensor, a range finder and a camera,
 coupled motors with a multiplier; random position, velocity, acceleration and torque commands per
 copy). Closed form: a pan turned a quarter makes its sensor read the side wall, and its light
 sensor face a lamp; a range finder turned back on its pan sees its own robot. What is not
-simulated is refused in one line (a plane on a link, a bumper's shapes on one; an LED on a joint;
+simulated is refused in one line (a bumper's shapes on a link; an LED on a joint;
 a link's shapes and lights themselves: tests/test_batched_links.py).
 A bumper on a joint without shapes reads its robot's contact, as in Simulation."""
 
@@ -384,9 +384,6 @@ def test_a_range_finder_turned_back_on_its_pan_sees_its_own_robot():
 
 
 @pytest.mark.parametrize("change, message", [
-    (lambda r: r.setdefault("shapes", []).append(
-        {"name": "slab", "on_joint": "lift motor", "geometry": {"type": "plane", "size": [1, 1]}}),
-     "robot 'lift': shape 'slab' rides joint 'lift motor'; the batched simulation moves no plane on a link"),
     (lambda r: (r["devices"].append({"device": "TouchSensor", "name": "bump", "on_joint": "tilt"}),
                 r.setdefault("shapes", []).append({"name": "pad", "of_device": "bump", "on_joint": "tilt",
                                                    "geometry": {"type": "box", "size": [0.02, 0.1, 0.05]}})),
@@ -396,7 +393,7 @@ def test_a_range_finder_turned_back_on_its_pan_sees_its_own_robot():
      "robot 'lift': LED 'lamp' rides joint 'tilt'; the batched simulation moves distance sensors, light "
      "sensors, cameras, range finders, lidars, GPS, compasses, inertial units, gyros, accelerometers, "
      "altimeters and bumpers without shapes on joints only"),
-], ids=["plane on a link", "bumper with shapes", "LED"])
+], ids=["bumper with shapes", "LED"])
 def test_what_rides_a_joint_and_is_not_simulated_is_refused_in_one_line(change, message):
     lift = lift_robot()
     change(lift)

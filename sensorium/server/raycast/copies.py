@@ -14,7 +14,7 @@ One :meth:`CopyRays.cast` covers every copy's rays of one ray kind:
 
 * the robots' planes first (the template bodies' ``plane`` parts, analytic, never in a tier): each ray
   against its own copy's, each plane at that copy's pose as the single world composes it, with that
-  world's float64 plane arithmetic (:func:`.planes.plane_terms`), its excluded slot's planes left out
+  world's float64 plane arithmetic (:func:`.planes.plane_terms`), its excluded slot's planes (its links' too) left out
   (a mount does not hide them: the single world casts planes with every ray); the static pass then
   goes only up to a ray's robot-plane hit, as that world's tiers go only up to its planes' hits, and
   a robot's plane wins a tie with a static tier's hit, never with a static plane (ordered first);
@@ -302,6 +302,7 @@ class CopyRays:
             return None
         pl, slots = got
         world = self._plane_poses(pl, slots, rot, pos)
+        owners = self.owner[slots]          # (a link's planes: its robot's, which an excluded slot hides)
         copy = np.asarray(copy, dtype=np.int64).reshape(n)
         big = max(float(O.max()), -float(O.min()))
         eps64 = 1e-9 + 1e-14 * big          # the engine's float64 self-hit threshold for this cast
@@ -317,7 +318,7 @@ class CopyRays:
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # as the engine's casts
             for a in range(0, n, _CHUNK):
                 sl = slice(a, min(n, a + _CHUNK))
-                got = _plane_block(pl, slots, world, O[sl], D[sl], copy[sl],
+                got = _plane_block(pl, slots, owners, world, O[sl], D[sl], copy[sl],
                                    near[sl, None] if isinstance(near, np.ndarray) else near,
                                    far[sl, None] if isinstance(far, np.ndarray) else far,
                                    excl[sl, None] if isinstance(excl, np.ndarray) else excl, distance_only)
@@ -712,7 +713,8 @@ class CopyRays:
         return keep["job"], keep
 
 
-def _plane_block(pl, slots: np.ndarray, world: tuple, O: np.ndarray, D: np.ndarray, copy: np.ndarray, lo, hi, excl,
+def _plane_block(pl, slots: np.ndarray, owners: np.ndarray, world: tuple, O: np.ndarray, D: np.ndarray, copy: np.ndarray,
+                 lo, hi, excl,
                  distance_only: bool) -> tuple | None:
     """A block of :meth:`CopyRays._robot_plane_pass`: its rays against their copies' planes ``world``
     ((C, K, 3) points, normals, x and y axes), limits ``lo``, ``hi`` and excluded slots ``excl``
@@ -725,7 +727,7 @@ def _plane_block(pl, slots: np.ndarray, world: tuple, O: np.ndarray, D: np.ndarr
     den = (D[:, 0:1] * nz0 + D[:, 1:2] * nz1) + D[:, 2:3] * nz2      # cast_planes' sum, element by element
     ok = den < 0.0 if pl.visual else den != 0.0
     if excl is not None:
-        ok &= slots != excl
+        ok &= owners != excl
     if not np.count_nonzero(ok):
         return None
     pt = PT.take(copy, axis=0)

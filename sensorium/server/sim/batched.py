@@ -56,11 +56,15 @@ there as Simulation's scene places a link's body, and numbered as that scene num
 (:func:`~sensorium.server.sim.scene.robot_bodies`): every ray of a copy meets its own links, a ray blind to
 its robot (``exclude_owner``) its robot's links too (every copy's lidar beams meeting a link: one C
 pass for all copies, each copy's packed as its own lidar's); a robot's lights riding a joint are placed in each
-copy on its link (batched_lights.py). Refused (BatchedError, one line): a plane, textured shape or
+copy on its link (batched_lights.py). A distance sensor riding a link with shapes is mounted on that
+link's template body (its hits on it made once from its mount, as DistanceBatch's own-body hits), and
+so is a lidar, camera or range finder with shapes of its own (its hits on it made once from its mount,
+blind to them, as Lidar._own_distances and OwnBodyRays; a hit's normal turned by the copy's robot and
+link); the other devices riding one meet it in the copies' cast, through the world's frame as the
+single ones do.
+Refused (BatchedError, one line): a textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
-runs (its footprint would not follow the joint), a device that sees its own robot riding a link with
-shapes (lidars, cameras, range finders, infra-red sensors; distance and light sensors with self-collision);
-other devices on a joint, steered drives with free
+runs (its footprint would not follow the joint); other devices on a joint, steered drives with free
 wheels and belts.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
@@ -323,6 +327,7 @@ class BatchedSimulation:
                 raise BatchedError(f"threads must be >= 1, got {threads}")
             self.scene.engine.threads = movers.threads = int(threads)
         self.link_slots = link_slots
+        self.link_bodies = {(i, joint): body for i, joint, body in link_slots}   # (robot slot, joint) -> body
         self._link_cols: tuple[np.ndarray, np.ndarray] | None = None   # (robot slot, joint column) per link
         self.rays = CopyRays(self.scene.engine, movers, slot_body + [b for _, _, b in link_slots], n_static,
                              owner=[*range(R), *(i for i, _, _ in link_slots)],
@@ -504,25 +509,18 @@ class BatchedSimulation:
                                                                             else "")
                 why = ("bumper's shapes on a link (its contact does not follow the joint here)"
                        if x.of_device in bumpers else
-                       "plane on a link" if isinstance(x.geometry, wm.Plane) else
                        "textured shape on a link" if textured_robot(r.model_copy(update={"body": None, "shapes": [x]}))
                        else None)
                 if why:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {what} rides joint {x.on_joint!r}; "
                                        f"the batched simulation moves no {why} (use Simulation)")
-            shaped = {x.on_joint for x in r.shapes if x.on_joint is not None}
+            # a device riding a link with shapes meets it as the single one does: a distance sensor, or
+            # one with shapes of its own, from its mount (on the link's template body), the others
+            # through the world's frame (a lidar's Mount, a camera's Riding: the same products)
             for d in r.devices:
                 joint = getattr(d, "on_joint", None)
                 if joint is None:
                     continue
-                # a device that sees its own robot, on a link with shapes: the single simulation meets that
-                # link from the device's frame (its mount); the copies' casts would meet it from the world's
-                if joint in shaped and (d.device in ("Lidar", "Camera", "RangeFinder") or (
-                        d.device in ("DistanceSensor", "LightSensor") and r.self_collision)
-                        or (d.device == "DistanceSensor" and d.type == "infra-red")):    # (visual rays: see their robot)
-                    raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
-                                       f"{joint!r}, whose link has shapes it sees; the batched simulation casts from "
-                                       "a link with shapes only the rays blind to their own robot (use Simulation)")
                 if d.device not in batched_joints.RIDING_KINDS:
                     raise BatchedError(f"{self.loaded.source}: robot {r.name!r}: {d.device} {d.name!r} rides joint "
                                        f"{joint!r}; the batched simulation moves distance sensors, light sensors, "
@@ -576,11 +574,19 @@ class BatchedSimulation:
                 riding = dev.on_joint is not None and d.device in batched_joints.PLACED_KINDS
                 if riding:
                     # its rays are mounted on no body: on a link without shapes as the single simulation's
-                    # (Scene.device_body is None); on one with shapes only if blind to its robot
-                    # (_check_supported), so its link is never met; a light sensor's occlusion rays
-                    # skip its robot as the single one's do (exclude_self); each copy's local pose is
-                    # the joints' (batched_joints.py)
+                    # (Scene.device_body is None); a distance sensor on one with shapes is mounted on
+                    # that link's template body (its own-body hits made from its mount, as
+                    # DistanceBatch's), a lidar's beams meet it in the cast (_check_supported); a
+                    # light sensor's occlusion rays are mounted on nothing in either; each copy's
+                    # local pose is the joints' (batched_joints.py)
                     dev.move_with(Pose.identity())
+                    link = self.link_bodies.get((slot, dev.on_joint))
+                    if d.device == "DistanceSensor":   # on a link with shapes: mounted on it, as Simulation's
+                        dev.link_body = link
+                    elif d.device == "Lidar" and dev.own_shapes and link is not None:
+                        # its beams meet its link once, in the link's frame from its mount, blind to its
+                        # own shapes (Lidar._own_distances, on the movers' engine), the cast skipping it
+                        dev._own_body = (_OnEngine(self.rays.movers), link, None)
                     self.joints.add_rider(d.device, len(lists[d.device]), slot, dev.on_joint, dev.mount_pose, dev.local_pose)
                 elif d.device == "Lidar" and dev.own_shapes and self.rays.slot_body[slot] is not None:
                     # its beams meet its own robot's body once, in the body frame, blind to its own
@@ -646,6 +652,18 @@ class BatchedSimulation:
         if self.distance:
             bodies = [self.rays.slot_body[s] for s in range(self.R)]
             self._d_plan = DistancePlan(self.distance, bodies)
+            # per engine body (index -1: the last entry, -1): the slot a sensor mounted on it skips in the
+            # cast (its robot's, or its link's: its own-body hits are made apart) and the joint column
+            # turning a link body (-1: a robot's)
+            self._d_mount_slot = np.full(max((b for b in self.rays.slot_body if b is not None), default=0) + 2, -1,
+                                         dtype=np.int64)
+            self._d_link_joint = self._d_mount_slot.copy()
+            for s, b in enumerate(self.rays.slot_body):
+                if b is not None:
+                    self._d_mount_slot[b] = s
+            for i, joint, b in self.link_slots:
+                self._d_link_joint[b] = self.joints.of(i, joint)
+            self._d_on_link = any(d.link_body is not None for d in self.distance)
             self._d_col = {id(d): k for k, d in enumerate(self.distance)}
             self._d_empty = np.array([not d.config.lookup_table for d in self.distance], dtype=bool)
             self._d_slot = np.array([d.robot_index for d in self.distance], dtype=np.int64)
@@ -1670,7 +1688,7 @@ class BatchedSimulation:
             n = g.n
             mount: np.ndarray | int = -1
             if g.mount is not None:
-                mount = np.repeat(np.where(g.mount.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
+                mount = np.repeat(self._d_mount_slot[g.mount.reshape(-1, n)[k, 0]], n)
             exclude = np.repeat(np.where(g.exclude.reshape(-1, n)[k, 0] >= 0, slot, -1), n)
             t_far = g.far_arg if not isinstance(g.far_arg, np.ndarray) else g.t_far.reshape(-1, n)[k].reshape(-1)
             local_rot, local_pos = plan.local_rot, plan.local_pos
@@ -1696,7 +1714,7 @@ class BatchedSimulation:
         for (g, rows, k, c, slot, positions, dirs), h in zip(state["groups"], hits):
             S, n = dirs.shape[:2]
             dist, shape, normal = h.distance, h.shape, h.normal
-            own = g.own_hits(self.rays.movers, plan.local_rot, plan.local_pos) if g.mount is not None else None
+            own = g.own_hits(self.rays.movers, plan.mount_rot, plan.mount_pos) if g.mount is not None else None
             if own is not None:   # the nearer of the cast and the ray's own-body hit (decided once)
                 od, osh, onr = self._own_rows(g, own, k)
                 win = (od < dist).nonzero()[0]
@@ -1705,7 +1723,13 @@ class BatchedSimulation:
                     dist[win] = od[win]
                     shape[win] = np.where(osh[win] >= 0, osh[win] + self.n_static_shapes, -1)
                     rr = np.repeat(np.arange(S), n)[win]
-                    normal[win] = np.einsum("sij,sj->si", self.rot[c[rr], slot[rr]], onr[win])
+                    carrier = self.rot[c[rr], slot[rr]]
+                    if self._d_on_link:   # mounted on a link: its copy's displacement turns it too (DistanceBatch)
+                        joint = self._d_link_joint[g.mount.reshape(-1, n)[k[rr], 0]]
+                        on = (joint >= 0).nonzero()[0]
+                        if len(on):
+                            carrier[on] = carrier[on] @ self.joints.link_rot[c[rr[on]], joint[on]]
+                    normal[win] = np.einsum("sij,sj->si", carrier, onr[win])
             dist = dist.reshape(S, n)
             reflection = None
             if g.kind == RayKind.VISUAL:
@@ -1857,13 +1881,19 @@ class BatchedSimulation:
         ray_copy = np.repeat(copies, W)
         skip = self._lidar_skip(col)
         if lid._own_body is not None:
-            mount: np.ndarray | int = lid.robot_index
+            mount: np.ndarray | int = self.slot_of_body(lid._own_body[1])
         elif len(skip) and (skip == skip[0]).all():   # every beam alike: one value (the pairing skips the
             mount = int(skip[0])                       # slot without reading a value per ray)
         else:
             mount = np.tile(skip, len(copies))
         self._lidar_plan[col] = (copies.copy(), ray_copy, mount)
         return ray_copy, mount
+
+    def slot_of_body(self, body: int) -> int:
+        """The slot of a template body (a robot's, or a link's): the slot the rays of a device
+        meeting that body apart skip in the cast (a housed lidar's ``_own_body``, a housed camera's
+        ``own``)."""
+        return self.rays.slot_body.index(body)
 
     def _lidar_skip(self, col: int) -> np.ndarray:
         """Per beam: the lidar's own robot slot where the beam can never meet that robot's body

@@ -131,8 +131,8 @@ class _Device:
 
 def own_body_hits(pixels: PixelDevices, col: int, copies: np.ndarray, h: RayHits) -> RayHits:
     """A housed device's hits (``pixels.devices[col]``, the copies' cast): the nearer of the world cast
-    and its robot's body (OwnBodyRays.cast, per copy: the body-frame normal turned by that copy's robot
-    rotation, on the same rows)."""
+    and its robot's body or link (OwnBodyRays.cast, per copy: the body-frame normal turned by that
+    copy's robot rotation, on a link by its displacement's too, on the same rows)."""
     dev = pixels.devices[col]
     if dev.own is None:
         return h
@@ -149,7 +149,10 @@ def own_body_hits(pixels: PixelDevices, col: int, copies: np.ndarray, h: RayHits
             continue
         dist[a + win] = b.distance[win]
         shape[a + win] = offset + b.shape[win]
-        normal[a + win] = b.normal[win] @ sim.rot[cc, slot].T          # body frame -> world
+        carrier = sim.rot[cc, slot]          # (on a link: robot ∘ that copy's link, Device.carrier_rotation)
+        if dev.own_joint >= 0:
+            carrier = carrier @ sim.joints.link_rot[cc, dev.own_joint]
+        normal[a + win] = b.normal[win] @ carrier.T          # body frame -> world
     return RayHits(dist, normal, shape)
 
 

@@ -110,6 +110,7 @@ class _Device:
         self.factors = imaging.depth_factors(template.geometry, dirs, template.lens)
         self.limits = imaging.clip_limits(template.geometry, self.factors, c.near, c.max_range)
         self.own: OwnBodyRays | None = None
+        self.own_joint = -1                              # a housed device's link's joint column (-1: its robot's body)
         self.skip: np.ndarray | int | None = None       # per pixel: the mount slot where it never meets its robot
         self.plan: tuple | None = None                   # (copies, each ray's copy, mount, t_near, t_far) kept
 
@@ -200,11 +201,21 @@ class PixelDevices:
         """The slot a device's pixel rays are never paired with in the world cast: its robot's, for
         a device with shapes of its own (that body is met apart, in the body frame: ``own``), else per
         pixel its robot's where the ray can never meet that body, -1 where it may (it sees its robot).
-        A device riding a joint (on a link without shapes: mounted on no body, as the single
-        device's ``device_body`` is None) turns in the body frame: every ray may meet its robot."""
+        A device riding a joint turns in the body frame: every ray may meet its robot (on a link
+        without shapes the single device is mounted on no body; on one with shapes its rays ride
+        that link, meeting it through the world's frame as any ray does: ``Riding``), and one with
+        shapes of its own on a link with shapes meets that link apart, as ``own``."""
         dev = self.devices[col]
-        if dev.skip is None and (self.kind, col) in self.sim.joints.riders:
-            dev.skip = -1
+        rider = self.sim.joints.riders.get((self.kind, col))
+        if dev.skip is None and rider is not None:
+            tpl = dev.template
+            link = self.sim.link_bodies.get((rider[0], rider[1]))
+            if tpl.own_shapes and link is not None:   # (its mount: its pose in the link's frame)
+                dev.own = OwnBodyRays(link, tpl.mount_pose, dev.dirs, *dev.limits, tpl.own_shapes)
+                dev.own_joint = self.sim.joints.of(rider[0], rider[1])
+                dev.skip = self.sim.slot_of_body(link)
+            else:
+                dev.skip = -1
         if dev.skip is None:
             tpl = dev.template
             slot = tpl.robot_index

@@ -135,8 +135,8 @@ class RotatingLidars:
         if isinstance(t_far, np.ndarray):          # per layer (a planar head's depth): each beam's own
             t_far = np.concatenate([sectors[int(g)].t_far for g in group.tolist()])
         mount: np.ndarray | int
-        if lid._own_body is not None:   # its robot's body met apart, in the body frame (finish)
-            mount = slot
+        if lid._own_body is not None:   # its robot's body (or link) met apart, in the body frame (finish)
+            mount = sim.slot_of_body(lid._own_body[1])
         elif all(isinstance(sectors[int(g)].skip, int) for g in group.tolist()) and \
                 len({sectors[int(g)].skip for g in group.tolist()}) == 1:
             mount = sectors[int(group[0])].skip   # type: ignore[assignment]

@@ -97,6 +97,7 @@ class _Centres:
         rng = float(c.recognition.max_range) if c.recognition is not None else math.inf
         self.limits = imaging.clip_limits(template.geometry, factors, c.near, rng)
         self.own: Any = None
+        self.own_joint = -1        # a housed camera's link's joint column (-1: its robot's body)
         self.skip: np.ndarray | int | None = None
         self.plan: tuple | None = None
 
