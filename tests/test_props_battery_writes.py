@@ -1,0 +1,156 @@
+"""Property tests of a Supervisor's writes of a robot's ``battery`` items and ``cpuConsumption`` (daemon/
+supervisor.py, sim/battery.py; README "Battery and Charger"), through the server's services on the sans-IO
+core, without a Charger.
+
+Closed form: a battery holding E (J) at a write, drained at P (W) by 32 ms steps (x = 0.032 P J a step),
+holds max(0, E − n·x) n steps later; the step that empties it is the ⌈E/x⌉-th, which powers the robot off;
+a write of energy left powers a robot that is off on again at the end of its next step if that step's drain
+leaves some. Its sensor, enabled with a period T (a multiple of the step) at t0, reads the energy at the
+latest of t0 + kT (NaN before the first), or 0 from the step that emptied it (enabled). Far-fetched values (1e300,
+denormals, 0, huge powers whose drain overflows to infinity) follow the closed form; a value that is no
+finite number >= 0, an index out of the world's items, an insert or remove is one refusal line that changes
+nothing; no value read is ever NaN but the sensor's before its first sample."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from _fuzz import example_counts
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+from test_battery import DT, supervised, world
+from test_fuzz_core import SETTINGS
+
+FAR = [0.0, 5e-324, 2.2e-308, 1e-300, 1e300, 1.7976931348623157e308]
+energies = st.floats(0.0, 50.0) | st.sampled_from(FAR)
+powers = st.floats(0.0, 400.0) | st.sampled_from(FAR)
+bad_values = st.sampled_from([-1.0, -5e-324, -1e300, True, False, None, "1", [1.0, 2.0], {"a": 1}, b"x"])
+
+
+class Model:
+    """The closed form's state: the energy at the last write of the energy or the power (``e0``), the steps
+    since (``n``), the power, whether the robot is on, and the sensor's (period, enabled at, last value)."""
+
+    def __init__(self, e0: float, p: float) -> None:
+        self.e0, self.n, self.p, self.on = e0, 0, p, True
+        self.period, self.since, self.value = 0, 0, math.nan
+
+    def per_step(self) -> float:
+        return self.p * DT * 0.001
+
+    def energy(self, n: int | None = None) -> float:
+        n = self.n if n is None else n
+        if not self.e0 > 0.0:
+            return self.e0
+        return max(0.0, self.e0 - n * self.per_step()) if n else self.e0
+
+    def emptying_step(self) -> float:
+        """The step (1-based) after the write that empties the battery; inf when none does."""
+        if not self.e0 > 0.0:
+            return math.inf
+        x = self.per_step()
+        steps = self.e0 / x if x > 0.0 else math.inf
+        return math.inf if not math.isfinite(steps) else max(1, math.ceil(steps))
+
+    def restart(self) -> None:          # a write of the energy or the power: a new segment
+        self.e0, self.n = self.energy(), 0
+
+    def step(self, t_ms: int) -> None:
+        was = self.energy()
+        self.n += 1
+        now = self.energy()
+        if was > 0.0:
+            self.on = now > 0.0
+        if self.period and (t_ms > self.since and (t_ms - self.since) % self.period == 0 or was > 0.0 == now):
+            self.value = now         # a sample, or (enabled) the step that emptied it
+
+
+steps = st.integers(0, 12)
+ops = st.one_of(
+    st.tuples(st.just("energy"), energies, steps),
+    st.tuples(st.just("maximum"), energies, steps),
+    st.tuples(st.just("speed"), powers, steps),
+    st.tuples(st.just("cpu"), powers, steps),
+    st.tuples(st.just("bad"), st.tuples(st.sampled_from(["battery", "cpuConsumption"]), st.integers(-5, 5),
+                                        bad_values), steps),
+    st.tuples(st.just("sensor"), st.sampled_from([0, DT, 2 * DT, 5 * DT]), steps))
+
+
+def _near_a_whole_step(e: float, x: float) -> bool:
+    """Whether E/x is so close to a whole number that the repeated subtraction may empty a step apart."""
+    if not (e > 0.0 and x > 0.0) or not math.isfinite(e / x) or e / x > 1e6:
+        return False
+    r = e / x
+    return abs(r - round(r)) < 1e-6 * max(1.0, r)
+
+
+@pytest.mark.parametrize("examples", example_counts(400))
+def test_written_batteries_drain_by_the_closed_form_and_refusals_change_nothing(examples: int) -> None:
+    loaded = st.just(0.0) | st.floats(1e-3, 50.0)       # (a world file's numbers: 0 or in [1e-30, 1e9])
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(e0=loaded, p=loaded, script=st.lists(ops, min_size=1, max_size=6))
+    def run(e0: float, p: float, script: list) -> None:
+        assume(not _near_a_whole_step(e0, p * DT * 0.001))
+        sim, call, node = supervised(world([{"name": "r", "def_name": "R", "battery": [e0, 100.0, 1.0],
+                                             "cpu_consumption": p}, {"name": "boss", "supervisor": True}]))
+        r = sim.robots["r"]
+        model, maximum, speed = Model(e0, p), 100.0, 1.0
+        for kind, value, n in script:
+            if kind == "sensor":
+                sim.enable_battery_sensor(r, value)
+                model.period, model.since = value, sim.time_ms
+            elif kind == "bad":
+                field, index, v = value
+                before = (r.battery.energy, r.battery.maximum, r.battery.speed, r.battery.cpu)
+                args = {"node": node, "field": field, "value": v}
+                if field == "battery":
+                    args |= {"index": index, "op": "set"}
+                got = call("/boss/robot/set_field", args)
+                assert got["ok"] is False, (args, got)
+                line = got["error"]["message"]
+                assert "\n" not in line and line and got["error"]["code"] != "INTERNAL", line
+                assert (r.battery.energy, r.battery.maximum, r.battery.speed, r.battery.cpu) == before
+            else:
+                if kind == "cpu":
+                    args = {"node": node, "field": "cpuConsumption", "value": value}
+                else:
+                    args = {"node": node, "field": "battery", "op": "set",
+                            "index": ("energy", "maximum", "speed").index(kind), "value": value}
+                got = call("/boss/robot/set_field", args)
+                assert got["ok"] is True, (args, got)
+                model.restart()
+                if kind == "energy":
+                    model.e0 = value
+                elif kind == "cpu":
+                    model.p = value
+                elif kind == "maximum":
+                    maximum = value
+                else:
+                    speed = value
+                assume(not _near_a_whole_step(model.e0, model.per_step()))
+            for _ in range(n):
+                before_on = r.battery.powered
+                sim.step()
+                model.step(sim.time_ms)
+                e = model.energy()
+                assert r.battery.energy == pytest.approx(e, rel=1e-9, abs=1e-9 * max(1.0, model.e0)), (model.n, e)
+                assert not math.isnan(r.battery.energy)
+                if model.n == model.emptying_step():
+                    assert r.battery.energy == 0.0 and not r.battery.powered         # off exactly then
+                elif model.e0 > 0.0 and model.n < model.emptying_step():
+                    assert r.battery.powered, (model.n, model.emptying_step())
+                else:
+                    assert r.battery.powered == before_on
+                assert r.battery.powered == model.on
+                if math.isnan(model.value):
+                    assert math.isnan(r.battery_value)
+                else:
+                    assert r.battery_value == pytest.approx(model.value, rel=1e-9, abs=1e-9 * max(1.0, model.e0))
+            got = call("/boss/robot/get_field", {"node": node, "field": "battery"})["result"]["value"]
+            assert got[1:] == [maximum, speed] and not any(math.isnan(v) for v in got)
+            assert got[0] == r.battery.energy
+            assert call("/boss/robot/get_field", {"node": node, "field": "cpuConsumption"})["result"]["value"] \
+                == model.p
+    run()
