@@ -510,8 +510,10 @@ def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
     if r is None:
         return
     try:
+        if isinstance(velocity, str):      # (its characters are no numbers: ctypes refuses them too)
+            raise TypeError
         wire = [float(v) for v in velocity]
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         print(f"Error: {func}(): expected 6 numbers, got {velocity!r}.", file=sys.stderr)
         return
     if len(wire) != 6:
@@ -521,6 +523,9 @@ def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
         print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
         return
     if not any(wire):
+        if node == 0:      # the root is no Solid: Webots warns and sets nothing (its resetPhysics would stop all)
+            print(f"Warning: {func}() can exclusively be used with a Solid.", file=sys.stderr)
+            return
         _answer(r, "reset_physics", {"node": int(node)}, func)  # type: ignore[arg-type]
         return
     if _set_velocity_warned:
