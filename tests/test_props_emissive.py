@@ -1,0 +1,70 @@
+"""Property test of emissive colours in camera images (sim/scene.py, sim/cameras.py; README "Cameras"), on the
+wall of tests/test_camera_emissive.py lit by the ambient term alone (0.3: every pixel lit alike). For a random
+base colour d, emissive colour e, texel t of a one-colour texture (sRGB-decoded, as WREN's shaders decode
+it) and texel m of a one-colour emissiveColorMap (taken as stored), every pixel reads Webots' resolve of:
+
+- a Phong surface (Appearance) textured: ``0.3·d·t + e·t`` (phong.frag multiplies the glow by the texel);
+- a PBR surface textured or not: ``0.3·d(·t) + e``, with an emissive map ``0.3·d(·t) + m/255``.
+
+Within one byte of the float64 closed form (the resolve of a value at a rounding edge), both precisions."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _fuzz import example_counts
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_camera_emissive import _linear, world
+from test_camera_light_radius import AMBIENT, BOTH, byte
+from test_fuzz_core import SETTINGS
+
+from sensorium.server.sim.simulation import Simulation
+
+colour = st.tuples(*[st.floats(0.0, 1.0).map(lambda x: 0.0 if x < 1e-30 else x)] * 3)
+texel = st.tuples(*[st.integers(0, 255)] * 3)
+
+
+@pytest.mark.parametrize("precision", BOTH)
+@pytest.mark.parametrize("examples", example_counts(120))
+def test_a_flat_lit_glowing_surface_reads_the_emissive_rule(tmp_path_factory, precision: str, examples: int) -> None:
+    from PIL import Image
+
+    folder = tmp_path_factory.mktemp("glow")
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(d=colour, e=colour, t=texel, m=texel, kind=st.sampled_from(["phong", "pbr", "pbr plain", "map", "map plain"]))
+    def run(d, e, t, m, kind) -> None:
+        Image.fromarray(np.full((2, 2, 3), t, dtype=np.uint8), "RGB").save(folder / "t.png")
+        Image.fromarray(np.full((2, 2, 3), m, dtype=np.uint8), "RGB").save(folder / "m.png")
+        appearance = {"base_color": list(d), "emissive_color": list(e), "phong": kind == "phong"}
+        if "plain" not in kind:
+            appearance["texture"] = "t.png"
+        if kind.startswith("map"):
+            appearance["emissive_map"] = "m.png"
+        sim = Simulation(world([AMBIENT], appearance), precision=precision, base_dir=folder)
+        cam = sim.device("r/cam")
+        cam.enable(16)
+        sim.run(1)
+        got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+        tex = np.array([_linear(v) for v in t]) if "plain" not in kind else np.ones(3)
+        glow = np.asarray(e) * tex if kind == "phong" else np.asarray(m) / 255.0 if kind.startswith("map") else np.asarray(e)
+        want = byte(0.3 * np.asarray(d) * tex + glow)
+        assert np.abs(got - want).max() <= 1, (kind, got[3, 4].tolist(), want.tolist())
+        assert (got == got[3, 4]).all()                  # flat: every pixel alike
+    run()
+
+
+def test_the_emissive_rule_tells_a_map_from_the_colour_it_replaces(tmp_path: Path) -> None:
+    # a map's texel (0, 255, 0) over an emissive colour (1, 0, 0) in the dark: green alone glows (m/255)
+    from PIL import Image
+
+    Image.fromarray(np.full((2, 2, 3), (0, 255, 0), dtype=np.uint8), "RGB").save(tmp_path / "m.png")
+    sim = Simulation(world([], {"base_color": [1.0, 1.0, 1.0], "emissive_color": [1.0, 0.0, 0.0],
+                                "emissive_map": "m.png"}), base_dir=tmp_path)
+    cam = sim.device("r/cam")
+    cam.enable(16)
+    sim.run(1)
+    assert cam.image[3, 4, [2, 1, 0]].tolist() == byte(np.array([0.0, 1.0, 0.0])).tolist()
