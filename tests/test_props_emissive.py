@@ -68,3 +68,43 @@ def test_the_emissive_rule_tells_a_map_from_the_colour_it_replaces(tmp_path: Pat
     cam.enable(16)
     sim.run(1)
     assert cam.image[3, 4, [2, 1, 0]].tolist() == byte(np.array([0.0, 1.0, 0.0])).tolist()
+
+
+@pytest.mark.parametrize("url, refused", [
+    ("nope.png", None), ("notes.png", None), ("", None), ("sub", None),
+    ("bomb.png", "has 100000x100000 = 10,000,000,000 pixels, more than the limit of 16,777,216"),
+    ("../outside.png", "leaves the world's folder"),
+])
+def test_an_emissive_color_map_not_loaded_is_one_line_and_glows_its_emissive_color(tmp_path: Path, url, refused):
+    """An emissiveColorMap whose url is missing, no image, empty or a folder: the world's one line of textures
+    not loaded, naming the map and saying it reads as its emissiveColor (Webots draws no map: the colour
+    glows, ``0.3·d + e``); one declaring a huge size or outside the world's folder: the load's one line."""
+    from PIL import Image
+    from test_camera_emissive import DIFFUSE, GLOW, WBT
+    from test_fuzz_texture_url import _png_header
+
+    from sensorium.server.world.loader import WorldError, load_world
+
+    folder = tmp_path / "w"
+    (folder / "sub").mkdir(parents=True)
+    Image.fromarray(np.full((2, 2, 3), 9, dtype=np.uint8), "RGB").save(tmp_path / "outside.png")
+    (folder / "notes.png").write_text("no image")
+    (folder / "bomb.png").write_bytes(_png_header(100_000, 100_000))
+    path = folder / "glow.wbt"
+    path.write_text(WBT.format(appearance="PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 "
+                                          f'0.7 emissiveColorMap ImageTexture {{ url "{url}" }} }}'))
+    if refused:
+        with pytest.raises(WorldError) as err:
+            load_world(path)
+        assert refused in str(err.value) and "emissive_map" in str(err.value) and "\n" not in str(err.value)
+        return
+    lw = load_world(path)
+    said = [w for w in lw.warnings if "texture" in w]
+    assert len(said) == 1 and "\n" not in said[0]
+    assert "(first: emissiveColorMap: " in said[0] and said[0].endswith(", an emissiveColorMap as its emissiveColor")
+    sim = Simulation(lw)
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    sim.run(1)
+    got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+    np.testing.assert_array_equal(got, np.broadcast_to(byte(0.3 * np.asarray(DIFFUSE) + np.asarray(GLOW)), got.shape))
