@@ -5,11 +5,12 @@ core, without a Charger.
 Closed form: a battery holding E (J) at a write, drained at P (W) by 32 ms steps (x = 0.032 P J a step),
 holds max(0, E − n·x) n steps later; the step that empties it is the ⌈E/x⌉-th, which powers the robot off;
 a write of energy left powers a robot that is off on again at the end of its next step if that step's drain
-leaves some. Its sensor, enabled with a period T (a multiple of the step) at t0, reads the energy at the
-latest of t0 + kT (NaN before the first), or 0 from the step that emptied it (enabled). Far-fetched values (1e300,
-denormals, 0, huge powers whose drain overflows to infinity) follow the closed form; a value that is no
-finite number >= 0, an index out of the world's items, an insert or remove is one refusal line that changes
-nothing; no value read is ever NaN but the sensor's before its first sample."""
+leaves some. Its sensor, enabled with a period T (a multiple of the step) at t0, reads the energy at
+the step where T has passed since t0 or its last reading (NaN before the first); the step that empties the
+battery gives it 0 and starts its period again (WbSensor::updateTimer), enabled or not (Webots sends it).
+Far-fetched values (1e300, denormals, 0, huge powers whose drain overflows to infinity) follow the closed
+form; a value that is no finite number >= 0, an index out of the world's items, an insert or remove is
+one refusal line that changes nothing; no value read is ever NaN but the sensor's before its first sample."""
 
 from __future__ import annotations
 
@@ -34,7 +35,7 @@ class Model:
 
     def __init__(self, e0: float, p: float) -> None:
         self.e0, self.n, self.p, self.on = e0, 0, p, True
-        self.period, self.since, self.value = 0, 0, math.nan
+        self.period, self.last, self.value = 0, 0, math.nan
 
     def per_step(self) -> float:
         return self.p * DT * 0.001
@@ -62,8 +63,8 @@ class Model:
         now = self.energy()
         if was > 0.0:
             self.on = now > 0.0
-        if self.period and (t_ms > self.since and (t_ms - self.since) % self.period == 0 or was > 0.0 == now):
-            self.value = now         # a sample, or (enabled) the step that emptied it
+        if self.period and t_ms - self.last >= self.period or was > 0.0 == now:
+            self.value, self.last = now, t_ms    # a sample, or the step that emptied it (WbSensor::updateTimer)
 
 
 steps = st.integers(0, 12)
@@ -73,7 +74,11 @@ ops = st.one_of(
     st.tuples(st.just("speed"), powers, steps),
     st.tuples(st.just("cpu"), powers, steps),
     st.tuples(st.just("bad"), st.tuples(st.sampled_from(["battery", "cpuConsumption"]), st.integers(-5, 5),
-                                        bad_values), steps),
+                                        bad_values, st.just("set")), steps),
+    st.tuples(st.just("bad"), st.tuples(st.just("battery"), st.sampled_from([3, 4, 1 << 40, -4, -(1 << 40)]),
+                                        energies, st.just("set")), steps),
+    st.tuples(st.just("bad"), st.tuples(st.just("battery"), st.integers(-3, 3), energies,
+                                        st.sampled_from(["insert", "remove"])), steps),
     st.tuples(st.just("sensor"), st.sampled_from([0, DT, 2 * DT, 5 * DT]), steps))
 
 
@@ -100,13 +105,13 @@ def test_written_batteries_drain_by_the_closed_form_and_refusals_change_nothing(
         for kind, value, n in script:
             if kind == "sensor":
                 sim.enable_battery_sensor(r, value)
-                model.period, model.since = value, sim.time_ms
+                model.period, model.last = value, sim.time_ms
             elif kind == "bad":
-                field, index, v = value
+                field, index, v, op = value
                 before = (r.battery.energy, r.battery.maximum, r.battery.speed, r.battery.cpu)
                 args = {"node": node, "field": field, "value": v}
                 if field == "battery":
-                    args |= {"index": index, "op": "set"}
+                    args |= {"index": index, "op": op}
                 got = call("/boss/robot/set_field", args)
                 assert got["ok"] is False, (args, got)
                 line = got["error"]["message"]
@@ -154,3 +159,31 @@ def test_written_batteries_drain_by_the_closed_form_and_refusals_change_nothing(
             assert call("/boss/robot/get_field", {"node": node, "field": "cpuConsumption"})["result"]["value"] \
                 == model.p
     run()
+
+
+def test_the_step_that_empties_a_battery_gives_its_sensor_0_enabled_or_not_and_starts_its_period_again() -> None:
+    """Regression (WbRobot::postPhysicsStep calls WbSensor::updateTimer, and writeAnswer sends the pending value
+    whether the sensor is enabled or not): a sensor never enabled read NaN after its battery emptied. 1 J at
+    31.25 W (1 J a step) written 2.5 J empties in the 3rd step."""
+    sim, call, node = supervised(world([{"name": "r", "def_name": "R", "battery": [10.0, 20.0, 1.0],
+                                         "cpu_consumption": 31.25}, {"name": "boss", "supervisor": True}]))
+    r = sim.robots["r"]
+    assert call("/boss/robot/set_field", {"node": node, "field": "battery", "index": 0, "value": 2.5})["ok"]
+    sim.run(2)
+    assert math.isnan(r.battery_value)                   # never enabled: nothing sampled
+    sim.step()
+    assert r.battery.energy == 0.0 and r.battery_value == 0.0 and sim.time_ms == 3 * DT
+    sim, call, node = supervised(world([{"name": "r", "def_name": "R", "battery": [10.0, 20.0, 1.0],
+                                         "cpu_consumption": 31.25}, {"name": "boss", "supervisor": True}]))
+    r = sim.robots["r"]
+    sim.enable_battery_sensor(r, 2 * DT)                # samples at 64, 128, ...
+    assert call("/boss/robot/set_field", {"node": node, "field": "battery", "index": 0, "value": 2.5})["ok"]
+    sim.run(2)
+    assert r.battery_value == 0.5
+    sim.step()                                          # 96: emptied, 0 at once; the period from 96: 160, 224
+    assert r.battery_value == 0.0 and r.battery_schedule.last_update_ms == 3 * DT
+    assert call("/boss/robot/set_field", {"node": node, "field": "battery", "index": 0, "value": 7.0})["ok"]
+    sim.step()                                          # 128: no sample (was one before the empty step)
+    assert r.battery_value == 0.0 and r.battery.energy == 6.0
+    sim.step()                                          # 160
+    assert r.battery_value == 5.0
