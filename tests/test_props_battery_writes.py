@@ -187,3 +187,42 @@ def test_the_step_that_empties_a_battery_gives_its_sensor_0_enabled_or_not_and_s
     assert r.battery_value == 0.0 and r.battery.energy == 6.0
     sim.step()                                          # 160
     assert r.battery_value == 5.0
+
+
+def test_export_string_and_world_save_write_the_battery_and_cpu_consumption_now(tmp_path) -> None:
+    """Regression: WbRobot writes its energy in its battery field each step (and a Supervisor's writes land in
+    the fields), so exportString and worldSave write the values now; they wrote the world file's. A robot
+    without a battery and a PROTO robot's fields through IS (our Cell PROTO: 1 J a step) alike; the saved
+    world loads to the same battery."""
+    from pathlib import Path
+
+    from sensorium.server.daemon import supervisor as sv
+    from sensorium.server.daemon.export import node_string, world_string
+    from sensorium.server.sim.simulation import Simulation
+    from sensorium.server.world.loader import load_world
+    from sensorium.server.world.wbt.parser import parse_wbt
+
+    world = tmp_path / "w.wbt"
+    world.write_text('#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 32 }\n'
+                     'DEF R Robot { name "r" battery [ 5, 10, 1 ] cpuConsumption 2 }\nDEF N Robot { name "n" }\n')
+    sim = Simulation(load_world(world))
+    r, n = sv.find_node(sim, "R"), sv.find_node(sim, "N")
+    assert sv.change_item(sim, r, "battery", "set", 1, 7.5) == [] and sv.set_field(sim, r, "cpuConsumption", 3.0) == []
+    sim.run(2)                                             # 3 W: 0.096 J a step
+    (got,) = parse_wbt("#VRML_SIM R2023b utf8\n" + node_string(sim, r)).nodes
+    assert got.fields["battery"] == pytest.approx([5.0 - 0.192, 7.5, 1.0], abs=1e-12)
+    assert got.fields["cpuConsumption"] == 3.0
+    assert node_string(sim, n) == 'DEF N Robot {\n  name "n"\n}'
+    saved = tmp_path / "saved.wbt"
+    saved.write_text(world_string(sim))
+    again = {x.name: x for x in load_world(saved).world.robots}
+    assert again["r"].battery == pytest.approx([4.808, 7.5, 1.0], abs=1e-12) and again["r"].cpu_consumption == 3.0
+    assert again["n"].battery == []
+
+    cells = Simulation(load_world(Path(__file__).parent / "worlds" / "battery_proto.wbt"))
+    cell = sv.find_node(cells, "CELL")
+    assert sv.change_item(cells, cell, "battery", "set", 0, 3.5) == [] and sv.set_field(cells, cell, "cpu", 0.5) == []
+    cells.run(2)                                           # 0.5 W: 0.016 J a step
+    (got,) = parse_wbt("#VRML_SIM R2023b utf8\n" + node_string(cells, cell)).nodes
+    assert got.type == "Cell" and got.fields["battery"] == pytest.approx([3.5 - 0.032, 10.0, 1.0], abs=1e-12)
+    assert got.fields["cpu"] == 0.5
