@@ -108,3 +108,33 @@ def test_an_emissive_color_map_not_loaded_is_one_line_and_glows_its_emissive_col
     sim.run(1)
     got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
     np.testing.assert_array_equal(got, np.broadcast_to(byte(0.3 * np.asarray(DIFFUSE) + np.asarray(GLOW)), got.shape))
+
+
+@pytest.mark.parametrize("examples", example_counts(120))
+def test_a_chargers_glow_reads_its_energys_colour(examples: int) -> None:
+    """A camera in the dark facing a Charger's box (its own emissive colour c0), no robot near: the Charger
+    holds E = min(E0 + n·s·dt, Emax) after n steps (Emax when it loaded above), and the box reads the
+    resolve of WbCharger's colour: full (E >= Emax, a maximum of 0 too) its emissiveColor f; else, gradual,
+    ``c0 + (f − c0)·E/Emax``, not gradual c0."""
+    from test_camera_emissive import _charger_world
+
+    amount = st.just(0.0) | st.floats(1e-3, 5.0)
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(e0=amount, emax=amount, speed=amount, c0=colour, full=colour, gradual=st.booleans(), n=st.integers(1, 6))
+    def run(e0, emax, speed, c0, full, gradual, n) -> None:
+        w = _charger_world(gradual, c0)
+        charger = w.chargers[0].model_copy(update={"battery": [e0, emax, speed], "emissive_color": full})
+        sim = Simulation(w.model_copy(update={"chargers": [charger]}))
+        cam = sim.device("r/cam")
+        cam.enable(16)
+        energy = e0
+        for _ in range(n):
+            energy = min(energy + speed * 16 * 0.001, emax)
+        sim.run(n)
+        assert sim.chargers[0].energy == pytest.approx(energy, rel=1e-12, abs=1e-12)
+        f, c = np.asarray(full), np.asarray(c0)
+        glow = f if energy >= emax else (c + (f - c) * (energy / emax) if gradual else c)
+        got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+        assert np.abs(got - byte(glow)).max() <= 1, (got[3, 4].tolist(), byte(glow).tolist())
+    run()
