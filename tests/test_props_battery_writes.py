@@ -23,6 +23,8 @@ from hypothesis import strategies as st
 from test_battery import DT, supervised, world
 from test_fuzz_core import SETTINGS
 
+from sensorium.schemas import wire
+
 FAR = [0.0, 5e-324, 2.2e-308, 1e-300, 1e300, 1.7976931348623157e308]
 energies = st.floats(0.0, 50.0) | st.sampled_from(FAR)
 powers = st.floats(0.0, 400.0) | st.sampled_from(FAR)
@@ -115,7 +117,7 @@ def test_written_batteries_drain_by_the_closed_form_and_refusals_change_nothing(
                 got = call("/boss/robot/set_field", args)
                 assert got["ok"] is False, (args, got)
                 line = got["error"]["message"]
-                assert "\n" not in line and line and got["error"]["code"] != "INTERNAL", line
+                assert "\n" not in line and line and got["error"]["code"] != wire.ErrorCode.INTERNAL, line
                 assert (r.battery.energy, r.battery.maximum, r.battery.speed, r.battery.cpu) == before
             else:
                 if kind == "cpu":

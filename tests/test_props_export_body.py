@@ -131,3 +131,37 @@ def test_a_body_nodes_export_after_its_proto_file_changed_is_one_line_within_the
         line = str(err.value)
         assert "\n" not in line and line.startswith("Solid 'inner'") and "made by the body of PROTO Tagged" in line
         assert says in line, line
+
+
+def test_export_string_of_a_removed_instance_and_of_its_bodys_nodes_is_one_line(tmp_path) -> None:
+    """Through the server's services: a body's node exports, then its instance is removed; the instance, the
+    body's node and another node of that body each answer one line naming what was removed (a refusal, not an
+    internal error), as does an id never given."""
+    import msgpack
+
+    from sensorium.schemas import wire
+    from sensorium.server.daemon.services import Core
+
+    world = tmp_path / "w.wbt"
+    world.write_text(f'{HEADER}EXTERNPROTO "{PROTO}"\nDEF T Tagged {{ name "t" }}\n'
+                     'Robot {\n  name "boss"\n  controller "<extern>"\n  supervisor TRUE\n}\n')
+    core = Core(Simulation(load_world(world)), new_token=lambda: "s0", log=lambda *_: None)
+    rid = iter(range(1, 100))
+
+    def call(service: str, args: dict) -> dict:
+        (frames,) = core.handle([b"A", wire.pack({"id": next(rid), "service": service, "args": args})], 0.0)
+        return msgpack.unpackb(frames[-1])
+
+    assert call("attach", {"robot": "boss"})["ok"]
+    t = call("/boss/robot/get_from_def", {"name": "T"})["result"]["node"]
+    inner = call("/boss/robot/get_from_proto_def", {"node": t, "name": "INNER"})["result"]["node"]
+    paint = call("/boss/robot/get_from_proto_def", {"node": t, "name": "PAINT"})["result"]["node"]
+    assert call("/boss/robot/node_export_string", {"node": inner})["result"]["value"].startswith("DEF INNER Solid {")
+    assert call("/boss/robot/remove_node", {"node": t})["ok"]
+    for node, says in ((t, f"node {t} (Solid 't') was removed"),
+                       (inner, f"node {inner} (Solid 'inner') was removed with 't'"),
+                       (paint, "was removed with 't'"), (1 << 30, "no node with id 1073741824")):
+        got = call("/boss/robot/node_export_string", {"node": node})
+        assert got["ok"] is False and got["error"]["code"] == wire.ErrorCode.INVALID_ARGUMENT
+        line = got["error"]["message"]
+        assert says in line and "\n" not in line, line
