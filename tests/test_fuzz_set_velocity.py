@@ -7,6 +7,7 @@ that node and print nothing; on the root (no Solid) they print Webots' warning a
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -67,7 +68,8 @@ def test_set_velocity_answers_each_call_with_at_most_one_line(monkeypatch, capsy
 def test_set_velocity_of_the_root_or_of_characters_asks_nothing(monkeypatch, capsys) -> None:
     """Regressions: six zeros on the root asked the root's reset_physics (every falling solid stopped;
     Webots warns that setVelocity takes a Solid and sets nothing); a string of six digits was six numbers;
-    an int past a double raised OverflowError out of the call."""
+    an int past a double raised OverflowError out of the call; an endless iterator never returned; a long
+    list of non-numbers was written whole in the line."""
     fake = _FakeSupervisor()
     monkeypatch.setattr(ws, "_supervisor", lambda func: fake)
     monkeypatch.setattr(ws, "_set_velocity_warned", [])
@@ -78,8 +80,16 @@ def test_set_velocity_of_the_root_or_of_characters_asks_nothing(monkeypatch, cap
     ws.wb_supervisor_node_set_velocity(7, [1 << 1100] + [0] * 5)
     assert capsys.readouterr().err.startswith(f"Error: {FUNC}(): expected 6 numbers, got [")
     assert fake.calls == []
+    ws.wb_supervisor_node_set_velocity(7, itertools.repeat(0.0))            # endless: 7 read, refused
+    assert capsys.readouterr().err == f"Error: {FUNC}(): expected 6 numbers, got more than 6.\n"
+    ws.wb_supervisor_node_set_velocity(7, (0.0 for _ in range(6)))          # a generator of six zeros: served
+    ws.wb_supervisor_node_set_velocity(7, [0.0] * 100)
+    assert capsys.readouterr().err == f"Error: {FUNC}(): expected 6 numbers, got 100.\n"
+    ws.wb_supervisor_node_set_velocity(7, ["x"] * 100_000)                  # its line stays short
+    assert len(capsys.readouterr().err) < 200
+    assert fake.calls == ["/boss/robot/reset_physics"]
     ws.wb_supervisor_node_set_velocity(7, np.zeros(6))
-    assert fake.calls == ["/boss/robot/reset_physics"] and capsys.readouterr().err == ""
+    assert fake.calls == ["/boss/robot/reset_physics"] * 2 and capsys.readouterr().err == ""
 
 
 @pytest.mark.slow
