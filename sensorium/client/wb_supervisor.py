@@ -12,8 +12,11 @@ answered at once; setters take effect before the next measurement.
 
 from __future__ import annotations
 
+import itertools
 import math
+import reprlib
 import sys
+from collections.abc import Sized
 from typing import Any
 
 from sensorium.client import nodes
@@ -510,17 +513,23 @@ def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
     if r is None:
         return
     try:
-        wire = [float(v) for v in velocity]
-    except (TypeError, ValueError):
-        print(f"Error: {func}(): expected 6 numbers, got {velocity!r}.", file=sys.stderr)
+        if isinstance(velocity, str):      # (its characters are no numbers: ctypes refuses them too)
+            raise TypeError
+        wire = [float(v) for v in itertools.islice(velocity, 7)]     # (an endless iterator: 7 at most)
+    except (TypeError, ValueError, OverflowError):
+        print(f"Error: {func}(): expected 6 numbers, got {reprlib.repr(velocity)}.", file=sys.stderr)
         return
     if len(wire) != 6:
-        print(f"Error: {func}(): expected 6 numbers, got {len(wire)}.", file=sys.stderr)
+        count = len(velocity) if isinstance(velocity, Sized) else "more than 6" if len(wire) > 6 else len(wire)
+        print(f"Error: {func}(): expected 6 numbers, got {count}.", file=sys.stderr)
         return
     if not all(math.isfinite(v) for v in wire):
         print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
         return
     if not any(wire):
+        if node == 0:      # the root is no Solid: Webots warns and sets nothing (its resetPhysics would stop all)
+            print(f"Warning: {func}() can exclusively be used with a Solid.", file=sys.stderr)
+            return
         _answer(r, "reset_physics", {"node": int(node)}, func)  # type: ignore[arg-type]
         return
     if _set_velocity_warned:

@@ -38,7 +38,8 @@ DEFAULTS: dict[str, dict[str, Any]] = {
     # a .wbt robot without a controller reads "<extern>" here (Webots' default is "<generic>"): one set to
     # "<extern>" keeps its field written, and one never written stays unwritten
     "Robot": {**_POSE, "name": "robot", "model": "", "radarCrossSection": 0.0, "customData": "",
-              "controller": "<extern>", "supervisor": False, "synchronization": True},
+              "controller": "<extern>", "supervisor": False, "synchronization": True,
+              "battery": [], "cpuConsumption": 10.0},     # (WbRobot writes its energy now in its field each step)
     "Solid": {**_POSE, "name": "solid", "model": "", "radarCrossSection": 0.0},
     "PointLight": {**_LIGHT, **_LOCAL},
     "SpotLight": {**_LIGHT, **_LOCAL, "direction": [0.0, 0.0, -1.0], "beamWidth": 1.570796, "cutOffAngle": 0.785398},

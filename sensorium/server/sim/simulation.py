@@ -941,6 +941,9 @@ class Simulation:
                 # without a battery Webots' sensor reads -1 (WbRobot::currentEnergy)
                 robot.battery_value = robot.battery.energy if robot.battery.present else -1.0
                 s.last_update_ms = now
+        for robot in emptied:         # Webots sends the 0 of an emptied battery whether its sensor is enabled or not
+            if robot.battery_schedule.period_ms == 0:     # (WbRobot::writeAnswer's pending value)
+                robot.battery_value = 0.0
         if self._by_kind is None:   # devices never change after loading: sort them by kind once
             every = list(self.all_devices())
             self._by_kind = ([d for d in every if isinstance(d, LightSensor)],

@@ -815,6 +815,10 @@ void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
     }
     zero = zero && velocity[i] == 0.0;
   }
+  if (zero && node->id == 0) { /* the root is no Solid: Webots warns, sets nothing (its resetPhysics stops all) */
+    fprintf(stderr, "Warning: %s() can exclusively be used with a Solid.\n", func);
+    return;
+  }
   if (zero) {
     reset_physics(rb, node->id, func);
     return;

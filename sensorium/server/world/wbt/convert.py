@@ -388,7 +388,9 @@ class Converter:
             (_, _, where, why), n = min(self.textured.values()), len(self.textured)
             self.warnings.append(f"{where}: {n} texture{'s' if n > 1 else ''} not loaded (first: {why}); "
                                  "read as Webots reads a texture it cannot load: an Appearance as its material's "
-                                 "diffuseColor, a PBRAppearance as its baseColor")
+                                 "diffuseColor, a PBRAppearance as its baseColor"
+                                 + (", an emissiveColorMap as its emissiveColor" if any(
+                                     why.startswith(fx.GLOW_MAP + ": ") for *_, why in self.textured.values()) else ""))
         if self.left_fanned:
             where, n = next(iter(self.left_fanned.items())), len(self.left_fanned)
             self.warnings.append(

@@ -494,7 +494,9 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
                 extra = image_texture(f.node_(field), source, warn, resolve)
                 if extra is not None:
                     out[key] = extra
-        glow_map = image_texture(f.node_("emissiveColorMap"), source, warn, resolve)
+        def warn_glow(n: Node, message: str) -> None:        # (named: the summary line says what such a map reads)
+            warn(n, message.replace("texture: ", f"texture: {GLOW_MAP}: ", 1))
+        glow_map = image_texture(f.node_("emissiveColorMap"), source, warn_glow, resolve)
         if glow_map is not None:
             out["emissive_map"] = glow_map
         if f.node_("baseColorMap") is not None or glow_map is not None:      # (kept for a url a Supervisor sets)
@@ -627,6 +629,10 @@ def shape_node(node: Node, source: str, keep_def, key) -> dict:
     if values:
         out["values"] = values
     return out
+
+
+GLOW_MAP = "emissiveColorMap"
+"""How a note of an emissiveColorMap not loaded begins (after ``texture: ``)."""
 
 
 def image_texture(node: Node | None, source: str, warn, resolve=None) -> dict | None:
