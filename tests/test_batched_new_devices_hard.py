@@ -162,8 +162,9 @@ def _fresh_simulation(sims: list[Simulation], copies: list[int], kw: dict) -> No
 
 def test_256_copies_reset_on_the_step_their_sector_wraps_read_as_fresh_simulations():
     """256 copies at random headings, each copy's head starting at 0 (40 columns, 9.3 Hz: 5.95
-    columns a step). A copy is reset (a new world, its Simulation rebuilt: one for the copies reset together) right after the step whose
-    sweep wrapped past 2π, another right before such a step (from the single model's next sweep):
+    columns a step). A copy is reset (a new world, its Simulation rebuilt: one for the copies reset
+    together) right after the step whose sweep wrapped past 2π, another right before such a step
+    (from the single model's next sweep):
     after every step every copy's image and head angle equal its Simulation's bit for bit, and the
     resets did happen on wrapping steps."""
     C, kw = 256, {"W": 40, "L": 2, "f": 9.3}
