@@ -151,10 +151,20 @@ def test_any_rotating_lidar_anywhere_sweeps_as_the_single_simulation(W, L, f, dt
         _same_lidar(bs, sims, [0, 1], k)
 
 
+def _fresh_simulation(sims: list[Simulation], copies: list[int], kw: dict) -> None:
+    """The listed copies, reset together, become one new Simulation of the room (heading 0): fresh
+    simulations of one world step alike, so one stands for them all (stepped once a step)."""
+    fresh = Simulation(from_model(_room(**kw)), precision="fast")
+    fresh.robot("bot").device("head").enable(16)
+    for c in copies:
+        sims[c] = fresh
+
+
 def test_256_copies_reset_on_the_step_their_sector_wraps_read_as_fresh_simulations():
     """256 copies at random headings, each copy's head starting at 0 (40 columns, 9.3 Hz: 5.95
-    columns a step). A copy is reset (a new world, its Simulation rebuilt) right after the step whose
-    sweep wrapped past 2π, another right before such a step (from the single model's next sweep):
+    columns a step). A copy is reset (a new world, its Simulation rebuilt: one for the copies reset
+    together) right after the step whose sweep wrapped past 2π, another right before such a step
+    (from the single model's next sweep):
     after every step every copy's image and head angle equal its Simulation's bit for bit, and the
     resets did happen on wrapping steps."""
     C, kw = 256, {"W": 40, "L": 2, "f": 9.3}
@@ -173,22 +183,18 @@ def test_256_copies_reset_on_the_step_their_sector_wraps_read_as_fresh_simulatio
         if wrap_next:
             bs.reset(wrap_next, [1] * len(wrap_next))
             bs.enable(ref, 16, copies=wrap_next)
-            for c in wrap_next:
-                sims[c] = Simulation(from_model(_room(**kw)), precision="fast")
-                sims[c].robot("bot").device("head").enable(16)
+            _fresh_simulation(sims, wrap_next, kw)
             resets["before"] += len(wrap_next)
             before = [s.robot("bot").device("head").head_angle for s in sims]
         bs.step()
-        for s in sims:
+        for s in {id(s): s for s in sims}.values():
             s.step()
         _same_lidar(bs, sims, range(C), step)
         wrapped = [c for c in range(1, C, 3) if sims[c].robot("bot").device("head").head_angle > before[c]]
         if wrapped:     # the sector just swept past 2π: reset right after
             bs.reset(wrapped, [1] * len(wrapped))
             bs.enable(ref, 16, copies=wrapped)
-            for c in wrapped:
-                sims[c] = Simulation(from_model(_room(**kw)), precision="fast")
-                sims[c].robot("bot").device("head").enable(16)
+            _fresh_simulation(sims, wrapped, kw)
             resets["after"] += len(wrapped)
             assert (bs.range_image(ref)[wrapped] == 0.0).all()
     assert resets["after"] > 50 and resets["before"] > 50

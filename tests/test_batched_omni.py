@@ -120,14 +120,16 @@ def random_commands(rng, w) -> dict:
 NAMES = ("tri", "quad", "yb", "boe", "skid")
 
 
+@pytest.mark.parametrize("steps", [200, pytest.param(400, marks=pytest.mark.slow)])
 @pytest.mark.parametrize("contact", [True, False])
-def test_every_copy_steps_as_the_single_simulation_bit_for_bit(contact):
-    """Three copies, each against its own Simulation (world seeds 5, 6, 7), 400 steps of random
-    commands changed every 40 steps (velocity and position control), set_poses at step 200: every
-    robot's pose and every device's reading the same bits every step; contact clipped moves."""
+def test_every_copy_steps_as_the_single_simulation_bit_for_bit(contact, steps):
+    """Three copies, each against its own Simulation (world seeds 5, 6, 7), 200 steps (400 in the
+    slow stage) of random commands changed every 40 steps (velocity and position control), set_poses
+    half-way: every robot's pose and every device's reading the same bits every step; contact
+    clipped moves (every robot pressed already in the first 200 steps)."""
     moves = {"tri": ([-0.5, -0.1, 0.05], [0, 0, 1, 0.7]), "boe": ([0.2, 0.8, 0.04], [0, 0, 1, -2.0])}
-    batched, _, pressed = lockstep(world(contact), 400, (5, 6, 7), random_commands, rng_seed=8, sample_ms=32,
-                                   set_poses=(200, 1, moves))
+    batched, _, pressed = lockstep(world(contact), steps, (5, 6, 7), random_commands, rng_seed=8, sample_ms=32,
+                                   set_poses=(steps // 2, 1, moves))
     assert batched.omni is not None and batched.omni.width == 4 and batched.omni.count.tolist() == [3, 4]
     assert list(pressed) == list(NAMES)
     if contact:       # walls and robots were met, by every kind of robot

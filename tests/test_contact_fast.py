@@ -14,6 +14,8 @@ from contextlib import contextmanager
 from unittest import mock
 
 import numpy as np
+import pytest
+from _fuzz import example_counts
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -76,7 +78,8 @@ def _both(shape, rnd, turn, ob, p, gap) -> tuple[bool, bool]:
     return screened, exact
 
 
-def test_the_turn_screens_answer_as_the_arcs_on_adversarial_cases_and_are_taken():
+@pytest.mark.parametrize("examples", example_counts(2500, share=2))
+def test_the_turn_screens_answer_as_the_arcs_on_adversarial_cases_and_are_taken(examples):
     fired = {"_start_touching": 0, "_inside_in_turn": 0, "_end_nearer": 0}
     real = {name: getattr(C, name) for name in fired}
 
@@ -89,7 +92,7 @@ def test_the_turn_screens_answer_as_the_arcs_on_adversarial_cases_and_are_taken(
 
     answers = {True: 0, False: 0}
     with mock.patch.multiple(C, **{name: counted(name) for name in fired}):
-        for seed in range(2500):
+        for seed in range(examples):
             case = _case(seed)
             screened, exact = _both(*case)
             assert screened == exact, (seed, case)

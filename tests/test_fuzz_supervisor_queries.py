@@ -28,7 +28,7 @@ DEFS = ("BOX", "BALL", "CART", "LEFT", "RIGHT", "CASTER")
 
 def fresh() -> tuple[Fuzzed, list[int]]:
     """A new core each example: every node there at first, so each example can query and then remove."""
-    f = Fuzzed("contact_points.wbt")
+    f = Fuzzed("contact_points.wbt", copied=True)
     [reply] = send(f, "attach", {"robot": "sup"})
     assert reply["ok"], reply
     ids = [send(f, R + "get_from_def", {"name": d})[0]["result"]["node"] for d in DEFS]

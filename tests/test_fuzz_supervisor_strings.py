@@ -26,7 +26,7 @@ R = "/sup/robot/"
 
 def fresh() -> tuple[Fuzzed, int, str]:
     """A new core, the first box's id and its exportString."""
-    f = Fuzzed("contact_points.wbt")
+    f = Fuzzed("contact_points.wbt", copied=True)
     [reply] = send(f, "attach", {"robot": "sup"})
     assert reply["ok"], reply
     box = send(f, R + "get_from_def", {"name": "BOX"})[0]["result"]["node"]

@@ -11,6 +11,7 @@ import warnings
 
 import numpy as np
 import pytest
+from _fuzz import example_counts
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -174,26 +175,32 @@ def _check_hull(points: np.ndarray) -> None:
 coordinate = st.integers(-4, 4).map(float) | st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False)
 
 
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=60),
-       st.integers(0, 3))
-def test_the_hull_holds_every_point_and_its_corners_are_points(rows: list, copies: int) -> None:
+@pytest.mark.parametrize("examples", example_counts(200))
+def test_the_hull_holds_every_point_and_its_corners_are_points(examples: int) -> None:
     """Random points, small integer grids (many coplanar and collinear), each repeated ``copies`` times."""
-    points = np.array(rows * (copies + 1), dtype=np.float64)
-    _check_hull(points)
+    @settings(max_examples=examples, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=60),
+           st.integers(0, 3))
+    def run(rows: list, copies: int) -> None:
+        _check_hull(np.array(rows * (copies + 1), dtype=np.float64))
+
+    run()
 
 
 tiny = st.floats(-1e-8, 1e-8, allow_nan=False)
 
 
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=12),
-       st.lists(st.tuples(tiny, tiny, tiny), min_size=2, max_size=4))
-def test_the_hull_of_near_duplicate_clusters_holds_every_point(centres: list, offsets: list) -> None:
+@pytest.mark.parametrize("examples", example_counts(200))
+def test_the_hull_of_near_duplicate_clusters_holds_every_point(examples: int) -> None:
     """Each point repeated a few times 1e-8 or less apart (a mesh's vertices written twice, rounded):
     thin slivers whose float64 normals would be wrong; the sides are decided exactly."""
-    points = (np.array(centres)[:, None, :] + np.array(offsets)[None, :, :]).reshape(-1, 3)
-    _check_hull(points)
+    @settings(max_examples=examples, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(st.lists(st.tuples(coordinate, coordinate, coordinate), min_size=1, max_size=12),
+           st.lists(st.tuples(tiny, tiny, tiny), min_size=2, max_size=4))
+    def run(centres: list, offsets: list) -> None:
+        _check_hull((np.array(centres)[:, None, :] + np.array(offsets)[None, :, :]).reshape(-1, 3))
+
+    run()
 
 
 @pytest.mark.parametrize("points, kind", [

@@ -8,13 +8,17 @@ always allowed). Third-party imports with a single owner (zmq, embreex) are chec
 
 from __future__ import annotations
 
-import ast
+import dis
+import types
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 PKG = ROOT / "sensorium"
+
+IMPORT_NAME = bytes([dis.opmap["IMPORT_NAME"]])
 
 SERVER_STAGES = ("world", "raycast", "devices", "sim", "daemon", "recording", "viewer")
 
@@ -57,27 +61,54 @@ def module_name(path: Path) -> str:
     return ".".join(parts)
 
 
+def code_objects(code: types.CodeType) -> Iterator[types.CodeType]:
+    yield code
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            yield from code_objects(const)
+
+
+def instruction_lines(code: types.CodeType) -> Iterator[tuple[int, dis.Instruction]]:
+    line = code.co_firstlineno
+    for ins in dis.get_instructions(code):
+        positions = getattr(ins, "positions", None)                 # Python 3.11+
+        if positions is not None and positions.lineno is not None:
+            line = positions.lineno
+        elif isinstance(ins.starts_line, int) and not isinstance(ins.starts_line, bool):
+            line = ins.starts_line
+        yield line, ins
+
+
 def imports(path: Path, source: str | None = None) -> list[tuple[int, str]]:
-    """(line, absolute module name) of every import statement in a module."""
+    """(line, absolute module name) of every import statement in a module.
+
+    Read from the compiled code, not an ``ast`` walk: every import statement, at any depth, compiles
+    to an ``IMPORT_NAME`` preceded by its level and names, and compiling builds no Python tree
+    (``ast.parse`` of the whole package was most of this file's time). A ``finally`` body is compiled
+    twice, so a repeated (line, module) is kept once."""
     module = module_name(path)
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
-    tree = ast.parse(source if source is not None else path.read_text(), filename=str(path))
-    out = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            out += [(node.lineno, a.name) for a in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[:len(package.split(".")) - (node.level - 1)]
-                name = ".".join(base + ([node.module] if node.module else []))
+    code = compile(source if source is not None else path.read_text(), str(path), "exec", dont_inherit=True)
+    out: dict[tuple[int, str], None] = {}
+    for each in code_objects(code):
+        if IMPORT_NAME not in each.co_code[::2]:                     # opcodes sit at even offsets
+            continue
+        listed = list(instruction_lines(each))
+        for i, (line, ins) in enumerate(listed):
+            if ins.opname != "IMPORT_NAME":
+                continue
+            level, names = listed[i - 2][1].argval, listed[i - 1][1].argval
+            if level:
+                base = package.split(".")[:len(package.split(".")) - (level - 1)]
+                name = ".".join(base + ([ins.argval] if ins.argval else []))
                 # "from . import x" imports submodules: check each as its own module
-                if not node.module:
-                    out += [(node.lineno, f"{name}.{a.name}") for a in node.names]
+                if not ins.argval:
+                    out.update(((line, f"{name}.{a}"), None) for a in names)
                     continue
-                out.append((node.lineno, name))
-            elif node.module:
-                out.append((node.lineno, node.module))
-    return out
+                out[(line, name)] = None
+            else:
+                out[(line, ins.argval)] = None
+    return list(out)
 
 
 def source_files() -> list[Path]:
@@ -185,3 +216,19 @@ def test_slow_marker_finds_tests_that_start_processes(request: pytest.FixtureReq
     assert {"_cli", "test_cli_validate_ok_and_failure", "test_cli_info_default_world"} <= found  # via the helper
     assert "test_infrared_spelling_normalised" not in found
     assert request.node.get_closest_marker("slow") is None           # this test is not
+
+
+def test_the_compiled_reading_finds_every_form_of_import() -> None:
+    # every form once, at every depth; the ``finally`` body (compiled twice) gives one line
+    source = ("from __future__ import annotations\nimport zmq, sensorium.server.sim.simulation as s\n"
+              "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from sensorium.client import wb\n"
+              "from .. import raycast, devices\nfrom .geometry import (\n    Pose,\n    Frame,\n)\n"
+              "class A:\n    import embreex\n    def f(self):\n        try:\n            pass\n"
+              "        finally:\n            from ...cli import main\n"
+              "g = lambda: __import__('os')\nh = [__import__ for _ in ()]\n"
+              "def k():\n    def inner():\n        from sensorium.server.daemon import topics\n")
+    assert imports(PKG / "server" / "world" / "loader.py", source) == [
+        (1, "__future__"), (2, "zmq"), (2, "sensorium.server.sim.simulation"), (3, "typing"),
+        (5, "sensorium.client"), (6, "sensorium.server.raycast"), (6, "sensorium.server.devices"),
+        (7, "sensorium.server.world.geometry"), (12, "embreex"), (17, "sensorium.cli"),
+        (22, "sensorium.server.daemon")]

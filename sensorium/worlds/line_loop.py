@@ -67,9 +67,12 @@ def render() -> np.ndarray:
     rho = np.hypot(pts[:, 0], pts[:, 1])
     theta = np.mod(np.arctan2(pts[:, 1], pts[:, 0]), 2 * math.pi)
     r_line = R0 + AMPLITUDE * np.cos(LOBES * theta)
-    near = (np.abs(rho - r_line) < 0.05).nonzero()[0]       # texels that may be within a line width
-    # the loop is star-shaped: a texel's nearest segment lies within a few degrees of its own angle
-    n, window = 8000, 100
+    # a texel within WIDTH/2 of the loop (at ρ >= 0.41) sees its nearest point at most asin(0.01/0.41)
+    # = 0.0244 rad (31 segments) from its own angle, where the loop's radius differs from its own by at
+    # most 0.01 + 0.36 x 0.0244 = 0.0188 m (|dr/dθ| <= AMPLITUDE x LOBES): only those texels, and only
+    # those segments, are looked at
+    near = (np.abs(rho - r_line) < 0.02).nonzero()[0]
+    n, window = 8000, 40
     a = centreline(n)
     ab = np.roll(a, -1, axis=0) - a
     dark = np.zeros(len(pts), dtype=bool)
