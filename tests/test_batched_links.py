@@ -138,6 +138,24 @@ def _reading(batched: BatchedSimulation, sim: Simulation, c: int, robot: str, na
     return batched.value(ref)[c].tobytes(), np.float64(dev.value).tobytes()
 
 
+def _command(batched, singles: list, c: int, robot: str, name: str, target: float) -> None:
+    """Copy ``c``'s joint ``name`` of ``robot`` and its Simulation's both sent to ``target``."""
+    singles[c].robot(robot).motor(name).set_position(target)
+    batched.joints.command(batched.slot(robot), name, position=target, copies=[c])
+
+
+def _step_together(batched, singles: list, arm: int, t: int) -> None:
+    """One step of every Simulation and of the batched one; each copy's swing and wrist at its
+    Simulation's positions, bit for bit."""
+    for s in singles:
+        s.step()
+    batched.step()
+    for c, s in enumerate(singles):
+        for name in ("swing", "wrist"):
+            got = batched.joints.position[c, batched.joints.of(arm, name)]
+            assert got.tobytes() == np.float64(s.robot("arm").joints[name].position).tobytes(), (t, c, name)
+
+
 @pytest.mark.parametrize("precision", ["exact", "fast"])
 def test_every_copy_sees_its_own_links_as_its_simulation_bit_for_bit(precision):
     """Three copies and a Simulation per copy (seeds 3, 4, 5), 200 steps; every 40 steps each copy's
@@ -173,15 +191,9 @@ def test_every_copy_sees_its_own_links_as_its_simulation_bit_for_bit(precision):
                     # (the swing now and then straight ahead or back: the bar between a lamp and a light sensor)
                     pick = rng.integers(3) if name == "swing" else 2
                     target = (0.0, math.pi, float(rng.uniform(-span, span)))[pick]
-                    singles[c].robot(robot).motor(name).set_position(target)
-                    batched.joints.command(batched.slot(robot), name, position=target, copies=[c])
-        for s in singles:
-            s.step()
-        batched.step()
+                    _command(batched, singles, c, robot, name, target)
+        _step_together(batched, singles, arm, t)
         for c, s in enumerate(singles):
-            for name in ("swing", "wrist"):
-                got = batched.joints.position[c, batched.joints.of(arm, name)]
-                assert got.tobytes() == np.float64(s.robot("arm").joints[name].position).tobytes(), (t, c, name)
             for robot, names in DEVICES.items():
                 for name in names:
                     got, want = _reading(batched, s, c, robot, name)
@@ -485,15 +497,9 @@ def test_devices_riding_a_link_see_its_shapes_as_their_simulation_bit_for_bit(ca
                 for robot, name, span in (("arm", "swing", math.pi), ("arm", "wrist", 1.2),
                                           ("watcher", "flag pan", math.pi)):
                     target = float(rng.uniform(-span, span))
-                    singles[c].robot(robot).motor(name).set_position(target)
-                    batched.joints.command(batched.slot(robot), name, position=target, copies=[c])
-        for s in singles:
-            s.step()
-        batched.step()
+                    _command(batched, singles, c, robot, name, target)
+        _step_together(batched, singles, arm, t)
         for c, s in enumerate(singles):
-            for name in ("swing", "wrist"):
-                got = batched.joints.position[c, batched.joints.of(arm, name)]
-                assert got.tobytes() == np.float64(s.robot("arm").joints[name].position).tobytes(), (t, c, name)
             for name, ref in refs.items():
                 got, want = _reading(batched, s, c, *_at(name))
                 assert got == want, (t, c, name)

@@ -44,7 +44,11 @@ def _read(text: str) -> Node:
 
 def _as_written(world: Path, def_name: str) -> Node:
     """The node of that DEF as the world file writes it (our parser on the file itself)."""
-    todo: list = list(parse_wbt(world.read_text(), str(world)).nodes)
+    return _find_def(list(parse_wbt(world.read_text(), str(world)).nodes), def_name)
+
+
+def _find_def(todo: list, def_name: str) -> Node:
+    """The node of DEF ``def_name`` among the parsed nodes ``todo`` and everything under them."""
     while todo:
         v = todo.pop()
         if isinstance(v, Node):
@@ -171,16 +175,7 @@ def _in_body(proto: Path, def_name: str) -> Node:
 
     text = proto.read_text()
     body = text[text.index("\n]\n{") + 4:text.rindex("}")]
-    todo: list = [Parser(Tokens(body, str(proto)), str(proto), proto_body=True).node(0)]
-    while todo:
-        v = todo.pop()
-        if isinstance(v, Node):
-            if v.def_name == def_name:
-                return v
-            todo.extend(v.fields.values())
-        elif isinstance(v, list):
-            todo.extend(v)
-    raise AssertionError(def_name)
+    return _find_def([Parser(Tokens(body, str(proto)), str(proto), proto_body=True).node(0)], def_name)
 
 
 BODY = REPO / "tests" / "worlds" / "export_body.wbt"
