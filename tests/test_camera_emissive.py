@@ -1,7 +1,7 @@
 """Emissive colours in camera images, as Webots' shaders add them: WREN's phong.frag writes
 ``emissive + ambient + diffuse (+ specular)`` and pbr.frag adds the emissive colour to the lit one,
-so a surface of albedo d, emissive colour e (a PBRAppearance's ``emissiveIntensity`` left out, as WREN's
-shadow-volume shader leaves it out; its forward shader would apply it: a departure, README)
+so a surface of albedo d, emissive colour e (a PBRAppearance's ``emissiveIntensity`` 1 here; where WREN's
+forward shader multiplies by it: tests/test_camera_emissive_intensity.py)
 sends ``d·Σ lights + e`` into the HDR buffer, and glows with ``e`` alone where no light reaches.
 
 Closed forms: a camera at the origin looking along +x at a flat wall (face x = 1.95) lit by an
@@ -78,12 +78,9 @@ Robot {{ children [ Camera {{ name "cam" width 9 height 7 fieldOfView 1 }} ] con
 @pytest.mark.parametrize("appearance, glow", [
     ("Appearance { material Material { diffuseColor 0.6 0.3 0.15 emissiveColor 0.05 0.4 0.7 } }", GLOW),
     ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 }", GLOW),
-    ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 emissiveIntensity 0.5 }", GLOW),
-    ("PBRAppearance { baseColor 0.6 0.3 0.15 metalness 0 emissiveColor 0.05 0.4 0.7 emissiveIntensity -2 }", GLOW),
 ])
 def test_a_world_files_emissive_colours_are_drawn(tmp_path: Path, appearance: str, glow):
-    """A Material's emissiveColor; a PBRAppearance's, whatever its emissiveIntensity (left out, as WREN's
-    shadow-volume shader leaves it out outside wireframe rendering; Webots resets no negative one)."""
+    """A Material's emissiveColor; a PBRAppearance's (its emissiveIntensity: test_camera_emissive_intensity.py)."""
     path = tmp_path / "glow.wbt"
     path.write_text(WBT.format(appearance=appearance))
     sim = Simulation(load_world(path))

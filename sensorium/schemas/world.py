@@ -404,8 +404,9 @@ class Appearance(Strict):
     a PBRAppearance's baseColor by its baseColorMap; a textured Appearance's diffuse colour is
     replaced by white). ``roughness_map``/``occlusion_map`` (red channel) are read only where
     ``texture`` is set, as in Webots. Cameras add ``emissive_color`` to the light a surface sends
-    (Webots' Material ``emissiveColor``; a PBRAppearance's ``emissiveColor``, its ``emissiveIntensity``
-    left out: WREN applies it in its forward shader only, not in the shadow-volume one)."""
+    (Webots' Material ``emissiveColor``; a PBRAppearance's ``emissiveColor`` times ``emissive_intensity``
+    where WREN's forward shader draws it: a translucent shape, or an opaque one while no light that is on
+    casts shadows)."""
 
     base_color: Vec3 = (1.0, 1.0, 1.0)
     emissive_color: Vec3 = (0.0, 0.0, 0.0)
@@ -415,6 +416,10 @@ class Appearance(Strict):
     roughness_map: TextureField = None
     occlusion_map: TextureField = None
     texture_transform: TextureTransform | None = None
+    emissive_intensity: float = Field(default=1.0, ge=0.0, description="Webots' PBRAppearance emissiveIntensity: "
+                                      "cameras multiply the emissive colour (or emissive_map texel) by it on a "
+                                      "translucent shape, and on an opaque one while no light that is on casts "
+                                      "shadows (WREN's shadow-volume shader leaves it out); not read with phong")
     emissive_map: TextureField = Field(default=None, description="Webots' PBRAppearance emissiveColorMap: cameras "
                                        "take its texel, as stored (no sRGB decoding), for the emissive colour, as "
                                        "WREN's PBR shaders do; read with or without a texture")

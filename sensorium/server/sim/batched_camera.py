@@ -51,8 +51,10 @@ from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import (
     _base_color,
     emissive_arrays,
+    emissive_intensities,
     emissive_of,
     emissive_rows,
+    emissive_scale,
     receives_shadows,
     scene_robot_parts,
     surface_colors,
@@ -188,7 +190,17 @@ class CameraDevices(PixelDevices):
         self.transparency = np.array([m.appearance.transparency if m.appearance is not None else 0.0
                                       for m in models] + [0.0])
         self.emissive, self.emissive_texel = emissive_arrays([emissive_of(m) for m in models], models)
+        self.emissive_intensity = None if self.emissive is None else emissive_intensities(models)
         self.clear = bool((self.transparency > 0.0).any())     # semi-transparent surfaces: layers per copy
+
+    def _shadow_volumes(self, copies: np.ndarray) -> np.ndarray:
+        """Per copy whether a light that is on casts shadows (WREN then draws opaque shapes with its
+        shadow-volume shaders, which leave emissiveIntensity out): an LED's lights count in the copies
+        where it is on."""
+        carried = self.sim.carried
+        if carried is None:
+            return np.full(len(copies), bool(self.shadows.any()))
+        return np.array([bool(carried.shadows(int(c), self._fixed_shadows).any()) for c in copies], dtype=bool)
 
     def _lights_of(self, copy: int) -> light_math.LightArrays:
         """The lights copy ``copy`` (a copy of the simulation) shades with: its robots' at its poses."""
@@ -341,6 +353,9 @@ class CameraDevices(PixelDevices):
             s = shape.take(kk)
             glow = emissive_rows(self.emissive, s)
             albedo = self._albedo(s, org, row_copy, Dk, tk, copies, glow)
+            if glow is not None and self.emissive_intensity is not None:
+                emissive_scale(glow, self.emissive_intensity, ~receives_shadows(self.transparency,
+                               self._translucent_shapes(), s), s, self._shadow_volumes(copies)[row_copy])
             lit = None
             if self.shadows.any():
                 translucent = self._translucent_shapes()
@@ -423,6 +438,9 @@ class CameraDevices(PixelDevices):
             zeros = np.zeros(len(s), dtype=np.int64)
             glow = emissive_rows(self.emissive, s)
             albedo = self._albedo(s, origin[None, :], zeros, D, t, copy, glow)
+            if glow is not None and self.emissive_intensity is not None:
+                emissive_scale(glow, self.emissive_intensity, ~receives_shadows(self.transparency, translucent, s), s,
+                               bool(self._shadow_volumes(copy[:1])[0]))
             lit = None
             if self.shadows.any():    # on opaque surfaces only, as Camera's surface
                 lit = np.ones((len(s), len(self.shadows)), dtype=bool)

@@ -23,7 +23,7 @@ from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import blocks
 from sensorium.server.raycast.engine import RayHits, RayKind, Riding
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
-from sensorium.server.sim.scene import emissive_rows, light_from_model
+from sensorium.server.sim.scene import emissive_rows, emissive_scale, light_from_model
 from sensorium.server.sim.sensors import Device, Schedule
 from sensorium.server.sim.sensors import _check_period as _period
 from sensorium.server.world.geometry import Pose
@@ -646,6 +646,8 @@ class Camera(Device):
             texel = scene.emissive_texel
             albedo = scene.surface_colors(s, np.broadcast_to(origin, (len(s), 3)), D, t,
                                           None if glow is None or texel is None else (glow, texel))
+            if glow is not None and scene.emissive_intensity is not None:
+                emissive_scale(glow, scene.emissive_intensity, ~scene.receives_shadows(s), s, bool(shadows.any()))
             lit = None
             if shadows.any():    # shadows fall on opaque surfaces only (Webots' translucent ones take none)
                 on = scene.receives_shadows(s).nonzero()[0]

@@ -82,11 +82,34 @@ def _base_color(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
 
 def emissive_of(shape: wm.Shape | wm.Solid) -> tuple[float, float, float]:
     """The radiance a shape's surface sends whatever the lights: its emissive colour (Webots' Phong
-    and PBR shaders add it to the lit colour; a PBRAppearance's emissiveIntensity is left out)."""
+    and PBR shaders add it to the lit colour; a PBRAppearance's emissiveIntensity, which only WREN's
+    forward shader applies, comes on top: :func:`emissive_scale`)."""
     a = shape.appearance
     if a is None:
         return (0.0, 0.0, 0.0)
     return tuple(float(v) for v in a.emissive_color)  # type: ignore[return-value]
+
+
+def emissive_intensities(models: list[wm.Shape | wm.Solid]) -> np.ndarray | None:
+    """Per shape (and a trailing 1 for no hit) a PBRAppearance's emissiveIntensity (1 for an
+    ``Appearance`` node's, which has none), or None when every one is 1."""
+    values = [1.0 if m.appearance is None or m.appearance.phong else float(m.appearance.emissive_intensity)
+              for m in models]
+    return np.array(values + [1.0]) if any(v != 1.0 for v in values) else None
+
+
+def emissive_scale(glow: np.ndarray, intensity: np.ndarray, translucent: np.ndarray, shape: np.ndarray,
+                   shadow_volumes: bool | np.ndarray) -> None:
+    """Multiply the hits' emissive rows ``glow`` (n, 3: colour or emissiveColorMap texel) in place by
+    their shapes' emissiveIntensity where WREN's forward shader draws them: a ``translucent`` hit
+    (its translucent pass) always, an opaque one only while no light that is on casts shadows
+    (``shadow_volumes`` False); WREN's shadow-volume ambient-emissive shader, which draws opaque
+    shapes otherwise, applies the intensity in wireframe rendering only. ``shadow_volumes``: one
+    answer, or one per hit (a batched camera's copies)."""
+    k = np.take(intensity, shape)
+    if np.any(shadow_volumes):
+        k = np.where(translucent | ~np.asarray(shadow_volumes, dtype=bool), k, 1.0)
+    glow *= k[:, None]
 
 
 def emissive_rows(emissive: np.ndarray | None, shape: np.ndarray) -> np.ndarray | None:
@@ -642,8 +665,11 @@ class Scene:
     def _rebuild_emissive(self) -> None:
         """Every shape's emissive row now and how a texture makes it (``emissive_texel``, see
         :func:`emissive_arrays`: both None when nothing glows)."""
+        models = [m for _, _, m in self._parts]
         self.emissive, self.emissive_texel = emissive_arrays(
-            [self._emissive_now(k, m) for k, (_, _, m) in enumerate(self._parts)], [m for _, _, m in self._parts])
+            [self._emissive_now(k, m) for k, m in enumerate(models)], models)
+        # a PBRAppearance's emissiveIntensity per shape (None: all 1, or nothing glows): emissive_scale
+        self.emissive_intensity = None if self.emissive is None else emissive_intensities(models)
 
     def _refresh_emissive(self, shape: int) -> None:
         """One shape's emissive row after its model or glow changed: the arrays built when it is the first
@@ -651,17 +677,21 @@ class Scene:
         model = self._parts[shape][2]
         glow = self._emissive_now(shape, model)
         code = _emissive_texel(model)
-        if self.emissive is None or (self.emissive_texel is None and code):
-            if any(glow) or code:
+        intensity = emissive_intensities([model])
+        if self.emissive is None or (self.emissive_texel is None and code) or \
+                (self.emissive_intensity is None and intensity is not None):
+            if self.emissive is not None or any(glow) or code:
                 self._rebuild_emissive()
             return
         self.emissive[shape] = glow
+        if self.emissive_intensity is not None:
+            self.emissive_intensity[shape] = 1.0 if intensity is None else intensity[0]
         if self.emissive_texel is not None:
             self.emissive_texel[shape] = code
             if not self.emissive_texel.any():
                 self.emissive_texel = None
         if not self.emissive.any() and (self.emissive_texel is None or not (self.emissive_texel == FROM_MAP).any()):
-            self.emissive = self.emissive_texel = None
+            self.emissive = self.emissive_texel = self.emissive_intensity = None
 
     def _emissive_now(self, shape: int, model: wm.Shape | wm.Solid) -> tuple[float, float, float]:
         """:func:`emissive_of` a shape, its colour a Charger's glow (``set_glow``) where it has one."""

@@ -482,11 +482,12 @@ def appearance(node: Node | None, source: str, warn, resolve=None, reset: Reset 
         out: dict[str, Any] = {"base_color": list(f.color("baseColor", (1.0, 1.0, 1.0))),
                                "transparency": f.within("transparency", 0.0, 0.0, 1.0, 0.0),
                                "roughness": f.within("roughness", 0.0, 0.0, 1.0, 0.0)}
-        # emissiveIntensity is not read: WREN's shadow-volume shader applies it in wireframe rendering only,
-        # its forward shader (no light casting shadows, translucent shapes) always (a departure: README)
         emissive = f.color("emissiveColor", (0.0, 0.0, 0.0))
         if any(emissive):          # (the model's defaults otherwise: a world without glow dumps as before)
             out["emissive_color"] = list(emissive)
+        intensity = f.non_negative("emissiveIntensity", 1.0, 1.0)    # (WbPbrAppearance: a negative one is reset to 1)
+        if intensity != 1.0:
+            out["emissive_intensity"] = intensity
         base = image_texture(f.node_("baseColorMap"), source, warn, resolve)
         if base is not None:
             out["texture"] = base
