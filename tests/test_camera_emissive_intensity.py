@@ -140,3 +140,36 @@ def test_every_copy_applies_the_intensity_as_the_single_simulation(precision: st
     for c in range(len(x)):
         L = (0.5 if glass else 1.0) * (np.asarray(DIFFUSE) * (0.3 + 0.6) + k * np.asarray(GLOW))
         np.testing.assert_array_equal(centre[c], byte(L), err_msg=str(c))
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_an_leds_shadow_casting_light_changes_the_glow_in_the_copies_where_it_is_on(precision: str):
+    """An LED at the camera holding a white point light that casts shadows (0.8, no attenuation), on in
+    copy 0 only: there the centre pixel reads ``d·(0.3 + 0.8) + e``, in copy 1 (LED off, no light
+    casting shadows) ``0.3·d + e·I``; each copy's bytes are its single simulation's."""
+    from sensorium.server.sim.batched import BatchedSimulation
+    led = {"device": "LED", "name": "led", "color": [[1.0, 1.0, 1.0]], "lights": [point(None, cast_shadows=True)]}
+    lw = _carried(False, False)
+    robot = lw.world.robots[0]
+    robot = robot.model_validate({**robot.model_dump(mode="json", exclude_defaults=True), "lights": [],
+                                  "devices": [*robot.model_dump(mode="json", exclude_defaults=True)["devices"], led]})
+    lw = LoadedWorld(world=lw.world.model_copy(update={"robots": [robot]}), source="<test>", base_dir=Path.cwd())
+    bs = BatchedSimulation(lw, 2, precision=precision)
+    ref = bs.device("bot", "cam")
+    bs.enable(ref, 8)
+    bs.set_led(bs.slot("bot"), "led", 1, [0])
+    singles = []
+    for c in range(2):
+        single = Simulation(lw, precision=precision)
+        single.robot("bot").device("cam").enable(8)
+        if c == 0:
+            single.device("bot/led").set(1, single.time_ms)
+        singles.append(single)
+    bs.step()
+    img = bs.image(ref)
+    for c, single in enumerate(singles):
+        single.step()
+        assert img[c].tobytes() == single.robot("bot").device("cam").image.tobytes(), c
+    d, e = np.asarray(DIFFUSE), np.asarray(GLOW)
+    np.testing.assert_array_equal(img[0, 2, 5, 2::-1].astype(np.int64), byte(d * 1.1 + e))
+    np.testing.assert_array_equal(img[1, 2, 5, 2::-1].astype(np.int64), byte(d * 0.3 + INTENSITY * e))
