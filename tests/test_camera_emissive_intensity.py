@@ -21,7 +21,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, load_world
 from tests.test_batched_camera import images_with_robot_placed
-from tests.test_camera_emissive import DIFFUSE, GLOW, world
+from tests.test_camera_emissive import DIFFUSE, GLOW, MAP_TEXEL, world
 from tests.test_camera_light_radius import AMBIENT, byte, point, rays
 
 INTENSITY = 2.5
@@ -173,3 +173,15 @@ def test_an_leds_shadow_casting_light_changes_the_glow_in_the_copies_where_it_is
     d, e = np.asarray(DIFFUSE), np.asarray(GLOW)
     np.testing.assert_array_equal(img[0, 2, 5, 2::-1].astype(np.int64), byte(d * 1.1 + e))
     np.testing.assert_array_equal(img[1, 2, 5, 2::-1].astype(np.int64), byte(d * 0.3 + INTENSITY * e))
+
+
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+def test_an_emissive_maps_texel_is_multiplied_by_the_intensity(tmp_path: Path, precision: str):
+    """pbr.frag multiplies the emissiveColorMap's texel (as stored) by the intensity too: in a world
+    without light (no light casts shadows) the box reads the resolve of ``I·texel/255``."""
+    from PIL import Image
+    Image.fromarray(np.full((2, 2, 3), MAP_TEXEL, dtype=np.uint8), "RGB").save(tmp_path / "m.png")
+    app = {"base_color": DIFFUSE, "emissive_map": "m.png", "emissive_intensity": INTENSITY}
+    sim = Simulation(world([], app), precision=precision, base_dir=tmp_path)
+    got = _shot(sim)
+    np.testing.assert_array_equal(got, np.broadcast_to(byte(INTENSITY * np.asarray(MAP_TEXEL) / 255.0), got.shape))
