@@ -81,45 +81,42 @@ def test_the_e_puck2_stand_in_loads_its_model_and_the_devices_the_e_puck_control
     assert (camera.width, camera.height) == (160, 120)
 
 
-def test_the_e_puck_calls_drive_the_e_puck2_by_its_closed_form_readings_and_arcs() -> None:
-    """e-puck.c's calls in process for 36.992 s (578 steps of 64 ms, the sensors' noise zeroed in the
-    stand-in): each step the eight infra-red sensors read the table at the ray's distance to the
-    nearest wall or box face (white: the distance itself; 67.19 past 0.07 m), the wheels' sensors read
-    their angles rounded to 0.00628 rad, the accelerometer reads 9.81 up while the robot drives straight,
-    and the pose is the arc of the wheel speeds set from the readings (1e-9). In open space both wheels
-    turn at 1.572 × (1 − 67.19/512) = 1.36571 rad/s: 0.0273141 m/s along its heading, until ps0 and ps7
-    meet the wall at y 1 (ps0 first, at 33.216 s, the robot at y 0.9055 = 0.0273141 × 33.152 s), where it
-    turns left, away from it, to (−0.0030, 0.9588) heading 2.9750 at 36.992 s."""
-    sim = Simulation(load_world(DATA / "e-puck2.wbt"), "exact")
-    robot = sim.robot(EP)
+def run_e_puck(world: str, name: str, yaw0: float, duration_ms: int) -> tuple[int, tuple[int, int] | None, list[float]]:
+    """e-puck.c's calls in process on ``world`` for ``duration_ms`` (the sensors' noise zeroed in the
+    stand-in), each step checked against the closed forms: the eight infra-red sensors read the table at
+    the ray's distance to the nearest wall or box face (white: the distance itself; 67.19 past 0.07 m),
+    the wheels' sensors their angles rounded to 0.00628 rad, the accelerometer 9.81 up while the robot
+    drives straight, and the pose is the arc of the wheel speeds set from the readings (1e-9). Returns
+    the step the model chose, when and which sensor first met something, and the final x, y, yaw."""
+    sim = Simulation(load_world(DATA / world), "exact")
+    robot = sim.robot(name)
     step = 64 if robot.model.model == "GCtronic e-puck2" else 256
-    assert step == 64 and sim.basic_time_step == 32
-    sim.device(f"{EP}/camera").enable(step)
-    accelerometer = sim.device(f"{EP}/accelerometer")
+    sim.device(f"{name}/camera").enable(step if step == 64 else 1024)
+    accelerometer = sim.device(f"{name}/accelerometer")
     accelerometer.enable(step)
     left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
     for m in (left, right):
         m.set_position(math.inf)
         m.set_velocity(0.0)
-    wheel_sensors = [sim.device(f"{EP}/left wheel sensor"), sim.device(f"{EP}/right wheel sensor")]
+    wheel_sensors = [sim.device(f"{name}/left wheel sensor"), sim.device(f"{name}/right wheel sensor")]
     for s in wheel_sensors:
         s.enable(step)
-    ps = [sim.device(f"{EP}/ps{i}") for i in range(8)]
+    ps = [sim.device(f"{name}/ps{i}") for i in range(8)]
     for s in ps:
         s.enable(step)
     obstacles = ep_obstacles()
     rays = [(np.array([x, y, 0.033]), rot(axis, angle) @ rot((0, 0, 1), 0.16) @ np.array([1.0, 0.0, 0.0]))
             for x, y, axis, angle in EP_RING]
-    turn0 = rot((0, 0, 1), 1.57)
-    x, y, yaw, wl, wr = 0.0, 0.0, 1.57, 0.0, 0.0
+    turn0 = rot((0, 0, 1), yaw0)
+    x, y, yaw, wl, wr = 0.0, 0.0, yaw0, 0.0, 0.0
     angles = [0.0, 0.0]
     first_seen = None
-    for k in range(1, 579):
+    for k in range(1, duration_ms // step + 1):
         for _ in range(step // sim.basic_time_step):
             sim.step()
         x, y, yaw = ep_move_on(x, y, yaw, wl, wr, step / 1000)
         angles = [angles[0] + wl * step / 1000, angles[1] + wr * step / 1000]
-        body = rot((0, 0, 1), yaw - 1.57) @ turn0
+        body = rot((0, 0, 1), yaw - yaw0) @ turn0
         assert list(robot.pose.translation) == pytest.approx([x, y, 0.0], abs=1e-9), k
         assert np.asarray(robot.pose.rotation) == pytest.approx(body, abs=1e-9), k
         values = []
@@ -136,5 +133,28 @@ def test_the_e_puck_calls_drive_the_e_puck2_by_its_closed_form_readings_and_arcs
         wl, wr = (sum(c[side] * (1.0 - v / 512) for c, v in zip(EP_WEIGHTS, values, strict=True)) for side in (0, 1))
         left.set_velocity(wl)
         right.set_velocity(wr)
-    assert first_seen == (33216, 0), first_seen
-    assert [x, y, yaw] == pytest.approx([-0.0030, 0.9588, 2.9750], abs=1e-4)
+    return step, first_seen, [x, y, yaw]
+
+
+def test_the_e_puck_calls_drive_the_e_puck2_by_its_closed_form_readings_and_arcs() -> None:
+    """e-puck2: the controller picks 64 ms from the model; for 36.992 s (578 steps) every reading and
+    pose meets run_e_puck's closed forms. In open space both wheels turn at 1.572 × (1 − 67.19/512) =
+    1.36571 rad/s: 0.0273141 m/s along its heading, until ps0 and ps7 meet the wall at y 1 (ps0 first,
+    at 33.216 s, the robot at y 0.9055 = 0.0273141 × 33.152 s), where it turns left, away from it, to
+    (−0.0030, 0.9588) heading 2.9750 at 36.992 s."""
+    step, first_seen, end = run_e_puck("e-puck2.wbt", EP, 1.57, 36992)
+    assert step == 64 and first_seen == (33216, 0), (step, first_seen)
+    assert end == pytest.approx([-0.0030, 0.9588, 2.9750], abs=1e-4)
+
+
+def test_the_e_puck_calls_drive_the_kinematic_e_puck_by_the_same_closed_forms() -> None:
+    """e-puck_kinematic: the version-1 E-puck without Physics (Webots moves such a two-wheel robot by its
+    wheels' speeds, as Sensorium moves every robot): the controller picks 256 ms from the model "GCtronic
+    e-puck"; the same closed forms hold every step for 40.96 s (160 steps): ps0 meets the wall at
+    33.536 s, the robot then turning left to (−0.0792, 0.9214) heading −2.5771. The stand-in loads
+    without mass (nothing to settle) and with the version-1 wheels' maxVelocity, 6.28 rad/s."""
+    step, first_seen, end = run_e_puck("e-puck_kinematic.wbt", "e-puck", 1.571595307179586, 40960)
+    assert step == 256 and first_seen == (33536, 0), (step, first_seen)
+    assert end == pytest.approx([-0.0792, 0.9214, -2.5771], abs=1e-4)
+    (robot,) = load_world(DATA / "e-puck_kinematic.wbt").world.robots
+    assert robot.mass is None and robot.model == "GCtronic e-puck" and robot.differential_drive.max_wheel_speed == 6.28
