@@ -148,9 +148,10 @@ def test_the_e_puck_calls_drive_the_e_puck2_by_its_closed_form_readings_and_arcs
 
 
 def test_the_e_puck_calls_drive_the_kinematic_e_puck_by_the_same_closed_forms() -> None:
-    """e-puck_kinematic: the version-1 E-puck without Physics (Webots moves such a two-wheel robot by its
-    wheels' speeds, as Sensorium moves every robot): the controller picks 256 ms from the model "GCtronic
-    e-puck"; the same closed forms hold every step for 40.96 s (160 steps): ps0 meets the wall at
+    """e-puck_kinematic: the version-1 E-puck without Physics: the controller picks 256 ms from the model
+    "GCtronic e-puck"; the same closed forms hold every step for 40.96 s (160 steps) (Webots' own
+    kinematic rule for a robot without Physics takes a 3D axle of 0.0656 m and mid-step headings: a
+    departure the README names, not fixed by this sweep): ps0 meets the wall at
     33.536 s, the robot then turning left to (−0.0792, 0.9214) heading −2.5771. The stand-in loads
     without mass (nothing to settle) and with the version-1 wheels' maxVelocity, 6.28 rad/s."""
     step, first_seen, end = run_e_puck("e-puck_kinematic.wbt", "e-puck", 1.571595307179586, 40960)
