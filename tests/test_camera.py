@@ -175,6 +175,33 @@ def test_semi_transparent_surfaces_are_composited_front_to_back(pane_geometry):
     np.testing.assert_array_equal(rgb(img), np.broadcast_to(expected_bytes(L), (5, 5, 3)))
 
 
+@pytest.mark.parametrize("precision", ["fast", "exact"])
+@pytest.mark.parametrize("yaw", [0.0, 0.95])
+@pytest.mark.parametrize("offset", [(0.0, 0.0), (5e3, -5e3)])
+def test_a_half_transparent_box_wall_is_seen_once_at_every_pixel(precision, yaw, offset):
+    """A 0.1 m thick, 400 m wide half-transparent box wall turned by ``yaw`` 2 m before the camera, over
+    the black sky, lit by the ambient 0.3 and a point light at the camera (0.8·cos of each ray's
+    incidence): every pixel reads the resolve of 0.5·d·(0.3 + 0.8·cos), its front face composited once
+    and its back face culled, up to grazing incidence (cos 0.049 at the turned wall's edge) and 7 km
+    from the origin. FAST's float32 start past the front face once landed short of it at oblique pixels,
+    which met the face again, took it for the far face and the far face for a new one (23 to 40 levels
+    too bright)."""
+    cam = {"width": 15, "height": 11, "field_of_view": 1.2}
+    d = np.array([0.6, 0.3, 0.15])
+    wall = {"name": "wall", "pose": {"translation": [2.0 + offset[0], offset[1], 0.0], "rotation": [0, 0, 1, yaw]},
+            "geometry": {"type": "box", "size": [0.1, 400, 400]}, "appearance": {"base_color": d.tolist(),
+                                                                               "transparency": 0.5}}
+    lights = [{"type": "DirectionalLight", "direction": [1, 0, 0], "intensity": 0.0, "ambient_intensity": 0.3},
+              {"type": "PointLight", "location": [offset[0], offset[1], 0.0], "intensity": 0.8}]
+    _, img = shoot(wm.World.model_validate({
+        "world_info": {"basic_time_step": 16}, "solids": [wall], "lights": lights,
+        "robots": [{"name": "r", "pose": {"translation": [offset[0], offset[1], 0.0]},
+                    "devices": [{"device": "Camera", "name": "cam", **cam}]}]}), precision)
+    cos = -(rays(cam)[0] @ np.array([-math.cos(yaw), -math.sin(yaw), 0.0]))
+    assert cos.min() < 0.05 if yaw else cos.min() > 0.75      # (grazing at the turned wall's edge)
+    np.testing.assert_array_equal(rgb(img), expected_bytes(0.5 * d * (0.3 + 0.8 * cos)[..., None]))
+
+
 def test_background_and_far_plane():
     """Webots clears a camera's HDR buffer with the sky colour reverse tone mapped
     (WbBackground::applyColorToWren: -ln(1.000000001 - c^2.2)), so at exposure 1 the background

@@ -44,7 +44,7 @@ import numpy as np
 
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
-from sensorium.server.raycast.engine import RayHits, RayKind
+from sensorium.server.raycast.engine import Precision, RayHits, RayKind
 from sensorium.server.sim.batched_depth import PixelDevices, _Draws
 from sensorium.server.sim.cameras import Camera, _shade, camera_lights, composite, masked, noise_mask_planes
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
@@ -462,7 +462,7 @@ class CameraDevices(PixelDevices):
 
             alpha = (alpha_shapes, opacity)
         return composite(origin, dirs, hits, dev.limits, cast_on, self.transparency, scene.background, scene.fog,
-                         surface, alpha)
+                         surface, alpha, float32=scene.engine.precision is Precision.FAST)
 
     def _finish_image(self, col: int, copies: np.ndarray, out: np.ndarray) -> None:
         """Camera._capture_image from the radiance of every copy's rays: the samples' mean, the

@@ -21,7 +21,7 @@ from sensorium.schemas import world as wm
 from sensorium.server.devices import imaging, shading
 from sensorium.server.devices import light as light_math
 from sensorium.server.raycast import blocks
-from sensorium.server.raycast.engine import RayHits, RayKind, Riding
+from sensorium.server.raycast.engine import Precision, RayHits, RayKind, Riding
 from sensorium.server.sim.own_shapes import OwnBodyRays, cast_skipping
 from sensorium.server.sim.scene import emissive_rows, emissive_scale, light_from_model
 from sensorium.server.sim.sensors import Device, Schedule
@@ -238,8 +238,20 @@ MAX_LAYERS = 8
 most this many; the surface it meets after them is taken as opaque (its colour, even where its
 texel is clear), so a pixel never costs more than ``MAX_LAYERS + 1`` casts."""
 
+F32_PAST = 2.0 ** -15
+"""FAST: how far past a semi-transparent surface a ray goes on, per metre of |origin| + t, at normal
+incidence (divided by |cos| of the incidence, at most by 16). Its float32 start point (origin + t D
+rounded) and Embree's float32 distance to a large triangle (error growing with the vertices' distance
+from the ray's origin) can put the start on the surface's near side: the surface is met again, taken
+for its far face, and the real far face for a new entering one (a half-transparent box wall read 23 to
+40 levels too bright at oblique pixels). 2^-18 was the least that kept a 400 m wall exact up to grazing
+incidence (tests/test_camera.py); this is 8 times it. A far face nearer than that is passed with its
+front face, as back-face culling hides it anyway"""
+
+
 def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tuple[Any, Any], cast_on,
-              transparency: np.ndarray, background: np.ndarray, fog, surface, alpha=None) -> np.ndarray:
+              transparency: np.ndarray, background: np.ndarray, fog, surface, alpha=None,
+              float32: bool = False) -> np.ndarray:
     """The radiance (N, 3) along every ray of a camera at ``origin``: the surfaces it crosses
     composited front to back (semi-transparent ones let ``transparency`` of what is behind through;
     a closed shape's faces are crossed twice and only its entering face is seen, as with back-face
@@ -250,8 +262,9 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
     seen, before fog. ``alpha``: None in a world without alpha textures, else ``(shapes, opacity)``:
     ``shapes[s]`` whether shape s's image has transparent texels, ``opacity(shape, D, t)`` the
     texel alpha (n,) at hits on such shapes; a hit there lets ``1 − (1 − transparency)·alpha``
-    through (Webots' final alpha), and a fully clear texel is not shaded. The single camera and the
-    batched one (per copy) share it."""
+    through (Webots' final alpha), and a fully clear texel is not shaded. ``float32``: the casts are
+    FAST's float32 traversal, so a ray goes on past a surface by :data:`F32_PAST` of its reach (EXACT's
+    float64 hits: by 1e-7 m and 1e-12 of t). The single camera and the batched one (per copy) share it."""
     n = len(dirs)
     t_near, t_far = limits
     tn = tf = inside = None           # per-ray limits and the transparent shapes each ray is in: made
@@ -362,7 +375,14 @@ def composite(origin: np.ndarray, dirs: np.ndarray, first: RayHits, limits: tupl
         if (~ent).any():         # leaving: forget it
             lv = rg[~ent]
             inside[lv] = np.where(inside[lv] == sg[~ent][:, None], -1, inside[lv])
-        tn[rg] = t[k[g]] * (1.0 + 1e-12) + 1e-7      # just past this surface
+        kg = k[g]
+        tg = t[kg]
+        past = tg * (1.0 + 1e-12) + 1e-7                 # just past this surface
+        if float32:                                      # (beyond float32's rounding of the start point)
+            nd = np.abs(np.einsum("ij,ij->i", normal[kg], D[kg]))
+            reach = float(np.max(np.abs(origin))) + tg
+            past = np.maximum(past, tg + F32_PAST * reach / np.maximum(nd, 1.0 / 16.0))
+        tn[rg] = past
         rows = rg
     return out
 
@@ -669,7 +689,7 @@ class Camera(Device):
 
             alpha = (shapes, opacity)
         return composite(origin, dirs, first, self._limits, cast_on, scene.transparency, self._background, scene.fog,
-                         surface, alpha)
+                         surface, alpha, float32=engine.precision is Precision.FAST)
 
     def _shadows(self, P: np.ndarray, N: np.ndarray, lights: light_math.LightArrays, shadows: np.ndarray,
                  counters: Any) -> np.ndarray:
