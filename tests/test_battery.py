@@ -486,6 +486,41 @@ def test_a_battery_write_out_of_its_values_is_one_line_and_changes_nothing(args:
     assert (b.energy, b.maximum, b.speed) == (5.0, 10.0, 1.0)
 
 
+@pytest.mark.parametrize("value", [0.0, 1e-30, 5e-324, 1e-31, 9.99e-31, 1e9, 1e9 * (1 + 2 ** -52), 2e9, 1e300])
+def test_a_battery_or_cpu_consumption_write_takes_exactly_what_a_world_file_takes(value: float) -> None:
+    """The same number in a world file and in a Supervisor's write of each battery item and of
+    cpuConsumption: both take it or both refuse it, the write's one line in the loader's words."""
+    for field in ("battery[0]", "battery[1]", "battery[2]", "cpu_consumption"):
+        battery = [5.0, 10.0, 1.0]
+        at = int(field[-2]) if field.startswith("battery") else None
+        robot: dict = {"name": "r", "battery": battery, "cpu_consumption": 2.0}
+        if at is None:
+            robot["cpu_consumption"] = value
+        else:
+            robot["battery"] = [value if i == at else b for i, b in enumerate(battery)]
+        try:
+            world([robot])
+            loader = None
+        except WorldError as e:
+            (loader,) = str(e).splitlines()
+            loader = loader.split(f"{field}: ", 1)[1]
+        sim, call, node = supervised(world([{"name": "r", "def_name": "R", "battery": battery, "cpu_consumption": 2.0},
+                                            {"name": "boss", "supervisor": True}]))
+        args = {"field": "cpuConsumption", "value": value} if at is None else \
+            {"field": "battery", "op": "set", "index": at, "value": value}
+        got = call("/boss/robot/set_field", {"node": node, **args})
+        b = sim.robots["r"].battery
+        now = (b.energy, b.maximum, b.speed, b.cpu)
+        if loader is None:
+            assert got["ok"] is True, (field, got)
+            assert now[3 if at is None else at] == value
+        else:
+            message = got["error"]["message"]
+            assert got["ok"] is False and message.endswith(f"{loader}; nothing changed") and "\n" not in message, \
+                (field, message)
+            assert now == (5.0, 10.0, 1.0, 2.0)
+
+
 def test_a_proto_robots_battery_field_passing_through_is_is_written_the_same_way() -> None:
     # tests/protos/battery/Cell.proto: battery IS battery ([5, 10, 1]), cpuConsumption IS cpu (31.25 W: 1 J a step)
     from sensorium.server.daemon import supervisor as sv

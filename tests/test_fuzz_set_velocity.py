@@ -3,7 +3,7 @@ a server: velocities of every shape (lists and tuples of 0..8 items, NaN, infini
 a double, strings, None, nested lists, numpy arrays) on node ids valid and not. Each call returns None and
 prints at most one line; six finite zeros on a node other than the root ask the server ``reset_physics`` of
 that node and print nothing; on the root (no Solid) they print Webots' warning and ask nothing (the root's
-``reset_physics`` would stop every falling solid); any other velocity asks nothing."""
+``reset_physics`` would stop every falling solid); any other velocity asks nothing (but the node's type)."""
 
 from __future__ import annotations
 
@@ -53,12 +53,13 @@ def test_set_velocity_answers_each_call_with_at_most_one_line(monkeypatch, capsy
         fake.calls.clear()
         assert ws.wb_supervisor_node_set_velocity(n, v) is None
         err = capsys.readouterr().err
+        asked = [c for c in fake.calls if not c.endswith("/get_from_id")]      # (the node's type: a question only)
         assert err.count("\n") <= 1 and (err == "" or err.endswith("\n")), err
         valid_node = isinstance(n, int) and not isinstance(n, bool) and 0 <= n < 1 << 31
         if valid_node and _six_finite_zeros(v) and n != 0:
-            assert fake.calls == ["/boss/robot/reset_physics"] and err == ""
+            assert asked == ["/boss/robot/reset_physics"] and err == ""
         else:
-            assert fake.calls == [], (n, v)
+            assert asked == [], (n, v)
             assert err.startswith(("Error: ", "Warning: ")) and FUNC in err, (n, v, err)
         if valid_node and n == 0 and _six_finite_zeros(v):
             assert err == f"Warning: {FUNC}() can exclusively be used with a Solid.\n"
@@ -87,16 +88,50 @@ def test_set_velocity_of_the_root_or_of_characters_asks_nothing(monkeypatch, cap
     assert capsys.readouterr().err == f"Error: {FUNC}(): expected 6 numbers, got 100.\n"
     ws.wb_supervisor_node_set_velocity(7, ["x"] * 100_000)                  # its line stays short
     assert len(capsys.readouterr().err) < 200
-    assert fake.calls == ["/boss/robot/reset_physics"]
+    assert fake.calls == ["/boss/robot/get_from_id", "/boss/robot/reset_physics"]
     ws.wb_supervisor_node_set_velocity(7, np.zeros(6))
-    assert fake.calls == ["/boss/robot/reset_physics"] * 2 and capsys.readouterr().err == ""
+    assert fake.calls == ["/boss/robot/get_from_id", "/boss/robot/reset_physics"] * 2 and capsys.readouterr().err == ""
+
+
+class _TypedSupervisor(_FakeSupervisor):
+    """The fake, its get_from_id answering a node of type ``kind``."""
+
+    kind = "Solid"
+
+    def call(self, service: str, args: dict | None = None) -> dict:
+        super().call(service, args)
+        return {"type": self.kind, "id": 7} if service.endswith("/get_from_id") else {}
+
+
+@pytest.mark.parametrize(("kind", "solid"), [
+    ("Solid", True), ("Robot", True), ("Charger", True), ("Track", True), ("Camera", True), ("Connector", True),
+    ("Pose", False), ("Transform", False), ("Group", False), ("Shape", False), ("HingeJoint", False),
+    ("RotationalMotor", False), ("PositionSensor", False), ("Propeller", False), ("Skin", False)])
+def test_set_velocity_of_a_node_that_is_no_solid_is_webots_warning_and_asks_no_change(
+        monkeypatch, capsys, kind: str, solid: bool) -> None:
+    """Webots' Solid and the nodes derived from it (Robot, Charger, Track, the devices that are Solids) take
+    setVelocity (zeros: ``reset_physics``); any other node, whatever the velocity, is Webots' warning each call
+    and no request but its type."""
+    fake = _TypedSupervisor()
+    fake.kind = kind
+    monkeypatch.setattr(ws, "_supervisor", lambda func: fake)
+    monkeypatch.setattr(ws, "_set_velocity_warned", [])
+    for velocity in ([0.0] * 6, [0.0] * 6, [1.0] + [0.0] * 5):
+        ws.wb_supervisor_node_set_velocity(7, velocity)
+    err = capsys.readouterr().err
+    if solid:
+        assert fake.calls == ["/boss/robot/get_from_id", "/boss/robot/reset_physics"] * 2 + ["/boss/robot/get_from_id"]
+        assert err.startswith(f"Warning: {FUNC}(): a velocity other than zero is ignored") and err.count("\n") == 1
+    else:
+        assert fake.calls == ["/boss/robot/get_from_id"] * 3
+        assert err == f"Warning: {FUNC}() can exclusively be used with a Solid.\n" * 3
 
 
 @pytest.mark.slow
 def test_a_c_supervisors_hostile_set_velocity_calls_are_one_line_each(tmp_path_factory) -> None:
     """tests/c/set_velocity_bad.c, built with sanitizers, through ``sensorium serve`` on tests/worlds/
     reset_falls.wbt: a NULL node, a NULL velocity, NaN and infinities at each of the six places are Webots'
-    lines; zeros on the root are its warning and stop nothing (the box lifted to 1 m still falls at
+    lines; zeros on the root and on the box's Shape are its warning each and stop nothing (the box lifted to 1 m still falls at
     −g·t, t = 4 steps of 16 ms); a denormal is the one warning; zeros with -0.0 stop the box."""
     import json
     from pathlib import Path
@@ -115,6 +150,6 @@ def test_a_c_supervisors_hostile_set_velocity_calls_are_one_line_each(tmp_path_f
         f"Error: {FUNC}() called with a NULL or invalid 'node' argument.",
         f"Error: {FUNC}() called with NULL argument.",
         *[f"Error: {FUNC}() called with a NaN or infinite value."] * 6,
-        f"Warning: {FUNC}() can exclusively be used with a Solid.",
+        *[f"Warning: {FUNC}() can exclusively be used with a Solid."] * 2,
         f"Warning: {FUNC}(): a velocity other than zero is ignored: Sensorium has no physics engine (robots move by "
         "their wheels' commands, solids only fall straight down from rest)."]

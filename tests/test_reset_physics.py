@@ -272,7 +272,7 @@ def test_a_c_supervisor_stops_a_falling_box_and_sees_it_fall_again(tmp_path_fact
 def test_set_velocity_zero_asks_reset_physics_and_anything_else_is_one_line(monkeypatch, capsys) -> None:
     """The Python client's ``setVelocity`` without a server: zero (any zeros: ints, -0.0) is the node's
     ``reset_physics`` request; a velocity that is not 6 finite numbers is refused with its line; another
-    velocity prints the warning once and asks nothing."""
+    velocity prints the warning once and asks nothing but the node's type."""
     from test_movie import _FakeSupervisor
 
     from sensorium.client import wb_supervisor as ws
@@ -281,7 +281,7 @@ def test_set_velocity_zero_asks_reset_physics_and_anything_else_is_one_line(monk
     monkeypatch.setattr(ws, "_set_velocity_warned", [])
     func = "wb_supervisor_node_set_velocity"
     ws.wb_supervisor_node_set_velocity(7, [0, 0, 0, -0.0, 0.0, 0])
-    assert fake.calls == ["/boss/robot/reset_physics"] and capsys.readouterr().err == ""
+    assert fake.calls == ["/boss/robot/get_from_id", "/boss/robot/reset_physics"] and capsys.readouterr().err == ""
     for bad, line in (([0.0] * 5, "expected 6 numbers, got 5."), ([0.0] * 7, "expected 6 numbers, got 7."),
                       (None, "expected 6 numbers, got None."), (["x"] * 6, "expected 6 numbers, got ['x', 'x', "
                                                                           "'x', 'x', 'x', 'x']."),
@@ -292,4 +292,4 @@ def test_set_velocity_zero_asks_reset_physics_and_anything_else_is_one_line(monk
     for _ in range(2):
         ws.wb_supervisor_node_set_velocity(7, [0.0, 0.0, 0.0, 0.0, 0.0, 1.0])
     assert capsys.readouterr().err == SET_VELOCITY_LINES[1] + "\n"
-    assert fake.calls == ["/boss/robot/reset_physics"]
+    assert [c for c in fake.calls if not c.endswith("/get_from_id")] == ["/boss/robot/reset_physics"]

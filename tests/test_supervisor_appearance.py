@@ -310,3 +310,58 @@ def test_a_c_controller_does_the_same(c_controller: str) -> None:
     lines, err = run_controller(WORLD, lambda url: [c_controller], env=SAN_ENV, robot="looker")
     assert "Sanitizer" not in err and "runtime error" not in err, err
     assert lines == _expected_lines(), err
+
+
+# ------------------------------------------------------------------------ a Charger's glowing fields
+
+CHARGER_WBT = """#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 16 }
+Charger {
+  translation 2 0 0
+  children [
+    Group { children [
+      Shape { appearance DEF GLOW_PBR PBRAppearance { baseColor 0.5 0.5 0.5 emissiveColor 0 0 0.2 } geometry Box { size 0.1 1 1 } }
+      Shape { appearance Appearance { material DEF GLOW_MATERIAL Material { emissiveColor 0.2 0.4 0 } }
+              geometry Box { size 0.1 1 1 } }
+    ] }
+    Shape { appearance Appearance { material DEF CALM_MATERIAL Material { emissiveColor 0.1 0.1 0.1 } }
+            geometry Box { size 0.1 1 1 } }
+  ]
+  name "dock"
+  battery [ 0, 1, 10 ]
+  emissiveColor 1 0.5 0
+}
+Robot { controller "<none>" supervisor TRUE }
+"""
+
+
+def test_a_supervisor_reads_a_chargers_glowing_emissive_colour_now(tmp_path):
+    """WbCharger writes its first child's materials' emissiveColor at each step: a Supervisor reads
+    initial + (emissiveColor − initial)·E/Emax after n steps (10 W, 16 ms: E = 0.16·n J, full from the
+    7th), a Material's and a PBRAppearance's; its own write reads back until the next step, which writes
+    the Charger's colour again; a shape outside the first child keeps its own."""
+    path = tmp_path / "dock.wbt"
+    path.write_text(CHARGER_WBT)
+    sim = Simulation(load_world(path))
+    glowing = {"GLOW_MATERIAL": np.array([0.2, 0.4, 0.0]), "GLOW_PBR": np.array([0.0, 0.0, 0.2])}
+    nodes = {name: sv.find_node(sim, name) for name in glowing}
+    full = np.array([1.0, 0.5, 0.0])
+
+    def expect(energy: float, step: int) -> None:
+        for name, initial in glowing.items():
+            want = full if energy >= 1.0 else initial + (full - initial) * energy
+            np.testing.assert_allclose(field(sim, nodes[name], "emissiveColor"), want, rtol=0, atol=1e-15,
+                                       err_msg=f"{name} step {step}")
+
+    for n in range(1, 9):
+        sim.run(1)
+        expect(min(0.16 * n, 1.0), n)
+    assert field(sim, sv.find_node(sim, "CALM_MATERIAL"), "emissiveColor") == [0.1, 0.1, 0.1]
+    sim.reset()
+    expect(0.0, 0)                                  # the loaded energy, 0 J: the world file's colours
+    sim.run(1)
+    for node in nodes.values():
+        sv.set_field(sim, node, "emissiveColor", [0.0, 0.0, 1.0])
+        assert field(sim, node, "emissiveColor") == [0.0, 0.0, 1.0]   # the Supervisor's write, until...
+    sim.run(1)                                                         # ...the Charger's next step
+    expect(0.32, 2)

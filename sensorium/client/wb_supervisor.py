@@ -499,6 +499,12 @@ def wb_supervisor_node_load_state(node: int | None, state_name: str) -> None:
 
 
 _set_velocity_warned: list[bool] = []
+# Webots' Solid and the nodes derived from it (its node chart): Robot, Charger, Track and the devices that are
+# Solids; not Pose, Group, Shape, joints, motors, position sensors, brakes, Propeller, Skin, ...
+SOLID_TYPES = frozenset({
+    "Solid", "Robot", "Charger", "Track", "Accelerometer", "Altimeter", "Camera", "Compass", "Connector", "Display",
+    "DistanceSensor", "Emitter", "GPS", "Gyro", "InertialUnit", "LED", "Lidar", "LightSensor", "Pen", "Radar",
+    "RangeFinder", "Receiver", "Speaker", "TouchSensor", "VacuumGripper", "Microphone", "Radio"})
 
 
 def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
@@ -507,7 +513,7 @@ def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
     again from rest; a robot keeps its motors' commands), the usual call after a supervisor moves a
     solid. Any other velocity has nothing to act on without a physics engine (a robot moves only by its
     wheels, a solid only falls straight down): one warning, ignored. Webots' check first: 6 finite
-    numbers."""
+    numbers; then a node that is no Solid (its type from get_from_id) is Webots' warning, nothing asked."""
     func = "wb_supervisor_node_set_velocity"
     r = _checked_node(node, func)
     if r is None:
@@ -526,10 +532,13 @@ def wb_supervisor_node_set_velocity(node: int | None, velocity: Any) -> None:
     if not all(math.isfinite(v) for v in wire):
         print(f"Error: {func}() called with a NaN or infinite value.", file=sys.stderr)
         return
+    # a node that is no Solid (the root, whose resetPhysics would stop all, a Pose, a joint, ...): Webots
+    # warns and sets nothing, whatever the velocity; no request (a node the server no longer has: its answer)
+    info = None if node == 0 else _call(r, "get_from_id", {"id": int(node)})  # type: ignore[arg-type]
+    if node == 0 or info is not None and info.get("type") and info["type"] not in SOLID_TYPES:
+        print(f"Warning: {func}() can exclusively be used with a Solid.", file=sys.stderr)
+        return
     if not any(wire):
-        if node == 0:      # the root is no Solid: Webots warns and sets nothing (its resetPhysics would stop all)
-            print(f"Warning: {func}() can exclusively be used with a Solid.", file=sys.stderr)
-            return
         _answer(r, "reset_physics", {"node": int(node)}, func)  # type: ignore[arg-type]
         return
     if _set_velocity_warned:

@@ -1,6 +1,6 @@
 /* wb_supervisor_node_set_velocity with hostile arguments (tests/test_fuzz_set_velocity.py, tests/worlds/
  * reset_falls.wbt), built with sanitizers: a NULL node, a NULL velocity, NaN and infinities at each place,
- * zeros on the root (no Solid: Webots' warning, nothing stopped), a denormal (not zero: the one warning), then
+ * zeros on the root and on the box's Shape (no Solids: Webots' warning each, nothing stopped), a denormal (not zero: the one warning), then
  * zeros with -0.0 on the falling box (resetPhysics). Prints one JSON line: the box's height after the lift and
  * 4 steps, its vertical velocity after the hostile calls (still falling) and after the zeros (0). */
 #include <math.h>
@@ -30,6 +30,8 @@ int main(void) {
     wb_supervisor_node_set_velocity(box, bad);
   }
   wb_supervisor_node_set_velocity(root, zero);
+  WbNodeRef shape = wb_supervisor_field_get_mf_node(wb_supervisor_node_get_field(box, "children"), 0);
+  wb_supervisor_node_set_velocity(shape, zero); /* a Shape is no Solid either: the same warning, nothing stopped */
   const double tiny[6] = {0.0, 0.0, 4.9406564584124654e-324, 0.0, 0.0, 0.0};
   wb_supervisor_node_set_velocity(box, tiny);
   wb_supervisor_node_set_velocity(box, tiny);

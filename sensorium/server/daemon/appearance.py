@@ -121,6 +121,10 @@ def _value(sim: Any, ref: ShapeRef, name: str, default: Any) -> Any:
     changed = sim.scene.appearance_values.get(ref.index, {})
     if key in changed:
         return changed[key]
+    if name == "emissiveColor" and ref.role in ("appearance", "material"):
+        glow = sim.scene.glow_of(ref.index)     # a Charger's colour now (WbCharger writes the field)
+        if glow is not None:
+            return [float(v) for v in glow]
     seen = _seen(ref, sim.scene.loaded_model(ref.index).appearance, name) if ref.role in ("appearance", "material") \
         else None
     if seen is not None:

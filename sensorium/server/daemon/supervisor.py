@@ -36,7 +36,7 @@ from sensorium.server.daemon import appearance, nested, visuals
 from sensorium.server.daemon.mf_items import item_position
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import balance, states, viewshot
-from sensorium.server.world.limits import RAISE, custom_data_chars
+from sensorium.server.world.limits import RAISE, custom_data_chars, number_problem
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion, pose_from_model
 from sensorium.server.world.top_nodes import Scenery
 
@@ -613,13 +613,19 @@ def _set_battery_item(sim: Any, node: Node, where: str, op: str, index: Any, val
     if isinstance(value, bool) or not isinstance(value, int | float) or not 0.0 <= value < math.inf:
         raise ValueError(f"{where}: item {index} takes a finite number >= 0 ({('J', 'J', 'W')[at]}), got {value!r}; "
                          "nothing changed")
+    problem = number_problem(float(value), sim.limits)      # what a world file's battery may hold
+    if problem is not None:
+        raise ValueError(f"{where}: item {index}: {problem}; nothing changed")
     setattr(robot.battery, _BATTERY_ITEMS[at], float(value))
 
 
 def _set_cpu_consumption(sim: Any, node: Node, value: float) -> None:
     """Webots' WbRobot reads ``cpuConsumption`` at each step's drain: the next step drains at the new power."""
-    if value < 0.0:
+    if not value >= 0.0:
         raise ValueError(f"field 'cpuConsumption' takes a value >= 0 (W), got {value!r}; nothing changed")
+    problem = number_problem(float(value), sim.limits)      # what a world file's cpuConsumption may be
+    if problem is not None:
+        raise ValueError(f"field 'cpuConsumption': {problem}; nothing changed")
     sim.robots[node.key].battery.cpu = float(value)
 
 

@@ -704,6 +704,10 @@ class Scene:
         """The shapes of top-level solid ``name`` (its own, then its nested solids'), in order."""
         return [k for k, (key, _, _) in enumerate(self._parts) if key == name]
 
+    def glow_of(self, shape: int) -> tuple[float, float, float] | None:
+        """A Charger's emissive colour for a shape now (:meth:`set_glow`), None where no Charger set one."""
+        return self._glow.get(shape)
+
     def set_glow(self, shape: int, color: tuple[float, float, float]) -> None:
         """A Charger's glowing shape's emissive colour now (WbCharger sets its Material's or
         PBRAppearance's ``emissiveColor``): cameras add it from the next image; the shape's model keeps

@@ -315,6 +315,19 @@ def triangle_count(geom: Any, mesh_triangles: Callable[[Any], int]) -> int:
     return len(faces) if faces is not None else 0
 
 
+def number_problem(v: float, limits: WorldLimits) -> str | None:
+    """Why a world refuses number ``v`` (not finite, over ``number_magnitude``, or nearer 0 than
+    1e-30 without being 0), in the loader's words; None when it takes it."""
+    mag = abs(v)
+    if not math.isfinite(v):
+        return f"expected a finite number, got {v!r}"
+    if mag > limits.number_magnitude:
+        return f"the magnitude of {v:g} exceeds the limit of {limits.number_magnitude:g} {RAISE}"
+    if 0.0 < mag < 1e-30:
+        return f"{v!r} is too close to 0 (use 0, or a magnitude of at least 1e-30)"
+    return None
+
+
 def _numbers_fine(v: Any, levels: int, cap: float) -> bool:
     """Every number of a list of floats (``levels`` 1) or of rows of floats (2) finite, at most
     ``cap`` in magnitude, and 0 or at least 1e-30; one numpy pass."""
@@ -328,20 +341,16 @@ def _numbers_fine(v: Any, levels: int, cap: float) -> bool:
 _GEOMETRY_TYPES = {"box", "sphere", "cylinder", "capsule", "cone", "plane", "mesh", "triangles", "elevation_grid"}
 
 
-def _walk_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int], problems: list,
-               over: Callable[[str, str, float, float], None]) -> tuple[int, int]:
+def _walk_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], int],
+               problems: list) -> tuple[int, int]:
     """(triangles, lights) of a validated world; every number out of bounds added to ``problems``,
     named by its path (a list of numbers checked in one numpy pass, walked number by number when it
     holds a bad one)."""
 
     def number(path: str, v: float) -> None:
-        mag = abs(v)
-        if not math.isfinite(v):
-            problems.append((path, f"expected a finite number, got {v!r}"))
-        elif mag > limits.number_magnitude:
-            over(path, "the magnitude of", v, limits.number_magnitude)
-        elif 0.0 < mag < 1e-30:
-            problems.append((path, f"{v!r} is too close to 0 (use 0, or a magnitude of at least 1e-30)"))
+        problem = number_problem(v, limits)
+        if problem is not None:
+            problems.append((path, problem))
 
     triangles = 0
     lights = 0                              # occluding light sensors cast a ray per light
@@ -434,7 +443,7 @@ def check_work(world: Any, limits: WorldLimits, mesh_triangles: Callable[[Any], 
 
     counted = _scan_work(world, limits, mesh_triangles)
     if counted is None:        # some number out of bounds: the walk with paths, to name each
-        counted = _walk_work(world, limits, mesh_triangles, problems, over)
+        counted = _walk_work(world, limits, mesh_triangles, problems)
     triangles, lights = counted
     # robots, devices, lights and solids: check_counts, on the data before validation
     if triangles > limits.triangles:

@@ -797,6 +797,23 @@ void wb_supervisor_node_reset_physics(WbNodeRef node) {
    Zero is served: it is resetPhysics here (the one velocity of its own a node can have is a top-level
    solid's fall, which starts again from rest; a robot keeps its motors' commands). Any other velocity has
    nothing to act on without a physics engine: one warning, ignored. */
+/* Webots' Solid and the nodes derived from it (its node chart): Robot, Charger, Track and the devices
+   that are Solids; not Pose, Group, Shape, joints, motors, position sensors, brakes, Propeller, Skin, ... */
+static bool is_solid(WbNodeType type) {
+  switch (type) {
+    case WB_NODE_SOLID: case WB_NODE_ROBOT: case WB_NODE_CHARGER: case WB_NODE_TRACK:
+    case WB_NODE_ACCELEROMETER: case WB_NODE_ALTIMETER: case WB_NODE_CAMERA: case WB_NODE_COMPASS:
+    case WB_NODE_CONNECTOR: case WB_NODE_DISPLAY: case WB_NODE_DISTANCE_SENSOR: case WB_NODE_EMITTER:
+    case WB_NODE_GPS: case WB_NODE_GYRO: case WB_NODE_INERTIAL_UNIT: case WB_NODE_LED: case WB_NODE_LIDAR:
+    case WB_NODE_LIGHT_SENSOR: case WB_NODE_PEN: case WB_NODE_RADAR: case WB_NODE_RANGE_FINDER:
+    case WB_NODE_RECEIVER: case WB_NODE_SPEAKER: case WB_NODE_TOUCH_SENSOR: case WB_NODE_VACUUM_GRIPPER:
+    case WB_NODE_MICROPHONE: case WB_NODE_RADIO:
+      return true;
+    default:
+      return false;
+  }
+}
+
 void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
   static const char *func = "wb_supervisor_node_set_velocity";
   static bool warned;
@@ -815,7 +832,9 @@ void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
     }
     zero = zero && velocity[i] == 0.0;
   }
-  if (zero && node->id == 0) { /* the root is no Solid: Webots warns, sets nothing (its resetPhysics stops all) */
+  /* a node that is no Solid (the root, whose resetPhysics would stop all, a Pose, a joint, ...): Webots
+     warns and sets nothing, whatever the velocity; no request */
+  if (node->id == 0 || (node->type != WB_NODE_NO_NODE && !is_solid(node->type))) {
     fprintf(stderr, "Warning: %s() can exclusively be used with a Solid.\n", func);
     return;
   }
