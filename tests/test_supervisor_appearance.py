@@ -164,7 +164,8 @@ def test_refusals_name_the_field_and_change_nothing():
 
 def test_an_emissive_colour_set_glows_as_if_the_world_file_said_it(tmp_path):
     """Every pixel of the ambient-lit wall reads 0.5·albedo + emissive (Webots' shaders add it); a
-    PBRAppearance's emissiveIntensity (world file: 2) changes nothing, as in WREN outside wireframe."""
+    PBRAppearance's emissiveIntensity (world file: 2) doubles it, as WREN's forward shader does where no
+    light casts shadows (this world's)."""
     sim = _sim()
     app = sv.find_node(sim, "WALL_APP")
     sv.set_field(sim, app, "emissiveColor", [0.2, 0.0, 0.1])
@@ -176,7 +177,7 @@ def test_an_emissive_colour_set_glows_as_if_the_world_file_said_it(tmp_path):
     assert np.array_equal(img, ref)
     sim = _sim(_variant(tmp_path, "roughness 0.3", "roughness 0.3 emissiveIntensity 2"))
     sv.set_field(sim, sv.find_node(sim, "WALL_APP"), "emissiveColor", [0.2, 0.0, 0.1])
-    L = AMBIENT * np.array([0.8, 0.5, 0.2]) + [0.2, 0.0, 0.1]
+    L = AMBIENT * np.array([0.8, 0.5, 0.2]) + 2.0 * np.array([0.2, 0.0, 0.1])
     img, _ = _shot(sim)
     assert img[2, 2, [2, 1, 0]].tolist() == np.floor(255.0 * (1.0 - np.exp(-L)) ** (1.0 / 2.2) + 0.5).astype(int).tolist()
     sv.set_field(sim, sv.find_node(sim, "WALL_APP"), "emissiveColor", [0.0, 0.0, 0.0])     # back to no glow
