@@ -37,6 +37,15 @@ def world(lights, appearance: dict, robot_extra: dict | None = None) -> wm.World
         "robots": [{"name": "r", "devices": [{"device": "Camera", "name": "cam", **CAM}], **(robot_extra or {})}]})
 
 
+def wbt_image(path: Path) -> np.ndarray:
+    """The (H, W, 3) red, green, blue bytes of the first image of the camera ``robot/cam`` in world file ``path``."""
+    sim = Simulation(load_world(path))
+    cam = sim.device("robot/cam")
+    cam.enable(16)
+    sim.run(1)
+    return cam.image[:, :, [2, 1, 0]].astype(np.int64)
+
+
 @pytest.mark.parametrize("precision", BOTH)
 def test_a_lit_face_reads_its_lit_colour_plus_its_emissive_colour(precision: str):
     _, cos = rays()
@@ -83,11 +92,7 @@ def test_a_world_files_emissive_colours_are_drawn(tmp_path: Path, appearance: st
     """A Material's emissiveColor; a PBRAppearance's (its emissiveIntensity: test_camera_emissive_intensity.py)."""
     path = tmp_path / "glow.wbt"
     path.write_text(WBT.format(appearance=appearance))
-    sim = Simulation(load_world(path))
-    cam = sim.device("robot/cam")
-    cam.enable(16)
-    sim.run(1)
-    got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+    got = wbt_image(path)
     np.testing.assert_array_equal(got, np.broadcast_to(byte(0.3 * np.asarray(DIFFUSE) + np.asarray(glow)), got.shape))
 
 
@@ -284,13 +289,9 @@ def test_a_world_files_textured_appearance_multiplies_its_glow(texel_dir: Path, 
     (Phong); a PBRAppearance's baseColorMap does not touch its emissive colour."""
     path = texel_dir / "glow.wbt"
     path.write_text(WBT.format(appearance=appearance))
-    sim = Simulation(load_world(path))
-    cam = sim.device("robot/cam")
-    cam.enable(16)
-    sim.run(1)
+    got = wbt_image(path)
     t = np.array([_linear(v) for v in TEXEL])
     glow = np.asarray(GLOW) * (t if textured_glow else 1.0)
-    got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
     np.testing.assert_array_equal(got, np.broadcast_to(byte(0.3 * t + glow), got.shape))
 
 

@@ -19,9 +19,9 @@ import pytest
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import LoadedWorld, load_world
+from sensorium.server.world.loader import LoadedWorld
 from tests.test_batched_camera import images_with_robot_placed
-from tests.test_camera_emissive import DIFFUSE, GLOW, MAP_TEXEL, world
+from tests.test_camera_emissive import DIFFUSE, GLOW, MAP_TEXEL, wbt_image, world
 from tests.test_camera_light_radius import AMBIENT, byte, point, rays
 
 INTENSITY = 2.5
@@ -104,11 +104,7 @@ def test_a_world_files_emissive_intensity_is_read(tmp_path: Path, intensity: flo
     shader's ``e·I``; a negative intensity is reset to 1 (WbPbrAppearance)."""
     path = tmp_path / "glow.wbt"
     path.write_text(WBT.format(intensity=intensity))
-    sim = Simulation(load_world(path))
-    cam = sim.device("robot/cam")
-    cam.enable(16)
-    sim.run(1)
-    got = cam.image[:, :, [2, 1, 0]].astype(np.int64)
+    got = wbt_image(path)
     np.testing.assert_array_equal(got, np.broadcast_to(byte(0.3 * np.asarray(DIFFUSE) + used * np.asarray(GLOW)),
                                                        got.shape))
 
