@@ -188,7 +188,7 @@ def test_work_scan_counts_as_the_walk_with_paths(tmp_path):
     loaded = load_world(str(write_swarm(6, tmp_path / "swarm.wbt", housing=True)))
     world, limits = loaded.world, lim.WorldLimits()
     problems: list = []
-    walked = lim._walk_work(world, limits, lambda g: 0, problems, lambda *a: problems.append(a))
+    walked = lim._walk_work(world, limits, lambda g: 0, problems)
     assert lim._scan_work(world, limits, lambda g: 0) == walked and not problems
     assert walked[0] > 6 * 100 and walked[1] >= 1          # the robots' triangles; the PointLight
     assert not lim.has_model(world, Mesh)
