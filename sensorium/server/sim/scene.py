@@ -711,7 +711,14 @@ class Scene:
     def set_glow(self, shape: int, color: tuple[float, float, float]) -> None:
         """A Charger's glowing shape's emissive colour now (WbCharger sets its Material's or
         PBRAppearance's ``emissiveColor``): cameras add it from the next image; the shape's model keeps
-        the world file's colour."""
+        the world file's colour. WbCharger writes that field at each step, so a Supervisor's own value of
+        it, read back until now, gives way to it."""
+        written = self.appearance_values.get(shape)
+        if written:
+            written.pop("material.emissiveColor", None)
+            written.pop("appearance.emissiveColor", None)
+            if not written:
+                del self.appearance_values[shape]
         if self._glow.get(shape) == color:
             return
         self._glow[shape] = color

@@ -1050,14 +1050,6 @@ class Simulation:
         for charger, shapes, lights in self._glowing:
             if charger.solid in self.scene.solid_poses:
                 for k, initial in shapes:
-                    # WbCharger writes the emissiveColor field at each step: a Supervisor's own value,
-                    # read back until now, gives way to it
-                    written = self.scene.appearance_values.get(k)
-                    if written:
-                        written.pop("material.emissiveColor", None)
-                        written.pop("appearance.emissiveColor", None)
-                        if not written:
-                            del self.scene.appearance_values[k]
                     self.scene.set_glow(k, charger.glow(initial))
                 if lights:         # (their places now: another solid's removal moves them)
                     slots = self.scene.solid_light_slots(charger.solid)

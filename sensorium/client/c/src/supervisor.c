@@ -793,10 +793,6 @@ void wb_supervisor_node_reset_physics(WbNodeRef node) {
     reset_physics(rb, node->id, func);
 }
 
-/* Webots' setVelocity (linear then angular, world axes), after Webots' checks (NULL, NaN, infinite).
-   Zero is served: it is resetPhysics here (the one velocity of its own a node can have is a top-level
-   solid's fall, which starts again from rest; a robot keeps its motors' commands). Any other velocity has
-   nothing to act on without a physics engine: one warning, ignored. */
 /* Webots' Solid and the nodes derived from it (its node chart): Robot, Charger, Track and the devices
    that are Solids; not Pose, Group, Shape, joints, motors, position sensors, brakes, Propeller, Skin, ... */
 static bool is_solid(WbNodeType type) {
@@ -814,6 +810,10 @@ static bool is_solid(WbNodeType type) {
   }
 }
 
+/* Webots' setVelocity (linear then angular, world axes), after Webots' checks (NULL, NaN, infinite).
+   Zero is served: it is resetPhysics here (the one velocity of its own a node can have is a top-level
+   solid's fall, which starts again from rest; a robot keeps its motors' commands). Any other velocity has
+   nothing to act on without a physics engine: one warning, ignored. */
 void wb_supervisor_node_set_velocity(WbNodeRef node, const double velocity[6]) {
   static const char *func = "wb_supervisor_node_set_velocity";
   static bool warned;
