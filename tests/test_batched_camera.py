@@ -282,6 +282,12 @@ def images_with_robot_placed(lw: LoadedWorld, precision: str, robot: str, places
         single.robot(robot).set_pose(t)
         single.robot("bot").device("cam").enable(8)
         singles.append(single)
+    return stepped_alike(bs, ref, singles)
+
+
+def stepped_alike(bs: BatchedSimulation, ref, singles: list[Simulation]) -> np.ndarray:
+    """One step of the batched simulation and of each copy's Simulation: copy c's image of camera ``ref``
+    (bot/cam) the bytes of ``singles[c]``'s; the batched images."""
     bs.step()
     img = bs.image(ref)
     for c, single in enumerate(singles):
