@@ -89,6 +89,18 @@ BOX_UPRIGHT_TOL = 1e-12   # |tilt| of a box's local axis from the world's up sti
 RAMP_MAX_TILT = math.pi / 4
 
 
+def deepest_end(gap: float, p: np.ndarray) -> float:
+    """The least signed distance a move or turn that starts ``gap`` from something (negative:
+    overlapping) may end at: touching or within the tolerance, -EPS, whatever the steps (so a robot
+    turning into a solid by steps of less than EPS each stops EPS in; a bound on each move's change
+    let it creep in step by step); overlapping deeper (placed so from outside), no deeper than it
+    starts, less a rounding slack of 4e-15 of the coordinates (~30 ulps: two distances found apart,
+    at a slide's start and end, may round that much deeper; taken for going in, it stalled the robot)."""
+    if gap >= -EPS:
+        return -EPS
+    return gap - 4e-15 * (1.0 + abs(float(p[0])) + abs(float(p[1])))
+
+
 def ramp_top(r: np.ndarray, t: np.ndarray, half: tuple[float, float, float]) -> tuple[int, float, np.ndarray, float] | None:
     """A box (rotation ``r``, centre ``t`` in ENU, half sizes ``half``) that is a ramp: not upright
     (none of its axes within BOX_UPRIGHT_TOL of the world's up: ground.py's box tops) and its top
@@ -638,8 +650,8 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
         gap = abs(dist) - rho
         rate = float(nrm @ d)
         if gap <= EPS:       # touching: an impact when the move goes in by more than the tolerance
-            # (overlapping, as a move from outside may leave it: deeper than it already is)
-            return (0.0, nrm) if rate < -EPS or gap + rate < min(gap, 0.0) - EPS else (math.inf, None)
+            # or ends past it (overlapping, as a move from outside may leave it: deeper than it is)
+            return (0.0, nrm) if rate < -EPS or gap + rate < deepest_end(gap, p) else (math.inf, None)
         if rate >= 0.0 or gap + rate > 0.0:
             return math.inf, None
         return gap / -rate, nrm
@@ -663,7 +675,7 @@ def time_of_impact(p: np.ndarray, d: np.ndarray, ob: Obstacle, rho: float) -> tu
             if float(normal @ d) < -EPS:
                 return 0.0, normal
             end_dist, _ = _closest_on_hull(p + d, pts)
-            return (0.0, normal) if end_dist - rad < min(dist - rad, 0.0) - EPS else (math.inf, None)
+            return (0.0, normal) if end_dist - rad < deepest_end(dist - rad, p) else (math.inf, None)
     best: float = math.inf
     best_n: np.ndarray | None = None
     a = float(d @ d)
@@ -1806,7 +1818,7 @@ class Contact:
             before, after = _turned(piece.points, yaw), _turned(piece.points, yaw1)
             for ob in pcands:
                 self.checks += 1
-                if _gap(q, *_grown(ob, after, piece.round, q)) < min(_gap(p, *_grown(ob, before, piece.round, p)), 0.0) - EPS:
+                if _gap(q, *_grown(ob, after, piece.round, q)) < deepest_end(_gap(p, *_grown(ob, before, piece.round, p)), p):
                     return None
         return q
 
@@ -1838,7 +1850,7 @@ class Contact:
             self.checks += 1
             gap, normal = _gap_normal(p, *g1)
             target = min(before, 0.0)
-            if gap < target - EPS and float(normal @ _gap_normal(p, *g0)[1]) > 0.0:
+            if gap < deepest_end(before, p) and float(normal @ _gap_normal(p, *g0)[1]) > 0.0:
                 tries.append((target - gap, k, normal))
         if not tries:
             return None
@@ -1858,7 +1870,7 @@ class Contact:
             ok = True
             for k, (_, _, _, g1, before) in enumerate(tests):
                 self.checks += 1
-                if _gap(q, *g1) < min(before, 0.0) - EPS or (k not in into and time_of_impact(p, step, *g1)[1] is not None):
+                if _gap(q, *g1) < deepest_end(before, p) or (k not in into and time_of_impact(p, step, *g1)[1] is not None):
                     ok = False
                     break
             if ok and self._pieces_turn_clear(tests, q, yaw, turn):
@@ -1872,7 +1884,7 @@ class Contact:
         for piece, ob, _, _, before in tests:
             assert piece.points is not None
             now = _gap(q, *_grown(ob, _turned(piece.points, yaw), piece.round, q))
-            if now < min(before, 0.0) - EPS:
+            if now < deepest_end(before, q):
                 return False
             entry = by_piece.setdefault(id(piece), (piece, [], []))
             entry[1].append(ob)
@@ -1959,7 +1971,7 @@ class Contact:
             self.checks += 1
             gap, normal = _gap_normal(p, *g)
             target = min(before, 0.0)
-            if gap < target - EPS:
+            if gap < deepest_end(before, p):
                 pushes.append((target - gap, i, normal))
         if not pushes:
             # the turned footprint overlaps nothing where the turn ends, but a corner's arc dips into
@@ -1987,7 +1999,7 @@ class Contact:
             if q is None or float(np.hypot(*(q - p))) > foot.radius * min(abs(turn), 2.0):
                 return None
             after = [_gap(q, *_grown(ob, here, foot.round, q)) for ob in others]
-            if min(a - min(b, 0.0) for a, b in zip(after, before)) < -EPS or not self._turn_clear(foot, q, yaw, turn, others, after):
+            if any(a < deepest_end(b, p) for a, b in zip(after, before)) or not self._turn_clear(foot, q, yaw, turn, others, after):
                 return None
             return q
         limit = foot.radius * min(abs(turn), 2.0)
@@ -2003,7 +2015,7 @@ class Contact:
             ok = True
             for j, (g, before) in enumerate(zip(grown, now)):
                 self.checks += 1
-                if _gap(q, *g) < min(before, 0.0) - EPS or (j != i and time_of_impact(p, step, *g)[1] is not None):
+                if _gap(q, *g) < deepest_end(before, p) or (j != i and time_of_impact(p, step, *g)[1] is not None):
                     ok = False
                     break
             if ok:
@@ -2076,7 +2088,7 @@ class Contact:
             for j, (g, before) in enumerate(zip(grown, now)):
                 self.checks += 1
                 gap = _gap(q, *_grown(cands[j], here, rnd, q))
-                if gap < min(before, 0.0) - EPS or (j not in into and time_of_impact(p, step, *g)[1] is not None):
+                if gap < deepest_end(before, p) or (j not in into and time_of_impact(p, step, *g)[1] is not None):
                     break
                 after.append(gap)
             else:
@@ -2143,7 +2155,7 @@ class Contact:
         q = p + step
         for k, (g, before) in enumerate(zip(grown, now)):
             self.checks += 1
-            if _gap(q, *g) < min(before, 0.0) - EPS or (k != i and k != j and time_of_impact(p, step, *g)[1] is not None):
+            if _gap(q, *g) < deepest_end(before, p) or (k != i and k != j and time_of_impact(p, step, *g)[1] is not None):
                 return None
         return q
 
@@ -2172,12 +2184,12 @@ class Contact:
         margin = 1e-9 * (1.0 + abs(float(p[0])) + abs(float(p[1])) + foot.radius)
         shape = None
         for ob, gap in zip(cands, now):
-            if gap - delta - margin >= min(gap, 0.0) - EPS:
+            if gap - delta - margin >= deepest_end(gap, p):
                 continue
             if shape is None:
                 shape = _turned(foot.points, yaw)
             self.checks += 1
-            if not turn_gap_holds(shape, foot.round, turn, ob, p, min(gap, 0.0) - EPS, gap):
+            if not turn_gap_holds(shape, foot.round, turn, ob, p, deepest_end(gap, p), gap):
                 return False
         return True
 
