@@ -7,6 +7,8 @@ pixel is ``round(255 (1 - e^(-0.5 albedo))^(1/2.2))``). The same from Python and
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from _serve import run_controller, sensorium
@@ -14,6 +16,7 @@ from test_c_client import sanitized_controller
 from test_multiprocess import REPO
 
 from sensorium.schemas import world as wm
+from sensorium.server.daemon import export
 from sensorium.server.daemon import supervisor as sv
 from sensorium.server.daemon.nested import FIRST_ID
 from sensorium.server.sim.simulation import Simulation
@@ -182,6 +185,35 @@ def test_an_emissive_colour_set_glows_as_if_the_world_file_said_it(tmp_path):
     assert img[2, 2, [2, 1, 0]].tolist() == np.floor(255.0 * (1.0 - np.exp(-L)) ** (1.0 / 2.2) + 0.5).astype(int).tolist()
     sv.set_field(sim, sv.find_node(sim, "WALL_APP"), "emissiveColor", [0.0, 0.0, 0.0])     # back to no glow
     assert np.array_equal(_shot(sim)[0], _shot(_sim())[0]) and sim.scene.emissive is None
+
+
+def test_an_emissive_intensity_set_scales_the_glow_as_if_the_world_file_said_it(tmp_path):
+    """A PBRAppearance's emissiveIntensity a Supervisor sets multiplies its emissiveColor in the image
+    (WREN's forward shader, this world's lights casting no shadows): the pixels of the world written
+    with it, Webots' resolve of 0.5·albedo + 3·emissive; a negative or non-finite one is refused in one
+    line, nothing changed; the reset brings the loaded 1 back."""
+    sim = _sim()
+    app = sv.find_node(sim, "WALL_APP")
+    assert field(sim, app, "emissiveIntensity") == 1.0
+    sv.set_field(sim, app, "emissiveColor", [0.2, 0.0, 0.1])
+    sv.set_field(sim, app, "emissiveIntensity", 3.0)
+    assert field(sim, app, "emissiveIntensity") == 3.0
+    img, _ = _shot(sim)
+    L = AMBIENT * np.array([0.8, 0.5, 0.2]) + 3.0 * np.array([0.2, 0.0, 0.1])
+    assert img[2, 2, [2, 1, 0]].tolist() == np.floor(255.0 * (1.0 - np.exp(-L)) ** (1.0 / 2.2) + 0.5).astype(int).tolist()
+    ref, _ = _shot(_sim(_variant(tmp_path, "roughness 0.3", "roughness 0.3 emissiveColor 0.2 0 0.1 emissiveIntensity 3")))
+    assert np.array_equal(img, ref)
+    with pytest.raises(ValueError, match=r"'emissiveIntensity' .* must be >= 0, got -0.5 .*nothing changed"):
+        sv.set_field(sim, app, "emissiveIntensity", -0.5)
+    for bad in (math.inf, math.nan):
+        with pytest.raises(ValueError, match="'emissiveIntensity' is an SFFloat: takes a finite number"):
+            sv.set_field(sim, app, "emissiveIntensity", bad)
+    assert field(sim, app, "emissiveIntensity") == 3.0 and np.array_equal(_shot(sim)[0], img)
+    assert "  emissiveIntensity 3\n" in export.node_string(sim, app)        # exportString writes it
+    sv.set_field(sim, app, "emissiveIntensity", 0.0)           # no glow at all
+    assert np.array_equal(_shot(sim)[0], _shot(_sim())[0])
+    sim.reset()
+    assert field(sim, app, "emissiveIntensity") == 1.0 and field(sim, app, "emissiveColor") == [0.0, 0.0, 0.0]
 
 
 def test_a_simulation_reset_brings_the_loaded_colours_back():

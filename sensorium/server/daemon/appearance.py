@@ -7,7 +7,7 @@ the world file wrote (``schemas.world.ShapeNode``; Webots' defaults for what it 
 values sensors see where the world's model has them (a colour, transparency and roughness as the
 loader sanitised them), or what a Supervisor set since. A Supervisor sets a Material's
 ``diffuseColor``, ``emissiveColor`` and ``transparency``, a PBRAppearance's ``baseColor``,
-``roughness``, ``metalness``, ``transparency`` and ``emissiveColor``: the scene takes the new
+``roughness``, ``metalness``, ``transparency``, ``emissiveColor`` and ``emissiveIntensity``: the scene takes the new
 appearance for that one shape (``Scene.set_appearance``), so every sensor sees it at its next
 measurement as if the world file had said it (a transparency crossing 0 or 1 too: which rays see
 the shape and its shadows follows). Everything else is read-only.
@@ -33,7 +33,8 @@ GEOMETRY_TYPES = {wm.Box: "Box", wm.Sphere: "Sphere", wm.Cylinder: "Cylinder", w
                   wm.ElevationGrid: "ElevationGrid"}
 
 SETTABLE = {"Material": frozenset({"diffuseColor", "emissiveColor", "transparency"}),
-            "PBRAppearance": frozenset({"baseColor", "roughness", "metalness", "transparency", "emissiveColor"}),
+            "PBRAppearance": frozenset({"baseColor", "roughness", "metalness", "transparency", "emissiveColor",
+                                        "emissiveIntensity"}),
             "ImageTexture": frozenset({"repeatS", "repeatT", "filtering"})}
 """The SF fields a Supervisor sets here (an ImageTexture's ``url`` is an MF field: :func:`change_url`);
 the rest of these nodes is read-only."""
@@ -106,7 +107,8 @@ def _seen(ref: ShapeRef, loaded: wm.Appearance | None, name: str) -> Any:
     if loaded is None:
         return None
     if ref.type == "PBRAppearance":
-        held = {"baseColor": loaded.base_color, "transparency": loaded.transparency, "roughness": loaded.roughness}
+        held = {"baseColor": loaded.base_color, "transparency": loaded.transparency, "roughness": loaded.roughness,
+                "emissiveIntensity": loaded.emissive_intensity}
     else:      # a Material: its transparency; its diffuse colour unless a texture replaces it by white
         held = {"transparency": loaded.transparency}
         if loaded.texture is None:
@@ -155,7 +157,11 @@ def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
     def set_value(sim: Any, node: Any, value: Any) -> None:
         where = f"field {name!r} ({kind}) of {_what(ref, node.def_name, node.id)}"
         values = value if isinstance(value, list) else [value]
-        if not all(0.0 <= float(v) <= 1.0 for v in values):
+        if name == "emissiveIntensity":      # a multiplier (WbPbrAppearance: any value >= 0)
+            if float(value) < 0.0:
+                raise ValueError(f"{where}: the value must be >= 0, got {value!r} (Webots resets it to 1 with a "
+                                 "warning); nothing changed")
+        elif not all(0.0 <= float(v) <= 1.0 for v in values):
             raise ValueError(f"{where}: {'each component' if kind == 'SFColor' else 'the value'} must be in [0, 1], "
                              f"got {value!r} (Webots resets it with a warning); nothing changed")
         scene = sim.scene
@@ -171,6 +177,8 @@ def _setter(ref: ShapeRef, name: str, kind: str) -> Setter:
                 update["roughness"] = float(value)
             elif name == "emissiveColor":
                 update["emissive_color"] = tuple(float(v) for v in values)
+            elif name == "emissiveIntensity":
+                update["emissive_intensity"] = float(value)
             if update and current is not None:      # (metalness: not rendered here, kept)
                 scene.set_appearance(k, current.model_copy(update=update))
             scene.appearance_values.setdefault(k, {})[f"{ref.role}.{name}"] = \
