@@ -371,8 +371,9 @@ Robot { controller "<none>" supervisor TRUE }
 def test_a_supervisor_reads_a_chargers_glowing_emissive_colour_now(tmp_path):
     """WbCharger writes its first child's materials' emissiveColor at each step: a Supervisor reads
     initial + (emissiveColor − initial)·E/Emax after n steps (10 W, 16 ms: E = 0.16·n J, full from the
-    7th), a Material's and a PBRAppearance's; its own write reads back until the next step, which writes
-    the Charger's colour again; a shape outside the first child keeps its own."""
+    7th), a Material's and a PBRAppearance's, and exportString and worldSave write it so; its own write
+    reads back until the next step, which writes the Charger's colour again; a shape outside the first
+    child keeps its own."""
     path = tmp_path / "dock.wbt"
     path.write_text(CHARGER_WBT)
     sim = Simulation(load_world(path))
@@ -390,6 +391,11 @@ def test_a_supervisor_reads_a_chargers_glowing_emissive_colour_now(tmp_path):
         sim.run(1)
         expect(min(0.16 * n, 1.0), n)
     assert field(sim, sv.find_node(sim, "CALM_MATERIAL"), "emissiveColor") == [0.1, 0.1, 0.1]
+    # exportString and worldSave write the field as it is now (full: the Charger's colour), the calm one as written
+    assert "  emissiveColor 1 0.5 0\n" in export.node_string(sim, nodes["GLOW_MATERIAL"])
+    assert "  emissiveColor 1 0.5 0\n" in export.node_string(sim, nodes["GLOW_PBR"])
+    saved = [line.strip() for line in export.world_string(sim).splitlines() if "emissiveColor" in line]
+    assert saved == ["emissiveColor 1 0.5 0"] * 2 + ["emissiveColor 0.1 0.1 0.1", "emissiveColor 1 0.5 0"], saved
     sim.reset()
     expect(0.0, 0)                                  # the loaded energy, 0 J: the world file's colours
     sim.run(1)

@@ -182,6 +182,12 @@ def _nested_written(sim: Any, table: nested.Table, n: nested.Nested) -> ParsedNo
                       "has no .wbt text here")
 
 
+def _shape_changed(sim: Any, shape: int) -> bool:
+    """Whether a shape's nodes hold a field the server changed: one a Supervisor set, or the
+    ``emissiveColor`` a Charger makes glow."""
+    return shape in sim.scene.appearance_values or sim.scene.glow_of(shape) is not None
+
+
 def _made_string(sim: Any, table: nested.Table, n: nested.Nested) -> str:
     """A PROTO body's node ``n`` as text (:func:`_made`), with what the server changed in it and the nodes
     inside it (an end point's pose its joint moved, a joint's ``position``, a shape's fields a Supervisor set)."""
@@ -192,7 +198,7 @@ def _made_string(sim: Any, table: nested.Table, n: nested.Nested) -> str:
     out = _as_webots_writes(found, done)
     changed: dict[int, dict[str, Any]] = {}
     for m in table.by_owner.get(n.owner, ()):
-        if not (m.motor or m.joint or m.shape is not None and m.shape.index in sim.scene.appearance_values):
+        if not (m.motor or m.joint or m.shape is not None and _shape_changed(sim, m.shape.index)):
             continue             # nothing the server changes
         now = _nested_now(sim, table, m)
         at = _made_node(sim, table, m, memo) if now else None
@@ -333,6 +339,9 @@ def _nested_now(sim: Any, table: nested.Table, n: nested.Nested) -> list[tuple[s
     if n.shape is not None:
         changed = [key.split(".", 1)[1] for key in sim.scene.appearance_values.get(n.shape.index, {})
                    if key.split(".", 1)[0] == n.shape.role]
+        if sim.scene.glow_of(n.shape.index) is not None and n.shape.role in ("appearance", "material") \
+                and "emissiveColor" not in changed:
+            changed.append("emissiveColor")          # a Charger's glow (WbCharger writes the field each step)
         if changed:
             node = sv._nested_node(n)
             base = sv._base_fields(sim, node)
@@ -386,9 +395,8 @@ def _nested_fields(sim: Any, owner: int | None) -> dict[int, dict[str, Any]]:
     table = sv._table(sim)
     out: dict[int, dict[str, Any]] = {}
     inside = table.by_owner.get(owner, ()) if owner is not None else [n for v in table.by_owner.values() for n in v]
-    changed_shapes = sim.scene.appearance_values
     for n in inside:
-        if not (n.motor or n.joint or n.shape is not None and n.shape.index in changed_shapes):
+        if not (n.motor or n.joint or n.shape is not None and _shape_changed(sim, n.shape.index)):
             continue             # nothing the server changes
         now = _nested_now(sim, table, n)
         written = _found(sim, table, n) if now else None
