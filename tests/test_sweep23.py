@@ -114,3 +114,41 @@ def test_the_two_wheels_vehicle_calls_read_the_open_ring_and_turn_the_wheels_by_
         assert [float(e.value) for e in encoders] == pytest.approx(expected, abs=1e-12), n
         assert np.array(robot.pose.translation) == pytest.approx(start, abs=1e-15)
     assert wanted == (-10.5, 11.5)
+
+
+# vision_car (kinematics/tinkerbots, R2023b): the base turned as braitenberg's, one "motor" block in its down
+# slot whose hinge carries two axles and wheels (its front and back slots, either side of the block), its
+# "distance sensor" block beside it, and two passive wheels on the free hinges of two round-slot cubies on
+# the base's top. Webots' `vision_car.py` sets the motor to half its maxVelocity (11 rad/s: the front wheels
+# roll the car along +x at 11·0.02625 = 0.289 m/s) and stops it once the sensor reads under 100 (0.39 m).
+VC = "vision car"
+
+
+def test_the_vision_car_calls_turn_its_one_motor_by_the_kinematic_rule_where_webots_drives_the_car() -> None:
+    """The five devices load through the slots; the one motorised hinge, which carries both driven wheels,
+    is no drive here (one load line says its joint moves kinematically: a departure from Webots, whose
+    physics rolls the car on it). The controller's calls: the motor in velocity control at 0.5·22 = 11
+    rad/s, the sensor reading 128 every step (its ray along +x meets the ring about 0.88 m away, past the table's
+    0.5 m), so it never stops; the motor's sensor reads 0.5·0.008²·n(n+1)/2 after n steps (its speed growing
+    by maxTorque 0.5 rad/s² a second towards 11, 1e-12) and the car stays where the world puts it."""
+    lw = load_world(DATA / "vision_car.wbt")
+    (robot,) = lw.world.robots
+    assert {d.name for d in robot.devices} == {"motor", "motor sensor", "motor led", "distance sensor",
+                                               "distance sensor led"}
+    assert robot.differential_drive is None
+    (line,) = [w for w in lw.warnings if "'motor'" in w]
+    assert "only motorised hinge" in line and "moves kinematically" in line
+    sim = Simulation(lw, "exact")
+    car = sim.robot(VC)
+    motor = car.motor("motor")
+    motor.set_position(math.inf)
+    motor.set_velocity(0.5 * motor.max_velocity)
+    sensor, encoder = sim.device(f"{VC}/distance sensor"), sim.device(f"{VC}/motor sensor")
+    sensor.enable(8)
+    encoder.enable(8)
+    start = np.array(car.pose.translation)
+    for n in range(1, 301):
+        sim.step()
+        assert float(sensor.value) == 128.0, n
+        assert float(encoder.value) == pytest.approx(0.5 * 0.008 ** 2 * n * (n + 1) / 2, abs=1e-12), n
+        assert np.array(car.pose.translation) == pytest.approx(start, abs=1e-15)
