@@ -152,3 +152,15 @@ def test_the_vision_car_calls_turn_its_one_motor_by_the_kinematic_rule_where_web
         assert float(sensor.value) == 128.0, n
         assert float(encoder.value) == pytest.approx(0.5 * 0.008 ** 2 * n * (n + 1) / 2, abs=1e-12), n
         assert np.array(car.pose.translation) == pytest.approx(start, abs=1e-15)
+
+
+@pytest.mark.xfail(strict=True, reason="departures named in the README's twenty-third sweep, left to the drive's "
+                   "judgement (world/wbt/drive.py): a robot built on its side, mirrored wheel axes, one hinge "
+                   "carrying both sides' wheels, the radius taken from the hinge's own sphere")
+@pytest.mark.parametrize("world", ["braitenberg.wbt", "vision_car.wbt"])
+def test_webots_rolls_the_tinkerbots_vehicles_on_their_wheels(world: str) -> None:
+    """What Webots' physics does with both robots: each rolls on its 0.02625 m wheels (the cylinders two
+    Solids past the motor's hinge), so each should get a drive of that radius."""
+    (robot,) = load_world(DATA / world).world.robots
+    assert robot.differential_drive is not None
+    assert robot.differential_drive.wheel_radius == pytest.approx(0.02625, abs=1e-12)
