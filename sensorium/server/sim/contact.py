@@ -94,7 +94,7 @@ def deepest_end(gap: float, p: np.ndarray) -> float:
     overlapping) may end at: touching or within the tolerance, -EPS, whatever the steps (so a robot
     turning into a solid by steps of less than EPS each stops EPS in; a bound on each move's change
     let it creep in step by step); overlapping deeper (placed so from outside), no deeper than it
-    starts, less a rounding slack of 4e-15 of the coordinates (~30 ulps: two distances found apart,
+    starts, less a rounding slack of 4e-15 of the coordinates (~18 ulps: two distances found apart,
     at a slide's start and end, may round that much deeper; taken for going in, it stalled the robot)."""
     if gap >= -EPS:
         return -EPS
