@@ -113,9 +113,8 @@ def test_a_world_with_omni_and_mecanum_robots_steps_its_two_wheel_robots_in_c(mo
     if packets.library() is None:
         pytest.skip(f"no C helper: {packets.status()}")
     from tests.test_batched_omni import NAMES as MIXED
-    from tests.test_batched_omni import world as mixed_world
-
     from tests.test_batched_omni import omni, youbot
+    from tests.test_batched_omni import world as mixed_world
 
     assert [r.name for r in mixed_world(True).world.robots] == list(MIXED)     # its world, and one robot more here
     w = parse_world({"world_info": {"basic_time_step": STEP, "contact": True, "random_seed": 5},
