@@ -26,7 +26,8 @@ ROVER, SHELF = 1, 2                                  # robots first, then the to
 MAST, CAM, ARM, TIP, DS, LEFT_JOINT, LEFT_MOTOR, LEFT_ENCODER, LEFT_WHEEL = range(FIRST_ID, FIRST_ID + 9)
 RIGHT_JOINT, RIGHT_MOTOR, RIGHT_WHEEL, LID = range(FIRST_ID + 9, FIRST_ID + 13)
 LEFT_PARAMETERS, RIGHT_PARAMETERS = FIRST_ID + 13, FIRST_ID + 14   # after every other nested node
-W, R, AXLE, DT = 2.0, 0.05, 0.2, 0.032               # wheel speed (rad/s), radius, axle (m), basic step (s)
+W, R, DT = 2.0, 0.05, 0.032                          # wheel speed (rad/s), radius, basic step (s)
+AXLE = 2 * math.hypot(0.1, 0.05)   # m; no Physics: Webots' kinematic rule, the wheels' 3-D distances from the origin
 HALF_PI = math.pi / 2
 
 

@@ -247,7 +247,8 @@ def test_the_collision_avoidance_calls_under_sensorium_run_turn_at_the_closed_fo
 # too): wheels of radius 0.0825 m at y ±0.1603, 16 infra-red sensors (x, y, heading in degrees) at z
 # 0.209; the ground's walls, blocks and wedges (its y-up boxes: translation x, z, turn about y, size x,
 # z) and the central cylinder, green PBR (roughness 1).
-P2_R, P2_AXLE, P2_STEP = 0.0825, 0.3206, 32
+P2_R, P2_STEP = 0.0825, 32
+P2_AXLE = 2.0 * math.hypot(0.1603, 0.0825)    # no Physics: Webots' kinematic rule's axle, the wheels' 3-D distances
 P2_SENSORS = [(0.164, 0.027, 10), (0.147, 0.077, 30), (0.116, 0.118, 50), (0.071, 0.136, 90), (-0.16, 0.136, 90),
               (-0.205, 0.118, 130), (-0.236, 0.077, 150), (-0.253, 0.027, 170), (-0.253, -0.027, -170),
               (-0.236, -0.077, -150), (-0.205, -0.118, -130), (-0.16, -0.136, -90), (0.071, -0.136, -90),
@@ -298,12 +299,13 @@ def test_the_braitenberg_controller_drives_the_pioneer_2_on_its_closed_form_arcs
     """Webots' braitenberg controller's pioneer2 rule in process (32 ms steps, each wheel 0.1 · Σ
     weight · (1 - value/512), within ±10 rad/s), the sensors' 10 % noise taken out, for 60 s: every step
     the 16 infra-red sensors read the closed form's (the nearest green face at d reads the table at
-    d / 0.2413, the cylinder's at d / 0.2658; 0.02 of 1024, rays in float32) and the pose is the arc of
-    the wheel speeds set the step before (1e-9) unless a wall holds it. In open space every sensor
-    reads 0: left 1.4, right 1.2 rad/s, 0.10725 m/s curving right at 0.05147 rad/s (radius 2.084 m)
-    from (1, 0) heading +y, until ds13 (50° right) first sees the east wall within 0.0965 m at 16.832 s;
-    its turn away is too slow, and at 18.016 s the east wall holds its body (its footprint's 16-gon
-    2.1 mm short of the arc, see Kinematic contact); then it roams, held by the walls now and then."""
+    d / 0.2413, the cylinder's at d / 0.2658; 0.02 of 1024, rays in float32) and the pose is Webots'
+    kinematic rule's for a robot without Physics (axle 2·√(0.1603² + 0.0825²) = 0.36057 m, a straight
+    segment along the mid-step heading) from the wheel speeds set the step before (1e-9), no wall
+    holding it. In open space every sensor reads 0: left 1.4, right 1.2 rad/s, 0.10725 m/s curving right
+    at 0.04576 rad/s (radius 2.344 m) from (1, 0) heading +y, until ds13 (50° right) first sees the east
+    wall at 17.792 s; it turns away in time and roams the 60 s without a wall holding it. (By the arc on
+    the 0.3206 m between the wheels it curved at 0.05147 rad/s and met the wall at 18.016 s.)"""
     text = (DATA / "pioneer2.wbt").read_text()
     text = text.replace("lookupTable [ 0 1024 0, 0.2 1024 0.1, 0.4 0 0.1 ]", "lookupTable [ 0 1024 0, 0.2 1024 0, 0.4 0 0 ]")
     path = tmp_path / "pioneer2.wbt"
@@ -311,7 +313,8 @@ def test_the_braitenberg_controller_drives_the_pioneer_2_on_its_closed_form_arcs
     w = load_world(path)
     assert w.warnings == []
     drive = w.world.robots[0].differential_drive
-    assert drive is not None and (drive.wheel_radius, drive.axle_length) == (P2_R, P2_AXLE)
+    assert drive is not None and (drive.wheel_radius, drive.step_rule) == (P2_R, "mid_heading")
+    assert drive.axle_length == pytest.approx(P2_AXLE, abs=1e-15)
     sim = Simulation(w, "exact")
     robot = sim.robot("pioneer2")
     sensors = [sim.device(f"pioneer2/ds{i}") for i in range(16)]
@@ -328,12 +331,10 @@ def test_the_braitenberg_controller_drives_the_pioneer_2_on_its_closed_form_arcs
         x, y = (float(c) for c in robot.pose.translation[:2])
         yaw = yaw_of(robot)
         sim.run(1)
-        v, w_ = P2_R * (wl + wr) / 2, P2_R * (wr - wl) / P2_AXLE
-        if w_ == 0.0:
-            x, y = x + v * dt * math.cos(yaw), y + v * dt * math.sin(yaw)
-        else:
-            x, y = x + v / w_ * (math.sin(yaw + w_ * dt) - math.sin(yaw)), y - v / w_ * (math.cos(yaw + w_ * dt) - math.cos(yaw))
-            yaw = math.remainder(yaw + w_ * dt, 2 * math.pi)
+        # Webots' kinematic rule: a straight segment along the mid-step heading yaw + d, the heading then yaw + 2d
+        d = (wr - wl) * dt * P2_R / (2.0 * P2_AXLE)
+        v = 0.5 * (wl + wr) * P2_R * dt
+        x, y, yaw = x + v * math.cos(yaw + d), y + v * math.sin(yaw + d), yaw + 2.0 * d
         gx, gy = (float(c) for c in robot.pose.translation[:2])
         if math.hypot(gx - x, gy - y) > 1e-9 or abs(math.remainder(yaw_of(robot) - yaw, 2 * math.pi)) > 1e-9:
             held.append((k, round(gx - x, 6), round(gy - y, 6)))       # a wall held it
@@ -351,9 +352,8 @@ def test_the_braitenberg_controller_drives_the_pioneer_2_on_its_closed_form_arcs
             assert (wl, wr) == pytest.approx((1.4, 1.2), abs=1e-12)     # open space: Σ weights / 10
         left.set_velocity(wl)
         right.set_velocity(wr)
-    assert first_seen == (16832, [13], 1.7303, 1.5861)
-    assert held[0] == (563, -0.002082, 0.0)             # the east wall (x 1.99) holds its 16-gon's corner
-    assert 100 < len(held) < 400                        # it meets walls again as it roams
+    assert first_seen == (17792, [13], 1.731, 1.7025)
+    assert held == []             # turning by Webots' rule it turns away in time: no wall holds it in 60 s
 
 
 def test_the_motor_sample_s_turntable_follows_its_staircase_by_the_kinematic_rule() -> None:

@@ -26,6 +26,7 @@ DATA = Path(__file__).parent / "data" / "sweep22"
 # ring rotation, its DistanceSensor turned 0.16 rad more about z; the table's last row is 67.19 at 0.07 m.
 EP = "e-puck2"
 EP_R, EP_AXLE, EP_RES = 0.02, 0.052, 0.00628
+EP_KINEMATIC_AXLE = 2.0 * math.hypot(0.026, 0.02)    # Webots' rule without Physics: the wheels' 3-D distances
 EP_RING = [(0.03, -0.01, (-0.977797, 0.14818, 0.148178), -1.593259),
            (0.022, -0.025, (0.858029, -0.363171, -0.363172), 1.723331),
            (0.0, -0.031, (-0.577352, 0.577348, 0.577352), -2.094405),
@@ -47,6 +48,14 @@ def ep_move_on(x: float, y: float, yaw: float, wl: float, wr: float, dt: float) 
     if abs(wr - wl) * EP_R / EP_AXLE * dt < 1e-13:
         wl = wr = (wl + wr) / 2
     return k3_move_on(x, y, yaw, wl, wr, dt, EP_R, EP_AXLE)
+
+
+def ep_mid_heading(x: float, y: float, yaw: float, wl: float, wr: float, t: float) -> tuple[float, float, float]:
+    """One basic step of ``t`` s of Webots' kinematic rule (the e-puck without Physics): d = (ωr − ωl)·t·r /
+    (2·axle), a straight segment of v = (ωl + ωr)·r·t/2 along yaw + d, the heading then yaw + 2d."""
+    d = (wr - wl) * t * EP_R / (2.0 * EP_KINEMATIC_AXLE)
+    v = 0.5 * (wl + wr) * EP_R * t
+    return x + v * math.cos(yaw + d), y + v * math.sin(yaw + d), yaw + 2.0 * d
 
 
 def ep_obstacles() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -81,12 +90,14 @@ def test_the_e_puck2_stand_in_loads_its_model_and_the_devices_the_e_puck_control
     assert (camera.width, camera.height) == (160, 120)
 
 
-def run_e_puck(world: str, name: str, yaw0: float, duration_ms: int) -> tuple[int, tuple[int, int] | None, list[float]]:
+def run_e_puck(world: str, name: str, yaw0: float, duration_ms: int,
+               kinematic: bool = False) -> tuple[int, tuple[int, int] | None, list[float]]:
     """e-puck.c's calls in process on ``world`` for ``duration_ms`` (the sensors' noise zeroed in the
     stand-in), each step checked against the closed forms: the eight infra-red sensors read the table at
     the ray's distance to the nearest wall or box face (white: the distance itself; 67.19 past 0.07 m),
     the wheels' sensors their angles rounded to 0.00628 rad, the accelerometer 9.81 up while the robot
-    drives straight, and the pose is the arc of the wheel speeds set from the readings (1e-9). Returns
+    drives straight, and the pose is the arc of the wheel speeds set from the readings (1e-9; ``kinematic``:
+    Webots' rule without Physics, :func:`ep_mid_heading` each basic step). Returns
     the step the model chose, when and which sensor first met something, and the final x, y, yaw."""
     sim = Simulation(load_world(DATA / world), "exact")
     robot = sim.robot(name)
@@ -114,7 +125,11 @@ def run_e_puck(world: str, name: str, yaw0: float, duration_ms: int) -> tuple[in
     for k in range(1, duration_ms // step + 1):
         for _ in range(step // sim.basic_time_step):
             sim.step()
-        x, y, yaw = ep_move_on(x, y, yaw, wl, wr, step / 1000)
+        if kinematic:
+            for _ in range(step // sim.basic_time_step):
+                x, y, yaw = ep_mid_heading(x, y, yaw, wl, wr, sim.basic_time_step / 1000)
+        else:
+            x, y, yaw = ep_move_on(x, y, yaw, wl, wr, step / 1000)
         angles = [angles[0] + wl * step / 1000, angles[1] + wr * step / 1000]
         body = rot((0, 0, 1), yaw - yaw0) @ turn0
         assert list(robot.pose.translation) == pytest.approx([x, y, 0.0], abs=1e-9), k
@@ -149,13 +164,16 @@ def test_the_e_puck_calls_drive_the_e_puck2_by_its_closed_form_readings_and_arcs
 
 def test_the_e_puck_calls_drive_the_kinematic_e_puck_by_the_same_closed_forms() -> None:
     """e-puck_kinematic: the version-1 E-puck without Physics: the controller picks 256 ms from the model
-    "GCtronic e-puck"; the same closed forms hold every step for 40.96 s (160 steps) (Webots' own
-    kinematic rule for a robot without Physics takes a 3D axle of 0.0656 m and mid-step headings: a
-    departure the README names, not fixed by this sweep): ps0 meets the wall at
-    33.536 s, the robot then turning left to (−0.0792, 0.9214) heading −2.5771. The stand-in loads
+    "GCtronic e-puck"; the same closed forms hold every step for 40.96 s (160 steps), the pose's by Webots'
+    kinematic rule for a robot without Physics (a 3-D axle of 0.0656 m, each 32 ms basic step a straight
+    segment along the mid-step heading): ps0 meets the wall at 33.536 s, the robot then turning left to
+    (−0.0683, 0.9316) heading −2.6259 (by the arc and the 0.052 m axle it was (−0.0792, 0.9214), −2.5771). The
+    stand-in loads
     without mass (nothing to settle) and with the version-1 wheels' maxVelocity, 6.28 rad/s."""
-    step, first_seen, end = run_e_puck("e-puck_kinematic.wbt", "e-puck", 1.571595307179586, 40960)
+    step, first_seen, end = run_e_puck("e-puck_kinematic.wbt", "e-puck", 1.571595307179586, 40960, kinematic=True)
     assert step == 256 and first_seen == (33536, 0), (step, first_seen)
-    assert end == pytest.approx([-0.0792, 0.9214, -2.5771], abs=1e-4)
+    assert [*end[:2], math.remainder(end[2], 2 * math.pi)] == pytest.approx([-0.0683, 0.9316, -2.6259], abs=1e-4)
     (robot,) = load_world(DATA / "e-puck_kinematic.wbt").world.robots
     assert robot.mass is None and robot.model == "GCtronic e-puck" and robot.differential_drive.max_wheel_speed == 6.28
+    assert robot.differential_drive.step_rule == "mid_heading"
+    assert robot.differential_drive.axle_length == pytest.approx(EP_KINEMATIC_AXLE, abs=1e-15)

@@ -370,8 +370,10 @@ def test_slots_hold_wheels_and_devices(tmp_path: Path) -> None:
     w = load_world(p)
     assert not w.report.losses and not w.warnings, w.warnings
     (robot,) = w.world.robots
-    assert robot.differential_drive == wm.DifferentialDrive(wheel_radius=0.03, axle_length=0.1, max_wheel_speed=10.0,
-                                                            left_motor="left", right_motor="right")
+    # (no Physics: Webots' kinematic rule, the axle the wheels' 3-D distances from the origin, 2·|(0, 0.05, 0.02)|)
+    assert robot.differential_drive == wm.DifferentialDrive(
+        wheel_radius=0.03, axle_length=2.0 * float(np.linalg.norm([0.0, 0.05, 0.02])), max_wheel_speed=10.0,
+        left_motor="left", right_motor="right", step_rule="mid_heading")
     assert [s.pose.translation for s in robot.shapes] == [(0.0, 0.05, 0.02), (0.0, -0.05, 0.02)]
     assert [s.seen_by for s in robot.shapes] == ["both", "both"]
     ds = next(d for d in robot.devices if d.name == "ds")
@@ -789,13 +791,15 @@ def test_duplicate_def_names_rejected_in_world_files() -> None:
 
 
 def test_drive_from_wheel_end_points_when_anchors_coincide(tmp_path: Path) -> None:
-    """As in Webots' e-puck: both hinge anchors at the axle's centre, the wheels placed by their end points."""
+    """As in Webots' e-puck: both hinge anchors at the axle's centre, the wheels placed by their end points
+    (no Physics: Webots' kinematic rule, the axle the wheels' 3-D distances from the origin, 2·|(0, 0.026, 0.02)|)."""
     wheel = ('HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 0 0.02 }} '
              'device [ RotationalMotor {{ name "{0} wheel motor" maxVelocity 6.28 }} ] endPoint Solid {{ translation 0 {1} 0.02 '
              'boundingObject Transform {{ rotation 1 0 0 1.570796 children [ Cylinder {{ height 0.005 radius 0.02 }} ] }} }} }}\n')
     p = write(tmp_path, 'Robot { name "e" children [\n' + wheel.format("left", 0.026) + wheel.format("right", -0.026) + "] }\n")
     dd = load_world(p).world.robots[0].differential_drive
-    assert dd == wm.DifferentialDrive(wheel_radius=0.02, axle_length=0.052, max_wheel_speed=6.28)
+    assert dd == wm.DifferentialDrive(wheel_radius=0.02, axle_length=2.0 * float(np.linalg.norm([0.0, 0.026, 0.02])),
+                                      max_wheel_speed=6.28, step_rule="mid_heading")
 
 
 def test_textures_summarised_once(tmp_path: Path) -> None:

@@ -33,6 +33,13 @@ def wheel(name: str, x: float, y: float, axis: str = "0 1 0", joint: str = "Hing
             f'Cylinder {{ radius {R} height 0.095 }} }} ] boundingObject USE W }} }}\n')
 
 
+def kinematic(y: float) -> dict:
+    """The drive fields of a two-wheel robot without Physics, wheels (:func:`wheel`) at (0, ±y, R): Webots'
+    kinematic rule (wbt/drive.py ``webots_kinematic_pair``), its axle the sum of the wheels' 3-D distances from
+    the robot's origin, 2·|(0, y, R)|, each step along the mid-step heading."""
+    return {"axle_length": 2.0 * float(np.linalg.norm([0.0, y, R])), "step_rule": "mid_heading"}
+
+
 def pioneer(name: str = "p3at", at: str = "0 0 0") -> str:
     return (f'Robot {{ name "{name}" translation {at} children [\n'
             f'  Pose {{ translation 0 0 0.2 children [ Shape {{ geometry Box {{ size 0.5 0.4 0.2 }} }} ] }}\n'
@@ -256,7 +263,7 @@ def test_a_devices_own_motorised_joints_are_no_wheels(tmp_path: Path) -> None:
     (robot,) = w.world.robots
     assert robot.ackermann_drive is None
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=0.16, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+        wheel_radius=R, **kinematic(0.08), max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert [(d.name, d.device) for d in robot.devices][:3] == [
         ("spin", "Lidar"), ("spin_turret", "RotationalMotor"), ("spin_belt", "RotationalMotor")]
     assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == ["left wheel", "right wheel"]
@@ -282,7 +289,7 @@ def test_a_motorised_arm_on_a_two_wheel_robot_is_no_wheel(tmp_path: Path) -> Non
     w = load_world(p)
     (robot,) = w.world.robots
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=0.052, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+        wheel_radius=R, **kinematic(0.026), max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert [(d.name, d.device) for d in robot.devices][:3] == [
         ("lift", "RotationalMotor"), ("lift sensor", "PositionSensor"), ("grip", "LinearMotor")]
     assert [d.motor for d in robot.devices if d.device == "PositionSensor"] == ["lift", "left wheel", "right wheel"]
@@ -318,7 +325,7 @@ def test_an_arm_of_plain_cylinders_on_a_two_wheel_robot_is_no_wheel(tmp_path: Pa
     w = load_world(p)
     (robot,) = w.world.robots
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+        wheel_radius=R, **kinematic(0.15), max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert not [x for x in w.warnings if "drive" in x]
     assert f"{p}:6:1: HingeJoint motor 'shoulder' is no wheel (nothing round at its end point turns about its " \
            "axis as a wheel does): its joint moves kinematically (Webots' rule without physics; its PositionSensor " \
@@ -330,7 +337,7 @@ def test_an_arm_of_plain_cylinders_on_a_two_wheel_robot_is_no_wheel(tmp_path: Pa
     p = write(tmp_path, body(roller))
     w = load_world(p)
     assert w.world.robots[0].differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=0.3, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+        wheel_radius=R, **kinematic(0.15), max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert f"{p}:6:1: HingeJoint motor 'shoulder' is no wheel (its round part's bottom is 0.28 m above the robot's " \
            "lowest wheels: it never touches the ground): its joint moves kinematically (Webots' rule without " \
            "physics; its PositionSensor reads it), and the shapes and devices past the joint with it" in w.warnings
@@ -417,7 +424,7 @@ def _two_wheels_and_a_joint(tmp_path: Path, name: str, joint: str, motor: str,
     w = load_world(p)
     (robot,) = w.world.robots
     assert robot.ackermann_drive is None and robot.differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=2 * Y, max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
+        wheel_radius=R, **kinematic(Y), max_wheel_speed=12.3, left_motor="left wheel", right_motor="right wheel")
     assert not [x for x in w.warnings if "drive" in x], w.warnings
     assert [x.split(": ", 1)[1] for x in w.warnings if motor in x] == [
         f"HingeJoint motor '{motor}' {why}: its joint moves kinematically (Webots' rule without physics; its "
@@ -456,7 +463,7 @@ def test_coupled_drive_wheels_are_said_and_turn_on_their_own(tmp_path: Path) -> 
     w = load_world(p)
     (robot,) = w.world.robots
     assert robot.differential_drive == wm.DifferentialDrive(
-        wheel_radius=R, axle_length=0.16, max_wheel_speed=12.3, left_motor="wheel::left", right_motor="wheel::right")
+        wheel_radius=R, **kinematic(0.08), max_wheel_speed=12.3, left_motor="wheel::left", right_motor="wheel::right")
     said = [x.split(": ", 1)[1] for x in w.warnings if "coupled" in x]
     assert said == [f"RotationalMotor 'wheel::{side}': a coupled motor (Webots passes a command to every motor whose "
                     f"name shares the part before '::', scaled by its multiplier, here {m}) that is a wheel of the "

@@ -1,6 +1,6 @@
 """Each wheel motor keeps its own maxVelocity (drives' ``motor_max_speeds``): a robot of our own with
 two wheels of 133.33 and 140 rad/s (an Elisa-3's), written as a .wbt, clamps each wheel to its own,
-drives the closed-form arc of the two clamped speeds, tells the client each motor's own maximum (the
+drives the closed form of the two clamped speeds (no Physics: Webots' kinematic rule's steps), tells the client each motor's own maximum (the
 warning names it), steps batched copies bit for bit and scales the gym's ±1 by each wheel's own."""
 
 from __future__ import annotations
@@ -75,11 +75,13 @@ def test_each_wheel_clamps_to_its_own_and_the_robot_drives_their_arc(tmp_path: P
     n = 50
     for _ in range(n):
         sim.step()
-    t = n * STEP / 1000.0
-    v, w = R * (LEFT_MAX + RIGHT_MAX) / 2.0, R * (RIGHT_MAX - LEFT_MAX) / (2 * HALF_AXLE)
+    # no Physics: Webots' rule, the axle the wheels' 3-D distances from the origin; each step a chord s along
+    # the mid-step heading, turning 2d: after n steps from heading 0, s·sin(nd)/sin(d) along heading nd
+    t, axle = STEP / 1000.0, 2.0 * math.hypot(HALF_AXLE, R)
+    s, d = R * (LEFT_MAX + RIGHT_MAX) / 2.0 * t, (RIGHT_MAX - LEFT_MAX) * t * R / (2.0 * axle)
     end = robot.pose.translation
-    assert end[0] == pytest.approx(v / w * math.sin(w * t), abs=1e-9)
-    assert end[1] == pytest.approx(v / w * (1.0 - math.cos(w * t)), abs=1e-9)
+    assert end[0] == pytest.approx(s * math.sin(n * d) / math.sin(d) * math.cos(n * d), abs=1e-12)
+    assert end[1] == pytest.approx(s * math.sin(n * d) / math.sin(d) * math.sin(n * d), abs=1e-12)
 
 
 def test_the_client_clamps_and_warns_with_each_motors_own_maximum(tmp_path: Path, capsys) -> None:

@@ -1518,6 +1518,11 @@ class DifferentialDrive(Strict):
         "wheels' centre) from the robot's origin, along forward and its left; (0, 0): under the origin. Elsewhere "
         "(a Boe-Bot's axle 2.5 cm ahead of its origin) the centre follows the drive's arc and the origin, rigidly "
         "attached to it, turns about it")
+    step_rule: Literal["arc", "mid_heading"] = Field(
+        default="arc", description="how a basic step moves the robot: arc, the exact arc of the step's constant wheel "
+        "speeds; mid_heading, Webots' rule for a robot without Physics (WbKinematicDifferentialWheels): a straight "
+        "segment of length v·dt along the heading at mid-step (heading + ω·dt/2), then the heading turned by ω·dt, "
+        "about the robot's origin (axle_center (0, 0))")
 
     @property
     def motor_names(self) -> tuple[list[str], list[str]]:
@@ -1536,6 +1541,9 @@ class DifferentialDrive(Strict):
         if len(set(names)) != len(names):
             raise ValueError(f"every wheel motor needs its own name, got {names}")
         _check_motor_max_speeds(self.motor_max_speeds, names, "drive's wheel motors")
+        if self.step_rule == "mid_heading" and any(self.axle_center):
+            raise ValueError(f"step_rule mid_heading turns the robot about its origin (Webots' kinematic rule), so "
+                             f"axle_center must be (0, 0), got {list(self.axle_center)}")
         for side, motors in zip(("left", "right"), self.motor_names):
             # a side's wheels roll as one (their mean), stepped as one state in the batched simulation
             if len({wheel_max_speed(self, m) for m in motors}) > 1:

@@ -1443,13 +1443,14 @@ static inline double np_remainder(double a, double b) {
  * remainder((yaw + dyaw) + pi, 2 pi) - pi) and then the new yaw's cos and sin (the pose's Rz), the
  * libm calls math.cos/math.sin make. Returns the number of infinite angles handed to cos or sin
  * (math.cos refuses them: the caller's Python way says so); the outputs are then not to be used. */
-/* one robot's arc of sp_arc_steps (its new x, y and yaw); returns its infinite angles' count */
-static inline size_t arc_one(double x, double y, double yaw, double v, double w, double dt, double* out_x,
-                             double* out_y, double* out_yaw) {
+/* one robot's arc of sp_arc_steps (its new x, y and yaw); returns its infinite angles' count. ``straight``:
+ * the straight branch whatever the turn (motion.mid_heading_step: Webots' rule without Physics) */
+static inline size_t arc_one(double x, double y, double yaw, double v, double w, double dt, int straight,
+                             double* out_x, double* out_y, double* out_yaw) {
   const double pi = 3.141592653589793, two_pi = 2.0 * 3.141592653589793;
   size_t inf = 0;
   const double dyaw = w * dt;
-  if (fabs(dyaw) < 1e-9) {
+  if (straight || fabs(dyaw) < 1e-9) {
     const double mid = yaw + 0.5 * dyaw;
     const double cm = cos(mid);
     const double sm = sin(mid);
@@ -1511,17 +1512,19 @@ static size_t new_yaws_cos_sin(size_t n, const double* out_yaw, double* out_cos,
 size_t sp_arc_steps(size_t n, const double* x, const double* y, const double* yaw, const double* v, const double* w,
                     double dt, double* out_x, double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
   size_t inf = 0;
-  for (size_t i = 0; i < n; i++) inf += arc_one(x[i], y[i], yaw[i], v[i], w[i], dt, out_x + i, out_y + i, out_yaw + i);
+  for (size_t i = 0; i < n; i++)
+    inf += arc_one(x[i], y[i], yaw[i], v[i], w[i], dt, 0, out_x + i, out_y + i, out_yaw + i);
   return inf + new_yaws_cos_sin(n, out_yaw, out_cos, out_sin);
 }
 
 /* sp_drive_step's moves: move i of slot slot[i] by its arc about its origin, or, when the slot's
  * wheels' centre (centre[2 slot], centre[2 slot + 1]) is off its origin (centre not NULL), by the
  * origin's body twist (v + w cy, -w cx, w) (batched.py's _drive_numpy: DifferentialDrive.step's
- * twist); then the new yaws' cos and sin. Returns the infinite angles' count. */
-static size_t drive_moves(size_t n, const int64_t* slot, const double* centre, const double* x, const double* y,
-                          const double* yaw, const double* v, const double* w, double dt, double* out_x,
-                          double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
+ * twist), or, when mid[slot] is set (mid not NULL: step_rule mid_heading), by the straight segment
+ * along the mid-step heading; then the new yaws' cos and sin. Returns the infinite angles' count. */
+static size_t drive_moves(size_t n, const int64_t* slot, const double* centre, const uint8_t* mid, const double* x,
+                          const double* y, const double* yaw, const double* v, const double* w, double dt,
+                          double* out_x, double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
   size_t inf = 0;
   for (size_t i = 0; i < n; i++) {
     const double* cc = centre ? centre + 2 * (size_t)slot[i] : NULL;
@@ -1529,7 +1532,7 @@ static size_t drive_moves(size_t n, const int64_t* slot, const double* centre, c
       inf += twist_one(x[i], y[i], yaw[i], v[i] + w[i] * cc[1], -w[i] * cc[0], w[i], dt, out_x + i, out_y + i,
                        out_yaw + i);
     else
-      inf += arc_one(x[i], y[i], yaw[i], v[i], w[i], dt, out_x + i, out_y + i, out_yaw + i);
+      inf += arc_one(x[i], y[i], yaw[i], v[i], w[i], dt, mid && mid[slot[i]], out_x + i, out_y + i, out_yaw + i);
   }
   return inf + new_yaws_cos_sin(n, out_yaw, out_cos, out_sin);
 }
@@ -1591,17 +1594,18 @@ size_t sp_plane1(size_t n, const double* O, size_t o_stride, const double* D, in
 
 /* drive_moves for the numpy drive pass of a world with other drives too (packets.drive_moves):
  * the two-wheel robots' moves in C, the cars' and holonomic robots' beside them in numpy. */
-size_t sp_drive_moves(size_t n, const int64_t* slot, const double* centre, const double* x, const double* y,
-                      const double* yaw, const double* v, const double* w, double dt, double* out_x, double* out_y,
-                      double* out_yaw, double* out_cos, double* out_sin) {
-  return drive_moves(n, slot, centre, x, y, yaw, v, w, dt, out_x, out_y, out_yaw, out_cos, out_sin);
+size_t sp_drive_moves(size_t n, const int64_t* slot, const double* centre, const uint8_t* mid, const double* x,
+                      const double* y, const double* yaw, const double* v, const double* w, double dt, double* out_x,
+                      double* out_y, double* out_yaw, double* out_cos, double* out_sin) {
+  return drive_moves(n, slot, centre, mid, x, y, yaw, v, w, dt, out_x, out_y, out_yaw, out_cos, out_sin);
 }
 
 /* batched.py's _drive up to the contact narrow phase, in one pass over the state arrays (their
  * addresses in a[], see DriveStep in packets.py): the live copies' robots stop pressing; their
  * wheels and drives (sp_drive_wheels); the moving robots' arcs (sp_arc_steps, from x, y, yaw
  * gathered), or their origin's twist for a robot whose wheels' centre is off its origin (a[42]:
- * the slots' centres (R, 2), NULL when none is: drive_moves), and their new yaws written; with contact, each move's reach hypot(end - start) + eps
+ * the slots' centres (R, 2), NULL when none is; a[43]: the slots' mid_heading flags (R,) uint8, NULL
+ * when none has it: drive_moves), and their new yaws written; with contact, each move's reach hypot(end - start) + eps
  * + spin[slot] * fmin(|yaw1 - yaw0|, 2) (a shaped robot's push off what its turn goes into)
  * (np.hypot is libm's hypot), the grown discs (grow: 0, then the movers' reach) and the broad phase
  * (sp_contact_near). When no move is near anything, the moves end where Contact._clip without
@@ -1650,7 +1654,7 @@ size_t sp_drive_step(size_t L, const int64_t* live, size_t D, const int64_t* dri
     y0[m] = y[at];
     yaw0[m] = yaw[at];
   }
-  status[0] = (int64_t)drive_moves(k, ms, a[42], x0, y0, yaw0, v, w, dt, x1, y1, yaw1, cs, sn);
+  status[0] = (int64_t)drive_moves(k, ms, a[42], a[43], x0, y0, yaw0, v, w, dt, x1, y1, yaw1, cs, sn);
   if (status[0]) return k;
   for (size_t m = 0; m < k; m++) {
     const size_t at = (size_t)mc[m] * R + (size_t)ms[m];

@@ -192,7 +192,7 @@ def _load() -> None:
     lib.sp_arc_steps.restype = sz
     lib.sp_arc_steps.argtypes = [sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp]
     lib.sp_drive_moves.restype = sz
-    lib.sp_drive_moves.argtypes = [sz, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp]
+    lib.sp_drive_moves.argtypes = [sz, vp, vp, vp, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp]
     lib.sp_cos_sin.restype = sz
     lib.sp_cos_sin.argtypes = [sz, vp, vp, vp]
     lib.sp_box3.restype = None
@@ -744,11 +744,14 @@ def arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: n
 
 
 def drive_moves(slots: np.ndarray, centre: np.ndarray | None, x: np.ndarray, y: np.ndarray, yaw: np.ndarray,
-                v: np.ndarray, w: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+                v: np.ndarray, w: np.ndarray, dt: float,
+                mid: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """Two-wheel robots' moves in one C pass (``sp_drive_moves``, :class:`DriveStep`'s): move i of
     robot slot ``slots[i]`` by its arc about its origin (:func:`.batched._arc_steps`), or, when
     ``centre[slot]`` (``centre``: (R, 2) float64, or None for none) is off its origin, by the
-    origin's body twist (v + w cy, -w cx, w) (:func:`.batched_holonomic.twist_steps`): the new
+    origin's body twist (v + w cy, -w cx, w) (:func:`.batched_holonomic.twist_steps`), or, when
+    ``mid[slot]`` (``mid``: (R,) uint8, or None for none) is set, by the straight segment along the
+    mid-step heading (:func:`.batched._mid_heading_steps`, ``step_rule: mid_heading``): the new
     (x, y, yaw), the numpy path's bits; None without the helper or when an angle is infinite
     (math.cos refuses it: the caller's numpy way says so)."""
     lib = library()
@@ -763,9 +766,13 @@ def drive_moves(slots: np.ndarray, centre: np.ndarray | None, x: np.ndarray, y: 
         _check_buffer("drive_moves", centre, np.float64, centre.shape[:1] + (2,))
         if n and (slots.min() < 0 or slots.max() >= len(centre)):
             raise IndexError("drive_moves: a slot beyond the centres")
+    if mid is not None:
+        _check_buffer("drive_moves", mid, np.uint8, mid.shape[:1])
+        if n and (slots.min() < 0 or slots.max() >= len(mid)):
+            raise IndexError("drive_moves: a slot beyond the mid_heading flags")
     outs = [np.empty(n) for _ in range(5)]
     p = _small_addresses([slots, *ins, *outs])
-    if lib.sp_drive_moves(n, p[0], _ptr(centre), *p[1:6], float(dt), *p[6:]):
+    if lib.sp_drive_moves(n, p[0], _ptr(centre), _ptr(mid), *p[1:6], float(dt), *p[6:]):
         return None
     return outs[0], outs[1], outs[2]
 
@@ -976,13 +983,18 @@ class DriveStep:
             arrays += [contact[k] for k in ("foot_radius", "foot_low", "foot_high", "heights", "centres")]
             _check_buffer("drive_step", contact["spin"], np.float64, (R,))
         # a[34..40]: the solids' arrays and the broad phase's outputs (run); a[41]: the spin reach;
-        # a[42]: the wheels' centres of the slots (R, 2) when some robot's is off its origin, else NULL
+        # a[42]: the wheels' centres of the slots (R, 2) when some robot's is off its origin, else NULL;
+        # a[43]: the slots' mid_heading flags (R,) uint8 when some robot has step_rule mid_heading, else NULL
         spin = contact["spin"] if contact is not None else self.reach
         centre = state.get("centre")
         if centre is not None:
             _check_buffer("drive_step", centre, np.float64, (R, 2))
-        self.ptrs = (ctypes.c_void_p * 43)(*(a.ctypes.data for a in arrays), *([0] * (41 - len(arrays))),
-                                           spin.ctypes.data, None if centre is None else centre.ctypes.data)
+        mid = state.get("mid_heading")
+        if mid is not None:
+            _check_buffer("drive_step", mid, np.uint8, (R,))
+        self.ptrs = (ctypes.c_void_p * 44)(*(a.ctypes.data for a in arrays), *([0] * (41 - len(arrays))),
+                                           spin.ctypes.data, None if centre is None else centre.ctypes.data,
+                                           None if mid is None else mid.ctypes.data)
         self._solids: tuple = ()
         self.p_status = self.status.ctypes.data
         self.p_scatter = [a.ctypes.data for a in (self.copies, self.slots, self.rot, state["x"], state["y"],

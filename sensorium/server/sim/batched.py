@@ -39,7 +39,8 @@ a speed per wheel), both on :mod:`~sensorium.server.sim.batched_holonomic`'s whe
 through the single drive's exact twist step (:func:`~sensorium.server.sim.batched_holonomic.twist_steps`),
 then the same contact and placing. A two-wheel or skid-steer robot whose wheels' centre is off its
 origin (``differential_drive.axle_center``) moves by the same twist step (its origin's body twist,
-as DifferentialDrive.step), the others by their arcs, both in the C drive pass (packets.c, the numpy
+as DifferentialDrive.step), one with ``step_rule: mid_heading`` by Webots' straight segment along the
+mid-step heading, the others by their arcs, all in the C drive pass (packets.c, the numpy
 path's operations); in a world with car-like, mecanum or omni-wheel robots those take the numpy
 drive and the two-wheel robots' wheels and moves are C passes within it.
 
@@ -363,6 +364,11 @@ class BatchedSimulation:
                                      for r in w.robots], dtype=np.float64).reshape(-1, 2)
         self.off_centre = (self.axle_center != 0.0).any(axis=1)
         self._any_off_centre = bool(self.off_centre.any())
+        # a two-wheel robot with step_rule mid_heading (Webots' rule without Physics, always about its origin:
+        # never off centre) moves by the straight segment along its mid-step heading (_mid_heading_steps)
+        self.mid_heading = np.array([r.differential_drive is not None and r.differential_drive.step_rule == "mid_heading"
+                                     for r in w.robots], dtype=np.uint8)
+        self._any_mid_heading = bool(self.mid_heading.any())
         # the terrains robots ride (sim/ground.py; None in a world without one: heights never change)
         self.ground = Ground.from_world(w, self.scene.solid_poses, self.to_enu)
         # each robot's band bottom below its origin (its support ceiling's, ground.band_low; 0 without a ground)
@@ -1039,7 +1045,8 @@ class BatchedSimulation:
                 {"target": self.target, "velocity": self.velocity, "angle": self.wheel_angle,
                  "sides": self.side_wheels, "radius": self.wheel_radius, "axle": self.axle, "x": self.x, "y": self.y,
                  "yaw": self.yaw, "z": self.z, "pressing": self.pressing, "base": self.base, "rot": self.rot,
-                 "pos": self.pos, "centre": self.axle_center if self._any_off_centre else None}, contact)
+                 "pos": self.pos, "centre": self.axle_center if self._any_off_centre else None,
+                 "mid_heading": self.mid_heading if self._any_mid_heading else None}, contact)
         return got
 
     def _place(self, copies: np.ndarray, slots: np.ndarray, rz: np.ndarray, base: np.ndarray, cos: np.ndarray,
@@ -1147,18 +1154,22 @@ class BatchedSimulation:
     def _two_wheel_moves(self, copies: np.ndarray, slots: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):
         """The moving two-wheel robots' (copies, slots, x0, y0, yaw0, x, y, yaw): an arc about the origin,
         or for a robot whose wheels' centre is off its origin the origin's body twist (v + ω cy, −ω cx, ω),
+        or for one with step_rule mid_heading the straight segment along its mid-step heading,
         DifferentialDrive.step's; in one C pass (packets.drive_moves) where the helper is built."""
         x0, y0, yaw0 = self.x[copies, slots], self.y[copies, slots], self.yaw[copies, slots]
         centre = self.axle_center if self._any_off_centre else None
-        moved = packets.drive_moves(slots, centre, x0, y0, yaw0, v, w, dt)
+        moved = packets.drive_moves(slots, centre, x0, y0, yaw0, v, w, dt,
+                                    self.mid_heading if self._any_mid_heading else None)
         if moved is not None:
             return (copies, slots, x0, y0, yaw0, *moved)
         off = self.off_centre[slots]
-        if not off.any():
+        mid = self.mid_heading[slots].astype(bool)
+        if not off.any() and not mid.any():
             return (copies, slots, x0, y0, yaw0, *_arc_steps(x0, y0, yaw0, v, w, dt))
         x, y, yaw = np.empty_like(x0), np.empty_like(y0), np.empty_like(yaw0)
-        on = ~off
+        on = ~off & ~mid
         x[on], y[on], yaw[on] = _arc_steps(x0[on], y0[on], yaw0[on], v[on], w[on], dt)
+        x[mid], y[mid], yaw[mid] = _mid_heading_steps(x0[mid], y0[mid], yaw0[mid], v[mid], w[mid], dt)
         cx, cy, wo = self.axle_center[slots[off], 0], self.axle_center[slots[off], 1], w[off]
         x[off], y[off], yaw[off] = twist_steps(x0[off], y0[off], yaw0[off], v[off] + wo * cy, -wo * cx, wo, dt)
         return copies, slots, x0, y0, yaw0, x, y, yaw
@@ -2060,6 +2071,13 @@ def _offset_arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarr
     x1[k] = x1[k] - ak * c1
     y1[k] = y1[k] - ak * s1
     return x1, y1, yaw1
+
+
+def _mid_heading_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):
+    """motion.mid_heading_step for many robots, element by element the same float64 operations."""
+    dyaw = w * dt
+    cm, sm = kin.libm_cos_sin(yaw + 0.5 * dyaw)
+    return x + v * dt * cm, y + v * dt * sm, np.remainder(yaw + dyaw + math.pi, _TWO_PI) - math.pi
 
 
 def _arc_steps(x: np.ndarray, y: np.ndarray, yaw: np.ndarray, v: np.ndarray, w: np.ndarray, dt: float):

@@ -124,6 +124,15 @@ def arc_step(x: float, y: float, yaw: float, v: float, w: float, dt: float) -> t
     return x, y, _wrap(yaw + dyaw)
 
 
+def mid_heading_step(x: float, y: float, yaw: float, v: float, w: float, dt: float) -> tuple[float, float, float]:
+    """Webots' kinematic step of a robot without Physics (``step_rule: mid_heading``): a straight segment of
+    length ``v·dt`` along the heading at mid-step, then the heading turned by ``w·dt`` (:func:`arc_step`'s
+    straight branch, whatever the turn: the same float64 operations)."""
+    dyaw = w * dt
+    mid = yaw + 0.5 * dyaw
+    return x + v * dt * math.cos(mid), y + v * dt * math.sin(mid), _wrap(yaw + dyaw)
+
+
 def _wrap(a: float) -> float:
     return (a + math.pi) % _TWO_PI - math.pi
 
@@ -317,6 +326,8 @@ class DifferentialDrive(PlanarState):
     robot turns: it moves at v along the heading while the robot turns at w, so the origin, at
     -(cx, cy) from it, moves with the body twist (v + w·cy, -w·cx), taken exactly over a step by
     :func:`twist_step`; a centre under the origin is the arc of the origin itself (:func:`arc_step`).
+    ``config.step_rule`` ``mid_heading`` (Webots' rule without Physics) moves the origin by
+    :func:`mid_heading_step` instead.
     """
 
     def __init__(self, config, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0):
@@ -324,6 +335,7 @@ class DifferentialDrive(PlanarState):
         self.axle_length = float(config.axle_length)
         cx, cy = getattr(config, "axle_center", (0.0, 0.0))
         self.center: tuple[float, float] | None = (float(cx), float(cy)) if (cx or cy) else None
+        self.mid_heading = getattr(config, "step_rule", "arc") == "mid_heading"
         skid = getattr(config, "skid_steer", None)
         self.left = WheelMotor(config.left_motor, wheel_max_speed(config, config.left_motor))
         self.right = WheelMotor(config.right_motor, wheel_max_speed(config, config.right_motor))
@@ -350,7 +362,8 @@ class DifferentialDrive(PlanarState):
         w = self.wheel_radius * (wr - wl) / self.axle_length
         v, w = self.over_ground(v, w)
         if self.center is None:
-            self.x, self.y, self.yaw = arc_step(self.x, self.y, self.yaw, v, w, dt)
+            step = mid_heading_step if self.mid_heading else arc_step
+            self.x, self.y, self.yaw = step(self.x, self.y, self.yaw, v, w, dt)
             self.moved(v, w)
             return self.pose()
         cx, cy = self.center           # the origin's body twist, the wheels' centre moving at v

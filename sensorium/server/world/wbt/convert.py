@@ -2513,6 +2513,7 @@ class Converter:
             omni_wheels,
             rolls_about_its_axis,
             spins_in_place,
+            webots_kinematic_pair,
             wheel_radius,
         )
 
@@ -2696,6 +2697,14 @@ class Converter:
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no differential drive ({why}); the robot will not move")
                 return
+            if self.fields(node).node_("physics") is None and up == 2 and "skid_steer" not in drive \
+                    and "forward" not in drive:
+                # no Physics: Webots moves the robot by its own kinematic rule, with its own axle (wbt/drive.py)
+                pair = webots_kinematic_pair(robot.wheels, self)
+                if pair is not None and {pair["left_motor"], pair["right_motor"]} == {drive["left_motor"],
+                                                                                      drive["right_motor"]}:
+                    drive.pop("axle_center", None)
+                    drive.update(pair)
             robot.data["differential_drive"] = drive
             for w in wheels:      # a wheel's cylinder lying across its hinge's axis: Webots' would not roll
                 if not rolls_about_its_axis(w, self, centred=False):

@@ -343,6 +343,97 @@ def _two_wheels(wheels: list[dict], conv) -> tuple[dict | None, str]:
                      "right_motor": right["motor"]}, mid[0], mid[1]), ""
 
 
+def webots_kinematic_pair(wheels: list[dict], conv) -> dict | None:
+    """The two wheels Webots moves a robot without Physics by (``WbKinematicDifferentialWheels``), as the
+    drive's fields: ``left_motor``, ``right_motor``, ``wheel_radius``, ``axle_length`` and ``step_rule``
+    ``mid_heading``; None when no pair qualifies (Webots then does not move the robot at all).
+
+    The candidates are the robot's motorised HingeJoints with a Solid end point, in the world's order (here
+    those not inside another candidate's end point: the robot's own joints). The first pair (i < j) taken is
+    the first whose end points' boundingObjects hold a Cylinder (:func:`_biggest_cylinder`) of one radius > 0,
+    the two at distances from the robot's origin (3-D, to the Pose, Transform or Solid holding each cylinder)
+    within 1e-5 m of each other, their joints' axes parallel and their anchors on a line along them. The
+    axle is the sum of the two distances (not the wheels' separation: 2·√(0.026² + 0.02²) for an e-puck, whose
+    wheels are 0.052 m apart), the radius the cylinders' (its field, as Webots reads it); the left wheel the one
+    with the larger y in the robot's frame."""
+    candidates = [w for w in wheels if w["node"].type == "HingeJoint"
+                  and (end := conv.slotted(w["end"])) is not None and end.type == "Solid"]
+    inner = set().union(*(_inside_ids(conv, w["end"]) for w in candidates)) if candidates else set()
+    candidates = [w for w in candidates if id(w["node"]) not in inner]
+    found = [_biggest_cylinder(w, conv) for w in candidates]
+
+    def parallel(a, b) -> bool:
+        a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+        return float(np.linalg.norm(np.cross(a, b))) <= 1e-9 * float(np.linalg.norm(a)) * max(float(np.linalg.norm(b)), 1.0)
+
+    for i, wi in enumerate(candidates):
+        if found[i] is None or found[i][0] <= 0.0:
+            continue
+        ri, pi = found[i]
+        for j in range(i + 1, len(candidates)):
+            wj = candidates[j]
+            if found[j] is None or found[j][0] <= 0.0 or found[j][0] != ri:
+                continue
+            pj = found[j][1]
+            di, dj = float(np.linalg.norm(pi)), float(np.linalg.norm(pj))
+            if abs(di - dj) > 1e-5 or not parallel(wi["axis"], wj["axis"]) \
+                    or not parallel(wi["axis"], np.asarray(wj["anchor"]) - np.asarray(wi["anchor"])):
+                continue
+            left, right = (wi, wj) if pi[1] > pj[1] else (wj, wi)
+            return {"left_motor": left["motor"], "right_motor": right["motor"], "wheel_radius": float(ri),
+                    "axle_length": di + dj, "step_rule": "mid_heading"}
+    return None
+
+
+def _inside_ids(conv, end: Node | None) -> set[int]:
+    """The ids of the joints inside an end point (through its children and its joints' end points)."""
+    out: set[int] = set()
+    stack = [conv.slotted(end)] if end is not None else []
+    while stack:
+        node = stack.pop()
+        if node is None:
+            continue
+        conv.walk(node)
+        nf = conv.fields(node)
+        for child in nf.nodes("children") if node.type in ("Pose", "Transform", "Group", "Solid", "Robot") else ():
+            if child.type in ("HingeJoint", "Hinge2Joint", "SliderJoint", "BallJoint"):
+                out.add(id(child))
+                stack.append(conv.slotted(conv.fields(child).node_("endPoint")))
+            else:
+                stack.append(child)
+    return out
+
+
+def _biggest_cylinder(w: dict, conv) -> tuple[float, np.ndarray] | None:
+    """(radius field, where its holding Pose, Transform or Solid is in the robot's frame) of the Cylinder
+    Webots' kinematic rule finds in a wheel's end point's boundingObject: the node itself when a Cylinder,
+    a Shape's Cylinder geometry, else of a Group's (a Pose's, a Transform's) children's the one of the
+    largest radius (the first of equal ones); None without one."""
+    end = conv.slotted(w["end"])
+
+    def find(node: Node | None, frame) -> tuple[float, np.ndarray] | None:
+        if node is None:
+            return None
+        conv.walk(node)
+        nf = conv.fields(node)
+        if node.type == "Cylinder":
+            return nf.num("radius", 1.0), np.asarray(frame.translation, dtype=np.float64)
+        if node.type == "Shape":
+            geometry = nf.node_("geometry")
+            return find(geometry, frame) if geometry is not None and geometry.type == "Cylinder" else None
+        best = None
+        if node.type in ("Pose", "Transform", "Group"):
+            inner = frame if node.type == "Group" else conv.child_frame(node, frame)
+            for child in nf.nodes("children"):
+                got = find(child, inner)
+                if got is not None and (best is None or got[0] > best[0]):
+                    best = got
+        return best
+
+    end_frame = conv.child_frame(end, w["frame"])
+    return find(conv.fields(end).node_("boundingObject"), end_frame)
+
+
 def _centred(drive: dict, cx: float, cy: float) -> dict:
     """The drive with its ``axle_center`` when the wheels' centre is not under the robot's origin
     (Webots' robot turns about its wheels' centre wherever its origin is: a Boe-Bot's axle is
