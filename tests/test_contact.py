@@ -175,7 +175,9 @@ def test_a_robot_placed_overlapping_a_solid_or_a_robot_can_back_out():
 
 def test_overlapping_moves_never_go_deeper():
     """From random starts inside a box's grown footprint (up to 10 cm deep), random moves: the
-    robot ends no deeper than it started (a move straight out of it is never stopped)."""
+    robot ends no deeper than it started, but for contact's rounding slack (4e-15 of the coordinates,
+    contact.deepest_end; 1e-9, the touching tolerance, before), and a move straight out of it is never
+    stopped."""
     box = C.obstacle("b", -1, geo.Box((0.6, 0.3, 1.0)), Pose.from_axis_angle((0, 0, 1), 0.4, (0.2, -0.1, 0.0)))
     c = C.Contact([], [], None)
     half, yaw, centre = np.array([0.3, 0.15]), 0.4, np.array([0.2, -0.1])
@@ -188,12 +190,21 @@ def test_overlapping_moves_never_go_deeper():
             continue
         d = rng.normal(size=2) * 10.0 ** rng.uniform(-4, 0)
         end, clipped = c._clip(p.copy(), d, R, [box])
-        assert R - _rect_distance(end, centre, yaw, half) <= depth + 1e-9
+        assert R - _rect_distance(end, centre, yaw, half) <= depth + 1e-14
         out = C._closest_on_hull(p, box.points)[1]
         end, clipped = c._clip(p.copy(), 0.01 * out, R, [box])
         freed += not clipped
         assert not clipped and end == pytest.approx(p + 0.01 * out, abs=1e-15)
     assert freed > 50
+    # moves in by 5e-10 m each (under the 1e-9 m tolerance), across the box's +y face: from 3 cm deep none is
+    # taken; from touching they take the robot no further in than the tolerance, however many (before, each
+    # was allowed: 2.5e-9 m in after 5)
+    up = np.array([-math.sin(yaw), math.cos(yaw)])            # the face's outward normal
+    for depth0, most in ((0.03, 0.03), (0.0, C.EPS)):
+        p = centre + (half[1] + R - depth0) * up
+        for _ in range(5):
+            p, _ = c._clip(p, -5e-10 * up, R, [box])
+        assert R - _rect_distance(p, centre, yaw, half) <= most + 1e-15, (depth0, R - _rect_distance(p, centre, yaw, half))
 
 
 def test_time_of_impact_closed_forms():
