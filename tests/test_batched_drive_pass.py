@@ -5,7 +5,8 @@ the numpy drive (``_drive_numpy``, what runs with ``SENSORIUM_PACKETS=0``) and e
 single Simulation give the same poses, bit for bit (off-centre and centred two-wheel robots, an
 off-centre skid-steer robot, walls, contact on and off, position and velocity control, a set_pose);
 and robots with ``step_rule: mid_heading`` (Webots' kinematic rule without Physics: a two-wheel and a
-skid-steer one) beside them, in the C pass and among the holonomic robots' numpy drive."""
+skid-steer one) beside them, in the C pass and among the holonomic robots' numpy drive; and the same
+robots with a side mounted mirrored (``reversed_motors``: its speed counts negated), bit for bit too."""
 
 from __future__ import annotations
 
@@ -30,17 +31,27 @@ def mid_heading(name: str, x: float, y: float, skid: bool = False) -> dict:
     return robot
 
 
-def world(contact: bool):
+MIRRORED = {"boe": ["left wheel motor"], "boe2": ["right wheel motor"], "skid": ["left wheel motor", "rear left"],
+            "dd": ["left wheel motor", "right wheel motor"], "mid": ["right wheel motor"],
+            "midskid": ["right wheel motor", "rear right"]}
+"""Each robot's wheels mounted mirrored in the mirrored world (a side each, both of one robot)."""
+
+
+def world(contact: bool, mirrored: bool = False):
     centred = boebot("dd", 0.2, 0.5)
     centred["differential_drive"].pop("axle_center")
     backward = boebot("boe2", -0.3, -0.7)
     backward["differential_drive"]["axle_center"] = [-0.03, 0.012]     # behind and beside its origin
+    robots = [boebot("boe", -0.95, 0.9), backward, boebot("skid", 0.6, -0.1, skid=True),
+              centred, mid_heading("mid", -0.5, 0.0), mid_heading("midskid", 0.0, -0.8, True)]
+    if mirrored:
+        for r in robots:
+            r["differential_drive"]["reversed_motors"] = MIRRORED[r["name"]]
     return parse_world({"world_info": {"basic_time_step": STEP, "contact": contact, "random_seed": 5},
                         "solids": [wall("north", 0, 1.2, 2.6, 0.2), wall("south", 0, -1.2, 2.6, 0.2),
                                    wall("east", 1.2, 0, 0.2, 2.2), wall("west", -1.2, 0, 0.2, 2.2),
                                    wall("block", 0.5, -0.6, 0.3, 0.3)],
-                        "robots": [boebot("boe", -0.95, 0.9), backward, boebot("skid", 0.6, -0.1, skid=True),
-                                   centred, mid_heading("mid", -0.5, 0.0), mid_heading("midskid", 0.0, -0.8, True)]})
+                        "robots": robots})
 
 
 def _seeded(w, seed: int) -> Simulation:
@@ -59,16 +70,19 @@ def _same_poses(singles, batched, names, t: int) -> None:
                 assert b.rot[c, r].tobytes() == p.rotation.tobytes(), (t, c, name, k)
 
 
-@pytest.mark.parametrize("contact", [True, False])
-def test_off_centre_robots_take_the_c_pass_and_it_gives_the_numpy_and_single_bits(contact):
+@pytest.mark.parametrize("contact, mirrored", [(True, False), (False, False), (True, True)])
+def test_off_centre_robots_take_the_c_pass_and_it_gives_the_numpy_and_single_bits(contact, mirrored):
     if packets.library() is None:
         pytest.skip(f"no C helper: {packets.status()}")
     from sensorium.gym.views import CopySim
 
-    w = world(contact)
+    w = world(contact, mirrored)
     n, seeds = 3, [5, 6, 7]
     c_pass, numpy_pass = BatchedSimulation(w, n), BatchedSimulation(w, n)
     numpy_pass._drive_step = None          # its _drive_pass: no helper (the SENSORIUM_PACKETS=0 path)
+    signs = [[-1.0 if m in MIRRORED[name] else 1.0 for m in ("left wheel motor", "right wheel motor")]
+             for name in NAMES]
+    assert c_pass.wheel_sign.tolist() == (signs if mirrored else [[1.0, 1.0]] * len(NAMES))
     assert c_pass.off_centre.tolist() == [True, True, True, False, False, False]
     assert c_pass.mid_heading.tolist() == [0, 0, 0, 0, 1, 1]
     singles = [_seeded(w, s) for s in seeds]

@@ -286,10 +286,12 @@ class Agent:
                 robot.motors[name].set_velocity(u)
             return
         drive = robot.drive
-        for m in drive.lefts:        # every wheel of a side (a skid-steer robot has several)
-            m.set_velocity(float(v[0]))
+        # every wheel of a side (a skid-steer robot has several); a side mounted mirrored (reversed_motors) is
+        # commanded negated: an action's left and right are the sides' forward rolling speeds
+        for m in drive.lefts:
+            m.set_velocity(drive.left_sign * float(v[0]))
         for m in drive.rights:
-            m.set_velocity(float(v[1]))
+            m.set_velocity(drive.right_sign * float(v[1]))
 
     def observe(self, sim: Simulation):
         robot = sim.robot(self.robot)

@@ -311,8 +311,10 @@ class AvoidObstacles:
         drive = robot.drive
         if robot.model.differential_drive is None:
             raise ValueError(_NO_WHEEL_PAIR.format(robot.name))
-        wl = drive.left.velocity / drive.left.max_velocity          # each over its own maximum, as actions scale
-        wr = drive.right.velocity / drive.right.max_velocity
+        # each over its own maximum, as actions scale; a side mounted mirrored (reversed_motors) rolls forward
+        # at its negated velocity
+        wl = drive.left_sign * drive.left.velocity / drive.left.max_velocity
+        wr = drive.right_sign * drive.right.velocity / drive.right.max_velocity
         v = 0.5 * (wl + wr)
         dv = abs(wl - wr) / 2.0
         gap = self._gap(sim, robot)
@@ -342,7 +344,10 @@ class _AvoidObstaclesCopies(VectorGoal):
         self.goal, self.sim, self.slot = goal, sim, slot
         self.radius = body_radius(SimpleNamespace(model=sim.world.robots[slot]), sim.loaded.base_dir, sim.world)
         self.dirs = horizontal_directions(enu_axes(sim.world), self.RAYS)   # clearance()'s directions
-        self.vmax = (float(sim.max_wheel[slot, 0]), float(sim.max_wheel[slot, 1]))    # each wheel's own
+        # each wheel's own maximum, signed: a side mounted mirrored (reversed_motors) rolls forward at its negated
+        # velocity, and velocity / -max is -(velocity / max) exactly, the single env's sign * velocity / max
+        self.vmax = (float(sim.wheel_sign[slot, 0] * sim.max_wheel[slot, 0]),
+                     float(sim.wheel_sign[slot, 1] * sim.max_wheel[slot, 1]))
         self.wheels = sim.world.robots[slot].differential_drive is not None    # (a car has no wheel pair)
         self._gap: tuple | None = None     # (step key, copies, gaps, terminations or None)
         self._passes = packets.avoid_outcome(sim.velocity)   # (None without the C helper)

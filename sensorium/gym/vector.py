@@ -266,8 +266,9 @@ class SensoriumVectorEnv(VectorEnv):
         which = None if copies is self._every else copies
         if self.agent.wheel_motors is not None:     # a mecanum or omni-wheel robot: its wheels (the drive's order)
             self._wheels().command(self.slot, cmd, which)
-        elif self.agent.car is None:
-            self.sim.set_wheels(self.slot, cmd[:, 0], cmd[:, 1], which)
+        elif self.agent.car is None:      # (a side mounted mirrored commanded negated, as the single env's act)
+            sign = self.sim.wheel_sign[self.slot]
+            self.sim.set_wheels(self.slot, sign[0] * cmd[:, 0], sign[1] * cmd[:, 1], which)
         elif len(copies):       # a car: its steering motors to the Ackermann angles, its driven wheels to the speed
             assert self.sim.cars is not None
             right, left = (np.array(side) for side in zip(*map(self.agent.steering_positions, cmd[:, 0].tolist())))

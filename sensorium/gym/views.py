@@ -12,7 +12,8 @@ and its ``RobotState``. The vector environment hands them these views of one cop
 * ``CopyRobot``: ``name``, ``index``, ``model``, ``pose``, ``set_pose(...)``, ``motors`` /
   ``motor(name)``, ``drive.left`` / ``drive.right`` and ``drive.lefts`` / ``drive.rights`` (every
   wheel of a side: ``set_position``, ``set_velocity``, ``velocity``, ``position``,
-  ``max_velocity``), ``device(name).enable(period)`` / ``.value`` (a GPS's ``.values``, ``.speed``,
+  ``max_velocity``), ``drive.left_sign`` / ``drive.right_sign`` (-1.0 for a side mounted mirrored:
+  ``reversed_motors``), ``device(name).enable(period)`` / ``.value`` (a GPS's ``.values``, ``.speed``,
   ``.speed_vector``, a compass's, a gyro's or an accelerometer's ``.values``, an inertial unit's
   ``.roll_pitch_yaw``, ``.quaternion``; a bumper's or an altimeter's ``.value``; a camera's ``.image``,
   ``.recognition_enable(period)``, ``.enable_segmentation(on)``, ``.recognition_objects`` (or
@@ -135,6 +136,7 @@ class _Drive:
         self.lefts = [_Motor.wheel(sim, copy, slot, name) for name in left]
         self.rights = [_Motor.wheel(sim, copy, slot, name) for name in right]
         self.left, self.right = self.lefts[0], self.rights[0]
+        self.left_sign, self.right_sign = (float(v) for v in sim.wheel_sign[slot])   # (motion.DifferentialDrive's)
 
     @property
     def motors(self) -> dict[str, _Motor]:

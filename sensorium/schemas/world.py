@@ -1511,6 +1511,11 @@ class DifferentialDrive(Strict):
     left_motor: str = Field(default="left wheel motor", min_length=1)
     right_motor: str = Field(default="right wheel motor", min_length=1)
     skid_steer: SkidSteer | None = Field(default=None, description="more wheels per side (skid steer)")
+    reversed_motors: list[str] = Field(
+        default_factory=list, max_length=32, description="the wheel motors whose wheel rolls backward for a positive "
+        "speed (mounted mirrored: its hinge axis opposite the others', as Webots users build one side and negate its "
+        "speed in the controller): each one's speed counts negated in the drive's motion; its encoder still reads "
+        "the motor's own position. A skid-steer side's wheels roll as one: all of a side's or none")
     forward: Forward = _forward_field()
     wheel_bottom: float | None = _wheel_bottom_field()
     axle_center: tuple[float, float] = Field(
@@ -1530,6 +1535,12 @@ class DifferentialDrive(Strict):
         extra = self.skid_steer or SkidSteer()
         return [self.left_motor, *extra.left], [self.right_motor, *extra.right]
 
+    @property
+    def side_signs(self) -> tuple[float, float]:
+        """(left, right): -1.0 for a side whose wheels are ``reversed_motors``, else 1.0."""
+        left, right = self.motor_names
+        return (-1.0 if left[0] in self.reversed_motors else 1.0, -1.0 if right[0] in self.reversed_motors else 1.0)
+
     _forward_nonzero = field_validator("forward")(_nonzero_forward)
 
     @model_validator(mode="after")
@@ -1541,6 +1552,16 @@ class DifferentialDrive(Strict):
         if len(set(names)) != len(names):
             raise ValueError(f"every wheel motor needs its own name, got {names}")
         _check_motor_max_speeds(self.motor_max_speeds, names, "drive's wheel motors")
+        for name in self.reversed_motors:
+            if name not in names:
+                raise ValueError(f"reversed_motors: {name!r} is not one of the drive's wheel motors "
+                                 f"({', '.join(map(repr, names))})")
+        for side, motors in zip(("left", "right"), self.motor_names):
+            # a side's wheels roll as one (their mean), stepped as one state in the batched simulation
+            named = [m for m in motors if m in self.reversed_motors]
+            if named and len(named) != len(motors):
+                raise ValueError(f"reversed_motors: the {side} side's wheels {motors} roll as one, so name all of "
+                                 f"them or none, got {named}")
         if self.step_rule == "mid_heading" and any(self.axle_center):
             raise ValueError(f"step_rule mid_heading turns the robot about its origin (Webots' kinematic rule), so "
                              f"axle_center must be (0, 0), got {list(self.axle_center)}")

@@ -39,8 +39,10 @@ def _wheeled(robot) -> bool:
 
 
 def _velocity(robot, left: float, right: float) -> None:
-    # every wheel of a side (a skid-steer robot has several; sim/motion.py rolls a side at their mean)
-    for motors, v in ((robot.drive.lefts, left), (robot.drive.rights, right)):
+    # every wheel of a side (a skid-steer robot has several; sim/motion.py rolls a side at their mean); a
+    # side mounted mirrored (reversed_motors) is commanded negated, so that left and right roll forward
+    drive = robot.drive
+    for motors, v in ((drive.lefts, drive.left_sign * left), (drive.rights, drive.right_sign * right)):
         for motor in motors:
             motor.set_position(math.inf)
             motor.set_velocity(v)

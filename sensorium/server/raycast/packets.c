@@ -1347,13 +1347,14 @@ size_t sp_contact_near(size_t k, size_t R, size_t S, const int64_t* copies, cons
  * every live copy live[l] (l < L): WheelMotor.advance of its left and right wheel (target,
  * velocity, angle: (C, R, 2); the angle advanced in place), DifferentialDrive.step's side means
  * (for a slot with a side of several equal wheels, each side 0 + w + ... + w (its count times),
- * then / count) and its speeds v = r (wl + wr) / 2, w = r (wr - wl) / axle -- the numpy path's
+ * then / count), each side's sign (sign (R, 2): -1.0 for a side mounted mirrored; NULL: 1.0) and its
+ * speeds v = r (wl + wr) / 2, w = r (wr - wl) / axle -- the numpy path's
  * operations, element for element (np.minimum's NaN). The moving robots (a side turning), copy
  * by copy and slot by slot: their copy, slot, v and w into out_*; returns their number. */
 size_t sp_drive_wheels(size_t L, size_t D, size_t R, const int64_t* live, const int64_t* driven,
                        const double* target, const double* velocity, double* angle, double dt,
-                       const int64_t* sides, const double* radius, const double* axle, int64_t* out_copy,
-                       int64_t* out_slot, double* out_v, double* out_w) {
+                       const int64_t* sides, const double* radius, const double* axle, const double* sign,
+                       int64_t* out_copy, int64_t* out_slot, double* out_v, double* out_w) {
   size_t k = 0;
   for (size_t l = 0; l < L; l++) {
     const int64_t c = live[l];
@@ -1379,6 +1380,7 @@ size_t sp_drive_wheels(size_t L, size_t D, size_t R, const int64_t* live, const 
           for (int64_t i = 1; i < n; i++) acc = acc + o;
           o = acc / (double)n;
         }
+        if (sign) o = o * sign[2 * s + side];
         om[side] = o;
       }
       if (om[0] != 0.0 || om[1] != 0.0) {
@@ -1605,7 +1607,8 @@ size_t sp_drive_moves(size_t n, const int64_t* slot, const double* centre, const
  * wheels and drives (sp_drive_wheels); the moving robots' arcs (sp_arc_steps, from x, y, yaw
  * gathered), or their origin's twist for a robot whose wheels' centre is off its origin (a[42]:
  * the slots' centres (R, 2), NULL when none is; a[43]: the slots' mid_heading flags (R,) uint8, NULL
- * when none has it: drive_moves), and their new yaws written; with contact, each move's reach hypot(end - start) + eps
+ * when none has it: drive_moves; a[44]: the slots' side signs (R, 2), NULL when no robot's wheels are mounted
+ * mirrored: sp_drive_wheels), and their new yaws written; with contact, each move's reach hypot(end - start) + eps
  * + spin[slot] * fmin(|yaw1 - yaw0|, 2) (a shaped robot's push off what its turn goes into)
  * (np.hypot is libm's hypot), the grown discs (grow: 0, then the movers' reach) and the broad phase
  * (sp_contact_near). When no move is near anything, the moves end where Contact._clip without
@@ -1645,8 +1648,8 @@ size_t sp_drive_step(size_t L, const int64_t* live, size_t D, const int64_t* dri
   double* base_g = a[26];   /* (k, 3, 3) */
   status[0] = status[1] = 0;
   for (size_t l = 0; l < L; l++) memset(pressing + (size_t)live[l] * R, 0, R);
-  const size_t k = sp_drive_wheels(L, D, R, live, driven, target, velocity, angle, dt, sides, radius, axle, mc, ms,
-                                   v, w);
+  const size_t k = sp_drive_wheels(L, D, R, live, driven, target, velocity, angle, dt, sides, radius, axle, a[44], mc,
+                                   ms, v, w);
   if (!k) return 0;
   for (size_t m = 0; m < k; m++) {
     const size_t at = (size_t)mc[m] * R + (size_t)ms[m];

@@ -209,7 +209,7 @@ def _load() -> None:
     lib.sp_drive_wheels.restype = sz
     lib.sp_lidar_beams.restype = None
     lib.sp_lidar_beams.argtypes = [sz, sz, vp, vp, vp, vp, vp, vp, vp, vp]
-    lib.sp_drive_wheels.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp, vp, vp]
+    lib.sp_drive_wheels.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, d, vp, vp, vp, vp, vp, vp, vp, vp]
     lib.sp_contact_near.argtypes = [sz, sz, sz, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, vp, d, d, vp, vp,
                                     vp]
     # the batched step's passes (DriveStep, lookup, atan2, the sonars, AvoidObstacles, the due scan,
@@ -880,13 +880,14 @@ def contact_near(copies: np.ndarray, slots: np.ndarray, starts: np.ndarray, reac
 
 
 def drive_wheels(live: np.ndarray, driven: np.ndarray, target: np.ndarray, velocity: np.ndarray,
-                 angle: np.ndarray, dt: float, sides: np.ndarray, radius: np.ndarray, axle: np.ndarray
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+                 angle: np.ndarray, dt: float, sides: np.ndarray, radius: np.ndarray, axle: np.ndarray,
+                 sign: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
     """The wheels and drives of :meth:`.batched.BatchedSimulation._drive` in one C pass
     (``sp_drive_wheels``): every live copy's driven slots' wheel motors advanced (``angle`` (C, R, 2)
     written in place), and the moving robots' (copies, slots, v, w) in the numpy path's order and
     bits; or None without the helper (nothing written). ``target``/``velocity``/``angle`` (C, R, 2),
-    ``sides`` (R, 2) wheels per side, ``radius``/``axle`` (R,)."""
+    ``sides`` (R, 2) wheels per side, ``radius``/``axle`` (R,), ``sign`` (R, 2) each side's sign (-1.0: its
+    wheels mounted mirrored) or None (every side 1.0)."""
     lib = library()
     if lib is None:
         return None
@@ -895,6 +896,8 @@ def drive_wheels(live: np.ndarray, driven: np.ndarray, target: np.ndarray, veloc
     for a, dt_, shape in ((target, f64, (C, R, 2)), (velocity, f64, (C, R, 2)), (sides, i64, (R, 2)),
                           (radius, f64, (R,)), (axle, f64, (R,))):
         _check_buffer("drive_wheels", a, dt_, shape)
+    if sign is not None:
+        _check_buffer("drive_wheels", sign, f64, (R, 2))
     _check_buffer("drive_wheels", angle, f64, (C, R, 2), writes=True)      # advanced in place
     live = np.ascontiguousarray(live, dtype=i64)
     driven = np.ascontiguousarray(driven, dtype=i64)
@@ -902,7 +905,7 @@ def drive_wheels(live: np.ndarray, driven: np.ndarray, target: np.ndarray, veloc
     copies, slots = np.empty(n, dtype=i64), np.empty(n, dtype=i64)
     v, w = np.empty(n), np.empty(n)
     p = _small_addresses((live, driven, target, velocity, angle, sides, radius, axle, copies, slots, v, w))
-    k = lib.sp_drive_wheels(len(live), len(driven), R, *p[:5], float(dt), *p[5:])
+    k = lib.sp_drive_wheels(len(live), len(driven), R, *p[:5], float(dt), *p[5:8], _ptr(sign), *p[8:])
     return copies[:k], slots[:k], v[:k], w[:k]
 
 
@@ -984,7 +987,8 @@ class DriveStep:
             _check_buffer("drive_step", contact["spin"], np.float64, (R,))
         # a[34..40]: the solids' arrays and the broad phase's outputs (run); a[41]: the spin reach;
         # a[42]: the wheels' centres of the slots (R, 2) when some robot's is off its origin, else NULL;
-        # a[43]: the slots' mid_heading flags (R,) uint8 when some robot has step_rule mid_heading, else NULL
+        # a[43]: the slots' mid_heading flags (R,) uint8 when some robot has step_rule mid_heading, else NULL;
+        # a[44]: the slots' side signs (R, 2) when some robot's wheels are mounted mirrored, else NULL
         spin = contact["spin"] if contact is not None else self.reach
         centre = state.get("centre")
         if centre is not None:
@@ -992,9 +996,13 @@ class DriveStep:
         mid = state.get("mid_heading")
         if mid is not None:
             _check_buffer("drive_step", mid, np.uint8, (R,))
-        self.ptrs = (ctypes.c_void_p * 44)(*(a.ctypes.data for a in arrays), *([0] * (41 - len(arrays))),
+        sign = state.get("sign")
+        if sign is not None:
+            _check_buffer("drive_step", sign, np.float64, (R, 2))
+        self.ptrs = (ctypes.c_void_p * 45)(*(a.ctypes.data for a in arrays), *([0] * (41 - len(arrays))),
                                            spin.ctypes.data, None if centre is None else centre.ctypes.data,
-                                           None if mid is None else mid.ctypes.data)
+                                           None if mid is None else mid.ctypes.data,
+                                           None if sign is None else sign.ctypes.data)
         self._solids: tuple = ()
         self.p_status = self.status.ctypes.data
         self.p_scatter = [a.ctypes.data for a in (self.copies, self.slots, self.rot, state["x"], state["y"],

@@ -356,6 +356,11 @@ class BatchedSimulation:
         self.wheel_side: list[dict[str, int]] = [
             {name: side for side, names in enumerate(r.differential_drive.motor_names) for name in names}
             if r.differential_drive else {} for r in w.robots]
+        # each side's sign: -1.0 where its wheels are mounted mirrored (reversed_motors: a positive speed rolls
+        # them backward), multiplied into the side's speed after its mean, as DifferentialDrive.step does
+        self.wheel_sign = np.array([r.differential_drive.side_signs if r.differential_drive else (1.0, 1.0)
+                                    for r in w.robots], dtype=np.float64).reshape(-1, 2)
+        self._any_reversed = bool((self.wheel_sign < 0.0).any())
         self.side_wheels = np.array([[len(n) for n in r.differential_drive.motor_names] if r.differential_drive
                                      else [1, 1] for r in w.robots], dtype=np.int64)
         # a two-wheel robot's wheels' centre (axle_center, x forward and y left of its origin): where it
@@ -1046,7 +1051,8 @@ class BatchedSimulation:
                  "sides": self.side_wheels, "radius": self.wheel_radius, "axle": self.axle, "x": self.x, "y": self.y,
                  "yaw": self.yaw, "z": self.z, "pressing": self.pressing, "base": self.base, "rot": self.rot,
                  "pos": self.pos, "centre": self.axle_center if self._any_off_centre else None,
-                 "mid_heading": self.mid_heading if self._any_mid_heading else None}, contact)
+                 "mid_heading": self.mid_heading if self._any_mid_heading else None,
+                 "sign": self.wheel_sign if self._any_reversed else None}, contact)
         return got
 
     def _place(self, copies: np.ndarray, slots: np.ndarray, rz: np.ndarray, base: np.ndarray, cos: np.ndarray,
@@ -1073,7 +1079,8 @@ class BatchedSimulation:
         moves = []
         if len(driven):
             wheels = packets.drive_wheels(live, driven, self.target, self.velocity, self.wheel_angle, dt,
-                                          self.side_wheels, self.wheel_radius, self.axle)
+                                          self.side_wheels, self.wheel_radius, self.axle,
+                                          self.wheel_sign if self._any_reversed else None)
             copies, slots, v, w = wheels if wheels is not None else self._drive_wheels(live, driven, dt)
             if len(copies):
                 v, w = self._over_ground(copies, slots, v, w)
@@ -1212,6 +1219,9 @@ class BatchedSimulation:
             for j in skid.tolist():
                 wl[:, j] = _side_mean(wl[:, j], int(counts[j, 0]))
                 wr[:, j] = _side_mean(wr[:, j], int(counts[j, 1]))
+        if self._any_reversed:      # a mirrored side rolls backward for a positive speed (exact: a sign)
+            sign = self.wheel_sign[driven]
+            wl, wr = wl * sign[:, 0], wr * sign[:, 1]
         moving = (wl != 0.0) | (wr != 0.0)                      # (live, driven)
         ci, ri = moving.nonzero()
         copies, slots = live[ci], driven[ri]

@@ -314,7 +314,7 @@ class DifferentialDrive(PlanarState):
     """The drive of one robot: its wheel motors and the robot's planar state (x, y, yaw).
 
     Two wheels, or several per side (skid steer, ``config.skid_steer``): each side rolls at the
-    mean of its wheels' speeds, without slip, so a skid-steer robot turns as a two-wheel robot whose
+    mean of its wheels' speeds (negated for a side in ``config.reversed_motors``), without slip, so a skid-steer robot turns as a two-wheel robot whose
     track is the distance between its wheel lines (a real one skids and turns slower).
 
     The robot's rotation is kept as ``Rz(yaw) @ base`` where ``base`` is the part of its initial
@@ -341,6 +341,8 @@ class DifferentialDrive(PlanarState):
         self.right = WheelMotor(config.right_motor, wheel_max_speed(config, config.right_motor))
         self.lefts = [self.left, *(WheelMotor(n, wheel_max_speed(config, n)) for n in (skid.left if skid else ()))]
         self.rights = [self.right, *(WheelMotor(n, wheel_max_speed(config, n)) for n in (skid.right if skid else ()))]
+        # -1.0 for a side whose wheels are mounted mirrored (reversed_motors): a positive speed rolls them backward
+        self.left_sign, self.right_sign = config.side_signs if hasattr(config, "side_signs") else (1.0, 1.0)
         super().__init__(pose, up, ground, band_low, getattr(config, "forward", None))
 
     @property
@@ -355,6 +357,7 @@ class DifferentialDrive(PlanarState):
         else:       # skid steer: each side at the mean of its wheels
             wl = sum(m.advance(dt) for m in self.lefts) / len(self.lefts)
             wr = sum(m.advance(dt) for m in self.rights) / len(self.rights)
+        wl, wr = self.left_sign * wl, self.right_sign * wr      # (exact: a sign, the same bits as the batched pass)
         if wl == 0.0 and wr == 0.0:
             self.moved(0.0, 0.0)
             return None

@@ -56,6 +56,8 @@ def drive_line(r: wm.Robot) -> str:
                 else f"two-wheel ({d.left_motor}, {d.right_motor})")
         cx, cy = d.axle_center
         centre = f", turning about ({cx:g}, {cy:g}) m from its origin" if (cx or cy) else ""
+        if d.reversed_motors:
+            kind += f", mounted mirrored: {', '.join(d.reversed_motors)}"
         if d.step_rule == "mid_heading":
             return (f"{kind}: wheels of radius {d.wheel_radius:g} m, axle {d.axle_length:g} m, each step straight along "
                     "the mid-step heading (Webots' rule without Physics)")

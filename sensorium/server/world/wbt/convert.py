@@ -2704,6 +2704,9 @@ class Converter:
                 if pair is not None and {pair["left_motor"], pair["right_motor"]} == {drive["left_motor"],
                                                                                       drive["right_motor"]}:
                     drive.pop("axle_center", None)
+                    # Webots' rule reads the two motors' velocities as they are, whichever way each axis points
+                    # (its pair's axes need only be parallel or opposite): a mirrored wheel is not reversed there
+                    drive.pop("reversed_motors", None)
                     drive.update(pair)
             robot.data["differential_drive"] = drive
             for w in wheels:      # a wheel's cylinder lying across its hinge's axis: Webots' would not roll

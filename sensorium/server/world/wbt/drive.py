@@ -2,7 +2,9 @@
 
 The kinematic drive turns the robot about its wheels' centre, x forward, wheels along the robot's y axis, and
 a positive wheel speed drives forward. A Webots robot maps onto it when it clearly is such a robot:
-every motorised hinge's axis along the robot's +y and wheels of one radius, and either
+every motorised hinge's axis along the robot's +y (or -y: a wheel mounted mirrored,
+which a positive speed rolls backward, the drive's ``reversed_motors``; a skid-steer side all or none) and
+wheels of one radius, and either
 
 * two wheels: both anchors on one line parallel to y, the wheels (their end points' origins) at
   two places along it; or
@@ -205,12 +207,15 @@ def _axis_off_y(wheels: list[dict], tol: float, why: str) -> str:
     return ""
 
 
-def drive_frame(wheels: list[dict], tol: float = TOL, up: int = 2) -> tuple[np.ndarray | None, str]:
+def drive_frame(wheels: list[dict], tol: float = TOL, up: int = 2,
+                opposite: bool = False) -> tuple[np.ndarray | None, str]:
     """The rotation from the robot's frame to its drive's (rows: forward, left, up), or None when a
     wheel turns about the robot's +y within ``tol`` on a z-up robot (its frame is the drive's, as it
     always was) or there is no wheel; with the sentence saying why there is none when the wheels turn
     about different or non-horizontal axes. ``up``: the robot's own axis that is up, 2 its z, 1 its y
-    (a robot built y-up in a NUE world, as Webots' were before R2022a)."""
+    (a robot built y-up in a NUE world, as Webots' were before R2022a). ``opposite``: a wheel turning
+    about the opposite axis (within ``tol``: mounted mirrored) is along the same line, not different;
+    the frame is then the +y wheel's (the robot's own), else the first wheel's."""
     y = np.array([0.0, 1.0, 0.0])
     axes = [w["axis"] / np.linalg.norm(w["axis"]) for w in wheels]
     if not axes or (up == 2 and any(np.linalg.norm(a - y) <= tol for a in axes)):
@@ -224,10 +229,12 @@ def drive_frame(wheels: list[dict], tol: float = TOL, up: int = 2) -> tuple[np.n
                       f"horizontal in its frame (perpendicular to its {name}, its up): the kinematic drive rolls on "
                       "wheels whose axis is horizontal")
     for w, a in zip(wheels[1:], axes[1:]):
-        if np.linalg.norm(a - a0) > tol:
+        if np.linalg.norm(a - a0) > tol and not (opposite and np.linalg.norm(a + a0) <= tol):
             return None, (f"wheel axis of motor {w['motor']!r} is {np.round(a, 6).tolist()}, not "
-                          f"{np.round(a0, 6).tolist()}, the axis of motor {first!r} (the kinematic drive needs every "
-                          "axis along one direction so that positive speeds drive forward)")
+                          f"{np.round(a0, 6).tolist()}, the axis of motor {first!r}"
+                          + (" nor its opposite (the kinematic drive needs every axis along one line)" if opposite else
+                             " (the kinematic drive needs every axis along one direction so that positive speeds drive "
+                             "forward)"))
     u = np.zeros(3)
     u[up] = 1.0
     a = a0.copy()
@@ -253,14 +260,29 @@ def differential_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | No
     if len(wheels) < 2:
         return None, f"{len(wheels)} motorised hinge joint; a drive needs two wheels or more, on both sides"
     # (axes within AXIS_TOL, as a car's: Webots' Moose turns its right wheels' frames by 3.14159, not pi)
-    frame, why = drive_frame(wheels, AXIS_TOL, up)
+    frame, why = drive_frame(wheels, AXIS_TOL, up, opposite=True)
     if why:
         return None, why
     wheels = _in_frame(wheels, frame)
-    off = _axis_off_y(wheels, AXIS_TOL, "the kinematic drive needs every axis along +y so that positive speeds drive forward")
+    # a wheel about -y is mounted mirrored: a positive speed rolls it backward (Webots' physics rolls each
+    # wheel about its own axis), so its speed counts negated (the drive's reversed_motors)
+    mirrored = [w for w in wheels if np.linalg.norm(w["axis"] / np.linalg.norm(w["axis"]) + [0.0, 1.0, 0.0])
+                <= AXIS_TOL]
+    off = _axis_off_y([w for w in wheels if not any(w is m for m in mirrored)], AXIS_TOL,
+                      "the kinematic drive needs every axis along +y or -y, the wheels on one line")
     if off:
         return None, off
     drive, why = _two_wheels(wheels, conv) if len(wheels) == 2 else _skid_steer(wheels, conv)
+    if drive is not None and mirrored:
+        reversed_motors = {w["motor"] for w in mirrored}
+        left = [drive["left_motor"], *drive.get("skid_steer", {}).get("left", ())]
+        right = [drive["right_motor"], *drive.get("skid_steer", {}).get("right", ())]
+        for side, motors in (("left", left), ("right", right)):
+            named = [m for m in motors if m in reversed_motors]
+            if named and len(named) != len(motors):
+                return None, (f"the {side} side's wheels {motors} turn about opposite axes ({named} about the "
+                              "opposite one): a skid-steer side's wheels roll as one")
+        drive["reversed_motors"] = [m for m in (*left, *right) if m in reversed_motors]
     return _framed(drive, why, frame)
 
 
@@ -352,7 +374,8 @@ def webots_kinematic_pair(wheels: list[dict], conv) -> dict | None:
     those not inside another candidate's end point: the robot's own joints). The first pair (i < j) taken is
     the first whose end points' boundingObjects hold a Cylinder (:func:`_biggest_cylinder`) of one radius > 0,
     the two at distances from the robot's origin (3-D, to the Pose, Transform or Solid holding each cylinder)
-    within 1e-5 m of each other, their joints' axes parallel and their anchors on a line along them. The
+    within 1e-5 m of each other, their joints' axes parallel or opposite (a null cross product: a wheel mounted
+    mirrored qualifies, its velocity then read as it is, not negated) and their anchors on a line along them. The
     axle is the sum of the two distances (not the wheels' separation: 2·√(0.026² + 0.02²) for an e-puck, whose
     wheels are 0.052 m apart), the radius the cylinders' (its field, as Webots reads it); the left wheel the one
     with the larger y in the robot's frame."""
