@@ -212,3 +212,38 @@ def test_reversed_motors_must_be_the_drives_and_a_sides_all_or_none(reversed_mot
         parse_world(data)
     assert why in str(e.value)
     assert "\n" not in str(e.value).strip()
+
+
+@pytest.mark.parametrize("helper", [True, False], ids=["helper", "numpy"])
+def test_the_gym_takes_left_and_right_as_the_sides_forward_speeds(tmp_path: Path, helper: bool, monkeypatch) -> None:
+    """The gym's (+1, +1) on the mirrored-left robot commands (−20, 20) rad/s: it drives straight ahead at full
+    speed, AvoidObstacles' v 1 and dv 0 (reward exactly 1 in open space; the motors' own velocities would give
+    0), the single env and the vector env's C and numpy passes alike; (+1, −1) turns it right in place."""
+    pytest.importorskip("gymnasium")
+    from sensorium.gym.env import SensoriumEnv
+    from sensorium.gym.task import AvoidObstacles, Task
+    from sensorium.gym.vector import SensoriumVectorEnv
+    from sensorium.server.raycast import packets
+
+    if not helper:
+        monkeypatch.setattr(packets, "avoid_reward", lambda *args: None)
+        monkeypatch.setattr(packets, "avoid_outcome", lambda *args: None)
+    goal = AvoidObstacles(near=0.05)
+    task = Task(robot="bot", observations=[], reward=goal, terminated=goal.terminated)
+    path = write(tmp_path, two_wheels("left"))
+    env = SensoriumEnv(load_world(path), task)
+    env.reset(seed=0)
+    venv = SensoriumVectorEnv(load_world(path), task, 2)
+    venv.reset(seed=0)
+    start = np.array(env.sim.robot("bot").pose.translation)
+    for action, want in (([1.0, 1.0], 1.0), ([1.0, -1.0], 0.0)):
+        _, reward, *_ = env.step(np.array(action, dtype=np.float32))
+        _, rewards, *_ = venv.step(np.array([action, action], dtype=np.float32))
+        motors = env.sim.robot("bot").motors
+        assert (motors[LEFT].velocity, motors[RIGHT].velocity) == (-20.0 * action[0], 20.0 * action[1])
+        assert reward == want
+        assert rewards.tolist() == [reward, reward]
+        if action == [1.0, 1.0]:
+            moved = np.array(env.sim.robot("bot").pose.translation) - start
+            assert moved[:2] / np.linalg.norm(moved[:2]) == pytest.approx([math.cos(H0), math.sin(H0)], abs=1e-12)
+            assert heading(env.sim.robot("bot").pose.rotation) == pytest.approx(H0, abs=1e-12)
