@@ -247,3 +247,20 @@ def test_the_gym_takes_left_and_right_as_the_sides_forward_speeds(tmp_path: Path
             moved = np.array(env.sim.robot("bot").pose.translation) - start
             assert moved[:2] / np.linalg.norm(moved[:2]) == pytest.approx([math.cos(H0), math.sin(H0)], abs=1e-12)
             assert heading(env.sim.robot("bot").pose.rotation) == pytest.approx(H0, abs=1e-12)
+
+
+def test_the_sweeps_spin_spins_the_mirrored_robot_in_place(tmp_path: Path) -> None:
+    """The built-in ``spin`` asks the sides for (−v/2, v/2), v = maxVelocity 20: the mirrored left motor is
+    commanded +10 rad/s, so the robot turns in place at ω = 2·r·10 / axle (the motors' own (−10, 10) would
+    drive it straight)."""
+    from sensorium.sweep.controllers import spin
+
+    sim = Simulation(load_world(write(tmp_path, two_wheels("left"))))
+    spin(sim)
+    motors = sim.robot("bot").motors
+    assert (motors[LEFT].velocity, motors[RIGHT].velocity) == (10.0, 10.0)
+    sim.run(10)
+    pose = sim.robot("bot").pose
+    assert pose.translation[:2] == pytest.approx([X0, Y0], abs=1e-15)
+    om = 2.0 * R * 10.0 / (2.0 * Y)
+    assert math.remainder(heading(pose.rotation) - (H0 + om * 10 * T), 2.0 * math.pi) == pytest.approx(0.0, abs=1e-13)
