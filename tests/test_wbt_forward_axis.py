@@ -157,9 +157,10 @@ def test_the_same_drive_in_a_yaml_world_and_its_checks(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("axes, why", [
-    # every wheel about one direction: a mirrored side would roll backwards
-    ({"front_left_wheel": "1 0 0"}, "wheel axis of motor 'front_left_wheel' is [1.0, 0.0, 0.0], not [-1.0, 0.0, 0.0], "
-                                    "the axis of motor 'front_right_wheel'"),
+    # one wheel of a side mounted mirrored and not the other (a whole side may be: tests/test_wbt_mirrored.py)
+    ({"front_left_wheel": "1 0 0"}, "the left side's wheels ['front_left_wheel', 'rear_left_wheel'] turn about "
+                                    "opposite axes, ['front_left_wheel'] mounted mirrored and not the others: a "
+                                    "skid-steer side's wheels roll as one"),
     # a tilted axis is no wheel the kinematic drive rolls
     ({n: "-1 0 1" for n in WHEELS}, "wheel axis of motor 'front_right_wheel' is [-0.707107, 0.0, 0.707107], neither "
                                     "the robot's +y nor horizontal in its frame"),

@@ -280,8 +280,8 @@ def differential_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | No
         for side, motors in (("left", left), ("right", right)):
             named = [m for m in motors if m in reversed_motors]
             if named and len(named) != len(motors):
-                return None, (f"the {side} side's wheels {motors} turn about opposite axes ({named} about the "
-                              "opposite one): a skid-steer side's wheels roll as one")
+                return None, (f"the {side} side's wheels {motors} turn about opposite axes, {named} mounted "
+                              "mirrored and not the others: a skid-steer side's wheels roll as one")
         drive["reversed_motors"] = [m for m in (*left, *right) if m in reversed_motors]
     return _framed(drive, why, frame)
 
