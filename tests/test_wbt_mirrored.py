@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _gym_avoid import avoid_envs
 
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
@@ -220,21 +221,8 @@ def test_the_gym_takes_left_and_right_as_the_sides_forward_speeds(tmp_path: Path
     speed, AvoidObstacles' v 1 and dv 0 (reward exactly 1 in open space; the motors' own velocities would give
     0), the single env and the vector env's C and numpy passes alike; (+1, −1) turns it right in place."""
     pytest.importorskip("gymnasium")
-    from sensorium.gym.env import SensoriumEnv
-    from sensorium.gym.task import AvoidObstacles, Task
-    from sensorium.gym.vector import SensoriumVectorEnv
-    from sensorium.server.raycast import packets
-
-    if not helper:
-        monkeypatch.setattr(packets, "avoid_reward", lambda *args: None)
-        monkeypatch.setattr(packets, "avoid_outcome", lambda *args: None)
-    goal = AvoidObstacles(near=0.05)
-    task = Task(robot="bot", observations=[], reward=goal, terminated=goal.terminated)
     path = write(tmp_path, two_wheels("left"))
-    env = SensoriumEnv(load_world(path), task)
-    env.reset(seed=0)
-    venv = SensoriumVectorEnv(load_world(path), task, 2)
-    venv.reset(seed=0)
+    env, venv = avoid_envs(path, helper, monkeypatch)
     start = np.array(env.sim.robot("bot").pose.translation)
     for action, want in (([1.0, 1.0], 1.0), ([1.0, -1.0], 0.0)):
         _, reward, *_ = env.step(np.array(action, dtype=np.float32))

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _gym_avoid import avoid_envs
 
 from sensorium.gym.views import CopySim
 from sensorium.schemas import world as wm
@@ -205,20 +206,7 @@ def test_avoid_obstacles_scores_each_wheel_over_its_own_maximum(tmp_path: Path, 
     v is 1 and dv 0, so in open space the reward is exactly 1 (the left's maximum for both would give
     1.025 * (1 - sqrt(0.025)) = 0.863); the single env and the vector env's C and numpy passes agree."""
     pytest.importorskip("gymnasium")
-    from sensorium.gym.env import SensoriumEnv
-    from sensorium.gym.task import AvoidObstacles, Task
-    from sensorium.gym.vector import SensoriumVectorEnv
-    from sensorium.server.raycast import packets
-
-    if not helper:
-        monkeypatch.setattr(packets, "avoid_reward", lambda *args: None)
-        monkeypatch.setattr(packets, "avoid_outcome", lambda *args: None)
-    goal = AvoidObstacles(near=0.05)
-    task = Task(robot="bot", observations=[], reward=goal, terminated=goal.terminated)
-    env = SensoriumEnv(load_world(_wbt(tmp_path)), task)
-    env.reset(seed=0)
-    venv = SensoriumVectorEnv(load_world(_wbt(tmp_path)), task, 2)
-    venv.reset(seed=0)
+    env, venv = avoid_envs(_wbt(tmp_path), helper, monkeypatch)
     for action in ([1.0, 1.0], [0.5, 0.5], [1.0, 0.0]):
         _, reward, *_ = env.step(np.array(action, dtype=np.float32))
         _, rewards, *_ = venv.step(np.array([action, action], dtype=np.float32))
