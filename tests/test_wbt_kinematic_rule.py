@@ -11,38 +11,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _wheeled_wbt import H0, STEP, X0, Y0, R, T, Y, heading, robot_world, wheel
 
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.sim.summary import drive_line
 from sensorium.server.world.loader import WorldError, load_world, parse_world
 
-R, Y, STEP = 0.02, 0.026, 32              # wheel radius, its distance along the axle, basic step (ms)
 AXLE = 2.0 * math.hypot(Y, R)             # Webots' axle: the wheels' cylinders (at height R) from the origin
-T = STEP / 1000.0
-X0, Y0, H0 = 0.1, -0.2, 0.3               # where the robot starts, its heading
-
-
-def wheel(name: str, y: float, radius: float = R) -> str:
-    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} {R} }}\n'
-            f'  device [ RotationalMotor {{ name "{name}" maxVelocity 20 }} PositionSensor {{ name "{name} sensor" }} ]\n'
-            f'  endPoint Solid {{ translation 0 {y} {R} children [ DEF W Pose {{ rotation 1 0 0 1.5708 children [\n'
-            f'    Shape {{ geometry Cylinder {{ radius {radius} height 0.003 }} }} ] }} ] boundingObject USE W }} }}\n')
 
 
 def write(tmp_path: Path, physics: bool = False, right_y: float = -Y) -> Path:
-    p = tmp_path / "kinematic.wbt"
-    p.write_text(f'#VRML_SIM R2023b utf8\nWorldInfo {{ basicTimeStep {STEP} }}\n'
-                 f'Robot {{ name "bot" translation {X0} {Y0} 0 rotation 0 0 1 {H0} children [\n'
-                 '  DEF BODY Pose { translation 0 0 0.025 children [ Shape { geometry Cylinder { radius 0.037 '
-                 'height 0.045 } } ] }\n'
-                 + wheel("left wheel motor", Y) + wheel("right wheel motor", right_y)
-                 + '] boundingObject USE BODY' + (' physics Physics { }' if physics else '') + ' }\n')
-    return p
-
-
-def heading(pose) -> float:
-    return math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])
+    return robot_world(tmp_path / "kinematic.wbt",
+                       wheel("left wheel motor", 0.0, Y) + wheel("right wheel motor", 0.0, right_y), physics)
 
 
 def run(sim: Simulation, wl: float, wr: float, steps: int) -> None:
@@ -72,7 +53,7 @@ def test_without_physics_the_drive_takes_webots_axle_and_mid_heading_rule(tmp_pa
     v = 0.5 * (wl + wr) * R * T
     pose = sim.robot("bot").pose
     assert pose.translation[:2] == pytest.approx([X0 + v * math.cos(H0 + d), Y0 + v * math.sin(H0 + d)], abs=1e-16)
-    assert heading(pose) == pytest.approx(H0 + 2.0 * d, abs=1e-15)
+    assert heading(pose.rotation) == pytest.approx(H0 + 2.0 * d, abs=1e-15)
     # the wheels' encoders read what the wheels turned, as under the arc
     run(sim, wl, wr, 9)
     assert sim.robot("bot").device("left wheel motor sensor").value == pytest.approx(wl * 10 * T, abs=1e-12)
@@ -97,7 +78,7 @@ def test_a_circle_of_n_steps_is_a_regular_polygon(tmp_path: Path) -> None:
         sim.run(1)
         pose = sim.robot("bot").pose
         assert math.dist(pose.translation[:2], centre) == pytest.approx(radius, abs=1e-13), k
-        assert math.remainder(heading(pose) - (H0 + 2.0 * d * k), 2.0 * math.pi) == pytest.approx(0.0, abs=1e-12)
+        assert math.remainder(heading(pose.rotation) - (H0 + 2.0 * d * k), 2.0 * math.pi) == pytest.approx(0.0, abs=1e-12)
     assert pose.translation[:2] == pytest.approx([X0, Y0], abs=1e-13)
 
 
@@ -120,7 +101,7 @@ def test_with_physics_or_without_a_webots_pair_the_exact_arc(tmp_path: Path) -> 
             x = X0 + v / om * (math.sin(H0 + om * T) - math.sin(H0))
             y = Y0 - v / om * (math.cos(H0 + om * T) - math.cos(H0))
             assert pose.translation[:2] == pytest.approx([x, y], abs=1e-15)
-        assert heading(pose) == pytest.approx(H0 + om * T, abs=1e-15)
+        assert heading(pose.rotation) == pytest.approx(H0 + om * T, abs=1e-15)
 
 
 def test_batched_copies_step_the_rule_as_the_simulation(tmp_path: Path) -> None:

@@ -15,43 +15,24 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _gym_avoid import avoid_envs
+from _wheeled_wbt import H0, STEP, X0, Y0, R, T, Y, heading, robot_world, wheel
 
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.sim.summary import drive_line
 from sensorium.server.world.loader import WorldError, load_world, parse_world
 
-R, Y, STEP = 0.02, 0.026, 32              # wheel radius, its distance along the axle, basic step (ms)
-T = STEP / 1000.0
-X0, Y0, H0 = 0.1, -0.2, 0.3               # where the robot starts, its heading
 W = 5.0                                   # rad/s
 LEFT, RIGHT = "left wheel motor", "right wheel motor"
 
 
-def wheel(name: str, x: float, y: float, axis: str) -> str:
-    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {axis} anchor {x} {y} {R} }}\n'
-            f'  device [ RotationalMotor {{ name "{name}" maxVelocity 20 }} PositionSensor {{ name "{name} sensor" }} ]\n'
-            f'  endPoint Solid {{ translation {x} {y} {R} children [ DEF W Pose {{ rotation 1 0 0 1.5708 children [\n'
-            f'    Shape {{ geometry Cylinder {{ radius {R} height 0.003 }} }} ] }} ] boundingObject USE W }} }}\n')
-
-
 def write(tmp_path: Path, wheels: str, physics: bool = True) -> Path:
-    p = tmp_path / "mirrored.wbt"
-    p.write_text(f'#VRML_SIM R2023b utf8\nWorldInfo {{ basicTimeStep {STEP} }}\n'
-                 f'Robot {{ name "bot" translation {X0} {Y0} 0 rotation 0 0 1 {H0} children [\n'
-                 '  DEF BODY Pose { translation 0 0 0.025 children [ Shape { geometry Cylinder { radius 0.037 '
-                 'height 0.045 } } ] }\n' + wheels
-                 + '] boundingObject USE BODY' + (' physics Physics { }' if physics else '') + ' }\n')
-    return p
+    return robot_world(tmp_path / "mirrored.wbt", wheels, physics)
 
 
 def two_wheels(mirrored: str = "left", right_y: float = -Y) -> str:
     left_axis, right_axis = ("0 -1 0", "0 1 0") if mirrored == "left" else ("0 1 0", "0 -1 0")
     return wheel(LEFT, 0.0, Y, left_axis) + wheel(RIGHT, 0.0, right_y, right_axis)
-
-
-def heading(rotation) -> float:
-    return math.atan2(rotation[1, 0], rotation[0, 0])
 
 
 def drive(sim: Simulation, speeds: dict[str, float], steps: int) -> None:
