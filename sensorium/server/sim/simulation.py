@@ -200,8 +200,11 @@ class RobotState:
         self.drive: DifferentialDrive | AckermannDrive | MecanumDrive | OmniDrive | SteeredDrive | None = None
         low = sim.band_low(index) if sim.ground is not None else 0.0     # (its support ceiling: sim/ground.py)
         if model.differential_drive is not None:
+            # a robot without Physics (Webots' kinematic rule, mid_heading) moves in its plane only: Webots
+            # gives it no contact with the ground, so it rides no terrain or ramp and keeps its height and tilt
+            kinematic = model.differential_drive.step_rule == "mid_heading"
             self.drive = DifferentialDrive(model.differential_drive, sim.scene.robot_poses[index], up=up,
-                                           ground=sim.ground, band_low=low)
+                                           ground=None if kinematic else sim.ground, band_low=0.0 if kinematic else low)
         elif model.ackermann_drive is not None:
             self.drive = AckermannDrive(model.ackermann_drive, sim.scene.robot_poses[index], up=up, ground=sim.ground,
                                         band_low=low)
@@ -456,7 +459,7 @@ class Simulation:
             warnings.warn(f"{self.loaded.source}: solid {name!r}: its ElevationGrid is tilted (its local z is not "
                           "the world's up): not ground, robots keep their height over it", GroundWarning, stacklevel=3)
         for r in self._driven:
-            if r.drive is not None and r.drive.rest is None:
+            if r.drive is not None and r.drive.ground is not None and r.drive.rest is None:   # (without Physics: none)
                 warnings.warn(f"{self.loaded.source}: robot {r.name!r} starts over no ground (no upright terrain, "
                               "floor plane or box top at most 1 mm above its body's bottom under its origin): "
                               "it keeps its height, terrains do not lift it",

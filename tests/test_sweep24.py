@@ -1,0 +1,193 @@
+"""Sweep 24: Webots samples not run before, each on a stand-in world of ours (tests/data/sweep24/: the
+sample's poses, sizes and devices, our own text, PROTO meshes stood in for by plain shapes) driven in
+process by the calls its controller makes and checked against closed forms."""
+
+from __future__ import annotations
+
+import math
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_sweep19 import rot
+from test_sweep20 import ray_to_boxes
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+DATA = Path(__file__).parent / "data" / "sweep24"
+
+# ------------------------------------------------------------------------------------------------ koala
+# koala (k-team/koala): the Koala, six wheels of radius 0.0425 m (the middle pair on motorised hinges 0.285 m
+# apart), no Physics, named "koala", turned half a turn at (1, 0, 0) in a 4 m arena whose walls and blocks are
+# boxes of a Solid turned (0.99965, 0.01878, 0.01878) 1.57115 rad (y-up geometry stood up, with 2.15° of yaw),
+# a green cylinder of radius 0.3 m at the centre, running Webots' generic `braitenberg` controller: 32 ms
+# steps, each wheel's speed 0.1 × Σ_j w_j (1 − ds_j/512), bounded to ±10 rad/s, from its sixteen infra-red
+# sensors (table 0 → 1024, 0.5 m → 0, or 0.35 m for ds3, ds6, ds9, ds12).
+KOALA_R = 0.0425
+KOALA_AXLE = 2.0 * math.hypot(0.1425, 0.0425)     # Webots' rule without Physics: the wheels' 3-D distances
+# the sensors in the robot's frame (x forward, y left): position, turn about z, range of the table
+KOALA_DS = [((0.175, -0.015, 0.102), -0.0999963, 0.5), ((0.169, -0.04, 0.102), -0.1999963, 0.5),
+            ((0.16, -0.07, 0.102), -0.2999963, 0.5), ((0.14, -0.12, 0.102), -0.8, 0.35),
+            ((0.055, -0.14, 0.102), -1.5707963, 0.5), ((-0.05, -0.14, 0.102), -1.5707963, 0.5),
+            ((-0.12, -0.125, 0.102), -2.4231963, 0.35), ((-0.13, -0.0475, 0.107), -3.1415963, 0.5),
+            ((-0.13, 0.0475, 0.107), -3.1415963, 0.5), ((-0.12, 0.125, 0.102), -3.9307963, 0.35),
+            ((-0.05, 0.14, 0.102), 1.5709937, 0.5), ((0.055, 0.14, 0.102), 1.5707937, 0.5),
+            ((0.14, 0.125, 0.102), 0.8000037, 0.35), ((0.16, 0.07, 0.102), 0.3000037, 0.5),
+            ((0.169, 0.04, 0.102), 0.2000037, 0.5), ((0.175, 0.015, 0.102), 0.1000037, 0.5)]
+KOALA_WEIGHTS = [(17, -1), (8, -2), (4, -3), (9, -2), (5, -3), (-4, -2), (-4, -2), (-2, -2),
+                 (-2, -2), (-2, -4), (-2, -4), (-4, 5), (-3, 8), (-3, 5), (-2, 10), (-1, 15)]
+ARENA_TURN = rot((0.9996471590895996, 0.018782402989139663, 0.018782402989139663), 1.57115)
+# the arena's boxes in the turned Solid's frame (y up there): centre, turn about its y, size
+ARENA_BOXES = [((0, -0.02, 0), 0.0, (4, 0.04, 4)), ((2, 0.15, 0), 0.0, (0.02, 0.3, 4)),
+               ((-2, 0.15, 0), 0.0, (0.02, 0.3, 4)), ((0, 0.15, 2), 1.57, (0.02, 0.3, 4)),
+               ((0, 0.15, -2), 1.57, (0.02, 0.3, 4)), ((1.7, 0.15, 0), 0.0, (0.4, 0.3, 0.6)),
+               ((1.77, 0.15, 0.455), 0.885, (0.1, 0.3, 0.6)), ((-1.77, 0.15, -0.455), 0.885, (0.1, 0.3, 0.6)),
+               ((1.77, 0.15, -0.455), -0.885, (0.1, 0.3, 0.6)), ((-1.77, 0.15, 0.455), -0.885, (0.1, 0.3, 0.6)),
+               ((-1.7, 0.15, 0), 0.0, (0.4, 0.3, 0.6)), ((0, 0.15, 1.7), 1.57, (0.4, 0.3, 0.6)),
+               ((0, 0.15, -1.7), 1.57, (0.4, 0.3, 0.6)), ((-0.445, 0.15, 1.77), -0.685, (0.1, 0.3, 0.6)),
+               ((0.445, 0.15, 1.77), 0.685, (0.1, 0.3, 0.6)), ((0.445, 0.15, -1.77), -0.685, (0.1, 0.3, 0.6)),
+               ((-0.445, 0.15, -1.77), 0.685, (0.1, 0.3, 0.6))]
+# Webots' infra-red factor 0.2 + 0.8 · red · (1 − 0.5 · roughness), both PBRAppearances of roughness 1
+WALL_FACTOR = 0.2 + 0.4 * 0.103335
+CYLINDER_FACTOR = 0.2 + 0.4 * 0.16452
+CYLINDER_RADIUS = 0.3
+
+
+def koala_boxes() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    return [(ARENA_TURN @ np.array(c, dtype=float), ARENA_TURN @ rot((0, 1, 0), a), np.array(s) / 2)
+            for c, a, s in ARENA_BOXES]
+
+
+def ray_to_cylinder(origin: np.ndarray, u: np.ndarray) -> float:
+    """The distance along a horizontal unit ray (from outside, below its 0.3 m top) to the central
+    cylinder's side; inf when it misses."""
+    b = origin[0] * u[0] + origin[1] * u[1]
+    a = u[0] ** 2 + u[1] ** 2
+    c = origin[0] ** 2 + origin[1] ** 2 - CYLINDER_RADIUS ** 2
+    disc = b * b - a * c
+    if a == 0.0 or disc < 0.0:
+        return math.inf
+    t = (-b - math.sqrt(disc)) / a
+    return t if t >= 0.0 else math.inf
+
+
+def koala_mid_heading(x: float, y: float, yaw: float, wl: float, wr: float, t: float) -> tuple[float, float, float]:
+    """One basic step of Webots' kinematic rule (a robot without Physics): d = (ωr − ωl)·t·r/(2·axle), a
+    straight segment of (ωl + ωr)·r·t/2 along yaw + d, the heading then yaw + 2d."""
+    d = (wr - wl) * t * KOALA_R / (2.0 * KOALA_AXLE)
+    v = 0.5 * (wl + wr) * KOALA_R * t
+    return x + v * math.cos(yaw + d), y + v * math.sin(yaw + d), yaw + 2.0 * d
+
+
+def noiseless_koala(tmp_path: Path) -> Path:
+    """A copy of the koala stand-in whose sensors' tables have no noise (their third column 0.01 at 0.5 m)."""
+    shutil.copytree(DATA / "protos", tmp_path / "protos")
+    proto = tmp_path / "protos" / "Koala.proto"
+    proto.write_text(re.sub(r"(lookupTable \[ 0 1024 0, \S+ 0) 0\.01 \]", r"\1 0 ]", proto.read_text()))
+    shutil.copy(DATA / "koala.wbt", tmp_path / "koala.wbt")
+    return tmp_path / "koala.wbt"
+
+
+def run_koala(world: Path, duration_ms: int) -> tuple[list[tuple[int, int]], list[tuple[int, float]], list[float]]:
+    """braitenberg.c's calls in process for the robot "koala" for ``duration_ms``, each step checked against
+    the closed forms: each infra-red sensor reads the table at its ray's distance to the nearest green wall or
+    block face divided by 0.24133, or to the cylinder divided by 0.26581 (Webots' reflection factors), and
+    the pose is Webots' kinematic rule on the wheel speeds set from the readings (1e-9), flat (no tilt: a
+    robot without Physics rides nothing) — but where kinematic contact pushes the body off the cylinder or
+    a wall, from where it is pushed. Returns when each sensor first read something, each step contact
+    pushed the robot and by how much, and the final x, y, yaw."""
+    sim = Simulation(load_world(world), "exact")
+    robot = sim.robot("koala")
+    step = sim.basic_time_step
+    assert step == 32
+    ds = [sim.device(f"koala/ds{i}") for i in range(16)]
+    for s in ds:
+        s.enable(step)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    boxes = koala_boxes()
+    x, y, yaw, wl, wr = 1.0, 0.0, 3.14159, 0.0, 0.0
+    seen: dict[int, int] = {}
+    pushes: list[tuple[int, float]] = []
+    for k in range(1, duration_ms // step + 1):
+        sim.step()
+        x, y, yaw = koala_mid_heading(x, y, yaw, wl, wr, step / 1000)
+        body = rot((0, 0, 1), yaw)
+        at = np.asarray(robot.pose.translation)
+        if abs(at[0] - x) + abs(at[1] - y) > 1e-9:
+            pushes.append((k, float(np.hypot(at[0] - x, at[1] - y))))
+            x, y = float(at[0]), float(at[1])
+        assert list(robot.pose.translation) == pytest.approx([x, y, 0.0], abs=1e-9), k
+        assert np.asarray(robot.pose.rotation) == pytest.approx(body, abs=1e-9), k
+        values = []
+        for i, (at, turn, reach) in enumerate(KOALA_DS):
+            origin = np.array([x, y, 0.0]) + body @ np.array(at)
+            u = body @ rot((0, 0, 1), turn) @ np.array([1.0, 0.0, 0.0])
+            seen_at = min(ray_to_boxes(origin, u, boxes) / WALL_FACTOR, ray_to_cylinder(origin, u) / CYLINDER_FACTOR)
+            values.append(1024.0 * (1.0 - seen_at / reach) if seen_at < reach else 0.0)
+            if values[-1] > 0.0:
+                seen.setdefault(i, k * step)
+            assert float(ds[i].value) == pytest.approx(values[-1], abs=1e-6), (k, i, seen_at)
+        wl, wr = (max(-10.0, min(10.0, sum(0.1 * w[side] * (1.0 - v / 512) for w, v in zip(KOALA_WEIGHTS, values,
+                                                                                            strict=True))))
+                  for side in (0, 1))
+        left.set_velocity(wl)
+        right.set_velocity(wr)
+    return sorted((t, i) for i, t in seen.items()), pushes, [x, y, math.remainder(yaw, 2 * math.pi)]
+
+
+def test_the_koala_stand_in_loads_the_devices_braitenberg_asks_for_and_webots_kinematic_rule() -> None:
+    """The Koala loads without a line with its 20 devices (ds0…ds15, both wheel motors and sensors) and, having
+    no Physics, Webots' kinematic rule: radius 0.0425 m, axle 2·√(0.1425² + 0.0425²) = 0.29741 m (its middle
+    wheels' 3-D distances from its origin; the four wheels on no hinge play no part). The arena's floor box,
+    stood up by a rotation written to six digits, leans 7.7e-7 rad: a ramp, so the world has a ground; the
+    Koala, which Webots gives no contact with it, is not said to start over no ground (it rides none)."""
+    import warnings
+
+    w = load_world(DATA / "koala.wbt")
+    assert w.warnings == []
+    (robot,) = w.world.robots
+    names = {d.name for d in robot.devices}
+    assert len(names) == 20 and {*(f"ds{i}" for i in range(16)), "left wheel motor", "right wheel motor",
+                                 "left wheel sensor", "right wheel sensor"} <= names
+    drive = robot.differential_drive
+    assert robot.mass is None and drive.step_rule == "mid_heading"
+    assert (drive.wheel_radius, drive.axle_length) == pytest.approx((KOALA_R, KOALA_AXLE), abs=1e-15)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sim = Simulation(w, "exact")
+    assert sim.ground is not None
+    lean = math.acos(min(1.0, float((ARENA_TURN @ np.array([0.0, 1.0, 0.0]))[2])))
+    assert 7e-7 < lean < 8e-7
+
+
+def test_braitenbergs_calls_drive_the_koala_by_webots_kinematic_rule_flat_on_the_leaning_floor(tmp_path: Path) -> None:
+    """koala: for 12 s (375 steps of 32 ms) every reading and pose meets run_koala's closed forms. In open
+    space every sensor reads 0, so the wheels turn at 0.1·Σ w = 1.4 and 1.6 rad/s: 0.06375 m/s, curving left
+    at 0.2·0.0425/0.29741 = 0.02858 rad/s towards the cylinder, which ds1 first sees at 6.272 s (the green
+    cylinder reflects as a white one 0.26581 times as near: ds1's 0.5 m reach is 0.133 m of it), then ds0
+    and ds2 at 6.336 s, the robot turning right round it; its body touches the cylinder at 8.672 s, contact
+    pushing it off by at most 0.66 mm for 12 steps (Webots' kinematic robot is pushed out of what it meets
+    too); at 12 s it is at (0.4185, −0.2796), heading −1.8351. It stays flat: the floor's 7.7e-7 rad lean
+    tilted it by as much (it rode the floor as a ramp, where Webots gives a robot without Physics no contact
+    with the ground)."""
+    seen, pushes, end = run_koala(noiseless_koala(tmp_path), 12000)
+    assert seen == [(6272, 1), (6336, 0), (6336, 2), (7328, 3), (8544, 4), (9408, 5), (11616, 6)]
+    assert [k for k, _ in pushes] == list(range(271, 283)) and max(p for _, p in pushes) < 6.6e-4
+    assert end == pytest.approx([0.4185, -0.2796, -1.8351], abs=1e-4)
+
+
+@pytest.mark.slow
+def test_braitenbergs_calls_drive_the_koala_for_a_minute(tmp_path: Path) -> None:
+    """The same closed forms for 60 s (1875 steps): after the cylinder the Koala meets the arena's walls and
+    blocks (pushed off them at most 1.8 mm from 28.35 s and 55.23 s), its front-left sensors ds15 and ds14 first read at
+    51.808 and 52.032 s, and it ends at (1.8235, −1.2926), heading 1.8576."""
+    seen, pushes, end = run_koala(noiseless_koala(tmp_path), 60000)
+    assert seen[-2:] == [(51808, 15), (52032, 14)] and len(seen) == 9
+    assert max(p for _, p in pushes) < 1.8e-3 and {k for k, _ in pushes} >= {886, 1726}
+    assert end == pytest.approx([1.8235, -1.2926, 1.8576], abs=1e-4)
