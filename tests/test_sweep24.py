@@ -191,3 +191,135 @@ def test_braitenbergs_calls_drive_the_koala_for_a_minute(tmp_path: Path) -> None
     assert seen[-2:] == [(51808, 15), (52032, 14)] and len(seen) == 9
     assert max(p for _, p in pushes) < 1.8e-3 and {k for k, _ in pushes} >= {886, 1726}
     assert end == pytest.approx([1.8235, -1.2926, 1.8576], abs=1e-4)
+
+
+# ------------------------------------------------------------------------------------------------ khepera2
+# khepera2 (k-team/khepera2): the Khepera II, no Physics, two wheels of radius 0.0075 m whose hinges run
+# along y through (0, 0, 0.0075) and whose end points sit at y ±0.026, named "khepera2" at the centre of a 2 m
+# RectangleArena with five 0.1 m boxes, running Webots' generic `braitenberg` controller: the name starts
+# with "khepera", so eight sensors ds0…ds7 (table 0 → 1023, 0.05 m → 0), each wheel 1.0 × Σ_j w_j (1 − ds_j/512)
+# bounded to ±1 rad/s; its wheels' sensors have a resolution of 0.0314 rad.
+K2_R, K2_RES = 0.0075, 0.0314
+K2_AXLE = 2.0 * math.hypot(0.026, 0.0075)     # Webots' rule without Physics: the wheels' 3-D distances
+K2_DS = [((0.015, 0.027, 0.017), (-0.754266, -0.464264, -0.464264), -1.849141),
+         ((0.022, 0.021, 0.017), (0.917492, 0.281254, 0.281254), 1.656801),
+         ((0.029, 0.007, 0.017), (1, -0.000398, -0.000398), 1.570796),
+         ((0.029, -0.007, 0.017), (1, -0.000398, -0.000398), 1.570796),
+         ((0.022, -0.021, 0.017), (0.909527, -0.293906, -0.293906), 1.665485),
+         ((0.015, -0.027, 0.017), (-0.72051, 0.490339, 0.490339), -1.892875),
+         ((-0.029, -0.007, 0.017), (-0.000282, 0.707107, 0.707107), -3.14103),
+         ((-0.029, 0.007, 0.017), (-0.000282, 0.707107, 0.707107), -3.14103)]
+K2_WEIGHTS = [(-2, 4), (-3, 5), (-7, 7), (7, -6), (5, -4), (4, -2), (-0.5, -0.5), (-0.5, -0.5)]
+K2_BOXES = [((-0.2, -0.683174), (-0.45445591677276886, -0.7661198596958863, 0.45445591677276886), -1.8341153071795864),
+            ((-0.75, 0.35), (-0.12634796090434602, 0.9839066955512742, -0.12634796090434602), -1.5870153071795858),
+            ((0.5, -0.35471), (-1.46018e-08, 7.19235e-09, -1), 0.915365),
+            ((-0.3, 0.36), (-0.3063990552359414, 0.9012431624711751, -0.3063990552359414), -1.6745853071795862),
+            ((-0.65, -0.66), (-0.3063990552359414, 0.9012431624711751, -0.3063990552359414), -1.6745853071795862)]
+
+
+def k2_obstacles() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The arena's four walls (0.01 m thick, 0.1 m high, outside the 2 m floor) and the five boxes."""
+    walls = [((1.005, 0.0), (0.005, 1.0)), ((-1.005, 0.0), (0.005, 1.0)),
+             ((0.0, 1.005), (1.01, 0.005)), ((0.0, -1.005), (1.01, 0.005))]
+    out = [(np.array([x, y, 0.05]), np.eye(3), np.array([hx, hy, 0.05])) for (x, y), (hx, hy) in walls]
+    out += [(np.array([x, y, 0.05]), rot(axis, a), np.full(3, 0.05)) for (x, y), axis, a in K2_BOXES]
+    return out
+
+
+def noiseless_khepera2(tmp_path: Path) -> Path:
+    """A copy of the khepera2 stand-in whose infra-red tables have no noise (0.01 at 0.05 m)."""
+    shutil.copytree(DATA / "protos", tmp_path / "protos")
+    proto = tmp_path / "protos" / "Khepera2.proto"
+    proto.write_text(proto.read_text().replace("lookupTable [ 0 1023 0, 0.05 0 0.01 ]", "lookupTable [ 0 1023 0, 0.05 0 0 ]"))
+    shutil.copy(DATA / "khepera2.wbt", tmp_path / "khepera2.wbt")
+    return tmp_path / "khepera2.wbt"
+
+
+def run_khepera2(world: Path, duration_ms: int) -> tuple[list[tuple[int, int]], list[tuple[int, float]], list[float]]:
+    """braitenberg.c's calls in process for the robot "khepera2", each 32 ms step checked against the closed
+    forms: each infra-red sensor reads the table at its ray's distance to the nearest (white) wall or box
+    face, the wheels' sensors their angles rounded to 0.0314 rad, and the pose is Webots' kinematic rule on
+    the wheel speeds set from the readings (1e-9), flat, but where kinematic contact pushes it. Returns when
+    each sensor first read something, the pushes, and the final x, y, yaw."""
+    sim = Simulation(load_world(world), "exact")
+    robot = sim.robot("khepera2")
+    step = sim.basic_time_step
+    ds = [sim.device(f"khepera2/ds{i}") for i in range(8)]
+    for s in ds:
+        s.enable(step)
+    wheel_sensors = [sim.device("khepera2/left wheel sensor"), sim.device("khepera2/right wheel sensor")]
+    for s in wheel_sensors:
+        s.enable(step)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    obstacles = k2_obstacles()
+    rays = [(np.array(at), rot(axis, a) @ np.array([1.0, 0.0, 0.0])) for at, axis, a in K2_DS]
+    x, y, yaw, wl, wr = 0.0, 0.0, 0.0, 0.0, 0.0
+    angles = [0.0, 0.0]
+    seen: dict[int, int] = {}
+    pushes: list[tuple[int, float]] = []
+    for k in range(1, duration_ms // step + 1):
+        sim.step()
+        d = (wr - wl) * step / 1000 * K2_R / (2.0 * K2_AXLE)
+        v = 0.5 * (wl + wr) * K2_R * step / 1000
+        x, y, yaw = x + v * math.cos(yaw + d), y + v * math.sin(yaw + d), yaw + 2.0 * d
+        angles = [angles[0] + wl * step / 1000, angles[1] + wr * step / 1000]
+        at = np.asarray(robot.pose.translation)
+        if abs(at[0] - x) + abs(at[1] - y) > 1e-9:
+            pushes.append((k, float(np.hypot(at[0] - x, at[1] - y))))
+            x, y = float(at[0]), float(at[1])
+        body = rot((0, 0, 1), yaw)
+        assert list(robot.pose.translation) == pytest.approx([x, y, 0.0], abs=1e-9), k
+        assert np.asarray(robot.pose.rotation) == pytest.approx(body, abs=1e-9), k
+        values = []
+        for i, (p, u) in enumerate(rays):
+            distance = ray_to_boxes(np.array([x, y, 0.0]) + body @ p, body @ u, obstacles)
+            values.append(1023.0 * (1.0 - distance / 0.05) if distance < 0.05 else 0.0)
+            if values[-1] > 0.0:
+                seen.setdefault(i, k * step)
+            assert float(ds[i].value) == pytest.approx(values[-1], abs=1e-6), (k, i, distance)
+        for s, a in zip(wheel_sensors, angles, strict=True):
+            assert float(s.value) == pytest.approx(round(a / K2_RES) * K2_RES, abs=1e-12), k
+        wl, wr = (max(-1.0, min(1.0, sum(w[side] * (1.0 - v / 512) for w, v in zip(K2_WEIGHTS, values, strict=True))))
+                  for side in (0, 1))
+        left.set_velocity(wl)
+        right.set_velocity(wr)
+    return sorted((t, i) for i, t in seen.items()), pushes, [x, y, math.remainder(yaw, 2 * math.pi)]
+
+
+def test_the_khepera2_stand_in_loads_the_devices_braitenberg_asks_for_and_webots_kinematic_rule() -> None:
+    """The Khepera II loads without a line with its 24 devices (ds0…ds7, ls0…ls7, two LEDs, the serial
+    emitter and receiver, both wheel motors and sensors) and, having no Physics, Webots' kinematic rule:
+    radius 0.0075 m (the wheels' cylinders, turned onto −y by their end points' and Poses' rotations, within
+    1e-4), axle 2·√(0.026² + 0.0075²) = 0.054120 m where the wheels are 0.052 m apart."""
+    w = load_world(DATA / "khepera2.wbt")
+    assert w.warnings == []
+    (robot,) = w.world.robots
+    names = {d.name for d in robot.devices}
+    assert len(names) == 24 and {*(f"ds{i}" for i in range(8)), *(f"ls{i}" for i in range(8)), "led0", "led1",
+                                 "rs232_out", "rs232_in", "left wheel sensor", "right wheel sensor"} <= names
+    drive = robot.differential_drive
+    assert robot.mass is None and drive.step_rule == "mid_heading"
+    assert (drive.wheel_radius, drive.axle_length) == pytest.approx((K2_R, K2_AXLE), abs=1e-15)
+
+
+def test_braitenbergs_calls_drive_the_khepera2_straight_at_its_bounded_speed(tmp_path: Path) -> None:
+    """khepera2: in open space the Braitenberg sums are 3 on both wheels, bounded to 1 rad/s: 0.0075 m/s
+    along +x; for 40 s (1250 steps) every reading (0) and wheel sensor (t rad, rounded to 0.0314) and the
+    pose meet run_khepera2's closed forms: 0.0075 × 39.968 = 0.29976 m along x (the speeds are set after
+    the first step's readings)."""
+    seen, pushes, end = run_khepera2(noiseless_khepera2(tmp_path), 40000)
+    assert seen == [] and pushes == []
+    assert end == pytest.approx([0.0075 * 39.968, 0.0, 0.0], abs=1e-12)
+
+
+@pytest.mark.slow
+def test_braitenbergs_calls_drive_the_khepera2_to_the_wall_and_round(tmp_path: Path) -> None:
+    """The same closed forms for 200 s (6250 steps): ds2 and ds3 meet the wall at x 1 at 122.848 s (the
+    robot at 0.9214 = 1 − 0.029 − 0.05 + a step), then ds1, ds4 and ds0; it turns right along the wall,
+    never touching it, to (0.7914, −0.4642), heading −1.9113."""
+    seen, pushes, end = run_khepera2(noiseless_khepera2(tmp_path), 200000)
+    assert seen == [(122848, 2), (122848, 3), (124928, 1), (125056, 4), (127808, 0)] and pushes == []
+    assert end == pytest.approx([0.7914, -0.4642, -1.9113], abs=1e-4)
