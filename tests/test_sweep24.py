@@ -172,8 +172,7 @@ def test_braitenbergs_calls_drive_the_koala_by_webots_kinematic_rule_flat_on_the
     at 0.2·0.0425/0.29741 = 0.02858 rad/s towards the cylinder, which ds1 first sees at 6.272 s (the green
     cylinder reflects as a white one 0.26581 times as near: ds1's 0.5 m reach is 0.133 m of it), then ds0
     and ds2 at 6.336 s, the robot turning right round it; its body touches the cylinder at 8.672 s, contact
-    pushing it off by at most 0.66 mm for 12 steps (Webots' kinematic robot is pushed out of what it meets
-    too); at 12 s it is at (0.4185, −0.2796), heading −1.8351. It stays flat: the floor's 7.7e-7 rad lean
+    pushing it off by at most 0.66 mm for 12 steps (Sensorium's kinematic contact); at 12 s it is at (0.4185, −0.2796), heading −1.8351. It stays flat: the floor's 7.7e-7 rad lean
     tilted it by as much (it rode the floor as a ramp, where Webots gives a robot without Physics no contact
     with the ground)."""
     seen, pushes, end = run_koala(noiseless_koala(tmp_path), 12000)
