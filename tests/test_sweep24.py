@@ -306,12 +306,12 @@ def test_the_khepera2_stand_in_loads_the_devices_braitenberg_asks_for_and_webots
 
 def test_braitenbergs_calls_drive_the_khepera2_straight_at_its_bounded_speed(tmp_path: Path) -> None:
     """khepera2: in open space the Braitenberg sums are 3 on both wheels, bounded to 1 rad/s: 0.0075 m/s
-    along +x; for 40 s (1250 steps) every reading (0) and wheel sensor (t rad, rounded to 0.0314) and the
-    pose meet run_khepera2's closed forms: 0.0075 × 39.968 = 0.29976 m along x (the speeds are set after
+    along +x; for 24 s (750 steps) every reading (0) and wheel sensor (t rad, rounded to 0.0314) and the
+    pose meet run_khepera2's closed forms: 0.0075 × 23.968 = 0.17976 m along x (the speeds are set after
     the first step's readings)."""
-    seen, pushes, end = run_khepera2(noiseless_khepera2(tmp_path), 40000)
+    seen, pushes, end = run_khepera2(noiseless_khepera2(tmp_path), 24000)
     assert seen == [] and pushes == []
-    assert end == pytest.approx([0.0075 * 39.968, 0.0, 0.0], abs=1e-12)
+    assert end == pytest.approx([0.0075 * 23.968, 0.0, 0.0], abs=1e-12)
 
 
 @pytest.mark.slow
@@ -322,3 +322,145 @@ def test_braitenbergs_calls_drive_the_khepera2_to_the_wall_and_round(tmp_path: P
     seen, pushes, end = run_khepera2(noiseless_khepera2(tmp_path), 200000)
     assert seen == [(122848, 2), (122848, 3), (124928, 1), (125056, 4), (127808, 0)] and pushes == []
     assert end == pytest.approx([0.7914, -0.4642, -1.9113], abs=1e-4)
+
+
+# ------------------------------------------------------------------------------------------------ khepera_kinematic
+# khepera_kinematic (k-team/khepera1): two Khepera I robots with `kinematic TRUE` (the template leaves out
+# their Physics), "khepera" and "khepera(1)", facing each other across a 1 m RectangleArena with a light blue
+# box (0.1 × 0.3 m seen from above, a quarter turn about x) between them and a cylinder of radius 0.1 m at the
+# centre turned 4.7e-6 rad about x; each runs `braitenberg` with the Khepera weights, as the Khepera II.
+K1_DS = [((0.012, 0.0245, 0.0145), (0.610934, 0.559803, 0.559803), 2.044752),
+         ((0.021, 0.0185, 0.0145), (0.862854, 0.357409, 0.357409), 1.717773),
+         ((0.027, 0.0075, 0.0145), (-1, 0, 0), -1.570796),
+         ((0.027, -0.0075, 0.0145), (-1, 0, 0), -1.570796),
+         ((0.021, -0.0185, 0.0145), (0.862857, -0.357406, -0.357406), 1.717771),
+         ((0.012, -0.0245, 0.0145), (0.610937, -0.559802, -0.559802), 2.044747),
+         ((-0.026, -0.009, 0.0145), (0, -0.707107, -0.707107), -3.14159),
+         ((-0.026, 0.009, 0.0145), (0, -0.707107, -0.707107), -3.14159)]
+K1_ROBOTS = {"khepera": ((0.425571, 0.341915), (6.42555e-10, -7.19234e-09, 1), -2.9633853071795864),
+             "khepera(1)": ((-0.441747, 0.329789), (4.3816e-07, -7.19235e-09, 1), -0.03282530717958654)}
+OBSTACLE_FACTOR = 0.2 + 0.4 * 0.678431      # the light blue PBRAppearance, roughness 1
+K1_CYLINDER_TURN = rot((1, 0, 0), 4.692820414042842e-06)
+
+
+def k1_walls_and_box() -> tuple[list, list]:
+    """The 1 m arena's four white walls (0.01 m thick, 0.1 m high), and the light blue box."""
+    walls = [((0.505, 0.0), (0.005, 0.5)), ((-0.505, 0.0), (0.005, 0.5)),
+             ((0.0, 0.505), (0.51, 0.005)), ((0.0, -0.505), (0.51, 0.005))]
+    white = [(np.array([x, y, 0.05]), np.eye(3), np.array([hx, hy, 0.05])) for (x, y), (hx, hy) in walls]
+    blue = [(np.array([0.0, 0.35, 0.0]), rot((1, 0, 0), 1.5707963267948966), np.array([0.05, 0.05, 0.15]))]
+    return white, blue
+
+
+def ray_to_tilted_cylinder(origin: np.ndarray, u: np.ndarray) -> float:
+    """The distance along the unit ray to the side of the centre cylinder (radius 0.1 m, 0.1 m high, its axis
+    turned 4.7e-6 rad about x), in its own frame; inf when the ray misses it or passes above it."""
+    p, d = K1_CYLINDER_TURN.T @ origin, K1_CYLINDER_TURN.T @ u
+    a, b, c = d[0] ** 2 + d[1] ** 2, p[0] * d[0] + p[1] * d[1], p[0] ** 2 + p[1] ** 2 - 0.01
+    disc = b * b - a * c
+    if a == 0.0 or disc < 0.0:
+        return math.inf
+    t = (-b - math.sqrt(disc)) / a
+    return t if t >= 0.0 and abs(p[2] + t * d[2]) <= 0.05 else math.inf
+
+
+def run_khepera_kinematic(world: Path, duration_ms: int) -> dict[str, tuple[list[tuple[int, int]], list[float]]]:
+    """braitenberg.c's calls for both robots in process, each 32 ms step checked against the closed forms:
+    each infra-red sensor reads the table at its ray's distance to the nearest wall face (white), or to the
+    box or the cylinder over 0.47137 (their light blue, roughness 1), and each robot moves by Webots'
+    kinematic rule on the speeds set from its readings (1e-9; the robots stay over 0.12 m apart, beyond each
+    other's rays). Returns, per robot, when each sensor first read something and the final x, y, yaw."""
+    sim = Simulation(load_world(world), "exact")
+    step = sim.basic_time_step
+    white, blue = k1_walls_and_box()
+    rays = [(np.array(at), rot(axis, a) @ np.array([1.0, 0.0, 0.0])) for at, axis, a in K1_DS]
+    state = {}
+    for name, ((x, y), axis, angle) in K1_ROBOTS.items():
+        robot = sim.robot(name)
+        ds = [sim.device(f"{name}/ds{i}") for i in range(8)]
+        for s in ds:
+            s.enable(step)
+        motors = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+        for m in motors:
+            m.set_position(math.inf)
+            m.set_velocity(0.0)
+        state[name] = {"robot": robot, "ds": ds, "motors": motors, "pose": [x, y, angle], "turn0": rot(axis, angle),
+                       "yaw0": angle, "speeds": (0.0, 0.0), "seen": {}}
+    for k in range(1, duration_ms // step + 1):
+        sim.step()
+        for name, st in state.items():
+            x, y, yaw = st["pose"]
+            wl, wr = st["speeds"]
+            d = (wr - wl) * step / 1000 * K2_R / (2.0 * K2_AXLE)
+            v = 0.5 * (wl + wr) * K2_R * step / 1000
+            x, y, yaw = x + v * math.cos(yaw + d), y + v * math.sin(yaw + d), yaw + 2.0 * d
+            st["pose"] = [x, y, yaw]
+            body = rot((0, 0, 1), yaw - st["yaw0"]) @ st["turn0"]
+            assert list(st["robot"].pose.translation) == pytest.approx([x, y, 0.0], abs=1e-9), (k, name)
+            assert np.asarray(st["robot"].pose.rotation) == pytest.approx(body, abs=1e-9), (k, name)
+            values = []
+            for i, (p, u) in enumerate(rays):
+                o, w = np.array([x, y, 0.0]) + body @ p, body @ u
+                seen_at = min(ray_to_boxes(o, w, white),
+                              min(ray_to_boxes(o, w, blue), ray_to_tilted_cylinder(o, w)) / OBSTACLE_FACTOR)
+                values.append(1023.0 * (1.0 - seen_at / 0.05) if seen_at < 0.05 else 0.0)
+                if values[-1] > 0.0:
+                    st["seen"].setdefault(i, k * step)
+                assert float(st["ds"][i].value) == pytest.approx(values[-1], abs=1e-6), (k, name, i, seen_at)
+            st["speeds"] = tuple(max(-1.0, min(1.0, sum(w[side] * (1.0 - r / 512) for w, r in zip(K2_WEIGHTS, values,
+                                                                                                   strict=True))))
+                                 for side in (0, 1))
+            for m, s in zip(st["motors"], st["speeds"], strict=True):
+                m.set_velocity(s)
+        (ax, ay, _), (bx, by, _) = (st["pose"] for st in state.values())
+        assert math.hypot(ax - bx, ay - by) > 0.12, k
+    return {name: (sorted((t, i) for i, t in st["seen"].items()), [*st["pose"][:2], math.remainder(st["pose"][2], 2 * math.pi)])
+            for name, st in state.items()}
+
+
+def noiseless_khepera1(tmp_path: Path) -> Path:
+    shutil.copytree(DATA / "protos", tmp_path / "protos")
+    proto = tmp_path / "protos" / "Khepera1.proto"
+    proto.write_text(proto.read_text().replace("lookupTable [ 0 1023 0, 0.05 0 0.01 ]", "lookupTable [ 0 1023 0, 0.05 0 0 ]"))
+    shutil.copy(DATA / "khepera_kinematic.wbt", tmp_path / "khepera_kinematic.wbt")
+    return tmp_path / "khepera_kinematic.wbt"
+
+
+def test_the_kinematic_khepera_template_leaves_out_physics_and_gives_webots_kinematic_rule() -> None:
+    """Both Khepera I robots load without a line with their 24 devices; `kinematic TRUE` leaves out their
+    Physics (no mass), so each moves by Webots' kinematic rule (radius 0.0075 m, axle 0.054120 m, as the
+    Khepera II's); the box and the cylinder, half sunk in the floor, make no ground to ride."""
+    w = load_world(DATA / "khepera_kinematic.wbt")
+    assert w.warnings == []
+    assert [r.name for r in w.world.robots] == ["khepera", "khepera(1)"]
+    for robot in w.world.robots:
+        assert len({d.name for d in robot.devices}) == 24 and robot.mass is None
+        drive = robot.differential_drive
+        assert drive.step_rule == "mid_heading"
+        assert (drive.wheel_radius, drive.axle_length) == pytest.approx((K2_R, K2_AXLE), abs=1e-15)
+    assert Simulation(w, "exact").ground is None
+
+
+def test_braitenbergs_calls_drive_both_kinematic_kheperas_by_the_closed_forms(tmp_path: Path) -> None:
+    """khepera_kinematic: for 16 s (500 steps) every reading and pose of both robots meets
+    run_khepera_kinematic's closed forms; each starts 7 cm from the wall behind it, which its rear sensors
+    read from the first step (ds7 for "khepera", ds6 and ds7 for "khepera(1)"), too little to lower the
+    bounded speed: both drive straight at 0.0075 m/s, 0.11976 m in 15.968 s, towards the box."""
+    out = run_khepera_kinematic(noiseless_khepera1(tmp_path), 16000)
+    assert out["khepera"][0] == [(32, 7)] and out["khepera(1)"][0] == [(32, 6), (32, 7)]
+    for name, ((x, y), _, yaw) in K1_ROBOTS.items():
+        travel = 0.0075 * 15.968
+        assert out[name][1] == pytest.approx([x + travel * math.cos(yaw), y + travel * math.sin(yaw), yaw], abs=1e-9)
+
+
+@pytest.mark.slow
+def test_braitenbergs_calls_drive_both_kinematic_kheperas_round_the_box_and_cylinder(tmp_path: Path) -> None:
+    """The same closed forms for 120 s (3750 steps): "khepera" meets the box at 44.0 s (ds3 first) and
+    "khepera(1)" at 45.536 s (ds2), the light blue faces seen 0.47137 times as near as white ones; each
+    turns away, never within 0.12 m of the other (beyond its rays), to (0.2990, −0.1552), heading −0.9094,
+    and (−0.2023, −0.1642), heading −1.8075."""
+    out = run_khepera_kinematic(noiseless_khepera1(tmp_path), 120000)
+    assert out["khepera"][0] == [(32, 7), (44000, 3), (44352, 2), (45056, 4), (47168, 5)]
+    assert out["khepera(1)"][0] == [(32, 6), (32, 7), (45536, 2), (45600, 3), (47136, 1), (49248, 0)]
+    assert out["khepera"][1] == pytest.approx([0.2990, -0.1552, -0.9094], abs=1e-4)
+    assert out["khepera(1)"][1] == pytest.approx([-0.2023, -0.1642, -1.8075], abs=1e-4)
