@@ -296,3 +296,43 @@ def test_webots_rolls_the_tinkerbots_vehicles_on_their_wheels(world: str) -> Non
     else:
         assert robot.steered_drive is not None and robot.differential_drive is None
         assert [w.radius for w in robot.steered_drive.wheels] == pytest.approx([0.02625] * 3, abs=1e-12)
+
+
+@pytest.mark.parametrize("helper", [True, False])
+def test_the_batched_simulation_rolls_braitenberg_as_simulation_does_bit_for_bit(helper: bool) -> None:
+    """braitenberg's drive (its forward the robot's −z, up its x, the left wheel mirrored, off-centre) in
+    the batched simulation: each copy's pose is the single Simulation's, bit for bit, at every step, with
+    the C drive pass and without it (numpy: SENSORIUM_PACKETS=0's path). vision_car's steered drive has free
+    wheels, which the batched simulation refuses in one line (use Simulation)."""
+    from sensorium.gym.views import CopySim
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+
+    if helper and packets.library() is None:
+        pytest.skip(f"no C helper: {packets.status()}")
+    lw = load_world(DATA / "braitenberg.wbt")
+    batched = BatchedSimulation(lw, 2)
+    if not helper:
+        batched._drive_step = None
+    assert batched.wheel_sign.tolist() == [[-1.0, 1.0]] and batched.off_centre.tolist() == [True]
+    batched.reset(np.arange(2), [1, 2])
+    singles = [Simulation(lw, "exact") for _ in range(2)]
+    speeds = [(-10.5, 11.5), (22.0, -3.0)]
+    for c, single in enumerate(singles):
+        for sim in (single, CopySim(batched, c)):
+            for m, v in zip(("left motor", "right motor"), speeds[c]):
+                motor = sim.robot(TB).motors[m]
+                motor.set_position(math.inf)
+                motor.set_velocity(v)
+    slot = batched.slot(TB)
+    for t in range(100):
+        batched.step()
+        for c, single in enumerate(singles):
+            single.step()
+            p = single.robot(TB).pose
+            assert batched.pos[c, slot].tobytes() == p.translation.tobytes(), (t, c)
+            assert batched.rot[c, slot].tobytes() == p.rotation.tobytes(), (t, c)
+    assert not batched._numpy_drives
+    assert float(singles[0].robot(TB).pose.translation[0]) > 0.2
+    with pytest.raises(BatchedError, match="robot 'vision car' has a steered_drive with free wheels"):
+        BatchedSimulation(load_world(DATA / "vision_car.wbt"), 2)

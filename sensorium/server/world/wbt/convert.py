@@ -2345,7 +2345,8 @@ class Converter:
             for free in robot.free:     # an encoder on a wheel axis no motor turns and no car rolls: still
                 if id(free) not in rolling and free["line"] is not None:
                     self.warn(free["node"], free["line"])
-            if car is not None and rolling and self.fields(node).node_("physics") is not None:
+            if car is not None and rolling and self.fields(node).node_("physics") is not None \
+                    and self._settles_along(self._robot_up(robot)):
                 self._free_wheel_bottom(robot, car, [f for f in robot.free if id(f) in rolling])
 
     def track(self, node: Node, frame: Frame, owner: Owner, motor: dict, line: str) -> None:
@@ -2422,7 +2423,7 @@ class Converter:
         tracks = robot.tracks
         if not tracks:
             return
-        up = self._robot_up(robot)
+        up = self._robot_up(robot, on_side=False)
         drive, why = (None, "") if robot.wheels or len(tracks) != 2 else track_drive(tracks, self, up)
         if drive is None:
             if why:
@@ -2456,19 +2457,20 @@ class Converter:
         if bottom is not None:
             car["wheel_bottom"] = min(car.get("wheel_bottom", bottom), bottom)
 
-    def _robot_up(self, robot: Owner) -> int:
-        """The robot's own axis that stands up, its drive judged with it for its z (wbt/drive.py): the
+    def _robot_up(self, robot: Owner, on_side: bool = True) -> int:
+        """The robot's own axis that stands up, its wheels judged with it for their z (wbt/drive.py): the
         axis closest to the world's up when it is that within ROBOT_UPRIGHT_TOL (a robot built on its side:
         Tinkerbots' base turned -pi/2 about y, its x up), else its z, or in a NUE world its y when that is
-        nearer the world's up (a robot built y-up, as Webots' were before R2022a). Its ``wheel_bottom`` is
-        measured along its z or a NUE robot's y (:meth:`_settles_along`)."""
+        nearer the world's up (a robot built y-up, as Webots' were before R2022a; ``on_side`` False: these
+        two only, as Tracks and belts are judged). Its ``wheel_bottom`` is measured along its z or a NUE
+        robot's y (:meth:`_settles_along`)."""
         from sensorium.server.sim.ground import ROBOT_UPRIGHT_TOL
         from sensorium.server.world.poses import pose_from_model
 
         r = pose_from_model(wm.Pose.model_validate(robot.data["pose"])).rotation
         world_up = 1 if self.world["world_info"].get("coordinate_system", "ENU") == "NUE" else 2
         nearest = int(np.argmax(r[world_up]))
-        if r[world_up, nearest] >= 1.0 - 0.5 * ROBOT_UPRIGHT_TOL ** 2:      # within ROBOT_UPRIGHT_TOL rad
+        if on_side and r[world_up, nearest] >= 1.0 - 0.5 * ROBOT_UPRIGHT_TOL ** 2:      # within ROBOT_UPRIGHT_TOL rad
             return nearest
         if world_up == 2:
             return 2
@@ -2625,7 +2627,15 @@ class Converter:
                                 f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
                                 "turning about a vertical axis"))
             return
-        if omni_wheels(wheels, self, up):     # three or more wheels about horizontal axes not along one line (drive.py)
+        if up == 0 and any(w["steers"] for w in wheels):
+            # a robot built on its side (its x up: Tinkerbots' base) is judged for a two-wheel, skid-steer or
+            # one-motor drive only (the other drives' frames take a z or y up)
+            steering = next(w["motor"] for w in wheels if w["steers"])
+            self.warn(node, f"robot {robot.data['name']!r}: no drive (it is built on its side, its x up, where only "
+                            f"wheels about one horizontal axis make a drive here; motor {steering!r} turns about its "
+                            "x); the robot will not move")
+            return
+        if up != 0 and omni_wheels(wheels, self, up):     # three or more wheels about horizontal axes not along one line
             drive, why = omni_drive(wheels, self, up)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no omni drive ({why}); the robot will not move")
@@ -2652,7 +2662,7 @@ class Converter:
                         nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel "
                                         f"(an arm's joint on a mecanum base): {JOINT_MOVES}", "an arm's joints"))
                 wheels = base
-        else:
+        elif up != 0:
             turns = mecanum_turns(wheels, self)
         groups = self._steering_groups(wheels, up) if turns is None else None
         if groups is not None:                    # steered casters or corners: each wheel steered on its own

@@ -3,8 +3,11 @@
 The kinematic drive turns the robot about its wheels' centre, x forward, wheels along the robot's y axis, and
 a positive wheel speed drives forward. A Webots robot maps onto it when it clearly is such a robot:
 every motorised hinge's axis along the robot's +y (or -y: a wheel mounted mirrored,
-which a positive speed rolls backward, the drive's ``reversed_motors``; a skid-steer side all or none) and
-wheels of one radius, and either
+which a positive speed rolls backward, the drive's ``reversed_motors``; a skid-steer side all or none;
+within WHEEL_AXES_TOL, 5e-3 rad: the drive rolls each wheel along its forward, so a wheel ε off it is
+taken ε from where Webots' would roll, s·sin ε across over a path s) and wheels of one radius (a
+wheel's round part the largest turning about its hinge's axis past its end point's own shapes when
+larger than their first: :func:`rolling_part`, Tinkerbots' wheel two Solids along the slots), and either
 
 * two wheels: both anchors on one line parallel to y, the wheels (their end points' origins) at
   two places along it; or
@@ -53,6 +56,13 @@ A robot built y-up in a NUE world (Webots before R2022a; convert.py's ``_robot_u
 for its z throughout: its axes horizontal when perpendicular to its y, forward = axis × y (a 3-D
 ``forward``, its left y × forward), the drive's frame rows (forward, left, y) (:func:`drive_axes`);
 its omni wheels' places and axes along its x and its left.
+
+A robot built on its side (its own x, or in an ENU world its y, the world's up within 1 mrad: Tinkerbots'
+base turned -pi/2 about y) is judged with that axis as up in the same way (convert.py's ``_robot_up``;
+with x up, two-wheel and skid-steer wheels and one motor's axle only); its drive has no ``wheel_bottom``
+(it keeps its height). One motorised hinge carrying the wheels of both sides (:func:`one_motor_axle`:
+Tinkerbots' vision_car) is a steered drive: one driven wheel midway between them, the robot's free
+wheels keeping it straight.
 
 Anything else gets one sentence saying which of these failed.
 """
