@@ -97,3 +97,33 @@ def test_two_wheels_axes_opposite_within_5e_3_make_a_drive_and_farther_none(tmp_
     assert not lines and dd is not None and dd.reversed_motors == [LEFT] and dd.forward == (1.0, 0.0)
     pose = roll(path, (-5.0, 5.0), 25).robot("bot").pose
     assert pose.translation[:2] == pytest.approx([X0 + R * 5.0 * 25 * T, Y0], abs=1e-15)
+
+
+def test_a_wheel_two_solids_past_its_hinge_is_the_drives_and_the_robot_settles_on_it(tmp_path: Path) -> None:
+    """Each hinge's end point is a hub (a 5 mm sphere on the axis) holding, 0.01 m further out along the axis,
+    a Solid whose cylinder of radius R is the wheel (Tinkerbots' motor, axle and wheel, upright). The drive's
+    radius is R, not the hub's, its axle the cylinders' places, 2·(Y + 0.01); its ``wheel_bottom`` the
+    cylinders' bottom, 0 (their axis R up): placed 0.05 m up over a floor at 0, the robot settles to z 0
+    (the hub's bottom would have left it R − 0.005 too low), and (w, w) rolls it straight at R·w."""
+    def hub(name: str, y: float) -> str:
+        out = 0.01 if y > 0 else -0.01
+        return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} {R} }}\n'
+                f'  device [ RotationalMotor {{ name "{name}" maxVelocity 20 }} ]\n'
+                f'  endPoint Solid {{ translation 0 {y} {R} children [\n'
+                f'    Solid {{ translation 0 {out} 0 children [ DEF W Pose {{ rotation 1 0 0 1.5708 children [\n'
+                f'      Shape {{ geometry Cylinder {{ radius {R} height 0.003 }} }} ] }} ] boundingObject USE W }} ]\n'
+                f'    boundingObject Sphere {{ radius 0.005 }} }} }}\n')
+
+    path = tmp_path / "hub.wbt"
+    path.write_text(f'#VRML_SIM R2023b utf8\nWorldInfo {{ basicTimeStep {STEP} }}\n'
+                    'Solid { children [ Shape { geometry DEF FLOOR Plane { size 10 10 } } ] boundingObject USE FLOOR }\n'
+                    f'Robot {{ name "bot" translation {X0} {Y0} 0.05 children [\n{hub(LEFT, Y)}{hub(RIGHT, -Y)}]\n'
+                    '  boundingObject Box { size 0.01 0.01 0.01 } physics Physics { } }\n')
+    lw = load_world(path)
+    dd = lw.world.robots[0].differential_drive
+    assert dd is not None and dd.wheel_radius == R and dd.forward == (1.0, 0.0)
+    assert dd.axle_length == pytest.approx(2 * (Y + 0.01), abs=1e-15)
+    assert dd.wheel_bottom == pytest.approx(0.0, abs=1e-15)
+    sim = roll(path, (5.0, 5.0), 25)
+    pose = sim.robot("bot").pose
+    assert np.asarray(pose.translation) == pytest.approx([X0 + R * 5.0 * 25 * T, Y0, 0.0], abs=1e-15)

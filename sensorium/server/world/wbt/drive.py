@@ -902,13 +902,19 @@ def wheel_bottom(wheels: list[dict], conv, up: int = 2) -> float | None:
     robot built y-up in a NUE world), of its wheels that do not
     steer (each one's round part's centre, where it is as the world loads, less its radius), or None
     without one whose radius is known. The robot settles on the ground with it at load. ``wheels``:
-    motorised hinges, or a car's free wheels (no ``steers``: their rolling axes)."""
+    motorised hinges, or a car's free wheels (no ``steers``: their rolling axes). A wheel whose larger round
+    part turns with its hinge past its end point's own shapes (:func:`rolling_part`, as :func:`_rolled`
+    takes it for the drive's radius) reaches down that part's bottom."""
     bottoms = []
     for w in wheels:
         radius = None if w.get("steers") else wheel_radius(w["end"], conv)
         if radius is not None:
             centre = round_centre(w, conv)
-            bottoms.append(float((w["centre"] if centre is None else centre)[up]) - radius)
+            bottom = float((w["centre"] if centre is None else centre)[up]) - radius
+            rolled = rolling_part(w, conv) if "anchor" in w and "axis" in w else None
+            if rolled is not None and not rolled[2] and rolled[0] > radius:
+                bottom = float(rolled[1][up]) - rolled[0]
+            bottoms.append(bottom)
     return min(bottoms) if bottoms else None
 
 
