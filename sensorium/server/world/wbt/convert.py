@@ -1946,12 +1946,12 @@ class Converter:
                     f"{sensors[0].get('position', 0.0):g} (nothing turns the joint here)") if sensors else None
             pf = self.fields(f.node_("jointParameters")) if f.node_("jointParameters") is not None else None
             axis = pf.vec("axis", (1.0, 0.0, 0.0)) if pf else (1.0, 0.0, 0.0)
-            centre = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
+            centre = anchor = pf.vec("anchor", (0.0, 0.0, 0.0)) if pf else (0.0, 0.0, 0.0)
             wheel = self.slotted(end)
             if wheel is not None and wheel.type == "Solid":
                 centre = self.fields(wheel).vec("translation", (0.0, 0.0, 0.0))
             owner.free.append({"node": node, "sensors": sensors, "line": line, "steer": None,
-                               "axis": frame.rotation @ np.asarray(axis),
+                               "axis": frame.rotation @ np.asarray(axis), "anchor": np.asarray(frame.apply(anchor)),
                                "centre": np.asarray(frame.apply(centre)), "end": end, "frame": frame})
         elif sensors and not motors and node.type != "Hinge2Joint":
             self.warn(node, f"PositionSensor on a joint without a motor: reads the joint's position, "
@@ -2345,7 +2345,8 @@ class Converter:
             for free in robot.free:     # an encoder on a wheel axis no motor turns and no car rolls: still
                 if id(free) not in rolling and free["line"] is not None:
                     self.warn(free["node"], free["line"])
-            if car is not None and rolling and self.fields(node).node_("physics") is not None:
+            if car is not None and rolling and self.fields(node).node_("physics") is not None \
+                    and self._settles_along(self._robot_up(robot)):
                 self._free_wheel_bottom(robot, car, [f for f in robot.free if id(f) in rolling])
 
     def track(self, node: Node, frame: Frame, owner: Owner, motor: dict, line: str) -> None:
@@ -2422,7 +2423,7 @@ class Converter:
         tracks = robot.tracks
         if not tracks:
             return
-        up = self._robot_up(robot)
+        up = self._robot_up(robot, on_side=False)
         drive, why = (None, "") if robot.wheels or len(tracks) != 2 else track_drive(tracks, self, up)
         if drive is None:
             if why:
@@ -2456,16 +2457,30 @@ class Converter:
         if bottom is not None:
             car["wheel_bottom"] = min(car.get("wheel_bottom", bottom), bottom)
 
-    def _robot_up(self, robot: Owner) -> int:
-        """The robot's own axis its ``wheel_bottom`` is measured along: its z, or in a NUE world its y
-        when that is nearer the world's up (a robot built y-up, as Webots' were before R2022a;
-        sim/ground.py settles it along that axis)."""
-        if self.world["world_info"].get("coordinate_system", "ENU") != "NUE":
-            return 2
+    def _robot_up(self, robot: Owner, on_side: bool = True) -> int:
+        """The robot's own axis that stands up, its wheels judged with it for their z (wbt/drive.py): the
+        axis closest to the world's up when it is that within ROBOT_UPRIGHT_TOL (a robot built on its side:
+        Tinkerbots' base turned -pi/2 about y, its x up), else its z, or in a NUE world its y when that is
+        nearer the world's up (a robot built y-up, as Webots' were before R2022a; ``on_side`` False: these
+        two only, as Tracks and belts are judged). Its ``wheel_bottom`` is measured along its z or a NUE
+        robot's y (:meth:`_settles_along`)."""
+        from sensorium.server.sim.ground import ROBOT_UPRIGHT_TOL
         from sensorium.server.world.poses import pose_from_model
 
         r = pose_from_model(wm.Pose.model_validate(robot.data["pose"])).rotation
+        world_up = 1 if self.world["world_info"].get("coordinate_system", "ENU") == "NUE" else 2
+        nearest = int(np.argmax(r[world_up]))
+        if on_side and r[world_up, nearest] >= 1.0 - 0.5 * ROBOT_UPRIGHT_TOL ** 2:      # within ROBOT_UPRIGHT_TOL rad
+            return nearest
+        if world_up == 2:
+            return 2
         return 1 if abs(r[1, 1]) > abs(r[1, 2]) else 2
+
+    def _settles_along(self, up: int) -> bool:
+        """Whether a robot whose own ``up`` axis stands up settles on the ground at load (sim/ground.py's
+        ``robot_up``: its z, or a NUE world's robot's y); one built on another side keeps its height."""
+        nue = self.world["world_info"].get("coordinate_system", "ENU") == "NUE"
+        return up == 2 or (nue and up == 1)
 
     def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         if len(nowheel) <= MANY_JOINTS:
@@ -2511,6 +2526,7 @@ class Converter:
             mecanum_turns,
             omni_drive,
             omni_wheels,
+            one_motor_axle,
             rolls_about_its_axis,
             spins_in_place,
             webots_kinematic_pair,
@@ -2527,6 +2543,15 @@ class Converter:
                     w["steers"] = abs(float(w["axis"][up])) > 0.9 * float(np.linalg.norm(w["axis"]))
         round_ = [wheel_radius(w["end"], self) is not None for w in wheels]
         rounded = {id(w): r for w, r in zip(wheels, round_)}       # read once: the fallback below asks again
+        if len(wheels) == 1 and wheels[0]["node"].type == "HingeJoint" and round_[0] \
+                and self.fields(node).node_("physics") is not None:
+            # one motorised hinge carrying the wheels of both sides (Tinkerbots' vision_car): Webots' physics
+            # rolls the robot straight on them; a turntable's or a lone wheel's hinge is none (wbt/drive.py)
+            drive, why = one_motor_axle(wheels[0], robot.free, self, up)
+            if drive is not None:
+                robot.data["steered_drive"] = drive
+                self._drive_wheels(node, robot, wheels)
+                return
         if len({id(w["node"]) for w in wheels}) == 1 or not any(round_):
             # one motorised hinge (Webots' motor sample: a turntable; motor2's one Hinge2Joint, its
             # two axes the joint's), or nothing round to roll on at
@@ -2602,7 +2627,15 @@ class Converter:
                                 f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
                                 "turning about a vertical axis"))
             return
-        if omni_wheels(wheels, self, up):     # three or more wheels about horizontal axes not along one line (drive.py)
+        if up == 0 and any(w["steers"] for w in wheels):
+            # a robot built on its side (its x up: Tinkerbots' base) is judged for a two-wheel, skid-steer or
+            # one-motor drive only (the other drives' frames take a z or y up)
+            steering = next(w["motor"] for w in wheels if w["steers"])
+            self.warn(node, f"robot {robot.data['name']!r}: no drive (it is built on its side, its x up, where only "
+                            f"wheels about one horizontal axis make a drive here; motor {steering!r} turns about its "
+                            "x); the robot will not move")
+            return
+        if up != 0 and omni_wheels(wheels, self, up):     # three or more wheels about horizontal axes not along one line
             drive, why = omni_drive(wheels, self, up)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no omni drive ({why}); the robot will not move")
@@ -2629,7 +2662,7 @@ class Converter:
                         nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel "
                                         f"(an arm's joint on a mecanum base): {JOINT_MOVES}", "an arm's joints"))
                 wheels = base
-        else:
+        elif up != 0:
             turns = mecanum_turns(wheels, self)
         groups = self._steering_groups(wheels, up) if turns is None else None
         if groups is not None:                    # steered casters or corners: each wheel steered on its own
@@ -2723,8 +2756,9 @@ class Converter:
         gravity drops it, so it settles on the ground at load; one without stays where it is put)."""
         from sensorium.server.world.wbt.drive import wheel_bottom
 
-        bottom = (wheel_bottom(wheels, self, self._robot_up(robot)) if self.fields(node).node_("physics") is not None
-                  else None)
+        up = self._robot_up(robot)
+        bottom = (wheel_bottom(wheels, self, up)
+                  if self.fields(node).node_("physics") is not None and self._settles_along(up) else None)
         if bottom is not None:
             for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive"):
                 if key in robot.data:

@@ -3,8 +3,11 @@
 The kinematic drive turns the robot about its wheels' centre, x forward, wheels along the robot's y axis, and
 a positive wheel speed drives forward. A Webots robot maps onto it when it clearly is such a robot:
 every motorised hinge's axis along the robot's +y (or -y: a wheel mounted mirrored,
-which a positive speed rolls backward, the drive's ``reversed_motors``; a skid-steer side all or none) and
-wheels of one radius, and either
+which a positive speed rolls backward, the drive's ``reversed_motors``; a skid-steer side all or none;
+within WHEEL_AXES_TOL, 5e-3 rad: the drive rolls each wheel along its forward, so a wheel ε off it is
+taken ε from where Webots' would roll, s·sin ε across over a path s) and wheels of one radius (a
+wheel's round part the largest turning about its hinge's axis past its end point's own shapes when
+larger than their first: :func:`rolling_part`, Tinkerbots' wheel two Solids along the slots), and either
 
 * two wheels: both anchors on one line parallel to y, the wheels (their end points' origins) at
   two places along it; or
@@ -54,6 +57,13 @@ for its z throughout: its axes horizontal when perpendicular to its y, forward =
 ``forward``, its left y × forward), the drive's frame rows (forward, left, y) (:func:`drive_axes`);
 its omni wheels' places and axes along its x and its left.
 
+A robot built on its side (its own x, or in an ENU world its y, the world's up within 1 mrad: Tinkerbots'
+base turned -pi/2 about y) is judged with that axis as up in the same way (convert.py's ``_robot_up``;
+with x up, two-wheel and skid-steer wheels and one motor's axle only); its drive has no ``wheel_bottom``
+(it keeps its height). One motorised hinge carrying the wheels of both sides (:func:`one_motor_axle`:
+Tinkerbots' vision_car) is a steered drive: one driven wheel midway between them, the robot's free
+wheels keeping it straight.
+
 Anything else gets one sentence saying which of these failed.
 """
 
@@ -67,6 +77,9 @@ from sensorium.server.world.wbt.parser import Node
 
 TOL = 1e-6
 AXIS_TOL = 1e-4     # wheels' axes: Webots' PROTOs turn their joints' frames by 1.5708 or 3.14159 (not pi/2, pi)
+# a two-wheel or skid-steer drive's wheels' axes, parallel or opposite: PROTO authors also write 1.57 for pi/2
+# (7.96e-4 off), and robots built of blocks (Tinkerbots' Slots) compose several such turns: up to five of them
+WHEEL_AXES_TOL = 5e-3
 
 
 def wheel_radius(end: Node | None, conv) -> float | None:
@@ -259,16 +272,18 @@ def differential_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | No
     steer), or (None, the sentence saying why not); ``up`` the robot's up axis (:func:`drive_frame`)."""
     if len(wheels) < 2:
         return None, f"{len(wheels)} motorised hinge joint; a drive needs two wheels or more, on both sides"
-    # (axes within AXIS_TOL, as a car's: Webots' Moose turns its right wheels' frames by 3.14159, not pi)
-    frame, why = drive_frame(wheels, AXIS_TOL, up, opposite=True)
+    # (axes within WHEEL_AXES_TOL of parallel or opposite: Webots' Moose turns its right wheels' frames by
+    # 3.14159, not pi; Tinkerbots' slots by 1.57, not pi/2)
+    wheels = [_rolled(w, conv) for w in wheels]
+    frame, why = drive_frame(wheels, WHEEL_AXES_TOL, up, opposite=True)
     if why:
         return None, why
     wheels = _in_frame(wheels, frame)
     # a wheel about -y is mounted mirrored: a positive speed rolls it backward (Webots' physics rolls each
     # wheel about its own axis), so its speed counts negated (the drive's reversed_motors)
     mirrored = [w for w in wheels if np.linalg.norm(w["axis"] / np.linalg.norm(w["axis"]) + [0.0, 1.0, 0.0])
-                <= AXIS_TOL]
-    off = _axis_off_y([w for w in wheels if not any(w is m for m in mirrored)], AXIS_TOL,
+                <= WHEEL_AXES_TOL]
+    off = _axis_off_y([w for w in wheels if not any(w is m for m in mirrored)], WHEEL_AXES_TOL,
                       "the kinematic drive needs every axis along +y or -y, the wheels on one line")
     if off:
         return None, off
@@ -284,6 +299,94 @@ def differential_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | No
                               "mirrored and not the others: a skid-steer side's wheels roll as one")
         drive["reversed_motors"] = [m for m in (*left, *right) if m in reversed_motors]
     return _framed(drive, why, frame)
+
+
+def rolling_part(w: dict, conv) -> tuple[float, np.ndarray, bool] | None:
+    """(radius, centre in the robot's frame, whether it is the end point's own) of the round part a hinge's
+    wheel rolls on the ground with: the largest of :func:`rolling_parts` (the lowest turning with the hinge:
+    Tinkerbots' motor turns a 0.01 m sphere of its own and, two Solids further along the slots, the 0.02625 m
+    wheel that meets the ground), the first of equals; None when nothing round turns so."""
+    parts = rolling_parts(w, conv)
+    return max(parts, key=lambda p: p[0]) if parts else None
+
+
+def rolling_parts(w: dict, conv) -> list[tuple[float, np.ndarray, bool]]:
+    """(radius, centre in the robot's frame, whether it is the end point's own) of each cylinder, capsule or
+    sphere turning about a hinge's axis (:func:`rolls_about_its_axis`'s test: along it within 5°, centred on
+    its line within a quarter of its radius) that its end point carries without another joint between (its
+    children, Solids, Slots), in the world's order: the boundingObjects', else (none there) the shapes'."""
+    end = conv.slotted(w["end"])
+    if end is None:
+        return []
+    axis = np.asarray(w["axis"], dtype=np.float64)
+    axis = axis / np.linalg.norm(axis)
+    anchor = np.asarray(w["anchor"], dtype=np.float64)
+    found: dict[bool, list[tuple[float, np.ndarray, bool]]] = {True: [], False: []}
+
+    def part(node: Node, frame, own: bool, bounding: bool) -> None:
+        nf = conv.fields(node)
+        radius = nf.num("radius", 1.0) * frame.scale
+        centre = np.asarray(frame.translation, dtype=np.float64)
+        off = (centre - anchor) - axis * float(np.dot(centre - anchor, axis))
+        if radius <= 0.0 or float(np.linalg.norm(off)) > 0.25 * radius:
+            return
+        if node.type != "Sphere":
+            along = np.asarray(frame.rotation, dtype=np.float64) @ np.array([0.0, 0.0, 1.0])
+            if abs(float(np.dot(along, axis))) < math.cos(math.radians(5.0)) * float(np.linalg.norm(along)):
+                return
+        found[bounding].append((radius, centre, own))
+
+    def shapes(node: Node | None, frame, own: bool, bounding: bool) -> None:
+        if node is None:
+            return
+        conv.walk(node)
+        nf = conv.fields(node)
+        if node.type in ("Cylinder", "Sphere", "Capsule"):
+            part(node, frame, own, bounding)
+        elif node.type == "Shape":
+            shapes(nf.node_("geometry"), frame, own, bounding)
+        elif node.type in ("Pose", "Transform", "Group") or (node.type == "Solid" and bounding):
+            inner = frame if node.type == "Group" else conv.child_frame(node, frame)
+            for child in nf.nodes("children"):
+                shapes(child, inner, own, bounding)
+
+    def solid(node: Node, frame, own: bool) -> None:
+        inner = conv.child_frame(node, frame)
+        shapes(conv.fields(node).node_("boundingObject"), inner, own, True)
+        walk(conv.fields(node).nodes("children"), inner, own)
+
+    def walk(children: list[Node], frame, own: bool) -> None:
+        for child in children:
+            conv.walk(child)
+            cf = conv.fields(child)
+            if child.type == "Solid":
+                solid(child, frame, False)
+            elif child.type == "Slot":
+                held = conv.slotted(child)
+                if held is not None and held.type == "Solid":
+                    solid(held, frame, False)
+            elif child.type in ("Pose", "Transform", "Group"):
+                walk(cf.nodes("children"), frame if child.type == "Group" else conv.child_frame(child, frame), own)
+            elif child.type == "Shape":
+                shapes(child, frame, own, False)
+
+    if end.type == "Solid":
+        solid(end, w["frame"], True)
+    return found[True] or found[False]
+
+
+def _rolled(w: dict, conv) -> dict:
+    """A wheel whose largest round part turning with its hinge (:func:`rolling_part`) lies past its end
+    point's own shapes and is larger than its first round part: its radius that part's and its place
+    that part's centre on the hinge's axis (a copy); else the wheel as it is (its end point's first round
+    part, its place the end point's origin)."""
+    rolled = rolling_part(w, conv)
+    first = wheel_radius(w["end"], conv)
+    if rolled is None or rolled[2] or (first is not None and rolled[0] <= first):
+        return w
+    axis = np.asarray(w["axis"], dtype=np.float64) / np.linalg.norm(w["axis"])
+    anchor = np.asarray(w["anchor"], dtype=np.float64)
+    return {**w, "radius": rolled[0], "centre": anchor + axis * float(np.dot(rolled[1] - anchor, axis))}
 
 
 def _in_frame(wheels: list[dict], frame: np.ndarray | None) -> list[dict]:
@@ -309,7 +412,7 @@ def _framed(drive: dict | None, why: str, frame: np.ndarray | None) -> tuple[dic
 
 
 def _radius(wheels: list[dict], conv) -> tuple[float | None, str]:
-    radii = [wheel_radius(w["end"], conv) for w in wheels]
+    radii = [w["radius"] if "radius" in w else wheel_radius(w["end"], conv) for w in wheels]
     if any(r is None for r in radii):
         return None, "a wheel end point has no cylinder or sphere to take the wheel radius from"
     r0 = radii[0]
@@ -349,7 +452,9 @@ def _wheel_speeds(wheels: list[dict], conv, sides: tuple[list[dict], ...] = ()) 
 
 def _two_wheels(wheels: list[dict], conv) -> tuple[dict | None, str]:
     a0, a1 = wheels[0]["anchor"], wheels[1]["anchor"]
-    if abs(a0[0] - a1[0]) > TOL or abs(a0[2] - a1[2]) > TOL:
+    # (axes up to WHEEL_AXES_TOL apart put anchors on "one axle" that far off it per metre between them)
+    near = TOL + WHEEL_AXES_TOL * abs(float(a0[1] - a1[1]))
+    if abs(a0[0] - a1[0]) > near or abs(a0[2] - a1[2]) > near:
         return None, "the two wheel anchors are not on one axle parallel to the robot's y axis"
     # where the wheels are along the axle: their end points' origins (an anchor may be anywhere on it)
     a0, a1 = wheels[0]["centre"], wheels[1]["centre"]
@@ -797,13 +902,19 @@ def wheel_bottom(wheels: list[dict], conv, up: int = 2) -> float | None:
     robot built y-up in a NUE world), of its wheels that do not
     steer (each one's round part's centre, where it is as the world loads, less its radius), or None
     without one whose radius is known. The robot settles on the ground with it at load. ``wheels``:
-    motorised hinges, or a car's free wheels (no ``steers``: their rolling axes)."""
+    motorised hinges, or a car's free wheels (no ``steers``: their rolling axes). A wheel whose larger round
+    part turns with its hinge past its end point's own shapes (:func:`rolling_part`, as :func:`_rolled`
+    takes it for the drive's radius) reaches down that part's bottom."""
     bottoms = []
     for w in wheels:
         radius = None if w.get("steers") else wheel_radius(w["end"], conv)
         if radius is not None:
             centre = round_centre(w, conv)
-            bottoms.append(float((w["centre"] if centre is None else centre)[up]) - radius)
+            bottom = float((w["centre"] if centre is None else centre)[up]) - radius
+            rolled = rolling_part(w, conv) if "anchor" in w and "axis" in w else None
+            if rolled is not None and not rolled[2] and rolled[0] > radius:
+                bottom = float(rolled[1][up]) - rolled[0]
+            bottoms.append(bottom)
     return min(bottoms) if bottoms else None
 
 
@@ -1036,4 +1147,54 @@ def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions:
     drive: dict = {"wheels": out, **_wheel_speeds(rolling, conv)}
     if frame is not None:
         drive["forward"] = [1.0, 0.0, 0.0]
+    return drive, ""
+
+
+def one_motor_axle(w: dict, free: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
+    """The kinematic ``steered_drive`` of a robot whose only motorised hinge carries the wheels of both its
+    sides (Tinkerbots' vision_car: one motor block whose hinge carries an axle and a wheel either side), or
+    (None, the sentence why not). The hinge's axis is horizontal in the robot's frame (within
+    WHEEL_AXES_TOL); its largest round parts turning about it (:func:`rolling_parts`, of one radius) stand at
+    two places along it or more: turned together, they roll their midpoint at r·ω along axis × up and turn
+    the robot nowhere, so the drive's one driven wheel stands there, heading 0 (the drive's forward that
+    rolling direction). The robot's free hinges (no motor) whose round parts turn about their horizontal
+    axes and meet the ground with them (bottoms within GROUND_TOL) are its free wheels, each where its round
+    part is on its axis, heading along its rolling direction (0 or pi when within WHEEL_AXES_TOL of either: its
+    axis taken parallel to the driven one, as a two-wheel drive's are); one of them at least off the driven axle's
+    line, so that the wheels leave the robot one line of motion (straight along forward)."""
+    axis = np.asarray(w["axis"], dtype=np.float64) / np.linalg.norm(w["axis"])
+    if abs(float(axis[up])) > WHEEL_AXES_TOL:
+        return None, (f"its axis {np.round(axis, 6).tolist()} is not horizontal in the robot's frame (perpendicular "
+                      f"to its {'xyz'[up]})")
+    parts = rolling_parts(w, conv)
+    radius = max((p[0] for p in parts), default=0.0)
+    anchor = np.asarray(w["anchor"], dtype=np.float64)
+    along = sorted(float(np.dot(p[1] - anchor, axis)) for p in parts if p[0] >= radius * (1.0 - TOL))
+    if radius <= 0.0 or along[-1] - along[0] <= TOL:
+        return None, "its end point carries no two wheels at two places along its axis"
+    u = np.zeros(3)
+    u[up] = 1.0
+    rolling = np.cross(axis, u)
+    rolling[up] = 0.0
+    frame = drive_axes(rolling, up)
+    driven = frame @ (anchor + axis * (along[0] + along[-1]) / 2.0)
+    bottom = float((anchor + axis * along[0])[up]) - radius
+    wheels: list[dict] = [{"motor": w["motor"], "radius": radius, "position": [float(driven[0]), float(driven[1])]}]
+    for f in free:
+        fa = np.asarray(f["axis"], dtype=np.float64) / np.linalg.norm(f["axis"])
+        part = rolling_part({**f, "axis": fa}, conv) if abs(float(fa[up])) <= WHEEL_AXES_TOL else None
+        if part is None or abs(float(part[1][up]) - part[0] - bottom) > GROUND_TOL:
+            continue
+        at = frame @ (f["anchor"] + fa * float(np.dot(part[1] - f["anchor"], fa)))
+        a = frame @ fa
+        heading = math.atan2(-float(a[0]), float(a[1]))         # axis × up: (a_y, -a_x)
+        if abs(math.remainder(heading, math.pi)) <= WHEEL_AXES_TOL:    # parallel to the axle, as a drive's wheels
+            heading = math.pi * round(heading / math.pi)
+        wheels.append({"radius": part[0], "position": [float(at[0]), float(at[1])],
+                       **({"heading": math.remainder(heading, 2.0 * math.pi)} if heading else {})})
+    if not any(abs(o["position"][0] - wheels[0]["position"][0]) > TOL for o in wheels[1:]):
+        return None, ("no free wheel meets the ground off its wheels' axle (its two wheels alone stand on one line: "
+                      "nothing keeps the robot from tipping or turning)")
+    drive: dict = {"wheels": wheels, "max_wheel_speed": float(w["max_velocity"]),
+                   "forward": [float(v) for v in frame[0, :2 if frame[2, 2] == 1.0 else 3]]}
     return drive, ""
