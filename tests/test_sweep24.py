@@ -464,3 +464,43 @@ def test_braitenbergs_calls_drive_both_kinematic_kheperas_round_the_box_and_cyli
     assert out["khepera(1)"][0] == [(32, 6), (32, 7), (45536, 2), (45600, 3), (47136, 1), (49248, 0)]
     assert out["khepera"][1] == pytest.approx([0.2990, -0.1552, -0.9094], abs=1e-4)
     assert out["khepera(1)"][1] == pytest.approx([-0.2023, -0.1642, -1.8075], abs=1e-4)
+
+
+@pytest.mark.parametrize("helper", [True, False])
+def test_the_batched_simulation_keeps_the_koala_flat_as_simulation_does_bit_for_bit(tmp_path: Path, helper: bool) -> None:
+    """The Koala without Physics in the batched simulation rides no ground either: on the arena floor leaning
+    7.7e-7 rad, each copy's pose is the single Simulation's bit for bit at every step (C drive pass and numpy),
+    its rotation a turn about the world's z only (third row and column exactly (0, 0, 1)) and its height the one
+    it was placed at. Before, the batched copies rode the floor as a ramp: tilted by the lean, 1.3e-10 m up."""
+    from sensorium.gym.views import CopySim
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.batched import BatchedSimulation
+
+    if helper and packets.library() is None:
+        pytest.skip(f"no C helper: {packets.status()}")
+    lw = load_world(noiseless_koala(tmp_path))
+    batched = BatchedSimulation(lw, 2)
+    if not helper:
+        batched._drive_step = None
+    batched.reset(np.arange(2), [1, 2])
+    singles = [Simulation(lw, "exact") for _ in range(2)]
+    slot = batched.slot("koala")
+    z0 = float(batched.pos[0, slot, 2])
+    speeds = [(1.4, 1.6), (-3.0, 5.0)]
+    for c, single in enumerate(singles):
+        for sim in (single, CopySim(batched, c)):
+            for m, v in zip(("left wheel motor", "right wheel motor"), speeds[c]):
+                motor = sim.robot("koala").motors[m]
+                motor.set_position(math.inf)
+                motor.set_velocity(v)
+    for t in range(60):
+        batched.step()
+        for c, single in enumerate(singles):
+            single.step()
+            p = single.robot("koala").pose
+            assert batched.pos[c, slot].tobytes() == p.translation.tobytes(), (t, c)
+            assert batched.rot[c, slot].tobytes() == p.rotation.tobytes(), (t, c)
+            assert batched.pos[c, slot, 2] == z0, (t, c)
+            assert batched.rot[c, slot, 2].tolist() == [0.0, 0.0, 1.0], (t, c)
+            assert batched.rot[c, slot, :, 2].tolist() == [0.0, 0.0, 1.0], (t, c)
+    assert float(np.hypot(*(batched.pos[1, slot, :2] - batched.pos[0, slot, :2]))) > 0.01   # the copies differ

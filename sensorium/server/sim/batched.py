@@ -377,10 +377,13 @@ class BatchedSimulation:
         # the terrains robots ride (sim/ground.py; None in a world without one: heights never change)
         self.ground = Ground.from_world(w, self.scene.solid_poses, self.to_enu)
         # each robot's band bottom below its origin (its support ceiling's, ground.band_low; 0 without a ground)
+        # (a robot moved by Webots' kinematic rule, mid_heading, rides no ground: Simulation's RobotState)
         self.band_low = np.array([band_low(robot_bounding_parts(r, base), self.initial[i], self.to_enu)
-                                  if self.ground is not None else 0.0 for i, r in enumerate(w.robots)], dtype=np.float64)
+                                  if self.ground is not None and not self.mid_heading[i] else 0.0
+                                  for i, r in enumerate(w.robots)], dtype=np.float64)
         self._templates: list[PlanarState | None] = [
-            DifferentialDrive(r.differential_drive, self.initial[i], up=up, ground=self.ground,
+            DifferentialDrive(r.differential_drive, self.initial[i], up=up,
+                              ground=None if self.mid_heading[i] else self.ground,
                               band_low=float(self.band_low[i])) if r.differential_drive
             else AckermannDrive(r.ackermann_drive, self.initial[i], up=up, ground=self.ground,
                                 band_low=float(self.band_low[i])) if r.ackermann_drive
