@@ -90,6 +90,8 @@ class Nested:
     at: tuple[int, ...] = ()      # (line, column) where its owner's file writes it (() none: a PROTO body's, or a node
                                   # in its parent's SF field, found there: export.py)
     made: tuple[int, ...] = ()    # (line, column) where the PROTO body that made it writes it (export.py)
+    light: int = -1               # a light: its index among its robot's or top-level solid's lights (the scene's
+                                  # ``carried_light_slots``); -1: no light
     path: tuple[int, ...] = ()    # a top-level solid's nested Solid: its place among each parent's ``children`` from the
                                   # top one down (wm.Solid.children indices): the key that names its model (contact points)
 
@@ -301,6 +303,40 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
     return added
 
 
+def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, first: int) -> list[Nested]:
+    """The lights of a robot (node ``owner``) that are nodes (``LightNode``: a .wbt robot's, not its LEDs'),
+    numbered from ``first``; ``start``: the id of its first world entry (their parents' ids count from it)."""
+    out: list[Nested] = []
+    for k, lt in enumerate(robot.model.lights):
+        if lt.node is None:
+            continue
+        parent = owner if lt.node.parent < 0 or start is None else start + lt.node.parent
+        out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", parent, "children", None, None, "",
+                          owner, "Robot", name, order=lt.node.after + 0.5, light=k))
+    return out
+
+
+def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidIds, first: int) -> list[Nested]:
+    """The lights of top-level solid ``solid`` (node ``owner``) and of the solids inside it that are nodes
+    (``LightNode``: a .wbt solid's), numbered from ``first``, each under the solid holding it; their indices
+    among the solid's lights follow scene.solid_lights (its own, then its children's, depth first)."""
+    out: list[Nested] = []
+    index = 0
+
+    def walk(s: wm.Solid, holder: int, path: tuple[int, ...]) -> None:
+        nonlocal index
+        for lt in s.lights:
+            if lt.node is not None:
+                out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", holder, "children", None,
+                                  None, "", owner, "Solid", key, order=lt.node.after + 0.5, light=index))
+            index += 1
+        for k, child in enumerate(s.children):
+            walk(child, solid_ids[owner, (*path, k)], (*path, k))
+
+    walk(solid, owner, ())
+    return out
+
+
 def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Nested], solid_ids: SolidIds,
                  tags: list[tuple[int, wm.InnerDef, int | str]], serials: dict[int, dict[int, int]]) -> None:
     """The solids inside top-level solid ``solid`` (node ``owner``, named ``key``) at any depth, appended to
@@ -390,6 +426,11 @@ def build(sim: Any, loaded_solids: int) -> Table:
     shape_tags: list[tuple[int, wm.InnerDef, int]] = []
     out += _shape_nodes(sim, holders, FIRST_ID + len(out), starts, shape_tags)     # after all others: no other id moves
     tags.extend(shape_tags)
+    for i, name in enumerate(robots):          # the lights, after the shapes: no shape's id moves
+        out += _robot_light_nodes(sim.robots[name], name, i + 1, starts.get(i + 1), FIRST_ID + len(out))
+    for j in range(loaded_solids):
+        out += _solid_light_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], solid_ids,
+                                  FIRST_ID + len(out))
     inner: dict[int, dict[str, int | str]] = {}
     for owner, tag, target in tags:
         if owner in firsts:                # a robot: the instance's entry (a world file's scope past them: none)
@@ -417,6 +458,7 @@ def add_solid(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid) -> 
     shape_tags: list[tuple[int, wm.InnerDef, int]] = []
     out += _shape_nodes(sim, _solid_holders(solid, owner, owner, key, solid_ids), table.end + len(out), {},
                         shape_tags)
+    out += _solid_light_nodes(solid, owner, key, solid_ids, table.end + len(out))
     tags.extend(shape_tags)
     inner = table.inner if table.inner is not None else {}
     for _, tag, target in tags:

@@ -500,8 +500,52 @@ def _solid_model(sim: Any, node: Node) -> Any:
     return next(s for s in sim.world.solids if s.name == node.key)
 
 
+def _carrier(sim: Any, node: Node) -> tuple[str | int, int]:
+    """A nested light's robot (its index) or top-level solid (its name) and its index among their lights."""
+    n = _nested_of(sim, node)
+    return (sim.robots[n.owner_key].index if n.owner_kind == "Robot" else n.owner_key), n.light
+
+
+def _carried_model(sim: Any, node: Node) -> Any:
+    """A nested light's model as the scene holds it (``location``/``direction`` in its owner's frame)."""
+    owner, k = _carrier(sim, node)
+    return sim.scene.light_model(sim.scene.carried_light_slots(owner)[k])
+
+
 def _light(sim: Any, node: Node) -> Any:
-    return sim.scene.top_lights()[node.key]
+    """A light's model as its fields read: a nested light's ``location``/``direction`` in its parent's frame."""
+    if not node.nested:
+        return sim.scene.top_lights()[node.key]
+    model = _carried_model(sim, node)
+    return model.model_copy(update={a: getattr(model.node, a) for a in ("location", "direction")
+                                    if getattr(model.node, a) is not None})
+
+
+def _set_carried_light(sim: Any, node: Node, attr: str, changed: Any) -> None:
+    """A nested light's field set: ``changed`` (its fields as read, :func:`_light`) placed in its owner's
+    frame by its parent's (``LightNode.frame``), a spot light's light-sensor axis turned by ``LightNode.aim``
+    (the .wbt import's rule, sim/scene.py ``sensor_aimed``); the other fields as set."""
+    stored = _carried_model(sim, node)
+    info = stored.node
+    keep = {a: getattr(stored, a) for a in ("location", "direction", "light_sensor_direction") if hasattr(stored, a)}
+    placed = changed.model_copy(update=keep)
+    if attr in ("location", "direction"):
+        value = getattr(changed, attr)
+        info = info.model_copy(update={attr: value})
+        frame = pose_from_model(info.frame)
+        update: dict[str, Any] = {}
+        if attr == "location":
+            update["location"] = tuple(float(v) for v in frame.apply(np.asarray(value, dtype=np.float64)))
+        elif changed.type == "SpotLight":        # a directional light's direction is in world axes (Webots)
+            update["direction"] = tuple(float(v) for v in frame.apply_dirs(np.asarray(value, dtype=np.float64)))
+            if info.aim is not None:
+                aim = pose_from_model(info.aim).apply_dirs(np.asarray(value, dtype=np.float64))
+                update["light_sensor_direction"] = tuple(float(v) for v in aim)
+        else:
+            update["direction"] = tuple(float(v) for v in value)
+        placed = placed.model_copy(update=update)
+    owner, k = _carrier(sim, node)
+    sim.scene.set_carried_light(owner, k, placed.model_copy(update={"node": info}))
 
 
 def _radar_key(sim: Any, node: Node) -> str | int:
@@ -556,7 +600,10 @@ def _set_light(attr: str, kind: str) -> Setter:
                 raise ValueError(f"{kind} {attr}: must be 0 while attenuation is not 1 0 0 (Webots' rule), "
                                  f"got {value}")
             changed = changed.model_copy(update={"ambient_intensity": 0.0})
-        sim.scene.set_top_light(node.key, changed)
+        if node.nested:
+            _set_carried_light(sim, node, attr, changed)
+        else:
+            sim.scene.set_top_light(node.key, changed)
     return setter
 
 
@@ -725,6 +772,8 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
     n = _nested_of(sim, node)
     if n.shape is not None:            # a Shape or a node inside it (appearance.py)
         return appearance.fields(n.shape, lambda field: _sf_child(sim, n.id, field))
+    if n.light >= 0:                   # a light inside a robot or solid: as a top-level light's
+        return FIELDS[n.type]
     out = dict(_NESTED_POSE) if n.own is not None else {}
     if n.name:
         out["name"] = ("SFString", lambda sim, node: node.name, None)

@@ -558,6 +558,8 @@ class Scene:
         self._lights: list[tuple[object, str | int | tuple[int, str] | None, Pose]] = [
             (lt, None, Pose.identity()) for lt in world.lights]
         self._led_lights: dict[tuple[int, str], list] = {}   # (robot, LED) -> its lights' models now
+        # (robot index or solid name, index among its lights) -> the light as loaded, for those a Supervisor set
+        self._set_carried: dict[tuple[str | int, int], object] = {}
         # (robot, k) -> its radar_targets[k], (solid, k) -> the k-th solid inside it with a cross section:
         # its pose in the robot's or solid's frame, the joint it rides on, its shapes
         self.carried_targets: dict[tuple[int, int] | tuple[str, int], tuple[Pose, str | None, tuple[int, ...]]] = {}
@@ -899,6 +901,35 @@ class Scene:
             return
         self._lights[slot] = (model.model_copy(update={"color": tuple(color)}), owner, local)
         self.lights_version += 1
+
+    def carried_light_slots(self, owner: str | int) -> list[int]:
+        """Where robot ``owner``'s lights (its index: its own ``lights``, then its LEDs') or top-level solid
+        ``owner``'s (its name: :func:`solid_lights` order) are among the scene's lights now."""
+        return [k for k, (_, o, _) in enumerate(self._lights)
+                if o == owner or (isinstance(o, tuple) and o[0] == owner)]
+
+    def set_carried_light(self, owner: str | int, index: int, model: object) -> None:
+        """Replace light ``index`` of a robot or top-level solid (:meth:`carried_light_slots`; a Supervisor
+        field change, its ``location``/``direction`` in the owner's frame): it keeps its carrier and frame;
+        light sensors and cameras recompute their light arrays at their next measurement
+        (``lights_version``). The light as loaded comes back at :meth:`restore_carried_lights`."""
+        slot = self.carried_light_slots(owner)[index]
+        old, carrier, local = self._lights[slot]
+        self._set_carried.setdefault((owner, index), old)
+        self._lights[slot] = (model, carrier, local)
+        self.lights_version += 1
+
+    def restore_carried_lights(self) -> None:
+        """The lights :meth:`set_carried_light` changed, as loaded (a simulation reset; those of a
+        removed solid stay gone)."""
+        for (owner, index), model in self._set_carried.items():
+            slots = self.carried_light_slots(owner)
+            if index < len(slots):
+                _, carrier, local = self._lights[slots[index]]
+                self._lights[slots[index]] = (model, carrier, local)
+        if self._set_carried:
+            self._set_carried.clear()
+            self.lights_version += 1
 
     def top_lights(self) -> list:
         """The world's top-level light models (the world file's ``lights``, in order; the Supervisor's
