@@ -614,6 +614,8 @@ class LightNode(Strict):
                              "`light_sensor_direction` (the nearest Pose's or Solid's own); None: it has none")
     location: Vec3 | None = Field(default=None, description="the field as written (its parent's frame)")
     direction: Vec3 | None = Field(default=None, description="the field as written (its parent's frame)")
+    inner_defs: list[InnerDef] = Field(default=[], max_length=64, description="its DEFs in PROTO bodies "
+                                       "(getFromProtoDef), as a nested node's")
 
 
 class _Light(Strict):

@@ -303,9 +303,11 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
     return added
 
 
-def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, first: int) -> list[Nested]:
+def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, first: int,
+                       tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[Nested]:
     """The lights of a robot (node ``owner``) that are nodes (``LightNode``: a .wbt robot's, not its LEDs'),
-    numbered from ``first``; ``start``: the id of its first world entry (their parents' ids count from it)."""
+    numbered from ``first``; ``start``: the id of its first world entry (their parents' ids count from it);
+    ``tags`` gets their PROTO-body DEFs."""
     out: list[Nested] = []
     for k, lt in enumerate(robot.model.lights):
         if lt.node is None:
@@ -313,13 +315,16 @@ def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, fir
         parent = owner if lt.node.parent < 0 or start is None else start + lt.node.parent
         out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", parent, "children", None, None, "",
                           owner, "Robot", name, order=lt.node.after + 0.5, light=k))
+        tags.extend((owner, t, out[-1].id) for t in lt.node.inner_defs)
     return out
 
 
-def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidIds, first: int) -> list[Nested]:
+def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidIds, first: int,
+                       tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[Nested]:
     """The lights of top-level solid ``solid`` (node ``owner``) and of the solids inside it that are nodes
     (``LightNode``: a .wbt solid's), numbered from ``first``, each under the solid holding it; their indices
-    among the solid's lights follow scene.solid_lights (its own, then its children's, depth first)."""
+    among the solid's lights follow scene.solid_lights (its own, then its children's, depth first); ``tags``
+    gets their PROTO-body DEFs."""
     out: list[Nested] = []
     index = 0
 
@@ -329,6 +334,7 @@ def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidId
             if lt.node is not None:
                 out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", holder, "children", None,
                                   None, "", owner, "Solid", key, order=lt.node.after + 0.5, light=index))
+                tags.extend((owner, t, out[-1].id) for t in lt.node.inner_defs)
             index += 1
         for k, child in enumerate(s.children):
             walk(child, solid_ids[owner, (*path, k)], (*path, k))
@@ -427,10 +433,10 @@ def build(sim: Any, loaded_solids: int) -> Table:
     out += _shape_nodes(sim, holders, FIRST_ID + len(out), starts, shape_tags)     # after all others: no other id moves
     tags.extend(shape_tags)
     for i, name in enumerate(robots):          # the lights, after the shapes: no shape's id moves
-        out += _robot_light_nodes(sim.robots[name], name, i + 1, starts.get(i + 1), FIRST_ID + len(out))
+        out += _robot_light_nodes(sim.robots[name], name, i + 1, starts.get(i + 1), FIRST_ID + len(out), tags)
     for j in range(loaded_solids):
         out += _solid_light_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], solid_ids,
-                                  FIRST_ID + len(out))
+                                  FIRST_ID + len(out), tags)
     inner: dict[int, dict[str, int | str]] = {}
     for owner, tag, target in tags:
         if owner in firsts:                # a robot: the instance's entry (a world file's scope past them: none)
@@ -458,7 +464,7 @@ def add_solid(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid) -> 
     shape_tags: list[tuple[int, wm.InnerDef, int]] = []
     out += _shape_nodes(sim, _solid_holders(solid, owner, owner, key, solid_ids), table.end + len(out), {},
                         shape_tags)
-    out += _solid_light_nodes(solid, owner, key, solid_ids, table.end + len(out))
+    out += _solid_light_nodes(solid, owner, key, solid_ids, table.end + len(out), tags)
     tags.extend(shape_tags)
     inner = table.inner if table.inner is not None else {}
     for _, tag, target in tags:

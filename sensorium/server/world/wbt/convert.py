@@ -229,7 +229,7 @@ def _unserved_why(kind: str) -> str:
     if kind in _PHYSICS_ONLY:
         return f"a {kind} node: physics only, which Sensorium does not simulate (no Supervisor node here)"
     if kind in LIGHTS:
-        return f"a {kind} of a PROTO's body: getFromProtoDef does not search for lights here"
+        return f"a {kind} Sensorium serves no Supervisor node for (an LED's light, or one under a scaled Transform)"
     if kind in GEOMETRIES:
         return (f"a {kind} geometry of no visible Shape (a boundingObject's: Sensorium serves the geometries of "
                 "visible shapes only)")
@@ -1438,6 +1438,9 @@ class Converter:
             entry["after"] = len(self.tree) - 1
         else:
             entry["after"] = len(owner.data.get("children", ())) - 1
+        tags = self.inner_defs(node)
+        if tags:
+            entry["inner_defs"] = tags[:64]
         if self.nested_def(node):
             data["def_name"] = node.def_name
         data["node"] = entry
