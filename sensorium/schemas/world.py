@@ -614,6 +614,10 @@ class LightNode(Strict):
                              "`light_sensor_direction` (the nearest Pose's or Solid's own); None: it has none")
     location: Vec3 | None = Field(default=None, description="the field as written (its parent's frame)")
     direction: Vec3 | None = Field(default=None, description="the field as written (its parent's frame)")
+    written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
+    made_at: list[Annotated[int, Field(ge=1)]] | None = _made_at()
+    body: bool = Field(default=False, description="written by a PROTO's body, not the world file (a "
+                       "Supervisor cannot remove it: Webots' node internal to a PROTO)")
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description="its DEFs in PROTO bodies "
                                        "(getFromProtoDef), as a nested node's")
 

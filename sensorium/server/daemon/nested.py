@@ -305,16 +305,19 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
 
 def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, first: int,
                        tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[Nested]:
-    """The lights of a robot (node ``owner``) that are nodes (``LightNode``: a .wbt robot's, not its LEDs'),
+    """The lights of a robot (node ``owner``) that are nodes (``LightNode``: a .wbt robot's, its LEDs' too),
     numbered from ``first``; ``start``: the id of its first world entry (their parents' ids count from it);
     ``tags`` gets their PROTO-body DEFs."""
     out: list[Nested] = []
-    for k, lt in enumerate(robot.model.lights):
+    model = robot.model
+    lights = list(model.lights) + [lt for d in model.devices if isinstance(d, wm.LED) for lt in d.lights]
+    for k, lt in enumerate(lights):       # its own, then its LEDs' (scene.robot_led_lights' order)
         if lt.node is None:
             continue
         parent = owner if lt.node.parent < 0 or start is None else start + lt.node.parent
         out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", parent, "children", None, None, "",
-                          owner, "Robot", name, order=lt.node.after + 0.5, light=k))
+                          owner, "Robot", name, order=lt.node.after + 0.5, light=k,
+                          at=tuple(lt.node.written_at or ()), made=tuple(lt.node.made_at or ())))
         tags.extend((owner, t, out[-1].id) for t in lt.node.inner_defs)
     return out
 
@@ -333,7 +336,8 @@ def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidId
         for lt in s.lights:
             if lt.node is not None:
                 out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", holder, "children", None,
-                                  None, "", owner, "Solid", key, order=lt.node.after + 0.5, light=index))
+                                  None, "", owner, "Solid", key, order=lt.node.after + 0.5, light=index,
+                                  at=tuple(lt.node.written_at or ()), made=tuple(lt.node.made_at or ())))
                 tags.extend((owner, t, out[-1].id) for t in lt.node.inner_defs)
             index += 1
         for k, child in enumerate(s.children):
@@ -497,7 +501,7 @@ def drop(table: Table, owner: int) -> None:
 
 
 def drop_shape(table: Table, shape: int) -> None:
-    """A Shape node a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
+    """A Shape node (or a light) a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
     getFromProtoDef finds them and their ids read as removed (never given again)."""
     gone = {shape}
     todo = [shape]

@@ -1532,6 +1532,13 @@ def remove_node(sim: Any, node: Node) -> None:
         sim.scene.remove_shapes(ref.peers or (ref.index,))
         nested.drop_shape(_table(sim), node.id)
         return
+    if node.nested and node.type in LIGHTS:     # a light inside a robot or solid: unlit from the next measurement
+        if _carried_model(sim, node).node.body:
+            raise ValueError(f"Node '{node.type}' is internal to a PROTO and therefore cannot be deleted from a "
+                             "Supervisor.")
+        sim.scene.remove_carried_light(*_carrier(sim, node))
+        nested.drop_shape(_table(sim), node.id)
+        return
     if node.nested:
         raise ValueError(f"{node.type} {node.name or node.def_name or node.id!r} (node {node.id}) cannot be removed "
                          "here: only top-level solids and lights and the Shapes inside robots and solids can, not "

@@ -1406,6 +1406,8 @@ class Converter:
         data["_at"] = self.at(node)
         if owner.kind == "world":
             self.def_name(node, data)
+        else:                     # (an LED's too: the scene places its lights in the robot's frame)
+            self.light_node(node, frame, owner, data, written)
         led = self.led_of.get(id(node))
         if led is not None:       # switched by an LED: in the LED's frame, in its lights
             entry, at = led
@@ -1418,8 +1420,6 @@ class Converter:
             return
         if owner.kind == "robot":     # a robot's light past a joint rides on it (an LED's ride with the LED)
             self.ride(data)
-        if owner.kind != "world":
-            self.light_node(node, frame, owner, data, written)
         owner.data.setdefault("lights", []).append(data) if owner.kind != "world" else self.world["lights"].append(data)
 
     def light_node(self, node: Node, frame: Frame, owner: Owner, data: dict, written: dict) -> None:
@@ -1441,6 +1441,9 @@ class Converter:
         tags = self.inner_defs(node)
         if tags:
             entry["inner_defs"] = tags[:64]
+        if not self.written(node):
+            entry["body"] = True
+        self.written_at(node, entry)
         if self.nested_def(node):
             data["def_name"] = node.def_name
         data["node"] = entry
