@@ -4,7 +4,8 @@ A robot's nodes are its world entry's ``nodes`` (the ``.wbt`` import keeps its S
 Poses, Transforms, Groups, Slots and joints, schemas.world.NestedNode), or one node per device of
 its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth.
 Both hold their Shapes too, numbered after every other nested node (:func:`_shape_nodes`; their
-fields: appearance.py). They are
+fields: appearance.py), then the lights a .wbt world writes in them (``LightNode``: an LED's too; their fields:
+supervisor.py, on the scene's ``carried_light_slots``). They are
 numbered once per simulation, in scene order (robots, then solids, each depth first), from
 :data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
 imports) are never shifted by them. The nodes inside a solid a Supervisor imported, or one a PROTO field set

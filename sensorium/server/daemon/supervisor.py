@@ -9,13 +9,14 @@ are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dott
 direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
 a removed solid or light keeps its id, which then answers NULL and is never given to another node; a
 top-level solid built again by a PROTO field set keeps its own (Webots keeps a regenerated node's).
-Shapes with their appearances and geometries are nested nodes too (:mod:`.appearance`); lights
-carried by a solid or robot are not nodes here: Webots' NULL.
+Shapes with their appearances and geometries are nested nodes too (:mod:`.appearance`), and so are the
+lights a .wbt robot or solid carries (their fields a top-level light's, ``location``/``direction`` in their
+parent's frame: :func:`_light`, :func:`_set_carried_light`).
 
 Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame. Setting one field
 keeps the others (Webots). A field change applies at once; the next measurement sees it. A nested
-node's fields are read-only here, but a joint's parameters' ``position`` and a shape's colours,
-roughness and transparency (:mod:`.appearance`). A joint is set with
+node's fields are read-only here, but a joint's parameters' ``position``, a shape's colours,
+roughness and transparency (:mod:`.appearance`) and a light's fields. A joint is set with
 ``set_joint_position``; a node's state is saved and loaded by name (sim/states.py).
 """
 
