@@ -267,3 +267,55 @@ def test_a_c_supervisor_finds_reads_and_sets_them(tmp_path, tmp_path_factory):
                                 point((1.0, 0.0, 1.5), 2.0, LS) + bulb(LS)], rel=1e-12)
     assert out["bad"] == "2"            # the negative intensity refused: the field keeps its value
     assert "intensity: must be >= 0" in err
+
+
+CAMERA_WBT = """#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 16 }
+Robot {
+  translation 0 0 1
+  name "cam"
+  supervisor TRUE
+  controller "<extern>"
+  children [ Camera { rotation 0 1 0 1.5707963267948966 width 24 height 16 } ]
+}
+Solid { translation 0 0 -0.05 children [ Shape { geometry Box { size 4 4 0.1 } } ] name "floor" }
+%s
+"""
+CARRIED = """Robot {
+  translation 0 0 1.5
+  name "carrier"
+  controller "<extern>"
+  children [ Pose { translation 0 0 0.5 children [ DEF HL PointLight { location 0 0 0 } ] } ]
+}"""
+
+
+def test_cameras_see_a_nested_lights_set_as_a_world_file_writing_it_there(tmp_path):
+    """A camera looking down at a floor lit by a light a robot carries: after the light is switched off its
+    image is black (no other light, a black sky); after its intensity, colour and location are set, the image
+    is byte for byte that of the world file writing a top-level light with those fields at its place now
+    ((0.3, 0, 2): the robot's 1.5 m, the Pose's 0.5 m and the new location's 0.3 m along x)."""
+    def image(body: str, change=None):
+        path = tmp_path / f"w{len(list(tmp_path.iterdir()))}.wbt"
+        path.write_text(CAMERA_WBT % body)
+        sim = Simulation(load_world(path))
+        if change is not None:
+            change(sim)
+        cam = sim.robot("cam").device("camera")
+        cam.enable(16)
+        sim.step()
+        return cam.image.copy()
+
+    def off(sim):
+        sv.set_field(sim, sv.find_node(sim, "HL"), "on", False)
+
+    def changed(sim):
+        hl = sv.find_node(sim, "HL")
+        sv.set_field(sim, hl, "intensity", 2.0)
+        sv.set_field(sim, hl, "color", [1.0, 0.5, 0.25])
+        sv.set_field(sim, hl, "location", [0.3, 0.0, 0.0])
+
+    lit = image(CARRIED)
+    assert lit[:, :, :3].any() and not image(CARRIED, off)[:, :, :3].any()
+    want = image("PointLight { location 0.3 0 2 intensity 2 color 1 0.5 0.25 }")
+    got = image(CARRIED, changed)
+    assert got.tobytes() == want.tobytes() and got.tobytes() != lit.tobytes()

@@ -1009,6 +1009,9 @@ class Scene:
             self._lights = [entry for entry in self._lights if entry[1] != name]
             self._attached.discard(name)
             self.lights_version += 1
+        for key in [k for k in self._set_carried if k[0] == name]:     # (a solid built again starts afresh)
+            del self._set_carried[key]
+        self.removed_carried = {k for k in self.removed_carried if k[0] != name}
 
     def _forget_shapes(self, dead: list[int]) -> None:
         """The shapes of a removed body let go: what was kept per shape (a Supervisor's appearance changes,
