@@ -229,7 +229,7 @@ def _unserved_why(kind: str) -> str:
     if kind in _PHYSICS_ONLY:
         return f"a {kind} node: physics only, which Sensorium does not simulate (no Supervisor node here)"
     if kind in LIGHTS:
-        return f"a {kind} Sensorium serves no Supervisor node for (an LED's light, or one under a scaled Transform)"
+        return f"a {kind} under a scaled Transform, which Sensorium serves no Supervisor node for"
     if kind in GEOMETRIES:
         return (f"a {kind} geometry of no visible Shape (a boundingObject's: Sensorium serves the geometries of "
                 "visible shapes only)")
