@@ -25,7 +25,7 @@ SAN_ENV = {"ASAN_OPTIONS": "detect_leaks=1:exitcode=86", "UBSAN_OPTIONS": "halt_
 EXPECTED = ["chassis Pose 1 0 0 0.05", "shape Shape 1", "paint PBRAppearance 0.2 0.4 0.6 0.5", "hull Box 0.2 0.1 0.05",
             "eye DistanceSensor eye 1.1 0 0.05", "arm Arm Solid 1", "tool tool 1 0 0.4 1", "elbow 1 Pose grip 1",
             "given 1", "top Pose Shape 0 1", "none 1 1 1 1 1 1", "board Solid board 0 2 0.5", "leg Shape 0.5 0.3 0.1",
-            "bulb 1"]
+            "bulb PointLight 1 0 0 0.6"]
 FUNC = "wb_supervisor_node_get_from_proto_def"
 
 
@@ -97,8 +97,9 @@ def test_the_nulls_say_why():
     assert node is None and "Physics node: physics only" in why and "DEF MASS of PROTO Rover's body" in why
     node, why = _found(sim, rover, "BOUND")
     assert node is None and "a Box geometry of no visible Shape" in why
-    node, why = _found(sim, shelf, "BULB")
-    assert node is None and "PointLight carried by a solid or robot" in why
+    bulb, why = _found(sim, shelf, "BULB")        # a light of the body: a node, under the shelf
+    assert (bulb.type, why, sv.node_ref(sim, bulb)["parent"]) == ("PointLight", "", shelf.id)
+    assert sv.get_field(sim, bulb, "location")["value"] == [0.0, 0.0, 0.6]
     assert _found(sim, box, "INSIDE") == (None, "'node' is not a PROTO node")
     node, why = _found(sim, sv.find_node(sim, "LAMP"), "BULB")
     assert node is None and why.startswith("the body of PROTO Beacon (PointLight 'LAMP' (node 5)) is not searched")
@@ -129,10 +130,10 @@ def test_bad_requests_get_one_line():
 
 def _check_lines(err: str) -> None:
     lines = [x for x in err.splitlines() if x.startswith("Error:")]
-    assert len(lines) == 5, err
+    assert len(lines) == 4, err
     assert f"Error: {FUNC}() called with NULL or empty 'def' argument." in lines, err
     assert f"Error: {FUNC}(): 'node' is not a PROTO node." in lines, err
-    assert sum(f"Error: {FUNC}(): DEF {name} of PROTO" in x for x in lines for name in ("MASS", "BOUND", "BULB")) == 3, err
+    assert sum(f"Error: {FUNC}(): DEF {name} of PROTO" in x for x in lines for name in ("MASS", "BOUND")) == 2, err
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="ipc endpoints")

@@ -65,10 +65,10 @@ def same(a: list, b: list) -> None:
 def test_full_wbt_is_its_yaml_twin_bit_for_bit() -> None:
     wbt, yml = load_world(HERE / "full.wbt"), load_world(HERE / "full.yaml")
     # a YAML world has no file order, nor the nodes inside its robots a Supervisor walks (nor the Solid among
-    # them a shape belongs to), nor its Shape nodes, nor where a world file writes its nested solids
+    # them a shape belongs to), nor its Shape and light nodes, nor where a world file writes its nested solids
     def bare(owner):
         update = {"shapes": [p.model_copy(update={"node": None, "in_solid": -1}) for p in owner.shapes],
-                  "written_at": None}
+                  "lights": [lt.model_copy(update={"node": None}) for lt in owner.lights], "written_at": None}
         if hasattr(owner, "children"):
             update["children"] = [bare(c) for c in owner.children]
         return owner.model_copy(update=update)

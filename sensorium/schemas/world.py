@@ -600,6 +600,28 @@ def _range_doc(field: str) -> str:
     return f"{_range_text(*LIGHT_RANGES[field])} (outside: reset with a warning, as Webots)"
 
 
+class LightNode(Strict):
+    """A ``.wbt`` light inside a robot or solid as a Supervisor serves it (README "Supervisor"): where it
+    sits among its parent's children and its ``location``/``direction`` fields as written (in its parent's
+    frame); the light's own ``location``/``direction`` are those placed in its robot's or solid's frame."""
+
+    parent: int = Field(default=-1, ge=-1, description="on a robot: the index in the robot's `nodes` of the node "
+                        "holding it (-1: the robot); on a solid: -1 (the solid holding it)")
+    after: int = Field(default=-1, ge=-1, description="its place among its parent's children, as a Shape's `after`")
+    frame: Pose = Field(default=Pose(), description="its parent's frame in the robot's or solid's frame: "
+                        "`location` and `direction` are the fields placed by it")
+    aim: Pose | None = Field(default=None, description="a spot light's: the rotation turning `direction` into "
+                             "`light_sensor_direction` (the nearest Pose's or Solid's own); None: it has none")
+    location: Vec3 | None = Field(default=None, description="the field as written (its parent's frame)")
+    direction: Vec3 | None = Field(default=None, description="the field as written (its parent's frame)")
+    written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
+    made_at: list[Annotated[int, Field(ge=1)]] | None = _made_at()
+    body: bool = Field(default=False, description="written by a PROTO's body, not the world file (a "
+                       "Supervisor cannot remove it: Webots' node internal to a PROTO)")
+    inner_defs: list[InnerDef] = Field(default=[], max_length=64, description="its DEFs in PROTO bodies "
+                                       "(getFromProtoDef), as a nested node's")
+
+
 class _Light(Strict):
     name: str | None = None
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
@@ -613,6 +635,8 @@ class _Light(Strict):
         description="on a robot's `lights` only: the motor (RotationalMotor or LinearMotor, not a drive's) whose "
                     "joint carries this light, the innermost one; it moves with that joint (README 'Joints'). An "
                     "LED's lights ride with the LED (its own `on_joint`). Left out: the robot's body")
+    node: LightNode | None = Field(default=None, description="a .wbt light inside a robot or solid: the "
+                                   "Supervisor node it is (none: the light is no node of its own)")
 
     _unit = field_validator("color")(_unit_colors)
 

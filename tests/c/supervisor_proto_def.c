@@ -66,7 +66,11 @@ int main(void) {
   g(wb_supervisor_node_get_position(board), 3);
   printf("\nleg %s", wb_supervisor_node_get_type_name(wb_supervisor_node_get_from_proto_def(shelf, "LEG")));
   g(wb_supervisor_field_get_sf_color(field(wb_supervisor_node_get_from_proto_def(shelf, "WOOD"), "diffuseColor")), 3);
-  printf("\nbulb %d\n", wb_supervisor_node_get_from_proto_def(shelf, "BULB") == NULL);
+  WbNodeRef bulb = wb_supervisor_node_get_from_proto_def(shelf, "BULB"); /* a light of the body: a node, under the shelf */
+  printf("\nbulb %s %d", bulb ? wb_supervisor_node_get_type_name(bulb) : "NULL", same(wb_supervisor_node_get_parent_node(bulb), shelf));
+  if (bulb)
+    g(wb_supervisor_field_get_sf_vec3f(field(bulb, "location")), 3);
+  printf("\n");
   wb_robot_cleanup();
   return 0;
 }

@@ -47,4 +47,5 @@ print("none", int(rover.getFromProtoDef("NOPE") is None), int(rover.getFromProto
 board = shelf.getFromProtoDef("BOARD")
 print("board", board.getTypeName(), board.getField("name").getSFString(), g(board.getPosition()))
 print("leg", shelf.getFromProtoDef("LEG").getTypeName(), g(shelf.getFromProtoDef("WOOD").getField("diffuseColor").getSFColor()))
-print("bulb", int(shelf.getFromProtoDef("BULB") is None))
+bulb = shelf.getFromProtoDef("BULB")      # a light of the body: a node, under the shelf
+print("bulb", bulb.getTypeName(), same(bulb.getParentNode(), shelf), g(bulb.getField("location").getSFVec3f()))

@@ -334,7 +334,8 @@ def _same_value(a: Any, b: Any) -> bool:
 
 def _nested_now(sim: Any, table: nested.Table, n: nested.Nested) -> list[tuple[str, str, Any, Any]]:
     """(field, type, value now, Webots' default or None) of the fields of nested node ``n`` the server changed:
-    an end point's pose its joint moved, a JointParameters' ``position``, a shape's fields a Supervisor set."""
+    an end point's pose its joint moved, a JointParameters' ``position``, a shape's fields a Supervisor set, a
+    light's fields."""
     out: list[tuple[str, str, Any, Any]] = []
     if n.shape is not None:
         changed = [key.split(".", 1)[1] for key in sim.scene.appearance_values.get(n.shape.index, {})
@@ -347,6 +348,11 @@ def _nested_now(sim: Any, table: nested.Table, n: nested.Nested) -> list[tuple[s
             base = sv._base_fields(sim, node)
             out += [(name, base[name][0], base[name][1](sim, node), None) for name in changed if name in base]
         return out
+    if n.light >= 0:       # a light's fields as they are now (a Supervisor's sets, a Charger's colour)
+        node = sv._nested_node(n)
+        defaults = DEFAULTS[n.type]
+        out += [(name, kind, get(sim, node), defaults[name]) for name, (kind, get, _) in sv._base_fields(sim, node).items()
+                if name in defaults]
     if n.motor:
         out.append(("position", "SFFloat", nested.joint_position(sim, n), 0.0))
     if n.own is not None and _moved(n.own, nested.own_pose(sim, table, n)):
@@ -396,7 +402,7 @@ def _nested_fields(sim: Any, owner: int | None) -> dict[int, dict[str, Any]]:
     out: dict[int, dict[str, Any]] = {}
     inside = table.by_owner.get(owner, ()) if owner is not None else [n for v in table.by_owner.values() for n in v]
     for n in inside:
-        if not (n.motor or n.joint or n.shape is not None and _shape_changed(sim, n.shape.index)):
+        if not (n.motor or n.joint or n.light >= 0 or n.shape is not None and _shape_changed(sim, n.shape.index)):
             continue             # nothing the server changes
         now = _nested_now(sim, table, n)
         written = _found(sim, table, n) if now else None

@@ -4,7 +4,8 @@ A robot's nodes are its world entry's ``nodes`` (the ``.wbt`` import keeps its S
 Poses, Transforms, Groups, Slots and joints, schemas.world.NestedNode), or one node per device of
 its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth.
 Both hold their Shapes too, numbered after every other nested node (:func:`_shape_nodes`; their
-fields: appearance.py). They are
+fields: appearance.py), then the lights a .wbt world writes in them (``LightNode``: an LED's too; their fields:
+supervisor.py, on the scene's ``carried_light_slots``). They are
 numbered once per simulation, in scene order (robots, then solids, each depth first), from
 :data:`FIRST_ID` on: the top-level nodes' ids (robots, solids, lights, the other top-level nodes,
 imports) are never shifted by them. The nodes inside a solid a Supervisor imported, or one a PROTO field set
@@ -90,6 +91,8 @@ class Nested:
     at: tuple[int, ...] = ()      # (line, column) where its owner's file writes it (() none: a PROTO body's, or a node
                                   # in its parent's SF field, found there: export.py)
     made: tuple[int, ...] = ()    # (line, column) where the PROTO body that made it writes it (export.py)
+    light: int = -1               # a light: its index among its robot's or top-level solid's lights (the scene's
+                                  # ``carried_light_slots``); -1: no light
     path: tuple[int, ...] = ()    # a top-level solid's nested Solid: its place among each parent's ``children`` from the
                                   # top one down (wm.Solid.children indices): the key that names its model (contact points)
 
@@ -301,6 +304,50 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
     return added
 
 
+def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, first: int,
+                       tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[Nested]:
+    """The lights of a robot (node ``owner``) that are nodes (``LightNode``: a .wbt robot's, its LEDs' too),
+    numbered from ``first``; ``start``: the id of its first world entry (their parents' ids count from it);
+    ``tags`` gets their PROTO-body DEFs."""
+    out: list[Nested] = []
+    model = robot.model
+    lights = list(model.lights) + [lt for d in model.devices if isinstance(d, wm.LED) for lt in d.lights]
+    for k, lt in enumerate(lights):       # its own, then its LEDs' (scene.robot_led_lights' order)
+        if lt.node is None:
+            continue
+        parent = owner if lt.node.parent < 0 or start is None else start + lt.node.parent
+        out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", parent, "children", None, None, "",
+                          owner, "Robot", name, order=lt.node.after + 0.5, light=k,
+                          at=tuple(lt.node.written_at or ()), made=tuple(lt.node.made_at or ())))
+        tags.extend((owner, t, out[-1].id) for t in lt.node.inner_defs)
+    return out
+
+
+def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidIds, first: int,
+                       tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[Nested]:
+    """The lights of top-level solid ``solid`` (node ``owner``) and of the solids inside it that are nodes
+    (``LightNode``: a .wbt solid's), numbered from ``first``, each under the solid holding it; their indices
+    among the solid's lights follow scene.solid_lights (its own, then its children's, depth first); ``tags``
+    gets their PROTO-body DEFs."""
+    out: list[Nested] = []
+    index = 0
+
+    def walk(s: wm.Solid, holder: int, path: tuple[int, ...]) -> None:
+        nonlocal index
+        for lt in s.lights:
+            if lt.node is not None:
+                out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", holder, "children", None,
+                                  None, "", owner, "Solid", key, order=lt.node.after + 0.5, light=index,
+                                  at=tuple(lt.node.written_at or ()), made=tuple(lt.node.made_at or ())))
+                tags.extend((owner, t, out[-1].id) for t in lt.node.inner_defs)
+            index += 1
+        for k, child in enumerate(s.children):
+            walk(child, solid_ids[owner, (*path, k)], (*path, k))
+
+    walk(solid, owner, ())
+    return out
+
+
 def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Nested], solid_ids: SolidIds,
                  tags: list[tuple[int, wm.InnerDef, int | str]], serials: dict[int, dict[int, int]]) -> None:
     """The solids inside top-level solid ``solid`` (node ``owner``, named ``key``) at any depth, appended to
@@ -390,6 +437,11 @@ def build(sim: Any, loaded_solids: int) -> Table:
     shape_tags: list[tuple[int, wm.InnerDef, int]] = []
     out += _shape_nodes(sim, holders, FIRST_ID + len(out), starts, shape_tags)     # after all others: no other id moves
     tags.extend(shape_tags)
+    for i, name in enumerate(robots):          # the lights, after the shapes: no shape's id moves
+        out += _robot_light_nodes(sim.robots[name], name, i + 1, starts.get(i + 1), FIRST_ID + len(out), tags)
+    for j in range(loaded_solids):
+        out += _solid_light_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], solid_ids,
+                                  FIRST_ID + len(out), tags)
     inner: dict[int, dict[str, int | str]] = {}
     for owner, tag, target in tags:
         if owner in firsts:                # a robot: the instance's entry (a world file's scope past them: none)
@@ -417,6 +469,7 @@ def add_solid(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid) -> 
     shape_tags: list[tuple[int, wm.InnerDef, int]] = []
     out += _shape_nodes(sim, _solid_holders(solid, owner, owner, key, solid_ids), table.end + len(out), {},
                         shape_tags)
+    out += _solid_light_nodes(solid, owner, key, solid_ids, table.end + len(out), tags)
     tags.extend(shape_tags)
     inner = table.inner if table.inner is not None else {}
     for _, tag, target in tags:
@@ -449,7 +502,7 @@ def drop(table: Table, owner: int) -> None:
 
 
 def drop_shape(table: Table, shape: int) -> None:
-    """A Shape node a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
+    """A Shape node (or a light) a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
     getFromProtoDef finds them and their ids read as removed (never given again)."""
     gone = {shape}
     todo = [shape]

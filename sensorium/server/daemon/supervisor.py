@@ -9,13 +9,14 @@ are found by DEF name (``def_name``, set from a ``.wbt`` world's ``DEF``; a dott
 direct children) or else (top-level nodes) by name. Ids are stable for the life of the server:
 a removed solid or light keeps its id, which then answers NULL and is never given to another node; a
 top-level solid built again by a PROTO field set keeps its own (Webots keeps a regenerated node's).
-Shapes with their appearances and geometries are nested nodes too (:mod:`.appearance`); lights
-carried by a solid or robot are not nodes here: Webots' NULL.
+Shapes with their appearances and geometries are nested nodes too (:mod:`.appearance`), and so are the
+lights a .wbt robot or solid carries (their fields a top-level light's, ``location``/``direction`` in their
+parent's frame: :func:`_light`, :func:`_set_carried_light`).
 
 Fields are Webots' names and types (:data:`FIELDS`), values in the parent frame. Setting one field
 keeps the others (Webots). A field change applies at once; the next measurement sees it. A nested
-node's fields are read-only here, but a joint's parameters' ``position`` and a shape's colours,
-roughness and transparency (:mod:`.appearance`). A joint is set with
+node's fields are read-only here, but a joint's parameters' ``position``, a shape's colours,
+roughness and transparency (:mod:`.appearance`) and a light's fields. A joint is set with
 ``set_joint_position``; a node's state is saved and loaded by name (sim/states.py).
 """
 
@@ -500,8 +501,52 @@ def _solid_model(sim: Any, node: Node) -> Any:
     return next(s for s in sim.world.solids if s.name == node.key)
 
 
+def _carrier(sim: Any, node: Node) -> tuple[str | int, int]:
+    """A nested light's robot (its index) or top-level solid (its name) and its index among their lights."""
+    n = _nested_of(sim, node)
+    return (sim.robots[n.owner_key].index if n.owner_kind == "Robot" else n.owner_key), n.light
+
+
+def _carried_model(sim: Any, node: Node) -> Any:
+    """A nested light's model as the scene holds it (``location``/``direction`` in its owner's frame)."""
+    owner, k = _carrier(sim, node)
+    return sim.scene.light_model(sim.scene.carried_light_slots(owner)[k])
+
+
 def _light(sim: Any, node: Node) -> Any:
-    return sim.scene.top_lights()[node.key]
+    """A light's model as its fields read: a nested light's ``location``/``direction`` in its parent's frame."""
+    if not node.nested:
+        return sim.scene.top_lights()[node.key]
+    model = _carried_model(sim, node)
+    return model.model_copy(update={a: getattr(model.node, a) for a in ("location", "direction")
+                                    if getattr(model.node, a) is not None})
+
+
+def _set_carried_light(sim: Any, node: Node, attr: str, changed: Any) -> None:
+    """A nested light's field set: ``changed`` (its fields as read, :func:`_light`) placed in its owner's
+    frame by its parent's (``LightNode.frame``), a spot light's light-sensor axis turned by ``LightNode.aim``
+    (the .wbt import's rule, sim/scene.py ``sensor_aimed``); the other fields as set."""
+    stored = _carried_model(sim, node)
+    info = stored.node
+    keep = {a: getattr(stored, a) for a in ("location", "direction", "light_sensor_direction") if hasattr(stored, a)}
+    placed = changed.model_copy(update=keep)
+    if attr in ("location", "direction"):
+        value = getattr(changed, attr)
+        info = info.model_copy(update={attr: value})
+        frame = pose_from_model(info.frame)
+        update: dict[str, Any] = {}
+        if attr == "location":
+            update["location"] = tuple(float(v) for v in frame.apply(np.asarray(value, dtype=np.float64)))
+        elif changed.type == "SpotLight":        # a directional light's direction is in world axes (Webots)
+            update["direction"] = tuple(float(v) for v in frame.apply_dirs(np.asarray(value, dtype=np.float64)))
+            if info.aim is not None:
+                aim = pose_from_model(info.aim).apply_dirs(np.asarray(value, dtype=np.float64))
+                update["light_sensor_direction"] = tuple(float(v) for v in aim)
+        else:
+            update["direction"] = tuple(float(v) for v in value)
+        placed = placed.model_copy(update=update)
+    owner, k = _carrier(sim, node)
+    sim.scene.set_carried_light(owner, k, placed.model_copy(update={"node": info}))
 
 
 def _radar_key(sim: Any, node: Node) -> str | int:
@@ -556,7 +601,10 @@ def _set_light(attr: str, kind: str) -> Setter:
                 raise ValueError(f"{kind} {attr}: must be 0 while attenuation is not 1 0 0 (Webots' rule), "
                                  f"got {value}")
             changed = changed.model_copy(update={"ambient_intensity": 0.0})
-        sim.scene.set_top_light(node.key, changed)
+        if node.nested:
+            _set_carried_light(sim, node, attr, changed)
+        else:
+            sim.scene.set_top_light(node.key, changed)
     return setter
 
 
@@ -725,6 +773,8 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
     n = _nested_of(sim, node)
     if n.shape is not None:            # a Shape or a node inside it (appearance.py)
         return appearance.fields(n.shape, lambda field: _sf_child(sim, n.id, field))
+    if n.light >= 0:                   # a light inside a robot or solid: as a top-level light's
+        return FIELDS[n.type]
     out = dict(_NESTED_POSE) if n.own is not None else {}
     if n.name:
         out["name"] = ("SFString", lambda sim, node: node.name, None)
@@ -1481,6 +1531,13 @@ def remove_node(sim: Any, node: Node) -> None:
     ref = _nested_of(sim, node).shape if node.nested else None
     if ref is not None and ref.role == "Shape":      # a Shape inside a robot or solid: every piece of it unseen
         sim.scene.remove_shapes(ref.peers or (ref.index,))
+        nested.drop_shape(_table(sim), node.id)
+        return
+    if node.nested and node.type in LIGHTS:     # a light inside a robot or solid: unlit from the next measurement
+        if _carried_model(sim, node).node.body:
+            raise ValueError(f"Node '{node.type}' is internal to a PROTO and therefore cannot be deleted from a "
+                             "Supervisor.")
+        sim.scene.remove_carried_light(*_carrier(sim, node))
         nested.drop_shape(_table(sim), node.id)
         return
     if node.nested:

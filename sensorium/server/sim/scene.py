@@ -558,6 +558,10 @@ class Scene:
         self._lights: list[tuple[object, str | int | tuple[int, str] | None, Pose]] = [
             (lt, None, Pose.identity()) for lt in world.lights]
         self._led_lights: dict[tuple[int, str], list] = {}   # (robot, LED) -> its lights' models now
+        self._led_state: dict[tuple[int, str], tuple[bool, tuple]] = {}   # (robot, LED) -> its last (on, colour)
+        # (robot index or solid name, index among its lights) -> the light as loaded, for those a Supervisor set
+        self._set_carried: dict[tuple[str | int, int], object] = {}
+        self.removed_carried: set[tuple[str | int, int]] = set()   # those a Supervisor removed (same keys)
         # (robot, k) -> its radar_targets[k], (solid, k) -> the k-th solid inside it with a cross section:
         # its pose in the robot's or solid's frame, the joint it rides on, its shapes
         self.carried_targets: dict[tuple[int, int] | tuple[str, int], tuple[Pose, str | None, tuple[int, ...]]] = {}
@@ -610,6 +614,7 @@ class Scene:
             for k, t in enumerate(r.radar_targets):          # solids it carries that radars detect apart
                 self.carried_targets[(i, k)] = (pose_from_model(t.pose), t.on_joint,
                                                 tuple(sorted({placed[id(r.shapes[j])] for j in t.shapes})))
+        self._loaded_lights = list(self._lights)      # as loaded (an LED's: off and black), for restore_carried_lights
         self._attached = {owner[0] if isinstance(owner, tuple) else owner for _, owner, _ in self._lights
                           if owner is not None}
         # the links carrying lights: light sensors and cameras recompute their lights when one moves
@@ -849,12 +854,19 @@ class Scene:
         """Every light model with its location and direction in world coordinates (now)."""
         out = []
         top = -1
+        counts: dict[str | int, int] = {}       # each carrier's lights so far (those a Supervisor removed)
         for model, owner, local in self._lights:
             if owner is None:
                 top += 1
                 if top not in self.removed_lights:
                     out.append(model)
-            elif isinstance(owner, tuple):      # on a joint: where its link has moved it
+                continue
+            if self.removed_carried:
+                carrier = owner[0] if isinstance(owner, tuple) else owner
+                k = counts[carrier] = counts.get(carrier, -1) + 1
+                if (carrier, k) in self.removed_carried:
+                    continue
+            if isinstance(owner, tuple):      # on a joint: where its link has moved it
                 displacement = self.link_poses.get(owner, _IDENTITY)
                 placed = place_light(model, self.robot_poses[owner[0]].compose(displacement).compose(local))
                 out.append(link_aimed(placed, displacement))
@@ -871,10 +883,14 @@ class Scene:
     def set_led_lights(self, robot: int, led: str, on: bool, color: tuple[float, float, float]) -> None:
         """An LED's new state (``WbLed::setMaterialsAndLightsColor``): its lights take ``color`` and are
         on exactly when ``on``; light sensors and cameras recompute their light arrays at their next
-        measurement (``lights_version``). Nothing changes (nor is recomputed) when the state is the same."""
+        measurement (``lights_version``). Nothing changes (nor is recomputed) when the state is the same as
+        the LED's last (``WbLed::setValue`` returns on the same value): a Supervisor's write to its lights'
+        fields stays until the LED's state changes."""
         old = self._led_lights.get((robot, led))
-        if not old or all(m.on == on and m.color == color for m in old):
+        state = (bool(on), tuple(color))
+        if not old or self._led_state.get((robot, led), (False, (0.0, 0.0, 0.0))) == state:
             return
+        self._led_state[(robot, led)] = state
         new = [m.model_copy(update={"on": on, "color": color}) for m in old]
         swap = {id(a): b for a, b in zip(old, new)}
         self._lights = [(swap.get(id(m), m), owner, local) for m, owner, local in self._lights]
@@ -899,6 +915,55 @@ class Scene:
             return
         self._lights[slot] = (model.model_copy(update={"color": tuple(color)}), owner, local)
         self.lights_version += 1
+
+    def carried_light_slots(self, owner: str | int) -> list[int]:
+        """Where robot ``owner``'s lights (its index: its own ``lights``, then its LEDs') or top-level solid
+        ``owner``'s (its name: :func:`solid_lights` order) are among the scene's lights now."""
+        return [k for k, (_, o, _) in enumerate(self._lights)
+                if o == owner or (isinstance(o, tuple) and o[0] == owner)]
+
+    def set_carried_light(self, owner: str | int, index: int, model: object) -> None:
+        """Replace light ``index`` of a robot or top-level solid (:meth:`carried_light_slots`; a Supervisor
+        field change, its ``location``/``direction`` in the owner's frame): it keeps its carrier and frame;
+        light sensors and cameras recompute their light arrays at their next measurement
+        (``lights_version``). The light as loaded comes back at :meth:`restore_carried_lights`."""
+        slot = self.carried_light_slots(owner)[index]
+        old, carrier, local = self._lights[slot]
+        if (owner, index) not in self._set_carried:
+            loaded = [m for m, o, _ in self._loaded_lights if o == owner or (isinstance(o, tuple) and o[0] == owner)]
+            self._set_carried[(owner, index)] = loaded[index] if index < len(loaded) else old
+        self._lights[slot] = (model, carrier, local)
+        self._led_swap(old, model)
+        self.lights_version += 1
+
+    def _led_swap(self, old: object, new: object) -> None:
+        """An LED's light replaced (a Supervisor's set): the LED's next state change starts from it."""
+        for models in self._led_lights.values():
+            for j, m in enumerate(models):
+                if m is old:
+                    models[j] = new
+                    return
+
+    def remove_carried_light(self, owner: str | int, index: int) -> None:
+        """Take light ``index`` of a robot or top-level solid out for good (a Supervisor's ``node.remove()``):
+        light sensors and cameras stop counting it at their next measurement (``lights_version``); the
+        others keep their indices (its slot stays, unlit by :meth:`world_lights`)."""
+        if (owner, index) not in self.removed_carried:
+            self.removed_carried.add((owner, index))
+            self.lights_version += 1
+
+    def restore_carried_lights(self) -> None:
+        """The lights :meth:`set_carried_light` changed, as loaded (a simulation reset: an LED's off and
+        black, as its reset leaves them; those of a removed solid stay gone)."""
+        for (owner, index), model in self._set_carried.items():
+            slots = self.carried_light_slots(owner)
+            if index < len(slots):
+                now, carrier, local = self._lights[slots[index]]
+                self._lights[slots[index]] = (model, carrier, local)
+                self._led_swap(now, model)
+        if self._set_carried:
+            self._set_carried.clear()
+            self.lights_version += 1
 
     def top_lights(self) -> list:
         """The world's top-level light models (the world file's ``lights``, in order; the Supervisor's
@@ -944,6 +1009,9 @@ class Scene:
             self._lights = [entry for entry in self._lights if entry[1] != name]
             self._attached.discard(name)
             self.lights_version += 1
+        for key in [k for k in self._set_carried if k[0] == name]:     # (a solid built again starts afresh)
+            del self._set_carried[key]
+        self.removed_carried = {k for k in self.removed_carried if k[0] != name}
 
     def _forget_shapes(self, dead: list[int]) -> None:
         """The shapes of a removed body let go: what was kept per shape (a Supervisor's appearance changes,

@@ -574,6 +574,7 @@ class Simulation:
         for k, light in enumerate(self._initial["lights"]):    # fields a supervisor changed
             if self.scene.top_lights()[k] is not light:
                 self.scene.set_top_light(k, light)
+        self.scene.restore_carried_lights()     # those inside robots and solids too
         self.scene.clear_ink()          # WbPen::reset clears every paint texture
         self.scene.restore_appearances()     # colours a Supervisor set: as loaded
         if self.chargers:

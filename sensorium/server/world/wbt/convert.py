@@ -29,7 +29,7 @@ import numpy as np
 
 from sensorium.schemas import world as wm
 from sensorium.server.world.cad import EAR_CLIP_CORNERS, ear_clip, reflex_corners
-from sensorium.server.world.poses import axis_angle_matrix
+from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
 from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
 from sensorium.server.world.wbt.fields import Fields
@@ -229,7 +229,7 @@ def _unserved_why(kind: str) -> str:
     if kind in _PHYSICS_ONLY:
         return f"a {kind} node: physics only, which Sensorium does not simulate (no Supervisor node here)"
     if kind in LIGHTS:
-        return f"a {kind} carried by a solid or robot: lights inside them are no Supervisor nodes here"
+        return f"a {kind} under a scaled Transform, which Sensorium serves no Supervisor node for"
     if kind in GEOMETRIES:
         return (f"a {kind} geometry of no visible Shape (a boundingObject's: Sensorium serves the geometries of "
                 "visible shapes only)")
@@ -1393,6 +1393,7 @@ class Converter:
             self.warn(node, f"{node.type} color {' '.join(f'{c:g}' for c in data['color'])} clamped to [0, 1] "
                             "(Webots resets it)")
             data["color"] = [min(max(c, 0.0), 1.0) for c in data["color"]]
+        written = {k: list(data[k]) for k in ("location", "direction") if k in data}
         if "location" in data:
             data["location"] = frame.apply(data["location"])
         if node.type == "SpotLight":
@@ -1405,6 +1406,8 @@ class Converter:
         data["_at"] = self.at(node)
         if owner.kind == "world":
             self.def_name(node, data)
+        else:                     # (an LED's too: the scene places its lights in the robot's frame)
+            self.light_node(node, frame, owner, data, written)
         led = self.led_of.get(id(node))
         if led is not None:       # switched by an LED: in the LED's frame, in its lights
             entry, at = led
@@ -1418,6 +1421,32 @@ class Converter:
         if owner.kind == "robot":     # a robot's light past a joint rides on it (an LED's ride with the LED)
             self.ride(data)
         owner.data.setdefault("lights", []).append(data) if owner.kind != "world" else self.world["lights"].append(data)
+
+    def light_node(self, node: Node, frame: Frame, owner: Owner, data: dict, written: dict) -> None:
+        """A light inside a robot or solid as the Supervisor node it is (schemas.world.LightNode): its DEF,
+        its place among its parent's children, its parent's frame and its fields as written. One under a
+        scaled Transform is none (its fields no longer map to its place rigidly)."""
+        if not frame.rigid or (owner.kind == "robot" and self.tree is None):
+            return
+        entry: dict[str, Any] = {"frame": frame.pose(), **written}
+        if "light_sensor_direction" in data and frame.own_rotation is not None:
+            entry["aim"] = {"quaternion": list(matrix_quaternion(frame.own_rotation))}
+        if owner.kind == "robot":
+            assert self.tree is not None
+            if self.tree_stack:
+                entry["parent"] = self.tree_stack[-1][1]
+            entry["after"] = len(self.tree) - 1
+        else:
+            entry["after"] = len(owner.data.get("children", ())) - 1
+        tags = self.inner_defs(node)
+        if tags:
+            entry["inner_defs"] = tags[:64]
+        if not self.written(node):
+            entry["body"] = True
+        self.written_at(node, entry)
+        if self.nested_def(node):
+            data["def_name"] = node.def_name
+        data["node"] = entry
 
     def led_lights(self, node: Node) -> list[Node]:
         """The lights an LED switches (``WbLed::findMaterialsAndLights``): only its first child counts; a
