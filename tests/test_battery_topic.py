@@ -267,6 +267,18 @@ def test_a_rosbag2_export_holds_the_battery_for_both_distros(tmp_path) -> None:
         assert all(math.isnan(m.voltage) and m.present and m.power_supply_status == 2 for m in msgs)
 
 
+def test_a_layout_plots_every_robots_battery_percentage(tmp_path) -> None:
+    pytest.importorskip("foxglove.layouts")
+    from sensorium.server.viewer.layout import layout_for
+
+    world = tmp_path / "battery.yaml"
+    world.write_text(yaml.safe_dump({**WORLD, "robots": [*WORLD["robots"], {"name": "q", "battery": [1.0]}]}))
+    lay = json.loads(layout_for(world))
+    side = lay["content"]["items"][1]["content"]["items"]
+    (plot,) = [item["content"]["config"] for item in side if item["content"].get("panelType") == "Plot"]
+    assert [p["value"] for p in plot["paths"]] == ["/q/battery.percentage", "/r/battery.percentage"]
+
+
 ECHO_WORLD = """\
 world_info: {name: battery, basic_time_step: 32}
 robots:
