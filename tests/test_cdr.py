@@ -20,8 +20,8 @@ from sensorium.server.sim.simulation import Simulation  # noqa: E402
 WORLD = Path(__file__).parent / "worlds" / "server.yaml"
 
 
-def published(steps: int = 5) -> list[tuple[str, str, bytes]]:
-    sim = Simulation.from_file(WORLD, precision="fast")
+def published(steps: int = 5, sim: Simulation | None = None) -> list[tuple[str, str, bytes]]:
+    sim = sim or Simulation.from_file(WORLD, precision="fast")
     topics = Topics(sim)
     got: list[tuple[str, str, bytes]] = []
     topics.set_recorder(lambda t, ty, env, body, ns, seq: got.append((t, ty, body)))
@@ -31,11 +31,18 @@ def published(steps: int = 5) -> list[tuple[str, str, bytes]]:
     return got
 
 
+def battery_world() -> Simulation:
+    from sensorium.server.world.loader import parse_world
+    return Simulation(parse_world({"world_info": {"basic_time_step": 32},
+                                   "robots": [{"name": "r", "battery": [100.0, 200.0, 0.0], "cpu_consumption": 10.0},
+                                              {"name": "unbounded", "battery": [3.0]}]}))
+
+
 @pytest.mark.parametrize("distro", ["humble", "jazzy"])
 @pytest.mark.parametrize("pointcloud2", [True, False])
 def test_direct_cdr_is_byte_identical_to_rosbags(distro, pointcloud2):
     enc = CdrEncoder(distro, pointcloud2=pointcloud2)
-    msgs = published()
+    msgs = published() + published(sim=battery_world())      # the server world has no battery
     types = set()
     for topic, ros_type, body in msgs:
         typename, fast = enc.encode(ros_type, body)
@@ -62,6 +69,12 @@ def test_edge_cases_match_rosbags(distro):
                                    "variance": 0.0}),
         ("sensor_msgs/msg/Image", {"header": hdr, "height": 1, "width": 3, "encoding": "32FC1", "is_bigendian": 0,
                                    "step": 12, "data": bytes(range(12))}),
+        ("sensor_msgs/msg/BatteryState", {"header": hdr, "voltage": 12.5, "temperature": math.nan, "current": -0.5,
+                                          "charge": 1.0, "capacity": 2.0, "design_capacity": 2.5, "percentage": 0.5,
+                                          "power_supply_status": 4, "power_supply_health": 1,
+                                          "power_supply_technology": 2, "present": False,
+                                          "cell_voltage": b"\x00\x00\x80\x3f" * 3, "cell_temperature": b"",
+                                          "location": "slot 1", "serial_number": "sn-ü"}),
     ]
     for ros_type, body in cases:
         b = pack(body)

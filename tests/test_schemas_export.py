@@ -42,7 +42,7 @@ def test_documents_cover_every_type():
                                         "geometry_msgs/msg/PointStamped", "geometry_msgs/msg/Vector3Stamped",
                                         "sensor_msgs/msg/NavSatFix", "std_msgs/msg/Float64", "sensor_msgs/msg/Imu",
                                         "sensor_msgs/msg/MagneticField", "sensor_msgs/msg/CameraInfo",
-                                        "radar_msgs/msg/RadarScan", "std_msgs/msg/String"}
+                                        "radar_msgs/msg/RadarScan", "std_msgs/msg/String", "sensor_msgs/msg/BatteryState"}
     for ref in msgs["x-ros-types"].values():
         assert ref.split("/")[-1] in msgs["$defs"]
     svc = docs["services.schema.json"]

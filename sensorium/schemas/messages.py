@@ -285,6 +285,37 @@ class RadarScan(Msg):
     returns: list[RadarReturn]
 
 
+class BatteryState(Msg):
+    """``sensor_msgs/msg/BatteryState`` of a robot's battery (Webots' ``battery`` field, in joules):
+    ``percentage`` is the energy ÷ the maximum (NaN without a positive maximum); Webots models no
+    voltage, current, charge in Ah, temperature or cells, so those are NaN (the ROS message's "not
+    measured") or empty; ``power_supply_status`` says CHARGING while a Charger gives it energy, FULL
+    at its maximum, DISCHARGING while it loses energy to ``cpuConsumption``, NOT_CHARGING otherwise."""
+
+    STATUS_CHARGING: ClassVar[int] = 1
+    STATUS_DISCHARGING: ClassVar[int] = 2
+    STATUS_NOT_CHARGING: ClassVar[int] = 3
+    STATUS_FULL: ClassVar[int] = 4
+
+    header: Header
+    voltage: float = Field(description="V: NaN (Webots models no voltage)")
+    temperature: float = Field(description="°C: NaN (not measured)")
+    current: float = Field(description="A: NaN (not measured)")
+    charge: float = Field(description="Ah: NaN (Webots' energy is in J; without a voltage, no Ah)")
+    capacity: float = Field(description="Ah: NaN")
+    design_capacity: float = Field(description="Ah: NaN")
+    percentage: float = Field(description="the energy ÷ the maximum (the battery's first two values), 0..1; "
+                                          "NaN without a positive maximum")
+    power_supply_status: int = Field(ge=0, le=255, description="1 charging, 2 discharging, 3 not charging, 4 full")
+    power_supply_health: int = Field(ge=0, le=255, description="0: unknown")
+    power_supply_technology: int = Field(ge=0, le=255, description="0: unknown")
+    present: bool = Field(description="true")
+    cell_voltage: bytes = Field(description="<f4[]: empty")
+    cell_temperature: bytes = Field(description="<f4[]: empty")
+    location: str = ""
+    serial_number: str = ""
+
+
 class Envelope(Msg):
     """The second frame of every topic message."""
 
@@ -311,6 +342,7 @@ MAGNETIC_FIELD = "sensor_msgs/msg/MagneticField"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
 RADAR_SCAN = "radar_msgs/msg/RadarScan"
 STRING = "std_msgs/msg/String"
+BATTERY_STATE = "sensor_msgs/msg/BatteryState"
 
 MESSAGE_TYPES: dict[str, type[Msg]] = {
     ILLUMINANCE: Illuminance,
@@ -331,6 +363,7 @@ MESSAGE_TYPES: dict[str, type[Msg]] = {
     CAMERA_INFO: CameraInfo,
     RADAR_SCAN: RadarScan,
     STRING: String,
+    BATTERY_STATE: BatteryState,
 }
 """ROS type name → model, for every topic the server publishes."""
 

@@ -10,8 +10,9 @@ controller's own ``enable`` always wins and is never altered (its period, phase 
 controller enabled it or its ``point_cloud`` topic is demanded.
 
 After each basic step :meth:`Topics.publish` builds the messages of every demanded topic whose
-device produced a new value (plus ``/clock``, each demanded ``/<robot>/pose`` and, for a robot with
-joints, ``/<robot>/joint_states``) as ready-to-send
+device produced a new value (plus ``/clock``, each demanded ``/<robot>/pose``, for a robot with
+joints ``/<robot>/joint_states``, and for a robot with a battery ``/<robot>/battery`` when its battery
+was sampled: at its controller's sensor period, else every basic step while demanded) as ready-to-send
 frames, calls the recorder (and the viewer sink, sensorium.server.viewer) with the very same bytes,
 and counts ``seq`` per topic. A text a controller sends its robot window (``wwi_send``) is published
 on ``/<robot>/robot_window`` when it arrives, not after a step, and a text sent to the window side
@@ -37,7 +38,7 @@ from sensorium.schemas.devices import KINDS
 from sensorium.schemas.wire import pack, stamp, topic_frame
 
 __all__ = ["Topic", "Topics", "Recorder", "POINT_DTYPE", "header", "image_msg", "point_cloud_msg", "lidar_cloud_msg", "laser_scan_angles",
-           "pose_quaternion", "pose_msg", "joint_states_msg"]
+           "pose_quaternion", "pose_msg", "joint_states_msg", "battery_state_msg"]
 
 MAX_PREFIX = 1024     # bytes: longer subscriptions are refused (topic names are short)
 
@@ -58,7 +59,7 @@ class Topic:
     name: str
     type: str
     kind: str                # value | range_image | laser_scan | point_cloud | clock | pose | joint_states | robot_window
-                             # | robot_window_to_controller
+                             # | robot_window_to_controller | battery
     path: str | None         # "robot/device"; the robot's name for pose; None for /clock
     frame: bytes             # name + NUL
 
@@ -190,6 +191,22 @@ def joint_states_msg(hdr: dict, joints: dict[str, Any]) -> dict:
             "velocity": np.array([m.rate for m in motors], dtype="<f8").tobytes(), "effort": b""}
 
 
+# Battery.state (sim/battery.py) -> sensor_msgs/BatteryState's power_supply_status
+_SUPPLY_STATUS = {"charging": msgs.BatteryState.STATUS_CHARGING, "discharging": msgs.BatteryState.STATUS_DISCHARGING,
+                  "idle": msgs.BatteryState.STATUS_NOT_CHARGING, "full": msgs.BatteryState.STATUS_FULL}
+
+
+def battery_state_msg(hdr: dict, energy: float, maximum: float, state: str) -> dict:
+    """``sensor_msgs/BatteryState`` of a battery sample: ``percentage`` the energy ÷ the maximum (NaN
+    without a positive maximum); what Webots does not model (voltage, current, charge and capacities in
+    Ah, temperature, cells) NaN or empty, health and technology unknown (0)."""
+    nan = math.nan
+    return {"header": hdr, "voltage": nan, "temperature": nan, "current": nan, "charge": nan, "capacity": nan,
+            "design_capacity": nan, "percentage": energy / maximum if maximum > 0.0 else nan,
+            "power_supply_status": _SUPPLY_STATUS[state], "power_supply_health": 0, "power_supply_technology": 0,
+            "present": True, "cell_voltage": b"", "cell_temperature": b"", "location": "", "serial_number": ""}
+
+
 def laser_scan_angles(cfg: Any) -> tuple[float, float, float] | None:
     """(angle_min, angle_max, angle_increment) of ranges in range-image order (left to right), or
     ``None`` when the lidar gets no LaserScan (several layers, or planar: unequal angles)."""
@@ -226,6 +243,7 @@ class Topics:
         self.joint_topics: dict[str, Topic] = {}     # robot with joints -> its /<robot>/joint_states topic
         self.window_topics: dict[str, Topic] = {}    # robot -> its /<robot>/robot_window topic
         self.window_in_topics: dict[str, Topic] = {}  # robot -> its /<robot>/robot_window/to_controller topic
+        self.battery_topics: dict[str, Topic] = {}   # robot with a battery -> its /<robot>/battery topic
         world_info = getattr(getattr(sim, "world", None), "world_info", None)
         for robot_name, robot in sim.robots.items():
             for dev_name, dev in robot.devices.items():
@@ -252,6 +270,12 @@ class Topics:
             window_in = Topic(name, msgs.STRING, "robot_window_to_controller", robot_name, topic_frame(name))
             self.topics.append(window_in)
             self.window_in_topics[robot_name] = window_in
+            battery = getattr(robot, "battery", None)
+            if battery is not None and battery.present:     # a robot without a battery has no battery topic
+                name = f"/{robot_name}/battery"
+                battery_topic = Topic(name, msgs.BATTERY_STATE, "battery", robot_name, topic_frame(name))
+                self.topics.append(battery_topic)
+                self.battery_topics[robot_name] = battery_topic
         self.by_name = {t.name: t for t in self.topics}
         self.seq: dict[str, int] = {t.name: 0 for t in self.topics}
         self.prefixes: dict[bytes, int] = {}       # accepted subscription prefix -> subscriptions
@@ -267,6 +291,7 @@ class Topics:
         self._clock_demanded = False
         self._poses: list[Topic] = []                # demanded pose topics
         self._joint_states: list[Topic] = []         # demanded joint_states topics
+        self._batteries: dict[str, int] = {}         # robot of a demanded battery topic -> its samples last published
         self.work: Counter[str] = Counter()          # what publishing computed (poses_built)
         self.outbox: list[list[bytes]] = []          # published between steps (robot-window texts), to send
 
@@ -352,6 +377,15 @@ class Topics:
         self._clock_demanded = CLOCK in demanded
         self._poses = [t for t in self.pose_topics.values() if t.name in demanded]
         self._joint_states = [t for t in self.joint_topics.values() if t.name in demanded]
+        for robot, t in self.battery_topics.items():
+            wanted = t.name in demanded
+            if wanted != (robot in self._batteries):
+                state = self.sim.robots[robot]
+                self.sim.demand_battery(state, wanted)
+                if wanted:                             # new samples only, never a stale one
+                    self._batteries[robot] = state.battery_samples
+                else:
+                    del self._batteries[robot]
         self._active = []
         for ctl in self.controls.values():
             was = bool(ctl.demanded)
@@ -414,7 +448,7 @@ class Topics:
     def publish(self, time_ms: int) -> list[list[bytes]]:
         """After a basic step: the frames of every demanded topic with a new value, ``/clock``
         first, then the demanded joint states (every basic step while demanded), then the demanded
-        robot poses, then the devices' topics. The recorder gets the same
+        robot poses, then the batteries sampled, then the devices' topics. The recorder gets the same
         bytes."""
         out: list[list[bytes]] = []
         if self._clock_demanded:
@@ -427,6 +461,12 @@ class Topics:
             for t in self._poses:
                 self._emit(t, time_ms, pose_msg(hdr, self.sim.robots[t.path].pose), out)
             self.work["poses_built"] += len(self._poses)
+        for robot, seen in self._batteries.items():
+            state = self.sim.robots[robot]
+            if state.battery_samples != seen:
+                self._batteries[robot] = state.battery_samples
+                at = state.battery_sampled_at_ms
+                self._emit(self.battery_topics[robot], at, battery_state_msg(header(robot, at), *state.battery_sample), out)
         for ctl in self._active:
             m = ctl.device.measurements
             if m == ctl.seen:

@@ -1,8 +1,8 @@
 """Direct ROS 2 CDR serialisation of Sensorium's own message bodies (msgpack dicts as published).
 
 The generic path (rosbags type store: body → nested dicts → dataclasses → ``serialize_cdr``) costs
-~0.3 ms per message, too much inside the step loop of a Foxglove-ready recording. For the seven
-types Sensorium publishes this module writes the same XCDR1 little-endian bytes directly (header
+~0.3 ms per message, too much inside the step loop of a Foxglove-ready recording. For the eight
+types Sensorium publishes most this module writes the same XCDR1 little-endian bytes directly (header
 ``00 01 00 00``, every primitive aligned to its size counted from the end of that header, strings
 as uint32 length including the NUL). ``tests/test_cdr.py`` checks it byte for byte against
 rosbags' ``serialize_cdr`` on real messages of every type; :class:`~.export.CdrEncoder` falls back to
@@ -147,6 +147,20 @@ def _point_cloud2(w: _Writer, m: dict, distro: str) -> None:
     w.u8(bool(m["is_dense"]))
 
 
+def _battery_state(w: _Writer, b: dict, distro: str) -> None:
+    w.header(b.get("header"))
+    w.f32(*(b.get(k, 0.0) for k in ("voltage", "temperature", "current", "charge", "capacity", "design_capacity",
+                                     "percentage")))
+    w.u8(b.get("power_supply_status", 0))
+    w.u8(b.get("power_supply_health", 0))
+    w.u8(b.get("power_supply_technology", 0))
+    w.u8(bool(b.get("present", False)))
+    w.blob(_bytes(b.get("cell_voltage")), 4)
+    w.blob(_bytes(b.get("cell_temperature")), 4)
+    w.string(b.get("location", ""))
+    w.string(b.get("serial_number", ""))
+
+
 FAST_TYPES: dict[str, Callable[[_Writer, dict, str], None]] = {
     "sensor_msgs/msg/Illuminance": _illuminance,
     "sensor_msgs/msg/Range": _range,
@@ -155,6 +169,7 @@ FAST_TYPES: dict[str, Callable[[_Writer, dict, str], None]] = {
     "geometry_msgs/msg/PoseStamped": _pose_stamped,
     "rosgraph_msgs/msg/Clock": _clock,
     "sensor_msgs/msg/PointCloud2": _point_cloud2,
+    "sensor_msgs/msg/BatteryState": _battery_state,
 }
 
 

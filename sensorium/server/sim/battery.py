@@ -33,6 +33,7 @@ class Battery:
     initial: float
     powered: bool = True    # Webots' mPowerOn: off only once a step empties the battery (a robot
                             # loaded with 0 J is on), on again when a Charger gives it energy
+    gained: float = 0.0     # J a Charger gave it in the last step (its topic says "charging" then)
 
     @classmethod
     def from_model(cls, robot: wm.Robot) -> Battery:
@@ -40,7 +41,19 @@ class Battery:
         return cls(float(b[0]), float(b[1]), float(b[2]), float(robot.cpu_consumption), float(b[0]))
 
     def reset(self) -> None:
-        self.energy, self.powered = self.initial, True
+        self.energy, self.powered, self.gained = self.initial, True, 0.0
+
+    @property
+    def state(self) -> str:
+        """What the battery does now: ``full`` (at its maximum), ``charging`` (a Charger gave it energy
+        in the last step), ``discharging`` (it holds energy that cpuConsumption takes), else ``idle``."""
+        if self.maximum > 0.0 and self.energy >= self.maximum:
+            return "full"
+        if self.gained > 0.0:
+            return "charging"
+        if self.energy > 0.0 and self.cpu > 0.0:
+            return "discharging"
+        return "idle"
 
     def power_back(self) -> None:
         """A robot off whose battery holds energy again (a Charger's) powers on."""
@@ -133,5 +146,6 @@ class Charger:
             self.done = True
             return
         held.energy += given
+        held.gained += given
         if held.energy > held.maximum:
             held.energy, self.done = held.maximum, True

@@ -252,6 +252,12 @@ class RobotState:
         self.battery = Battery.from_model(model)
         self.battery_schedule = Schedule()      # its battery sensor (Webots' wb_robot_battery_sensor_*)
         self.battery_value = math.nan           # the sensor's latest value (J)
+        # its /<robot>/battery topic (daemon/topics.py): demanded, it samples at every basic step unless the
+        # controller's sensor samples; each sample keeps (energy J, maximum J, Battery.state) and its time
+        self.battery_demanded = False
+        self.battery_samples = 0
+        self.battery_sampled_at_ms = 0
+        self.battery_sample: tuple[float, float, str] = (math.nan, math.nan, "idle")
 
     @property
     def pose(self) -> Pose:
@@ -413,7 +419,7 @@ class Simulation:
             self._glowing.append((c, [(mine[i], self.scene.loaded_model(mine[i]).appearance.emissive_color)  # type: ignore[union-attr]
                                       for i in shapes if i < len(mine) and self.scene.loaded_model(mine[i]).appearance],
                                   [(i, tuple(self.scene.light_model(slots[i]).color)) for i in lights if i < len(slots)]))
-        self._battery_sensing: list[RobotState] = []     # robots whose battery sensor is enabled
+        self._battery_sensing: list[RobotState] = []     # robots whose battery sensor is enabled or topic demanded
         self._jointed = [j for r in self.robots.values() for j in r.joints.values()]
         self._joint_robot = [r.index for r in self.robots.values() for _ in r.joints.values()]
         self._linked = [r for r in self.robots.values() if r.links is not None]
@@ -940,11 +946,16 @@ class Simulation:
                     dev.power_off()
         for robot in self._battery_sensing:
             s = robot.battery_schedule
-            # Webots refreshes the sensor when the battery empties: it reads 0 at once
-            if now - s.last_update_ms >= s.period_ms or robot in emptied:
-                # without a battery Webots' sensor reads -1 (WbRobot::currentEnergy)
-                robot.battery_value = robot.battery.energy if robot.battery.present else -1.0
-                s.last_update_ms = now
+            if s.period_ms > 0:
+                # Webots refreshes the sensor when the battery empties: it reads 0 at once
+                if now - s.last_update_ms >= s.period_ms or robot in emptied:
+                    # without a battery Webots' sensor reads -1 (WbRobot::currentEnergy)
+                    robot.battery_value = robot.battery.energy if robot.battery.present else -1.0
+                    s.last_update_ms = now
+                    if robot.battery_demanded:
+                        self._sample_battery(robot, now)
+            else:                     # only its topic wants it: every basic step
+                self._sample_battery(robot, now)
         for robot in emptied:         # Webots sends the 0 of an emptied battery whether its sensor is enabled or not
             if robot.battery_schedule.period_ms == 0:     # (WbRobot::writeAnswer's pending value)
                 robot.battery_value = 0.0
@@ -1030,15 +1041,35 @@ class Simulation:
         """Webots' wb_robot_battery_sensor_enable: a value every ``period_ms`` from now (0 disables;
         the last value stays)."""
         robot.battery_schedule.enable(period_ms, self.time_ms)
-        if period_ms > 0 and robot not in self._battery_sensing:
+        self._battery_sensed(robot)
+
+    def demand_battery(self, robot: RobotState, on: bool) -> None:
+        """The robot's battery topic is wanted (``on``) or not: a wanted battery with a present energy keeps
+        a sample (:attr:`RobotState.battery_sample`) at each of its controller's sensor values, or at every
+        basic step while its controller's sensor is off; the controller's sensor is left as it asked."""
+        robot.battery_demanded = bool(on) and robot.battery.present
+        self._battery_sensed(robot)
+
+    def _battery_sensed(self, robot: RobotState) -> None:
+        sensed = robot.battery_schedule.period_ms > 0 or robot.battery_demanded
+        if sensed and robot not in self._battery_sensing:
             self._battery_sensing.append(robot)
-        elif period_ms == 0 and robot in self._battery_sensing:
+        elif not sensed and robot in self._battery_sensing:
             self._battery_sensing.remove(robot)
+
+    @staticmethod
+    def _sample_battery(robot: RobotState, now: int) -> None:
+        b = robot.battery
+        robot.battery_sample = (b.energy, b.maximum, b.state)
+        robot.battery_sampled_at_ms = now
+        robot.battery_samples += 1
 
     def _charge(self, dt: int) -> None:
         """Every Charger's step (sim/battery.py) at the robots' and its solid's present positions; a
         Charger whose solid a Supervisor removed does nothing."""
         positions = np.array([p.translation for p in self.scene.robot_poses], dtype=np.float64).reshape(-1, 3)
+        for battery in self._batteries:
+            battery.gained = 0.0
         for charger in self.chargers:
             own = self.scene.solid_poses.get(charger.solid)
             if own is not None:

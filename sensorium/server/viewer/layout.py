@@ -3,7 +3,8 @@ Foxglove *Layouts → Import from file*.
 
 Built with the SDK's layout types (``foxglove.layouts``), from the topics of a recording or a world
 file: a 3D panel (fixed frame ``world``; the scene, every laser scan and point cloud visible), a
-plot of every light sensor's illuminance and every distance sensor's range, an image panel on the
+plot of every light sensor's illuminance, every distance sensor's range and every robot's battery
+percentage, an image panel on the
 first camera image (else the first lidar or range-finder range image), a raw-messages panel on ``/clock``
 and one on each robot's ``/<robot>/robot_window`` (the latest text its controller sent), for the
 robots with a controller (a world file) or whose window texts a recording holds: one tab each in one
@@ -35,7 +36,8 @@ def layout_json(topics: Mapping[str, str], windows: Iterable[str] = ()) -> str:
             three_d[name] = fl.BaseRendererPointCloudTopicSettings(visible=True, point_size=3.0)
     series = []
     for name, typ in sorted(topics.items()):
-        field = {"sensor_msgs/msg/Illuminance": "illuminance", "sensor_msgs/msg/Range": "range"}.get(typ)
+        field = {"sensor_msgs/msg/Illuminance": "illuminance", "sensor_msgs/msg/Range": "range",
+                 "sensor_msgs/msg/BatteryState": "percentage"}.get(typ)
         if field:
             series.append(fl.PlotSeries(value=f"{name}.{field}"))
     # a camera's image first (…/image), then range images
