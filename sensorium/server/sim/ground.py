@@ -78,7 +78,13 @@ from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_p
 from sensorium.server.sim.hull import FlatPoints, convex_hull, enclosed, extreme_points, hull_tolerance
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
-from sensorium.server.world.poses import axis_angle, axis_angle_matrix, matrix_quaternion, pose_from_model
+from sensorium.server.world.poses import (
+    ROBOT_UPRIGHT_TOL,
+    axis_angle,
+    axis_angle_matrix,
+    matrix_quaternion,
+    pose_from_model,
+)
 
 __all__ = ["Ground", "GroundPieces", "GroundWarning", "band_low", "falling_shapes", "falling_span", "ground_rotation", "hull_2d", "land_pose", "land_solid", "lift_pose", "over_support", "placing_ceiling", "resting_pose",
            "ride_height", "robot_up", "settle_pose", "settle_world", "settles", "settling_ground", "shapes_span", "slope_scales", "support_ceiling",
@@ -88,10 +94,6 @@ UPRIGHT_TOL = BOX_UPRIGHT_TOL     # |tilt| of a grid's or plane's local z from t
 SETTLE_TOL = 1e-6       # m: wheels off the ground by at most this stay as placed (a world on it keeps its bits)
 SETTLE_NOTE = 1e-3      # m: a robot settled by more than this gets a load note
 SETTLE_NOTES = 8        # load notes said one robot a line; more robots settled are counted in one more line
-# |x, y| of a robot's z axis (ENU) still taken as upright: it is settled. Webots' saved worlds keep the
-# small tilts physics left (pr2.wbt's robot at 4.7e-6 rad); settling along the robot's up then errs by
-# under 1 mm per metre between its origin and a wheel
-ROBOT_UPRIGHT_TOL = 1e-3
 
 
 class GroundWarning(UserWarning):

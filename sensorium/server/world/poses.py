@@ -8,6 +8,12 @@ import numpy as np
 
 from sensorium.server.world.geometry import Pose
 
+# rad: a robot's own axis this near the world's up still counts as its up (sim/ground.py settles a robot
+# whose z is; the .wbt drive judgement takes that axis for the robot's up). Webots' saved worlds keep the
+# small tilts physics left (pr2.wbt's robot at 4.7e-6 rad); settling along the robot's up then errs by
+# under 1 mm per metre between its origin and a wheel
+ROBOT_UPRIGHT_TOL = 1e-3
+
 
 def axis_angle_matrix(axis: tuple[float, float, float] | np.ndarray, angle: float) -> np.ndarray:
     a = np.asarray(axis, dtype=np.float64)

@@ -2493,8 +2493,7 @@ class Converter:
         nearer the world's up (a robot built y-up, as Webots' were before R2022a; ``on_side`` False: these
         two only, as Tracks and belts are judged). Its ``wheel_bottom`` is measured along its z or a NUE
         robot's y (:meth:`_settles_along`)."""
-        from sensorium.server.sim.ground import ROBOT_UPRIGHT_TOL
-        from sensorium.server.world.poses import pose_from_model
+        from sensorium.server.world.poses import ROBOT_UPRIGHT_TOL, pose_from_model
 
         r = pose_from_model(wm.Pose.model_validate(robot.data["pose"])).rotation
         world_up = 1 if self.world["world_info"].get("coordinate_system", "ENU") == "NUE" else 2
