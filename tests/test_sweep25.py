@@ -1,0 +1,129 @@
+"""Sweep 25: Webots samples not run before, each on a stand-in world of ours (tests/data/sweep25/: the
+sample's poses, sizes and devices, our own text, PROTO meshes stood in for by plain shapes) driven in
+process by the calls its controller makes and checked against closed forms."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_sweep19 import rot
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+DATA = Path(__file__).parent / "data" / "sweep25"
+
+# ----------------------------------------------------------------------------------------------- boomer
+# boomer (projects/vehicles, R2023b): the Boomer 3050 tractor, Webots' Tractor PROTO (a 4x4 Car: front
+# wheels of radius 0.38 m steering 1.76 m ahead of the rear ones of radius 0.6 m, tracks 1.4 m, every wheel's
+# centre at the origin's height; its default rotation 0 1 0 0.13 leans it nose down), at (2.79493, −17.8,
+# 0.609281), running boomer.c: 20 ms steps, each wheel motor at 10 km/h over its radius, the steering motors
+# never set, the five LEDs blinking with the simulated second, GPS speed from successive positions.
+SPEED = 10.0 / 3.6                 # m/s
+FRONT_R, REAR_R, WHEELBASE = 0.38, 0.6, 1.76
+LEAN = math.asin((REAR_R - FRONT_R) / WHEELBASE)      # both axles' wheels on the floor: L sin θ = r_rear − r_front
+START = (2.79493, -17.8)
+LEDS = ("left_flasher", "right_flasher", "tail_lights", "work_head_lights", "road_head_lights")
+
+
+def tractor_world(tmp_path: Path, rotation: str) -> Path:
+    """boomer.wbt with the tractor's rotation written out (``rotation``: its field's text)."""
+    text = (DATA / "boomer.wbt").read_text().replace("  controller \"boomer\"\n",
+                                                     f"  rotation {rotation}\n  controller \"boomer\"\n")
+    (tmp_path / "protos").mkdir(exist_ok=True)
+    for p in (DATA / "protos").iterdir():
+        (tmp_path / "protos" / p.name).write_text(p.read_text())
+    out = tmp_path / "boomer.wbt"
+    out.write_text(text)
+    return out
+
+
+def test_the_tractor_loads_as_a_4x4_car_and_lands_leaning_on_its_wheels_of_two_sizes() -> None:
+    """The tractor loads without a line with the 18 devices boomer.c asks for and the car's 4x4 drive (its
+    radii 0.38 and 0.6 m, its axles' bottoms 0.38 and 0.6 m below its origin). Webots' physics lays it on its
+    four wheels: leaning asin(0.22/1.76) = 0.12533 rad (the PROTO's 0.13 is 4.7 mrad off), its rear wheels'
+    centres 0.6 m up, from the 0.609281 the world gives; here it settles so at load, one line saying so, and
+    both axles' wheels touch the floor (1e-12)."""
+    w = load_world(DATA / "boomer.wbt")
+    assert w.warnings == []
+    (robot,) = w.world.robots
+    names = {d.name for d in robot.devices}
+    assert len(names) == 18 and {"left_steer", "right_steer", "left_front_wheel", "right_front_wheel",
+                                 "left_rear_wheel", "right_rear_wheel", "camera", "Sick LMS 291", "gps",
+                                 "gyro", *LEDS} <= names
+    car = robot.ackermann_drive
+    assert (car.type, car.wheelbase, car.track_front, car.track_rear) == ("4x4", WHEELBASE, 1.4, 1.4)
+    assert (car.front_wheel_radius, car.rear_wheel_radius) == (FRONT_R, REAR_R)
+    assert car.axle_bottoms == pytest.approx((-REAR_R, -FRONT_R), abs=1e-12)
+    sim = Simulation(w, "exact")
+    (said,) = w.warnings
+    assert said.endswith("boomer.wbt: robot 'vehicle' settled on the ground at load, as Webots' physics drops it: "
+                         "leaning 0.1253 rad about its y on its wheels of two sizes (both axles now touch the ground "
+                         "under it), its origin's z from 0.6093 to 0.6000 m")
+    pose = sim.robot("vehicle").pose
+    body = rot((0, 1, 0), LEAN)
+    assert np.asarray(pose.rotation) == pytest.approx(body, abs=1e-12)
+    assert list(pose.translation) == pytest.approx([*START, REAR_R], abs=1e-12)
+    t = np.asarray(pose.translation)
+    for x, radius in ((0.0, REAR_R), (WHEELBASE, FRONT_R)):
+        assert float((t + body @ np.array([x, 0.0, 0.0]))[2]) - radius == pytest.approx(0.0, abs=1e-12)
+
+
+def test_a_tractor_placed_upright_leans_onto_its_front_wheels_and_one_turned_far_keeps_its_pose(tmp_path: Path) -> None:
+    """Placed upright and turned 0.7 rad about z, the tractor (its front wheels 0.22 m above the floor when
+    upright) leans the same 0.12533 rad about its own y, its heading kept: Webots' physics drops its nose onto
+    its front wheels. Turned 0.5 rad about y (beyond 0.35 rad of upright) it keeps the world's pose, as any
+    tilted robot does."""
+    sim = Simulation(load_world(tractor_world(tmp_path, "0 0 1 0.7")), "exact")
+    pose = sim.robot("vehicle").pose
+    assert np.asarray(pose.rotation) == pytest.approx(rot((0, 0, 1), 0.7) @ rot((0, 1, 0), LEAN), abs=1e-12)
+    assert list(pose.translation) == pytest.approx([*START, REAR_R], abs=1e-12)
+    far = Simulation(load_world(tractor_world(tmp_path, "0 1 0 0.5")), "exact").robot("vehicle").pose
+    assert np.asarray(far.rotation) == pytest.approx(rot((0, 1, 0), 0.5), abs=1e-12)
+    assert list(far.translation) == pytest.approx([*START, 0.609281], abs=1e-12)
+
+
+def test_boomers_calls_drive_the_tractor_straight_at_10_kmh_leaning_as_it_landed() -> None:
+    """boomer.c's calls for 4 s (200 steps of 20 ms): the front wheels at 2.7778/0.38 = 7.3099 rad/s, the rear
+    ones at 4.6296 rad/s roll the car at 10 km/h along its heading (the world's +x: its lean is about its
+    y), so the GPS reads (2.79493 + 2.7778·t, −17.8, 0.6) each step (1e-9) and the controller's GPS speed,
+    |Δp| / 20 ms · 3600, is 10 km/h from the second step (1e-9); the gyro reads 0, the tractor keeps its lean
+    and height; the LEDs blink with the simulated second (on in odd seconds); the SICK LMS 291 (180 rays over
+    π, 80 m) looks 0.0150 rad above the horizon (its 0.140345 rad up less the body's 0.12533 down), so it sees
+    no floor: every ray reads inf, as in Webots' empty field."""
+    sim = Simulation(load_world(DATA / "boomer.wbt"), "exact")
+    robot = sim.robot("vehicle")
+    step = sim.basic_time_step
+    assert step == 20
+    for name, radius in (("left_front_wheel", FRONT_R), ("right_front_wheel", FRONT_R),
+                         ("left_rear_wheel", REAR_R), ("right_rear_wheel", REAR_R)):
+        robot.motor(name).set_position(math.inf)
+        robot.motor(name).set_velocity(10.0 * 1000.0 / 3600.0 / radius)
+    camera, sick = sim.device("vehicle/camera"), sim.device("vehicle/Sick LMS 291")
+    gps, gyro = sim.device("vehicle/gps"), sim.device("vehicle/gyro")
+    for d in (camera, sick, gps, gyro):
+        d.enable(step)
+    assert (camera.config.width, camera.config.height, camera.fov) == (128, 64, 1.0)
+    assert (sick.config.horizontal_resolution, sick.config.max_range) == (180, 80.0)
+    leds = [sim.device(f"vehicle/{n}") for n in LEDS]
+    body = rot((0, 1, 0), LEAN)
+    last = np.zeros(3)
+    for k in range(1, 201):
+        sim.step()
+        now = k * step
+        x = START[0] + SPEED * now / 1000.0
+        got = np.asarray(gps.values, dtype=float)
+        assert list(got) == pytest.approx([x, START[1], REAR_R], abs=1e-9), k
+        if k > 1:
+            assert float(np.linalg.norm(got - last)) / step * 3600.0 == pytest.approx(10.0, abs=1e-9), k
+        last = got
+        assert list(np.asarray(gyro.values, dtype=float)) == pytest.approx([0.0, 0.0, 0.0], abs=1e-12)
+        assert np.asarray(robot.pose.rotation) == pytest.approx(body, abs=1e-12)
+        assert np.all(np.isinf(np.asarray(sick.range_image, dtype=float)))
+        on = int(now / 1000.0) % 2
+        for led in leds:
+            led.set(on, now)
+        assert [led.value for led in leds] == [on] * 5
