@@ -127,3 +127,40 @@ def test_boomers_calls_drive_the_tractor_straight_at_10_kmh_leaning_as_it_landed
         for led in leds:
             led.set(on, now)
         assert [led.value for led in leds] == [on] * 5
+
+
+def test_a_supervisor_put_and_the_batched_simulation_land_the_tractor_as_the_load_does() -> None:
+    """Where a Supervisor puts the tractor (its world-file pose, upright 2 m up, turned 1 rad about z), it
+    lands leaning as at load, its heading kept (the load's bits for the world-file pose); the batched
+    simulation's copies load it leaning and drive it at 10 km/h bit for bit as Simulation does."""
+    from sensorium.gym.views import CopySim
+    from sensorium.server.sim.batched import BatchedSimulation
+    from sensorium.server.world.geometry import Pose
+
+    lw = load_world(DATA / "boomer.wbt")
+    single = Simulation(lw, "exact")
+    model = single.world.robots[0]
+    landed = single.robot("vehicle").pose
+    put = single.settled(model, Pose(rot((0, 1, 0), 0.13), np.array([*START, 0.609281])))
+    assert put.translation.tobytes() == landed.translation.tobytes()
+    assert put.rotation.tobytes() == landed.rotation.tobytes()
+    put = single.settled(model, Pose(rot((0, 0, 1), 1.0), np.array([1.0, 2.0, 2.0])))
+    assert np.asarray(put.rotation) == pytest.approx(rot((0, 0, 1), 1.0) @ rot((0, 1, 0), LEAN), abs=1e-12)
+    assert list(put.translation) == pytest.approx([1.0, 2.0, REAR_R], abs=1e-12)
+    batched = BatchedSimulation(lw, 2)
+    batched.reset(np.arange(2), [1, 2])
+    for sim in (single, CopySim(batched, 0), CopySim(batched, 1)):
+        for name, radius in (("left_front_wheel", FRONT_R), ("right_front_wheel", FRONT_R),
+                             ("left_rear_wheel", REAR_R), ("right_rear_wheel", REAR_R)):
+            motor = sim.robot("vehicle").motors[name]
+            motor.set_position(math.inf)
+            motor.set_velocity(10.0 * 1000.0 / 3600.0 / radius)
+    slot = batched.slot("vehicle")
+    for t in range(50):
+        batched.step()
+        single.step()
+        p = single.robot("vehicle").pose
+        for c in range(2):
+            assert batched.pos[c, slot].tobytes() == p.translation.tobytes(), (t, c)
+            assert batched.rot[c, slot].tobytes() == p.rotation.tobytes(), (t, c)
+    assert float(p.translation[0]) == pytest.approx(START[0] + SPEED, abs=1e-9)
