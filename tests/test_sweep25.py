@@ -5,10 +5,13 @@ process by the calls its controller makes and checked against closed forms."""
 from __future__ import annotations
 
 import math
+import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _serve import child_env, sensorium
 from test_sweep19 import rot
 
 from sensorium.server.sim.simulation import Simulation
@@ -164,3 +167,77 @@ def test_a_supervisor_put_and_the_batched_simulation_land_the_tractor_as_the_loa
             assert batched.pos[c, slot].tobytes() == p.translation.tobytes(), (t, c)
             assert batched.rot[c, slot].tobytes() == p.rotation.tobytes(), (t, c)
     assert float(p.translation[0]) == pytest.approx(START[0] + SPEED, abs=1e-9)
+
+
+BOOMER_CONTROLLER = '''\
+import math
+from controller import Keyboard, Robot
+
+FRONT_WHEEL_RADIUS, REAR_WHEEL_RADIUS = 0.38, 0.6
+robot = Robot()
+step = int(robot.getBasicTimeStep())
+wheels = {n: robot.getDevice(n) for n in ("left_front_wheel", "right_front_wheel", "left_rear_wheel",
+                                          "right_rear_wheel")}
+for m in wheels.values():
+    m.setPosition(math.inf)
+steer = [robot.getDevice("left_steer"), robot.getDevice("right_steer")]
+camera = robot.getDevice("camera")
+camera.enable(step)
+sick = robot.getDevice("Sick LMS 291")
+sick.enable(step)
+gps = robot.getDevice("gps")
+gps.enable(step)
+leds = [robot.getDevice(n) for n in ("left_flasher", "right_flasher", "tail_lights", "work_head_lights",
+                                     "road_head_lights")]
+print(f"camera {camera.getWidth()} {camera.getHeight()} {camera.getFov():g} sick "
+      f"{sick.getHorizontalResolution()} {sick.getMaxRange():g} {sick.getFov():.5f}", flush=True)
+kmh = 10.0
+for name, m in wheels.items():
+    m.setVelocity(kmh * 1000.0 / 3600.0 / (FRONT_WHEEL_RADIUS if "front" in name else REAR_WHEEL_RADIUS))
+keyboard = Keyboard()
+keyboard.enable(step)
+last = [0.0, 0.0, 0.0]
+while robot.step(step) != -1:
+    key = keyboard.getKey()
+    coords = gps.getValues()
+    speed = math.dist(coords, last) / step * 3600.0
+    last = list(coords)
+    on = int(robot.getTime()) % 2
+    for led in leds:
+        led.set(on)
+    t = round(robot.getTime() * 1000)
+    if t % 1000 == 0:
+        ranges = sick.getRangeImage()
+        print(f"{t} {key} {coords[0]:.9f} {coords[1]:.9f} {coords[2]:.9f} {speed:.9f} {leds[0].get()} "
+              f"{sum(math.isinf(r) for r in ranges)}", flush=True)
+'''
+
+
+@pytest.mark.slow
+def test_boomers_calls_drive_the_tractor_under_sensorium_run(tmp_path: Path) -> None:
+    """Our Python controller making boomer.c's calls under ``sensorium run`` for 3 s: the load report says
+    the tractor settled leaning 0.1253 rad; the camera is 128 × 64 with fov 1, the SICK 180 rays over π to
+    80 m; no key is pressed (−1); at 1, 2 and 3 s the GPS reads (2.79493 + 2.7778·t, −17.8, 0.6) and the
+    controller's GPS speed 10 km/h (1e-9), the LEDs on in odd seconds, every SICK ray inf."""
+    (tmp_path / "worlds").mkdir()
+    shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
+    world = tmp_path / "worlds" / "boomer.wbt"
+    world.write_text((DATA / "boomer.wbt").read_text())
+    (tmp_path / "controllers" / "boomer").mkdir(parents=True)
+    (tmp_path / "controllers" / "boomer" / "boomer.py").write_text(BOOMER_CONTROLLER)
+    done = subprocess.run(sensorium("run", str(world), "--until", "3000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "robot 'vehicle' settled on the ground at load, as Webots' physics drops it: leaning 0.1253 rad" in \
+        done.stdout + done.stderr
+    lines = [line.split("] ", 1)[1] for line in done.stdout.splitlines() if line.startswith("[vehicle] ")]
+    assert lines[0] == "camera 128 64 1 sick 180 80 3.14159"
+    rows = [line.split() for line in lines[1:]]
+    assert [int(r[0]) for r in rows] == [1000, 2000, 3000]
+    for t, key, x, y, z, speed, led, inf in rows:
+        assert int(key) == -1
+        assert [float(x), float(y), float(z)] == pytest.approx(
+            [START[0] + SPEED * int(t) / 1000.0, START[1], REAR_R], abs=1e-9)
+        assert float(speed) == pytest.approx(10.0, abs=1e-9)
+        assert (int(led), int(inf)) == (int(t) // 1000 % 2, 180)
