@@ -241,3 +241,68 @@ def test_boomers_calls_drive_the_tractor_under_sensorium_run(tmp_path: Path) -> 
             [START[0] + SPEED * int(t) / 1000.0, START[1], REAR_R], abs=1e-9)
         assert float(speed) == pytest.approx(10.0, abs=1e-9)
         assert (int(led), int(inf)) == (int(t) // 1000 % 2, 180)
+
+
+# -------------------------------------------------------------------------------------------------- url
+# url (projects/samples/howto, R2025a): assets named by https URLs (the background's cube maps, the robot's
+# body texture, its camera's noise mask, a mesh, a contact sound), the MyBot supervisor robot (wheels of radius
+# 0.025 m 0.09 m apart, turned 1 rad at (0, −0.15)) running url.c: 32 ms steps, both wheels at 1 rad/s, its
+# camera's image read each step, its body's ImageTexture (DEF IMAGE_TEXTURE, inside the robot) found by
+# getFromDef, its url set at the 81st step to a file that does not exist and at the 160th to another https URL.
+URL_R, URL_START, URL_HEADING = 0.025, (0.0, -0.15), 1.0
+
+
+def test_the_url_how_to_names_each_remote_asset_and_downloads_nothing() -> None:
+    """Every https asset is named in one line (the mesh a loss, the noise mask and the body texture warnings:
+    nothing is downloaded; the texture read as Webots reads one it cannot load, the body's baseColor), the
+    robot loads with its 7 devices and a two-wheel drive (radius 0.025 m, axle 0.09 m), the ball settles on the
+    floor (z 0.04)."""
+    w = load_world(DATA / "url.wbt")
+    said = "\n".join(w.warnings + [str(x) for x in w.report.lines()])
+    for asset in ("meshes/suzanne.obj", "textures/noise_mask.png", "textures/varnished_pine_base_color.jpg"):
+        assert said.count(f"https://example.org/{asset}") >= 1, asset
+    assert "nothing is downloaded" in said
+    (robot,) = w.world.robots
+    assert robot.name == "MyBot" and robot.supervisor
+    assert {d.name for d in robot.devices} == {"left wheel motor", "right wheel motor", "left wheel sensor",
+                                               "right wheel sensor", "ds0", "ds1", "camera"}
+    drive = robot.differential_drive
+    assert (drive.wheel_radius, drive.axle_length) == pytest.approx((URL_R, 0.09), abs=1e-12)
+    sim = Simulation(w, "exact")
+    assert list(sim.scene.solid_poses["soccer ball"].translation) == pytest.approx([0.04, -0.06, 0.04], abs=1e-12)
+
+
+def test_urls_calls_drive_mybot_and_its_texture_url_is_refused_where_webots_sets_it() -> None:
+    """url.c's calls in process: both wheels at 1 rad/s carry MyBot along its heading at 0.025 m/s (1e-9 each
+    step for 0.48 s, before its body meets the ball, which kinematic contact does not push); its Supervisor
+    finds the ImageTexture DEF'd inside its own body and reads its url (the world's https one). Setting it to a
+    file that does not exist, or to another https URL, is refused here in one line and the field keeps its
+    value: Webots sets the field, warns, and draws the body untextured (a failed download likewise)."""
+    from sensorium.server.daemon import supervisor as sv
+
+    sim = Simulation(load_world(DATA / "url.wbt"), "exact")
+    robot = sim.robot("MyBot")
+    step = sim.basic_time_step
+    assert step == 32
+    sim.device("MyBot/camera").enable(step)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(1.0)
+    for k in range(1, 16):
+        sim.step()
+        s = URL_R * 1.0 * k * step / 1000.0
+        assert list(robot.pose.translation[:2]) == pytest.approx(
+            [URL_START[0] + s * math.cos(URL_HEADING), URL_START[1] + s * math.sin(URL_HEADING)], abs=1e-9), k
+    texture = sv.find_node(sim, "IMAGE_TEXTURE")
+    assert texture is not None and texture.type == "ImageTexture"
+    written = ["https://example.org/textures/varnished_pine_base_color.jpg"]
+    assert sv.get_field(sim, texture, "url")["value"] == written
+    for url, problem in (("this_file_doesnt_exist.jpg", "texture file 'this_file_doesnt_exist.jpg' not found"),
+                         ("https://example.org/textures/brushed_steel_base_color.jpg",
+                          "only local image files are read here")):
+        with pytest.raises(ValueError) as err:
+            sv.change_item(sim, texture, "url", "set", 0, url)
+        line = str(err.value)
+        assert problem in line and line.endswith("nothing changed") and "\n" not in line, line
+        assert sv.get_field(sim, texture, "url")["value"] == written
