@@ -231,11 +231,11 @@ def test_attach_gives_a_clients_vehicle_library_the_car() -> None:
     (frames,) = core.handle([b"A", msgpack.packb({"id": 1, "service": "attach", "args": {"robot": "car"}})], 0.0)
     reply = msgpack.unpackb(frames[-1])
     res = S.AttachResult.model_validate(reply["result"])
-    # (the world entry's placement field wheel_bottom is not the vehicle library's: not on the wire; nor
+    # (the world entry's placement fields wheel_bottom and axle_bottoms are not the vehicle library's: not on the wire; nor
     # is motor_max_speeds: each motor's own maximum reaches the client as that motor's maxVelocity)
     assert res.ackermann_drive is not None and res.ackermann_drive.model_dump() == wm.AckermannDrive(
         wheelbase=L, track_front=TF, track_rear=TR, front_wheel_radius=RF, rear_wheel_radius=RR, max_wheel_speed=1000.0,
-        max_steering_angle=0.5).model_dump(exclude={"wheel_bottom", "motor_max_speeds"})
+        max_steering_angle=0.5).model_dump(exclude={"wheel_bottom", "axle_bottoms", "motor_max_speeds"})
     motors = {d.name: (d.minPosition, d.maxPosition) for d in res.devices if d.type == "RotationalMotor"}
     assert motors == {"right_steer": (-0.5, 0.5), "left_steer": (-0.5, 0.5), "right_rear_wheel": (0.0, 0.0),
                       "left_rear_wheel": (0.0, 0.0)}       # Webots: 0 and 0 is no limit (a wheel)

@@ -302,17 +302,24 @@ def _car_world(tmp_path: Path, front_radius: float, rear_radius: float, traction
 
 @pytest.mark.parametrize("traction, sensor", [(True, True), (True, False), (False, True)])
 def test_a_cars_free_wheels_hold_it_up_as_its_driven_ones_do(tmp_path: Path, traction: bool, sensor: bool) -> None:
-    """A front-wheel-drive car whose free rear wheels are larger (0.45 against 0.3: their bottoms 10 cm
+    """A front-wheel-drive car whose free rear wheels are larger (0.45 against 0.3: their bottoms 15 cm
     below the front ones'), with or without encoders, and a rear-wheel-drive car whose free front
-    wheels are: it settles on its lowest wheels, origin = floor − (axle height − the larger radius)."""
+    wheels are: the free wheels' bottoms count as the driven ones' (``wheel_bottom`` the lowest, both
+    axles' in ``axle_bottoms``), so it lands on both axles as Webots' physics lays it, leaning by θ about
+    its y with L sin θ = r_rear − r_front, its rear wheels touching the floor: origin = floor − (axle
+    height · cos θ − the rear radius)."""
     small, large = 0.3, 0.45
     front, rear = (small, large) if traction else (large, small)
     w = load_world(_car_world(tmp_path, front, rear, traction, sensor))
     car = w.world.robots[0].ackermann_drive
     assert car is not None and car.type == ("traction" if traction else "propulsion")
     assert car.wheel_bottom == AXLE_Z - large
+    assert car.axle_bottoms == pytest.approx((AXLE_Z - rear, AXLE_Z - front), abs=1e-12)
     assert not [n for n in w.warnings if "PositionSensor" in n]
-    assert _t(Simulation(w), "car")[2] == 0.1 - (AXLE_Z - large)
+    theta = math.asin((rear - front) / CAR_L)
+    pose = Simulation(w).robot("car").pose
+    assert pose.translation[2] == pytest.approx(0.1 - (AXLE_Z * math.cos(theta) - rear), abs=1e-12)
+    assert pose.rotation[2, 0] == pytest.approx(-math.sin(theta), abs=1e-12)      # nose down when the rear is larger
     # equal wheels: the driven ones' bottom, as before
     w = load_world(_car_world(tmp_path, small, small, traction, sensor))
     assert w.world.robots[0].ackermann_drive.wheel_bottom == AXLE_Z - small

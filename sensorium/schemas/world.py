@@ -1636,6 +1636,11 @@ class AckermannDrive(Strict):
     rear_axle_offset: float = Field(default=0.0, description="m, where the rear axle's centre is along forward from "
                                     "the robot's origin (negative: behind it); 0, the origin on the rear axle, as "
                                     "Webots' car PROTOs have it")
+    axle_bottoms: tuple[float, float] | None = Field(
+        default=None, description="m, (rear, front): each axle's wheels' bottom from the origin along its z when the "
+        "robot is upright, given when they differ (wheels of two sizes, as Webots' Tractor's 0.6 and 0.38 m, or "
+        "axles at two heights; the .wbt import gives it for a Robot with physics): with ``wheel_bottom`` the car "
+        "settles leaning about its y until both axles' wheels touch the ground (README \"Settling on the ground\")")
     engine_type: Literal["combustion", "electric", "parallel hybrid", "power-split hybrid"] = Field(
         default="combustion", description="Webots' Car engineType: what the vehicle library's getEngineType answers "
         "(no engine is simulated)")

@@ -682,6 +682,57 @@ def _upright_wheels(robot: wm.Robot, pose: Pose, to_enu: np.ndarray | None) -> t
     return bottom, max(0.0, bottom + radius), t
 
 
+CAR_LEAN_TOL = 0.35
+"""rad: a car on wheels of two sizes (``axle_bottoms``) whose up is within this of the world's, turned about
+its own y only (its left level within ROBOT_UPRIGHT_TOL), settles onto its lean; beyond, it keeps its pose."""
+
+
+def car_lean(robot: wm.Robot) -> tuple[float, float, float] | None:
+    """(θ, h, c) for a car whose axles' wheels differ (``axle_bottoms``, x forward): θ its lean about its y
+    (Webots' rotation about +y: positive puts its nose down) at which both axles' wheels touch a flat ground,
+    h the rear wheels' contact height above its origin leaning so, c their centre's; None for any other robot. With the
+    axles' centres c = bottom + radius, a wheel's lowest point stays its centre less its radius however it
+    leans (a circle turned in its plane), so L sin θ + (c_rear − c_front) cos θ = r_rear − r_front."""
+    a = robot.ackermann_drive
+    if a is None or a.axle_bottoms is None or a.wheel_bottom is None or tuple(a.forward) != (1.0, 0.0):
+        return None
+    rr, rf = float(a.rear_wheel_radius), float(a.front_wheel_radius)
+    cr, cf = float(a.axle_bottoms[0]) + rr, float(a.axle_bottoms[1]) + rf
+    size = math.hypot(float(a.wheelbase), cr - cf)
+    if abs(rr - rf) >= size:
+        return None
+    theta = math.asin((rr - rf) / size) - math.atan2(cr - cf, float(a.wheelbase))
+    x = float(a.rear_axle_offset)
+    centre = -x * math.sin(theta) + cr * math.cos(theta)
+    return theta, centre - rr, centre
+
+
+def lean_pose(robot: wm.Robot, pose: Pose, ground: Ground | None,
+              to_enu: np.ndarray | None) -> tuple[Pose | None, bool]:
+    """(its pose, True) for a car on wheels of two sizes (:func:`car_lean`) in a z-up world, placed within
+    CAR_LEAN_TOL of upright and turned about its own y only: leaning by θ about its y, its heading kept,
+    its origin's height ``ground − h`` over the ground under it (``pose`` itself when within SETTLE_TOL and
+    1e-9 rad of that, or over no ground); (None, False) for any other robot, settled by the upright rule."""
+    lean = None if to_enu is not None else car_lean(robot)
+    r, t = pose.rotation, pose.translation
+    if lean is None or abs(r[2, 1]) > ROBOT_UPRIGHT_TOL or r[2, 2] < math.cos(CAR_LEAN_TOL):
+        return None, False
+    theta, contact, centre = lean
+    if ground is None:
+        return pose, True
+    found, heights, _, _ = ground.under(np.array([float(t[0])]), np.array([float(t[1])]),
+                                        np.array([float(t[2]) + max(0.0, centre)]) + FLOOR)
+    if not found[0]:
+        return pose, True
+    yaw = math.atan2(float(r[1, 0]), float(r[0, 0]))
+    pitch = math.atan2(-float(r[2, 0]), float(r[2, 2]))
+    height = float(heights[0]) - contact
+    if abs(pitch - theta) <= 1e-9 and abs(height - float(t[2])) <= SETTLE_TOL:
+        return pose, True
+    rotation = axis_angle_matrix((0.0, 0.0, 1.0), yaw) @ axis_angle_matrix((0.0, 1.0, 0.0), theta)
+    return Pose(rotation, np.array([float(t[0]), float(t[1]), height])), True
+
+
 def _up_axis(to_enu: np.ndarray | None) -> tuple[int, float]:
     """The world axis that is up and its sign (ENU's z: the world's y in a NUE world)."""
     if to_enu is None:
@@ -701,6 +752,9 @@ def settle_pose(robot: wm.Robot, pose: Pose, ground: Ground | None, to_enu: np.n
     the same arithmetic (so a robot put back at its world-file pose takes its settled initial pose,
     bit for bit); ``pose`` itself when it does not settle (no ``wheel_bottom``, not upright, over no
     ground, within SETTLE_TOL of it)."""
+    leaned, leans = lean_pose(robot, pose, ground, to_enu)
+    if leans:
+        return pose if leaned is None else leaned
     got = None if ground is None else _upright_wheels(robot, pose, to_enu)
     if got is None:
         return pose
@@ -1252,20 +1306,39 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str, base_d
     ground here too, as the world loads them (Webots' physics drops a robot on any bounding object).
     Over no ground, off by at most SETTLE_TOL, or not upright, a robot keeps its pose bit for bit."""
     world, solid_notes = _settle_solids(world, to_enu, base_dir, source, caught)
+    leaning = [i for i, r in enumerate(world.robots)
+               if to_enu is None and car_lean(r) is not None and lean_pose(r, pose_from_model(r.pose), None, None)[1]]
     settling = [(i, r, got) for i, r in enumerate(world.robots)
-                if (got := _upright_wheels(r, pose_from_model(r.pose), to_enu)) is not None]
-    if not settling:
+                if i not in leaning and (got := _upright_wheels(r, pose_from_model(r.pose), to_enu)) is not None]
+    if not settling and not leaning:
         return world, solid_notes
     ground = settling_ground([(s, pose_from_model(s.pose)) for s in world.solids],
                              [(r, pose_from_model(r.pose)) for r in world.robots if not r.drive_motors], to_enu)
     if ground is None:
         return world, solid_notes
+    robots = list(world.robots)
+    lean_notes = []
+    for i in leaning:       # cars on wheels of two sizes: onto both axles (ground.lean_pose)
+        robot = robots[i]
+        before = pose_from_model(robot.pose)
+        after, _ = lean_pose(robot, before, ground, None)
+        if after is None or after is before:
+            continue
+        axis, angle = axis_angle(after.rotation)[:3], axis_angle(after.rotation)[3]
+        robots[i] = robot.model_copy(update={"pose": wm.Pose(translation=tuple(float(v) for v in after.translation),
+                                                             rotation=(*axis, angle))})
+        theta = car_lean(robot)[0]  # type: ignore[index]
+        lean_notes.append(f"{source}: robot {robot.name!r} settled on the ground at load, as Webots' physics drops it: "
+                          f"leaning {theta:.4f} rad about its y on its wheels of two sizes (both axles now touch the "
+                          f"ground under it), its origin's z from {float(before.translation[2]):.4f} to "
+                          f"{float(after.translation[2]):.4f} m")
+    if not settling:
+        return world.model_copy(update={"robots": robots}), [*solid_notes, *lean_notes]
     up, sign = _up_axis(to_enu)
     # every robot's ground in one call (element-wise: the bits settle_pose gives one robot)
     bottoms, axles, xs, ys, zs = (np.array(c) for c in zip(*[(b, a, float(t[0]), float(t[1]), float(t[2]))
                                                                for _, _, (b, a, t) in settling]))
     move, heights = _settled(ground, bottoms, axles, xs, ys, zs)
-    robots = list(world.robots)
     moved: list[tuple[str, float, float]] = []
     for k, (i, robot, _) in enumerate(settling):
         if not move[k]:
@@ -1282,4 +1355,5 @@ def settle_world(world: wm.World, to_enu: np.ndarray | None, source: str, base_d
     if len(notes) > SETTLE_NOTES:
         more = len(notes) - SETTLE_NOTES
         notes = [*notes[:SETTLE_NOTES], f"{source}: {more} more robots settled on the ground at load"]
-    return (world.model_copy(update={"robots": robots}) if moved else world), [*solid_notes, *notes]
+    return (world.model_copy(update={"robots": robots}) if moved or lean_notes else world), \
+        [*solid_notes, *lean_notes, *notes]

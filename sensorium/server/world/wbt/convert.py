@@ -2377,6 +2377,8 @@ class Converter:
             if car is not None and rolling and self.fields(node).node_("physics") is not None \
                     and self._settles_along(self._robot_up(robot)):
                 self._free_wheel_bottom(robot, car, [f for f in robot.free if id(f) in rolling])
+            if car is not None:
+                self._car_axles_done(car)
 
     def track(self, node: Node, frame: Frame, owner: Owner, motor: dict, line: str) -> None:
         """A robot's Track driven by its LinearMotor (``motor``'s entry), kept for ``_track_drive``:
@@ -2485,6 +2487,28 @@ class Converter:
         bottom = wheel_bottom(free, self, self._robot_up(robot))
         if bottom is not None:
             car["wheel_bottom"] = min(car.get("wheel_bottom", bottom), bottom)
+            self._car_axles(car, free, self._robot_up(robot))
+
+    def _car_axles(self, car: dict, wheels: list[dict], up: int) -> None:
+        """A car's ``axle_bottoms`` (rear, front) from its driven and free wheels, kept when both axles'
+        are known and differ by more than GROUND_TOL: wheels of two sizes (Webots' Tractor), so Webots'
+        physics leans it until both axles touch the ground."""
+        from sensorium.server.world.wbt.drive import axle_bottoms
+
+        known = dict(zip(("rear", "front"), car.pop("axle_bottoms", None) or (None, None)))
+        for axle, bottom in axle_bottoms(car, wheels, self, up).items():
+            was = known.get(axle)
+            known[axle] = bottom if was is None else min(was, bottom)
+        car["axle_bottoms"] = (known.get("rear"), known.get("front"))   # the free wheels may give the other
+
+    @staticmethod
+    def _car_axles_done(car: dict) -> None:
+        """Keep a car's ``axle_bottoms`` only when both axles' are known and differ by more than GROUND_TOL."""
+        from sensorium.server.world.wbt.drive import GROUND_TOL
+
+        rear, front = car.pop("axle_bottoms", None) or (None, None)
+        if rear is not None and front is not None and abs(rear - front) > GROUND_TOL:
+            car["axle_bottoms"] = (rear, front)
 
     def _robot_up(self, robot: Owner, on_side: bool = True) -> int:
         """The robot's own axis that stands up, its wheels judged with it for their z (wbt/drive.py): the
@@ -2791,6 +2815,8 @@ class Converter:
             for key in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive"):
                 if key in robot.data:
                     robot.data[key]["wheel_bottom"] = bottom
+            if "ackermann_drive" in robot.data:
+                self._car_axles(robot.data["ackermann_drive"], wheels, up)
         for w in wheels:    # the wheels' encoders measure the drive's wheels
             for entry in w.get("sensors", ()):
                 entry["motor"] = w["motor"]

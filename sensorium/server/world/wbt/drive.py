@@ -918,6 +918,20 @@ def wheel_bottom(wheels: list[dict], conv, up: int = 2) -> float | None:
     return min(bottoms) if bottoms else None
 
 
+def axle_bottoms(car: dict, wheels: list[dict], conv, up: int = 2) -> dict[str, float]:
+    """A car's wheels' lowest bottom (:func:`wheel_bottom`'s) on each axle, "rear" and "front", of
+    ``wheels`` (its driven or its free ones), each wheel on the axle nearer its centre along x."""
+    rear_x = float(car.get("rear_axle_offset", 0.0))
+    middle = rear_x + 0.5 * float(car["wheelbase"])
+    out: dict[str, float] = {}
+    for w in wheels:
+        bottom = wheel_bottom([w], conv, up)
+        if bottom is not None:
+            axle = "front" if float(w["centre"][0]) > middle else "rear"
+            out[axle] = min(out.get(axle, bottom), bottom)
+    return out
+
+
 def _on_axis(w: dict, conv) -> np.ndarray:
     """Where a wheel rolls on the ground (above it): the centre of its round part (:func:`round_centre`,
     else its end point's origin) taken onto its axis's line, in the robot's frame."""
