@@ -284,9 +284,11 @@ def serve(world: Path | str | None = None, *extra: str, rpc: str = ANY_PORT, pub
 
 
 def run_controller(world: Path, argv, env: dict[str, str] | None = None, robot: str = "bot",
-                   cwd: Path | str = REPO, timeout: float = 120.0) -> tuple[list[str], str]:
+                   cwd: Path | str = REPO, timeout: float = 120.0,
+                   server_log: list[str] | None = None) -> tuple[list[str], str]:
     """``argv(url)`` run (in ``cwd``) as ``robot``'s controller against a fresh ``sensorium serve WORLD
-    --mode fast`` until it exits by itself (code 0 asserted): (its stdout lines, its stderr)."""
+    --mode fast`` until it exits by itself (code 0 asserted): (its stdout lines, its stderr). ``server_log``
+    (when given) receives the server's stderr once it has stopped (what Webots prints in its console)."""
     with serve(world, "--mode", "fast", env=env) as server:
         url = server.url(robot)
         proc = Proc(argv(url), env={**(env or {}), "SENSORIUM_CONTROLLER_URL": url}, cwd=cwd)
@@ -295,7 +297,9 @@ def run_controller(world: Path, argv, env: dict[str, str] | None = None, robot: 
         finally:
             proc.stop()
         assert code == 0, proc.stderr()
-        return proc.stdout().splitlines(), proc.stderr()
+    if server_log is not None:
+        server_log.append(server.stderr())
+    return proc.stdout().splitlines(), proc.stderr()
 
 
 def run_example(world: str, example: str, robot: str, steps: int) -> tuple[dict, Proc]:

@@ -4,9 +4,11 @@ the folder, in a sub-folder, with '..', absolute, a symlink out of the folder, h
 strings, a file that is no image, a PNG declaring a huge size, a file replaced between its check and
 its read), interleaved with Material colour sets and simulationReset, on the world of
 test_supervisor_texture.py. After every change the camera and the infra-red sensor read what the
-world file written with the current first url (and colour) reads, or the change was refused with
-one line and nothing changed; a reset brings the world file's image back; the images no shape uses
-are let go (memory bounded)."""
+world file written with the current first url (and colour) reads, or, when that url's image is not
+read (missing, no image, outside the folder), what the world written without url reads, with one line
+(Webots' rule), or the change was refused with one line and nothing changed (an image over the limits,
+bad input); a reset brings the world file's image back; the images no shape uses are let go (memory
+bounded)."""
 
 from __future__ import annotations
 
@@ -122,12 +124,14 @@ def test_random_url_changes_read_as_the_world_file_with_that_url(folder: Path, m
     def run(ops):
         sim.reset()
         urls, diffuse = ["a.png"], None
+        unread = False                  # the first url's image was not read: the shapes untextured
         for kind, a, b in ops:
             before = (field(sim, tex, "url"), _shot(sim))
+            lines: list[str] = []
             try:
                 if kind == "reset":
                     sim.reset()
-                    urls, diffuse = ["a.png"], None
+                    urls, diffuse, unread = ["a.png"], None, False
                 elif kind == "diffuse":
                     sv.set_field(sim, material, "diffuseColor", list(a))
                     diffuse = a
@@ -136,7 +140,7 @@ def test_random_url_changes_read_as_the_world_file_with_that_url(folder: Path, m
                         continue
                     swap[:] = [(a, b)]
                     try:
-                        sv.change_item(sim, tex, "url", "set", 0, a)
+                        lines = sv.change_item(sim, tex, "url", "set", 0, a)
                     finally:
                         for kind_, done in swap:
                             if kind_ == "restore":
@@ -144,10 +148,16 @@ def test_random_url_changes_read_as_the_world_file_with_that_url(folder: Path, m
                                 (folder / good).unlink()
                                 (folder / good).write_bytes(saved)
                         swap.clear()
-                    urls = field(sim, tex, "url")
                 else:
-                    sv.change_item(sim, tex, "url", kind, a, b)
-                    urls = field(sim, tex, "url")
+                    lines = sv.change_item(sim, tex, "url", kind, a, b)
+                now = field(sim, tex, "url")
+                assert len(lines) <= 1 and all("\n" not in x and len(x) < 600 for x in lines), lines
+                if lines:
+                    assert "drawn without its texture" in lines[0] and now != urls, (lines, now, urls)
+                    unread = True
+                elif now != urls:      # the list changed and its first url's image (or none) was read
+                    unread = False
+                urls = now
             except ValueError as exc:
                 line = str(exc)
                 assert "\n" not in line and len(line) < 600 and "nothing changed" in line, line
@@ -155,7 +165,7 @@ def test_random_url_changes_read_as_the_world_file_with_that_url(folder: Path, m
                 got = _shot(sim)
                 assert np.array_equal(got[0], before[1][0]) and got[1] == before[1][1], (kind, a, b)
                 continue
-            first = urls[0] if urls and urls[0].strip() else None
+            first = urls[0] if urls and urls[0].strip() and not unread else None
             want = refs(first, diffuse)
             got = _shot(sim)
             assert np.array_equal(got[0], want[0]) and got[1] == want[1], (kind, a, b, urls, diffuse)
@@ -198,8 +208,8 @@ def test_a_world_image_deleted_after_load_still_comes_back_on_reset(tmp_path: Pa
     again = _shot(sim)
     assert np.array_equal(again[0], first[0]) and again[1] == first[1]
     sv.change_item(sim, tex, "url", "set", 0, "c.jpg")      # and a shape holding it is checked without reading it
-    with pytest.raises(ValueError, match="texture file 'a.png' not found"):     # a url set is read now: refused
-        sv.change_item(sim, tex, "url", "set", 0, "a.png")
+    (line,) = sv.change_item(sim, tex, "url", "set", 0, "a.png")     # a url set is read now: gone, untextured
+    assert "texture file 'a.png' not found" in line and sim.scene.shape_model(0).appearance.texture is None
 
 
 @pytest.mark.parametrize("examples", example_counts(400))

@@ -3,8 +3,9 @@ ImageTexture's ``url`` set, inserted into or emptied through ``setMFString``/``i
 ``removeMF`` is what cameras and infra-red sensors see from the next step, image for image and
 reading for reading as the same world written with that url; a texture a DEF names changes in the
 shapes that USE it; ``repeatS``/``repeatT`` too; a reset brings the world file's image back; a url
-that cannot be read is refused with one line and nothing changes. Our own world and images, written
-in the test's folder. The same from Python and C controllers."""
+whose image cannot be read is set with one line and the shapes drawn untextured (Webots' rule), one
+over the world's texture limits refused with one line and nothing changed. Our own world and images,
+written in the test's folder. The same from Python and C controllers."""
 
 from __future__ import annotations
 
@@ -351,20 +352,31 @@ def test_an_unchanged_file_named_again_is_the_image_held_not_a_second_copy(folde
     assert np.array_equal(got[0], ref[0]) and got[1] == ref[1]
 
 
-def test_a_file_overwritten_with_no_image_is_refused_when_named_again(folder):
+def _untextured(sim, tex, url: str, problem: str) -> None:
+    """Setting ``url``, whose image is not read, sets the field with one line naming the problem, and the
+    shapes are drawn untextured: what the world written with no url shows (its Material's diffuse colour)."""
+    lines = sv.change_item(sim, tex, "url", "set", 0, url)
+    assert len(lines) == 1 and "\n" not in lines[0], lines
+    assert lines[0].startswith(f"field 'url' (MFString) of ImageTexture 'TEX' (node {tex.id}): ") and \
+        problem in lines[0] and lines[0].endswith("the shape is drawn without its texture (as Webots draws an "
+                                                   "image it cannot load)"), lines[0]
+    assert field(sim, tex, "url") == [url]
+    got = _shot(sim)
+    ref = _written(sim.scene.base_dir, "", "empty.wbt")
+    assert np.array_equal(got[0], ref[0]) and got[1] == ref[1]
+    assert _centre(got[0]) == expected_bytes(DIFFUSE)
+
+
+def test_a_file_overwritten_with_no_image_leaves_the_shapes_untextured_when_named_again(folder):
     sim = _sim(folder / "world.wbt")
     tex = sv.find_node(sim, "TEX")
     sv.change_item(sim, tex, "url", "set", 0, "b.png")
-    shown = _shot(sim)
     (folder / "a.png").write_bytes(b"\x89PNG\r\n\x1a\n" + b"broken" * 10)
-    with pytest.raises(ValueError) as exc:
-        sv.change_item(sim, tex, "url", "set", 0, "a.png")
-    line = str(exc.value)
-    assert line.startswith(f"field 'url' (MFString) of ImageTexture 'TEX' (node {tex.id}): ") and \
-        line.endswith("; nothing changed") and "\n" not in line and "a.png" in line, line
-    assert field(sim, tex, "url") == ["b.png"]
+    _untextured(sim, tex, "a.png", "a.png")
+    # the world written with that url loads untextured too (one load line), as the Supervisor's set leaves it
     got = _shot(sim)
-    assert np.array_equal(got[0], shown[0]) and got[1] == shown[1]
+    ref = _written(folder, '"a.png"', "broken.wbt")
+    assert np.array_equal(got[0], ref[0]) and got[1] == ref[1]
 
 
 @pytest.mark.parametrize(("url", "problem"), [
@@ -375,19 +387,34 @@ def test_a_file_overwritten_with_no_image_is_refused_when_named_again(folder):
     ("webots://projects/default/worlds/textures/stone.jpg",
      '"webots://projects/default/worlds/textures/stone.jpg" not found (Webots); looked in: nothing'),
     ("ftp://example.com/t.png", "only local image files are read here"),
-    ("big.png", "'big.png' has 64x64 = 4,096 pixels, more than the limit of 1,000"),
 ])
-def test_a_url_that_cannot_be_read_is_refused_and_nothing_changes(folder, url, problem, monkeypatch):
+def test_a_url_whose_image_is_not_read_is_set_and_the_shapes_drawn_untextured(folder, url, problem, monkeypatch):
+    """Webots' WbImageTexture sets the url, warns and draws the shape without its texture when the image
+    cannot be loaded (missing, not an image, a failed download); here too, a download never tried and a
+    file outside the world's folder never read. A valid url set after brings the image back."""
     monkeypatch.delenv("WEBOTS_HOME", raising=False)
     monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
     (folder.parent / "outside.png").write_bytes((folder / "a.png").read_bytes())
+    sim = _sim(folder / "world.wbt")
+    before = _shot(sim)
+    tex = sv.find_node(sim, "TEX")
+    _untextured(sim, tex, url, problem)
+    assert sv.change_item(sim, tex, "url", "set", 0, "a.png") == []
+    got = _shot(sim)
+    assert np.array_equal(got[0], before[0]) and got[1] == before[1]
+
+
+def test_an_image_over_the_texture_limits_is_refused_and_nothing_changes(folder):
+    """A limit of the world's, not Webots' rule: an image over it is refused with one line (raise the limits
+    with --allow-large), the field and the image shown as before."""
     sim = _sim(folder / "world.wbt", limits=WorldLimits(texture_pixels=1000))
     before = _shot(sim)
     tex = sv.find_node(sim, "TEX")
     with pytest.raises(ValueError) as err:
-        sv.change_item(sim, tex, "url", "set", 0, url)
+        sv.change_item(sim, tex, "url", "set", 0, "big.png")
     line = str(err.value)
-    assert line.startswith("field 'url' (MFString) of ImageTexture 'TEX' (node ") and problem in line, line
+    assert line.startswith("field 'url' (MFString) of ImageTexture 'TEX' (node ") and \
+        "'big.png' has 64x64 = 4,096 pixels, more than the limit of 1,000" in line, line
     assert line.endswith("nothing changed") and "\n" not in line
     assert field(sim, tex, "url") == ["a.png"]
     got = _shot(sim)
@@ -409,7 +436,7 @@ def test_a_webots_url_of_the_installation_is_read_from_it(folder, tmp_path, monk
     """Webots' texture_change how-to sets webots:// urls its world file never writes: with
     --webots-home (WEBOTS_HOME) the image is read from the installation, and the camera and the
     infra-red sensor see what they see in the world written with that file; one the installation
-    lacks is refused with one line naming where it looked, nothing changed."""
+    lacks is set with one line naming where it looked, the shapes drawn untextured."""
     home = _home(tmp_path)
     monkeypatch.setenv("WEBOTS_HOME", str(home))
     monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
@@ -424,14 +451,10 @@ def test_a_webots_url_of_the_installation_is_read_from_it(folder, tmp_path, monk
     ref = _written(folder, '"copy.png"')
     assert np.array_equal(got[0], ref[0]) and got[1] == ref[1]
     assert not np.array_equal(got[0], before[0])
-    with pytest.raises(ValueError) as err:
-        sv.change_item(sim, tex, "url", "set", 0, "webots://projects/default/worlds/textures/none.png")
-    line = str(err.value)
-    assert '"webots://projects/default/worlds/textures/none.png" not found' in line and str(home) in line, line
-    assert line.endswith("; nothing changed") and "\n" not in line
-    assert field(sim, tex, "url") == [url]
-    again = _shot(sim)
-    assert np.array_equal(again[0], got[0])
+    none = "webots://projects/default/worlds/textures/none.png"
+    _untextured(sim, tex, none, f'"{none}" not found')
+    (line,) = sv.change_item(sim, tex, "url", "set", 0, none + "x")
+    assert str(home) in line, line
 
 
 def test_bad_indices_and_values_are_one_line(folder):
@@ -487,7 +510,7 @@ def _expected_lines() -> list[str]:
             "set b.png 1",
             f"removed 0 {diffuse[0]} {diffuse[1]} {diffuse[2]}",
             f"inserted a.png {a[0]} {a[1]} {a[2]}",
-            f"refused a.png {a[0]} {a[1]} {a[2]}"]
+            f"missing nope.png {diffuse[0]} {diffuse[1]} {diffuse[2]}"]
 
 
 @pytest.fixture(scope="module")
@@ -496,14 +519,21 @@ def c_controller(tmp_path_factory) -> str:
 
 
 def test_a_python_controller_changes_a_texture_its_camera_sees(folder) -> None:
+    log: list[str] = []
     lines, err = run_controller(folder / "world.wbt", lambda url: sensorium(
-        "controller", "--url", url, str(REPO / "tests" / "controllers" / "texture_change.py")), robot="looker")
+        "controller", "--url", url, str(REPO / "tests" / "controllers" / "texture_change.py")), robot="looker",
+        server_log=log)
     assert lines == _expected_lines(), err
-    assert "'nope.png' not found" in err and err.count("nope.png") == 1, err
+    # the url set to a missing file: one line in the server's log (Webots' console), none for the controller
+    assert "nope.png" not in err, err
+    assert log[0].count("texture file 'nope.png' not found") == 1, log[0]
 
 
 def test_a_c_controller_does_the_same(folder, c_controller: str) -> None:
-    lines, err = run_controller(folder / "world.wbt", lambda url: [c_controller], env=SAN_ENV, robot="looker")
+    log: list[str] = []
+    lines, err = run_controller(folder / "world.wbt", lambda url: [c_controller], env=SAN_ENV, robot="looker",
+                                server_log=log)
     assert "Sanitizer" not in err and "runtime error" not in err, err
     assert lines == _expected_lines(), err
-    assert "'nope.png' not found" in err, err
+    assert "nope.png" not in err, err
+    assert log[0].count("texture file 'nope.png' not found") == 1, log[0]

@@ -1,8 +1,8 @@
 /* A Webots-style C supervisor changing a wall's texture and its camera seeing it (tests/test_supervisor_texture.py,
  * which writes the world and its images): the ImageTexture found by DEF, its url set
  * (wb_supervisor_field_set_mf_string), emptied (wb_supervisor_field_remove_mf), given again
- * (wb_supervisor_field_insert_mf_string) and set to a file that does not exist (refused with one error line,
- * nothing changed). Prints the lines tests/controllers/texture_change.py prints. */
+ * (wb_supervisor_field_insert_mf_string) and set to a file that does not exist (set, with one warning line:
+ * the wall is drawn untextured, as in Webots). Prints the lines tests/controllers/texture_change.py prints. */
 #include <stdio.h>
 #include <string.h>
 
@@ -45,7 +45,7 @@ int main(void) {
   wb_supervisor_field_set_mf_string(url, 0, "nope.png");
   wb_robot_step(dt);
   centre(now);
-  printf("refused %s %d %d %d\n", wb_supervisor_field_get_mf_string(url, 0), now[0], now[1], now[2]);
+  printf("missing %s %d %d %d\n", wb_supervisor_field_get_mf_string(url, 0), now[0], now[1], now[2]);
   wb_robot_cleanup();
   return 0;
 }

@@ -1,6 +1,6 @@
 """A Webots-style supervisor changing a wall's texture and its camera seeing it (tests/test_supervisor_texture.py,
 which writes the world and its images): the ImageTexture found by DEF, its url set, emptied, given again and set to
-a file that does not exist (refused with one error line, nothing changed). Written as for Webots; prints the lines
+a file that does not exist (set, with one warning line: the wall is drawn untextured, as in Webots). Written as for Webots; prints the lines
 tests/c/texture_change.c prints."""
 
 from controller import Supervisor
@@ -32,4 +32,4 @@ robot.step(timestep)
 print("inserted", url.getMFString(0), centre())
 url.setMFString(0, "nope.png")
 robot.step(timestep)
-print("refused", url.getMFString(0), centre())
+print("missing", url.getMFString(0), centre())

@@ -21,7 +21,7 @@ from typing import Any
 
 from sensorium.schemas import world as wm
 from sensorium.server.daemon.mf_items import item_position
-from sensorium.server.world.textures import TextureFileError, read_checked_image
+from sensorium.server.world.textures import TextureFileError, TextureLimitError, read_checked_image
 from sensorium.server.world.wbt.fields import GEOMETRY_FIELDS, MATERIAL_FIELDS, PBR_FIELDS, TEXTURE_FIELDS
 
 TYPES = frozenset({"Shape", "Appearance", "PBRAppearance", "Material", "ImageTexture", "Box", "Sphere", "Cylinder",
@@ -243,65 +243,80 @@ def _world_url(scene: Any, url: str) -> str | None:
     return None
 
 
-def _installed_url(scene: Any, url: str, where: str) -> str:
+class _Unreadable(Exception):
+    """A url whose image is not read (not found, not an image, not local): Webots sets the field, warns and
+    draws the shape without its texture."""
+
+
+def _installed_url(scene: Any, url: str) -> str:
     """The file a ``webots://`` url names in the Webots installation (``--webots-home``/``WEBOTS_HOME``)
     or the ``--proto-path`` folders, found as a world file's are: Webots reads any such url a Supervisor
-    sets (its how-to ``texture_change`` swaps two of its textures). Not found there: ValueError (one line
-    naming the places tried)."""
+    sets (its how-to ``texture_change`` swaps two of its textures). Not found there: _Unreadable (naming
+    the places tried)."""
     from sensorium.server.world.proto import ProtoError, ProtoSearch, asset_roots, resolve_url
 
     search = ProtoSearch.create(scene.base_dir)
     try:
         path = resolve_url(url, scene.base_dir / "world.wbt", search).resolve()
     except ProtoError as exc:
-        raise ValueError(f"{where}: texture file {exc.message}; nothing changed") from None
+        raise _Unreadable(f"texture file {exc.message}") from None
     except (OSError, ValueError) as exc:
-        raise ValueError(f"{where}: {_quoted(url)} cannot be resolved ({exc}); nothing changed") from None
+        raise _Unreadable(f"{_quoted(url)} cannot be resolved ({exc})") from None
     if not any(path.is_relative_to(root) for root in asset_roots(search)):
-        raise ValueError(f"{where}: {_quoted(url)} names a file outside the Webots installation and the --proto-path "
-                         "folders; nothing changed")
+        raise _Unreadable(f"{_quoted(url)} names a file outside the Webots installation and the --proto-path folders")
     return str(path)
 
 
-def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> None:
-    """Every shape holding the texture takes ``url`` (checked as a world file's textures are), or
-    none of them does (ValueError: one line)."""
+def _retexture(sim: Any, ref: ShapeRef, where: str, url: str | None) -> list[str]:
+    """Every shape holding the texture takes ``url`` (checked as a world file's textures are). A url whose
+    image is not read (missing, not a PNG/JPEG, outside the world's folder, a download) leaves them
+    untextured, as Webots draws a texture it cannot load: its one line returned. An image over the world's
+    texture limits: ValueError (one line), nothing changed."""
     scene = sim.scene
     shapes = ref.peers or (ref.index,)
     name = url
+    given: dict = {}
+    lines: list[str] = []
     if url is not None:
-        known = _world_url(scene, url)
-        if known is None and url.startswith("webots://"):
-            known = _installed_url(scene, url, where)
-        if known is None and "://" in url:
-            raise ValueError(f"{where}: {_quoted(url)}: only local image files are read here, named relative to the world "
-                             "file's folder, or webots:// urls of the Webots installation (no downloads); "
-                             "nothing changed")
-        name = known or url
-        before = scene.textures.pixels(without=shapes) if scene.textures is not None else 0
-        try:      # (the file as it is now, read once: the image checked is the image shown, whatever happens to
-                  # the file after; the same image as held is not held twice: TextureSampler)
+        try:
+            known = _world_url(scene, url)
+            if known is None and url.startswith("webots://"):
+                known = _installed_url(scene, url)
+            if known is None and "://" in url:
+                raise _Unreadable(f"{_quoted(url)}: only local image files are read here, named relative to the "
+                                  "world file's folder, or webots:// urls of the Webots installation (no downloads)")
+            name = known or url
+            before = scene.textures.pixels(without=shapes) if scene.textures is not None else 0
+            # (the file as it is now, read once: the image checked is the image shown, whatever happens to
+            # the file after; the same image as held is not held twice: TextureSampler)
             file, _, decoded = read_checked_image(
                 name, scene.base_dir, sim.limits, pixels_before=before,
                 allow_outside=known is not None or bool(getattr(sim, "allow_outside_meshes", False)))
-        except TextureFileError as exc:
+            given = {name: (file, decoded)}
+        except TextureLimitError as exc:
             raise ValueError(f"{where}: {str(exc).replace(repr(name), _quoted(name))}; nothing changed") from None
-        given = {name: (file, decoded)}
-    else:
-        given = {}
+        except (TextureFileError, _Unreadable) as exc:
+            problem = str(exc).replace(repr(name), _quoted(name)) if isinstance(exc, TextureFileError) else str(exc)
+            lines.append(f"{where}: {problem}; the shape is drawn without its texture (as Webots draws an image it "
+                         "cannot load)")
+            name = None
     for k in shapes:        # (an image whose pixel format has alpha: the shape casts no shadow, as Webots draws it)
         new = _retextured(scene, k, name)
         if new is not None:
             scene.set_texture(k, new, given)
+    return lines
 
 
-def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: Any) -> None:
+def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: Any) -> list[str]:
     """Webots' ``setMFString``/``insertMFString``/``removeMF`` on an ImageTexture's ``url``: when the list
     changes (an item set to another value, one inserted or removed: Webots' ``updateUrl``), the image its
     first item names is read from its file as it is now (relative to the world file's folder, within the
     world's texture limits) and every shape holding the texture shows it from the next step, as if the
-    world file had named it; an empty url (or none) leaves the shapes untextured, as Webots. A url that
-    cannot be read: ValueError (one line naming the node, the field and the problem), nothing changed."""
+    world file had named it; an empty url (or none) leaves the shapes untextured, as Webots. A url whose
+    image is not read (missing, not an image, a download) is set all the same and leaves the shapes
+    untextured, as Webots does: its one line returned. Bad input (not a string, too long, an item out of
+    range) and an image over the texture limits: ValueError (one line naming the node, the field and the
+    problem), nothing changed."""
     where = f"field 'url' (MFString) of {_what(ref, node.def_name, node.id)}"
     items = [str(v) for v in _value(sim, ref, "url", ())]
     count = len(items)
@@ -320,11 +335,13 @@ def change_url(sim: Any, ref: ShapeRef, node: Any, op: str, index: Any, value: A
         del new[at]
     else:
         new[at] = value.replace("\\", "/")
+    lines: list[str] = []
     if new != items:        # Webots' updateUrl: any change of the list (not the same value set again) reads the image
         first = new[0] if new else ""
-        _retexture(sim, ref, where, first if first.strip() else None)
+        lines = _retexture(sim, ref, where, first if first.strip() else None)
     for k in ref.peers or (ref.index,):
         sim.scene.appearance_values.setdefault(k, {})["texture.url"] = list(new)
+    return lines
 
 
 def _texture_setter(ref: ShapeRef, name: str, kind: str) -> Setter:

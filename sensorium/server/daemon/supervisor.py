@@ -1203,8 +1203,7 @@ def change_item(sim: Any, node: Node, field: str, op: str, index: int, value: An
                          "items are read-only, as in Webots; nothing changed")
     ref = _nested_of(sim, node).shape if node.nested else None
     if ref is not None and ref.type == "ImageTexture" and field == "url":      # a texture's image (appearance.py)
-        appearance.change_url(sim, ref, node, op, index, value)
-        return []
+        return appearance.change_url(sim, ref, node, op, index, value)
     if not (node.visual and node.id >= visuals.FIRST_ID and visuals.settable(_vnode(sim, node), field)):
         if node.visual and node.id >= visuals.FIRST_ID:
             raise ValueError(visuals.read_only_line(_vnode(sim, node), field, kind))

@@ -46,7 +46,7 @@ import numpy as np
 from sensorium.schemas import world as wm
 from sensorium.server.world import texcoords as tc
 
-__all__ = ["TextureFileError", "resolve_texture_url", "image_header", "read_texture_file",
+__all__ = ["TextureFileError", "TextureLimitError", "resolve_texture_url", "image_header", "read_texture_file",
            "read_checked_image", "load_image", "load_alpha", "uses_alpha", "check_textures", "Checked",
            "TextureImage", "transform_uv", "TextureSampler", "TriangleLocator", "texture_urls"]
 
@@ -56,6 +56,11 @@ _FEW = 8                     # up to this many points, plain Python beats numpy'
 
 class TextureFileError(Exception):
     """A texture file that is missing, unreadable, not a PNG/JPEG, or over a limit."""
+
+
+class TextureLimitError(TextureFileError):
+    """A texture file over a limit of the world's (bytes, pixels, pixels of all textures together): Webots
+    would read it; here it is refused, as a world asking for that much is."""
 
 
 def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False,
@@ -88,7 +93,7 @@ def resolve_texture_url(url: str, base_dir: Path, *, allow_outside: bool = False
     except OSError as exc:
         raise TextureFileError(f"texture file {url!r} cannot be read: {exc.strerror or exc}") from None
     if max_bytes is not None and size > max_bytes:
-        raise TextureFileError(f"texture file {url!r} is larger than the limit of {max_bytes:,} bytes "
+        raise TextureLimitError(f"texture file {url!r} is larger than the limit of {max_bytes:,} bytes "
                                "(raise the limits with --allow-large)")
     return path
 
@@ -235,10 +240,10 @@ def _appearances(world: wm.World) -> Iterator[tuple[str, Any]]:
 def _check_pixels(url: str, w: int, h: int, limits: Any, pixels_before: int) -> None:
     """An image of w×h pixels within the texture limits, alone and with the others' ``pixels_before``."""
     if w * h > limits.texture_pixels:
-        raise TextureFileError(f"texture {url!r} has {w}x{h} = {w * h:,} pixels, more than the "
+        raise TextureLimitError(f"texture {url!r} has {w}x{h} = {w * h:,} pixels, more than the "
                                f"limit of {limits.texture_pixels:,} (raise the limits with --allow-large)")
     if pixels_before + w * h > limits.texture_pixels_total:
-        raise TextureFileError(f"the world's textures have more than {limits.texture_pixels_total:,} "
+        raise TextureLimitError(f"the world's textures have more than {limits.texture_pixels_total:,} "
                                "pixels together (raise the limits with --allow-large)")
 
 
@@ -251,7 +256,7 @@ def read_texture_file(file: Path, url: str, max_bytes: int) -> bytes:
     except OSError as exc:
         raise TextureFileError(f"texture file {url!r} cannot be read: {exc.strerror or exc}") from None
     if len(data) > max_bytes:
-        raise TextureFileError(f"texture file {url!r} is larger than the limit of {max_bytes:,} "
+        raise TextureLimitError(f"texture file {url!r} is larger than the limit of {max_bytes:,} "
                                "bytes (raise the limits with --allow-large)")
     return data
 
