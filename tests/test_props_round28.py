@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import msgpack
 import numpy as np
 import pytest
 from _fuzz import example_counts
@@ -160,5 +161,107 @@ def test_a_wheel_axis_off_by_4e_3_still_drives_and_by_over_5e_3_gives_one_line(t
             assert dd.wheel_radius == pytest.approx(R, abs=1e-6)
         else:
             assert dd is None and len(lines) == 1 and "\n" not in lines[0], lw.warnings
+
+    check()
+
+
+# --- the battery topic (sim/battery.py, daemon/topics.py; PROTOCOL.md §4) ---------------------------------
+
+STATUS = {"full": 4, "charging": 1, "discharging": 2, "idle": 3}       # sensor_msgs/BatteryState's
+CHARGER_AT, CHARGER_RADIUS = (1.0, 0.0, 0.0), 0.2
+
+
+class BatteryModel:
+    """The closed form of one robot's battery each basic step of ``dt`` ms: a full Charger holding it (its
+    energy ``c``) gives min(speed·dt, c) until the battery passes its maximum (kept at it; the Charger then
+    gives it nothing more), then cpuConsumption takes P·dt, stopping at 0; its status: full (at its maximum,
+    a maximum > 0), charging (given energy this step), discharging (energy left and P > 0), else idle."""
+
+    def __init__(self, e: float, emax: float, speed: float, p: float, dt: int, charger: float | None) -> None:
+        self.e, self.emax, self.speed, self.p, self.dt = e, emax, speed, p, dt
+        self.c, self.done, self.gained = charger, charger is None, 0.0
+
+    def step(self) -> None:
+        self.gained = 0.0
+        if self.c is not None:
+            given = min(self.speed * self.dt * 0.001, self.c)
+            self.c -= given
+            if not self.done:
+                if self.e > self.emax:
+                    self.done = True
+                else:
+                    self.e += given
+                    self.gained = given
+                    if self.e > self.emax:
+                        self.e, self.done = self.emax, True
+        if self.e > 0.0:
+            self.e -= self.p * self.dt * 0.001
+            if self.e <= 0.0:
+                self.e = 0.0
+
+    @property
+    def status(self) -> int:
+        if self.emax > 0.0 and self.e >= self.emax:
+            return STATUS["full"]
+        if self.gained > 0.0:
+            return STATUS["charging"]
+        return STATUS["discharging"] if self.e > 0.0 and self.p > 0.0 else STATUS["idle"]
+
+
+battery_ops = st.lists(st.one_of(st.tuples(st.just("step"), st.integers(1, 6)),
+                                 st.tuples(st.just("enable"), st.integers(0, 4)),       # period: k basic steps
+                                 st.tuples(st.just("subscribe"), st.booleans())), max_size=14)
+
+
+@pytest.mark.parametrize("examples", example_counts(200, 4))
+def test_battery_messages_meet_the_closed_form_and_none_come_unwanted(examples: int) -> None:
+    from sensorium.server.daemon.topics import Topics
+    from sensorium.server.world.loader import parse_world
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.floats(0.0, 300.0), st.floats(0.0, 300.0), st.floats(0.0, 500.0), st.floats(0.0, 400.0),
+           st.sampled_from([1, 8, 16, 32, 64]), st.booleans(), battery_ops)
+    def check(e: float, emax: float, speed: float, p: float, dt: int, charging: bool, ops: list) -> None:
+        e, emax, speed, p = (v if v == 0.0 or v >= 1e-30 else 0.0 for v in (e, emax, speed, p))
+        world = {"world_info": {"basic_time_step": dt},
+                 "solids": [{"name": "dock", "pose": {"translation": list(CHARGER_AT)}}],
+                 "chargers": [{"solid": "dock", "battery": [1000.0, 1000.0, 0.0], "radius": CHARGER_RADIUS}],
+                 "robots": [{"name": "r", "battery": [e, emax, speed], "cpu_consumption": p,
+                             "pose": {"translation": [1.05 if charging else 3.0, 0.0, 0.0]}}]}
+        sim = Simulation(parse_world(world))
+        topics = Topics(sim)
+        robot = sim.robots["r"]
+        model = BatteryModel(e, emax, speed, p, dt, 1000.0 if charging else None)
+        period, last, wanted = 0, 0, False          # the controller's sensor: period (ms), last value's time
+        for op, arg in ops:
+            if op == "enable":
+                period, last = arg * dt, sim.time_ms
+                sim.enable_battery_sensor(robot, period)
+            elif op == "subscribe":
+                wanted = arg
+                topics.subscription((b"\x01" if arg else b"\x00") + b"/r/battery\0")
+                topics.publish(sim.time_ms)         # (the demand takes effect at a publish)
+            else:
+                for _ in range(arg):
+                    sim.step()
+                    model.step()
+                    due = period > 0 and sim.time_ms - last >= period
+                    if due:
+                        last = sim.time_ms
+                        assert robot.battery_value == pytest.approx(model.e, rel=1e-9, abs=1e-9)
+                    sent = [msgpack.unpackb(f[2]) for f in topics.publish(sim.time_ms) if f[0] == b"/r/battery\0"]
+                    if not wanted or (period > 0 and not due):
+                        assert sent == [], (op, arg, period, wanted)
+                        continue
+                    (body,) = sent
+                    if period > 0:                  # the controller's sample: the service's very value
+                        assert body["percentage"] == (robot.battery_value / emax if emax > 0.0 else body["percentage"])
+                    if emax > 0.0:
+                        assert body["percentage"] == pytest.approx(model.e / emax, rel=1e-9, abs=1e-12)
+                    else:
+                        assert math.isnan(body["percentage"])
+                    assert body["power_supply_status"] == model.status, (model.e, model.emax, model.gained)
+                    assert body["header"]["stamp"]["sec"] * 1000 + body["header"]["stamp"]["nanosec"] // 1_000_000 \
+                        == sim.time_ms
 
     check()
