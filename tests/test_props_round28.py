@@ -265,3 +265,107 @@ def test_battery_messages_meet_the_closed_form_and_none_come_unwanted(examples: 
                         == sim.time_ms
 
     check()
+
+
+# --- lights inside robots and solids as Supervisor nodes (daemon/supervisor.py, nested.py, export.py) -----
+
+NESTED = Path(__file__).resolve().parent / "worlds" / "nested_lights.wbt"
+SPOT_LS2 = 1.0          # SPOT (intensity 4, 2 m above ls2, aimed at it): 4 / 2²; ls is past its cut-off
+
+
+def light_world(name: str, loc, carrier=(0.0, 0.0, 1.0)) -> tuple[float, float, float]:
+    """HEADLIGHT's location (its parent's frame) in the world: the robot at ``carrier``, its Pose 0.5 m up
+    turned +pi/2 about y ((x, y, z) -> (z, y, -x)); BULB's: the lamp at (10, 0, 0)."""
+    if name == "HEADLIGHT":
+        return (carrier[0] + loc[2], carrier[1] + loc[1], carrier[2] + 0.5 - loc[0])
+    return (10.0 + loc[0], loc[1], loc[2])
+
+
+LOADED = {"HEADLIGHT": {"on": True, "intensity": 2.0, "color": [1.0, 1.0, 1.0], "location": [0.0, 0.0, 0.5]},
+          "BULB": {"on": True, "intensity": 3.0, "color": [1.0, 1.0, 1.0], "location": [0.0, 0.0, 1.0]}}
+# (numbers a world file takes, 0 or at least 1e-30: an exported light's text is imported as a world file's)
+unit = st.floats(0.0, 1.0).map(lambda v: v if v >= 1e-30 else 0.0)
+light_ops = st.lists(st.one_of(
+    st.tuples(st.sampled_from(["HEADLIGHT", "BULB"]), st.just("on"), st.booleans()),
+    st.tuples(st.sampled_from(["HEADLIGHT", "BULB"]), st.just("intensity"), unit.map(lambda v: 10.0 * v)),
+    st.tuples(st.sampled_from(["HEADLIGHT", "BULB"]), st.just("color"), st.lists(unit, min_size=3, max_size=3)),
+    # (HEADLIGHT's world z is 1.5 − x: x in [-1, 1]; BULB's z its own: both stay 0.5 m or more above the sensors)
+    st.tuples(st.sampled_from(["HEADLIGHT", "BULB"]), st.just("location"),
+              st.tuples(st.floats(-1.0, 1.0).map(lambda v: v if abs(v) >= 1e-30 else 0.0),
+                        st.floats(-1.0, 1.0).map(lambda v: v if abs(v) >= 1e-30 else 0.0), st.floats(0.5, 3.0))),
+    st.tuples(st.sampled_from(["HEADLIGHT", "BULB"]), st.sampled_from(["remove", "export"]), st.none()),
+    st.tuples(st.just("CARRIER"), st.just("translation"),        # the robot moves: HEADLIGHT with it
+              st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(1.0, 2.0))),
+    st.tuples(st.just("-"), st.just("reset"), st.none())), max_size=10)
+
+
+@pytest.mark.parametrize("examples", example_counts(120, 4))
+def test_nested_lights_follow_a_model_of_their_fields_through_sets_removals_resets_and_imports(examples: int) -> None:
+    """Random Supervisor sequences on HEADLIGHT (inside a robot, under a turned Pose) and BULB (inside a
+    solid): set on, intensity, colour, location; remove; simulationReset (the fields as loaded, the removed
+    ones staying removed, the imported ones gone: README, as in Webots); exportString then importMFNodeFromString
+    of its text at the root (a top-level light at the exported location). The model's fields read back,
+    and both light sensors read the closed form of every light as it should be (test_supervisor_nested_lights'
+    ``point``)."""
+    from test_supervisor import A, Live
+    from test_supervisor_nested_lights import point
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(light_ops)
+    def check(ops: list) -> None:
+        lv = Live(Simulation(load_world(NESTED)))
+        lv.ok(A, "attach", {"robot": "probe"})
+        bot = lv.sim.robot("probe")
+        bot.device("ls").enable(8)
+        bot.device("ls2").enable(8)
+
+        def call(item: str, args: dict | None = None):
+            return lv.ok(A, f"/probe/robot/{item}", args)
+
+        ids = {n: call("get_from_def", {"name": n})["node"] for n in LOADED}
+        lights = {n: {k: (list(v) if isinstance(v, list) else v) for k, v in f.items()} for n, f in LOADED.items()}
+        imported: list[dict] = []           # top-level copies: (world location, fields)
+        carrier, robot = (0.0, 0.0, 1.0), call("get_from_def", {"name": "CARRIER"})["node"]
+        for name, op, value in ops:
+            if op == "translation":
+                carrier = tuple(v if abs(v) >= 1e-30 else 0.0 for v in value)
+                call("set_field", {"node": robot, "field": "translation", "value": list(carrier)})
+                continue
+            if op == "reset":
+                call("simulation_reset")
+                imported.clear()
+                carrier = (0.0, 0.0, 1.0)
+                for n in lights:
+                    if lights[n] is not None:
+                        lights[n] = {k: (list(v) if isinstance(v, list) else v) for k, v in LOADED[n].items()}
+            elif lights[name] is None:
+                continue
+            elif op == "remove":
+                call("remove_node", {"node": ids[name]})
+                lights[name] = None
+            elif op == "export":
+                text = call("node_export_string", {"node": ids[name]})["value"]
+                text = text.replace(f"DEF {name} ", "", 1)      # (its DEF name stays the nested light's)
+                call("import_node_from_string", {"node": 0, "field": "children", "position": -1, "node_string": text})
+                imported.append({**lights[name], "location": list(lights[name]["location"])})
+            else:
+                v = list(value) if isinstance(value, tuple) else value
+                call("set_field", {"node": ids[name], "field": op, "value": v})
+                lights[name][op] = v
+        for n, fields in lights.items():
+            if fields is not None:
+                for k, v in fields.items():
+                    got = call("get_field", {"node": ids[n], "field": k})["value"]
+                    assert got == (pytest.approx(v, abs=1e-12) if k != "on" else v), (n, k)
+        lv.step(A, "probe")
+        for sensor, at, spot in (("ls", (0.0, 0.0, 0.0), 0.0), ("ls2", (10.0, 0.0, 0.0), SPOT_LS2)):
+            expected = spot
+            for n, f in lights.items():
+                if f is not None and f["on"]:
+                    expected += point(light_world(n, f["location"], carrier), f["intensity"], at, f["color"])
+            for f in imported:
+                if f["on"]:
+                    expected += point(tuple(f["location"]), f["intensity"], at, f["color"])
+            assert bot.device(sensor).value == pytest.approx(expected, rel=1e-9, abs=1e-12), (sensor, ops)
+
+    check()
