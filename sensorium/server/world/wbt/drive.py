@@ -60,7 +60,8 @@ its omni wheels' places and axes along its x and its left.
 A robot built on its side (its own x, or in an ENU world its y, the world's up within 1 mrad: Tinkerbots'
 base turned -pi/2 about y) is judged with that axis as up in the same way (convert.py's ``_robot_up``;
 with x up, two-wheel and skid-steer wheels and one motor's axle only); its drive has no ``wheel_bottom``
-(it keeps its height). One motorised hinge carrying the wheels of both sides (:func:`one_motor_axle`:
+(it keeps its height). A robot whose own -x, -y or -z is the world's up is judged with that end up
+(:class:`Up`: forward = axis × -that axis). One motorised hinge carrying the wheels of both sides (:func:`one_motor_axle`:
 Tinkerbots' vision_car) is a steered drive: one driven wheel midway between them, the robot's free
 wheels keeping it straight.
 
