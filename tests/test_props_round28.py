@@ -9,6 +9,8 @@ reversed motor, forward in the world (cos h, sin h, 0)) and, driven with the sam
 
 from __future__ import annotations
 
+import gc
+import itertools
 import math
 from pathlib import Path
 
@@ -81,7 +83,7 @@ def wheeled(path: Path, base: np.ndarray, yaw: float, physics: bool, tilt: np.nd
 
 
 def roll(path: Path, speeds: tuple[float, float], steps: int) -> Simulation:
-    sim = Simulation(load_world(path))
+    sim = simulation(load_world(path))
     for name, w in zip((LEFT, RIGHT), speeds):
         sim.robot("bot").motor(name).set_position(math.inf)
         sim.robot("bot").motor(name).set_velocity(w)
@@ -90,6 +92,15 @@ def roll(path: Path, speeds: tuple[float, float], steps: int) -> Simulation:
 
 
 speeds = st.floats(-10.0, 10.0, allow_nan=False)
+_built = itertools.count()
+
+
+def simulation(loaded) -> Simulation:
+    """A Simulation of ``loaded``; every 20th collects the ones gone first (each holds an Embree device
+    until the collector frees its cycles: about a thousand at once make rtcNewDevice fail)."""
+    if next(_built) % 20 == 19:
+        gc.collect()
+    return Simulation(loaded)
 
 
 def drives_as_its_twin(tmp_path: Path, up: str, yaw: float, physics: bool, wl: float, wr: float, steps: int) -> None:
@@ -228,17 +239,18 @@ def test_battery_messages_meet_the_closed_form_and_none_come_unwanted(examples: 
                  "chargers": [{"solid": "dock", "battery": [1000.0, 1000.0, 0.0], "radius": CHARGER_RADIUS}],
                  "robots": [{"name": "r", "battery": [e, emax, speed], "cpu_consumption": p,
                              "pose": {"translation": [1.05 if charging else 3.0, 0.0, 0.0]}}]}
-        sim = Simulation(parse_world(world))
+        sim = simulation(parse_world(world))
         topics = Topics(sim)
         robot = sim.robots["r"]
         model = BatteryModel(e, emax, speed, p, dt, 1000.0 if charging else None)
-        period, last, wanted = 0, 0, False          # the controller's sensor: period (ms), last value's time
+        period, last = 0, 0                         # the controller's sensor: period (ms), last value's time
+        subscribers = 0                             # (XPUB events count: one leaving leaves the others')
         for op, arg in ops:
             if op == "enable":
                 period, last = arg * dt, sim.time_ms
                 sim.enable_battery_sensor(robot, period)
             elif op == "subscribe":
-                wanted = arg
+                subscribers = subscribers + 1 if arg else max(subscribers - 1, 0)
                 topics.subscription((b"\x01" if arg else b"\x00") + b"/r/battery\0")
                 topics.publish(sim.time_ms)         # (the demand takes effect at a publish)
             else:
@@ -250,12 +262,12 @@ def test_battery_messages_meet_the_closed_form_and_none_come_unwanted(examples: 
                         last = sim.time_ms
                         assert robot.battery_value == pytest.approx(model.e, rel=1e-9, abs=1e-9)
                     sent = [msgpack.unpackb(f[2]) for f in topics.publish(sim.time_ms) if f[0] == b"/r/battery\0"]
-                    if not wanted or (period > 0 and not due):
-                        assert sent == [], (op, arg, period, wanted)
+                    if not subscribers or (period > 0 and not due):
+                        assert sent == [], (op, arg, period, subscribers)
                         continue
                     (body,) = sent
-                    if period > 0:                  # the controller's sample: the service's very value
-                        assert body["percentage"] == (robot.battery_value / emax if emax > 0.0 else body["percentage"])
+                    if period > 0 and emax > 0.0:   # the controller's sample: the service's very value
+                        assert body["percentage"] == robot.battery_value / emax
                     if emax > 0.0:
                         assert body["percentage"] == pytest.approx(model.e / emax, rel=1e-9, abs=1e-12)
                     else:
@@ -313,7 +325,7 @@ def test_nested_lights_follow_a_model_of_their_fields_through_sets_removals_rese
     @settings(SETTINGS, max_examples=examples)
     @given(light_ops)
     def check(ops: list) -> None:
-        lv = Live(Simulation(load_world(NESTED)))
+        lv = Live(simulation(load_world(NESTED)))
         lv.ok(A, "attach", {"robot": "probe"})
         bot = lv.sim.robot("probe")
         bot.device("ls").enable(8)
@@ -440,7 +452,7 @@ def loads_and_steps_finite(tmp_path: Path, up: str, physics: bool, k1: str, k2: 
         assert str(exc).strip() and "Traceback" not in str(exc)
         return
     assert all(w.strip() and "Traceback" not in w for w in lw.warnings)
-    sim = Simulation(lw)
+    sim = simulation(lw)
     bot = sim.robot("bot")
     bot.device("ls").enable(STEP)
     for name, w in zip((LEFT, RIGHT), (wl, wr)):
