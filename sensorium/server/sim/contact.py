@@ -416,7 +416,9 @@ def _concave_groups(sections: list[tuple[np.ndarray, float] | None]) -> tuple[tu
                 excess = excesses.get(key)
                 if excess is None:
                     polys = [outline[k] for k in key]
-                    excess = excesses[key] = _area(_hull(np.concatenate(polys))) / _union_area(polys) - 1.0
+                    hull, union = _area(_hull(np.concatenate(polys))), _union_area(polys)
+                    # (outlines of no area, a 1e-30 wheel's: nothing to merge them into unless their hull has none)
+                    excess = excesses[key] = hull / union - 1.0 if union > 0.0 else (0.0 if hull <= 0.0 else math.inf)
                 if excess <= CONCAVE and (best is None or excess < best[0]):
                     best = (excess, gi, gj)
         if best is None:

@@ -2518,12 +2518,14 @@ class Converter:
         two only, as Tracks and belts are judged). Its ``wheel_bottom`` is measured along its z or a NUE
         robot's y (:meth:`_settles_along`)."""
         from sensorium.server.world.poses import ROBOT_UPRIGHT_TOL, pose_from_model
+        from sensorium.server.world.wbt.drive import Up
 
         r = pose_from_model(wm.Pose.model_validate(robot.data["pose"])).rotation
         world_up = 1 if self.world["world_info"].get("coordinate_system", "ENU") == "NUE" else 2
-        nearest = int(np.argmax(r[world_up]))
-        if on_side and r[world_up, nearest] >= 1.0 - 0.5 * ROBOT_UPRIGHT_TOL ** 2:      # within ROBOT_UPRIGHT_TOL rad
-            return nearest
+        nearest = int(np.argmax(np.abs(r[world_up])))
+        if on_side and abs(r[world_up, nearest]) >= 1.0 - 0.5 * ROBOT_UPRIGHT_TOL ** 2:   # within ROBOT_UPRIGHT_TOL rad
+            # (its negative end up: built on its side the other way, or upside down, its wheels' rolling turned)
+            return nearest if r[world_up, nearest] > 0.0 else Up(nearest, -1.0)
         if world_up == 2:
             return 2
         return 1 if abs(r[1, 1]) > abs(r[1, 2]) else 2
@@ -2532,7 +2534,7 @@ class Converter:
         """Whether a robot whose own ``up`` axis stands up settles on the ground at load (sim/ground.py's
         ``robot_up``: its z, or a NUE world's robot's y); one built on another side keeps its height."""
         nue = self.world["world_info"].get("coordinate_system", "ENU") == "NUE"
-        return up == 2 or (nue and up == 1)
+        return getattr(up, "sign", 1.0) > 0.0 and (up == 2 or (nue and up == 1))
 
     def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         if len(nowheel) <= MANY_JOINTS:
@@ -2679,15 +2681,18 @@ class Converter:
                                 f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
                                 "turning about a vertical axis"))
             return
-        if up == 0 and any(w["steers"] for w in wheels):
-            # a robot built on its side (its x up: Tinkerbots' base) is judged for a two-wheel, skid-steer or
-            # one-motor drive only (the other drives' frames take a z or y up)
+        sideways = up == 0 or getattr(up, "sign", 1.0) < 0.0      # on its side (x up), or its -x, -y or -z up
+        if sideways and any(w["steers"] for w in wheels):
+            # a robot built on its side (its x up: Tinkerbots' base) or with an axis's negative end up is judged
+            # for a two-wheel, skid-steer or one-motor drive only (the other drives' frames take a z or y up)
             steering = next(w["motor"] for w in wheels if w["steers"])
-            self.warn(node, f"robot {robot.data['name']!r}: no drive (it is built on its side, its x up, where only "
+            axis = ("-" if getattr(up, "sign", 1.0) < 0.0 else "") + "xyz"[up]
+            how = "upside down" if axis == "-z" else "built on its side"
+            self.warn(node, f"robot {robot.data['name']!r}: no drive (it is {how}, its {axis} up, where only "
                             f"wheels about one horizontal axis make a drive here; motor {steering!r} turns about its "
-                            "x); the robot will not move")
+                            f"{axis[-1]}); the robot will not move")
             return
-        if up != 0 and omni_wheels(wheels, self, up):     # three or more wheels about horizontal axes not along one line
+        if not sideways and omni_wheels(wheels, self, up):     # three or more wheels about horizontal axes not along one line
             drive, why = omni_drive(wheels, self, up)
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no omni drive ({why}); the robot will not move")
@@ -2714,7 +2719,7 @@ class Converter:
                         nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel "
                                         f"(an arm's joint on a mecanum base): {JOINT_MOVES}", "an arm's joints"))
                 wheels = base
-        elif up != 0:
+        elif not sideways:
             turns = mecanum_turns(wheels, self)
         groups = self._steering_groups(wheels, up) if turns is None else None
         if groups is not None:                    # steered casters or corners: each wheel steered on its own

@@ -60,7 +60,8 @@ its omni wheels' places and axes along its x and its left.
 A robot built on its side (its own x, or in an ENU world its y, the world's up within 1 mrad: Tinkerbots'
 base turned -pi/2 about y) is judged with that axis as up in the same way (convert.py's ``_robot_up``;
 with x up, two-wheel and skid-steer wheels and one motor's axle only); its drive has no ``wheel_bottom``
-(it keeps its height). One motorised hinge carrying the wheels of both sides (:func:`one_motor_axle`:
+(it keeps its height). A robot whose own -x, -y or -z is the world's up is judged with that end up
+(:class:`Up`: forward = axis × -that axis). One motorised hinge carrying the wheels of both sides (:func:`one_motor_axle`:
 Tinkerbots' vision_car) is a steered drive: one driven wheel midway between them, the robot's free
 wheels keeping it straight.
 
@@ -80,6 +81,26 @@ AXIS_TOL = 1e-4     # wheels' axes: Webots' PROTOs turn their joints' frames by 
 # a two-wheel or skid-steer drive's wheels' axes, parallel or opposite: PROTO authors also write 1.57 for pi/2
 # (7.96e-4 off), and robots built of blocks (Tinkerbots' Slots) compose several such turns: up to five of them
 WHEEL_AXES_TOL = 5e-3
+
+
+class Up(int):
+    """A robot's own axis that stands up (0 x, 1 y, 2 z: an index, as a plain int is) and ``sign``, -1 when
+    its negative end is the world's up (a robot built on its side the other way, or upside down): its
+    wheels roll along axis × (−that axis)."""
+
+    sign: float
+
+    def __new__(cls, axis: int, sign: float = 1.0) -> Up:
+        up = super().__new__(cls, axis)
+        up.sign = sign
+        return up
+
+
+def up_vector(up: int) -> np.ndarray:
+    """The robot's up in its own frame: its ``up`` axis, negated for an :class:`Up` whose sign is -1."""
+    u = np.zeros(3)
+    u[up] = getattr(up, "sign", 1.0)
+    return u
 
 
 def wheel_radius(end: Node | None, conv) -> float | None:
@@ -231,7 +252,7 @@ def drive_frame(wheels: list[dict], tol: float = TOL, up: int = 2,
     the frame is then the +y wheel's (the robot's own), else the first wheel's."""
     y = np.array([0.0, 1.0, 0.0])
     axes = [w["axis"] / np.linalg.norm(w["axis"]) for w in wheels]
-    if not axes or (up == 2 and any(np.linalg.norm(a - y) <= tol for a in axes)):
+    if not axes or (up == 2 and up_vector(up)[2] > 0.0 and any(np.linalg.norm(a - y) <= tol for a in axes)):
         return None, ""
     a0 = axes[0]
     first = wheels[0]["motor"]
@@ -248,11 +269,9 @@ def drive_frame(wheels: list[dict], tol: float = TOL, up: int = 2,
                           + (" nor its opposite (the kinematic drive needs every axis along one line)" if opposite else
                              " (the kinematic drive needs every axis along one direction so that positive speeds drive "
                              "forward)"))
-    u = np.zeros(3)
-    u[up] = 1.0
     a = a0.copy()
     a[up] = 0.0
-    return drive_axes(np.cross(a, u), up), ""      # axis × up: where a positive speed rolls the wheel
+    return drive_axes(np.cross(a, up_vector(up)), up), ""      # axis × up: where a positive speed rolls the wheel
 
 
 def drive_axes(forward, up: int = 2) -> np.ndarray:
@@ -262,8 +281,7 @@ def drive_axes(forward, up: int = 2) -> np.ndarray:
     f = np.zeros(3)
     f[:len(forward)] = forward
     f /= math.hypot(*f)
-    u = np.zeros(3)
-    u[up] = 1.0
+    u = up_vector(up)
     return np.array([f, np.cross(u, f), u])
 
 
@@ -407,7 +425,7 @@ def _framed(drive: dict | None, why: str, frame: np.ndarray | None) -> tuple[dic
         fwd = np.round(frame[0, :2 if frame[2, 2] == 1.0 else 3], 6).tolist()
         return None, f"{why}; in the drive's frame: x forward along {fwd} in the robot's, y its left"
     # (x, y) for a z-up robot, as it always was; (x, y, z) for a y-up one, its up its y
-    drive["forward"] = [float(v) for v in frame[0, :2 if frame[2, 2] == 1.0 else 3]]
+    drive["forward"] = [float(v) + 0.0 for v in frame[0, :2 if frame[2, 2] == 1.0 else 3]]      # (no -0.0)
     return drive, ""
 
 
@@ -1186,18 +1204,17 @@ def one_motor_axle(w: dict, free: list[dict], conv, up: int = 2) -> tuple[dict |
     along = sorted(float(np.dot(p[1] - anchor, axis)) for p in parts if p[0] >= radius * (1.0 - TOL))
     if radius <= 0.0 or along[-1] - along[0] <= TOL:
         return None, "its end point carries no two wheels at two places along its axis"
-    u = np.zeros(3)
-    u[up] = 1.0
+    u = up_vector(up)
     rolling = np.cross(axis, u)
     rolling[up] = 0.0
     frame = drive_axes(rolling, up)
     driven = frame @ (anchor + axis * (along[0] + along[-1]) / 2.0)
-    bottom = float((anchor + axis * along[0])[up]) - radius
+    bottom = float(np.dot(anchor + axis * along[0], u)) - radius
     wheels: list[dict] = [{"motor": w["motor"], "radius": radius, "position": [float(driven[0]), float(driven[1])]}]
     for f in free:
         fa = np.asarray(f["axis"], dtype=np.float64) / np.linalg.norm(f["axis"])
         part = rolling_part({**f, "axis": fa}, conv) if abs(float(fa[up])) <= WHEEL_AXES_TOL else None
-        if part is None or abs(float(part[1][up]) - part[0] - bottom) > GROUND_TOL:
+        if part is None or abs(float(np.dot(part[1], u)) - part[0] - bottom) > GROUND_TOL:
             continue
         at = frame @ (f["anchor"] + fa * float(np.dot(part[1] - f["anchor"], fa)))
         a = frame @ fa
