@@ -182,6 +182,9 @@ def test_bad_values_get_one_line_and_change_nothing():
                                    (head, "color", [2.0, 0.0, 0.0], "color"),
                                    (spot, "cutOffAngle", 2.0, "cut_off_angle"),
                                    (head, "location", [1e9, 0.0, 0.0], "world bounds"),
+                                   # (found: a value a world file may not hold was taken, and its export refused)
+                                   (head, "intensity", 1e-40, "too close to 0"),
+                                   (head, "location", [0.0, 1e-310, 0.5], "too close to 0"),
                                    (head, "on", 1.5, "on")):
         r = lv.call(A, "/probe/robot/set_field", {"node": head if n == head else spot, "field": field, "value": value})
         assert r["ok"] is False and r["error"]["code"] == ErrorCode.INVALID_ARGUMENT, r

@@ -578,6 +578,10 @@ def _set_light(attr: str, kind: str) -> Setter:
     def setter(sim: Any, node: Node, value: Any) -> None:
         model = _light(sim, node)
         problem = wm.light_value_problem(attr, value)      # Webots' ranges, as the world file's
+        if problem is None:      # the numbers a world file may hold (so that exportString's text imports again)
+            numbers = [v for v in (value if isinstance(value, (list, tuple)) else [value])
+                       if isinstance(v, (int, float)) and not isinstance(v, bool)]
+            problem = next(filter(None, (number_problem(float(v), sim.limits) for v in numbers)), None)
         if problem is not None:
             raise ValueError(f"{kind} {attr}: {problem}")
         if attr == "location" and any(abs(v) > MAX_COORDINATE_M for v in value):   # as every pose a request sets
