@@ -440,3 +440,27 @@ def test_exact_on_adversarial_edge_rays_is_embreexs_on_both_paths(base, landmark
         assert got.normal.tobytes() == w.normal.tobytes() and got.shape.tobytes() == w.shape.tobytes()
         assert np.isfinite(w.distance).mean() > 0.5
     assert eng.counters["embree_calls"] > 0 and ref.counters["embree_calls"] > 0
+
+
+@needs_packets
+def test_devices_of_uncollected_simulations_are_freed_when_embree_runs_out() -> None:
+    """Found: Debian's Embree 3 refuses a new device after about 1,000 live ones in a process, and engines no
+    longer used but held in reference cycles (as a Simulation's are) keep theirs until the cycle collector
+    runs, so a loop building simulations could fail with "rtcNewDevice failed". A refused device now has the
+    garbage collected and is asked for once more."""
+    import gc
+
+    class Held:           # a device in a reference cycle: freed only by the cycle collector
+        def __init__(self) -> None:
+            self.me, self.device = self, packets.Device()
+
+    was = gc.isenabled()
+    gc.disable()
+    try:
+        for _ in range(1200):   # more than Embree 3 holds at once: every one unreachable but uncollected
+            Held()
+        assert packets.Device().handle
+    finally:
+        if was:
+            gc.enable()
+        gc.collect()

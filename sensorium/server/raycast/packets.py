@@ -30,6 +30,7 @@ engine casts through embreex as before (only slower); :func:`status` says which 
 from __future__ import annotations
 
 import ctypes
+import gc
 import hashlib
 import os
 import platform
@@ -283,7 +284,13 @@ class Device:
         self.lib = library()
         self.handle = self.lib.sp_new_device()
         if not self.handle:
-            raise RuntimeError("rtcNewDevice failed")
+            # Debian's Embree 3 holds about 1,000 devices at once in a process; simulations no longer
+            # used but not yet collected (reference cycles) still hold theirs: collect them, try again
+            gc.collect()
+            self.handle = self.lib.sp_new_device()
+        if not self.handle:
+            raise RuntimeError("Embree could not create another device (rtcNewDevice failed): each live "
+                               "Simulation holds one, and Embree 3 allows about 1,000 in one process")
 
     def __del__(self) -> None:
         if getattr(self, "handle", None):
