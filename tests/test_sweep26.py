@@ -1,0 +1,271 @@
+"""Sweep 26: Webots samples not run before, each on a stand-in world of ours (tests/data/sweep26/: the
+sample's poses, sizes, joints and devices, our own text, PROTO meshes stood in for by plain shapes) driven in
+process by the calls its controller makes and checked against closed forms."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_sweep19 import KinematicMotor, rot
+from test_sweep20 import ray_to_boxes
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+DATA = Path(__file__).parent / "data" / "sweep26"
+
+# ------------------------------------------------------------------------------------------ khepera_gripper
+# khepera_gripper (k-team/khepera1): a Khepera I with Physics at (-0.0746, -0.0246) on the 2 m RectangleArena,
+# which the world turns 4.692820414042842e-06 rad about y (Webots' R2021c conversion), so its floor plane
+# leans; a red stick (box bounds 0.013 x 0.013 x 0.06) stands 0.055 m ahead. The gripper turret: an arm on
+# a hinge about y through A = (-0.01, 0, 0.022), written at its position -1.4 (raised; the end point's rotation
+# R0 is the raised one), two fingers on sliders along the arm's +x and -x (LinearMotors of maxVelocity
+# 0.1 m/s, maxForce 100 N), the right finger's infra-red "ds" (table 0 -> 0, 0.05 m -> 1000) looking at the
+# left finger across the gap. khepera_gripper.c: 50 ms steps of a 281-step cycle: open the gripper (0.029 m),
+# arm down (0), close it (0.005), arm up (-1.4), turn (-2, 2 rad/s) 2 s, forward (10, 10) 1 s, turn 2 s, stop.
+K1_R, K1_AXLE = 0.0075, 0.052
+START = np.array([-0.0746, -0.0246, 0.0])
+FLOOR_TURN = 4.692820414042842e-06                     # the arena's turn about y
+ANCHOR = np.array([-0.01, 0.0, 0.022])
+ARM_R0 = rot((0.705814842414855, -0.7058148424148553, -0.06042198650976584), 3.020895)   # at position -1.4
+ARM_Q0 = -1.4
+HALF_PI_WRITTEN = 1.5708                               # the fingers' and the sensor's turns as written
+STICK_AT, STICK_RADIUS, STICK_HALF_HEIGHT = np.array([-0.0198, -0.0261, 0.03]), 0.008, 0.03   # its visible cylinder
+STICK_TURN = rot((1, 0, 0), 3.14159)
+FINGER_HALF = np.array([0.014, 0.0035, 0.0025])
+# Webots' infra-red factor 0.2 + 0.8 · red · (1 − 0.5 · roughness): the grey fingers (0.8, roughness 1), the red stick
+FINGER_FACTOR = 0.2 + 0.8 * 0.8 * 0.5
+STICK_FACTOR = 0.2 + 0.8 * 1.0 * (1.0 - 0.5 * 0.783569247)
+
+
+def gripper_frames(body: np.ndarray, origin: np.ndarray, q_arm: float, q_right: float,
+                   q_left: float) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """The ds's ray (origin, unit direction) and the left finger's box in the world, for the robot at
+    (``body``, ``origin``) and the joints at their positions: the arm turned q − q0 about y through the
+    anchor from where the file writes it, each finger slid along its axis (the arm's ±x) and placed 0.048 m
+    down the arm's −z, turned 1.5708 (right) or −1.5708 (left) about y; the ds 0.015 m along the right
+    finger's x, turned 1.5708 about y again (its ray along its x)."""
+    arm = body @ rot((0, 1, 0), q_arm - ARM_Q0) @ ARM_R0
+    arm_at = origin + body @ ANCHOR
+    right = arm @ rot((0, 1, 0), HALF_PI_WRITTEN)
+    right_at = arm_at + arm @ np.array([q_right, 0.0, -0.048])
+    ds = right @ rot((0, 1, 0), HALF_PI_WRITTEN)
+    ds_at = right_at + right @ np.array([0.015, 0.0, 0.0])
+    left = arm @ rot((0, 1, 0), -HALF_PI_WRITTEN)
+    left_at = arm_at + arm @ np.array([-q_left, 0.0, -0.048])
+    box = (left_at + left @ np.array([-0.015, 0.0, 0.003]), left, FINGER_HALF)
+    return ds_at, ds @ np.array([1.0, 0.0, 0.0]), box
+
+
+def ray_to_stick(o: np.ndarray, u: np.ndarray) -> float:
+    """The distance along the unit ray to the stick's visible cylinder (its side or its ends, in its Pose's
+    frame: turned 3.14159 about x, so its axis leans 2.65e-6 rad); inf if it misses."""
+    p, d = STICK_TURN.T @ (o - STICK_AT), STICK_TURN.T @ u
+    hits = []
+    a, b, c = d[0] ** 2 + d[1] ** 2, p[0] * d[0] + p[1] * d[1], p[0] ** 2 + p[1] ** 2 - STICK_RADIUS ** 2
+    if a > 0.0 and b * b - a * c >= 0.0:
+        # from inside (a finger closed through the stick, which Webots' physics would have stopped it at) the far
+        # wall: Sensorium's rays see both sides of a shape that is not the device's own (README's table)
+        for t in ((-b - math.sqrt(b * b - a * c)) / a, (-b + math.sqrt(b * b - a * c)) / a):
+            if t >= 0.0 and abs(p[2] + t * d[2]) <= STICK_HALF_HEIGHT:
+                hits.append(t)
+                break
+    for end in (-STICK_HALF_HEIGHT, STICK_HALF_HEIGHT):
+        if d[2] != 0.0 and (t := (end - p[2]) / d[2]) >= 0.0 and math.hypot(*(p[:2] + t * d[:2])) <= STICK_RADIUS:
+            hits.append(t)
+    return min(hits, default=math.inf)
+
+
+def gripper_reading(ds_at: np.ndarray, u: np.ndarray, finger: tuple) -> float:
+    """The table at the nearer of the left finger (grey) and the stick (red) over its reflection factor:
+    infra-red rays see the shapes (the stick's cylinder of radius 0.008 m), not its 0.013 m bounding box."""
+    finger_at, stick_at = ray_to_boxes(ds_at, u, [finger]), ray_to_stick(ds_at, u)
+    seen = finger_at / FINGER_FACTOR if finger_at <= stick_at else stick_at / STICK_FACTOR     # the nearer one
+    return 1000.0 * min(seen, 0.05) / 0.05
+
+
+def floor_pose(x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+    """A robot riding the leaning floor from START: its attitude the floor's (turned FLOOR_TURN about y), its
+    heading ``yaw``, its height the floor's rise from START (it keeps the clearance it was placed with)."""
+    slope = -math.tan(FLOOR_TURN)          # dz/dx of the plane whose normal is R_y(θ)·z
+    return rot((0, 1, 0), FLOOR_TURN) @ rot((0, 0, 1), yaw), np.array([x, y, slope * (x - START[0])])
+
+
+def test_the_gripper_khepera_loads_its_turret_raised_and_rides_the_leaning_arena_floor() -> None:
+    """The robot loads with the 29 devices (the turret's "motor", "left grip", "right grip" and "ds" among them)
+    and a differential drive on the wheels (radius 0.0075 m, axle 0.052 m: the arc rule of a robot with
+    Physics); the three joints each get their one line (kinematic motion), and nothing else: the arm starts at
+    −1.4, where the file writes it. What changed: the arena's floor Plane, turned 4.7e-6 rad, was no ground
+    (a plane had to face up within 1e-12), so the robot "started over no ground" in a GroundWarning; a plane
+    leaning less than 45° is now a sloped floor, as Webots' physics has it, and the robot stands on it, turned
+    with it (1e-12)."""
+    w = load_world(DATA / "khepera_gripper.wbt")
+    assert len(w.warnings) == 3 and all("moves kinematically" in line for line in w.warnings)
+    (robot,) = w.world.robots
+    names = {d.name for d in robot.devices}
+    assert len(names) == 29 and {"motor", "left grip", "right grip", "ds", "left wheel motor", "right wheel motor",
+                                 "camera"} <= names
+    drive = robot.differential_drive
+    assert (drive.wheel_radius, drive.axle_length, drive.step_rule) == (K1_R, K1_AXLE, "arc")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sim = Simulation(w, "exact")
+    r = sim.robot("khepera")
+    assert r.motor("motor").position == ARM_Q0
+    turn, at = floor_pose(*START[:2], 0.0)
+    assert np.asarray(r.pose.rotation) == pytest.approx(turn, abs=1e-12)
+    assert list(r.pose.translation) == pytest.approx(list(at), abs=1e-15)
+
+
+def run_gripper(control_steps: int) -> tuple[list[tuple[int, float, float, float, float]], list[float]]:
+    """khepera_gripper.c's calls in process for ``control_steps`` steps of 50 ms, each step checked against
+    the closed forms: the three joints by Webots' kinematic motor control (KinematicMotor: the arm's speed
+    grows by maxTorque 10 rad/s² up to 10 rad/s, the fingers' reach 0.1 m/s in one 10 ms step), the ds reading
+    its table at the ray's distance to the left finger (over 0.52) or the stick (over 0.68657), the robot's
+    pose the arc rule on the wheel speeds over the leaning floor (1e-9). Returns each step's (k, arm, left and
+    right grips, ds) and the final x, y, yaw."""
+    sim = Simulation(load_world(DATA / "khepera_gripper.wbt"), "exact")
+    r = sim.robot("khepera")
+    assert sim.basic_time_step == 10
+    ds = r.device("ds")
+    ds.enable(50)
+    wheels = r.motor("left wheel motor"), r.motor("right wheel motor")
+    for m in wheels:
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    model = {"motor": KinematicMotor(10.0, 10.0, ARM_Q0), "left grip": KinematicMotor(0.1, 100.0),
+             "right grip": KinematicMotor(0.1, 100.0)}
+    x, y, yaw, wl, wr = float(START[0]), float(START[1]), 0.0, 0.0, 0.0
+    out = []
+    i = 0
+    for k in range(control_steps):
+        for _ in range(5):
+            sim.step()
+            for mm in model.values():
+                mm.step(0.01)
+            v, w = 0.5 * (wl + wr) * K1_R, (wr - wl) * K1_R / K1_AXLE
+            x, y, yaw = x + v * 0.01 * math.cos(yaw), y + v * 0.01 * math.sin(yaw), yaw + w * 0.01
+        q = {name: mm.x for name, mm in model.items()}
+        for name, value in q.items():
+            assert r.motor(name).position == pytest.approx(value, abs=1e-12), (k, name)
+        body, origin = floor_pose(x, y, yaw)
+        assert np.asarray(r.pose.rotation) == pytest.approx(body, abs=1e-9), k
+        assert list(r.pose.translation) == pytest.approx(list(origin), abs=1e-9), k
+        ds_at, u, finger = gripper_frames(body, origin, q["motor"], q["right grip"], q["left grip"])
+        expected = gripper_reading(ds_at, u, finger)
+        assert float(ds.value) == pytest.approx(expected, abs=1e-6), (k, q)
+        out.append((k, q["motor"], q["left grip"], q["right grip"], float(ds.value)))
+        commands = {0: {"left grip": 0.029, "right grip": 0.029}, 20: {"motor": 0.0},
+                    40: {"left grip": 0.005, "right grip": 0.005}, 80: {"motor": -1.4}, 200: {"motor": 0.0},
+                    240: {"left grip": 0.029, "right grip": 0.029}, 260: {"motor": -1.4}}.get(i, {})
+        for name, target in commands.items():
+            r.motor(name).set_position(target)
+            model[name].target = target
+        speeds = {100: (-2.0, 2.0), 140: (10.0, 10.0), 160: (-2.0, 2.0), 200: (0.0, 0.0)}.get(i)
+        if speeds is not None:
+            wl, wr = speeds
+            for m, s in zip(wheels, speeds, strict=True):
+                m.set_velocity(s)
+        i = 0 if i == 280 else i + 1
+    return out, [x, y, yaw]
+
+
+def test_khepera_grippers_calls_open_lower_and_close_the_gripper_by_the_closed_forms() -> None:
+    """khepera_gripper: the first 60 steps (3 s). The fingers open at 0.1 m/s, 5 mm a step, to 0.029 m; the ds
+    reads the left finger across the gap 0.0005 + q_r + q_l (19.23 at rest, 403.84 at 5 mm each) and 1000 (the
+    table's last value) past 0.026 m of it. The arm comes down from 1.05 s, its speed growing 0.1 rad/s every
+    10 ms (0.53 s to its target), turned 1.4 rad about the anchor from where the file writes it; the ds then
+    sees the stick between the open fingers. The gripper closes from 2.05 s: the fingers pass through the
+    stick's bounds, which Webots' physics stops them at and grips (10 N·s friction): here joints are kinematic
+    and hold nothing (README: Joints)."""
+    out, _ = run_gripper(60)
+    assert [round(v, 3) for *_, v in out[:4]] == [19.227, 403.842, 788.457, 1000.0]
+    assert out[10][2:4] == (0.029, 0.029) and out[20][1] == ARM_Q0
+    down = next(k for k, q, *_ in out if q == 0.0)
+    assert down == 31      # 53 basic steps of 10 ms after the command at the end of step 20
+    assert next(o[0] for o in out[5:] if o[4] < 1000.0) == 29       # the stick, first seen as the arm comes down
+    assert out[35][4] == pytest.approx(574.0122, abs=1e-4)         # the stick 0.019705 m away, between the fingers
+
+
+@pytest.mark.slow
+def test_khepera_grippers_calls_for_a_whole_cycle_turn_drive_and_turn_the_robot() -> None:
+    """The whole 281-step cycle (14.05 s): after the arm is up again the robot turns in place at
+    2·2·0.0075/0.052 = 0.5769 rad/s for 2 s, drives 0.075 m at 0.075 m/s, turns 2 s more and stops at
+    (−0.0442, 0.0440), heading 2.3077, tilted with the floor; the arm goes down and up again, the fingers open."""
+    out, end = run_gripper(281)
+    assert out[-1][1:4] == (ARM_Q0, 0.029, 0.029)
+    turn = 2.0 * 2.0 * K1_R / K1_AXLE * 2.0
+    assert end == pytest.approx([START[0] + 0.075 * math.cos(turn), START[1] + 0.075 * math.sin(turn), 2.0 * turn],
+                                abs=1e-12)
+
+
+@pytest.mark.parametrize("angle", [4.692820414042842e-06, 0.3, -0.7])
+def test_a_plane_leaning_less_than_45_degrees_is_a_sloped_floor_everywhere(tmp_path: Path, angle: float) -> None:
+    """The fix khepera_gripper called for, in closed form: a Plane at (0.5, −0.2, 0.1) turned ``angle`` about
+    (1, 1, 0)/√2 is ground at every point (x, y): its height 0.1 − (n_x·(x − 0.5) + n_y·(y + 0.2))/n_z and its
+    slope (−n_x/n_z, −n_y/n_z), n its turned z (1e-15); turned 0.8 rad (over 45°) it is no ground, as a ramp
+    that steep is none."""
+    from sensorium.server.sim.ground import Ground
+
+    def ground(turn: float) -> Ground | None:
+        (tmp_path / "plane.wbt").write_text(
+            "#VRML_SIM R2023b utf8\nWorldInfo {}\n"
+            f"Solid {{ translation 0.5 -0.2 0.1 rotation 1 1 0 {turn!r} boundingObject Plane {{ size 1 1 }} }}\n")
+        return Simulation(load_world(tmp_path / "plane.wbt"), "exact").ground
+
+    n = rot((1, 1, 0), angle) @ np.array([0.0, 0.0, 1.0])
+    g = ground(angle)
+    assert g is not None
+    for x, y in [(0.5, -0.2), (3.0, 4.0), (-250.0, 17.5)]:
+        z, gx, gy = g.at(x, y)
+        assert (gx, gy) == pytest.approx((-n[0] / n[2], -n[1] / n[2]), abs=1e-15)
+        assert z == pytest.approx(0.1 - (n[0] * (x - 0.5) + n[1] * (y + 0.2)) / n[2], abs=1e-12)
+    assert ground(0.8) is None
+
+
+@pytest.mark.parametrize("helper", [True, False])
+def test_the_batched_simulation_rides_the_leaning_arena_floor_as_simulation_does_bit_for_bit(tmp_path: Path,
+                                                                                             helper: bool) -> None:
+    """The Khepera (Physics, its turret left out) on khepera_gripper's leaning arena floor in the batched
+    simulation: each copy's pose is the single Simulation's bit for bit at every step (C drive pass and numpy),
+    tilted with the floor (its rotation's third column the floor's normal, (sin θ, 0, cos θ))."""
+    import shutil
+
+    from sensorium.gym.views import CopySim
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.batched import BatchedSimulation
+
+    if helper and packets.library() is None:
+        pytest.skip(f"no C helper: {packets.status()}")
+    shutil.copytree(DATA / "protos", tmp_path / "protos")
+    text = (DATA / "khepera_gripper.wbt").read_text()
+    world = tmp_path / "khepera_floor.wbt"
+    world.write_text(text[:text.index("  extensionSlot [")] + "}\n")
+    lw = load_world(world)
+    batched = BatchedSimulation(lw, 2)
+    if not helper:
+        batched._drive_step = None
+    batched.reset(np.arange(2), [1, 2])
+    singles = [Simulation(lw, "exact") for _ in range(2)]
+    slot = batched.slot("khepera")
+    speeds = [(4.0, 6.0), (-3.0, 5.0)]
+    for c, single in enumerate(singles):
+        for sim in (single, CopySim(batched, c)):
+            for m, v in zip(("left wheel motor", "right wheel motor"), speeds[c], strict=True):
+                motor = sim.robot("khepera").motors[m]
+                motor.set_position(math.inf)
+                motor.set_velocity(v)
+    for t in range(60):
+        batched.step()
+        for c, single in enumerate(singles):
+            single.step()
+            p = single.robot("khepera").pose
+            assert batched.pos[c, slot].tobytes() == p.translation.tobytes(), (t, c)
+            assert batched.rot[c, slot].tobytes() == p.rotation.tobytes(), (t, c)
+            assert batched.rot[c, slot, :, 2] == pytest.approx([math.sin(FLOOR_TURN), 0.0, math.cos(FLOOR_TURN)],
+                                                               abs=1e-15)
+    assert float(np.hypot(*(batched.pos[1, slot, :2] - batched.pos[0, slot, :2]))) > 0.01   # the copies differ
