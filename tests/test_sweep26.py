@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 from test_sweep19 import KinematicMotor, rot
 from test_sweep20 import ray_to_boxes
+from test_sweep24 import K1_DS, K2_WEIGHTS
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
@@ -191,7 +192,6 @@ def test_khepera_grippers_calls_open_lower_and_close_the_gripper_by_the_closed_f
     assert out[35][4] == pytest.approx(574.0122, abs=1e-4)         # the stick 0.019705 m away, between the fingers
 
 
-@pytest.mark.slow
 def test_khepera_grippers_calls_for_a_whole_cycle_turn_drive_and_turn_the_robot() -> None:
     """The whole 281-step cycle (14.05 s): after the arm is up again the robot turns in place at
     2·2·0.0075/0.052 = 0.5769 rad/s for 2 s, drives 0.075 m at 0.075 m/s, turns 2 s more and stops at
@@ -269,3 +269,126 @@ def test_the_batched_simulation_rides_the_leaning_arena_floor_as_simulation_does
             assert batched.rot[c, slot, :, 2] == pytest.approx([math.sin(FLOOR_TURN), 0.0, math.cos(FLOOR_TURN)],
                                                                abs=1e-15)
     assert float(np.hypot(*(batched.pos[1, slot, :2] - batched.pos[0, slot, :2]))) > 0.01   # the copies differ
+
+
+# ------------------------------------------------------------------------------------------------ khepera
+# khepera (k-team/khepera1): the Khepera I with Physics, named "khepera", at the centre of the 2 m RectangleArena
+# with five 0.1 m boxes (Webots' WoodenBoxes; white boxes here), running Webots' generic `braitenberg`
+# controller: the name starts with "khepera", so the Khepera weights on ds0…ds7 (table 0 -> 1023, 0.05 m -> 0),
+# each wheel Σ_j w_j (1 − ds_j/512) bounded to ±1 rad/s. With Physics, its drive is the arc on the 0.052 m
+# between its wheels (not the kinematic rule of khepera_kinematic's robots, sweep 24).
+K1_BOXES = [((-0.2, -0.683174), (0.940554832051147, 0.240163077829669, 0.240163077829669), 1.632043330248321),
+            ((-0.75, 0.35), (-0.675244449310683, 0.521557731068725, 0.521557731068725), 4.329427817464676),
+            ((0.5, -0.35471), (-0.820542997539208, 0.404171491566001, 0.404171491566001), 4.515877143482041),
+            ((-0.3, 0.36), (-0.820542997539208, 0.404171491566001, 0.404171491566001), 4.515877143482041),
+            ((-0.65, -0.66), (-0.820542997539208, 0.404171491566001, 0.404171491566001), 4.515877143482041)]
+K1_RES = 0.0314
+
+
+def khepera_obstacles() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The arena's four walls (0.01 m thick, 0.1 m high, outside the 2 m floor) and the five boxes."""
+    walls = [((1.005, 0.0), (0.005, 1.0)), ((-1.005, 0.0), (0.005, 1.0)),
+             ((0.0, 1.005), (1.01, 0.005)), ((0.0, -1.005), (1.01, 0.005))]
+    out = [(np.array([x, y, 0.05]), np.eye(3), np.array([hx, hy, 0.05])) for (x, y), (hx, hy) in walls]
+    out += [(np.array([x, y, 0.05]), rot(axis, a), np.full(3, 0.05)) for (x, y), axis, a in K1_BOXES]
+    return out
+
+
+def noiseless_khepera(tmp_path: Path) -> Path:
+    """A copy of the khepera stand-in whose infra-red tables have no noise (0.01 at 0.05 m)."""
+    (tmp_path / "protos").mkdir()
+    proto = (DATA / "protos" / "Khepera1.proto").read_text()
+    (tmp_path / "protos" / "Khepera1.proto").write_text(
+        proto.replace("lookupTable [ 0 1023 0, 0.05 0 0.01 ]", "lookupTable [ 0 1023 0, 0.05 0 0 ]"))
+    (tmp_path / "khepera.wbt").write_text((DATA / "khepera.wbt").read_text())
+    return tmp_path / "khepera.wbt"
+
+
+def run_khepera(world: Path, duration_ms: int) -> tuple[list[tuple[int, int]], list[tuple[int, float]], list[float]]:
+    """braitenberg.c's calls in process, each 32 ms step checked against the closed forms: each infra-red sensor
+    reads the table at its ray's distance to the nearest (white) wall or box face, the wheels' sensors their
+    angles rounded to 0.0314 rad, the pose the exact arc of v = (ωl + ωr)·r/2, ω = (ωr − ωl)·r/0.052 (1e-9), flat,
+    but where kinematic contact pushes it. Returns when each sensor first read something, the pushes, and the
+    final x, y, yaw."""
+    sim = Simulation(load_world(world), "exact")
+    robot = sim.robot("khepera")
+    step = sim.basic_time_step
+    assert step == 32
+    ds = [sim.device(f"khepera/ds{i}") for i in range(8)]
+    for s in ds:
+        s.enable(step)
+    wheel_sensors = [sim.device("khepera/left wheel sensor"), sim.device("khepera/right wheel sensor")]
+    for s in wheel_sensors:
+        s.enable(step)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    obstacles = khepera_obstacles()
+    rays = [(np.array(at), rot(axis, a) @ np.array([1.0, 0.0, 0.0])) for at, axis, a in K1_DS]
+    x, y, yaw, wl, wr = 0.0, 0.0, 0.0, 0.0, 0.0
+    angles = [0.0, 0.0]
+    seen: dict[int, int] = {}
+    pushes: list[tuple[int, float]] = []
+    dt = step / 1000
+    for k in range(1, duration_ms // step + 1):
+        sim.step()
+        v, w = 0.5 * (wl + wr) * K1_R, (wr - wl) * K1_R / K1_AXLE
+        if w == 0.0:
+            x, y = x + v * dt * math.cos(yaw), y + v * dt * math.sin(yaw)
+        else:
+            x, y = x + v / w * (math.sin(yaw + w * dt) - math.sin(yaw)), y - v / w * (math.cos(yaw + w * dt) - math.cos(yaw))
+        yaw += w * dt
+        angles = [angles[0] + wl * dt, angles[1] + wr * dt]
+        at = np.asarray(robot.pose.translation)
+        if abs(at[0] - x) + abs(at[1] - y) > 1e-9:
+            pushes.append((k, float(np.hypot(at[0] - x, at[1] - y))))
+            x, y = float(at[0]), float(at[1])
+        body = rot((0, 0, 1), yaw)
+        assert list(robot.pose.translation) == pytest.approx([x, y, 0.0], abs=1e-9), k
+        assert np.asarray(robot.pose.rotation) == pytest.approx(body, abs=1e-9), k
+        values = []
+        for i, (p, u) in enumerate(rays):
+            distance = ray_to_boxes(np.array([x, y, 0.0]) + body @ p, body @ u, obstacles)
+            values.append(1023.0 * (1.0 - distance / 0.05) if distance < 0.05 else 0.0)
+            if values[-1] > 0.0:
+                seen.setdefault(i, k * step)
+            assert float(ds[i].value) == pytest.approx(values[-1], abs=1e-6), (k, i, distance)
+        for s, a in zip(wheel_sensors, angles, strict=True):
+            assert float(s.value) == pytest.approx(round(a / K1_RES) * K1_RES, abs=1e-12), k
+        wl, wr = (max(-1.0, min(1.0, sum(w[side] * (1.0 - v / 512) for w, v in zip(K2_WEIGHTS, values, strict=True))))
+                  for side in (0, 1))
+        left.set_velocity(wl)
+        right.set_velocity(wr)
+    return sorted((t, i) for i, t in seen.items()), pushes, [x, y, math.remainder(yaw, 2 * math.pi)]
+
+
+def test_the_khepera_with_physics_loads_the_devices_braitenberg_asks_for_and_the_arc_drive() -> None:
+    """The Khepera I with Physics loads without a line with its 24 devices and a differential drive of radius
+    0.0075 m on the 0.052 m between its wheels (the arc rule of a robot with Physics), its wheels on the floor."""
+    w = load_world(DATA / "khepera.wbt")
+    assert w.warnings == []
+    (robot,) = w.world.robots
+    assert len({d.name for d in robot.devices}) == 24
+    drive = robot.differential_drive
+    assert robot.mass is not None and drive.step_rule == "arc"
+    assert (drive.wheel_radius, drive.axle_length, drive.wheel_bottom) == (K1_R, K1_AXLE, 0.0)
+
+
+def test_braitenbergs_calls_drive_the_khepera_straight_at_its_bounded_speed(tmp_path: Path) -> None:
+    """khepera: in open space the Braitenberg sums are 3 on both wheels, bounded to 1 rad/s: 0.0075 m/s along +x;
+    for 24 s (750 steps) every reading (0), wheel sensor and pose meet run_khepera's closed forms."""
+    seen, pushes, end = run_khepera(noiseless_khepera(tmp_path), 24000)
+    assert seen == [] and pushes == []
+    assert end == pytest.approx([0.0075 * 23.968, 0.0, 0.0], abs=1e-12)
+
+
+@pytest.mark.slow
+def test_braitenbergs_calls_drive_the_khepera_to_the_wall_and_round(tmp_path: Path) -> None:
+    """The same closed forms for 200 s (6250 steps): ds2 and ds3 meet the wall at x 1 at 123.104 s (the robot at
+    1 − 0.027 − 0.05 m and a step), then ds1 and ds4, ds0, and the rear ds7 as it turns; it turns right along the
+    wall, never touching it, to (0.7014, −0.4097), heading −2.1339 (the arc where khepera_kinematic's rule
+    gave its robots a 4 % wider axle)."""
+    seen, pushes, end = run_khepera(noiseless_khepera(tmp_path), 200000)
+    assert seen == [(123104, 2), (123104, 3), (125856, 1), (125856, 4), (129216, 0), (134976, 7)] and pushes == []
+    assert end == pytest.approx([0.7014, -0.4097, -2.1339], abs=1e-4)
