@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from test_sweep19 import KinematicMotor, rot
 from test_sweep20 import ray_to_boxes
-from test_sweep24 import K1_DS, K2_WEIGHTS
+from test_sweep24 import K1_DS, K2_AXLE, K2_WEIGHTS
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
@@ -392,3 +392,131 @@ def test_braitenbergs_calls_drive_the_khepera_to_the_wall_and_round(tmp_path: Pa
     seen, pushes, end = run_khepera(noiseless_khepera(tmp_path), 200000)
     assert seen == [(123104, 2), (123104, 3), (125856, 1), (125856, 4), (129216, 0), (134976, 7)] and pushes == []
     assert end == pytest.approx([0.7014, -0.4097, -2.1339], abs=1e-4)
+
+
+# ------------------------------------------------------------------------------------------------ khepera_k213
+# khepera_k213 (k-team/khepera1): the Khepera I with `kinematic TRUE` (no Physics: Webots' kinematic rule, axle
+# 2·√(0.026² + 0.0075²)) at (−0.101226, −0.218527) heading 1.58668 rad, a K213 linear camera (64 × 1 pixels, field
+# of view 0.6283) 0.04 m up in its extensionSlot, in a 0.98 m RectangleArena turned a quarter turn with walls
+# 0.02 m high, five red 0.23 × 0.04 × 0.1 m boxes. khepera_k213.c: 64 ms steps; one step of 64 s first (the robot
+# still), then each step ds1…ds4 (their values truncated to integers) against 150: both front ones over it, back
+# at −2; none, forward at 4; else ds3 or ds4 over it, left (−2, 2); then ds1 or ds2 over it, right (2, −2); the
+# image read and printed as 64 characters, one per gray level band.
+K213_START = (-0.101226, -0.218527, 1.586680526794897)
+ARENA_TURN = rot((0, 0, 1), 1.570796326794897)
+RED_FACTOR = 0.2 + 0.8 * 1.0 * 0.5                   # baseColor red 1, roughness 1
+K213_BOXES = [((-0.2, -0.4), (0.577656775505086, 0.577196954995895, 0.577196954995895), 2.093935403939799),
+              ((0.37, 0.44), (1, 0, 0), 1.5707963267948966),
+              ((-0.39, -0.2), (0.990082465225964, -0.099339599486002, -0.099339599486002), 1.580763202889407),
+              ((0.45, -0.48), (0.888584723211755, 0.324358744043296, 0.324358744043296), 1.688647850036833),
+              ((-0.45, 0.48), (0.888584723211755, 0.324358744043296, 0.324358744043296), 1.688647850036833)]
+
+
+def k213_obstacles() -> tuple[list, list]:
+    """The arena's four white walls (0.01 m thick, 0.02 m high, outside the 0.98 m floor, turned with it), and the
+    five red boxes."""
+    walls = [((0.495, 0.0), (0.005, 0.49)), ((-0.495, 0.0), (0.005, 0.49)),
+             ((0.0, 0.495), (0.5, 0.005)), ((0.0, -0.495), (0.5, 0.005))]
+    white = [(ARENA_TURN @ np.array([x, y, 0.01]), ARENA_TURN, np.array([hx, hy, 0.01])) for (x, y), (hx, hy) in walls]
+    red = [(np.array([x, y, 0.02]), rot(axis, a), np.array([0.115, 0.02, 0.05])) for (x, y), axis, a in K213_BOXES]
+    return white, red
+
+
+def run_k213(duration_ms: int) -> tuple[list[tuple[int, tuple[int, int]]], list[float], np.ndarray]:
+    """khepera_k213.c's calls in process for ``duration_ms`` after its 64 s wait, each step checked against the
+    closed forms: ds1…ds4 read the table at their ray's distance to the nearest white wall, or red box over 0.6
+    (noise zeroed), the pose Webots' kinematic rule on the speeds set (1e-9), the camera's image 64 × 1. Returns
+    the speeds' changes (time, speeds), the final x, y, yaw and the last image's gray levels."""
+    import re
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        (Path(tmp) / "protos").mkdir()
+        proto = (DATA / "protos" / "Khepera1.proto").read_text()
+        (Path(tmp) / "protos" / "Khepera1.proto").write_text(re.sub(r"0\.05 0 0\.01 \]", "0.05 0 0 ]", proto))
+        (Path(tmp) / "khepera_k213.wbt").write_text((DATA / "khepera_k213.wbt").read_text())
+        sim = Simulation(load_world(Path(tmp) / "khepera_k213.wbt"), "exact")
+    robot = sim.robot("khepera")
+    step = sim.basic_time_step
+    assert step == 32
+    ds = [sim.device(f"khepera/ds{i}") for i in range(8)]
+    for s in ds:
+        s.enable(64)
+    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    camera = sim.device("khepera/k213")
+    camera.enable(64)
+    for _ in range(2000):                      # wb_robot_step(1000 * 64): 64 s still
+        sim.step()
+    x, y, yaw = K213_START
+    assert list(robot.pose.translation) == pytest.approx([x, y, 0.0], abs=1e-12)
+    white, red = k213_obstacles()
+    rays = [(np.array(at), rot(axis, a) @ np.array([1.0, 0.0, 0.0])) for at, axis, a in K1_DS]
+    wl = wr = 0
+    changes: list[tuple[int, tuple[int, int]]] = []
+    gray = np.zeros(64)
+    for k in range(1, duration_ms // 64 + 1):
+        for _ in range(2):
+            sim.step()
+            d = (wr - wl) * 0.032 * K1_R / (2.0 * K2_AXLE)
+            v = 0.5 * (wl + wr) * K1_R * 0.032
+            x, y, yaw = x + v * math.cos(yaw + d), y + v * math.sin(yaw + d), yaw + 2.0 * d
+        body = rot((0, 0, 1), yaw)
+        assert list(robot.pose.translation) == pytest.approx([x, y, 0.0], abs=1e-9), k
+        assert np.asarray(robot.pose.rotation) == pytest.approx(body, abs=1e-9), k
+        values = []
+        for i, (p, u) in enumerate(rays):
+            o, w = np.array([x, y, 0.0]) + body @ p, body @ u
+            seen = min(ray_to_boxes(o, w, white), ray_to_boxes(o, w, red) / RED_FACTOR)
+            values.append(1023.0 * (1.0 - seen / 0.05) if seen < 0.05 else 0.0)
+            assert float(ds[i].value) == pytest.approx(values[-1], abs=1e-6), (k, i, seen)
+        v1, v2, v3, v4 = (int(float(ds[i].value)) for i in (1, 2, 3, 4))      # unsigned short: truncated
+        speeds = wl, wr
+        if v2 > 150 and v3 > 150:
+            speeds = -2, -2
+        elif v1 < 150 and v2 < 150 and v3 < 150 and v4 < 150:
+            speeds = 4, 4
+        elif v3 > 150 or v4 > 150:
+            speeds = -2, 2
+        if v1 > 150 or v2 > 150:
+            speeds = 2, -2
+        image = np.asarray(camera.image)
+        assert image.shape == (1, 64, 4)
+        gray = image[0, :, :3].astype(int).sum(axis=1) // 3           # wb_camera_image_get_gray: (r + g + b) / 3
+        if speeds != (wl, wr):
+            changes.append((64000 + k * 64, speeds))
+        wl, wr = speeds
+        left.set_velocity(wl)
+        right.set_velocity(wr)
+    return changes, [x, y, math.remainder(yaw, 2 * math.pi)], gray
+
+
+def test_the_k213_khepera_loads_its_linear_camera_and_stays_still_through_the_wait_then_drives_straight() -> None:
+    """The robot loads without a line with 25 devices, the K213 a 64 × 1 camera of field of view 0.6283, and
+    Webots' kinematic rule; through the 64 s step it stays where it is placed (1e-12), then, its front sensors
+    reading 0, drives at 4 rad/s: 0.03 m/s along its heading 1.58668, every reading and pose the closed form's for
+    4 s (1e-9), each image 64 × 1."""
+    w = load_world(DATA / "khepera_k213.wbt")
+    assert w.warnings == []
+    (robot,) = w.world.robots
+    assert len({d.name for d in robot.devices}) == 25
+    (k213,) = [d for d in robot.devices if d.name == "k213"]
+    assert (k213.width, k213.height, k213.field_of_view) == (64, 1, 0.6283)
+    assert robot.differential_drive.step_rule == "mid_heading"
+    changes, end, _ = run_k213(4000)
+    assert changes == [(64064, (4, 4))]
+    x0, y0, yaw0 = K213_START
+    assert end == pytest.approx([x0 + 0.03 * 3.904 * math.cos(yaw0), y0 + 0.03 * 3.904 * math.sin(yaw0), yaw0], abs=1e-12)
+
+
+def test_khepera_k213s_calls_drive_the_khepera_to_the_wall_and_along_it() -> None:
+    """khepera_k213 for 30 s after the wait: forward until ds1, looking out to the front left, passes 150 on the
+    wall at y 0.49 at 85.376 s (the robot 0.63936 m on, at y 0.42075), then the controller's right turns and
+    forward steps alternating along the wall, to (0.0554, 0.4400), heading −0.0098, every reading and pose the
+    closed form's (1e-9)."""
+    changes, end, _ = run_k213(30000)
+    assert changes[:3] == [(64064, (4, 4)), (85376, (2, -2)), (85888, (4, 4))] and len(changes) == 31
+    assert all(s in ((4, 4), (2, -2)) for _, s in changes)
+    assert end == pytest.approx([0.0554, 0.4400, -0.0098], abs=1e-4)
