@@ -37,6 +37,13 @@ ARM_Q0 = -1.4
 HALF_PI_WRITTEN = 1.5708                               # the fingers' and the sensor's turns as written
 STICK_AT, STICK_RADIUS, STICK_HALF_HEIGHT = np.array([-0.0198, -0.0261, 0.03]), 0.008, 0.03   # its visible cylinder
 STICK_TURN = rot((1, 0, 0), 3.14159)
+# khepera_gripper_camera: the same turret on "khepera camera" put 4.6 mm up at (0.0245671, 0) (Webots' physics drops
+# it onto its wheels; here it settles at load), the arena not turned, the stick straight ahead at (0.08, 0), upright
+GRIPPER = {"world": "khepera_gripper.wbt", "robot": "khepera", "start": START, "floor": FLOOR_TURN,
+           "stick": STICK_AT, "stick turn": STICK_TURN}
+GRIPPER_CAMERA = {"world": "khepera_gripper_camera.wbt", "robot": "khepera camera",
+                  "start": np.array([0.0245671, 0.0, 0.0]), "floor": 0.0, "stick": np.array([0.08, 0.0, 0.03]),
+                  "stick turn": np.eye(3)}
 FINGER_HALF = np.array([0.014, 0.0035, 0.0025])
 # Webots' infra-red factor 0.2 + 0.8 · red · (1 − 0.5 · roughness): the grey fingers (0.8, roughness 1), the red stick
 FINGER_FACTOR = 0.2 + 0.8 * 0.8 * 0.5
@@ -62,10 +69,10 @@ def gripper_frames(body: np.ndarray, origin: np.ndarray, q_arm: float, q_right: 
     return ds_at, ds @ np.array([1.0, 0.0, 0.0]), box
 
 
-def ray_to_stick(o: np.ndarray, u: np.ndarray) -> float:
+def ray_to_stick(o: np.ndarray, u: np.ndarray, at: np.ndarray = STICK_AT, turn: np.ndarray = STICK_TURN) -> float:
     """The distance along the unit ray to the stick's visible cylinder (its side or its ends, in its Pose's
     frame: turned 3.14159 about x, so its axis leans 2.65e-6 rad); inf if it misses."""
-    p, d = STICK_TURN.T @ (o - STICK_AT), STICK_TURN.T @ u
+    p, d = turn.T @ (o - at), turn.T @ u
     hits = []
     a, b, c = d[0] ** 2 + d[1] ** 2, p[0] * d[0] + p[1] * d[1], p[0] ** 2 + p[1] ** 2 - STICK_RADIUS ** 2
     if a > 0.0 and b * b - a * c >= 0.0:
@@ -81,19 +88,19 @@ def ray_to_stick(o: np.ndarray, u: np.ndarray) -> float:
     return min(hits, default=math.inf)
 
 
-def gripper_reading(ds_at: np.ndarray, u: np.ndarray, finger: tuple) -> float:
+def gripper_reading(ds_at: np.ndarray, u: np.ndarray, finger: tuple, layout: dict = GRIPPER) -> float:
     """The table at the nearer of the left finger (grey) and the stick (red) over its reflection factor:
     infra-red rays see the shapes (the stick's cylinder of radius 0.008 m), not its 0.013 m bounding box."""
-    finger_at, stick_at = ray_to_boxes(ds_at, u, [finger]), ray_to_stick(ds_at, u)
+    finger_at, stick_at = ray_to_boxes(ds_at, u, [finger]), ray_to_stick(ds_at, u, layout["stick"], layout["stick turn"])
     seen = finger_at / FINGER_FACTOR if finger_at <= stick_at else stick_at / STICK_FACTOR     # the nearer one
     return 1000.0 * min(seen, 0.05) / 0.05
 
 
-def floor_pose(x: float, y: float, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+def floor_pose(x: float, y: float, yaw: float, layout: dict = GRIPPER) -> tuple[np.ndarray, np.ndarray]:
     """A robot riding the leaning floor from START: its attitude the floor's (turned FLOOR_TURN about y), its
     heading ``yaw``, its height the floor's rise from START (it keeps the clearance it was placed with)."""
-    slope = -math.tan(FLOOR_TURN)          # dz/dx of the plane whose normal is R_y(θ)·z
-    return rot((0, 1, 0), FLOOR_TURN) @ rot((0, 0, 1), yaw), np.array([x, y, slope * (x - START[0])])
+    slope = -math.tan(layout["floor"])          # dz/dx of the plane whose normal is R_y(θ)·z
+    return rot((0, 1, 0), layout["floor"]) @ rot((0, 0, 1), yaw), np.array([x, y, slope * (x - layout["start"][0])])
 
 
 def test_the_gripper_khepera_loads_its_turret_raised_and_rides_the_leaning_arena_floor() -> None:
@@ -122,15 +129,15 @@ def test_the_gripper_khepera_loads_its_turret_raised_and_rides_the_leaning_arena
     assert list(r.pose.translation) == pytest.approx(list(at), abs=1e-15)
 
 
-def run_gripper(control_steps: int) -> tuple[list[tuple[int, float, float, float, float]], list[float]]:
+def run_gripper(control_steps: int, layout: dict = GRIPPER) -> tuple[list[tuple[int, float, float, float, float]], list[float]]:
     """khepera_gripper.c's calls in process for ``control_steps`` steps of 50 ms, each step checked against
     the closed forms: the three joints by Webots' kinematic motor control (KinematicMotor: the arm's speed
     grows by maxTorque 10 rad/s² up to 10 rad/s, the fingers' reach 0.1 m/s in one 10 ms step), the ds reading
     its table at the ray's distance to the left finger (over 0.52) or the stick (over 0.68657), the robot's
     pose the arc rule on the wheel speeds over the leaning floor (1e-9). Returns each step's (k, arm, left and
     right grips, ds) and the final x, y, yaw."""
-    sim = Simulation(load_world(DATA / "khepera_gripper.wbt"), "exact")
-    r = sim.robot("khepera")
+    sim = Simulation(load_world(DATA / layout["world"]), "exact")
+    r = sim.robot(layout["robot"])
     assert sim.basic_time_step == 10
     ds = r.device("ds")
     ds.enable(50)
@@ -140,7 +147,7 @@ def run_gripper(control_steps: int) -> tuple[list[tuple[int, float, float, float
         m.set_velocity(0.0)
     model = {"motor": KinematicMotor(10.0, 10.0, ARM_Q0), "left grip": KinematicMotor(0.1, 100.0),
              "right grip": KinematicMotor(0.1, 100.0)}
-    x, y, yaw, wl, wr = float(START[0]), float(START[1]), 0.0, 0.0, 0.0
+    x, y, yaw, wl, wr = float(layout["start"][0]), float(layout["start"][1]), 0.0, 0.0, 0.0
     out = []
     i = 0
     for k in range(control_steps):
@@ -153,11 +160,11 @@ def run_gripper(control_steps: int) -> tuple[list[tuple[int, float, float, float
         q = {name: mm.x for name, mm in model.items()}
         for name, value in q.items():
             assert r.motor(name).position == pytest.approx(value, abs=1e-12), (k, name)
-        body, origin = floor_pose(x, y, yaw)
+        body, origin = floor_pose(x, y, yaw, layout)
         assert np.asarray(r.pose.rotation) == pytest.approx(body, abs=1e-9), k
         assert list(r.pose.translation) == pytest.approx(list(origin), abs=1e-9), k
         ds_at, u, finger = gripper_frames(body, origin, q["motor"], q["right grip"], q["left grip"])
-        expected = gripper_reading(ds_at, u, finger)
+        expected = gripper_reading(ds_at, u, finger, layout)
         assert float(ds.value) == pytest.approx(expected, abs=1e-6), (k, q)
         out.append((k, q["motor"], q["left grip"], q["right grip"], float(ds.value)))
         commands = {0: {"left grip": 0.029, "right grip": 0.029}, 20: {"motor": 0.0},
@@ -202,6 +209,25 @@ def test_khepera_grippers_calls_for_a_whole_cycle_turn_drive_and_turn_the_robot(
     assert end == pytest.approx([START[0] + 0.075 * math.cos(turn), START[1] + 0.075 * math.sin(turn), 2.0 * turn],
                                 abs=1e-12)
 
+
+
+def test_khepera_grippers_calls_on_the_gripper_camera_world_settle_the_robot_and_meet_the_closed_forms() -> None:
+    """khepera_gripper_camera: the robot put 4.6 mm up settles on its wheels at load (one line), its camera 64 × 64
+    of field of view 0.785398 (Webots' defaults); the whole cycle meets run_gripper's closed forms on the flat
+    floor, the ds seeing the stick centred between the open fingers at 622.772 (0.021378 m over the red's 0.68657)
+    and the robot ending at (0.0549, 0.0686), heading 2.3077."""
+    w = load_world(DATA / "khepera_gripper_camera.wbt")
+    assert len(w.warnings) == 3
+    sim = Simulation(w, "exact")
+    assert sim.loaded.warnings[3:] == [
+        f"{DATA / 'khepera_gripper_camera.wbt'}: robot 'khepera camera' settled on the ground at load, as Webots' "
+        "physics drops it: its origin's z from 0.0046 to 0.0000 m (its lowest wheel now touches the ground under it)"]
+    (camera,) = [d for d in w.world.robots[0].devices if d.name == "camera"]
+    assert (camera.width, camera.height, camera.field_of_view) == (64, 64, 0.785398)
+    out, end = run_gripper(281, GRIPPER_CAMERA)
+    assert out[35][4] == pytest.approx(622.7716, abs=1e-4)
+    turn = 2.0 * 2.0 * K1_R / K1_AXLE * 2.0
+    assert end == pytest.approx([0.0245671 + 0.075 * math.cos(turn), 0.075 * math.sin(turn), 2.0 * turn], abs=1e-12)
 
 @pytest.mark.parametrize("angle", [4.692820414042842e-06, 0.3, -0.7])
 def test_a_plane_leaning_less_than_45_degrees_is_a_sloped_floor_everywhere(tmp_path: Path, angle: float) -> None:
