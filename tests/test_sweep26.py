@@ -5,11 +5,14 @@ process by the calls its controller makes and checked against closed forms."""
 from __future__ import annotations
 
 import math
+import shutil
+import subprocess
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _serve import child_env, sensorium
 from test_sweep19 import KinematicMotor, rot
 from test_sweep20 import ray_to_boxes
 from test_sweep24 import K1_DS, K2_AXLE, K2_WEIGHTS
@@ -211,6 +214,55 @@ def test_khepera_grippers_calls_for_a_whole_cycle_turn_drive_and_turn_the_robot(
 
 
 
+
+GRIPPER_CONTROLLER = '''\
+import math
+from controller import Robot
+
+OPEN_GRIP, CLOSED_GRIP = 0.029, 0.005
+robot = Robot()
+motor, left_grip, right_grip = (robot.getDevice(n) for n in ("motor", "left grip", "right grip"))
+ds = robot.getDevice("ds")
+left_motor, right_motor = robot.getDevice("left wheel motor"), robot.getDevice("right wheel motor")
+for m in (left_motor, right_motor):
+    m.setPosition(math.inf)
+    m.setVelocity(0.0)
+ds.enable(50)
+i = k = 0
+while robot.step(50) != -1:
+    print(f"{k} {ds.getValue():.6f}", flush=True)
+    if i == 0:
+        left_grip.setPosition(OPEN_GRIP)
+        right_grip.setPosition(OPEN_GRIP)
+    elif i == 20:
+        motor.setPosition(0.0)
+    elif i == 40:
+        left_grip.setPosition(CLOSED_GRIP)
+        right_grip.setPosition(CLOSED_GRIP)
+    i, k = (0 if i == 280 else i + 1), k + 1
+'''
+
+
+@pytest.mark.slow
+def test_khepera_grippers_calls_under_sensorium_run(tmp_path: Path) -> None:
+    """Our Python controller making khepera_gripper.c's calls (its first 60 steps) under ``sensorium run``: no
+    GroundWarning, and each step's ds reading is the in-process closed form's (1e-6)."""
+    (tmp_path / "worlds").mkdir()
+    shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
+    world = tmp_path / "worlds" / "khepera_gripper.wbt"
+    world.write_text((DATA / "khepera_gripper.wbt").read_text())
+    (tmp_path / "controllers" / "khepera_gripper").mkdir(parents=True)
+    (tmp_path / "controllers" / "khepera_gripper" / "khepera_gripper.py").write_text(GRIPPER_CONTROLLER)
+    done = subprocess.run(sensorium("run", str(world), "--until", "3000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "ground" not in (done.stdout + done.stderr).lower()
+    rows = [line.split("] ", 1)[1].split() for line in done.stdout.splitlines() if line.startswith("[khepera] ")]
+    expected, _ = run_gripper(60)
+    assert [int(k) for k, _ in rows] == list(range(60))
+    assert [float(v) for _, v in rows] == pytest.approx([v for *_, v in expected], abs=1e-6)
+
 def test_khepera_grippers_calls_on_the_gripper_camera_world_settle_the_robot_and_meet_the_closed_forms() -> None:
     """khepera_gripper_camera: the robot put 4.6 mm up settles on its wheels at load (one line), its camera 64 × 64
     of field of view 0.785398 (Webots' defaults); the whole cycle meets run_gripper's closed forms on the flat
@@ -259,8 +311,6 @@ def test_the_batched_simulation_rides_the_leaning_arena_floor_as_simulation_does
     """The Khepera (Physics, its turret left out) on khepera_gripper's leaning arena floor in the batched
     simulation: each copy's pose is the single Simulation's bit for bit at every step (C drive pass and numpy),
     tilted with the floor (its rotation's third column the floor's normal, (sin θ, 0, cos θ))."""
-    import shutil
-
     from sensorium.gym.views import CopySim
     from sensorium.server.raycast import packets
     from sensorium.server.sim.batched import BatchedSimulation
