@@ -14,7 +14,11 @@ What counts as ground (seen by bounding rays, as kinematic contact reads the wor
   its closed extent ``[0, (x_dimension − 1)·x_spacing] × [0, (y_dimension − 1)·y_spacing]`` and
   nothing beyond;
 * a Plane facing up (its local z the world's up): a floor at its height, everywhere (bounding rays
-  and Webots' physics take every plane as infinite, whatever its size);
+  and Webots' physics take every plane as infinite, whatever its size); a Plane that leans less than
+  contact.RAMP_MAX_TILT (45°) from facing up -- a floor written with a small turn, as Webots' worlds
+  converted from R2021c write `RectangleArena { rotation 0 1 0 4.692820414042842e-06 }` -- a sloped floor,
+  everywhere, ridden as a terrain triangle is (its height under the origin through the plane's point,
+  its slope for the attitude);
 * the top of a Box whose faces are horizontal and vertical (one of its local axes the world's up,
   within UPRIGHT_TOL; turned about the vertical or not): a floor at its top over its closed
   footprint rectangle -- a slab used as the floor, a raised platform, a step -- but only *for a
@@ -51,7 +55,7 @@ ceiling at that ground + FLOOR: a box top between its band bottom + FLOOR and th
 be both, but contact (when on) keeps its disc, and so its origin, off it.) Terrains and planes are ground
 whatever their height (contact never stops a robot at them), as before.
 
-Other solids are not ridden. In a world without terrains or ramps there is no Ground at all: robots
+Other solids are not ridden. In a world without terrains, ramps or leaning planes there is no Ground at all: robots
 keep their heights over Box floors and Planes alike.
 
 Where several cover a point the highest is the ground (the first in world order on a tie). On a
@@ -74,7 +78,16 @@ from pathlib import Path
 import numpy as np
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.contact import BOX_UPRIGHT_TOL, FLOOR, enu_body, enu_pose, obstacle, ramp_top, robot_footprint
+from sensorium.server.sim.contact import (
+    BOX_UPRIGHT_TOL,
+    FLOOR,
+    RAMP_MAX_TILT,
+    enu_body,
+    enu_pose,
+    obstacle,
+    ramp_top,
+    robot_footprint,
+)
 from sensorium.server.sim.hull import FlatPoints, convex_hull, enclosed, extreme_points, hull_tolerance
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.geometry import Pose
@@ -137,6 +150,8 @@ class _Surface:
     # a box that is a ramp (contact.ramp_top; set by Ground.place): its top face's centre (cx, cy, cz),
     # slope (gx, gy), in-face axes and half sizes (ai, hi), (aj, hj), and low edge
     ramp: tuple | None = None
+    # a plane leaning less than RAMP_MAX_TILT (set by Ground.place): its slope (gx, gy) through (tx, ty, tz)
+    tilt: tuple[float, float] | None = None
     # an upright box's or cylinder's top seen from above (Ground.tops), made once per placing
     outline: np.ndarray | None = None
 
@@ -191,6 +206,10 @@ def _place_surface(s: _Surface, pose: Pose, to_enu: np.ndarray | None) -> None:
         s.upright = _is_upright(r)
         s.tx, s.ty, s.tz = (float(v) for v in t)
         s.r00, s.r01, s.r10, s.r11 = float(r[0, 0]), float(r[0, 1]), float(r[1, 0]), float(r[1, 1])
+        # a plane (no grid) whose normal, its local z, leans less than a ramp may: a sloped floor
+        s.tilt = None
+        if s.grid is None and not s.upright and float(r[2, 2]) > math.cos(RAMP_MAX_TILT):
+            s.tilt = (float(-r[0, 2] / r[2, 2]), float(-r[1, 2] / r[2, 2]))
 
 
 def _place_box(s: _Surface, r: np.ndarray, t: np.ndarray) -> None:
@@ -273,14 +292,14 @@ class Ground:
 
     @classmethod
     def from_world(cls, world: wm.World, solid_poses: dict[str, Pose], to_enu: np.ndarray | None) -> Ground | None:
-        """The ground of a world with at least one terrain or ramp seen by bounding rays (None otherwise:
-        robots then keep their heights, as they always did). ``solid_poses``: the top-level solids'
+        """The ground of a world with at least one terrain, ramp or leaning plane seen by bounding rays (None
+        otherwise: robots then keep their heights, as they always did). ``solid_poses``: the top-level solids'
         world poses; ``to_enu``: world axes to ENU (None in an ENU world)."""
         surfaces = [surface for s in world.solids for surface in _surfaces(s)]
-        if not any(s.grid is not None or s.half is not None for s in surfaces):
+        if all(s.disc is not None for s in surfaces):       # cylinder tops alone (or nothing) make no ground
             return None
         ground = cls(surfaces, solid_poses, to_enu)
-        return ground if any(s.grid is not None or s.ramp is not None for s in surfaces) else None
+        return ground if any(s.grid is not None or s.ramp is not None or s.tilt is not None for s in surfaces) else None
 
     def add_solid(self, solid: wm.Solid, pose: Pose) -> None:
         """A top-level solid built again (a Supervisor set a PROTO field of it): its terrains, floors and
@@ -343,6 +362,16 @@ class Ground:
                 best = np.where(take, z, best)
                 gx = np.where(take, sx, gx)
                 gy = np.where(take, sy, gy)
+                first = np.where(take, i, first)
+                found |= take
+                continue
+            if s.tilt is not None:               # a leaning plane: a sloped floor, everywhere
+                gpx, gpy = s.tilt
+                z = s.tz + (gpx * (x - s.tx) + gpy * (y - s.ty))
+                take = z > best
+                best = np.where(take, z, best)
+                gx = np.where(take, gpx, gx)
+                gy = np.where(take, gpy, gy)
                 first = np.where(take, i, first)
                 found |= take
                 continue
