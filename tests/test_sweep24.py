@@ -234,37 +234,52 @@ def noiseless_khepera2(tmp_path: Path) -> Path:
     return tmp_path / "khepera2.wbt"
 
 
-def run_khepera2(world: Path, duration_ms: int) -> tuple[list[tuple[int, int]], list[tuple[int, float]], list[float]]:
-    """braitenberg.c's calls in process for the robot "khepera2", each 32 ms step checked against the closed
-    forms: each infra-red sensor reads the table at its ray's distance to the nearest (white) wall or box
-    face, the wheels' sensors their angles rounded to 0.0314 rad, and the pose is Webots' kinematic rule on
-    the wheel speeds set from the readings (1e-9), flat, but where kinematic contact pushes it. Returns when
-    each sensor first read something, the pushes, and the final x, y, yaw."""
+def run_braitenberg_khepera(world: Path, robot_name: str, duration_ms: int, sensors: list, obstacles: list,
+                            radius: float, axle: float, resolution: float, rule: str
+                            ) -> tuple[list[tuple[int, int]], list[tuple[int, float]], list[float]]:
+    """braitenberg.c's calls in process for a Khepera ``robot_name`` (eight infra-red sensors ds0…ds7 at
+    ``sensors``' places and turns, tables 0 → 1023 at 0.05 m, two wheels), each 32 ms step checked against the
+    closed forms: each sensor reads the table at its ray's distance to the nearest (white) wall or box face of
+    ``obstacles``, the wheels' sensors their angles rounded to ``resolution``, and the pose (1e-9, flat) the
+    drive's ``rule`` on the wheel speeds set from the readings: ``mid_heading`` (Webots' kinematic rule without
+    Physics: a straight segment along the mid-step heading, axle the wheels' 3-D distances) or ``arc`` (the
+    exact arc of v = (ωl + ωr)·r/2, ω = (ωr − ωl)·r/axle) — but where kinematic contact pushes it, from where it
+    is pushed. Returns when each sensor first read something, the pushes, and the final x, y, yaw."""
     sim = Simulation(load_world(world), "exact")
-    robot = sim.robot("khepera2")
+    robot = sim.robot(robot_name)
     step = sim.basic_time_step
-    ds = [sim.device(f"khepera2/ds{i}") for i in range(8)]
+    assert step == 32
+    ds = [sim.device(f"{robot_name}/ds{i}") for i in range(8)]
     for s in ds:
         s.enable(step)
-    wheel_sensors = [sim.device("khepera2/left wheel sensor"), sim.device("khepera2/right wheel sensor")]
+    wheel_sensors = [sim.device(f"{robot_name}/left wheel sensor"), sim.device(f"{robot_name}/right wheel sensor")]
     for s in wheel_sensors:
         s.enable(step)
     left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
     for m in (left, right):
         m.set_position(math.inf)
         m.set_velocity(0.0)
-    obstacles = k2_obstacles()
-    rays = [(np.array(at), rot(axis, a) @ np.array([1.0, 0.0, 0.0])) for at, axis, a in K2_DS]
+    rays = [(np.array(at), rot(axis, a) @ np.array([1.0, 0.0, 0.0])) for at, axis, a in sensors]
     x, y, yaw, wl, wr = 0.0, 0.0, 0.0, 0.0, 0.0
     angles = [0.0, 0.0]
     seen: dict[int, int] = {}
     pushes: list[tuple[int, float]] = []
+    dt = step / 1000
     for k in range(1, duration_ms // step + 1):
         sim.step()
-        d = (wr - wl) * step / 1000 * K2_R / (2.0 * K2_AXLE)
-        v = 0.5 * (wl + wr) * K2_R * step / 1000
-        x, y, yaw = x + v * math.cos(yaw + d), y + v * math.sin(yaw + d), yaw + 2.0 * d
-        angles = [angles[0] + wl * step / 1000, angles[1] + wr * step / 1000]
+        if rule == "mid_heading":
+            d = (wr - wl) * dt * radius / (2.0 * axle)
+            v = 0.5 * (wl + wr) * radius * dt
+            x, y, yaw = x + v * math.cos(yaw + d), y + v * math.sin(yaw + d), yaw + 2.0 * d
+        else:
+            v, w = 0.5 * (wl + wr) * radius, (wr - wl) * radius / axle
+            if w == 0.0:
+                x, y = x + v * dt * math.cos(yaw), y + v * dt * math.sin(yaw)
+            else:
+                x, y = (x + v / w * (math.sin(yaw + w * dt) - math.sin(yaw)),
+                        y - v / w * (math.cos(yaw + w * dt) - math.cos(yaw)))
+            yaw += w * dt
+        angles = [angles[0] + wl * dt, angles[1] + wr * dt]
         at = np.asarray(robot.pose.translation)
         if abs(at[0] - x) + abs(at[1] - y) > 1e-9:
             pushes.append((k, float(np.hypot(at[0] - x, at[1] - y))))
@@ -280,12 +295,19 @@ def run_khepera2(world: Path, duration_ms: int) -> tuple[list[tuple[int, int]], 
                 seen.setdefault(i, k * step)
             assert float(ds[i].value) == pytest.approx(values[-1], abs=1e-6), (k, i, distance)
         for s, a in zip(wheel_sensors, angles, strict=True):
-            assert float(s.value) == pytest.approx(round(a / K2_RES) * K2_RES, abs=1e-12), k
+            assert float(s.value) == pytest.approx(round(a / resolution) * resolution, abs=1e-12), k
         wl, wr = (max(-1.0, min(1.0, sum(w[side] * (1.0 - v / 512) for w, v in zip(K2_WEIGHTS, values, strict=True))))
                   for side in (0, 1))
         left.set_velocity(wl)
         right.set_velocity(wr)
     return sorted((t, i) for i, t in seen.items()), pushes, [x, y, math.remainder(yaw, 2 * math.pi)]
+
+
+def run_khepera2(world: Path, duration_ms: int) -> tuple[list[tuple[int, int]], list[tuple[int, float]], list[float]]:
+    """braitenberg.c's calls for the robot "khepera2" (no Physics: Webots' kinematic rule), checked step by step
+    against the closed forms (:func:`run_braitenberg_khepera`)."""
+    return run_braitenberg_khepera(world, "khepera2", duration_ms, K2_DS, k2_obstacles(), K2_R, K2_AXLE, K2_RES,
+                                   "mid_heading")
 
 
 def test_the_khepera2_stand_in_loads_the_devices_braitenberg_asks_for_and_webots_kinematic_rule() -> None:

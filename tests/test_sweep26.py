@@ -15,7 +15,7 @@ import pytest
 from _serve import child_env, sensorium
 from test_sweep19 import KinematicMotor, rot
 from test_sweep20 import ray_to_boxes
-from test_sweep24 import K1_DS, K2_AXLE, K2_WEIGHTS
+from test_sweep24 import K1_DS, K2_AXLE, run_braitenberg_khepera
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
@@ -381,62 +381,10 @@ def noiseless_khepera(tmp_path: Path) -> Path:
 
 
 def run_khepera(world: Path, duration_ms: int) -> tuple[list[tuple[int, int]], list[tuple[int, float]], list[float]]:
-    """braitenberg.c's calls in process, each 32 ms step checked against the closed forms: each infra-red sensor
-    reads the table at its ray's distance to the nearest (white) wall or box face, the wheels' sensors their
-    angles rounded to 0.0314 rad, the pose the exact arc of v = (ωl + ωr)·r/2, ω = (ωr − ωl)·r/0.052 (1e-9), flat,
-    but where kinematic contact pushes it. Returns when each sensor first read something, the pushes, and the
-    final x, y, yaw."""
-    sim = Simulation(load_world(world), "exact")
-    robot = sim.robot("khepera")
-    step = sim.basic_time_step
-    assert step == 32
-    ds = [sim.device(f"khepera/ds{i}") for i in range(8)]
-    for s in ds:
-        s.enable(step)
-    wheel_sensors = [sim.device("khepera/left wheel sensor"), sim.device("khepera/right wheel sensor")]
-    for s in wheel_sensors:
-        s.enable(step)
-    left, right = robot.motor("left wheel motor"), robot.motor("right wheel motor")
-    for m in (left, right):
-        m.set_position(math.inf)
-        m.set_velocity(0.0)
-    obstacles = khepera_obstacles()
-    rays = [(np.array(at), rot(axis, a) @ np.array([1.0, 0.0, 0.0])) for at, axis, a in K1_DS]
-    x, y, yaw, wl, wr = 0.0, 0.0, 0.0, 0.0, 0.0
-    angles = [0.0, 0.0]
-    seen: dict[int, int] = {}
-    pushes: list[tuple[int, float]] = []
-    dt = step / 1000
-    for k in range(1, duration_ms // step + 1):
-        sim.step()
-        v, w = 0.5 * (wl + wr) * K1_R, (wr - wl) * K1_R / K1_AXLE
-        if w == 0.0:
-            x, y = x + v * dt * math.cos(yaw), y + v * dt * math.sin(yaw)
-        else:
-            x, y = x + v / w * (math.sin(yaw + w * dt) - math.sin(yaw)), y - v / w * (math.cos(yaw + w * dt) - math.cos(yaw))
-        yaw += w * dt
-        angles = [angles[0] + wl * dt, angles[1] + wr * dt]
-        at = np.asarray(robot.pose.translation)
-        if abs(at[0] - x) + abs(at[1] - y) > 1e-9:
-            pushes.append((k, float(np.hypot(at[0] - x, at[1] - y))))
-            x, y = float(at[0]), float(at[1])
-        body = rot((0, 0, 1), yaw)
-        assert list(robot.pose.translation) == pytest.approx([x, y, 0.0], abs=1e-9), k
-        assert np.asarray(robot.pose.rotation) == pytest.approx(body, abs=1e-9), k
-        values = []
-        for i, (p, u) in enumerate(rays):
-            distance = ray_to_boxes(np.array([x, y, 0.0]) + body @ p, body @ u, obstacles)
-            values.append(1023.0 * (1.0 - distance / 0.05) if distance < 0.05 else 0.0)
-            if values[-1] > 0.0:
-                seen.setdefault(i, k * step)
-            assert float(ds[i].value) == pytest.approx(values[-1], abs=1e-6), (k, i, distance)
-        for s, a in zip(wheel_sensors, angles, strict=True):
-            assert float(s.value) == pytest.approx(round(a / K1_RES) * K1_RES, abs=1e-12), k
-        wl, wr = (max(-1.0, min(1.0, sum(w[side] * (1.0 - v / 512) for w, v in zip(K2_WEIGHTS, values, strict=True))))
-                  for side in (0, 1))
-        left.set_velocity(wl)
-        right.set_velocity(wr)
-    return sorted((t, i) for i, t in seen.items()), pushes, [x, y, math.remainder(yaw, 2 * math.pi)]
+    """braitenberg.c's calls for the Khepera I with Physics (the exact arc on the 0.052 m between its wheels),
+    checked step by step against the closed forms (test_sweep24's :func:`run_braitenberg_khepera`)."""
+    return run_braitenberg_khepera(world, "khepera", duration_ms, K1_DS, khepera_obstacles(), K1_R, K1_AXLE, K1_RES,
+                                   "arc")
 
 
 def test_the_khepera_with_physics_loads_the_devices_braitenberg_asks_for_and_the_arc_drive() -> None:
