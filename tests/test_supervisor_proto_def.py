@@ -179,3 +179,16 @@ def test_the_cpp_classes_find_them_too(tmp_path, tmp_path_factory):
     assert [x for x in err.splitlines() if x.startswith("Error:")] == [
         f"Error: {FUNC}(): DEF MASS of PROTO Rover's body (Robot 'ROVER' (node 1)) names a Physics node: physics only, "
         "which Sensorium does not simulate (no Supervisor node here)."], err
+
+
+def test_a_light_of_a_body_cannot_be_removed_with_webots_line():
+    """Webots refuses a Supervisor's ``remove()`` of a node internal to a PROTO with one line naming it by
+    its usefulName (its DEF and type); the light stays lit (it still reads as before)."""
+    sim = _sim()
+    bulb, _ = _found(sim, sv.find_node(sim, "SHELF"), "BULB")
+    with pytest.raises(ValueError) as err:
+        sv.remove_node(sim, bulb)
+    assert str(err.value) == ("Node 'DEF BULB PointLight' is internal to a PROTO and therefore cannot be deleted "
+                              "from a Supervisor.")
+    assert sv.get_field(sim, bulb, "location")["value"] == [0.0, 0.0, 0.6]
+    assert len(sim.scene.removed_carried) == 0

@@ -1537,8 +1537,11 @@ def remove_node(sim: Any, node: Node) -> None:
         nested.drop_shape(_table(sim), node.id)
         return
     if node.nested and node.type in LIGHTS:     # a light inside a robot or solid: unlit from the next measurement
-        if _carried_model(sim, node).node.body:
-            raise ValueError(f"Node '{node.type}' is internal to a PROTO and therefore cannot be deleted from a "
+        model = _carried_model(sim, node)
+        if model.node.body:      # (Webots names it by its usefulName: "DEF <its body's DEF> <type>")
+            defs = [d.name for d in model.node.inner_defs if not d.role] or ([model.def_name] if model.def_name else [])
+            name = f"DEF {defs[0]} {node.type}" if defs else node.type
+            raise ValueError(f"Node '{name}' is internal to a PROTO and therefore cannot be deleted from a "
                              "Supervisor.")
         sim.scene.remove_carried_light(*_carrier(sim, node))
         nested.drop_shape(_table(sim), node.id)
