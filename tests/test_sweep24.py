@@ -216,13 +216,19 @@ K2_BOXES = [((-0.2, -0.683174), (-0.45445591677276886, -0.7661198596958863, 0.45
             ((-0.65, -0.66), (-0.3063990552359414, 0.9012431624711751, -0.3063990552359414), -1.6745853071795862)]
 
 
-def k2_obstacles() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """The arena's four walls (0.01 m thick, 0.1 m high, outside the 2 m floor) and the five boxes."""
+def khepera_arena(boxes: list) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """A Khepera world's obstacles: the 2 m arena's four walls (0.01 m thick, 0.1 m high, outside the floor)
+    and its 0.1 m boxes, each ((x, y), rotation axis, angle)."""
     walls = [((1.005, 0.0), (0.005, 1.0)), ((-1.005, 0.0), (0.005, 1.0)),
              ((0.0, 1.005), (1.01, 0.005)), ((0.0, -1.005), (1.01, 0.005))]
     out = [(np.array([x, y, 0.05]), np.eye(3), np.array([hx, hy, 0.05])) for (x, y), (hx, hy) in walls]
-    out += [(np.array([x, y, 0.05]), rot(axis, a), np.full(3, 0.05)) for (x, y), axis, a in K2_BOXES]
+    out += [(np.array([x, y, 0.05]), rot(axis, a), np.full(3, 0.05)) for (x, y), axis, a in boxes]
     return out
+
+
+def k2_obstacles() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """khepera2's arena and its five boxes."""
+    return khepera_arena(K2_BOXES)
 
 
 def noiseless_khepera2(tmp_path: Path) -> Path:

@@ -15,7 +15,7 @@ import pytest
 from _serve import child_env, sensorium
 from test_sweep19 import KinematicMotor, rot
 from test_sweep20 import ray_to_boxes
-from test_sweep24 import K1_DS, K2_AXLE, run_braitenberg_khepera
+from test_sweep24 import K1_DS, K2_AXLE, khepera_arena, run_braitenberg_khepera
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
@@ -362,12 +362,8 @@ K1_RES = 0.0314
 
 
 def khepera_obstacles() -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """The arena's four walls (0.01 m thick, 0.1 m high, outside the 2 m floor) and the five boxes."""
-    walls = [((1.005, 0.0), (0.005, 1.0)), ((-1.005, 0.0), (0.005, 1.0)),
-             ((0.0, 1.005), (1.01, 0.005)), ((0.0, -1.005), (1.01, 0.005))]
-    out = [(np.array([x, y, 0.05]), np.eye(3), np.array([hx, hy, 0.05])) for (x, y), (hx, hy) in walls]
-    out += [(np.array([x, y, 0.05]), rot(axis, a), np.full(3, 0.05)) for (x, y), axis, a in K1_BOXES]
-    return out
+    """khepera's arena and its five boxes."""
+    return khepera_arena(K1_BOXES)
 
 
 def noiseless_khepera(tmp_path: Path) -> Path:
