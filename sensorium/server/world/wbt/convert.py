@@ -2370,13 +2370,14 @@ class Converter:
             from sensorium.server.world.wbt.drive import free_car_wheels
 
             car = robot.data.get("ackermann_drive")
-            rolling = free_car_wheels(car, robot.free, self, self._robot_up(robot))
+            up = self._robot_up(robot)
+            rolling = free_car_wheels(car, robot.free, self, up)
             for free in robot.free:     # an encoder on a wheel axis no motor turns and no car rolls: still
                 if id(free) not in rolling and free["line"] is not None:
                     self.warn(free["node"], free["line"])
             if car is not None and rolling and self.fields(node).node_("physics") is not None \
-                    and self._settles_along(self._robot_up(robot)):
-                self._free_wheel_bottom(robot, car, [f for f in robot.free if id(f) in rolling])
+                    and self._settles_along(up):
+                self._free_wheel_bottom(car, [f for f in robot.free if id(f) in rolling], up)
             if car is not None:
                 self._car_axles_done(car)
 
@@ -2479,15 +2480,16 @@ class Converter:
                 entry.pop(key, None)
             entry["_wheel"] = True
 
-    def _free_wheel_bottom(self, robot: Owner, car: dict, free: list[dict]) -> None:
+    def _free_wheel_bottom(self, car: dict, free: list[dict], up: int) -> None:
         """A car's free wheels (no motor: a propulsion car's front ones, a traction car's rear ones) hold
-        it up as its driven ones do: its ``wheel_bottom`` is the lowest of them all, each with its radius."""
+        it up as its driven ones do: its ``wheel_bottom`` is the lowest of them all, each with its radius
+        (along the robot's ``up``, :meth:`_robot_up`)."""
         from sensorium.server.world.wbt.drive import wheel_bottom
 
-        bottom = wheel_bottom(free, self, self._robot_up(robot))
+        bottom = wheel_bottom(free, self, up)
         if bottom is not None:
             car["wheel_bottom"] = min(car.get("wheel_bottom", bottom), bottom)
-            self._car_axles(car, free, self._robot_up(robot))
+            self._car_axles(car, free, up)
 
     def _car_axles(self, car: dict, wheels: list[dict], up: int) -> None:
         """A car's ``axle_bottoms`` (rear, front) from its driven and free wheels, kept when both axles'
