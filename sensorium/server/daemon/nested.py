@@ -304,6 +304,18 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
     return added
 
 
+def _light_node(node_id: int, lt: Any, parent: int, owner: int, kind: str, key: str, light: int,
+                tags: list[tuple[int, wm.InnerDef, int | str]]) -> Nested:
+    """Light ``lt`` (its ``LightNode``) of a robot or top-level solid (node ``owner``, ``kind`` "Robot" or
+    "Solid", ``key`` its name) as node ``node_id`` under node ``parent``, the ``light``-th of its owner's
+    lights (the scene's ``carried_light_slots``); ``tags`` gets its PROTO-body DEFs."""
+    made = Nested(node_id, lt.type, "", lt.def_name or "", "", parent, "children", None, None, "", owner, kind, key,
+                  order=lt.node.after + 0.5, light=light, at=tuple(lt.node.written_at or ()),
+                  made=tuple(lt.node.made_at or ()))
+    tags.extend((owner, t, node_id) for t in lt.node.inner_defs)
+    return made
+
+
 def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, first: int,
                        tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[Nested]:
     """The lights of a robot (node ``owner``) that are nodes (``LightNode``: a .wbt robot's, its LEDs' too),
@@ -316,10 +328,7 @@ def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, fir
         if lt.node is None:
             continue
         parent = owner if lt.node.parent < 0 or start is None else start + lt.node.parent
-        out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", parent, "children", None, None, "",
-                          owner, "Robot", name, order=lt.node.after + 0.5, light=k,
-                          at=tuple(lt.node.written_at or ()), made=tuple(lt.node.made_at or ())))
-        tags.extend((owner, t, out[-1].id) for t in lt.node.inner_defs)
+        out.append(_light_node(first + len(out), lt, parent, owner, "Robot", name, k, tags))
     return out
 
 
@@ -336,10 +345,7 @@ def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidId
         nonlocal index
         for lt in s.lights:
             if lt.node is not None:
-                out.append(Nested(first + len(out), lt.type, "", lt.def_name or "", "", holder, "children", None,
-                                  None, "", owner, "Solid", key, order=lt.node.after + 0.5, light=index,
-                                  at=tuple(lt.node.written_at or ()), made=tuple(lt.node.made_at or ())))
-                tags.extend((owner, t, out[-1].id) for t in lt.node.inner_defs)
+                out.append(_light_node(first + len(out), lt, holder, owner, "Solid", key, index, tags))
             index += 1
         for k, child in enumerate(s.children):
             walk(child, solid_ids[owner, (*path, k)], (*path, k))
