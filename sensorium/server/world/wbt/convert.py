@@ -32,6 +32,7 @@ from sensorium.server.world.cad import EAR_CLIP_CORNERS, ear_clip, reflex_corner
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
 from sensorium.server.world.report import Loss
 from sensorium.server.world.wbt import fields as fx
+from sensorium.server.world.wbt.drive import UP_Z, Up
 from sensorium.server.world.wbt.fields import Fields
 from sensorium.server.world.wbt.frames import Frame, bounding_constraint, bounding_geometry, visual_geometry
 from sensorium.server.world.wbt.inside import enclosing_shapes, turn_meshes_away, unread_image_fields
@@ -2152,7 +2153,7 @@ class Converter:
                                  "anchor": np.asarray(frame.apply(anchor)) if anchor is not None else centre,
                                  "centre": centre, "end": end, "frame": frame, "sensors": found_sensors})
 
-    def _steering_groups(self, wheels: list[dict], up: int) -> list[tuple[dict | None, list[dict]]] | None:
+    def _steering_groups(self, wheels: list[dict], up: Up) -> list[tuple[dict | None, list[dict]]] | None:
         """A base on more than two steering joints, each carrying driven wheels of its own (a PR2's four
         casters, a rover's steered corners), or on two that are no car's front axle, one behind the
         other (a Shrimp's steered front and back wheels): each steering joint with the driven wheels it
@@ -2166,7 +2167,7 @@ class Converter:
         free = [w for w in wheels if not w["steers"] and id(w["node"]) not in carried]
         return [*zip(steering, riding), *([(None, free)] if free else [])]
 
-    def _tricycle(self, wheels: list[dict], up: int) -> list[tuple[dict | None, list[dict]]] | None:
+    def _tricycle(self, wheels: list[dict], up: Up) -> list[tuple[dict | None, list[dict]]] | None:
         """A tricycle's (a forklift's) steering groups: one steering joint holding a wheel that no motor
         drives the robot with (a passive hinge's wheel, or its end point's round part) and two driven
         wheels or more riding no steering joint, on one axle (coaxial, in the ground's plane), the
@@ -2210,7 +2211,7 @@ class Converter:
             free = {"end": end, "axis": None, "free": True}
         return [(None, driven), (steering[0], [free])]
 
-    def _steered(self, node: Node, robot: Owner, groups: list, driven: list[dict], up: int) -> bool:
+    def _steered(self, node: Node, robot: Owner, groups: list, driven: list[dict], up: Up) -> bool:
         """The steered-wheel drive of ``groups`` (steering joint, the wheels it turns) made the robot's, its
         ``driven`` wheels the drive's (the steering hinges stay joints, moved as Webots' kinematic motor
         control moves them; the drive reads their positions); False, with one line, when there is none."""
@@ -2226,7 +2227,7 @@ class Converter:
         self._drive_wheels(node, robot, driven)
         return True
 
-    def _one_axle(self, steering: list[dict], wheels: list[dict], up: int) -> bool:
+    def _one_axle(self, steering: list[dict], wheels: list[dict], up: Up) -> bool:
         """Whether two steering joints stand on one axle, as a car's front wheels do: the line between
         their anchors, in the ground's plane, along the axis of the wheels riding no steering joint (the
         robot's y when every wheel is steered)."""
@@ -2242,7 +2243,7 @@ class Converter:
         return abs(float(d[0] * axis[1] - d[1] * axis[0])) <= TOL * float(np.linalg.norm(d) * np.linalg.norm(axis))
 
     def _grounded(self, groups: list[tuple[dict | None, list[dict]]], nowheel: list[tuple[Node, str, str, str]],
-                  up: int) -> list[tuple[dict | None, list[dict]]]:
+                  up: Up) -> list[tuple[dict | None, list[dict]]]:
         """The steering groups with the driven hinges riding no steering joint kept only where they are
         wheels on the steered wheels' ground (their round part's bottom within the smallest steered
         wheel's radius of the lowest steered wheel's): a head's tilt hinge or an arm's joint beside
@@ -2270,7 +2271,7 @@ class Converter:
                 out.append((None, kept))
         return out
 
-    def _suspension(self, wheels: list[dict], up: int) -> list[tuple[dict, str]]:
+    def _suspension(self, wheels: list[dict], up: Up) -> list[tuple[dict, str]]:
         """The hinges of a rocker-bogie (a Sojourner's rockers and bogies), each with the names of the
         wheels it carries: a motorised hinge that steers nothing and whose end point carries one or more
         of the robot's wheels on the ground -- motorised hinges carrying no motorised hinge whose round
@@ -2300,7 +2301,7 @@ class Converter:
                 out.append((w, ", ".join(repr(m) for m in carried)))
         return out
 
-    def _lifted_wheels(self, wheels: list[dict], up: int) -> list[tuple[dict, float]]:
+    def _lifted_wheels(self, wheels: list[dict], up: Up) -> list[tuple[dict, float]]:
         """The motorised hinges about horizontal axes whose round part's bottom is more than the lowest
         wheels' diameter above their bottom, with that height, when at least two wheels are at the
         bottom (a base that stands on them); else none. Such a part never touches the ground the base
@@ -2397,7 +2398,7 @@ class Converter:
                              "origin": np.asarray(frame.apply((0.0, 0.0, 0.0))),
                              "frame": frame, "wheels": wheels})
 
-    def belts(self, node: Node, frame: Frame, motor: str, up: int = 2) -> list[dict]:
+    def belts(self, node: Node, frame: Frame, motor: str, up: Up = UP_Z) -> list[dict]:
         """A Track's belt as a conveyor carries on it (schemas ConveyorBelt): the top face of each Box in
         its boundingObject (the Box itself, a Shape of one, or under Group, Pose and Transform nodes of any
         number of children: an offset or a turn; a tilt the simulation finds not level), in the robot's
@@ -2423,7 +2424,7 @@ class Converter:
         visit(self.fields(node).node_("boundingObject"), frame)
         return faces
 
-    def _belt_face(self, box: Node, place: Frame, forward: np.ndarray, motor: str, up: int) -> dict:
+    def _belt_face(self, box: Node, place: Frame, forward: np.ndarray, motor: str, up: Up) -> dict:
         """One Box's top face placed at ``place``: its sides named so that ``along`` is the one nearest the
         Track's +x (``forward``), and ``direction``, the Track's +x, given when it is not ``along`` exactly
         (a Box turned in a Pose about the Track's up)."""
@@ -2480,7 +2481,7 @@ class Converter:
                 entry.pop(key, None)
             entry["_wheel"] = True
 
-    def _free_wheel_bottom(self, car: dict, free: list[dict], up: int) -> None:
+    def _free_wheel_bottom(self, car: dict, free: list[dict], up: Up) -> None:
         """A car's free wheels (no motor: a propulsion car's front ones, a traction car's rear ones) hold
         it up as its driven ones do: its ``wheel_bottom`` is the lowest of them all, each with its radius
         (along the robot's ``up``, :meth:`_robot_up`)."""
@@ -2491,7 +2492,7 @@ class Converter:
             car["wheel_bottom"] = min(car.get("wheel_bottom", bottom), bottom)
             self._car_axles(car, free, up)
 
-    def _car_axles(self, car: dict, wheels: list[dict], up: int) -> None:
+    def _car_axles(self, car: dict, wheels: list[dict], up: Up) -> None:
         """A car's ``axle_bottoms`` (rear, front) from its driven and free wheels, kept when both axles'
         are known and differ by more than GROUND_TOL: wheels of two sizes (Webots' Tractor), so Webots'
         physics leans it until both axles touch the ground."""
@@ -2512,7 +2513,7 @@ class Converter:
         if rear is not None and front is not None and abs(rear - front) > GROUND_TOL:
             car["axle_bottoms"] = (rear, front)
 
-    def _robot_up(self, robot: Owner, on_side: bool = True) -> int:
+    def _robot_up(self, robot: Owner, on_side: bool = True) -> Up:
         """The robot's own axis that stands up, its wheels judged with it for their z (wbt/drive.py): the
         axis closest to the world's up when it is that within ROBOT_UPRIGHT_TOL (a robot built on its side:
         Tinkerbots' base turned -pi/2 about y, its x up), else its z, or in a NUE world its y when that is
@@ -2520,23 +2521,22 @@ class Converter:
         two only, as Tracks and belts are judged). Its ``wheel_bottom`` is measured along its z or a NUE
         robot's y (:meth:`_settles_along`)."""
         from sensorium.server.world.poses import ROBOT_UPRIGHT_TOL, pose_from_model
-        from sensorium.server.world.wbt.drive import Up
 
         r = pose_from_model(wm.Pose.model_validate(robot.data["pose"])).rotation
         world_up = 1 if self.world["world_info"].get("coordinate_system", "ENU") == "NUE" else 2
         nearest = int(np.argmax(np.abs(r[world_up])))
         if on_side and abs(r[world_up, nearest]) >= 1.0 - 0.5 * ROBOT_UPRIGHT_TOL ** 2:   # within ROBOT_UPRIGHT_TOL rad
             # (its negative end up: built on its side the other way, or upside down, its wheels' rolling turned)
-            return nearest if r[world_up, nearest] > 0.0 else Up(nearest, -1.0)
+            return Up(nearest, 1.0 if r[world_up, nearest] > 0.0 else -1.0)
         if world_up == 2:
-            return 2
-        return 1 if abs(r[1, 1]) > abs(r[1, 2]) else 2
+            return UP_Z
+        return Up(1) if abs(r[1, 1]) > abs(r[1, 2]) else UP_Z
 
-    def _settles_along(self, up: int) -> bool:
+    def _settles_along(self, up: Up) -> bool:
         """Whether a robot whose own ``up`` axis stands up settles on the ground at load (sim/ground.py's
         ``robot_up``: its z, or a NUE world's robot's y); one built on another side keeps its height."""
         nue = self.world["world_info"].get("coordinate_system", "ENU") == "NUE"
-        return getattr(up, "sign", 1.0) > 0.0 and (up == 2 or (nue and up == 1))
+        return up.sign > 0.0 and (up == 2 or (nue and up == 1))
 
     def _say_no_wheels(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         if len(nowheel) <= MANY_JOINTS:
@@ -2683,12 +2683,12 @@ class Converter:
                                 f"about a vertical axis and no motor of the robot drives a wheel): {JOINT_MOVES}",
                                 "turning about a vertical axis"))
             return
-        sideways = up == 0 or getattr(up, "sign", 1.0) < 0.0      # on its side (x up), or its -x, -y or -z up
+        sideways = up == 0 or up.sign < 0.0      # on its side (x up), or its -x, -y or -z up
         if sideways and any(w["steers"] for w in wheels):
             # a robot built on its side (its x up: Tinkerbots' base) or with an axis's negative end up is judged
             # for a two-wheel, skid-steer or one-motor drive only (the other drives' frames take a z or y up)
             steering = next(w["motor"] for w in wheels if w["steers"])
-            axis = ("-" if getattr(up, "sign", 1.0) < 0.0 else "") + "xyz"[up]
+            axis = ("-" if up.sign < 0.0 else "") + "xyz"[up]
             how = "upside down" if axis == "-z" else "built on its side"
             self.warn(node, f"robot {robot.data['name']!r}: no drive (it is {how}, its {axis} up, where only "
                             f"wheels about one horizontal axis make a drive here; motor {steering!r} turns about its "

@@ -96,10 +96,13 @@ class Up(int):
         return up
 
 
-def up_vector(up: int) -> np.ndarray:
-    """The robot's up in its own frame: its ``up`` axis, negated for an :class:`Up` whose sign is -1."""
+UP_Z = Up(2)     # a robot built z-up: the judgement's default
+
+
+def up_vector(up: Up) -> np.ndarray:
+    """The robot's up in its own frame: its ``up`` axis, negated when its sign is -1."""
     u = np.zeros(3)
-    u[up] = getattr(up, "sign", 1.0)
+    u[up] = up.sign
     return u
 
 
@@ -241,7 +244,7 @@ def _axis_off_y(wheels: list[dict], tol: float, why: str) -> str:
     return ""
 
 
-def drive_frame(wheels: list[dict], tol: float = TOL, up: int = 2,
+def drive_frame(wheels: list[dict], tol: float = TOL, up: Up = UP_Z,
                 opposite: bool = False) -> tuple[np.ndarray | None, str]:
     """The rotation from the robot's frame to its drive's (rows: forward, left, up), or None when a
     wheel turns about the robot's +y within ``tol`` on a z-up robot (its frame is the drive's, as it
@@ -274,7 +277,7 @@ def drive_frame(wheels: list[dict], tol: float = TOL, up: int = 2,
     return drive_axes(np.cross(a, up_vector(up)), up), ""      # axis × up: where a positive speed rolls the wheel
 
 
-def drive_axes(forward, up: int = 2) -> np.ndarray:
+def drive_axes(forward, up: Up = UP_Z) -> np.ndarray:
     """The rotation from the robot's frame to its drive's (rows: forward, left = up × forward, up) for
     a ``forward`` in the robot's frame (two values: in its x–y plane) and its up axis ``up`` (2 its
     z, 1 its y)."""
@@ -285,7 +288,7 @@ def drive_axes(forward, up: int = 2) -> np.ndarray:
     return np.array([f, np.cross(u, f), u])
 
 
-def differential_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
+def differential_drive(wheels: list[dict], conv, up: Up = UP_Z) -> tuple[dict | None, str]:
     """The kinematic drive of a robot's motorised hinges (two wheels, or several per side: skid
     steer), or (None, the sentence saying why not); ``up`` the robot's up axis (:func:`drive_frame`)."""
     if len(wheels) < 2:
@@ -617,7 +620,7 @@ STEERING_UNLIMITED = 1.5
 below pi/2, where the bicycle model's turn radius reaches 0)."""
 
 
-def ackermann_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
+def ackermann_drive(wheels: list[dict], conv, up: Up = UP_Z) -> tuple[dict | None, str]:
     """The kinematic Ackermann drive of a car's motorised hinges, or (None, the sentence why not);
     judged in the drive's frame, its driven wheels' axis along its y (see the module docstring)."""
     frame, why = drive_frame([w for w in wheels if not w["steers"]], AXIS_TOL, up)
@@ -722,7 +725,7 @@ def car_engine(custom_data: str) -> str | None:
     return ENGINES.get(words[7][0], "combustion")
 
 
-def free_car_wheels(car: dict | None, free: list[dict], conv, up: int = 2) -> set[int]:
+def free_car_wheels(car: dict | None, free: list[dict], conv, up: Up = UP_Z) -> set[int]:
     """A car's wheels without a motor (Webots' Car: a propulsion car's front wheels, the second axis of
     its steering Hinge2Joints; a traction car's rear ones, HingeJoints on the rear axle under its
     origin) become the drive's free wheels: each encoder on them gets ``free_wheel`` (and
@@ -821,7 +824,7 @@ def mecanum_turns(wheels: list[dict], conv) -> list[float | None] | None:
     return turns if any(t is not None for t in turns) else None
 
 
-def mecanum_drive(wheels: list[dict], turns: list[float | None], conv, up: int = 2) -> tuple[dict | None, str]:
+def mecanum_drive(wheels: list[dict], turns: list[float | None], conv, up: Up = UP_Z) -> tuple[dict | None, str]:
     """The kinematic mecanum drive of four wheels whose friction is turned (:func:`mecanum_turns`),
     or (None, the sentence why not); judged in the drive's frame (x forward = the axis × up)."""
     frame, why = drive_frame(wheels, AXIS_TOL, up)
@@ -887,7 +890,7 @@ GROUND_TOL = 1e-3
 """m: how far apart the omni wheels' lowest points may be and still stand on one ground plane."""
 
 
-def omni_wheels(wheels: list[dict], conv, up: int = 2) -> bool:
+def omni_wheels(wheels: list[dict], conv, up: Up = UP_Z) -> bool:
     """Whether a robot's motorised hinges make an omni-wheel robot: three or more wheels, none
     steering, every axis horizontal in the robot's frame (perpendicular to its z) and not all along
     one line (parallel or opposite), each a wheel (something round at its end point turning about
@@ -915,7 +918,7 @@ def omni_wheels(wheels: list[dict], conv, up: int = 2) -> bool:
     return max(bottoms) - min(bottoms) <= GROUND_TOL
 
 
-def wheel_bottom(wheels: list[dict], conv, up: int = 2) -> float | None:
+def wheel_bottom(wheels: list[dict], conv, up: Up = UP_Z) -> float | None:
     """The drive's ``wheel_bottom``: the lowest bottom, along the robot's z (``up``: 1 along its y, a
     robot built y-up in a NUE world), of its wheels that do not
     steer (each one's round part's centre, where it is as the world loads, less its radius), or None
@@ -936,7 +939,7 @@ def wheel_bottom(wheels: list[dict], conv, up: int = 2) -> float | None:
     return min(bottoms) if bottoms else None
 
 
-def axle_bottoms(car: dict, wheels: list[dict], conv, up: int = 2) -> dict[str, float]:
+def axle_bottoms(car: dict, wheels: list[dict], conv, up: Up = UP_Z) -> dict[str, float]:
     """A car's wheels' lowest bottom (:func:`wheel_bottom`'s) on each axle, "rear" and "front", of
     ``wheels`` (its driven or its free ones), each wheel on the axle nearer its centre along x."""
     rear_x = float(car.get("rear_axle_offset", 0.0))
@@ -1041,7 +1044,7 @@ def has_rollers(w: dict, conv) -> bool:
     return False
 
 
-def omni_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
+def omni_drive(wheels: list[dict], conv, up: Up = UP_Z) -> tuple[dict | None, str]:
     """The kinematic omni drive of a robot's wheels (:func:`omni_wheels` said they make one), or
     (None, the sentence why not). Each wheel rolls on the ground where its round part is: the centre
     of its cylinder (or sphere) taken onto its axis's line, else the end point's origin; its radius
@@ -1075,7 +1078,7 @@ def omni_drive(wheels: list[dict], conv, up: int = 2) -> tuple[dict | None, str]
     return drive, ""
 
 
-def track_drive(tracks: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
+def track_drive(tracks: list[dict], conv, up: Up = UP_Z) -> tuple[dict | None, str]:
     """Two ``Track``s, a left and a right belt each driven by its LinearMotor, as the kinematic
     ``differential_drive`` they are (v = (vl + vr)/2, w = (vr - vl)/W, W between the belts' centre
     lines), or (None, the sentence saying why not). A belt at v m/s is a wheel of radius 1 m at
@@ -1108,7 +1111,7 @@ def track_drive(tracks: list[dict], conv, up: int = 2) -> tuple[dict | None, str
     return _framed(drive, "", None if along_x else frame)
 
 
-def belt_bottom(track_frame, wheels: list[tuple[float, float, float]], up: int = 2) -> float | None:
+def belt_bottom(track_frame, wheels: list[tuple[float, float, float]], up: Up = UP_Z) -> float | None:
     """A Track's lowest point along the robot's ``up`` axis: the lowest of its TrackWheels' circles,
     each (x, y, radius) in the Track's frame (a TrackWheel sits at (x, 0, y) there and turns in the
     Track's x-z plane, the belt around it); None without a TrackWheel. The belt's own thickness is
@@ -1123,7 +1126,7 @@ def belt_bottom(track_frame, wheels: list[tuple[float, float, float]], up: int =
 # ---------------------------------------------------------------- steered wheels (a PR2's casters, a rover's corners)
 
 def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions: dict[str, float], conv,
-                  up: int = 2) -> tuple[dict | None, str]:
+                  up: Up = UP_Z) -> tuple[dict | None, str]:
     """The kinematic steered-wheel drive of a robot whose driven wheels ride steering hinges of their
     own, or (None, the sentence why not). ``groups``: each steering hinge (None: the wheels that ride
     none, which keep their heading) with the driven wheels it turns; ``steer_positions``: each steering
@@ -1182,7 +1185,7 @@ def steered_drive(groups: list[tuple[dict | None, list[dict]]], steer_positions:
     return drive, ""
 
 
-def one_motor_axle(w: dict, free: list[dict], conv, up: int = 2) -> tuple[dict | None, str]:
+def one_motor_axle(w: dict, free: list[dict], conv, up: Up = UP_Z) -> tuple[dict | None, str]:
     """The kinematic ``steered_drive`` of a robot whose only motorised hinge carries the wheels of both its
     sides (Tinkerbots' vision_car: one motor block whose hinge carries an axle and a wheel either side), or
     (None, the sentence why not). The hinge's axis is horizontal in the robot's frame (within
