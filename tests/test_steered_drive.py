@@ -1,7 +1,7 @@
 """Steered-wheel robots (``steered_drive``): four wheels at the corners of a 0.4 x 0.3 box, each on a
 steering hinge moved as any joint is, strafe, turn in place and drive as closed form says; the fit
 of a two-wheel arrangement is the differential drive's twist; bad declarations are one line; the
-batched simulation drives them bit for bit as the single one (free wheels refused). Our own worlds."""
+batched simulation drives them bit for bit as the single one (free wheels too). Our own worlds."""
 
 from __future__ import annotations
 
@@ -202,14 +202,6 @@ def test_the_batched_simulation_drives_it_as_the_single_one_bit_for_bit(precisio
     assert pressed > 10
 
 
-def test_the_batched_simulation_refuses_free_steered_wheels_in_one_line() -> None:
-    loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [tricycle()]})
-    with pytest.raises(BatchedError, match=r"robot 'sw' has a steered_drive with free wheels \(no motor\); the "
-                                           r"batched simulation drives steered wheels that all have motors "
-                                           r"\(use Simulation\)$"):
-        BatchedSimulation(loaded, 2)
-
-
 def test_the_gym_refuses_it_as_an_agent_in_one_line() -> None:
     gym = pytest.importorskip("sensorium.gym")
     loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [swerve()]})
@@ -356,3 +348,115 @@ def test_a_free_wheel_encoder_on_a_driven_wheel_is_one_line() -> None:
     robot["devices"][1]["free_wheel"] = 0
     with pytest.raises(WorldError, match="PositionSensor 'front encoder': free_wheel 0 is no wheel without motor"):
         sim_of(robot)
+
+
+def cart() -> dict:
+    """Two driven rear wheels at (0, ±B) and two free front wheels at (L, ±B), each on its own steering
+    hinge, with encoders on both free wheels."""
+    fronts = {"fl": B, "fr": -B}
+    return {"name": "cart", "pose": {"translation": [0.0, 0.0, 0.1]},
+            "body": {"geometry": {"type": "box", "size": [0.6, 0.5, 0.1]}},
+            "steered_drive": {"max_wheel_speed": 20.0, "wheels": [
+                {"motor": "rl wheel", "position": [0.0, B], "radius": R},
+                {"motor": "rr wheel", "position": [0.0, -B], "radius": R},
+                *({"steer": f"{k} steer", "position": [L, y], "radius": 0.03} for k, y in fronts.items())]},
+            "devices": [{"device": "RotationalMotor", "name": f"{k} steer", "axis": [0.0, 0.0, 1.0],
+                         "anchor": [L, y, 0.0], "max_velocity": 100.0} for k, y in fronts.items()]
+            + [{"device": "PositionSensor", "name": f"{k} encoder", "free_wheel": i, "position": 0.25 * i}
+               for i, k in ((2, "fl"), (3, "fr"))]}
+
+
+@pytest.fixture(params=["helper", "math"])
+def native(request, monkeypatch):
+    """The batched simulation with the packets helper (libm's cos and sin in C) or without it
+    (``SENSORIUM_PACKETS=0``)."""
+    from sensorium.server.raycast import packets
+
+    if request.param == "math":
+        monkeypatch.setattr(packets, "_state", {})
+        monkeypatch.setenv("SENSORIUM_PACKETS", "0")
+        assert packets.library() is None
+    elif packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    return request.param
+
+
+def test_the_batched_simulation_drives_free_steered_wheels_as_the_single_one_bit_for_bit(native) -> None:
+    """Three copies of a cart with two free steered front wheels (and a tricycle beside it) in a walled
+    square, each against its own Simulation: every 40 steps per copy either both front wheels straight
+    (its twist's one line, straight), at Ackermann angles (the bicycle's line), tangent to circles about
+    the rear axle's centre with the rear wheels opposite (the driven wheels' a_i cancel) or at random
+    angles apart (no one turn centre: the least-squares fallback), while the hinges move between them;
+    random rear speeds per copy, 400 steps. Every step each robot's pose, each free wheel's encoder and
+    rolled angle and each driven wheel's angle are the single simulation's bits."""
+    import numpy as np
+
+    walls = [{"name": n, "pose": {"translation": [x, y, 0.25]}, "geometry": {"type": "box", "size": [sx, sy, 0.5]}}
+             for n, x, y, sx, sy in (("north", 0, 1.6, 3.6, 0.2), ("south", 0, -1.6, 3.6, 0.2),
+                                     ("east", 1.7, 0, 0.2, 3.0), ("west", -1.7, 0, 0.2, 3.0))]
+    trike = tricycle()
+    trike["pose"]["translation"] = [-0.8, 0.8, 0.1]
+    loaded = parse_world({"world_info": {"basic_time_step": 16, "contact": True}, "solids": walls,
+                          "robots": [cart(), trike]})
+    n = 3
+    batched = BatchedSimulation(loaded, n)
+    singles = [Simulation(loaded) for _ in range(n)]
+    names = [("cart", "fl encoder"), ("cart", "fr encoder"), ("sw", "front encoder")]
+    refs = [batched.device(robot, name) for robot, name in names]
+    for ref in refs:
+        batched.enable(ref, 16)
+    for s in singles:
+        for robot, name in names:
+            s.device(f"{robot}/{name}").enable(16)
+    rng = np.random.default_rng(11)
+    tangent = (math.atan2(L, -B), math.atan2(L, B))
+    pressed = 0
+    for t in range(400):
+        if t % 40 == 0:
+            speeds = rng.uniform(-12.0, 12.0, size=(n, 2))
+            for c, s in enumerate(singles):
+                case = int(rng.integers(4))
+                delta = float(rng.uniform(-0.6, 0.6))
+                rear = speeds[c]
+                if case == 0:
+                    angles = (0.0, 0.0)
+                elif case == 1:
+                    cot = 1.0 / math.tan(delta)             # left-positive: the inner wheel steers more
+                    angles = (math.atan(1.0 / (cot - B / L)), math.atan(1.0 / (cot + B / L)))
+                elif case == 2:
+                    angles, rear = tangent, np.array([-speeds[c, 0], speeds[c, 0]])
+                else:
+                    angles = tuple(float(a) for a in rng.uniform(-1.2, 1.2, size=2))
+                batched.steered.command(0, rear[None, :], copies=[c])
+                batched.steered.command(1, speeds[c][None, ::-1], copies=[c])
+                for name, angle in zip(("fl", "fr"), angles):
+                    s.robot("cart").motor(f"{name} steer").command(angle, 2.0, None, None)
+                    batched.joints.command(0, f"{name} steer", position=angle, velocity=2.0, copies=[c])
+                s.robot("sw").motor("fr steer").command(delta, 2.0, None, None)
+                batched.joints.command(1, "fr steer", position=delta, velocity=2.0, copies=[c])
+                for robot, wheels in (("cart", rear), ("sw", speeds[c][::-1])):
+                    for name, omega in zip(("rl wheel", "rr wheel"), wheels):
+                        m = s.robot(robot).motor(name)
+                        m.set_position(math.inf)
+                        m.set_velocity(float(omega))
+        for s in singles:
+            s.step()
+        batched.step()
+        for c, s in enumerate(singles):
+            for slot, robot in enumerate(("cart", "sw")):
+                pose, got = s.robot(robot).pose, batched.pose(c, slot)
+                assert got.translation.tobytes() == pose.translation.tobytes(), (t, c, robot)
+                assert got.rotation.tobytes() == pose.rotation.tobytes(), (t, c, robot)
+                k = batched.steered.of[slot]
+                drive = s.robot(robot).drive
+                for i, turned in drive.free_turned.items():
+                    assert batched.steered.free_turned[c, k, i] == turned, (t, c, robot, i)
+                for name in ("rl wheel", "rr wheel"):
+                    col = batched.steered.column(slot, name)
+                    assert batched.steered.angle[c, col[0], col[1]] == s.robot(robot).motor(name).position
+                pressed += bool(s.robot(robot).pressing)
+            for ref, (robot, name) in zip(refs, names):
+                assert np.float64(batched.value(ref)[c]).tobytes() == np.float64(
+                    s.device(f"{robot}/{name}").value).tobytes(), (t, c, name)
+    assert pressed > 10
+    assert all(abs(float(batched.value(ref)[c])) > 1.0 for ref in refs for c in range(n))
