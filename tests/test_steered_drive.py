@@ -460,3 +460,62 @@ def test_the_batched_simulation_drives_free_steered_wheels_as_the_single_one_bit
                     s.device(f"{robot}/{name}").value).tobytes(), (t, c, name)
     assert pressed > 10
     assert all(abs(float(batched.value(ref)[c])) > 1.0 for ref in refs for c in range(n))
+
+
+@pytest.mark.parametrize("robot", ["cart", "tricycle"])
+def test_the_copies_constrained_twists_are_the_single_drive_s_bits(robot: str, native) -> None:
+    """batched_steered.constrained_twists (the C pass with the helper, numpy without) over 3000 copies of
+    steering angles against SteeredDrive.constrained_twist copy by copy: random angles, the front wheels
+    straight, at Ackermann angles, tangent about the rear axle's centre, across (π/2), with random and
+    opposite rear speeds; every twist the same bits, every branch taken."""
+    import numpy as np
+
+    from sensorium.server.sim.batched_kinematic import libm_cos_sin
+    from sensorium.server.sim.batched_steered import constrained_twists
+
+    config = wm.SteeredDrive.model_validate((cart() if robot == "cart" else tricycle())["steered_drive"])
+    drive = SteeredDrive(config, Pose.identity())
+
+    class Hinge:
+        position = 0.0
+
+    hinges = [Hinge() for _ in drive.wheels]
+    drive.steering = [h if steer is not None else None for h, (*_, steer) in zip(hinges, drive.wheels)]
+    rng = np.random.default_rng(5)
+    n, W = 3000, len(drive.wheels)
+    steered = [i for i, (*_, steer) in enumerate(drive.wheels) if steer is not None]
+    angles = np.zeros((n, W))
+    case = rng.integers(5, size=n)
+    for i in steered:
+        angles[:, i] = np.select([case == 0, case == 1, case == 2, case == 3],
+                                 [rng.uniform(-1.5, 1.5, n), 0.0, math.pi / 2,
+                                  math.atan2(L, -drive.places[i][1])], rng.uniform(-0.6, 0.6, n))
+    if robot == "cart":                   # case 4: Ackermann angles for one turn centre on the rear axle's line
+        radius = L / np.tan(angles[case == 4, 2])
+        angles[case == 4, 2] = np.arctan2(L, radius - B)
+        angles[case == 4, 3] = np.arctan2(L, radius + B)
+    u = np.zeros((n, W))
+    u[:, :2] = rng.uniform(-10.0, 10.0, (n, 2))
+    u[case == 3, 1] = -u[case == 3, 0]
+    heading = np.array([h for _, _, h, _, _ in drive.wheels]) + angles
+    cos, sin = libm_cos_sin(heading)
+    places, driven = list(drive.places), [m is not None for m, *_ in drive.wheels]
+    arrays = (np.array(places), np.array(driven, dtype=np.uint8))
+    radius = np.array([r for _, r, *_ in drive.wheels])
+    got = np.stack(constrained_twists(places, driven, radius, u, cos, sin, arrays), axis=1)
+    lstsq = np.linalg.lstsq
+    fits = []
+    try:
+        np.linalg.lstsq = lambda *a, **k: (fits.append(1), lstsq(*a, **k))[1]
+        for c in range(n):
+            for hinge, a in zip(hinges, angles[c]):
+                hinge.position = float(a)
+            fits.append(0)
+            want = drive.constrained_twist(u[c].tolist())
+            assert got[c].tobytes() == np.array(want).tobytes(), (c, case[c], got[c], want)
+    finally:
+        np.linalg.lstsq = lstsq
+    assert sum(fits) > 50 if robot == "cart" else sum(fits) == 0      # (a tricycle's rows always meet in one line)
+    turning = got[case == 3]                      # about the rear axle's centre at r·(ω_rr − ω_rl)/2B
+    assert np.abs(turning[:, :2]).max() < 1e-12
+    assert turning[:, 2] == pytest.approx(R * (u[case == 3, 1] - u[case == 3, 0]) / (2 * B), abs=1e-12)

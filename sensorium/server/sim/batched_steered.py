@@ -27,6 +27,7 @@ import math
 
 import numpy as np
 
+from sensorium.server.raycast import packets
 from sensorium.server.sim.batched_holonomic import HolonomicDrives
 from sensorium.server.sim.batched_joints import BatchedJoints
 from sensorium.server.sim.batched_kinematic import libm_cos_sin
@@ -64,6 +65,9 @@ class SteeredDrives(HolonomicDrives):
             if d.has_free:
                 self.constrained[k] = (list(d.places), [m is not None for m, *_ in d.wheels])
         self.has_free = np.array([k in self.constrained for k in range(M)], dtype=bool)
+        # ... and as the C pass takes them: places (W, 2), driven (W,) uint8
+        self.constrained_arrays = {k: (np.array(places, dtype=np.float64), np.array(driven, dtype=np.uint8))
+                                   for k, (places, driven) in self.constrained.items()}
         self.free_turned = np.zeros((copies, M, W))
         """Each free wheel's rolled angle (rad, along its heading positive) per copy, at its wheel's column."""
         self._dt = 0.0                      # the step's (s), for the free wheels' roll
@@ -103,7 +107,7 @@ class SteeredDrives(HolonomicDrives):
                 sel = (rows == k).nonzero()[0]
                 places, driven = self.constrained[k]
                 tx, ty, tw = constrained_twists(places, driven, self.radius[k, :len(places)], u[sel],
-                                                cos[sel], sin[sel])
+                                                cos[sel], sin[sel], self.constrained_arrays[k])
                 vx[sel], vy[sel], w[sel] = tx, ty, tw
                 self._roll_free(copies[sel], k, places, driven, tx, ty, tw, cos[sel], sin[sel])
         return vx, vy, w
@@ -138,19 +142,23 @@ class SteeredDrives(HolonomicDrives):
 
 
 def constrained_twists(places: list[tuple[float, float]], driven: list[bool], radius: np.ndarray, u: np.ndarray,
-                       cos: np.ndarray, sin: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                       cos: np.ndarray, sin: np.ndarray, arrays: tuple[np.ndarray, np.ndarray] | None = None
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """SteeredDrive.constrained_twist of one robot in n copies: its wheels' ``places``, which are
     ``driven`` (have a motor), their radii, the copies' wheel speeds ``u`` (n, ≥ wheels) and headings'
     ``cos``, ``sin`` (n, ≥ wheels); the twists (vx, vy, ωz), element by element the same float64
-    operations (each sum from 0.0, left to right), the least-squares fallback copy by copy."""
+    operations (each sum from 0.0, left to right), the least-squares fallback copy by copy. One C pass
+    (packets.constrained_twists) where the helper is built, given ``arrays`` (places and driven as it
+    takes them); these numpy operations otherwise, the same bits."""
+    got = packets.constrained_twists(arrays[0], arrays[1], radius, u, cos, sin) if arrays is not None else None
+    if got is not None:
+        twist, fallback = got
+        vx, vy, w = twist[:, 0].copy(), twist[:, 1].copy(), twist[:, 2].copy()
+        if not fallback.any():
+            return vx, vy, w
+        return _least_squares(*_rows(places, driven, radius, u, cos, sin), ~fallback, vx, vy, w)
     n = len(u)
-    rows, along, rims = [], [], []
-    for i, ((px, py), has_motor) in enumerate(zip(places, driven)):
-        c, s = cos[:, i], sin[:, i]
-        rows.append((-s, c, px * c + py * s))
-        if has_motor:
-            along.append((c, s, py * -c + px * s))
-            rims.append(u[:, i] * radius[i])
+    rows, along, rims = _rows(places, driven, radius, u, cos, sin)
     best = np.zeros(n)
     d = [np.zeros(n), np.zeros(n), np.zeros(n)]
     for i, a in enumerate(rows):        # the first of the largest cross products, as the strict > keeps it
@@ -175,7 +183,28 @@ def constrained_twists(places: list[tuple[float, float]], driven: list[bool], ra
     line &= size > 0.0
     with np.errstate(divide="ignore", invalid="ignore"):
         k = np.where(np.abs(total) > 1e-9 * size, rim / total, cross_sum / square)
-    vx, vy, w = k * d[0], k * d[1], k * d[2]
+    return _least_squares(rows, along, rims, line, k * d[0], k * d[1], k * d[2])
+
+
+def _rows(places: list[tuple[float, float]], driven: list[bool], radius: np.ndarray, u: np.ndarray, cos: np.ndarray,
+          sin: np.ndarray) -> tuple[list, list, list]:
+    """constrained_twist's rows: each wheel's no-slip-across row (−sin h, cos h, x cos h + y sin h), each
+    driven wheel's ground speed along its heading (cos h, sin h, −y cos h + x sin h) and rim speed r·ω."""
+    rows, along, rims = [], [], []
+    for i, ((px, py), has_motor) in enumerate(zip(places, driven)):
+        c, s = cos[:, i], sin[:, i]
+        rows.append((-s, c, px * c + py * s))
+        if has_motor:
+            along.append((c, s, py * -c + px * s))
+            rims.append(u[:, i] * radius[i])
+    return rows, along, rims
+
+
+def _least_squares(rows: list, along: list, rims: list, line: np.ndarray, vx: np.ndarray, vy: np.ndarray,
+                   w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The twists of the copies whose rows leave no one line (``line`` False) written into (vx, vy, w):
+    SteeredDrive.constrained_twist's least-squares fit of every driven wheel's ground speed and every
+    wheel's no-slip-across row, copy by copy through the same np.linalg.lstsq call."""
     for j in (~line).nonzero()[0].tolist():     # rows of another rank: the least-squares fit of every row
         fit = np.array([[float(v[j]) for v in row] for row in rows] + [[float(v[j]) for v in a] for a in along],
                        dtype=np.float64)
