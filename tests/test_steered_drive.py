@@ -10,7 +10,7 @@ import math
 import pytest
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.motion import DifferentialDrive, SteeredDrive
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.geometry import Pose

@@ -13,7 +13,9 @@ other robot's. The sines and cosines are libm's (``math.sin`` / ``math.cos``: ba
 arcs of the other drives.
 
 Robots with fewer wheels than the widest one have their columns padded: a padded wheel never turns
-(maximum velocity 0) and adds 0 · 0 to the sums, which leaves them the same bits.
+(maximum velocity 0) and adds 0 · 0 to the sums, which leaves them the same bits. A steered drive's free
+wheel (no motor) has its column too, never turned alike; :meth:`HolonomicDrives.command` takes the motors'
+speeds only and puts each in its wheel's column.
 """
 
 from __future__ import annotations

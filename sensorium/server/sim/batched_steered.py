@@ -23,8 +23,6 @@ heading, and a PositionSensor with ``free_wheel`` reads them (:meth:`SteeredDriv
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from sensorium.server.raycast import packets
