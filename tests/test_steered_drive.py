@@ -352,18 +352,20 @@ def test_a_free_wheel_encoder_on_a_driven_wheel_is_one_line() -> None:
 
 def cart() -> dict:
     """Two driven rear wheels at (0, ±B) and two free front wheels at (L, ±B), each on its own steering
-    hinge, with encoders on both free wheels."""
+    hinge, with encoders on both free wheels; listed front left, rear left, front right, rear right (the
+    motored wheels' speeds go to columns 1 and 3)."""
     fronts = {"fl": B, "fr": -B}
     return {"name": "cart", "pose": {"translation": [0.0, 0.0, 0.1]},
             "body": {"geometry": {"type": "box", "size": [0.6, 0.5, 0.1]}},
             "steered_drive": {"max_wheel_speed": 20.0, "wheels": [
+                {"steer": "fl steer", "position": [L, B], "radius": 0.03},
                 {"motor": "rl wheel", "position": [0.0, B], "radius": R},
-                {"motor": "rr wheel", "position": [0.0, -B], "radius": R},
-                *({"steer": f"{k} steer", "position": [L, y], "radius": 0.03} for k, y in fronts.items())]},
+                {"steer": "fr steer", "position": [L, -B], "radius": 0.03},
+                {"motor": "rr wheel", "position": [0.0, -B], "radius": R}]},
             "devices": [{"device": "RotationalMotor", "name": f"{k} steer", "axis": [0.0, 0.0, 1.0],
                          "anchor": [L, y, 0.0], "max_velocity": 100.0} for k, y in fronts.items()]
-            + [{"device": "PositionSensor", "name": f"{k} encoder", "free_wheel": i, "position": 0.25 * i}
-               for i, k in ((2, "fl"), (3, "fr"))]}
+            + [{"device": "PositionSensor", "name": f"{k} encoder", "free_wheel": i, "position": 0.25 + i}
+               for i, k in ((0, "fl"), (2, "fr"))]}
 
 
 @pytest.fixture(params=["helper", "math"])
@@ -491,12 +493,13 @@ def test_the_copies_constrained_twists_are_the_single_drive_s_bits(robot: str, n
                                  [rng.uniform(-1.5, 1.5, n), 0.0, math.pi / 2,
                                   math.atan2(L, -drive.places[i][1])], rng.uniform(-0.6, 0.6, n))
     if robot == "cart":                   # case 4: Ackermann angles for one turn centre on the rear axle's line
-        radius = L / np.tan(angles[case == 4, 2])
-        angles[case == 4, 2] = np.arctan2(L, radius - B)
-        angles[case == 4, 3] = np.arctan2(L, radius + B)
+        radius = L / np.tan(angles[case == 4, 0])
+        angles[case == 4, 0] = np.arctan2(L, radius - B)
+        angles[case == 4, 2] = np.arctan2(L, radius + B)
+    rl, rr = [i for i, (m, *_) in enumerate(drive.wheels) if m is not None]     # the left and right rear wheels
     u = np.zeros((n, W))
-    u[:, :2] = rng.uniform(-10.0, 10.0, (n, 2))
-    u[case == 3, 1] = -u[case == 3, 0]
+    u[:, [rl, rr]] = rng.uniform(-10.0, 10.0, (n, 2))
+    u[case == 3, rr] = -u[case == 3, rl]
     heading = np.array([h for _, _, h, _, _ in drive.wheels]) + angles
     cos, sin = libm_cos_sin(heading)
     places, driven = list(drive.places), [m is not None for m, *_ in drive.wheels]
@@ -518,4 +521,4 @@ def test_the_copies_constrained_twists_are_the_single_drive_s_bits(robot: str, n
     assert sum(fits) > 50 if robot == "cart" else sum(fits) == 0      # (a tricycle's rows always meet in one line)
     turning = got[case == 3]                      # about the rear axle's centre at r·(ω_rr − ω_rl)/2B
     assert np.abs(turning[:, :2]).max() < 1e-12
-    assert turning[:, 2] == pytest.approx(R * (u[case == 3, 1] - u[case == 3, 0]) / (2 * B), abs=1e-12)
+    assert turning[:, 2] == pytest.approx(R * (u[case == 3, rr] - u[case == 3, rl]) / (2 * B), abs=1e-12)
