@@ -1,7 +1,7 @@
 """Steered-wheel robots (``steered_drive``): four wheels at the corners of a 0.4 x 0.3 box, each on a
 steering hinge moved as any joint is, strafe, turn in place and drive as closed form says; the fit
 of a two-wheel arrangement is the differential drive's twist; bad declarations are one line; the
-batched simulation drives them bit for bit as the single one (free wheels refused). Our own worlds."""
+batched simulation drives them bit for bit as the single one (free wheels too). Our own worlds."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import math
 import pytest
 
 from sensorium.schemas import world as wm
-from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.motion import DifferentialDrive, SteeredDrive
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.geometry import Pose
@@ -202,14 +202,6 @@ def test_the_batched_simulation_drives_it_as_the_single_one_bit_for_bit(precisio
     assert pressed > 10
 
 
-def test_the_batched_simulation_refuses_free_steered_wheels_in_one_line() -> None:
-    loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [tricycle()]})
-    with pytest.raises(BatchedError, match=r"robot 'sw' has a steered_drive with free wheels \(no motor\); the "
-                                           r"batched simulation drives steered wheels that all have motors "
-                                           r"\(use Simulation\)$"):
-        BatchedSimulation(loaded, 2)
-
-
 def test_the_gym_refuses_it_as_an_agent_in_one_line() -> None:
     gym = pytest.importorskip("sensorium.gym")
     loaded = parse_world({"world_info": {"basic_time_step": 16}, "robots": [swerve()]})
@@ -356,3 +348,177 @@ def test_a_free_wheel_encoder_on_a_driven_wheel_is_one_line() -> None:
     robot["devices"][1]["free_wheel"] = 0
     with pytest.raises(WorldError, match="PositionSensor 'front encoder': free_wheel 0 is no wheel without motor"):
         sim_of(robot)
+
+
+def cart() -> dict:
+    """Two driven rear wheels at (0, ±B) and two free front wheels at (L, ±B), each on its own steering
+    hinge, with encoders on both free wheels; listed front left, rear left, front right, rear right (the
+    motored wheels' speeds go to columns 1 and 3)."""
+    fronts = {"fl": B, "fr": -B}
+    return {"name": "cart", "pose": {"translation": [0.0, 0.0, 0.1]},
+            "body": {"geometry": {"type": "box", "size": [0.6, 0.5, 0.1]}},
+            "steered_drive": {"max_wheel_speed": 20.0, "wheels": [
+                {"steer": "fl steer", "position": [L, B], "radius": 0.03},
+                {"motor": "rl wheel", "position": [0.0, B], "radius": R},
+                {"steer": "fr steer", "position": [L, -B], "radius": 0.03},
+                {"motor": "rr wheel", "position": [0.0, -B], "radius": R}]},
+            "devices": [{"device": "RotationalMotor", "name": f"{k} steer", "axis": [0.0, 0.0, 1.0],
+                         "anchor": [L, y, 0.0], "max_velocity": 100.0} for k, y in fronts.items()]
+            + [{"device": "PositionSensor", "name": f"{k} encoder", "free_wheel": i, "position": 0.25 + i}
+               for i, k in ((0, "fl"), (2, "fr"))]}
+
+
+@pytest.fixture(params=["helper", "math"])
+def native(request, monkeypatch):
+    """The batched simulation with the packets helper (libm's cos and sin in C) or without it
+    (``SENSORIUM_PACKETS=0``)."""
+    from sensorium.server.raycast import packets
+
+    if request.param == "math":
+        monkeypatch.setattr(packets, "_state", {})
+        monkeypatch.setenv("SENSORIUM_PACKETS", "0")
+        assert packets.library() is None
+    elif packets.library() is None:
+        pytest.skip(f"no packets helper: {packets.status()}")
+    return request.param
+
+
+def test_the_batched_simulation_drives_free_steered_wheels_as_the_single_one_bit_for_bit(native) -> None:
+    """Three copies of a cart with two free steered front wheels (and a tricycle beside it) in a walled
+    square, each against its own Simulation: every 40 steps per copy either both front wheels straight
+    (its twist's one line, straight), at Ackermann angles (the bicycle's line), tangent to circles about
+    the rear axle's centre with the rear wheels opposite (the driven wheels' a_i cancel) or at random
+    angles apart (no one turn centre: the least-squares fallback), while the hinges move between them;
+    random rear speeds per copy, 400 steps. Every step each robot's pose, each free wheel's encoder and
+    rolled angle and each driven wheel's angle are the single simulation's bits."""
+    import numpy as np
+
+    walls = [{"name": n, "pose": {"translation": [x, y, 0.25]}, "geometry": {"type": "box", "size": [sx, sy, 0.5]}}
+             for n, x, y, sx, sy in (("north", 0, 1.6, 3.6, 0.2), ("south", 0, -1.6, 3.6, 0.2),
+                                     ("east", 1.7, 0, 0.2, 3.0), ("west", -1.7, 0, 0.2, 3.0))]
+    trike = tricycle()
+    trike["pose"]["translation"] = [-0.8, 0.8, 0.1]
+    loaded = parse_world({"world_info": {"basic_time_step": 16, "contact": True}, "solids": walls,
+                          "robots": [cart(), trike]})
+    n = 3
+    batched = BatchedSimulation(loaded, n)
+    singles = [Simulation(loaded) for _ in range(n)]
+    names = [("cart", "fl encoder"), ("cart", "fr encoder"), ("sw", "front encoder")]
+    refs = [batched.device(robot, name) for robot, name in names]
+    for ref in refs:
+        batched.enable(ref, 16)
+    for s in singles:
+        for robot, name in names:
+            s.device(f"{robot}/{name}").enable(16)
+    rng = np.random.default_rng(11)
+    tangent = (math.atan2(L, -B), math.atan2(L, B))
+    pressed = 0
+    for t in range(400):
+        if t % 40 == 0:
+            speeds = rng.uniform(-12.0, 12.0, size=(n, 2))
+            for c, s in enumerate(singles):
+                case = int(rng.integers(4))
+                delta = float(rng.uniform(-0.6, 0.6))
+                rear = speeds[c]
+                if case == 0:
+                    angles = (0.0, 0.0)
+                elif case == 1:
+                    cot = 1.0 / math.tan(delta)             # left-positive: the inner wheel steers more
+                    angles = (math.atan(1.0 / (cot - B / L)), math.atan(1.0 / (cot + B / L)))
+                elif case == 2:
+                    angles, rear = tangent, np.array([-speeds[c, 0], speeds[c, 0]])
+                else:
+                    angles = tuple(float(a) for a in rng.uniform(-1.2, 1.2, size=2))
+                batched.steered.command(0, rear[None, :], copies=[c])
+                batched.steered.command(1, speeds[c][None, ::-1], copies=[c])
+                for name, angle in zip(("fl", "fr"), angles):
+                    s.robot("cart").motor(f"{name} steer").command(angle, 2.0, None, None)
+                    batched.joints.command(0, f"{name} steer", position=angle, velocity=2.0, copies=[c])
+                s.robot("sw").motor("fr steer").command(delta, 2.0, None, None)
+                batched.joints.command(1, "fr steer", position=delta, velocity=2.0, copies=[c])
+                for robot, wheels in (("cart", rear), ("sw", speeds[c][::-1])):
+                    for name, omega in zip(("rl wheel", "rr wheel"), wheels):
+                        m = s.robot(robot).motor(name)
+                        m.set_position(math.inf)
+                        m.set_velocity(float(omega))
+        for s in singles:
+            s.step()
+        batched.step()
+        for c, s in enumerate(singles):
+            for slot, robot in enumerate(("cart", "sw")):
+                pose, got = s.robot(robot).pose, batched.pose(c, slot)
+                assert got.translation.tobytes() == pose.translation.tobytes(), (t, c, robot)
+                assert got.rotation.tobytes() == pose.rotation.tobytes(), (t, c, robot)
+                k = batched.steered.of[slot]
+                drive = s.robot(robot).drive
+                for i, turned in drive.free_turned.items():
+                    assert batched.steered.free_turned[c, k, i] == turned, (t, c, robot, i)
+                for name in ("rl wheel", "rr wheel"):
+                    col = batched.steered.column(slot, name)
+                    assert batched.steered.angle[c, col[0], col[1]] == s.robot(robot).motor(name).position
+                pressed += bool(s.robot(robot).pressing)
+            for ref, (robot, name) in zip(refs, names):
+                assert np.float64(batched.value(ref)[c]).tobytes() == np.float64(
+                    s.device(f"{robot}/{name}").value).tobytes(), (t, c, name)
+    assert pressed > 10
+    assert all(abs(float(batched.value(ref)[c])) > 1.0 for ref in refs for c in range(n))
+
+
+@pytest.mark.parametrize("robot", ["cart", "tricycle"])
+def test_the_copies_constrained_twists_are_the_single_drive_s_bits(robot: str, native) -> None:
+    """batched_steered.constrained_twists (the C pass with the helper, numpy without) over 3000 copies of
+    steering angles against SteeredDrive.constrained_twist copy by copy: random angles, the front wheels
+    straight, at Ackermann angles, tangent about the rear axle's centre, across (π/2), with random and
+    opposite rear speeds; every twist the same bits, every branch taken."""
+    import numpy as np
+
+    from sensorium.server.sim.batched_kinematic import libm_cos_sin
+    from sensorium.server.sim.batched_steered import constrained_twists
+
+    config = wm.SteeredDrive.model_validate((cart() if robot == "cart" else tricycle())["steered_drive"])
+    drive = SteeredDrive(config, Pose.identity())
+
+    class Hinge:
+        position = 0.0
+
+    hinges = [Hinge() for _ in drive.wheels]
+    drive.steering = [h if steer is not None else None for h, (*_, steer) in zip(hinges, drive.wheels)]
+    rng = np.random.default_rng(5)
+    n, W = 3000, len(drive.wheels)
+    steered = [i for i, (*_, steer) in enumerate(drive.wheels) if steer is not None]
+    angles = np.zeros((n, W))
+    case = rng.integers(5, size=n)
+    for i in steered:
+        angles[:, i] = np.select([case == 0, case == 1, case == 2, case == 3],
+                                 [rng.uniform(-1.5, 1.5, n), 0.0, math.pi / 2,
+                                  math.atan2(L, -drive.places[i][1])], rng.uniform(-0.6, 0.6, n))
+    if robot == "cart":                   # case 4: Ackermann angles for one turn centre on the rear axle's line
+        radius = L / np.tan(angles[case == 4, 0])
+        angles[case == 4, 0] = np.arctan2(L, radius - B)
+        angles[case == 4, 2] = np.arctan2(L, radius + B)
+    rl, rr = [i for i, (m, *_) in enumerate(drive.wheels) if m is not None]     # the left and right rear wheels
+    u = np.zeros((n, W))
+    u[:, [rl, rr]] = rng.uniform(-10.0, 10.0, (n, 2))
+    u[case == 3, rr] = -u[case == 3, rl]
+    heading = np.array([h for _, _, h, _, _ in drive.wheels]) + angles
+    cos, sin = libm_cos_sin(heading)
+    places, driven = list(drive.places), [m is not None for m, *_ in drive.wheels]
+    arrays = (np.array(places), np.array(driven, dtype=np.uint8))
+    radius = np.array([r for _, r, *_ in drive.wheels])
+    got = np.stack(constrained_twists(places, driven, radius, u, cos, sin, arrays), axis=1)
+    lstsq = np.linalg.lstsq
+    fits = []
+    try:
+        np.linalg.lstsq = lambda *a, **k: (fits.append(1), lstsq(*a, **k))[1]
+        for c in range(n):
+            for hinge, a in zip(hinges, angles[c]):
+                hinge.position = float(a)
+            fits.append(0)
+            want = drive.constrained_twist(u[c].tolist())
+            assert got[c].tobytes() == np.array(want).tobytes(), (c, case[c], got[c], want)
+    finally:
+        np.linalg.lstsq = lstsq
+    assert sum(fits) > 50 if robot == "cart" else sum(fits) == 0      # (a tricycle's rows always meet in one line)
+    turning = got[case == 3]                      # about the rear axle's centre at r·(ω_rr − ω_rl)/2B
+    assert np.abs(turning[:, :2]).max() < 1e-12
+    assert turning[:, 2] == pytest.approx(R * (u[case == 3, rr] - u[case == 3, rl]) / (2 * B), abs=1e-12)

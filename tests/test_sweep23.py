@@ -4,6 +4,7 @@ in process by the calls its controller makes and checked against closed forms.""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 
@@ -302,11 +303,10 @@ def test_webots_rolls_the_tinkerbots_vehicles_on_their_wheels(world: str) -> Non
 def test_the_batched_simulation_rolls_braitenberg_as_simulation_does_bit_for_bit(helper: bool) -> None:
     """braitenberg's drive (its forward the robot's −z, up its x, the left wheel mirrored, off-centre) in
     the batched simulation: each copy's pose is the single Simulation's, bit for bit, at every step, with
-    the C drive pass and without it (numpy: SENSORIUM_PACKETS=0's path). vision_car's steered drive has free
-    wheels, which the batched simulation refuses in one line (use Simulation)."""
+    the C drive pass and without it (numpy: SENSORIUM_PACKETS=0's path)."""
     from sensorium.gym.views import CopySim
     from sensorium.server.raycast import packets
-    from sensorium.server.sim.batched import BatchedError, BatchedSimulation
+    from sensorium.server.sim.batched import BatchedSimulation
 
     if helper and packets.library() is None:
         pytest.skip(f"no C helper: {packets.status()}")
@@ -334,5 +334,69 @@ def test_the_batched_simulation_rolls_braitenberg_as_simulation_does_bit_for_bit
             assert batched.rot[c, slot].tobytes() == p.rotation.tobytes(), (t, c)
     assert not batched._numpy_drives
     assert float(singles[0].robot(TB).pose.translation[0]) > 0.2
-    with pytest.raises(BatchedError, match="robot 'vision car' has a steered_drive with free wheels"):
-        BatchedSimulation(load_world(DATA / "vision_car.wbt"), 2)
+
+
+@pytest.mark.parametrize("helper", [True, False])
+def test_the_batched_simulation_rolls_vision_car_on_its_free_wheels_as_simulation_does(helper: bool,
+                                                                                        monkeypatch) -> None:
+    """vision_car's steered drive (one driven wheel, two free wheels) in four copies, each against its own
+    Simulation built with the copy's seed, 300 steps (2.4 s), with the packets helper (libm's cos and sin in
+    C) and without it (SENSORIUM_PACKETS=0): the controller's 11 rad/s stopped once the sensor reads under
+    100, −7 rad/s, the full 22 rad/s into the ring, new random speeds every 25 steps. Every step each copy's
+    pose, its motor sensor, its distance sensor and both free wheels' rolled angles are the single
+    simulation's bits; the first 100 steps of the 11 and −7 rad/s copies are the straight roll along
+    forward at r·ω, r·ω·0.008 m a step (1e-12)."""
+    from sensorium.server.raycast import packets
+    from sensorium.server.sim.batched import BatchedSimulation
+
+    if not helper:
+        monkeypatch.setattr(packets, "_state", {})
+        monkeypatch.setenv("SENSORIUM_PACKETS", "0")
+        assert packets.library() is None
+    elif packets.library() is None:
+        pytest.skip(f"no C helper: {packets.status()}")
+    lw = load_world(DATA / "vision_car.wbt")
+    n, seeds = 4, [3, 5, 7, 11]
+    batched = BatchedSimulation(lw, n)
+    batched.reset(np.arange(n), seeds)
+    singles = [Simulation(dataclasses.replace(lw, world=lw.world.model_copy(update={
+        "world_info": lw.world.world_info.model_copy(update={"random_seed": seed})})), "exact") for seed in seeds]
+    slot = batched.slot(VC)
+    k = batched.steered.of[slot]
+    refs = [batched.device(VC, name) for name in ("distance sensor", "motor sensor")]
+    for ref in refs:
+        batched.enable(ref, 8)
+    for single in singles:
+        for name in ("distance sensor", "motor sensor"):
+            single.device(f"{VC}/{name}").enable(8)
+        single.robot(VC).motor("motor").set_position(math.inf)
+    rng = np.random.default_rng(23)
+    speeds = np.array([11.0, -7.0, 22.0, 0.0])
+    start = batched.pos[:, slot].copy()
+    forward = VC_BASE @ np.asarray(lw.world.robots[0].steered_drive.forward)
+    forward = np.array([forward[0], forward[1], 0.0]) / math.hypot(forward[0], forward[1])
+    for t in range(300):
+        if t % 25 == 0:
+            speeds[3] = rng.uniform(-22.0, 22.0)
+        batched.steered.command(slot, speeds[:, None])
+        for c, single in enumerate(singles):
+            single.robot(VC).motor("motor").set_velocity(float(speeds[c]))
+            single.step()
+        batched.step()
+        for c, single in enumerate(singles):
+            car = single.robot(VC)
+            assert batched.pos[c, slot].tobytes() == car.pose.translation.tobytes(), (t, c)
+            assert batched.rot[c, slot].tobytes() == car.pose.rotation.tobytes(), (t, c)
+            for ref, name in zip(refs, ("distance sensor", "motor sensor")):
+                assert np.float64(batched.value(ref)[c]).tobytes() == np.float64(
+                    single.device(f"{VC}/{name}").value).tobytes(), (t, c, name)
+            assert batched.steered.free_turned[c, k, 1:3].tolist() == [car.drive.free_turned[1],
+                                                                       car.drive.free_turned[2]], (t, c)
+        if t < 100:
+            for c in (0, 1):
+                expected = start[c] + forward * 0.02625 * speeds[c] * 0.008 * (t + 1)
+                assert batched.pos[c, slot] == pytest.approx(expected, abs=1e-12), (t, c)
+        if batched.value(refs[0])[0] < 100.0:
+            speeds[0] = 0.0
+    assert speeds[0] == 0.0 and batched.steered.free_turned[:, k, 1:3].all()
+    assert (batched.value(refs[0]) < 128.0).sum() >= 2

@@ -1982,3 +1982,77 @@ size_t sp_due(size_t C, size_t D, const int64_t* time, const int64_t* last, cons
   }
   return k;
 }
+
+/* batched_steered.py's constrained_twists: SteeredDrive.constrained_twist of one robot of W wheels
+ * (places (W, 2), driven[j] 1 where wheel j has a motor, radius (W)) in n copies, from their wheel
+ * speeds u and headings' cos and sin (n rows of stride ws): the no-sideways-slip rows, the first of the
+ * largest cross products of two (the single drive's strict >), each sum from 0.0 left to right, the
+ * numpy path's operations. out (n, 3) the twists; fallback[i] 1 (out[i] unwritten) where copy i's rows
+ * leave no one line or its driven wheels no speed along it, for the caller's least-squares fit. The
+ * number of fallbacks; W above 64 is refused (every copy a fallback). */
+size_t sp_constrained_twists(size_t n, size_t W, const double* places, const uint8_t* driven, const double* radius,
+                             const double* u, const double* cs, const double* sn, size_t ws, double* out,
+                             uint8_t* fallback) {
+  double rows[64][3];
+  size_t falls = 0;
+  for (size_t i = 0; i < n; i++) {
+    if (W > 64) {
+      fallback[i] = 1;
+      falls++;
+      continue;
+    }
+    const double* ci = cs + i * ws;
+    const double* si = sn + i * ws;
+    for (size_t j = 0; j < W; j++) {
+      const double px = places[2 * j], py = places[2 * j + 1];
+      rows[j][0] = -si[j];
+      rows[j][1] = ci[j];
+      rows[j][2] = px * ci[j] + py * si[j];
+    }
+    double best = 0.0, d0 = 0.0, d1 = 0.0, d2 = 0.0;
+    for (size_t a = 0; a < W; a++)
+      for (size_t b = a + 1; b < W; b++) {
+        const double* ra = rows[a];
+        const double* rb = rows[b];
+        const double x0 = ra[1] * rb[2] - ra[2] * rb[1];
+        const double x1 = ra[2] * rb[0] - ra[0] * rb[2];
+        const double x2 = ra[0] * rb[1] - ra[1] * rb[0];
+        const double size = sqrt((x0 * x0 + x1 * x1) + x2 * x2);
+        if (size > best) {
+          best = size;
+          d0 = x0;
+          d1 = x1;
+          d2 = x2;
+        }
+      }
+    double scale = 0.0;
+    for (size_t j = 0; j < W; j++)
+      for (size_t m = 0; m < 3; m++) scale = scale + fabs(rows[j][m]);
+    int line = best > 1e-12 * scale * scale;
+    for (size_t j = 0; j < W && line; j++)
+      line = fabs((rows[j][0] * d0 + rows[j][1] * d1) + rows[j][2] * d2) <= 1e-9 * best * scale;
+    double total = 0.0, spread = 0.0, rim = 0.0, crossed = 0.0, square = 0.0;
+    for (size_t j = 0; j < W; j++) {
+      if (!driven[j]) continue;
+      const double c = ci[j], s = si[j];
+      const double along = (c * d0 + s * d1) + (places[2 * j + 1] * -c + places[2 * j] * s) * d2;
+      const double r = u[i * ws + j] * radius[j];
+      total = total + along;
+      spread = spread + fabs(along);
+      rim = rim + r;
+      crossed = crossed + along * r;
+      square = square + along * along;
+    }
+    if (!line || !(spread > 0.0)) {
+      fallback[i] = 1;
+      falls++;
+      continue;
+    }
+    fallback[i] = 0;
+    const double k = fabs(total) > 1e-9 * spread ? rim / total : crossed / square;
+    out[3 * i] = k * d0;
+    out[3 * i + 1] = k * d1;
+    out[3 * i + 2] = k * d2;
+  }
+  return falls;
+}

@@ -230,7 +230,8 @@ def _load() -> None:
             ("sp_roll_pitch_yaw", None, [sz, vp, i, vp]),
             ("sp_half_angles", sz, [sz, vp, vp]),
             ("sp_correlation_ratios", sz, [sz, vp, vp, vp]),
-            ("sp_gyro", None, [sz, vp, d, vp])):
+            ("sp_gyro", None, [sz, vp, d, vp]),
+            ("sp_constrained_twists", sz, [sz, sz, vp, vp, vp, vp, vp, vp, sz, vp, vp])):
         func = getattr(lib, name)
         func.restype, func.argtypes = restype, argtypes
     _state["lib"] = lib
@@ -1101,6 +1102,29 @@ def cross_norm(u: np.ndarray, back: np.ndarray) -> np.ndarray | None:
     out = np.empty(u.shape[:2])
     lib.sp_cross_norm(out.size, u.ctypes.data, back.ctypes.data, out.ctypes.data)
     return out
+
+
+def constrained_twists(places: np.ndarray, driven: np.ndarray, radius: np.ndarray, u: np.ndarray, cos: np.ndarray,
+                       sin: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """SteeredDrive.constrained_twist of one robot (``places`` (W, 2), ``driven`` (W,) uint8, ``radius``
+    (W,)) in n copies from their wheel speeds ``u`` and headings' ``cos``, ``sin`` (n, ≥ W) float64
+    (``sp_constrained_twists``: batched_steered.constrained_twists' numpy operations): the twists (n, 3)
+    and a (n,) bool, True where a copy needs the caller's least-squares fit (its twist unwritten); None
+    without the helper or for other arrays."""
+    lib = library()
+    if lib is None or not all(a.dtype == np.float64 and a.ndim == 2 and a.shape == u.shape for a in (u, cos, sin)):
+        return None
+    n, width = u.shape
+    W = len(places)
+    if places.shape != (W, 2) or driven.shape != (W,) or radius.shape != (W,) or W > width or W > 64 \
+            or places.dtype != np.float64 or driven.dtype != np.uint8 or radius.dtype != np.float64:
+        return None
+    u, cos, sin = np.ascontiguousarray(u), np.ascontiguousarray(cos), np.ascontiguousarray(sin)
+    places, driven, radius = np.ascontiguousarray(places), np.ascontiguousarray(driven), np.ascontiguousarray(radius)
+    out, fallback = np.empty((n, 3)), np.empty(n, dtype=np.uint8)
+    lib.sp_constrained_twists(n, W, *_small_addresses((places, driven, radius, u, cos, sin)), width,
+                              *_small_addresses((out, fallback)))
+    return out, fallback.view(bool)
 
 
 def sonar_nearest(r: np.ndarray, beta: np.ndarray, rmax: np.ndarray, max_incidence: float) -> np.ndarray | None:

@@ -50,7 +50,8 @@ cameras, range finders and lidars (rotating ones too) riding them cast from each
 inertial units, gyros, accelerometers and altimeters riding them measure there (a bumper without shapes
 riding one reads its robot's contact). Steered-wheel robots
 (``steered_drive``) are driven by :mod:`~sensorium.server.sim.batched_steered` (``sim.steered.command``)
-at each copy's steering joints.
+at each copy's steering joints, those with free wheels (a tricycle's, vision_car's) by the single drive's
+constrained twist, their free wheels' encoders reading what they rolled.
 A link's shapes (``on_joint``) are template bodies of their own in the copies' cast, owned by their
 robot (``CopyRays``' link slots), each copy's placed at its robot's pose ∘ its joint's displacement
 there as Simulation's scene places a link's body, and numbered as that scene numbers them
@@ -65,8 +66,7 @@ link); the other devices riding one meet it in the copies' cast, through the wor
 single ones do.
 Refused (BatchedError, one line): a textured shape or
 bumper's shape on a link, a link that bounds its robot while kinematic contact
-runs (its footprint would not follow the joint); other devices on a joint, steered drives with free
-wheels and belts.
+runs (its footprint would not follow the joint); other devices on a joint, and belts.
 
 In a NUE world (y up) the drive state (x, y, yaw, base, contact) is kept in ENU axes, as the single
 simulation's PlanarState keeps it, and the poses are turned into the world's axes when placed; such
@@ -477,12 +477,6 @@ class BatchedSimulation:
         if w.world_info.coordinate_system not in _TO_ENU:
             raise BatchedError(f"{self.loaded.source}: the batched simulation drives robots in ENU or NUE worlds only "
                                f"(world_info.coordinate_system is {w.world_info.coordinate_system})")
-        free = [r.name for r in w.robots if r.steered_drive is not None
-                and any(wheel.motor is None for wheel in r.steered_drive.wheels)]
-        if free:                      # their constrained fit is not written for the copies' arrays
-            raise BatchedError(f"{self.loaded.source}: robot {free[0]!r} has a steered_drive with free wheels (no "
-                               "motor); the batched simulation drives steered wheels that all have motors "
-                               "(use Simulation)")
         # batteries are not drained here: one that can empty (cpuConsumption > 0 and energy now, or a
         # Charger to give it some) would power its robot off in Simulation, so it is refused
         draining = [r for r in w.robots if r.battery and r.cpu_consumption > 0.0 and (r.battery[0] > 0.0 or w.chargers)]

@@ -13,7 +13,9 @@ other robot's. The sines and cosines are libm's (``math.sin`` / ``math.cos``: ba
 arcs of the other drives.
 
 Robots with fewer wheels than the widest one have their columns padded: a padded wheel never turns
-(maximum velocity 0) and adds 0 · 0 to the sums, which leaves them the same bits.
+(maximum velocity 0) and adds 0 · 0 to the sums, which leaves them the same bits. A steered drive's free
+wheel (no motor) has its column too, never turned alike; :meth:`HolonomicDrives.command` takes the motors'
+speeds only and puts each in its wheel's column.
 """
 
 from __future__ import annotations
@@ -42,21 +44,23 @@ class HolonomicDrives:
         mine = [(i, d) for i, d in enumerate(drives) if isinstance(d, drive_type)]
         self.slots = np.array([i for i, _ in mine], dtype=np.int64)
         self.of = {int(s): k for k, s in enumerate(self.slots.tolist())}
-        motors: list[list[WheelMotor]] = [self.wheel_motors(d) for _, d in mine]
-        self.columns: list[dict[str, int]] = [{m.name: j for j, m in enumerate(ms)} for ms in motors]
-        self.count = np.array([len(ms) for ms in motors], dtype=np.int64)
+        # each robot's wheels in its drive's order, a free wheel's (no motor: a steered drive's) None
+        motors: list[list[WheelMotor | None]] = [self.wheel_motors(d) for _, d in mine]
+        self.columns: list[dict[str, int]] = [{m.name: j for j, m in enumerate(ms) if m is not None} for ms in motors]
+        self.count = np.array([len(c) for c in self.columns], dtype=np.int64)
+        """Each robot's wheel motors (its free wheels have columns, never turned, and no motor)."""
         M, W = len(mine), max(len(ms) for ms in motors)
         self.width = W
-        self.max_velocity = np.zeros((M, W))
+        self.max_velocity = np.zeros((M, W))      # 0 for a free wheel and a padded one: they never turn
         for k, ms in enumerate(motors):
-            self.max_velocity[k, :len(ms)] = [m.max_velocity for m in ms]
+            self.max_velocity[k, :len(ms)] = [m.max_velocity if m is not None else 0.0 for m in ms]
         self.target = np.zeros((copies, M, W))        # inf: velocity control
         self.velocity = np.zeros((copies, M, W))
         self.angle = np.zeros((copies, M, W))
         self._encoders: np.ndarray | None = None           # per position sensor: (robot, column) or (-1, -1)
 
-    def wheel_motors(self, drive) -> list[WheelMotor]:
-        """A template drive's wheel motors in its order."""
+    def wheel_motors(self, drive) -> list[WheelMotor | None]:
+        """A template drive's wheels' motors in its order (None: a free wheel)."""
         raise NotImplementedError
 
     def order(self, k: int) -> str:
@@ -97,9 +101,16 @@ class HolonomicDrives:
                              f"got shape {u.shape}")
         if not np.isfinite(u).all():
             raise ValueError(f"{self.field[:-6]} wheel speeds must be finite")
-        vmax = self.max_velocity[k, :n]
-        self.target[idx, k, :n] = math.inf
-        self.velocity[idx, k, :n] = np.minimum(np.maximum(u, -vmax), vmax)
+        cols = list(self.columns[k].values())
+        if cols == list(range(n)):
+            vmax = self.max_velocity[k, :n]
+            self.target[idx, k, :n] = math.inf
+            self.velocity[idx, k, :n] = np.minimum(np.maximum(u, -vmax), vmax)
+            return
+        for i, j in enumerate(cols):       # the motors among free wheels: speed i to wheel column j
+            vmax = self.max_velocity[k, j]
+            self.target[idx, k, j] = math.inf
+            self.velocity[idx, k, j] = np.minimum(np.maximum(u[..., i], -vmax), vmax)
 
     # ------------------------------------------------------------------ stepping
     def step(self, live: np.ndarray, dt: float) -> tuple[np.ndarray, ...]:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import sys
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -131,6 +132,15 @@ def mid_heading_step(x: float, y: float, yaw: float, v: float, w: float, dt: flo
     dyaw = w * dt
     mid = yaw + 0.5 * dyaw
     return x + v * dt * math.cos(mid), y + v * dt * math.sin(mid), _wrap(yaw + dyaw)
+
+
+def plain_sum(values: Iterable[float]) -> float:
+    """The values added left to right from 0.0, one rounding each: ``sum()`` up to Python 3.11
+    (3.12's compensates), and what the batched simulation adds column by column (batched_steered.py)."""
+    total = 0.0
+    for v in values:
+        total = total + v
+    return total
 
 
 def _wrap(a: float) -> float:
@@ -606,16 +616,16 @@ class SteeredDrive(HolonomicDrive):
                 size = math.sqrt(cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2])
                 if size > best:
                     best, d = size, cross
-        scale = sum(abs(v) for row in rows for v in row)
+        scale = plain_sum(abs(v) for row in rows for v in row)
         if best > 1e-12 * scale * scale and all(
                 abs(row[0] * d[0] + row[1] * d[1] + row[2] * d[2]) <= 1e-9 * best * scale for row in rows):
             speeds_of_d = [a[0] * d[0] + a[1] * d[1] + a[2] * d[2] for a in along]
-            total, size = sum(speeds_of_d), sum(abs(a) for a in speeds_of_d)
+            total, size = plain_sum(speeds_of_d), plain_sum(abs(a) for a in speeds_of_d)
             if size > 0.0:
                 if abs(total) > 1e-9 * size:
-                    k = sum(rims) / total
+                    k = plain_sum(rims) / total
                 else:                   # the driven wheels' a_i cancel (a turn about the axle's centre)
-                    k = sum(a * u for a, u in zip(speeds_of_d, rims)) / sum(a * a for a in speeds_of_d)
+                    k = plain_sum(a * u for a, u in zip(speeds_of_d, rims)) / plain_sum(a * a for a in speeds_of_d)
                 return k * d[0], k * d[1], k * d[2]
         fit = np.array(rows + along, dtype=np.float64)
         target = np.array([0.0] * len(rows) + rims, dtype=np.float64)
