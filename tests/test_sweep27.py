@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_sweep19 import rot
+from test_sweep19 import KinematicMotor, rot
 
 from sensorium.server.sim.batched import BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
@@ -151,3 +151,131 @@ def test_batched_copies_of_the_tracked_robot_move_as_the_single_simulation() -> 
         assert pose.rotation.tobytes() == batched.rot[c, 0].tobytes(), c
         x, y, _ = arc(*START, HEADING, vl, vr, 0.8)
         assert list(batched.pos[c, 0]) == pytest.approx([x, y, REST_Z], abs=1e-9)
+
+
+# ------------------------------------------------------------------------------------------------ portal_pe
+# portal_pe (projects/robots/a4/portal, R2023b): A4 Technologie's PICAXE-28X2 sliding gate, Webots' Portal
+# (R2022b) at the origin, built y-up and turned by its inner Transform (0.5773 0.5773 0.5773 2.0944: the
+# model's x, y, z are the world's y, z, x). portal_pe.c talks to the PICAXE editor over a Windows named pipe
+# (on Linux its main returns 1); its keyboard path makes the calls below: 'O' held opens the gate (the
+# "gate" slider to 0.3 at its 0.05 m/s, the gear at +inf, the "rail" slider dropped 5 mm once the gate reads
+# 0.29), a released key stops both where they are, 'C' closes; pinsC, the bits the PICAXE reads, is
+# outside button + 2·open + 4·closed + 8·inside button. The gate's bounding box (0.29 m along the world's y)
+# spans y ∈ [p − 0.2998, p − 0.0098] at slider position p; the end stops' boxes y ∈ [−0.28, −0.26]
+# ("closed") and [0.23, 0.25] ("open"), within the gate's height and width.
+PORTAL = DATA / "portal_pe.wbt"
+PORTAL_STEP = 25
+
+
+def pins_c(sim: Simulation) -> int:
+    """portal_pe.c's pinsC from the four TouchSensors' readings."""
+    return sum(bit * int(sim.device(f"Portal/{name}").value)
+               for bit, name in ((1, "outside button"), (2, "open"), (4, "closed"), (8, "inside button")))
+
+
+def test_the_portal_loads_with_the_devices_portal_pe_asks_for_and_is_refused_by_the_batched_simulation() -> None:
+    """The Portal loads with the eleven devices portal_pe.c gets, its three joints one line each (kinematic),
+    its selfCollision read; the batched simulation, which does not take a robot's own shapes, refuses it in
+    one line rather than leave its end stops never pressed."""
+    w = load_world(PORTAL)
+    assert len(w.warnings) == 3 and all("moves kinematically" in x for x in w.warnings), w.warnings
+    (robot,) = w.world.robots
+    assert {d.name for d in robot.devices} == {"gear", "gear_sensor", "gate", "gate_sensor", "rail", "closed", "open",
+                                               "outside button", "inside button", "optical barrier", "lamp"}
+    assert robot.self_collision
+    with pytest.raises(Exception, match=r"robot 'Portal': bumper 'open' touches the robot's own shapes "
+                                        r"\(selfCollision\); the batched simulation does not \(use Simulation\)"):
+        BatchedSimulation(w.world, 2)
+
+
+def test_portal_pes_keyboard_calls_open_and_close_the_gate_onto_its_end_stops() -> None:
+    """portal_pe.c's calls, 25 ms steps: 3 steps stopped (the gate held at 0.03, the gear at 0), 'L' for 2
+    (the lamp on), 'O' held for 230 steps, released for 40, 'C' held for 250. Every step the gate's and the
+    gear's sensors read Webots' kinematic motor closed form (maxForce 10 as the acceleration: the gate at
+    0.05 m/s from its first step, the gear ramping to 3.16 rad/s by 0.25 rad/s a step; 1e-9), the rail drops
+    to −0.005 the step after the gate reads 0.29, and pinsC reads the end stops the gate presses: "closed"
+    (4) while p ≤ 0.0398, at load until 0.2 s of opening (p 0.04) and again from 5.225 s of closing (p
+    0.03875), "open" (2) while p ≥ 0.2398, from 4.2 s of opening (p 0.24) to 1.225 s of closing (p 0.23875):
+    151 and 54 steps. Before this sweep both read 0 always: a bumper touched only solids and other robots,
+    and a robot none drives had no contact at all."""
+    sim = Simulation(load_world(PORTAL), "exact")
+    robot = sim.robot("Portal")
+    for name in ("closed", "open", "outside button", "inside button", "gear_sensor", "gate_sensor"):
+        sim.device(f"Portal/{name}").enable(PORTAL_STEP)
+    gate, gear, rail = KinematicMotor(0.05, 10.0, 0.03), KinematicMotor(3.16, 10.0), KinematicMotor(10.0, 10.0)
+    lamp = sim.device("Portal/lamp")
+    gate_sensor, gear_sensor = sim.device("Portal/gate_sensor"), sim.device("Portal/gear_sensor")
+    seen = {"open": 0, "closed": 0}
+    plan = ["stop"] * 3 + ["L"] * 2 + ["O"] * 230 + [None] * 40 + ["C"] * 250
+    for key in plan:
+        p_read, g_read = gate_sensor.value, gear_sensor.value
+        if key == "stop":          # SIMULATION_STATE_STOP: every actuator back to its initial value
+            if not math.isnan(g_read):
+                gear.target = math.floor(g_read / (math.pi / 7)) * (math.pi / 7)
+                robot.motor("gear").set_position(gear.target)
+            rail.target, gate.target = 0.0, 0.03
+            robot.motor("rail").set_position(0.0)
+            robot.motor("gate").set_position(0.03)
+            lamp.set(0, sim.time_ms)
+        else:
+            lamp.set(1 if key == "L" else 0, sim.time_ms)
+            if key in ("O", "C"):
+                gate.target, gear.target = (0.3, math.inf) if key == "O" else (0.0, -math.inf)
+                derail = p_read >= 0.29 if key == "O" else p_read <= 0.01
+                rail.target = -0.005 if derail else 0.0
+            else:                  # no key ('L' included): the motors stop where their sensors read
+                gear.target, gate.target = g_read, p_read
+            robot.motor("gate").set_position(gate.target)
+            robot.motor("gear").set_position(gear.target)
+            robot.motor("rail").set_position(rail.target)
+        sim.step()
+        for m in (gate, gear, rail):
+            m.step(PORTAL_STEP / 1000.0)
+        assert gate_sensor.value == pytest.approx(gate.x, abs=1e-9)
+        assert gear_sensor.value == pytest.approx(gear.x, abs=1e-9)
+        assert lamp.value == (1 if key == "L" else 0)
+        pressed_open, pressed_closed = gate.x - 0.0098 >= 0.23, gate.x - 0.2998 <= -0.26
+        assert pins_c(sim) == 2 * pressed_open + 4 * pressed_closed, (key, gate.x)
+        seen["open"] += pressed_open
+        seen["closed"] += pressed_closed
+    assert gate.x == pytest.approx(0.0, abs=1e-12) and rail.x == pytest.approx(-0.005, abs=1e-12)
+    assert seen == {"open": 63 + 40 + 48, "closed": 3 + 2 + 7 + 42}
+
+
+def own_stop_world(tmp_path: Path, flag: str) -> Path:
+    """A robot (selfCollision ``flag``) with a bumper box at (0.1, 0, 0.05), a slider "a" on its body whose
+    end point's box overlaps the bumper, and a slider "b" (along y) on that end point whose box starts 0.3 m
+    beside it."""
+    box = "boundingObject Box { size 0.02 0.02 0.02 }"
+    p = tmp_path / f"own_stop_{flag}.wbt"
+    p.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 32 }\n"
+                 f'Robot {{ name "r" selfCollision {flag} children [\n'
+                 f'  TouchSensor {{ translation 0.1 0 0.05 name "stop" {box} }}\n'
+                 '  SliderJoint { jointParameters JointParameters { axis 1 0 0 } device [ LinearMotor { name "a" } ]\n'
+                 f'    endPoint Solid {{ translation 0.1 0 0.05 name "first" {box} children [\n'
+                 '      SliderJoint { jointParameters JointParameters { axis 0 1 0 } device [ LinearMotor { name "b" '
+                 'minPosition -1 } ]\n'
+                 f'        endPoint Solid {{ translation 0 0.3 0 name "second" {box} }} }} ] }} }} ] }}\n')
+    return p
+
+
+@pytest.mark.parametrize("flag", ["TRUE", "FALSE"])
+def test_a_bumper_touches_its_robots_own_solids_that_are_not_consecutive_to_it(tmp_path: Path, flag: str) -> None:
+    """Webots detects collisions within a robot with selfCollision TRUE between solids that are not
+    consecutive (not a joint's end point and the solid it hangs from): the end point of "a", on the body,
+    overlaps the bumper on the body and is never touched; the end point of "b", one joint further, touches
+    it once "b" brings it over it (its box 0.3 m off, ramping to 10 m/s: from its 7th step of 32 ms); with
+    selfCollision FALSE nothing of the robot's own touches it."""
+    sim = Simulation(load_world(own_stop_world(tmp_path, flag)), "exact")
+    stop = sim.device("r/stop")
+    stop.enable(32)
+    sim.step()
+    assert stop.value == 0.0
+    sim.robot("r").motor("b").set_position(-0.3)
+    b = KinematicMotor(10.0, 10.0)
+    b.target = -0.3
+    for _ in range(10):
+        sim.step()
+        b.step(0.032)
+        assert stop.value == (1.0 if flag == "TRUE" and abs(b.x + 0.3) <= 0.02 + 1e-6 else 0.0), b.x
+    assert b.x == pytest.approx(-0.3, abs=1e-12)
