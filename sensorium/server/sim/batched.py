@@ -147,7 +147,7 @@ from sensorium.server.sim.scene import (
     robot_bounding_parts,
     solid_parts,
 )
-from sensorium.server.sim.sensors import LED, DistanceSensor, Lidar, LightSensor, PositionSensor
+from sensorium.server.sim.sensors import LED, DistanceSensor, Lidar, LightSensor, PositionSensor, self_collision_shapes
 from sensorium.server.sim.simulation import SettlingGrounds, lights_from_models
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import check_pose
@@ -508,6 +508,14 @@ class BatchedSimulation:
         if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "
                                "carries solids; the batched simulation moves no belt (use Simulation)")
+        pressed = [(r.name, d.name) for r in w.robots if r.self_collision for d in r.devices
+                   if d.device == "TouchSensor" and d.type == "bumper"
+                   and (own := {x.on_joint for x in r.shapes if x.of_device == d.name
+                                and x.seen_by in ("both", "bounding")})
+                   and self_collision_shapes(r, d.name, own)]
+        if pressed:                   # sensors.self_collision_shapes: not taken here, refused rather than never touched
+            raise BatchedError(f"{self.loaded.source}: robot {pressed[0][0]!r}: bumper {pressed[0][1]!r} touches the "
+                               "robot's own shapes (selfCollision); the batched simulation does not (use Simulation)")
         for r in w.robots:            # joints move per copy (batched_joints.py): links' shapes and devices ride them
             bumpers = {d.name for d in r.devices if d.device == "TouchSensor"}
             for i, x in enumerate(r.shapes):

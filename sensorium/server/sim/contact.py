@@ -1676,6 +1676,14 @@ class Contact:
         return pieces_touch(pieces, self.centres[index], float(self.yaw[index]), float(self.heights[index]),
                             solids, robots)
 
+    def touching_own(self, index: int, pieces: list[Footprint], own: list[Footprint]) -> bool:
+        """Whether robot ``index``'s ``pieces`` touch its own shapes' pieces ``own`` (both as
+        :meth:`pieces` makes them, where its joints hold them now), as :meth:`touching` takes another
+        robot's footprint: a robot with selfCollision, whose bumpers its own parts press."""
+        centre, yaw, height = self.centres[index], float(self.yaw[index]), float(self.heights[index])
+        obstacles = [shaped_obstacle(index, pc, centre, yaw, (height + pc.z_low, height + pc.z_high)) for pc in own]
+        return pieces_touch(pieces, centre, yaw, height, [], obstacles)
+
     def _robot_obstacles(self, j: int) -> list[Obstacle]:
         """Robot ``j``'s footprint where it is now, as obstacles (:func:`robot_obstacles`)."""
         foot = self.feet[j]

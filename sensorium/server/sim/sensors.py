@@ -976,6 +976,19 @@ class Altimeter(Device):
         return {"accuracy": float(self.config.accuracy), "resolution": float(self.config.resolution)}
 
 
+def self_collision_shapes(model: wm.Robot, device: str, links: set[str | None]) -> list:
+    """The bounding shapes of robot ``model`` (its selfCollision TRUE) that bumper ``device``, whose
+    own shapes ride on ``links`` (joint names, None the body), may touch: Webots detects collisions
+    between the robot's solids that are not consecutive, so those on its own links and on the links
+    one joint away from them (a joint's end point and the solid it hangs from) are left out, and the
+    bumper's own shapes."""
+    parent = {d.name: d.on_joint for d in model.devices if isinstance(d, wm.Motor)}
+    near = set(links) | {parent.get(j) for j in links if j is not None} | \
+        {j for j, up in parent.items() if up in links}
+    return [p for p in model.shapes if p.seen_by in ("both", "bounding") and p.of_device != device
+            and p.on_joint not in near]
+
+
 class TouchSensor(Device):
     """Webots TouchSensor. A bumper with bounding shapes of its own (the robot's shapes whose
     ``of_device`` names it) touches on a step when, at the end of it, one of them touches a solid or
@@ -987,7 +1000,9 @@ class TouchSensor(Device):
     the simulation asks the bumpers that are not due -- enabled ones between two readings, and
     disabled ones that were enabled before (``armed``) -- whether they touch (:meth:`sample`), each
     only until it touched. A bumper never enabled is never asked. ``force`` and ``force-3d`` read NaN
-    (they need physics; Webots' force readings are each reading's step's value, never kept)."""
+    (they need physics; Webots' force readings are each reading's step's value, never kept). On a
+    robot whose ``selfCollision`` is TRUE a bumper also touches the robot's own shapes that are not
+    consecutive to it (:func:`self_collision_shapes`: Webots' A4 Portal's end stops, pressed by its gate)."""
 
     kinematic = True
     TYPE_CODES: ClassVar[dict[str, int]] = {"bumper": 0, "force": 1, "force-3d": 2}
@@ -1006,6 +1021,11 @@ class TouchSensor(Device):
         self._riding = False                   # whether any of its shapes rides on a joint
         self.touched = False                   # a bumper touched on a step since its last reading
         self.armed = False                     # a bumper enabled at least once: asked between readings
+        # selfCollision: its robot's own bounding shapes it may touch (primitive, pose, joint), their
+        # pieces as contact takes them and the joints' displacements they were made at
+        self._others: list = []
+        self._other_pieces: list | None = None
+        self._others_held: list = []
 
     def bind(self, robot: Any) -> None:
         self._robot = robot
@@ -1016,6 +1036,16 @@ class TouchSensor(Device):
             self._on = [p.on_joint for p in own]
             self._riding = any(j is not None for j in self._on)
             self._held = [None] * len(own)
+            if own and robot.model.self_collision:
+                others = self_collision_shapes(robot.model, self.name, set(self._on))
+                self._others = [(primitive_from_model(p.geometry, base), pose_from_model(p.pose), p.on_joint)
+                                for p in others]
+                self._others_held = [None] * len(others)
+
+    @property
+    def self_touching(self) -> bool:
+        """Whether this bumper may touch its own robot's shapes (selfCollision: :func:`self_collision_shapes`)."""
+        return bool(self._others)
 
     def _held_now(self) -> list:
         """Where the joints its shapes ride on hold them now: each one's displacement (a joint's
@@ -1039,7 +1069,16 @@ class TouchSensor(Device):
             own = [(prim, local if at is None else at.compose(local)) for (prim, local), at in zip(self._own, held)]
             self._pieces = contact.pieces(robot.index, own)
             self._held = held
-        return contact.touching(robot.index, self._pieces)
+        if contact.touching(robot.index, self._pieces):
+            return True
+        if not self._others:
+            return False
+        held = [None if j is None else robot.link_pose(j) for _, _, j in self._others]
+        if self._other_pieces is None or any(a is not b for a, b in zip(held, self._others_held)):
+            parts = [(prim, local if at is None else at.compose(local)) for (prim, local, _), at in zip(self._others, held)]
+            self._other_pieces = contact.pieces(robot.index, parts)
+            self._others_held = held
+        return contact.touching_own(robot.index, self._pieces, self._other_pieces)
 
     def enable(self, period_ms: int) -> None:
         super().enable(period_ms)

@@ -441,7 +441,10 @@ class Simulation:
         self._distance_plans: dict[tuple[int, ...], DistancePlan] = {}   # by the due sensors (see _distance_plan)
         self._joined_mounts: dict[tuple, tuple[list, Mount]] = {}        # see _joined_mount
         use_contact = self.world.world_info.contact if contact is None else bool(contact)
-        self.contact: Contact | None = self._build_contact() if use_contact and self._driven else None
+        # a robot none drives has no contact to ask, unless a bumper of it may touch its own parts (selfCollision)
+        pressed_by_own = any(isinstance(d, TouchSensor) and d.self_touching for d in self.all_devices())
+        self.contact: Contact | None = self._build_contact() if use_contact and (self._driven or pressed_by_own) \
+            else None
         every = list(self.all_devices())
         self.radio = Radio([d for d in every if isinstance(d, Emitter)], [d for d in every if isinstance(d, Receiver)],
                            self.scene, self._counters)

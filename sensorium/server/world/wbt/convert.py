@@ -2398,6 +2398,44 @@ class Converter:
                              "origin": np.asarray(frame.apply((0.0, 0.0, 0.0))),
                              "frame": frame, "wheels": wheels})
 
+    def bounds_bottom(self, node: Node, frame: Frame, up: Up = UP_Z) -> float | None:
+        """The lowest point along the robot's axis ``up`` of ``node``'s boundingObject (its Boxes,
+        Cylinders, Capsules and Spheres, under Group, Pose and Transform nodes and Shapes), ``frame``
+        the node's frame in the robot's; None when it holds none of these. Webots' physics rests a Track
+        on its bounding object (its TrackWheels have none), which may reach below the wheels' circles."""
+        low: list[float] = []
+
+        def visit(bo: Node | None, place: Frame) -> None:
+            if bo is None:
+                return
+            if bo.type in ("Group", "Pose", "Transform"):
+                inner = place if bo.type == "Group" else self.child_frame(bo, place)
+                for child in self.fields(bo).nodes("children"):
+                    visit(child, inner)
+                return
+            if bo.type == "Shape":
+                bo = self.fields(bo).node_("geometry")
+            if bo is None or place.stretch is not None:
+                return
+            g = self.fields(bo)
+            centre = np.asarray(place.apply((0.0, 0.0, 0.0)))
+            r = np.asarray(place.rotation, dtype=np.float64)
+            if bo.type == "Box":
+                hx, hy, hz = (float(v) / 2.0 for v in g.vec("size", (2.0, 2.0, 2.0)))
+                low.append(min(place.apply((sx * hx, sy * hy, sz * hz))[up]
+                               for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)))
+            elif bo.type == "Sphere":
+                low.append(float(centre[up]) - g.num("radius", 1.0) * place.scale)
+            elif bo.type in ("Cylinder", "Capsule"):
+                radius, half = g.num("radius", 1.0) * place.scale, g.num("height", 2.0) * place.scale / 2.0
+                a = float(r[up, 1])      # the axis (the shape's y) along up
+                ends = min(float(centre[up]) + half * a, float(centre[up]) - half * a)
+                rim = radius if bo.type == "Capsule" else radius * math.sqrt(max(0.0, 1.0 - a * a))
+                low.append(ends - rim)
+
+        visit(self.fields(node).node_("boundingObject"), frame)
+        return min(low) if low else None
+
     def belts(self, node: Node, frame: Frame, motor: str, up: Up = UP_Z) -> list[dict]:
         """A Track's belt as a conveyor carries on it (schemas ConveyorBelt): the top face of each Box in
         its boundingObject (the Box itself, a Shape of one, or under Group, Pose and Transform nodes of any
@@ -2448,16 +2486,19 @@ class Converter:
         return face
 
     def _track_drive(self, node: Node, robot: Owner) -> None:
-        """A robot with two motorised Tracks and no motorised hinge drives on them: their motors are
-        its ``differential_drive``'s wheels of radius 1 (wbt/drive.py ``track_drive``), their entries kept
-        LinearMotors (controllers see Webots' types); otherwise each Track is said once (a conveyor belt's one)."""
-        from sensorium.server.world.wbt.drive import belt_bottom, track_drive
+        """A robot with two motorised Tracks and no motorised hinge that is a wheel drives on them: their
+        motors are its ``differential_drive``'s wheels of radius 1 (wbt/drive.py ``track_drive``), their
+        entries kept LinearMotors (controllers see Webots' types); otherwise each Track is said once (a
+        conveyor belt's one). Hinges whose end points have nothing round to roll on (Webots' TrackedRobot's
+        camera head) move as joints beside the belts, as Webots' physics drives the belts whatever else moves."""
+        from sensorium.server.world.wbt.drive import belt_bottom, track_drive, wheel_radius
 
         tracks = robot.tracks
         if not tracks:
             return
         up = self._robot_up(robot, on_side=False)
-        drive, why = (None, "") if robot.wheels or len(tracks) != 2 else track_drive(tracks, self, up)
+        rolls = any(wheel_radius(w["end"], self) is not None for w in robot.wheels)
+        drive, why = (None, "") if rolls or len(tracks) != 2 else track_drive(tracks, self, up)
         if drive is None:
             if why:
                 self.warn(node, f"robot {robot.data['name']!r}: no tracked drive ({why}); the robot will not move")
@@ -2471,7 +2512,8 @@ class Converter:
                           "the solids with physics lying on its top face at its motor's velocity; its texture "
                           "animation and wheels do not move here")
             return
-        bottoms = [belt_bottom(t["frame"], t["wheels"], up) for t in tracks]
+        bottoms = [self.bounds_bottom(t["node"], t["frame"], up) for t in tracks]   # what Webots' physics rests on
+        bottoms = [b if b is not None else belt_bottom(t["frame"], t["wheels"], up) for b, t in zip(bottoms, tracks)]
         if self.fields(node).node_("physics") is not None and all(b is not None for b in bottoms):
             drive["wheel_bottom"] = min(b for b in bottoms if b is not None)
         robot.data["differential_drive"] = drive
