@@ -1,6 +1,6 @@
 """Property tests (Hypothesis, derandomized) of the whole load-and-step path on real-shaped robots: the
 sweeps' stand-in worlds (tests/data/sweep*/: Webots samples' robots with their joints, wheels, drives,
-lights and devices, our own text) with one to three of their numbers, in the world or in a PROTO it uses,
+lights and devices, our own text) and the test worlds of tests/worlds/ with one to three of their numbers, in the world or in a PROTO it uses,
 replaced by a degenerate value (0, −0, ±1, ±1e-6, ±1e-9, ±1e6, the number negated or nudged by 1e-9 of
 itself, and the loader's refused 1e-31, 1e12, 1e300 and nan). Each such world loads or is refused with ``WorldError`` lines that each name the file;
 once loaded, its Simulation builds, every device enabled and every motor driven, and steps, every robot's
@@ -28,7 +28,8 @@ from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import LoadedWorld, WorldError, load_world
 
 DATA = Path(__file__).parent / "data"
-WORLDS = sorted(DATA.glob("sweep*/*.wbt"))
+WORLDS = sorted(DATA.glob("sweep*/*.wbt")) + sorted((DATA.parent / "worlds").glob("*.wbt")) + sorted(
+    (DATA.parent / "worlds").glob("*/*.wbt"))
 # a number token of a world or PROTO file (not inside a word: a DEF name's digits stay)
 NUMBER = re.compile(r"(?<![\w.\-+])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.])")
 # the refused ones (past the loader's limits) once each, those it takes several times
@@ -66,11 +67,10 @@ def replaced(token: str, pick: str) -> str:
 
 
 def mutated_copy(world: Path, folder: Path, target: int, cuts: list[tuple[int, int]]) -> tuple[Path, str]:
-    """The world's sweep folder copied into ``folder`` (symlinked PROTOs as files), one file of it (the world,
-    or one of its PROTOs by ``target``) with its numbers at the cuts' places replaced; that file's name."""
+    """The world's folder copied into ``folder`` (symlinked PROTOs as files), one file of it (the world, or
+    one of the PROTOs under the folder by ``target``) with its numbers at the cuts' places replaced; that file's name."""
     shutil.copytree(world.parent, folder, symlinks=False)
-    files = [folder / world.name] + sorted((folder / "protos").glob("*.proto")) if (folder / "protos").is_dir() \
-        else [folder / world.name]
+    files = [folder / world.name] + sorted(folder.rglob("*.proto"))
     file = files[target % len(files)]
     text = file.read_text()
     spots = numbers_of(text)
@@ -133,16 +133,16 @@ def run_world(path: Path) -> None:
             assert np.isfinite(pose.translation).all() and np.isfinite(pose.rotation).all(), (name, pose)
 
 
-def test_every_sweep_world_loads_and_steps_unmutated() -> None:
+def test_every_world_loads_and_steps_unmutated() -> None:
     """The baseline: each stand-in world as committed loads and steps under this test's driving (so a mutation's
     failure is the mutation's)."""
-    assert len(WORLDS) >= 30
+    assert len(WORLDS) >= 60
     for world in WORLDS:
         run_world(world)
 
 
 @pytest.mark.parametrize("examples", example_counts(int(__import__("os").environ.get("R29_N", "600")), share=6))
-def test_sweep_worlds_with_degenerate_numbers_load_or_fail_in_lines_and_step_finite(examples: int) -> None:
+def test_worlds_with_degenerate_numbers_load_or_fail_in_lines_and_step_finite(examples: int) -> None:
     @settings(max_examples=examples, deadline=None, derandomize=True,
               suppress_health_check=[HealthCheck.too_slow])
     @given(which=st.integers(0, len(WORLDS) - 1), target=st.integers(0, 40),
@@ -188,14 +188,14 @@ def run_batched(path: Path, c_pass: bool) -> None:
                     assert batched.rot[c, slot].tobytes() == pose.rotation.tobytes(), (t, c, name)
 
 
-def test_every_sweep_world_steps_batched_as_single_or_is_refused_in_a_line() -> None:
+@pytest.mark.parametrize("c_pass", [True, pytest.param(False, marks=pytest.mark.slow)], ids=["c", "numpy"])
+def test_every_world_steps_batched_as_single_or_is_refused_in_a_line(c_pass: bool) -> None:
     for world in WORLDS:
-        for c_pass in (True, False):
-            run_batched(world, c_pass)
+        run_batched(world, c_pass)
 
 
 @pytest.mark.parametrize("examples", example_counts(int(__import__("os").environ.get("R29_N", "300")), share=10))
-def test_sweep_worlds_with_degenerate_numbers_step_batched_as_single(examples: int) -> None:
+def test_worlds_with_degenerate_numbers_step_batched_as_single(examples: int) -> None:
     @settings(max_examples=examples, deadline=None, derandomize=True,
               suppress_health_check=[HealthCheck.too_slow])
     @given(which=st.integers(0, len(WORLDS) - 1), target=st.integers(0, 40), c_pass=st.booleans(),
