@@ -2404,6 +2404,30 @@ class Converter:
         the node's frame in the robot's; None when it holds none of these. Webots' physics rests a Track
         on its bounding object (its TrackWheels have none), which may reach below the wheels' circles."""
         low: list[float] = []
+        for g_node, place in self._bounding_geometries(node, frame):
+            if place.stretch is not None:
+                continue
+            g = self.fields(g_node)
+            centre = np.asarray(place.apply((0.0, 0.0, 0.0)))
+            r = np.asarray(place.rotation, dtype=np.float64)
+            if g_node.type == "Box":
+                hx, hy, hz = (float(v) / 2.0 for v in g.vec("size", (2.0, 2.0, 2.0)))
+                low.append(min(place.apply((sx * hx, sy * hy, sz * hz))[up]
+                               for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)))
+            elif g_node.type == "Sphere":
+                low.append(float(centre[up]) - g.num("radius", 1.0) * place.scale)
+            elif g_node.type in ("Cylinder", "Capsule"):
+                radius, half = g.num("radius", 1.0) * place.scale, g.num("height", 2.0) * place.scale / 2.0
+                a = float(r[up, 1])      # the axis (the shape's y) along up
+                ends = min(float(centre[up]) + half * a, float(centre[up]) - half * a)
+                rim = radius if g_node.type == "Capsule" else radius * math.sqrt(max(0.0, 1.0 - a * a))
+                low.append(ends - rim)
+        return min(low) if low else None
+
+    def _bounding_geometries(self, node: Node, frame: Frame) -> list[tuple[Node, Frame]]:
+        """The geometry nodes of ``node``'s boundingObject, each with its frame (``frame`` the node's): the
+        geometry itself, a Shape's, or those under Group, Pose and Transform nodes of any depth."""
+        out: list[tuple[Node, Frame]] = []
 
         def visit(bo: Node | None, place: Frame) -> None:
             if bo is None:
@@ -2415,26 +2439,11 @@ class Converter:
                 return
             if bo.type == "Shape":
                 bo = self.fields(bo).node_("geometry")
-            if bo is None or place.stretch is not None:
-                return
-            g = self.fields(bo)
-            centre = np.asarray(place.apply((0.0, 0.0, 0.0)))
-            r = np.asarray(place.rotation, dtype=np.float64)
-            if bo.type == "Box":
-                hx, hy, hz = (float(v) / 2.0 for v in g.vec("size", (2.0, 2.0, 2.0)))
-                low.append(min(place.apply((sx * hx, sy * hy, sz * hz))[up]
-                               for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)))
-            elif bo.type == "Sphere":
-                low.append(float(centre[up]) - g.num("radius", 1.0) * place.scale)
-            elif bo.type in ("Cylinder", "Capsule"):
-                radius, half = g.num("radius", 1.0) * place.scale, g.num("height", 2.0) * place.scale / 2.0
-                a = float(r[up, 1])      # the axis (the shape's y) along up
-                ends = min(float(centre[up]) + half * a, float(centre[up]) - half * a)
-                rim = radius if bo.type == "Capsule" else radius * math.sqrt(max(0.0, 1.0 - a * a))
-                low.append(ends - rim)
+            if bo is not None:
+                out.append((bo, place))
 
         visit(self.fields(node).node_("boundingObject"), frame)
-        return min(low) if low else None
+        return out
 
     def belts(self, node: Node, frame: Frame, motor: str, up: Up = UP_Z) -> list[dict]:
         """A Track's belt as a conveyor carries on it (schemas ConveyorBelt): the top face of each Box in
@@ -2444,23 +2453,8 @@ class Converter:
         object; no face when it holds no Box (its other geometries carry nothing here). The face's normal
         is the Box's axis ``up`` (the robot's: z, or y for a robot built y-up in a NUE world)."""
         forward = np.asarray(frame.rotation, dtype=np.float64)[:, 0]
-        faces: list[dict] = []
-
-        def visit(bo: Node | None, place: Frame) -> None:
-            if bo is None:
-                return
-            if bo.type in ("Group", "Pose", "Transform"):
-                inner = place if bo.type == "Group" else self.child_frame(bo, place)
-                for child in self.fields(bo).nodes("children"):
-                    visit(child, inner)
-                return
-            if bo.type == "Shape":
-                bo = self.fields(bo).node_("geometry")
-            if bo is not None and bo.type == "Box" and place.stretch is None:
-                faces.append(self._belt_face(bo, place, forward, motor, up))
-
-        visit(self.fields(node).node_("boundingObject"), frame)
-        return faces
+        return [self._belt_face(box, place, forward, motor, up) for box, place in self._bounding_geometries(node, frame)
+                if box.type == "Box" and place.stretch is None]
 
     def _belt_face(self, box: Node, place: Frame, forward: np.ndarray, motor: str, up: Up) -> dict:
         """One Box's top face placed at ``place``: its sides named so that ``along`` is the one nearest the
