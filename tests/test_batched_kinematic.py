@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _packets import use_packets
 
 from sensorium.schemas import world as wm
 from sensorium.server.devices import motion_sensors as motion_math
@@ -47,12 +48,7 @@ def _readings(bs: BatchedSimulation, sim: Simulation, copy: int, robot: str, nam
 def native(request, monkeypatch):
     """The batched kinematic passes in C (the packets helper) or, with ``SENSORIUM_PACKETS=0``, their
     ``math`` fallback."""
-    if request.param == "math":
-        monkeypatch.setattr(packets, "_state", {})
-        monkeypatch.setenv("SENSORIUM_PACKETS", "0")
-        assert packets.library() is None
-    elif packets.library() is None:
-        pytest.skip(f"no packets helper: {packets.status()}")
+    use_packets(request.param == "helper", monkeypatch)
     return request.param
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from _packets import use_packets
 
 from sensorium.schemas import world as wm
 from sensorium.server.sim.batched import BatchedSimulation
@@ -372,14 +373,7 @@ def cart() -> dict:
 def native(request, monkeypatch):
     """The batched simulation with the packets helper (libm's cos and sin in C) or without it
     (``SENSORIUM_PACKETS=0``)."""
-    from sensorium.server.raycast import packets
-
-    if request.param == "math":
-        monkeypatch.setattr(packets, "_state", {})
-        monkeypatch.setenv("SENSORIUM_PACKETS", "0")
-        assert packets.library() is None
-    elif packets.library() is None:
-        pytest.skip(f"no packets helper: {packets.status()}")
+    use_packets(request.param == "helper", monkeypatch)
     return request.param
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _packets import use_packets
 from test_sweep19 import rot
 
 from sensorium.server.sim.simulation import Simulation
@@ -346,15 +347,9 @@ def test_the_batched_simulation_rolls_vision_car_on_its_free_wheels_as_simulatio
     pose, its motor sensor, its distance sensor and both free wheels' rolled angles are the single
     simulation's bits; the first 100 steps of the 11 and −7 rad/s copies are the straight roll along
     forward at r·ω, r·ω·0.008 m a step (1e-12)."""
-    from sensorium.server.raycast import packets
     from sensorium.server.sim.batched import BatchedSimulation
 
-    if not helper:
-        monkeypatch.setattr(packets, "_state", {})
-        monkeypatch.setenv("SENSORIUM_PACKETS", "0")
-        assert packets.library() is None
-    elif packets.library() is None:
-        pytest.skip(f"no C helper: {packets.status()}")
+    use_packets(helper, monkeypatch)
     lw = load_world(DATA / "vision_car.wbt")
     n, seeds = 4, [3, 5, 7, 11]
     batched = BatchedSimulation(lw, n)
