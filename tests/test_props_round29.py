@@ -6,6 +6,9 @@ itself, and the loader's refused 1e-31, 1e12, 1e300 and nan). Each such world lo
 once loaded, its Simulation builds, every device enabled and every motor driven, and steps, every robot's
 and solid's pose finite. Nothing else may happen: no other exception, no NaN pose.
 
+`sensorium convert`'s YAML of each such world (wbt/emit.py) runs as the world itself: every robot's pose and
+every device's value the same bits over the steps.
+
 The batched simulation on the same worlds: two copies, driven as the single simulation is, either refuse the
 world in one ``BatchedError`` line or move every robot bit for bit as Simulation does (its C pass and numpy)."""
 
@@ -204,6 +207,55 @@ def test_worlds_with_degenerate_numbers_step_batched_as_single(examples: int) ->
         with tempfile.TemporaryDirectory() as tmp:
             path, _file = mutated_copy(WORLDS[which], Path(tmp) / "w", target, cuts)
             run_batched(path, c_pass)
+
+    run()
+
+
+def trace(loaded: LoadedWorld) -> list:
+    """Every robot's pose and every device's value, as bytes, over STEPS steps with every device enabled and
+    every motor driven."""
+    sim = Simulation(loaded, "exact")
+    for device in sim.all_devices():
+        if hasattr(device, "enable"):
+            device.enable(sim.basic_time_step)
+    drive(sim)
+    out: list = []
+    for k in range(STEPS):
+        sim.step()
+        for name in sorted(sim.robots):
+            pose = sim.robot(name).pose
+            out.append((k, name, pose.translation.tobytes(), pose.rotation.tobytes()))
+        for device in sim.all_devices():
+            value = getattr(device, "value", None)
+            if value is not None:
+                out.append((k, device.config.name, np.asarray(value, dtype=np.float64).tobytes()))
+    return out
+
+
+def run_converted(path: Path) -> None:
+    """The world's converted YAML, written beside it, loads and runs as the world does, bit for bit."""
+    from sensorium.server.world.wbt.emit import converted_world, dump_yaml
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        loaded = loaded_or_refused(path)
+        if loaded is None:
+            return
+        out = path.parent / "converted.yaml"
+        out.write_text(dump_yaml(converted_world(path, path.parent)))
+        assert trace(load_world(out, allow_outside_meshes=True)) == trace(loaded)
+
+
+@pytest.mark.parametrize("examples", example_counts(int(__import__("os").environ.get("R29_N", "200")), share=20))
+def test_converted_worlds_with_degenerate_numbers_run_as_the_worlds(examples: int) -> None:
+    @settings(max_examples=examples, deadline=None, derandomize=True,
+              suppress_health_check=[HealthCheck.too_slow])
+    @given(which=st.integers(0, len(WORLDS) - 1), target=st.integers(0, 40),
+           cuts=st.lists(st.tuples(st.integers(0, 10_000), st.integers(0, len(PICKS) - 1)), min_size=0, max_size=3))
+    def run(which: int, target: int, cuts: list[tuple[int, int]]) -> None:
+        with tempfile.TemporaryDirectory() as tmp:
+            path, _file = mutated_copy(WORLDS[which], Path(tmp) / "w", target, cuts)
+            run_converted(path)
 
     run()
 
