@@ -144,7 +144,7 @@ def test_every_world_loads_and_steps_unmutated() -> None:
         run_world(world)
 
 
-@pytest.mark.parametrize("examples", example_counts(int(__import__("os").environ.get("R29_N", "600")), share=6))
+@pytest.mark.parametrize("examples", example_counts(600, share=6))
 def test_worlds_with_degenerate_numbers_load_or_fail_in_lines_and_step_finite(examples: int) -> None:
     @settings(max_examples=examples, deadline=None, derandomize=True,
               suppress_health_check=[HealthCheck.too_slow])
@@ -197,7 +197,7 @@ def test_every_world_steps_batched_as_single_or_is_refused_in_a_line(c_pass: boo
         run_batched(world, c_pass)
 
 
-@pytest.mark.parametrize("examples", example_counts(int(__import__("os").environ.get("R29_N", "300")), share=10))
+@pytest.mark.parametrize("examples", example_counts(300, share=10))
 def test_worlds_with_degenerate_numbers_step_batched_as_single(examples: int) -> None:
     @settings(max_examples=examples, deadline=None, derandomize=True,
               suppress_health_check=[HealthCheck.too_slow])
@@ -246,7 +246,7 @@ def run_converted(path: Path) -> None:
         assert trace(load_world(out, allow_outside_meshes=True)) == trace(loaded)
 
 
-@pytest.mark.parametrize("examples", example_counts(int(__import__("os").environ.get("R29_N", "200")), share=20))
+@pytest.mark.parametrize("examples", example_counts(200, share=20))
 def test_converted_worlds_with_degenerate_numbers_run_as_the_worlds(examples: int) -> None:
     @settings(max_examples=examples, deadline=None, derandomize=True,
               suppress_health_check=[HealthCheck.too_slow])
