@@ -25,7 +25,7 @@ int main(void) {
   printf("found");
   name(cam);
   name(tip);
-  name(wb_supervisor_node_get_from_def("SHELF.LID"));
+  name(wb_supervisor_node_get_from_def("SHELF.BOARD.LID"));
   printf("\n");
   printf("parents %s %s %d\n", wb_supervisor_node_get_def(wb_supervisor_node_get_parent_node(cam)),
          wb_supervisor_node_get_def(wb_supervisor_node_get_parent_node(tip)),
