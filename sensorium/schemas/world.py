@@ -828,7 +828,7 @@ class Solid(Strict):
                 raise ValueError(f"poses[{i}]: parent {p.parent} is not an earlier entry of `poses`")
         held = [("children", i, c.in_pose) for i, c in enumerate(self.children)]
         held += [("shapes", i, s.node.parent) for i, s in enumerate(self.shapes) if s.node is not None]
-        held += [("lights", i, lt.node.parent) for i, lt in enumerate(self.lights) if getattr(lt, "node", None)]
+        held += [("lights", i, lt.node.parent) for i, lt in enumerate(self.lights) if lt.node is not None]
         for where, i, parent in held:
             if parent >= len(self.poses):
                 raise ValueError(f"{where}[{i}]: its Pose {parent} is not in `poses` ({len(self.poses)} entries)")

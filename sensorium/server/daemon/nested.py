@@ -2,7 +2,9 @@
 
 A robot's nodes are its world entry's ``nodes`` (the ``.wbt`` import keeps its Solids, devices,
 Poses, Transforms, Groups, Slots and joints, schemas.world.NestedNode), or one node per device of
-its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth.
+its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth
+and the Poses, Transforms and Groups inside them (``poses``: numbered after the lights, :func:`_number_poses`; the
+solids, shapes and lights they hold are their children, in file order by ``seq``).
 Both hold their Shapes too, numbered after every other nested node (:func:`_shape_nodes`; their
 fields: appearance.py), then the lights a .wbt world writes in them (``LightNode``: an LED's too; their fields:
 supervisor.py, on the scene's ``carried_light_slots``). They are
@@ -573,7 +575,7 @@ def drop(table: Table, owner: int) -> None:
 
 
 def drop_shape(table: Table, shape: int) -> None:
-    """A Shape node (or a light) a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
+    """A Shape node (or a light, or a solid's Pose or Group) a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
     getFromProtoDef finds them and their ids read as removed (never given again)."""
     gone = {shape}
     todo = [shape]

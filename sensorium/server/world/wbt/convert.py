@@ -237,7 +237,8 @@ def _unserved_why(kind: str) -> str:
     if kind in ("JointParameters", "HingeJointParameters"):
         return f"a {kind} node: read through its joint's 'jointParameters' field here"
     return (f"a {kind} node, which Sensorium does not serve as a Supervisor node there (it serves the solids, "
-            "devices, joints, Poses and Groups of robots, the solids inside top-level solids and visible shapes)")
+            "devices, joints, Poses and Groups of robots, the solids, Poses and Groups inside top-level solids and "
+            "visible shapes)")
 
 
 class Converter:
