@@ -31,6 +31,7 @@ def _live(path=WORLD) -> Live:
     bot = lv.sim.robot("probe")
     bot.device("lidar").enable(8)
     bot.device("ls").enable(8)
+    bot.device("camera").enable(8)
     return lv
 
 
@@ -50,6 +51,10 @@ def readings(lv: Live) -> tuple[float, float]:
     lv.step(A, "probe")
     bot = lv.sim.robot("probe")
     return float(np.asarray(bot.device("lidar").range_image).reshape(-1)[0]), bot.device("ls").value
+
+
+def image(lv: Live) -> bytes:
+    return np.asarray(lv.sim.robot("probe").device("camera").image).tobytes()
 
 
 def test_found_by_def_dotted_paths_id_and_their_parents_children():
@@ -121,8 +126,13 @@ def test_readings_see_what_they_hold_and_remove_takes_it_out_as_a_world_without_
     end = text.index("    DEF G Group {")
     without = tmp_path / "without_top.wbt"
     without.write_text(text[:start] + text[end:])
-    expected = readings(_live(without))
+    seen = _live()
+    readings(seen)
+    marker_seen = image(seen)
+    twin = _live(without)
+    expected = readings(twin)
     assert readings(lv) == expected and expected[1] == 0.0 and expected[0] > 1.8   # bit for bit
+    assert image(lv) == image(twin) != marker_seen        # the camera too
     assert node(lv, "TOP") == 0 and node(lv, "MARKER") == 0 and node(lv, "LAMP") == 0
     for gone in (top, marker, lamp):                  # NULL by id, one line as a node
         assert call(lv, "get_from_id", {"id": gone})["node"] == 0
@@ -159,3 +169,42 @@ def test_refused_in_one_line_and_nothing_changes():
     assert "holds Solid 'inner'" in message and "\n" not in message, message
     assert get(lv, top, "translation") == [0.0, 0.0, 1.0] and node(lv, "INNER") != 0
     assert readings(lv) == before
+
+
+TABLE_PROTO = """#VRML_SIM R2023b utf8
+PROTO Table [
+  field SFVec3f translation 0 0 0
+]
+{
+  Solid {
+    translation IS translation
+    children [
+      DEF TOP Pose {
+        translation 0 0 1
+        children [ DEF PLATE Shape { geometry Box { size 1 1 0.1 } } ]
+      }
+    ]
+  }
+}
+"""
+
+
+def test_a_protos_pose_is_found_by_get_from_proto_def_and_not_removed(tmp_path):
+    (tmp_path / "protos").mkdir()
+    (tmp_path / "protos" / "Table.proto").write_text(TABLE_PROTO)
+    world = tmp_path / "table.wbt"
+    world.write_text('#VRML_SIM R2023b utf8\nEXTERNPROTO "protos/Table.proto"\nWorldInfo { }\n'
+                     'DEF PROBE Robot { name "probe" supervisor TRUE controller "<extern>" }\n'
+                     'DEF T1 Table { translation 1 0 0 }\n')
+    lv = Live(Simulation(load_world(world)))
+    lv.ok(A, "attach", {"robot": "probe"})
+    table = node(lv, "T1")
+    assert node(lv, "TOP") == 0                       # a PROTO's internal DEF (Webots)
+    found = call(lv, "get_from_proto_def", {"node": table, "name": "TOP"})
+    assert (found["type"], found["parent"]) == ("Pose", table)
+    assert call(lv, "get_node_pose", {"node": found["node"]})["position"] == [1.0, 0.0, 1.0]
+    plate = call(lv, "get_from_proto_def", {"node": table, "name": "PLATE"})
+    assert plate["parent"] == found["node"]
+    message = lv.err(A, "/probe/robot/remove_node", {"node": found["node"]}, ErrorCode.INVALID_ARGUMENT)
+    assert message == ("remove_node: Node 'DEF TOP Pose' is internal to a PROTO and therefore cannot be deleted from "
+                       "a Supervisor.")

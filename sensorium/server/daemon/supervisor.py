@@ -1576,8 +1576,9 @@ def _remove_solid_pose(sim: Any, node: Node) -> None:
     as is one a PROTO's body writes (Webots' line)."""
     table = _table(sim)
     n = _nested_of(sim, node)
-    if not n.at:
-        name = f"DEF {n.def_name} {n.type}" if n.def_name else n.type
+    if not n.at:             # (Webots names it by its usefulName: "DEF <its body's DEF> <type>")
+        defs = sorted({k for found in (table.inner or {}).values() for k, v in found.items() if v == n.id})
+        name = f"DEF {defs[0]} {n.type}" if defs else n.type
         raise ValueError(f"Node '{name}' is internal to a PROTO and therefore cannot be deleted from a Supervisor.")
     inside: list[nested.Nested] = []
     todo = [n.id]
