@@ -208,3 +208,17 @@ def test_a_protos_pose_is_found_by_get_from_proto_def_and_not_removed(tmp_path):
     message = lv.err(A, "/probe/robot/remove_node", {"node": found["node"]}, ErrorCode.INVALID_ARGUMENT)
     assert message == ("remove_node: Node 'DEF TOP Pose' is internal to a PROTO and therefore cannot be deleted from "
                        "a Supervisor.")
+
+
+def test_an_imported_solids_pose_is_a_node_too():
+    lv = _live()
+    before = readings(lv)
+    call(lv, "import_node_from_string", {"node": 0, "field": "children", "position": -1, "node_string":
+                                         "DEF BOX Solid { translation 1 0 0 children [ DEF P Pose { children [ "
+                                         "DEF S Shape { geometry Box { size 0.2 0.2 0.2 } } ] } ] }"})
+    box, pose, shape = node(lv, "BOX"), node(lv, "BOX.P"), node(lv, "BOX.P.S")
+    assert call(lv, "get_from_id", {"id": pose})["parent"] == box and get(lv, pose, "children") == [shape]
+    assert get(lv, box, "children") == [pose]
+    assert readings(lv)[0] == pytest.approx(0.9, abs=1e-6)        # the box's near face, 0.1 m before x = 1
+    call(lv, "remove_node", {"node": pose})
+    assert readings(lv) == before and node(lv, "BOX.P") == 0
