@@ -675,7 +675,8 @@ def test_c_supervisor_reaches_nested_nodes(cbin, servers):
     device's node (a motor: no position), the robot's children; the camera at (1, 2.15, 0.3) moves
     10 steps · 32 ms · 2 rad/s · 0.05 m along +y with the robot and stays at (0.15, 0, 0.3) in its
     frame, and the solid ARM's centre of mass (with TIP's) moves with it; the left wheel's jointParameters
-    (SFNode) hold its angle; setting a nested field gets the server's one line."""
+    (SFNode) hold its angle; the Pose BOARD inside the solid SHELF is a node; setting a nested field gets the
+    server's one line."""
     code, out, err = finish(start([cbin["nested_nodes"]], servers(NESTED_WORLD).url("rover")))
     assert code == 0, err
     assert out[:6] == ["found Camera:CAM:cam Solid:TIP:tip Solid:LID:lid",
@@ -687,7 +688,11 @@ def test_c_supervisor_reaches_nested_nodes(cbin, servers):
     parameters = next(line for line in out if line.startswith("parameters")).split()
     assert parameters[:3] == ["parameters", "HingeJointParameters", "1"]
     assert float(parameters[3]) == pytest.approx(2.0 * 10 * 0.032, abs=1e-9)    # the wheel's angle: 2 rad/s, 10 steps
-    values = {line.split()[0]: [float(v) for v in line.split()[1:]] for line in out[6:] if line.split()[0] != "parameters"}
+    values = {line.split()[0]: [float(v) for v in line.split()[1:]] for line in out[6:]
+              if line.split()[0] not in ("parameters", "board")}
+    board = next(line for line in out if line.startswith("board")).split()
+    assert board[:5] == ["board", "Pose", "BOARD", "1", "1"]     # SHELF's Pose, its only child
+    assert [float(v) for v in board[5:]] == pytest.approx([-2.0, 0.0, 0.75], abs=1e-12)   # SHELF at (-2, 0, 0.5)
     d = 2.0 * 0.05 * 10 * 0.032
     assert values["before"] == pytest.approx([1.0, 2.15, 0.3], abs=1e-9)
     assert values["after"] == pytest.approx([1.0, 2.15 + d, 0.3], abs=1e-9)

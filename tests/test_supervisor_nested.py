@@ -77,7 +77,7 @@ def test_nested_defs_are_found_anywhere_and_by_dotted_paths():
     assert node(lv, "ROVER.MAST.CAM") == CAM
     assert node(lv, "ROVER.ARM.TIP") == node(lv, "ARM.TIP") == TIP
     assert node(lv, "ROVER.LEFT_JOINT.LEFT_WHEEL") == LEFT_WHEEL
-    assert node(lv, "SHELF.LID") == LID
+    assert node(lv, "SHELF.BOARD.LID") == LID and node(lv, "SHELF.LID") == 0     # through the Pose, as Webots
     assert node(lv, "ROVER.") == ROVER          # nothing after the dot (Webots)
     for missing in ("ROVER.CAM", "ROVER.TIP", "ARM.CAM", "ROVER..ds", ".CAM", "NOPE.TIP", "ROVER.ARM.TIP.X"):
         assert rover(lv, "get_from_def", {"name": missing})["type"] == "", missing
@@ -96,14 +96,16 @@ def test_parents_types_and_the_children_walk():
     def kids(n: int) -> list[int]:
         return rover(lv, "get_field", {"node": n, "field": "children"})["value"]
 
-    assert [ref(n)["parent"] for n in (MAST, CAM, ARM, TIP, DS, LEFT_JOINT, LEFT_MOTOR, LEFT_WHEEL, LID)] == \
-        [ROVER, MAST, ROVER, ARM, ROVER, ROVER, LEFT_JOINT, LEFT_JOINT, SHELF]
+    board = rover(lv, "get_from_def", {"name": "BOARD"})["node"]     # the Pose inside SHELF: after every other
+    assert [ref(n)["parent"] for n in (MAST, CAM, ARM, TIP, DS, LEFT_JOINT, LEFT_MOTOR, LEFT_WHEEL, LID, board)] == \
+        [ROVER, MAST, ROVER, ARM, ROVER, ROVER, LEFT_JOINT, LEFT_JOINT, board, SHELF]
     assert [ref(n)["type"] for n in (MAST, DS, LEFT_JOINT, LEFT_MOTOR, LEFT_ENCODER, RIGHT_WHEEL)] == \
         ["Pose", "DistanceSensor", "HingeJoint", "RotationalMotor", "PositionSensor", "Solid"]
     assert ref(DS)["def_name"] == "" and ref(DS)["name"] == "ds"
     # the children (a joint's end point and devices are in its other fields)
     assert kids(ROVER) == [MAST, ARM, DS, LEFT_JOINT, RIGHT_JOINT]
-    assert kids(MAST) == [CAM] and kids(ARM) == [TIP] and kids(TIP) == [] and kids(SHELF) == [LID]
+    assert kids(MAST) == [CAM] and kids(ARM) == [TIP] and kids(TIP) == [] and kids(SHELF) == [board]
+    assert kids(board) == [LID] and ref(board)["type"] == "Pose"
     assert rover(lv, "get_field", {"node": LEFT_JOINT, "field": "children"}) == {"type": "", "value": [], "absent": True}
     assert ref(RIGHT_MOTOR)["name"] == "right wheel"
 
@@ -129,7 +131,7 @@ def test_fields_are_read_in_the_parents_frame_and_refused_when_set():
     assert get(CAM, "translation")["value"] == pytest.approx([0.05, 0.0, 0.1], abs=1e-12)
     assert get(CAM, "rotation")["value"] == pytest.approx([0.0, 0.0, 1.0, HALF_PI], abs=1e-12)
     assert get(LEFT_WHEEL, "rotation")["value"] == pytest.approx([1.0, 0.0, 0.0, HALF_PI], abs=1e-12)
-    assert get(LID, "translation")["value"] == pytest.approx([0.1, 0.0, 0.25], abs=1e-12)   # the Pose folded in
+    assert get(LID, "translation")["value"] == pytest.approx([0.1, 0.0, 0.0], abs=1e-12)    # in the Pose's frame
     assert get(TIP, "name") == {"type": "SFString", "value": "tip"}
     assert get(CAM, "name") == {"type": "SFString", "value": "cam"}
     assert get(MAST, "name") == {"type": "", "value": [], "absent": True}     # a Pose has no name in Webots either

@@ -462,6 +462,10 @@ def _written_at() -> Any:
     return Field(default=None, min_length=2, max_length=2, description=_WRITTEN_AT)
 
 
+_SEQ = ("inside a top-level solid holding Poses or Groups (`poses`): its file order there (larger: written later), "
+        "which orders its parent's children (Supervisor getMFNode); none otherwise")
+
+
 _MADE_AT = ("where the PROTO body that made this node writes it: [line, column] in that body's text (as its template "
             "generated it; a PROTO instance inside a body: where the instance is written there); none for a node the "
             "world file writes. A Supervisor's exportString finds its text there")
@@ -479,7 +483,9 @@ class ShapeNode(Strict):
 
     def_name: str | None = Field(default=None, min_length=1)
     parent: int = Field(default=-1, ge=-1, description="on a robot: the index in the robot's `nodes` of the node "
-                        "holding it (-1: the robot); on a solid: -1 (the solid holding it)")
+                        "holding it (-1: the robot); on a solid: the index in its solid's `poses` of the Pose or "
+                        "Group holding it (-1: the solid)")
+    seq: int | None = Field(default=None, ge=1, description=_SEQ)
     after: int = Field(default=-1, ge=-1, description="its place among its parent's children: on a robot, the "
                        "index of the last `nodes` entry written before it; on a solid, how many of the solid's "
                        "children solids come before it, minus one")
@@ -606,7 +612,9 @@ class LightNode(Strict):
     frame); the light's own ``location``/``direction`` are those placed in its robot's or solid's frame."""
 
     parent: int = Field(default=-1, ge=-1, description="on a robot: the index in the robot's `nodes` of the node "
-                        "holding it (-1: the robot); on a solid: -1 (the solid holding it)")
+                        "holding it (-1: the robot); on a solid: the index in its solid's `poses` of the Pose or "
+                        "Group holding it (-1: the solid)")
+    seq: int | None = Field(default=None, ge=1, description=_SEQ)
     after: int = Field(default=-1, ge=-1, description="its place among its parent's children, as a Shape's `after`")
     frame: Pose = Field(default=Pose(), description="its parent's frame in the robot's or solid's frame: "
                         "`location` and `direction` are the fields placed by it")
@@ -737,6 +745,23 @@ def _one_mass(mass: Mass | None, pending: PendingMass | None) -> None:
         raise ValueError("pending_mass: give either mass or pending_mass (which the loader makes the mass), not both")
 
 
+class SolidPose(Strict):
+    """A ``.wbt`` Pose, Transform (unscaled) or Group inside a solid as a Supervisor serves it (README
+    "Supervisor"): getFromDef, its parent's children, its ``translation`` and ``rotation`` (read here), its
+    world pose. The shapes, lights and solids inside it are its solid's, placed through it as the world loads."""
+
+    type: Literal["Pose", "Transform", "Group"]
+    def_name: str | None = Field(default=None, min_length=1)
+    parent: int = Field(default=-1, ge=-1, description="the index of the Pose or Group holding it in the same "
+                        "`poses` (an earlier entry); -1: the solid")
+    seq: int = Field(ge=1, description=_SEQ)
+    pose: Pose | None = Field(default=None, description="its frame in the solid's frame as the world loads; none "
+                              "for a Group")
+    inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
+    written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
+    made_at: list[Annotated[int, Field(ge=1)]] | None = _made_at()
+
+
 class Solid(Strict):
     """A static object (movable by a supervisor; carried by a VacuumGripper when it has ``physics``), seen
     by rays through its shapes.
@@ -773,6 +798,12 @@ class Solid(Strict):
                                        "solid, those of its PROTO instances' DEFs that name no node here (`why`)")
     proto_scope: int | None = Field(default=None, ge=0, description="a PROTO instance inside a top-level solid: its "
                                     "number there (InnerDef.scope)")
+    poses: list[SolidPose] = Field(default=[], max_length=100_000, description="the Poses, Transforms and Groups "
+                                   "inside it (not inside its children solids), in file order: Supervisor nodes")
+    in_pose: int = Field(default=-1, ge=-1, description="a solid inside a solid: the index in its parent's `poses` "
+                         "of the Pose or Group holding it (-1: the parent solid itself)")
+    seq: int | None = Field(default=None, ge=1, description=_SEQ)
+
     written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
     made_at: list[Annotated[int, Field(ge=1)]] | None = _made_at()
     physics: bool = Field(default=False, description="Webots: the solid has a Physics node. Nothing is pushed here "
@@ -792,6 +823,15 @@ class Solid(Strict):
         for i, con in enumerate(self.connectors):
             if con.on_joint is not None:
                 raise ValueError(f"connectors[{i}] ({con.name}): a solid has no joints (leave out on_joint)")
+        for i, p in enumerate(self.poses):
+            if p.parent >= i:
+                raise ValueError(f"poses[{i}]: parent {p.parent} is not an earlier entry of `poses`")
+        held = [("children", i, c.in_pose) for i, c in enumerate(self.children)]
+        held += [("shapes", i, s.node.parent) for i, s in enumerate(self.shapes) if s.node is not None]
+        held += [("lights", i, lt.node.parent) for i, lt in enumerate(self.lights) if lt.node is not None]
+        for where, i, parent in held:
+            if parent >= len(self.poses):
+                raise ValueError(f"{where}[{i}]: its Pose {parent} is not in `poses` ({len(self.poses)} entries)")
         for i, child in enumerate(self.children):
             if child.recognition_colors:
                 raise ValueError(f"children[{i}] ({child.name}): recognition_colors are read on top-level solids "

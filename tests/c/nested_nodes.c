@@ -2,7 +2,8 @@
  * (tests/worlds/nested_nodes.wbt): by DEF and dotted path, by device, through parents and children;
  * the camera's world position before and after driving straight ahead, and in the robot's frame;
  * the left wheel's joint parameters (an SFNode) and their position after driving; the solid ARM's centre of
- * mass (with TIP's) before and after driving, and the robot's (no Physics: 0 0 0).
+ * mass (with TIP's) before and after driving, and the robot's (no Physics: 0 0 0); the Pose BOARD inside the solid
+ * SHELF (its type, parent, its solid's children count, its world position).
  * Prints "key values" lines for tests/test_c_client.py. */
 #include <math.h>
 #include <stdio.h>
@@ -25,7 +26,7 @@ int main(void) {
   printf("found");
   name(cam);
   name(tip);
-  name(wb_supervisor_node_get_from_def("SHELF.LID"));
+  name(wb_supervisor_node_get_from_def("SHELF.BOARD.LID"));
   printf("\n");
   printf("parents %s %s %d\n", wb_supervisor_node_get_def(wb_supervisor_node_get_parent_node(cam)),
          wb_supervisor_node_get_def(wb_supervisor_node_get_parent_node(tip)),
@@ -69,6 +70,13 @@ int main(void) {
          wb_supervisor_field_get_sf_float(wb_supervisor_node_get_field(params, "position")));
   const double *m = wb_supervisor_node_get_pose(cam, wb_supervisor_node_get_self());
   printf("in_robot %.12f %.12f %.12f\n", m[3], m[7], m[11]);
+  /* the Pose BOARD inside the top-level solid SHELF: LID's parent, SHELF's only child, at SHELF's pose composed with its own */
+  WbNodeRef board = wb_supervisor_node_get_parent_node(wb_supervisor_node_get_from_def("SHELF.BOARD.LID"));
+  WbNodeRef shelf = wb_supervisor_node_get_from_def("SHELF");
+  const double *b = wb_supervisor_node_get_position(board);
+  printf("board %s %s %d %d %.12f %.12f %.12f\n", wb_supervisor_node_get_type_name(board), wb_supervisor_node_get_def(board),
+         wb_supervisor_node_get_parent_node(board) == shelf,
+         wb_supervisor_field_get_count(wb_supervisor_node_get_field(shelf, "children")), b[0], b[1], b[2]);
   wb_supervisor_field_set_sf_vec3f(wb_supervisor_node_get_field(tip, "translation"), (double[3]){0, 0, 1});
   wb_robot_cleanup();
   return 0;

@@ -13,7 +13,7 @@ robot.step(timestep)
 
 cam = robot.getFromDef("CAM")
 tip = robot.getFromDef("ROVER.ARM.TIP")
-lid = robot.getFromDef("SHELF.LID")
+lid = robot.getFromDef("SHELF.BOARD.LID")
 found = [[n.getTypeName(), n.getDef(), n.getField("name").getSFString()] for n in (cam, tip, lid)]
 parents = [cam.getParentNode().getDef(), robot.getFromDef("ARM").getParentNode().getDef(),
            tip.getParentNode().getDef()]

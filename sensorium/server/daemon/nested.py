@@ -2,7 +2,9 @@
 
 A robot's nodes are its world entry's ``nodes`` (the ``.wbt`` import keeps its Solids, devices,
 Poses, Transforms, Groups, Slots and joints, schemas.world.NestedNode), or one node per device of
-its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth.
+its device list for a robot written without them (a YAML world); a top-level solid's are its ``children`` solids at any depth
+and the Poses, Transforms and Groups inside them (``poses``: numbered after the lights, :func:`_number_poses`; the
+solids, shapes and lights they hold are their children, in file order by ``seq``).
 Both hold their Shapes too, numbered after every other nested node (:func:`_shape_nodes`; their
 fields: appearance.py), then the lights a .wbt world writes in them (``LightNode``: an LED's too; their fields:
 supervisor.py, on the scene's ``carried_light_slots``). They are
@@ -218,6 +220,16 @@ SolidIds = dict[tuple[int, tuple[int, ...]], int]
 """(owner id, :attr:`Nested.path`) -> the nested solid's node id, as :func:`_solid_nodes` numbers them."""
 
 
+PoseIds = dict[tuple[int, int], int]
+"""(the id of the solid holding it, its index in that solid's ``poses``) -> a Pose's or Group's placeholder id (below
+-1) until :func:`_number_poses` numbers them after every other node."""
+
+
+def _pose_parent(holder: int, index: int, pose_ids: PoseIds) -> int:
+    """The parent id of a node of solid ``holder`` held by its ``index``-th Pose or Group (-1: the solid)."""
+    return holder if index < 0 else pose_ids[holder, index]
+
+
 def _solid_holders(s: wm.Solid, holder: int, owner: int, key: str, solid_ids: SolidIds,
                    path: tuple[int, ...] = ()) -> list[Holder]:
     """A top-level solid's shapes (``holder``: its id), then those of the solids inside it, depth first."""
@@ -229,7 +241,7 @@ def _solid_holders(s: wm.Solid, holder: int, owner: int, key: str, solid_ids: So
 
 
 def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, int],
-                 shape_tags: list[tuple[int, wm.InnerDef, int]]) -> list[Nested]:
+                 shape_tags: list[tuple[int, wm.InnerDef, int]], pose_ids: PoseIds | None = None) -> list[Nested]:
     """The Shape nodes of ``holders`` (appearance.py), each followed by the nodes inside it, numbered from id
     ``first``. A robot's shape sits under the node its world entry names (``ShapeNode.parent``: ``starts``
     gives the id of each robot's first entry), a solid's under the solid holding it. A DEF'd appearance,
@@ -272,7 +284,9 @@ def _shape_nodes(sim: Any, holders: list[Holder], first: int, starts: dict[int, 
         node = getattr(shape, "node", None)
         if node is not None and kind == "Robot" and node.parent >= 0 and owner in starts:
             parent = starts[owner] + node.parent
-        order = float("inf") if node is None else node.after + 0.5
+        elif node is not None and kind == "Solid" and pose_ids is not None:
+            parent = _pose_parent(parent, node.parent, pose_ids)
+        order = float("inf") if node is None else node.after + 0.5 if node.seq is None else float(node.seq)
         me = first + len(added)
         added.append(Nested(me, "Shape", "", (node.def_name if node else None) or "", "", parent, "children", None,
                             None, "", owner, kind, key, order=order,
@@ -309,8 +323,9 @@ def _light_node(node_id: int, lt: Any, parent: int, owner: int, kind: str, key: 
     """Light ``lt`` (its ``LightNode``) of a robot or top-level solid (node ``owner``, ``kind`` "Robot" or
     "Solid", ``key`` its name) as node ``node_id`` under node ``parent``, the ``light``-th of its owner's
     lights (the scene's ``carried_light_slots``); ``tags`` gets its PROTO-body DEFs."""
+    order = lt.node.after + 0.5 if lt.node.seq is None else float(lt.node.seq)
     made = Nested(node_id, lt.type, "", lt.def_name or "", "", parent, "children", None, None, "", owner, kind, key,
-                  order=lt.node.after + 0.5, light=light, at=tuple(lt.node.written_at or ()),
+                  order=order, light=light, at=tuple(lt.node.written_at or ()),
                   made=tuple(lt.node.made_at or ()))
     tags.extend((owner, t, node_id) for t in lt.node.inner_defs)
     return made
@@ -333,7 +348,7 @@ def _robot_light_nodes(robot: Any, name: str, owner: int, start: int | None, fir
 
 
 def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidIds, first: int,
-                       tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[Nested]:
+                       tags: list[tuple[int, wm.InnerDef, int | str]], pose_ids: PoseIds) -> list[Nested]:
     """The lights of top-level solid ``solid`` (node ``owner``) and of the solids inside it that are nodes
     (``LightNode``: a .wbt solid's), numbered from ``first``, each under the solid holding it; their indices
     among the solid's lights follow scene.solid_lights (its own, then its children's, depth first); ``tags``
@@ -345,7 +360,8 @@ def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidId
         nonlocal index
         for lt in s.lights:
             if lt.node is not None:
-                out.append(_light_node(first + len(out), lt, holder, owner, "Solid", key, index, tags))
+                parent = _pose_parent(holder, lt.node.parent, pose_ids)
+                out.append(_light_node(first + len(out), lt, parent, owner, "Solid", key, index, tags))
             index += 1
         for k, child in enumerate(s.children):
             walk(child, solid_ids[owner, (*path, k)], (*path, k))
@@ -355,18 +371,23 @@ def _solid_light_nodes(solid: wm.Solid, owner: int, key: str, solid_ids: SolidId
 
 
 def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Nested], solid_ids: SolidIds,
-                 tags: list[tuple[int, wm.InnerDef, int | str]], serials: dict[int, dict[int, int]]) -> None:
+                 tags: list[tuple[int, wm.InnerDef, int | str]], serials: dict[int, dict[int, int]],
+                 posed: list[Nested], pose_ids: PoseIds) -> None:
     """The solids inside top-level solid ``solid`` (node ``owner``, named ``key``) at any depth, appended to
     ``out`` depth first, numbered from ``first`` on (``first + len(out)``), each with its :attr:`Nested.path`;
     ``solid_ids`` gets each one's id by (owner, path), ``tags`` the PROTO-body DEFs, ``serials`` the PROTO
     instances by number."""
 
     def walk(s: wm.Solid, parent: int, at: Pose | None, path: tuple[int, ...]) -> None:
+        frames = _pose_nodes(s, parent, at, owner, key, posed, pose_ids, tags)
         for k, child in enumerate(s.children):
-            own = pose_from_model(child.pose)
-            local = own if at is None else at.compose(own)
-            node = Nested(first + len(out), "Solid", "", child.def_name or "", child.name, parent, "children",
-                          local, own, "", owner, "Solid", key, order=float(k), mass=child.mass,
+            placed = pose_from_model(child.pose)       # in its parent solid's frame
+            own = _own(placed, frames[child.in_pose][0] if child.in_pose >= 0 else None)
+            local = placed if at is None else at.compose(placed)
+            node = Nested(first + len(out), "Solid", "", child.def_name or "", child.name,
+                          _pose_parent(parent, child.in_pose, pose_ids), "children",
+                          local, own, "", owner, "Solid", key, order=float(k if child.seq is None else child.seq),
+                          frame=frames[child.in_pose][1] if child.in_pose >= 0 else -1, mass=child.mass,
                           at=tuple(child.written_at or ()), made=tuple(child.made_at or ()), path=(*path, k))
             out.append(node)
             solid_ids[owner, node.path] = node.id
@@ -377,6 +398,46 @@ def _solid_nodes(solid: wm.Solid, owner: int, key: str, first: int, out: list[Ne
 
     walk(solid, owner, None, ())
     tags.extend((owner, t, t.why) for t in solid.inner_defs if t.why)
+
+
+def _pose_nodes(s: wm.Solid, holder: int, at: Pose | None, owner: int, key: str, posed: list[Nested],
+                pose_ids: PoseIds, tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[tuple[Pose | None, int]]:
+    """The Poses, Transforms and Groups of solid ``s`` (node ``holder``, at ``at`` in its top-level solid's frame;
+    None: it is that solid) appended to ``posed`` with placeholder ids (``pose_ids``); returns each one's frame:
+    (its nearest Pose's pose in ``s``'s frame (None: ``s``'s own), that Pose's id (-1: the solid's))."""
+    frames: list[tuple[Pose | None, int]] = []
+    for i, p in enumerate(s.poses):
+        me = -2 - len(posed)
+        pose_ids[holder, i] = me
+        above, above_id = frames[p.parent] if p.parent >= 0 else (None, -1)
+        placed = None if p.pose is None else pose_from_model(p.pose)
+        local = None if placed is None else placed if at is None else at.compose(placed)
+        posed.append(Nested(me, p.type, "", p.def_name or "", "", _pose_parent(holder, p.parent, pose_ids),
+                            "children", local, _own(placed, above), "", owner, "Solid", key, frame=above_id,
+                            order=float(p.seq), at=tuple(p.written_at or ()), made=tuple(p.made_at or ())))
+        tags.extend((owner, t, me) for t in p.inner_defs)
+        frames.append((placed, me) if placed is not None else (above, above_id))
+    return frames
+
+
+def _number_poses(posed: list[Nested], first: int, out: list[Nested],
+                  tags: list[tuple[int, wm.InnerDef, int | str]]) -> list[Nested]:
+    """The Poses and Groups inside solids numbered from ``first`` on, after every other nested node (no other id
+    moves); the parents, frames and PROTO-body DEF targets in ``out`` and ``tags`` naming their placeholder ids
+    made theirs. Returns the numbered nodes, ``out`` changed in place."""
+    if not posed:
+        return []
+
+    def real(node_id: int) -> int:
+        return first + (-2 - node_id) if node_id < -1 else node_id
+
+    for k, n in enumerate(out):
+        if n.parent < -1 or n.frame < -1:
+            out[k] = dataclasses.replace(n, parent=real(n.parent), frame=real(n.frame))
+    for k, (owner, tag, target) in enumerate(tags):
+        if isinstance(target, int) and target < -1:
+            tags[k] = (owner, tag, real(target))
+    return [dataclasses.replace(n, id=real(n.id), parent=real(n.parent), frame=real(n.frame)) for n in posed]
 
 
 def _index(nodes: list[Nested], by_owner: dict[int, tuple[Nested, ...]],
@@ -423,9 +484,11 @@ def build(sim: Any, loaded_solids: int) -> Table:
                               interface=tuple(e.interface), order=float(k), mass=e.mass,
                               at=tuple(e.written_at or ()), made=tuple(e.made_at or ())))
     solid_ids: SolidIds = {}
+    posed: list[Nested] = []
+    pose_ids: PoseIds = {}
     for j in range(loaded_solids):
         _solid_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], FIRST_ID, out, solid_ids,
-                     tags, serials)
+                     tags, serials, posed, pose_ids)
     parameters, bare = _joint_parameters(sim, robots, out)
     out += parameters
     starts: dict[int, int] = {}       # a robot's node id -> the id of its first world entry
@@ -441,13 +504,14 @@ def build(sim: Any, loaded_solids: int) -> Table:
         owner = len(robots) + 1 + j
         holders += _solid_holders(sim.world.solids[j], owner, owner, sim.scene.solid_names[j], solid_ids)
     shape_tags: list[tuple[int, wm.InnerDef, int]] = []
-    out += _shape_nodes(sim, holders, FIRST_ID + len(out), starts, shape_tags)     # after all others: no other id moves
+    out += _shape_nodes(sim, holders, FIRST_ID + len(out), starts, shape_tags, pose_ids)  # after all others: no other id moves
     tags.extend(shape_tags)
     for i, name in enumerate(robots):          # the lights, after the shapes: no shape's id moves
         out += _robot_light_nodes(sim.robots[name], name, i + 1, starts.get(i + 1), FIRST_ID + len(out), tags)
     for j in range(loaded_solids):
         out += _solid_light_nodes(sim.world.solids[j], len(robots) + 1 + j, sim.scene.solid_names[j], solid_ids,
-                                  FIRST_ID + len(out), tags)
+                                  FIRST_ID + len(out), tags, pose_ids)
+    out += _number_poses(posed, FIRST_ID + len(out), out, tags)      # the solids' Poses and Groups, after the lights
     inner: dict[int, dict[str, int | str]] = {}
     for owner, tag, target in tags:
         if owner in firsts:                # a robot: the instance's entry (a world file's scope past them: none)
@@ -471,12 +535,15 @@ def add_solid(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid) -> 
     solid_ids: SolidIds = {}
     tags: list[tuple[int, wm.InnerDef, int | str]] = []
     serials: dict[int, dict[int, int]] = {}
-    _solid_nodes(solid, owner, key, table.end, out, solid_ids, tags, serials)
+    posed: list[Nested] = []
+    pose_ids: PoseIds = {}
+    _solid_nodes(solid, owner, key, table.end, out, solid_ids, tags, serials, posed, pose_ids)
     shape_tags: list[tuple[int, wm.InnerDef, int]] = []
     out += _shape_nodes(sim, _solid_holders(solid, owner, owner, key, solid_ids), table.end + len(out), {},
-                        shape_tags)
-    out += _solid_light_nodes(solid, owner, key, solid_ids, table.end + len(out), tags)
+                        shape_tags, pose_ids)
+    out += _solid_light_nodes(solid, owner, key, solid_ids, table.end + len(out), tags, pose_ids)
     tags.extend(shape_tags)
+    out += _number_poses(posed, table.end + len(out), out, tags)
     inner = table.inner if table.inner is not None else {}
     for _, tag, target in tags:
         instance = owner if tag.scope < 0 else serials.get(owner, {}).get(tag.scope)
@@ -508,7 +575,7 @@ def drop(table: Table, owner: int) -> None:
 
 
 def drop_shape(table: Table, shape: int) -> None:
-    """A Shape node (or a light) a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
+    """A Shape node (or a light, or a solid's Pose or Group) a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
     getFromProtoDef finds them and their ids read as removed (never given again)."""
     gone = {shape}
     todo = [shape]

@@ -780,6 +780,8 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
     if n.light >= 0:                   # a light inside a robot or solid: as a top-level light's
         return FIELDS[n.type]
     out = dict(_NESTED_POSE) if n.own is not None else {}
+    if n.type == "Transform" and n.owner_kind == "Solid":      # (a scaled one inside a solid is no node here)
+        out["scale"] = ("SFVec3f", lambda sim, node: [1.0, 1.0, 1.0], None)
     if n.name:
         out["name"] = ("SFString", lambda sim, node: node.name, None)
     if nested.has_children(n):
@@ -1546,6 +1548,9 @@ def remove_node(sim: Any, node: Node) -> None:
         sim.scene.remove_carried_light(*_carrier(sim, node))
         nested.drop_shape(_table(sim), node.id)
         return
+    if node.nested and node.type in _SOLID_POSES and _nested_of(sim, node).owner_kind == "Solid":
+        _remove_solid_pose(sim, node)
+        return
     if node.nested:
         raise ValueError(f"{node.type} {node.name or node.def_name or node.id!r} (node {node.id}) cannot be removed "
                          "here: only top-level solids and lights and the Shapes inside robots and solids can, not "
@@ -1559,6 +1564,42 @@ def remove_node(sim: Any, node: Node) -> None:
                          "solids and lights can (a departure from Webots, which removes robots too)")
     else:
         raise ValueError("the root node cannot be removed")
+
+
+_SOLID_POSES = frozenset({"Pose", "Transform", "Group"})
+
+
+def _remove_solid_pose(sim: Any, node: Node) -> None:
+    """A Pose, Transform or Group inside a top-level solid removed with what it holds, as Webots removes a subtree:
+    its Shapes unseen and its lights unlit from the next measurement, their nodes read as removed. One holding a
+    solid is refused (a nested solid's contact, radar and recognition parts stay with its top-level solid here),
+    as is one a PROTO's body writes (Webots' line)."""
+    table = _table(sim)
+    n = _nested_of(sim, node)
+    if not n.at:             # (Webots names it by its usefulName: "DEF <its body's DEF> <type>")
+        defs = sorted({k for found in (table.inner or {}).values() for k, v in found.items() if v == n.id})
+        name = f"DEF {defs[0]} {n.type}" if defs else n.type
+        raise ValueError(f"Node '{name}' is internal to a PROTO and therefore cannot be deleted from a Supervisor.")
+    inside: list[nested.Nested] = []
+    todo = [n.id]
+    while todo:
+        for c in table.by_parent.get(todo.pop(), ()):
+            inside.append(c)
+            todo.append(c.id)
+    held = next((c for c in inside if c.type == "Solid" and c.shape is None), None)
+    if held is not None:
+        raise ValueError(f"{_what(node)} cannot be removed here: it holds Solid {held.name!r} (node {held.id}), and "
+                         "only the Shapes and lights inside a solid's Poses and Groups leave with them; remove the "
+                         "top-level solid instead")
+    shapes: set[int] = set()
+    for c in inside:
+        if c.shape is not None and c.shape.role == "Shape":
+            shapes.update(c.shape.peers or (c.shape.index,))
+        elif c.light >= 0:
+            sim.scene.remove_carried_light(*_carrier(sim, _nested_node(c)))
+    if shapes:
+        sim.scene.remove_shapes(sorted(shapes))
+    nested.drop_shape(table, n.id)
 
 
 def _remove(sim: Any, ls: Any, robot: str, a: Any) -> dict:

@@ -237,7 +237,8 @@ def _unserved_why(kind: str) -> str:
     if kind in ("JointParameters", "HingeJointParameters"):
         return f"a {kind} node: read through its joint's 'jointParameters' field here"
     return (f"a {kind} node, which Sensorium does not serve as a Supervisor node there (it serves the solids, "
-            "devices, joints, Poses and Groups of robots, the solids inside top-level solids and visible shapes)")
+            "devices, joints, Poses and Groups of robots, the solids, Poses and Groups inside top-level solids and "
+            "visible shapes)")
 
 
 class Converter:
@@ -293,6 +294,11 @@ class Converter:
         self.top_names_read = False
         self.inner_owner: dict | None = None
         self.scope_serial = 0
+        # the Poses, Transforms and Groups inside solids (schemas.world.SolidPose): the one being walked in each
+        # solid (id of its data -> its index in the solid's `poses`), and a counter giving what a solid holds its
+        # file order among its parent's children (`seq`)
+        self.pose_at: dict[int, int] = {}
+        self.node_seq = 0
         self.lights_seen = 0               # lights on, or an LED's, anywhere (the world's, solids', robots')
         self.image_lit = False             # a TexturedBackground or a Background with cube maps (Webots' IBL)
 
@@ -782,8 +788,12 @@ class Converter:
                                 "are kept as a solid")
                 self.solid(node, frame, owner, OTHER_NAMES.get(t, t.lower()))
         elif t == "Group":
-            for child in f.nodes("children"):
-                self.visit(child, frame, owner)
+            mark = self.solid_pose(node, frame, owner)
+            try:
+                for child in f.nodes("children"):
+                    self.visit(child, frame, owner)
+            finally:
+                self.end_solid_pose(owner, mark)
         elif t == "Propeller":           # a robot's motor (listed: controllers ask for it) and its helix
             if owner.kind == "robot":
                 self.joint_devices(node, owner)
@@ -804,8 +814,12 @@ class Converter:
             self.solid(node, frame, owner, node.def_name, bounding=False)
         elif t in ("Pose", "Transform"):
             inner = self.child_frame(node, frame)
-            for child in f.nodes("children"):
-                self.visit(child, inner, owner)
+            mark = self.solid_pose(node, inner, owner)
+            try:
+                for child in f.nodes("children"):
+                    self.visit(child, inner, owner)
+            finally:
+                self.end_solid_pose(owner, mark)
         elif t == "TrackWheel":          # a Pose at (position.x, 0, position.y) in its Track's frame (Webots)
             px, py = f.vec("position", (0.0, 0.0))
             inner = frame.then((px, 0.0, py), (0.0, 0.0, 1.0, 0.0), (1.0, 1.0, 1.0))
@@ -855,6 +869,66 @@ class Converter:
                 why = (f"{t}: not a built-in node or PROTO here; skipped (with everything inside it). "
                        f"Built-in PROTOs: {', '.join(sorted(BUILTIN_PROTOS))}")
             self.drop(node, why, "robot" if robot_like else "node", named if isinstance(named, str) else t)
+
+    # ------------------------------------------------------------ the Poses and Groups a Supervisor walks in a solid
+    def solid_pose(self, node: Node, inner: Frame, owner: Owner) -> int | None:
+        """Record a Pose, Transform or Group inside a solid (``inner``: its frame there; a Group's is its
+        parent's) as the Supervisor node it is (schemas.world.SolidPose) and make it the parent of what is
+        walked inside it; returns the parent to restore (None: not recorded: outside a solid, or under a
+        scaled Transform, whose fields no longer map to its place rigidly)."""
+        if owner.kind != "solid" or not inner.rigid:
+            return None
+        poses = owner.data.setdefault("poses", [])
+        above = self.pose_at.get(id(owner.data), -1)
+        entry: dict[str, Any] = {"type": node.type, "seq": self.next_seq()}
+        if above >= 0:
+            entry["parent"] = above
+        if node.type != "Group":
+            entry["pose"] = inner.pose()
+        if self.nested_def(node):
+            entry["def_name"] = node.def_name
+        tags = self.inner_defs(node)
+        if tags:
+            entry["inner_defs"] = tags[:64]
+        self.written_at(node, entry)
+        poses.append(entry)
+        self.pose_at[id(owner.data)] = len(poses) - 1
+        return above
+
+    def end_solid_pose(self, owner: Owner, mark: int | None) -> None:
+        if mark is not None:
+            self.pose_at[id(owner.data)] = mark
+
+    def next_seq(self) -> int:
+        self.node_seq += 1
+        return self.node_seq
+
+    def in_solid_pose(self, owner: Owner, entry: dict, key: str = "parent") -> None:
+        """A node inside a solid (a nested solid, a Shape, a light): the Pose or Group of the solid holding
+        it (``parent``, as ``key``) and its file order there (``seq``)."""
+        if owner.kind != "solid":
+            return
+        above = self.pose_at.get(id(owner.data), -1)
+        if above >= 0:
+            entry[key] = above
+        entry["seq"] = self.next_seq()
+
+    @staticmethod
+    def drop_seq(solid: dict) -> bool:
+        """Leave out the file order of a top-level solid's nodes when no Pose or Group is among them (the
+        solids', shapes' and lights' other fields order them then); True when one is."""
+        stack, posed, held = [solid], False, []
+        while stack:
+            s = stack.pop()
+            posed = posed or bool(s.get("poses"))
+            held += [p["node"] for p in s.get("shapes", ()) if isinstance(p.get("node"), dict)]
+            held += [lt["node"] for lt in s.get("lights", ()) if isinstance(lt.get("node"), dict)]
+            held += s.get("children", [])
+            stack += s.get("children", [])
+        if not posed:
+            for entry in held:
+                entry.pop("seq", None)
+        return posed
 
     def billboard(self, node: Node) -> None:
         """A Billboard: Webots pins its children to the 3D view's viewpoint, and no Camera sees them nor
@@ -1086,6 +1160,7 @@ class Converter:
             out["after"] = len(self.tree) - 1
         elif owner.kind != "robot":
             out["after"] = len(owner.data.get("children", ())) - 1
+            self.in_solid_pose(owner, out)
         return out
 
     def cad_shape(self, node: Node, frame: Frame, owner: Owner) -> None:
@@ -1439,6 +1514,7 @@ class Converter:
             entry["after"] = len(self.tree) - 1
         else:
             entry["after"] = len(owner.data.get("children", ())) - 1
+            self.in_solid_pose(owner, entry)
         tags = self.inner_defs(node)
         if tags:
             entry["inner_defs"] = tags[:64]
@@ -1499,6 +1575,7 @@ class Converter:
         elif self.nested_def(node):     # a nested solid: found by DEF (a Supervisor walks it)
             data["def_name"] = node.def_name
         if owner.kind == "solid":       # inside a top-level solid: a node a Supervisor walks
+            self.in_solid_pose(owner, data, "in_pose")
             tags = self.inner_defs(node)
             if tags:
                 data["inner_defs"] = tags[:64]
@@ -1538,6 +1615,7 @@ class Converter:
         out = self.solid_dict(mine, data)
         out["_at"] = self.at(node)
         if owner.kind == "world":
+            self.drop_seq(out)
             self.world["solids"].append(out)
         else:
             owner.data.setdefault("children", []).append(out)
