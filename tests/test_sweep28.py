@@ -240,3 +240,55 @@ def test_the_display_controllers_frame_the_yellow_box_and_trace_the_robot_by_the
         assert min(box_distance(at), 0.5 - abs(float(at[0])), 0.5 - abs(float(at[1]))) > 0.15 + 0.047, k
     draw(ground, ["copy", 1, 0, 0, GROUND, GROUND])
     assert (ground.images[1] == want).all()
+
+
+def floor_texels(at: np.ndarray, rows: range) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """For MyBot at ``at`` (heading BOT_YAW), each camera pixel of ``rows`` whose centre's ray meets the
+    floor: (row, column, the ground display's texel column and row under the hit, how far the hit is from
+    a texel's edge in texels). The ground display's Plane (1 m, the supervisor robot turned −π/2) maps
+    world (x, y) to texel (⌊(0.5 − y)·64⌋, ⌊(0.5 − x)·64⌋): display_supervisor.c's own formula."""
+    c, s = math.cos(BOT_YAW), math.sin(BOT_YAW)
+    j, i = np.meshgrid(np.arange(rows.start, rows.stop), np.arange(256), indexing="ij")
+    left, up = (128 - (i + 0.5)) / FOCAL, (64 - (j + 0.5)) / FOCAL
+    t = 0.0915 / -up
+    x = at[0] + 0.04 * c + t * (c - left * s)
+    y = at[1] + 0.04 * s + t * (s + left * c)
+    u, v = (0.5 - y) * GROUND, (0.5 - x) * GROUND
+    edge = np.minimum(np.abs(u - np.round(u)), np.abs(v - np.round(v)))
+    return j.ravel(), i.ravel(), np.floor(u).astype(int).ravel(), np.floor(v).astype(int).ravel(), edge.ravel()
+
+
+def test_a_camera_sees_the_ground_display_drawn_on_its_screen_shape() -> None:
+    """The ground display's first child is a Shape whose PBRAppearance has a baseColorMap (an ImageTexture
+    without url, as the sample's emoticon screen has): Webots replaces that texture with the display's
+    image, so MyBot's camera sees on the floor what the supervisor draws. Black before anything is drawn
+    (Webots' new display), then the grey with its red axis: each floor pixel of the camera (rows 96 to 127,
+    their centres' rays meeting the floor 0.37 to 0.66 m ahead) shows the texel under its ray's hit, the
+    closed form (the rays within 0.05 texel of a texel's edge, and the yellow box's pixels, left out): red
+    exactly where that texel is column 32, the axis, grey elsewhere, every grey pixel the same shade."""
+    w = load_world(DATA / "display.wbt")
+    (ground_cfg,) = [d for d in w.world.robots[1].devices if d.name == "ground_display"]
+    (emoticons,) = [d for d in w.world.robots[0].devices if d.name == "emoticon_display"]
+    assert ground_cfg.screen_shape == 0 and emoticons.screen_shape is not None
+    assert [d.screen_shape for d in w.world.robots[0].devices if d.name == "camera_display"] == [None]
+    sim = Simulation(w, "exact")
+    cam, ground = sim.device("MyBot/camera"), sim.device("supervisor/ground_display")
+    cam.enable(32)
+    sim.step()
+    rows = range(96, 128)
+    j, i, col, row, edge = floor_texels(BOT0, rows)
+    image = np.asarray(cam.image)[..., :3].astype(int)          # B, G, R
+    seen = image[j, i]
+    yellow = (seen[:, 2] > 80) & (seen[:, 1] > 80) & (seen[:, 0] < 40)
+    on_floor = (np.abs(col - 31.5) < 32) & (np.abs(row - 31.5) < 32) & ~yellow & (edge > 0.05)
+    assert on_floor.sum() > 4000
+    assert (seen[on_floor] == 0).all()                          # a new display is black
+    draw(ground, ["color", LIGHT_GRAY], ["rectangle", 0, 0, GROUND, GROUND, True], ["color", RED],
+         ["line", GROUND // 2, 0, GROUND // 2, GROUND - 1])
+    sim.step()
+    seen = np.asarray(cam.image)[..., :3].astype(int)[j, i]
+    red = seen[:, 2] > seen[:, 1] + 40
+    assert (red[on_floor] == (col[on_floor] == GROUND // 2)).all()
+    assert red[on_floor].sum() > 20
+    grey = seen[on_floor & ~red]
+    assert (grey == grey[0]).all() and grey[0][0] == grey[0][1] == grey[0][2] > 0
