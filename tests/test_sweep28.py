@@ -35,7 +35,7 @@ def test_the_muscle_robots_load_with_their_motors_and_sensors_and_stand_where_th
     Muscle nodes, which Webots draws and stretches with the joint, are no device and need no line. No
     robot has wheels, so each keeps the world's pose: hinge2's base box (its bottom 0.04 m below the origin
     at z 0.035) stays 5 mm into the floor, where Webots' physics would push it out (only wheels settle a
-    robot: [Settling](#settling))."""
+    robot: README "Settling on the ground")."""
     w = load_world(DATA / "muscle.wbt")
     assert len(w.warnings) == 4
     assert sum("motor 'muscle'" in x and "moves kinematically" in x for x in w.warnings) == 3
@@ -265,7 +265,8 @@ def test_a_camera_sees_the_ground_display_drawn_on_its_screen_shape() -> None:
     (Webots' new display), then the grey with its red axis: each floor pixel of the camera (rows 96 to 127,
     their centres' rays meeting the floor 0.37 to 0.66 m ahead) shows the texel under its ray's hit, the
     closed form (the rays within 0.05 texel of a texel's edge, and the yellow box's pixels, left out): red
-    exactly where that texel is column 32, the axis, grey elsewhere, every grey pixel the same shade."""
+    exactly where that texel is column 32, the axis, grey elsewhere, every grey pixel the same shade; after a
+    simulation reset the display and the floor are black again."""
     w = load_world(DATA / "display.wbt")
     (ground_cfg,) = [d for d in w.world.robots[1].devices if d.name == "ground_display"]
     (emoticons,) = [d for d in w.world.robots[0].devices if d.name == "emoticon_display"]
@@ -292,3 +293,8 @@ def test_a_camera_sees_the_ground_display_drawn_on_its_screen_shape() -> None:
     assert red[on_floor].sum() > 20
     grey = seen[on_floor & ~red]
     assert (grey == grey[0]).all() and grey[0][0] == grey[0][1] == grey[0][2] > 0
+    # a simulation reset makes the display black again (WbDisplay's reset), and so its screen
+    sim.reset()
+    cam.enable(32)
+    sim.step()
+    assert (np.asarray(cam.image)[..., :3].astype(int)[j, i][on_floor] == 0).all()
