@@ -5,14 +5,18 @@ left out) driven in process by the calls its controllers make and checked agains
 from __future__ import annotations
 
 import math
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 from test_display import midpoint_oval
 from test_supervisor import A, Live
+from test_sweep18 import REPO
+from test_sweep18 import clib as built_library  # noqa: F401 - a fixture: our libController, built once
 from test_sweep19 import KinematicMotor
 
+from sensorium.client import wb
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 
@@ -298,3 +302,130 @@ def test_a_camera_sees_the_ground_display_drawn_on_its_screen_shape() -> None:
     cam.enable(32)
     sim.step()
     assert (np.asarray(cam.image)[..., :3].astype(int)[j, i][on_floor] == 0).all()
+
+
+# ------------------------------------------------------------------------------------------ gps_lat_long
+# gps_lat_long (projects/samples/devices, R2023b): a WGS84 world (gpsReference 40.67 −73.94 10); MyBot at
+# (0, −0.15) heading 1 rad runs `gps_lat_long` (64 ms): GPS latitude, longitude, altitude and speed printed
+# each step (degrees also as text), wheels at 6 rad/s (0.15 m/s) until ds1 passes 500, then it turns.
+WGS_A, WGS_F = 6378137.0, 1 / 298.257223563
+GPS_REF = (40.67, -73.94, 10.0)
+
+
+def utm_convergence_and_scale() -> tuple[float, float]:
+    """The grid convergence γ and point scale k of UTM zone 18 (central meridian 75° W) at the reference
+    (the first terms of their series: γ = atan(tan Δλ · sin φ), k = 0.9996 (1 + (Δλ cos φ)²/2))."""
+    phi, dlam = math.radians(GPS_REF[0]), math.radians(GPS_REF[1] + 75.0)
+    return math.atan(math.tan(dlam) * math.sin(phi)), 0.9996 * (1 + (dlam * math.cos(phi)) ** 2 / 2)
+
+
+def ground_step(lat0: float, lon0: float, lat1: float, lon1: float) -> tuple[float, float]:
+    """The ground displacement between two nearby WGS84 points as (length m, direction from east rad):
+    the ellipsoid's meridian and prime-vertical radii of curvature at the reference."""
+    e2 = WGS_F * (2 - WGS_F)
+    s2 = math.sin(math.radians(GPS_REF[0])) ** 2
+    m, n = WGS_A * (1 - e2) / (1 - e2 * s2) ** 1.5, WGS_A / math.sqrt(1 - e2 * s2)
+    north = math.radians(lat1 - lat0) * m
+    east = math.radians(lon1 - lon0) * n * math.cos(math.radians(GPS_REF[0]))
+    return math.hypot(north, east), math.atan2(north, east)
+
+
+def test_gps_lat_long_reads_the_wgs84_track_of_the_robot_and_prints_it_as_webots_does() -> None:
+    """gps_lat_long.c's calls in process: the GPS says WGS84; the robot drives straight at 0.15 m/s along its
+    heading of 1 rad (its pose the closed form's, 1e-12) while ds1 reads under 500 (ds0 sees nothing: 0), 18
+    steps; the altitude is the reference's 10 m (the GPS at the floor), the speed NaN at the first sample,
+    then 0.15 m/s (1e-12); each 64 ms the latitude and longitude move by a ground step of 0.0096 m scaled by
+    UTM's 1/k (1.000301: the reference's zone series, 1e-5) and turned by its grid convergence γ (0.012058
+    rad: the track's true direction 1 − γ from east, 1e-6). At the 19th step ds1 passes 500 and the robot
+    turns on the spot's arc the controller asks (wheels −ds1/100 and 0.5 rad/s): the next GPS speed is that
+    arc's chord over 64 ms (1e-12). Its texts are libController's: "40° 40′ 11″" and "-73° -56′ -24″" at the
+    start, "-73° -56′ -23″" once it moved 2 mm east of 73.94° W's 23.99…″ (whole seconds, truncated)."""
+    w = load_world(DATA / "gps_lat_long.wbt")
+    assert w.warnings == []
+    sim = Simulation(w, "exact")
+    bot, gps = sim.robot("MyBot"), sim.device("MyBot/gps")
+    ds = [sim.device("MyBot/ds0"), sim.device("MyBot/ds1")]
+    for d in (gps, *ds):
+        d.enable(64)
+    assert gps.coordinate_system == 1                       # WB_GPS_WGS84_COORDINATE
+    for m in ("left wheel motor", "right wheel motor"):
+        bot.motor(m).set_position(math.inf)
+        bot.motor(m).set_velocity(0.0)
+    gamma, k = utm_convergence_and_scale()
+    text = wb.wb_gps_convert_to_degrees_minutes_seconds
+    heading = np.array([math.cos(1.0), math.sin(1.0)])
+    last = None
+    left = right = 0.0
+    for step in range(1, 21):
+        sim.step()
+        sim.step()
+        t = sim.time_ms / 1000.0
+        lat, lon, alt = (float(v) for v in gps.values)
+        assert alt == pytest.approx(GPS_REF[2], abs=1e-9), step
+        d0, d1 = ds[0].value, ds[1].value
+        if step == 1:
+            assert math.isnan(gps.speed)
+            assert (text(lat), text(lon)) == ("40\u00b0 40\u2032 11\u2033", "-73\u00b0 -56\u2032 -24\u2033")
+        elif step < 20:
+            assert list(bot.pose.translation[:2]) == pytest.approx(
+                list(np.array([0.0, -0.15]) + 0.15 * (t - 0.064) * heading), abs=1e-12), step
+            assert gps.speed == pytest.approx(0.15, abs=1e-12), step
+            length, direction = ground_step(*last, lat, lon)
+            assert length == pytest.approx(0.15 * 0.064 / k, rel=1e-5), step
+            assert direction == pytest.approx(1.0 - gamma, abs=1e-6), step
+            assert text(lon) == "-73\u00b0 -56\u2032 -23\u2033"
+        else:                                               # the arc asked at step 19, over 64 ms
+            v, omega = (left + right) / 2 * 0.025, (right - left) * 0.025 / 0.09
+            half = omega * 0.064 / 2
+            assert gps.speed == pytest.approx(abs(v) * math.sin(half) / half, abs=1e-12)
+        assert d0 == pytest.approx(0.0, abs=1e-12), step
+        if step < 19:
+            assert d1 <= 500, step
+            left = right = 6.0
+        elif step == 19:
+            assert d1 > 500
+            left, right = -d1 / 100, d0 / 100 + 0.5
+        if step < 20:
+            bot.motor("left wheel motor").set_velocity(left)
+            bot.motor("right wheel motor").set_velocity(right)
+        last = (lat, lon)
+
+
+DMS_PROGRAM = r"""
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <webots/gps.h>
+int main(void) {
+  const double values[] = {40.66999864942021, -73.94000002138547, -73.93999995887448, 46.5202, -1.5, NAN};
+  for (int i = 0; i < 6; i++) {
+    const char *text = wb_gps_convert_to_degrees_minutes_seconds(values[i]);
+    printf("%s\n", text);
+    free((void *)text);     /* as gps_lat_long.c does: the string is the caller's */
+  }
+  return 0;
+}
+"""
+
+
+@pytest.mark.slow
+def test_the_c_librarys_degrees_minutes_seconds_text_is_webots_and_the_caller_frees_it(tmp_path: Path,
+                                                                                      request) -> None:
+    """gps_lat_long.c prints wb_gps_convert_to_degrees_minutes_seconds' text and frees it: built against our
+    libController, it prints Webots' whole seconds ("%d° %d′ %d″" of C's (int)s) and the frees pass (the
+    string was a static buffer, which free() aborts on); the Python client's text is the same."""
+    build, libs = request.getfixturevalue("built_library")
+    source = tmp_path / "dms.c"
+    source.write_text(DMS_PROGRAM)
+    made = subprocess.run(["cc", f"-I{REPO / 'sensorium' / 'client' / 'c' / 'include'}", str(source), "-o",
+                           str(tmp_path / "dms"), str(build / "libController.a"), *libs, "-lm"],
+                          capture_output=True, text=True, timeout=120)
+    assert made.returncode == 0, made.stderr
+    ran = subprocess.run([str(tmp_path / "dms")], capture_output=True, text=True, timeout=30)
+    assert ran.returncode == 0, ran.stderr
+    want = ["40\u00b0 40\u2032 11\u2033", "-73\u00b0 -56\u2032 -24\u2033", "-73\u00b0 -56\u2032 -23\u2033",
+            "46\u00b0 31\u2032 12\u2033", "-1\u00b0 -30\u2032 0\u2033",
+            "-2147483648\u00b0 -2147483648\u2032 -2147483648\u2033"]
+    assert ran.stdout.splitlines() == want
+    assert [wb.wb_gps_convert_to_degrees_minutes_seconds(v) for v in
+            (40.66999864942021, -73.94000002138547, -73.93999995887448, 46.5202, -1.5, math.nan)] == want
