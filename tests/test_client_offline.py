@@ -647,7 +647,7 @@ def test_gps_degrees_minutes_seconds_text_as_the_c_library_also_for_nan():
     convert = wb.wb_gps_convert_to_degrees_minutes_seconds
     assert convert(46.5202) == "46\u00b0 31\u2032 12\u2033"             # 31.212′: 12.72″ truncated
     assert convert(-1.5) == "-1\u00b0 -30\u2032 0\u2033"
-    assert convert(-73.94) == "-73\u00b0 -56\u2032 -23\u2033"     # −0.94 is −0.9399999999999977: 23.99…″
+    assert convert(-73.94) == "-73\u00b0 -56\u2032 -23\u2033"     # −73.94 + 73 is −0.9399999999999977: 23.99…″
     indefinite = "-2147483648"
     assert convert(math.nan) == f"{indefinite}\u00b0 {indefinite}\u2032 {indefinite}\u2033"
     assert convert(math.inf) == f"{indefinite}\u00b0 {indefinite}\u2032 {indefinite}\u2033"
