@@ -641,13 +641,16 @@ def test_motor_class(server, monkeypatch, capsys):
 
 
 def test_gps_degrees_minutes_seconds_text_as_the_c_library_also_for_nan():
-    """The C library's text (libController's sprintf of truncated degrees and minutes); a GPS value
-    before its first sample is NaN and must not raise (math.trunc does): the C text again."""
+    """libController's text, "%d° %d′ %d″" of C's (int) of the degrees, minutes and seconds (each
+    truncated toward zero); a GPS value before its first sample is NaN and must not raise: C's (int)
+    of it on x86-64 is INT_MIN, and so for infinities."""
     convert = wb.wb_gps_convert_to_degrees_minutes_seconds
-    assert convert(46.5202) == "46\u00b0 31\u2032 12.72\u2033"
-    assert convert(-1.5) == "-1\u00b0 -30\u2032 0.00\u2033"
-    assert convert(math.nan) == "nan\u00b0 nan\u2032 nan\u2033"
-    assert convert(math.inf) == "inf\u00b0 -nan\u2032 -nan\u2033"          # glibc prints the NaN's sign
+    assert convert(46.5202) == "46\u00b0 31\u2032 12\u2033"             # 31.212′: 12.72″ truncated
+    assert convert(-1.5) == "-1\u00b0 -30\u2032 0\u2033"
+    assert convert(-73.94) == "-73\u00b0 -56\u2032 -23\u2033"     # −73.94 + 73 is −0.9399999999999977: 23.99…″
+    indefinite = "-2147483648"
+    assert convert(math.nan) == f"{indefinite}\u00b0 {indefinite}\u2032 {indefinite}\u2033"
+    assert convert(math.inf) == f"{indefinite}\u00b0 {indefinite}\u2032 {indefinite}\u2033"
 
 
 def test_numpy_scalars_are_numbers_as_in_webots(server, monkeypatch):

@@ -69,25 +69,20 @@ def wb_gps_get_coordinate_system(tag: int) -> int:
 
 
 def wb_gps_convert_to_degrees_minutes_seconds(decimal_degrees: float) -> str:
-    """Whole degrees, whole minutes and seconds (2 decimals), each with the angle's sign (the C
-    library's text, also for NaN, a GPS value before its first sample, and infinities)."""
-    decimal_degrees = float(decimal_degrees)
-    degrees = math.copysign(_trunc(decimal_degrees), decimal_degrees)       # C's trunc keeps -0
-    minutes = math.copysign(_trunc((decimal_degrees - degrees) * 60.0), decimal_degrees - degrees)
-    seconds = (decimal_degrees - degrees - minutes / 60.0) * 3600.0
-    return f"{_printf(degrees, 0)}\u00b0 {_printf(minutes, 0)}\u2032 {_printf(seconds, 2)}\u2033"
+    """libController's text: whole degrees, minutes and seconds, each C's ``(int)`` of its double
+    (truncated toward zero, so each carries the angle's sign; NaN, a GPS value before its first
+    sample, and infinities give INT_MIN, as x86-64 converts them)."""
+    d = float(decimal_degrees)
+    degrees = _c_int(d)
+    minutes = _c_int((d - degrees) * 60)
+    seconds = _c_int(((d - degrees) * 60 - minutes) * 60)
+    return f"{degrees}\u00b0 {minutes}\u2032 {seconds}\u2033"
 
 
-def _trunc(v: float) -> float:
-    """C's ``trunc``: NaN and infinities pass through (``math.trunc`` raises on them)."""
-    return float(math.trunc(v)) if math.isfinite(v) else v
-
-
-def _printf(v: float, decimals: int) -> str:
-    """C's ``%.Nf``: glibc writes a NaN's sign ("-nan"), Python's format does not."""
-    if math.isnan(v):
-        return "-nan" if math.copysign(1.0, v) < 0 else "nan"
-    return f"{v:.{decimals}f}"
+def _c_int(v: float) -> int:
+    """C's ``(int)`` of a double on x86-64: truncated toward zero; INT_MIN for NaN, infinities and
+    values out of int's range (undefined in C, the processor's "integer indefinite")."""
+    return int(v) if -2147483649.0 < v < 2147483648.0 else -(1 << 31)
 
 
 # ---------------------------------------------------------------------- InertialUnit

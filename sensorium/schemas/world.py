@@ -1420,6 +1420,9 @@ class Display(_Device):
     device: Literal["Display"]
     width: int = Field(default=64, ge=1, le=1 << 16, description="pixels (wb_display_get_width)")
     height: int = Field(default=64, ge=1, le=1 << 16, description="pixels (wb_display_get_height)")
+    screen_shape: int | None = Field(default=None, ge=0, description=(
+        "the robot's shape (index in its shapes) whose ImageTexture shows the display's image, as Webots "
+        "replaces the texture of the Shape its Display's first child is or holds; None: no such shape"))
 
 
 class VacuumGripper(_Device):

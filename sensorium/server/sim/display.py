@@ -669,3 +669,14 @@ def _over_camera(display: np.ndarray, camera: np.ndarray) -> np.ndarray:
     for shift in (16, 8, 0):
         out |= (((0xFF - a) * ((camera >> shift) & 0xFF) + a * ((display >> shift) & 0xFF)) // 0xFF) << shift
     return out
+
+
+def screen_image(pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray | None, bool]:
+    """A display's pixels (0xAARRGGBB) as a decoded texture image (world/textures.Decoded): RGB rows top
+    first, its alpha when a pixel is not opaque (a camera sees through it), else None."""
+    p = np.asarray(pixels, dtype=np.uint32)
+    rgb = np.stack([(p >> 16) & 0xFF, (p >> 8) & 0xFF, p & 0xFF], axis=-1).astype(np.uint8)
+    a = (p >> 24).astype(np.uint8)
+    alpha = a if (a != 0xFF).any() else None
+    return rgb, alpha, alpha is not None
+

@@ -32,6 +32,7 @@ from sensorium.server.sim.belt import Belts
 from sensorium.server.sim.cameras import Camera
 from sensorium.server.sim.connector import Connector, SolidConnector, solid_connectors
 from sensorium.server.sim.contact import Contact
+from sensorium.server.sim.display import screen_image
 from sensorium.server.sim.falling import Falls
 from sensorium.server.sim.ground import (
     Ground,
@@ -426,6 +427,7 @@ class Simulation:
         if self.ground is not None:
             self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
+        self._screens = self._display_screens()
         self._speakers = [d for d in self.all_devices() if isinstance(d, Speaker)]
         self._grippers = [d for d in self.all_devices() if isinstance(d, VacuumGripper)]
         connectors = [d for d in self.all_devices() if isinstance(d, Connector)]
@@ -858,6 +860,40 @@ class Simulation:
         return out
 
     # ------------------------------------------------------------------ stepping
+    def _display_screens(self) -> list[list[Any]]:
+        """[display, scene shape, the display's measurements last shown] for each Display whose screen
+        shape (``screen_shape``: the Shape with an ImageTexture its first child is or holds) is in the
+        scene: Webots shows the display's image as that shape's texture, which cameras see."""
+        out = []
+        for robot in self.robots.values():
+            for dev in robot.devices.values():
+                k = getattr(dev.config, "screen_shape", None) if dev.kind == "Display" else None
+                if k is None or k >= len(robot.model.shapes):
+                    continue
+                model = robot.model.shapes[k]
+                shape = next((i for i in range(len(self.scene.shapes)) if self.scene.shape_model(i) is model), None)
+                if shape is not None and model.appearance is not None:
+                    out.append([dev, shape, -1])
+        return out
+
+    def _show_screens(self) -> None:
+        """Each display changed since it was last shown becomes its screen shape's texture (base and,
+        when the appearance has one, emissive map), from this step's measurements on."""
+        for entry in self._screens:
+            dev, shape, shown = entry
+            if dev.measurements == shown:
+                continue
+            entry[2] = dev.measurements
+            app = self.scene.shape_model(shape).appearance
+            if app is None:           # (a Supervisor took its appearance away: nothing to show it on)
+                continue
+            url = f"display:{dev.robot_name}/{dev.name}"
+            texture = wm.Texture(url=url, filtering=0)
+            update: dict[str, Any] = {"texture": texture}
+            if app.emissive_map is not None:
+                update["emissive_map"] = texture
+            self.scene.set_texture(shape, app.model_copy(update=update), {url: (Path(url), screen_image(dev.pixels))})
+
     def step(self) -> StepReport:
         """Advance one basic time step and measure every due device at the end-of-step pose."""
         self.time_ms += self.basic_time_step
@@ -875,6 +911,8 @@ class Simulation:
         if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
+        if self._screens:             # what displays drew (with the step request) shows on their screens
+            self._show_screens()
         for speaker in self._speakers:     # sounds and speech played for this step (sim/speaker.py)
             speaker.advance(dt, now)
         moved: list[tuple[RobotState, DifferentialDrive | AckermannDrive | MecanumDrive | OmniDrive | SteeredDrive,

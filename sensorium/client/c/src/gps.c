@@ -1,7 +1,9 @@
 /* Sensorium C controller library: GPS. Position, speed and speed vector arrive with the step reply
  * (NaN before the first measurement); the coordinate system comes from the attach description. */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #include <webots/gps.h>
 
@@ -35,12 +37,20 @@ WbGpsCoordinateSystem wb_gps_get_coordinate_system(WbDeviceTag tag) {
   return d && d->coordinate_system == 1 ? WB_GPS_WGS84_COORDINATE : WB_GPS_LOCAL_COORDINATE;
 }
 
+/* C's (int) of a double as x86-64 converts it: truncated toward zero, and INT_MIN (the "integer
+ * indefinite") for NaN, infinities and values out of int's range, which C leaves undefined. */
+static int c_int(double v) {
+  return v > -2147483649.0 && v < 2147483648.0 ? (int)v : INT_MIN;
+}
+
 const char *wb_gps_convert_to_degrees_minutes_seconds(double decimal_degrees) {
-  /* whole degrees, whole minutes and seconds, each carrying the sign of the angle */
-  static char text[64];
-  double degrees = trunc(decimal_degrees);
-  double minutes = trunc((decimal_degrees - degrees) * 60.0);
-  double seconds = (decimal_degrees - degrees - minutes / 60.0) * 3600.0;
-  snprintf(text, sizeof text, "%.0f\xc2\xb0 %.0f\xe2\x80\xb2 %.2f\xe2\x80\xb3", degrees, minutes, seconds);
+  /* libController's text: whole degrees, minutes and seconds, each truncated toward zero (so each
+   * carries the angle's sign), in a string the caller frees, as Webots' does */
+  const int degrees = c_int(decimal_degrees);
+  const int minutes = c_int((decimal_degrees - degrees) * 60);
+  const int seconds = c_int(((decimal_degrees - degrees) * 60 - minutes) * 60);
+  char *text = malloc(64);
+  if (text != NULL)
+    snprintf(text, 64, "%d\xc2\xb0 %d\xe2\x80\xb2 %d\xe2\x80\xb3", degrees, minutes, seconds);
   return text;
 }

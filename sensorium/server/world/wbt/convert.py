@@ -774,7 +774,10 @@ class Converter:
                             self.track(node, inner, owner, motors[0], line)
                         else:
                             self.warn(node, line)
+                start = len(owner.parts)
                 self.device_contents(node, inner, owner, data)
+                if t == "Display" and data is not None:
+                    self.display_screen(node, owner, start, data)
             elif t == "Connector":       # a solid that robots' connectors dock with (Webots allows it)
                 out = self.solid(node, frame, owner, "connector")
                 if out is not None:
@@ -1656,12 +1659,43 @@ class Converter:
         owner.data.setdefault("radar_targets", []).append(target)
         return target
 
+    def display_screen(self, node: Node, owner: Owner, start: int, device: dict) -> None:
+        """The shape whose texture a Display's image replaces, as WbDisplay finds it: its first child, or
+        that child's first child while it is a Group (a Pose, a Transform), must be a Shape whose
+        appearance has an ImageTexture (an Appearance's texture, a PBRAppearance's baseColorMap or
+        emissiveColorMap; its url may be empty). Kept as ``_screen`` (its part, made an index in the
+        robot's shapes by :meth:`carried_shapes`)."""
+        child = next(iter(self.fields(node).nodes("children")), None)
+        while child is not None and child.type in ("Group", "Pose", "Transform"):
+            child = next(iter(self.fields(child).nodes("children")), None)
+        if child is None or child.type != "Shape":
+            return
+        look = self.fields(child).node_("appearance")
+        if look is None or not any(isinstance(look.fields.get(k), Node)
+                                   for k in ("texture", "baseColorMap", "emissiveColorMap")):
+            return
+        geometry = self.fields(child).node_("geometry")
+        added = {id(p) for p in owner.parts[start:]}
+        made = [p for k, p in owner.keys.items() if geometry is not None and k[0] == id(geometry) and id(p) in added]
+        if made:                # (none: its geometry was left out, with its own line)
+            device["_screen"] = id(made[0])
+            for k in ("texture", "baseColorMap", "emissiveColorMap"):    # the display's image replaces them:
+                texture = look.fields.get(k)                              # one not loaded (no url) is no loss
+                if isinstance(texture, Node):
+                    self.textured.pop(id(texture), None)
+
     @staticmethod
     def carried_shapes(robot: dict, parts: list[dict]) -> None:
-        """Each carried radar target's shapes as indices in the robot's final ``shapes``."""
+        """Each carried radar target's shapes, and each Display's screen shape, as indices in the
+        robot's final ``shapes``."""
         index = {id(p): k for k, p in enumerate(parts)}
         for target in robot.get("radar_targets", ()):
             target["shapes"] = sorted({index[m] for m in target.pop("_members") if m in index})
+        for device in robot.get("devices", ()):
+            if "_screen" in device:
+                screen = index.get(device.pop("_screen"))
+                if screen is not None:
+                    device["screen_shape"] = screen
 
     def solid_contents(self, node: Node, frame: Frame, owner: Owner, bounding: bool = True) -> None:
         f = self.fields(node)

@@ -2,6 +2,7 @@
 #ifndef WEBOTS_GPS_HPP
 #define WEBOTS_GPS_HPP
 
+#include <cstdlib>
 #include <string>
 
 #include <webots/Device.hpp>
@@ -22,7 +23,10 @@ public:
   const double *getSpeedVector() const { return wb_gps_get_speed_vector(tag_); }
   CoordinateSystem getCoordinateSystem() const { return static_cast<CoordinateSystem>(wb_gps_get_coordinate_system(tag_)); }
   static std::string convertToDegreesMinutesSeconds(double decimalDegrees) {
-    return wb_gps_convert_to_degrees_minutes_seconds(decimalDegrees);
+    const char *text = wb_gps_convert_to_degrees_minutes_seconds(decimalDegrees);  // the caller frees it
+    const std::string result(text != NULL ? text : "");
+    std::free(const_cast<char *>(text));
+    return result;
   }
 };
 
