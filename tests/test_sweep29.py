@@ -169,3 +169,236 @@ def test_the_sick_reads_the_obstacle_box_by_its_closed_form() -> None:
     angle, dist = sick_obstacle(got)
     assert angle == pytest.approx((92.5 / 180 - 0.5) * 3.14159, abs=1e-12)
     assert dist == pytest.approx(float(np.mean(want[88:98])), abs=1e-5)
+
+
+# our Python controller making autonomous_vehicle.c's calls in its order (only the prints are the test's)
+AUTONOMOUS_VEHICLE = '''"""Sensorium's stand-in for autonomous_vehicle.c (sweep 29): our own Python making its calls in its order
+(the Driver, the device scan by index, camera, SICK, GPS, display and keyboard, the yellow-line PID and the
+SICK's obstacle steering every 50 ms); each sensor cycle prints what it read and sent."""
+import math
+
+from vehicle import Driver
+
+TIME_STEP = 50
+UNKNOWN = 99999.99
+KP, KI, KD = 0.25, 0.006, 2.0
+REF = (95, 187, 203)
+
+driver = Driver()
+names = [driver.getDeviceByIndex(j).getName() for j in range(driver.getNumberOfDevices())]
+camera = driver.getDevice("camera")
+camera.enable(TIME_STEP)
+width, height, fov = camera.getWidth(), camera.getHeight(), camera.getFov()
+sick = driver.getDevice("Sick LMS 291")
+sick.enable(TIME_STEP)
+sick_width, sick_fov = sick.getHorizontalResolution(), sick.getFov()
+gps = driver.getDevice("gps")
+gps.enable(TIME_STEP)
+display = driver.getDevice("display")
+speedometer = display.imageLoad("speedometer.png")
+wheel, needle = driver.getDevice("steering_wheel_motor"), driver.getDevice("speed_needle_motor")
+wiper = driver.getDevice("wiper_sensor")
+print("devices", len(names), "Sick LMS 291" in names, "display" in names, width, height, fov, sick_width,
+      f"{sick_fov:.5f}", flush=True)
+driver.setCruisingSpeed(50.0)
+driver.setHazardFlashers(True)
+driver.setDippedBeams(True)
+driver.setAntifogLights(True)
+driver.setWiperMode(Driver.SLOW)
+driver.getKeyboard().enable(TIME_STEP)
+
+steering_angle = 0.0
+sent = 0.0
+old = [0.0, 0.0, 0.0]
+first = True
+pid_reset = False
+pid_old, integral = 0.0, 0.0
+
+
+def set_steering_angle(a):
+    global steering_angle, sent
+    a = min(max(a, steering_angle - 0.1), steering_angle + 0.1)
+    steering_angle = a
+    sent = min(max(a, -0.5), 0.5)
+    driver.setSteeringAngle(sent)
+
+
+def line_angle(image):
+    sumx, count = 0, 0
+    for k in range(width * height):
+        b, g, r = image[4 * k], image[4 * k + 1], image[4 * k + 2]
+        if abs(b - REF[0]) + abs(g - REF[1]) + abs(r - REF[2]) < 30:
+            sumx += k % width
+            count += 1
+    return UNKNOWN if count == 0 else (sumx / count / width - 0.5) * fov
+
+
+def filtered(value):
+    global first, old
+    if first or value == UNKNOWN:
+        first = False
+        old = [0.0, 0.0, 0.0]
+    else:
+        old = old[1:] + [0.0]
+    if value == UNKNOWN:
+        return UNKNOWN
+    old[2] = value
+    return sum(old) / 3
+
+
+def obstacle(ranges):
+    hits = [(x, ranges[x]) for x in range(sick_width // 2 - 20, sick_width // 2 + 20) if ranges[x] < 20.0]
+    if not hits:
+        return UNKNOWN, 0.0
+    return (sum(x for x, _ in hits) / len(hits) / sick_width - 0.5) * sick_fov, sum(d for _, d in hits) / len(hits)
+
+
+def cdiv(a, b):
+    """a / b as C divides doubles (b == 0: an infinity or NaN)."""
+    if b != 0.0:
+        return a / b
+    return math.nan if a == 0.0 else math.copysign(math.inf, a) * math.copysign(1.0, b)
+
+
+def pid(a):
+    global pid_reset, pid_old, integral
+    if pid_reset:
+        pid_old, integral, pid_reset = a, 0.0, False
+    if math.copysign(1, a) != math.copysign(1, pid_old):
+        integral = 0.0
+    diff = a - pid_old
+    if -30 < integral < 30:
+        integral += a
+    pid_old = a
+    return KP * a + KI * integral + KD * diff
+
+
+i = 0
+while driver.step() != -1:
+    driver.getKeyboard().getKey()
+    wiper_at = wiper.getValue()
+    if i % (TIME_STEP // int(driver.getBasicTimeStep())) == 0:
+        image = camera.getImage()
+        ranges = sick.getRangeImage()
+        yellow = filtered(line_angle(image))
+        ob_angle, ob_dist = obstacle(ranges)
+        brake = 0.0
+        if ob_angle != UNKNOWN:
+            ob_steer = steering_angle
+            if 0.0 < ob_angle < 0.4:
+                ob_steer = steering_angle + cdiv(ob_angle - 0.25, ob_dist)
+            elif ob_angle > -0.4:
+                ob_steer = steering_angle + cdiv(ob_angle + 0.25, ob_dist)
+            steer = steering_angle
+            if yellow != UNKNOWN:
+                line = pid(yellow)
+                if ob_steer > 0 and line > 0:
+                    steer = max(ob_steer, line)
+                elif ob_steer < 0 and line < 0:
+                    steer = min(ob_steer, line)
+            else:
+                pid_reset = True
+            set_steering_angle(steer)
+        elif yellow != UNKNOWN:
+            set_steering_angle(pid(yellow))
+        else:
+            brake = 0.4
+            pid_reset = True
+        driver.setBrakeIntensity(brake)
+        coords = gps.getValues()
+        gps_speed = gps.getSpeed() * 3.6
+        speed = driver.getCurrentSpeed()
+        display.imagePaste(speedometer, 0, 0, False)
+        alpha = speed / 260.0 * 3.72 - 0.27
+        display.drawLine(100, 95, 100 + int(-50 * math.cos(alpha)), 95 + int(-50 * math.sin(alpha)))
+        display.drawText(f"GPS coords: {coords[0]:.1f} {coords[1]:.1f}", 10, 130)
+        display.drawText(f"GPS speed:  {gps_speed:.1f}", 10, 140)
+        t = round(driver.getTime() * 1000)
+        if t == 1010:
+            display.imageSave(None, "display.png")
+        print(f"{t} {yellow!r} {ob_angle!r} {ob_dist!r} {sent!r} {brake} {coords[0]!r} {coords[1]!r} {gps_speed!r} "
+              f"{speed!r} {wheel.getTargetPosition()!r} {needle.getTargetPosition()!r} {wiper_at!r}", flush=True)
+    else:
+        print(f"w {round(driver.getTime() * 1000)} {wiper_at!r}", flush=True)
+    i += 1
+'''
+
+
+def wiper_closed_form(steps: int) -> list[float]:
+    """The wiper sensor after each 10 ms step under Webots' driver library in SLOW mode: before each step, at
+    its minPosition 0 both wipers go up to 1.6, at 1.6 (or in a second t with int(t) % 4 != 0) down to 0; the
+    motors (maxVelocity 10, maxTorque 10: 10 rad/s² as their acceleration) follow Webots' kinematic rule; the
+    sensor reads nothing (NaN) before the first step."""
+    motor, read, out = KinematicMotor(10.0, 10.0), math.nan, []
+    for k in range(steps):
+        t = k * 0.01
+        if read == 0.0:
+            motor.target = 1.6
+        if read == 1.6 or int(t) % 4 != 0:
+            motor.target = 0.0
+        motor.step(0.01)
+        read = motor.x
+        out.append(read)
+    return out
+
+
+@pytest.mark.slow
+def test_autonomous_vehicles_calls_follow_the_line_avoid_the_box_and_turn_the_interior(tmp_path: Path) -> None:
+    """Our Python controller making autonomous_vehicle.c's calls under ``sensorium run`` for 2 s: it finds the
+    37 devices by index, the SICK and the display; 50 km/h from the first step (wheel accelerations are not
+    simulated). At 60 ms, the first images (taken at 50 ms, the car 0.6944 m on, straight): the line angle is a
+    third of the closed-form mask's (the filter's zeros), the obstacle the closed form's, and the controller
+    steers min(its PID, (angle − 0.25) / distance) (1e-5: the SICK's float32); it steers left past the box and
+    loses it from the SICK's middle rays at 560 ms. Each cycle Webots' library turns the steering wheel to 10 ×
+    the angle sent and the speed needle to 50 · 4.42 / 220; the wiper sensor follows the library's SLOW sweep
+    step by step (1e-12). The display saved at 1.01 s shows our speedometer image with the needle's line from
+    (100, 95) to (55, 74) in white."""
+    from PIL import Image
+
+    (tmp_path / "worlds").mkdir()
+    shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
+    world = tmp_path / "worlds" / "city.wbt"
+    world.write_text(CITY.read_text())
+    folder = tmp_path / "controllers" / "autonomous_vehicle"
+    folder.mkdir(parents=True)
+    (folder / "autonomous_vehicle.py").write_text(AUTONOMOUS_VEHICLE)
+    Image.new("RGB", (200, 150), (40, 60, 80)).save(folder / "speedometer.png")     # ours, a plain dial
+    done = subprocess.run(sensorium("run", str(world), "--until", "2000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "exited with status" not in done.stderr and "not simulated" not in done.stderr, done.stderr
+    lines = [line.split("] ", 1)[1] for line in done.stdout.splitlines() if line.startswith("[vehicle] ")]
+    assert lines[0] == "devices 37 True True 128 64 1.0 180 3.14159"
+    wipers = wiper_closed_form(200)
+    cycles = []
+    for line in lines[1:]:
+        cols = line.split()
+        if cols[0] == "w":
+            t, at = int(cols[1]), float(cols[2])
+        else:
+            t, at = int(cols[0]), float(cols[12])
+            cycles.append([float(c) for c in cols[:12]])
+        assert at == pytest.approx(wipers[t // 10 - 1], abs=1e-12), t
+    assert [int(c[0]) for c in cycles] == list(range(10, 2000, 50))
+    for t, yellow, ob_angle, ob_dist, sent, brake, x, y, gps_speed, speed, wheel, needle in cycles:
+        assert wheel == pytest.approx(10.0 * sent, abs=1e-15) and speed == pytest.approx(50.0, abs=1e-9)
+        assert needle == pytest.approx(50.0 * 4.42 / 220.0, abs=1e-12)
+    first = cycles[1]
+    assert (first[6], first[7]) == pytest.approx((START[0] - 50 / 3.6 * 0.05, START[1] + 50 / 3.6 * 0.05 *
+                                                  math.sin(HEADING)), abs=1e-9)
+    pose = (first[6], first[7], TYRE)
+    assert first[1] == pytest.approx(line_angle(yellow_mask(pose)) / 3.0, abs=1e-12)
+    angle, dist = sick_obstacle(sick_closed_form(pose))
+    assert (first[2], first[3]) == pytest.approx((angle, dist), abs=1e-5)
+    line = 0.25 * first[1] + 0.006 * first[1]          # the PID's first value after its reset
+    assert first[4] == pytest.approx(min((angle - 0.25) / dist, line), abs=1e-5)
+    seen = [int(c[0]) for c in cycles if c[2] != 99999.99]
+    assert seen[0] == 10 and seen[-1] == 510 and all(c[2] == 99999.99 for c in cycles if c[0] > 510)
+    assert all(c[7] < 45.5 for c in cycles if -62.0 - 3.91 < c[6] < -60.0 + 1.0)      # past the box, to its left
+    shown = Image.open(folder / "display.png").convert("RGB")
+    assert shown.size == (200, 150)
+    for xy in ((100, 95), (55, 74), (77, 84)):
+        assert shown.getpixel(xy) == (255, 255, 255), xy
+    for xy in ((0, 0), (150, 20), (199, 149)):
+        assert shown.getpixel(xy) == (40, 60, 80), xy
