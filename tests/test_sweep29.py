@@ -6,6 +6,7 @@ controller makes and checked against closed forms."""
 from __future__ import annotations
 
 import math
+import os
 import shutil
 import subprocess
 from pathlib import Path
@@ -13,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _serve import child_env, sensorium
+from test_sweep18 import REPO, clib  # noqa: F401  (clib: the fixture building our libController)
 from test_sweep19 import KinematicMotor
 
 from sensorium.server.sim.simulation import Simulation
@@ -402,3 +404,47 @@ def test_autonomous_vehicles_calls_follow_the_line_avoid_the_box_and_turn_the_in
         assert shown.getpixel(xy) == (255, 255, 255), xy
     for xy in ((0, 0), (150, 20), (199, 149)):
         assert shown.getpixel(xy) == (40, 60, 80), xy
+
+
+@pytest.mark.slow
+def test_the_c_driver_library_turns_the_interior_as_webots_library_does(tmp_path: Path, clib) -> None:
+    """A C controller built against our libController: without $WEBOTS_HOME, ours (tests/c/car_interior.c)
+    making autonomous_vehicle.c's library calls for 1.5 s: the wiper mode kept (SLOW, 1, by both names), the
+    steering wheel at 0 then 10 × −0.05 from the 20th step, the speed needle at 50 · 4.42 / 220 from the first,
+    the wiper sensor the library's SLOW sweep (1e-12), as the Python library's. With it, Webots'
+    autonomous_vehicle.c itself runs 1.5 s and says it set 50 km/h, no line of ours refusing a call."""
+    build, libs = clib
+    (tmp_path / "worlds").mkdir()
+    shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
+    world = tmp_path / "worlds" / "city.wbt"
+    world.write_text(CITY.read_text())
+    folder = tmp_path / "controllers" / "autonomous_vehicle"
+    home = os.environ.get("WEBOTS_HOME")
+    webots = home is not None and (Path(home) / "projects" / "vehicles" / "controllers" / "autonomous_vehicle").is_dir()
+    if webots:
+        shutil.copytree(Path(home) / "projects" / "vehicles" / "controllers" / "autonomous_vehicle", folder)  # type: ignore[arg-type]
+    else:
+        folder.mkdir(parents=True)
+        shutil.copy(REPO / "tests" / "c" / "car_interior.c", folder / "autonomous_vehicle.c")
+    done = subprocess.run(["cc", f"-I{REPO / 'sensorium' / 'client' / 'c' / 'include'}", str(folder / "autonomous_vehicle.c"),
+                           "-o", str(folder / "autonomous_vehicle"), str(build / "libController.a"), *libs, "-lm"],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    done = subprocess.run(sensorium("run", str(world), "--until", "1500", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert "exited with status" not in done.stderr, done.stderr
+    lines = [line.split("] ", 1)[1] for line in done.stdout.splitlines() if line.startswith("[vehicle] ")]
+    if webots:
+        assert "setting speed to 50 km/h" in lines
+        return
+    assert "not simulated" not in done.stderr, done.stderr
+    assert lines[0] == "mode 1 1"
+    wipers = wiper_closed_form(150)
+    rows = [line.split() for line in lines[1:]]
+    assert [int(r[0]) for r in rows] == list(range(1, 151))
+    for k, wheel, needle, at in rows:
+        assert float(wheel) == (0.0 if int(k) < 20 else 10.0 * -0.05), k
+        assert float(needle) == pytest.approx(50.0 * 4.42 / 220.0, abs=1e-12), k
+        assert float(at) == pytest.approx(wipers[int(k) - 1], abs=1e-12), k
