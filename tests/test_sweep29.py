@@ -14,12 +14,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from _serve import child_env, sensorium
-from test_sweep18 import REPO, clib  # noqa: F401  (clib: the fixture building our libController)
 from test_sweep19 import KinematicMotor
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 
+REPO = Path(__file__).resolve().parent.parent
 DATA = Path(__file__).parent / "data" / "sweep29"
 CITY = DATA / "city.wbt"
 
@@ -383,7 +383,8 @@ def test_autonomous_vehicles_calls_follow_the_line_avoid_the_box_and_turn_the_in
             cycles.append([float(c) for c in cols[:12]])
         assert at == pytest.approx(wipers[t // 10 - 1], abs=1e-12), t
     assert [int(c[0]) for c in cycles] == list(range(10, 2000, 50))
-    for t, yellow, ob_angle, ob_dist, sent, brake, x, y, gps_speed, speed, wheel, needle in cycles:
+    for c in cycles:
+        sent, speed, wheel, needle = c[4], c[9], c[10], c[11]
         assert wheel == pytest.approx(10.0 * sent, abs=1e-15) and speed == pytest.approx(50.0, abs=1e-9)
         assert needle == pytest.approx(50.0 * 4.42 / 220.0, abs=1e-12)
     first = cycles[1]
@@ -404,6 +405,18 @@ def test_autonomous_vehicles_calls_follow_the_line_avoid_the_box_and_turn_the_in
         assert shown.getpixel(xy) == (255, 255, 255), xy
     for xy in ((0, 0), (150, 20), (199, 149)):
         assert shown.getpixel(xy) == (40, 60, 80), xy
+
+
+@pytest.fixture(scope="module")
+def clib(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[str]]:
+    """Our libController built once for this file: (its build folder, the libraries to link)."""
+    if shutil.which("cc") is None or shutil.which("make") is None:
+        pytest.skip("needs a C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
+    build = tmp_path_factory.mktemp("cbuild")
+    make = ["make", "-s", "-C", str(REPO / "sensorium" / "client" / "c")]
+    done = subprocess.run([*make, f"BUILD={build}"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    return build, subprocess.run([*make, "libs"], capture_output=True, text=True, timeout=60).stdout.split()
 
 
 @pytest.mark.slow
