@@ -173,6 +173,78 @@ def test_the_sick_reads_the_obstacle_box_by_its_closed_form() -> None:
     assert dist == pytest.approx(float(np.mean(want[88:98])), abs=1e-5)
 
 
+# ------------------------------------------------------------------------------------------- city_night
+# city_night (projects/vehicles, R2023b): the same BmwX5 and place with `frontSpotLights TRUE`: two SpotLights
+# (intensity 20, attenuation 0 0 1, cutOffAngle 0.8, radius 20, directions (1, ∓0.2, −1) from (3.95, ±0.65,
+# 0.45)) in a Group, the first child of its "front_lights" LED, which the driver library's dipped beams switch;
+# the camera turned 0.15 rad down, no SICK, a near-black sky (0.00784), no other light (the street lights left
+# out). autonomous_vehicle.c switches the dipped beams on before its first step.
+NIGHT = DATA / "city_night.wbt"
+SPOTS = (((3.95, 0.65, 0.45), (1.0, -0.2, -1.0)), ((3.95, -0.65, 0.45), (1.0, 0.2, -1.0)))
+BODY = (((2.6775, 0.0, 0.29), (2.0, 1.73, 0.76)), ((0.5875, 0.0, 0.63), (2.14, 1.73, 1.44)),
+        ((-0.1725, 0.0, 0.53), (1.41, 1.73, 0.78)))
+
+
+def night_lit(pose, camera_pose) -> dict[tuple[int, int], bool]:
+    """For each pixel whose centre's ray meets the floor (within its 1000 m) before the car's body: whether the
+    road there is within 0.8 rad of a headlight's axis and 20 m of it (lit) or not (dark)."""
+    r, t = np.asarray(pose.rotation), np.asarray(pose.translation)
+    rc, eye = np.asarray(camera_pose.rotation), np.asarray(camera_pose.translation)
+    lights = [(t + r @ np.array(p), r @ (np.array(d) / np.linalg.norm(d))) for p, d in SPOTS]
+
+    def body_hit(d: np.ndarray) -> float:
+        best = math.inf
+        for centre, size in BODY:
+            o, e, h = r.T @ (eye - t) - np.array(centre), r.T @ d, np.array(size) / 2.0
+            lo, hi = -math.inf, math.inf
+            for k in range(3):
+                a, b = (-h[k] - o[k]) / e[k], (h[k] - o[k]) / e[k]
+                lo, hi = max(lo, min(a, b)), min(hi, max(a, b))
+            if lo <= hi and hi > 0.0:
+                best = min(best, lo)
+        return best
+
+    f = 64.0 / math.tan(0.5)
+    out = {}
+    for v in range(64):
+        for u in range(128):
+            d = rc @ np.array([f, 64.0 - (u + 0.5), 32.0 - (v + 0.5)])
+            if d[2] >= 0.0:
+                continue
+            s = (0.001 - eye[2]) / d[2]
+            p = eye + s * d
+            if max(abs(p[0]), abs(p[1])) > 1000.0 or body_hit(d) < s:
+                continue
+            out[(v, u)] = any(np.linalg.norm(p - q) <= 20.0 and
+                              math.acos(float(np.dot((p - q) / np.linalg.norm(p - q), a))) <= 0.8 for q, a in lights)
+    return out
+
+
+def test_the_headlights_light_their_cones_only_while_the_dipped_beams_are_on() -> None:
+    """city_night's BmwX5: with its front_lights LED off (as loaded, before the controller's dipped beams) every
+    floor pixel is black; on, a floor pixel shows exactly where its point is within a headlight's cone (0.8 rad)
+    and reach (20 m): 3880 of them, the hood hiding the rest below; off again, black. The yellow line in the
+    beams renders dimmer than the controller's reference (none within 30), so autonomous_vehicle.c sees no line
+    here and brakes (0.4), as the stand-in has none of the sample's street lights."""
+    w = load_world(NIGHT)
+    joints, background = w.warnings
+    assert "its 7 motorised joints are no wheels" in joints
+    assert background.endswith("skipped nodes that do not matter to these sensors: Background (all but its skyColor)")
+    sim = Simulation(w, "exact")
+    camera, led = sim.device("vehicle/camera"), sim.device("vehicle/front_lights")
+    camera.enable(10)
+    pose = sim.robot("vehicle").pose
+    lit = night_lit(pose, camera.world_pose(pose))
+    assert sum(lit.values()) == 3880
+    for on in (0, 1, 0):
+        led.set(on, sim.time_ms)
+        sim.step()
+        image = np.asarray(camera.image).astype(int)
+        shown = {k: bool(image[k][:3].max() > 0) for k in lit}
+        assert shown == ({k: False for k in lit} if on == 0 else lit), on
+        assert not (np.abs(image[..., :3] - YELLOW).sum(axis=-1) < 30).any()
+
+
 # our Python controller making autonomous_vehicle.c's calls in its order (only the prints are the test's)
 AUTONOMOUS_VEHICLE = '''"""Sensorium's stand-in for autonomous_vehicle.c (sweep 29): our own Python making its calls in its order
 (the Driver, the device scan by index, camera, SICK, GPS, display and keyboard, the yellow-line PID and the
