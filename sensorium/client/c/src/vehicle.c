@@ -5,8 +5,9 @@
  * driven wheels' velocities by Webots' geometric differentials. The brake intensity, indicators,
  * hazard flashers, lights and the car's flags are the controller's commands, kept and answered as
  * Webots' library keeps them (the car's LEDs of Webots' names switched for them); the engine type
- * is the world's. The car is kinematic (no engine, gearbox, torque control or wipers): those
- * functions print one line the first time and answer Webots' "no value". wbu_car_init()/
+ * is the world's; the interior's motors Webots' library turns (steering wheel, speedometer needle,
+ * wipers) are turned as it turns them. The car is kinematic (no engine, gearbox or torque control):
+ * those functions print one line the first time and answer Webots' "no value". wbu_car_init()/
  * wbu_driver_init() on a robot without an ackermann_drive print one line and end the controller with
  * status 1. Before init every function answers "no value". */
 #include <math.h>
@@ -39,6 +40,9 @@ static struct {
   double free_last[4], free_speed[4]; /* a free wheel's encoder at the last driver step (NaN: none yet), its speed */
   WbDeviceTag lights[9]; /* LIGHTS' order; 0: the car has none */
   int lit[9];            /* what each was last set to (-1: never) */
+  /* the interior's motors Webots' library turns (0: the car has none) and the wipers' mode */
+  WbDeviceTag steering_wheel, speed_needle, wipers[2], wiper_sensor;
+  WbuDriverWiperMode wiper_mode;
 } g_car;
 
 /* The LEDs Webots' car library switches when the car has them (Webots' VehicleLights names). */
@@ -48,6 +52,8 @@ static const char *const LIGHTS[9] = {"front_lights",     "antifog_lights", "rig
                                       "brake_lights",     "interior_right_indicators", "interior_left_indicators"};
 #define INDICATOR_PERIOD 0.34          /* s: Webots' default */
 #define AUTO_DISABLING_THRESHOLD 0.1   /* rad: Webots' driver library's */
+#define STEERING_WHEEL_RATIO 10.0      /* the steering wheel motor's position per radian of steering (Webots') */
+#define SPEEDOMETER_MAX 220.0          /* km/h at the speed needle's maxPosition (Webots' speedometer texture) */
 
 /* Switch the car's LED (and an indicator's interior one), if it has it. */
 static void light(int which, bool on) {
@@ -67,7 +73,7 @@ static void unmodelled(const char *func, bool *said) {
   *said = true;
   fprintf(stderr,
           "Warning: %s(): not simulated (Sensorium's car is kinematic, a bicycle model of its steering and wheel "
-          "motors: no engine, gearbox, torque control or wipers); it answers Webots' \"no value\".\n",
+          "motors: no engine, gearbox or torque control); it answers Webots' \"no value\".\n",
           func);
   fflush(stderr);
 }
@@ -163,6 +169,14 @@ static void car_init(const char *func) {
     g_car.lights[i] = quiet_device(rb, LIGHTS[i], SN_LED);
     g_car.lit[i] = -1;
   }
+  g_car.steering_wheel = quiet_device(rb, "steering_wheel_motor", SN_MOTOR);
+  g_car.speed_needle = quiet_device(rb, "speed_needle_motor", SN_MOTOR);
+  g_car.wipers[0] = quiet_device(rb, "right_wiper_motor", SN_MOTOR);
+  g_car.wipers[1] = quiet_device(rb, "left_wiper_motor", SN_MOTOR);
+  g_car.wiper_sensor = quiet_device(rb, "wiper_sensor", SN_POSITION);
+  if (g_car.wiper_sensor)
+    wb_position_sensor_enable(g_car.wiper_sensor, step);
+  g_car.wiper_mode = DOWN;
   g_car.indicator_period = INDICATOR_PERIOD;
   g_car.limited_slip = g_car.auto_disabling = true;
   g_car.mode = UNDEFINED_CONTROL_MODE;
@@ -294,7 +308,9 @@ void wbu_driver_cleanup(void) {
 }
 
 /* Before the step, as Webots' library: the indicators' LEDs blink (on for the first half of each
- * period, by the simulated time) and the backwards lights are on while a negative cruising speed is set. */
+ * period, by the simulated time), the wipers sweep in any mode but DOWN (up to their maxPosition from
+ * their minPosition and back; SLOW only in the first second of every four), the backwards lights are
+ * on while a negative cruising speed is set and the speedometer's needle shows the current speed. */
 int wbu_driver_step(void) {
   if (!g_car.ready)
     return -1;
@@ -303,8 +319,22 @@ int wbu_driver_step(void) {
   bool on = isfinite(q) ? fmod(floor(q), 2.0) == 0.0 : true;
   light(RIGHT_IND, on && (g_car.hazard || g_car.indicator == RIGHT));
   light(LEFT_IND, on && (g_car.hazard || g_car.indicator == LEFT));
+  if (g_car.wipers[0] && g_car.wipers[1] && g_car.wiper_sensor && g_car.wiper_mode != DOWN) {
+    double at = wb_position_sensor_get_value(g_car.wiper_sensor);
+    if (at == wb_motor_get_min_position(g_car.wipers[0])) /* at rest down: up */
+      for (int i = 0; i < 2; i++)
+        wb_motor_set_position(g_car.wipers[i], wb_motor_get_max_position(g_car.wipers[i]));
+    if (at == wb_motor_get_max_position(g_car.wipers[0]) ||
+        (g_car.wiper_mode == SLOW && (int)wb_robot_get_time() % 4 != 0))
+      for (int i = 0; i < 2; i++)
+        wb_motor_set_position(g_car.wipers[i], wb_motor_get_min_position(g_car.wipers[i]));
+  }
   g_car.backwards = g_car.mode == SPEED && g_car.cruising < 0.0;
   light(BACKWARDS, g_car.backwards);
+  if (g_car.speed_needle) {
+    double top = wb_motor_get_max_position(g_car.speed_needle), speed = fabs(wbu_driver_get_current_speed());
+    wb_motor_set_position(g_car.speed_needle, speed <= SPEEDOMETER_MAX ? speed * top / SPEEDOMETER_MAX : top);
+  }
   int ms = (int)wb_robot_get_basic_time_step();
   for (int i = 0; i < 4; i++) { /* a free wheel's speed: its encoder's change since the last step */
     if (g_car.wheel[i] || !g_car.wheel_sensor[i])
@@ -323,6 +353,8 @@ void wbu_driver_set_steering_angle(double steering_angle) {
     refused("wbu_driver_set_steering_angle", "steering_angle", steering_angle, "");
     return;
   }
+  if (g_car.steering_wheel) /* Webots' library turns the steering wheel with it */
+    wb_motor_set_position(g_car.steering_wheel, STEERING_WHEEL_RATIO * steering_angle);
   g_car.angle = steering_angle;
   ackermann(steering_angle, &g_car.right_angle, &g_car.left_angle);
   wb_motor_set_position(g_car.steer[0], g_car.geo->sign * g_car.right_angle);
@@ -522,14 +554,14 @@ WbuDriverControlMode wbu_driver_get_control_mode(void) {
   return g_car.ready ? g_car.mode : UNDEFINED_CONTROL_MODE;
 }
 
+/* Kept; the car's wipers sweep at each wbu_driver_step() as Webots' library sweeps them. */
 void wbu_driver_set_wiper_mode(WbuDriverWiperMode mode) {
-  (void)mode;
-  UNMODELLED();
+  if (g_car.ready)
+    g_car.wiper_mode = mode;
 }
 
 WbuDriverWiperMode wbu_driver_get_wiper_mode(void) {
-  UNMODELLED();
-  return DOWN;
+  return g_car.ready ? g_car.wiper_mode : DOWN;
 }
 
 /* Webots' deprecated names of the brake intensity's functions. */
@@ -542,11 +574,9 @@ double wbu_driver_get_brake(void) {
 }
 
 void wbu_driver_set_wipers_mode(wbu_wipers_mode mode) {
-  (void)mode;
-  UNMODELLED();
+  wbu_driver_set_wiper_mode((WbuDriverWiperMode)mode);
 }
 
 wbu_wipers_mode wbu_driver_get_wipers_mode(void) {
-  UNMODELLED();
-  return DOWN;
+  return (wbu_wipers_mode)wbu_driver_get_wiper_mode();
 }

@@ -5,8 +5,8 @@ through its ordinary motors: ``Driver.setSteeringAngle`` sets the two steering m
 Ackermann angles, ``setCruisingSpeed`` the driven wheels' velocities by Webots' geometric
 differentials. The brake intensity, indicators, lights and the car's flags are kept and answered as
 Webots' library keeps them (the car's LEDs of Webots' names switched for them). There is no engine,
-gearbox, torque control or wiper model: those functions print one line the first time and answer
-Webots' "no value". On a robot without an ``ackermann_drive`` the constructor prints one line and
+gearbox or torque control model: those functions print one line the first time and answer
+Webots' "no value"; the steering wheel, speedometer needle and wipers turn as Webots' library turns them. On a robot without an ``ackermann_drive`` the constructor prints one line and
 exits with status 1."""
 
 from .car import Car

@@ -3,9 +3,10 @@
 angles, ``setCruisingSpeed`` sets the driven wheels' velocities by Webots' geometric differentials,
 ``getCurrentSpeed`` reads them back. The brake intensity, indicators, hazard flashers, dipped beams
 and antifog lights are the controller's commands, kept and answered as Webots' library keeps them
-(and the car's LEDs of Webots' names switched for them); Sensorium's car is kinematic (no engine,
-gearbox, torque control or wipers): those functions answer Webots' "no value" after one line the
-first time."""
+(and the car's LEDs of Webots' names switched for them); the interior's motors Webots' library turns
+(the steering wheel, the speedometer's needle, the wipers) are turned as it turns them. Sensorium's
+car is kinematic (no engine, gearbox or torque control): those functions answer Webots' "no value"
+after one line the first time."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ from sensorium.client.webots.controller.supervisor import Supervisor
 from sensorium.client.webots.controller.unsimulated import signed
 
 _UNMODELLED = ("Sensorium's car is kinematic (a bicycle model of its steering and wheel motors): no engine, "
-               "gearbox, torque control or wipers")
+               "gearbox or torque control")
 
 LIGHTS = ("front_lights", "antifog_lights", "right_indicators", "left_indicators", "rear_lights", "backwards_lights",
           "brake_lights", "interior_right_indicators", "interior_left_indicators")
@@ -29,6 +30,10 @@ INDICATOR_PERIOD = 0.34
 AUTO_DISABLING_THRESHOLD = 0.1
 """rad: how far the steering comes back from its furthest turn towards the indicator's side before
 the indicator switches itself off (Webots' driver library)."""
+STEERING_WHEEL_RATIO = 10.0
+"""The steering wheel motor's position per radian of steering angle (Webots' driver library)."""
+SPEEDOMETER_MAX = 220.0
+"""km/h: the speed at the speedometer needle's maxPosition (Webots' speedometer texture's last mark)."""
 
 
 def refuse(cls: str, robot: str) -> SystemExit:
@@ -157,6 +162,20 @@ class Driver(Supervisor):
         self._auto_disabling = True
         engine = geo.get("engine_type", "combustion")
         self._engine = ("combustion", "electric", "parallel hybrid", "power-split hybrid").index(engine)
+        # the interior's motors Webots' library turns when the car has them (looked up quietly, as Webots does)
+        self._steering_wheel = self._quiet("steering_wheel_motor", "RotationalMotor")
+        self._speed_needle = self._quiet("speed_needle_motor", "RotationalMotor")
+        self._wipers = [self._quiet(n, "RotationalMotor") for n in ("right_wiper_motor", "left_wiper_motor")]
+        self._wiper_sensor = self._quiet("wiper_sensor", "PositionSensor")
+        self._wiper_mode = self.DOWN
+        if self._wiper_sensor is not None:
+            self._wiper_sensor.enable(step)
+
+    def _quiet(self, name: str, kind: str) -> Any:
+        """The car's device ``name`` of class ``kind``, None when it has none (no line: Webots' library
+        looks its optional devices up quietly)."""
+        dev = self.devices.get(name)
+        return dev if dev is not None and type(dev).__name__ == kind else None
 
     def _light(self, name: str, on: bool) -> None:
         """Switch the car's LED ``name`` (and the interior indicator with an indicator), if it has it."""
@@ -182,6 +201,8 @@ class Driver(Supervisor):
             print("Warning: wbu_driver_set_steering_angle() called with an invalid 'steering_angle' argument "
                   f"({shown})", file=sys.stderr)
             return
+        if self._steering_wheel is not None:       # Webots' library turns the steering wheel with it
+            self._steering_wheel.setPosition(STEERING_WHEEL_RATIO * float(steeringAngle))
         self._angle = float(steeringAngle)
         self._angles = ackermann_angles(self._angle, self._geo["wheelbase"], self._geo["track_front"])
         for motor, angle in zip(self._steer, self._angles):
@@ -269,12 +290,28 @@ class Driver(Supervisor):
     def step(self, time_step: int | None = None) -> int:
         """One basic time step (Webots' ``wbu_driver_step``); -1 when the simulation ends. Before it,
         as Webots' library: the indicators' LEDs blink (on for the first half of each period, by the
-        simulated time), and the backwards lights are on while a negative cruising speed is set."""
+        simulated time), the wipers sweep in any mode but ``DOWN`` (up to their motors' maxPosition from
+        their minPosition and back; in ``SLOW`` only during the first second of every four), the
+        backwards lights are on while a negative cruising speed is set and the speedometer's needle
+        shows the current speed (its maxPosition at 220 km/h)."""
         on = blink_on(self.getTime(), self._indicator_period)
         self._light("right_indicators", on and (self._hazard or self._indicator == self.INDICATOR_RIGHT))
         self._light("left_indicators", on and (self._hazard or self._indicator == self.INDICATOR_LEFT))
+        right, left = self._wipers
+        if right is not None and left is not None and self._wiper_sensor is not None and self._wiper_mode != self.DOWN:
+            at = self._wiper_sensor.getValue()
+            if at == right.getMinPosition():     # Webots' library: at rest down, the wipers go up
+                right.setPosition(right.getMaxPosition())
+                left.setPosition(left.getMaxPosition())
+            if at == right.getMaxPosition() or (self._wiper_mode == self.SLOW and int(self.getTime()) % 4 != 0):
+                right.setPosition(right.getMinPosition())
+                left.setPosition(left.getMinPosition())
         self._backwards = self._mode == self.SPEED and self._cruising < 0.0
         self._light("backwards_lights", self._backwards)
+        if self._speed_needle is not None:
+            top = self._speed_needle.getMaxPosition()
+            speed = abs(self.getCurrentSpeed())
+            self._speed_needle.setPosition(speed * top / SPEEDOMETER_MAX if speed <= SPEEDOMETER_MAX else top)
         # a free wheel's speed, as Webots' driver works out every wheel's: its encoder's change since the
         # last step over the basic time step (0 until the encoder has read twice)
         ms = self.getBasicTimeStep()
@@ -338,6 +375,15 @@ class Driver(Supervisor):
     def getAntifogLights(self) -> bool:
         return self._antifog
 
+    def setWiperMode(self, mode: int) -> None:
+        """``DOWN``, ``SLOW``, ``NORMAL`` or ``FAST``: kept, and the car's wipers (Webots' motor names,
+        with their ``wiper_sensor``) sweep at each ``step`` as Webots' library sweeps them; ``NORMAL``
+        and ``FAST`` alike, as there (the motors' speed is the world's)."""
+        self._wiper_mode = int(mode)
+
+    def getWiperMode(self) -> int:
+        return self._wiper_mode
+
     @staticmethod
     def isInitialisationPossible() -> bool:
         """Whether this controller's robot is a car the vehicle library drives (its world entry has an
@@ -345,15 +391,13 @@ class Driver(Supervisor):
         wb.wb_robot_init()
         return wb.current().ackermann_drive is not None
 
-    # -- no engine, gearbox, torque control or wipers here
+    # -- no engine, gearbox or torque control here
     setThrottle = unmodelled("wbu_driver_set_throttle", None, "throttle")
     getThrottle = unmodelled("wbu_driver_get_throttle", 0.0)
     setGear = unmodelled("wbu_driver_set_gear", None, "gear")
     getGear = unmodelled("wbu_driver_get_gear", 0)
     getGearNumber = unmodelled("wbu_driver_get_gear_number", 0)
     getRpm = unmodelled("wbu_driver_get_rpm", 0.0)
-    setWiperMode = unmodelled("wbu_driver_set_wiper_mode", None, "mode")
-    getWiperMode = unmodelled("wbu_driver_get_wiper_mode", DOWN)
 
     # Webots' properties
     steering_angle = property(getSteeringAngle, setSteeringAngle)

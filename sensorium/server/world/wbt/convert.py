@@ -2721,6 +2721,7 @@ class Converter:
 
     def _drive(self, node: Node, robot: Owner, nowheel: list[tuple[Node, str, str, str]]) -> None:
         from sensorium.server.world.wbt.drive import (
+            AXIS_TOL,
             ackermann_drive,
             car_engine,
             differential_drive,
@@ -2900,6 +2901,21 @@ class Converter:
                 self.warn(node, f"robot {robot.data['name']!r}: no drive ({casters}); the robot will not move")
                 return
             drive, why = ackermann_drive(wheels, self, up)
+            # a car's fittings (Webots' BmwX5: its wipers, steering wheel and speedometer needles, on hinges
+            # its driver library turns): a motorised hinge about an axis off the horizontal, or with nothing
+            # round at its end point, rolls on nothing; the car is the rest when the rest make one
+            fittings = [w for w in wheels if not w["steers"] and (
+                not rounded[id(w)] or abs(float(w["axis"][up])) > AXIS_TOL * float(np.linalg.norm(w["axis"])))]
+            if drive is None and fittings:
+                rest = [w for w in wheels if not any(w is f for f in fittings)]
+                fitted, _ = ackermann_drive(rest, self, up) if any(not w["steers"] for w in rest) else (None, "")
+                if fitted is not None:
+                    drive = fitted
+                    for w in fittings:
+                        nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (a "
+                                        "car's fitting: its axis is off the horizontal or its end point has nothing "
+                                        f"round to roll on): {JOINT_MOVES}", "a car's fittings"))
+                    wheels = rest
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no Ackermann drive ({why}); the robot will not move")
                 return
