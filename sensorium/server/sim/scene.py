@@ -944,6 +944,10 @@ class Scene:
                     models[j] = new
                     return
 
+    def changed_carried(self) -> set[tuple[str | int, int]]:
+        """The (owner, index) of the carried lights a Supervisor set or removed."""
+        return set(self._set_carried) | self.removed_carried
+
     def remove_carried_light(self, owner: str | int, index: int) -> None:
         """Take light ``index`` of a robot or top-level solid out for good (a Supervisor's ``node.remove()``):
         light sensors and cameras stop counting it at their next measurement (``lights_version``); the
