@@ -122,7 +122,8 @@ def _replaced(node: ParsedNode, at: tuple[int, int], fields: dict[str, Any]) -> 
     if (node.line, node.col) == at:
         new = {k: v for k, v in node.fields.items() if k not in fields}
         new.update({k: v for k, v in fields.items() if v is not None})
-        return replace(node, fields={k: new[k] for k in [*node.fields, *new] if k in new})
+        order = [*(k for k in new if k not in node.fields), *node.fields]     # (pose fields first, as Webots writes)
+        return replace(node, fields={k: new[k] for k in order if k in new})
     for name, value in node.fields.items():
         items = value if isinstance(value, list) else [value]
         for i, item in enumerate(items):
