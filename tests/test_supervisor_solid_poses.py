@@ -207,6 +207,9 @@ def test_a_protos_pose_is_found_by_get_from_proto_def_and_not_removed(tmp_path):
     assert call(lv, "get_node_pose", {"node": found["node"]})["position"] == [1.0, 0.0, 1.0]
     plate = call(lv, "get_from_proto_def", {"node": table, "name": "PLATE"})
     assert plate["parent"] == found["node"]
+    message = lv.err(A, "/probe/robot/set_field", {"node": found["node"], "field": "translation",
+                                                    "value": [0.0, 0.0, 2.0]}, ErrorCode.INVALID_ARGUMENT)
+    assert "PROTO internal field" in message and "\n" not in message, message
     message = lv.err(A, "/probe/robot/remove_node", {"node": found["node"]}, ErrorCode.INVALID_ARGUMENT)
     assert message == ("remove_node: Node 'DEF TOP Pose' is internal to a PROTO and therefore cannot be deleted from "
                        "a Supervisor.")

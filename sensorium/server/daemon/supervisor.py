@@ -1445,6 +1445,10 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
                          "Supervisor sets a Material's diffuseColor, emissiveColor and transparency, a "
                          "PBRAppearance's baseColor, roughness, metalness, transparency and emissiveColor and an "
                          "ImageTexture's url, repeatS, repeatT and filtering only")
+    if setter is None and node.nested and field in ("translation", "rotation") and node.type in _SOLID_POSES \
+            and _nested_of(sim, node).owner_kind == "Solid":      # (one written in a PROTO's body: no place)
+        raise ValueError(f"field {field!r} ({kind}) of {_what(node)} is a PROTO internal field, read-only as in "
+                         "Webots: set the PROTO's fields instead; nothing changed")
     if setter is None and node.nested:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
                          "top-level robots, solids and lights only, not the nodes inside them")
