@@ -295,16 +295,42 @@ def test_a_transform_set_moves_the_solid_it_holds_and_a_moved_table_stays_where_
     assert call(lv, "get_node_pose", {"node": inner})["position"] == pytest.approx([2.1, 0.5, 0.0], abs=1e-15)
 
 
-def test_a_set_is_refused_in_one_line_where_a_rebuild_would_undo_other_changes():
+def test_a_shapes_colour_set_before_stays_and_a_reset_brings_back_both(tmp_path):
     lv = _live()
     top, marker = node(lv, "TOP"), node(lv, "MARKER")
-    before = readings(lv)
+    readings(lv)
+    loaded_image = image(lv)
     material = get(lv, get(lv, marker, "appearance"), "material")
     call(lv, "set_field", {"node": material, "field": "emissiveColor", "value": [0.0, 1.0, 0.0]})
-    message = lv.err(A, "/probe/robot/set_field", {"node": top, "field": "translation", "value": [0.5, 0.0, 1.0]},
-                     ErrorCode.INVALID_ARGUMENT)
-    assert "would undo" in message and "\n" not in message, message
-    assert get(lv, top, "translation") == [0.0, 0.0, 1.0] and readings(lv)[0] == before[0]
+    call(lv, "set_field", {"node": top, "field": "translation", "value": [0.5, 0.0, 1.0]})
+    assert get(lv, material, "emissiveColor") == [0.0, 1.0, 0.0]
+    twin = _live(_green_moved(tmp_path))
+    assert readings(lv) == readings(twin) and image(lv) == image(twin)
+    call(lv, "simulation_reset")
+    readings(lv)
+    assert image(lv) == loaded_image and get(lv, material, "emissiveColor") == [1.0, 0.0, 0.0]
+
+
+def _green_moved(tmp_path):
+    path = tmp_path / "green_moved.wbt"
+    path.write_text(WORLD.read_text().replace("emissiveColor 1 0 0", "emissiveColor 0 1 0").replace(
+        TOP_AT, "      translation 0.5 0 1\n      rotation 0 0 1 1.5707963267948966\n"))
+    return path
+
+
+def test_a_set_is_refused_in_one_line_where_a_rebuild_would_undo_other_changes():
+    for undone in ({"node": "LAMP", "field": "intensity", "value": 1.0}, "LEG"):
+        lv = _live()
+        top = node(lv, "TOP")
+        if isinstance(undone, dict):
+            call(lv, "set_field", {**undone, "node": node(lv, undone["node"])})
+        else:
+            call(lv, "remove_node", {"node": node(lv, undone)})
+        before = readings(lv)
+        message = lv.err(A, "/probe/robot/set_field", {"node": top, "field": "translation",
+                                                        "value": [0.5, 0.0, 1.0]}, ErrorCode.INVALID_ARGUMENT)
+        assert "would undo" in message and "\n" not in message, message
+        assert get(lv, top, "translation") == [0.0, 0.0, 1.0] and readings(lv) == before
 
 
 def test_an_imported_solids_pose_set_moves_its_shape():

@@ -811,8 +811,9 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     holds (shapes, lights, solids) is from the next measurement where the world file written with that value
     puts it, its solid built again through the path a PROTO field set takes (sim/regenerate.py
     ``rebuild_posed``); every node inside the solid keeps its id. ``simulationReset`` puts the loaded value
-    back (:func:`reset_solid_poses`). One line and nothing changed for a solid holding a Supervisor's other
-    changes (a shape's or light's field set, a node removed: a rebuild would lose them)."""
+    back (:func:`reset_solid_poses`); its shapes keep the appearances a Supervisor gave them. One line and nothing
+    changed for a solid a rebuild would lose more of (a node inside it removed, a light's field set) or a
+    Charger's."""
     from sensorium.server.sim.imports import ImportRefused
     from sensorium.server.sim.regenerate import rebuild_posed, written_fields, written_value
 
@@ -825,11 +826,15 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     table = _table(sim)
     n = _nested_of(sim, node)
     key, scene = n.owner_key, sim.scene
-    shapes = set(scene.solid_shapes(key))
-    if any(m.owner == n.owner for m in table.removed_shapes.values()) or shapes & scene.removed_shapes \
-            or any(k in scene.appearance_values for k in shapes) or any(k[0] == key for k in scene.changed_carried()):
-        raise ValueError(f"field {field!r} of {_what(node)} not set: a Supervisor changed or removed nodes inside "
-                         f"solid {key!r}, which building it again with the new frame would undo; nothing changed")
+    if any(m.owner == n.owner for m in table.removed_shapes.values()) or set(scene.solid_shapes(key)) & \
+            scene.removed_shapes or any(k[0] == key for k in scene.changed_carried()):
+        raise ValueError(f"field {field!r} of {_what(node)} not set: a Supervisor removed a node or changed a light "
+                         f"inside solid {key!r}, which building it again with the new frame would undo; nothing "
+                         "changed")
+    if any(c.solid == key for c in sim.chargers):
+        raise ValueError(f"field {field!r} of {_what(node)} not set: solid {key!r} is a Charger's (its glowing "
+                         "shapes stay those it loaded with here); nothing changed")
+    looks = scene.appearance_changes(key)
     at = (n.at[0], n.at[1])
     loaded = written_fields(sim, key, at, ("translation", "rotation"))
     if loaded is None:
@@ -848,6 +853,7 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
         raise ValueError(f"field {field!r} of {_what(node)} not set: {exc}; nothing changed") from None
     if moved:                        # built where the solid was loaded, then moved where the Supervisor put it
         sim.place_solid(key, now_pose)
+    scene.take_appearance_changes(key, looks)       # (its shapes keep the colours a Supervisor gave them)
     sim.__dict__.setdefault("_posed", {}).setdefault(key, {}).setdefault(at, (n.id, loaded))
     nested.renew(sim, table, n.owner, key, made.model, n.id)
     translation = np.asarray(value, dtype=np.float64) if field == "translation" else own.translation
