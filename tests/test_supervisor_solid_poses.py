@@ -345,3 +345,40 @@ def test_an_imported_solids_pose_set_moves_its_shape():
     assert readings(lv)[0] == pytest.approx(1.4, abs=1e-6)          # the box's near face, 0.1 m before x = 1.5
     assert node(lv, "BOX.P") == pose and node(lv, "BOX.P.S") == shape and get(lv, pose, "children") == [shape]
     assert "DEF P Pose {\n      translation 0.5 0 0\n" in call(lv, "node_export_string", {"node": node(lv, "BOX")})["value"]
+
+
+def _recognised(text: str) -> str:
+    """The world with TABLE recognised (red), INNER a radar target and the camera recognising."""
+    for old, new in (('  name "table"\n', '  name "table"\n  recognitionColors [ 1 0 0 ]\n'),
+                     ('              name "inner"\n', '              name "inner"\n              radarCrossSection 1\n'),
+                     ('      name "camera"\n', '      name "camera"\n      recognition Recognition { }\n')):
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    return text
+
+
+def _seen(lv: Live) -> tuple[list, dict]:
+    cam = lv.sim.robot("probe").device("camera")
+    cam.recognition_enable(8)
+    lv.step(A, "probe")
+    scene = lv.sim.scene
+    targets = {str(k): (scene.target_pose(k).translation.tolist(), scene.target_pose(k).rotation.tolist())
+               for k in scene.radar_targets}
+    return [o.as_dict() for o in cam.objects], targets
+
+
+def test_recognition_and_radar_targets_follow_as_the_world_file_written_so(tmp_path):
+    (tmp_path / "r.wbt").write_text(_recognised(WORLD.read_text()))
+    lv = _live(tmp_path / "r.wbt")
+    loaded = _seen(lv)
+    call(lv, "set_field", {"node": node(lv, "TOP"), "field": "rotation", "value": [0.0, 0.0, 1.0, 0.3]})
+    call(lv, "set_field", {"node": node(lv, "T"), "field": "translation", "value": [-0.6, 0.0, 1.2]})
+    moved = _seen(lv)
+    (tmp_path / "twin.wbt").write_text(_recognised(WORLD.read_text()).replace(
+        TOP_AT, "      translation 0 0 1\n      rotation 0 0 1 0.3\n").replace(
+        "          translation 0 0.5 1\n", "          translation -0.6 0 1.2\n"))
+    assert moved == _seen(_live(tmp_path / "twin.wbt")) != loaded
+    assert len(moved[0]) == 1 and len(moved[1]) == 1      # the table recognised, INNER a target
+    assert list(moved[1].values())[0][0] == pytest.approx([1.5, 0.0, 0.2], abs=1e-15)   # (2, 0, -1) + T + 0.1 x
+    call(lv, "simulation_reset")
+    assert _seen(lv) == loaded
