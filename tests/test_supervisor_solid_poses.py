@@ -1,7 +1,9 @@
 """Poses, Transforms and Groups inside a top-level solid as Supervisor nodes (tests/worlds/solid_poses.wbt): found
 by DEF (dotted paths too), by id and by their parent's ``children`` in file order; their parents, types and DEFs;
-their fields and world poses; exportString and worldSave; remove() taking what they hold out of the sensors'
-view, exactly as the world file written without them; one line for what is refused.
+their fields and world poses; a Pose's or Transform's translation and rotation set moving what it holds exactly
+as the world file written with that value (node ids kept, simulationReset restoring the loaded value);
+exportString and worldSave; remove() taking what they hold out of the sensors' view, exactly as the world file
+written without them; one line for what is refused.
 
 Closed forms (the world file's comment places everything): the lidar's one beam runs along +x from the origin and
 meets MARKER's near face at x = 1.8; the light sensor at the origin looks up at LAMP, 2 cd at (2, 0, 1) with
@@ -160,9 +162,9 @@ def test_refused_in_one_line_and_nothing_changes():
     lv = _live()
     top, g, t = node(lv, "TOP"), node(lv, "G"), node(lv, "T")
     before = readings(lv)
-    for args, words in (({"node": top, "field": "translation", "value": [0.0, 0.0, 2.0]}, "read-only here"),
-                        ({"node": top, "field": "rotation", "value": [0.0, 0.0, 1.0, 0.0]}, "read-only here"),
-                        ({"node": t, "field": "scale", "value": [2.0, 2.0, 2.0]}, "read-only here")):
+    for args, words in (({"node": t, "field": "scale", "value": [2.0, 2.0, 2.0]}, "read-only here"),
+                        ({"node": top, "field": "translation", "value": [0.0, math.inf, 2.0]}, "finite"),
+                        ({"node": top, "field": "rotation", "value": [0.0, 0.0, 0.0, 1.0]}, "axis must not be zero")):
         message = lv.err(A, "/probe/robot/set_field", args, ErrorCode.INVALID_ARGUMENT)
         assert words in message and "\n" not in message, message
     message = lv.err(A, "/probe/robot/remove_node", {"node": g}, ErrorCode.INVALID_ARGUMENT)
@@ -205,6 +207,9 @@ def test_a_protos_pose_is_found_by_get_from_proto_def_and_not_removed(tmp_path):
     assert call(lv, "get_node_pose", {"node": found["node"]})["position"] == [1.0, 0.0, 1.0]
     plate = call(lv, "get_from_proto_def", {"node": table, "name": "PLATE"})
     assert plate["parent"] == found["node"]
+    message = lv.err(A, "/probe/robot/set_field", {"node": found["node"], "field": "translation",
+                                                    "value": [0.0, 0.0, 2.0]}, ErrorCode.INVALID_ARGUMENT)
+    assert "PROTO internal field" in message and "\n" not in message, message
     message = lv.err(A, "/probe/robot/remove_node", {"node": found["node"]}, ErrorCode.INVALID_ARGUMENT)
     assert message == ("remove_node: Node 'DEF TOP Pose' is internal to a PROTO and therefore cannot be deleted from "
                        "a Supervisor.")
@@ -222,3 +227,158 @@ def test_an_imported_solids_pose_is_a_node_too():
     assert readings(lv)[0] == pytest.approx(0.9, abs=1e-6)        # the box's near face, 0.1 m before x = 1
     call(lv, "remove_node", {"node": pose})
     assert readings(lv) == before and node(lv, "BOX.P") == 0
+
+
+def _written(tmp_path, name: str, old: str, new: str):
+    text = WORLD.read_text()
+    assert text.count(old) == 1
+    path = tmp_path / name
+    path.write_text(text.replace(old, new))
+    return path
+
+
+TOP_AT = "      translation 0 0 1\n      rotation 0 0 1 1.5707963267948966\n"
+
+
+def test_a_set_moves_what_it_holds_as_the_world_file_written_with_that_value(tmp_path):
+    lv = _live()
+    ids = {n: node(lv, n) for n in ("TABLE", "LEG", "TOP", "MARKER", "LAMP", "G", "T", "INNER", "OTHER")}
+    children = get(lv, ids["TABLE"], "children")
+    readings(lv)
+    loaded_image = image(lv)
+    call(lv, "set_field", {"node": ids["TOP"], "field": "translation", "value": [0.5, 0.0, 1.0]})
+    lidar, ls = readings(lv)
+    # the marker's near face 0.5 m further, at 2.3; the lamp at (2.5, 0, 1): 2 / 7.25^1.5
+    assert lidar == pytest.approx(2.3, abs=1e-6) and ls == pytest.approx(2.0 / 7.25 ** 1.5, rel=1e-12)
+    call(lv, "set_field", {"node": ids["TOP"], "field": "rotation", "value": [0.0, 0.0, 1.0, 0.0]})
+    lidar, ls = readings(lv)
+    assert lidar == pytest.approx(2.4, abs=1e-6)       # unturned: 0.2 m along x, its near face at 2.5 - 0.1
+    twin = _live(_written(tmp_path, "top.wbt", TOP_AT, "      translation 0.5 0 1\n      rotation 0 0 1 0\n"))
+    assert (lidar, ls) == readings(twin) and image(lv) == image(twin) != loaded_image       # bit for bit
+    # every handle still names its node; the fields read the values set; its world pose and its shape's follow
+    assert {n: node(lv, n) for n in ids} == ids and get(lv, ids["TABLE"], "children") == children
+    assert get(lv, ids["TOP"], "children") == [ids["MARKER"], ids["LAMP"]]
+    assert get(lv, ids["TOP"], "translation") == [0.5, 0.0, 1.0]
+    assert get(lv, ids["TOP"], "rotation") == [0.0, 0.0, 1.0, 0.0]
+    assert call(lv, "get_node_pose", {"node": ids["TOP"]})["position"] == [2.5, 0.0, 0.0]
+    assert get(lv, ids["LAMP"], "location") == [0.0, 0.0, 1.0]       # in its Pose's frame, as written
+    # exportString and worldSave write the values set
+    assert call(lv, "node_export_string", {"node": ids["TOP"]})["value"].splitlines()[:3] == [
+        "DEF TOP Pose {", "  translation 0.5 0 1", "  rotation 0 0 1 0"]
+    assert "    DEF TOP Pose {\n      translation 0.5 0 1\n" in call(lv, "world_save")["value"]
+    # a reset puts the loaded value back (WbPose::reset), handles still valid
+    call(lv, "simulation_reset")
+    assert readings(lv) == readings(_live()) and image(lv) == loaded_image
+    assert get(lv, ids["TOP"], "translation") == [0.0, 0.0, 1.0] and node(lv, "TABLE.TOP.MARKER") == ids["MARKER"]
+    assert "translation 0 0 1" in call(lv, "node_export_string", {"node": ids["TOP"]})["value"]
+
+
+def test_a_transform_set_moves_the_solid_it_holds_and_a_moved_table_stays_where_it_was(tmp_path):
+    lv = _live()
+    table, top, t, inner = (node(lv, n) for n in ("TABLE", "TOP", "T", "INNER"))
+    call(lv, "set_field", {"node": table, "field": "translation", "value": [2.0, 0.0, -2.0]})
+    call(lv, "set_field", {"node": top, "field": "translation", "value": [0.0, 0.0, 3.0]})  # the marker off the beam
+    # T at (2 - 0.6, 0, 0): the sphere INNER (r 0.05) at x = 1.5, its near face at 1.45
+    call(lv, "set_field", {"node": t, "field": "translation", "value": [-0.6, 0.0, 2.0]})
+    assert call(lv, "get_node_pose", {"node": inner})["position"] == pytest.approx([1.5, 0.0, 0.0], abs=1e-15)
+    assert call(lv, "get_node_pose", {"node": table})["position"] == [2.0, 0.0, -2.0]
+    lidar, _ = readings(lv)
+    assert lidar == pytest.approx(1.45, abs=1e-6)
+    text = WORLD.read_text().replace("  translation 2 0 -1\n", "  translation 2 0 -2\n").replace(
+        TOP_AT, "      translation 0 0 3\n      rotation 0 0 1 1.5707963267948966\n").replace(
+        "          translation 0 0.5 1\n", "          translation -0.6 0 2\n")
+    (tmp_path / "t.wbt").write_text(text)
+    twin = _live(tmp_path / "t.wbt")
+    assert readings(lv) == readings(twin) and image(lv) == image(twin)
+    call(lv, "simulation_reset")
+    assert readings(lv) == readings(_live())
+    assert call(lv, "get_node_pose", {"node": inner})["position"] == pytest.approx([2.1, 0.5, 0.0], abs=1e-15)
+
+
+def test_a_shapes_colour_set_before_stays_and_a_reset_brings_back_both(tmp_path):
+    lv = _live()
+    top, marker = node(lv, "TOP"), node(lv, "MARKER")
+    readings(lv)
+    loaded_image = image(lv)
+    material = get(lv, get(lv, marker, "appearance"), "material")
+    call(lv, "set_field", {"node": material, "field": "emissiveColor", "value": [0.0, 1.0, 0.0]})
+    call(lv, "set_field", {"node": top, "field": "translation", "value": [0.5, 0.0, 1.0]})
+    assert get(lv, material, "emissiveColor") == [0.0, 1.0, 0.0]
+    twin = _live(_green_moved(tmp_path))
+    assert readings(lv) == readings(twin) and image(lv) == image(twin)
+    call(lv, "simulation_reset")
+    readings(lv)
+    assert image(lv) == loaded_image and get(lv, material, "emissiveColor") == [1.0, 0.0, 0.0]
+
+
+def _green_moved(tmp_path):
+    path = tmp_path / "green_moved.wbt"
+    path.write_text(WORLD.read_text().replace("emissiveColor 1 0 0", "emissiveColor 0 1 0").replace(
+        TOP_AT, "      translation 0.5 0 1\n      rotation 0 0 1 1.5707963267948966\n"))
+    return path
+
+
+def test_a_set_is_refused_in_one_line_where_a_rebuild_would_undo_other_changes():
+    for undone in ({"node": "LAMP", "field": "intensity", "value": 1.0}, "LEG"):
+        lv = _live()
+        top = node(lv, "TOP")
+        if isinstance(undone, dict):
+            call(lv, "set_field", {**undone, "node": node(lv, undone["node"])})
+        else:
+            call(lv, "remove_node", {"node": node(lv, undone)})
+        before = readings(lv)
+        message = lv.err(A, "/probe/robot/set_field", {"node": top, "field": "translation",
+                                                        "value": [0.5, 0.0, 1.0]}, ErrorCode.INVALID_ARGUMENT)
+        assert "would undo" in message and "\n" not in message, message
+        assert get(lv, top, "translation") == [0.0, 0.0, 1.0] and readings(lv) == before
+
+
+def test_an_imported_solids_pose_set_moves_its_shape():
+    lv = _live()
+    call(lv, "set_field", {"node": node(lv, "TOP"), "field": "translation", "value": [0.0, 0.0, 3.0]})
+    call(lv, "import_node_from_string", {"node": 0, "field": "children", "position": -1, "node_string":
+                                         "DEF BOX Solid { translation 1 0 0 children [ DEF P Pose { children [ "
+                                         "DEF S Shape { geometry Box { size 0.2 0.2 0.2 } } ] } ] }"})
+    pose, shape = node(lv, "BOX.P"), node(lv, "BOX.P.S")
+    assert readings(lv)[0] == pytest.approx(0.9, abs=1e-6)
+    call(lv, "set_field", {"node": pose, "field": "translation", "value": [0.5, 0.0, 0.0]})
+    assert readings(lv)[0] == pytest.approx(1.4, abs=1e-6)          # the box's near face, 0.1 m before x = 1.5
+    assert node(lv, "BOX.P") == pose and node(lv, "BOX.P.S") == shape and get(lv, pose, "children") == [shape]
+    assert "DEF P Pose {\n      translation 0.5 0 0\n" in call(lv, "node_export_string", {"node": node(lv, "BOX")})["value"]
+
+
+def _recognised(text: str) -> str:
+    """The world with TABLE recognised (red), INNER a radar target and the camera recognising."""
+    for old, new in (('  name "table"\n', '  name "table"\n  recognitionColors [ 1 0 0 ]\n'),
+                     ('              name "inner"\n', '              name "inner"\n              radarCrossSection 1\n'),
+                     ('      name "camera"\n', '      name "camera"\n      recognition Recognition { }\n')):
+        assert text.count(old) == 1, old
+        text = text.replace(old, new)
+    return text
+
+
+def _seen(lv: Live) -> tuple[list, dict]:
+    cam = lv.sim.robot("probe").device("camera")
+    cam.recognition_enable(8)
+    lv.step(A, "probe")
+    scene = lv.sim.scene
+    targets = {str(k): (scene.target_pose(k).translation.tolist(), scene.target_pose(k).rotation.tolist())
+               for k in scene.radar_targets}
+    return [o.as_dict() for o in cam.objects], targets
+
+
+def test_recognition_and_radar_targets_follow_as_the_world_file_written_so(tmp_path):
+    (tmp_path / "r.wbt").write_text(_recognised(WORLD.read_text()))
+    lv = _live(tmp_path / "r.wbt")
+    loaded = _seen(lv)
+    call(lv, "set_field", {"node": node(lv, "TOP"), "field": "rotation", "value": [0.0, 0.0, 1.0, 0.3]})
+    call(lv, "set_field", {"node": node(lv, "T"), "field": "translation", "value": [-0.6, 0.0, 1.2]})
+    moved = _seen(lv)
+    (tmp_path / "twin.wbt").write_text(_recognised(WORLD.read_text()).replace(
+        TOP_AT, "      translation 0 0 1\n      rotation 0 0 1 0.3\n").replace(
+        "          translation 0 0.5 1\n", "          translation -0.6 0 1.2\n"))
+    assert moved == _seen(_live(tmp_path / "twin.wbt")) != loaded
+    assert len(moved[0]) == 1 and len(moved[1]) == 1      # the table recognised, INNER a target
+    assert list(moved[1].values())[0][0] == pytest.approx([1.5, 0.0, 0.2], abs=1e-15)   # (2, 0, -1) + T + 0.1 x
+    call(lv, "simulation_reset")
+    assert _seen(lv) == loaded

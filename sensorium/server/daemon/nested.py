@@ -113,6 +113,8 @@ class Table:
                                                 # the nodes inside them (export leaves them out)
     segments: dict[int, str] = dataclasses.field(default_factory=dict)  # owner id -> its solid's name, for those in ``added``
     end: int = FIRST_ID                         # the next id to give (ids are never reused)
+    set_own: dict[int, Pose] = dataclasses.field(default_factory=dict)  # a solid's Pose or Transform a Supervisor
+                                                # set: its translation and rotation now (:func:`own_pose`)
     imports_seen: int = 0                       # how many of the simulation's imports were looked at
 
     def get(self, node_id: int) -> Nested | None:
@@ -574,6 +576,50 @@ def drop(table: Table, owner: int) -> None:
         del table.removed_shapes[node_id]
 
 
+def renew(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, kept: int) -> None:
+    """The nodes inside top-level solid ``owner`` (named ``key``) built again as ``solid``, the same tree with other
+    frames (a Supervisor set a Pose's fields inside it): each keeps its id (a Supervisor's handles stay valid, as
+    in Webots), its place and frame now ``solid``'s, its shape the new body's; node ``kept`` (the Pose set) keeps
+    its loaded ``own`` (export.py compares it with :attr:`Table.set_own`). Nothing inside it was removed (the
+    caller checks): the new nodes come in the order of the old ones."""
+    old = table.by_owner.get(owner, ())
+    segment = table.segments.get(owner)
+    start, forgotten = table.end, set(table.forgotten)
+    drop(table, owner)
+    add_solid(sim, table, owner, key, solid)
+    new = table.by_owner.pop(owner, ())
+    if len(new) != len(old) or any(a.type != b.type for a, b in zip(new, old)):
+        raise AssertionError(f"solid {key!r} built again into another tree")
+    ids = {n.id: o.id for n, o in zip(new, old)}
+
+    def real(node_id: int) -> int:
+        return ids.get(node_id, node_id)
+
+    renewed = [dataclasses.replace(n, id=real(n.id), parent=real(n.parent), frame=real(n.frame),
+                                   own=o.own if o.id == kept else n.own) for n, o in zip(new, old)]
+    for n in new:
+        table.added.pop(n.id, None)
+        table.by_parent.pop(n.id, None)
+    table.by_parent.pop(owner, None)
+    if table.inner is not None:
+        for instance in [k for k in table.inner if k in ids or k == owner]:
+            defs = table.inner.pop(instance)
+            table.inner[real(instance)] = {k: real(v) if isinstance(v, int) else v for k, v in defs.items()}
+    nodes = list(table.nodes)
+    for n in renewed:
+        k = n.id - FIRST_ID
+        if 0 <= k < len(nodes):
+            nodes[k] = n
+        else:
+            table.added[n.id] = n
+    table.nodes = tuple(nodes)
+    table.forgotten = forgotten
+    table.end = start
+    if segment is None:
+        table.segments.pop(owner, None)
+    _index(renewed, table.by_owner, table.by_parent)
+
+
 def drop_shape(table: Table, shape: int) -> None:
     """A Shape node (or a light, or a solid's Pose or Group) a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
     getFromProtoDef finds them and their ids read as removed (never given again)."""
@@ -654,6 +700,8 @@ def own_pose(sim: Any, table: Table, n: Nested) -> Pose | None:
     axis through the anchor by the joint's displacement, slid along the axis)."""
     if n.own is None:
         return None
+    if n.id in table.set_own:
+        return table.set_own[n.id]
     above = table.get(n.frame)
     if n.joint == (above.joint if above is not None else ""):
         return n.own                        # moved with its frame, or nothing moved

@@ -37,6 +37,7 @@ from sensorium.server.daemon import appearance, nested, visuals
 from sensorium.server.daemon.mf_items import item_position
 from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import balance, states, viewshot
+from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import RAISE, custom_data_chars, number_problem
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion, pose_from_model
 from sensorium.server.world.top_nodes import Scenery
@@ -780,6 +781,8 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
     if n.light >= 0:                   # a light inside a robot or solid: as a top-level light's
         return FIELDS[n.type]
     out = dict(_NESTED_POSE) if n.own is not None else {}
+    if n.own is not None and n.owner_kind == "Solid" and n.type in ("Pose", "Transform") and n.at:
+        out = {name: (kind, get, _solid_pose_setter(name)) for name, (kind, get, _) in out.items()}
     if n.type == "Transform" and n.owner_kind == "Solid":      # (a scaled one inside a solid is no node here)
         out["scale"] = ("SFVec3f", lambda sim, node: [1.0, 1.0, 1.0], None)
     if n.name:
@@ -797,6 +800,86 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
         out["position"] = ("SFFloat", lambda sim, node: nested.joint_position(sim, _nested_of(sim, node)),
                            _set_parameter_position)
     return out
+
+
+def _solid_pose_setter(field: str) -> Setter:
+    return lambda sim, node, value: _set_solid_pose(sim, node, field, value)
+
+
+def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> None:
+    """A Pose's or Transform's ``translation`` or ``rotation`` inside a top-level solid set (WbPose): what it
+    holds (shapes, lights, solids) is from the next measurement where the world file written with that value
+    puts it, its solid built again through the path a PROTO field set takes (sim/regenerate.py
+    ``rebuild_posed``); every node inside the solid keeps its id. ``simulationReset`` puts the loaded value
+    back (:func:`reset_solid_poses`); its shapes keep the appearances a Supervisor gave them. One line and nothing
+    changed for a solid a rebuild would lose more of (a node inside it removed, a light's field set) or a
+    Charger's."""
+    from sensorium.server.sim.imports import ImportRefused
+    from sensorium.server.sim.regenerate import rebuild_posed, written_fields, written_value
+
+    if not all(math.isfinite(v) for v in value):
+        raise ValueError(f"field {field!r}: values must be finite")
+    if field == "translation":
+        check_pose(translation=value)
+    if field == "rotation" and math.hypot(*value[:3]) == 0.0:
+        raise ValueError("rotation axis must not be zero")
+    table = _table(sim)
+    n = _nested_of(sim, node)
+    key, scene = n.owner_key, sim.scene
+    if any(m.owner == n.owner for m in table.removed_shapes.values()) or set(scene.solid_shapes(key)) & \
+            scene.removed_shapes or any(k[0] == key for k in scene.changed_carried()):
+        raise ValueError(f"field {field!r} of {_what(node)} not set: a Supervisor removed a node or changed a light "
+                         f"inside solid {key!r}, which building it again with the new frame would undo; nothing "
+                         "changed")
+    if any(c.solid == key for c in sim.chargers):
+        raise ValueError(f"field {field!r} of {_what(node)} not set: solid {key!r} is a Charger's (its glowing "
+                         "shapes stay those it loaded with here); nothing changed")
+    looks = scene.appearance_changes(key)
+    at = (n.at[0], n.at[1])
+    loaded = written_fields(sim, key, at, ("translation", "rotation"))
+    if loaded is None:
+        raise ValueError(f"field {field!r} of {_what(node)} not set: solid {key!r} was not loaded from a .wbt "
+                         "world file's node kept here (a solid a Supervisor imported); nothing changed")
+    own = nested.own_pose(sim, table, n)
+    assert own is not None
+    now_pose = scene.solid_poses[key]
+    built = pose_from_model(next(s for s in reversed(sim.world.solids) if s.name == key).pose)
+    moved = not (np.array_equal(now_pose.translation, built.translation)
+                 and np.array_equal(now_pose.rotation, built.rotation))
+    kind = "SFVec3f" if field == "translation" else "SFRotation"
+    try:
+        made = rebuild_posed(sim, key, n.owner, at, {field: written_value(kind, value)})
+    except ImportRefused as exc:
+        raise ValueError(f"field {field!r} of {_what(node)} not set: {exc}; nothing changed") from None
+    if moved:                        # built where the solid was loaded, then moved where the Supervisor put it
+        sim.place_solid(key, now_pose)
+    scene.take_appearance_changes(key, looks)       # (its shapes keep the colours a Supervisor gave them)
+    sim.__dict__.setdefault("_posed", {}).setdefault(key, {}).setdefault(at, (n.id, loaded))
+    nested.renew(sim, table, n.owner, key, made.model, n.id)
+    translation = np.asarray(value, dtype=np.float64) if field == "translation" else own.translation
+    rotation = axis_angle_matrix(value[:3], value[3]) if field == "rotation" else own.rotation
+    table.set_own[n.id] = Pose(rotation, translation)
+
+
+def reset_solid_poses(sim: Any) -> None:
+    """After a ``simulationReset``: the Poses and Transforms a Supervisor set inside top-level solids back at
+    their loaded values (WbPose::reset), their solids built again so (node ids kept)."""
+    from sensorium.server.sim.regenerate import rebuild_posed
+
+    posed = sim.__dict__.pop("_posed", {})
+    if not posed:
+        return
+    table = _table(sim)
+    for key, sets in posed.items():
+        if key not in sim.scene.solid_poses:
+            continue
+        owner = next(n.owner for n_id, _ in sets.values() for n in [table.get(n_id)] if n is not None)
+        made = None
+        for at, (node_id, loaded) in sets.items():
+            made = rebuild_posed(sim, key, owner, at, loaded)
+            table.set_own.pop(node_id, None)
+        assert made is not None
+        nested.renew(sim, table, owner, key, made.model, -1)
 
 
 def _sf_child(sim: Any, parent: int, field: str) -> int:
@@ -1368,6 +1451,10 @@ def set_field(sim: Any, node: Node, field: str, value: Any, level: int = -1) -> 
                          "Supervisor sets a Material's diffuseColor, emissiveColor and transparency, a "
                          "PBRAppearance's baseColor, roughness, metalness, transparency and emissiveColor and an "
                          "ImageTexture's url, repeatS, repeatT and filtering only")
+    if setter is None and node.nested and field in ("translation", "rotation") and node.type in _SOLID_POSES \
+            and _nested_of(sim, node).owner_kind == "Solid":      # (one written in a PROTO's body: no place)
+        raise ValueError(f"field {field!r} ({kind}) of {_what(node)} is a PROTO internal field, read-only as in "
+                         "Webots: set the PROTO's fields instead; nothing changed")
     if setter is None and node.nested:
         raise ValueError(f"field {field!r} ({kind}) of {what} is read-only here: a Supervisor moves and changes "
                          "top-level robots, solids and lights only, not the nodes inside them")
@@ -1781,6 +1868,7 @@ them): what Webots would print in its console, e.g. an imported node's corrected
 
 def _reset(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     sim.reset()
+    reset_solid_poses(sim)
     return {"success": True}
 
 

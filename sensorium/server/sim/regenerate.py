@@ -65,8 +65,9 @@ def _world_instances(sim: Any) -> tuple[WbtFile, dict[str, ParsedNode]]:
         solids = 0
         faces = sim.top_level.interfaces
         for written, top in zip(wbt.nodes, sim.loaded.world.top_nodes):
-            if top.solids == 1 and not top.robots and not top.lights and ("solids", solids) in faces:
-                instances[sim.scene.solid_names[solids]] = written
+            if top.solids == 1 and not top.robots and not top.lights and (("solids", solids) in faces
+                                                                          or written.type == "Solid"):
+                instances[sim.scene.solid_names[solids]] = written      # (a plain Solid: its Poses' sets)
             solids += top.solids
         kept = (replace(wbt, nodes=[]), instances)
     sim._regen_world = kept
@@ -112,4 +113,62 @@ def regenerate(sim: Any, key: str, node_id: int, values: dict[str, tuple[str, An
         sim.imported_interfaces[key] = node.interface
     else:
         sim.top_level.interfaces[("solids", sim.scene.solid_names.index(key))] = node.interface
+    return node
+
+
+def _replaced(node: ParsedNode, at: tuple[int, int], fields: dict[str, Any]) -> ParsedNode | None:
+    """``node`` with the node written at ``at`` (line, column, in the same file) given ``fields`` (None:
+    the field taken out, as unwritten), or None when no node inside it is written there."""
+    if (node.line, node.col) == at:
+        new = {k: v for k, v in node.fields.items() if k not in fields}
+        new.update({k: v for k, v in fields.items() if v is not None})
+        order = [*(k for k in new if k not in node.fields), *node.fields]     # (pose fields first, as Webots writes)
+        return replace(node, fields={k: new[k] for k in order if k in new})
+    for name, value in node.fields.items():
+        items = value if isinstance(value, list) else [value]
+        for i, item in enumerate(items):
+            if isinstance(item, ParsedNode):
+                found = _replaced(item, at, fields)
+                if found is not None:
+                    value = found if not isinstance(value, list) else [*value[:i], found, *value[i + 1:]]
+                    return replace(node, fields={**node.fields, name: value})
+    return None
+
+
+def written_fields(sim: Any, key: str, at: tuple[int, int], names: tuple[str, ...]) -> dict[str, Any] | None:
+    """The values ``names`` have in the node written at ``at`` inside top-level solid ``key`` as it is
+    written now (None each: unwritten); None when that node is not at hand (:func:`rebuild_posed`)."""
+    found = _instance(sim, key)
+    if found is None:
+        return None
+    stack = [found[0]]
+    while stack:
+        node = stack.pop()
+        if (node.line, node.col) == at:
+            return {name: node.fields.get(name) for name in names}
+        for value in node.fields.values():
+            stack += [v for v in (value if isinstance(value, list) else [value]) if isinstance(v, ParsedNode)]
+    return None
+
+
+def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields: dict[str, Any]) -> ImportedNode:
+    """Top-level solid ``key`` (Supervisor node ``node_id``) built again with the Pose or Transform written at
+    ``at`` inside it given ``fields`` (a parsed value each; None: unwritten): what that Pose holds is where
+    the world file written with those values puts it, through the path a PROTO field set takes
+    (:func:`regenerate`). ``ImportRefused`` (one line, nothing changed) when the solid's written node is not
+    at hand here (a solid a Supervisor imported) or does not build."""
+    found = _instance(sim, key)
+    if found is None:
+        raise ImportRefused(f"solid {key!r} was not loaded from a .wbt world file's node kept here")
+    written, file = found
+    new = _replaced(written, at, fields)
+    if new is None:
+        raise ImportRefused(f"no node of solid {key!r} is written at line {at[0]}, column {at[1]}")
+    taken = set(sim.scene.solid_names) - {key}
+    node = rebuild_node(new, file, sim.loaded, sim.world, taken=taken, limits=sim.limits,
+                        allow_outside_meshes=sim.allow_outside_meshes)
+    if node.type != "Solid" or node.model.name != key:
+        raise ImportRefused(f"solid {key!r} does not build again as it was")
+    sim.replace_solid(key, node, node_id)
+    sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
     return node

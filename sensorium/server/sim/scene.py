@@ -709,6 +709,23 @@ class Scene:
         """The shapes of top-level solid ``name`` (its own, then its nested solids'), in order."""
         return [k for k, (key, _, _) in enumerate(self._parts) if key == name]
 
+    def appearance_changes(self, name: str) -> dict[int, tuple[wm.Appearance | None, dict]]:
+        """What a Supervisor changed of top-level solid ``name``'s shapes' appearances, by each shape's place
+        among the solid's shapes: its appearance now and the values set (:meth:`take_appearance_changes`)."""
+        return {k: (self._parts[shape][2].appearance, dict(self.appearance_values.get(shape, {})))
+                for k, shape in enumerate(self.solid_shapes(name)) if shape in self._loaded_models}
+
+    def take_appearance_changes(self, name: str, changes: dict[int, tuple[wm.Appearance | None, dict]]) -> None:
+        """:meth:`appearance_changes` given to top-level solid ``name`` built again with the same shapes (a
+        Supervisor set a Pose's frame inside it): each of its shapes at those places looks as it did (a reset
+        brings back the appearance the world file gives it)."""
+        mine = self.solid_shapes(name)
+        for k, (appearance, values) in changes.items():
+            if appearance is not None:
+                self.set_texture(mine[k], appearance)
+            if values:
+                self.appearance_values[mine[k]] = values
+
     def glow_of(self, shape: int) -> tuple[float, float, float] | None:
         """A Charger's emissive colour for a shape now (:meth:`set_glow`), None where no Charger set one."""
         return self._glow.get(shape)
@@ -943,6 +960,10 @@ class Scene:
                 if m is old:
                     models[j] = new
                     return
+
+    def changed_carried(self) -> set[tuple[str | int, int]]:
+        """The (owner, index) of the carried lights a Supervisor set or removed."""
+        return set(self._set_carried) | self.removed_carried
 
     def remove_carried_light(self, owner: str | int, index: int) -> None:
         """Take light ``index`` of a robot or top-level solid out for good (a Supervisor's ``node.remove()``):
