@@ -258,3 +258,149 @@ def test_the_c_library_and_the_cpp_class_write_webots_degrees_text_for_every_dou
     for value, line in zip(values, lines):
         want = dms_reference(value)
         assert line == f"{want}|{want}", value
+
+
+# ---------------------------------------------------------------- Display screens
+#
+# A Display (``Dw`` x ``Dh``) whose first child is a 1 m Plane on the floor, its appearance a PBRAppearance
+# with black base and an ImageTexture as emissiveColorMap (no url, a url, or beside a url-less baseColorMap),
+# no lights: what a camera sees of the plane is the display's image through the emissive path alone. The
+# camera (W x W pixels, W a multiple of both sizes) 1 m above it looks straight down with tan(fov/2) = 1/2,
+# its image up the world's +x and right its −y: pixel (j, i) sees the floor point x = (W/2 − j − ½)/W,
+# y = (W/2 − i − ½)/W, the texel (⌊(x + ½)·Dw⌋, ⌊(½ − y)·Dh⌋) (column, row: the Plane's texture lies with
+# its top row at +y), never within 1/2W of a texel's edge. Random drawing (colours, opacity, lines,
+# rectangles, ovals, pixels, coordinates past the display's edges and far out) then: each channel of the
+# camera is one strictly increasing function of the texel's channel (the tone mapping's, the same for every
+# pixel), black for black, at every step a drawing changed the image.
+
+SCREEN_WBT = """#VRML_SIM R2025a utf8
+WorldInfo {{ basicTimeStep 16 }}
+Robot {{
+  children [
+    Display {{
+      children [
+        Shape {{
+          appearance PBRAppearance {{ baseColor 0 0 0 {maps} roughness 1 metalness 0 }}
+          geometry Plane {{ }}
+        }}
+      ]
+      name "screen"
+      width {dw}
+      height {dh}
+    }}
+  ]
+  name "board"
+  controller "<extern>"
+}}
+Robot {{
+  translation 0 0 1
+  rotation 0 1 0 1.5707963267948966
+  children [ Camera {{ name "camera" width {w} height {w} fieldOfView {fov!r} }} ]
+  name "eye"
+  controller "<extern>"
+}}
+"""
+SCREEN_MAPS = {"emissive": 'emissiveColorMap ImageTexture { filtering 0 }',
+               "emissive url": 'emissiveColorMap ImageTexture { url "grey.png" filtering 0 }',
+               "base and emissive": 'baseColorMap ImageTexture { } emissiveColorMap ImageTexture { filtering 0 }'}
+
+
+def screen_world(folder, dw: int, dh: int, maps: str) -> tuple[object, int]:
+    """The world above in ``folder`` (and its grey.png); its camera's width."""
+    from PIL import Image
+
+    w = math.lcm(dw, dh)
+    w *= max(1, -(-16 // w))
+    Image.fromarray(np.full((4, 4, 3), 77, np.uint8)).save(folder / "grey.png")
+    path = folder / "screen.wbt"
+    path.write_text(SCREEN_WBT.format(maps=SCREEN_MAPS[maps], dw=dw, dh=dh, w=w, fov=2 * math.atan(0.5)))
+    return path, w
+
+
+def seen_texels(dw: int, dh: int, w: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each camera pixel's texel (row, column arrays of w x w), by the closed form above."""
+    j, i = np.meshgrid(np.arange(w), np.arange(w), indexing="ij")
+    x, y = (w / 2 - j - 0.5) / w, (w / 2 - i - 0.5) / w
+    return np.floor((0.5 - y) * dh).astype(int), np.floor((x + 0.5) * dw).astype(int)
+
+
+def one_increasing_function(texel: np.ndarray, seen: np.ndarray) -> None:
+    """``seen`` (n,) is f(``texel``) (n,) for one strictly increasing f with f(0) = 0."""
+    pairs = np.unique(np.stack([texel, seen], axis=1), axis=0)
+    values, counts = np.unique(pairs[:, 0], return_counts=True)
+    assert (counts == 1).all(), f"texel values seen as two: {pairs[np.isin(pairs[:, 0], values[counts > 1])]}"
+    assert (np.diff(pairs[:, 1].astype(int)) > 0).all(), pairs
+    if pairs[0, 0] == 0:
+        assert pairs[0, 1] == 0, pairs
+
+
+coord = st.integers(-6, 18) | st.sampled_from([-65536, 65536, -(2**31), 2**31 - 1])
+
+
+def display_command(draw) -> list:
+    op = draw(st.sampled_from(["color", "opacity", "pixel", "line", "rectangle", "oval"]))
+    if op == "color":
+        return ["color", draw(st.integers(0, 0xFFFFFF))]
+    if op == "opacity":
+        return ["opacity", draw(st.sampled_from([1.0, 1.0, 0.5, 0.25]))]
+    if op == "pixel":
+        return ["pixel", draw(coord), draw(coord)]
+    if op == "line":
+        return ["line", draw(coord), draw(coord), draw(coord), draw(coord)]
+    small = st.integers(-6, 18)
+    return [op, draw(small), draw(small), draw(st.integers(1, 20)), draw(st.integers(1, 20)), draw(st.booleans())]
+
+
+@st.composite
+def drawings(draw) -> list[list[list]]:
+    return [[display_command(draw) for _ in range(draw(st.integers(1, 8)))] for _ in range(draw(st.integers(1, 4)))]
+
+
+def a_camera_sees_the_screen_as_drawn(folder, dw: int, dh: int, maps: str, steps: list[list[list]]) -> None:
+    from sensorium.server.world.loader import load_world
+
+    path, w = screen_world(folder, dw, dh, maps)
+    sim = Simulation(load_world(path), "exact")
+    cam, display = sim.device("eye/camera"), sim.device("board/screen")
+    cam.enable(16)
+    rows, cols = seen_texels(dw, dh, w)
+    for commands in [[]] + steps:
+        display.apply(display.check(commands), sim.time_ms)
+        sim.step()
+        texels = np.asarray(display.pixels, dtype=np.uint32)[rows, cols]
+        assert ((texels >> 24) == 0xFF).all()           # (opaque: no alpha drawn)
+        image = np.asarray(cam.image)[..., :3].astype(np.uint8)     # B, G, R
+        for k, shift in enumerate((0, 8, 16)):
+            one_increasing_function(((texels >> shift) & 0xFF).ravel().astype(np.uint8), image[..., k].ravel())
+
+
+@pytest.mark.parametrize("examples", example_counts(80, 4))
+def test_a_camera_sees_a_display_s_random_drawing_on_its_screen_by_the_texel_closed_form(tmp_path, examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.integers(1, 10), st.integers(1, 10), st.sampled_from(sorted(SCREEN_MAPS)), drawings())
+    def check(dw: int, dh: int, maps: str, steps: list[list[list]]) -> None:
+        a_camera_sees_the_screen_as_drawn(tmp_path, dw, dh, maps, steps)
+
+    check()
+
+
+@pytest.mark.parametrize("maps", sorted(SCREEN_MAPS))
+def test_regression_a_screen_whose_emissive_color_map_has_no_url_shows_the_image(tmp_path, maps: str) -> None:
+    """Found by the property above: a screen whose PBRAppearance's ImageTexture without url is its
+    emissiveColorMap stayed black (the image went to the base map, which its black base colour and no
+    light show as black; WbDisplay replaces the emissiveColorMap's texture, and both maps when both are
+    ImageTextures). A 4 x 2 display of eight colours, the camera's pixels by the closed form."""
+    colours = [0x102030, 0xF0E0D0, 0x00FF00, 0x808080, 0xFF0000, 0x0000FF, 0x404000, 0xFFFFFF]
+    a_camera_sees_the_screen_as_drawn(tmp_path, 4, 2, maps, [[c for k, colour in enumerate(colours) for c in (
+        ["color", colour], ["pixel", k % 4, k // 4])]])
+    from sensorium.server.world.loader import load_world
+
+    sim = Simulation(load_world(tmp_path / "screen.wbt"), "exact")
+    assert sim.world.robots[0].devices[0].screen_maps == (
+        ["emissive_map"] if maps != "base and emissive" else ["texture", "emissive_map"])
+    cam = sim.device("eye/camera")
+    cam.enable(16)
+    sim.device("board/screen").apply(sim.device("board/screen").check([["color", 0xFFFFFF],
+                                                                       ["rectangle", 0, 0, 4, 2, True]]), 0)
+    sim.step()
+    assert (np.asarray(cam.image)[..., :3] > 150).all()          # white everywhere (black before the fix)
