@@ -10,7 +10,12 @@ are its Simulation's bits at every step, with the C pass and with numpy's, every
 GPS degrees text: the Python client, the C library and the C++ class write Webots' text (its rule computed
 apart) for any double: NaN, ±inf, −0, subnormals, ±180, values a hair off whole seconds, past int's range.
 
-Display screens: see their section below."""
+Display screens: a camera looking straight down at a Display's screen sees its random drawing by the texel
+closed form, whichever of its maps the screen's ImageTextures are (fixed: a url-less emissiveColorMap).
+
+A solid's Poses, Transforms and Groups as Supervisor nodes: random trees and random operation sequences against
+a model of the tree and of Webots' getFromDef (copies imported from exportString included); the lidar's range
+after each operation the nearest live box face on its beam."""
 
 from __future__ import annotations
 
@@ -27,7 +32,7 @@ from test_sweep18 import clib  # noqa: F401 - a fixture: our libController, buil
 
 from sensorium.server.sim.batched import BatchedError, BatchedSimulation
 from sensorium.server.sim.simulation import Simulation
-from sensorium.server.world.loader import WorldError, parse_world
+from sensorium.server.world.loader import WorldError, load_world, parse_world
 
 # ---------------------------------------------------------------- batched free wheels
 
@@ -357,8 +362,6 @@ def drawings(draw) -> list[list[list]]:
 
 
 def a_camera_sees_the_screen_as_drawn(folder, dw: int, dh: int, maps: str, steps: list[list[list]]) -> None:
-    from sensorium.server.world.loader import load_world
-
     path, w = screen_world(folder, dw, dh, maps)
     sim = Simulation(load_world(path), "exact")
     cam, display = sim.device("eye/camera"), sim.device("board/screen")
@@ -404,3 +407,236 @@ def test_regression_a_screen_whose_emissive_color_map_has_no_url_shows_the_image
                                                                        ["rectangle", 0, 0, 4, 2, True]]), 0)
     sim.step()
     assert (np.asarray(cam.image)[..., :3] > 150).all()          # white everywhere (black before the fix)
+
+
+# ---------------------------------------------------------------- Poses, Transforms and Groups as nodes
+#
+# A top-level solid ROOT at (2, 0, 0) holding a random tree of Poses (translations on a 0.1 m grid, quarter
+# turns about z), Transforms (scale 1), Groups and Box shapes (sizes 0.12, 0.26, 0.34: their faces never at
+# y = 0 or z = 0 exactly), every node DEF'd N0, N1, ... A supervisor at the origin with a one-beam lidar
+# along +x runs a random sequence of getFromDef (plain, dotted through the DEF'd ancestors, dotted past a
+# level: NULL), children, world positions, remove(), exportString of a node then importMFNodeFromString of
+# it inside a new solid, and simulationReset, against a model of the tree: ids stable, removed ones NULL
+# (also after the reset), children in file order, positions the composed poses (1e-12), and after every
+# operation the lidar's range the nearest box face on its beam (float32's 1e-6), inf for none.
+
+QUARTERS = [np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]),
+            np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]),
+            np.array([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]),
+            np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])]
+ROOT_AT = np.array([2.0, 0.0, 0.0])
+grid = st.integers(-4, 4).map(lambda k: k / 10.0)
+
+
+@st.composite
+def pose_trees(draw, depth: int = 0) -> list[dict]:
+    """Children lists: each a dict type, translation, quarter (turns about z), size (Box), children."""
+    out = []
+    for _ in range(draw(st.integers(0 if depth else 1, 3))):
+        kind = draw(st.sampled_from(["Pose", "Transform", "Group", "Shape"] if depth < 3 else ["Shape"]))
+        node: dict = {"type": kind, "children": []}
+        if kind in ("Pose", "Transform"):
+            node["translation"] = [draw(grid), draw(grid), draw(grid)]
+            node["quarter"] = draw(st.integers(0, 3))
+        if kind == "Shape":
+            node["size"] = [draw(st.sampled_from([0.12, 0.26, 0.34])) for _ in range(3)]
+        else:
+            node["children"] = draw(pose_trees(depth + 1))
+        out.append(node)
+    return out
+
+
+def number_nodes(children: list[dict], parent: dict | None, out: list[dict]) -> None:
+    for node in children:
+        node["def"], node["parent"] = f"N{len(out)}", parent
+        out.append(node)
+        number_nodes(node["children"], node, out)
+
+
+def vrml(node: dict, indent: str) -> str:
+    inner = indent + "  "
+    if node["type"] == "Shape":
+        size = " ".join(repr(v) for v in node["size"])
+        return f"{indent}DEF {node['def']} Shape {{ geometry Box {{ size {size} }} }}\n"
+    head = f"{indent}DEF {node['def']} {node['type']} {{\n"
+    if node["type"] != "Group":
+        t = " ".join(repr(v) for v in node["translation"])
+        head += f"{inner}translation {t}\n{inner}rotation 0 0 1 {node['quarter'] * math.pi / 2!r}\n"
+    return head + f"{inner}children [\n" + "".join(vrml(c, inner + "  ") for c in node["children"]) + f"{inner}]\n{indent}}}\n"
+
+
+def tree_world(children: list[dict]) -> str:
+    return ("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 8 }\n"
+            'DEF PROBE Robot { name "probe" supervisor TRUE controller "<extern>" children [ Lidar { name "lidar" '
+            "horizontalResolution 1 fieldOfView 0.1 numberOfLayers 1 minRange 0.05 maxRange 10 } ] }\n"
+            "DEF ROOT Solid {\n  translation 2 0 0\n  name \"root\"\n  children [\n"
+            + "".join(vrml(c, "    ") for c in children) + "  ]\n}\n")
+
+
+def world_frame(node: dict | None) -> tuple[np.ndarray, np.ndarray]:
+    """(rotation, translation) of a node's frame in the world (a Group's: its parent's)."""
+    if node is None:
+        return np.eye(3), ROOT_AT.copy()
+    rot, at = world_frame(node["parent"])
+    if node["type"] in ("Pose", "Transform"):
+        return rot @ QUARTERS[node["quarter"]], at + rot @ np.array(node["translation"])
+    return rot, at
+
+
+def alive(node: dict) -> bool:
+    while node is not None:
+        if node.get("removed"):
+            return False
+        node = node["parent"]
+    return True
+
+
+def copied(node: dict, parent: dict | None) -> dict:
+    """A live subtree's copy (an imported exportString), its nodes marked ``copy``."""
+    out = {"def": node["def"], "type": node["type"], "parent": parent, "copy": True}
+    out["children"] = [copied(c, out) for c in node["children"] if not c.get("removed")]
+    return out
+
+
+def resolve(scene: list[dict], dotted: str) -> dict | None:
+    """Webots' getFromDef in the model: the first live node of the path's first DEF in the scene tree's
+    order (depth first, children in order), then each further name a live direct child of the last."""
+    first, *rest = dotted.split(".")
+
+    def search(nodes: list[dict]) -> dict | None:
+        for n in nodes:
+            if n.get("removed"):
+                continue
+            if n["def"] == first:
+                return n
+            hit = search(n["children"])
+            if hit is not None:
+                return hit
+        return None
+
+    at = search(scene)
+    for name in rest:
+        if at is None:
+            return None
+        at = next((c for c in at["children"] if c["def"] == name and not c.get("removed")), None)
+    return at
+
+
+def beam_range(nodes: list[dict]) -> float:
+    """The nearest face x of a live box across the lidar's beam (y = z = 0, x > 0), inf for none."""
+    best = math.inf
+    for node in nodes:
+        if node["type"] != "Shape" or not alive(node):
+            continue
+        rot, centre = world_frame(node["parent"])
+        half = np.abs(rot) @ (np.array(node["size"]) / 2.0)
+        if abs(centre[1]) < half[1] and abs(centre[2]) < half[2]:
+            best = min(best, float(centre[0] - half[0]))
+    return best
+
+
+operations = st.lists(st.tuples(st.sampled_from(["find", "dotted", "skip", "children", "position", "remove",
+                                                 "copy", "reset"]), st.integers(0, 1000)), min_size=1, max_size=8)
+
+
+def supervisor_ops_follow_the_model(children: list[dict], ops: list[tuple[str, int]], folder) -> None:
+    from test_supervisor import A, Live
+
+    nodes: list[dict] = []
+    number_nodes(children, None, nodes)
+    path = folder / "tree.wbt"
+    path.write_text(tree_world(children))
+    lv = Live(Simulation(load_world(path)))
+    lv.ok(A, "attach", {"robot": "probe"})
+
+    def call(item: str, args: dict | None = None):
+        return lv.ok(A, f"/probe/robot/{item}", args)
+
+    def find(name: str) -> int:
+        return call("get_from_def", {"name": name})["node"]
+
+    def reading() -> float:
+        lv.step(A, "probe")
+        return float(np.asarray(lv.sim.robot("probe").device("lidar").range_image).reshape(-1)[0])
+
+    lv.sim.robot("probe").device("lidar").enable(8)
+    root = find("ROOT")
+    ids = {n["def"]: find(n["def"]) for n in nodes}
+    assert 0 not in ids.values() and len(set(ids.values())) == len(ids)
+    copies = 0
+
+    def check_range(what) -> None:
+        want, got = beam_range(nodes), reading()
+        assert got == want if math.isinf(want) else got == pytest.approx(want, abs=1e-6), (what, got, want)
+
+    scene = [{"def": "ROOT", "type": "Solid", "children": children}]     # the root's solids: ROOT, then copies
+
+    def expect(got: int, want: dict | None, what) -> None:
+        if want is None:
+            assert got == 0, what
+        elif want.get("copy"):              # a copy's node: an id of its own
+            assert got not in (0, *ids.values()), what
+        else:
+            assert got == ids[want["def"]], what
+
+    check_range("start")
+    for op, k in ops:
+        node = nodes[k % len(nodes)]
+        name = node["def"]
+        if op == "find":
+            expect(find(name), resolve(scene, name), (op, name))
+        elif op == "dotted":                 # from a DEF'd ancestor (ROOT or any) down to it, level by level
+            chain = [node]
+            while chain[-1]["parent"] is not None:
+                chain.append(chain[-1]["parent"])
+            chain.append({"def": "ROOT"})
+            start = k % len(chain)
+            dotted = ".".join(n["def"] for n in reversed(chain[:start + 1]))
+            expect(find(dotted), resolve(scene, dotted), (op, dotted))
+        elif op == "skip":                   # a dotted path past a level names nothing
+            if node["parent"] is not None:
+                assert find(f"ROOT.{name}") == 0, (op, name)
+        elif op == "children" and node["type"] != "Shape" and alive(node):
+            want = [ids[c["def"]] for c in node["children"] if not c.get("removed")]
+            assert call("get_field", {"node": ids[name], "field": "children"})["value"] == want, (op, name)
+        elif op == "position" and node["type"] in ("Pose", "Transform") and alive(node):
+            got = call("get_node_pose", {"node": ids[name]})
+            rot, at = world_frame(node)
+            assert got["position"] == pytest.approx(at.tolist(), abs=1e-12), (op, name)
+            assert got["orientation"] == pytest.approx(rot.reshape(-1).tolist(), abs=1e-12), (op, name)
+        elif op == "remove" and alive(node):
+            call("remove_node", {"node": ids[name]})
+            node["removed"] = True
+            expect(find(name), resolve(scene, name), (op, name))
+            check_range(("remove", name))
+        elif op == "copy" and alive(node):   # its text imported inside a new solid far off the beam
+            text = call("node_export_string", {"node": ids[name]})["value"]
+            copies += 1
+            call("import_node_from_string", {"node": 0, "field": "children", "position": -1, "node_string":
+                                             f"DEF C{copies} Solid {{ translation 0 {4 + copies} 0 name \"c{copies}\" "
+                                             f"children [ {text} ] }}"})
+            scene.append({"def": f"C{copies}", "type": "Solid", "children": [copied(node, None)]})
+            copy = find(f"C{copies}.{name}")
+            assert copy not in (0, *ids.values()), (op, name)
+            again = call("node_export_string", {"node": copy})["value"]
+            assert again == text, (op, name)
+            if node["type"] != "Shape":
+                live_children = [c for c in node["children"] if not c.get("removed")]
+                assert len(call("get_field", {"node": copy, "field": "children"})["value"]) == len(live_children)
+            check_range(("copy", name))
+        elif op == "reset":
+            call("simulation_reset")
+            lv.sim.robot("probe").device("lidar").enable(8)
+            check_range("reset")
+    assert call("get_field", {"node": root, "field": "children"})["value"] == [
+        ids[c["def"]] for c in children if not c.get("removed")]
+
+
+@pytest.mark.parametrize("examples", example_counts(80, 4))
+def test_supervisor_operations_on_a_solid_s_poses_follow_a_model_of_the_tree(tmp_path, examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(pose_trees(), operations)
+    def check(children: list[dict], ops: list[tuple[str, int]]) -> None:
+        supervisor_ops_follow_the_model(children, ops, tmp_path)
+
+    check()
