@@ -742,3 +742,60 @@ def test_a_tracked_robot_rests_on_the_lowest_point_of_its_tracks_bounding_object
         assert sim.robot("tank").pose.translation == pytest.approx([0.0, 0.0, -bottom], abs=1e-12)
 
     check()
+
+
+# ---------------------------------------------------------------- a bumper touching its robot's own parts
+#
+# A robot (selfCollision TRUE or FALSE) with a bumper box of random size at (0.1, 0, 0.05) on its body, a
+# slider "a" (along x) on the body whose end point "first" (a random box) starts on the bumper, and a slider
+# "b" (along y) on "first" whose end point "second" (a random box) starts 0.3 m beside it. Both sliders
+# driven to random positions: once there, the bumper reads 1 exactly when selfCollision is TRUE and
+# second's box overlaps the bumper's (axis-aligned boxes: |Δ| < (s₁ + s₂)/2 on every axis), never for
+# "first", consecutive to the body (cases within 1e-3 of touching left out).
+
+def bumper_world(folder, flag: str, stop: list[float], first: list[float], second: list[float]):
+    def box(size: list[float]) -> str:
+        return f"boundingObject Box {{ size {' '.join(repr(v) for v in size)} }}"
+
+    path = folder / "own_stop.wbt"
+    path.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 32 }\n"
+                    f'Robot {{ name "r" selfCollision {flag} children [\n'
+                    f'  TouchSensor {{ translation 0.1 0 0.05 name "stop" {box(stop)} }}\n'
+                    '  SliderJoint { jointParameters JointParameters { axis 1 0 0 } device [ LinearMotor { name "a" '
+                    'minPosition -1 maxPosition 1 } ]\n'
+                    f'    endPoint Solid {{ translation 0.1 0 0.05 name "first" {box(first)} children [\n'
+                    '      SliderJoint { jointParameters JointParameters { axis 0 1 0 } device [ LinearMotor { name "b" '
+                    'minPosition -1 maxPosition 1 } ]\n'
+                    f'        endPoint Solid {{ translation 0 0.3 0 name "second" {box(second)} }} }} ] }} }} ] }}\n')
+    return path
+
+
+box_size = st.lists(st.sampled_from([0.02, 0.05, 0.1]) | st.floats(0.01, 0.2), min_size=3, max_size=3)
+slide_a = st.floats(-0.15, 0.15).map(_plain)
+slide_b = st.floats(-0.45, -0.15).map(_plain) | st.floats(-0.6, 0.2).map(_plain)   # mostly near over the bumper
+
+
+@pytest.mark.parametrize("examples", example_counts(120, 4))
+def test_a_bumper_reads_the_overlap_of_its_robots_own_non_consecutive_part(tmp_path, examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.sampled_from(["TRUE", "FALSE"]), box_size, box_size, box_size, slide_a, slide_b)
+    def check(flag: str, stop: list[float], first: list[float], second: list[float], a: float, b: float) -> None:
+        gap = np.abs(np.array([a, 0.3 + b, 0.0])) - (np.array(stop) + np.array(second)) / 2.0
+        closest = float(gap.max())                # < 0: overlapping; > 0: apart
+        if abs(closest) < 1e-3:
+            return
+        sim = Simulation(load_world(bumper_world(tmp_path, flag, stop, first, second)), "exact")
+        sensor = sim.device("r/stop")
+        sensor.enable(32)
+        robot = sim.robot("r")
+        robot.motor("a").set_position(a)
+        robot.motor("b").set_position(b)
+        for _ in range(400):                      # until both sliders are there (10 m/s at most)
+            sim.step()
+            if robot.motor("a").position == a and robot.motor("b").position == b:
+                break
+        sim.step()
+        assert (robot.motor("a").position, robot.motor("b").position) == (a, b)
+        assert sensor.value == (1.0 if flag == "TRUE" and closest < 0.0 else 0.0), (closest, flag)
+
+    check()
