@@ -709,18 +709,19 @@ def piece_lowest(p: dict, track_z: float) -> float:
     return track_z + p["move"][2] + p["scale"] * (p["pose"][2] - below)
 
 
-def tracked_world(folder, tracks: list[tuple[float, list[dict]]]):
+def tracked_world(folder, tracks: list[tuple[float, list[dict]]], heading: float = 0.0, backwards: bool = False):
     text = []
+    turned = " rotation 0 0 1 3.141592653589793" if backwards else ""     # (a turn about up: the same bottom)
     for (z, pieces), side, y in zip(tracks, ("left", "right"), (0.15, -0.15)):
         bounds = pieces[0] if len(pieces) == 1 else {"group": False, "raw": pieces}
         bo = piece_vrml(bounds) if "raw" not in bounds else \
             "Group { children [ " + " ".join(piece_vrml(p) for p in pieces) + " ] }"
-        text.append(f'Track {{ translation 0 {y} {z!r} name "{side} track" boundingObject {bo} children [\n'
+        text.append(f'Track {{ translation 0 {y} {z!r}{turned} name "{side} track" boundingObject {bo} children [\n'
                     '  TrackWheel { position -0.1 0 radius 0.05 }\n  TrackWheel { position 0.1 0 radius 0.05 }\n'
                     f'] device [ LinearMotor {{ name "{side} motor" }} ] }}\n')
     path = folder / "tracked.wbt"
     path.write_text('#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 10 }\n'
-                    'Robot { name "tank" translation 0 0 2 children [\n'
+                    f'Robot {{ name "tank" translation 0 0 2 rotation 0 0 1 {heading!r} children [\n'
                     '  DEF BODY Shape { geometry Box { size 0.2 0.2 0.04 } }\n' + "".join(text)
                     + '] boundingObject USE BODY physics Physics { } }\n'
                     'Solid { name "floor" children [ DEF F Shape { geometry Plane { size 10 10 } } ] '
@@ -732,9 +733,9 @@ def tracked_world(folder, tracks: list[tuple[float, list[dict]]]):
 def test_a_tracked_robot_rests_on_the_lowest_point_of_its_tracks_bounding_objects(tmp_path, examples: int) -> None:
     @settings(SETTINGS, max_examples=examples)
     @given(st.lists(st.tuples(st.floats(-0.05, 0.05).map(_plain), st.lists(bound_pieces(), min_size=1, max_size=3)),
-                    min_size=2, max_size=2))
-    def check(tracks: list[tuple[float, list[dict]]]) -> None:
-        w = load_world(tracked_world(tmp_path, tracks))
+                    min_size=2, max_size=2), st.floats(-3.2, 3.2).map(_plain), st.booleans())
+    def check(tracks: list[tuple[float, list[dict]]], heading: float, backwards: bool) -> None:
+        w = load_world(tracked_world(tmp_path, tracks, heading, backwards))
         bottom = min(piece_lowest(p, z) for z, pieces in tracks for p in pieces)
         assert w.world.robots[0].differential_drive.wheel_bottom == pytest.approx(bottom, abs=1e-12)
         sim = Simulation(w)
