@@ -83,10 +83,14 @@ def command_of(robot: dict, rng: np.random.Generator) -> tuple[list[float], dict
 
 def batched_as_single(robot: dict, copies: int, seed: int, contact: bool, steps: int = 40) -> None:
     """The robot in ``copies`` batched copies against as many Simulations, commanded alike (random per
-    copy, new commands every 10 steps): loads with a WorldError line (or BatchedError's) or is the same
-    bits every step."""
+    copy, new commands every 10 steps; with ``contact``, inside four walls 0.3 m off that it meets): loads
+    with a WorldError line (or BatchedError's) or is the same bits every step."""
     try:
-        loaded = parse_world({"world_info": {"basic_time_step": 16, "contact": contact}, "robots": [robot]})
+        walls = [{"name": f"wall{k}", "pose": {"translation": [0.3 * x, 0.3 * y, 0.25]},
+                  "geometry": {"type": "box", "size": [0.1 if x else 1.2, 0.1 if y else 1.2, 0.5]}}
+                 for k, (x, y) in enumerate(((1, 0), (-1, 0), (0, 1), (0, -1)))] if contact else []
+        loaded = parse_world({"world_info": {"basic_time_step": 16, "contact": contact}, "solids": walls,
+                              "robots": [robot]})
     except WorldError as e:                     # one line per refused value, each naming the source
         assert str(e) and all(line.startswith("<memory>: ") for line in str(e).splitlines()), str(e)
         return
