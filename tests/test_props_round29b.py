@@ -22,6 +22,7 @@ A tracked robot with Physics on random Track bounding objects rests on their clo
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -638,6 +639,8 @@ def supervisor_ops_follow_the_model(children: list[dict], ops: list[tuple[str, i
             check_range("reset")
     assert call("get_field", {"node": root, "field": "children"})["value"] == [
         ids[c["def"]] for c in children if not c.get("removed")]
+    exported = call("node_export_string", {"node": root})["value"]      # the live nodes, in file order
+    assert re.findall(r"DEF (N\d+) ", exported) == [n["def"] for n in nodes if alive(n)]
 
 
 @pytest.mark.parametrize("examples", example_counts(400, 8))
