@@ -282,7 +282,7 @@ def test_the_c_library_and_the_cpp_class_write_webots_degrees_text_for_every_dou
 # y = (W/2 − i − ½)/W, the texel (⌊(x + ½)·Dw⌋, ⌊(½ − y)·Dh⌋) (column, row: the Plane's texture lies with
 # its top row at +y), never within 1/2W of a texel's edge. Random drawing (colours, opacity, lines,
 # rectangles, ovals, pixels, coordinates past the display's edges and far out) then: each channel of the
-# camera is one strictly increasing function of the texel's channel (the tone mapping's, the same for every
+# camera is one non-decreasing function of the texel's channel (the tone mapping's, the same for every
 # pixel), black for black, at every step a drawing changed the image.
 
 SCREEN_WBT = """#VRML_SIM R2025a utf8
@@ -337,11 +337,12 @@ def seen_texels(dw: int, dh: int, w: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def one_increasing_function(texel: np.ndarray, seen: np.ndarray) -> None:
-    """``seen`` (n,) is f(``texel``) (n,) for one strictly increasing f with f(0) = 0."""
+    """``seen`` (n,) is f(``texel``) (n,) for one non-decreasing f with f(0) = 0 (the tone mapping is
+    increasing, but its 8-bit output may give two near texel values one value: 64 and 65 both 129)."""
     pairs = np.unique(np.stack([texel, seen], axis=1), axis=0)
     values, counts = np.unique(pairs[:, 0], return_counts=True)
     assert (counts == 1).all(), f"texel values seen as two: {pairs[np.isin(pairs[:, 0], values[counts > 1])]}"
-    assert (np.diff(pairs[:, 1].astype(int)) > 0).all(), pairs
+    assert (np.diff(pairs[:, 1].astype(int)) >= 0).all(), pairs
     if pairs[0, 0] == 0:
         assert pairs[0, 1] == 0, pairs
 
