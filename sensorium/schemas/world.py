@@ -1423,6 +1423,11 @@ class Display(_Device):
     screen_shape: int | None = Field(default=None, ge=0, description=(
         "the robot's shape (index in its shapes) whose ImageTexture shows the display's image, as Webots "
         "replaces the texture of the Shape its Display's first child is or holds; None: no such shape"))
+    screen_maps: list[Literal["texture", "emissive_map"]] | None = Field(default=None, max_length=2, description=(
+        "the screen shape's maps the image replaces, each an ImageTexture of its appearance with a url or "
+        "none (texture: an Appearance's texture or a PBRAppearance's baseColorMap; emissive_map: its "
+        "emissiveColorMap), as WbDisplay replaces each; None: texture, and emissive_map when the "
+        "appearance has one"))
 
 
 class VacuumGripper(_Device):

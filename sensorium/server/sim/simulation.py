@@ -877,8 +877,8 @@ class Simulation:
         return out
 
     def _show_screens(self) -> None:
-        """Each display changed since it was last shown becomes its screen shape's texture (base and,
-        when the appearance has one, emissive map), from this step's measurements on."""
+        """Each display changed since it was last shown becomes its screen shape's texture (the maps
+        ``screen_maps`` names: base, emissive or both), from this step's measurements on."""
         for entry in self._screens:
             dev, shape, shown = entry
             if dev.measurements == shown:
@@ -889,9 +889,10 @@ class Simulation:
                 continue
             url = f"display:{dev.robot_name}/{dev.name}"
             texture = wm.Texture(url=url, filtering=0)
-            update: dict[str, Any] = {"texture": texture}
-            if app.emissive_map is not None:
-                update["emissive_map"] = texture
+            maps = dev.config.screen_maps
+            if maps is None:
+                maps = ["texture"] + (["emissive_map"] if app.emissive_map is not None else [])
+            update: dict[str, Any] = dict.fromkeys(maps, texture)
             self.scene.set_texture(shape, app.model_copy(update=update), {url: (Path(url), screen_image(dev.pixels))})
 
     def step(self) -> StepReport:

@@ -1679,6 +1679,11 @@ class Converter:
         made = [p for k, p in owner.keys.items() if geometry is not None and k[0] == id(geometry) and id(p) in added]
         if made:                # (none: its geometry was left out, with its own line)
             device["_screen"] = id(made[0])
+            # the maps WbDisplay replaces: each ImageTexture present, a url or none (the appearance keeps
+            # only those it loaded, so one without url would be missed, or the base given an image it lacks)
+            device["screen_maps"] = [m for m, keys in (("texture", ("texture", "baseColorMap")),
+                                                       ("emissive_map", ("emissiveColorMap",)))
+                                     if any(isinstance(look.fields.get(k), Node) for k in keys)]
             for k in ("texture", "baseColorMap", "emissiveColorMap"):    # the display's image replaces them:
                 texture = look.fields.get(k)                              # one not loaded (no url) is no loss
                 if isinstance(texture, Node):
