@@ -304,6 +304,35 @@ def test_a_camera_sees_the_ground_display_drawn_on_its_screen_shape() -> None:
     assert (np.asarray(cam.image)[..., :3].astype(int)[j, i][on_floor] == 0).all()
 
 
+def test_a_screen_is_retextured_only_while_something_may_see_it() -> None:
+    """A display drawn on every step while no ray-casting device is enabled (nothing can see its screen)
+    leaves its screen shape's texture alone, the drawing's cost only; enabling the camera shows the latest
+    drawing from that step, as if it had been shown all along; a Viewpoint picture shows it too."""
+    from sensorium.server.sim import viewshot
+
+    sim = Simulation(load_world(DATA / "display.wbt"), "exact")
+    cam, ground = sim.device("MyBot/camera"), sim.device("supervisor/ground_display")
+    assert not any(d.enabled for d in sim.all_devices() if d.kind in ("Camera", "DistanceSensor", "LightSensor"))
+    (screen,) = [shape for _dev, shape, _shown in sim._screens if _dev is ground]
+    loaded_texture = sim.scene.shape_model(screen).appearance.texture
+    for k in range(5):
+        draw(ground, ["color", LIGHT_GRAY if k % 2 else RED], ["rectangle", 0, 0, GROUND, GROUND, True])
+        sim.step()
+        assert sim.scene.shape_model(screen).appearance.texture is loaded_texture     # not retextured
+    draw(ground, ["color", LIGHT_GRAY], ["rectangle", 0, 0, GROUND, GROUND, True], ["color", RED],
+         ["line", GROUND // 2, 0, GROUND // 2, GROUND - 1])
+    viewshot.render(sim, 32, 24)                           # a Viewpoint picture shows what was drawn
+    assert sim.scene.shape_model(screen).appearance.texture.url == "display:supervisor/ground_display"
+    cam.enable(32)
+    sim.step()
+    j, i, col, row, edge = floor_texels(BOT0, range(96, 128))
+    seen = np.asarray(cam.image)[..., :3].astype(int)[j, i]
+    yellow = (seen[:, 2] > 80) & (seen[:, 1] > 80) & (seen[:, 0] < 40)
+    on_floor = (np.abs(col - 31.5) < 32) & (np.abs(row - 31.5) < 32) & ~yellow & (edge > 0.05)
+    red = seen[:, 2] > seen[:, 1] + 40
+    assert on_floor.sum() > 4000 and (red[on_floor] == (col[on_floor] == GROUND // 2)).all()
+
+
 # ------------------------------------------------------------------------------------------ gps_lat_long
 # gps_lat_long (projects/samples/devices, R2023b): a WGS84 world (gpsReference 40.67 −73.94 10); MyBot at
 # (0, −0.15) heading 1 rad runs `gps_lat_long` (64 ms): GPS latitude, longitude, altitude and speed printed

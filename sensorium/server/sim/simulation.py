@@ -89,6 +89,9 @@ from sensorium.server.world.poses import moved_pose
 from sensorium.server.world.report import warn_losses
 from sensorium.server.world.top_nodes import top_level
 
+# the devices that cast rays into the scene: what may see a Display's screen (its texels' colours, or its alpha
+# letting rays and shadows through); while none is enabled a screen is not retextured (Simulation.show_screens)
+SCREEN_WATCHERS = frozenset({"Camera", "RangeFinder", "DistanceSensor", "LightSensor", "Lidar", "Radar", "Receiver"})
 _REMOVED = wm.Solid.model_construct(name="", def_name="")   # a removed imported solid's model: its name and DEF
 _NOBODY: frozenset[int] = frozenset()   # no robot powered off (a world without batteries)
 
@@ -428,6 +431,8 @@ class Simulation:
             self._warn_ground()
         self._pens = [d for d in self.all_devices() if isinstance(d, Pen)]
         self._screens = self._display_screens()
+        # what may see a screen (its colours, its alpha's see-through and shadows): shown only while one is enabled
+        self._screen_watchers = [d for d in self.all_devices() if d.kind in SCREEN_WATCHERS] if self._screens else []
         self._speakers = [d for d in self.all_devices() if isinstance(d, Speaker)]
         self._grippers = [d for d in self.all_devices() if isinstance(d, VacuumGripper)]
         connectors = [d for d in self.all_devices() if isinstance(d, Connector)]
@@ -876,9 +881,11 @@ class Simulation:
                     out.append([dev, shape, -1])
         return out
 
-    def _show_screens(self) -> None:
+    def show_screens(self) -> None:
         """Each display changed since it was last shown becomes its screen shape's texture (the maps
-        ``screen_maps`` names: base, emissive or both), from this step's measurements on."""
+        ``screen_maps`` names: base, emissive or both), from this step's measurements on. A step calls it
+        while a device that may see a screen is enabled (``SCREEN_WATCHERS``), a Viewpoint picture
+        (viewshot.render) before it looks: a display drawn on while nothing looks costs nothing more."""
         for entry in self._screens:
             dev, shape, shown = entry
             if dev.measurements == shown:
@@ -912,8 +919,8 @@ class Simulation:
         if self._pens:                # pens ink at the pose the step starts from (Webots' prePhysicsStep)
             lay_ink(self._pens, self.scene, self.scene.robot_poses, now, self._counters)
         self.scene.evaporate_ink(dt)
-        if self._screens:             # what displays drew (with the step request) shows on their screens
-            self._show_screens()
+        if self._screens and any(d.enabled for d in self._screen_watchers):
+            self.show_screens()       # what displays drew (with the step request) shows on their screens
         for speaker in self._speakers:     # sounds and speech played for this step (sim/speaker.py)
             speaker.advance(dt, now)
         moved: list[tuple[RobotState, DifferentialDrive | AckermannDrive | MecanumDrive | OmniDrive | SteeredDrive,

@@ -164,6 +164,8 @@ def geometry(vp: Viewpoint, width: int, height: int) -> imaging.ImageGeometry:
 def render(sim: Any, width: int, height: int) -> np.ndarray:
     """The world seen from its Viewpoint now: RGB uint8 (height, width, 3), row 0 at the top."""
     width, height = parse_size_values(width, height)
+    if hasattr(sim, "show_screens"):      # displays drawn on while no device looked show now
+        sim.show_screens()
     vp = viewpoint_of(sim)
     g = geometry(vp, width, height)
     dirs = imaging.pixel_directions(g)[0]
