@@ -616,12 +616,38 @@ def test_robot_inside_groups_gets_the_composed_pose(tmp_path: Path) -> None:
     assert w.warnings == []
 
 
-def test_a_robot_on_a_robot_is_dropped_with_a_reason(tmp_path: Path) -> None:
-    p = write(tmp_path, 'Robot { name "base" children [ Robot { name "rider" } ] }\n')
+def test_a_robot_on_a_robot_rides_it_fixed_in_its_frame(tmp_path: Path) -> None:
+    """A Robot with a controller or a device in another robot's children (highway_overtake's radar robot) is a
+    robot of the world listed after its carrier, carried in the frame its place writes: here (1, 0, 0.5) on a
+    carrier at (2, 0, 0) facing +y, so at (2, 1, 0.5) facing +y, and it goes where the carrier goes."""
+    p = write(tmp_path, 'Robot { translation 2 0 0 rotation 0 0 1 1.5707963267948966 name "base" children [ '
+                        'Pose { translation 1 0 0 children [ Robot { translation 0 0 0.5 name "rider" '
+                        'children [ DistanceSensor { } ] } ] } ] }\n')
     w = load_world(p)
-    assert [r.name for r in w.world.robots] == ["base"]
-    assert (f"{p}:2:32: Robot 'rider' inside robot 'base': a robot riding on another robot is not supported here; "
-            "dropped with everything inside it") in w.warnings
+    assert [r.name for r in w.world.robots] == ["base", "rider"] and w.warnings == [] and w.report.losses == ()
+    rider = w.world.robots[1]
+    assert rider.carried_by is not None and rider.carried_by.robot == "base"
+    assert rider.carried_by.frame.translation == pytest.approx((1.0, 0.0, 0.5), abs=1e-12)
+    sim = Simulation(w)
+    pose = sim.robot("rider").pose
+    assert pose.translation == pytest.approx([2.0, 1.0, 0.5], abs=1e-12)
+    assert pose.rotation[:, 0] == pytest.approx([0.0, 1.0, 0.0], abs=1e-12)
+    sim.robot("base").set_pose(translation=[5.0, 5.0, 0.0], rotation=[0.0, 0.0, 1.0, math.pi])
+    sim.step()
+    assert sim.robot("rider").pose.translation == pytest.approx([4.0, 5.0, 0.5], abs=1e-12)
+    assert sim.robot("rider").pose.rotation[:, 0] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)
+
+
+@pytest.mark.parametrize("nest", ['Robot { name "rider" children [ Robot { name "third" controller "x" } ] }',
+                                  'HingeJoint { endPoint Solid { children [ Robot { name "third" controller "x" } ] '
+                                  '} device [ RotationalMotor { name "m" } ] }'])
+def test_a_robot_on_a_riding_robot_or_a_joint_is_dropped_with_a_reason(tmp_path: Path, nest: str) -> None:
+    p = write(tmp_path, f'Robot {{ name "base" children [ {nest} ] }}\n')
+    w = load_world(p)
+    assert "third" not in [r.name for r in w.world.robots]
+    (loss,) = w.report.losses
+    assert (loss.kind, loss.name) == ("robot", "third")
+    assert "a robot riding on another robot's joint, or on a robot that rides itself, is not supported" in loss.why
 
 
 def test_a_robot_without_controller_or_device_rides_its_robot_as_part_of_its_body(tmp_path: Path) -> None:
@@ -654,14 +680,12 @@ Robot {{ translation 0.2 1 0.05 rotation 0 0 1 -1.5707963267948966 name "eye" ch
 @pytest.mark.parametrize("inner", ['controller "<none>" children [ DistanceSensor { } ]',
                                    'controller "rider" children [ Pose { } ]',
                                    'children [ Shape { geometry Box { size 0.1 0.1 0.1 } } ]'])
-def test_a_robot_with_a_controller_or_a_device_on_a_robot_is_still_dropped(tmp_path: Path, inner: str) -> None:
-    # a controller that would run (Webots' default one included) or a device it would read: a loss, said
+def test_a_robot_with_a_controller_or_a_device_on_a_robot_rides_it(tmp_path: Path, inner: str) -> None:
+    # a controller that would run (Webots' default one included) or a device it would read: a robot of its own
     p = write(tmp_path, f'Robot {{ name "base" children [ Robot {{ name "rider" {inner} }} ] }}\n')
     w = load_world(p)
-    assert [r.name for r in w.world.robots] == ["base"]
-    (loss,) = w.report.losses
-    assert (loss.kind, loss.name) == ("robot", "rider")
-    assert loss.why.startswith("Robot 'rider' inside robot 'base': a robot riding on another robot is not supported")
+    assert [r.name for r in w.world.robots] == ["base", "rider"] and w.report.losses == ()
+    assert w.world.robots[1].carried_by is not None and w.world.robots[1].carried_by.robot == "base"
 
 
 def test_cameras_in_a_world_without_light_lit_by_a_background_in_webots_are_said_black(tmp_path: Path) -> None:

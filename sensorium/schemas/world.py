@@ -1999,6 +1999,15 @@ class CarriedTarget(Strict):
         return v
 
 
+class Carrier(Strict):
+    """The robot a robot rides on (Webots: a Robot with a controller or devices in another robot's children,
+    as the radar robot in highway_overtake's car): its pose is the carrier's composed with ``frame`` every
+    step, fixed there (no joint between them)."""
+
+    robot: str = Field(min_length=1, description="the carrying robot's name")
+    frame: Pose = Field(default=Pose(), description="this robot's frame in the carrier's")
+
+
 class Robot(Strict):
     name: str = Field(min_length=1)
     def_name: str | None = Field(default=None, min_length=1, description="Webots DEF name (Supervisor getFromDef)")
@@ -2037,6 +2046,9 @@ class Robot(Strict):
     custom_data: str = Field(default="", max_length=1 << 20, description="Webots customData (get/setCustomData)")
     model: str = Field(default="", max_length=4096, description="Webots model (getModel)")
     self_collision: bool = False
+    carried_by: Carrier | None = Field(
+        default=None, description="the robot this one rides on, fixed in its frame (a .wbt Robot nested in "
+        "another's children); its own pose is then where the carrier puts it")
     body: Shape | None = None
     shapes: list[Part] = Field(default=[], description="further body shapes, each with its pose in the robot frame")
     lights: list[Light] = Field(

@@ -504,6 +504,11 @@ class BatchedSimulation:
             raise BatchedError(f"{self.loaded.source}: Charger {lit[0]!r}: its lights' colour follows its energy, which "
                                f"{seeing[0][0]}/{seeing[0][1]} sees; the batched simulation runs no Charger (use "
                                "Simulation, or glow_lights: 0 and glow_solids: 0)")
+        riders = [r for r in w.robots if r.carried_by is not None]
+        if riders:                    # Simulation._carry moves them with their carriers; no copy here does
+            raise BatchedError(f"{self.loaded.source}: robot {riders[0].name!r} rides robot "
+                               f"{riders[0].carried_by.robot!r}; the batched simulation carries no robot (use "
+                               "Simulation)")
         belts = [(r.name, b.motor) for r in w.robots for b in r.belts]
         if belts:                     # sim/belt.py carries solids here on no copy: refused, not silently still
             raise BatchedError(f"{self.loaded.source}: robot {belts[0][0]!r}: its conveyor belt (motor {belts[0][1]!r}) "

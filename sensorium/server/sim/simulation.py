@@ -85,7 +85,7 @@ from sensorium.server.sim.vacuum import VacuumGripper, caught_at_load
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import WorldLimits, check_pose
 from sensorium.server.world.loader import LoadedWorld, from_model, load_world
-from sensorium.server.world.poses import moved_pose
+from sensorium.server.world.poses import moved_pose, pose_from_model
 from sensorium.server.world.report import warn_losses
 from sensorium.server.world.top_nodes import top_level
 
@@ -455,6 +455,17 @@ class Simulation:
         every = list(self.all_devices())
         self.radio = Radio([d for d in every if isinstance(d, Emitter)], [d for d in every if isinstance(d, Receiver)],
                            self.scene, self._counters)
+        # robots riding others (a .wbt Robot nested in another's children): each follows its carrier's pose,
+        # fixed in its frame, from the carrier's settled pose at load on
+        self._riders: list[tuple[RobotState, RobotState, Pose]] = [
+            (r, self.robots[r.model.carried_by.robot], pose_from_model(r.model.carried_by.frame))
+            for r in self.robots.values() if r.model.carried_by is not None]
+        for rider, _, _ in self._riders:
+            if rider.drive is not None:
+                raise ValueError(f"robot {rider.name!r}: a robot riding another has no drive of its own")
+        self._carry()
+        for rider, _, _ in self._riders:
+            rider.initial_pose = rider.pose
         self._initial: dict[str, Any] = {"robots": [(r.initial_pose, r.custom_data) for r in self.robots.values()],
                          "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights(),
                          "radar_targets": dict(self.scene.radar_targets)}
@@ -526,13 +537,22 @@ class Simulation:
 
     def place_robot(self, robot: RobotState, pose: Pose) -> None:
         """Put a robot somewhere from outside (no contact check). Its gyros and accelerometers see a
-        jump, not motion: their poses start over from there (_MotionSensor.placed)."""
+        jump, not motion: their poses start over from there (_MotionSensor.placed); the robots riding
+        it go with it."""
         self.scene.set_robot_pose(robot.index, pose)
         if self.contact is not None:
             self.contact.place(robot.index, pose, None if robot.drive is None else robot.drive.yaw)
         for dev in robot.devices.values():
             if dev.tracks_motion:
                 dev.placed()          # type: ignore[attr-defined]
+        for rider, carrier, frame in self._riders:
+            if carrier is robot:
+                self.place_robot(rider, carrier.pose.compose(frame))
+
+    def _carry(self) -> None:
+        """The robots riding others where their carriers now put them (as they moved)."""
+        for rider, carrier, frame in self._riders:
+            self.scene.set_robot_pose(rider.index, carrier.pose.compose(frame))
 
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
@@ -973,6 +993,8 @@ class Simulation:
                         self.contact.heights[robot.index] = drive.z    # (ENU, as contact works)
         for robot, _, _, pose in moved:
             self.scene.set_robot_pose(robot.index, pose)
+        if self._riders:
+            self._carry()
         if self._belts is not None:   # belts carry what lies on them by their motors' travel this step
             self._belts.carry(dt * 0.001)
         if self.falls:                # solids let go fall on before the grippers look (one may catch them)

@@ -426,6 +426,14 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
             else:
                 first[name] = path
 
+    robot_names = {r.name for r in world.robots}
+    carried = {r.name for r in world.robots if r.carried_by is not None}
+    for i, r in enumerate(world.robots):
+        if r.carried_by is not None and (r.carried_by.robot not in robot_names or r.carried_by.robot in carried
+                                         or r.carried_by.robot == r.name):
+            problems.append(Problem(f"robots[{i}].carried_by.robot", f"{r.carried_by.robot!r} is no other robot "
+                                    "that is not carried itself"))
+
     def name_ok(path: str, name: str, reserved: tuple[str, ...] = ()) -> None:
         # names become topic and service paths (/<robot>/<device>/value): a robot's name is one
         # segment; a device's may hold '/' as Webots' do (NAO: 'Sonar/Left'), one segment or more

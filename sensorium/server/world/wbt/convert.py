@@ -262,6 +262,9 @@ class Converter:
         self.checked: set[int] = set()     # nodes whose field names were checked
         self.device_depth = 0              # > 0 while inside a device's children (its joints are no wheels)
         self.riding: list[dict] = []       # the motor entries of the robot's joints being visited, innermost last
+        self.robot_frames: dict[str, Frame] = {}     # each robot's frame in the world, by its name
+        self.riders: dict[str, list[dict]] = {}      # the robots riding a robot being visited, by its name
+        self.in_rider = False                        # visiting a robot that rides another
         self.coupled_nodes: dict[int, Node] = {}   # id(motor entry) -> its node, for a 'group::part' name
         self.device_where: dict[int, str] = {}   # id(device entry) -> where its node is written
         self.led_of: dict[int, tuple[dict, Frame]] = {}   # id(light node) -> (its LED's entry, the LED's frame)
@@ -841,9 +844,20 @@ class Converter:
                                 f"its shapes and bounding objects are kept as part of {owner.data['name']!r}'s body "
                                 "(a robot riding on another robot is not simulated here)")
                 self.solid(node, frame, owner)
-            elif owner.kind == "robot":
+            elif owner.kind == "robot" and (self.riding or self.in_rider):
                 self.drop(node, f"Robot {name!r} inside robot {owner.data['name']!r}: a robot riding on another "
-                                "robot is not supported here; dropped with everything inside it", "robot", name)
+                                "robot's joint, or on a robot that rides itself, is not supported here; dropped with "
+                                "everything inside it", "robot", name)
+            elif owner.kind == "robot":      # it rides the robot, fixed in its frame (Webots: a static child)
+                riding, carrier = self.riding, owner.data
+                self.in_rider = True
+                try:
+                    self.robot(node, self.robot_frames[carrier["name"]].compose(frame))
+                finally:
+                    self.riding, self.in_rider = riding, False
+                rider = self.world["robots"].pop()      # listed after its carrier, as Webots' scene tree has it
+                rider["carried_by"] = {"robot": carrier["name"], "frame": self.child_frame(node, frame).pose()}
+                self.riders.setdefault(carrier["name"], []).append(rider)
             else:     # at the top or nested in solids and groups: a robot placed where they put it
                 self.robot(node, owner.placed.compose(frame))
         elif t == "Solid":
@@ -1730,6 +1744,7 @@ class Converter:
         unique = self.unique_robot(name)
         if unique != name:
             self.warn(node, f"robot name {name!r} used before: renamed {unique!r}")
+        self.robot_frames[unique] = inner
         data: dict[str, Any] = {"name": unique, "pose": inner.pose(),
                                 "synchronization": f.flag("synchronization", True), "devices": []}
         self.def_name(node, data)
@@ -1798,6 +1813,7 @@ class Converter:
         if not data["devices"]:
             del data["devices"]
         self.world["robots"].append(data)
+        self.world["robots"].extend(self.riders.pop(unique, ()))
 
     def devices_inside(self, robot: dict) -> None:
         """One warning for each visual device whose origin is inside one of its robot's closed
