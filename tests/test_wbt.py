@@ -638,6 +638,53 @@ def test_a_robot_on_a_robot_rides_it_fixed_in_its_frame(tmp_path: Path) -> None:
     assert sim.robot("rider").pose.rotation[:, 0] == pytest.approx([-1.0, 0.0, 0.0], abs=1e-12)
 
 
+def test_a_riding_robots_wheels_and_tracks_are_no_drive_and_its_carrier_carries_it(tmp_path: Path) -> None:
+    """A rider is fixed in its carrier's frame (Webots: no joint between them): its two wheels' hinges make no
+    drive (one line each, they turn as joints) and its two Tracks none either (one line), where a drive made
+    Simulation refuse the world; the carrier, a two-wheel robot of radius 0.05 m at 5 rad/s, rolls 0.25 m/s
+    and carries it 0.06 m above its origin."""
+    wheel = ('HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0 }} device [ '
+             'RotationalMotor {{ name "{side} wheel motor" }} ] endPoint Solid {{ translation 0 {y} 0 rotation 1 0 0 '
+             '1.5707963267948966 children [ Shape {{ geometry Cylinder {{ radius {r} height 0.01 }} }} ] '
+             'boundingObject Cylinder {{ radius {r} height 0.01 }} physics Physics {{ }} name "{side}" }} }}')
+    track = ('Track {{ translation 0 {y} 0 name "{side} track" device [ LinearMotor {{ name "{side} track motor" }} ] '
+             'boundingObject Box {{ size 0.1 0.02 0.02 }} children [ TrackWheel {{ radius 0.01 }} ] }}')
+    rider_parts = {"wheels": " ".join(wheel.format(y=y, side=side, r=0.03) for y, side in ((0.06, "left"),
+                                                                                         (-0.06, "right"))),
+                   "tracks": " ".join(track.format(y=y, side=side) for y, side in ((0.06, "left"), (-0.06, "right")))}
+    for kind, parts in rider_parts.items():
+        p = write(tmp_path, 'Robot { translation 0 0 0.05 name "truck" children [ '
+                            + " ".join(wheel.format(y=y, side=side, r=0.05) for y, side in ((0.12, "left"),
+                                                                                           (-0.12, "right")))
+                            + f' Robot {{ translation 0 0 0.06 name "rider" children [ {parts} ] }} ] '
+                            'physics Physics { } }\n', name=f"{kind}.wbt")
+        w = load_world(p)
+        truck, rider = w.world.robots
+        assert truck.differential_drive is not None and rider.carried_by is not None
+        assert (rider.differential_drive, rider.steered_drive) == (None, None), kind
+        riding = [x for x in w.warnings if "rides robot 'truck', fixed in its frame" in x]
+        assert len(riding) == (2 if kind == "wheels" else 1), (kind, w.warnings)
+        sim = Simulation(w)
+        for m in sim.robot("truck").motors.values():
+            m.set_position(math.inf)
+            m.set_velocity(5.0)
+        sim.run(50)
+        at = sim.robot("truck").pose.translation
+        assert at[0] == pytest.approx(50 * sim.basic_time_step * 0.001 * 5.0 * 0.05, abs=1e-12)
+        assert sim.robot("rider").pose.translation == pytest.approx(at + [0.0, 0.0, 0.06], abs=1e-12)
+
+
+def test_a_yaml_robot_carried_by_another_with_a_drive_is_refused_in_a_line() -> None:
+    from sensorium.server.world.loader import WorldError, parse_world
+
+    drive = {"left_motor": "l", "right_motor": "r", "wheel_radius": 0.02, "axle_length": 0.1}
+    with pytest.raises(WorldError) as caught:
+        parse_world({"robots": [{"name": "base"}, {"name": "rider", "carried_by": {"robot": "base"},
+                                                    "differential_drive": drive}]})
+    assert str(caught.value) == ("<memory>: robots[1] (rider).differential_drive: a robot riding another (carried_by) "
+                                 "has no drive of its own: it is fixed in its carrier's frame")
+
+
 @pytest.mark.parametrize("nest", ['Robot { name "rider" children [ Robot { name "third" controller "x" } ] }',
                                   'HingeJoint { endPoint Solid { children [ Robot { name "third" controller "x" } ] '
                                   '} device [ RotationalMotor { name "m" } ] }'])

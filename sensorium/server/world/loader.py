@@ -433,6 +433,11 @@ def check_world(world: wm.World, base_dir: Path, *, limits: WorldLimits | None =
                                          or r.carried_by.robot == r.name):
             problems.append(Problem(f"robots[{i}].carried_by.robot", f"{r.carried_by.robot!r} is no other robot "
                                     "that is not carried itself"))
+        drives = [k for k in ("differential_drive", "ackermann_drive", "mecanum_drive", "omni_drive", "steered_drive")
+                  if getattr(r, k) is not None]
+        if r.carried_by is not None and drives:
+            problems.append(Problem(f"robots[{i}].{drives[0]}", "a robot riding another (carried_by) has no drive "
+                                    "of its own: it is fixed in its carrier's frame"))
 
     def name_ok(path: str, name: str, reserved: tuple[str, ...] = ()) -> None:
         # names become topic and service paths (/<robot>/<device>/value): a robot's name is one

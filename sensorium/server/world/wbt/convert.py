@@ -264,7 +264,7 @@ class Converter:
         self.riding: list[dict] = []       # the motor entries of the robot's joints being visited, innermost last
         self.robot_frames: dict[str, Frame] = {}     # each robot's frame in the world, by its name
         self.riders: dict[str, list[dict]] = {}      # the robots riding a robot being visited, by its name
-        self.in_rider = False                        # visiting a robot that rides another
+        self.in_rider: str | None = None             # visiting a robot that rides another: that carrier's name
         self.coupled_nodes: dict[int, Node] = {}   # id(motor entry) -> its node, for a 'group::part' name
         self.device_where: dict[int, str] = {}   # id(device entry) -> where its node is written
         self.led_of: dict[int, tuple[dict, Frame]] = {}   # id(light node) -> (its LED's entry, the LED's frame)
@@ -850,11 +850,11 @@ class Converter:
                                 "everything inside it", "robot", name)
             elif owner.kind == "robot":      # it rides the robot, fixed in its frame (Webots: a static child)
                 riding, carrier = self.riding, owner.data
-                self.in_rider = True
+                self.in_rider = carrier["name"]
                 try:
                     self.robot(node, self.robot_frames[carrier["name"]].compose(frame))
                 finally:
-                    self.riding, self.in_rider = riding, False
+                    self.riding, self.in_rider = riding, None
                 rider = self.world["robots"].pop()      # listed after its carrier, as Webots' scene tree has it
                 rider["carried_by"] = {"robot": carrier["name"], "frame": self.child_frame(node, frame).pose()}
                 self.riders.setdefault(carrier["name"], []).append(rider)
@@ -2626,6 +2626,8 @@ class Converter:
         up = self._robot_up(robot, on_side=False)
         rolls = any(wheel_radius(w["end"], self) is not None for w in robot.wheels)
         drive, why = (None, "") if rolls or len(tracks) != 2 else track_drive(tracks, self, up)
+        if drive is not None and self.in_rider:       # fixed in its carrier's frame: its belts carry, it rolls nowhere
+            drive, why = None, f"it rides robot {self.in_rider!r}, fixed in its frame"
         if drive is None:
             if why:
                 self.warn(node, f"robot {robot.data['name']!r}: no tracked drive ({why}); the robot will not move")
@@ -2761,6 +2763,12 @@ class Converter:
 
         wheels = robot.wheels
         if not wheels:
+            return
+        if self.in_rider:               # fixed in its carrier's frame (Webots: no joint between them), it rolls nowhere
+            for w in wheels:
+                nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (robot "
+                                f"{robot.data['name']!r} rides robot {self.in_rider!r}, fixed in its frame): {JOINT_MOVES}",
+                                "its robot rides another"))
             return
         up = self._robot_up(robot)      # the robot's own up axis: its z, a y-up robot's y in a NUE world
         if up != 2:                     # a y-up robot's hinge steers about its y (the walk judged its z)
