@@ -674,6 +674,42 @@ def test_a_riding_robots_wheels_and_tracks_are_no_drive_and_its_carrier_carries_
         assert sim.robot("rider").pose.translation == pytest.approx(at + [0.0, 0.0, 0.06], abs=1e-12)
 
 
+def test_a_carrier_and_its_rider_are_one_body_for_contact(tmp_path: Path) -> None:
+    """A rider's 0.1 m box just ahead of its carrier's 0.4 m body (0.01 m gap): the carrier driving forward is
+    not stopped by its own rider (one body in Webots), but stops where the rider meets a wall 1 m ahead,
+    the rider's front face at the wall (1e-9); a robot then driven across where the rider was loaded passes
+    freely (the rider is met where it is now, not where the world file put it)."""
+    wheel = ('HingeJoint {{ jointParameters HingeJointParameters {{ axis 0 1 0 anchor 0 {y} 0 }} device [ '
+             'RotationalMotor {{ name "{side} wheel motor" }} ] endPoint Solid {{ translation 0 {y} 0 rotation 1 0 0 '
+             '1.5707963267948966 children [ Shape {{ geometry Cylinder {{ radius 0.05 height 0.02 }} }} ] '
+             'boundingObject Cylinder {{ radius 0.05 height 0.02 }} physics Physics {{ }} name "{side}" }} }}')
+    wheels = " ".join(wheel.format(y=y, side=side) for y, side in ((0.12, "left"), (-0.12, "right")))
+    p = write(tmp_path, f"""
+Robot {{ translation 0 0 0.05 name "truck" children [ {wheels}
+  Robot {{ translation 0.26 0 0 name "rider" children [ DistanceSensor {{ }} ] boundingObject Box {{ size 0.1 0.1 0.06 }} }} ]
+  boundingObject Box {{ size 0.4 0.2 0.06 }} physics Physics {{ }} }}
+Solid {{ translation 1.36 0 0.05 name "wall" boundingObject Box {{ size 0.1 2 0.1 }} }}
+Robot {{ translation 0.26 -0.6 0.05 rotation 0 0 1 1.5707963267948966 name "other" children [ {wheels} ]
+  boundingObject Box {{ size 0.2 0.2 0.06 }} physics Physics {{ }} }}
+""")
+    sim = Simulation(load_world(p))
+    truck, rider, other = sim.robot("truck"), sim.robot("rider"), sim.robot("other")
+    for m in truck.motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(5.0)
+    sim.run(20)                                             # 20 steps at 0.25 m/s: 0.16 m (32 ms steps)
+    assert truck.pose.translation[0] == pytest.approx(20 * sim.basic_time_step * 0.001 * 0.25, abs=1e-12)
+    sim.run(200)
+    # stopped by its rider: the rider's front face (0.26 + 0.05 ahead of the truck) on the wall's face (1.31)
+    assert truck.pose.translation[0] + 0.26 + 0.05 == pytest.approx(1.31, abs=1e-9)
+    assert rider.pose.translation[0] == pytest.approx(truck.pose.translation[0] + 0.26, abs=1e-12)
+    for m in other.motors.values():
+        m.set_position(math.inf)
+        m.set_velocity(5.0)
+    sim.run(100)                                            # 0.8 m along +y, across the rider's loaded place
+    assert other.pose.translation[1] == pytest.approx(-0.6 + 100 * sim.basic_time_step * 0.001 * 0.25, abs=1e-9)
+
+
 def test_a_yaml_robot_carried_by_another_with_a_drive_is_refused_in_a_line() -> None:
     from sensorium.server.world.loader import WorldError, parse_world
 

@@ -1427,6 +1427,9 @@ class Contact:
         # height band in the footprint's frame)}: the load is part of its carrier's outline, so the
         # carrier stops where its load meets something (:meth:`_clip_carrying`)
         self.loads: dict[int, dict[str, list[Footprint]]] = {}
+        # robot index -> the robots fixed to it (a robot riding another, its carrier, the carrier's other riders):
+        # one body in Webots, so they never stop or touch each other
+        self.attached: dict[int, frozenset[int]] = {}
         self._rebuild()
 
     def update_solid(self, name: str, pose: Pose) -> None:
@@ -1530,6 +1533,21 @@ class Contact:
         self._z_low[index] = foot.z_low if foot else nan
         self._z_high[index] = foot.z_high if foot else nan
 
+    def attach(self, groups: list[list[int]]) -> None:
+        """Each group's robots fixed to one another (a carrier and the robots riding it): never each other's
+        obstacle."""
+        for group in groups:
+            for i in group:
+                self.attached[i] = frozenset(self.attached.get(i, frozenset()) | (set(group) - {i}))
+
+    def fix_rider(self, index: int, rider: int, parts: list[tuple[geo.Primitive, Pose]]) -> None:
+        """Robot ``rider`` rides robot ``index``, fixed in its frame: its bounding shapes ``parts`` (the
+        carrier's frame, as :meth:`hold` takes a load's) are part of the carrier's outline, so the carrier
+        stops where its rider meets something, as one body in Webots; the two never meet (:meth:`attach`)."""
+        pieces = self.pieces(index, parts) if parts else []
+        if pieces:
+            self.loads.setdefault(index, {})[f"\0robot {rider}"] = pieces    # (no solid's name)
+
     def place(self, index: int, pose: Pose, yaw: float | None = None) -> None:
         """A robot was moved from outside (set_pose, reset): no contact check, as in Webots.
         ``yaw``: its drive's heading there (None: :func:`heading` of the pose)."""
@@ -1599,6 +1617,10 @@ class Contact:
                          & (c[None, :, 1] + r_all[None] >= box_lo[:, None, 1]) & (c[None, :, 1] - r_all[None] <= box_hi[:, None, 1])
                          & (a_hi[None] > band_lo[:, None] + EPS) & (a_lo[None] < band_hi[:, None] - EPS))
             robot_hit[np.arange(k), idx] = False
+            if self.attached:
+                for m, i in enumerate(idx.tolist()):
+                    for j in self.attached.get(i, ()):
+                        robot_hit[m, j] = False
         near_solids: list[list[int]] = [[] for _ in range(k)]
         near_robots: list[list[int]] = [[] for _ in range(k)]
         if len(self._obs):
@@ -1670,7 +1692,9 @@ class Contact:
     def touching(self, index: int, pieces: list[Footprint]) -> bool:
         """Whether robot ``index``'s ``pieces`` touch a solid or another robot where they all are now
         (:func:`pieces_touch`)."""
-        robots = [ob for j, f in enumerate(self.feet) if f is not None and j != index for ob in self._robot_obstacles(j)]
+        fixed = self.attached.get(index, ())
+        robots = [ob for j, f in enumerate(self.feet) if f is not None and j != index and j not in fixed
+                  for ob in self._robot_obstacles(j)]
         held = self.carried.get(index)      # what it carries is part of it: never touched
         solids = [ob for ob in self._obs if ob.name not in held] if held else self._obs
         return pieces_touch(pieces, self.centres[index], float(self.yaw[index]), float(self.heights[index]),

@@ -463,6 +463,15 @@ class Simulation:
         for rider, _, _ in self._riders:
             if rider.drive is not None:
                 raise ValueError(f"robot {rider.name!r}: a robot riding another has no drive of its own")
+        if self.contact is not None and self._riders:     # one body with its carrier: never each other's obstacle
+            carriers = {c.index: [c.index] for _, c, _ in self._riders}
+            for rider, carrier, _ in self._riders:
+                carriers[carrier.index].append(rider.index)
+            self.contact.attach(list(carriers.values()))
+            for rider, carrier, frame in self._riders:      # its shapes as loaded, part of its carrier's outline
+                parts = [(prim, frame.compose(local)) for prim, local in
+                         robot_bounding_parts(rider.model, self.loaded.base_dir)]
+                self.contact.fix_rider(carrier.index, rider.index, parts)
         self._carry()
         for rider, _, _ in self._riders:
             rider.initial_pose = rider.pose
@@ -552,7 +561,10 @@ class Simulation:
     def _carry(self) -> None:
         """The robots riding others where their carriers now put them (as they moved)."""
         for rider, carrier, frame in self._riders:
-            self.scene.set_robot_pose(rider.index, carrier.pose.compose(frame))
+            pose = carrier.pose.compose(frame)
+            self.scene.set_robot_pose(rider.index, pose)
+            if self.contact is not None:          # other robots meet it where it is now
+                self.contact.place(rider.index, pose)
 
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
