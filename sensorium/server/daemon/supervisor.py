@@ -476,13 +476,19 @@ Getter = Callable[[Any, Node], Any]
 Setter = Callable[[Any, Node, Any], None] | None
 
 
-def _set_pose(sim: Any, node: Node, field: str, value: list[float]) -> None:
+def _check_pose_value(field: str, value: list[float]) -> None:
+    """A ``translation`` or ``rotation`` value a Supervisor sets: finite, within the world's limits, a
+    rotation about a non-zero axis (one line each, nothing changed)."""
     if not all(math.isfinite(v) for v in value):
         raise ValueError(f"field {field!r}: values must be finite")
     if field == "translation":
         check_pose(translation=value)
     if field == "rotation" and math.hypot(*value[:3]) == 0.0:
         raise ValueError("rotation axis must not be zero")
+
+
+def _set_pose(sim: Any, node: Node, field: str, value: list[float]) -> None:
+    _check_pose_value(field, value)
     kwargs = {"translation": value} if field == "translation" else {"translation": None, "rotation": value}
     if node.type == "Robot":
         sim.robots[node.key].set_pose(**kwargs)
@@ -817,12 +823,7 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     from sensorium.server.sim.imports import ImportRefused
     from sensorium.server.sim.regenerate import rebuild_posed, written_fields, written_value
 
-    if not all(math.isfinite(v) for v in value):
-        raise ValueError(f"field {field!r}: values must be finite")
-    if field == "translation":
-        check_pose(translation=value)
-    if field == "rotation" and math.hypot(*value[:3]) == 0.0:
-        raise ValueError("rotation axis must not be zero")
+    _check_pose_value(field, value)
     table = _table(sim)
     n = _nested_of(sim, node)
     key, scene = n.owner_key, sim.scene
