@@ -39,7 +39,7 @@ from sensorium.server.daemon.roles import MAX_COORDINATE_M, check_pose
 from sensorium.server.sim import balance, states, viewshot
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import RAISE, custom_data_chars, number_problem
-from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion, pose_from_model
+from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion, moved_pose, pose_from_model
 from sensorium.server.world.top_nodes import Scenery
 
 T = TypeVar("T")
@@ -491,15 +491,27 @@ def _set_pose(sim: Any, node: Node, field: str, value: list[float]) -> None:
     _check_pose_value(field, value)
     kwargs = {"translation": value} if field == "translation" else {"translation": None, "rotation": value}
     if node.type == "Robot":
-        sim.robots[node.key].set_pose(**kwargs)
+        robot = sim.robots[node.key]
+        frame = sim.rider_frame(robot) if hasattr(sim, "rider_frame") else None
+        if frame is not None:        # a robot riding another: its fields are in its carrier's frame (WbPose)
+            sim.set_rider_frame(robot, moved_pose(frame, **kwargs))
+            return
+        robot.set_pose(**kwargs)
     else:
         sim.set_solid_pose(node.key, **kwargs)
 
 
+def _field_pose(sim: Any, node: Node) -> Any:
+    """What a robot's or solid's ``translation`` and ``rotation`` fields give: its pose in the world, a robot
+    riding another's in its carrier's frame (its parent's, as Webots gives a nested node's fields)."""
+    frame = sim.rider_frame(sim.robots[node.key]) if node.type == "Robot" and hasattr(sim, "rider_frame") else None
+    return _pose(sim, node) if frame is None else frame
+
+
 _POSE_FIELDS: dict[str, tuple[str, Getter, Setter]] = {
-    "translation": ("SFVec3f", lambda sim, n: [float(v) for v in _pose(sim, n).translation],
+    "translation": ("SFVec3f", lambda sim, n: [float(v) for v in _field_pose(sim, n).translation],
                     lambda sim, n, v: _set_pose(sim, n, "translation", v)),
-    "rotation": ("SFRotation", lambda sim, n: matrix_axis_angle(_pose(sim, n).rotation),
+    "rotation": ("SFRotation", lambda sim, n: matrix_axis_angle(_field_pose(sim, n).rotation),
                  lambda sim, n, v: _set_pose(sim, n, "rotation", v)),
 }
 

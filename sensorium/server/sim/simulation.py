@@ -16,7 +16,7 @@ import math
 import warnings
 from collections import Counter
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 from typing import Any, cast
@@ -92,6 +92,19 @@ from sensorium.server.world.top_nodes import top_level
 # the devices that cast rays into the scene: what may see a Display's screen (its texels' colours, or its alpha
 # letting rays and shadows through); while none is enabled a screen is not retextured (Simulation.show_screens)
 SCREEN_WATCHERS = frozenset({"Camera", "RangeFinder", "DistanceSensor", "LightSensor", "Lidar", "Radar", "Receiver"})
+@dataclass(slots=True)
+class Rider:
+    """A robot riding another, fixed in its frame (``carried_by``): its frame there now and as loaded."""
+
+    robot: RobotState
+    carrier: RobotState
+    frame: Pose
+    loaded_frame: Pose = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.loaded_frame = self.frame
+
+
 _REMOVED = wm.Solid.model_construct(name="", def_name="")   # a removed imported solid's model: its name and DEF
 _NOBODY: frozenset[int] = frozenset()   # no robot powered off (a world without batteries)
 
@@ -457,24 +470,21 @@ class Simulation:
                            self.scene, self._counters)
         # robots riding others (a .wbt Robot nested in another's children): each follows its carrier's pose,
         # fixed in its frame, from the carrier's settled pose at load on
-        self._riders: list[tuple[RobotState, RobotState, Pose]] = [
-            (r, self.robots[r.model.carried_by.robot], pose_from_model(r.model.carried_by.frame))
-            for r in self.robots.values() if r.model.carried_by is not None]
-        for rider, _, _ in self._riders:
-            if rider.drive is not None:
-                raise ValueError(f"robot {rider.name!r}: a robot riding another has no drive of its own")
+        self._riders = [Rider(r, self.robots[r.model.carried_by.robot], pose_from_model(r.model.carried_by.frame))
+                        for r in self.robots.values() if r.model.carried_by is not None]
+        for ride in self._riders:
+            if ride.robot.drive is not None:
+                raise ValueError(f"robot {ride.robot.name!r}: a robot riding another has no drive of its own")
         if self.contact is not None and self._riders:     # one body with its carrier: never each other's obstacle
-            carriers = {c.index: [c.index] for _, c, _ in self._riders}
-            for rider, carrier, _ in self._riders:
-                carriers[carrier.index].append(rider.index)
+            carriers = {ride.carrier.index: [ride.carrier.index] for ride in self._riders}
+            for ride in self._riders:
+                carriers[ride.carrier.index].append(ride.robot.index)
             self.contact.attach(list(carriers.values()))
-            for rider, carrier, frame in self._riders:      # its shapes as loaded, part of its carrier's outline
-                parts = [(prim, frame.compose(local)) for prim, local in
-                         robot_bounding_parts(rider.model, self.loaded.base_dir)]
-                self.contact.fix_rider(carrier.index, rider.index, parts)
+            for ride in self._riders:
+                self._fix_rider(ride)
         self._carry()
-        for rider, _, _ in self._riders:
-            rider.initial_pose = rider.pose
+        for ride in self._riders:
+            ride.robot.initial_pose = ride.robot.pose
         self._initial: dict[str, Any] = {"robots": [(r.initial_pose, r.custom_data) for r in self.robots.values()],
                          "solids": dict(self.scene.solid_poses), "lights": self.scene.top_lights(),
                          "radar_targets": dict(self.scene.radar_targets)}
@@ -554,17 +564,40 @@ class Simulation:
         for dev in robot.devices.values():
             if dev.tracks_motion:
                 dev.placed()          # type: ignore[attr-defined]
-        for rider, carrier, frame in self._riders:
-            if carrier is robot:
-                self.place_robot(rider, carrier.pose.compose(frame))
+        for ride in self._riders:
+            if ride.carrier is robot:
+                self.place_robot(ride.robot, robot.pose.compose(ride.frame))
 
     def _carry(self) -> None:
         """The robots riding others where their carriers now put them (as they moved)."""
-        for rider, carrier, frame in self._riders:
-            pose = carrier.pose.compose(frame)
-            self.scene.set_robot_pose(rider.index, pose)
+        for ride in self._riders:
+            pose = ride.carrier.pose.compose(ride.frame)
+            self.scene.set_robot_pose(ride.robot.index, pose)
             if self.contact is not None:          # other robots meet it where it is now
-                self.contact.place(rider.index, pose)
+                self.contact.place(ride.robot.index, pose)
+
+    def _fix_rider(self, ride: Rider) -> None:
+        """A rider's shapes as loaded, at its frame, part of its carrier's outline for contact."""
+        assert self.contact is not None
+        parts = [(prim, ride.frame.compose(local)) for prim, local in
+                 robot_bounding_parts(ride.robot.model, self.loaded.base_dir)]
+        self.contact.fix_rider(ride.carrier.index, ride.robot.index, parts)
+
+    def rider_frame(self, robot: RobotState, loaded: bool = False) -> Pose | None:
+        """A robot riding another: its frame in its carrier's now (``loaded``: as the world file put it), its
+        translation and rotation fields as Webots gives a nested node's, in its parent's frame; None for a
+        robot that rides none."""
+        ride = next((ride for ride in self._riders if ride.robot is robot), None)
+        return None if ride is None else ride.loaded_frame if loaded else ride.frame
+
+    def set_rider_frame(self, robot: RobotState, frame: Pose) -> None:
+        """A riding robot put elsewhere on its carrier (a Supervisor set its translation or rotation): fixed
+        there from now on, where a reset puts it back as loaded."""
+        ride = next(ride for ride in self._riders if ride.robot is robot)
+        ride.frame = frame
+        if self.contact is not None:
+            self._fix_rider(ride)
+        self.place_robot(robot, ride.carrier.pose.compose(frame))
 
     def reset(self) -> None:
         """Webots' ``simulationReset`` subset: robots and solids back to their initial poses, nodes a
@@ -610,6 +643,9 @@ class Simulation:
                     dev.reset_fov()
         self.radio.reset()
         self.falls.clear()
+        for ride in self._riders:        # each rider where the world file put it on its carrier
+            if ride.frame is not ride.loaded_frame:
+                self.set_rider_frame(ride.robot, ride.loaded_frame)
         for name, pose in self._initial["solids"].items():
             if name not in self.scene.solid_poses:      # removed: stays removed (Webots' reset)
                 continue

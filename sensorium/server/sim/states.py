@@ -79,8 +79,11 @@ def _now(sim: Any, scope: Scope) -> State:
     elif scope.own_pose:
         robot = sim.robots[scope.robot]
         drive = robot.drive
-        # a driven robot on a slope: its own pose (the ground's attitude is applied again on loading)
-        pose = drive.own_pose() if drive is not None and drive.slope is not None else robot.pose
+        # a driven robot on a slope: its own pose (the ground's attitude is applied again on loading); a robot
+        # riding another: its frame on its carrier (its fields')
+        frame = _rider_frame(sim, robot)
+        pose = drive.own_pose() if drive is not None and drive.slope is not None else \
+            robot.pose if frame is None else frame
     motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
     turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
     return State(pose, tuple(float(motors[m].position) for m in scope.motors),
@@ -92,7 +95,8 @@ def _initial(sim: Any, scope: Scope) -> State:
     if scope.solid is not None:
         pose = sim.initial_solid_pose(scope.solid)
     elif scope.own_pose:
-        pose = sim.robots[scope.robot].initial_pose
+        frame = _rider_frame(sim, sim.robots[scope.robot], loaded=True)
+        pose = sim.robots[scope.robot].initial_pose if frame is None else frame
     motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
     turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
     # a joint motor's initial position is the world file's; a wheel's angle starts at 0
@@ -116,7 +120,10 @@ def _restore(sim: Any, scope: Scope, state: State) -> None:
         if robot.drive is not None:
             robot.drive.reset(pose)
             pose = robot.drive.placed(pose)
-        sim.place_robot(robot, pose)
+        if _rider_frame(sim, robot) is not None:
+            sim.set_rider_frame(robot, pose)
+        else:
+            sim.place_robot(robot, pose)
         for dev in robot.devices.values():
             if dev.kind in ("GPS", "Radar"):       # no previous position: the next speeds are NaN
                 dev.restart()
@@ -124,3 +131,9 @@ def _restore(sim: Any, scope: Scope, state: State) -> None:
         led = robot.devices.get(name)
         if led is not None and led.value != 0:
             led.set(0, sim.time_ms)
+
+
+def _rider_frame(sim: Any, robot: Any, loaded: bool = False) -> Any:
+    """A robot riding another: its frame on its carrier (Simulation.rider_frame); None otherwise."""
+    frame = getattr(sim, "rider_frame", None)
+    return None if frame is None else frame(robot, loaded)
