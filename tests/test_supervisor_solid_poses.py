@@ -382,3 +382,26 @@ def test_recognition_and_radar_targets_follow_as_the_world_file_written_so(tmp_p
     assert list(moved[1].values())[0][0] == pytest.approx([1.5, 0.0, 0.2], abs=1e-15)   # (2, 0, -1) + T + 0.1 x
     call(lv, "simulation_reset")
     assert _seen(lv) == loaded
+
+
+def test_a_solids_saved_state_keeps_the_poses_inside_it_as_set() -> None:
+    """saveState of TABLE with TOP set 0.5 m along x keeps TOP's place (Webots' WbNode::save covers every field
+    below the node): after TOP is set elsewhere, loadState puts it back (the lidar on the marker's near face at
+    2.3 again, the field read as set); loadState("__init__") puts the loaded value back, the readings the
+    loaded world's."""
+    lv = _live()
+    table, top = node(lv, "TABLE"), node(lv, "TOP")
+    loaded = readings(lv)
+    call(lv, "set_field", {"node": top, "field": "translation", "value": [0.5, 0.0, 1.0]})
+    moved = readings(lv)
+    assert moved[0] == pytest.approx(2.3, abs=1e-6)
+    call(lv, "save_node_state", {"node": table, "state": "moved"})
+    call(lv, "set_field", {"node": top, "field": "translation", "value": [0.0, 0.0, 3.0]})
+    call(lv, "set_field", {"node": top, "field": "rotation", "value": [0.0, 0.0, 1.0, 0.3]})
+    assert readings(lv) != moved
+    call(lv, "load_node_state", {"node": table, "state": "moved"})
+    assert readings(lv) == moved
+    assert get(lv, top, "translation") == [0.5, 0.0, 1.0]
+    assert get(lv, top, "rotation") == pytest.approx([0.0, 0.0, 1.0, math.pi / 2], abs=1e-15)
+    call(lv, "load_node_state", {"node": table, "state": "__init__"})
+    assert readings(lv) == loaded and get(lv, top, "translation") == [0.0, 0.0, 1.0]

@@ -1803,14 +1803,55 @@ def _states(sim: Any) -> states.States:
 
 def _save_state(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     node = node_by_id(sim, a.node)
-    _states(sim).save(sim, node.id, state_scope(sim, node), a.state)
+    scope = state_scope(sim, node)
+    _states(sim).save(sim, node.id, scope, a.state)
+    if scope.solid is not None:       # with the Poses inside it as written now (WbNode::save covers them)
+        _kept(sim, "_pose_states", dict)[(node.id, a.state)] = _posed_values(sim, node, loaded=False)
     return {"success": True}
 
 
 def _load_state(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     node = node_by_id(sim, a.node)
-    _states(sim).load(sim, node.id, state_scope(sim, node), a.state)
+    scope = state_scope(sim, node)
+    _states(sim).load(sim, node.id, scope, a.state)
+    if scope.solid is not None:
+        saved = _kept(sim, "_pose_states", dict).get((node.id, a.state))
+        _restore_posed(sim, _posed_values(sim, node, loaded=True) if saved is None else saved)
     return {"success": True}
+
+
+_POSE_DEFAULTS = {"translation": (0.0, 0.0, 0.0), "rotation": (0.0, 0.0, 1.0, 0.0)}
+
+
+def _posed_values(sim: Any, node: Node, loaded: bool) -> dict[int, dict[str, Any]]:
+    """The translation and rotation of each Pose and Transform inside top-level solid ``node`` that a
+    Supervisor may set, as its world file writes them now (``loaded``: as loaded), by node id."""
+    from sensorium.server.sim.regenerate import written_fields
+
+    table, out = _table(sim), {}
+    posed = getattr(sim, "_posed", {}).get(node.key, {})
+    for n in table.by_owner.get(node.id, ()):
+        if n.own is None or n.type not in ("Pose", "Transform") or not n.at:
+            continue
+        at = (n.at[0], n.at[1])
+        values = posed[at][1] if loaded and at in posed else written_fields(sim, node.key, at, tuple(_POSE_DEFAULTS))
+        if values is not None:
+            out[n.id] = {k: _POSE_DEFAULTS[k] if v is None else tuple(v) for k, v in values.items()}
+    return out
+
+
+def _restore_posed(sim: Any, values: dict[int, dict[str, Any]]) -> None:
+    """Each Pose back at its saved translation and rotation (through its set: the solid built again)."""
+    table = _table(sim)
+    for node_id, saved in values.items():
+        n = table.get(node_id)
+        if n is None:                 # (removed since)
+            continue
+        node = node_by_id(sim, node_id)
+        now = _posed_values(sim, node_by_id(sim, n.owner), loaded=False).get(node_id)
+        for field, value in saved.items():
+            if now is None or now[field] != value:
+                _set_solid_pose(sim, node, field, list(value))
 
 
 def insert_index(position: int, count: int) -> int:
