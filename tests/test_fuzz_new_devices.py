@@ -213,6 +213,7 @@ def test_supervisor_services_on_nested_nodes_answer_or_refuse_in_one_line(world:
             if got["type"] == "SFNode" and got["value"]:
                 todo.append(got["value"])
             for value in (math.nan, math.inf, 1e308, True, [1.0, 2.0, 3.0], [math.nan] * 4, "x", None, []):
+                before = state()      # (a set taken, as a solid's Pose's translation, changes what follows)
                 [reply] = send(f, f"/{robot}/robot/set_field", {"node": node, "field": field, "value": value})
                 if not reply["ok"]:
                     assert state() == before, (node, field, value, reply)
