@@ -1816,7 +1816,7 @@ def _load_state(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     _states(sim).load(sim, node.id, scope, a.state)
     if scope.solid is not None:
         saved = _kept(sim, "_pose_states", dict).get((node.id, a.state))
-        _restore_posed(sim, _posed_values(sim, node, loaded=True) if saved is None else saved)
+        _restore_posed(sim, node, _posed_values(sim, node, loaded=True) if saved is None else saved)
     return {"success": True}
 
 
@@ -1840,17 +1840,16 @@ def _posed_values(sim: Any, node: Node, loaded: bool) -> dict[int, dict[str, Any
     return out
 
 
-def _restore_posed(sim: Any, values: dict[int, dict[str, Any]]) -> None:
-    """Each Pose back at its saved translation and rotation (through its set: the solid built again)."""
-    table = _table(sim)
+def _restore_posed(sim: Any, solid: Node, values: dict[int, dict[str, Any]]) -> None:
+    """Each Pose inside top-level solid ``solid`` back at its saved translation and rotation (through its
+    set: the solid built again; a set changes no other Pose's values, so they are read once)."""
+    now = _posed_values(sim, solid, loaded=False)
     for node_id, saved in values.items():
-        n = table.get(node_id)
-        if n is None:                 # (removed since)
+        if node_id not in now:        # (removed since)
             continue
         node = node_by_id(sim, node_id)
-        now = _posed_values(sim, node_by_id(sim, n.owner), loaded=False).get(node_id)
         for field, value in saved.items():
-            if now is None or now[field] != value:
+            if now[node_id][field] != value:
                 _set_solid_pose(sim, node, field, list(value))
 
 

@@ -92,6 +92,8 @@ from sensorium.server.world.top_nodes import top_level
 # the devices that cast rays into the scene: what may see a Display's screen (its texels' colours, or its alpha
 # letting rays and shadows through); while none is enabled a screen is not retextured (Simulation.show_screens)
 SCREEN_WATCHERS = frozenset({"Camera", "RangeFinder", "DistanceSensor", "LightSensor", "Lidar", "Radar", "Receiver"})
+
+
 @dataclass(slots=True)
 class Rider:
     """A robot riding another, fixed in its frame (``carried_by``): its frame there now and as loaded."""
