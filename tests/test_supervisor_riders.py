@@ -75,3 +75,17 @@ def test_a_riders_saved_state_is_its_place_on_its_carrier(live) -> None:
     live.sim.step()
     assert call(live, "get_field", field)["value"] == pytest.approx([0.2, 0.0, 0.1], abs=1e-15)
     assert world_position(live, rider) == pytest.approx([1.0, 0.2, 0.1], abs=1e-12)
+
+
+def test_a_rider_put_in_the_world_stays_there_on_its_carrier(live) -> None:
+    """set_pose of a riding robot (world coordinates, as the service takes them): it stays where it is put,
+    its frame on its carrier that place (carrier at (1, 0, 0) facing +y: (3, 1, 0.5) is (1, -2, 0.5) on it),
+    and goes with the carrier after."""
+    rider, truck = live.sim.robot("rider"), live.sim.robot("truck")
+    rider.set_pose(translation=[3.0, 1.0, 0.5])
+    live.sim.step()
+    assert rider.pose.translation == pytest.approx([3.0, 1.0, 0.5], abs=1e-12)
+    assert live.sim.rider_frame(rider).translation == pytest.approx([1.0, -2.0, 0.5], abs=1e-12)
+    truck.set_pose(translation=[2.0, 0.0, 0.0])
+    live.sim.step()
+    assert rider.pose.translation == pytest.approx([4.0, 1.0, 0.5], abs=1e-12)

@@ -356,6 +356,7 @@ class RobotState:
             self.drive.reset(pose)
             pose = self.drive.placed(pose)
         self._sim.place_robot(self, pose)
+        self._sim.rider_moved(self)
 
     def motor(self, name: str) -> WheelMotor | JointMotor:
         try:
@@ -591,6 +592,14 @@ class Simulation:
         robot that rides none."""
         ride = next((ride for ride in self._riders if ride.robot is robot), None)
         return None if ride is None else ride.loaded_frame if loaded else ride.frame
+
+    def rider_moved(self, robot: RobotState) -> None:
+        """A robot riding another was put somewhere in the world (set_pose): it stays fixed to its carrier
+        there, its frame on it where that puts it (carried from the next step, as Webots keeps a moved
+        child in its parent)."""
+        ride = next((ride for ride in self._riders if ride.robot is robot), None)
+        if ride is not None:
+            self.set_rider_frame(robot, ride.carrier.pose.inverse().compose(robot.pose))
 
     def set_rider_frame(self, robot: RobotState, frame: Pose) -> None:
         """A riding robot put elsewhere on its carrier (a Supervisor set its translation or rotation): fixed
