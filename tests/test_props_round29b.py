@@ -711,7 +711,7 @@ def piece_lowest(p: dict, track_z: float) -> float:
     elif p["kind"] == "Sphere":
         below = p["radius"]
     else:
-        a = abs(float(r[2, 1]))
+        a = abs(float(r[2, 2]))      # a Cylinder's and a Capsule's axis: their z (Webots R2022a+)
         rim = p["radius"] if p["kind"] == "Capsule" else p["radius"] * math.sqrt(max(0.0, 1.0 - a * a))
         below = a * p["height"] / 2.0 + rim
     return track_z + p["move"][2] + p["scale"] * (p["pose"][2] - below)

@@ -1197,19 +1197,12 @@ def falling_shapes(solid: wm.Solid, base_dir: Path) -> list[tuple[Pose, object, 
     return shapes or None
 
 
-def _exact_reach(g: object, r: np.ndarray) -> float | None:
+def _exact_reach(prim: object, r: np.ndarray) -> float | None:
     """How far a Box, Sphere, Cylinder or Capsule with ENU rotation ``r`` reaches above and below its
-    centre, exactly (a box's half sizes times the vertical parts of its axes; a cylinder's or capsule's
-    axis's vertical part a, each end's rim (or cap) reaching r·√(1 − a²) (or r) beyond), where
-    contact.obstacle bounds a tilted cylinder by its circumscribed facets; None for other shapes."""
-    if isinstance(g, wm.Box):
-        return sum(abs(float(r[2, k])) * float(g.size[k]) / 2.0 for k in range(3))
-    if isinstance(g, wm.Sphere):
-        return float(g.radius)
-    if isinstance(g, (wm.Cylinder, wm.Capsule)):
-        a = abs(float(r[2, 2]))
-        return float(g.height) / 2.0 * a + float(g.radius) * (
-            math.sqrt(max(0.0, 1.0 - a * a)) if isinstance(g, wm.Cylinder) else 1.0)
+    centre, exactly (:func:`geometry.reach`), where contact.obstacle bounds a tilted cylinder by its
+    circumscribed facets; None for other shapes."""
+    if isinstance(prim, (geo.Box, geo.Sphere, geo.Cylinder, geo.Capsule)):
+        return geo.reach(prim, r[2, :])
     return None
 
 
@@ -1221,9 +1214,9 @@ def shapes_span(shapes: list[tuple[Pose, object, object]], pose: Pose, to_enu: n
     is an obstacle. ``footprint`` False: the heights alone (the xy box None)."""
     spans: list[tuple[float, float]] = []
     boxes = []
-    for local, prim, g in shapes:
+    for local, prim, _ in shapes:
         at = enu_pose(pose.compose(local), to_enu)
-        reach = _exact_reach(g, at.rotation)
+        reach = _exact_reach(prim, at.rotation)
         ob = obstacle("shape", -1, prim, at) if footprint or reach is None else None
         if reach is not None:
             z = float(at.translation[2])

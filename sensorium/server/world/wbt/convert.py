@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from sensorium.schemas import world as wm
+from sensorium.server.world import geometry as geo
 from sensorium.server.world.cad import EAR_CLIP_CORNERS, ear_clip, reflex_corners
 from sensorium.server.world.poses import axis_angle_matrix, matrix_quaternion
 from sensorium.server.world.report import Loss
@@ -2535,27 +2536,28 @@ class Converter:
         """The lowest point along the robot's axis ``up`` of ``node``'s boundingObject (its Boxes,
         Cylinders, Capsules and Spheres, under Group, Pose and Transform nodes and Shapes), ``frame``
         the node's frame in the robot's; None when it holds none of these. Webots' physics rests a Track
-        on its bounding object (its TrackWheels have none), which may reach below the wheels' circles."""
+        on its bounding object (its TrackWheels have none), which may reach below the wheels' circles. A
+        Cylinder's and a Capsule's axis is their z, as in Webots since R2022a (:func:`geometry.reach`)."""
         low: list[float] = []
         for g_node, place in self._bounding_geometries(node, frame):
-            if place.stretch is not None:
-                continue
-            g = self.fields(g_node)
-            centre = np.asarray(place.apply((0.0, 0.0, 0.0)))
-            r = np.asarray(place.rotation, dtype=np.float64)
-            if g_node.type == "Box":
-                hx, hy, hz = (float(v) / 2.0 for v in g.vec("size", (2.0, 2.0, 2.0)))
-                low.append(min(place.apply((sx * hx, sy * hy, sz * hz))[up]
-                               for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)))
-            elif g_node.type == "Sphere":
-                low.append(float(centre[up]) - g.num("radius", 1.0) * place.scale)
-            elif g_node.type in ("Cylinder", "Capsule"):
-                radius, half = g.num("radius", 1.0) * place.scale, g.num("height", 2.0) * place.scale / 2.0
-                a = float(r[up, 1])      # the axis (the shape's y) along up
-                ends = min(float(centre[up]) + half * a, float(centre[up]) - half * a)
-                rim = radius if g_node.type == "Capsule" else radius * math.sqrt(max(0.0, 1.0 - a * a))
-                low.append(ends - rim)
+            prim = self._bounding_primitive(g_node, place.scale) if place.stretch is None else None
+            if prim is not None:
+                row = np.asarray(place.rotation, dtype=np.float64)[up, :]   # the robot's up in the shape's frame
+                low.append(float(place.apply((0.0, 0.0, 0.0))[up]) - geo.reach(prim, row))
         return min(low) if low else None
+
+    def _bounding_primitive(self, g_node: Node, s: float) -> geo.Box | geo.Sphere | geo.Cylinder | geo.Capsule | None:
+        """A Box, Sphere, Cylinder or Capsule bounding node as a primitive, scaled by ``s``, its sizes
+        sanitised as Webots' (a non-positive one 1); None for any other node."""
+        g = self.fields(g_node)
+        if g_node.type == "Box":
+            return geo.Box(tuple(v * s for v in g.positive_vec("size", (2.0, 2.0, 2.0), (1.0, 1.0, 1.0))))
+        if g_node.type == "Sphere":
+            return geo.Sphere(g.positive("radius", 1.0) * s)
+        if g_node.type in ("Cylinder", "Capsule"):
+            kind = geo.Cylinder if g_node.type == "Cylinder" else geo.Capsule
+            return kind(g.positive("radius", 1.0) * s, g.positive("height", 2.0) * s)
+        return None
 
     def _bounding_geometries(self, node: Node, frame: Frame) -> list[tuple[Node, Frame]]:
         """The geometry nodes of ``node``'s boundingObject, each with its frame (``frame`` the node's): the
