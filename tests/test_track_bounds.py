@@ -10,6 +10,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from test_fuzz_core import SETTINGS
 
 from sensorium.server.world import geometry as geo
 from sensorium.server.world.loader import load_world
@@ -104,3 +107,32 @@ def test_reach_along_a_direction_is_the_closed_form_for_each_primitive() -> None
     assert geo.reach(geo.Capsule(0.1, 0.5), (0.0, 0.0, -1.0)) == pytest.approx(0.35, abs=1e-15)
     assert geo.reach(geo.Capsule(0.1, 0.5), (1.0, 0.0, 0.0)) == 0.1
     assert geo.reach(geo.Sphere(0.3), d) == 0.3
+
+
+size = st.floats(0.01, 3.0)
+direction = st.tuples(*(st.floats(-1.0, 1.0),) * 3).filter(lambda d: math.hypot(*d) > 1e-3)
+
+
+@given(kind=st.sampled_from(["Box", "Sphere", "Cylinder", "Capsule"]), a=size, b=size, c=size, d=direction)
+@settings(SETTINGS, max_examples=300)
+def test_reach_lies_between_the_true_shape_and_its_circumscribed_tessellation(kind, a, b, c, d) -> None:
+    """geometry.reach along any direction is at most the tessellation's furthest vertex (every tessellation
+    circumscribes its shape) and at least that vertex shrunk by the tessellation's outward factor: a box's
+    equal, a cylinder's rim within 1/cos(π/n), a capsule's and a sphere's within their vertices' radii."""
+    p = {"Box": lambda: geo.Box((a, b, c)), "Sphere": lambda: geo.Sphere(a),
+         "Cylinder": lambda: geo.Cylinder(a, b), "Capsule": lambda: geo.Capsule(a, b)}[kind]()
+    unit = np.asarray(d) / np.linalg.norm(d)
+    vertices, _ = geo.tessellate(p)
+    furthest = float((vertices @ unit).max())
+    exact = geo.reach(p, unit)
+    assert exact <= furthest + 1e-12 * (1.0 + furthest)
+    if kind == "Box":
+        assert exact == pytest.approx(furthest, rel=1e-12)
+    elif kind == "Cylinder":
+        k = math.hypot(unit[0], unit[1])
+        out = b / 2.0 * abs(unit[2]) + a * k / math.cos(math.pi / p.subdivision)
+        assert furthest <= out + 1e-12 * out
+    else:     # the sphere's or capsule's vertices: at most the largest distance of a vertex to the axis segment
+        seg = np.clip(vertices[:, 2], -b / 2.0, b / 2.0) if kind == "Capsule" else np.zeros(len(vertices))
+        grow = float(np.linalg.norm(vertices - np.outer(seg, [0.0, 0.0, 1.0]), axis=1).max()) / a
+        assert furthest <= exact * grow + 1e-12 * furthest

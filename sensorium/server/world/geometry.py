@@ -128,16 +128,16 @@ class Plane:
 def reach(p: Box | Sphere | Cylinder | Capsule, direction: Sequence[float] | np.ndarray) -> float:
     """How far ``p`` reaches from its centre along the unit ``direction`` (in ``p``'s own frame), exactly:
     a box's half sizes times the direction's parts; a cylinder's or capsule's axis (local z) part a, each
-    end reaching h/2·|a| plus its rim's r·√(1 − a²) (a capsule's cap: r). The lowest point of a shape
+    end reaching h/2·|a| plus its rim's r·√(1 − a²) (a capsule's cap: r), ``direction`` of unit length. The lowest point of a shape
     whose frame has rotation R is its centre's height less reach(p, R[up, :])."""
     d = [float(v) for v in direction]
     if isinstance(p, Box):
         return sum(abs(d[k]) * float(p.size[k]) / 2.0 for k in range(3))
     if isinstance(p, Sphere):
         return float(p.radius)
-    a = abs(d[2])
-    rim = math.sqrt(max(0.0, 1.0 - a * a)) if isinstance(p, Cylinder) else 1.0
-    return float(p.height) / 2.0 * a + float(p.radius) * rim
+    # the rim's part from the direction's other two (not √(1 − a²), which cancels near the axis)
+    rim = min(1.0, math.hypot(d[0], d[1])) if isinstance(p, Cylinder) else 1.0
+    return float(p.height) / 2.0 * abs(d[2]) + float(p.radius) * rim
 
 
 def _own(values: object, dtype: type) -> np.ndarray:
