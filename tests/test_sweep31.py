@@ -1,0 +1,227 @@
+"""Sweep 31: Webots `projects/robots` worlds of wheeled robots with range sensors not run before, each on a
+stand-in world of ours (tests/data/sweep31/: the PROTOs' device names, places, joints and bounding objects,
+our own text, meshes left out) driven in process by the calls its controller makes and checked against
+closed forms."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+DATA = Path(__file__).parent / "data" / "sweep31"
+HALF = 7.5                      # the arena's walls' inner faces (floorSize 15)
+
+
+def yaw_of(pose) -> float:
+    r = np.asarray(pose.rotation)
+    return math.atan2(r[1, 0], r[0, 0])
+
+
+def ray_length(eye: np.ndarray, d: np.ndarray, boxes: list[tuple[np.ndarray, np.ndarray]]) -> float:
+    """How far a horizontal ray from ``eye`` along unit ``d`` runs to the arena's walls (the inside of
+    [−HALF, HALF]²) or the nearest axis-aligned box (centre, half sizes) in its way, in the plane."""
+    t = min((math.copysign(HALF, d[k]) - eye[k]) / d[k] for k in (0, 1) if d[k] != 0.0)
+    for c, h in boxes:
+        lo, hi = c[:2] - h[:2], c[:2] + h[:2]
+        near, far = -math.inf, math.inf
+        for k in (0, 1):
+            if d[k] == 0.0:
+                if not lo[k] <= eye[k] <= hi[k]:
+                    near, far = math.inf, -math.inf
+                continue
+            a, b = (lo[k] - eye[k]) / d[k], (hi[k] - eye[k]) / d[k]
+            near, far = max(near, min(a, b)), min(far, max(a, b))
+        if 0.0 < near <= far:
+            t = min(t, near)
+    return t
+
+
+# ------------------------------------------------------------------------------------ TIAGo PMB-2 Base
+# tiago_pmb2_base (pal_robotics/tiago_pmb2_base, R2023b): the TIAGo PMB-2 Base at (−4.416, 1.063, 0) facing +x,
+# its Hokuyo URG-04LX-UG01 in the lidar slot at (0.202, 0, 0.091): 667 rays over 4.18879 rad, 0.2 to 5.6 m; drive
+# wheels of radius 0.0985 m whose Solids are at y ±0.202; four free casters. The world's basicTimeStep is
+# Webots' default 32 ms. Our wooden box (0.6 m cube) stands at (−0.6, 0.863).
+PMB2 = DATA / "tiago_pmb2_base.wbt"
+PMB2_NAME = "TIAGo PMB-2 Base"
+HOKUYO = "Hokuyo URG-04LX-UG01"
+HOKUYO_FOV, HOKUYO_RAYS, HOKUYO_MAX = 4.18879, 667, 5.6
+LIDAR_AT = (0.202, 0.091)       # in the slot: ahead of the origin, height
+WHEEL_R, AXLE = 0.0985, 0.404
+PMB2_Z = 0.0035                 # 0.0985 − 0.095: wheels (and casters: 0.025 + 0.04 − 0.0615) 3.5 mm into the floor
+CRATE = (np.array([-0.6, 0.863]), np.array([0.3, 0.3]))
+PMB2_STEP = 32
+UNUSED_POINT, N_SECTOR = 83, 5   # tiago_pmb2_base.c's
+MAX_SPEED, CRUISING_SPEED = 6.4, 3.0
+FAR_OBSTACLE_THRESHOLD, NEAR_OBSTACLE_THRESHOLD = 0.4, 0.7
+FAST_DECREASE_FACTOR, SLOW_DECREASE_FACTOR = 0.9, 0.5
+
+
+def hokuyo_closed_form(x: float, y: float, h: float) -> np.ndarray:
+    """The Hokuyo's ranges with the robot at (x, y) heading h: ray i at azimuth fov/2 − (i + 0.5)·fov/667 from
+    the robot's x, from the lidar 0.202 m ahead of the origin to the walls or our box (inf past 5.6 m)."""
+    eye = np.array([x + LIDAR_AT[0] * math.cos(h), y + LIDAR_AT[0] * math.sin(h)])
+    out = np.full(HOKUYO_RAYS, math.inf)
+    for i in range(HOKUYO_RAYS):
+        a = h + HOKUYO_FOV / 2 - (i + 0.5) * HOKUYO_FOV / HOKUYO_RAYS
+        t = ray_length(eye, np.array([math.cos(a), math.sin(a)]), [CRATE])
+        out[i] = t if t <= HOKUYO_MAX else math.inf
+    return out
+
+
+def braitenberg_pmb2(values, width: int, max_range: float) -> tuple[float, float, bool]:
+    """tiago_pmb2_base.c's loop body: the wheel speeds it sets from one range image, and whether it makes its
+    extra wb_robot_step(1) (the front-obstacle u-turn)."""
+    sector_size = int((width - 2.0 * UNUSED_POINT - 1.0) / N_SECTOR)
+    sector_range = [UNUSED_POINT + (i + 1) * sector_size for i in range(N_SECTOR)]
+    threshold = max_range / 2.0
+    left = front_left = front = front_right = right = 0.0
+    for i in range(UNUSED_POINT, width - UNUSED_POINT - 1):
+        v = float(values[i])
+        if v < threshold:
+            w = 1.0 - v / max_range
+            if i < sector_range[0]:
+                left += w
+            if sector_range[0] <= i < sector_range[1]:
+                front_left += w
+            if sector_range[1] <= i < sector_range[2]:
+                front += w
+            if sector_range[2] <= i < sector_range[3]:
+                front_right += w
+            if sector_range[3] <= i < sector_range[4] + 1:
+                right += w
+    left, front_left, front, front_right, right = (s / sector_size for s in (left, front_left, front, front_right,
+                                                                           right))
+
+    def check(s: float) -> float:
+        return min(s, MAX_SPEED)
+
+    if left > right and left > NEAR_OBSTACLE_THRESHOLD:
+        f = (1.0 - FAST_DECREASE_FACTOR * left) * MAX_SPEED / left
+        return check(f * left), check(f * right), False
+    if front_left > front_right and front_left > FAR_OBSTACLE_THRESHOLD:
+        f = (1.0 - SLOW_DECREASE_FACTOR * front_left) * MAX_SPEED / front_left
+        return check(f * front_left), check(f * front_right), False
+    if front_right > front_left and front_right > FAR_OBSTACLE_THRESHOLD:
+        f = (1.0 - SLOW_DECREASE_FACTOR * front_right) * MAX_SPEED / front_right
+        return check(f * front_left), check(f * front_right), False
+    if right > left and right > NEAR_OBSTACLE_THRESHOLD:
+        f = (1.0 - FAST_DECREASE_FACTOR * right) * MAX_SPEED / right
+        return check(f * left), check(f * right), False
+    if front > NEAR_OBSTACLE_THRESHOLD:
+        f = (1.0 - FAST_DECREASE_FACTOR * front) * MAX_SPEED / front
+        if front_right > front_left or right > left:
+            return -check(f * front), check(f * front), True
+        return check(f * front), -check(f * front), True
+    return CRUISING_SPEED, CRUISING_SPEED, False
+
+
+def diff_arc(x: float, y: float, h: float, wl: float, wr: float, dt: float) -> tuple[float, float, float]:
+    """A two-wheel drive's exact arc: wheel speeds wl, wr (rad/s) for dt s."""
+    v, w = WHEEL_R * (wl + wr) / 2.0, WHEEL_R * (wr - wl) / AXLE
+    if w == 0.0:
+        return x + v * dt * math.cos(h), y + v * dt * math.sin(h), h
+    return (x + v / w * (math.sin(h + w * dt) - math.sin(h)), y - v / w * (math.cos(h + w * dt) - math.cos(h)),
+            h + w * dt)
+
+
+def test_the_pmb2_base_loads_as_a_two_wheel_drive_with_its_lidar_sonars_and_bumper() -> None:
+    """The PMB-2 stand-in loads with the arena's stand-in line only: its two motorised wheels (radius 0.0985 m,
+    Solids 0.404 m apart) are its drive, its four casters' free hinges no wheel and no line, and every device
+    the PROTO has is there with the Hokuyo from the slot (667 rays, 4.18879 rad, 5.6 m). It settles 3.5 mm up,
+    where its wheels and casters (all reaching 3.5 mm below its origin) touch the floor."""
+    w = load_world(PMB2)
+    assert len(w.warnings) == 1 and "built-in stand-ins used for RectangleArena" in w.warnings[0], w.warnings
+    (robot,) = w.world.robots
+    assert [d.name for d in robot.devices] == [
+        HOKUYO, "accelerometer", "inertial unit", "gyro", "base_cover_link", "base_sonar_03_link",
+        "base_sonar_02_link", "base_sonar_01_link", "wheel_right_joint", "wheel_right_joint_sensor",
+        "wheel_left_joint", "wheel_left_joint_sensor"]
+    dd = robot.differential_drive
+    assert (dd.wheel_radius, dd.axle_length, dd.left_motor, dd.right_motor) == (WHEEL_R, AXLE, "wheel_left_joint",
+                                                                                "wheel_right_joint")
+    sim = Simulation(w, "exact")
+    assert "its origin's z from 0.0000 to 0.0035 m" in w.warnings[-1]
+    pose = sim.robot(PMB2_NAME).pose
+    assert list(pose.translation) == pytest.approx([-4.416, 1.063, PMB2_Z], abs=1e-12)
+    lidar = sim.device(f"{PMB2_NAME}/{HOKUYO}")
+    info = lidar.info()
+    assert (info["horizontalResolution"], info["fov"], info["minRange"], info["maxRange"]) == (
+        HOKUYO_RAYS, HOKUYO_FOV, 0.2, HOKUYO_MAX)
+
+
+def test_the_hokuyo_reads_the_box_and_the_walls_by_their_closed_forms() -> None:
+    """At the start every ray the controller uses (83 to 583, ±90° about the robot's x) reads the distance from
+    the lidar to our box's west face or the arena's walls along its azimuth (float32, 1e-5), inf past 5.6 m:
+    our box on 28 rays (329 to 356) from 3.314 m (ray 333, nearly straight ahead) to 3.3489 m, every wall beyond
+    5.6 m (the nearest, north, 6.437 m off) so inf on every other ray; the rays
+    outside ±90° see the robot's own wheels (0.2098 m on the first: as Webots' lidar sees its robot, which is why
+    the controller skips 83 rays each side)."""
+    sim = Simulation(load_world(PMB2), "exact")
+    lidar = sim.device(f"{PMB2_NAME}/{HOKUYO}")
+    lidar.enable(PMB2_STEP)
+    sim.step()
+    got = np.asarray(lidar.range_image, dtype=float).reshape(-1)
+    want = hokuyo_closed_form(-4.416, 1.063, 0.0)
+    used = slice(UNUSED_POINT, HOKUYO_RAYS - UNUSED_POINT)
+    assert np.array_equal(np.isinf(got[used]), np.isinf(want[used]))
+    hit = np.isfinite(want[used])
+    assert got[used][hit] == pytest.approx(want[used][hit], abs=1e-5)
+    assert list(np.nonzero(np.isfinite(got[used]))[0] + UNUSED_POINT) == list(range(329, 357))
+    assert (got[333], got[356]) == pytest.approx((3.314, 3.348873), abs=1e-5)
+    # the first ray (120° left) meets the left wheel's inner face (y 0.182) within its radius
+    assert got[0] == pytest.approx(0.182 / math.sin(HOKUYO_FOV / 2 - 0.5 * HOKUYO_FOV / HOKUYO_RAYS), abs=1e-5)
+
+
+def test_tiago_pmb2_base_calls_drive_to_the_box_and_turn_away_on_closed_form_arcs() -> None:
+    """tiago_pmb2_base.c's calls for 12 s: each step the range image is the closed form's at the robot's pose
+    (1e-5) and the wheel speeds its Braitenberg rule sets from it carry the robot on the two-wheel arc of those
+    speeds (1e-9). It cruises at 3 rad/s (0.2955 m/s) for 8.8 s, when the box, on its right, passes 0.4 in its
+    front-right sector: on 43 steps to 10.208 s (two runs, three cruising steps between at 9.4 s) the rule
+    stops the left wheel and turns the right one between 1.379 and 5.1137 rad/s, pivoting the robot left about
+    its left wheel, then it cruises on past the box, at (−1.3394, 1.5763) heading 0.9385 rad at 12 s. The u-turn branch (and its wb_robot_step(1)) is not
+    reached."""
+    sim = Simulation(load_world(PMB2), "exact")
+    robot = sim.robot(PMB2_NAME)
+    lidar = sim.device(f"{PMB2_NAME}/{HOKUYO}")
+    lidar.enable(PMB2_STEP)
+    left, right = robot.motor("wheel_left_joint"), robot.motor("wheel_right_joint")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    x, y, h = -4.416, 1.063, 0.0
+    wl = wr = 0.0
+    dt = PMB2_STEP / 1000.0
+    branches = []
+    t = 0
+    while t < 12000:
+        sim.step()
+        t += PMB2_STEP
+        x, y, h = diff_arc(x, y, h, wl, wr, dt)
+        pose = robot.pose
+        assert [*pose.translation[:2], yaw_of(pose)] == pytest.approx([x, y, h], abs=1e-9), t
+        got = np.asarray(lidar.range_image, dtype=float).reshape(-1)
+        want = hokuyo_closed_form(x, y, h)
+        used = slice(UNUSED_POINT, HOKUYO_RAYS - UNUSED_POINT)
+        assert np.array_equal(np.isinf(got[used]), np.isinf(want[used])), t
+        hit = np.isfinite(want[used])
+        assert got[used][hit] == pytest.approx(want[used][hit], abs=1e-5), t
+        new_wl, new_wr, extra = braitenberg_pmb2(got, HOKUYO_RAYS, HOKUYO_MAX)
+        if extra:                   # wb_robot_step(1): one basic step on the speeds set before
+            sim.step()
+            t += PMB2_STEP
+            x, y, h = diff_arc(x, y, h, wl, wr, dt)
+        wl, wr = new_wl, new_wr
+        branches.append((t, wl, wr, extra))
+        left.set_velocity(wl)
+        right.set_velocity(wr)
+    turning = [b for b in branches if b[1:3] != (CRUISING_SPEED, CRUISING_SPEED)]
+    assert (len(turning), turning[0][0], turning[-1][0]) == (43, 8800, 10208)
+    assert all(b[1] == 0.0 and 1.37 < b[2] < 5.12 for b in turning) and not any(b[3] for b in branches)
+    assert turning[0][2] == pytest.approx(5.113733, abs=1e-6)
+    assert (x, y, h) == pytest.approx((-1.339437, 1.576264, 0.938508), abs=1e-6)
