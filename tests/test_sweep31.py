@@ -225,3 +225,90 @@ def test_tiago_pmb2_base_calls_drive_to_the_box_and_turn_away_on_closed_form_arc
     assert all(b[1] == 0.0 and 1.37 < b[2] < 5.12 for b in turning) and not any(b[3] for b in branches)
     assert turning[0][2] == pytest.approx(5.113733, abs=1e-6)
     assert (x, y, h) == pytest.approx((-1.339437, 1.576264, 0.938508), abs=1e-6)
+
+
+# ------------------------------------------------------------------------------------ TIAGo OMNI Base
+# tiago_omni_base (pal_robotics/tiago_omni_base, R2023b): the TIAGo OMNI Base at (−4.416, 1.063, 0) facing +x on
+# four mecanum wheels (radius 0.0762 m at (±0.244, ±0.1725)), the world's ContactProperties turning the left
+# wheels' friction by −0.785398 rad and the right ones' by 0.785398; its two SICK lidars (818 rays over 4.71 rad
+# in front, 4.712389 at the rear, 0.05 to 25 m, 1 mm resolution) each upside down in a Pose turned π about a
+# horizontal axis, the front one at (0.27512, −0.18297, 0.20864) facing 45° right, the rear one at
+# (−0.27512, 0.18297, 0.20864) facing 135° left.
+OMNI = DATA / "tiago_omni_base.wbt"
+OMNI_NAME = "TIAGo OMNI Base"
+OMNI_LIDARS = {  # name: (place in the robot, Pose's axis, fov)
+    "base_front_laser": ((0.27512, -0.18297, 0.20864), (-0.9238797538373538, 0.38268289803626016, 0.0), 4.71),
+    "base_rear_laser": ((-0.27512, 0.18297, 0.20864), (-0.382683, -0.92388, 0.0), 4.712389),
+}
+OMNI_RAYS = 818
+
+
+def axis_angle(axis, angle: float) -> np.ndarray:
+    a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+
+
+def omni_world(tmp_path: Path) -> Path:
+    """The stand-in with both lidars' noise (0.0024 m) taken out."""
+    out = tmp_path / "sweep31"
+    (out / "protos").mkdir(parents=True)
+    for src in [OMNI, *(DATA / "protos").glob("TiagoOmniBase*.proto")]:
+        dst = out / src.relative_to(DATA)
+        dst.write_text(src.read_text().replace("noise 0.0024", "noise 0"))
+    return out / OMNI.name
+
+
+def omni_lidar_closed_form(name: str, x: float, y: float) -> np.ndarray:
+    """A lidar's ranges with the robot at (x, y) facing +x: ray i at azimuth fov/2 − (i + 0.5)·fov/818 in the
+    lidar's own xy plane, turned by its Pose (π about its axis: upside down) into the robot's, to the walls,
+    rounded to the 1 mm resolution."""
+    place, axis, fov = OMNI_LIDARS[name]
+    turn = axis_angle(axis, 3.141593)
+    eye = np.array([x + place[0], y + place[1]])
+    out = np.empty(OMNI_RAYS)
+    for i in range(OMNI_RAYS):
+        a = fov / 2 - (i + 0.5) * fov / OMNI_RAYS
+        d = turn @ np.array([math.cos(a), math.sin(a), 0.0])
+        out[i] = round(ray_length(eye, d[:2] / np.linalg.norm(d[:2]), []) / 0.001) * 0.001
+    return out
+
+
+def test_the_omni_base_loads_with_its_lidars_and_wheels_but_no_drive_for_its_side_wise_rollers() -> None:
+    """The OMNI stand-in loads every device the PROTO has (the two lidars, the four wheel motors and their
+    sensors, the accelerometer, inertial unit, gyro, GPS) and one line besides the arena's: no mecanum drive,
+    as its rollers (the friction turned alike on each side's front and rear wheels, whose frames are alike)
+    are not the youBot's pattern (alike on diagonal wheels); the robot does not move."""
+    w = load_world(OMNI)
+    assert len(w.warnings) == 2 and "built-in stand-ins used for RectangleArena" in w.warnings[0], w.warnings
+    assert ("robot 'TIAGo OMNI Base': no mecanum drive (the rollers (friction turned by 0.785398, -0.785398, "
+            "0.785398, -0.785398 on the front left, front right, rear left and rear right wheels) are not alike on "
+            "diagonal wheels and opposite on the front two") in w.warnings[1]
+    (robot,) = w.world.robots
+    assert [d.name for d in robot.devices] == [
+        "accelerometer", "inertial unit", "gyro", "gps", "base_rear_laser", "base_front_laser",
+        *(f"wheel_{k}_joint{s}" for k in ("front_right", "front_left", "rear_right", "rear_left")
+          for s in ("", "_sensor"))]
+    assert robot.differential_drive is None and getattr(robot, "mecanum_drive", None) is None
+
+
+def test_the_omni_bases_upside_down_lidars_read_the_walls_by_their_closed_forms(tmp_path: Path) -> None:
+    """Both lidars, upside down (so their rays sweep right to left in the robot's frame) and facing 45° right
+    (front) and 135° left (rear), read the arena's walls along each ray's turned azimuth, rounded to their
+    1 mm resolution (float32, 1e-6): mirrored, ray i points (i + 0.5)·fov/818 − fov/2 from its facing, counted
+    anticlockwise seen from above, so the front one sweeps from due west (3.359 m) round by south and east to due north (6.62 m), the rear
+    one from due east (12.191 m) round by north and west (2.809 m, ray 542) to due south (8.746 m)."""
+    sim = Simulation(load_world(omni_world(tmp_path)), "exact")
+    for name in OMNI_LIDARS:
+        sim.device(f"{OMNI_NAME}/{name}").enable(32)
+    sim.step()
+    ends = {}
+    for name in OMNI_LIDARS:
+        got = np.asarray(sim.device(f"{OMNI_NAME}/{name}").range_image, dtype=float).reshape(-1)
+        want = omni_lidar_closed_form(name, -4.416, 1.063)
+        assert got == pytest.approx(want, abs=1e-6), name
+        ends[name] = (got[0], got[-1], int(np.argmin(got)), got.min())
+    # upside down, ray 0 (135° left in its own frame) points 135° right of where the lidar faces: the front
+    # one's west (3.359 m to the wall at x −7.5), its last north (6.62 m); the rear one's east and south
+    assert ends["base_front_laser"] == pytest.approx((3.359, 6.62, 0, 3.359), abs=1e-6)
+    assert ends["base_rear_laser"] == pytest.approx((12.191, 8.746, 542, 2.809), abs=1e-6)
