@@ -62,14 +62,14 @@ FAR_OBSTACLE_THRESHOLD, NEAR_OBSTACLE_THRESHOLD = 0.4, 0.7
 FAST_DECREASE_FACTOR, SLOW_DECREASE_FACTOR = 0.9, 0.5
 
 
-def hokuyo_closed_form(x: float, y: float, h: float) -> np.ndarray:
+def hokuyo_closed_form(x: float, y: float, h: float, box=CRATE) -> np.ndarray:
     """The Hokuyo's ranges with the robot at (x, y) heading h: ray i at azimuth fov/2 − (i + 0.5)·fov/667 from
     the robot's x, from the lidar 0.202 m ahead of the origin to the walls or our box (inf past 5.6 m)."""
     eye = np.array([x + LIDAR_AT[0] * math.cos(h), y + LIDAR_AT[0] * math.sin(h)])
     out = np.full(HOKUYO_RAYS, math.inf)
     for i in range(HOKUYO_RAYS):
         a = h + HOKUYO_FOV / 2 - (i + 0.5) * HOKUYO_FOV / HOKUYO_RAYS
-        t = ray_length(eye, np.array([math.cos(a), math.sin(a)]), [CRATE])
+        t = ray_length(eye, np.array([math.cos(a), math.sin(a)]), [box])
         out[i] = t if t <= HOKUYO_MAX else math.inf
     return out
 
@@ -178,15 +178,11 @@ def test_the_hokuyo_reads_the_box_and_the_walls_by_their_closed_forms() -> None:
     assert got[0] == pytest.approx(0.182 / math.sin(HOKUYO_FOV / 2 - 0.5 * HOKUYO_FOV / HOKUYO_RAYS), abs=1e-5)
 
 
-def test_tiago_pmb2_base_calls_drive_to_the_box_and_turn_away_on_closed_form_arcs() -> None:
-    """tiago_pmb2_base.c's calls for 12 s: each step the range image is the closed form's at the robot's pose
-    (1e-5) and the wheel speeds its Braitenberg rule sets from it carry the robot on the two-wheel arc of those
-    speeds (1e-9). It cruises at 3 rad/s (0.2955 m/s) for 8.8 s, when the box, on its right, passes 0.4 in its
-    front-right sector: on 43 steps to 10.208 s (two runs, three cruising steps between at 9.4 s) the rule
-    stops the left wheel and turns the right one between 1.379 and 5.1137 rad/s, pivoting the robot left about
-    its left wheel, then it cruises on past the box, at (−1.3394, 1.5763) heading 0.9385 rad at 12 s. The u-turn branch (and its wb_robot_step(1)) is not
-    reached."""
-    sim = Simulation(load_world(PMB2), "exact")
+def run_pmb2(world: Path, box, until_ms: int) -> tuple[tuple[float, float, float], list]:
+    """tiago_pmb2_base.c's calls in process until ``until_ms``, every step checking the range image against
+    the closed form at the robot's pose (1e-5) and the pose against the two-wheel arcs of the speeds set
+    (1e-9); the final (x, y, heading) and each control step's (time, left, right, extra step)."""
+    sim = Simulation(load_world(world), "exact")
     robot = sim.robot(PMB2_NAME)
     lidar = sim.device(f"{PMB2_NAME}/{HOKUYO}")
     lidar.enable(PMB2_STEP)
@@ -199,15 +195,15 @@ def test_tiago_pmb2_base_calls_drive_to_the_box_and_turn_away_on_closed_form_arc
     dt = PMB2_STEP / 1000.0
     branches = []
     t = 0
-    while t < 12000:
+    used = slice(UNUSED_POINT, HOKUYO_RAYS - UNUSED_POINT)
+    while t < until_ms:
         sim.step()
         t += PMB2_STEP
         x, y, h = diff_arc(x, y, h, wl, wr, dt)
         pose = robot.pose
         assert [*pose.translation[:2], yaw_of(pose)] == pytest.approx([x, y, h], abs=1e-9), t
         got = np.asarray(lidar.range_image, dtype=float).reshape(-1)
-        want = hokuyo_closed_form(x, y, h)
-        used = slice(UNUSED_POINT, HOKUYO_RAYS - UNUSED_POINT)
+        want = hokuyo_closed_form(x, y, h, box)
         assert np.array_equal(np.isinf(got[used]), np.isinf(want[used])), t
         hit = np.isfinite(want[used])
         assert got[used][hit] == pytest.approx(want[used][hit], abs=1e-5), t
@@ -220,11 +216,49 @@ def test_tiago_pmb2_base_calls_drive_to_the_box_and_turn_away_on_closed_form_arc
         branches.append((t, wl, wr, extra))
         left.set_velocity(wl)
         right.set_velocity(wr)
+    return (x, y, h), branches
+
+
+def test_tiago_pmb2_base_calls_drive_to_the_box_and_turn_away_on_closed_form_arcs() -> None:
+    """tiago_pmb2_base.c's calls for 12 s: each step the range image is the closed form's at the robot's pose
+    (1e-5) and the wheel speeds its Braitenberg rule sets from it carry the robot on the two-wheel arc of those
+    speeds (1e-9). It cruises at 3 rad/s (0.2955 m/s) for 8.8 s, when the box, on its right, passes 0.4 in its
+    front-right sector: on 43 steps to 10.208 s (two runs, three cruising steps between at 9.4 s) the rule
+    stops the left wheel and turns the right one between 1.379 and 5.1137 rad/s, pivoting the robot left about
+    its left wheel, then it cruises on past the box, at (−1.3394, 1.5763) heading 0.9385 rad at 12 s. The
+    u-turn branch (and its wb_robot_step(1)) is not reached: the next test reaches it."""
+    (x, y, h), branches = run_pmb2(PMB2, CRATE, 12000)
     turning = [b for b in branches if b[1:3] != (CRUISING_SPEED, CRUISING_SPEED)]
     assert (len(turning), turning[0][0], turning[-1][0]) == (43, 8800, 10208)
     assert all(b[1] == 0.0 and 1.37 < b[2] < 5.12 for b in turning) and not any(b[3] for b in branches)
     assert turning[0][2] == pytest.approx(5.113733, abs=1e-6)
     assert (x, y, h) == pytest.approx((-1.339437, 1.576264, 0.938508), abs=1e-6)
+
+
+POST = (np.array([-2.5, 1.063]), np.array([0.15, 0.15]))
+
+
+def test_tiago_pmb2_base_calls_u_turn_before_a_post_dead_ahead(tmp_path: Path) -> None:
+    """With a 0.3 m post of ours dead ahead instead of the box (at (−2.5, 1.063): mirror-symmetric, the side
+    sectors empty) only the front sector fills: at 3.296 s (the post's face 0.5995 m ahead of the lidar) it passes
+    0.7 and the rule takes its u-turn branch, right wheel back and left ahead at 2.3418 rad/s (neither side
+    fuller: it turns right), after its wb_robot_step(1), one basic step of 32 ms on the speeds set before (a
+    step shorter than the basic step ends at the next basic step, as in Webots); three times (3.328, 3.392 and
+    4.16 s, counting the extra steps), cruising between as the post leaves the front sector, then the post
+    fills the front-left sector and the rule pivots the robot right about its right wheel (left wheel at
+    4.8549 rad/s and falling) until it is clear; at 10 s it is at (−2.2964, −0.0956) heading −0.9242 rad,
+    every step the closed forms' (the image 1e-5, the pose 1e-9)."""
+    world = tmp_path / "post.wbt"
+    world.write_text(PMB2.read_text().replace("protos/", f"{DATA}/protos/")
+                     .replace("translation -0.6 0.863 0.3", "translation -2.5 1.063 0.3")
+                     .replace("size 0.6 0.6 0.6", "size 0.3 0.3 0.6"))
+    (x, y, h), branches = run_pmb2(world, POST, 10000)
+    u_turns = [b for b in branches if b[3]]
+    assert [b[0] for b in u_turns] == [3328, 3392, 4160]
+    assert all(b[1] == -b[2] > 2.3 for b in u_turns) and u_turns[0][1] == pytest.approx(2.341800, abs=1e-6)
+    after = next(b for b in branches if b[0] > 4160)
+    assert after[0] == 4192 and after[2] == 0.0 and after[1] == pytest.approx(4.854942, abs=1e-6)
+    assert (x, y, h) == pytest.approx((-2.296422, -0.095565, -0.924233), abs=1e-6)
 
 
 # ------------------------------------------------------------------------------------ TIAGo OMNI Base
