@@ -6,10 +6,13 @@ closed forms."""
 from __future__ import annotations
 
 import math
+import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from _serve import child_env, sensorium
 
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
@@ -259,6 +262,110 @@ def test_tiago_pmb2_base_calls_u_turn_before_a_post_dead_ahead(tmp_path: Path) -
     after = next(b for b in branches if b[0] > 4160)
     assert after[0] == 4192 and after[2] == 0.0 and after[1] == pytest.approx(4.854942, abs=1e-6)
     assert (x, y, h) == pytest.approx((-2.296422, -0.095565, -0.924233), abs=1e-6)
+
+
+# our Python controller making tiago_pmb2_base.c's calls in its order (only the prints are the test's)
+PMB2_CONTROLLER = '''"""Sensorium's stand-in for tiago_pmb2_base.c (sweep 31): our own Python making its calls in its order (the
+Hokuyo enabled at the basic step, both wheels in velocity control, each step the Braitenberg rule on the range
+image, its u-turn branch with robot.step(1)); each control step prints the time and the speeds it set."""
+from controller import Robot
+
+MAX_SPEED, CRUISING_SPEED = 6.4, 3.0
+FAR, NEAR, FAST, SLOW = 0.4, 0.7, 0.9, 0.5
+UNUSED_POINT, N_SECTOR = 83, 5
+
+robot = Robot()
+time_step = int(robot.getBasicTimeStep())
+lidar = robot.getDevice("Hokuyo URG-04LX-UG01")
+left_wheel, right_wheel = robot.getDevice("wheel_left_joint"), robot.getDevice("wheel_right_joint")
+lidar.enable(time_step)
+width = lidar.getHorizontalResolution()
+sector_size = int((width - 2.0 * UNUSED_POINT - 1.0) / N_SECTOR)
+sector_range = [UNUSED_POINT + (i + 1) * sector_size for i in range(N_SECTOR)]
+max_range = lidar.getMaxRange()
+threshold = max_range / 2.0
+for wheel in (left_wheel, right_wheel):
+    wheel.setPosition(float("inf"))
+    wheel.setVelocity(0.0)
+
+
+def check(speed):
+    return min(speed, MAX_SPEED)
+
+
+while robot.step(time_step) != -1:
+    values = lidar.getRangeImage()
+    left = front_left = front = front_right = right = 0.0
+    for i in range(UNUSED_POINT, width - UNUSED_POINT - 1):
+        if values[i] < threshold:
+            w = 1.0 - values[i] / max_range
+            if i < sector_range[0]:
+                left += w
+            if sector_range[0] <= i < sector_range[1]:
+                front_left += w
+            if sector_range[1] <= i < sector_range[2]:
+                front += w
+            if sector_range[2] <= i < sector_range[3]:
+                front_right += w
+            if sector_range[3] <= i < sector_range[4] + 1:
+                right += w
+    left, front_left, front, front_right, right = (v / sector_size for v in (left, front_left, front, front_right,
+                                                                           right))
+    extra = 0
+    if left > right and left > NEAR:
+        f = (1.0 - FAST * left) * MAX_SPEED / left
+        ls, rs = check(f * left), check(f * right)
+    elif front_left > front_right and front_left > FAR:
+        f = (1.0 - SLOW * front_left) * MAX_SPEED / front_left
+        ls, rs = check(f * front_left), check(f * front_right)
+    elif front_right > front_left and front_right > FAR:
+        f = (1.0 - SLOW * front_right) * MAX_SPEED / front_right
+        ls, rs = check(f * front_left), check(f * front_right)
+    elif right > left and right > NEAR:
+        f = (1.0 - FAST * right) * MAX_SPEED / right
+        ls, rs = check(f * left), check(f * right)
+    elif front > NEAR:
+        f = (1.0 - FAST * front) * MAX_SPEED / front
+        if front_right > front_left or right > left:
+            ls, rs = -check(f * front), check(f * front)
+        else:
+            ls, rs = check(f * front), -check(f * front)
+        robot.step(1)
+        extra = 1
+    else:
+        ls, rs = CRUISING_SPEED, CRUISING_SPEED
+    left_wheel.setVelocity(ls)
+    right_wheel.setVelocity(rs)
+    print(round(robot.getTime() * 1000), repr(ls), repr(rs), extra, flush=True)
+'''
+
+
+@pytest.mark.slow
+def test_tiago_pmb2_base_calls_under_sensorium_run_set_the_in_process_speeds(tmp_path: Path) -> None:
+    """Our Python controller making tiago_pmb2_base.c's calls under ``sensorium run`` before the post for 10 s:
+    every control step sets exactly the speeds the in-process run's closed-form-checked steps set, at the same
+    times; its robot.step(1) ends at the next basic step (the three u-turns at 3.328, 3.392 and 4.16 s) and
+    says once that the step duration of 1 ms is rounded up."""
+    (tmp_path / "worlds").mkdir()
+    shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
+    world = tmp_path / "worlds" / "tiago_pmb2_base.wbt"
+    world.write_text(PMB2.read_text().replace("translation -0.6 0.863 0.3", "translation -2.5 1.063 0.3")
+                     .replace("size 0.6 0.6 0.6", "size 0.3 0.3 0.6"))
+    folder = tmp_path / "controllers" / "tiago_pmb2_base"
+    folder.mkdir(parents=True)
+    (folder / "tiago_pmb2_base.py").write_text(PMB2_CONTROLLER)
+    done = subprocess.run(sensorium("run", str(world), "--until", "10000", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.count("the step duration 1 ms of robot 'TIAGo PMB-2 Base' is not a multiple of the basic "
+                             "time step (32 ms)") == 1, done.stderr
+    rows = [line.split("] ", 1)[1].split() for line in done.stdout.splitlines()
+            if line.startswith(f"[{PMB2_NAME}] ")]
+    _, want = run_pmb2(world, POST, 10000)
+    got = [(int(r[0]), float(r[1]), float(r[2]), r[3] == "1") for r in rows]
+    assert got[:len(want)] == want
+    assert [b[0] for b in got if b[3]] == [3328, 3392, 4160]
 
 
 # ------------------------------------------------------------------------------------ TIAGo OMNI Base
