@@ -136,8 +136,9 @@ def diff_arc(x: float, y: float, h: float, wl: float, wr: float, dt: float) -> t
 def test_the_pmb2_base_loads_as_a_two_wheel_drive_with_its_lidar_sonars_and_bumper() -> None:
     """The PMB-2 stand-in loads with the arena's stand-in line only: its two motorised wheels (radius 0.0985 m,
     Solids 0.404 m apart) are its drive, its four casters' free hinges no wheel and no line, and every device
-    the PROTO has is there with the Hokuyo from the slot (667 rays, 4.18879 rad, 5.6 m). It settles 3.5 mm up,
-    where its wheels and casters (all reaching 3.5 mm below its origin) touch the floor."""
+    the PROTO has is there with the Hokuyo from the slot (667 rays, 4.18879 rad, 0.2 to 5.6 m). It settles 3.5
+    mm up, where its wheels and casters (all reaching 3.5 mm below its origin) touch the floor; its rear sonars
+    read 1000 (nothing within their table's 0.1 m) and its bumper 0."""
     w = load_world(PMB2)
     assert len(w.warnings) == 1 and "built-in stand-ins used for RectangleArena" in w.warnings[0], w.warnings
     (robot,) = w.world.robots
@@ -156,6 +157,14 @@ def test_the_pmb2_base_loads_as_a_two_wheel_drive_with_its_lidar_sonars_and_bump
     info = lidar.info()
     assert (info["horizontalResolution"], info["fov"], info["minRange"], info["maxRange"]) == (
         HOKUYO_RAYS, HOKUYO_FOV, 0.2, HOKUYO_MAX)
+    # the rear sonars (DistanceSensors with Webots' default table, 0 m -> 0, 0.1 m -> 1000) see nothing within
+    # 0.1 m: the table's last value; the bumper touches nothing
+    sensors = [sim.device(f"{PMB2_NAME}/base_sonar_0{k}_link") for k in (1, 2, 3)] + [
+        sim.device(f"{PMB2_NAME}/base_cover_link")]
+    for d in sensors:
+        d.enable(PMB2_STEP)
+    sim.step()
+    assert [float(d.value) for d in sensors] == [1000.0, 1000.0, 1000.0, 0.0]
 
 
 def test_the_hokuyo_reads_the_box_and_the_walls_by_their_closed_forms() -> None:
