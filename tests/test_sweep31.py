@@ -428,12 +428,15 @@ def test_the_omni_base_loads_with_its_lidars_and_wheels_but_no_drive_for_its_sid
     """The OMNI stand-in loads every device the PROTO has (the two lidars, the four wheel motors and their
     sensors, the accelerometer, inertial unit, gyro, GPS) and one line besides the arena's: no mecanum drive,
     as its rollers (the friction turned alike on each side's front and rear wheels, whose frames are alike)
-    are not the youBot's pattern (alike on diagonal wheels); the robot does not move."""
+    are not the youBot's pattern (alike on diagonal wheels), judged in the drive's frame, which its wheels
+    turning about −y turn half round (its names' front and rear, left and right swapped: a positive speed
+    would drive the robot backward; its direction written without a −0.0); the robot does not move."""
     w = load_world(OMNI)
     assert len(w.warnings) == 2 and "built-in stand-ins used for RectangleArena" in w.warnings[0], w.warnings
     assert ("robot 'TIAGo OMNI Base': no mecanum drive (the rollers (friction turned by 0.785398, -0.785398, "
             "0.785398, -0.785398 on the front left, front right, rear left and rear right wheels) are not alike on "
-            "diagonal wheels and opposite on the front two") in w.warnings[1]
+            "diagonal wheels and opposite on the front two; in the drive's frame: x forward along [-1.0, 0.0] in the "
+            "robot's, y its left); the robot will not move") in w.warnings[1]
     (robot,) = w.world.robots
     assert [d.name for d in robot.devices] == [
         "accelerometer", "inertial unit", "gyro", "gps", "base_rear_laser", "base_front_laser",
