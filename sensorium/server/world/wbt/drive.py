@@ -425,7 +425,7 @@ def _framed(drive: dict | None, why: str, frame: np.ndarray | None) -> tuple[dic
     if frame is None:
         return drive, why
     if drive is None:
-        fwd = np.round(frame[0, :2 if frame[2, 2] == 1.0 else 3], 6).tolist()
+        fwd = [float(v) + 0.0 for v in np.round(frame[0, :2 if frame[2, 2] == 1.0 else 3], 6)]      # (no -0.0)
         return None, f"{why}; in the drive's frame: x forward along {fwd} in the robot's, y its left"
     # (x, y) for a z-up robot, as it always was; (x, y, z) for a y-up one, its up its y
     drive["forward"] = [float(v) + 0.0 for v in frame[0, :2 if frame[2, 2] == 1.0 else 3]]      # (no -0.0)
