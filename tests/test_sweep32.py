@@ -133,8 +133,8 @@ def test_the_ratslife_world_loads_with_its_walls_feeders_and_rats() -> None:
     assert sum(n.startswith("LEGO wall") for n in names) == 121
     assert sum(n.startswith("LEGO interval") for n in names) == 121
     assert [(c.battery, c.radius, c.gradual) for c in w.world.chargers] == [([100.0, 100.0, 0.833], 0.064, False)] * 4
-    assert [(r.name, r.battery) for r in w.world.robots[:2]] == [("Rat0", [200.0, 100.0, 1000.0])] * 1 + \
-        [("Rat1", [200.0, 100.0, 1000.0])]
+    assert [(r.name, r.battery) for r in w.world.robots[:2]] == [("Rat0", [200.0, 100.0, 1000.0]),
+                                                                 ("Rat1", [200.0, 100.0, 1000.0])]
     sim = Simulation(w, "exact")
     helper, debug = sim.device(f"{MANAGER}/helper_display"), sim.device(f"{MANAGER}/debug_display")
     assert (helper.width, helper.height, debug.width, debug.height) == (64, 32, 21, 21)
@@ -166,9 +166,9 @@ def test_the_contest_manager_builds_the_maze_where_build_maze_places_each_piece(
         assert r == pytest.approx(want, abs=1e-12), name
     assert m.get(m.node("W000"), "rotation") == pytest.approx([0, 0, -1, 2 * math.pi - (math.pi / 2 + 1.5708)], abs=1e-15)
     c, s = math.cos(0.0 + 1.5708), math.sin(0.0 + 1.5708)
-    wall = next(n for n, *_ in todo[20:] if n.startswith("W"))      # an outer side wall, alpha 0
-    (wall_key,) = [k for k in poses if isinstance(k, str) and k == f"LEGO wall({int(wall[1:]) + 1})"]
-    assert np.asarray(poses[wall_key].rotation)[:2, :2] == pytest.approx(np.array([[c, -s], [s, c]]), abs=1e-15)
+    wall = todo[20][0]                                              # an outer side wall, alpha 0
+    assert todo[20][3] == 0.0
+    assert np.asarray(poses[f"LEGO wall({int(wall[1:]) + 1})"].rotation)[:2, :2] == pytest.approx(np.array([[c, -s], [s, c]]), abs=1e-15)
     # the feeders' Chargers at their new places: F0 (cell 0, 0) gives energy to a robot put there
     rat = m.node("R0")
     m.set(rat, "battery", 50.0, index=0)
@@ -232,7 +232,7 @@ def test_the_wall_textures_the_manager_saves_are_shown_on_the_walls(tmp_path: Pa
         sim.step()
     finally:
         outside.unlink(missing_ok=True)
-    for k, (name, x, y, _alpha) in enumerate(placements()[:4]):
+    for k, (_name, x, y, _alpha) in enumerate(placements()[:4]):
         key = f"LEGO wall({k + 1})"
         assert np.asarray(sim.scene.solid_poses[key].translation) == pytest.approx([x, y, 0.025], abs=1e-12)
         (shape,) = sim.scene.solid_shapes(key)
