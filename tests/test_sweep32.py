@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import random
 import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -271,3 +272,98 @@ def test_the_round_reads_the_rats_batteries_until_one_is_empty() -> None:
                                                     "transparency": 0.0, "color": 0xFFFFFF, "font": "Arial"})
         counter += 1
     assert (winner, sim.time_ms, counter) == ("Rat1", 20032, 313)
+
+
+MANAGER_CONTROLLER = '''
+import os
+import random
+import sys
+from controller import Supervisor
+
+sys.path.insert(0, os.environ["SWEEP32_TESTS"])
+from test_sweep32 import placements  # noqa: E402  (the maze's placements, build_maze's order)
+
+sup = Supervisor()
+for name, x, y, alpha in placements():                 # maze_builder.c's place_object
+    node = sup.getFromDef(name)
+    t = node.getField("translation").getSFVec3f()
+    node.getField("rotation").getSFRotation()
+    node.getField("translation").setSFVec3f([x, y, t[2]])
+    node.getField("rotation").setSFRotation([0.0, 0.0, 1.0, alpha + 1.5708])
+display = sup.getDevice("helper_display")
+rng = random.Random(7)
+w, h = display.getWidth(), display.getHeight()
+for k in range(121):                                   # texture_generator.c's update_wall_textures
+    display.setColor(0xFFFFFF)
+    display.fillRectangle(0, 0, w, h)
+    display.setColor(0x000000)
+    display.fillRectangle(w // 2, 3 * h // 4, w // 2, h // 4)
+    offset = 0
+    for _ in range(2):
+        display.setColor((0xFF0000, 0x00FF00, 0x0000FF, 0xFFFF00)[rng.randrange(4)])
+        for i in range(offset, offset + 4):
+            for j in range(3):
+                if rng.randrange(2):
+                    display.fillRectangle(8 * i, 8 * j, 8, 8)
+        offset += 4
+    image = display.imageCopy(0, 0, w, h)
+    path = os.path.join(os.environ["TMP"], f"ratslife_{k}.jpg")
+    display.imageSave(image, path)
+    display.imageDelete(image)
+    sup.getFromDef(f"W{k:03d}").getField("textureUrl").setMFString(0, path)
+sup.step(0)
+print("built", sup.getFromDef("W000").getField("translation").getSFVec3f(),
+      sup.getFromDef("W000").getField("rotation").getSFRotation(), flush=True)
+rats = [sup.getFromDef("R0").getField("battery"), sup.getFromDef("R1").getField("battery")]
+counter = 0
+while sup.step(64) != -1:                              # round_manager.c's run_round
+    battery = [f.getMFFloat(0) for f in rats]
+    if battery[0] <= 0.0:
+        sup.setLabel(0, "Rat1 wins", 0.0, 0.0, 0.1, 0xFFFFFF, 0.0, "Arial")
+        print("Rat1 wins", round(sup.getTime() * 1000), counter, flush=True)
+        break
+    if counter > 100:
+        sup.setLabel(0, f"Rat0: {battery[0]:3.2f}", 0.0, 0.0, 0.1, 0xFF0000, 0.0, "Arial")
+    else:
+        sup.setLabel(0, "Rat0 vs Rat1", 0.0, 0.0, 0.1, 0xFFFFFF, 0.0, "Arial")
+    if counter % 50 == 0:
+        print("battery", round(sup.getTime() * 1000), *battery, flush=True)
+    counter += 1
+'''
+
+
+@pytest.mark.slow
+def test_our_contest_manager_runs_the_round_under_sensorium_run(tmp_path: Path) -> None:
+    """Our Python controller making contest_manager.c's calls under ``sensorium run``, ``TMP`` in the world's
+    folder: the 248 placements, 121 textures saved as JPEG by ``imageSave`` and set on the walls without a
+    line, the first wall where the maze puts it (1e-12), the batteries 200 − 10·t at each 3.2 s, and the
+    round won by Rat1 at 20.032 s, the manager's 313th read."""
+    from _serve import child_env, sensorium
+
+    for folder in ("sweep32", "sweep22"):
+        shutil.copytree(DATA / folder, tmp_path / folder)
+    world = tmp_path / "sweep32" / "ratslife.wbt"
+    text = world.read_text()
+    head, manager = text.rsplit('controller "<extern>"', 1)
+    world.write_text(head.replace('controller "<extern>"', 'controller "<none>"') + 'controller "contest_manager"'
+                     + manager)
+    (tmp_path / "controllers" / "contest_manager").mkdir(parents=True)
+    (tmp_path / "controllers" / "contest_manager" / "contest_manager.py").write_text(MANAGER_CONTROLLER)
+    (tmp_path / "sweep32" / "tmp").mkdir()
+    env = {**child_env(), "TMP": str(tmp_path / "sweep32" / "tmp"), "SWEEP32_TESTS": str(Path(__file__).parent)}
+    done = subprocess.run(sensorium("run", str(world), "--until", "20200", "--rpc", "tcp://127.0.0.1:0",
+                                    "--pub", "tcp://127.0.0.1:0"),
+                          env=env, cwd=tmp_path, capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "not loaded" not in done.stdout + done.stderr
+    assert len(list((tmp_path / "sweep32" / "tmp").glob("ratslife_*.jpg"))) == 121
+    lines = [line.split("] ", 1)[1] for line in done.stdout.splitlines() if line.startswith("[contest manager] ")]
+    assert lines, done.stdout[-2000:] + done.stderr[-2000:]
+    built = next(line for line in lines if line.startswith("built"))
+    _, x, y, alpha = placements()[0]
+    numbers = [float(v) for v in built.replace("[", " ").replace("]", " ").replace(",", " ").split()[1:]]
+    assert numbers == pytest.approx([x, y, 0.025, 0, 0, -1, 2 * math.pi - (alpha + 1.5708)], abs=1e-12)
+    for line in (line for line in lines if line.startswith("battery")):
+        t, b0, b1 = (float(v) for v in line.split()[1:])
+        assert [b0, b1] == pytest.approx([200.0 - 10.0 * t / 1000.0] * 2, abs=1e-9), line
+    assert "Rat1 wins 20032 312" in lines             # counter counts the reads before this one, lines[-5:]
