@@ -367,3 +367,88 @@ def test_our_contest_manager_runs_the_round_under_sensorium_run(tmp_path: Path) 
         t, b0, b1 = (float(v) for v in line.split()[1:])
         assert [b0, b1] == pytest.approx([200.0 - 10.0 * t / 1000.0] * 2, abs=1e-9), line
     assert "Rat1 wins 20032 312" in lines             # counter counts the reads before this one, lines[-5:]
+
+
+# ------------------------------------------------------------------------------------------------ battery
+# battery (projects/samples/devices, R2023a, not run by the earlier sweeps: Batteries were not simulated when
+# the nineteenth ran): MyBot (wheels of radius 0.025 m, 0.09 m apart) at (0, −0.15) heading 1 rad, its battery
+# [50 J, 100 J, 30 W], cpuConsumption 0.5 W; four Chargers at the arena's corners, radius 0.1, [100, 100, s]
+# with s = 3, 4, 2, 5 W. battery.c: 64 ms steps, the battery sensor enabled, both wheels at 6 rad/s unless a
+# distance sensor reads over 500, then turning away in proportion to the readings.
+CHARGERS = [((0.43, 0.43), 3.0), ((-0.43, 0.43), 4.0), ((-0.43, -0.43), 2.0), ((0.43, -0.43), 5.0)]
+
+
+def battery_speeds(v0: float, v1: float) -> tuple[float, float]:
+    """battery.c's wheel speeds for the readings ``v0`` (ds0) and ``v1`` (ds1)."""
+    if v1 > 500:
+        return (-6.0, -3.0) if v0 > 200 else (-v1 / 100, v0 / 100 + 0.5)
+    if v0 > 500:
+        return v1 / 100 + 0.5, -v0 / 100
+    return 6.0, 6.0
+
+
+def test_the_battery_sample_drains_recharges_and_drives_by_the_closed_forms() -> None:
+    """battery.c's calls in process for 20 s. The robot drives the differential drive's arcs of the speeds it
+    sets (1e-12 every step: nothing stops it), turning away from the green box from 1.216 s (ds1 557) and
+    along the arena's walls; its battery sensor reads the energy each 64 ms (NaN before the first sample) by
+    WbCharger's rule: 50 − 0.5·t until, at 6.72 s, it comes within 0.1 m of charger 0 (full), which then
+    gives 30 W (the robot's speed) each basic step while it stays within 0.11 m, until the robot holds its
+    100 J (the rest wasted: it then drains from 100), and is emptied when it leaves (then gathers its 3 W);
+    charger 3 takes it at 13.216 s (the basic step from there: it samples every 32 ms). The
+    motors' consumption (consumptionFactor 70 × torque: physics) is not simulated: one load line."""
+    w = load_world(DATA / "sweep32" / "battery.wbt")
+    assert sum("energy consumption" in x for x in w.warnings) == 1
+    sim = Simulation(w, "exact")
+    bot = sim.robot("MyBot")
+    ds = [sim.device("MyBot/ds0"), sim.device("MyBot/ds1")]
+    for d in ds:
+        d.enable(64)
+    left, right = bot.motor("left wheel motor"), bot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    sim.enable_battery_sensor(bot, 64)
+    assert math.isnan(bot.battery_value)
+    x, y, th, speeds = 0.0, -0.15, 1.0, (0.0, 0.0)
+    energy = 50.0
+    chargers = [{"n": n, "at": at, "e": 100.0, "s": s, "held": False, "done": True}
+                for n, (at, s) in enumerate(CHARGERS)]
+    taken, first_turn = [], None
+    for k in range(1, 313):
+        for _ in range(2):                               # two basic steps of 32 ms
+            for c in chargers:                           # WbCharger, at the step's starting position
+                d = math.hypot(x - c["at"][0], y - c["at"][1])
+                if c["held"] and d > 0.11:
+                    c["held"], c["e"] = False, 0.0       # the robot leaving empties it
+                elif not c["held"] and d <= 0.1 and c["e"] == 100.0:
+                    c["held"], c["done"] = True, False
+                    taken.append((c["n"], sim.time_ms))
+                if c["held"]:                            # it gives the robot's 30 W; once the robot is
+                    given = min(30.0 * 0.032, c["e"])    # full ("done") that energy is wasted
+                    c["e"] -= given
+                    if not c["done"]:
+                        energy += given
+                        if energy > 100.0:
+                            energy, c["done"] = 100.0, True
+                else:
+                    c["e"] = min(c["e"] + c["s"] * 0.032, 100.0)
+            sim.step()
+            v, om = 0.025 * sum(speeds) / 2, 0.025 * (speeds[1] - speeds[0]) / 0.09
+            if om == 0.0:
+                x, y = x + v * 0.032 * math.cos(th), y + v * 0.032 * math.sin(th)
+            else:
+                x += v / om * (math.sin(th + om * 0.032) - math.sin(th))
+                y -= v / om * (math.cos(th + om * 0.032) - math.cos(th))
+                th += om * 0.032
+            energy = max(energy - 0.5 * 0.032, 0.0)
+        assert list(bot.pose.translation[:2]) == pytest.approx([x, y], abs=1e-12), k
+        assert bot.battery_value == pytest.approx(energy, abs=1e-9), k
+        if k * 64 < 6720:
+            assert energy == pytest.approx(50.0 - 0.5 * k * 0.064, abs=1e-9)
+        speeds = battery_speeds(ds[0].value, ds[1].value)
+        if first_turn is None and speeds != (6.0, 6.0):
+            first_turn = (sim.time_ms, round(ds[1].value, 2))
+        left.set_velocity(speeds[0])
+        right.set_velocity(speeds[1])
+    assert first_turn == (1216, 557.18)
+    assert taken == [(0, 6720), (3, 13216)]
