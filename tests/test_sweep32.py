@@ -212,7 +212,8 @@ def test_the_wall_textures_the_manager_saves_are_shown_on_the_walls(tmp_path: Pa
     world (a url the PROTO does not hold, which Webots looks up in the project's protos/ and the world's
     folder) too, where it was looked for beside the PROTO only and the wall drawn untextured without a
     word; a file outside the world's folder (the sample's /tmp) is not read here: the wall is drawn
-    untextured and the server's log says so in one line (README: a departure)."""
+    untextured and the server's log says so in one line (README: a departure), as for a file in neither
+    place (the line naming both)."""
     for folder in ("sweep32", "sweep22"):
         shutil.copytree(DATA / folder, tmp_path / folder)
     world = tmp_path / "sweep32" / "ratslife.wbt"
@@ -243,6 +244,16 @@ def test_the_wall_textures_the_manager_saves_are_shown_on_the_walls(tmp_path: Pa
             continue
         assert texture is not None and Path(texture.url).name == f"ratslife_{k}.jpg"
     assert len(log) == 1 and "1 texture not loaded" in log[0] and outside.name in log[0] and "outside" in log[0]
+    # a file in neither place: its line names both (a fresh log: the server says a line's first 200
+    # characters once, and these lines start alike)
+    sim = Simulation(load_world(world), "exact")
+    log = []
+    m = Manager(sim, log)
+    m.set(m.node("W004"), "textureUrl", "missing.jpg", index=0)
+    (line,) = log
+    assert f"looked in: {tmp_path / 'sweep32' / 'protos' / 'missing.jpg'}, {tmp_path / 'sweep32' / 'missing.jpg'};" \
+        in line
+    assert sim.scene.shape_model(sim.scene.solid_shapes("LEGO wall(5)")[0]).appearance.texture is None
 
 
 def test_the_round_reads_the_rats_batteries_until_one_is_empty() -> None:

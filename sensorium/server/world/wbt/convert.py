@@ -225,10 +225,16 @@ def _solid_names(root: Node) -> set[str] | None:
 _PHYSICS_ONLY = frozenset({"Physics", "Damping", "ContactProperties", "ImmersionProperties", "Fluid", "Muscle"})
 
 
+def _relative(url: str) -> bool:
+    """Whether ``url`` is a relative path (no scheme, no root, no drive)."""
+    u = url.strip().replace("\\", "/")
+    return bool(u) and "://" not in u and not u.startswith("/") and not (len(u) > 1 and u[1] == ":") and "\0" not in u
+
+
 def _world_relative(url: str, world: str) -> bool:
     """Whether ``url`` is a relative path naming a file in the world file's folder (and staying in it)."""
     u = url.strip().replace("\\", "/")
-    if not u or "://" in u or u.startswith("/") or (len(u) > 1 and u[1] == ":") or "\0" in u:
+    if not _relative(u):
         return False
     folder = Path(world).resolve().parent
     path = (folder / u).resolve()
@@ -1349,7 +1355,11 @@ class Converter:
                 # Supervisor sets): Webots' WbUrl::computePath looks in the project's protos/ folder, then
                 # the world's folder; read there, confined to it as a world file's textures are
                 return url, ""
-            return None, f"{kind} file {exc.message}; {lost}"
+            message = exc.message
+            if kind == "texture" and _relative(url):     # the world's folder was looked in too
+                message = message.replace("; nothing is downloaded",
+                                          f", {Path(self.source).resolve().parent / url}; nothing is downloaded", 1)
+            return None, f"{kind} file {message}; {lost}"
         except (OSError, ValueError) as exc:
             return None, f"{kind} url {url!r} cannot be resolved ({exc}); {lost}"
         roots = [*asset_roots(self.search), Path(src).resolve().parent.parent, Path(self.source).resolve().parent]
