@@ -278,6 +278,8 @@ def _convert(wbt: WbtFile, source: str, loaded: LoadedWorld, world: wm.World, ta
         else:
             where = f"{label}: {first.path}" if first.path else label
         raise ImportRefused(f"{where}: {_shown(first.message, source, label)}{more}") from None
+    if conv.textured:        # said once, as a world's are: a texture not loaded draws the shape untextured
+        conv.warnings.append(conv.textures_not_loaded())
     warnings += [_shown(w, source, label) for w in conv.warnings]
     warnings += [_wbt_warning(w, origin, label) for w in parsed.warnings]
     queue: Counter[str] = Counter()

@@ -226,6 +226,22 @@ def _solid_names(root: Node) -> set[str] | None:
 _PHYSICS_ONLY = frozenset({"Physics", "Damping", "ContactProperties", "ImmersionProperties", "Fluid", "Muscle"})
 
 
+def _relative(url: str) -> bool:
+    """Whether ``url`` is a relative path (no scheme, no root, no drive)."""
+    u = url.strip().replace("\\", "/")
+    return bool(u) and "://" not in u and not u.startswith("/") and not (len(u) > 1 and u[1] == ":") and "\0" not in u
+
+
+def _world_relative(url: str, world: str) -> bool:
+    """Whether ``url`` is a relative path naming a file in the world file's folder (and staying in it)."""
+    u = url.strip().replace("\\", "/")
+    if not _relative(u):
+        return False
+    folder = Path(world).resolve().parent
+    path = (folder / u).resolve()
+    return path.is_relative_to(folder) and path.is_file()
+
+
 def _unserved_why(kind: str) -> str:
     """Why a DEF'd node of a PROTO's body is no Supervisor node here (getFromProtoDef's line)."""
     if kind in _PHYSICS_ONLY:
@@ -395,13 +411,8 @@ class Converter:
         self.world["top_nodes"] = top_nodes
         if world.parts:   # shapes outside any Solid: one solid holding them (visual only, as in Webots)
             self.world["solids"].append(self.solid_dict(world, {"name": self.unique_name("shapes")}))
-        if self.textured:   # textures not loaded: one line (world/textures.py says why each is refused)
-            (_, _, where, why), n = min(self.textured.values()), len(self.textured)
-            self.warnings.append(f"{where}: {n} texture{'s' if n > 1 else ''} not loaded (first: {why}); "
-                                 "read as Webots reads a texture it cannot load: an Appearance as its material's "
-                                 "diffuseColor, a PBRAppearance as its baseColor"
-                                 + (", an emissiveColorMap as its emissiveColor" if any(
-                                     why.startswith(fx.GLOW_MAP + ": ") for *_, why in self.textured.values()) else ""))
+        if self.textured:
+            self.warnings.append(self.textures_not_loaded())
         if self.left_fanned:
             where, n = next(iter(self.left_fanned.items())), len(self.left_fanned)
             self.warnings.append(
@@ -1217,6 +1228,16 @@ class Converter:
                     app["texture"] = image
             owner.parts[-1]["appearance"] = app
 
+    def textures_not_loaded(self) -> str:
+        """The one line for the textures not loaded (world/textures.py says why each is refused): a world's,
+        or a node's a Supervisor imports or builds again."""
+        (_, _, where, why), n = min(self.textured.values()), len(self.textured)
+        return (f"{where}: {n} texture{'s' if n > 1 else ''} not loaded (first: {why}); "
+                "read as Webots reads a texture it cannot load: an Appearance as its material's "
+                "diffuseColor, a PBRAppearance as its baseColor"
+                + (", an emissiveColorMap as its emissiveColor" if any(
+                    why.startswith(fx.GLOW_MAP + ": ") for *_, why in self.textured.values()) else ""))
+
     def cad_texture(self, node: Node, where: Path, texture: str) -> dict | None:
         """A CadShape material's diffuse image (its path as the file writes it, relative to the file)
         → the world's texture, or None (said once, as other textures not loaded): a PROTO's or
@@ -1330,7 +1351,16 @@ class Converter:
         try:
             path = resolve_url(url, src, self.search).resolve()
         except ProtoError as exc:
-            return None, f"{kind} file {exc.message}; {lost}"
+            if kind == "texture" and _world_relative(url, self.source):
+                # a relative url a PROTO does not hold (a value the world writes for its field, or a
+                # Supervisor sets): Webots' WbUrl::computePath looks in the project's protos/ folder, then
+                # the world's folder; read there, confined to it as a world file's textures are
+                return url, ""
+            message = exc.message
+            if kind == "texture" and _relative(url):     # the world's folder was looked in too
+                message = message.replace("; nothing is downloaded",
+                                          f", {Path(self.source).resolve().parent / url}; nothing is downloaded", 1)
+            return None, f"{kind} file {message}; {lost}"
         except (OSError, ValueError) as exc:
             return None, f"{kind} url {url!r} cannot be resolved ({exc}); {lost}"
         roots = [*asset_roots(self.search), Path(src).resolve().parent.parent, Path(self.source).resolve().parent]
