@@ -134,6 +134,16 @@ def test_a_repeated_error_is_logged_at_powers_of_ten() -> None:
                      "internal error: another"]
 
 
+def test_errors_sharing_a_long_start_are_each_logged() -> None:
+    """Two lines whose first 300 characters agree (a rebuilt PROTO's path, then what failed) both print."""
+    lines: list[str] = []
+    core = Core(Simulation.from_file(WORLD, precision="fast"), log=lines.append)
+    start = "/a/long/path/" + "p" * 300 + ".proto: "
+    for what in ("texture 'a.png' not found", "texture 'b.png' not found", "texture 'a.png' not found"):
+        core.log_error(start + what)
+    assert lines == [start + "texture 'a.png' not found", start + "texture 'b.png' not found"]
+
+
 def test_a_step_with_thousands_of_motor_commands_is_refused_cheaply(server) -> None:
     core, transport = server
     client = Dealer(transport.rpc_endpoint)

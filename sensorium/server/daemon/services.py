@@ -201,8 +201,9 @@ class Core(DeviceServices):
     def log_error(self, line: str) -> None:
         """Log an error a client may trigger again and again: the same first line is printed the
         1st, 10th, 100th… time only, with its count, so a client repeating a failing request
-        cannot flood the log (counting, not timing: the core has no clock)."""
-        key = line.split("\n", 1)[0][:200]
+        cannot flood the log (counting, not timing: the core has no clock). The whole first line is the
+        key (to 4,000 characters): lines that share a long start (a PROTO's path) and then differ each print."""
+        key = line.split("\n", 1)[0][:4000]
         if len(self._log_counts) > 1000 and key not in self._log_counts:
             self._log_counts.clear()
         n = self._log_counts.get(key, 0) + 1
