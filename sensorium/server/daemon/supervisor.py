@@ -1903,7 +1903,11 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
     if entry is not None and entry[0] == "SFNode":        # importSFNodeFromString
         return [import_sf_node(sim, node, field, text)]
     if node.id != 0 and field == "children" and _solid_holder(sim, node):
-        return _import_into_solid(sim, node, position, text)
+        return _import_into_solid(sim, node, position, text, warnings)
+    if field == "children" and node.type == "Robot" or node.nested and _nested_of(sim, node).owner_kind == "Robot":
+        raise ValueError(f"field {field!r} of {_what(node)}: nodes are not imported into a robot here (a departure "
+                         "from Webots): its shapes and devices are fixed at load; import into the root's children "
+                         "and move them with it")
     if node.id != 0 or field != "children":
         what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
         raise ValueError(f"field {field!r} of {what}: nodes are imported into the 'children' of the root, of a "
@@ -1932,7 +1936,7 @@ def _solid_key(sim: Any, node: Node) -> tuple[str, int]:
     return str(node.key), node.id
 
 
-def _import_into_solid(sim: Any, node: Node, position: int, text: str) -> list[int]:
+def _import_into_solid(sim: Any, node: Node, position: int, text: str, warnings: list[str] | None) -> list[int]:
     """Webots' ``importMFNodeFromString`` into the ``children`` of a top-level Solid or of a Pose, Transform or
     Group inside one: the string's nodes written there, at ``position`` (:func:`insert_index` among the children
     written), the solid built again as its world file would build with them (sim/regenerate.py
@@ -1942,7 +1946,7 @@ def _import_into_solid(sim: Any, node: Node, position: int, text: str) -> list[i
     until ``simulationReset`` takes them out (:func:`reset_nested_imports`). Returns the new top nodes' ids. What
     does not parse or build changes nothing (one line)."""
     from sensorium.server.sim.imports import ImportRefused
-    from sensorium.server.sim.regenerate import imported_line, parse_nested_import, rebuild_children, written_node
+    from sensorium.server.sim.regenerate import IMPORT_LINES, parse_nested_import, rebuild_children, written_node
 
     table = _table(sim)
     key, owner = _solid_key(sim, node)
@@ -1960,16 +1964,27 @@ def _import_into_solid(sim: Any, node: Node, position: int, text: str) -> list[i
         nodes = parse_nested_import(sim, key, text, serial)
         children = holder.fields.get("children", [])
         index = insert_index(position, len(children) if isinstance(children, list) else 1)
-        before = top
+        corrected: list[str] = []
         made = _rebuilt_in_place(sim, key, lambda: rebuild_children(
-            sim, key, owner, at, lambda now: [*now[:index], *nodes, *now[index:]]))
+            sim, key, owner, at, lambda now: [*now[:index], *nodes, *now[index:]], corrected))
     except ImportRefused as exc:
         raise ValueError(f"{doing}: {_import_line(str(exc))}") from None
+    if warnings is not None:
+        warnings += [_import_line(w) for w in corrected]
     sim._nested_import_serial = serial
-    sim.__dict__.setdefault("_nested_loaded", {}).setdefault(key, before)
-    added = nested.regrow(sim, table, owner, key, made.model, fresh=lambda m: bool(m.at) and imported_line(m.at[0]))
-    tops = {(n.line, n.col) for n in nodes}
-    return [i for i in added if tuple(_table(sim).get(i).at[:2]) in tops]      # type: ignore[union-attr]
+    sim.__dict__.setdefault("_nested_imports", set()).add(key)
+    added = nested.regrow(sim, table, owner, key, made.model,      # (this import's lines: IMPORT_LINES)
+                          fresh=lambda m: bool(m.at) and m.at[0] // IMPORT_LINES == serial)
+    tops = {(n.line, n.col): n for n in nodes}
+    made_tops = [i for i in added if tuple(table.get(i).at[:2]) in tops]      # type: ignore[union-attr]
+    if len(made_tops) != len(nodes):          # one of them is no node here: the solid back as it was
+        lost = next(n for at, n in tops.items() if all(tuple(table.get(i).at[:2]) != at for i in made_tops))  # type: ignore[union-attr]
+        again = _rebuilt_in_place(sim, key, lambda: rebuild_children(
+            sim, key, owner, at, lambda now: [c for c in now if all(c is not n for n in nodes)]))
+        nested.regrow(sim, table, owner, key, again.model, gone=frozenset(added))
+        raise ValueError(f"{doing}: node string:{lost.line % IMPORT_LINES}:{lost.col}: {lost.type} is no node a "
+                         "solid's children hold here (a Shape, a Pose, Transform or Group, a Solid or a light)")
+    return made_tops
 
 
 def _import_line(line: str) -> str:
@@ -2023,15 +2038,15 @@ def _remove_imported(sim: Any, node: Node) -> None:
 
 def reset_nested_imports(sim: Any) -> None:
     """After a ``simulationReset``: the nodes a Supervisor imported inside top-level solids taken out (Webots'
-    reset reloads the world), each solid built again from its node as written before the first of them (node
-    ids kept; the Poses set since are put back by :func:`reset_solid_poses`)."""
-    from sensorium.server.sim.regenerate import imported_line, restore_written
+    reset reloads the world), each solid built again as written now without them (the other nodes' ids kept;
+    the Poses set since are put back by :func:`reset_solid_poses`)."""
+    from sensorium.server.sim.regenerate import imported_line, rebuild_unimported
 
-    loaded = sim.__dict__.pop("_nested_loaded", {})
-    if not loaded:
+    keys = sim.__dict__.pop("_nested_imports", set())
+    if not keys:
         return
     table = _table(sim)
-    for key, written in loaded.items():
+    for key in sorted(keys):
         posed = getattr(sim, "_posed", {}).get(key, {})
         for at in [a for a in posed if imported_line(a[0])]:
             del posed[at]
@@ -2040,7 +2055,7 @@ def reset_nested_imports(sim: Any) -> None:
         owner = next(o for o, k in _solid_owners(sim) if k == key)
         gone = frozenset(m.id for m in table.by_owner.get(owner, ()) if any(
             imported_line(p.at[0]) for p in _line_of(table, m) if p.at))
-        made = _rebuilt_in_place(sim, key, lambda: restore_written(sim, key, owner, written))   # noqa: B023
+        made = _rebuilt_in_place(sim, key, lambda: rebuild_unimported(sim, key, owner))   # noqa: B023
         nested.regrow(sim, table, owner, key, made.model, gone=gone)
 
 

@@ -254,7 +254,8 @@ def written_node(sim: Any, key: str, at: tuple[int, int] | None = None) -> Parse
     return None
 
 
-def rebuild_children(sim: Any, key: str, node_id: int, at: tuple[int, int], change: Any) -> ImportedNode:
+def rebuild_children(sim: Any, key: str, node_id: int, at: tuple[int, int], change: Any,
+                     warnings: list[str] | None = None) -> ImportedNode:
     """Top-level solid ``key`` (Supervisor node ``node_id``) built again with the ``children`` of the node written at
     ``at`` inside it (its own node's place: its own children) changed by ``change`` (the written list -> the new
     one): a Supervisor's import into, or removal from, a node's children, through the path a Pose's set takes
@@ -266,21 +267,30 @@ def rebuild_children(sim: Any, key: str, node_id: int, at: tuple[int, int], chan
     new = _grown(written, at, change)
     if new is None:
         raise ImportRefused(f"no node of solid {key!r} is written at line {at[0]}, column {at[1]}")
-    return _rebuilt(sim, key, node_id, new, file)
+    return _rebuilt(sim, key, node_id, new, file, warnings)
 
 
-def restore_written(sim: Any, key: str, node_id: int, written: ParsedNode) -> ImportedNode:
-    """Top-level solid ``key`` built again from ``written`` (its node as written before, e.g. before the imports
-    a ``simulationReset`` takes out)."""
+def _unimported(node: ParsedNode) -> ParsedNode:
+    fields = {name: [_unimported(v) if isinstance(v, ParsedNode) else v for v in value
+                     if not (isinstance(v, ParsedNode) and imported_line(v.line))] if isinstance(value, list)
+              else _unimported(value) if isinstance(value, ParsedNode) else value
+              for name, value in node.fields.items()}
+    return replace(node, fields=fields)
+
+
+def rebuild_unimported(sim: Any, key: str, node_id: int) -> ImportedNode:
+    """Top-level solid ``key`` built again without the nodes a Supervisor imported inside it (what a
+    ``simulationReset`` takes out), as it is written now otherwise."""
     found = _instance(sim, key)
     assert found is not None
-    return _rebuilt(sim, key, node_id, written, found[1])
+    return _rebuilt(sim, key, node_id, _unimported(found[0]), found[1])
 
 
-def _rebuilt(sim: Any, key: str, node_id: int, new: ParsedNode, file: WbtFile) -> ImportedNode:
+def _rebuilt(sim: Any, key: str, node_id: int, new: ParsedNode, file: WbtFile,
+             warnings: list[str] | None = None) -> ImportedNode:
     taken = set(sim.scene.solid_names) - {key}
     node = rebuild_node(new, file, sim.loaded, sim.world, taken=taken, limits=sim.limits,
-                        allow_outside_meshes=sim.allow_outside_meshes)
+                        allow_outside_meshes=sim.allow_outside_meshes, warnings=warnings)
     if node.type != "Solid" or node.model.name != key:
         raise ImportRefused(f"solid {key!r} would not build again as a solid of that name")
     sim.replace_solid(key, node, node_id)
