@@ -10,6 +10,8 @@ lidar (shapes) look along +x from the origin; the Pose HOLD sits at BASE's trans
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from test_multiprocess import REPO
@@ -152,7 +154,9 @@ def test_save_and_load_state_keep_them_at_their_saved_translation():
     ("HOLD", "children", "# nothing", "nothing imported: node string: no node in it"),
     ("HOLD", "translation", BOX, "field 'translation' of Pose"),             # an SF field, not MFNode
     ("CAP", "children", BOX, "field 'children' of Shape"),                   # a Shape has none
-    ("PROBE", "children", BOX, "not imported into a robot here"),            # a robot's: refused here
+    ("PROBE", "children", BOX, "node string:1:9: a Pose is not imported into a robot here"),  # (it holds a solid)
+    ("PROBE", "children", "Solid { boundingObject Box { } }", "a Solid is not imported into a robot here"),
+    ("PROBE", "children", "PointLight { }", "a PointLight is not imported into a robot here"),
 ])
 def test_what_is_refused_is_one_line_and_changes_nothing(target, field, text, expected):
     lv = _live()
@@ -176,3 +180,99 @@ def test_a_value_corrected_as_webots_corrects_it_is_logged_where_the_string_writ
     assert corrected == ["node string:2:40: Sphere.radius: -1 is not > 0; using 1 (as Webots does)"]
     # the unit ball at HOLD's origin: its near side at x = 1.5
     assert get(lv, node(lv, "HOLD"), "children") == [ball] and readings(lv)[1] == pytest.approx(1.5, abs=1e-6)
+
+
+ROVER_WORLD = REPO / "tests" / "worlds" / "nested_nodes.wbt"     # tests/test_supervisor_nested.py's rover
+W, R, DT = 2.0, 0.05, 0.032                 # wheel speed (rad/s), radius, basic step (s)
+AXLE = 2 * math.hypot(0.1, 0.05)            # Webots' kinematic rule: the wheels' distances from the origin
+MARKER = ("DEF MK Transform { translation 0.3 0 0.5 children [ Shape { appearance Appearance { material Material { "
+          "diffuseColor 1 0 0 } } geometry Box { size 0.1 0.1 0.1 } } ] }")
+
+
+def _rover() -> Live:
+    lv = Live(Simulation(load_world(ROVER_WORLD)))
+    lv.ok(A, "attach", {"robot": "rover"})
+    return lv
+
+
+def rover(lv: Live, item: str, args: dict | None = None):
+    return lv.ok(A, f"/rover/robot/{item}", args)
+
+
+def drive(lv: Live, left: float, right: float, steps: int) -> None:
+    bot = lv.sim.robot("rover")
+    for name, speed in (("left wheel", left), ("right wheel", right)):
+        bot.motor(name).set_position(math.inf)
+        bot.motor(name).set_velocity(speed)
+    for _ in range(steps):
+        lv.step(A, "rover")
+
+
+def test_a_marker_imported_into_its_own_robots_children_rides_it_and_moves_in_its_frame():
+    """radar_target_tracker's calls: the robot imports a marker Transform into its own children, finds it as the
+    last child, and sets its translation (in the robot's frame) as the robot drives."""
+    lv = _rover()
+    me = rover(lv, "get_self")["node"]
+    before = rover(lv, "get_field", {"node": me, "field": "children"})["value"]
+    (mk,) = rover(lv, "import_node_from_string", {"node": me, "field": "children", "position": -1,
+                                                  "node_string": MARKER})["value"]
+    assert rover(lv, "get_field", {"node": me, "field": "children"})["value"] == [*before, mk]
+    found = rover(lv, "get_from_def", {"name": "MK"})
+    assert (found["node"], found["parent"]) == (mk, me)
+    assert rover(lv, "get_field", {"node": mk, "field": "translation"})["value"] == [0.3, 0.0, 0.5]
+
+    def where() -> list[float]:
+        return rover(lv, "get_node_pose", {"node": mk})["position"]
+
+    # the robot at (1, 2) turned a quarter turn: its +x is the world's +y
+    assert where() == pytest.approx([1.0, 2.3, 0.5], abs=1e-12)
+    drive(lv, W, W, 10)                         # straight ahead W·R·t
+    d = W * R * 10 * DT
+    assert where() == pytest.approx([1.0, 2.3 + d, 0.5], abs=1e-12)
+    drive(lv, -W, W, 5)                         # on the spot: the marker on a circle of 0.3 m about the origin
+    yaw = math.pi / 2 + 2 * W * R / AXLE * 5 * DT
+    assert where() == pytest.approx([0.3 * math.cos(yaw) + 1.0, 0.3 * math.sin(yaw) + 2.0 + d, 0.5], abs=1e-12)
+    # its translation set in the robot's frame, kept there as the robot turns on
+    rover(lv, "set_field", {"node": mk, "field": "translation", "value": [0.0, -0.4, 1.0]})
+    assert rover(lv, "get_field", {"node": mk, "field": "translation"})["value"] == [0.0, -0.4, 1.0]
+    drive(lv, -W, W, 5)
+    yaw += 2 * W * R / AXLE * 5 * DT
+    assert where() == pytest.approx([0.4 * math.sin(yaw) + 1.0, -0.4 * math.cos(yaw) + 2.0 + d, 1.0], abs=1e-12)
+    # removed: out of its robot's children; simulationReset takes another one out too
+    rover(lv, "remove_node", {"node": mk})
+    assert rover(lv, "get_field", {"node": me, "field": "children"})["value"] == before
+    (again,) = rover(lv, "import_node_from_string", {"node": me, "field": "children", "position": 0,
+                                                     "node_string": MARKER})["value"]
+    assert rover(lv, "get_field", {"node": me, "field": "children"})["value"] == [again, *before]
+    rover(lv, "simulation_reset")
+    assert rover(lv, "get_field", {"node": me, "field": "children"})["value"] == before
+    assert rover(lv, "get_from_def", {"name": "MK"})["node"] == 0
+
+
+def test_the_robots_camera_sees_its_marker_as_the_world_file_writing_it_there(tmp_path):
+    """A robot's own shapes are seen by its camera (Webots); the marker is as one written in its children."""
+    written = MARKER.replace("translation 0.3 0 0.5", "translation 0.15 0.6 0.3").replace("diffuse", "emissive")
+    text = ROVER_WORLD.read_text()
+    assert text.count("  children [\n    DEF MAST Pose {") == 1
+    (tmp_path / "twin.wbt").write_text(text.replace("  children [\n    DEF MAST Pose {",
+                                                    f"  children [\n    {written}\n    DEF MAST Pose {{"))
+    images = []
+    for path, imports in ((ROVER_WORLD, True), (tmp_path / "twin.wbt", False)):
+        lv = Live(Simulation(load_world(path)))
+        lv.ok(A, "attach", {"robot": "rover"})
+        if imports:
+            rover(lv, "import_node_from_string", {"node": rover(lv, "get_self")["node"], "field": "children",
+                                                  "position": -1, "node_string": written})
+        lv.sim.robot("rover").device("cam").enable(32)
+        drive(lv, W, W, 3)
+        images.append(np.asarray(lv.sim.robot("rover").device("cam").image).copy())
+    blank = _camera_without_marker()
+    assert not np.array_equal(images[1], blank)       # the marker is in view
+    assert np.array_equal(images[0], images[1])
+
+
+def _camera_without_marker() -> np.ndarray:
+    lv = _rover()
+    lv.sim.robot("rover").device("cam").enable(32)
+    drive(lv, W, W, 3)
+    return np.asarray(lv.sim.robot("rover").device("cam").image).copy()

@@ -317,7 +317,8 @@ def _group_of(sim: Any, node: Node) -> int:
 
 def _scene_tops(sim: Any) -> list[Node]:
     """The root's children, each group followed by the nodes it holds."""
-    return [m for top in root_children(sim) for m in (top, *_group_members(sim, top))]
+    return [m for top in root_children(sim) for m in (top, *_group_members(sim, top), *(
+        _robot_riders(sim, top) if top.type == "Robot" else ()))]
 
 
 def _first_def(sim: Any, name: str) -> Node | None:
@@ -442,8 +443,10 @@ def node_from_id(sim: Any, node: int) -> Node | None:
 def node_ref(sim: Any, node: Node | None) -> dict:
     if node is None:
         return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
+    rider = _rider(sim, node) if node.type == "Solid" else None
     parent = _nested_of(sim, node).parent if node.nested else _vnode(sim, node).parent \
-        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else _group_of(sim, node)
+        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else _group_of(sim, node) \
+        if rider is None else robot_node(sim, rider[0]).id       # type: ignore[union-attr]
     return {"node": node.id, "type": node.type, "name": node.name, "def_name": node.def_name,
             "parent": parent, "proto": node.proto}
 
@@ -707,8 +710,14 @@ def _set_controller(sim: Any, node: Node, value: str) -> None:
 
 
 def _children(sim: Any, node: Node) -> list[int]:
-    """A robot's, solid's or nested node's ``children``: the nodes inside it (nested.py)."""
-    return nested.children(_table(sim), node.id)
+    """A robot's, solid's or nested node's ``children``: the nodes inside it (nested.py); a robot's with the solids
+    a Supervisor imported there (:func:`_import_into_robot`) where they were inserted."""
+    inside = nested.children(_table(sim), node.id)
+    order = getattr(sim, "_robot_child_order", {}).get(node.key) if node.type == "Robot" and not node.nested else None
+    if not order:
+        return inside
+    riding = {n.id for n in _robot_riders(sim, node)}
+    return [i for i in order if i in riding or i in inside] + [i for i in inside if i not in order]
 
 
 FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
@@ -979,6 +988,8 @@ def _base_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
         return _nested_fields(sim, node)
     if node.scenery and node.type in ("Group", "Pose", "Transform") and not _scenery(sim)[int(node.key)].members:
         return {}            # a group of shapes only: a visual node (visuals.py), not served from here
+    if node.type == "Solid" and _rider(sim, node) is not None:      # in its robot's frame
+        return {**FIELDS["Solid"], **_RIDER_POSE}
     return SCENERY_FIELDS.get(node.type, {}) if node.scenery else FIELDS[node.type]
 
 
@@ -1904,10 +1915,11 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
         return [import_sf_node(sim, node, field, text)]
     if node.id != 0 and field == "children" and _solid_holder(sim, node):
         return _import_into_solid(sim, node, position, text, warnings)
-    if field == "children" and node.type == "Robot" or node.nested and _nested_of(sim, node).owner_kind == "Robot":
-        raise ValueError(f"field {field!r} of {_what(node)}: nodes are not imported into a robot here (a departure "
-                         "from Webots): its shapes and devices are fixed at load; import into the root's children "
-                         "and move them with it")
+    if field == "children" and node.type == "Robot" and not node.nested:
+        return _import_into_robot(sim, node, position, text, warnings)
+    if node.nested and _nested_of(sim, node).owner_kind == "Robot":
+        raise ValueError(f"field {field!r} of {_what(node)}: nodes are not imported into a node inside a robot here "
+                         "(a departure from Webots): import into the robot's own children")
     if node.id != 0 or field != "children":
         what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
         raise ValueError(f"field {field!r} of {what}: nodes are imported into the 'children' of the root, of a "
@@ -1917,6 +1929,100 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
     added = [node_id for _, _, node_id in sim.import_nodes(text, warnings)]
     sim.root_order = current[:index] + added + current[index:]
     return added
+
+
+_RIDING = frozenset({"Pose", "Transform", "Group", "Shape", "Solid"})
+
+
+def _import_into_robot(sim: Any, node: Node, position: int, text: str, warnings: list[str] | None) -> list[int]:
+    """Webots' ``importMFNodeFromString`` into a robot's own ``children`` (radar_target_tracker's markers): each of
+    the string's nodes (a Pose, Transform or Group of shapes, a Shape, or a Solid without boundingObject or
+    physics) is imported as at the root (a solid of its shapes) and rides the robot from then on, fixed where
+    its translation and rotation put it in the robot's frame (``Simulation.ride_solid``); it is listed in the
+    robot's ``children`` at ``position``, its parent the robot, its ``translation``/``rotation`` in the robot's
+    frame (set: moved there). One line and nothing changed for any other node (a solid with a bounding object
+    would be its own robot's obstacle here)."""
+    from sensorium.server.sim.imports import LABEL, ImportRefused
+
+    doing = f"field 'children' of {_what(node)}: nothing imported"
+    try:
+        for part in _string_nodes(text, sim.limits):
+            if not _shapes_only(part):
+                raise ValueError(f"{doing}: {LABEL}:{part.line}:{part.col}: a {part.type} is not imported into a robot "
+                                 "here, only a Shape, or a Pose, Transform, Group or Solid holding only shapes (no "
+                                 "boundingObject, no physics): a departure from Webots")
+    except ImportRefused as exc:
+        raise ValueError(f"{doing}: {exc}") from None
+    current = _children(sim, node)
+    index = insert_index(position, len(current))
+    made = sim.import_nodes(text, warnings)
+    ids = [node_id for _, _, node_id in made]
+    riders = sim.__dict__.setdefault("_rider_ids", {})
+    for _, key, node_id in made:
+        riders[node_id] = (str(node.key), str(key))
+        sim.ride_solid(str(key), str(node.key), sim.scene.solid_poses[str(key)])   # (its pose as written: in the robot)
+    sim.__dict__.setdefault("_robot_child_order", {})[str(node.key)] = current[:index] + ids + current[index:]
+    return ids
+
+
+def _shapes_only(part: Any) -> bool:
+    """A node written that rides a robot here: a Shape, a Pose, Transform or Group of shapes, or a Solid of shapes
+    without a boundingObject or physics (kinematic contact never makes it its own robot's obstacle)."""
+    from sensorium.server.sim.imports import _only_shapes
+
+    if part.type == "Solid" and part.proto is None and not {"boundingObject", "physics"} & part.fields.keys():
+        children = part.fields.get("children", [])
+        return all(_only_shapes(c) for c in (children if isinstance(children, list) else [children]))
+    return part.type in _RIDING and part.type != "Solid" and _only_shapes(part)
+
+
+def _string_nodes(text: str, limits: Any) -> list[Any]:
+    """A node string's nodes as written (its syntax checked, within the world's limits): ``ImportRefused``."""
+    from sensorium.server.sim.imports import LABEL, ImportRefused, _check_string
+    from sensorium.server.world.limits import ProtoLimits
+    from sensorium.server.world.wbt.parser import Parser, Tokens, WbtSyntaxError
+
+    _check_string(text, limits)
+    try:
+        wbt = Parser(Tokens(text, LABEL), LABEL, limits=ProtoLimits.matching(limits)).file("R2023b", text)
+    except WbtSyntaxError as exc:
+        raise ImportRefused(f"{LABEL}:{exc.line}:{exc.col}: {exc.message}") from None
+    return list(wbt.nodes)
+
+
+def _rider(sim: Any, node: Node) -> tuple[str, str] | None:
+    """(robot, solid) for a solid a Supervisor imported into that robot's children and still there; else None."""
+    found = getattr(sim, "_rider_ids", {}).get(node.id) if not node.nested and not node.visual else None
+    return found if found is not None and found[1] in sim.solid_riders else None
+
+
+def _rider_frame(sim: Any, n: Node) -> Any:
+    rider = _rider(sim, n)
+    assert rider is not None
+    return sim.solid_riders[rider[1]][1]
+
+
+def _set_rider(sim: Any, n: Node, field: str, value: list[float]) -> None:
+    _check_pose_value(field, value)
+    kwargs = {"translation": value} if field == "translation" else {"translation": None, "rotation": value}
+    robot, key = _rider(sim, n)        # type: ignore[misc]
+    sim.ride_solid(key, robot, moved_pose(_rider_frame(sim, n), **kwargs))
+
+
+_RIDER_POSE: dict[str, tuple[str, Getter, Setter]] = {
+    "translation": ("SFVec3f", lambda sim, n: [float(v) for v in _rider_frame(sim, n).translation],
+                    lambda sim, n, v: _set_rider(sim, n, "translation", v)),
+    "rotation": ("SFRotation", lambda sim, n: matrix_axis_angle(_rider_frame(sim, n).rotation),
+                 lambda sim, n, v: _set_rider(sim, n, "rotation", v)),
+}
+
+
+def _robot_riders(sim: Any, robot: Node) -> list[Node]:
+    """The solids riding ``robot`` that a Supervisor imported into its children, in their order there."""
+    order = getattr(sim, "_robot_child_order", {}).get(robot.key, ())
+    riders = getattr(sim, "_rider_ids", {})
+    by_id = {n.id: n for n in _nodes(sim)}
+    return [by_id[i] for i in order if i in riders and i in by_id and _rider(sim, by_id[i]) is not None]
 
 
 def _solid_holder(sim: Any, node: Node) -> bool:
