@@ -276,3 +276,21 @@ def _camera_without_marker() -> np.ndarray:
     lv.sim.robot("rover").device("cam").enable(32)
     drive(lv, W, W, 3)
     return np.asarray(lv.sim.robot("rover").device("cam").image).copy()
+
+
+def test_a_colour_set_stays_with_its_shape_when_an_import_goes_before_it():
+    lv = _live()
+    base = node(lv, "BASE")
+
+    def marker(name: str, x: float) -> str:
+        return (f"DEF {name} Pose {{ translation {x} 0 -1 children [ Shape {{ appearance Appearance {{ material "
+                f"DEF {name}_LOOK Material {{ diffuseColor 1 0 0 }} }} geometry Box {{ size 0.2 0.2 0.2 }} }} ] }}")
+
+    imported(lv, base, marker("M1", 1.0))
+    put(lv, node(lv, "M1_LOOK"), "diffuseColor", [0.0, 0.0, 1.0])
+    imported(lv, base, marker("M2", 3.0), 0)          # before every shape of the solid
+    assert get(lv, node(lv, "M1_LOOK"), "diffuseColor") == [0.0, 0.0, 1.0]
+    assert get(lv, node(lv, "M2_LOOK"), "diffuseColor") == [1.0, 0.0, 0.0]
+    put(lv, node(lv, "HOLD"), "translation", [0.5, 0.0, -2.0])      # a Pose's set keeps them too
+    call(lv, "remove_node", {"node": node(lv, "M2")})
+    assert get(lv, node(lv, "M1_LOOK"), "diffuseColor") == [0.0, 0.0, 1.0]

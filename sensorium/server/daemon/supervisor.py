@@ -887,6 +887,7 @@ def _rebuilt_in_place(sim: Any, key: str, build: Callable[[], Any]) -> Any:
     Supervisor had moved it, its shapes keeping the appearances a Supervisor gave them; returns what it became."""
     scene = sim.scene
     looks = scene.appearance_changes(key)
+    places = _shape_places(sim, key)
     now_pose = scene.solid_poses[key]
     built = pose_from_model(next(s for s in reversed(sim.world.solids) if s.name == key).pose)
     moved = not (np.array_equal(now_pose.translation, built.translation)
@@ -894,8 +895,24 @@ def _rebuilt_in_place(sim: Any, key: str, build: Callable[[], Any]) -> Any:
     made = build()
     if moved:                        # built where the solid was loaded, then moved where the Supervisor put it
         sim.place_solid(key, now_pose)
-    scene.take_appearance_changes(key, looks)       # (its shapes keep the colours a Supervisor gave them)
+    after = {place: k for k, place in enumerate(_shape_places(sim, key))}
+    # (its shapes keep the colours a Supervisor gave them, each found by where it is written: an import or a
+    # removal moves the others among the solid's shapes)
+    scene.take_appearance_changes(key, {after[places[k]]: v for k, v in looks.items() if places[k] in after})
     return made
+
+
+def _shape_places(sim: Any, key: str) -> list[tuple]:
+    """Each shape of top-level solid ``key``, in its order, by where its file writes it (a split mesh's pieces,
+    or shapes written nowhere, by their count among those written at the same place)."""
+    out: list[tuple] = []
+    seen: dict[tuple, int] = {}
+    for shape in sim.scene.solid_shapes(key):
+        node = getattr(sim.scene.loaded_model(shape), "node", None)
+        at = (tuple(node.written_at or ()), tuple(node.made_at or ())) if node is not None else ((), ())
+        seen[at] = seen.get(at, -1) + 1
+        out.append((*at, seen[at]))
+    return out
 
 
 def reset_solid_poses(sim: Any) -> None:
