@@ -2010,7 +2010,7 @@ def _string_nodes(text: str, limits: Any) -> list[Any]:
 def _rider(sim: Any, node: Node) -> tuple[str, str] | None:
     """(robot, solid) for a solid a Supervisor imported into that robot's children and still there; else None."""
     found = getattr(sim, "_rider_ids", {}).get(node.id) if not node.nested and not node.visual else None
-    return found if found is not None and found[1] in sim.solid_riders else None
+    return found if found is not None and found[1] in getattr(sim, "solid_riders", {}) else None
 
 
 def _rider_frame(sim: Any, n: Node) -> Any:
