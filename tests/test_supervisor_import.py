@@ -238,7 +238,7 @@ def test_only_the_roots_and_a_wbt_worlds_solids_children_take_nodes():
         "file's Solid kept here (a PROTO instance's children are its body's, or a solid a Supervisor imported)")
     assert refused(lv, BOX, field="translation") == (
         "field 'translation' of the root: nodes are imported into the 'children' of the root, of a top-level Solid "
-        "and of the Poses, Transforms and Groups inside one only here")
+        "and of the Poses, Transforms, Groups and Solids inside one only here")
     assert lv.err(A, "/boss/robot/import_node_from_string", {"node": 0, "field": "children", "position": 0},
                   ErrorCode.INVALID_ARGUMENT) == "/boss/robot/import_node_from_string: missing argument 'node_string'"
 

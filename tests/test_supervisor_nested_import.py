@@ -294,3 +294,22 @@ def test_a_colour_set_stays_with_its_shape_when_an_import_goes_before_it():
     put(lv, node(lv, "HOLD"), "translation", [0.5, 0.0, -2.0])      # a Pose's set keeps them too
     call(lv, "remove_node", {"node": node(lv, "M2")})
     assert get(lv, node(lv, "M1_LOOK"), "diffuseColor") == [0.0, 0.0, 1.0]
+
+
+def test_a_nested_solids_children_take_nodes_too():
+    """tests/worlds/solid_poses.wbt: the solid INNER, inside TABLE's Transform T, stands at (2.1, 0.5, 0); a box
+    imported 0.5 m along its -y sits on the probe's lidar beam, its near face at x = 2.0."""
+    from test_supervisor_solid_poses import _live as poses_live
+    from test_supervisor_solid_poses import readings as poses_readings
+
+    lv = poses_live()
+    inner = node(lv, "INNER")
+    was = get(lv, inner, "children")
+    (box,) = imported(lv, inner, "DEF NB Pose { translation 0 -0.5 0 children [ Shape { geometry Box { size 0.2 0.2 "
+                                 "0.2 } } ] }")
+    assert get(lv, inner, "children") == [*was, box] and node(lv, "INNER.NB") == box
+    assert poses_readings(lv)[0] == pytest.approx(1.8, abs=1e-6)       # MARKER's face, nearer, still first
+    put(lv, node(lv, "TOP"), "translation", [0.0, 0.0, 3.0])            # the marker off the beam
+    assert poses_readings(lv)[0] == pytest.approx(2.0, abs=1e-6)
+    call(lv, "remove_node", {"node": box})
+    assert get(lv, inner, "children") == was and math.isinf(poses_readings(lv)[0])

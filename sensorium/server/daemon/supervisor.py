@@ -1940,7 +1940,7 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
     if node.id != 0 or field != "children":
         what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
         raise ValueError(f"field {field!r} of {what}: nodes are imported into the 'children' of the root, of a "
-                         "top-level Solid and of the Poses, Transforms and Groups inside one only here")
+                         "top-level Solid and of the Poses, Transforms, Groups and Solids inside one only here")
     current = [n.id for n in root_children(sim)]
     index = insert_index(position, len(current))
     added = [node_id for _, _, node_id in sim.import_nodes(text, warnings)]
@@ -2043,11 +2043,11 @@ def _robot_riders(sim: Any, robot: Node) -> list[Node]:
 
 
 def _solid_holder(sim: Any, node: Node) -> bool:
-    """A top-level Solid (not a robot, no imported Shape's holder) or a Pose, Transform or Group its world file
-    writes inside it: a node whose ``children`` a Supervisor imports into (:func:`_import_into_solid`)."""
+    """A top-level Solid (not a robot, no imported Shape's holder) or a Pose, Transform, Group or Solid its world
+    file writes inside it: a node whose ``children`` a Supervisor imports into (:func:`_import_into_solid`)."""
     if node.nested:
         n = _nested_of(sim, node)
-        return n.owner_kind == "Solid" and n.type in _SOLID_POSES and bool(n.at) and n.shape is None
+        return n.owner_kind == "Solid" and n.type in (*_SOLID_POSES, "Solid") and bool(n.at) and n.shape is None
     return node.type == "Solid" and not node.visual and not node.scenery
 
 
