@@ -231,12 +231,14 @@ def test_in_process_imports_give_their_corrections():
     assert ball.shapes[0].geometry.radius == 1.0
 
 
-def test_only_the_roots_children_take_nodes():
+def test_only_the_roots_and_a_wbt_worlds_solids_children_take_nodes():
     lv = _live()
-    assert refused(lv, BOX, node=WALL, field="children") == \
-        "field 'children' of Solid 'wall': nodes are imported into the root's 'children' only here"
-    assert refused(lv, BOX, field="translation") == \
-        "field 'translation' of the root: nodes are imported into the root's 'children' only here"
+    assert refused(lv, BOX, node=WALL, field="children") == (
+        "field 'children' of Solid 'wall' (node 3): nothing imported: solid 'wall' was not loaded from a .wbt world "
+        "file's Solid kept here (a PROTO instance's children are its body's, or a solid a Supervisor imported)")
+    assert refused(lv, BOX, field="translation") == (
+        "field 'translation' of the root: nodes are imported into the 'children' of the root, of a top-level Solid "
+        "and of the Poses, Transforms, Groups and Solids inside one only here")
     assert lv.err(A, "/boss/robot/import_node_from_string", {"node": 0, "field": "children", "position": 0},
                   ErrorCode.INVALID_ARGUMENT) == "/boss/robot/import_node_from_string: missing argument 'node_string'"
 

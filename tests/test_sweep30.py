@@ -235,20 +235,52 @@ while robot.step(step) != -1:
 '''
 
 RADAR_TARGET_TRACKER = '''"""Sensorium's stand-in for radar_target_tracker.c (sweep 30): our own Python making its calls in its order
-(the radar enabled at 10 ms, a marker Transform imported into its own children, which it then counts); each
-step it prints the targets it read (the markers' moves left out: the import is refused here)."""
+(the radar enabled at 10 ms, 25 marker Transforms imported into its own children, each found as the last child
+with its translation and its material's diffuseColor, hidden from the named lidars and camera; each step each
+marker moved to its target, in the robot's frame, and coloured by its power, or parked 10 m up). The markers'
+box size set is left out (a Box's size is read-only here, one line). Each step it prints the targets it read,
+then its own position and its first marker's."""
+import math
+
 from controller import Supervisor
 
+MAX_TARGETS = 25
+TARGET = ("Transform {\\n  translation 0 0 10.0\\n  children [\\n    Shape {\\n      appearance Appearance {\\n"
+          "        material Material {\\n          diffuseColor 0.8 0 0.0117647\\n          transparency 0.7\\n"
+          "        }\\n      }\\n      geometry Box {\\n        size 5.0 2.5 2.0\\n      }\\n    }\\n  ]\\n}\\n")
 robot = Supervisor()
 radar = robot.getDevice("radar")
 radar.enable(10)
 children = robot.getSelf().getField("children")
-children.importMFNodeFromString(-1, "Transform { translation 0 0 10.0 children [ Shape { geometry Box { size 5 2.5 2 } } ] }")
+translations, colors, markers = [], [], []
+for i in range(MAX_TARGETS):
+    children.importMFNodeFromString(-1, TARGET)
+    node = children.getMFNode(-1)
+    markers.append(node)
+    translations.append(node.getField("translation"))
+    shape = node.getField("children").getMFNode(0)
+    material = shape.getField("appearance").getSFNode().getField("material").getSFNode()
+    colors.append(material.getField("diffuseColor"))
+    for name in ("FRONT_RIGHT_LIDAR", "FRONT_LEFT_LIDAR", "REAR_RIGHT_LIDAR", "REAR_LEFT_LIDAR", "TOP_CAMERA"):
+        viewer = robot.getFromDef(name)
+        if viewer is not None:
+            node.setVisibility(viewer, False)
 print("children", children.getCount(), flush=True)
 while robot.step(10) != -1:
     targets = radar.getTargets()
-    print(round(robot.getTime() * 1000), radar.getNumberOfTargets(),
+    n = radar.getNumberOfTargets()
+    for i in range(MAX_TARGETS):
+        if 0 < i < n and targets[i].distance > 2.0:
+            d = targets[i].distance
+            translations[i].setSFVec3f([d, -d * math.sin(targets[i].azimuth), -0.5])
+            factor = max(min((targets[i].received_power + 60.0) / 50.0, 1.0), 0.0) ** 0.33
+            colors[i].setSFColor([factor, 0.0, 1.0 - factor])
+        else:
+            translations[i].setSFVec3f([0.0, 0.0, 10.0])
+    print(round(robot.getTime() * 1000), n,
           " ".join(f"{t.distance!r} {t.speed!r} {t.azimuth!r}" for t in targets), flush=True)
+    print("at", *(repr(v) for v in robot.getSelf().getPosition()), *(repr(v) for v in markers[0].getPosition()),
+          flush=True)
 '''
 
 HIGHWAY_OVERTAKE = '''"""Sensorium's stand-in for highway_overtake.py (sweep 30): our own Python making its calls in its order (the
@@ -362,10 +394,15 @@ def test_highway_overtakes_calls_change_lane_past_the_slow_car(tmp_path: Path) -
                           env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     assert "exited with status" not in done.stderr and "not simulated" not in done.stderr, done.stderr
-    assert "nodes are imported into the root's 'children' only here" in done.stderr
     rows = [line.split("] ", 1)[1].split() for line in done.stdout.splitlines() if line.startswith("[vehicle] ")]
-    radar = [line.split("] ", 1)[1].split() for line in done.stdout.splitlines() if line.startswith("[robot] ")]
-    assert radar[0] == ["children", "1"] and [int(r[0]) for r in radar[1:]] == list(range(10, 3001, 10))
+    lines = [line.split("] ", 1)[1].split() for line in done.stdout.splitlines() if line.startswith("[robot] ")]
+    radar = [r for r in lines if r[0] != "at"]
+    assert radar[0] == ["children", "26"] and [int(r[0]) for r in radar[1:]] == list(range(10, 3001, 10))
+    # its markers ride it: the first (one target: every marker parked) 10 m above the radar robot, as it drives
+    rides = [[float(v) for v in r[1:]] for r in lines if r[0] == "at"]
+    assert len(rides) == 300 and math.dist(rides[-1][:2], rides[0][:2]) > 50.0
+    for r in rides:
+        assert r[3:] == pytest.approx([r[0], r[1], r[2] + 10.0], abs=1e-9)
     assert [int(r[0]) for r in rows] == list(range(10, 3001, 10))
     first = rows[0]
     front = float(first[9])

@@ -620,6 +620,64 @@ def renew(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, kept: i
     _index(renewed, table.by_owner, table.by_parent)
 
 
+def regrow(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, gone: frozenset[int] = frozenset(),
+           fresh: Any = lambda n: False) -> list[int]:
+    """The nodes inside top-level solid ``owner`` (named ``key``) built again as ``solid``, a tree that differs from
+    the old one by subtrees a Supervisor imported (``fresh`` names each new one's top nodes) or removed (``gone``:
+    the old ids that leave): every other node keeps its id, place and loaded ``own`` as :func:`renew` keeps them;
+    the new ones take ids from ``table.end`` on (never a removed node's), the ones that left read as removed.
+    Returns the new nodes' ids, in the new tree's order."""
+    old = [n for n in table.by_owner.get(owner, ()) if n.id not in gone]
+    segment = table.segments.get(owner)
+    start, forgotten = table.end, set(table.forgotten)
+    drop(table, owner)
+    add_solid(sim, table, owner, key, solid)
+    new = table.by_owner.pop(owner, ())
+    added = {n.id for n in new if fresh(n)}
+    grown = True
+    while grown:                        # what the new nodes hold is new too
+        more = {n.id for n in new if n.parent in added} - added
+        added |= more
+        grown = bool(more)
+    kept = [n for n in new if n.id not in added]
+    if len(kept) != len(old) or any(a.type != b.type for a, b in zip(kept, old)):
+        raise AssertionError(f"solid {key!r} built again into another tree")
+    ids = {n.id: o.id for n, o in zip(kept, old)}
+    fresh_ids = [n.id for n in new if n.id in added]
+    ids.update((node_id, start + k) for k, node_id in enumerate(fresh_ids))
+
+    def real(node_id: int) -> int:
+        return ids.get(node_id, node_id)
+
+    owns = {o.id: o.own for o in old if o.id in table.set_own}
+    renewed = [dataclasses.replace(n, id=real(n.id), parent=real(n.parent), frame=real(n.frame),
+                                   own=owns.get(real(n.id), n.own)) for n in new]
+    for n in new:
+        table.added.pop(n.id, None)
+        table.by_parent.pop(n.id, None)
+    table.by_parent.pop(owner, None)
+    if table.inner is not None:           # (popped first: a new node's id may be another's number in add_solid)
+        moved = {instance: table.inner.pop(instance) for instance in [k for k in table.inner if k in ids or k == owner]}
+        for instance, defs in moved.items():
+            table.inner[real(instance)] = {k: real(v) if isinstance(v, int) else v for k, v in defs.items()}
+    nodes = list(table.nodes)
+    for n in renewed:
+        k = n.id - FIRST_ID
+        if 0 <= k < len(nodes):
+            nodes[k] = n
+        else:
+            table.added[n.id] = n
+    table.nodes = tuple(nodes)
+    table.forgotten = forgotten
+    for node_id in gone:
+        table.set_own.pop(node_id, None)
+    table.end = start + len(fresh_ids)
+    if segment is None:
+        table.segments.pop(owner, None)
+    _index(renewed, table.by_owner, table.by_parent)
+    return [real(n) for n in fresh_ids]
+
+
 def drop_shape(table: Table, shape: int) -> None:
     """A Shape node (or a light, or a solid's Pose or Group) a Supervisor removed, with the nodes inside it, leaves the tree: no walk, DEF or
     getFromProtoDef finds them and their ids read as removed (never given again)."""

@@ -317,7 +317,8 @@ def _group_of(sim: Any, node: Node) -> int:
 
 def _scene_tops(sim: Any) -> list[Node]:
     """The root's children, each group followed by the nodes it holds."""
-    return [m for top in root_children(sim) for m in (top, *_group_members(sim, top))]
+    return [m for top in root_children(sim) for m in (top, *_group_members(sim, top), *(
+        _robot_riders(sim, top) if top.type == "Robot" else ()))]
 
 
 def _first_def(sim: Any, name: str) -> Node | None:
@@ -442,8 +443,10 @@ def node_from_id(sim: Any, node: int) -> Node | None:
 def node_ref(sim: Any, node: Node | None) -> dict:
     if node is None:
         return {"node": 0, "type": "", "name": "", "def_name": "", "parent": -1, "proto": ""}
+    rider = _rider(sim, node) if node.type == "Solid" else None
     parent = _nested_of(sim, node).parent if node.nested else _vnode(sim, node).parent \
-        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else _group_of(sim, node)
+        if node.visual and node.id >= visuals.FIRST_ID else -1 if node.id == 0 else _group_of(sim, node) \
+        if rider is None else robot_node(sim, rider[0]).id       # type: ignore[union-attr]
     return {"node": node.id, "type": node.type, "name": node.name, "def_name": node.def_name,
             "parent": parent, "proto": node.proto}
 
@@ -707,8 +710,14 @@ def _set_controller(sim: Any, node: Node, value: str) -> None:
 
 
 def _children(sim: Any, node: Node) -> list[int]:
-    """A robot's, solid's or nested node's ``children``: the nodes inside it (nested.py)."""
-    return nested.children(_table(sim), node.id)
+    """A robot's, solid's or nested node's ``children``: the nodes inside it (nested.py); a robot's with the solids
+    a Supervisor imported there (:func:`_import_into_robot`) where they were inserted."""
+    inside = nested.children(_table(sim), node.id)
+    order = getattr(sim, "_robot_child_order", {}).get(node.key) if node.type == "Robot" and not node.nested else None
+    if not order:
+        return inside
+    riding = {n.id for n in _robot_riders(sim, node)}
+    return [i for i in order if i in riding or i in inside] + [i for i in inside if i not in order]
 
 
 FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
@@ -838,16 +847,8 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     _check_pose_value(field, value)
     table = _table(sim)
     n = _nested_of(sim, node)
-    key, scene = n.owner_key, sim.scene
-    if any(m.owner == n.owner for m in table.removed_shapes.values()) or set(scene.solid_shapes(key)) & \
-            scene.removed_shapes or any(k[0] == key for k in scene.changed_carried()):
-        raise ValueError(f"field {field!r} of {_what(node)} not set: a Supervisor removed a node or changed a light "
-                         f"inside solid {key!r}, which building it again with the new frame would undo; nothing "
-                         "changed")
-    if any(c.solid == key for c in sim.chargers):
-        raise ValueError(f"field {field!r} of {_what(node)} not set: solid {key!r} is a Charger's (its glowing "
-                         "shapes stay those it loaded with here); nothing changed")
-    looks = scene.appearance_changes(key)
+    key = n.owner_key
+    _check_rebuildable(sim, table, n.owner, key, f"field {field!r} of {_what(node)} not set", "the new frame")
     at = (n.at[0], n.at[1])
     loaded = written_fields(sim, key, at, ("translation", "rotation"))
     if loaded is None:
@@ -855,23 +856,63 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
                          "world file's node kept here (a solid a Supervisor imported); nothing changed")
     own = nested.own_pose(sim, table, n)
     assert own is not None
-    now_pose = scene.solid_poses[key]
-    built = pose_from_model(next(s for s in reversed(sim.world.solids) if s.name == key).pose)
-    moved = not (np.array_equal(now_pose.translation, built.translation)
-                 and np.array_equal(now_pose.rotation, built.rotation))
     kind = "SFVec3f" if field == "translation" else "SFRotation"
     try:
-        made = rebuild_posed(sim, key, n.owner, at, {field: written_value(kind, value)})
+        made = _rebuilt_in_place(sim, key, lambda: rebuild_posed(sim, key, n.owner, at, {field: written_value(kind, value)}))
     except ImportRefused as exc:
         raise ValueError(f"field {field!r} of {_what(node)} not set: {exc}; nothing changed") from None
-    if moved:                        # built where the solid was loaded, then moved where the Supervisor put it
-        sim.place_solid(key, now_pose)
-    scene.take_appearance_changes(key, looks)       # (its shapes keep the colours a Supervisor gave them)
     sim.__dict__.setdefault("_posed", {}).setdefault(key, {}).setdefault(at, (n.id, loaded))
     nested.renew(sim, table, n.owner, key, made.model, n.id)
     translation = np.asarray(value, dtype=np.float64) if field == "translation" else own.translation
     rotation = axis_angle_matrix(value[:3], value[3]) if field == "rotation" else own.rotation
     table.set_own[n.id] = Pose(rotation, translation)
+
+
+def _check_rebuildable(sim: Any, table: nested.Table, owner: int, key: str, doing: str, with_what: str) -> None:
+    """One line (``doing``: what is refused) for a top-level solid a rebuild would lose more of: a node inside it a
+    Supervisor removed (but the ones it imported there: :func:`_remove_imported`) or a light's field it set, or a
+    Charger's."""
+    scene = sim.scene
+    if any(m.owner == owner for m in table.removed_shapes.values()) or set(scene.solid_shapes(key)) & \
+            scene.removed_shapes or any(k[0] == key for k in scene.changed_carried()):
+        raise ValueError(f"{doing}: a Supervisor removed a node or changed a light inside solid {key!r}, which "
+                         f"building it again with {with_what} would undo; nothing changed")
+    if any(c.solid == key for c in sim.chargers):
+        raise ValueError(f"{doing}: solid {key!r} is a Charger's (its glowing shapes stay those it loaded with "
+                         "here); nothing changed")
+
+
+def _rebuilt_in_place(sim: Any, key: str, build: Callable[[], Any]) -> Any:
+    """Top-level solid ``key`` built again by ``build`` (it builds it where it was loaded), then put where a
+    Supervisor had moved it, its shapes keeping the appearances a Supervisor gave them; returns what it became."""
+    scene = sim.scene
+    looks = scene.appearance_changes(key)
+    places = _shape_places(sim, key)
+    now_pose = scene.solid_poses[key]
+    built = pose_from_model(next(s for s in reversed(sim.world.solids) if s.name == key).pose)
+    moved = not (np.array_equal(now_pose.translation, built.translation)
+                 and np.array_equal(now_pose.rotation, built.rotation))
+    made = build()
+    if moved:                        # built where the solid was loaded, then moved where the Supervisor put it
+        sim.place_solid(key, now_pose)
+    after = {place: k for k, place in enumerate(_shape_places(sim, key))}
+    # (its shapes keep the colours a Supervisor gave them, each found by where it is written: an import or a
+    # removal moves the others among the solid's shapes)
+    scene.take_appearance_changes(key, {after[places[k]]: v for k, v in looks.items() if places[k] in after})
+    return made
+
+
+def _shape_places(sim: Any, key: str) -> list[tuple]:
+    """Each shape of top-level solid ``key``, in its order, by where its file writes it (a split mesh's pieces,
+    or shapes written nowhere, by their count among those written at the same place)."""
+    out: list[tuple] = []
+    seen: dict[tuple, int] = {}
+    for shape in sim.scene.solid_shapes(key):
+        node = getattr(sim.scene.loaded_model(shape), "node", None)
+        at = (tuple(node.written_at or ()), tuple(node.made_at or ())) if node is not None else ((), ())
+        seen[at] = seen.get(at, -1) + 1
+        out.append((*at, seen[at]))
+    return out
 
 
 def reset_solid_poses(sim: Any) -> None:
@@ -884,7 +925,7 @@ def reset_solid_poses(sim: Any) -> None:
         return
     table = _table(sim)
     for key, sets in posed.items():
-        if key not in sim.scene.solid_poses:
+        if key not in sim.scene.solid_poses or not sets:
             continue
         owner = next(n.owner for n_id, _ in sets.values() for n in [table.get(n_id)] if n is not None)
         made = None
@@ -964,6 +1005,8 @@ def _base_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]]:
         return _nested_fields(sim, node)
     if node.scenery and node.type in ("Group", "Pose", "Transform") and not _scenery(sim)[int(node.key)].members:
         return {}            # a group of shapes only: a visual node (visuals.py), not served from here
+    if node.type == "Solid" and _rider(sim, node) is not None:      # in its robot's frame
+        return {**FIELDS["Solid"], **_RIDER_POSE}
     return SCENERY_FIELDS.get(node.type, {}) if node.scenery else FIELDS[node.type]
 
 
@@ -1648,6 +1691,9 @@ def remove_node(sim: Any, node: Node) -> None:
         sim.scene.remove_carried_light(*_carrier(sim, node))
         nested.drop_shape(_table(sim), node.id)
         return
+    if node.nested and _imported_inside(sim, node):
+        _remove_imported(sim, node)
+        return
     if node.nested and node.type in _SOLID_POSES and _nested_of(sim, node).owner_kind == "Solid":
         _remove_solid_pose(sim, node)
         return
@@ -1667,6 +1713,16 @@ def remove_node(sim: Any, node: Node) -> None:
 
 
 _SOLID_POSES = frozenset({"Pose", "Transform", "Group"})
+
+
+def _imported_inside(sim: Any, node: Node) -> bool:
+    """A node a Supervisor imported inside a top-level solid, written in its parent's children (a Shape, a Pose, a
+    solid: not an appearance or geometry inside a Shape)."""
+    from sensorium.server.sim.regenerate import imported_line
+
+    n = _nested_of(sim, node)
+    return n.owner_kind == "Solid" and bool(n.at) and imported_line(n.at[0]) and n.field == "children" \
+        and (n.shape is None or n.shape.role == "Shape")
 
 
 def _remove_solid_pose(sim: Any, node: Node) -> None:
@@ -1874,14 +1930,270 @@ def import_nodes(sim: Any, node: Node, field: str, position: int, text: str,
         entry = None
     if entry is not None and entry[0] == "SFNode":        # importSFNodeFromString
         return [import_sf_node(sim, node, field, text)]
+    if node.id != 0 and field == "children" and _solid_holder(sim, node):
+        return _import_into_solid(sim, node, position, text, warnings)
+    if field == "children" and node.type == "Robot" and not node.nested:
+        return _import_into_robot(sim, node, position, text, warnings)
+    if node.nested and _nested_of(sim, node).owner_kind == "Robot":
+        raise ValueError(f"field {field!r} of {_what(node)}: nodes are not imported into a node inside a robot here "
+                         "(a departure from Webots): import into the robot's own children")
     if node.id != 0 or field != "children":
         what = "the root" if node.id == 0 else f"{node.type} {node.name or node.id!r}"
-        raise ValueError(f"field {field!r} of {what}: nodes are imported into the root's 'children' only here")
+        raise ValueError(f"field {field!r} of {what}: nodes are imported into the 'children' of the root, of a "
+                         "top-level Solid and of the Poses, Transforms, Groups and Solids inside one only here")
     current = [n.id for n in root_children(sim)]
     index = insert_index(position, len(current))
     added = [node_id for _, _, node_id in sim.import_nodes(text, warnings)]
     sim.root_order = current[:index] + added + current[index:]
     return added
+
+
+_RIDING = frozenset({"Pose", "Transform", "Group", "Shape", "Solid"})
+
+
+def _import_into_robot(sim: Any, node: Node, position: int, text: str, warnings: list[str] | None) -> list[int]:
+    """Webots' ``importMFNodeFromString`` into a robot's own ``children`` (radar_target_tracker's markers): each of
+    the string's nodes (a Pose, Transform or Group of shapes, a Shape, or a Solid without boundingObject or
+    physics) is imported as at the root (a solid of its shapes) and rides the robot from then on, fixed where
+    its translation and rotation put it in the robot's frame (``Simulation.ride_solid``); it is listed in the
+    robot's ``children`` at ``position``, its parent the robot, its ``translation``/``rotation`` in the robot's
+    frame (set: moved there). One line and nothing changed for any other node (a solid with a bounding object
+    would be its own robot's obstacle here)."""
+    from sensorium.server.sim.imports import LABEL, ImportRefused
+
+    doing = f"field 'children' of {_what(node)}: nothing imported"
+    try:
+        for part in _string_nodes(text, sim.limits):
+            if not _shapes_only(part):
+                raise ValueError(f"{doing}: {LABEL}:{part.line}:{part.col}: a {part.type} is not imported into a robot "
+                                 "here, only a Shape, or a Pose, Transform, Group or Solid holding only shapes (no "
+                                 "boundingObject, no physics): a departure from Webots")
+    except ImportRefused as exc:
+        raise ValueError(f"{doing}: {exc}") from None
+    current = _children(sim, node)
+    index = insert_index(position, len(current))
+    made = sim.import_nodes(text, warnings)
+    ids = [node_id for _, _, node_id in made]
+    riders = sim.__dict__.setdefault("_rider_ids", {})
+    for _, key, node_id in made:
+        riders[node_id] = (str(node.key), str(key))
+        sim.ride_solid(str(key), str(node.key), sim.scene.solid_poses[str(key)])   # (its pose as written: in the robot)
+    sim.__dict__.setdefault("_robot_child_order", {})[str(node.key)] = current[:index] + ids + current[index:]
+    return ids
+
+
+def _shapes_only(part: Any) -> bool:
+    """A node written that rides a robot here: a Shape, a Pose, Transform or Group of shapes, or a Solid of shapes
+    without a boundingObject or physics (kinematic contact never makes it its own robot's obstacle)."""
+    from sensorium.server.sim.imports import _only_shapes
+
+    if part.type == "Solid" and part.proto is None and not {"boundingObject", "physics"} & part.fields.keys():
+        children = part.fields.get("children", [])
+        return all(_only_shapes(c) for c in (children if isinstance(children, list) else [children]))
+    return part.type in _RIDING and part.type != "Solid" and _only_shapes(part)
+
+
+def _string_nodes(text: str, limits: Any) -> list[Any]:
+    """A node string's nodes as written (its syntax checked, within the world's limits): ``ImportRefused``."""
+    from sensorium.server.sim.imports import LABEL, ImportRefused, _check_string
+    from sensorium.server.world.limits import ProtoLimits
+    from sensorium.server.world.wbt.parser import Parser, Tokens, WbtSyntaxError
+
+    _check_string(text, limits)
+    try:
+        wbt = Parser(Tokens(text, LABEL), LABEL, limits=ProtoLimits.matching(limits)).file("R2023b", text)
+    except WbtSyntaxError as exc:
+        raise ImportRefused(f"{LABEL}:{exc.line}:{exc.col}: {exc.message}") from None
+    return list(wbt.nodes)
+
+
+def _rider(sim: Any, node: Node) -> tuple[str, str] | None:
+    """(robot, solid) for a solid a Supervisor imported into that robot's children and still there; else None."""
+    found = getattr(sim, "_rider_ids", {}).get(node.id) if not node.nested and not node.visual else None
+    return found if found is not None and found[1] in getattr(sim, "solid_riders", {}) else None
+
+
+def _rider_frame(sim: Any, n: Node) -> Any:
+    rider = _rider(sim, n)
+    assert rider is not None
+    return sim.solid_riders[rider[1]][1]
+
+
+def _set_rider(sim: Any, n: Node, field: str, value: list[float]) -> None:
+    _check_pose_value(field, value)
+    kwargs = {"translation": value} if field == "translation" else {"translation": None, "rotation": value}
+    robot, key = _rider(sim, n)        # type: ignore[misc]
+    sim.ride_solid(key, robot, moved_pose(_rider_frame(sim, n), **kwargs))
+
+
+_RIDER_POSE: dict[str, tuple[str, Getter, Setter]] = {
+    "translation": ("SFVec3f", lambda sim, n: [float(v) for v in _rider_frame(sim, n).translation],
+                    lambda sim, n, v: _set_rider(sim, n, "translation", v)),
+    "rotation": ("SFRotation", lambda sim, n: matrix_axis_angle(_rider_frame(sim, n).rotation),
+                 lambda sim, n, v: _set_rider(sim, n, "rotation", v)),
+}
+
+
+def _robot_riders(sim: Any, robot: Node) -> list[Node]:
+    """The solids riding ``robot`` that a Supervisor imported into its children, in their order there."""
+    order = getattr(sim, "_robot_child_order", {}).get(robot.key, ())
+    riders = getattr(sim, "_rider_ids", {})
+    by_id = {n.id: n for n in _nodes(sim)}
+    return [by_id[i] for i in order if i in riders and i in by_id and _rider(sim, by_id[i]) is not None]
+
+
+def _solid_holder(sim: Any, node: Node) -> bool:
+    """A top-level Solid (not a robot, no imported Shape's holder) or a Pose, Transform, Group or Solid its world
+    file writes inside it: a node whose ``children`` a Supervisor imports into (:func:`_import_into_solid`)."""
+    if node.nested:
+        n = _nested_of(sim, node)
+        return n.owner_kind == "Solid" and n.type in (*_SOLID_POSES, "Solid") and bool(n.at) and n.shape is None
+    return node.type == "Solid" and not node.visual and not node.scenery
+
+
+def _solid_key(sim: Any, node: Node) -> tuple[str, int]:
+    """The name and node id of the top-level solid ``node`` is or is inside."""
+    if node.nested:
+        n = _nested_of(sim, node)
+        return n.owner_key, n.owner
+    return str(node.key), node.id
+
+
+def _import_into_solid(sim: Any, node: Node, position: int, text: str, warnings: list[str] | None) -> list[int]:
+    """Webots' ``importMFNodeFromString`` into the ``children`` of a top-level Solid or of a Pose, Transform or
+    Group inside one: the string's nodes written there, at ``position`` (:func:`insert_index` among the children
+    written), the solid built again as its world file would build with them (sim/regenerate.py
+    ``rebuild_children``, the path a Pose's set takes): from the next measurement they are part of it, seen as its
+    other shapes are and moving with it. Every other node keeps its id; the new ones are Supervisor nodes like
+    the solid's others (found by DEF, their fields read and their Poses' set, removable: :func:`_remove_imported`)
+    until ``simulationReset`` takes them out (:func:`reset_nested_imports`). Returns the new top nodes' ids. What
+    does not parse or build changes nothing (one line)."""
+    from sensorium.server.sim.imports import ImportRefused
+    from sensorium.server.sim.regenerate import IMPORT_LINES, parse_nested_import, rebuild_children, written_node
+
+    table = _table(sim)
+    key, owner = _solid_key(sim, node)
+    doing = f"field 'children' of {_what(node)}: nothing imported"
+    _check_rebuildable(sim, table, owner, key, doing, "the nodes imported")
+    holder_at = tuple(_nested_of(sim, node).at[:2]) if node.nested else None
+    top = written_node(sim, key)
+    holder = written_node(sim, key, holder_at) if holder_at else top     # type: ignore[arg-type]
+    if top is None or holder is None or holder.type not in ("Solid", *_SOLID_POSES):
+        raise ValueError(f"{doing}: solid {key!r} was not loaded from a .wbt world file's Solid kept here (a PROTO "
+                         "instance's children are its body's, or a solid a Supervisor imported)")
+    at = (holder.line, holder.col)
+    serial = getattr(sim, "_nested_import_serial", 0) + 1
+    try:
+        nodes = parse_nested_import(sim, key, text, serial)
+        children = holder.fields.get("children", [])
+        index = insert_index(position, len(children) if isinstance(children, list) else 1)
+        corrected: list[str] = []
+        made = _rebuilt_in_place(sim, key, lambda: rebuild_children(
+            sim, key, owner, at, lambda now: [*now[:index], *nodes, *now[index:]], corrected))
+    except ImportRefused as exc:
+        raise ValueError(f"{doing}: {_import_line(str(exc))}") from None
+    if warnings is not None:
+        warnings += [_import_line(w) for w in corrected]
+    sim._nested_import_serial = serial
+    sim.__dict__.setdefault("_nested_imports", set()).add(key)
+    added = nested.regrow(sim, table, owner, key, made.model,      # (this import's lines: IMPORT_LINES)
+                          fresh=lambda m: bool(m.at) and m.at[0] // IMPORT_LINES == serial)
+    tops = {(n.line, n.col): n for n in nodes}
+    made_tops = [i for i in added if tuple(table.get(i).at[:2]) in tops]      # type: ignore[union-attr]
+    if len(made_tops) != len(nodes):          # one of them is no node here: the solid back as it was
+        lost = next(n for at, n in tops.items() if all(tuple(table.get(i).at[:2]) != at for i in made_tops))  # type: ignore[union-attr]
+        again = _rebuilt_in_place(sim, key, lambda: rebuild_children(
+            sim, key, owner, at, lambda now: [c for c in now if all(c is not n for n in nodes)]))
+        nested.regrow(sim, table, owner, key, again.model, gone=frozenset(added))
+        raise ValueError(f"{doing}: node string:{lost.line % IMPORT_LINES}:{lost.col}: {lost.type} is no node a "
+                         "solid's children hold here (a Shape, a Pose, Transform or Group, a Solid or a light)")
+    return made_tops
+
+
+def _import_line(line: str) -> str:
+    """An error line of a rebuild with a node string in it: the string's lines as the string numbers them."""
+    import re
+
+    from sensorium.server.sim.imports import LABEL
+    from sensorium.server.sim.regenerate import IMPORT_LINES
+
+    def back(m: re.Match[str]) -> str:
+        return f"{LABEL}:{int(m.group(2)) % IMPORT_LINES}:"
+
+    return re.sub(r"(\S+):(\d{10,}):", back, line)
+
+
+def _remove_imported(sim: Any, node: Node) -> None:
+    """A node a Supervisor imported inside a top-level solid removed (Webots' ``remove()``): the solid built again
+    without it (its written node taken out of its parent's children), so that nothing of it stays and the solid's
+    Poses stay settable; its id and those of the nodes inside it read as removed."""
+    from sensorium.server.sim.imports import ImportRefused
+    from sensorium.server.sim.regenerate import rebuild_children
+
+    table = _table(sim)
+    n = _nested_of(sim, node)
+    key, owner = n.owner_key, n.owner
+    parent = table.get(n.parent)
+    holder_at = tuple(parent.at[:2]) if parent is not None else None
+    if holder_at is None:
+        from sensorium.server.sim.regenerate import written_node
+
+        top = written_node(sim, key)
+        assert top is not None
+        holder_at = (top.line, top.col)
+    gone = {n.id}
+    todo = [n.id]
+    while todo:
+        for c in table.by_parent.get(todo.pop(), ()):
+            gone.add(c.id)
+            todo.append(c.id)
+    mine = (n.at[0], n.at[1])
+    try:
+        made = _rebuilt_in_place(sim, key, lambda: rebuild_children(
+            sim, key, owner, holder_at, lambda now: [c for c in now if not (
+                hasattr(c, "line") and (c.line, c.col) == mine)]))
+    except ImportRefused as exc:
+        raise ValueError(f"{_what(node)} not removed: {_import_line(str(exc))}") from None
+    for at in [a for a, (node_id, _) in getattr(sim, "_posed", {}).get(key, {}).items() if node_id in gone]:
+        del sim._posed[key][at]
+    nested.regrow(sim, table, owner, key, made.model, gone=frozenset(gone))
+
+
+def reset_nested_imports(sim: Any) -> None:
+    """After a ``simulationReset``: the nodes a Supervisor imported inside top-level solids taken out (Webots'
+    reset reloads the world), each solid built again as written now without them (the other nodes' ids kept;
+    the Poses set since are put back by :func:`reset_solid_poses`)."""
+    from sensorium.server.sim.regenerate import imported_line, rebuild_unimported
+
+    keys = sim.__dict__.pop("_nested_imports", set())
+    if not keys:
+        return
+    table = _table(sim)
+    for key in sorted(keys):
+        posed = getattr(sim, "_posed", {}).get(key, {})
+        for at in [a for a in posed if imported_line(a[0])]:
+            del posed[at]
+        if key not in sim.scene.solid_poses:
+            continue
+        owner = next(o for o, k in _solid_owners(sim) if k == key)
+        gone = frozenset(m.id for m in table.by_owner.get(owner, ()) if any(
+            imported_line(p.at[0]) for p in _line_of(table, m) if p.at))
+        made = _rebuilt_in_place(sim, key, lambda: rebuild_unimported(sim, key, owner))   # noqa: B023
+        nested.regrow(sim, table, owner, key, made.model, gone=gone)
+
+
+def _line_of(table: nested.Table, n: nested.Nested) -> list[nested.Nested]:
+    """``n`` and the nodes above it inside its owner."""
+    out = [n]
+    while True:
+        up = table.get(out[-1].parent)
+        if up is None:
+            return out
+        out.append(up)
+
+
+def _solid_owners(sim: Any) -> list[tuple[int, str]]:
+    return [(n.id, str(n.key)) for n in _nodes(sim) if n.type == "Solid" and not n.nested and not n.visual]
 
 
 def import_sf_node(sim: Any, node: Node, field: str, text: str) -> int:
@@ -1921,6 +2233,7 @@ them): what Webots would print in its console, e.g. an imported node's corrected
 
 def _reset(sim: Any, ls: Any, robot: str, a: Any) -> dict:
     sim.reset()
+    reset_nested_imports(sim)
     reset_solid_poses(sim)
     return {"success": True}
 

@@ -172,3 +172,127 @@ def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields:
     sim.replace_solid(key, node, node_id)
     sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
     return node
+
+
+IMPORT_LINES = 1 << 32
+"""Where the lines of the nodes a Supervisor imports inside a top-level solid are numbered from: the string's
+``k``-th such import's line ``n`` is ``k * IMPORT_LINES + n``, past any world file's, so that each node inside
+the solid keeps a place (line, column) no other node has (what a Pose's set, a removal and export find it by)."""
+
+
+def imported_line(line: int) -> bool:
+    """A line :func:`parse_nested_import` numbered (a node a Supervisor imported inside a solid)."""
+    return line >= IMPORT_LINES
+
+
+def _shifted(node: ParsedNode, by: int) -> ParsedNode:
+    fields = {name: [_shifted(v, by) if isinstance(v, ParsedNode) else v for v in value] if isinstance(value, list)
+              else _shifted(value, by) if isinstance(value, ParsedNode) else value
+              for name, value in node.fields.items()}
+    return replace(node, fields=fields, line=node.line + by,
+                   field_pos={k: (line + by, col) for k, (line, col) in node.field_pos.items()})
+
+
+def parse_nested_import(sim: Any, key: str, text: Any, serial: int) -> list[ParsedNode]:
+    """The nodes of an ``importMFNodeFromString`` string meant for a node inside top-level solid ``key``, as written
+    in that solid's file (its relative urls resolve there), numbered past its lines (:data:`IMPORT_LINES`, ``serial``
+    the import's number, from 1). ``ImportRefused`` (one line placed in the string) for a string that does not parse,
+    declares a PROTO or holds no node."""
+    from sensorium.server.sim.imports import LABEL, _check_string
+    from sensorium.server.world.wbt.parser import Parser, Tokens
+
+    found = _instance(sim, key)
+    if found is None:
+        raise ImportRefused(f"solid {key!r} was not loaded from a .wbt world file's node kept here")
+    _check_string(text, sim.limits)
+    file = found[1]
+    try:
+        wbt = Parser(Tokens(text, file.source), file.source, limits=ProtoLimits.matching(sim.limits)).file(
+            file.version or "R2023b", text)
+    except WbtSyntaxError as exc:
+        at = f"{LABEL}:{exc.line}:{exc.col}" if exc.line else LABEL
+        raise ImportRefused(f"{at}: {exc.message.replace(file.source, LABEL)}") from None
+    if wbt.declarations or wbt.protos:
+        raise ImportRefused(f"{LABEL}: a node string declares no PROTO: declare it in the world file "
+                            "(IMPORTABLE EXTERNPROTO), as Webots requires")
+    if not wbt.nodes:
+        raise ImportRefused(f"{LABEL}: no node in it (e.g. 'Pose {{ ... }}')")
+    return [_shifted(n, serial * IMPORT_LINES) for n in wbt.nodes]
+
+
+def _grown(node: ParsedNode, at: tuple[int, int], change: Any) -> ParsedNode | None:
+    """``node`` with the ``children`` of the node written at ``at`` changed by ``change`` (its list -> the new
+    list), or None when no node inside it is written there."""
+    if (node.line, node.col) == at:
+        children = node.fields.get("children", [])
+        return replace(node, fields={**node.fields, "children": change(list(children) if isinstance(children, list)
+                                                                       else [children])})
+    for name, value in node.fields.items():
+        items = value if isinstance(value, list) else [value]
+        for i, item in enumerate(items):
+            if isinstance(item, ParsedNode):
+                found = _grown(item, at, change)
+                if found is not None:
+                    value = found if not isinstance(value, list) else [*value[:i], found, *value[i + 1:]]
+                    return replace(node, fields={**node.fields, name: value})
+    return None
+
+
+def written_node(sim: Any, key: str, at: tuple[int, int] | None = None) -> ParsedNode | None:
+    """The node written at ``at`` inside top-level solid ``key`` as it is written now (None: the solid's own
+    node), or None when it is not at hand."""
+    found = _instance(sim, key)
+    if found is None:
+        return None
+    stack = [found[0]]
+    while stack:
+        node = stack.pop()
+        if at is None or (node.line, node.col) == at:
+            return node
+        for value in node.fields.values():
+            stack += [v for v in (value if isinstance(value, list) else [value]) if isinstance(v, ParsedNode)]
+    return None
+
+
+def rebuild_children(sim: Any, key: str, node_id: int, at: tuple[int, int], change: Any,
+                     warnings: list[str] | None = None) -> ImportedNode:
+    """Top-level solid ``key`` (Supervisor node ``node_id``) built again with the ``children`` of the node written at
+    ``at`` inside it (its own node's place: its own children) changed by ``change`` (the written list -> the new
+    one): a Supervisor's import into, or removal from, a node's children, through the path a Pose's set takes
+    (:func:`rebuild_posed`). ``ImportRefused`` (one line, nothing changed) when it does not build."""
+    found = _instance(sim, key)
+    if found is None:
+        raise ImportRefused(f"solid {key!r} was not loaded from a .wbt world file's node kept here")
+    written, file = found
+    new = _grown(written, at, change)
+    if new is None:
+        raise ImportRefused(f"no node of solid {key!r} is written at line {at[0]}, column {at[1]}")
+    return _rebuilt(sim, key, node_id, new, file, warnings)
+
+
+def _unimported(node: ParsedNode) -> ParsedNode:
+    fields = {name: [_unimported(v) if isinstance(v, ParsedNode) else v for v in value
+                     if not (isinstance(v, ParsedNode) and imported_line(v.line))] if isinstance(value, list)
+              else _unimported(value) if isinstance(value, ParsedNode) else value
+              for name, value in node.fields.items()}
+    return replace(node, fields=fields)
+
+
+def rebuild_unimported(sim: Any, key: str, node_id: int) -> ImportedNode:
+    """Top-level solid ``key`` built again without the nodes a Supervisor imported inside it (what a
+    ``simulationReset`` takes out), as it is written now otherwise."""
+    found = _instance(sim, key)
+    assert found is not None
+    return _rebuilt(sim, key, node_id, _unimported(found[0]), found[1])
+
+
+def _rebuilt(sim: Any, key: str, node_id: int, new: ParsedNode, file: WbtFile,
+             warnings: list[str] | None = None) -> ImportedNode:
+    taken = set(sim.scene.solid_names) - {key}
+    node = rebuild_node(new, file, sim.loaded, sim.world, taken=taken, limits=sim.limits,
+                        allow_outside_meshes=sim.allow_outside_meshes, warnings=warnings)
+    if node.type != "Solid" or node.model.name != key:
+        raise ImportRefused(f"solid {key!r} would not build again as a solid of that name")
+    sim.replace_solid(key, node, node_id)
+    sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
+    return node

@@ -478,6 +478,8 @@ class Simulation:
         for ride in self._riders:
             if ride.robot.drive is not None:
                 raise ValueError(f"robot {ride.robot.name!r}: a robot riding another has no drive of its own")
+        # solids a Supervisor imported into a robot's children: each fixed in its robot's frame (ride_solid)
+        self.solid_riders: dict[str, tuple[RobotState, Pose]] = {}
         if self.contact is not None and self._riders:     # one body with its carrier: never each other's obstacle
             carriers = {ride.carrier.index: [ride.carrier.index] for ride in self._riders}
             for ride in self._riders:
@@ -750,6 +752,14 @@ class Simulation:
         if self.ground is not None:
             self.ground.update_solid(name, pose)
 
+    def ride_solid(self, name: str, robot: str, frame: Pose) -> None:
+        """Top-level solid ``name`` (one a Supervisor imported into robot ``robot``'s children) put and kept at
+        ``frame`` in the robot's frame: placed there now and after each step's moves, seen there by every
+        sensor from the next measurement; :meth:`remove_solid` (and so ``simulationReset``) ends the ride."""
+        carrier = self.robots[robot]
+        self.solid_riders[name] = (carrier, frame)
+        self.place_solid(name, carrier.pose.compose(frame))
+
     def initial_solid_pose(self, name: str) -> Pose:
         """A top-level solid's pose as the world file (or its import) placed it."""
         initial: dict[str, Pose] = self._initial["solids"]
@@ -766,6 +776,7 @@ class Simulation:
         next measurement no sensor sees it, kinematic contact no longer stops robots at it, and
         ``simulationReset`` does not bring it back (Webots' reset adds no removed node)."""
         self._take_out(name)
+        self.solid_riders.pop(name, None)
         # what only a removed imported solid needed goes with it (a Supervisor importing and removing for days
         # keeps a name, a node id and a few hundred bytes per removed solid): its model in ``world.solids``
         # (where it keeps its place: the Supervisor numbers nodes by it) becomes its name and DEF alone (a
@@ -1054,6 +1065,8 @@ class Simulation:
             self.scene.set_robot_pose(robot.index, pose)
         if self._riders:
             self._carry()
+        for name, (robot, frame) in self.solid_riders.items():      # after the robots they ride moved
+            self.place_solid(name, robot.pose.compose(frame))
         if self._belts is not None:   # belts carry what lies on them by their motors' travel this step
             self._belts.carry(dt * 0.001)
         if self.falls:                # solids let go fall on before the grippers look (one may catch them)
