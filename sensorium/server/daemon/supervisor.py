@@ -842,7 +842,7 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     changed for a solid a rebuild would lose more of (a node inside it removed, a light's field set) or a
     Charger's."""
     from sensorium.server.sim.imports import ImportRefused
-    from sensorium.server.sim.regenerate import rebuild_posed, written_fields, written_value
+    from sensorium.server.sim.regenerate import move_posed, rebuild_posed, written_fields, written_value
 
     _check_pose_value(field, value)
     table = _table(sim)
@@ -857,12 +857,16 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     own = nested.own_pose(sim, table, n)
     assert own is not None
     kind = "SFVec3f" if field == "translation" else "SFRotation"
-    try:
-        made = _rebuilt_in_place(sim, key, lambda: rebuild_posed(sim, key, n.owner, at, {field: written_value(kind, value)}))
-    except ImportRefused as exc:
-        raise ValueError(f"field {field!r} of {_what(node)} not set: {exc}; nothing changed") from None
+    fields = {field: written_value(kind, value)}
+    # only shapes moved within the solid: placed anew, the solid not built again (the same readings)
+    model = None if getattr(sim, "rebuild_pose_sets", False) else move_posed(sim, key, at, fields)
+    if model is None:
+        try:
+            model = _rebuilt_in_place(sim, key, lambda: rebuild_posed(sim, key, n.owner, at, fields)).model
+        except ImportRefused as exc:
+            raise ValueError(f"field {field!r} of {_what(node)} not set: {exc}; nothing changed") from None
     sim.__dict__.setdefault("_posed", {}).setdefault(key, {}).setdefault(at, (n.id, loaded))
-    nested.renew(sim, table, n.owner, key, made.model, n.id)
+    nested.renew(sim, table, n.owner, key, model, n.id)
     translation = np.asarray(value, dtype=np.float64) if field == "translation" else own.translation
     rotation = axis_angle_matrix(value[:3], value[3]) if field == "rotation" else own.rotation
     table.set_own[n.id] = Pose(rotation, translation)

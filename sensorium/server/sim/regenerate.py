@@ -11,12 +11,18 @@ written node kept is then the one with the value, so successive sets add up."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
+from sensorium.schemas import world as wm
+
 from sensorium.server.sim.imports import ImportedNode, ImportRefused, rebuild_node, string_file, world_protos
+from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import ProtoLimits
+from sensorium.server.world.poses import pose_from_model
 from sensorium.server.world.wbt.parser import Node as ParsedNode
+from sensorium.server.world.wbt.frames import Frame
 from sensorium.server.world.wbt.parser import WbtFile, WbtSyntaxError, parse_wbt
 
 _VECTORS = frozenset({"SFVec2f", "SFVec3f", "SFColor", "SFRotation"})
@@ -172,6 +178,150 @@ def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields:
     sim.replace_solid(key, node, node_id)
     sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
     return node
+
+
+_UNIT = (1.0, 1.0, 1.0)
+
+
+def _vec(node: ParsedNode, name: str, default: tuple[float, ...]) -> tuple[float, ...] | None:
+    """A field's numbers as the converter reads them (wbt/fields.py ``vec``); None for anything else."""
+    v = node.fields.get(name, default)
+    if isinstance(v, float | int) and not isinstance(v, bool):
+        v = (float(v),)
+    if not isinstance(v, tuple) or len(v) != len(default) or not all(isinstance(x, float | int) for x in v):
+        return None
+    return tuple(float(x) for x in v)
+
+
+def _frame(node: ParsedNode, frame: Frame) -> Frame | None:
+    """The frame of a Pose or unscaled Transform under ``frame``, as the converter makes it (``child_frame``);
+    None for a scaled Transform or a rotation the converter refuses."""
+    translation, rotation = _vec(node, "translation", (0.0, 0.0, 0.0)), _vec(node, "rotation", (0.0, 0.0, 1.0, 0.0))
+    if translation is None or rotation is None or (rotation[3] != 0.0 and math.hypot(*rotation[:3]) == 0.0):
+        return None
+    if node.type == "Transform" and _vec(node, "scale", _UNIT) != _UNIT:
+        return None
+    return frame.then(translation, rotation, _UNIT)
+
+
+def _children(node: ParsedNode) -> list[Any]:
+    value = node.fields.get("children", [])
+    return value if isinstance(value, list) else [value]
+
+
+def _placed(top: ParsedNode, at: tuple[int, int]) -> tuple[dict, dict] | None:
+    """Where the shapes and Poses under the Pose written at ``at`` inside plain Solid ``top`` sit in its frame,
+    as the converter places them: ((line, column) of each Shape -> its Frame, of each Pose or Transform -> its
+    frame); None unless only Poses, unscaled Transforms and Groups lead from ``top`` to it through ``children``
+    and only those and Shapes are under it, each written once in the solid (a USE would place one written node
+    twice)."""
+    seen: set[int] = set()
+    stack: list[ParsedNode] = [top]
+    while stack:                                # (a node written once: no USE inside the solid)
+        node = stack.pop()
+        if id(node) in seen:
+            return None
+        seen.add(id(node))
+        for value in node.fields.values():
+            stack += [v for v in (value if isinstance(value, list) else [value]) if isinstance(v, ParsedNode)]
+    frame, node = Frame.identity(), top
+    while (node.line, node.col) != at:          # down to it, a frame at a time
+        below = [c for c in _children(node) if isinstance(c, ParsedNode) and c.type in ("Pose", "Transform", "Group")
+                 and _holds(c, at)]
+        if not below:
+            return None
+        node = below[0]
+        if node.type != "Group":
+            step = _frame(node, frame)
+            if step is None:
+                return None
+            frame = step
+    if node.type not in ("Pose", "Transform"):
+        return None
+    shapes: dict[tuple[int, int], Frame] = {}
+    poses: dict[tuple[int, int], Frame] = {(node.line, node.col): frame}
+    walk = [(node, frame)]
+    while walk:
+        parent, inner = walk.pop()
+        for child in _children(parent):
+            if not isinstance(child, ParsedNode):
+                return None
+            if child.type == "Shape":
+                shapes[(child.line, child.col)] = inner
+            elif child.type == "Group":
+                walk.append((child, inner))
+            elif child.type in ("Pose", "Transform"):
+                step = _frame(child, inner)
+                if step is None:
+                    return None
+                poses[(child.line, child.col)] = step
+                walk.append((child, step))
+            else:                               # a light, a solid, a PROTO instance...: the rebuild places it
+                return None
+    return shapes, poses
+
+
+def _holds(node: ParsedNode, at: tuple[int, int]) -> bool:
+    if (node.line, node.col) == at:
+        return True
+    return any(isinstance(c, ParsedNode) and c.type in ("Pose", "Transform", "Group") and _holds(c, at)
+               for c in _children(node))
+
+
+def _pose_model(frame: Frame) -> wm.Pose:
+    return wm.Pose.model_validate(frame.pose())
+
+
+def move_posed(sim: Any, key: str, at: tuple[int, int], fields: dict[str, Any]) -> wm.Solid | None:
+    """:func:`rebuild_posed` without building the solid again, where the set only moves shapes within it: the
+    shapes under the Pose (or Transform) written at ``at`` get the poses in the solid's frame the converter
+    gives them with ``fields``, their numbers, entries and looks kept, and the solid's model and written node
+    become those the rebuild would leave; returns the new model. None (nothing changed: the caller rebuilds)
+    unless top-level solid ``key`` is a plain Solid written in the file, without physics (the rebuild lands it),
+    and only visual shapes sit under that Pose: a light, a solid or a device under it, a scaled Transform, a
+    bounding shape (kinematic contact and the terrains judge those), a USE or a PROTO instance (which the
+    converter places through its body) are left to the rebuild."""
+    found = _instance(sim, key)
+    if found is None or found[0].type != "Solid" or found[0].proto is not None:
+        return None
+    written = found[0]
+    new = _replaced(written, at, fields)
+    placed = None if new is None else _placed(new, at)
+    if placed is None:
+        return None
+    shapes, poses = placed
+    k = next(i for i in range(len(sim.world.solids) - 1, -1, -1) if sim.world.solids[i].name == key)
+    solid = sim.world.solids[k]
+    if solid.physics:
+        return None
+    mine = sim.scene.solid_shapes(key)
+    first = 0 if solid.geometry is None else 1
+    parts = list(solid.shapes)
+    moved: dict[int, tuple[Pose, wm.Part]] = {}
+    for j, part in enumerate(parts):
+        where = part.node.written_at if part.node is not None else None
+        frame = shapes.get((where[0], where[1])) if where else None
+        if frame is None:
+            continue
+        if part.seen_by != "visual" or part.node.piece or first + j >= len(mine) \
+                or sim.scene.loaded_model(mine[first + j]) is not part:
+            return None
+        parts[j] = part.model_copy(update={"pose": _pose_model(frame)})
+        moved[mine[first + j]] = (Pose.identity().compose(pose_from_model(parts[j].pose)), parts[j])
+    entries = list(solid.poses)
+    found_poses = 0
+    for j, entry in enumerate(entries):
+        frame = poses.get((entry.written_at[0], entry.written_at[1])) if entry.written_at else None
+        if frame is not None and entry.type != "Group":
+            entries[j] = entry.model_copy(update={"pose": _pose_model(frame)})
+            found_poses += 1
+    if found_poses != len(poses):               # (a Pose the solid does not serve: placed otherwise)
+        return None
+    model = solid.model_copy(update={"shapes": parts, "poses": entries})
+    sim.world.solids[k] = model
+    sim.scene.move_shapes(moved)
+    sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
+    return model
 
 
 IMPORT_LINES = 1 << 32
