@@ -59,7 +59,7 @@ def node(lv: Live, name: str) -> int:
 
 def readings(lv: Live) -> tuple:
     """Every device's reading after a step, and the world pose of every Pose (and of what it holds: NaN for a
-    shape, as in Webots), as bytes."""
+    shape, as in Webots) and its translation and rotation fields, as bytes."""
     lv.step(A, "probe")
     bot = lv.sim.robot("probe")
     poses = []
@@ -68,6 +68,8 @@ def readings(lv: Live) -> tuple:
         for m in [n, *call(lv, "get_field", {"node": n, "field": "children"})["value"]]:
             pose = call(lv, "get_node_pose", {"node": m})
             poses.append(np.asarray(pose["position"] + pose["orientation"], dtype=np.float64).tobytes())
+        own = [call(lv, "get_field", {"node": n, "field": f})["value"] for f in ("translation", "rotation")]
+        poses.append(np.asarray(own[0] + own[1], dtype=np.float64).tobytes())
     return (np.asarray(bot.device("lidar").range_image, dtype=np.float64).tobytes(),
             np.asarray(bot.device("camera").image).tobytes(), np.float64(bot.device("ds").value).tobytes(), *poses)
 

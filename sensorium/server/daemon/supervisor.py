@@ -858,15 +858,18 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     assert own is not None
     kind = "SFVec3f" if field == "translation" else "SFRotation"
     fields = {field: written_value(kind, value)}
-    # only shapes moved within the solid: placed anew, the solid not built again (the same readings)
-    model = None if getattr(sim, "rebuild_pose_sets", False) else move_posed(sim, key, at, fields)
-    if model is None:
+    # only shapes moved within the solid: placed anew, the solid not built again (the same readings and records)
+    moved = None if getattr(sim, "rebuild_pose_sets", False) else move_posed(sim, key, at, fields)
+    if moved is None:
         try:
-            model = _rebuilt_in_place(sim, key, lambda: rebuild_posed(sim, key, n.owner, at, fields)).model
+            made = _rebuilt_in_place(sim, key, lambda: rebuild_posed(sim, key, n.owner, at, fields))
         except ImportRefused as exc:
             raise ValueError(f"field {field!r} of {_what(node)} not set: {exc}; nothing changed") from None
     sim.__dict__.setdefault("_posed", {}).setdefault(key, {}).setdefault(at, (n.id, loaded))
-    nested.renew(sim, table, n.owner, key, model, n.id)
+    if moved is None:
+        nested.renew(sim, table, n.owner, key, made.model, n.id)
+    else:
+        nested.reframe(table, n.owner, *moved, n.id)
     translation = np.asarray(value, dtype=np.float64) if field == "translation" else own.translation
     rotation = axis_angle_matrix(value[:3], value[3]) if field == "rotation" else own.rotation
     table.set_own[n.id] = Pose(rotation, translation)

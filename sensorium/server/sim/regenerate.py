@@ -16,13 +16,12 @@ from dataclasses import replace
 from typing import Any
 
 from sensorium.schemas import world as wm
-
 from sensorium.server.sim.imports import ImportedNode, ImportRefused, rebuild_node, string_file, world_protos
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import ProtoLimits
 from sensorium.server.world.poses import pose_from_model
-from sensorium.server.world.wbt.parser import Node as ParsedNode
 from sensorium.server.world.wbt.frames import Frame
+from sensorium.server.world.wbt.parser import Node as ParsedNode
 from sensorium.server.world.wbt.parser import WbtFile, WbtSyntaxError, parse_wbt
 
 _VECTORS = frozenset({"SFVec2f", "SFVec3f", "SFColor", "SFRotation"})
@@ -209,35 +208,54 @@ def _children(node: ParsedNode) -> list[Any]:
     return value if isinstance(value, list) else [value]
 
 
+def _unshared(sim: Any, key: str, top: ParsedNode) -> bool:
+    """Whether each node inside ``top`` (top-level solid ``key``'s written node) is written once there (a USE
+    would place one written node twice); kept for the node checked, and for the one a set makes of it (a
+    Pose's new values share no node)."""
+    if getattr(sim, "_regen_unshared", {}).get(key) is top:
+        return True
+    seen: set[int] = set()
+    stack: list[ParsedNode] = [top]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            return False
+        seen.add(id(node))
+        for value in node.fields.values():
+            stack += [v for v in (value if isinstance(value, list) else [value]) if isinstance(v, ParsedNode)]
+    sim._regen_unshared = {**getattr(sim, "_regen_unshared", {}), key: top}
+    return True
+
+
+def _path(top: ParsedNode, at: tuple[int, int]) -> list[ParsedNode] | None:
+    """The nodes from ``top`` down to the one written at ``at`` through Poses', Transforms' and Groups'
+    ``children`` (None: not so)."""
+    stack: list[list[ParsedNode]] = [[top]]
+    while stack:
+        path = stack.pop()
+        if (path[-1].line, path[-1].col) == at:
+            return path
+        stack += [[*path, c] for c in _children(path[-1])
+                  if isinstance(c, ParsedNode) and c.type in ("Pose", "Transform", "Group")]
+    return None
+
+
 def _placed(top: ParsedNode, at: tuple[int, int]) -> tuple[dict, dict] | None:
     """Where the shapes and Poses under the Pose written at ``at`` inside plain Solid ``top`` sit in its frame,
     as the converter places them: ((line, column) of each Shape -> its Frame, of each Pose or Transform -> its
     frame); None unless only Poses, unscaled Transforms and Groups lead from ``top`` to it through ``children``
-    and only those and Shapes are under it, each written once in the solid (a USE would place one written node
-    twice)."""
-    seen: set[int] = set()
-    stack: list[ParsedNode] = [top]
-    while stack:                                # (a node written once: no USE inside the solid)
-        node = stack.pop()
-        if id(node) in seen:
-            return None
-        seen.add(id(node))
-        for value in node.fields.values():
-            stack += [v for v in (value if isinstance(value, list) else [value]) if isinstance(v, ParsedNode)]
-    frame, node = Frame.identity(), top
-    while (node.line, node.col) != at:          # down to it, a frame at a time
-        below = [c for c in _children(node) if isinstance(c, ParsedNode) and c.type in ("Pose", "Transform", "Group")
-                 and _holds(c, at)]
-        if not below:
-            return None
-        node = below[0]
+    and only those and Shapes are under it."""
+    path = _path(top, at)
+    if path is None or path[-1].type not in ("Pose", "Transform"):
+        return None
+    frame = Frame.identity()
+    for node in path[1:]:                       # down to it, a frame at a time
         if node.type != "Group":
             step = _frame(node, frame)
             if step is None:
                 return None
             frame = step
-    if node.type not in ("Pose", "Transform"):
-        return None
+    node = path[-1]
     shapes: dict[tuple[int, int], Frame] = {}
     poses: dict[tuple[int, int], Frame] = {(node.line, node.col): frame}
     walk = [(node, frame)]
@@ -261,22 +279,15 @@ def _placed(top: ParsedNode, at: tuple[int, int]) -> tuple[dict, dict] | None:
     return shapes, poses
 
 
-def _holds(node: ParsedNode, at: tuple[int, int]) -> bool:
-    if (node.line, node.col) == at:
-        return True
-    return any(isinstance(c, ParsedNode) and c.type in ("Pose", "Transform", "Group") and _holds(c, at)
-               for c in _children(node))
-
-
 def _pose_model(frame: Frame) -> wm.Pose:
     return wm.Pose.model_validate(frame.pose())
 
 
-def move_posed(sim: Any, key: str, at: tuple[int, int], fields: dict[str, Any]) -> wm.Solid | None:
+def move_posed(sim: Any, key: str, at: tuple[int, int], fields: dict[str, Any]) -> tuple[wm.Solid, list[int]] | None:
     """:func:`rebuild_posed` without building the solid again, where the set only moves shapes within it: the
     shapes under the Pose (or Transform) written at ``at`` get the poses in the solid's frame the converter
     gives them with ``fields``, their numbers, entries and looks kept, and the solid's model and written node
-    become those the rebuild would leave; returns the new model. None (nothing changed: the caller rebuilds)
+    become those the rebuild would leave; returns the new model and the indices of its ``poses`` moved. None (nothing changed: the caller rebuilds)
     unless top-level solid ``key`` is a plain Solid written in the file, without physics (the rebuild lands it),
     and only visual shapes sit under that Pose: a light, a solid or a device under it, a scaled Transform, a
     bounding shape (kinematic contact and the terrains judge those), a USE or a PROTO instance (which the
@@ -285,7 +296,7 @@ def move_posed(sim: Any, key: str, at: tuple[int, int], fields: dict[str, Any]) 
     if found is None or found[0].type != "Solid" or found[0].proto is not None:
         return None
     written = found[0]
-    new = _replaced(written, at, fields)
+    new = _replaced(written, at, fields) if _unshared(sim, key, written) else None
     placed = None if new is None else _placed(new, at)
     if placed is None:
         return None
@@ -309,19 +320,20 @@ def move_posed(sim: Any, key: str, at: tuple[int, int], fields: dict[str, Any]) 
         parts[j] = part.model_copy(update={"pose": _pose_model(frame)})
         moved[mine[first + j]] = (Pose.identity().compose(pose_from_model(parts[j].pose)), parts[j])
     entries = list(solid.poses)
-    found_poses = 0
+    changed = []
     for j, entry in enumerate(entries):
         frame = poses.get((entry.written_at[0], entry.written_at[1])) if entry.written_at else None
         if frame is not None and entry.type != "Group":
             entries[j] = entry.model_copy(update={"pose": _pose_model(frame)})
-            found_poses += 1
-    if found_poses != len(poses):               # (a Pose the solid does not serve: placed otherwise)
+            changed.append(j)
+    if len(changed) != len(poses):              # (a Pose the solid does not serve: placed otherwise)
         return None
     model = solid.model_copy(update={"shapes": parts, "poses": entries})
     sim.world.solids[k] = model
     sim.scene.move_shapes(moved)
     sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
-    return model
+    sim._regen_unshared[key] = new
+    return model, changed
 
 
 IMPORT_LINES = 1 << 32
