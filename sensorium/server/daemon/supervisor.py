@@ -837,7 +837,9 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     """A Pose's or Transform's ``translation`` or ``rotation`` inside a top-level solid set (WbPose): what it
     holds (shapes, lights, solids) is from the next measurement where the world file written with that value
     puts it, its solid built again through the path a PROTO field set takes (sim/regenerate.py
-    ``rebuild_posed``); every node inside the solid keeps its id. ``simulationReset`` puts the loaded value
+    ``rebuild_posed``), or where the set only moves visual shapes, those shapes placed anew (``move_posed``: the
+    same readings; ``sim.rebuild_pose_sets`` true always rebuilds, for tests and benchmarks); every node inside
+    the solid keeps its id. ``simulationReset`` puts the loaded value
     back (:func:`reset_solid_poses`); its shapes keep the appearances a Supervisor gave them. One line and nothing
     changed for a solid a rebuild would lose more of (a node inside it removed, a light's field set) or a
     Charger's."""

@@ -287,11 +287,12 @@ def move_posed(sim: Any, key: str, at: tuple[int, int], fields: dict[str, Any]) 
     """:func:`rebuild_posed` without building the solid again, where the set only moves shapes within it: the
     shapes under the Pose (or Transform) written at ``at`` get the poses in the solid's frame the converter
     gives them with ``fields``, their numbers, entries and looks kept, and the solid's model and written node
-    become those the rebuild would leave; returns the new model and the indices of its ``poses`` moved. None (nothing changed: the caller rebuilds)
-    unless top-level solid ``key`` is a plain Solid written in the file, without physics (the rebuild lands it),
-    and only visual shapes sit under that Pose: a light, a solid or a device under it, a scaled Transform, a
-    bounding shape (kinematic contact and the terrains judge those), a USE or a PROTO instance (which the
-    converter places through its body) are left to the rebuild."""
+    become those the rebuild would leave; returns the new model and the indices of its ``poses`` moved.
+    None (nothing changed: the caller rebuilds) unless top-level solid ``key`` is a plain Solid written in the
+    file, without physics (the rebuild lands it), and only visual shapes sit under that Pose. Left to the
+    rebuild: a light (the scene's light arrays), a solid (contact, radar targets, its nodes), a scaled
+    Transform (its geometry follows the scale), a bounding shape (kinematic contact and the terrains judge
+    those), a USE (one written node placed twice), a PROTO instance (placed through its body)."""
     found = _instance(sim, key)
     if found is None or found[0].type != "Solid" or found[0].proto is not None:
         return None
@@ -319,6 +320,8 @@ def move_posed(sim: Any, key: str, at: tuple[int, int], fields: dict[str, Any]) 
             return None
         parts[j] = part.model_copy(update={"pose": _pose_model(frame)})
         moved[mine[first + j]] = (Pose.identity().compose(pose_from_model(parts[j].pose)), parts[j])
+    if len(moved) != len(shapes):               # (a Shape that is no part here, or not found by its place)
+        return None
     entries = list(solid.poses)
     changed = []
     for j, entry in enumerate(entries):
