@@ -2,7 +2,7 @@
 (tests/worlds/pose_moves.wbt): its shapes placed anew, the solid not built again (sim/regenerate.py ``move_posed``),
 with readings bit for bit those of the rebuild (a twin simulation with ``rebuild_pose_sets``): lidar ranges, camera
 images, the distance sensor's value and every node's world pose, through nested Poses, a turned and a moved solid, a
-set back and forth, a colour set before, saveState/loadState and simulationReset; a Pose holding a light is built
+set back and forth, a Pose a Supervisor imported, a colour set before, saveState/loadState and simulationReset; a Pose holding a light is built
 again (the fallback), the same readings still.
 
 Closed form (the world file's comment places everything): M1 set 0.3 m back along BOARD's x puts its box at
@@ -120,6 +120,14 @@ def test_sets_that_move_shapes_read_bit_for_bit_as_the_rebuild_without_building_
     t.same()
     t.set("M1", "rotation", [0.0, 1.0, 0.0, 0.5])               # after a rebuild, placed anew again
     assert t.regenerations() == (1, 8)
+    t.same()
+    t.call("import_node_from_string", "OUTER", {"field": "children", "position": -1, "node_string":
+           "DEF NEW Pose { translation -0.4 0 0 children [ Shape { geometry Box { size 0.1 0.3 0.1 } } ] }"})
+    assert t.regenerations() == (2, 9)                          # an import builds the solid again
+    t.same()
+    t.set("NEW", "translation", [-0.2, -0.3, 0.0])              # a Pose a Supervisor imported
+    t.set("OUTER", "translation", [0.0, 0.1, 0.0])              # one holding it
+    assert t.regenerations() == (2, 11)
     t.same()
 
 
