@@ -2,8 +2,8 @@
 (tests/worlds/pose_moves.wbt): its shapes placed anew, the solid not built again (sim/regenerate.py ``move_posed``),
 with readings bit for bit those of the rebuild (a twin simulation with ``rebuild_pose_sets``): lidar ranges, camera
 images, the distance sensor's value and every node's world pose, through nested Poses, a turned and a moved solid, a
-set back and forth, a Pose a Supervisor imported, a colour set before, saveState/loadState and simulationReset; a Pose holding a light is built
-again (the fallback), the same readings still.
+set back and forth, a Pose a Supervisor imported, a colour set before, saveState/loadState and simulationReset; a Pose
+holding a light is built again (the fallback), the same readings still.
 
 Closed form (the world file's comment places everything): M1 set 0.3 m back along BOARD's x puts its box at
 (2 − 0.3 cos 0.3, −0.3 sin 0.3, 0.1)."""
