@@ -1,9 +1,10 @@
 """A Supervisor's set of a Pose's translation or rotation inside a top-level solid that only moves shapes within it
 (tests/worlds/pose_moves.wbt): its shapes placed anew, the solid not built again (sim/regenerate.py ``move_posed``),
 with readings bit for bit those of the rebuild (a twin simulation with ``rebuild_pose_sets``): lidar ranges, camera
-images, the distance sensor's value and every node's world pose, through nested Poses, a turned and a moved solid, a
-set back and forth, a Pose a Supervisor imported, a colour set before, saveState/loadState and simulationReset; a Pose
-holding a light is built again (the fallback), the same readings still.
+images and recognition objects, the distance sensor's value and every Pose's world pose and fields, through nested
+Poses, a turned and a moved solid, a set back and forth, a Pose a Supervisor imported, a colour set before,
+saveState/loadState and simulationReset; a Pose holding a light is built again (the fallback), the same readings
+still.
 
 Closed form (the world file's comment places everything): M1 set 0.3 m back along BOARD's x puts its box at
 (2 − 0.3 cos 0.3, −0.3 sin 0.3, 0.1)."""
@@ -46,6 +47,7 @@ def _live(rebuild: bool, path: Path) -> Live:
     bot = lv.sim.robot("probe")
     for device in ("lidar", "camera", "ds"):
         bot.device(device).enable(8)
+    bot.device("camera").recognition_enable(8)
     return lv
 
 
@@ -70,8 +72,11 @@ def readings(lv: Live) -> tuple:
             poses.append(np.asarray(pose["position"] + pose["orientation"], dtype=np.float64).tobytes())
         own = [call(lv, "get_field", {"node": n, "field": f})["value"] for f in ("translation", "rotation")]
         poses.append(np.asarray(own[0] + own[1], dtype=np.float64).tobytes())
+    objects = bot.device("camera").objects
+    assert len(objects) == 1                                    # BOARD recognised
     return (np.asarray(bot.device("lidar").range_image, dtype=np.float64).tobytes(),
-            np.asarray(bot.device("camera").image).tobytes(), np.float64(bot.device("ds").value).tobytes(), *poses)
+            np.asarray(bot.device("camera").image).tobytes(), np.float64(bot.device("ds").value).tobytes(),
+            repr([o.as_dict() for o in objects]), *poses)
 
 
 class Twins:
