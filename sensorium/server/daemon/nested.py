@@ -32,6 +32,7 @@ joint's ``endPoint`` and ``device`` fields (``end_point``, ``joint_devices``).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Collection
 from dataclasses import dataclass
 from typing import Any
 
@@ -618,6 +619,45 @@ def renew(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, kept: i
     if segment is None:
         table.segments.pop(owner, None)
     _index(renewed, table.by_owner, table.by_parent)
+
+
+def reframe(table: Table, owner: int, solid: wm.Solid, changed: Collection[int], kept: int) -> None:
+    """:func:`renew` where top-level solid ``owner``'s model ``solid`` differs from the one its nodes were made of
+    only by the frames of its ``poses`` at indices ``changed`` (a Supervisor's set moved only shapes: no node comes
+    or goes): those Poses' nodes take the ``local`` and ``own`` renew gives them (node ``kept``, the Pose set, its
+    loaded ``own``), every other record as it is."""
+    mine = {n.at: n for n in table.by_owner.get(owner, ()) if n.type in ("Pose", "Transform") and n.at}
+    placed: dict[int, Pose | None] = {}
+
+    def frame(i: int) -> Pose | None:            # a Pose's nearest Pose's frame in the solid's (None: the solid's)
+        if i < 0:
+            return None
+        if i not in placed:
+            p = solid.poses[i]
+            placed[i] = frame(p.parent) if p.pose is None else pose_from_model(p.pose)
+        return placed[i]
+
+    new: dict[int, Nested] = {}
+    for i in changed:
+        p = solid.poses[i]
+        old = mine.get(tuple(p.written_at or ()))
+        if old is None or p.pose is None:
+            raise AssertionError(f"no node for Pose {i} of solid node {owner}")
+        local = frame(i)
+        own = old.own if old.id == kept else _own(local, frame(p.parent))
+        new[old.id] = dataclasses.replace(old, local=local, own=own)
+    if not new:
+        return
+    first = [k - FIRST_ID for k in new if 0 <= k - FIRST_ID < len(table.nodes)]
+    if first:
+        nodes = list(table.nodes)
+        for k in first:
+            nodes[k] = new[k + FIRST_ID]
+        table.nodes = tuple(nodes)
+    table.added.update((k, n) for k, n in new.items() if k in table.added)
+    table.by_owner[owner] = tuple(new.get(n.id, n) for n in table.by_owner[owner])
+    for parent in {n.parent for n in new.values()}:
+        table.by_parent[parent] = tuple(new.get(n.id, n) for n in table.by_parent.get(parent, ()))
 
 
 def regrow(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, gone: frozenset[int] = frozenset(),

@@ -837,12 +837,14 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     """A Pose's or Transform's ``translation`` or ``rotation`` inside a top-level solid set (WbPose): what it
     holds (shapes, lights, solids) is from the next measurement where the world file written with that value
     puts it, its solid built again through the path a PROTO field set takes (sim/regenerate.py
-    ``rebuild_posed``); every node inside the solid keeps its id. ``simulationReset`` puts the loaded value
+    ``rebuild_posed``), or where the set only moves visual shapes, those shapes placed anew (``move_posed``: the
+    same readings; ``sim.rebuild_pose_sets`` true always rebuilds, for tests and benchmarks); every node inside
+    the solid keeps its id. ``simulationReset`` puts the loaded value
     back (:func:`reset_solid_poses`); its shapes keep the appearances a Supervisor gave them. One line and nothing
     changed for a solid a rebuild would lose more of (a node inside it removed, a light's field set) or a
     Charger's."""
     from sensorium.server.sim.imports import ImportRefused
-    from sensorium.server.sim.regenerate import rebuild_posed, written_fields, written_value
+    from sensorium.server.sim.regenerate import move_posed, rebuild_posed, written_fields, written_value
 
     _check_pose_value(field, value)
     table = _table(sim)
@@ -857,12 +859,19 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     own = nested.own_pose(sim, table, n)
     assert own is not None
     kind = "SFVec3f" if field == "translation" else "SFRotation"
-    try:
-        made = _rebuilt_in_place(sim, key, lambda: rebuild_posed(sim, key, n.owner, at, {field: written_value(kind, value)}))
-    except ImportRefused as exc:
-        raise ValueError(f"field {field!r} of {_what(node)} not set: {exc}; nothing changed") from None
+    fields = {field: written_value(kind, value)}
+    # only shapes moved within the solid: placed anew, the solid not built again (the same readings and records)
+    moved = None if getattr(sim, "rebuild_pose_sets", False) else move_posed(sim, key, at, fields)
+    if moved is None:
+        try:
+            made = _rebuilt_in_place(sim, key, lambda: rebuild_posed(sim, key, n.owner, at, fields))
+        except ImportRefused as exc:
+            raise ValueError(f"field {field!r} of {_what(node)} not set: {exc}; nothing changed") from None
     sim.__dict__.setdefault("_posed", {}).setdefault(key, {}).setdefault(at, (n.id, loaded))
-    nested.renew(sim, table, n.owner, key, made.model, n.id)
+    if moved is None:
+        nested.renew(sim, table, n.owner, key, made.model, n.id)
+    else:
+        nested.reframe(table, n.owner, *moved, n.id)
     translation = np.asarray(value, dtype=np.float64) if field == "translation" else own.translation
     rotation = axis_angle_matrix(value[:3], value[3]) if field == "rotation" else own.rotation
     table.set_own[n.id] = Pose(rotation, translation)

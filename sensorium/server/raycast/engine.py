@@ -333,6 +333,18 @@ class RayEngine(TierTracer):
         self._forget_tiers(self._bodies[self._shape_body[shape]])
         self.seen_version += 1
 
+    def set_shape_poses(self, poses: dict[int, Pose]) -> None:
+        """Shapes moved within their bodies (a Supervisor set a Pose inside a solid): each one's pose in its
+        body's frame now (``ShapeEntry.local_pose``); the scenes holding them are made again at the next
+        cast, as after :meth:`set_shape_seen`, from the same items a world loaded with these poses builds
+        them of. Every body and shape keeps its number."""
+        bodies = set()
+        for shape, local in poses.items():
+            self._entries[shape] = dataclasses.replace(self._entries[shape], local_pose=local)
+            bodies.add(self._shape_body[shape])
+        for body in sorted(bodies):
+            self._forget_tiers(self._bodies[body])
+
     def _forget_tiers(self, b: _Body) -> None:
         """The scenes holding body ``b``'s shapes forgotten (made again on use): the planes, the static
         tier of a static body, a mover's own tiers and the movers' tables; body-frame tiers no mover

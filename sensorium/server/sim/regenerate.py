@@ -11,11 +11,16 @@ written node kept is then the one with the value, so successive sets add up."""
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Any
 
+from sensorium.schemas import world as wm
 from sensorium.server.sim.imports import ImportedNode, ImportRefused, rebuild_node, string_file, world_protos
+from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import ProtoLimits
+from sensorium.server.world.poses import pose_from_model
+from sensorium.server.world.wbt.frames import Frame
 from sensorium.server.world.wbt.parser import Node as ParsedNode
 from sensorium.server.world.wbt.parser import WbtFile, WbtSyntaxError, parse_wbt
 
@@ -172,6 +177,166 @@ def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields:
     sim.replace_solid(key, node, node_id)
     sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
     return node
+
+
+_UNIT = (1.0, 1.0, 1.0)
+
+
+def _vec(node: ParsedNode, name: str, default: tuple[float, ...]) -> tuple[float, ...] | None:
+    """A field's numbers as the converter reads them (wbt/fields.py ``vec``); None for anything else."""
+    v = node.fields.get(name, default)
+    if isinstance(v, float | int) and not isinstance(v, bool):
+        v = (float(v),)
+    if not isinstance(v, tuple) or len(v) != len(default) or not all(isinstance(x, float | int) for x in v):
+        return None
+    return tuple(float(x) for x in v)
+
+
+def _frame(node: ParsedNode, frame: Frame) -> Frame | None:
+    """The frame of a Pose or unscaled Transform under ``frame``, as the converter makes it (``child_frame``);
+    None for a scaled Transform or a rotation the converter refuses."""
+    translation, rotation = _vec(node, "translation", (0.0, 0.0, 0.0)), _vec(node, "rotation", (0.0, 0.0, 1.0, 0.0))
+    if translation is None or rotation is None or (rotation[3] != 0.0 and math.hypot(*rotation[:3]) == 0.0):
+        return None
+    if node.type == "Transform" and _vec(node, "scale", _UNIT) != _UNIT:
+        return None
+    return frame.then(translation, rotation, _UNIT)
+
+
+def _children(node: ParsedNode) -> list[Any]:
+    value = node.fields.get("children", [])
+    return value if isinstance(value, list) else [value]
+
+
+def _unshared(sim: Any, key: str, top: ParsedNode) -> bool:
+    """Whether each node inside ``top`` (top-level solid ``key``'s written node) is written once there (a USE
+    would place one written node twice); kept for the node checked, and for the one a set makes of it (a
+    Pose's new values share no node)."""
+    if getattr(sim, "_regen_unshared", {}).get(key) is top:
+        return True
+    seen: set[int] = set()
+    stack: list[ParsedNode] = [top]
+    while stack:
+        node = stack.pop()
+        if id(node) in seen:
+            return False
+        seen.add(id(node))
+        for value in node.fields.values():
+            stack += [v for v in (value if isinstance(value, list) else [value]) if isinstance(v, ParsedNode)]
+    sim._regen_unshared = {**getattr(sim, "_regen_unshared", {}), key: top}
+    return True
+
+
+def _path(top: ParsedNode, at: tuple[int, int]) -> list[ParsedNode] | None:
+    """The nodes from ``top`` down to the one written at ``at`` through Poses', Transforms' and Groups'
+    ``children`` (None: not so)."""
+    stack: list[list[ParsedNode]] = [[top]]
+    while stack:
+        path = stack.pop()
+        if (path[-1].line, path[-1].col) == at:
+            return path
+        stack += [[*path, c] for c in _children(path[-1])
+                  if isinstance(c, ParsedNode) and c.type in ("Pose", "Transform", "Group")]
+    return None
+
+
+def _placed(top: ParsedNode, at: tuple[int, int]) -> tuple[dict, dict] | None:
+    """Where the shapes and Poses under the Pose written at ``at`` inside plain Solid ``top`` sit in its frame,
+    as the converter places them: ((line, column) of each Shape -> its Frame, of each Pose or Transform -> its
+    frame); None unless only Poses, unscaled Transforms and Groups lead from ``top`` to it through ``children``
+    and only those and Shapes are under it."""
+    path = _path(top, at)
+    if path is None or path[-1].type not in ("Pose", "Transform"):
+        return None
+    frame = Frame.identity()
+    for node in path[1:]:                       # down to it, a frame at a time
+        if node.type != "Group":
+            step = _frame(node, frame)
+            if step is None:
+                return None
+            frame = step
+    node = path[-1]
+    shapes: dict[tuple[int, int], Frame] = {}
+    poses: dict[tuple[int, int], Frame] = {(node.line, node.col): frame}
+    walk = [(node, frame)]
+    while walk:
+        parent, inner = walk.pop()
+        for child in _children(parent):
+            if not isinstance(child, ParsedNode):
+                return None
+            if child.type == "Shape":
+                shapes[(child.line, child.col)] = inner
+            elif child.type == "Group":
+                walk.append((child, inner))
+            elif child.type in ("Pose", "Transform"):
+                step = _frame(child, inner)
+                if step is None:
+                    return None
+                poses[(child.line, child.col)] = step
+                walk.append((child, step))
+            else:                               # a light, a solid, a PROTO instance...: the rebuild places it
+                return None
+    return shapes, poses
+
+
+def _pose_model(frame: Frame) -> wm.Pose:
+    return wm.Pose.model_validate(frame.pose())
+
+
+def move_posed(sim: Any, key: str, at: tuple[int, int], fields: dict[str, Any]) -> tuple[wm.Solid, list[int]] | None:
+    """:func:`rebuild_posed` without building the solid again, where the set only moves shapes within it: the
+    shapes under the Pose (or Transform) written at ``at`` get the poses in the solid's frame the converter
+    gives them with ``fields``, their numbers, entries and looks kept, and the solid's model and written node
+    become those the rebuild would leave; returns the new model and the indices of its ``poses`` moved.
+    None (nothing changed: the caller rebuilds) unless top-level solid ``key`` is a plain Solid written in the
+    file, without physics (the rebuild lands it), and only visual shapes sit under that Pose. Left to the
+    rebuild: a light (the scene's light arrays), a solid (contact, radar targets, its nodes), a scaled
+    Transform (its geometry follows the scale), a bounding shape (kinematic contact and the terrains judge
+    those), a USE (one written node placed twice), a PROTO instance (placed through its body)."""
+    found = _instance(sim, key)
+    if found is None or found[0].type != "Solid" or found[0].proto is not None:
+        return None
+    written = found[0]
+    new = _replaced(written, at, fields) if _unshared(sim, key, written) else None
+    placed = None if new is None else _placed(new, at)
+    if placed is None:
+        return None
+    shapes, poses = placed
+    k = next(i for i in range(len(sim.world.solids) - 1, -1, -1) if sim.world.solids[i].name == key)
+    solid = sim.world.solids[k]
+    if solid.physics:
+        return None
+    mine = sim.scene.solid_shapes(key)
+    first = 0 if solid.geometry is None else 1
+    parts = list(solid.shapes)
+    moved: dict[int, tuple[Pose, wm.Part]] = {}
+    for j, part in enumerate(parts):
+        where = part.node.written_at if part.node is not None else None
+        frame = shapes.get((where[0], where[1])) if where else None
+        if frame is None:
+            continue
+        if part.seen_by != "visual" or part.node.piece or first + j >= len(mine) \
+                or sim.scene.loaded_model(mine[first + j]) is not part:
+            return None
+        parts[j] = part.model_copy(update={"pose": _pose_model(frame)})
+        moved[mine[first + j]] = (Pose.identity().compose(pose_from_model(parts[j].pose)), parts[j])
+    if len(moved) != len(shapes):               # (a Shape that is no part here, or not found by its place)
+        return None
+    entries = list(solid.poses)
+    changed = []
+    for j, entry in enumerate(entries):
+        frame = poses.get((entry.written_at[0], entry.written_at[1])) if entry.written_at else None
+        if frame is not None and entry.type != "Group":
+            entries[j] = entry.model_copy(update={"pose": _pose_model(frame)})
+            changed.append(j)
+    if len(changed) != len(poses):              # (a Pose the solid does not serve: placed otherwise)
+        return None
+    model = solid.model_copy(update={"shapes": parts, "poses": entries})
+    sim.world.solids[k] = model
+    sim.scene.move_shapes(moved)
+    sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
+    sim._regen_unshared[key] = new
+    return model, changed
 
 
 IMPORT_LINES = 1 << 32

@@ -1167,6 +1167,22 @@ class Scene:
         if name in self._solid_body:
             self.engine.set_body_pose(self._solid_body[name], pose)
 
+    def move_shapes(self, moved: dict[int, tuple[Pose, wm.Shape | wm.Solid]]) -> None:
+        """Shapes of a top-level solid placed anew in its frame (a Supervisor set a Pose inside it, only shapes
+        under it): shape -> (its pose in the solid's frame, its model as the solid now loads it). Each keeps
+        its number, its entries and the appearance a Supervisor gave it; every ray kind sees it there from the
+        next cast, as the solid built again would show it."""
+        for shape, (local, model) in moved.items():
+            key, _, now = self._parts[shape]
+            if shape in self._loaded_models:       # (its look a Supervisor's: the loaded model is the new one)
+                self._loaded_models[shape] = model
+                model = now.model_copy(update={"pose": getattr(model, "pose", None)})
+            self._parts[shape] = (key, local, model)
+            self._inverse.pop(shape, None)
+        self.engine.set_shape_poses({shape: local for shape, (local, _) in moved.items()})
+        self.solids_version += 1
+        self.shapes_version += 1
+
     def _carrier(self, shape: int, key: str | int) -> Pose:
         """The pose a shape is fixed in: its owner's, or a robot's composed with its link's."""
         owner = self.robot_poses[key] if isinstance(key, int) else self.solid_poses[key]
