@@ -860,6 +860,7 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     moved = not (np.array_equal(now_pose.translation, built.translation)
                  and np.array_equal(now_pose.rotation, built.rotation))
     kind = "SFVec3f" if field == "translation" else "SFRotation"
+    value = _writable(field, value)
     try:
         made = rebuild_posed(sim, key, n.owner, at, {field: written_value(kind, value)})
     except ImportRefused as exc:
@@ -872,6 +873,20 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     translation = np.asarray(value, dtype=np.float64) if field == "translation" else own.translation
     rotation = axis_angle_matrix(value[:3], value[3]) if field == "rotation" else own.rotation
     table.set_own[n.id] = Pose(rotation, translation)
+
+
+def _writable(field: str, value: list[float]) -> list[float]:
+    """A Pose's set value as its world file written anew takes it, the same translation or rotation: an axis
+    normalized (as Webots keeps it), a component under the loader's 1e-30 written 0 (a robot's or solid's set
+    takes either; written as given, the loader refused the solid in a line naming a shape in it), an angle past
+    its 1e9 as the angle in [-π, π] of the same sine and cosine."""
+    if field == "rotation":
+        axis = np.asarray(value[:3], dtype=np.float64)
+        axis = axis / np.abs(axis).max()           # (scaled first: an axis of 1e-300's squares to 0)
+        axis = axis / np.linalg.norm(axis)
+        angle = value[3] if abs(value[3]) <= 1e9 else math.atan2(math.sin(value[3]), math.cos(value[3]))
+        value = [*axis.tolist(), angle]
+    return [0.0 if abs(v) < 1e-30 else float(v) for v in value]
 
 
 def reset_solid_poses(sim: Any) -> None:
@@ -887,12 +902,16 @@ def reset_solid_poses(sim: Any) -> None:
         if key not in sim.scene.solid_poses:
             continue
         owner = next(n.owner for n_id, _ in sets.values() for n in [table.get(n_id)] if n is not None)
+        # the nodes inside it a Supervisor removed since stay removed (Webots' reset), where building the solid
+        # again from its written node brought them back (and the node table no longer matched it)
+        gone = {(m.at[0], m.at[1]) for m in table.removed_shapes.values() if m.owner == owner and m.at}
         made = None
         for at, (node_id, loaded) in sets.items():
-            made = rebuild_posed(sim, key, owner, at, loaded)
             table.set_own.pop(node_id, None)
-        assert made is not None
-        nested.renew(sim, table, owner, key, made.model, -1)
+            if at not in gone:       # (a removed Pose's value is seen nowhere: left as set)
+                made = rebuild_posed(sim, key, owner, at, loaded, gone)
+        if made is not None:
+            nested.renew(sim, table, owner, key, made.model, -1)
 
 
 def _sf_child(sim: Any, parent: int, field: str) -> int:
