@@ -467,3 +467,69 @@ def test_regression_a_reset_after_a_set_pose_was_removed(tmp_path) -> None:
     assert lv.ok(A, "/probe/robot/get_from_def", {"name": "N0"})["node"] == 0
     root = lv.ok(A, "/probe/robot/get_from_def", {"name": "ROOT"})["node"]
     assert lv.ok(A, "/probe/robot/get_field", {"node": root, "field": "children"})["value"] == []
+
+
+# ---------------------------------------------------------------- lazy display screens
+#
+# Round 29b's screen world (a Display's screen under a camera looking straight down; tests/test_props_round29b.py)
+# twice: in one the camera is enabled all along (every drawing shown at once, as before screens were lazy),
+# in the other it is enabled and disabled at random steps, Viewpoint pictures taken at random, the world reset
+# at random, both drawn alike: whenever the second camera takes a picture it is the first's bit for bit (and
+# each texel's colour seen as one non-decreasing function of it, round 29b's closed form), and each Viewpoint
+# picture of the second is the first's.
+
+
+@st.composite
+def screen_steps(draw) -> list[tuple]:
+    """Each step: the drawing (maybe none), the camera's enabled state from it on, a picture before it, a reset."""
+    from test_props_round29b import display_command
+
+    return [([display_command(draw) for _ in range(draw(st.integers(0, 4)))], draw(st.booleans()),
+             draw(st.integers(0, 5)) == 0, draw(st.integers(0, 9)) == 0) for _ in range(draw(st.integers(1, 8)))]
+
+
+def lazy_screens_show_what_eager_ones_do(folder: Path, dw: int, dh: int, maps: str, steps: list[tuple]) -> None:
+    from test_props_round29b import one_increasing_function, screen_world, seen_texels
+
+    from sensorium.server.sim import viewshot
+
+    path, w = screen_world(folder, dw, dh, maps)
+    eager, lazy = (Simulation(load_world(path), "exact") for _ in range(2))
+    eager.device("eye/camera").enable(16)
+    rows, cols = seen_texels(dw, dh, w)
+    for k, (commands, looking, picture, reset) in enumerate(steps):
+        if reset:
+            eager.reset()
+            lazy.reset()
+        for sim in (eager, lazy):
+            display = sim.device("board/screen")
+            display.apply(display.check(commands), sim.time_ms)
+        cam = lazy.device("eye/camera")
+        cam.enable(16) if looking else cam.disable()
+        if picture:
+            assert np.array_equal(viewshot.render(lazy, 24, 16), viewshot.render(eager, 24, 16)), k
+        taken = cam.measurements
+        eager.step()
+        lazy.step()
+        if cam.measurements != taken:
+            image = np.asarray(cam.image)
+            assert np.array_equal(image, np.asarray(eager.device("eye/camera").image)), k
+            texels = np.asarray(lazy.device("board/screen").pixels, dtype=np.uint32)[rows, cols]
+            for c, shift in enumerate((0, 8, 16)):
+                one_increasing_function(((texels >> shift) & 0xFF).ravel().astype(np.uint8),
+                                        image[..., c].astype(np.uint8).ravel())
+
+
+@pytest.mark.parametrize("examples", example_counts(120, 4))
+def test_a_lazy_screen_shows_what_an_eager_one_would(tmp_path, examples: int) -> None:
+    from test_props_round29b import SCREEN_MAPS
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.integers(1, 10), st.integers(1, 10), st.sampled_from(sorted(SCREEN_MAPS)), screen_steps())
+    def run(dw: int, dh: int, maps: str, steps: list[tuple]) -> None:
+        try:
+            lazy_screens_show_what_eager_ones_do(tmp_path, dw, dh, maps, steps)
+        finally:
+            gc.collect()
+
+    run()
