@@ -4,7 +4,8 @@ regression test naming it (tests/test_props_round29*.py fuzz round 29's).
 Riding robots: a two-wheel carrier driven and put anywhere, its rider's place on it set through its fields or
 put in the world, both saved and loaded, the world reset, in random order: the rider is always at the carrier's
 pose composed with its frame on it, the frame as a model of Webots' nested node predicts it (1e-9); the
-rider's and the carrier's distance sensors read the distance along their beams to a wall (closed form).
+rider's and the carrier's distance sensors read the distance along their beams to a wall, or to the rider's
+box where it is carried (closed forms).
 
 A solid's Poses set through a Supervisor: random sets of translation and rotation (degenerate ones refused in
 one line, nothing changed), steps, removes, saves, loads and resets against a model of the tree: every world
@@ -67,7 +68,8 @@ def beam(at: np.ndarray, rot: np.ndarray) -> float:
     return t if t <= 20.0 and abs(hit[1]) < 20.0 and abs(hit[2]) < 20.0 else 20.0
 
 
-def rider_world(folder: Path, truck: tuple[float, float, float], frame: tuple) -> Path:
+def rider_world(folder: Path, truck: tuple[float, float, float], frame: tuple, box: bool = False) -> Path:
+    """The world above (``box``: the rider a 0.1 m cube boundingObject, its sensor on its front face)."""
     wheels = " ".join(WHEEL.format(y=y, side=side) for y, side in ((0.12, "left"), (-0.12, "right")))
     (x, y, yaw), (t, ryaw, rpitch) = truck, frame
     rider_rot = " ".join(repr(v) for v in axis_angle_of(rotation_of(ryaw, rpitch)))
@@ -80,7 +82,8 @@ DEF TRUCK Robot {{ translation {x!r} {y!r} 0.05 rotation 0 0 1 {yaw!r} name "tru
   {wheels}
   DistanceSensor {{ translation 0 0 0.1 name "ds" lookupTable [0 0 0, 20 20 0] }}
   DEF RIDER Robot {{ translation {' '.join(repr(v) for v in t)} rotation {rider_rot} name "rider" controller "<extern>"
-    children [ DistanceSensor {{ name "rs" lookupTable [0 0 0, 20 20 0] }} ] }} ]
+    children [ DistanceSensor {{ translation {0.06 if box else 0.0!r} 0 0 name "rs" lookupTable [0 0 0, 20 20 0] }} ]
+    {"boundingObject Box { size 0.1 0.1 0.1 }" if box else ""} }} ]
   boundingObject Box {{ size 0.3 0.2 0.06 }} physics Physics {{ }} }}
 """)
     return path
@@ -108,10 +111,26 @@ rider_ops = st.lists(st.one_of(
     st.tuples(st.just("reset"))), min_size=1, max_size=10)
 
 
-def riders_follow_the_model(folder: Path, truck: tuple, frame: tuple, ops: list[tuple]) -> None:
+def box_hit(origin: np.ndarray, d: np.ndarray, rot: np.ndarray, centre: np.ndarray, half: np.ndarray) -> float:
+    """Where a ray enters a box (inf: it does not, or only behind; nan: it starts inside)."""
+    o, d = rot.T @ (origin - centre), rot.T @ d
+    if (np.abs(o) <= half).all():
+        return math.nan
+    near, far = -math.inf, math.inf
+    for i in range(3):
+        if abs(d[i]) < 1e-15:
+            if abs(o[i]) > half[i]:
+                return math.inf
+            continue
+        a, b = (-half[i] - o[i]) / d[i], (half[i] - o[i]) / d[i]
+        near, far = max(near, min(a, b)), min(far, max(a, b))
+    return near if near <= far and near > 0.0 else math.inf
+
+
+def riders_follow_the_model(folder: Path, truck: tuple, frame: tuple, ops: list[tuple], box: bool = False) -> None:
     from test_supervisor import A, Live
 
-    lv = Live(Simulation(load_world(rider_world(folder, truck, frame))))
+    lv = Live(Simulation(load_world(rider_world(folder, truck, frame, box))))
     lv.ok(A, "attach", {"robot": "probe"})
     sim = lv.sim
 
@@ -135,8 +154,19 @@ def riders_follow_the_model(folder: Path, truck: tuple, frame: tuple, ops: list[
         assert rider.pose.rotation == pytest.approx(rot, abs=1e-9), what
         got = call("get_field", {"node": ids["RIDER"], "field": "translation"})["value"]
         assert got == pytest.approx(now[1].tolist(), abs=1e-9), what
-        assert sim.device("rider/rs").value == pytest.approx(beam(at, rot), abs=1e-6), what
-        assert sim.device("truck/ds").value == pytest.approx(beam(c_at + c_rot[:, 2] * 0.1, c_rot), abs=1e-6), what
+        sensor = at + rot[:, 0] * (0.06 if box else 0.0)
+        assert sim.device("rider/rs").value == pytest.approx(beam(sensor, rot), abs=1e-6), what
+        # the carrier's beam: the wall, or the rider's box where it is carried (one beam grazing it not asked)
+        origin = c_at + c_rot[:, 2] * 0.1
+        want = beam(origin, c_rot)
+        if box:
+            hits = [box_hit(origin, c_rot[:, 0], rot, at, np.full(3, 0.05 + grow)) for grow in (-1e-6, 1e-6)]
+            if any(math.isnan(h) for h in hits) or (hits[0] == math.inf) != (hits[1] == math.inf):
+                want = math.nan
+            elif hits[1] <= 20.0:
+                want = min(want, hits[1])
+        if not math.isnan(want):
+            assert sim.device("truck/ds").value == pytest.approx(want, abs=1e-5), what
 
     check("start")
     for op in ops:
@@ -215,10 +245,10 @@ def test_regression_a_carriers_load_state_puts_its_rider_back_where_it_was_saved
 @pytest.mark.parametrize("examples", example_counts(200, 8))
 def test_a_rider_is_where_its_carrier_and_its_frame_on_it_put_it(tmp_path, examples: int) -> None:
     @settings(SETTINGS, max_examples=examples)
-    @given(places, frames, rider_ops)
-    def run(truck: tuple, frame: tuple, ops: list[tuple]) -> None:
+    @given(places, frames, rider_ops, st.booleans())
+    def run(truck: tuple, frame: tuple, ops: list[tuple], box: bool) -> None:
         try:
-            riders_follow_the_model(tmp_path, truck, frame, ops)
+            riders_follow_the_model(tmp_path, truck, frame, ops, box)
         finally:
             gc.collect()          # each Simulation's Embree device freed (a process holds about 1,000)
 
