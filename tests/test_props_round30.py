@@ -563,3 +563,85 @@ def test_a_lazy_screen_shows_what_an_eager_one_would(tmp_path, examples: int) ->
             gc.collect()
 
     run()
+
+
+# ---------------------------------------------------------------- a carrier stopped by its rider
+#
+# Contact on (Physics): the carrier (a 0.3 x 0.2 box on its two wheels) at x0 heading +x, its rider a 0.1 m cube
+# at a random place and turn about z on it, set through its fields, put in the world, or given back by the
+# carrier's loadState, the world reset between rounds; a wall's face at x = 1.4 ahead. Driven at 10 rad/s for
+# 250 steps (2 m) the carrier stops where the front-most of its box and its rider's footprint meets the face:
+# x = 1.4 − max(0.15, tx + 0.05·(|cos ψ| + |sin ψ|)), 1e-9, its rider carried there.
+
+def stop_world(folder: Path, frame: tuple[tuple, float]) -> Path:
+    wheels = " ".join(WHEEL.format(y=y, side=side) for y, side in ((0.12, "left"), (-0.12, "right")))
+    t, yaw = frame
+    path = folder / "stop.wbt"
+    path.write_text(f"""#VRML_SIM R2023b utf8
+WorldInfo {{ basicTimeStep 16 }}
+Robot {{ name "probe" controller "<extern>" supervisor TRUE }}
+Solid {{ translation 1.5 0 0.5 name "wall" boundingObject Box {{ size 0.2 4 1 }} }}
+DEF TRUCK Robot {{ translation 0 0 0.05 name "truck" controller "<extern>" children [ {wheels}
+  DEF RIDER Robot {{ translation {' '.join(repr(v) for v in t)} rotation 0 0 1 {yaw!r} name "rider" controller "<extern>"
+    boundingObject Box {{ size 0.1 0.1 0.1 }} }} ]
+  boundingObject Box {{ size 0.3 0.2 0.06 }} physics Physics {{ }} }}
+""")
+    return path
+
+
+flat_frames = st.tuples(st.tuples(offset, offset, span(0.0, 0.4)), turn)
+stop_rounds = st.lists(st.tuples(span(-0.5, 0.3), st.sampled_from(["keep", "field", "world", "load", "reset"]),
+                                 flat_frames, st.booleans()), min_size=1, max_size=4)
+
+
+def a_carrier_stops_where_its_rider_meets_the_wall(folder: Path, frame: tuple, rounds: list[tuple]) -> None:
+    from test_supervisor import A, Live
+
+    lv = Live(Simulation(load_world(stop_world(folder, frame))))
+    lv.ok(A, "attach", {"robot": "probe"})
+    sim = lv.sim
+    truck, rider = sim.robot("truck"), sim.robot("rider")
+    ids = {n: lv.ok(A, "/probe/robot/get_from_def", {"name": n})["node"] for n in ("TRUCK", "RIDER")}
+    now, saved = frame, None
+    for x0, how, new, save in rounds:
+        if how == "reset":
+            sim.reset()
+            now = frame
+        truck.set_pose(translation=[x0, 0.0, 0.05], rotation=[0.0, 0.0, 1.0, 0.0])
+        if how == "field":
+            lv.ok(A, "/probe/robot/set_field", {"node": ids["RIDER"], "field": "translation", "value": list(new[0])})
+            lv.ok(A, "/probe/robot/set_field", {"node": ids["RIDER"], "field": "rotation", "value": [0.0, 0.0, 1.0,
+                                                                                                   new[1]]})
+            now = new
+        elif how == "world":
+            rider.set_pose(translation=[x0 + new[0][0], new[0][1], 0.05 + new[0][2]], rotation=[0.0, 0.0, 1.0, new[1]])
+            now = new
+        elif how == "load" and saved is not None:
+            lv.ok(A, "/probe/robot/load_node_state", {"node": ids["TRUCK"], "state": "s"})
+            now = saved
+            truck.set_pose(translation=[x0, 0.0, 0.05], rotation=[0.0, 0.0, 1.0, 0.0])
+        if save:
+            lv.ok(A, "/probe/robot/save_node_state", {"node": ids["TRUCK"], "state": "s"})
+            saved = now
+        for m in truck.motors.values():
+            m.set_position(math.inf)
+            m.set_velocity(10.0)
+        sim.run(250)
+        (tx, ty, tz), yaw = now
+        front = max(0.15, tx + 0.05 * (abs(math.cos(yaw)) + abs(math.sin(yaw))))
+        at = truck.pose.translation
+        assert at == pytest.approx([1.4 - front, 0.0, 0.05], abs=1e-9), (how, x0, now)
+        assert rider.pose.translation == pytest.approx([at[0] + tx, ty, 0.05 + tz], abs=1e-9), (how, x0, now)
+
+
+@pytest.mark.parametrize("examples", example_counts(120, 8))
+def test_a_carrier_stops_where_the_front_of_it_and_its_rider_meets_a_wall(tmp_path, examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(flat_frames, stop_rounds)
+    def run(frame: tuple, rounds: list[tuple]) -> None:
+        try:
+            a_carrier_stops_where_its_rider_meets_the_wall(tmp_path, frame, rounds)
+        finally:
+            gc.collect()
+
+    run()
