@@ -859,6 +859,7 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     own = nested.own_pose(sim, table, n)
     assert own is not None
     kind = "SFVec3f" if field == "translation" else "SFRotation"
+    value = _writable(field, value)
     fields = {field: written_value(kind, value)}
     # only shapes moved within the solid: placed anew, the solid not built again (the same readings and records)
     moved = None if getattr(sim, "rebuild_pose_sets", False) else move_posed(sim, key, at, fields)
@@ -924,6 +925,20 @@ def _shape_places(sim: Any, key: str) -> list[tuple]:
     return out
 
 
+def _writable(field: str, value: list[float]) -> list[float]:
+    """A Pose's set value as its world file written anew takes it, the same translation or rotation: an axis
+    normalized (as Webots keeps it), a component under the loader's 1e-30 written 0 (a robot's or solid's set
+    takes either; written as given, the loader refused the solid in a line naming a shape in it), an angle past
+    its 1e9 as the angle in [-π, π] of the same sine and cosine."""
+    if field == "rotation":
+        axis = np.asarray(value[:3], dtype=np.float64)
+        axis = axis / np.abs(axis).max()           # (scaled first: an axis of 1e-300's squares to 0)
+        axis = axis / np.linalg.norm(axis)
+        angle = value[3] if abs(value[3]) <= 1e9 else math.atan2(math.sin(value[3]), math.cos(value[3]))
+        value = [*axis.tolist(), angle]
+    return [0.0 if abs(v) < 1e-30 else float(v) for v in value]
+
+
 def reset_solid_poses(sim: Any) -> None:
     """After a ``simulationReset``: the Poses and Transforms a Supervisor set inside top-level solids back at
     their loaded values (WbPose::reset), their solids built again so (node ids kept)."""
@@ -937,12 +952,16 @@ def reset_solid_poses(sim: Any) -> None:
         if key not in sim.scene.solid_poses or not sets:
             continue
         owner = next(n.owner for n_id, _ in sets.values() for n in [table.get(n_id)] if n is not None)
+        # the nodes inside it a Supervisor removed since stay removed (Webots' reset), where building the solid
+        # again from its written node brought them back (and the node table no longer matched it)
+        gone = {(m.at[0], m.at[1]) for m in table.removed_shapes.values() if m.owner == owner and m.at}
         made = None
         for at, (node_id, loaded) in sets.items():
-            made = rebuild_posed(sim, key, owner, at, loaded)
             table.set_own.pop(node_id, None)
-        assert made is not None
-        nested.renew(sim, table, owner, key, made.model, -1)
+            if at not in gone:       # (a removed Pose's value is seen nowhere: left as set)
+                made = rebuild_posed(sim, key, owner, at, loaded, gone)
+        if made is not None:
+            nested.renew(sim, table, owner, key, made.model, -1)
 
 
 def _sf_child(sim: Any, parent: int, field: str) -> int:

@@ -140,6 +140,21 @@ def _replaced(node: ParsedNode, at: tuple[int, int], fields: dict[str, Any]) -> 
     return None
 
 
+def _without(node: ParsedNode, gone: set[tuple[int, int]]) -> ParsedNode:
+    """``node`` without the nodes written at ``gone`` (line, column) inside it (a Supervisor removed them)."""
+    fields = {}
+    for name, value in node.fields.items():
+        if isinstance(value, list):
+            value = [_without(v, gone) if isinstance(v, ParsedNode) else v for v in value
+                     if not (isinstance(v, ParsedNode) and (v.line, v.col) in gone)]
+        elif isinstance(value, ParsedNode):
+            value = None if (value.line, value.col) in gone else _without(value, gone)
+            if value is None:
+                continue
+        fields[name] = value
+    return replace(node, fields=fields)
+
+
 def written_fields(sim: Any, key: str, at: tuple[int, int], names: tuple[str, ...]) -> dict[str, Any] | None:
     """The values ``names`` have in the node written at ``at`` inside top-level solid ``key`` as it is
     written now (None each: unwritten); None when that node is not at hand (:func:`rebuild_posed`)."""
@@ -156,12 +171,14 @@ def written_fields(sim: Any, key: str, at: tuple[int, int], names: tuple[str, ..
     return None
 
 
-def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields: dict[str, Any]) -> ImportedNode:
+def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields: dict[str, Any],
+                  gone: set[tuple[int, int]] | None = None) -> ImportedNode:
     """Top-level solid ``key`` (Supervisor node ``node_id``) built again with the Pose or Transform written at
     ``at`` inside it given ``fields`` (a parsed value each; None: unwritten): what that Pose holds is where
     the world file written with those values puts it, through the path a PROTO field set takes
     (:func:`regenerate`). ``ImportRefused`` (one line, nothing changed) when the solid's written node is not
-    at hand here (a solid a Supervisor imported) or does not build."""
+    at hand here (a solid a Supervisor imported) or does not build. ``gone``: the nodes written there a
+    Supervisor removed since, left out (a reset keeps them removed)."""
     found = _instance(sim, key)
     if found is None:
         raise ImportRefused(f"solid {key!r} was not loaded from a .wbt world file's node kept here")
@@ -169,6 +186,8 @@ def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields:
     new = _replaced(written, at, fields)
     if new is None:
         raise ImportRefused(f"no node of solid {key!r} is written at line {at[0]}, column {at[1]}")
+    if gone:
+        new = _without(new, gone)
     taken = set(sim.scene.solid_names) - {key}
     node = rebuild_node(new, file, sim.loaded, sim.world, taken=taken, limits=sim.limits,
                         allow_outside_meshes=sim.allow_outside_meshes)

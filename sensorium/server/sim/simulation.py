@@ -595,6 +595,10 @@ class Simulation:
         ride = next((ride for ride in self._riders if ride.robot is robot), None)
         return None if ride is None else ride.loaded_frame if loaded else ride.frame
 
+    def riders_of(self, carrier: RobotState) -> list[RobotState]:
+        """The robots riding ``carrier``, in world-file order."""
+        return [ride.robot for ride in self._riders if ride.carrier is carrier]
+
     def rider_moved(self, robot: RobotState) -> None:
         """A robot riding another was put somewhere in the world (set_pose): it stays fixed to its carrier
         there, its frame on it where that puts it (carried from the next step, as Webots keeps a moved

@@ -2,7 +2,7 @@
 
 A node's state is what Webots' ``WbNode::save(id)`` keeps of the node and everything inside it, as
 far as Sensorium has it: the pose of a robot or top-level solid (a node inside one moves only with
-its joints), and the position of each joint in it (the joint motors' and a drive's wheels' and
+its joints; a robot riding it: its place on it), and the position of each joint in it (the joint motors' and a drive's wheels' and
 steering's, a car's free wheels' too). Loading a state puts each back: the pose bit for bit (a driven robot stops there, its
 GPS and radar speeds start over as after a jump), each joint at its saved position with its motor
 holding it there at ``maxVelocity`` with its full torque/force (WbMotor::reset, then
@@ -42,6 +42,7 @@ class State:
     pose: Pose | None             # the robot's or solid's (None: the node has none of its own)
     positions: tuple[float, ...]  # the joints' positions, in the scope's motor order
     free_wheels: dict[str | int, float] | None = None  # free wheels' rolled angles: a car's by key, a tricycle's by index
+    riders: dict[str, Pose] | None = None   # the robots riding it: each one's frame on it (fields below the node)
 
 
 class States:
@@ -87,7 +88,7 @@ def _now(sim: Any, scope: Scope) -> State:
     motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
     turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
     return State(pose, tuple(float(motors[m].position) for m in scope.motors),
-                 dict(turned) if turned is not None else None)
+                 dict(turned) if turned is not None else None, _riders(sim, scope, loaded=False))
 
 
 def _initial(sim: Any, scope: Scope) -> State:
@@ -101,7 +102,7 @@ def _initial(sim: Any, scope: Scope) -> State:
     turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
     # a joint motor's initial position is the world file's; a wheel's angle starts at 0
     return State(pose, tuple(float(getattr(motors[m], "initial_position", 0.0)) for m in scope.motors),
-                 dict.fromkeys(turned, 0.0) if turned is not None else None)
+                 dict.fromkeys(turned, 0.0) if turned is not None else None, _riders(sim, scope, loaded=True))
 
 
 def _restore(sim: Any, scope: Scope, state: State) -> None:
@@ -127,10 +128,21 @@ def _restore(sim: Any, scope: Scope, state: State) -> None:
         for dev in robot.devices.values():
             if dev.kind in ("GPS", "Radar"):       # no previous position: the next speeds are NaN
                 dev.restart()
+        for name, frame in (state.riders or {}).items():
+            sim.set_rider_frame(sim.robots[name], frame)
     for name in scope.leds:
         led = robot.devices.get(name)
         if led is not None and led.value != 0:
             led.set(0, sim.time_ms)
+
+
+def _riders(sim: Any, scope: Scope, loaded: bool) -> dict[str, Pose] | None:
+    """A robot's riders' frames on it (``loaded``: as the world file put them): Webots' state of a node covers
+    the fields of the nodes below it, a rider's translation and rotation among them."""
+    riders = getattr(sim, "riders_of", None)
+    if not scope.own_pose or riders is None:
+        return None
+    return {r.name: sim.rider_frame(r, loaded) for r in riders(sim.robots[scope.robot])} or None
 
 
 def _rider_frame(sim: Any, robot: Any, loaded: bool = False) -> Any:
