@@ -13,6 +13,7 @@ written with the same nodes at the same places. The same sequence with every Pos
 from __future__ import annotations
 
 import gc
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -287,6 +288,123 @@ def test_the_fast_placing_path_reads_as_the_rebuild(tmp_path, examples: int) -> 
     def run(sequence: list[tuple]) -> None:
         try:
             fast_path_is_the_rebuild(tmp_path, sequence)
+        finally:
+            gc.collect()
+
+    run()
+
+
+# ---------------------------------------------------------------- markers riding a robot
+#
+# The two-wheel ROVER (tests/test_props_round30.py's carrier: wheels of radius 0.05 m at y = ±0.12) with a
+# DistanceSensor "ds" 0.5 m above its origin along its x (bounding objects, 0..10 m -> 0..10); nothing else in
+# the world has a boundingObject but the rover itself, so "ds" reads 10 always: its own markers are no bounding
+# objects. The robot WATCH has a one-beam lidar along its x; before each look it is put 3 m behind a marker's
+# expected centre, its beam through it: the lidar reads where that beam enters the nearest marker's box.
+
+MARKER_WORLD = """#VRML_SIM R2023b utf8
+WorldInfo {{ basicTimeStep 16 }}
+DEF WATCH Robot {{ translation -5 0 3 name "watch" controller "<extern>" children [
+  Lidar {{ name "lidar" horizontalResolution 1 fieldOfView 0.1 numberOfLayers 1 minRange 0.01 maxRange 10 }} ] }}
+DEF ROVER Robot {{ translation 0 0 0.05 name "rover" supervisor TRUE controller "<extern>" children [
+  {wheels}
+  DistanceSensor {{ translation 0 0 0.5 name "ds" lookupTable [ 0 0 0, 10 10 0 ] }} ]
+  boundingObject Box {{ size 0.3 0.2 0.06 }} physics Physics {{ }} }}
+"""
+
+marker_places = st.tuples(span(0.2, 1.0), st.one_of(st.just(0.0), span(-0.3, 0.3)),
+                          st.one_of(st.just(0.45), span(0.3, 0.8)))
+marker_ops = st.lists(st.one_of(
+    st.tuples(st.just("import"), st.sampled_from(["Pose", "Transform"]), positions, marker_places,
+              st.sampled_from([0.1, 0.2])),
+    st.tuples(st.just("move"), st.integers(0, 20), marker_places),
+    st.tuples(st.just("remove"), st.integers(0, 20)),
+    st.tuples(st.just("drive"), st.floats(-8.0, 8.0), st.floats(-8.0, 8.0), st.integers(1, 6))),
+    min_size=1, max_size=8)
+
+
+def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
+    from test_props_round30 import WHEEL, box_hit
+    from test_supervisor import A, Live
+
+    wheels = " ".join(WHEEL.format(y=y, side=side) for y, side in ((0.12, "left"), (-0.12, "right")))
+    path = folder / "markers.wbt"
+    path.write_text(MARKER_WORLD.format(wheels=wheels))
+    lv = Live(Simulation(load_world(path)))
+    lv.ok(A, "attach", {"robot": "rover"})
+    sim = lv.sim
+    rover, watch = sim.robot("rover"), sim.robot("watch")
+    rover.device("ds").enable(16)
+    watch.device("lidar").enable(16)
+
+    def call(item: str, args: dict | None = None):
+        return lv.ok(A, f"/rover/robot/{item}", args)
+
+    me = call("get_self")["node"]
+    written = call("get_field", {"node": me, "field": "children"})["value"]
+    markers: list[tuple[int, float, tuple]] = []        # (id, size, frame translation), in children order
+    seen: set[int] = set(written)
+    count = 0
+    for op in sequence:
+        kind = op[0]
+        if kind == "import":
+            count += 1
+            what, position, at, size = op[1:]
+            text = (f"DEF M{count} {what} {{ translation {' '.join(num(v) for v in at)} children [ Shape {{ "
+                    f"geometry Box {{ size {size} {size} {size} }} }} ] }}")
+            (n,) = call("import_node_from_string", {"node": me, "field": "children", "position": position,
+                                                    "node_string": text})["value"]
+            assert n not in seen, op
+            seen.add(n)
+            markers.append((n, size, at))
+            children = call("get_field", {"node": me, "field": "children"})["value"]
+            assert children.index(n) == webots_index(position, len(children) - 1), (op, children)
+            assert sorted(children) == sorted(written + [m[0] for m in markers]), op
+            assert [c for c in children if c in written] == written, op        # the world file's keep their order
+            markers.sort(key=lambda m: children.index(m[0]))
+        elif kind == "move" and markers:
+            i = op[1] % len(markers)
+            call("set_field", {"node": markers[i][0], "field": "translation", "value": list(op[2])})
+            markers[i] = (markers[i][0], markers[i][1], op[2])
+        elif kind == "remove" and markers:
+            n = markers.pop(op[1] % len(markers))[0]
+            call("remove_node", {"node": n})
+        elif kind == "drive":
+            for side, speed in zip(("left", "right"), op[1:3]):
+                rover.motor(side).set_position(math.inf)
+                rover.motor(side).set_velocity(speed)
+            for _ in range(op[3]):
+                lv.step(A, "rover")
+            for side in ("left", "right"):          # standing while the watcher looks
+                rover.motor(side).set_velocity(0.0)
+        lv.step(A, "rover")
+        rot, at = rover.pose.rotation, rover.pose.translation
+        assert rover.device("ds").value == 10.0, op         # no bounding ray of its own meets its markers
+        centres = [at + rot @ np.array(m[2]) for m in markers]
+        for (n, _, frame), centre in zip(markers, centres):
+            got = call("get_node_pose", {"node": n})["position"]
+            assert got == pytest.approx(centre.tolist(), abs=1e-9), op
+            assert call("get_field", {"node": n, "field": "translation"})["value"] == list(frame), op
+        for centre in centres:                    # another robot's lidar sees each: the ray-box closed form
+            origin = centre - np.array([3.0, 0.0, 0.0])
+            watch.set_pose(translation=origin.tolist(), rotation=[0.0, 0.0, 1.0, 0.0])
+            lv.step(A, "rover")
+            assert rover.pose.translation == pytest.approx(at, abs=1e-12), op         # standing still
+            boxes = [(at + rot @ np.array(m[2]), np.full(3, m[1] / 2)) for m in markers]
+            hits = [box_hit(origin, np.array([1.0, 0.0, 0.0]), rot, c, h) for c, h in boxes]
+            want = min(h for h in hits if not math.isnan(h))
+            got = float(np.asarray(watch.device("lidar").range_image).reshape(-1)[0])
+            assert got == pytest.approx(want, abs=1e-5), (op, hits)
+
+
+@pytest.mark.parametrize("examples", example_counts(120, 12))
+def test_markers_imported_into_a_robot_ride_it_seen_by_others_not_by_its_bounding_rays(tmp_path,
+                                                                                      examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(marker_ops)
+    def run(sequence: list[tuple]) -> None:
+        try:
+            markers_ride_their_robot(tmp_path, sequence)
         finally:
             gc.collect()
 
