@@ -63,8 +63,10 @@ class Item:
             return f"DEF HOLD Pose {{ {place} children [ {' '.join(c.text() for c in self.children)} ] }}"
         if self.kind == "shape":
             return f"DEF {self.name} {box}"
+        if self.kind == "inner":
+            return box
         if self.kind == "pose":
-            return f"DEF {self.name} Pose {{ {place} children [ {box} ] }}"
+            return f"DEF {self.name} Pose {{ {place} children [ {' '.join(c.text() for c in self.children)} ] }}"
         return (f'DEF {self.name} Pose {{ {place} children [ Solid {{ name "{self.name.lower()}" '
                 f"boundingObject Box {{ size {num(self.size)} {num(self.size)} {num(self.size)} }} "
                 f"children [ {box} ] }} ] }}")
@@ -91,7 +93,7 @@ def span(low: float, high: float) -> st.SearchStrategy[float]:
 places = st.tuples(span(-1.0, 1.5), span(-0.25, 0.25), span(-1.2, 0.2))
 positions = st.one_of(st.sampled_from([0, -1, -2, 99, -99]), st.integers(-4, 6))
 ops = st.lists(st.one_of(
-    st.tuples(st.just("import"), st.sampled_from(["BASE", "HOLD"]), st.sampled_from(["shape", "pose", "solid"]),
+    st.tuples(st.just("import"), st.sampled_from(["BASE", "HOLD", 0, 1, 2]), st.sampled_from(["shape", "pose", "solid"]),
               positions, places, st.sampled_from([0.1, 0.2, 0.3]), st.integers(1, 2)),
     st.tuples(st.just("remove"), st.integers(0, 20)),
     st.tuples(st.just("move"), st.integers(0, 20), places),
@@ -146,7 +148,21 @@ class Run:
         return self.tree[[i.kind for i in self.tree].index("hold")]
 
     def items(self) -> list[Item]:
-        return [i for i in self.tree if i.kind not in ("cap", "hold")] + self.hold().children
+        """Every imported node, the ones inside imported Poses too."""
+        found: list[Item] = []
+
+        def walk(siblings: list[Item]) -> None:
+            for i in siblings:
+                if i.kind not in ("cap", "hold", "inner"):
+                    found.append(i)
+                walk(i.children)
+
+        walk(self.tree)
+        return found
+
+    def containers(self) -> list[tuple[int, list[Item]]]:
+        return [(self.base, self.tree), (self.hold().node, self.hold().children),
+                *((i.node, i.children) for i in self.items() if i.kind == "pose")]
 
     def poses(self) -> list[Item]:
         return [i for i in self.items() if i.kind != "shape"]
@@ -158,28 +174,37 @@ class Run:
             new = []
             for _ in range(many):
                 self.count += 1
-                new.append(Item(f"N{self.count}", what, size, at if what != "shape" else (0.0, 0.0, 0.0)))
-            parent = self.base if target == "BASE" else self.hold().node
+                new.append(Item(f"N{self.count}", what, size, at if what != "shape" else (0.0, 0.0, 0.0),
+                                [Item("", "inner", size)] if what == "pose" else []))
+            inner = [i for i in self.items() if i.kind == "pose"]
+            if isinstance(target, int) and inner:            # into a Pose imported before
+                holder = inner[target % len(inner)]
+                parent, siblings = holder.node, holder.children
+            else:
+                parent, siblings = (self.base, self.tree) if target == "BASE" else (self.hold().node,
+                                                                                  self.hold().children)
             ids = self.call("import_node_from_string", {"node": parent, "field": "children", "position": position,
                                                         "node_string": "\n".join(i.text() for i in new)})["value"]
             assert len(ids) == many and not set(ids) & self.seen, (ids, self.seen)
             self.seen |= set(ids)
-            siblings = self.tree if target == "BASE" else self.hold().children
             index = webots_index(position, len(siblings))
             for i, (item, n) in enumerate(zip(new, ids)):
                 item.node = n
                 siblings.insert(index + i, item)
+                if item.kind == "pose":
+                    (item.children[0].node,) = self.call("get_field", {"node": n, "field": "children"})["value"]
                 self.imported_at[item.name] = item.at
         elif kind == "remove":
             items = self.items()
             if not items:
                 return
             item = items[op[1] % len(items)]
+            gone = [item, *(i for i in self.items() if self._inside(i, item))]
             self.call("remove_node", {"node": item.node})
-            for siblings in (self.tree, self.hold().children):
+            for _, siblings in self.containers():
                 if item in siblings:
                     siblings.remove(item)
-            self.removed.add(item.node)
+            self.removed |= {i.node for i in gone}
         elif kind == "move":
             poses = self.poses()
             if not poses:
@@ -215,11 +240,14 @@ class Run:
             self.saved = {}
             self.enable()
 
+    @staticmethod
+    def _inside(item: Item, holder: Item) -> bool:
+        return any(c is item or Run._inside(item, c) for c in holder.children)
+
     def check_tree(self, what) -> None:
-        children = self.call("get_field", {"node": self.base, "field": "children"})["value"]
-        assert children == [i.node for i in self.tree], what
-        held = self.call("get_field", {"node": self.hold().node, "field": "children"})["value"]
-        assert held == [i.node for i in self.hold().children], what
+        for n, siblings in self.containers():
+            children = self.call("get_field", {"node": n, "field": "children"})["value"]
+            assert children == [i.node for i in siblings], (what, n)
         for item in [self.hold(), *self.items()]:
             assert self.node(item.name) == item.node, what
         for item in [self.hold(), *self.poses()]:
@@ -292,6 +320,36 @@ def test_the_fast_placing_path_reads_as_the_rebuild(tmp_path, examples: int) -> 
             gc.collect()
 
     run()
+
+
+def test_regression_removing_an_imported_shape_leaves_the_solids_poses_settable(tmp_path) -> None:
+    """Found by the twin property: a bare Shape imported into BASE's children and removed went the way of a
+    world file's Shape (unseen, counted as removed), so HOLD's translation set was refused ("a Supervisor removed a
+    node ... inside solid 'base'"); its removal now builds the solid again without it, as any imported node's. HOLD
+    then 0.5 m nearer: a 0.2 m box in it has its near face at 1.9 m on the beam."""
+    run = Run(tmp_path)
+    run.apply(("import", "BASE", "shape", 0, (0.0, 0.0, 0.0), 0.1, 2))
+    run.apply(("remove", 1))
+    run.apply(("import", "HOLD", "shape", -1, (0.0, 0.0, 0.0), 0.2, 1))
+    run.apply(("hold", (0.0, 0.0, -1.0)))
+    run.check_tree("after the set")
+    assert run.readings() == (10.0, float(np.float32(1.9)))
+    run.apply(("remove", 1))                 # the one in HOLD: off the beam, the solid still settable
+    run.apply(("hold", (0.5, 0.0, -1.0)))
+    assert run.readings() == (10.0, float("inf"))
+
+
+def test_regression_a_pose_reads_the_translation_its_string_writes(tmp_path) -> None:
+    """Found by the twin property: a Pose imported into HOLD with translation 0 0 -0.59 read (0, 0,
+    -0.5899999999999999): its translation was worked back from its place in the solid (HOLD's inverse composed with
+    it). It reads the written value, and so after a set of its rotation only (which kept the worked-back one)."""
+    run = Run(tmp_path)
+    run.apply(("import", "HOLD", "pose", 0, (0.0, 0.0, -0.59), 0.1, 1))
+    (item,) = run.items()
+    assert run.call("get_field", {"node": item.node, "field": "translation"})["value"] == [0.0, 0.0, -0.59]
+    run.call("set_field", {"node": item.node, "field": "rotation", "value": [0.0, 0.0, 1.0, 0.3]})
+    assert run.call("get_field", {"node": item.node, "field": "translation"})["value"] == [0.0, 0.0, -0.59]
+    run.check_tree("after the rotation set")
 
 
 # ---------------------------------------------------------------- markers riding a robot

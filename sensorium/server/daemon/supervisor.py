@@ -793,8 +793,22 @@ def _own_pose(sim: Any, node: Node) -> Any:
     return own
 
 
+def _own_translation(sim: Any, node: Node) -> list[float]:
+    """A nested node's translation now; a Pose's inside a top-level solid that no Supervisor set: the value its
+    world file or node string writes (its pose in its parent's frame, worked back from the solid's, is that value
+    to a rounding: -0.59 read -0.5899999999999999)."""
+    from sensorium.server.sim.regenerate import written_fields
+
+    n = _nested_of(sim, node)
+    if n.owner_kind == "Solid" and n.type in _SOLID_POSES and n.at and n.id not in _table(sim).set_own:
+        written = written_fields(sim, n.owner_key, (n.at[0], n.at[1]), ("translation",))
+        if written is not None:
+            return [float(v) for v in written["translation"] or (0.0, 0.0, 0.0)]
+    return [float(v) for v in _own_pose(sim, node).translation]
+
+
 _NESTED_POSE: dict[str, tuple[str, Getter, Setter]] = {
-    "translation": ("SFVec3f", lambda sim, n: [float(v) for v in _own_pose(sim, n).translation], None),
+    "translation": ("SFVec3f", _own_translation, None),
     "rotation": ("SFRotation", lambda sim, n: matrix_axis_angle(_own_pose(sim, n).rotation), None),
 }
 
@@ -858,6 +872,7 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
                          "world file's node kept here (a solid a Supervisor imported); nothing changed")
     own = nested.own_pose(sim, table, n)
     assert own is not None
+    was_set = n.id in table.set_own
     kind = "SFVec3f" if field == "translation" else "SFRotation"
     value = _writable(field, value)
     fields = {field: written_value(kind, value)}
@@ -874,6 +889,8 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     else:
         nested.reframe(table, n.owner, *moved, n.id)
     translation = np.asarray(value, dtype=np.float64) if field == "translation" else own.translation
+    if field != "translation" and not was_set:    # its written translation, not the one worked back to a rounding
+        translation = np.asarray(loaded.get("translation") or (0.0, 0.0, 0.0), dtype=np.float64)
     rotation = axis_angle_matrix(value[:3], value[3]) if field == "rotation" else own.rotation
     table.set_own[n.id] = Pose(rotation, translation)
 
@@ -1704,6 +1721,9 @@ def remove_node(sim: Any, node: Node) -> None:
     if node.visual:
         sim.remove_solid(node.key)
         return
+    if node.nested and _imported_inside(sim, node):     # (an imported Shape too: its solid built without it)
+        _remove_imported(sim, node)
+        return
     ref = _nested_of(sim, node).shape if node.nested else None
     if ref is not None and ref.role == "Shape":      # a Shape inside a robot or solid: every piece of it unseen
         sim.scene.remove_shapes(ref.peers or (ref.index,))
@@ -1718,9 +1738,6 @@ def remove_node(sim: Any, node: Node) -> None:
                              "Supervisor.")
         sim.scene.remove_carried_light(*_carrier(sim, node))
         nested.drop_shape(_table(sim), node.id)
-        return
-    if node.nested and _imported_inside(sim, node):
-        _remove_imported(sim, node)
         return
     if node.nested and node.type in _SOLID_POSES and _nested_of(sim, node).owner_kind == "Solid":
         _remove_solid_pose(sim, node)
