@@ -51,12 +51,14 @@ class Item:
     kind: str                        # "cap", "hold", "shape", "pose", "solid"
     size: float = 0.2
     at: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    turn: float = 0.0                # its rotation: a turn about z
     children: list[Item] = field(default_factory=list)
     node: int = 0
 
     def text(self) -> str:
         box = f"Shape {{ geometry Box {{ size {num(self.size)} {num(self.size)} {num(self.size)} }} }}"
-        place = "translation " + " ".join(num(v) for v in self.at)
+        place = "translation " + " ".join(num(v) for v in self.at) + (f" rotation 0 0 1 {num(self.turn)}"
+                                                                         if self.turn else "")
         if self.kind == "cap":
             return "DEF CAP Shape { geometry Box { size 0.1 0.1 0.1 } }"
         if self.kind == "hold":
@@ -98,6 +100,7 @@ ops = st.lists(st.one_of(
     st.tuples(st.just("remove"), st.integers(0, 20)),
     st.tuples(st.just("move"), st.integers(0, 20), places),
     st.tuples(st.just("hold"), st.tuples(span(-1.0, 1.0), span(-0.2, 0.2), span(-1.2, -0.8))),
+    st.tuples(st.just("turn"), st.integers(0, 20), span(-3.0, 3.0)),
     st.tuples(st.just("step"), st.integers(1, 3)),
     st.tuples(st.just("save"), st.sampled_from(["a", "b"])),
     st.tuples(st.just("load"), st.sampled_from(["a", "b", "__init__"])),
@@ -130,7 +133,7 @@ class Run:
         self.seen: set[int] = set(self.world_ids)   # every id handed out
         self.removed: set[int] = set()
         self.saved: dict[str, dict[str, tuple]] = {}
-        self.imported_at: dict[str, tuple] = {"HOLD": HOLD_AT}
+        self.imported_at: dict[str, tuple] = {"HOLD": (HOLD_AT, 0.0)}
         self.count = 0
 
     def enable(self) -> None:
@@ -175,7 +178,7 @@ class Run:
             for _ in range(many):
                 self.count += 1
                 new.append(Item(f"N{self.count}", what, size, at if what != "shape" else (0.0, 0.0, 0.0),
-                                [Item("", "inner", size)] if what == "pose" else []))
+                                children=[Item("", "inner", size)] if what == "pose" else []))
             inner = [i for i in self.items() if i.kind == "pose"]
             if isinstance(target, int) and inner:            # into a Pose imported before
                 holder = inner[target % len(inner)]
@@ -193,7 +196,7 @@ class Run:
                 siblings.insert(index + i, item)
                 if item.kind == "pose":
                     (item.children[0].node,) = self.call("get_field", {"node": n, "field": "children"})["value"]
-                self.imported_at[item.name] = item.at
+                self.imported_at[item.name] = (item.at, item.turn)
         elif kind == "remove":
             items = self.items()
             if not items:
@@ -212,6 +215,10 @@ class Run:
             item = poses[op[1] % len(poses)]
             self.call("set_field", {"node": item.node, "field": "translation", "value": list(op[2])})
             item.at = tuple(op[2])
+        elif kind == "turn":                  # the Pose or one imported
+            item = [self.hold(), *self.poses()][op[1] % (1 + len(self.poses()))]
+            self.call("set_field", {"node": item.node, "field": "rotation", "value": [0.0, 0.0, 1.0, op[2]]})
+            item.turn = op[2]
         elif kind == "hold":
             self.call("set_field", {"node": self.hold().node, "field": "translation", "value": list(op[1])})
             self.hold().at = tuple(op[1])
@@ -220,7 +227,7 @@ class Run:
                 self.lv.step(self.A, "probe")
         elif kind == "save":
             self.call("save_node_state", {"node": self.base, "state": op[1]})
-            self.saved[op[1]] = {i.name: i.at for i in [self.hold(), *self.poses()]}
+            self.saved[op[1]] = {i.name: (i.at, i.turn) for i in [self.hold(), *self.poses()]}
         elif kind == "load":
             if op[1] != "__init__" and op[1] not in self.saved:
                 return
@@ -230,13 +237,13 @@ class Run:
             states = self.imported_at if op[1] == "__init__" else self.saved[op[1]]
             for item in [self.hold(), *self.poses()]:
                 if item.name in states:
-                    item.at = states[item.name]
+                    item.at, item.turn = states[item.name]
         elif kind == "reset":
             self.call("simulation_reset")
             self.removed |= {i.node for i in self.items()}
             self.tree = initial_tree()
             self.tree[0].node, self.tree[1].node = self.world_ids[1:]
-            self.imported_at = {"HOLD": HOLD_AT}
+            self.imported_at = {"HOLD": (HOLD_AT, 0.0)}
             self.saved = {}
             self.enable()
 
@@ -265,11 +272,12 @@ class Run:
         return [self.call("get_node_pose", {"node": i.node})["position"] for i in [self.hold(), *self.items()]]
 
 
-def twin_readings(folder: Path, tree: list[Item]) -> tuple[float, float]:
+def twin_readings(folder: Path, tree: list[Item] | str) -> tuple[float, float]:
+    """The readings of a world written with BASE's children ``tree`` (a text: with that BASE)."""
     from test_supervisor import A, Live
 
     path = folder / "twin.wbt"
-    path.write_text(world_text(tree))
+    path.write_text(world_text(tree) if isinstance(tree, list) else HEAD + tree + "\n")
     lv = Live(Simulation(load_world(path)))
     lv.ok(A, "attach", {"robot": "probe"})
     bot = lv.sim.robot("probe")
@@ -284,7 +292,10 @@ def imports_follow_the_twin(folder: Path, sequence: list[tuple]) -> None:
     for op in sequence:
         run.apply(op)
         run.check_tree(op)
-        assert run.readings() == twin_readings(folder, run.tree), (op, world_text(run.tree))
+        seen = run.readings()
+        assert seen == twin_readings(folder, run.tree), (op, world_text(run.tree))
+        exported = run.call("node_export_string", {"node": run.base})["value"]
+        assert twin_readings(folder, exported) == seen, (op, exported)      # its export, written, reads the same
 
 
 def fast_path_is_the_rebuild(folder: Path, sequence: list[tuple]) -> None:
