@@ -388,8 +388,15 @@ marker_ops = st.lists(st.one_of(
               st.sampled_from([0.1, 0.2])),
     st.tuples(st.just("move"), st.integers(0, 20), marker_places),
     st.tuples(st.just("remove"), st.integers(0, 20)),
+    st.tuples(st.just("turn"), st.integers(0, 20), span(-3.0, 3.0)),
+    st.tuples(st.just("reset")),
     st.tuples(st.just("drive"), st.floats(-8.0, 8.0), st.floats(-8.0, 8.0), st.integers(1, 6))),
     min_size=1, max_size=8)
+
+
+def turned(angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
@@ -411,7 +418,7 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
 
     me = call("get_self")["node"]
     written = call("get_field", {"node": me, "field": "children"})["value"]
-    markers: list[tuple[int, float, tuple]] = []        # (id, size, frame translation), in children order
+    markers: list[list] = []        # [id, size, frame translation, turn about z], in children order
     seen: set[int] = set(written)
     count = 0
     for op in sequence:
@@ -425,7 +432,7 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
                                                     "node_string": text})["value"]
             assert n not in seen, op
             seen.add(n)
-            markers.append((n, size, at))
+            markers.append([n, size, at, 0.0])
             children = call("get_field", {"node": me, "field": "children"})["value"]
             assert children.index(n) == webots_index(position, len(children) - 1), (op, children)
             assert sorted(children) == sorted(written + [m[0] for m in markers]), op
@@ -434,7 +441,16 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
         elif kind == "move" and markers:
             i = op[1] % len(markers)
             call("set_field", {"node": markers[i][0], "field": "translation", "value": list(op[2])})
-            markers[i] = (markers[i][0], markers[i][1], op[2])
+            markers[i][2] = op[2]
+        elif kind == "turn" and markers:
+            i = op[1] % len(markers)
+            call("set_field", {"node": markers[i][0], "field": "rotation", "value": [0.0, 0.0, 1.0, op[2]]})
+            markers[i][3] = op[2]
+        elif kind == "reset":                      # the markers out, the robot back where it loaded
+            call("simulation_reset")
+            markers = []
+            rover.device("ds").enable(16)
+            watch.device("lidar").enable(16)
         elif kind == "remove" and markers:
             n = markers.pop(op[1] % len(markers))[0]
             call("remove_node", {"node": n})
@@ -450,7 +466,7 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
         rot, at = rover.pose.rotation, rover.pose.translation
         assert rover.device("ds").value == 10.0, op         # no bounding ray of its own meets its markers
         centres = [at + rot @ np.array(m[2]) for m in markers]
-        for (n, _, frame), centre in zip(markers, centres):
+        for (n, _, frame, _), centre in zip(markers, centres):
             got = call("get_node_pose", {"node": n})["position"]
             assert got == pytest.approx(centre.tolist(), abs=1e-9), op
             assert call("get_field", {"node": n, "field": "translation"})["value"] == list(frame), op
@@ -459,8 +475,8 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
             watch.set_pose(translation=origin.tolist(), rotation=[0.0, 0.0, 1.0, 0.0])
             lv.step(A, "rover")
             assert rover.pose.translation == pytest.approx(at, abs=1e-12), op         # standing still
-            boxes = [(at + rot @ np.array(m[2]), np.full(3, m[1] / 2)) for m in markers]
-            hits = [box_hit(origin, np.array([1.0, 0.0, 0.0]), rot, c, h) for c, h in boxes]
+            hits = [box_hit(origin, np.array([1.0, 0.0, 0.0]), rot @ turned(m[3]), at + rot @ np.array(m[2]),
+                            np.full(3, m[1] / 2)) for m in markers]
             want = min(h for h in hits if not math.isnan(h))
             got = float(np.asarray(watch.device("lidar").range_image).reshape(-1)[0])
             assert got == pytest.approx(want, abs=1e-5), (op, hits)
