@@ -74,8 +74,8 @@ class Item:
                 f"children [ {box} ] }} ] }}")
 
 
-def world_text(base: list[Item]) -> str:
-    return (HEAD + "DEF BASE Solid { translation " + " ".join(num(v) for v in BASE_AT) + ' name "base" children [\n  '
+def world_text(base: list[Item], at: tuple[float, ...] = BASE_AT) -> str:
+    return (HEAD + "DEF BASE Solid { translation " + " ".join(num(v) for v in at) + ' name "base" children [\n  '
             + "\n  ".join(i.text() for i in base) + " ] }\n")
 
 
@@ -101,6 +101,7 @@ ops = st.lists(st.one_of(
     st.tuples(st.just("move"), st.integers(0, 20), places),
     st.tuples(st.just("hold"), st.tuples(span(-1.0, 1.0), span(-0.2, 0.2), span(-1.2, -0.8))),
     st.tuples(st.just("turn"), st.integers(0, 20), span(-3.0, 3.0)),
+    st.tuples(st.just("base"), st.tuples(span(1.0, 3.0), span(-0.2, 0.2), span(0.8, 1.2))),
     st.tuples(st.just("step"), st.integers(1, 3)),
     st.tuples(st.just("save"), st.sampled_from(["a", "b"])),
     st.tuples(st.just("load"), st.sampled_from(["a", "b", "__init__"])),
@@ -135,6 +136,7 @@ class Run:
         self.saved: dict[str, dict[str, tuple]] = {}
         self.imported_at: dict[str, tuple] = {"HOLD": (HOLD_AT, 0.0)}
         self.count = 0
+        self.base_at = BASE_AT
 
     def enable(self) -> None:
         bot = self.lv.sim.robot("probe")
@@ -219,6 +221,9 @@ class Run:
             item = [self.hold(), *self.poses()][op[1] % (1 + len(self.poses()))]
             self.call("set_field", {"node": item.node, "field": "rotation", "value": [0.0, 0.0, 1.0, op[2]]})
             item.turn = op[2]
+        elif kind == "base":                  # the solid moved: what was imported into it with it
+            self.call("set_field", {"node": self.base, "field": "translation", "value": list(op[1])})
+            self.base_at = op[1]
         elif kind == "hold":
             self.call("set_field", {"node": self.hold().node, "field": "translation", "value": list(op[1])})
             self.hold().at = tuple(op[1])
@@ -228,6 +233,7 @@ class Run:
         elif kind == "save":
             self.call("save_node_state", {"node": self.base, "state": op[1]})
             self.saved[op[1]] = {i.name: (i.at, i.turn) for i in [self.hold(), *self.poses()]}
+            self.saved[op[1]]["BASE"] = self.base_at
         elif kind == "load":
             if op[1] != "__init__" and op[1] not in self.saved:
                 return
@@ -235,6 +241,7 @@ class Run:
             # WbNode::reset over the solid: each node inside back to its state of that name (as loaded or
             # imported for "__init__"); a node imported since has none of that name and stays as it is
             states = self.imported_at if op[1] == "__init__" else self.saved[op[1]]
+            self.base_at = BASE_AT if op[1] == "__init__" else states["BASE"]
             for item in [self.hold(), *self.poses()]:
                 if item.name in states:
                     item.at, item.turn = states[item.name]
@@ -245,6 +252,7 @@ class Run:
             self.tree[0].node, self.tree[1].node = self.world_ids[1:]
             self.imported_at = {"HOLD": (HOLD_AT, 0.0)}
             self.saved = {}
+            self.base_at = BASE_AT
             self.enable()
 
     @staticmethod
@@ -272,12 +280,12 @@ class Run:
         return [self.call("get_node_pose", {"node": i.node})["position"] for i in [self.hold(), *self.items()]]
 
 
-def twin_readings(folder: Path, tree: list[Item] | str) -> tuple[float, float]:
-    """The readings of a world written with BASE's children ``tree`` (a text: with that BASE)."""
+def twin_readings(folder: Path, tree: str) -> tuple[float, float]:
+    """The readings of world file text ``tree`` (or of the probe's world with BASE as ``tree`` writes it)."""
     from test_supervisor import A, Live
 
     path = folder / "twin.wbt"
-    path.write_text(world_text(tree) if isinstance(tree, list) else HEAD + tree + "\n")
+    path.write_text(tree if tree.startswith("#VRML") else HEAD + tree + "\n")
     lv = Live(Simulation(load_world(path)))
     lv.ok(A, "attach", {"robot": "probe"})
     bot = lv.sim.robot("probe")
@@ -293,7 +301,7 @@ def imports_follow_the_twin(folder: Path, sequence: list[tuple]) -> None:
         run.apply(op)
         run.check_tree(op)
         seen = run.readings()
-        assert seen == twin_readings(folder, run.tree), (op, world_text(run.tree))
+        assert seen == twin_readings(folder, world_text(run.tree, run.base_at)), (op, world_text(run.tree, run.base_at))
         exported = run.call("node_export_string", {"node": run.base})["value"]
         assert twin_readings(folder, exported) == seen, (op, exported)      # its export, written, reads the same
 
