@@ -398,6 +398,8 @@ marker_ops = st.lists(st.one_of(
     st.tuples(st.just("remove"), st.integers(0, 20)),
     st.tuples(st.just("turn"), st.integers(0, 20), span(-3.0, 3.0)),
     st.tuples(st.just("reset")),
+    st.tuples(st.just("save"), st.sampled_from(["a", "b"])),
+    st.tuples(st.just("load"), st.sampled_from(["a", "b", "__init__"])),
     st.tuples(st.just("drive"), st.floats(-8.0, 8.0), st.floats(-8.0, 8.0), st.integers(1, 6))),
     min_size=1, max_size=8)
 
@@ -426,7 +428,8 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
 
     me = call("get_self")["node"]
     written = call("get_field", {"node": me, "field": "children"})["value"]
-    markers: list[list] = []        # [id, size, frame translation, turn about z], in children order
+    markers: list[list] = []        # [id, size, frame translation, turn about z, as imported], in children order
+    saved: dict[str, dict[int, tuple]] = {}
     seen: set[int] = set(written)
     count = 0
     for op in sequence:
@@ -440,7 +443,7 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
                                                     "node_string": text})["value"]
             assert n not in seen, op
             seen.add(n)
-            markers.append([n, size, at, 0.0])
+            markers.append([n, size, at, 0.0, at])
             children = call("get_field", {"node": me, "field": "children"})["value"]
             assert children.index(n) == webots_index(position, len(children) - 1), (op, children)
             assert sorted(children) == sorted(written + [m[0] for m in markers]), op
@@ -456,12 +459,21 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
             markers[i][3] = op[2]
         elif kind == "reset":                      # the markers out, the robot back where it loaded
             call("simulation_reset")
-            markers = []
+            markers, saved = [], {}
             rover.device("ds").enable(16)
             watch.device("lidar").enable(16)
         elif kind == "remove" and markers:
             n = markers.pop(op[1] % len(markers))[0]
             call("remove_node", {"node": n})
+        elif kind == "save":
+            call("save_node_state", {"node": me, "state": op[1]})
+            saved[op[1]] = {m[0]: (m[2], m[3]) for m in markers}
+        elif kind == "load" and (op[1] == "__init__" or op[1] in saved):
+            # the robot's state covers the fields below it: its markers' (WbNode::save); one imported since has
+            # none of that name and stays, except for "__init__": as imported
+            call("load_node_state", {"node": me, "state": op[1]})
+            for m in markers:
+                m[2], m[3] = (m[4], 0.0) if op[1] == "__init__" else saved[op[1]].get(m[0], (m[2], m[3]))
         elif kind == "drive":
             for side, speed in zip(("left", "right"), op[1:3]):
                 rover.motor(side).set_position(math.inf)
@@ -474,7 +486,7 @@ def markers_ride_their_robot(folder: Path, sequence: list[tuple]) -> None:
         rot, at = rover.pose.rotation, rover.pose.translation
         assert rover.device("ds").value == 10.0, op         # no bounding ray of its own meets its markers
         centres = [at + rot @ np.array(m[2]) for m in markers]
-        for (n, _, frame, _), centre in zip(markers, centres):
+        for (n, _, frame, _, _), centre in zip(markers, centres):
             got = call("get_node_pose", {"node": n})["position"]
             assert got == pytest.approx(centre.tolist(), abs=1e-9), op
             assert call("get_field", {"node": n, "field": "translation"})["value"] == list(frame), op
@@ -502,3 +514,27 @@ def test_markers_imported_into_a_robot_ride_it_seen_by_others_not_by_its_boundin
             gc.collect()
 
     run()
+
+
+def test_regression_a_robots_load_state_puts_its_markers_back_where_they_were_saved_on_it() -> None:
+    """Found while fuzzing the markers: a marker imported into the rover's children, the rover's state saved, the
+    marker's translation set, the state loaded: the marker stayed where it was set (a robot's state held its riding
+    robots' frames but not its imported shapes'); Webots' state of a node covers every field below it. "__init__"
+    puts it back where its string wrote it (tests/worlds/nested_nodes.wbt: the rover at (1, 2) turned a quarter
+    turn, its +x the world's +y)."""
+    from test_supervisor_nested_import import MARKER, _rover, rover
+
+    lv = _rover()
+    me = rover(lv, "get_self")["node"]
+    (mk,) = rover(lv, "import_node_from_string", {"node": me, "field": "children", "position": -1,
+                                                  "node_string": MARKER})["value"]
+    field = {"node": mk, "field": "translation"}
+    rover(lv, "set_field", {**field, "value": [0.1, 0.0, 0.5]})
+    rover(lv, "save_node_state", {"node": me, "state": "s"})
+    rover(lv, "set_field", {**field, "value": [0.0, -0.4, 1.0]})
+    rover(lv, "load_node_state", {"node": me, "state": "s"})
+    assert rover(lv, "get_field", field)["value"] == [0.1, 0.0, 0.5]
+    assert rover(lv, "get_node_pose", {"node": mk})["position"] == pytest.approx([1.0, 2.1, 0.5], abs=1e-12)
+    rover(lv, "load_node_state", {"node": me, "state": "__init__"})
+    assert rover(lv, "get_field", field)["value"] == [0.3, 0.0, 0.5]
+    assert rover(lv, "get_node_pose", {"node": mk})["position"] == pytest.approx([1.0, 2.3, 0.5], abs=1e-12)

@@ -43,6 +43,7 @@ class State:
     positions: tuple[float, ...]  # the joints' positions, in the scope's motor order
     free_wheels: dict[str | int, float] | None = None  # free wheels' rolled angles: a car's by key, a tricycle's by index
     riders: dict[str, Pose] | None = None   # the robots riding it: each one's frame on it (fields below the node)
+    markers: dict[str, Pose] | None = None  # the shapes a Supervisor imported into its children: each one's frame
 
 
 class States:
@@ -88,7 +89,8 @@ def _now(sim: Any, scope: Scope) -> State:
     motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
     turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
     return State(pose, tuple(float(motors[m].position) for m in scope.motors),
-                 dict(turned) if turned is not None else None, _riders(sim, scope, loaded=False))
+                 dict(turned) if turned is not None else None, _riders(sim, scope, loaded=False),
+                 _markers(sim, scope, loaded=False))
 
 
 def _initial(sim: Any, scope: Scope) -> State:
@@ -102,7 +104,8 @@ def _initial(sim: Any, scope: Scope) -> State:
     turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
     # a joint motor's initial position is the world file's; a wheel's angle starts at 0
     return State(pose, tuple(float(getattr(motors[m], "initial_position", 0.0)) for m in scope.motors),
-                 dict.fromkeys(turned, 0.0) if turned is not None else None, _riders(sim, scope, loaded=True))
+                 dict.fromkeys(turned, 0.0) if turned is not None else None, _riders(sim, scope, loaded=True),
+                 _markers(sim, scope, loaded=True))
 
 
 def _restore(sim: Any, scope: Scope, state: State) -> None:
@@ -130,6 +133,10 @@ def _restore(sim: Any, scope: Scope, state: State) -> None:
                 dev.restart()
         for name, frame in (state.riders or {}).items():
             sim.set_rider_frame(sim.robots[name], frame)
+        for name, frame in (state.markers or {}).items():
+            ride = getattr(sim, "solid_riders", {}).get(name)
+            if ride is not None and ride[0] is robot:       # (removed since: gone)
+                sim.ride_solid(name, scope.robot, frame)
     for name in scope.leds:
         led = robot.devices.get(name)
         if led is not None and led.value != 0:
@@ -143,6 +150,17 @@ def _riders(sim: Any, scope: Scope, loaded: bool) -> dict[str, Pose] | None:
     if not scope.own_pose or riders is None:
         return None
     return {r.name: sim.rider_frame(r, loaded) for r in riders(sim.robots[scope.robot])} or None
+
+
+def _markers(sim: Any, scope: Scope, loaded: bool) -> dict[str, Pose] | None:
+    """The frames on a robot of the shapes a Supervisor imported into its children (``loaded``: as imported):
+    their translation and rotation are fields below it, in its state as a rider's are."""
+    riders = getattr(sim, "solid_riders", None)
+    if not scope.own_pose or not riders:
+        return None
+    robot = sim.robots[scope.robot]
+    return {name: sim.initial_solid_pose(name) if loaded else frame
+            for name, (carrier, frame) in riders.items() if carrier is robot} or None
 
 
 def _rider_frame(sim: Any, robot: Any, loaded: bool = False) -> Any:
