@@ -32,7 +32,7 @@ joint's ``endPoint`` and ``device`` fields (``end_point``, ``joint_devices``).
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Collection
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -584,11 +584,7 @@ def renew(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, kept: i
     its loaded ``own`` (export.py compares it with :attr:`Table.set_own`). Nothing inside it was removed (the
     caller checks): the new nodes come in the order of the old ones."""
     old = table.by_owner.get(owner, ())
-    segment = table.segments.get(owner)
-    start, forgotten = table.end, set(table.forgotten)
-    drop(table, owner)
-    add_solid(sim, table, owner, key, solid)
-    new = table.by_owner.pop(owner, ())
+    new, state = _made_again(sim, table, owner, key, solid)
     if len(new) != len(old) or any(a.type != b.type for a, b in zip(new, old)):
         raise AssertionError(f"solid {key!r} built again into another tree")
     ids = {n.id: o.id for n, o in zip(new, old)}
@@ -598,27 +594,7 @@ def renew(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, kept: i
 
     renewed = [dataclasses.replace(n, id=real(n.id), parent=real(n.parent), frame=real(n.frame),
                                    own=o.own if o.id == kept else n.own) for n, o in zip(new, old)]
-    for n in new:
-        table.added.pop(n.id, None)
-        table.by_parent.pop(n.id, None)
-    table.by_parent.pop(owner, None)
-    if table.inner is not None:
-        for instance in [k for k in table.inner if k in ids or k == owner]:
-            defs = table.inner.pop(instance)
-            table.inner[real(instance)] = {k: real(v) if isinstance(v, int) else v for k, v in defs.items()}
-    nodes = list(table.nodes)
-    for n in renewed:
-        k = n.id - FIRST_ID
-        if 0 <= k < len(nodes):
-            nodes[k] = n
-        else:
-            table.added[n.id] = n
-    table.nodes = tuple(nodes)
-    table.forgotten = forgotten
-    table.end = start
-    if segment is None:
-        table.segments.pop(owner, None)
-    _index(renewed, table.by_owner, table.by_parent)
+    _put_back(table, owner, new, renewed, ids, state, 0)
 
 
 def reframe(table: Table, owner: int, solid: wm.Solid, changed: Collection[int], kept: int) -> None:
@@ -668,11 +644,8 @@ def regrow(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, gone: 
     the new ones take ids from ``table.end`` on (never a removed node's), the ones that left read as removed.
     Returns the new nodes' ids, in the new tree's order."""
     old = [n for n in table.by_owner.get(owner, ()) if n.id not in gone]
-    segment = table.segments.get(owner)
-    start, forgotten = table.end, set(table.forgotten)
-    drop(table, owner)
-    add_solid(sim, table, owner, key, solid)
-    new = table.by_owner.pop(owner, ())
+    new, state = _made_again(sim, table, owner, key, solid)
+    start = state[0]
     added = {n.id for n in new if fresh(n)}
     grown = True
     while grown:                        # what the new nodes hold is new too
@@ -692,6 +665,26 @@ def regrow(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, gone: 
     owns = {o.id: o.own for o in old if o.id in table.set_own}
     renewed = [dataclasses.replace(n, id=real(n.id), parent=real(n.parent), frame=real(n.frame),
                                    own=owns.get(real(n.id), n.own)) for n in new]
+    for node_id in gone:
+        table.set_own.pop(node_id, None)
+    _put_back(table, owner, new, renewed, ids, state, len(fresh_ids))
+    return [real(n) for n in fresh_ids]
+
+
+def _made_again(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid) -> tuple[tuple[Nested, ...], tuple]:
+    """Top-level solid ``owner``'s nodes made again from ``solid`` (:func:`add_solid`, under new numbers), and the
+    table's state before (its end, forgotten ids and whether the solid had a segment) for :func:`_put_back`."""
+    state = (table.end, set(table.forgotten), table.segments.get(owner))
+    drop(table, owner)
+    add_solid(sim, table, owner, key, solid)
+    return table.by_owner.pop(owner, ()), state
+
+
+def _put_back(table: Table, owner: int, new: Sequence[Nested], renewed: list[Nested], ids: dict[int, int],
+              state: tuple, fresh: int) -> None:
+    """The ``renewed`` nodes (``new`` under the ids they keep: ``ids``, made number -> id) in the table in place
+    of the ones :func:`_made_again` made; ``fresh`` new ids taken from the table's old end on."""
+    start, forgotten, segment = state
     for n in new:
         table.added.pop(n.id, None)
         table.by_parent.pop(n.id, None)
@@ -699,7 +692,8 @@ def regrow(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, gone: 
     if table.inner is not None:           # (popped first: a new node's id may be another's number in add_solid)
         moved = {instance: table.inner.pop(instance) for instance in [k for k in table.inner if k in ids or k == owner]}
         for instance, defs in moved.items():
-            table.inner[real(instance)] = {k: real(v) if isinstance(v, int) else v for k, v in defs.items()}
+            table.inner[ids.get(instance, instance)] = {k: ids.get(v, v) if isinstance(v, int) else v
+                                                        for k, v in defs.items()}
     nodes = list(table.nodes)
     for n in renewed:
         k = n.id - FIRST_ID
@@ -709,13 +703,10 @@ def regrow(sim: Any, table: Table, owner: int, key: str, solid: wm.Solid, gone: 
             table.added[n.id] = n
     table.nodes = tuple(nodes)
     table.forgotten = forgotten
-    for node_id in gone:
-        table.set_own.pop(node_id, None)
-    table.end = start + len(fresh_ids)
+    table.end = start + fresh
     if segment is None:
         table.segments.pop(owner, None)
     _index(renewed, table.by_owner, table.by_parent)
-    return [real(n) for n in fresh_ids]
 
 
 def drop_shape(table: Table, shape: int) -> None:

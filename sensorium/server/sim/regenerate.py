@@ -12,6 +12,7 @@ written node kept is then the one with the value, so successive sets add up."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
@@ -121,23 +122,31 @@ def regenerate(sim: Any, key: str, node_id: int, values: dict[str, tuple[str, An
     return node
 
 
-def _replaced(node: ParsedNode, at: tuple[int, int], fields: dict[str, Any]) -> ParsedNode | None:
-    """``node`` with the node written at ``at`` (line, column, in the same file) given ``fields`` (None:
-    the field taken out, as unwritten), or None when no node inside it is written there."""
+def _edited(node: ParsedNode, at: tuple[int, int], edit: Callable[[ParsedNode], ParsedNode]) -> ParsedNode | None:
+    """``node`` with the node written at ``at`` (line, column, in the same file) replaced by ``edit`` of it, or
+    None when no node inside it is written there."""
     if (node.line, node.col) == at:
-        new = {k: v for k, v in node.fields.items() if k not in fields}
-        new.update({k: v for k, v in fields.items() if v is not None})
-        order = [*(k for k in new if k not in node.fields), *node.fields]     # (pose fields first, as Webots writes)
-        return replace(node, fields={k: new[k] for k in order if k in new})
+        return edit(node)
     for name, value in node.fields.items():
         items = value if isinstance(value, list) else [value]
         for i, item in enumerate(items):
             if isinstance(item, ParsedNode):
-                found = _replaced(item, at, fields)
+                found = _edited(item, at, edit)
                 if found is not None:
                     value = found if not isinstance(value, list) else [*value[:i], found, *value[i + 1:]]
                     return replace(node, fields={**node.fields, name: value})
     return None
+
+
+def _replaced(node: ParsedNode, at: tuple[int, int], fields: dict[str, Any]) -> ParsedNode | None:
+    """``node`` with the node written at ``at`` given ``fields`` (None: the field taken out, as unwritten), or
+    None when no node inside it is written there."""
+    def given(n: ParsedNode) -> ParsedNode:
+        new = {k: v for k, v in n.fields.items() if k not in fields}
+        new.update({k: v for k, v in fields.items() if v is not None})
+        order = [*(k for k in new if k not in n.fields), *n.fields]     # (pose fields first, as Webots writes)
+        return replace(n, fields={k: new[k] for k in order if k in new})
+    return _edited(node, at, given)
 
 
 def _without(node: ParsedNode, gone: set[tuple[int, int]]) -> ParsedNode:
@@ -407,19 +416,11 @@ def parse_nested_import(sim: Any, key: str, text: Any, serial: int) -> list[Pars
 def _grown(node: ParsedNode, at: tuple[int, int], change: Any) -> ParsedNode | None:
     """``node`` with the ``children`` of the node written at ``at`` changed by ``change`` (its list -> the new
     list), or None when no node inside it is written there."""
-    if (node.line, node.col) == at:
-        children = node.fields.get("children", [])
-        return replace(node, fields={**node.fields, "children": change(list(children) if isinstance(children, list)
-                                                                       else [children])})
-    for name, value in node.fields.items():
-        items = value if isinstance(value, list) else [value]
-        for i, item in enumerate(items):
-            if isinstance(item, ParsedNode):
-                found = _grown(item, at, change)
-                if found is not None:
-                    value = found if not isinstance(value, list) else [*value[:i], found, *value[i + 1:]]
-                    return replace(node, fields={**node.fields, name: value})
-    return None
+    def grown(n: ParsedNode) -> ParsedNode:
+        children = n.fields.get("children", [])
+        return replace(n, fields={**n.fields, "children": change(list(children) if isinstance(children, list)
+                                                                 else [children])})
+    return _edited(node, at, grown)
 
 
 def written_node(sim: Any, key: str, at: tuple[int, int] | None = None) -> ParsedNode | None:
