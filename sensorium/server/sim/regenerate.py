@@ -188,23 +188,21 @@ def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields:
     (:func:`regenerate`). ``ImportRefused`` (one line, nothing changed) when the solid's written node is not
     at hand here (a solid a Supervisor imported) or does not build. ``gone``: the nodes written there a
     Supervisor removed since, left out (a reset keeps them removed)."""
+    new, file = _written_edited(sim, key, at, lambda written: _replaced(written, at, fields))
+    return _rebuilt(sim, key, node_id, _without(new, gone) if gone else new, file)
+
+
+def _written_edited(sim: Any, key: str, at: tuple[int, int],
+                    edit: Callable[[ParsedNode], ParsedNode | None]) -> tuple[ParsedNode, WbtFile]:
+    """Top-level solid ``key``'s written node changed by ``edit`` (None: nothing written at ``at``), and its
+    file; ``ImportRefused`` when the solid's written node is not at hand or nothing is written at ``at``."""
     found = _instance(sim, key)
     if found is None:
         raise ImportRefused(f"solid {key!r} was not loaded from a .wbt world file's node kept here")
-    written, file = found
-    new = _replaced(written, at, fields)
+    new = edit(found[0])
     if new is None:
         raise ImportRefused(f"no node of solid {key!r} is written at line {at[0]}, column {at[1]}")
-    if gone:
-        new = _without(new, gone)
-    taken = set(sim.scene.solid_names) - {key}
-    node = rebuild_node(new, file, sim.loaded, sim.world, taken=taken, limits=sim.limits,
-                        allow_outside_meshes=sim.allow_outside_meshes)
-    if node.type != "Solid" or node.model.name != key:
-        raise ImportRefused(f"solid {key!r} does not build again as it was")
-    sim.replace_solid(key, node, node_id)
-    sim._regen_written = {**getattr(sim, "_regen_written", {}), key: new}
-    return node
+    return new, found[1]
 
 
 _UNIT = (1.0, 1.0, 1.0)
@@ -445,13 +443,7 @@ def rebuild_children(sim: Any, key: str, node_id: int, at: tuple[int, int], chan
     ``at`` inside it (its own node's place: its own children) changed by ``change`` (the written list -> the new
     one): a Supervisor's import into, or removal from, a node's children, through the path a Pose's set takes
     (:func:`rebuild_posed`). ``ImportRefused`` (one line, nothing changed) when it does not build."""
-    found = _instance(sim, key)
-    if found is None:
-        raise ImportRefused(f"solid {key!r} was not loaded from a .wbt world file's node kept here")
-    written, file = found
-    new = _grown(written, at, change)
-    if new is None:
-        raise ImportRefused(f"no node of solid {key!r} is written at line {at[0]}, column {at[1]}")
+    new, file = _written_edited(sim, key, at, lambda written: _grown(written, at, change))
     return _rebuilt(sim, key, node_id, new, file, warnings)
 
 
