@@ -167,17 +167,8 @@ def _without(node: ParsedNode, gone: set[tuple[int, int]]) -> ParsedNode:
 def written_fields(sim: Any, key: str, at: tuple[int, int], names: tuple[str, ...]) -> dict[str, Any] | None:
     """The values ``names`` have in the node written at ``at`` inside top-level solid ``key`` as it is
     written now (None each: unwritten); None when that node is not at hand (:func:`rebuild_posed`)."""
-    found = _instance(sim, key)
-    if found is None:
-        return None
-    stack = [found[0]]
-    while stack:
-        node = stack.pop()
-        if (node.line, node.col) == at:
-            return {name: node.fields.get(name) for name in names}
-        for value in node.fields.values():
-            stack += [v for v in (value if isinstance(value, list) else [value]) if isinstance(v, ParsedNode)]
-    return None
+    node = written_node(sim, key, at)
+    return None if node is None else {name: node.fields.get(name) for name in names}
 
 
 def rebuild_posed(sim: Any, key: str, node_id: int, at: tuple[int, int], fields: dict[str, Any],
