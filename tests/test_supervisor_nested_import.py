@@ -313,3 +313,24 @@ def test_a_nested_solids_children_take_nodes_too():
     assert poses_readings(lv)[0] == pytest.approx(2.0, abs=1e-6)
     call(lv, "remove_node", {"node": box})
     assert get(lv, inner, "children") == was and math.isinf(poses_readings(lv)[0])
+
+
+def test_get_from_def_walks_the_worlds_nodes_a_fixed_number_of_times_whatever_the_robots(tmp_path, monkeypatch) -> None:
+    """The robots' riding markers are looked for only where a robot has some: getFromDef in a world of 2 or 40
+    robots without markers lists the world's nodes as many times (it listed them once per robot: 66× slower
+    at 200 robots)."""
+    calls = []
+    listed = sv._nodes
+    monkeypatch.setattr(sv, "_nodes", lambda sim: calls.append(1) or listed(sim))
+
+    def walks(robots: int) -> int:
+        path = tmp_path / f"r{robots}.wbt"
+        path.write_text("#VRML_SIM R2025a utf8\nWorldInfo { basicTimeStep 16 }\n" + "".join(
+            f'DEF R{i} Robot {{ translation {i} 0 0 name "r{i}" controller "<none>" }}\n' for i in range(robots))
+            + 'DEF LAST Solid { name "last" }\n')
+        sim = Simulation.from_file(str(path), precision="fast")
+        calls.clear()
+        assert sv._first_def(sim, "LAST").def_name == "LAST"
+        return len(calls)
+
+    assert walks(40) == walks(2)

@@ -2083,6 +2083,8 @@ def _robot_riders(sim: Any, robot: Node) -> list[Node]:
     """The solids riding ``robot`` that a Supervisor imported into its children, in their order there."""
     order = getattr(sim, "_robot_child_order", {}).get(robot.key, ())
     riders = getattr(sim, "_rider_ids", {})
+    if not any(i in riders for i in order):        # (most robots: no walk over the world's nodes)
+        return []
     by_id = {n.id: n for n in _nodes(sim)}
     return [by_id[i] for i in order if i in riders and i in by_id and _rider(sim, by_id[i]) is not None]
 
