@@ -149,19 +149,24 @@ def _replaced(node: ParsedNode, at: tuple[int, int], fields: dict[str, Any]) -> 
     return _edited(node, at, given)
 
 
-def _without(node: ParsedNode, gone: set[tuple[int, int]]) -> ParsedNode:
-    """``node`` without the nodes written at ``gone`` (line, column) inside it (a Supervisor removed them)."""
+def _pruned(node: ParsedNode, drop: Callable[[ParsedNode], bool]) -> ParsedNode:
+    """``node`` without the nodes inside it that ``drop`` names (with what they hold)."""
     fields = {}
     for name, value in node.fields.items():
         if isinstance(value, list):
-            value = [_without(v, gone) if isinstance(v, ParsedNode) else v for v in value
-                     if not (isinstance(v, ParsedNode) and (v.line, v.col) in gone)]
+            value = [_pruned(v, drop) if isinstance(v, ParsedNode) else v for v in value
+                     if not (isinstance(v, ParsedNode) and drop(v))]
         elif isinstance(value, ParsedNode):
-            value = None if (value.line, value.col) in gone else _without(value, gone)
-            if value is None:
+            if drop(value):
                 continue
+            value = _pruned(value, drop)
         fields[name] = value
     return replace(node, fields=fields)
+
+
+def _without(node: ParsedNode, gone: set[tuple[int, int]]) -> ParsedNode:
+    """``node`` without the nodes written at ``gone`` (line, column) inside it (a Supervisor removed them)."""
+    return _pruned(node, lambda v: (v.line, v.col) in gone)
 
 
 def written_fields(sim: Any, key: str, at: tuple[int, int], names: tuple[str, ...]) -> dict[str, Any] | None:
@@ -406,9 +411,7 @@ def _grown(node: ParsedNode, at: tuple[int, int], change: Any) -> ParsedNode | N
     """``node`` with the ``children`` of the node written at ``at`` changed by ``change`` (its list -> the new
     list), or None when no node inside it is written there."""
     def grown(n: ParsedNode) -> ParsedNode:
-        children = n.fields.get("children", [])
-        return replace(n, fields={**n.fields, "children": change(list(children) if isinstance(children, list)
-                                                                 else [children])})
+        return replace(n, fields={**n.fields, "children": change(list(_children(n)))})
     return _edited(node, at, grown)
 
 
@@ -438,20 +441,12 @@ def rebuild_children(sim: Any, key: str, node_id: int, at: tuple[int, int], chan
     return _rebuilt(sim, key, node_id, new, file, warnings)
 
 
-def _unimported(node: ParsedNode) -> ParsedNode:
-    fields = {name: [_unimported(v) if isinstance(v, ParsedNode) else v for v in value
-                     if not (isinstance(v, ParsedNode) and imported_line(v.line))] if isinstance(value, list)
-              else _unimported(value) if isinstance(value, ParsedNode) else value
-              for name, value in node.fields.items()}
-    return replace(node, fields=fields)
-
-
 def rebuild_unimported(sim: Any, key: str, node_id: int) -> ImportedNode:
     """Top-level solid ``key`` built again without the nodes a Supervisor imported inside it (what a
     ``simulationReset`` takes out), as it is written now otherwise."""
     found = _instance(sim, key)
     assert found is not None
-    return _rebuilt(sim, key, node_id, _unimported(found[0]), found[1])
+    return _rebuilt(sim, key, node_id, _pruned(found[0], lambda v: imported_line(v.line)), found[1])
 
 
 def _rebuilt(sim: Any, key: str, node_id: int, new: ParsedNode, file: WbtFile,
