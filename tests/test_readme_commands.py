@@ -26,7 +26,7 @@ from sensorium.worlds import names as bundled_worlds
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "sensorium" / "client" / "examples"
 README = ROOT / "README.md"
-DOCS = ("README.md", "ARCHITECTURE.md", "PROTOCOL.md")
+DOCS = ("README.md", "ARCHITECTURE.md", "PROTOCOL.md", "docs/webots-samples.md")
 FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
 # options of other programs the README names in passing: Webots' command line (`webots --batch
 # --stdout`, a controller's `--stdout`/`--stderr` console filters), `docker run --rm`, `ray start`
@@ -311,8 +311,9 @@ def test_relative_links_point_at_files_and_headings_that_exist(name):
     assert link_problems(name, (ROOT / name).read_text()) == []
 
 
-def test_every_repository_path_the_readme_names_exists():
-    assert path_problems(README.read_text()) == []
+@pytest.mark.parametrize("name", ["README.md", "docs/webots-samples.md"])
+def test_every_repository_path_the_readme_names_exists(name):
+    assert path_problems((ROOT / name).read_text()) == []
 
 
 @pytest.mark.parametrize("name", ["ARCHITECTURE.md", "PROTOCOL.md"])
