@@ -155,7 +155,7 @@ def test_the_pioneer_3dx_sonars_read_the_closed_form_and_its_rule_drives_it_so(t
 
 # Webots' controller is Webots' file, never this repository's: the run below uses our own Python
 # controller making its calls (under `sensorium run`, Webots' C one, built against our libController,
-# printed the same poses: README, sweep 17), and a watcher of ours printing the robot's pose.
+# printed the same poses: docs/webots-samples.md, sweep 17), and a watcher of ours printing the robot's pose.
 P3DX_CONTROLLER = '''\
 import math
 

@@ -379,7 +379,7 @@ def test_highway_overtakes_calls_change_lane_past_the_slow_car(tmp_path: Path) -
     is below y 4.7, the car then 80 km/h with nothing ahead. Each step getCurrentSpeed is the cruising speed
     just set (1e-9; the kinematic car reaches it at once). The PID's derivative (25 per step) on the GPS 5.03 m
     ahead of the rear axle swings the steering sent between left and right every step: the bicycle model turns
-    the car at once, where Webots' tyres and inertia smooth it (README, sweep 30)."""
+    the car at once, where Webots' tyres and inertia smooth it (docs/webots-samples.md, sweep 30)."""
     (tmp_path / "worlds").mkdir()
     shutil.copytree(DATA / "protos", tmp_path / "worlds" / "protos")
     world = tmp_path / "worlds" / "highway_overtake.wbt"
