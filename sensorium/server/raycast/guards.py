@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from sensorium.server.world.arrays import unique_ints
+
 # a tier uses guards while they stay few: at most this many risky edges, and either at most this
 # many per flat triangle (a world of boxes has 1) or prisms (12 triangles each) adding at most this
 # many triangles per triangle of the tier (a room of boxes, a rock mesh and curved shells, like the
@@ -139,7 +141,13 @@ def _overlapping(lo: np.ndarray, hi: np.ndarray, limit: int) -> tuple[np.ndarray
         return None
     i = np.repeat(np.arange(n), cnt)
     j = i + np.arange(int(cnt.sum())) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-    ok = np.all((slo[j] <= shi[i]) & (shi[j] >= slo[i]), axis=1)
+    # along x every such pair overlaps (slo[j, 0] <= shi[i, 0] by the sweep, shi[j, 0] >= slo[j, 0] >=
+    # slo[i, 0] by the order): y and z are tested, a column at a time (no (pairs, 3) temporaries)
+    ok = np.ones(len(i), dtype=bool)
+    for axis in (1, 2):
+        lo_a, hi_a = np.ascontiguousarray(slo[:, axis]), np.ascontiguousarray(shi[:, axis])
+        ok &= lo_a[j] <= hi_a[i]
+        ok &= hi_a[j] >= lo_a[i]
     i, j = order[i[ok]], order[j[ok]]
     return np.r_[i, j], np.r_[j, i]
 
@@ -156,7 +164,7 @@ def candidates(V, edges, ptr, idx, ring, flat, w: float, budget: int) -> tuple[n
     if int(ring.sizes(tri).sum()) > budget:
         return None
     pos, cand = ring.rows(tri)
-    own = np.unique(e_of[pos] * (len(flat) + 1) + cand)     # (edge, triangle) keys, sorted
+    own = unique_ints(e_of[pos] * (len(flat) + 1) + cand)   # (edge, triangle) keys, sorted
     own_e, own_t = own // (len(flat) + 1), own % (len(flat) + 1)
     own_ptr = np.r_[0, np.cumsum(np.bincount(own_e, minlength=len(edges)))]
     p, q = V[edges[:, 0]], V[edges[:, 1]]
@@ -168,7 +176,7 @@ def candidates(V, edges, ptr, idx, ring, flat, w: float, budget: int) -> tuple[n
     if int((own_ptr[j + 1] - own_ptr[j]).sum()) > budget:
         return None
     pos, cand = _expand(own_ptr, own_t, j)
-    key = np.unique(i[pos] * (len(flat) + 1) + cand)
+    key = unique_ints(i[pos] * (len(flat) + 1) + cand)
     e_of, cand = key // (len(flat) + 1), key % (len(flat) + 1)
     keep = flat[cand]
     e_of, cand = e_of[keep], cand[keep]

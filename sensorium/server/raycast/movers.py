@@ -19,6 +19,7 @@ import numpy as np
 
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.exact import _DENSE_PAIRS, _INF, _TINY, _dot, _full, _mat, _minus, _take, _to_frame
+from sensorium.server.world.arrays import unique_ints
 from sensorium.server.world.geometry import Pose
 
 _FEW = 8   # one-origin batches against up to this many movers: one matrix-vector test per mover
@@ -600,7 +601,7 @@ def _own_pairs(st: _MountState, own: np.ndarray, mt: _Movers, O: np.ndarray, D: 
     rays, rows = st.mi[sel], st.rows[sel]
     grow = 1e-9 + 1e-12 * (float(np.abs(O[:1] if O.strides[0] == 0 else O).max()) + float(np.abs(mt.T).max()))
     prs, pms = [], []
-    for row in np.unique(rows).tolist():
+    for row in unique_ints(rows).tolist():
         k = (rows == row).nonzero()[0]
         r = rays[k]
         Rb, Tb = rot[mt.index[row]], mt.T[row]

@@ -86,8 +86,8 @@ class _Tier:
         self.empty = nv == 0
         if self.empty:
             return
-        lo = np.min([v.min(0) for v in verts], axis=0)
-        hi = np.max([v.max(0) for v in verts], axis=0)
+        box_lo, box_hi = _boxes(verts)
+        lo, hi = box_lo.min(0), box_hi.max(0)
         centre, half = (lo + hi) / 2.0, float(np.linalg.norm(hi - lo)) / 2.0
         # anchor at the bounding-box centre, unless the geometry is already around the origin
         # (then float32 coordinates lose at most one bit and casts skip a float64 subtraction)
@@ -129,9 +129,11 @@ class _Tier:
         self.has_cone = _CONE in c_code   # packets.c knows spheres, cylinders and capsules: numpy judges
         del curved   # the shapes' local vertices
         V = np.vstack(verts)
-        V -= self.anchor
         # from here on only the shapes' boxes are needed (see _isolation): not a second copy of V
-        verts = [np.array([v.min(0), v.max(0)]) for v in verts]
+        starts = np.cumsum([0] + [len(v) for v in verts[:-1]])
+        boxes = (np.minimum.reduceat(V, starts, axis=0), np.maximum.reduceat(V, starts, axis=0))
+        del verts
+        V -= self.anchor
         F = packets.padded(np.vstack(faces), np.int32)   # one index array: Embree's (shared with its scenes), and ours
         del faces
         self.V, self.F = V, F
@@ -185,7 +187,7 @@ class _Tier:
         self.c_py = [(code, r, h, *c, *rot, rad2, ax, sid) for code, r, h, c, rot, rad2, ax, sid in zip(
             self.c_code.tolist(), self.c_r.tolist(), self.c_h.tolist(), self.c_pos.tolist(),
             self.c_rot.reshape(-1, 9).tolist(), self.c_rad2.tolist(), self.c_ax.tolist(), self.c_shape.tolist())]
-        self.c_isolated = self._isolation(verts, tri_shape, c_shape)
+        self.c_isolated = self._isolation(*boxes, tri_shape, c_shape)
         # tight bound of the whole tier for pruning candidate rays (see ``may_hit``): the shell's own
         # cylinder for a tier of one cylinder or capsule (a round robot body), else the box of V
         slack = 16.0 * self.res
@@ -386,14 +388,13 @@ class _Tier:
         """True if the EXACT scene carries edge guards (False: EXACT uses the offset copy)."""
         return self.guard is not None or self._guard[1]
 
-    def _isolation(self, verts, tri_shape, c_shape) -> np.ndarray:
-        """Per curved slot: True if no other shape of the tier overlaps its shell's bounding box.
-        Then nothing can lie between a crossing of that shell and the true surface inside it."""
+    def _isolation(self, lo, hi, tri_shape, c_shape) -> np.ndarray:
+        """Per curved slot: True if no other shape of the tier overlaps its shell's bounding box
+        (``lo``, ``hi``: each shape's box, in the tier's order). Then nothing can lie between a
+        crossing of that shell and the true surface inside it."""
         if not c_shape:
             return np.zeros(0, dtype=bool)
         ids = np.array([int(t[0]) for t in tri_shape])
-        lo = np.array([v.min(0) for v in verts])
-        hi = np.array([v.max(0) for v in verts])
         out = np.empty(len(c_shape), dtype=bool)
         for i, sid in enumerate(c_shape):
             k = int(np.flatnonzero(ids == sid)[0])
@@ -455,3 +456,22 @@ def _edges(V: np.ndarray, F: np.ndarray):
         f = F[a:a + _BLOCK]
         v0 = V[f[:, 0]]
         yield a, a + len(f), v0, V[f[:, 1]] - v0, V[f[:, 2]] - v0
+
+
+def _boxes(verts: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Each vertex array's box (k, 3) lo and hi: ``v.min(0)``, ``v.max(0)`` each (the same values), the
+    arrays of small shapes stacked in blocks of up to ``_BLOCK`` rows and reduced at once (two numpy
+    reductions per shape cost ~5 us each: 25 ms for a tier of 5,000 boxes)."""
+    lo, hi = np.empty((len(verts), 3)), np.empty((len(verts), 3))
+    i = 0
+    while i < len(verts):
+        j, rows = i + 1, len(verts[i])
+        while j < len(verts) and rows + len(verts[j]) <= _BLOCK:
+            rows += len(verts[j])
+            j += 1
+        block = verts[i] if j == i + 1 else np.vstack(verts[i:j])
+        starts = np.cumsum([0] + [len(v) for v in verts[i:j - 1]])
+        lo[i:j] = np.minimum.reduceat(block, starts, axis=0)
+        hi[i:j] = np.maximum.reduceat(block, starts, axis=0)
+        i = j
+    return lo, hi

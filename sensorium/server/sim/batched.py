@@ -149,6 +149,7 @@ from sensorium.server.sim.scene import (
 )
 from sensorium.server.sim.sensors import LED, DistanceSensor, Lidar, LightSensor, PositionSensor, self_collision_shapes
 from sensorium.server.sim.simulation import SettlingGrounds, lights_from_models
+from sensorium.server.world.arrays import unique_ints
 from sensorium.server.world.geometry import Pose
 from sensorium.server.world.limits import check_pose
 from sensorium.server.world.loader import LoadedWorld, from_model
@@ -1589,7 +1590,7 @@ class BatchedSimulation:
         local_rot, local_pos = self._l_rot[cols], self._l_pos[cols]
         if self._l_riding:     # a sensor riding a joint: its copy's local pose (batched_joints.py)
             local_rot, local_pos = local_rot.copy(), local_pos.copy()
-            for col in np.unique(cols).tolist():
+            for col in unique_ints(cols).tolist():
                 key = ("LightSensor", col)
                 if key in self.joints.riders:
                     m = (cols == col).nonzero()[0]
@@ -1727,7 +1728,7 @@ class BatchedSimulation:
             if self._d_any_riding and (riding >= 0).any():
                 # one local pose per row: the plan's, or the copy's for a sensor riding a joint
                 local_rot, local_pos = plan.local_rot[pi], plan.local_pos[pi]
-                for col in np.unique(riding[riding >= 0]).tolist():
+                for col in unique_ints(riding[riding >= 0]).tolist():
                     m = (riding == col).nonzero()[0]
                     local_rot[m] = self.joints.local_rot[("DistanceSensor", col)][c[m]]
                     local_pos[m] = self.joints.local_pos[("DistanceSensor", col)][c[m]]

@@ -69,6 +69,7 @@ from sensorium.server.sim.sensors import (
     TouchSensor,
     altitude_offset,
 )
+from sensorium.server.world.arrays import unique_ints
 from sensorium.server.world.poses import pose_from_model
 
 __all__ = ["KINDS", "CLASSES", "SHAPES", "READINGS", "KinematicDevices", "draws_noise", "refusal", "libm_each",
@@ -526,7 +527,7 @@ class KinematicDevices:
         riding a joint (whose local pose moved with it)."""
         fixed = (self.local_rot[kind][cols], self.local_pos[kind][cols])
         out = [(fixed[0].copy(), fixed[1].copy()) for _ in range(3)]
-        riding = [col for col in np.unique(cols).tolist() if (kind, col) in self.motion_riders]
+        riding = [col for col in unique_ints(cols).tolist() if (kind, col) in self.motion_riders]
         if not riding:
             return out
         before = self.seen[kind][copies, cols]
@@ -565,7 +566,7 @@ class KinematicDevices:
         rr = np.ascontiguousarray(self.sim.rot[copies, slot])       # contiguous 3x3s, as a Pose holds them
         local_rot, local_pos = self.local_rot[kind][cols], self.local_pos[kind][cols]
         joints = self.sim.joints
-        riding = [col for col in np.unique(cols).tolist() if (kind, col) in joints.riders] if joints.riders else []
+        riding = [col for col in unique_ints(cols).tolist() if (kind, col) in joints.riders] if joints.riders else []
         if riding:
             local_rot, local_pos = local_rot.copy(), local_pos.copy()
             for col in riding:
@@ -631,7 +632,7 @@ class KinematicDevices:
         disabled axis."""
         out = np.full((len(copies), 3), math.nan)
         streams = self.sim._noise_of[kind]
-        for col in np.unique(cols).tolist():
+        for col in unique_ints(cols).tolist():
             sel = (cols == col).nonzero()[0]
             on = self.axes_on[kind][col]
             if not len(on):
@@ -728,7 +729,7 @@ class KinematicDevices:
         if sim.contact is None:
             out[has] = 0.0
             return out
-        for col in np.unique(cols[has]).tolist():
+        for col in unique_ints(cols[has]).tolist():
             rows = (cols == col).nonzero()[0]
             out[rows] = self._bumper_near(copies[rows], int(col))
         return out

@@ -36,6 +36,7 @@ from sensorium.server.devices import lidar as lmath
 from sensorium.server.raycast import packets
 from sensorium.server.raycast.engine import RayHits, RayKind
 from sensorium.server.sim.sensors import Lidar
+from sensorium.server.world.arrays import unique_ints
 
 __all__ = ["RotatingLidars"]
 
@@ -95,7 +96,7 @@ class RotatingLidars:
             sectors = [self._sweep(col, h, dt_ms) for h in heads.tolist()]
             self.head[c, col] = np.array([s.sweep.head_angle_after for s in sectors])[where]
             sizes = np.array([len(s.sweep.columns) for s in sectors], dtype=np.int64)
-            for n in np.unique(sizes).tolist():
+            for n in unique_ints(sizes).tolist():
                 if n == 0:      # a head that does not turn (frequency 0) samples nothing
                     continue
                 pick = (sizes[where] == n).nonzero()[0]

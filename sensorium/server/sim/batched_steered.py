@@ -30,6 +30,7 @@ from sensorium.server.sim.batched_holonomic import HolonomicDrives
 from sensorium.server.sim.batched_joints import BatchedJoints
 from sensorium.server.sim.batched_kinematic import libm_cos_sin
 from sensorium.server.sim.motion import SteeredDrive, WheelMotor
+from sensorium.server.world.arrays import unique_ints
 
 __all__ = ["SteeredDrives"]
 
@@ -101,7 +102,7 @@ class SteeredDrives(HolonomicDrives):
             w = w + a[:, 2, j] * ux[:, j] + b[:, 2, j] * uy[:, j]
         free = self.has_free[rows]
         if free.any():                  # robots with free wheels: their constrained twist, then their roll
-            for k in np.unique(rows[free]).tolist():
+            for k in unique_ints(rows[free]).tolist():
                 sel = (rows == k).nonzero()[0]
                 places, driven = self.constrained[k]
                 tx, ty, tw = constrained_twists(places, driven, self.radius[k, :len(places)], u[sel],

@@ -19,6 +19,7 @@ from sensorium.server.devices.lookup import RESOLUTION_OFF, add_noise, quantize_
 from sensorium.server.raycast.engine import Mount, RayHits, RayKind
 from sensorium.server.sim.own_shapes import cast_local_skipping
 from sensorium.server.sim.sensors import DistanceSensor, LightSensor, RayRequest
+from sensorium.server.world.arrays import unique_ints
 from sensorium.server.world.geometry import Pose
 
 _INFRA_RED = dmath.SENSOR_TYPES["infra-red"]
@@ -256,7 +257,7 @@ class _Group:
             t = np.full(S * n, np.inf)
             shape = np.full(S * n, -1, dtype=np.int64)
             normal = np.zeros((S * n, 3))
-            for body in np.unique(self.mount[self.own_visible]).tolist():
+            for body in unique_ints(self.mount[self.own_visible]).tolist():
                 rows = (self.own_visible & (self.mount == body)).nonzero()[0]
                 if self.blind is not None:
                     h = cast_local_skipping(engine, body, O[rows], D[rows], 0.0, self.t_far[rows], self.kind,

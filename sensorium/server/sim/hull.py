@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sensorium.server.world.arrays import unique_ints
+
 __all__ = ["FlatPoints", "Hull", "MAX_POINTS", "beyond", "convex_hull", "enclosed", "extreme_points",
            "hull_tolerance"]
 
@@ -53,7 +55,7 @@ def extreme_points(points: np.ndarray, limit: int = MAX_POINTS) -> np.ndarray:
         top = proj[rows, np.arange(len(dirs))]
         better = top > best
         best[better], index[better] = top[better], rows[better] + start
-    return points[np.unique(index)]
+    return points[unique_ints(index)]
 
 
 class FlatPoints(ValueError):
@@ -247,4 +249,4 @@ def convex_hull(points: np.ndarray) -> Hull:
             owner[moved], far[moved] = assign(moved, new)
     live = np.flatnonzero(alive[:count])
     faces_out = tri[live]
-    return Hull(p, faces_out, normals[live], offsets[live], np.unique(faces_out), tol)
+    return Hull(p, faces_out, normals[live], offsets[live], unique_ints(faces_out), tol)

@@ -33,6 +33,7 @@ from sensorium.server.devices import imaging
 from sensorium.server.devices import recognition as rmath
 from sensorium.server.raycast.engine import RayKind
 from sensorium.server.sim.scene import primitive_from_model
+from sensorium.server.world.arrays import unique_ints
 from sensorium.server.world.geometry import Pose, tessellate
 from sensorium.server.world.poses import axis_angle
 
@@ -181,7 +182,7 @@ class Recognizer:
         range, on the image and (occlusion 2) seen by a pixel: those occlusion 1 then tests."""
         c = self.config
         out: list[tuple[int, RecognisedObject, np.ndarray]] = []
-        seen_by_pixels = set(np.unique(pixel_objects).tolist()) if pixel_objects is not None else set()
+        seen_by_pixels = set(unique_ints(pixel_objects).tolist()) if pixel_objects is not None else set()
         for k, obj in enumerate(self.objects):
             if obj.key not in self.scene.recognisable:     # removed by a Supervisor
                 continue
