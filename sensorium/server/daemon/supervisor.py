@@ -2116,7 +2116,13 @@ def _import_into_solid(sim: Any, node: Node, position: int, text: str, warnings:
     until ``simulationReset`` takes them out (:func:`reset_nested_imports`). Returns the new top nodes' ids. What
     does not parse or build changes nothing (one line)."""
     from sensorium.server.sim.imports import ImportRefused
-    from sensorium.server.sim.regenerate import IMPORT_LINES, parse_nested_import, rebuild_children, written_node
+    from sensorium.server.sim.regenerate import (
+        IMPORT_LINES,
+        parse_nested_import,
+        rebuild_children,
+        written_children,
+        written_node,
+    )
 
     table = _table(sim)
     key, owner = _solid_key(sim, node)
@@ -2132,8 +2138,7 @@ def _import_into_solid(sim: Any, node: Node, position: int, text: str, warnings:
     serial = getattr(sim, "_nested_import_serial", 0) + 1
     try:
         nodes = parse_nested_import(sim, key, text, serial)
-        children = holder.fields.get("children", [])
-        index = insert_index(position, len(children) if isinstance(children, list) else 1)
+        index = insert_index(position, len(written_children(holder)))
         corrected: list[str] = []
         made = _rebuilt_in_place(sim, key, lambda: rebuild_children(
             sim, key, owner, at, lambda now: [*now[:index], *nodes, *now[index:]], corrected))
