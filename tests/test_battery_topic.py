@@ -88,11 +88,12 @@ def test_the_percentage_is_what_the_battery_service_reads_over_the_maximum_at_ea
         value = ctl.call("/r/robot/battery_sensor_get_value")["value"]
         assert topic == "/r/battery" and env == {"type": M.BATTERY_STATE, "seq": n - 1, "stamp_ns": n * DT * 1_000_000}
         assert body["percentage"] == value / EMAX                     # the very number, over the maximum
+        assert body["energy"] == value                                # and the very number itself
         assert body["percentage"] == pytest.approx(expected(n), abs=1e-13)
         assert body["header"] == {"stamp": {"sec": 0, "nanosec": n * DT * 1_000_000}, "frame_id": "r"}
         assert body["power_supply_status"] == M.BatteryState.STATUS_DISCHARGING
     M.BatteryState.model_validate(body)
-    assert list(body) == M.field_order(M.BatteryState)                # the ROS message's fields, in its order
+    assert list(body) == M.field_order(M.BatteryState)                # the ROS message's fields, in its order, then energy
     assert all(math.isnan(body[k]) for k in NAN_FIELDS)               # not modelled by Webots: not measured
     assert (body["power_supply_health"], body["power_supply_technology"], body["present"]) == (0, 0, True)
     assert (body["cell_voltage"], body["cell_temperature"], body["location"], body["serial_number"]) == (b"", b"", "", "")
@@ -194,6 +195,26 @@ def test_the_status_and_percentage_of_a_full_idle_empty_or_unbounded_battery(bat
     (_, _, body), = decoded(topics.publish(sim.time_ms))
     assert body["power_supply_status"] == status
     assert body["percentage"] == percentage or (math.isnan(percentage) and math.isnan(body["percentage"]))
+
+
+@pytest.mark.parametrize("battery", [[E0], [E0, 0.0], [E0, 0.0, 0.0]])
+def test_a_battery_without_a_maximum_carries_the_energy_the_sensor_reads(battery) -> None:
+    """Webots' sensor reads the battery's first value whatever else the field holds (WbRobot::currentEnergy):
+    the topic's ``energy`` is that number where ``percentage`` has no maximum to divide by."""
+    world = {"world_info": {"basic_time_step": DT}, "robots": [{"name": "r", "battery": battery, "cpu_consumption": P}]}
+    core = Core(sim_of(world), new_token=lambda: "s0", log=lambda *_: None)
+    ctl = Controller(core)
+    ctl.call("attach", {"robot": "r"})
+    core.subscription(SUB + b"/r/battery\0")
+    ctl.call("/r/robot/battery_sensor_enable", {"value": DT})
+    for n in range(1, 4):
+        ctl.step()
+        (_, _, body), = decoded(ctl.published)
+        ctl.published.clear()
+        value = ctl.call("/r/robot/battery_sensor_get_value")["value"]
+        assert value == pytest.approx(E0 - P * DT / 1000 * n, abs=1e-12)
+        assert body["energy"] == value and math.isnan(body["percentage"])
+    M.BatteryState.model_validate(body)
 
 
 def record_run(path, steps: int = 5) -> list[float]:

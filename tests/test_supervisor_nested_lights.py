@@ -322,3 +322,58 @@ def test_cameras_see_a_nested_lights_set_as_a_world_file_writing_it_there(tmp_pa
     want = image("PointLight { location 0.3 0 2 intensity 2 color 1 0.5 0.25 }")
     got = image(CARRIED, changed)
     assert got.tobytes() == want.tobytes() and got.tobytes() != lit.tobytes()
+
+
+SCALED_WBT = """#VRML_SIM R2023b utf8
+WorldInfo { basicTimeStep 8 }
+DEF PROBE Robot {
+  name "probe" supervisor TRUE controller "<extern>"
+  children [
+    LightSensor { rotation 0 1 0 -1.5707963267948966 name "ls" lookupTable [ 0 0 0, 100 100 0 ] }
+    LightSensor { translation 10 0 0 rotation 0 1 0 -1.5707963267948966 name "ls2" lookupTable [ 0 0 0, 100 100 0 ] }
+  ]
+}
+DEF CARRIER Robot {
+  translation 0 0 1 name "carrier" controller "<extern>"
+  children [
+    DEF GROW Transform {
+      translation 0 0 0.5 rotation 0 1 0 1.5707963267948966 scale 1 1 2
+      children [ DEF HEADLIGHT PointLight { location 0 0 0.25 intensity 2 attenuation 0 0 1 } ]
+    }
+  ]
+}
+DEF LAMP Solid {
+  translation 10 0 0 name "lamp"
+  children [
+    DEF BIG Transform { scale 2 2 2 children [ DEF BULB PointLight { location 0 0 0.5 intensity 3 attenuation 0 0 1 } ] }
+  ]
+}
+"""
+
+
+def test_lights_under_scaled_transforms_are_nodes_whose_location_is_set_through_the_scale(tmp_path):
+    """HEADLIGHT at (0, 0, 0.25) under GROW (scale 1 1 2, turned +90 degrees about y, 0.5 m up the robot at
+    z 1): (0, 0, 0.5) scaled, (0.5, 0, 0) turned, HEAD in the world; BULB at (0, 0, 0.5) under BIG (scale 2)
+    in the lamp at (10, 0, 0): (10, 0, 1). A location set is scaled the same way: HEADLIGHT's (0, 0, 0.5)
+    is (1, 0, 1.5), BULB's (0, 0, 1) is (10, 0, 2). A scaled Transform inside a solid is no node: BULB's
+    parent is the lamp, as a Shape's there."""
+    path = tmp_path / "scaled_lights.wbt"
+    path.write_text(SCALED_WBT)
+    lv = Live(Simulation(load_world(path)))
+    lv.ok(A, "attach", {"robot": "probe"})
+    bot = lv.sim.robot("probe")
+    bot.device("ls").enable(8)
+    bot.device("ls2").enable(8)
+    head, bulb_node, grow, lamp = (node(lv, n) for n in ("HEADLIGHT", "BULB", "GROW", "LAMP"))
+    assert head and bulb_node
+    assert call(lv, "get_from_id", {"id": head})["parent"] == grow and get(lv, grow, "children") == [head]
+    assert call(lv, "get_from_id", {"id": bulb_node})["parent"] == lamp and bulb_node in get(lv, lamp, "children")
+    assert get(lv, head, "location") == [0.0, 0.0, 0.25] and get(lv, bulb_node, "location") == [0.0, 0.0, 0.5]
+    assert readings(lv) == pytest.approx((point(HEAD, 2.0, LS) + bulb(LS), point(HEAD, 2.0, LS2) + bulb(LS2)),
+                                         rel=1e-12)
+    put(lv, head, "location", [0.0, 0.0, 0.5])
+    put(lv, bulb_node, "location", [0.0, 0.0, 1.0])
+    assert get(lv, head, "location") == [0.0, 0.0, 0.5] and get(lv, bulb_node, "location") == [0.0, 0.0, 1.0]
+    far = (10.0, 0.0, 2.0)
+    assert readings(lv) == pytest.approx((point((1.0, 0.0, 1.5), 2.0, LS) + point(far, 3.0, LS),
+                                          point((1.0, 0.0, 1.5), 2.0, LS2) + point(far, 3.0, LS2)), rel=1e-12)

@@ -1,13 +1,14 @@
 """Topic payloads (PROTOCOL.md §4): ROS 2 message shapes as pydantic models.
 
 Field names and order are those of ``sensor_msgs``/``std_msgs``/``builtin_interfaces``/
-``rosgraph_msgs``/``geometry_msgs`` (wire.md §1); arrays travel as little-endian raw bytes (``bytes`` fields, dtype
-named in each field's description). The server builds plain dicts in this order on its hot path;
+``rosgraph_msgs``/``geometry_msgs`` (wire.md §1; BatteryState adds one of its own last, ``energy``); arrays
+travel as little-endian raw bytes (``bytes`` fields, dtype named in each field's description). The server builds plain dicts in this order on its hot path;
 these models are the contract (JSON Schema export, tests, clients that want validation).
 """
 
 from __future__ import annotations
 
+import math
 from typing import ClassVar
 
 from pydantic import BaseModel, ConfigDict, Field
@@ -290,7 +291,8 @@ class BatteryState(Msg):
     ``percentage`` is the energy ÷ the maximum (NaN without a positive maximum); Webots models no
     voltage, current, charge in Ah, temperature or cells, so those are NaN (the ROS message's "not
     measured") or empty; ``power_supply_status`` says CHARGING while a Charger gives it energy, FULL
-    at its maximum, DISCHARGING while it loses energy to ``cpuConsumption``, NOT_CHARGING otherwise."""
+    at its maximum, DISCHARGING while it loses energy to ``cpuConsumption``, NOT_CHARGING otherwise. Last,
+    ``energy`` (J), not ROS's: the battery sensor's value, which a battery without a maximum has too."""
 
     STATUS_CHARGING: ClassVar[int] = 1
     STATUS_DISCHARGING: ClassVar[int] = 2
@@ -314,6 +316,10 @@ class BatteryState(Msg):
     cell_temperature: bytes = Field(description="<f4[]: empty")
     location: str = ""
     serial_number: str = ""
+    energy: float = Field(default=math.nan,
+                          description="J: Sensorium's own field (ROS's message has none in joules, so the ROS 2 export "
+                                      "and Foxglove's CDR leave it out): the energy at the sample, what "
+                                      "battery_sensor_get_value reads then, with or without a maximum")
 
 
 class Envelope(Msg):

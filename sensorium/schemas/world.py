@@ -618,6 +618,10 @@ class LightNode(Strict):
     after: int = Field(default=-1, ge=-1, description="its place among its parent's children, as a Shape's `after`")
     frame: Pose = Field(default=Pose(), description="its parent's frame in the robot's or solid's frame: "
                         "`location` and `direction` are the fields placed by it")
+    linear: list[float] | None = Field(default=None, min_length=9, max_length=9,
+                                       description="under a scaled Transform: the scale its parent's frame applies "
+                                       "before `frame` (row-major, in that frame's axes), so that `location` is "
+                                       "placed at frame(linear · location); None: unscaled")
     aim: Pose | None = Field(default=None, description="a spot light's: the rotation turning `direction` into "
                              "`light_sensor_direction` (the nearest Pose's or Solid's own); None: it has none")
     location: Vec3 | None = Field(default=None, description="the field as written (its parent's frame)")

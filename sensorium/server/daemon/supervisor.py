@@ -546,7 +546,7 @@ def _light(sim: Any, node: Node) -> Any:
 
 def _set_carried_light(sim: Any, node: Node, attr: str, changed: Any) -> None:
     """A nested light's field set: ``changed`` (its fields as read, :func:`_light`) placed in its owner's
-    frame by its parent's (``LightNode.frame``), a spot light's light-sensor axis turned by ``LightNode.aim``
+    frame by its parent's (``LightNode.frame``, after its ``linear`` scale), a spot light's light-sensor axis turned by ``LightNode.aim``
     (the .wbt import's rule, sim/scene.py ``sensor_aimed``); the other fields as set."""
     stored = _carried_model(sim, node)
     info = stored.node
@@ -558,7 +558,10 @@ def _set_carried_light(sim: Any, node: Node, attr: str, changed: Any) -> None:
         frame = pose_from_model(info.frame)
         update: dict[str, Any] = {}
         if attr == "location":
-            update["location"] = tuple(float(v) for v in frame.apply(np.asarray(value, dtype=np.float64)))
+            local = np.asarray(value, dtype=np.float64)
+            if info.linear is not None:         # under a scaled Transform: scaled first, as the import placed it
+                local = np.asarray(info.linear, dtype=np.float64).reshape(3, 3) @ local
+            update["location"] = tuple(float(v) for v in frame.apply(local))
         elif changed.type == "SpotLight":        # a directional light's direction is in world axes (Webots)
             update["direction"] = tuple(float(v) for v in frame.apply_dirs(np.asarray(value, dtype=np.float64)))
             if info.aim is not None:
@@ -2116,7 +2119,13 @@ def _import_into_solid(sim: Any, node: Node, position: int, text: str, warnings:
     until ``simulationReset`` takes them out (:func:`reset_nested_imports`). Returns the new top nodes' ids. What
     does not parse or build changes nothing (one line)."""
     from sensorium.server.sim.imports import ImportRefused
-    from sensorium.server.sim.regenerate import IMPORT_LINES, parse_nested_import, rebuild_children, written_node
+    from sensorium.server.sim.regenerate import (
+        IMPORT_LINES,
+        parse_nested_import,
+        rebuild_children,
+        written_children,
+        written_node,
+    )
 
     table = _table(sim)
     key, owner = _solid_key(sim, node)
@@ -2132,8 +2141,7 @@ def _import_into_solid(sim: Any, node: Node, position: int, text: str, warnings:
     serial = getattr(sim, "_nested_import_serial", 0) + 1
     try:
         nodes = parse_nested_import(sim, key, text, serial)
-        children = holder.fields.get("children", [])
-        index = insert_index(position, len(children) if isinstance(children, list) else 1)
+        index = insert_index(position, len(written_children(holder)))
         corrected: list[str] = []
         made = _rebuilt_in_place(sim, key, lambda: rebuild_children(
             sim, key, owner, at, lambda now: [*now[:index], *nodes, *now[index:]], corrected))

@@ -199,12 +199,14 @@ _SUPPLY_STATUS = {"charging": msgs.BatteryState.STATUS_CHARGING, "discharging": 
 def battery_state_msg(hdr: dict, energy: float, maximum: float, state: str) -> dict:
     """``sensor_msgs/BatteryState`` of a battery sample: ``percentage`` the energy ÷ the maximum (NaN
     without a positive maximum); what Webots does not model (voltage, current, charge and capacities in
-    Ah, temperature, cells) NaN or empty, health and technology unknown (0)."""
+    Ah, temperature, cells) NaN or empty, health and technology unknown (0); ``energy`` the J themselves
+    (Webots' sensor value: a battery without a maximum has one too)."""
     nan = math.nan
     return {"header": hdr, "voltage": nan, "temperature": nan, "current": nan, "charge": nan, "capacity": nan,
             "design_capacity": nan, "percentage": energy / maximum if maximum > 0.0 else nan,
             "power_supply_status": _SUPPLY_STATUS[state], "power_supply_health": 0, "power_supply_technology": 0,
-            "present": True, "cell_voltage": b"", "cell_temperature": b"", "location": "", "serial_number": ""}
+            "present": True, "cell_voltage": b"", "cell_temperature": b"", "location": "", "serial_number": "",
+            "energy": energy}
 
 
 def laser_scan_angles(cfg: Any) -> tuple[float, float, float] | None:

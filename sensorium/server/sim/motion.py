@@ -12,6 +12,7 @@ import math
 import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -61,6 +62,7 @@ class WheelMotor:
     target_position: float = 0.0        # Webots' default: position control at 0 ...
     velocity: float = math.nan          # ... at maxVelocity (set in __post_init__)
     position: float = 0.0               # wheel angle (rad), integrated
+    initial_position: float = 0.0       # its angle as loaded (a state's "__init__"), as a JointMotor's
 
     def __post_init__(self) -> None:
         if math.isnan(self.velocity):
@@ -194,6 +196,9 @@ class PlanarState:
     direction's in the world, about the world's up, and ``base`` what is left of the rotation, so the
     pose ``Rz(yaw) @ base`` is the robot's own rotation whichever of its axes is forward and whichever
     is up: an upright robot, z-up or y-up, turns about the world's up and rolls in the ground plane."""
+
+    free_turned: dict[Any, float] | None = None
+    """The rolled angles of its free wheels (a car's by key, a steered drive's by index); None: it has none."""
 
     def __init__(self, pose: Pose, up: str = "ENU", ground: Ground | None = None, band_low: float = 0.0,
                  forward: tuple[float, ...] | None = None):

@@ -225,7 +225,8 @@ def _frame(node: ParsedNode, frame: Frame) -> Frame | None:
     return frame.then(translation, rotation, _UNIT)
 
 
-def _children(node: ParsedNode) -> list[Any]:
+def written_children(node: ParsedNode) -> list[Any]:
+    """The nodes written in ``node``'s ``children`` (a lone node written without brackets: a list of one)."""
     value = node.fields.get("children", [])
     return value if isinstance(value, list) else [value]
 
@@ -257,7 +258,7 @@ def _path(top: ParsedNode, at: tuple[int, int]) -> list[ParsedNode] | None:
         path = stack.pop()
         if (path[-1].line, path[-1].col) == at:
             return path
-        stack += [[*path, c] for c in _children(path[-1])
+        stack += [[*path, c] for c in written_children(path[-1])
                   if isinstance(c, ParsedNode) and c.type in ("Pose", "Transform", "Group")]
     return None
 
@@ -283,7 +284,7 @@ def _placed(top: ParsedNode, at: tuple[int, int]) -> tuple[dict, dict] | None:
     walk = [(node, frame)]
     while walk:
         parent, inner = walk.pop()
-        for child in _children(parent):
+        for child in written_children(parent):
             if not isinstance(child, ParsedNode):
                 return None
             if child.type == "Shape":
@@ -411,7 +412,7 @@ def _grown(node: ParsedNode, at: tuple[int, int], change: Any) -> ParsedNode | N
     """``node`` with the ``children`` of the node written at ``at`` changed by ``change`` (its list -> the new
     list), or None when no node inside it is written there."""
     def grown(n: ParsedNode) -> ParsedNode:
-        return replace(n, fields={**n.fields, "children": change(list(_children(n)))})
+        return replace(n, fields={**n.fields, "children": change(list(written_children(n)))})
     return _edited(node, at, grown)
 
 

@@ -87,7 +87,7 @@ def _now(sim: Any, scope: Scope) -> State:
         pose = drive.own_pose() if drive is not None and drive.slope is not None else \
             robot.pose if frame is None else frame
     motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
-    turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
+    turned = _free_turned(sim, scope)
     return State(pose, tuple(float(motors[m].position) for m in scope.motors),
                  dict(turned) if turned is not None else None, _riders(sim, scope, loaded=False),
                  _markers(sim, scope, loaded=False))
@@ -101,9 +101,9 @@ def _initial(sim: Any, scope: Scope) -> State:
         frame = _rider_frame(sim, sim.robots[scope.robot], loaded=True)
         pose = sim.robots[scope.robot].initial_pose if frame is None else frame
     motors = sim.robots[scope.robot].motors if scope.robot is not None else {}
-    turned = getattr(sim.robots[scope.robot].drive, "free_turned", None) if scope.own_pose else None
+    turned = _free_turned(sim, scope)
     # a joint motor's initial position is the world file's; a wheel's angle starts at 0
-    return State(pose, tuple(float(getattr(motors[m], "initial_position", 0.0)) for m in scope.motors),
+    return State(pose, tuple(float(motors[m].initial_position) for m in scope.motors),
                  dict.fromkeys(turned, 0.0) if turned is not None else None, _riders(sim, scope, loaded=True),
                  _markers(sim, scope, loaded=True))
 
@@ -134,7 +134,7 @@ def _restore(sim: Any, scope: Scope, state: State) -> None:
         for name, frame in (state.riders or {}).items():
             sim.set_rider_frame(sim.robots[name], frame)
         for name, frame in (state.markers or {}).items():
-            ride = getattr(sim, "solid_riders", {}).get(name)
+            ride = sim.solid_riders.get(name)
             if ride is not None and ride[0] is robot:       # (removed since: gone)
                 sim.ride_solid(name, scope.robot, frame)
     for name in scope.leds:
@@ -146,16 +146,15 @@ def _restore(sim: Any, scope: Scope, state: State) -> None:
 def _riders(sim: Any, scope: Scope, loaded: bool) -> dict[str, Pose] | None:
     """A robot's riders' frames on it (``loaded``: as the world file put them): Webots' state of a node covers
     the fields of the nodes below it, a rider's translation and rotation among them."""
-    riders = getattr(sim, "riders_of", None)
-    if not scope.own_pose or riders is None:
+    if not scope.own_pose:
         return None
-    return {r.name: sim.rider_frame(r, loaded) for r in riders(sim.robots[scope.robot])} or None
+    return {r.name: sim.rider_frame(r, loaded) for r in sim.riders_of(sim.robots[scope.robot])} or None
 
 
 def _markers(sim: Any, scope: Scope, loaded: bool) -> dict[str, Pose] | None:
     """The frames on a robot of the shapes a Supervisor imported into its children (``loaded``: as imported):
     their translation and rotation are fields below it, in its state as a rider's are."""
-    riders = getattr(sim, "solid_riders", None)
+    riders = sim.solid_riders
     if not scope.own_pose or not riders:
         return None
     robot = sim.robots[scope.robot]
@@ -165,5 +164,11 @@ def _markers(sim: Any, scope: Scope, loaded: bool) -> dict[str, Pose] | None:
 
 def _rider_frame(sim: Any, robot: Any, loaded: bool = False) -> Any:
     """A robot riding another: its frame on its carrier (Simulation.rider_frame); None otherwise."""
-    frame = getattr(sim, "rider_frame", None)
-    return None if frame is None else frame(robot, loaded)
+    return sim.rider_frame(robot, loaded)
+
+
+def _free_turned(sim: Any, scope: Scope) -> dict[str | int, float] | None:
+    """The rolled angles of the free wheels of the robot the node is (PlanarState.free_turned); None for any
+    other node, and for a robot whose drive has none."""
+    drive = sim.robots[scope.robot].drive if scope.own_pose else None
+    return None if drive is None else drive.free_turned

@@ -247,7 +247,7 @@ def _unserved_why(kind: str) -> str:
     if kind in _PHYSICS_ONLY:
         return f"a {kind} node: physics only, which Sensorium does not simulate (no Supervisor node here)"
     if kind in LIGHTS:
-        return f"a {kind} under a scaled Transform, which Sensorium serves no Supervisor node for"
+        return f"a {kind} where Sensorium serves no Supervisor node for it"
     if kind in GEOMETRIES:
         return (f"a {kind} geometry of no visible Shape (a boundingObject's: Sensorium serves the geometries of "
                 "visible shapes only)")
@@ -1549,10 +1549,13 @@ class Converter:
     def light_node(self, node: Node, frame: Frame, owner: Owner, data: dict, written: dict) -> None:
         """A light inside a robot or solid as the Supervisor node it is (schemas.world.LightNode): its DEF,
         its place among its parent's children, its parent's frame and its fields as written. One under a
-        scaled Transform is none (its fields no longer map to its place rigidly)."""
-        if not frame.rigid or (owner.kind == "robot" and self.tree is None):
+        scaled Transform keeps the scale (``linear``) that places a location set; its parent is the nearest
+        node above it, as a Shape's (a scaled Transform is no node inside a solid, nor is a Pose under one)."""
+        if owner.kind == "robot" and self.tree is None:
             return
         entry: dict[str, Any] = {"frame": frame.pose(), **written}
+        if not frame.rigid:
+            entry["linear"] = [float(v) for v in frame.linear().ravel()]
         if "light_sensor_direction" in data and frame.own_rotation is not None:
             entry["aim"] = {"quaternion": list(matrix_quaternion(frame.own_rotation))}
         if owner.kind == "robot":
