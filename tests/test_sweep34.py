@@ -1,0 +1,154 @@
+"""Sweep 34: Webots' ``projects/languages/matlab`` world ``e-puck_matlab``, not run before, on a stand-in world
+of ours (tests/data/sweep34/: the sample's arena, boxes and cylinder where it puts them, sweep 22's E-puck with
+the 52 x 39 Display in its turret slot, the Supervisor's Emitter and Receiver on channel 1) driven in process
+by the calls its two controllers make (``matlab.m`` on the e-puck, ``e-puck_position_supervisor.c`` on the
+Supervisor) and checked against closed forms."""
+
+from __future__ import annotations
+
+import math
+import struct
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_supervisor import A, Live
+
+from sensorium.client.wb_display import WB_IMAGE_RGB, _to_bgra
+from sensorium.server.sim.simulation import Simulation
+from sensorium.server.world.loader import load_world
+
+DATA = Path(__file__).parent / "data"
+WORLD = DATA / "sweep34" / "e-puck_matlab.wbt"
+EPUCK = "e-puck camera"
+SUPERVISOR = "robot"
+START = (-0.616022, 0.463251, 5.85439)       # the e-puck's place and heading in the world file
+WHEEL_RADIUS = 0.02                          # the stand-in's (and Webots' bounding) wheel radius
+SPEED_UNIT = 0.00628                         # matlab.m
+BRAITENBERG = [(150, -35), (100, -15), (80, -10), (-10, -10), (-10, -10), (-10, 80), (-30, 100), (-20, 150)]
+
+
+def braitenberg(values: list[float]) -> tuple[float, float]:
+    """matlab.m's wheel speeds (rad/s) for the eight distance readings: (1 − v/500) · matrix · 5, each capped
+    at 1000 units, times SPEED_UNIT."""
+    speed = [sum((1 - v / 500) * row[j] for v, row in zip(values, BRAITENBERG)) * 5 for j in range(2)]
+    return SPEED_UNIT * min(speed[0], 1000), SPEED_UNIT * min(speed[1], 1000)
+
+
+def datestr(step: int) -> bytes:
+    """The e-puck's packet: MATLAB's ``uint8([datestr(now) 0])``, a null-terminated 20-character date
+    (a fixed date here, its seconds the step's count)."""
+    return b"08-Dec-2026 00:%02d:%02d\0" % (step // 60 % 60, step % 60)
+
+
+def test_the_e_puck_matlab_world_loads_with_the_turret_display_and_the_supervisors_radio() -> None:
+    """One load line (the arena's built-in stand-in); the e-puck's 36 devices and the turret's 52 × 39 Display
+    ("display", the size of the camera whose inverse it shows), both radios on channel 1 on either robot."""
+    w = load_world(WORLD)
+    assert len(w.warnings) == 1 and "RectangleArena" in w.warnings[0]
+    assert [r.name for r in w.world.robots] == [EPUCK, SUPERVISOR]
+    sim = Simulation(w, "exact")
+    display, camera = sim.device(f"{EPUCK}/display"), sim.device(f"{EPUCK}/camera")
+    assert (display.width, display.height, camera.config.width, camera.config.height) == (52, 39, 52, 39)
+    for robot in (EPUCK, SUPERVISOR):
+        assert sim.device(f"{robot}/emitter").channel == sim.device(f"{robot}/receiver").channel == 1
+    pose = sim.robot(EPUCK).pose
+    assert list(pose.translation) == pytest.approx([*START[:2], 0.0], abs=1e-12)
+
+
+class Supervisor:
+    """e-puck_position_supervisor.c's calls, in process: every 320 ms it sends the e-puck's ``translation``
+    as three doubles and shows each string it received as label 0 (a C string: up to its NUL)."""
+
+    def __init__(self, sim: Simulation) -> None:
+        self.lv = Live(sim)
+        self.lv.ok(A, "attach", {"robot": SUPERVISOR})
+        node = self.lv.ok(A, f"/{SUPERVISOR}/robot/get_from_def", {"name": "E_PUCK"})["node"]
+        self.trans = {"node": node, "field": "translation"}
+        self.emitter = sim.device(f"{SUPERVISOR}/emitter")
+        self.receiver = sim.device(f"{SUPERVISOR}/receiver")
+        self.receiver.enable(320)
+        self.labels: list[str] = []
+
+    def step(self) -> list[float]:
+        pos = self.lv.ok(A, f"/{SUPERVISOR}/robot/get_field", self.trans)["value"]
+        assert self.emitter.send(struct.pack("<3d", *pos))
+        for packet in self.receiver.take():
+            text = packet.data.split(b"\0", 1)[0].decode()
+            self.lv.ok(A, f"/{SUPERVISOR}/robot/set_label", {"id": 0, "text": text, "x": 0.01, "y": 0.01,
+                                                                "size": 0.1, "color": 0, "transparency": 0.0,
+                                                                "font": "Arial"})
+            self.labels.append(text)
+        return pos
+
+
+def test_the_matlab_controller_drives_straight_shows_the_inverse_image_and_hears_the_supervisor() -> None:
+    """matlab.m's calls for 6.4 s (64 ms steps; the Supervisor's every 320 ms), the e-puck meeting nothing:
+    its eight distance sensors read 67.19 (nothing within their range), so both wheels turn at the capped
+    1000 units, 6.28 rad/s, and it drives straight along its heading at 0.1256 m/s from the first step
+    (1e-12 each step). Each step its Display shows the camera's image inverted (255 − r, g, b, opaque:
+    WB_IMAGE_RGB pasted without blending) with the two black gunsight lines, row 19 and column 25, pixel for
+    pixel. The Supervisor reads the e-puck's translation every 320 ms and the e-puck gets those three
+    doubles at its next step (the packet leaves at the next basic step); the Supervisor gets every date
+    string the e-puck sent, in order, each shown as label 0 up to its NUL."""
+    sim = Simulation(load_world(WORLD), "exact")
+    sup = Supervisor(sim)
+    ps = [sim.device(f"{EPUCK}/ps{i}") for i in range(8)]
+    for d in ps:
+        d.enable(64)
+    display, camera = sim.device(f"{EPUCK}/display"), sim.device(f"{EPUCK}/camera")
+    camera.enable(64)
+    emitter, receiver = sim.device(f"{EPUCK}/emitter"), sim.device(f"{EPUCK}/receiver")
+    receiver.enable(64)
+    bot = sim.robot(EPUCK)
+    left, right = bot.motor("left wheel motor"), bot.motor("right wheel motor")
+    for m in (left, right):
+        m.set_position(math.inf)
+        m.set_velocity(0.0)
+    display.apply(display.check([["color", 0x000000]]), 0)
+    x0, y0, heading = START
+    sent: list[bytes] = []
+    told: list[tuple[int, list[float]]] = []        # (time the Supervisor read it, translation)
+    heard: list[tuple[int, list[float]]] = []
+    speed = 0.0
+    moving_since = 0
+    for step in range(1, 101):
+        for _ in range(2):                          # two basic steps of 32 ms
+            sim.step()
+            if sim.time_ms % 320 == 0:
+                told.append((sim.time_ms, sup.step()))
+        travelled = speed * WHEEL_RADIUS * (sim.time_ms - moving_since) / 1000.0
+        want = [x0 + travelled * math.cos(heading), y0 + travelled * math.sin(heading)]
+        assert list(bot.pose.translation[:2]) == pytest.approx(want, abs=1e-12), step
+        assert emitter.send(datestr(step))
+        sent.append(datestr(step))
+        values = [d.value for d in ps]
+        assert values == pytest.approx([67.19] * 8, abs=0.01), step
+        bgra = np.asarray(camera.image, dtype=np.uint8).reshape(39, 52, 4)
+        rgb = np.ascontiguousarray(bgra[:, :, 2::-1])                # wb_camera_get_image's RGB, as MATLAB's
+        inverse = 255 - rgb
+        display.apply(display.check([["load", 1, 52, 39, _to_bgra(inverse.tobytes(), WB_IMAGE_RGB, 52 * 39)],
+                                     ["paste", 1, 0, 0, False], ["delete", 1],
+                                     ["line", 0, 19, 51, 19], ["line", 25, 0, 25, 38]]), sim.time_ms)
+        words = (0xFF << 24) | (inverse[:, :, 0].astype(np.uint32) << 16) \
+            | (inverse[:, :, 1].astype(np.uint32) << 8) | inverse[:, :, 2].astype(np.uint32)
+        words[19, :] = 0xFF000000
+        words[:, 25] = 0xFF000000
+        assert (np.asarray(display.pixels, dtype=np.uint32).reshape(39, 52) == words).all(), step
+        for packet in receiver.take():
+            heard.append((sim.time_ms, list(struct.unpack("<3d", packet.data))))
+        v_left, v_right = braitenberg(values)
+        assert (v_left, v_right) == (SPEED_UNIT * 1000, SPEED_UNIT * 1000) == (6.28, 6.28)
+        if speed == 0.0:
+            speed, moving_since = v_left, sim.time_ms
+        left.set_velocity(v_left)
+        right.set_velocity(v_right)
+    assert speed * WHEEL_RADIUS == pytest.approx(0.1256, abs=1e-15)
+    # the Supervisor's positions, each heard by the e-puck at its step after the Supervisor's (to 1e-15)
+    assert len(told) == 20 and [t for t, _ in heard] == [t + 64 for t, _ in told[:-1]]
+    for (t, pos), (_, got) in zip(told, heard):
+        travelled = 0.1256 * (t - 64) / 1000.0
+        assert got == pos == pytest.approx([x0 + travelled * math.cos(heading), y0 + travelled * math.sin(heading),
+                                            0.0], abs=1e-12), t
+    # every date string the e-puck sent up to the Supervisor's last step, in order, each label 0's text
+    assert sup.labels == [s[:-1].decode() for s in sent[:len(sup.labels)]] and len(sup.labels) >= 95
