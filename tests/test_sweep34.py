@@ -152,3 +152,30 @@ def test_the_matlab_controller_drives_straight_shows_the_inverse_image_and_hears
                                             0.0], abs=1e-12), t
     # every date string the e-puck sent up to the Supervisor's last step, in order, each label 0's text
     assert sup.labels == [s[:-1].decode() for s in sent[:len(sup.labels)]] and len(sup.labels) >= 95
+
+
+def test_a_python_supervisor_showing_a_received_c_string_labels_it_up_to_its_nul(monkeypatch) -> None:
+    """A Python Supervisor making e-puck_position_supervisor.c's calls passes ``Receiver.getString()`` (the
+    packet's bytes, the sender's NUL kept, as Webots' Python gives them) to ``setLabel``. Webots hands the
+    str to libController as a C string, so the label reads up to the NUL; the client sent the NUL on and the
+    server refused the label ("only characters 32..127"), one error line per packet and no label shown. Now
+    the client cuts text (and font) at the first NUL, and the server takes the label."""
+    from types import SimpleNamespace
+
+    from sensorium.client import wb_supervisor
+    from sensorium.server.sim import viewshot
+
+    sent: list[dict] = []
+    fake = SimpleNamespace(supervisor=True, name=SUPERVISOR)
+    monkeypatch.setattr(wb_supervisor, "current", lambda: fake)
+    monkeypatch.setattr(wb_supervisor, "_call", lambda r, item, args=None: sent.append(args) or {"success": True})
+    text = datestr(7).decode()
+    assert text.endswith("\0")
+    wb_supervisor.wb_supervisor_set_label(0, text, 0.01, 0.01, 0.1, 0x000000, 0.0, "Arial\0Bold")
+    (args,) = sent
+    assert (args["text"], args["font"]) == ("08-Dec-2026 00:00:07", "Arial")
+    labels = viewshot.Labels()
+    labels.set(**{k: args[k] for k in ("id", "text", "x", "y", "size", "color", "transparency", "font")})
+    assert [label.text for _, label in labels.items()] == ["08-Dec-2026 00:00:07"]
+    with pytest.raises(ValueError, match="only characters 32..127"):        # what the server said before
+        labels.set(0, text, 0.01, 0.01, 0.1, 0, 0.0, "Arial")
