@@ -179,3 +179,129 @@ def test_a_python_supervisor_showing_a_received_c_string_labels_it_up_to_its_nul
     assert [label.text for _, label in labels.items()] == ["08-Dec-2026 00:00:07"]
     with pytest.raises(ValueError, match="only characters 32..127"):        # what the server said before
         labels.set(0, text, 0.01, 0.01, 0.1, 0, 0.0, "Arial")
+
+
+MATLAB_CONTROLLER = '''
+# matlab.m's calls in Python (our own text): the distance sensors, the camera's inverse on the turret's
+# Display with its gunsight lines, a date string to the Supervisor each step, its positions read back, and
+# the Braitenberg wheel speeds; it prints the positions it hears and each 25th step's readings.
+import struct
+from controller import Display, Robot
+
+BRAITENBERG = [(150, -35), (100, -15), (80, -10), (-10, -10), (-10, -10), (-10, 80), (-30, 100), (-20, 150)]
+robot = Robot()
+ps = [robot.getDevice(f"ps{i}") for i in range(8)]
+for p in ps:
+    p.enable(64)
+display = robot.getDevice("display")
+display.setColor(0x000000)
+camera = robot.getDevice("camera")
+camera.enable(64)
+emitter, receiver = robot.getDevice("emitter"), robot.getDevice("receiver")
+receiver.enable(64)
+left, right = robot.getDevice("left wheel motor"), robot.getDevice("right wheel motor")
+for m in (left, right):
+    m.setPosition(float("inf"))
+    m.setVelocity(0.0)
+print("Hello!", flush=True)
+step = 0
+while robot.step(64) != -1:
+    step += 1
+    emitter.send(b"08-Dec-2026 00:%02d:%02d\\0" % (step // 60 % 60, step % 60))
+    values = [p.getValue() for p in ps]
+    w, h, image = camera.getWidth(), camera.getHeight(), camera.getImage()
+    inverse = bytes(255 - image[4 * i + c] for i in range(w * h) for c in (2, 1, 0))
+    ref = display.imageNew(inverse, Display.RGB, w, h)
+    display.imagePaste(ref, 0, 0, False)
+    display.imageDelete(ref)
+    display.drawLine(0, 19, 51, 19)
+    display.drawLine(25, 0, 25, 38)
+    while receiver.getQueueLength() > 0:
+        print("heard %d %r %r %r" % (round(robot.getTime() * 1000), *struct.unpack("3d", receiver.getBytes())),
+              flush=True)
+        receiver.nextPacket()
+    speed = [min(sum((1 - v / 500) * row[j] for v, row in zip(values, BRAITENBERG)) * 5, 1000) for j in range(2)]
+    if step % 25 == 0:
+        copy = display.imageCopy(0, 0, w, h)
+        display.imageSave(copy, f"display_{step}.png")
+        display.imageDelete(copy)
+        print("step", step, *(f"{v:.2f}" for v in values), *speed, flush=True)
+    left.setVelocity(0.00628 * speed[0])
+    right.setVelocity(0.00628 * speed[1])
+'''
+
+
+@pytest.mark.slow
+def test_the_controllers_run_the_straight_drive_under_sensorium_run(tmp_path: Path) -> None:
+    """Our Python text of matlab.m on the e-puck and the Supervisor's C calls (Webots'
+    e-puck_position_supervisor.c from $WEBOTS_HOME, unchanged, else tests/c/epuck_position_supervisor.c) built
+    against our libController, under ``sensorium run`` for 8 s: no error line; the Supervisor sends the
+    e-puck's translation on the closed form's straight line at 0.1256 m/s (1e-12), which the e-puck hears one
+    step later; label 0 shows each date string the e-puck sent, in order (the C string up to its NUL); the
+    wheels stay at the capped 1000 units while the sensors read 67.19; the Display's saved images are the
+    inverted camera under black gunsight lines."""
+    import os
+    import shutil
+    import subprocess
+
+    from _serve import child_env, sensorium
+    from PIL import Image
+
+    if shutil.which("cc") is None or shutil.which("make") is None:
+        pytest.skip("needs a C toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
+    clib = Path(__file__).parent.parent / "sensorium" / "client" / "c"
+    build = tmp_path / "cbuild"
+    done = subprocess.run(["make", "-s", "-C", str(clib), f"BUILD={build}"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    libs = subprocess.run(["make", "-s", "-C", str(clib), "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+    webots = Path(os.environ.get("WEBOTS_HOME") or "/nonexistent") / "projects" / "languages" / "matlab" / \
+        "controllers" / "e-puck_position_supervisor" / "e-puck_position_supervisor.c"
+    source = webots if webots.is_file() else Path(__file__).parent / "c" / "epuck_position_supervisor.c"
+    folder = tmp_path / "controllers" / "e-puck_position_supervisor"
+    folder.mkdir(parents=True)
+    done = subprocess.run(["cc", "-std=c99", f"-I{clib / 'include'}", str(source), "-o",
+                           str(folder / "e-puck_position_supervisor"), str(build / "libController.a"), *libs, "-lm"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    (tmp_path / "controllers" / "matlab").mkdir()
+    (tmp_path / "controllers" / "matlab" / "matlab.py").write_text(MATLAB_CONTROLLER)
+    for folder_name in ("sweep34", "sweep22"):
+        shutil.copytree(DATA / folder_name, tmp_path / folder_name)
+    world = tmp_path / "sweep34" / "e-puck_matlab.wbt"
+    head, tail = world.read_text().split('controller "<extern>"', 1)
+    world.write_text(head + 'controller "matlab"' + tail.replace('controller "<extern>"',
+                                                                 'controller "e-puck_position_supervisor"'))
+    run = subprocess.run(sensorium("run", str(world), "--until", "8000", "--rpc", "tcp://127.0.0.1:0",
+                                   "--pub", "tcp://127.0.0.1:0"),
+                         env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert "Error" not in run.stdout + run.stderr and "Traceback" not in run.stderr, run.stderr[-2000:]
+    lines = run.stdout.splitlines()
+    epuck = [ln.split("] ", 1)[1] for ln in lines if ln.startswith(f"[{EPUCK}] ")]
+    sup = [ln.split("] ", 1)[1] for ln in lines if ln.startswith("[robot] ")]
+    assert epuck[0] == "Hello!"
+    x0, y0, heading = START
+
+    def on_line(t_ms: float) -> list[float]:
+        travelled = 0.1256 * (t_ms - 64) / 1000.0
+        return [x0 + travelled * math.cos(heading), y0 + travelled * math.sin(heading), 0.0]
+
+    sent = [[float(v) for v in ln.split()[1:]] for ln in sup if ln.startswith("sent")]
+    assert [s[0] for s in sent] == [1600.0, 3200.0, 4800.0, 6400.0, 8000.0]
+    for t, *pos in sent:
+        assert pos == pytest.approx(on_line(t), abs=1e-12), t
+    heard = [[float(v) for v in ln.split()[1:]] for ln in epuck if ln.startswith("heard")]
+    assert [h[0] for h in heard] == [320.0 * k + 64 for k in range(1, 25)]
+    for t, *pos in heard:
+        assert pos == pytest.approx(on_line(t - 64), abs=1e-12), t
+    labels = [ln.split(" ", 2)[1:] for ln in sup if ln.startswith("label")]
+    assert len(labels) >= 5 and all(text == datestr(int(n)).decode()[:-1] for n, text in labels), labels
+    steps = [ln.split()[1:] for ln in epuck if ln.startswith("step")]
+    assert [int(s[0]) for s in steps] == [25, 50, 75, 100, 125]
+    assert all(s[1:9] == ["67.19"] * 8 and s[9:] == ["1000", "1000"] for s in steps), steps
+    for k in (25, 125):
+        with Image.open(tmp_path / "controllers" / "matlab" / f"display_{k}.png") as im:   # its own folder
+            shown = np.asarray(im.convert("RGB"))
+        assert shown.shape == (39, 52, 3)
+        assert (shown[19] == 0).all() and (shown[:, 25] == 0).all()
+        assert shown.mean() > 0
