@@ -305,3 +305,107 @@ def test_the_controllers_run_the_straight_drive_under_sensorium_run(tmp_path: Pa
         assert shown.shape == (39, 52, 3)
         assert (shown[19] == 0).all() and (shown[:, 25] == 0).all()
         assert shown.mean() > 0
+
+
+# ------------------------------------------------------------------------------------------------ cpp example
+# example (projects/languages/cpp, R2023b): three MyBots (wheels r 0.025 m, 0.09 m apart) running slave.cpp
+# (32 ms; mode "avoid obstacles" at first: 5 ± 0.1·(ds0 − ds1) rad/s, "move forward" 10, "turn" 5/−5, "stop"),
+# the `driver` Supervisor (128 ms) sending the order of the key pressed, null-terminated, and 'R' moving
+# ROBOT1 to (−0.3, −0.1). No key can be pressed headless: the orders are sent here at the driver's steps.
+CPP_WORLD = DATA / "sweep34" / "example_cpp.wbt"
+SLAVES = {"robot1": (-0.140251, 0.362306, -0.221754), "robot2": (-0.511288, -0.288898, -2.67372),
+          "robot3": (0.0, -0.15, 2.54759)}
+ORDERS = {512: b"move forward", 1024: b"turn", 1536: b"stop", 2560: b"avoid obstacles"}
+
+
+def slave_speeds(mode: str, ds0: float, ds1: float) -> tuple[float, float]:
+    """slave.cpp's wheel speeds in ``mode``."""
+    delta = ds0 - ds1
+    return {"avoid obstacles": (min(10.0, max(-10.0, 5 + 0.1 * delta)), min(10.0, max(-10.0, 5 - 0.1 * delta))),
+            "move forward": (10.0, 10.0), "turn": (5.0, -5.0), "stop": (0.0, 0.0)}[mode]
+
+
+def test_the_cpp_example_world_loads_its_three_slaves_and_the_driver() -> None:
+    """One load line (the arena's built-in stand-in); three two-wheel MyBots where the world puts them and
+    the Driver with its Emitter, every receiver on channel 0 as the emitter."""
+    w = load_world(CPP_WORLD)
+    assert len(w.warnings) == 1 and "CircleArena" in w.warnings[0]
+    sim = Simulation(w, "exact")
+    assert [r.name for r in w.world.robots] == [*SLAVES, "Driver"]
+    for name, (x, y, heading) in SLAVES.items():
+        pose = sim.robot(name).pose
+        assert list(pose.translation) == pytest.approx([x, y, 0.0], abs=1e-12)
+        assert math.atan2(pose.rotation[1, 0], pose.rotation[0, 0]) == pytest.approx(heading, abs=1e-12)
+        assert sim.device(f"{name}/receiver").channel == 0
+    assert sim.device("Driver/emitter").channel == 0
+
+
+def test_the_slaves_follow_the_drivers_orders_by_the_closed_forms() -> None:
+    """slave.cpp's calls on the three robots and the driver's orders (its 'F', 'T', 'S', 'A' at 512, 1024,
+    1536 and 2560 ms; 'R' and 'G' at 2048) for 3.2 s. Each robot reads the order at its first step after
+    the driver's (the packet leaves at the next basic step) and its C string, up to the NUL, picks the mode:
+    avoiding at 0.125 m/s straight while both sensors read 0 (nothing within 0.15 m), forward at 0.25 m/s,
+    turning in place at 0.025 · (−5 − 5) / 0.09 = −2.78 rad/s, standing. Every pose is the exact arc of the
+    speeds set the step before (1e-12 m and rad, each 32 ms step); 'R' puts ROBOT1 at (−0.3, −0.1, 0), its
+    heading kept, which 'G' reads back, and the last 'A' drives it on from there."""
+    sim = Simulation(load_world(CPP_WORLD), "exact")
+    lv = Live(sim)
+    lv.ok(A, "attach", {"robot": "Driver"})
+    robot1 = lv.ok(A, "/Driver/robot/get_from_def", {"name": "ROBOT1"})["node"]
+    emitter = sim.device("Driver/emitter")
+    slaves = {}
+    for name, start in SLAVES.items():
+        ds = [sim.device(f"{name}/ds0"), sim.device(f"{name}/ds1")]
+        for d in ds:
+            d.enable(32)
+        sim.device(f"{name}/camera").enable(128)
+        receiver = sim.device(f"{name}/receiver")
+        receiver.enable(32)
+        motors = [sim.robot(name).motor("left wheel motor"), sim.robot(name).motor("right wheel motor")]
+        for m in motors:
+            m.set_position(math.inf)
+            m.set_velocity(0.0)
+        slaves[name] = {"ds": ds, "receiver": receiver, "motors": motors, "mode": "avoid obstacles",
+                        "pose": list(start), "speeds": (0.0, 0.0), "heard": [], "queue": []}
+    for _ in range(100):
+        sim.step()
+        t = sim.time_ms
+        if t in ORDERS:
+            assert emitter.send(ORDERS[t] + b"\0")
+        for name, s in slaves.items():
+            vl, vr = s["speeds"]
+            x, y, th = s["pose"]
+            v, om = 0.025 * (vl + vr) / 2, 0.025 * (vr - vl) / 0.09
+            if om == 0.0:
+                x, y = x + v * 0.032 * math.cos(th), y + v * 0.032 * math.sin(th)
+            else:
+                x += v / om * (math.sin(th + om * 0.032) - math.sin(th))
+                y -= v / om * (math.cos(th + om * 0.032) - math.cos(th))
+                th += om * 0.032
+            if name == "robot1" and t == 2080:          # where the Supervisor put it (standing: "stop")
+                x, y = -0.3, -0.1
+            s["pose"] = [x, y, th]
+            pose = sim.robot(name).pose
+            assert list(pose.translation[:2]) == pytest.approx([x, y], abs=1e-12), (name, t)
+            yaw = math.atan2(pose.rotation[1, 0], pose.rotation[0, 0])
+            assert math.remainder(yaw - th, 2 * math.pi) == pytest.approx(0.0, abs=1e-12), (name, t)
+            s["queue"] += s["receiver"].take()
+            if s["queue"]:                               # one packet a step, as slave.cpp reads them
+                s["mode"] = s["queue"].pop(0).data.split(b"\0", 1)[0].decode()
+                s["heard"].append((t, s["mode"]))
+            ds0, ds1 = (d.value for d in s["ds"])
+            if s["mode"] == "avoid obstacles":
+                assert (ds0, ds1) == (0.0, 0.0), (name, t)
+            s["speeds"] = slave_speeds(s["mode"], ds0, ds1)
+            for m, speed in zip(s["motors"], s["speeds"]):
+                m.set_velocity(speed)
+        if t == 2048:                                   # 'R' after the driver's step, then 'G' at its next
+            lv.ok(A, "/Driver/robot/set_field", {"node": robot1, "field": "translation", "value": [-0.3, -0.1, 0.0]})
+        if t == 2176:
+            assert lv.ok(A, "/Driver/robot/get_field", {"node": robot1, "field": "translation"})["value"] == \
+                pytest.approx([-0.3, -0.1, 0.0], abs=1e-15)
+    for name, s in slaves.items():
+        assert s["heard"] == [(t + 32, order.decode()) for t, order in ORDERS.items()], name
+    # the turn: 480 ms of −2.78 rad/s, and 32 ms more of the forward motion before it was heard
+    turned = slaves["robot3"]["pose"][2] - SLAVES["robot3"][2]
+    assert math.remainder(turned + 0.025 * 10 / 0.09 * 0.512, 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
