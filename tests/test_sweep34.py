@@ -409,3 +409,59 @@ def test_the_slaves_follow_the_drivers_orders_by_the_closed_forms() -> None:
     # the turn: 480 ms of −2.78 rad/s, and 32 ms more of the forward motion before it was heard
     turned = slaves["robot3"]["pose"][2] - SLAVES["robot3"][2]
     assert math.remainder(turned + 0.025 * 10 / 0.09 * 0.512, 2 * math.pi) == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.slow
+def test_the_cpp_controllers_follow_the_scheduled_keys_under_sensorium_run(tmp_path: Path) -> None:
+    """Our C++ texts of slave.cpp (tests/c/example_slave.cpp) on the three robots and of driver.cpp
+    (tests/c/example_driver.cpp: the keys from a schedule, none can be pressed headless) built against our
+    libController's C++ layer, under ``sensorium run`` for 3.2 s: each slave hears each order one basic step
+    after the driver sent it (544, 1056, 1568, 2592 ms) and sets the wheels the mode gives (5/5 avoiding with
+    both sensors at 0, 10/10, 5/−5, 0/0); 'G' reads ROBOT1 where 'R' put it, (−0.3, −0.1), then 0.06 m on
+    along its heading after 480 ms of avoiding at 0.125 m/s (the turn's −2.78 rad/s for 512 ms, 1e-12)."""
+    import shutil
+    import subprocess
+
+    from _serve import child_env, sensorium
+
+    if shutil.which("c++") is None or shutil.which("make") is None:
+        pytest.skip("needs a C++ toolchain (build-essential, libzmq3-dev, libmsgpack-dev, libpng-dev, libjpeg-dev)")
+    clib = Path(__file__).parent.parent / "sensorium" / "client" / "c"
+    build = tmp_path / "cbuild"
+    done = subprocess.run(["make", "-s", "-C", str(clib), f"BUILD={build}"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    libs = subprocess.run(["make", "-s", "-C", str(clib), "libs"], capture_output=True, text=True, timeout=60).stdout.split()
+    for name in ("slave", "driver"):
+        folder = tmp_path / "controllers" / name
+        folder.mkdir(parents=True)
+        done = subprocess.run(["c++", "-std=c++11", "-Wall", "-Werror", f"-I{clib / 'include'}",
+                               str(Path(__file__).parent / "c" / f"example_{name}.cpp"), "-o", str(folder / name),
+                               str(build / "libController.a"), *libs, "-lm"], capture_output=True, text=True, timeout=180)
+        assert done.returncode == 0, done.stderr
+    (tmp_path / "worlds").mkdir()
+    world = tmp_path / "worlds" / "example.wbt"
+    text = CPP_WORLD.read_text()
+    head, driver = text.rsplit('controller "<extern>"', 1)
+    world.write_text(head.replace('controller "<extern>"', 'controller "slave"') + 'controller "driver"' + driver)
+    run = subprocess.run(sensorium("run", str(world), "--until", "3200", "--rpc", "tcp://127.0.0.1:0",
+                                   "--pub", "tcp://127.0.0.1:0"),
+                         env=child_env(), cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert "Error" not in run.stdout + run.stderr, run.stderr[-2000:]
+    lines = run.stdout.splitlines()
+    said = [ln.split("] ", 1)[1] for ln in lines if ln.startswith("[Driver] ")]
+    assert [ln for ln in said if ln.startswith("Please")] == \
+        ["Please, move forward 512", "Please, turn 1024", "Please, stop 1536", "Please, avoid obstacles 2560"]
+    for name in SLAVES:
+        out = [ln.split("] ", 1)[1] for ln in lines if ln.startswith(f"[{name}] ")]
+        assert [ln for ln in out if ln.startswith("I should")] == \
+            ["I should move forward! 544", "I should turn! 1056", "I should stop! 1568", "I should avoid obstacles! 2592"]
+        speeds = [ln.split()[1:] for ln in out if ln.startswith("speeds")]
+        assert [s[0] for s in speeds] == ["512", "1024", "1536", "2048", "2560", "3072"]
+        assert [s[1:3] for s in speeds] == [["5", "5"], ["10", "10"], ["5", "-5"], ["0", "0"], ["0", "0"], ["5", "5"]]
+        assert all(s[3:] == ["0", "0"] for s in speeds if s[1:3] == ["5", "5"]), name
+    where = [ln for ln in said if ln.startswith("ROBOT1 is located")]
+    got = [[float(v) for v in ln.split("(")[1].rstrip(")").split(",")] for ln in where]
+    heading = SLAVES["robot1"][2] - 0.025 * 10 / 0.09 * 0.512
+    assert got[0] == pytest.approx([-0.3, -0.1], abs=1e-15)
+    assert got[1] == pytest.approx([-0.3 + 0.06 * math.cos(heading), -0.1 + 0.06 * math.sin(heading)], abs=1e-12)
