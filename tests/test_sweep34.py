@@ -125,6 +125,7 @@ def test_the_matlab_controller_drives_straight_shows_the_inverse_image_and_hears
         values = [d.value for d in ps]
         assert values == pytest.approx([67.19] * 8, abs=0.01), step
         bgra = np.asarray(camera.image, dtype=np.uint8).reshape(39, 52, 4)
+        assert len(np.unique(bgra.reshape(-1, 4), axis=0)) > 2, step   # the sky and the floor's shades at least
         rgb = np.ascontiguousarray(bgra[:, :, 2::-1])                # wb_camera_get_image's RGB, as MATLAB's
         inverse = 255 - rgb
         display.apply(display.check([["load", 1, 52, 39, _to_bgra(inverse.tobytes(), WB_IMAGE_RGB, 52 * 39)],
