@@ -1455,6 +1455,9 @@ def wb_supervisor_set_label(id: int, text: str, x: float, y: float, size: float,
     if isinstance(color, bool) or not isinstance(color, int) or not 0 <= color <= 0xFFFFFF:
         print(f"Error: {func}() called with a 'color' that is no 0xRRGGBB value ({color!r}).", file=sys.stderr)
         return
+    # Webots hands a Python str to libController as a C string: what follows its first NUL is never seen
+    # (a received packet's text keeps the sender's terminating NUL)
+    text, font = text.split("\0", 1)[0], font.split("\0", 1)[0]
     _answer(r, "set_label", {"id": id, "text": text, "x": float(x), "y": float(y), "size": float(size),
                              "color": color, "transparency": float(transparency), "font": font}, func)
 
