@@ -30,6 +30,7 @@ from test_sweep31 import (
     yaw_of,
 )
 
+from sensorium.server.sim import viewshot
 from sensorium.server.sim.simulation import Simulation
 from sensorium.server.world.loader import load_world
 
@@ -297,3 +298,101 @@ def test_tiago_lite_calls_in_c_under_sensorium_run_set_the_in_process_speeds(tmp
     _, want = run_lite(12000)
     got = [(int(r[0]), float(r[1]), float(r[2]), r[3] == "1") for r in rows]
     assert len(got) == 375 and got == want
+
+
+VIEW_AT = (-6.55, 0.74, 0.6)          # our Viewpoint's written position
+LITE_AT = (-4.416, 1.063, 0.095)      # the robot's translation in the world file
+
+
+def test_the_viewpoint_follows_the_tiago_lite_as_it_drives() -> None:
+    """The sample's Viewpoint follows "TIAGo LITE" with followSmoothness 0 (Webots' "Tracking Shot" at once):
+    after every step its position is the written one moved by the robot's displacement from its place in
+    the world file (1e-12), so the load's 3.5 mm settling lifts it on the first step, and driven straight at
+    3 rad/s for 6.4 s, then on an arc left (left wheel 1 rad/s), the robot takes it 2.0526 m east and 0.7744 m
+    north by 12 s, its orientation as written; pictures and movies are made from there
+    (viewshot.viewpoint_of) and a Supervisor reads it. A reset puts the written position back and the view
+    follows again from the world file's places (the settling counted again, as Webots' physics drops the
+    robot again). Sensorium kept the Viewpoint where the file put it."""
+    sim = Simulation(load_world(LITE), "exact")
+    vp = next(s for s in sim.top_level.scenery if s.type == "Viewpoint")
+    robot = sim.robot(LITE_NAME)
+    for m in (robot.motor("wheel_left_joint"), robot.motor("wheel_right_joint")):
+        m.set_position(math.inf)
+        m.set_velocity(3.0)
+    assert tuple(viewshot.viewpoint_of(sim).position) == VIEW_AT
+    for k in range(375):
+        if k == 200:
+            robot.motor("wheel_left_joint").set_velocity(1.0)
+        sim.step()
+        at = robot.pose.translation
+        want = [v + (a - b) for v, a, b in zip(VIEW_AT, at, LITE_AT)]
+        assert vp.fields["position"] == pytest.approx(want, abs=1e-12), k
+    assert list(viewshot.viewpoint_of(sim).position) == pytest.approx(want, abs=1e-12)
+    assert vp.fields["orientation"] == [0.04, -0.37, -0.93, 6.04]
+    assert [w - v for w, v in zip(want, VIEW_AT)] == pytest.approx([2.052571, 0.774372, 0.0035], abs=1e-6)
+    assert (want[0] - VIEW_AT[0], want[1] - VIEW_AT[1], want[2] - VIEW_AT[2]) == pytest.approx(
+        (at[0] - LITE_AT[0], at[1] - LITE_AT[1], 0.0035), abs=1e-12)
+    sim.reset()
+    assert vp.fields["position"] == list(VIEW_AT)
+    for m in (robot.motor("wheel_left_joint"), robot.motor("wheel_right_joint")):
+        m.set_position(math.inf)
+        m.set_velocity(3.0)
+    sim.step()
+    moved = [a - b for a, b in zip(robot.pose.translation, LITE_AT)]
+    assert moved == pytest.approx([3.0 * 0.0985 * 0.032, 0.0, 0.0035], abs=1e-12)
+    assert vp.fields["position"] == pytest.approx([v + d for v, d in zip(VIEW_AT, moved)], abs=1e-12)
+
+
+@pytest.mark.parametrize(("fields", "line"), [
+    ('follow "nobody"', "Viewpoint follow 'nobody': no robot or top-level solid has that name; the view stays"),
+    ('follow "TIAGo LITE" followType "Mounted Shot"',
+     "Viewpoint followType 'Mounted Shot' is not followed (only 'Tracking Shot'); the view stays")])
+def test_a_viewpoint_that_cannot_follow_is_one_line_and_stays(tmp_path: Path, fields: str, line: str) -> None:
+    world = tmp_path / "stays.wbt"
+    world.write_text(LITE.read_text().replace("protos/", f"{DATA}/protos/")
+                     .replace('follow "TIAGo LITE"', fields))
+    loaded = load_world(world)
+    sim = Simulation(loaded, "exact")
+    assert sum(line in w for w in loaded.warnings) == 1, loaded.warnings
+    for m in (sim.robot(LITE_NAME).motor("wheel_left_joint"), sim.robot(LITE_NAME).motor("wheel_right_joint")):
+        m.set_position(math.inf)
+        m.set_velocity(3.0)
+    for _ in range(10):
+        sim.step()
+    vp = next(s for s in sim.top_level.scenery if s.type == "Viewpoint")
+    assert vp.fields["position"] == list(VIEW_AT)
+
+
+def test_an_astra_in_the_camera_slot_reads_the_floor_and_the_box_by_their_closed_forms() -> None:
+    """With an Astra in the camera slot (tiago_lite.c enables its "Astra rgb" and "Astra depth" when the slot
+    holds one; the slot 0.6 m above the torso's origin is our place) the depth camera, 640 × 480 over 1.04 rad
+    from 0.6 to 8 m at (−4.45, 1.1, 0.8985) looking along +x, reads each pixel's planar depth (its ray
+    through (col + ½, row + ½) of the pinhole f = 320/tan 0.52) to the floor, our box's west face
+    (3.55 m: 8930 pixels) or its top (613), float32 (3e-7), and inf where that is beyond 8 m (the walls are
+    11.95 m away) or the ray rises: 191,787 pixels, every one where the closed form puts it."""
+    sim = Simulation(load_world(DATA / "tiago_lite_astra.wbt"), "exact")
+    depth = sim.device(f"{LITE_NAME}/Astra depth")
+    assert (sim.device(f"{LITE_NAME}/Astra rgb").kind, depth.kind) == ("Camera", "RangeFinder")
+    depth.enable(LITE_STEP)
+    sim.step()
+    got = np.asarray(depth.range_image, dtype=float).reshape(480, 640)
+    f = 320.0 / math.tan(0.52)
+    eye = (-4.416 - 0.054 + 0.02, 1.063 + 0.037, LITE_Z + 0.193 + 0.6 + 0.007)
+    left = -(np.arange(640) + 0.5 - 320.0) / f          # each column's ray: (1, left, −down) per metre ahead
+    down = (np.arange(480) + 0.5 - 240.0) / f
+    left, down = np.meshgrid(left, down)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(down > 0, eye[2] / down, np.inf)                       # the floor
+        ahead = -0.9 - eye[0]                                               # the box's west face, x = −0.9
+        y, z = eye[1] + ahead * left, eye[2] - ahead * down
+        face = (y >= 0.563) & (y <= 1.163) & (z >= 0.0) & (z <= 0.6)
+        t = np.where(face, np.minimum(t, ahead), t)
+        over = np.where(down > 0, (eye[2] - 0.6) / down, np.inf)           # its top, z = 0.6
+        x, y = eye[0] + over, eye[1] + over * left
+        top = (x >= -0.9) & (x <= -0.3) & (y >= 0.563) & (y <= 1.163)
+        t = np.where(top, np.minimum(t, over), t)
+    want = np.where((t >= 0.6) & (t < 8.0), t, np.inf)
+    assert (int(face.sum()), int(top.sum()), int(np.isinf(want).sum())) == (8930, 613, 191787)
+    assert np.array_equal(np.isinf(got), np.isinf(want))
+    seen = np.isfinite(want)
+    assert got[seen] == pytest.approx(want[seen], abs=3e-7)
