@@ -774,7 +774,9 @@ SCENERY_FIELDS: dict[str, dict[str, tuple[str, Getter, Setter]]] = {
                   "far": ("SFFloat", _written("far", 0.0), None),
                   "exposure": ("SFFloat", _written("exposure", 1.0), None),
                   "description": ("SFString", _written("description", ""), None),
-                  "follow": ("SFString", _written("follow", ""), None)},
+                  "follow": ("SFString", _written("follow", ""), None),
+                  "followType": ("SFString", _written("followType", "Tracking Shot"), None),
+                  "followSmoothness": ("SFFloat", _written("followSmoothness", 0.5), None)},
     "Background": {"skyColor": ("MFColor", _written("skyColor", [[0.0, 0.0, 0.0]]), None),
                    "luminosity": ("SFFloat", _written("luminosity", 1.0), None)},
     # a top-level group holding solids (world/top_nodes.py): its children are those nodes (the same ids their

@@ -34,6 +34,7 @@ from sensorium.server.sim.connector import Connector, SolidConnector, solid_conn
 from sensorium.server.sim.contact import Contact
 from sensorium.server.sim.display import screen_image
 from sensorium.server.sim.falling import Falls
+from sensorium.server.sim.follow import ViewFollow
 from sensorium.server.sim.ground import (
     Ground,
     GroundPieces,
@@ -409,6 +410,7 @@ class Simulation:
         self.viewpoint_hidden: dict[int, frozenset[int]] = {}
         # the Viewpoint's fields as loaded, kept when a Supervisor's moveViewpoint first moves it (reset restores them)
         self.viewpoint_loaded: dict | None = None
+        self.viewpoint_follow: ViewFollow | None = None     # set once the scene is built (sim/follow.py)
         self.root_order: list[int] | None = None            # the Supervisor's order of the root's children once
                                                             # a node was imported (None: the loaded order)
         self._import_protos: Any = None                     # the world's EXTERNPROTO declarations, read once
@@ -419,6 +421,13 @@ class Simulation:
         self.time_ms = 0
         self.step_count = 0
         self.scene = Scene(self.world, loaded.base_dir, precision, images=dict(loaded.textures))
+
+        def note(text: str) -> None:        # once however many simulations of the world
+            line = f"{loaded.source}: {text}"
+            if line not in loaded.warnings:
+                loaded.warnings.append(line)
+
+        self.viewpoint_follow = ViewFollow.of(self, note)
         self.ground = Ground.from_world(self.world, self.scene.solid_poses, _TO_ENU[self.world.world_info.coordinate_system])
         self.lights = lights_from_models(self.scene.sensor_lights())
         self._lights_version = self.scene.lights_version
@@ -685,6 +694,8 @@ class Simulation:
             vp.fields.clear()
             vp.fields.update(self.viewpoint_loaded)
             self.viewpoint_loaded = None
+        if self.viewpoint_follow is not None:     # following again from the world file's places
+            self.viewpoint_follow = ViewFollow.of(self)
         # radar cross sections a Supervisor set: back to the loaded ones (of the robots and solids still there)
         owners = {k: k[0] if isinstance(k, tuple) else k for k in self._initial["radar_targets"]}
         self.scene.radar_targets = {k: v for k, v in self._initial["radar_targets"].items()
@@ -1081,6 +1092,8 @@ class Simulation:
             if con.is_locked:
                 con.attach_attempt()
         poses = self.scene.robot_poses
+        if self.viewpoint_follow is not None:    # the Viewpoint moves as what it follows moved (WbViewpoint)
+            self.viewpoint_follow.update(self)
         if radio is not None:
             radio.deliver(poses)      # range, cones, line of sight and readings at the end-of-step poses
         # Webots' postPhysicsStep (a world without batteries pays nothing here)

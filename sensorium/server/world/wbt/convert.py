@@ -47,7 +47,8 @@ MAX_VISITS = 2_000_000  # nodes walked after DEF/USE expansion (empty groups USE
 # the fields of top-level nodes not simulated whose written values the Supervisor serves (daemon/supervisor.py)
 SCENERY_VALUES = {
     "Viewpoint": {"fieldOfView": "SFFloat", "orientation": "SFRotation", "position": "SFVec3f", "near": "SFFloat",
-                  "far": "SFFloat", "exposure": "SFFloat", "description": "SFString", "follow": "SFString"},
+                  "far": "SFFloat", "exposure": "SFFloat", "description": "SFString", "follow": "SFString",
+                  "followType": "SFString", "followSmoothness": "SFFloat"},
     "Background": {"skyColor": "MFColor", "luminosity": "SFFloat"},
     # a top-level Pose or Transform holding solids (world/top_nodes.py): a Supervisor reads where it is
     "Pose": {"translation": "SFVec3f", "rotation": "SFRotation"},
