@@ -13,7 +13,7 @@ outside (``moveViewpoint``) follows on from there.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 TRACKING = "Tracking Shot"
@@ -31,6 +31,9 @@ class ViewFollow:
     ref: tuple[float, float, float]
     last: tuple[float, float, float]
     at: tuple[float, float, float]
+    # what the last update saw: the Viewpoint, the node's pose object and the field's list (every move makes a new pose and
+    # every write a new list), so a step that moved neither costs two identity tests
+    seen: tuple[Any, Any, Any] = field(default=(None, None, None), repr=False, compare=False)
 
     @classmethod
     def of(cls, sim: Any, warn: Any = None) -> ViewFollow | None:
@@ -63,10 +66,13 @@ class ViewFollow:
 
     def update(self, sim: Any) -> None:
         """After a step: the Viewpoint's position moved by the followed node's displacement."""
-        vp = next(s for s in sim.top_level.scenery if s.type == "Viewpoint")
+        vp = next(s for s in sim.top_level.scenery if s.type == "Viewpoint") if self.seen[0] is None else self.seen[0]
         now = (sim.scene.robot_poses[self.robot] if self.robot is not None
                else sim.scene.solid_poses.get(self.solid))
         if now is None:                     # the followed solid was removed: Webots stops following
+            return
+        field_now = vp.fields.get("position")
+        if now is self.seen[1] and field_now is self.seen[2]:
             return
         at = tuple(float(c) for c in now.translation)
         written = tuple(float(c) for c in vp.fields.get("position", (-10.0, 0.0, 0.0)))
@@ -78,3 +84,4 @@ class ViewFollow:
                 sim.viewpoint_loaded = dict(vp.fields)
             vp.fields["position"] = list(new)
         self.last, self.at = new, at        # type: ignore[assignment]
+        self.seen = (vp, now, vp.fields.get("position"))
