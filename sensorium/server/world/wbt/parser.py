@@ -580,8 +580,11 @@ def header_comments(text: str) -> list[str]:
 def parse_wbt(text: str, source: str = "<memory>", limits: ProtoLimits | None = None) -> WbtFile:
     year, letter = parse_header(text, source)
     if (year, letter) < (2022, "a"):
+        # Webots R2022a+ turns such a world's nodes when it opens it (README "Worlds older than R2022a"); not done here
         raise WbtSyntaxError(source, 1, 1, f"Webots R{year}{letter} world: only R2022a and later are supported "
-                             "(open and save it in Webots R2022a+ to convert it to the z-up, FLU conventions)")
+                             "(open and save it in Webots R2022a or later, whose backward-compatibility pass turns its "
+                             "nodes to z-up, FLU; or run Webots' scripts/converter/convert_nue_to_enu_rub_to_flu.py "
+                             "on a copy: it rewrites the file in place, NUE to ENU)")
     wbt = Parser(Tokens(text, source), source, limits=limits).file(f"R{year}{letter}", text)
     wbt.header = header_comments(text)
     return wbt
