@@ -135,7 +135,7 @@ class _Expander:
         self.scopes[self.world] = world_scope
         self.files: dict[str, ProtoDef] = {}               # resolved path → PROTO read
         self.uses: dict[str, ProtoUse] = {}
-        self.warnings: list[str] = []
+        self.warnings: list[str] = list(wbt.warnings)
         self.noted: set[str] = set()
         self.stand_ins: dict[str, tuple[str, int, int]] = {}
         self.appearances: dict[str, set[str]] = {}          # file → the appearance PROTOs standing in there

@@ -158,6 +158,7 @@ class WbtFile:
     declarations: list[ExternProto] = field(default_factory=list)
     protos: list[Any] = field(default_factory=list)   # PROTO definitions written in the file (proto.interface.ProtoDef)
     header: list[str] = field(default_factory=list)   # the '#' comment lines after the first line
+    warnings: list[str] = field(default_factory=list)  # what reading it said (an R2020b-R2021b world's conversion)
 
 
 class Tokens:
@@ -579,14 +580,20 @@ def header_comments(text: str) -> list[str]:
 
 def parse_wbt(text: str, source: str = "<memory>", limits: ProtoLimits | None = None) -> WbtFile:
     year, letter = parse_header(text, source)
-    if (year, letter) < (2022, "a"):
-        # Webots R2022a+ turns such a world's nodes when it opens it (README "Worlds older than R2022a"); not done here
-        raise WbtSyntaxError(source, 1, 1, f"Webots R{year}{letter} world: only R2022a and later are supported "
-                             "(open and save it in Webots R2022a or later, whose backward-compatibility pass turns its "
-                             "nodes to z-up, FLU; or run Webots' scripts/converter/convert_nue_to_enu_rub_to_flu.py "
-                             "on a copy: it rewrites the file in place, NUE to ENU)")
+    legacy = (2020, "b") <= (year, letter) <= (2021, "b")
+    if (year, letter) < (2022, "a") and not legacy:
+        # R2021c (Webots' development name of R2022a) and worlds before R2020b (a vector gravity, northDirection)
+        raise WbtSyntaxError(source, 1, 1, f"Webots R{year}{letter} world: only R2020b-R2021b (converted) and "
+                             "R2022a and later are supported (open and save it in Webots R2022a or later, whose "
+                             "backward-compatibility pass turns its nodes to z-up, FLU; or run Webots' "
+                             "scripts/converter/convert_nue_to_enu_rub_to_flu.py on a copy: it rewrites the file "
+                             "in place, NUE to ENU)")
     wbt = Parser(Tokens(text, source), source, limits=limits).file(f"R{year}{letter}", text)
     wbt.header = header_comments(text)
+    if legacy:
+        from sensorium.server.world.wbt.legacy import turn_legacy
+
+        wbt.warnings = turn_legacy(wbt.nodes, wbt.version, source)
     return wbt
 
 
