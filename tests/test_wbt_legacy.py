@@ -153,7 +153,7 @@ def test_a_cylinder_whose_parent_holds_more_stays_as_written_with_webots_warning
 @pytest.mark.parametrize(("body", "line", "why"), [
     ('Robot { children [ Camera { boundingObject Group { children [ Box { } ] } } ] }\n', 3, "its boundingObject is a Group"),
     ('Robot { children [ Camera { children [ Group { children [ Emitter { } ] } ] } ] }\n', 3, "it is inside a Group of a turned Camera"),
-    ('RectangleArena { }\n', 3, "Webots turns the PROTOs it ships"),
+    ('RectangleArena { }\n', 3, r"a PROTO instance \(Webots turns one it ships"),
 ])
 def test_what_webots_sort_order_or_proto_files_decide_is_refused_in_one_line(tmp_path: Path, body: str, line: int,
                                                                              why: str) -> None:

@@ -151,8 +151,9 @@ class _Turner:
         while queue:
             node, parent, grand = queue.pop(0)
             if node.type not in BASE_NODES:
-                raise self.refuse(node, "Webots turns the PROTOs it ships by (-pi/2, 0, pi/2) and converts others "
-                                        "inside by their own file's version")
+                raise self.refuse(node, "a PROTO instance (Webots turns one it ships that is a pose by "
+                                        "(-pi/2, 0, pi/2), converts another's body by its file's version, "
+                                        "neither done here yet)")
             if node.type == "Track":
                 raise self.refuse(node, "Webots' turn of a Track's wheels depends on its sort order")
             weight = 3 if node.type in _GEOMETRIES else 1
