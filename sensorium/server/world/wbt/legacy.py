@@ -108,7 +108,17 @@ def _subnodes(node: Node) -> list[tuple[str, int, Node]]:
     return out
 
 
-def _contains(node: Node, types: frozenset[str]) -> Node | None:
+class _NotBase:
+    """Every node type but Webots' base nodes (PROTO instances), for ``_contains``."""
+
+    def __contains__(self, name: object) -> bool:
+        return name not in BASE_NODES
+
+
+_NOT_BASE = _NotBase()
+
+
+def _contains(node: Node, types: frozenset[str] | _NotBase) -> Node | None:
     stack, seen = [node], set()
     while stack:
         n = stack.pop()
@@ -129,6 +139,7 @@ class _Turner:
         self.done: set[tuple[str, int]] = set()    # (rule, id(node)): a node USEd twice is one node here, two copies in Webots
         self.turned = 0
         self.uses: set[tuple[int, str, int]] = set()  # (id(parent), field, index) of each USE
+        self.protos: list[Node] = []                   # the PROTO instances the walk met (rule C)
 
     def refuse(self, node: Node, why: str) -> WbtSyntaxError:
         return WbtSyntaxError(node.source or self.source, node.line, node.col,
@@ -151,9 +162,10 @@ class _Turner:
         while queue:
             node, parent, grand = queue.pop(0)
             if node.type not in BASE_NODES:
-                raise self.refuse(node, "a PROTO instance (Webots turns one it ships that is a pose by "
-                                        "(-pi/2, 0, pi/2), converts another's body by its file's version, "
-                                        "neither done here yet)")
+                # rule C, once the PROTO is found (proto.instantiate: legacy_proto); Webots' walk stops here
+                if all(p is not node for p in self.protos):
+                    self.protos.append(node)
+                continue
             if node.type == "Track":
                 raise self.refuse(node, "Webots' turn of a Track's wheels depends on its sort order")
             weight = 3 if node.type in _GEOMETRIES else 1
@@ -202,6 +214,13 @@ class _Turner:
         kids = [c for c in node.fields.get("children", []) if isinstance(c, Node)] \
             if isinstance(node.fields.get("children"), list) else []
         for c in [*kids, *([bounding] if isinstance(bounding, Node) else [])]:
+            if c.type not in BASE_NODES:
+                raise self.refuse(c, f"a PROTO instance held by a turned {node.type}: whether Webots turns it back "
+                                     "depends on its base node, which is not known yet here")
+            inside = _contains(c, _NOT_BASE)
+            if inside is not None and c.type not in _POSES:
+                raise self.refuse(inside, f"a PROTO instance inside a {c.type} of a turned {node.type}, which Webots "
+                                          "copies and deletes before it turns its PROTOs")
             if c.type not in _POSES:
                 inner = _contains(c, frozenset(_A2_TURNS) | {"Viewpoint", "Track"})
                 if inner is not None:
@@ -241,11 +260,20 @@ class _Turner:
                     source=child.source or device.source)
 
 
-def turn_legacy(roots: list[Node], version: str, source: str) -> list[str]:
-    """Turn an R2020b–R2021b world's nodes (in place) as Webots R2022a+ does on opening it; the warnings
-    to report, the first saying it was converted."""
+def turn_legacy(roots: list[Node], version: str, source: str) -> tuple[list[str], list[Node]]:
+    """Turn an R2020b–R2021b world's nodes (in place) as Webots R2022a+ does on opening it: the warnings
+    to report (the first saying it was converted), and the PROTO instances its walk met, which rule C
+    turns once their PROTO is found (:func:`turn_proto_instance`)."""
     turner = _Turner(version, source)
     turner.run(roots)
     return [f"{source}:1:1: Webots {version} world: converted as Webots R2022a and later convert it when "
-            f"they open it ({turner.turned} node(s) turned to z-up, FLU axes; Webots warns that parts may end up "
-            "upside down)", *turner.warnings]
+            f"they open it ({turner.turned} node(s) turned, {len(turner.protos)} PROTO instance(s) met; Webots "
+            "warns that parts may end up upside down)", *turner.warnings], turner.protos
+
+
+def turn_proto_instance(node: Node, pose: bool | None = None) -> None:
+    """Rule C on an instance of a PROTO Webots ships: a pose (``pose`` None: judged by the node's type,
+    an expanded instance's base node) turns by Rx(-pi/2)·Rz(pi/2), Webots' PROTOs turned to z-up in
+    R2022a turned back to the world's y-up; another stays."""
+    if node.type in _POSES if pose is None else pose:
+        node.fields["rotation"] = _axis_angle(_mul(_matrix(node.fields.get("rotation")), _A_CAMERA))

@@ -159,6 +159,7 @@ class WbtFile:
     protos: list[Any] = field(default_factory=list)   # PROTO definitions written in the file (proto.interface.ProtoDef)
     header: list[str] = field(default_factory=list)   # the '#' comment lines after the first line
     warnings: list[str] = field(default_factory=list)  # what reading it said (an R2020b-R2021b world's conversion)
+    legacy_protos: list[Node] = field(default_factory=list)  # an R2020b-R2021b world's PROTO instances (rule C)
 
 
 class Tokens:
@@ -593,7 +594,7 @@ def parse_wbt(text: str, source: str = "<memory>", limits: ProtoLimits | None = 
     if legacy:
         from sensorium.server.world.wbt.legacy import turn_legacy
 
-        wbt.warnings = turn_legacy(wbt.nodes, wbt.version, source)
+        wbt.warnings, wbt.legacy_protos = turn_legacy(wbt.nodes, wbt.version, source)
     return wbt
 
 
