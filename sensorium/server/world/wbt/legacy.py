@@ -11,9 +11,13 @@ world's nodes breadth-first, geometries first, and post-multiplies fixed turns o
   Receiver, Connector or TouchSensor by Rx(−π/2)·Rz(−π/2); its children and boundingObject that are
   poses take the inverse turn (they stay where they were), the others move into a new pose holding it.
 
-What depends on Webots' unstable sort or on PROTO files (a PROTO instance, a Track, a turned device
-whose boundingObject is a Group or which holds another turned device under a node that is no pose)
-is refused in one line rather than guessed."""
+* **C** (once the PROTO is found, in ``proto.instantiate``) an instance of a PROTO Webots ships whose
+  base node is a pose turns by Rx(−π/2)·Rz(π/2).
+
+What depends on Webots' unstable sort or on a PROTO's body (a world's own PROTO written before
+R2022a, a PROTO held by a turned device, a Track, a turned device whose boundingObject is a Group or
+which holds another turned device under a node that is no pose) is refused in one line rather than
+guessed."""
 
 from __future__ import annotations
 
