@@ -42,6 +42,7 @@ from sensorium.server.world.proto.interface import (
     show,
 )
 from sensorium.server.world.proto.resolve import ProtoSearch, logical_location, proto_index, resolve_url, webots_path
+from sensorium.server.world.wbt import legacy as wbt_legacy  # (a module: legacy imports proto.interface)
 from sensorium.server.world.wbt.convert import SKIPPED
 from sensorium.server.world.wbt.parser import ExternProto, IsRef, Node, Parser, Tokens, WbtFile, WbtSyntaxError, short
 from sensorium.server.world.wbt.protos import BUILTIN_PROTOS
@@ -135,7 +136,8 @@ class _Expander:
         self.scopes[self.world] = world_scope
         self.files: dict[str, ProtoDef] = {}               # resolved path → PROTO read
         self.uses: dict[str, ProtoUse] = {}
-        self.warnings: list[str] = []
+        self.warnings: list[str] = list(wbt.warnings)
+        self.legacy_protos = {id(n) for n in wbt.legacy_protos}   # rule C (wbt.legacy)
         self.noted: set[str] = set()
         self.stand_ins: dict[str, tuple[str, int, int]] = {}
         self.appearances: dict[str, set[str]] = {}          # file → the appearance PROTOs standing in there
@@ -382,14 +384,37 @@ class _Expander:
                              f"nodes nested deeper than {TREE_DEPTH} levels once PROTOs are expanded")
         chain = self.outer.get(key, chain)
         proto = self.lookup(node)
+        legacy = key in self.legacy_protos
+        if legacy and proto is None and node.type in BUILTIN_PROTOS:
+            # a stand-in for a PROTO Webots ships: its translation and rotation are its base Solid's
+            wbt_legacy.turn_proto_instance(node, pose=node.type != "TexturedBackgroundLight")
         if proto is not None:
+            if legacy:
+                self.legacy_instance(node, proto)
             result = self.instance(node, proto, chain, depth)
+            if legacy and self.ships(proto):
+                wbt_legacy.turn_proto_instance(result)
         elif self.appearances and node.type in self.appearances.get(node.source or self.world, ()):
             result = self.plain_appearance(node)
         else:
             result = self.fields(node, chain, depth)
         self.memo[key] = (node, result)
         return result
+
+    def ships(self, proto: ProtoDef) -> bool:
+        """Whether Webots ships ``proto``: its file under the installation (rule C of an R2020b-R2021b world)."""
+        home = self.search.home
+        return home is not None and Path(proto.source).resolve().is_relative_to(home.resolve())
+
+    def legacy_instance(self, node: Node, proto: ProtoDef) -> None:
+        """An R2020b-R2021b world's instance of a PROTO of its own: Webots converts the body of one whose file
+        is older than R2022a at each instance, which is not done here (refused); a newer one stays as it is."""
+        m = re.fullmatch(r"R(\d{4})([a-z])", proto.version)
+        if not self.ships(proto) and (m is None or (int(m.group(1)), m.group(2)) <= (2021, "b")) and proto.version:
+            raise ProtoError(node.source or self.world, node.line, node.col,
+                             f"{short(node.type)}: a PROTO written for Webots {proto.version} in a Webots "
+                             f"{self.wbt.version} world: Webots converts its body at each instance, not done here "
+                             "yet (open and save the world in Webots R2022a or later, and convert the PROTO)")
 
     def plain_appearance(self, node: Node) -> Node:
         """The PBRAppearance an appearance PROTO whose file is not found stands in as: grey × its

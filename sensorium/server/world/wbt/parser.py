@@ -158,6 +158,8 @@ class WbtFile:
     declarations: list[ExternProto] = field(default_factory=list)
     protos: list[Any] = field(default_factory=list)   # PROTO definitions written in the file (proto.interface.ProtoDef)
     header: list[str] = field(default_factory=list)   # the '#' comment lines after the first line
+    warnings: list[str] = field(default_factory=list)  # what reading it said (an R2020b-R2021b world's conversion)
+    legacy_protos: list[Node] = field(default_factory=list)  # an R2020b-R2021b world's PROTO instances (rule C)
 
 
 class Tokens:
@@ -579,11 +581,20 @@ def header_comments(text: str) -> list[str]:
 
 def parse_wbt(text: str, source: str = "<memory>", limits: ProtoLimits | None = None) -> WbtFile:
     year, letter = parse_header(text, source)
-    if (year, letter) < (2022, "a"):
-        raise WbtSyntaxError(source, 1, 1, f"Webots R{year}{letter} world: only R2022a and later are supported "
-                             "(open and save it in Webots R2022a+ to convert it to the z-up, FLU conventions)")
+    legacy = (2020, "b") <= (year, letter) <= (2021, "b")
+    if (year, letter) < (2022, "a") and not legacy:
+        # R2021c (Webots' development name of R2022a) and worlds before R2020b (a vector gravity, northDirection)
+        raise WbtSyntaxError(source, 1, 1, f"Webots R{year}{letter} world: only R2020b-R2021b (converted) and "
+                             "R2022a and later are supported (open and save it in Webots R2022a or later, whose "
+                             "backward-compatibility pass turns its nodes to z-up, FLU; or run Webots' "
+                             "scripts/converter/convert_nue_to_enu_rub_to_flu.py on a copy: it rewrites the file "
+                             "in place, NUE to ENU)")
     wbt = Parser(Tokens(text, source), source, limits=limits).file(f"R{year}{letter}", text)
     wbt.header = header_comments(text)
+    if legacy:
+        from sensorium.server.world.wbt.legacy import turn_legacy
+
+        wbt.warnings, wbt.legacy_protos = turn_legacy(wbt.nodes, wbt.version, source)
     return wbt
 
 
