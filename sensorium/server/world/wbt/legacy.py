@@ -1,6 +1,6 @@
 """Worlds written by Webots R2020b–R2021b, turned as Webots R2022a and later turn them when they open one.
 
-Webots' ``WbNodeUtilities::fixBackwardCompatibility`` (README "Worlds older than R2022a") walks the
+Webots' ``WbNodeUtilities::fixBackwardCompatibility`` (README "Worlds before R2022a") walks the
 world's nodes breadth-first, geometries first, and post-multiplies fixed turns onto rotations:
 
 * **B1** a Cylinder, Capsule, Cone, Plane or ElevationGrid turns its Shape's parent (or its own, in a
