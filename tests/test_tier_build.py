@@ -4,6 +4,8 @@ overlapping boxes (the sweep along x tests only y and z) against every pair test
 
 from __future__ import annotations
 
+from collections import Counter
+
 import numpy as np
 import pytest
 
@@ -27,7 +29,6 @@ def test_overlapping_boxes_are_every_overlapping_pair(seed):
     lo, hi = centre - half, centre + half
     i, j = guards._overlapping(lo, hi, 10 ** 9)
     assert set(zip(i.tolist(), j.tolist())) == _all_pairs(lo, hi)
-    from collections import Counter
     listed = Counter(zip(i.tolist(), j.tolist()))   # each pair once, a box with itself twice (both halves)
     assert all(count == (2 if a == b else 1) for (a, b), count in listed.items())
 
