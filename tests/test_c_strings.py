@@ -17,9 +17,11 @@ from _inproc import inproc_server
 from sensorium.client import wb
 from sensorium.client.webots.controller import Camera, Supervisor
 
-# the supervisor "boss" (a Display, a Speaker and a camera looking at the textured wall WALL), and
-# the texture TEX whose url a Supervisor changes item by item
+# the supervisor "boss" (a Display, a Speaker, a camera and a range finder looking at the textured wall
+# WALL), the texture TEX whose url a Supervisor changes item by item, and CRATE, a PROTO instance whose
+# body's shape is DEF LID
 WORLD = """#VRML_SIM R2023b utf8
+EXTERNPROTO "Crate.proto"
 WorldInfo {
   basicTimeStep 16
 }
@@ -44,6 +46,9 @@ DEF WALL Solid {
     }
   ]
 }
+DEF CRATE Crate {
+  translation 0 2 0
+}
 DEF BOSS Robot {
   name "boss"
   controller "<extern>"
@@ -62,7 +67,32 @@ DEF BOSS Robot {
       width 4
       height 4
     }
+    RangeFinder {
+      name "depth"
+      width 4
+      height 4
+    }
   ]
+}
+"""
+
+
+CRATE = """#VRML_SIM R2023b utf8
+PROTO Crate [
+  field SFVec3f translation 0 0 0
+]
+{
+  Solid {
+    translation IS translation
+    name "crate"
+    children [
+      DEF LID Shape {
+        geometry Box {
+          size 0.2 0.2 0.2
+        }
+      }
+    ]
+  }
 }
 """
 
@@ -74,6 +104,7 @@ def served(tmp_path, monkeypatch):
     from PIL import Image
 
     (tmp_path / "w.wbt").write_text(WORLD)
+    (tmp_path / "Crate.proto").write_text(CRATE)
     Image.new("RGB", (2, 2), (200, 100, 30)).save(tmp_path / "a.png")
     Image.new("RGB", (2, 2), (30, 100, 200)).save(tmp_path / "b.png")
     with wave.open(str(tmp_path / "tone.wav"), "wb") as w:
@@ -104,6 +135,9 @@ def test_node_and_field_lookups_and_string_fields_read_up_to_the_nul(served, cap
     custom = wb.wb_supervisor_node_get_field(boss, "customData\0tail")
     assert custom is not None and custom == wb.wb_supervisor_node_get_field(boss, "customData")
     assert wb.wb_supervisor_node_get_base_node_field(boss, "customData\0") is not None
+    crate = wb.wb_supervisor_node_get_from_def("CRATE")
+    lid = wb.wb_supervisor_node_get_from_proto_def(crate, "LID")
+    assert lid is not None and wb.wb_supervisor_node_get_from_proto_def(crate, "LID\0tail") == lid
     wb.wb_supervisor_field_set_sf_string(custom, "gain=2\0stale bytes")
     assert wb.wb_supervisor_field_get_sf_string(custom) == "gain=2"
     wb.wb_robot_set_custom_data("gain=3\0")
@@ -166,13 +200,18 @@ def test_file_names_are_written_up_to_the_nul(served, tmp_path) -> None:
     wb.wb_camera_enable(cam, 16)
     wb.wb_robot_step(16)
     assert wb.wb_camera_save_image(cam, "cam.png\0.jpg", 100) == 0
+    depth = wb.wb_robot_get_device("depth")
+    wb.wb_range_finder_enable(depth, 16)
+    wb.wb_robot_step(16)
+    assert wb.wb_range_finder_save_image(depth, "depth.png\0.hdr", 100) == 0
     screen = wb.wb_robot_get_device("screen")
     wb.wb_display_image_save(screen, None, "screen.png\0tail")
     assert wb.wb_display_image_load(screen, "screen.png\0tail") is not None
     wb.wb_supervisor_export_image("view.png\0tail", 100)
     assert wb.wb_supervisor_world_save("saved.wbt\0tail")
     written = sorted(p.name for p in tmp_path.iterdir())
-    assert written == ["a.png", "b.png", "cam.png", "saved.wbt", "screen.png", "tone.wav", "view.png", "w.wbt"]
+    assert written == ["Crate.proto", "a.png", "b.png", "cam.png", "depth.png", "saved.wbt", "screen.png", "tone.wav",
+                       "view.png", "w.wbt"]
 
 
 def test_the_speaker_plays_and_speaks_what_is_before_the_nul(served, tmp_path, capsys) -> None:
