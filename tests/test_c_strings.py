@@ -15,7 +15,7 @@ import pytest
 from _inproc import inproc_server
 
 from sensorium.client import wb
-from sensorium.client.webots.controller import Camera, Supervisor
+from sensorium.client.webots.controller import Camera, Robot, Supervisor
 
 # the supervisor "boss" (a Display, a Speaker, a camera and a range finder looking at the textured wall
 # WALL), the texture TEX whose url a Supervisor changes item by item, and CRATE, a PROTO instance whose
@@ -119,7 +119,7 @@ def served(tmp_path, monkeypatch):
             yield core
         finally:
             wb.wb_robot_cleanup()
-            Supervisor.created = None
+            Robot.created = None                     # (Supervisor() sets it on Robot)
 
 
 def test_the_helper_cuts_a_str_at_its_first_nul_and_leaves_anything_else() -> None:
