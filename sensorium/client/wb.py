@@ -82,6 +82,7 @@ from sensorium.client.wb_robot import (  # noqa: F401 - used by the controller c
     ROTATIONAL_MOTOR,
     DeviceState,
     RobotClient,
+    c_string,
     current,
 )
 from sensorium.client.wb_sensors import *  # noqa: F403

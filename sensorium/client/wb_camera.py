@@ -13,7 +13,7 @@ from typing import Any
 
 from sensorium.client import arrays, images
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import DeviceState, current, sensor_enable, sensor_period, sensor_reading
+from sensorium.client.wb_robot import DeviceState, c_string, current, sensor_enable, sensor_period, sensor_reading
 
 RANGE_FINDER = "RangeFinder"
 
@@ -126,6 +126,7 @@ def wb_range_finder_save_image(tag: int, filename: str, quality: int) -> int:
     """The latest range image in Webots' scale (``(depth − minRange)/maxRange`` clamped to [0, 1]):
     a grey PNG (or JPEG with Pillow), or Webots' float grey Radiance ``.hdr``; ``.tif``/``.tiff``
     answer Webots' "not supported anymore" line; 0 or -1."""
+    filename = c_string(filename)
     func = "wb_range_finder_save_image"
     dev = _rf(tag, func)
     buf = range_finder_bytes(tag, func)
@@ -335,6 +336,7 @@ def save_bgra(func: str, filename: str, quality: int, bgra: bytes | None, width:
 
 def wb_camera_save_image(tag: int, filename: str, quality: int) -> int:
     """The latest image as PNG (or JPEG with Pillow); 0, or -1 (Webots)."""
+    filename = c_string(filename)
     func = "wb_camera_save_image"
     dev = _cam(tag, func)
     img = dev.camera.get("image")
@@ -453,6 +455,7 @@ def wb_camera_recognition_get_segmentation_image(tag: int) -> bytes | None:
 
 
 def wb_camera_recognition_save_segmentation_image(tag: int, filename: str, quality: int) -> int:
+    filename = c_string(filename)
     func = "wb_camera_recognition_save_segmentation_image"
     dev = _cam(tag, func)
     return save_bgra(func, filename, quality, segmentation_bytes(tag, func), int(dev.desc.get("width", 0)),

@@ -19,7 +19,7 @@ from typing import Any
 
 from sensorium.client import images
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import DeviceState, current, integer, real
+from sensorium.client.wb_robot import DeviceState, c_string, current, integer, real
 
 DISPLAY = "Display"
 WB_IMAGE_RGB = 3
@@ -151,6 +151,7 @@ def wb_display_set_opacity(tag: int, opacity: float) -> None:
 
 
 def wb_display_set_font(tag: int, font: str, size: int, anti_aliasing: bool) -> None:
+    font = c_string(font)
     func = "wb_display_set_font"
     n = _int(size, func, "size")
     if n <= 0:
@@ -236,6 +237,7 @@ def wb_display_fill_polygon(tag: int, x: Any, y: Any, size: int | None = None) -
 
 
 def wb_display_draw_text(tag: int, text: str, x: int, y: int) -> None:
+    text = c_string(text)
     func = "wb_display_draw_text"
     if not text:
         return _err(func, "'text' argument is NULL or empty.")
@@ -299,6 +301,7 @@ def wb_display_image_new(tag: int, width: Any, height: Any, data: Any, format: i
 
 
 def wb_display_image_load(tag: int, filename: str) -> ImageRef | None:
+    filename = c_string(filename)
     func = "wb_display_image_load"
     if not filename:
         _err(func, "'filename' argument is NULL or empty.")
@@ -370,6 +373,7 @@ def wb_display_image_delete(tag: int, ref: Any) -> None:
 
 def wb_display_image_save(tag: int, ref: Any, filename: str) -> None:
     """Write the display as shown (``ref`` None) or a kept image to ``filename`` (.png or .jpg)."""
+    filename = c_string(filename)
     func = "wb_display_image_save"
     if not filename:
         return _err(func, "'filename' argument is NULL or empty.")

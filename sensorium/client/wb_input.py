@@ -11,7 +11,7 @@ import sys
 from dataclasses import dataclass
 
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import WB_EVENT_NO_EVENT, WB_EVENT_QUIT, current
+from sensorium.client.wb_robot import WB_EVENT_NO_EVENT, WB_EVENT_QUIT, c_string, current
 
 
 @dataclass
@@ -88,6 +88,7 @@ def wb_robot_get_world_path() -> str:
 def wb_robot_get_urdf(prefix: str = "") -> str:
     """The robot's URDF as Webots exports it, ``prefix`` before every link and joint name (the
     server's ``get_urdf``: the poses the world file gives, README "getUrdf")."""
+    prefix = c_string(prefix)
     r = current()
     if not isinstance(prefix, str):
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_robot_get_urdf(): prefix must be a string, got {prefix!r}")

@@ -26,7 +26,7 @@ from typing import Any, BinaryIO
 
 from sensorium.client.connection import ErrorCode, SensoriumError
 from sensorium.client.wb_motor import wb_motor_set_position
-from sensorium.client.wb_robot import LINEAR_MOTOR, ROTATIONAL_MOTOR, RobotClient, current, integer
+from sensorium.client.wb_robot import LINEAR_MOTOR, ROTATIONAL_MOTOR, RobotClient, c_string, current, integer
 
 __all__ = ["MotionFile", "MotionFileError", "MotionPlayer", "parse_motion", "wbu_motion_delete",
            "wbu_motion_get_duration", "wbu_motion_get_time", "wbu_motion_is_over", "wbu_motion_new",
@@ -247,6 +247,7 @@ def _hooked() -> RobotClient:
 
 def wbu_motion_new(filename: Any) -> MotionPlayer | None:
     """Load a motion file; None (one line printed) if it cannot be read or is damaged."""
+    filename = c_string(filename)
     if isinstance(filename, os.PathLike):
         filename = os.fspath(filename)
     if not isinstance(filename, str) or not filename:

@@ -20,7 +20,7 @@ import sys
 from typing import Any
 
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import RobotClient
+from sensorium.client.wb_robot import RobotClient, c_string
 from sensorium.client.wb_supervisor import _supervisor
 
 READY, RECORDING, SAVING, WRITE_ERROR, ENCODING_ERROR, SIMULATION_ERROR = range(6)
@@ -272,6 +272,7 @@ def wb_supervisor_movie_start_recording(filename: str, width: int, height: int, 
     """Webots' movie recording: the Viewpoint's frames (``width`` × ``height``, both even here) at
     Webots' frame times, encoded by ffmpeg (H.264, MP4) into ``filename`` once stopped; ``codec``
     is ignored as in Webots."""
+    filename = c_string(filename)
     func = "wb_supervisor_movie_start_recording"
     r = _supervisor(func)
     if r is None:
@@ -283,9 +284,6 @@ def wb_supervisor_movie_start_recording(filename: str, width: int, height: int, 
     name = os.fspath(filename) if isinstance(filename, str | os.PathLike) else None
     if not name or not isinstance(name, str):
         print(f"Error: {func}() called with NULL or empty 'filename' argument.", file=sys.stderr)
-        return
-    if "\0" in name:          # (ffmpeg's command line could not hold it)
-        print(f"Error: {func}(): 'filename' argument {name!r} holds a NUL byte.", file=sys.stderr)
         return
     if not _integer(width) or not _integer(height) or width <= 0 or height <= 0:
         print(f"Error: {func}(): 'width' and 'height' arguments must be postitive.", file=sys.stderr)

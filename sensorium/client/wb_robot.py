@@ -149,6 +149,13 @@ def real(v: Any) -> float | None:
     return float(v)
 
 
+def c_string(v: Any) -> Any:
+    """``v`` as Webots' C API receives a Python ``str``: cut at its first NUL, since Webots' Python
+    passes it down as a C string (a received packet's ``getString()`` keeps the sender's terminating
+    NUL, and controllers hand such text on); anything else unchanged, for the caller's own checks."""
+    return v.split("\0", 1)[0] if isinstance(v, str) else v
+
+
 class NoValue(Exception):
     """Raised by :meth:`RobotClient.device` for a device Sensorium lists but does not simulate; the
     public function catches it and answers Webots' "no value" (:func:`answers`)."""
@@ -786,6 +793,7 @@ def wb_robot_get_number_of_devices() -> int:
 
 def wb_robot_get_device(name: str) -> int:
     """The device's tag; 0, with a warning as in Webots, if the robot has no such device."""
+    name = c_string(name)
     r = current()
     if not isinstance(name, str) or not name:
         print(f"Error: wb_robot_get_device() called with a NULL or empty name ({name!r}).", file=sys.stderr)
@@ -830,6 +838,7 @@ def wb_robot_get_custom_data() -> str:
 
 def wb_robot_set_custom_data(data: str) -> None:
     """Stored by the server at once (other clients' ``get_custom_data`` see it)."""
+    data = c_string(data)
     if not isinstance(data, str):
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"wb_robot_set_custom_data(): data must be a string, got {data!r}")
     r = current()

@@ -19,7 +19,7 @@ import wave
 from typing import Any
 
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import DeviceState, answers, current, real
+from sensorium.client.wb_robot import DeviceState, answers, c_string, current, real
 
 SPEAKER = "Speaker"
 ENGINES = ("pico",)
@@ -89,8 +89,7 @@ def _play(dev: DeviceState, sound: str, volume: float, pitch: float, balance: fl
     if known is None:
         length = sound_length(sound)
         if length == "missing":
-            shown = sound.replace("\0", "\\0")                # a NUL inside, written as \0
-            _err(f"Warning: {func}(): Sound file '{shown}' not found. The sound file should be defined relatively to "
+            _err(f"Warning: {func}(): Sound file '{sound}' not found. The sound file should be defined relatively to "
                  "the controller, the PROTO or absolutely.")
             return
         if isinstance(length, str):
@@ -122,6 +121,7 @@ def wb_speaker_play_sound(left: int, right: int, sound: str, volume: float, pitc
     """Play ``sound`` (a WAV file) on ``left`` and/or ``right`` (0: none), as libController splits it:
     one speaker given twice plays it on both channels at ``volume``; two speakers each play their
     side at the volume the balance leaves it."""
+    sound = c_string(sound)
     func = "wb_speaker_play_sound"
     if not isinstance(sound, str):
         raise SensoriumError(ErrorCode.INVALID_ARGUMENT, f"{func}(): 'sound' must be a string, got {sound!r}")
@@ -153,6 +153,7 @@ def wb_speaker_play_sound(left: int, right: int, sound: str, volume: float, pitc
 @answers(None)
 def wb_speaker_stop(tag: int, sound: str | None) -> None:
     """Stop ``sound``, or with None or "" every sound and the speech."""
+    sound = c_string(sound)
     func = "wb_speaker_stop"
     r = current()
     dev = r.device(tag, SPEAKER, func)
@@ -171,6 +172,7 @@ def wb_speaker_stop(tag: int, sound: str | None) -> None:
 @answers(False)
 def wb_speaker_is_sound_playing(tag: int, sound: str | None) -> bool:
     """Whether ``sound`` plays; with None or "" whether anything plays or is spoken."""
+    sound = c_string(sound)
     func = "wb_speaker_is_sound_playing"
     dev = current().device(tag, SPEAKER, func)
     if sound is not None and not isinstance(sound, str):
@@ -184,6 +186,7 @@ def wb_speaker_is_sound_playing(tag: int, sound: str | None) -> bool:
 
 @answers(False)
 def wb_speaker_set_engine(tag: int, engine: str) -> bool:
+    engine = c_string(engine)
     dev = current().device(tag, SPEAKER, "wb_speaker_set_engine")
     if engine not in ENGINES:
         return False
@@ -195,6 +198,7 @@ def wb_speaker_set_engine(tag: int, engine: str) -> bool:
 def wb_speaker_set_language(tag: int, language: str) -> bool:
     """libController's rule: a malformed code is one error line and False, a well-formed one the
     engine does not speak is False silently, a language it speaks True."""
+    language = c_string(language)
     func = "wb_speaker_set_language"
     dev = current().device(tag, SPEAKER, func)
     lang = language if isinstance(language, str) else ""
@@ -226,6 +230,7 @@ def wb_speaker_get_language(tag: int) -> str:
 @answers(None)
 def wb_speaker_speak(tag: int, text: str, volume: float) -> None:
     """Speak ``text`` (it replaces what is being spoken); no synthesiser: it lasts 0.4 s a word."""
+    text = c_string(text)
     func = "wb_speaker_speak"
     r = current()
     dev = r.device(tag, SPEAKER, func)

@@ -21,7 +21,7 @@ from typing import Any
 
 from sensorium.client import nodes
 from sensorium.client.connection import ErrorCode, SensoriumError
-from sensorium.client.wb_robot import RobotClient, current
+from sensorium.client.wb_robot import RobotClient, c_string, current
 
 WB_SUPERVISOR_SIMULATION_MODE_PAUSE = 0
 WB_SUPERVISOR_SIMULATION_MODE_REAL_TIME = 1
@@ -145,6 +145,7 @@ def wb_supervisor_node_get_root() -> int | None:
 
 def wb_supervisor_node_get_from_def(name: str) -> int | None:
     """The node (robot, solid or light) of that DEF name (else name), None if there is none."""
+    name = c_string(name)
     r = _supervisor("wb_supervisor_node_get_from_def")
     if r is None:
         return None
@@ -472,6 +473,7 @@ MAX_STATE_NAME = 1024
 
 
 def _node_state(node: Any, state_name: Any, item: str, func: str) -> None:
+    state_name = c_string(state_name)
     r = _checked_node(node, func)
     if r is None:
         return
@@ -587,6 +589,7 @@ def _field_args(field: Field) -> dict:
 
 
 def _get_field(node: Any, field_name: Any, level: int, func: str) -> Field | None:
+    field_name = c_string(field_name)
     r = _checked_node(node, func)
     if r is None:
         return None
@@ -720,6 +723,7 @@ def wb_supervisor_node_get_from_proto_def(node: int | None, def_name: str) -> in
     its nested PROTO instances hold in their fields, not their own bodies) with that DEF, usable as any
     node; None when there is none. Webots' lines for a NULL or empty ``def``, a NULL node, a node that is
     no PROTO instance; Sensorium's line when the DEF names a node it serves no Supervisor node for."""
+    def_name = c_string(def_name)
     func = "wb_supervisor_node_get_from_proto_def"
     r = _supervisor(func)
     if r is None:
@@ -1033,6 +1037,7 @@ def wb_supervisor_field_set_sf_vec2f(field: Field | None, values: Any) -> None:
 
 
 def wb_supervisor_field_set_sf_string(field: Field | None, value: str) -> None:
+    value = c_string(value)
     _field_set(field, WB_SF_STRING, value, "wb_supervisor_field_set_sf_string")
 
 
@@ -1168,10 +1173,12 @@ def wb_supervisor_field_insert_mf_rotation(field: Field | None, index: int, valu
 
 
 def wb_supervisor_field_set_mf_string(field: Field | None, index: int, value: str) -> None:
+    value = c_string(value)
     _mf_change(field, WB_MF_STRING, "set", index, value, "wb_supervisor_field_set_mf_string")
 
 
 def wb_supervisor_field_insert_mf_string(field: Field | None, index: int, value: str) -> None:
+    value = c_string(value)
     _mf_change(field, WB_MF_STRING, "insert", index, value, "wb_supervisor_field_insert_mf_string")
 
 
@@ -1187,6 +1194,7 @@ def wb_supervisor_field_import_mf_node_from_string(field: Field | None, position
     ``simulationReset`` does too (Webots). A robot, a node that is neither a solid nor a light, or a
     string that does not read (the server's line names where: ``node string:LINE:COL``) is refused
     with one error line and nothing changes."""
+    node_string = c_string(node_string)
     func = "wb_supervisor_field_import_mf_node_from_string"
     r = _field_robot(field, WB_MF_NODE, func)
     if r is None:
@@ -1211,6 +1219,7 @@ def wb_supervisor_field_import_sf_node_from_string(field: Field | None, node_str
     """Webots' ``importSFNodeFromString``: served into the empty ``coord`` (a ``Coordinate``) or ``color`` (a
     ``Color``) of an imported line or point set; any other SFNode field, a full one or a string that does not
     read is refused with the server's one line, nothing changed."""
+    node_string = c_string(node_string)
     func = "wb_supervisor_field_import_sf_node_from_string"
     r = _field_robot(field, WB_SF_NODE, func)
     if r is None:
@@ -1348,6 +1357,7 @@ def wb_supervisor_world_load(filename: str) -> None:
     one's too, return -1), ``filename`` loads (relative to this controller's folder, as in Webots; within
     the folder of the world ``run`` started with) and its controllers start. A name that gives no world
     is one line of ``run``'s and the run ends (exit 1). Under ``sensorium serve`` one error line, nothing done."""
+    filename = c_string(filename)
     import os
 
     func = "wb_supervisor_world_load"
@@ -1365,6 +1375,7 @@ def wb_supervisor_world_save(filename: str | None = None) -> bool:
     (a ``.wbt`` file; relative to the controller's folder, as every file a controller writes), through a
     temporary file renamed onto it. Without a filename Webots overwrites the world file it loaded: here one
     line and False (a headless server never overwrites its world file; name the file)."""
+    filename = c_string(filename)
     import contextlib
     import os
 
@@ -1436,6 +1447,7 @@ def wb_supervisor_set_label(id: int, text: str, x: float, y: float, size: float,
                             transparency: float = 0.0, font: str = "Arial") -> None:
     """Webots' label over the 3D view: here over every ``wb_supervisor_export_image`` picture (and
     kept by the server under ``id`` until it ends; README "Supervisor")."""
+    text, font = c_string(text), c_string(font)
     func = "wb_supervisor_set_label"
     for name, value in (("x", x), ("y", y), ("size", size), ("transparency", transparency)):
         if not _unit_arg(func, name, value):
@@ -1455,9 +1467,6 @@ def wb_supervisor_set_label(id: int, text: str, x: float, y: float, size: float,
     if isinstance(color, bool) or not isinstance(color, int) or not 0 <= color <= 0xFFFFFF:
         print(f"Error: {func}() called with a 'color' that is no 0xRRGGBB value ({color!r}).", file=sys.stderr)
         return
-    # Webots hands a Python str to libController as a C string: what follows its first NUL is never seen
-    # (a received packet's text keeps the sender's terminating NUL)
-    text, font = text.split("\0", 1)[0], font.split("\0", 1)[0]
     _answer(r, "set_label", {"id": id, "text": text, "x": float(x), "y": float(y), "size": float(size),
                              "color": color, "transparency": float(transparency), "font": font}, func)
 
@@ -1467,6 +1476,7 @@ def wb_supervisor_export_image(filename: str, quality: int) -> None:
     over it, saved as ``filename`` (``.png``, or ``.jpg``/``.jpeg`` at ``quality`` 1..100, Pillow
     needed for JPEG). The server sends the pixels; this client writes the file, through a
     temporary file renamed onto ``filename`` (Webots' way: never a half-written picture)."""
+    filename = c_string(filename)
     import os
 
     from sensorium.client import images

@@ -465,6 +465,7 @@ class Supervisor(Robot):
         return _node_of(wb.wb_supervisor_node_get_root())
 
     def getFromDef(self, d: str) -> Node | None:
+        d = wb.c_string(d)
         return _node(self._lookup("get_from_def", {"name": d}, "wb_supervisor_node_get_from_def", d))
 
     def getSelf(self) -> Node | None:
