@@ -7,16 +7,23 @@ among the urls below both, a default url in the PROTO, a value the world writes 
 Supervisor's sets of the url and simulationReset (which keeps the value set) in random order: the shape shows the image of the first of
 the PROTO's folder and the world's folder that holds the url's file, the path cleaned first as Webots'
 QDir::cleanPath does (``tex/../t.png`` is ``t.png``), the world's only while the path stays in it; or none,
-drawn untextured."""
+drawn untextured.
+
+A car's fittings: test_wbt_car.py's Hinge2 car with up to four random motorised hinges on its body (tilted,
+upright or horizontal axes; nothing, a box, a sphere or a cylinder along or across the axis; a second hinge
+on the first's end point), all above the wheels' axles: the same Ackermann drive as the bare car, the bicycle
+model's circle (1e-9) whatever the fittings' motors are set to."""
 
 from __future__ import annotations
 
 import gc
 import itertools
+import math
 import os
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 from _fuzz import example_counts
 from hypothesis import given, settings
@@ -147,3 +154,113 @@ def test_regression_a_cleaned_url_names_the_file_beside_the_proto_without_its_fo
     textures_follow_webots_lookup(tmp_path / "case", "w", "protos/Plate.proto",
                                   [(True, "t.png"), (False, "t.png"), (False, "tex/u.png")],
                                   "u.png", "tex/../t.png", ["tex/../t.png", None])
+
+
+# ---------------------------------------------------------------- a car's fittings
+#
+# test_wbt_car.py's Hinge2Joint car (wheelbase L, track T, tyres R, its body box up to z 0.9) with random
+# fittings on its body: motorised hinges about a tilted, vertical or horizontal axis, holding nothing, a box, a
+# sphere, a cylinder along or across the axis, or another such hinge (a mirror's yaw then pitch), all above
+# the wheels' axles. The car is the same Ackermann drive as without them and drives the bicycle model's
+# circle (closed form, 1e-9) whatever the fittings' motors are set to; each fitting turns as a joint.
+
+FITTING_AXES = {"tilted": "0.6 0 0.8", "vertical": "0 0 1", "along": "1 0 0", "across": "0 1 0",
+                "leaning": "0.2 0.1 1"}
+FITTING_PARTS = {"nothing": "", "box": "Box { size 0.3 0.05 0.02 }", "sphere": "Sphere { radius 0.1 }",
+                 "upright cylinder": "Cylinder { radius 0.2 height 0.03 }",
+                 "cylinder on y": "Cylinder { radius 0.2 height 0.03 }", "cylinder on x": "Cylinder { radius 0.2 height 0.03 }"}
+PART_TURNS = {"cylinder on y": "rotation 1 0 0 1.5707963267948966", "cylinder on x": "rotation 0 1 0 1.5707963267948966"}
+
+
+def fitting_text(k: int, spec: tuple, inner: str = "") -> str:
+    axis, part, x, y, z = spec
+    shape = (f'Pose {{ {PART_TURNS.get(part, "")} children [ Shape {{ geometry {FITTING_PARTS[part]} }} ] }}'
+             if FITTING_PARTS[part] else "")
+    return (f'HingeJoint {{ jointParameters HingeJointParameters {{ axis {FITTING_AXES[axis]} anchor {x} {y} {z} }} '
+            f'device [ RotationalMotor {{ name "fitting {k}" maxVelocity 10 }} ] '
+            f'endPoint Solid {{ translation {x} {y} {z} children [ {shape} {inner} ] name "fitting {k}" }} }}\n')
+
+
+fitting_specs = st.tuples(st.sampled_from(sorted(FITTING_AXES)), st.sampled_from(sorted(FITTING_PARTS)),
+                          st.sampled_from([0.4, 1.3, 2.2, 3.0]), st.sampled_from([-0.5, 0.0, 0.4]),
+                          st.sampled_from([0.8, 1.0, 1.5]))
+
+
+def a_car_with_fittings_drives_as_without(folder: Path, fittings: list[tuple[tuple, tuple | None]],
+                                          turns: list[float], delta: float, speed: float) -> None:
+    from test_wbt_car import HINGE2_CAR, L, R, T, car, hinge2_front
+
+    from sensorium.client.webots.vehicle.driver import ackermann_angles
+
+    texts, k = [], 0
+    for outer, inner in fittings:
+        inner_text = ""
+        if inner is not None:          # a second hinge on the first's end point, in its frame
+            ax, part, x, y, z = inner
+            inner_text = fitting_text(k + 1, (ax, part, 0.1 * x, 0.1 * y, 0.1 * z))
+        texts.append(fitting_text(k, outer, inner_text))
+        k += 2
+    folder.mkdir(parents=True, exist_ok=True)
+    bare = folder / "bare.wbt"
+    bare.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n" + HINGE2_CAR)
+    fitted = folder / "fitted.wbt"
+    fitted.write_text("#VRML_SIM R2023b utf8\nWorldInfo { basicTimeStep 16 }\n"
+                      + car(hinge2_front("right", -T / 2) + hinge2_front("left", T / 2) + "".join(texts)))
+    w = load_world(fitted)
+    assert w.world.robots[0].ackermann_drive == load_world(bare).world.robots[0].ackermann_drive, w.warnings
+    sim = Simulation(w)
+    r = sim.robot("car")
+    motors = sorted(m for m in r.motors if m.startswith("fitting"))
+    assert len(motors) == sum(1 + (inner is not None) for _, inner in fittings)
+    for name, turn in zip(motors, turns):
+        r.motor(name).set_position(turn)
+    right, left = ackermann_angles(delta, L, T)
+    r.motor("right_steer").set_position(right)
+    r.motor("left_steer").set_position(left)
+    sim.run(10)
+    start = np.asarray(r.pose.translation, dtype=np.float64)
+    assert start == pytest.approx([0.0, 0.0, 0.0], abs=1e-12)
+    for name in ("right_rear_wheel", "left_rear_wheel"):
+        r.motor(name).set_position(math.inf)
+        r.motor(name).set_velocity(speed)
+    n = 100
+    sim.run(n)
+    # the bicycle model's circle about the rear axle's centre, turning right for a positive delta (the
+    # car's positive_steers "right"), radius L / tan(delta)
+    radius = L / math.tan(delta)
+    phi = R * speed * n * 0.016 / radius
+    p = r.pose.translation
+    assert (p[0], p[1]) == pytest.approx((radius * math.sin(phi), -radius + radius * math.cos(phi)), abs=1e-9)
+    for name, turn in zip(motors, turns):         # each fitting where its motor put it
+        assert r.motors[name].position == pytest.approx(turn, abs=1e-12)
+
+
+@pytest.mark.parametrize("examples", example_counts(200, 10))
+def test_a_cars_fittings_leave_its_ackermann_drive_as_it_is(tmp_path, examples: int) -> None:
+    cases = itertools.count()
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(st.lists(st.tuples(fitting_specs, st.one_of(st.none(), fitting_specs)), max_size=4),
+           st.lists(st.floats(-1.5, 1.5), min_size=8, max_size=8),
+           st.sampled_from([-0.3, -0.1, 0.05, 0.2, 0.4]), st.sampled_from([5.0, 20.0, 40.0]))
+    def run(fittings: list, turns: list[float], delta: float, speed: float) -> None:
+        try:
+            a_car_with_fittings_drives_as_without(tmp_path / f"car{next(cases)}", fittings, turns, delta, speed)
+        finally:
+            gc.collect()
+
+    run()
+
+
+@pytest.mark.parametrize("fittings", [
+    # a roller high on the body (its bottom 0.9 m above the wheels'): its line said the Hinge2 car's steering
+    # joints, whose end points are free wheels, "hold no wheel", and the car had no drive
+    [(("across", "cylinder on y", 0.4, -0.5, 1.0), None)],
+    # a roller above the axles but within a wheel's diameter of the ground: a wheel, and no pair with the rest
+    [(("along", "cylinder on x", 0.4, -0.5, 0.8), None)],
+    # an upright hinge turning a round part on the roof (a beacon), alone or on a fitting: a third steering joint
+    [(("leaning", "upright cylinder", 1.3, 0.4, 1.0), None)],
+    [(("across", "box", 0.4, -0.5, 0.8), ("leaning", "cylinder on x", 0.4, -0.5, 0.8))],
+], ids=["lifted roller", "low roller", "beacon", "beacon on a fitting"])
+def test_regression_a_cars_fittings_found_by_the_property(tmp_path, fittings: list) -> None:
+    a_car_with_fittings_drives_as_without(tmp_path, fittings, [0.3] * 8, -0.3, 5.0)
