@@ -264,3 +264,99 @@ def test_a_cars_fittings_leave_its_ackermann_drive_as_it_is(tmp_path, examples: 
 ], ids=["lifted roller", "low roller", "beacon", "beacon on a fitting"])
 def test_regression_a_cars_fittings_found_by_the_property(tmp_path, fittings: list) -> None:
     a_car_with_fittings_drives_as_without(tmp_path, fittings, [0.3] * 8, -0.3, 5.0)
+
+
+# ---------------------------------------------------------------- a rider inside a Pose of its carrier
+#
+# Round 30's two-wheel TRUCK with RIDER inside a Pose of its children (turned about z, moved): the rider's
+# translation and rotation fields are in that Pose's frame, as Webots gives a nested node's fields in its
+# parent's; read as written, set there (its world pose the truck's composed with the Pose's and the value set,
+# 1e-9) while the truck drives, and given back as written by simulationReset.
+
+def rider_in_pose_world(folder: Path, pose: tuple, local: tuple) -> Path:
+    from test_props_round30 import WHEEL
+
+    wheels = " ".join(WHEEL.format(y=y, side=side) for y, side in ((0.12, "left"), (-0.12, "right")))
+    (px, py, pz, pyaw), (lx, ly, lz, lyaw) = pose, local
+    path = folder / "pose_rider.wbt"
+    path.write_text(f"""#VRML_SIM R2023b utf8
+WorldInfo {{ basicTimeStep 16 }}
+Robot {{ name "boss" controller "<extern>" supervisor TRUE }}
+DEF TRUCK Robot {{ translation 0 0 0.05 name "truck" controller "<extern>" children [
+  {wheels}
+  Pose {{ translation {px!r} {py!r} {pz!r} rotation 0 0 1 {pyaw!r} children [
+    DEF RIDER Robot {{ translation {lx!r} {ly!r} {lz!r} rotation 0 0 1 {lyaw!r} name "rider" controller "<extern>"
+      children [ DistanceSensor {{ name "rs" }} ] }} ] }} ]
+  boundingObject Box {{ size 0.3 0.2 0.06 }} physics Physics {{ }} }}
+""")
+    return path
+
+
+def frame_of(x: float, y: float, z: float, yaw: float) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, :3] = [[math.cos(yaw), -math.sin(yaw), 0.0], [math.sin(yaw), math.cos(yaw), 0.0], [0.0, 0.0, 1.0]]
+    m[:3, 3] = (x, y, z)
+    return m
+
+
+def a_rider_in_a_pose_reads_and_sets_its_fields_there(folder: Path, pose: tuple, local: tuple, put: tuple,
+                                                      speeds: tuple[float, float]) -> None:
+    sim = Simulation(load_world(rider_in_pose_world(folder, pose, local)), "exact")
+    lv = Live(sim)
+    lv.ok(A, "attach", {"robot": "boss"})
+    node = lv.ok(A, "/boss/robot/get_from_def", {"name": "RIDER"})["node"]
+
+    def field(name: str) -> list[float]:
+        return lv.ok(A, "/boss/robot/get_field", {"node": node, "field": name})["value"]
+
+    def where(value: tuple) -> np.ndarray:
+        truck = sim.robot("truck").pose
+        t = np.eye(4)
+        t[:3, :3], t[:3, 3] = np.asarray(truck.rotation), np.asarray(truck.translation)
+        return t @ frame_of(*pose) @ frame_of(*value)
+
+    def check(value: tuple) -> None:
+        want, got = where(value), sim.robot("rider").pose
+        assert np.asarray(got.translation) == pytest.approx(want[:3, 3], abs=1e-9)
+        assert np.asarray(got.rotation) == pytest.approx(want[:3, :3], abs=1e-9)
+        assert field("translation") == pytest.approx(list(value[:3]), abs=1e-9)
+        axis_angle = field("rotation")
+        assert frame_of(0, 0, 0, axis_angle[3] * axis_angle[2])[:3, :3] == pytest.approx(frame_of(*value)[:3, :3], abs=1e-9)
+
+    truck = sim.robot("truck")
+    for side, speed in zip(("left", "right"), speeds):
+        truck.motor(side).set_position(math.inf)
+        truck.motor(side).set_velocity(speed)
+    sim.run(5)
+    check(local)
+    lv.ok(A, "/boss/robot/set_field", {"node": node, "field": "translation", "value": list(put[:3])})
+    lv.ok(A, "/boss/robot/set_field", {"node": node, "field": "rotation", "value": [0.0, 0.0, 1.0, put[3]]})
+    sim.run(5)
+    check(put)
+    lv.ok(A, "/boss/robot/simulation_reset")
+    sim.run(1)
+    check(local)
+
+
+small = st.sampled_from([-0.2, 0.0, 0.05, 0.3])
+turn = st.sampled_from([-2.0, 0.0, 0.4, 1.5707963267948966, 3.0])
+frames4 = st.tuples(small, small, st.sampled_from([0.1, 0.25]), turn)
+
+
+@pytest.mark.parametrize("examples", example_counts(100, 10))
+def test_a_rider_inside_a_pose_of_its_carrier_has_its_fields_in_that_pose(tmp_path, examples: int) -> None:
+    @settings(SETTINGS, max_examples=examples)
+    @given(frames4, frames4, frames4, st.tuples(st.sampled_from([0.0, 2.0, 5.0]), st.sampled_from([-1.0, 3.0])))
+    def run(pose: tuple, local: tuple, put: tuple, speeds: tuple) -> None:
+        try:
+            a_rider_in_a_pose_reads_and_sets_its_fields_there(tmp_path, pose, local, put, speeds)
+        finally:
+            gc.collect()
+
+    run()
+
+
+def test_regression_a_rider_inside_a_pose_reads_and_sets_its_fields_in_the_poses_frame(tmp_path) -> None:
+    """Its fields read its frame in the carrier's (the Pose composed with them) and a set was taken there."""
+    a_rider_in_a_pose_reads_and_sets_its_fields_there(tmp_path, (0.1, 0.0, 0.2, 0.5), (0.1, 0.05, 0.1, 0.3),
+                                                      (0.0, -0.1, 0.3, -0.4), (2.0, 5.0))

@@ -869,6 +869,8 @@ class Converter:
                     self.riding, self.in_rider = riding, None
                 rider = self.world["robots"].pop()      # listed after its carrier, as Webots' scene tree has it
                 rider["carried_by"] = {"robot": carrier["name"], "frame": self.child_frame(node, frame).pose()}
+                if not np.array_equal(frame.translation, np.zeros(3)) or not np.array_equal(frame.rotation, np.eye(3)):
+                    rider["carried_by"]["parent"] = frame.pose()     # Poses between: its fields are in theirs
                 self.riders.setdefault(carrier["name"], []).append(rider)
             else:     # at the top or nested in solids and groups: a robot placed where they put it
                 self.robot(node, owner.placed.compose(frame))
