@@ -2010,6 +2010,8 @@ class Carrier(Strict):
 
     robot: str = Field(min_length=1, description="the carrying robot's name")
     frame: Pose = Field(default=Pose(), description="this robot's frame in the carrier's")
+    parent: Pose | None = Field(default=None, description="the frame of its parent in the carrier's (the Poses "
+                                "between them), where its translation and rotation fields are; None: the carrier")
 
 
 class Robot(Strict):

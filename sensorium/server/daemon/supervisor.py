@@ -496,8 +496,12 @@ def _set_pose(sim: Any, node: Node, field: str, value: list[float]) -> None:
     if node.type == "Robot":
         robot = sim.robots[node.key]
         frame = sim.rider_frame(robot) if hasattr(sim, "rider_frame") else None
-        if frame is not None:        # a robot riding another: its fields are in its carrier's frame (WbPose)
-            sim.set_rider_frame(robot, moved_pose(frame, **kwargs))
+        if frame is not None:        # a robot riding another: its fields are in its parent's frame (WbPose)
+            parent = sim.rider_parent(robot)
+            if parent is None:
+                sim.set_rider_frame(robot, moved_pose(frame, **kwargs))
+            else:
+                sim.set_rider_frame(robot, parent.compose(moved_pose(parent.inverse().compose(frame), **kwargs)))
             return
         robot.set_pose(**kwargs)
     else:
@@ -507,8 +511,12 @@ def _set_pose(sim: Any, node: Node, field: str, value: list[float]) -> None:
 def _field_pose(sim: Any, node: Node) -> Any:
     """What a robot's or solid's ``translation`` and ``rotation`` fields give: its pose in the world, a robot
     riding another's in its carrier's frame (its parent's, as Webots gives a nested node's fields)."""
-    frame = sim.rider_frame(sim.robots[node.key]) if node.type == "Robot" and hasattr(sim, "rider_frame") else None
-    return _pose(sim, node) if frame is None else frame
+    robot = sim.robots[node.key] if node.type == "Robot" and hasattr(sim, "rider_frame") else None
+    frame = sim.rider_frame(robot) if robot is not None else None
+    if frame is None:
+        return _pose(sim, node)
+    parent = sim.rider_parent(robot)
+    return frame if parent is None else parent.inverse().compose(frame)
 
 
 _POSE_FIELDS: dict[str, tuple[str, Getter, Setter]] = {

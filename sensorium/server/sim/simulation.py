@@ -102,6 +102,7 @@ class Rider:
     robot: RobotState
     carrier: RobotState
     frame: Pose
+    parent: Pose | None = None      # its parent's frame in the carrier's (Poses between), where its fields are
     loaded_frame: Pose = field(init=False)
 
     def __post_init__(self) -> None:
@@ -482,7 +483,8 @@ class Simulation:
                            self.scene, self._counters)
         # robots riding others (a .wbt Robot nested in another's children): each follows its carrier's pose,
         # fixed in its frame, from the carrier's settled pose at load on
-        self._riders = [Rider(r, self.robots[r.model.carried_by.robot], pose_from_model(r.model.carried_by.frame))
+        self._riders = [Rider(r, self.robots[r.model.carried_by.robot], pose_from_model(r.model.carried_by.frame),
+                              None if r.model.carried_by.parent is None else pose_from_model(r.model.carried_by.parent))
                         for r in self.robots.values() if r.model.carried_by is not None]
         for ride in self._riders:
             if ride.robot.drive is not None:
@@ -603,6 +605,11 @@ class Simulation:
         robot that rides none."""
         ride = next((ride for ride in self._riders if ride.robot is robot), None)
         return None if ride is None else ride.loaded_frame if loaded else ride.frame
+
+    def rider_parent(self, robot: RobotState) -> Pose | None:
+        """A riding robot's parent's frame in its carrier's (the Poses between them), where its translation and
+        rotation fields are; None when its parent is the carrier."""
+        return next((ride.parent for ride in self._riders if ride.robot is robot), None)
 
     def riders_of(self, carrier: RobotState) -> list[RobotState]:
         """The robots riding ``carrier``, in world-file order."""

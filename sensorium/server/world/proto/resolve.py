@@ -237,7 +237,9 @@ def _find(url: str, base_file: str | Path, search: ProtoSearch, tried: list[str]
         elif base.startswith("webots://"):
             u = "webots://" + posixpath.normpath(posixpath.join(posixpath.dirname(base[len("webots://"):]), u))
         else:
-            p = Path(base).parent / u
+            # the path cleaned before it is looked up, as Webots' QDir::cleanPath: "tex/../a.png" names
+            # the a.png beside the naming file whether or not a folder tex is there
+            p = Path(os.path.normpath(Path(base).parent / u))
             tried.append(str(p))
             if _is_file(p):
                 return p, tag

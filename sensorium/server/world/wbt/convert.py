@@ -870,6 +870,8 @@ class Converter:
                     self.riding, self.in_rider = riding, None
                 rider = self.world["robots"].pop()      # listed after its carrier, as Webots' scene tree has it
                 rider["carried_by"] = {"robot": carrier["name"], "frame": self.child_frame(node, frame).pose()}
+                if not np.array_equal(frame.translation, np.zeros(3)) or not np.array_equal(frame.rotation, np.eye(3)):
+                    rider["carried_by"]["parent"] = frame.pose()     # Poses between: its fields are in theirs
                 self.riders.setdefault(carrier["name"], []).append(rider)
             else:     # at the top or nested in solids and groups: a robot placed where they put it
                 self.robot(node, owner.placed.compose(frame))
@@ -2852,8 +2854,17 @@ class Converter:
         holding = {id(w["node"]) for w in wheels if w["steers"] and holds_wheel(w["end"], self)}
         spinning = {id(w["node"]) for w in wheels if id(w["node"]) in holding and w["node"].type == "HingeJoint"
                     and spins_in_place(w, self)}
+        # (with parts lifted, one that carries no wheel left: a TIAGo++'s head pan; but not a car's steering
+        # joint whose end point is its free wheel on the ground, below the lowest axle)
+        ground = min((float(w["centre"][up]) * up.sign for w in wheels if rounded[id(w)]), default=0.0)
+
+        def on_ground(w: dict) -> bool:
+            radius = wheel_radius(w["end"], self)
+            return radius is not None and float(w["centre"][up]) * up.sign - radius <= ground
+
         pans = [w for w in wheels if w["steers"] and (id(w["node"]) not in holding or id(w["node"]) in spinning or (
-            gone and not any(id(o["node"]) in self._inside(w["end"]) for o in wheels if not o["steers"])))]
+            gone and not on_ground(w) and not any(id(o["node"]) in self._inside(w["end"])
+                                                  for o in wheels if not o["steers"])))]
         if pans and not all(w["steers"] for w in wheels):
             for w in pans:
                 why = ("it spins its round part in place about its own axis" if id(w["node"]) in spinning
@@ -2967,10 +2978,22 @@ class Converter:
                 return
             drive, why = ackermann_drive(wheels, self, up)
             # a car's fittings (Webots' BmwX5: its wipers, steering wheel and speedometer needles, on hinges
-            # its driver library turns): a motorised hinge about an axis off the horizontal, or with nothing
-            # round at its end point, rolls on nothing; the car is the rest when the rest make one
+            # its driver library turns): a motorised hinge about an axis off the horizontal, with nothing
+            # round at its end point, or one whose round part's lowest point is above the lowest wheel axle
+            # (a mixer's drum, a fan: nothing on the ground), rolls on nothing;
+            # the car is the rest when the rest make one
+            def height(w: dict) -> float:
+                return up.sign * float(w["centre"][up])
+
+            axle = min((height(w) for w in wheels if rounded[id(w)]), default=0.0)
             fittings = [w for w in wheels if not w["steers"] and (
-                not rounded[id(w)] or abs(float(w["axis"][up])) > AXIS_TOL * float(np.linalg.norm(w["axis"])))]
+                not rounded[id(w)] or abs(float(w["axis"][up])) > AXIS_TOL * float(np.linalg.norm(w["axis"]))
+                or height(w) - float(wheel_radius(w["end"], self) or 0.0) > axle)]
+            # and the upright hinges riding a fitting (a mirror's pitch on its yaw) or turning a round part
+            # off the ground (a beacon, a radar on the roof): they steer no wheel
+            riding = set().union(*(self._inside(f["end"]) for f in fittings))
+            fittings += [w for w in wheels if w["steers"] and (
+                id(w["node"]) in riding or height(w) - float(wheel_radius(w["end"], self) or 0.0) > axle)]
             if drive is None and fittings:
                 rest = [w for w in wheels if not any(w is f for f in fittings)]
                 fitted, _ = ackermann_drive(rest, self, up) if any(not w["steers"] for w in rest) else (None, "")
@@ -2979,7 +3002,7 @@ class Converter:
                     for w in fittings:
                         nowheel.append((w["node"], w["motor"], f"{w['node'].type} motor {w['motor']!r} is no wheel (a "
                                         "car's fitting: its axis is off the horizontal or its end point has nothing "
-                                        f"round to roll on): {JOINT_MOVES}", "a car's fittings"))
+                                        f"round to roll on the ground): {JOINT_MOVES}", "a car's fittings"))
                     wheels = rest
             if drive is None:
                 self.warn(node, f"robot {robot.data['name']!r}: no Ackermann drive ({why}); the robot will not move")
