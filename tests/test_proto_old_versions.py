@@ -1,4 +1,5 @@
-"""A PROTO file written before R2022a (y up) is said to be, since its poses may come out wrong here;
+"""A PROTO file written before R2022a (y up) is said to be (up to R2021b its body is converted at each
+instance, as Webots does; an R2021c one is read as written, as by Webots);
 one whose body places nothing along an axis (Webots' VehicleLights: LEDs in a Group, its header
 R2021b) has no pose to get wrong, and no longer gets the line."""
 
