@@ -150,8 +150,27 @@ def test_a_cylinder_whose_parent_holds_more_stays_as_written_with_webots_warning
     assert "converted as Webots R2022a" in loaded.report.warnings[0]
 
 
+def test_a_turned_devices_group_bounding_object_becomes_its_first_other_node_turned_back(tmp_path: Path) -> None:
+    """Webots hands a turned device its boundingObject Group's nodes, sorted geometries first: poses are
+    turned back inside the Group until the first other node, which, in a new Transform turning it back,
+    replaces the Group. So [Transform, Box 0.2] gives Transform(Fᵀ){Box 0.2}, the Transform dropped; a
+    Group of poses alone stays, each pose turned back: (0, 0.1, 0) → Fᵀ·(0, 0.1, 0) = (0, 0, 0.1)."""
+    back = np.array([[0, -1, 0], [0, 0, 1], [-1, 0, 0]]).T       # F = Rx(-pi/2)·Rz(pi/2), transposed
+    body = ('Robot { children [ Camera { name "a" boundingObject Group { children [\n'
+            '  Transform { translation 0 0.1 0 children [ Box { size 0.1 0.1 0.1 } ] } Box { size 0.2 0.2 0.2 } ] } }\n'
+            '  Camera { name "b" boundingObject Group { children [ Transform { translation 0 0.1 0 children [ Box { } ] } ] } } ] }\n')
+    (robot,) = [n for n in read_wbt(_write(tmp_path, body)).nodes if n.type == "Robot"]
+    a, b = robot.fields["children"]
+    wrap = a.fields["boundingObject"]
+    assert wrap.type == "Transform" and [c.fields["size"] for c in wrap.fields["children"]] == [(0.2, 0.2, 0.2)]
+    assert np.abs(np.array(_matrix(wrap.fields["rotation"])) - back).max() <= 1e-15
+    group = b.fields["boundingObject"]
+    (pose,) = group.fields["children"]
+    assert group.type == "Group" and np.abs(np.array(pose.fields["translation"]) - [0, 0, 0.1]).max() <= 1e-15
+    assert np.abs(np.array(_matrix(pose.fields["rotation"])) - back).max() <= 1e-15
+
+
 @pytest.mark.parametrize(("body", "line", "why"), [
-    ('Robot { children [ Camera { boundingObject Group { children [ Box { } ] } } ] }\n', 3, "its boundingObject is a Group"),
     ('Robot { children [ Camera { children [ Group { children [ Emitter { } ] } ] } ] }\n', 3, "it is inside a Group of a turned Camera"),
     ('Robot { children [ Camera { children [ SolidBox { } ] } ] }\n', 3, "a PROTO instance held by a turned Camera"),
 ])

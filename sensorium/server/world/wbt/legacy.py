@@ -9,7 +9,9 @@ world's nodes breadth-first, geometries first, and post-multiplies fixed turns o
 * **A1** the Viewpoint's orientation turns by Rx(−π/2)·Rz(π/2);
 * **A2** a Camera, Lidar or Radar turns by Rx(−π/2)·Rz(π/2), a Pen by Rx(−π/2), an Emitter,
   Receiver, Connector or TouchSensor by Rx(−π/2)·Rz(−π/2); its children and boundingObject that are
-  poses take the inverse turn (they stay where they were), the others move into a new pose holding it.
+  poses take the inverse turn (they stay where they were), the others move into a new pose holding it;
+  a boundingObject Group's poses take it until its first other node (geometries first), which, in a new
+  pose, replaces the Group.
 
 * **C** (once the PROTO is found, in ``proto.instantiate``) an instance of a PROTO Webots ships whose
   base node is a pose turns by Rx(−π/2)·Rz(π/2).
@@ -18,8 +20,8 @@ The same walk converts, in a world of any version, the body of each instance of 
 to R2021b (``turn_proto_body``, from ``proto.instantiate``), as Webots' ``WbConcreteNodeFactory`` does.
 
 What depends on Webots' unstable sort or on a PROTO's body (a PROTO held by a turned device, a Track, a
-turned device whose boundingObject is a Group or which holds another turned device under a node that is
-no pose; in an old PROTO's body, a node an instance's field gives that a rule would change, an old PROTO
+turned device which holds another turned device under a node that is no pose or more than 16 nodes in its
+children and boundingObject Group; in an old PROTO's body, a node an instance's field gives that a rule would change, an old PROTO
 inside it, a geometry at its root) is refused in one line rather than guessed."""
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ from sensorium.server.world.wbt.parser import Node, WbtSyntaxError
 Matrix = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
 
 _GEOMETRIES = frozenset({"Cylinder", "Capsule", "Cone", "Plane", "ElevationGrid"})
+# Webots' WbGeometry (the sort's first weight)
+_ALL_GEOMETRIES = _GEOMETRIES | {"Box", "Sphere", "IndexedFaceSet", "IndexedLineSet", "PointSet", "Mesh"}
 _SOLID_DEVICES = frozenset("""Accelerometer Altimeter Camera Compass Connector Display DistanceSensor Emitter GPS
 Gyro InertialUnit LED Lidar LightSensor Microphone Pen Radar Radio RangeFinder Receiver Speaker TouchSensor Track
 VacuumGripper""".split())
@@ -241,12 +245,13 @@ class _Turner:
         turn = _A2_TURNS[node.type]
         back = _transposed(turn)
         bounding = node.fields.get("boundingObject")
-        if isinstance(bounding, Node) and bounding.type in ("Group", "Billboard"):
-            raise self.refuse(node, "its boundingObject is a Group, which Webots' conversion replaces by one of its "
-                                    "nodes chosen by its sort order")
+        # a Group boundingObject (Webots: a Group that is no pose) gives its nodes instead of itself
+        group = bounding if isinstance(bounding, Node) and bounding.type in ("Group", "Billboard") else None
+        held = [c for c in group.fields.get("children", []) if isinstance(c, Node)] \
+            if group is not None and isinstance(group.fields.get("children"), list) else []
         kids = [c for c in node.fields.get("children", []) if isinstance(c, Node)] \
             if isinstance(node.fields.get("children"), list) else []
-        for c in [*kids, *([bounding] if isinstance(bounding, Node) else [])]:
+        for c in [*kids, *held, *([bounding] if isinstance(bounding, Node) and group is None else [])]:
             if c.type not in BASE_NODES:
                 raise self.refuse(c, f"a PROTO instance held by a turned {node.type}: whether Webots turns it back "
                                      "depends on its base node, which is not known yet here")
@@ -275,7 +280,23 @@ class _Turner:
                 wrapped.insert(0, self.wrapper(c, back, node))
         if wrapped:
             node.fields["children"] = [*wrapped, *(c for c in kids if c.type in _POSES)]
-        if isinstance(bounding, Node):
+        if group is not None:
+            # Webots' sorted order (geometries, USEs, others, DEFs: a stable insertion sort up to 16 nodes): poses
+            # turned back inside the Group until the first other node, which, in a new Pose turning it back,
+            # replaces the whole Group; the Group's nodes after it are no longer the device's and stay as they are
+            if len(kids) + len(held) > 16:
+                raise self.refuse(group, f"a turned {node.type}'s children and its boundingObject Group hold more "
+                                         "than 16 nodes, whose order Webots' unstable sort decides")
+            order = list(enumerate(held))
+            order.sort(key=lambda e: -(3 if e[1].type in _ALL_GEOMETRIES else 2 if (id(group), "children", e[0])
+                                       in self.uses else 0 if e[1].def_name else 1))
+            for _, c in order:
+                if c.type in _POSES:
+                    self.pre_turn(c, back)
+                else:
+                    node.fields["boundingObject"] = self.wrapper(c, back, node)
+                    break
+        elif isinstance(bounding, Node):
             if bounding.type in _POSES:
                 self.pre_turn(bounding, back)
             else:
