@@ -375,6 +375,9 @@ _OLD_INNER = '#VRML_SIM R2021b utf8\nPROTO Inner [ ]\n{ Solid { children [ Trans
              '{ Robot { controller "<extern>" children [ Camera { children IS extras } ] } }\n'},
      "Eye { extras [ Transform { } ] }\n", r"w.wbt: line 3, column 16: Transform in PROTO Eye \(written for Webots R2021b",
      "it comes from a field of the instance, whose node Webots converts twice"),
+    ({"Inner": _OLD_INNER.replace("R2021b", "R2023b"),
+      "Derived": '#VRML_SIM R2021b utf8\nEXTERNPROTO "Inner.proto"\nPROTO Derived [ ]\n{ Inner { } }\n'},
+     "Derived { }\n", r"Derived.proto:4:3: PROTO Derived \(written for Webots R2021b", "a derived PROTO"),
 ])
 def test_what_an_old_protos_conversion_leaves_unsettled_is_refused_in_one_line(tmp_path: Path, protos: dict[str, str],
                                                                                body: str, where: str, why: str) -> None:

@@ -435,6 +435,11 @@ class _Expander:
     def legacy_body(self, root: Node, proto: ProtoDef, values: dict[str, Any]) -> Node:
         """Webots' conversion of an old PROTO's body at this instance (``wbt.legacy.turn_proto_body``) on a
         copy of ``root`` (the body with the instance's values), the nodes those values hold left shared."""
+        if root.type not in BASE_NODES:
+            raise ProtoError(proto.source, root.line, root.col, f"PROTO {proto.name} (written for Webots "
+                             f"{proto.version}, whose body Webots converts at each instance): its body is an instance "
+                             f"of {short(root.type)} (a derived PROTO), which Webots walks into as one node; not "
+                             "converted here (port the PROTO to R2022a's z-up axes)")
         foreign: set[int] = set()
         stack = [v for v in values.values() if isinstance(v, (Node, list))]
         while stack:
