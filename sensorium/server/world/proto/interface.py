@@ -129,9 +129,11 @@ class ProtoDef:
 # ------------------------------------------------------------------------------------ reading
 
 
-# what a PROTO body written before R2022a (y up) places along its axes: poses, directions and geometry
+# what a PROTO body written before R2022a (y up) places along its axes: poses, directions, geometry and the
+# devices Webots' conversion turns (wbt.legacy's A2)
 _POSED = re.compile(r"\b(translation|rotation|location|direction|Box|Cylinder|Capsule|Cone|Plane|ElevationGrid|"
-                    r"Coordinate|Mesh|CadShape)\b")
+                    r"Coordinate|Mesh|CadShape|Camera|Lidar|Radar|Pen|Emitter|Receiver|Connector|TouchSensor|"
+                    r"Track)\b")
 
 
 def read_proto_file(path: Path, source: str, limits: ProtoLimits) -> ProtoDef:
