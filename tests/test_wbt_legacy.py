@@ -172,6 +172,8 @@ def test_a_turned_devices_group_bounding_object_becomes_its_first_other_node_tur
 
 @pytest.mark.parametrize(("body", "line", "why"), [
     ('Robot { children [ Camera { children [ Group { children [ Emitter { } ] } ] } ] }\n', 3, "it is inside a Group of a turned Camera"),
+    ('Robot { children [ Camera { children [' + ' Transform { }' * 16 + ' ] boundingObject Group { children [ Box { } ] } } ] }\n',
+     3, "a turned Camera's children and its boundingObject Group hold more than 16 nodes"),
     ('Robot { children [ Camera { children [ SolidBox { } ] } ] }\n', 3, "a PROTO instance held by a turned Camera"),
 ])
 def test_what_webots_sort_order_or_proto_files_decide_is_refused_in_one_line(tmp_path: Path, body: str, line: int,
