@@ -465,8 +465,8 @@ class _Expander:
             return new
 
         root = copy(root)
-        turned, warnings, inner = wbt_legacy.turn_proto_body(root, proto.name, proto.version, proto.source,
-                                                             frozenset(foreign))
+        _, warnings, inner = wbt_legacy.turn_proto_body(root, proto.name, proto.version, proto.source,
+                                                        frozenset(foreign))
         for n in inner:
             self.legacy_inner[id(n)] = (n, id(n) in foreign)
         self.warnings += [w for w in warnings if w not in self.warnings]
