@@ -1,4 +1,5 @@
-"""A PROTO file written before R2022a (y up) is said to be, since its poses may come out wrong here;
+"""A PROTO file written before R2022a (y up) is said to be (up to R2021b its body is converted at each
+instance, as Webots does; an R2021c one is read as written, as by Webots);
 one whose body places nothing along an axis (Webots' VehicleLights: LEDs in a Group, its header
 R2021b) has no pose to get wrong, and no longer gets the line."""
 
@@ -17,13 +18,17 @@ def test_an_old_proto_is_said_only_when_it_places_something(tmp_path: Path) -> N
     (tmp_path / "Post.proto").write_text(
         "#VRML_SIM R2021b utf8\nPROTO Post [ field SFVec3f translation 0 0 0 ]\n"
         "{ Solid { translation IS translation children [ Shape { geometry Cylinder { height 1 radius 0.05 } } ] } }\n")
+    # a camera alone places nothing by a field, yet Webots' conversion turns it: said
+    (tmp_path / "Eye.proto").write_text('#VRML_SIM R2021b utf8\nPROTO Eye [ ]\n{ Camera { name "eye" } }\n')
     world = tmp_path / "w.wbt"
     world.write_text('#VRML_SIM R2023b utf8\nEXTERNPROTO "Lights.proto"\nEXTERNPROTO "Post.proto"\n'
-                     'Robot { name "car" controller "<extern>" children [ Lights { } ] }\nPost { translation 1 0 0 }\n')
+                     'EXTERNPROTO "Eye.proto"\nRobot { name "car" controller "<extern>" children [ Lights { } Eye { } ] }\n'
+                     'Post { translation 1 0 0 }\n')
     w = load_world(world)
-    said = [x for x in w.warnings if "before R2022a" in x]
-    assert len(said) == 1 and "PROTO Post was written for Webots R2021b" in said[0], said
-    assert [d.name for d in w.world.robots[0].devices] == ["front_lights"]
+    said = sorted(x for x in w.warnings if "before R2022a" in x)
+    assert len(said) == 2 and "PROTO Eye was written for Webots R2021b" in said[0], said
+    assert "PROTO Post was written for Webots R2021b" in said[1], said
+    assert [d.name for d in w.world.robots[0].devices] == ["front_lights", "eye"]
 
 
 def test_a_proto_without_a_header_loads_as_a_current_one(tmp_path: Path) -> None:

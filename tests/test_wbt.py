@@ -231,7 +231,7 @@ def test_a_node_type_spelt_like_a_number_is_a_node(tmp_path: Path) -> None:
 def test_header_required_and_old_versions_refused(tmp_path: Path) -> None:
     p = tmp_path / "old.wbt"
     p.write_text("#VRML_SIM R2020a utf8\nWorldInfo { }\n")
-    with pytest.raises(WorldError, match=r"old.wbt: line 1, column 1: Webots R2020a world: only R2020b-R2021b \(converted\) and R2022a and later are supported "
+    with pytest.raises(WorldError, match=r"old.wbt: line 1, column 1: Webots R2020a world: only R2020b-R2021b \(converted\) and R2021c and later are supported "
                        r"\(open and save it in Webots R2022a or later, .*convert_nue_to_enu_rub_to_flu.py on a copy"):
         load_world(p)
     p.write_text("WorldInfo { }\n")

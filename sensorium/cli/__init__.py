@@ -36,7 +36,7 @@ def _validate_args(p: argparse.ArgumentParser) -> None:
 @command("convert", "write a Webots world (.wbt) as an equivalent Sensorium world file",
          "sensorium.cli.convert:convert")
 def _convert_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("world", help="Webots world file (.wbt, R2022a or later; R2020b-R2021b converted as Webots does)")
+    p.add_argument("world", help="Webots world file (.wbt, R2021c or later; R2020b-R2021b converted as Webots does)")
     p.add_argument("out", help="output world file (.yaml, .yml or .json; '-' = YAML on standard output)")
     p.add_argument("--force", action="store_true", help="overwrite OUT if it exists")
 

@@ -138,6 +138,9 @@ class _Expander:
         self.uses: dict[str, ProtoUse] = {}
         self.warnings: list[str] = list(wbt.warnings)
         self.legacy_protos = {id(n) for n in wbt.legacy_protos}   # rule C (wbt.legacy)
+        # the PROTO instances an old PROTO's converted body holds (wbt.legacy): id → (node, whether an instance's
+        # field value holds it)
+        self.legacy_inner: dict[int, tuple[Node, bool]] = {}
         self.noted: set[str] = set()
         self.stand_ins: dict[str, tuple[str, int, int]] = {}
         self.appearances: dict[str, set[str]] = {}          # file → the appearance PROTOs standing in there
@@ -385,14 +388,17 @@ class _Expander:
         chain = self.outer.get(key, chain)
         proto = self.lookup(node)
         legacy = key in self.legacy_protos
+        inner = self.legacy_inner.get(key)
+        if inner is not None:
+            legacy = self.legacy_nested(node, proto, inner[1])
         if legacy and proto is None and node.type in BUILTIN_PROTOS:
             # a stand-in for a PROTO Webots ships: its translation and rotation are its base Solid's
+            node = _copy(node, fields=dict(node.fields))
             wbt_legacy.turn_proto_instance(node, pose=node.type != "TexturedBackgroundLight")
         if proto is not None:
-            if legacy:
-                self.legacy_instance(node, proto)
             result = self.instance(node, proto, chain, depth)
             if legacy and self.ships(proto):
+                result = _copy(result, fields=dict(result.fields))
                 wbt_legacy.turn_proto_instance(result)
         elif self.appearances and node.type in self.appearances.get(node.source or self.world, ()):
             result = self.plain_appearance(node)
@@ -406,15 +412,65 @@ class _Expander:
         home = self.search.home
         return home is not None and Path(proto.source).resolve().is_relative_to(home.resolve())
 
-    def legacy_instance(self, node: Node, proto: ProtoDef) -> None:
-        """An R2020b-R2021b world's instance of a PROTO of its own: Webots converts the body of one whose file
-        is older than R2022a at each instance, which is not done here (refused); a newer one stays as it is."""
-        m = re.fullmatch(r"R(\d{4})([a-z])", proto.version)
-        if not self.ships(proto) and (m is None or (int(m.group(1)), m.group(2)) <= (2021, "b")) and proto.version:
-            raise ProtoError(node.source or self.world, node.line, node.col,
-                             f"{short(node.type)}: a PROTO written for Webots {proto.version} in a Webots "
-                             f"{self.wbt.version} world: Webots converts its body at each instance, not done here "
-                             "yet (open and save the world in Webots R2022a or later, and convert the PROTO)")
+    def legacy_nested(self, node: Node, proto: ProtoDef | None, foreign: bool) -> bool:
+        """A PROTO instance inside an old PROTO's converted body: whether rule C turns it (Webots ships it);
+        one Webots would convert twice (its own old body, at its creation and again within the outer
+        one's), or that an instance's field value holds (Webots walks the value and its copy), is refused."""
+        where = node.source or self.world
+        if proto is None:
+            ships = node.type in BUILTIN_PROTOS and node.type != "TexturedBackgroundLight"
+        else:
+            ships = self.ships(proto)      # (a pose is turned: its expansion's base node, turn_proto_instance)
+            if not ships and converted(proto):
+                raise ProtoError(where, node.line, node.col, f"{short(node.type)}: a PROTO written for Webots "
+                                 f"{proto.version} inside another's body written before R2022a: Webots converts its "
+                                 "body at its own instance and again within the outer one's; not converted here "
+                                 "(port the PROTOs to R2022a's z-up axes)")
+        if ships and foreign:
+            raise ProtoError(where, node.line, node.col, f"{short(node.type)}: a PROTO Webots ships, given to a field "
+                             "of an instance of a PROTO written before R2022a: Webots turns the value and its copy in "
+                             "the body, in an order not settled here; not converted")
+        return ships
+
+    def legacy_body(self, root: Node, proto: ProtoDef, values: dict[str, Any]) -> Node:
+        """Webots' conversion of an old PROTO's body at this instance (``wbt.legacy.turn_proto_body``) on a
+        copy of ``root`` (the body with the instance's values), the nodes those values hold left shared."""
+        if root.type not in BASE_NODES:
+            raise ProtoError(proto.source, root.line, root.col, f"PROTO {proto.name} (written for Webots "
+                             f"{proto.version}, whose body Webots converts at each instance): its body is an instance "
+                             f"of {short(root.type)} (a derived PROTO), which Webots walks into as one node; not "
+                             "converted here (port the PROTO to R2022a's z-up axes)")
+        foreign: set[int] = set()
+        stack = [v for v in values.values() if isinstance(v, (Node, list))]
+        while stack:
+            v = stack.pop()
+            if isinstance(v, list):
+                stack += [x for x in v if isinstance(x, (Node, list))]
+            elif id(v) not in foreign:
+                foreign.add(id(v))
+                stack += [x for x in v.fields.values() if isinstance(x, (Node, list))]
+        made: dict[int, Node] = {}
+
+        def copy(n: Node) -> Node:
+            if id(n) in foreign or n.type not in BASE_NODES:
+                return n
+            if id(n) in made:
+                return made[id(n)]
+            new = made[id(n)] = _copy(n, fields=dict(n.fields))
+            for name, v in n.fields.items():
+                if isinstance(v, Node):
+                    new.fields[name] = copy(v)
+                elif isinstance(v, list) and not set(map(type, v)) <= _VALUE_TYPES and any(isinstance(x, Node) for x in v):
+                    new.fields[name] = [copy(x) if isinstance(x, Node) else x for x in v]
+            return new
+
+        root = copy(root)
+        _, warnings, inner = wbt_legacy.turn_proto_body(root, proto.name, proto.version, proto.source,
+                                                        frozenset(foreign))
+        for n in inner:
+            self.legacy_inner[id(n)] = (n, id(n) in foreign)
+        self.warnings += [w for w in warnings if w not in self.warnings]
+        return root
 
     def plain_appearance(self, node: Node) -> Node:
         """The PBRAppearance an appearance PROTO whose file is not found stands in as: grey × its
@@ -488,6 +544,8 @@ class _Expander:
         body = self.body(node, proto, values)
         inner = (*chain, proto.name)
         root = self.substitute(body, proto, values, given, chain)
+        if converted(proto):
+            root = self.legacy_body(root, proto, values)
         out = self.node(root, inner, depth)
         # the PROTOs this node stands for (a derived PROTO's base too), counted where it sits in the
         # expanded tree (check_size): an expansion shared by several places is several instances
@@ -733,6 +791,13 @@ class _Expander:
         """Nodes marked by id must stay alive while the expansion runs (ids are reused)."""
         self._kept = getattr(self, "_kept", [])
         self._kept.append(node)
+
+
+def converted(proto: ProtoDef) -> bool:
+    """Whether Webots converts the body of ``proto``'s instances: its file's header is R2021b or older
+    (``fileVersion() > WbVersion(2021, 1, 1)`` is read as written; no header: read as current, here)."""
+    m = re.fullmatch(r"R(\d{4})([a-z])", proto.version)
+    return m is not None and (int(m.group(1)), m.group(2)) <= (2021, "b") and not proto.inline
 
 
 def proto_key(proto: ProtoDef) -> str:

@@ -129,9 +129,11 @@ class ProtoDef:
 # ------------------------------------------------------------------------------------ reading
 
 
-# what a PROTO body written before R2022a (y up) places along its axes: poses, directions and geometry
+# what a PROTO body written before R2022a (y up) places along its axes: poses, directions, geometry and the
+# devices Webots' conversion turns (wbt.legacy's A2)
 _POSED = re.compile(r"\b(translation|rotation|location|direction|Box|Cylinder|Capsule|Cone|Plane|ElevationGrid|"
-                    r"Coordinate|Mesh|CadShape)\b")
+                    r"Coordinate|Mesh|CadShape|Camera|Lidar|Radar|Pen|Emitter|Receiver|Connector|TouchSensor|"
+                    r"Track)\b")
 
 
 def read_proto_file(path: Path, source: str, limits: ProtoLimits) -> ProtoDef:
@@ -167,8 +169,13 @@ def read_proto_file(path: Path, source: str, limits: ProtoLimits) -> ProtoDef:
     proto.header = header_comments(text)
     proto.version = f"R{year}{letter}"
     if (year, letter) < (2022, "a") and _POSED.search(proto.body):    # a PROTO of devices alone has no poses to turn
+        # Webots converts the body of a file up to R2021b at each instance (proto.instantiate: legacy_body)
+        # and reads an R2021c one (its development name of R2022a) as written
+        done = ("its body is converted at each instance as Webots R2022a and later convert it (Webots warns that "
+                "parts may end up upside down)" if (year, letter) <= (2021, "b") else
+                "read as written, as Webots reads it (it converts files up to R2021b): its poses may come out wrong")
         proto.warnings.append(f"{source}:1:1: PROTO {proto.name} was written for Webots R{year}{letter}, before "
-                              "R2022a's z-up, FLU conventions: its poses may come out wrong")
+                              f"R2022a's z-up, FLU conventions: {done}")
     return proto
 
 

@@ -9,15 +9,20 @@ world's nodes breadth-first, geometries first, and post-multiplies fixed turns o
 * **A1** the Viewpoint's orientation turns by Rx(−π/2)·Rz(π/2);
 * **A2** a Camera, Lidar or Radar turns by Rx(−π/2)·Rz(π/2), a Pen by Rx(−π/2), an Emitter,
   Receiver, Connector or TouchSensor by Rx(−π/2)·Rz(−π/2); its children and boundingObject that are
-  poses take the inverse turn (they stay where they were), the others move into a new pose holding it.
+  poses take the inverse turn (they stay where they were), the others move into a new pose holding it;
+  a boundingObject Group's poses take it until its first other node (geometries first), which, in a new
+  pose, replaces the Group.
 
 * **C** (once the PROTO is found, in ``proto.instantiate``) an instance of a PROTO Webots ships whose
   base node is a pose turns by Rx(−π/2)·Rz(π/2).
 
-What depends on Webots' unstable sort or on a PROTO's body (a world's own PROTO written before
-R2022a, a PROTO held by a turned device, a Track, a turned device whose boundingObject is a Group or
-which holds another turned device under a node that is no pose) is refused in one line rather than
-guessed."""
+The same walk converts, in a world of any version, the body of each instance of a PROTO file written up
+to R2021b (``turn_proto_body``, from ``proto.instantiate``), as Webots' ``WbConcreteNodeFactory`` does.
+
+What depends on Webots' unstable sort or on a PROTO's body (a PROTO held by a turned device, a Track, a
+turned device which holds another turned device under a node that is no pose or more than 16 nodes in its
+children and boundingObject Group; in an old PROTO's body, a node an instance's field gives that a rule would change, an old PROTO
+inside it, a geometry at its root) is refused in one line rather than guessed."""
 
 from __future__ import annotations
 
@@ -30,6 +35,8 @@ from sensorium.server.world.wbt.parser import Node, WbtSyntaxError
 Matrix = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
 
 _GEOMETRIES = frozenset({"Cylinder", "Capsule", "Cone", "Plane", "ElevationGrid"})
+# Webots' WbGeometry (the sort's first weight)
+_ALL_GEOMETRIES = _GEOMETRIES | {"Box", "Sphere", "IndexedFaceSet", "IndexedLineSet", "PointSet", "Mesh"}
 _SOLID_DEVICES = frozenset("""Accelerometer Altimeter Camera Compass Connector Display DistanceSensor Emitter GPS
 Gyro InertialUnit LED Lidar LightSensor Microphone Pen Radar Radio RangeFinder Receiver Speaker TouchSensor Track
 VacuumGripper""".split())
@@ -81,7 +88,12 @@ def _matrix(rotation: Any) -> Matrix:
             (t * x * z - s * y, t * y * z + s * x, t * z * z + c))
 
 
-def _axis_angle(m: Matrix) -> tuple[float, float, float, float]:
+def _flushed(v: tuple[float, ...]) -> tuple[float, ...]:
+    """Products of cos(pi/2) (6e-17) under 1e-30, which world files may not hold (limits), taken as 0."""
+    return tuple(0.0 if abs(x) < 1e-30 else x for x in v)
+
+
+def _axis_angle(m: Matrix) -> tuple[float, ...]:
     """A rotation matrix as axis-angle (angle in [0, π]; the identity as 0 0 1 0, Webots' default)."""
     angle = math.acos(max(-1.0, min(1.0, (m[0][0] + m[1][1] + m[2][2] - 1.0) / 2.0)))
     x, y, z = m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1]
@@ -97,8 +109,8 @@ def _axis_angle(m: Matrix) -> tuple[float, float, float, float]:
         for j in range(3):
             if j != i:
                 axis[j] = (m[i][j] + m[j][i]) / 4.0 / axis[i]
-        return (axis[0], axis[1], axis[2], angle)
-    return (x / n, y / n, z / n, angle)
+        return _flushed((axis[0], axis[1], axis[2], angle))
+    return _flushed((x / n, y / n, z / n, angle))
 
 
 def _subnodes(node: Node) -> list[tuple[str, int, Node]]:
@@ -136,9 +148,14 @@ def _contains(node: Node, types: frozenset[str] | _NotBase) -> Node | None:
 
 
 class _Turner:
-    def __init__(self, version: str, source: str):
+    def __init__(self, version: str, source: str, proto: str | None = None, foreign: frozenset[int] = frozenset()):
         self.version = version
         self.source = source
+        # an old PROTO's body (``proto`` its name): the nodes its instance's parameters hold (``foreign``), which
+        # Webots walks twice (the parameter and its copy in the body), are refused if a rule would touch them
+        self.proto = proto
+        self.foreign = foreign
+        self.root: Node | None = None
         self.warnings: list[str] = []
         self.done: set[tuple[str, int]] = set()    # (rule, id(node)): a node USEd twice is one node here, two copies in Webots
         self.turned = 0
@@ -146,13 +163,25 @@ class _Turner:
         self.protos: list[Node] = []                   # the PROTO instances the walk met (rule C)
 
     def refuse(self, node: Node, why: str) -> WbtSyntaxError:
+        if self.proto is not None:
+            return WbtSyntaxError(node.source or self.source, node.line, node.col,
+                                  f"{node.type} in PROTO {self.proto} (written for Webots {self.version}, whose body "
+                                  f"Webots converts at each instance): {why}, so it is not converted here (port the "
+                                  "PROTO to R2022a's z-up axes)")
         return WbtSyntaxError(node.source or self.source, node.line, node.col,
                               f"{node.type} in a Webots {self.version} world: {why}, so this world is not converted "
                               "here (open and save it in Webots R2022a or later)")
 
+    def touch(self, node: Node) -> None:
+        """A node a rule changes: one a parameter of the PROTO's instance holds is refused."""
+        if id(node) in self.foreign:
+            raise self.refuse(node, "it comes from a field of the instance, whose node Webots converts twice (the "
+                                    "field's and its copy in the body, in an order not settled here)")
+
     def post_turn(self, node: Node, key: str, turn: Matrix) -> None:
         if (key, id(node)) in self.done:
             return
+        self.touch(node)
         self.done.add((key, id(node)))
         field = "orientation" if node.type == "Viewpoint" else "rotation"
         node.fields[field] = _axis_angle(_mul(_matrix(node.fields.get(field)), turn))
@@ -198,7 +227,10 @@ class _Turner:
             stack += [(c, id(n), f, j) for f, j, c in reversed(_subnodes(n))]
 
     def geometry(self, node: Node, parent: Node | None, grand: Node | None) -> None:
+        self.touch(node)
         holder, above = (parent, grand) if parent is not None and parent.type == "Shape" else (node, parent)
+        if self.proto is not None and above is None:
+            raise self.refuse(node, "Webots turns the node holding the instance (outside the PROTO's body) for it")
         if holder is None or above is None or above.type not in _POSES or len(_subnodes(above)) != 1:
             self.warnings.append(f"{node.source or self.source}:{node.line}:{node.col}: {node.type}: Webots' "
                                  "conversion to R2022a's z-up axes leaves it as written (its Shape's parent is no "
@@ -209,15 +241,17 @@ class _Turner:
     def device(self, node: Node) -> None:
         if ("A2", id(node)) in self.done:
             return
+        self.touch(node)
         turn = _A2_TURNS[node.type]
         back = _transposed(turn)
         bounding = node.fields.get("boundingObject")
-        if isinstance(bounding, Node) and bounding.type in ("Group", "Billboard"):
-            raise self.refuse(node, "its boundingObject is a Group, which Webots' conversion replaces by one of its "
-                                    "nodes chosen by its sort order")
+        # a Group boundingObject (Webots: a Group that is no pose) gives its nodes instead of itself
+        group = bounding if isinstance(bounding, Node) and bounding.type in ("Group", "Billboard") else None
+        held = [c for c in group.fields.get("children", []) if isinstance(c, Node)] \
+            if group is not None and isinstance(group.fields.get("children"), list) else []
         kids = [c for c in node.fields.get("children", []) if isinstance(c, Node)] \
             if isinstance(node.fields.get("children"), list) else []
-        for c in [*kids, *([bounding] if isinstance(bounding, Node) else [])]:
+        for c in [*kids, *held, *([bounding] if isinstance(bounding, Node) and group is None else [])]:
             if c.type not in BASE_NODES:
                 raise self.refuse(c, f"a PROTO instance held by a turned {node.type}: whether Webots turns it back "
                                      "depends on its base node, which is not known yet here")
@@ -230,7 +264,11 @@ class _Turner:
                 if inner is not None:
                     raise self.refuse(inner, f"it is inside a {c.type} of a turned {node.type}: whether Webots turns "
                                              "it depends on its sort order")
-        self.post_turn(node, "A2", turn)
+        if node is self.root:
+            # Webots turns no device that is the instance itself (``candidate != node``), only what it holds
+            self.done.add(("A2", id(node)))
+        else:
+            self.post_turn(node, "A2", turn)
         # Webots' order: USEs first, then the others, then DEFs (each wrapped node goes to index 0)
         entries = list(enumerate(kids))
         entries.sort(key=lambda e: -(2 if (id(node), "children", e[0]) in self.uses else 0 if e[1].def_name else 1))
@@ -242,7 +280,23 @@ class _Turner:
                 wrapped.insert(0, self.wrapper(c, back, node))
         if wrapped:
             node.fields["children"] = [*wrapped, *(c for c in kids if c.type in _POSES)]
-        if isinstance(bounding, Node):
+        if group is not None:
+            # Webots' sorted order (geometries, USEs, others, DEFs: a stable insertion sort up to 16 nodes): poses
+            # turned back inside the Group until the first other node, which, in a new Pose turning it back,
+            # replaces the whole Group; the Group's nodes after it are no longer the device's and stay as they are
+            if len(kids) + len(held) > 16:
+                raise self.refuse(group, f"a turned {node.type}'s children and its boundingObject Group hold more "
+                                         "than 16 nodes, whose order Webots' unstable sort decides")
+            order = list(enumerate(held))
+            order.sort(key=lambda e: -(3 if e[1].type in _ALL_GEOMETRIES else 2 if (id(group), "children", e[0])
+                                       in self.uses else 0 if e[1].def_name else 1))
+            for _, c in order:
+                if c.type in _POSES:
+                    self.pre_turn(c, back)
+                else:
+                    node.fields["boundingObject"] = self.wrapper(c, back, node)
+                    break
+        elif isinstance(bounding, Node):
             if bounding.type in _POSES:
                 self.pre_turn(bounding, back)
             else:
@@ -251,14 +305,16 @@ class _Turner:
     def pre_turn(self, node: Node, back: Matrix) -> None:
         if ("pre", id(node)) in self.done:
             return
+        self.touch(node)
         self.done.add(("pre", id(node)))
         node.fields["rotation"] = _axis_angle(_mul(back, _matrix(node.fields.get("rotation"))))
         t = node.fields.get("translation")
         if isinstance(t, tuple) and len(t) == 3:
-            node.fields["translation"] = _apply(back, t)
+            node.fields["translation"] = _flushed(_apply(back, t))
         self.turned += 1
 
     def wrapper(self, child: Node, back: Matrix, device: Node) -> Node:
+        self.touch(child)
         self.turned += 1
         return Node("Transform", {"rotation": _axis_angle(back), "children": [child]}, child.line, child.col,
                     source=child.source or device.source)
@@ -281,3 +337,18 @@ def turn_proto_instance(node: Node, pose: bool | None = None) -> None:
     R2022a turned back to the world's y-up; another stays."""
     if node.type in _POSES if pose is None else pose:
         node.fields["rotation"] = _axis_angle(_mul(_matrix(node.fields.get("rotation")), _A_CAMERA))
+
+
+def turn_proto_body(root: Node, proto: str, version: str, source: str,
+                    foreign: frozenset[int]) -> tuple[int, list[str], list[Node]]:
+    """Webots' conversion of the body of an instance of a PROTO file written up to R2021b
+    (``WbConcreteNodeFactory`` calls ``fixBackwardCompatibility`` on each instance it creates, in a world of
+    any version): the same walk and rules from the instance's root, in place on ``root`` (a copy of the body
+    with the instance's values); ``foreign``: the ids of the nodes those values hold. The device that is the
+    instance itself is not turned (its children are). The number of nodes turned, the warnings, and the PROTO
+    instances the body holds, which the caller turns by rule C (one Webots ships) or refuses (an old one:
+    Webots converts it at its own creation and again here)."""
+    turner = _Turner(version, source, proto, foreign)
+    turner.root = root
+    turner.run([root])
+    return turner.turned, turner.warnings, turner.protos

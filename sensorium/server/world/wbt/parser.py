@@ -581,11 +581,13 @@ def header_comments(text: str) -> list[str]:
 
 def parse_wbt(text: str, source: str = "<memory>", limits: ProtoLimits | None = None) -> WbtFile:
     year, letter = parse_header(text, source)
+    # Webots converts a world up to R2021b revision 1 (WbNodeUtilities::fixBackwardCompatibility: version >
+    # WbVersion(2021, 1, 1) is read as written, so R2021c, its development name of R2022a, is)
     legacy = (2020, "b") <= (year, letter) <= (2021, "b")
-    if (year, letter) < (2022, "a") and not legacy:
-        # R2021c (Webots' development name of R2022a) and worlds before R2020b (a vector gravity, northDirection)
+    if (year, letter) < (2020, "b"):
+        # worlds before R2020b: a vector gravity, northDirection (WbWorldInfo's conversion, not done here)
         raise WbtSyntaxError(source, 1, 1, f"Webots R{year}{letter} world: only R2020b-R2021b (converted) and "
-                             "R2022a and later are supported (open and save it in Webots R2022a or later, whose "
+                             "R2021c and later are supported (open and save it in Webots R2022a or later, whose "
                              "backward-compatibility pass turns its nodes to z-up, FLU; or run Webots' "
                              "scripts/converter/convert_nue_to_enu_rub_to_flu.py on a copy: it rewrites the file "
                              "in place, NUE to ENU)")
