@@ -355,8 +355,8 @@ def test_lights_under_scaled_transforms_are_nodes_whose_location_is_set_through_
     """HEADLIGHT at (0, 0, 0.25) under GROW (scale 1 1 2, turned +90 degrees about y, 0.5 m up the robot at
     z 1): (0, 0, 0.5) scaled, (0.5, 0, 0) turned, HEAD in the world; BULB at (0, 0, 0.5) under BIG (scale 2)
     in the lamp at (10, 0, 0): (10, 0, 1). A location set is scaled the same way: HEADLIGHT's (0, 0, 0.5)
-    is (1, 0, 1.5), BULB's (0, 0, 1) is (10, 0, 2). A scaled Transform inside a solid is no node: BULB's
-    parent is the lamp, as a Shape's there."""
+    is (1, 0, 1.5), BULB's (0, 0, 1) is (10, 0, 2). Both Transforms are nodes holding their lights, their
+    scale read as written."""
     path = tmp_path / "scaled_lights.wbt"
     path.write_text(SCALED_WBT)
     lv = Live(Simulation(load_world(path)))
@@ -364,10 +364,12 @@ def test_lights_under_scaled_transforms_are_nodes_whose_location_is_set_through_
     bot = lv.sim.robot("probe")
     bot.device("ls").enable(8)
     bot.device("ls2").enable(8)
-    head, bulb_node, grow, lamp = (node(lv, n) for n in ("HEADLIGHT", "BULB", "GROW", "LAMP"))
+    head, bulb_node, grow, big, lamp = (node(lv, n) for n in ("HEADLIGHT", "BULB", "GROW", "BIG", "LAMP"))
     assert head and bulb_node
     assert call(lv, "get_from_id", {"id": head})["parent"] == grow and get(lv, grow, "children") == [head]
-    assert call(lv, "get_from_id", {"id": bulb_node})["parent"] == lamp and bulb_node in get(lv, lamp, "children")
+    assert call(lv, "get_from_id", {"id": bulb_node})["parent"] == big and get(lv, big, "children") == [bulb_node]
+    assert get(lv, lamp, "children") == [big]
+    assert get(lv, grow, "scale") == [1.0, 1.0, 2.0] and get(lv, big, "scale") == [2.0, 2.0, 2.0]
     assert get(lv, head, "location") == [0.0, 0.0, 0.25] and get(lv, bulb_node, "location") == [0.0, 0.0, 0.5]
     assert readings(lv) == pytest.approx((point(HEAD, 2.0, LS) + bulb(LS), point(HEAD, 2.0, LS2) + bulb(LS2)),
                                          rel=1e-12)

@@ -162,7 +162,7 @@ def test_refused_in_one_line_and_nothing_changes():
     lv = _live()
     top, g, t = node(lv, "TOP"), node(lv, "G"), node(lv, "T")
     before = readings(lv)
-    for args, words in (({"node": t, "field": "scale", "value": [2.0, 2.0, 2.0]}, "read-only here"),
+    for args, words in (({"node": t, "field": "scale", "value": [2.0, 2.0, 2.0]}, "it holds a Solid"),
                         ({"node": top, "field": "translation", "value": [0.0, math.inf, 2.0]}, "finite"),
                         ({"node": top, "field": "rotation", "value": [0.0, 0.0, 0.0, 1.0]}, "axis must not be zero")):
         message = lv.err(A, "/probe/robot/set_field", args, ErrorCode.INVALID_ARGUMENT)

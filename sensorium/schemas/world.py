@@ -749,8 +749,12 @@ def _one_mass(mass: Mass | None, pending: PendingMass | None) -> None:
         raise ValueError("pending_mass: give either mass or pending_mass (which the loader makes the mass), not both")
 
 
+_SCALE = ("a Transform's scale as the world file writes it (a zero component: 1, as Webots resets it), which a "
+          "Supervisor's getField reads; none: 1 1 1 (and for every other node)")
+
+
 class SolidPose(Strict):
-    """A ``.wbt`` Pose, Transform (unscaled) or Group inside a solid as a Supervisor serves it (README
+    """A ``.wbt`` Pose, Transform or Group inside a solid as a Supervisor serves it (README
     "Supervisor"): getFromDef, its parent's children, its ``translation`` and ``rotation`` (read here), its
     world pose. The shapes, lights and solids inside it are its solid's, placed through it as the world loads."""
 
@@ -761,6 +765,7 @@ class SolidPose(Strict):
     seq: int = Field(ge=1, description=_SEQ)
     pose: Pose | None = Field(default=None, description="its frame in the solid's frame as the world loads; none "
                               "for a Group")
+    scale: Vec3 | None = Field(default=None, description=_SCALE)
     inner_defs: list[InnerDef] = Field(default=[], max_length=64, description=_INNER_DEFS)
     written_at: list[Annotated[int, Field(ge=1)]] | None = _written_at()
     made_at: list[Annotated[int, Field(ge=1)]] | None = _made_at()
@@ -1957,6 +1962,7 @@ class NestedNode(Strict):
         default="children", description="the parent's field that holds it")
     pose: Pose | None = Field(default=None, description="its frame in the robot's frame as the world loads; "
                               "none for a node that is no Pose (Group, joints, motors, position sensors)")
+    scale: Vec3 | None = Field(default=None, description=_SCALE)
     device: str | None = Field(default=None, min_length=1, description="the robot's device this node is "
                                "(Supervisor getFromDevice)")
     joint_parameters: bool = Field(default=False, description="a HingeJoint or SliderJoint whose world file gives "

@@ -96,6 +96,7 @@ class Nested:
     made: tuple[int, ...] = ()    # (line, column) where the PROTO body that made it writes it (export.py)
     light: int = -1               # a light: its index among its robot's or top-level solid's lights (the scene's
                                   # ``carried_light_slots``); -1: no light
+    scale: tuple[float, ...] | None = None   # a Transform's scale as written (None: 1 1 1)
     path: tuple[int, ...] = ()    # a top-level solid's nested Solid: its place among each parent's ``children`` from the
                                   # top one down (wm.Solid.children indices): the key that names its model (contact points)
 
@@ -417,7 +418,8 @@ def _pose_nodes(s: wm.Solid, holder: int, at: Pose | None, owner: int, key: str,
         local = None if placed is None else placed if at is None else at.compose(placed)
         posed.append(Nested(me, p.type, "", p.def_name or "", "", _pose_parent(holder, p.parent, pose_ids),
                             "children", local, _own(placed, above), "", owner, "Solid", key, frame=above_id,
-                            order=float(p.seq), at=tuple(p.written_at or ()), made=tuple(p.made_at or ())))
+                            order=float(p.seq), at=tuple(p.written_at or ()), made=tuple(p.made_at or ()),
+                            scale=p.scale))
         tags.extend((owner, t, me) for t in p.inner_defs)
         frames.append((placed, me) if placed is not None else (above, above_id))
     return frames
@@ -485,7 +487,7 @@ def build(sim: Any, loaded_solids: int) -> Table:
                               owner if e.parent < 0 else first + e.parent, e.field, local, _own(local, above),
                               e.device or "", owner, "Robot", name, joints[k], above_id,
                               interface=tuple(e.interface), order=float(k), mass=e.mass,
-                              at=tuple(e.written_at or ()), made=tuple(e.made_at or ())))
+                              at=tuple(e.written_at or ()), made=tuple(e.made_at or ()), scale=e.scale))
     solid_ids: SolidIds = {}
     posed: list[Nested] = []
     pose_ids: PoseIds = {}

@@ -837,8 +837,9 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
     out = dict(_NESTED_POSE) if n.own is not None else {}
     if n.own is not None and n.owner_kind == "Solid" and n.type in ("Pose", "Transform") and n.at:
         out = {name: (kind, get, _solid_pose_setter(name)) for name, (kind, get, _) in out.items()}
-    if n.type == "Transform" and n.owner_kind == "Solid":      # (a scaled one inside a solid is no node here)
-        out["scale"] = ("SFVec3f", lambda sim, node: [1.0, 1.0, 1.0], None)
+    if n.type == "Transform":          # as written; set only inside a top-level solid (:func:`_set_solid_scale`)
+        out["scale"] = ("SFVec3f", lambda sim, node: [float(v) for v in _nested_of(sim, node).scale or (1.0, 1.0, 1.0)],
+                        _set_solid_scale if n.owner_kind == "Solid" and n.at else None)
     if n.name:
         out["name"] = ("SFString", lambda sim, node: node.name, None)
     if nested.has_children(n):
@@ -854,6 +855,46 @@ def _nested_fields(sim: Any, node: Node) -> dict[str, tuple[str, Getter, Setter]
         out["position"] = ("SFFloat", lambda sim, node: nested.joint_position(sim, _nested_of(sim, node)),
                            _set_parameter_position)
     return out
+
+
+_LOADED = {"Pose": ("translation", "rotation"), "Transform": ("translation", "rotation", "scale")}
+"""The fields a ``simulationReset`` puts back in a Pose or Transform a Supervisor set inside a top-level solid."""
+
+
+def _set_solid_scale(sim: Any, node: Node, value: list[float]) -> None:
+    """A Transform's ``scale`` inside a top-level solid set (WbTransform): the Shapes it holds are from the next
+    measurement what the world file written with that value makes of them, its solid built again through the path a
+    PROTO field set takes (sim/regenerate.py ``rebuild_posed``; a zero component is 1, Webots' reset), node ids
+    kept; ``simulationReset`` puts the loaded value back. One line and nothing changed for a non-finite value, a
+    Transform holding anything but Shapes (a scale there would change which nodes it holds: a Pose under a scaled
+    Transform is no node here, a Solid none in Webots) and every solid :func:`_set_solid_pose` refuses."""
+    from sensorium.server.sim.imports import ImportRefused
+    from sensorium.server.sim.regenerate import rebuild_posed, written_children, written_node, written_value
+
+    if not all(math.isfinite(v) for v in value):
+        raise ValueError("field 'scale': values must be finite")
+    table = _table(sim)
+    n = _nested_of(sim, node)
+    key = n.owner_key
+    doing = f"field 'scale' of {_what(node)} not set"
+    _check_rebuildable(sim, table, n.owner, key, doing, "the new scale")
+    at = (n.at[0], n.at[1])
+    written = written_node(sim, key, at)
+    if written is None:
+        raise ValueError(f"{doing}: solid {key!r} was not loaded from a .wbt world file's node kept here (a solid a "
+                         "Supervisor imported); nothing changed")
+    held = sorted({getattr(c, "type", "") for c in written_children(written)} - {"Shape"})
+    if held:
+        raise ValueError(f"{doing}: it holds a {held[0]}, and only a Transform holding Shapes alone is scaled again "
+                         "here (a scale would change which nodes it holds); nothing changed")
+    loaded = {name: written.fields.get(name) for name in _LOADED["Transform"]}
+    fields = {"scale": written_value("SFVec3f", [float(v) for v in value])}
+    try:
+        made = _rebuilt_in_place(sim, key, lambda: rebuild_posed(sim, key, n.owner, at, fields))
+    except ImportRefused as exc:
+        raise ValueError(f"{doing}: {exc}; nothing changed") from None
+    sim.__dict__.setdefault("_posed", {}).setdefault(key, {}).setdefault(at, (n.id, loaded))
+    nested.renew(sim, table, n.owner, key, made.model, n.id)
 
 
 def _solid_pose_setter(field: str) -> Setter:
@@ -879,7 +920,7 @@ def _set_solid_pose(sim: Any, node: Node, field: str, value: list[float]) -> Non
     key = n.owner_key
     _check_rebuildable(sim, table, n.owner, key, f"field {field!r} of {_what(node)} not set", "the new frame")
     at = (n.at[0], n.at[1])
-    loaded = written_fields(sim, key, at, ("translation", "rotation"))
+    loaded = written_fields(sim, key, at, _LOADED[n.type])
     if loaded is None:
         raise ValueError(f"field {field!r} of {_what(node)} not set: solid {key!r} was not loaded from a .wbt "
                          "world file's node kept here (a solid a Supervisor imported); nothing changed")
@@ -2170,8 +2211,10 @@ def _import_into_solid(sim: Any, node: Node, position: int, text: str, warnings:
         again = _rebuilt_in_place(sim, key, lambda: rebuild_children(
             sim, key, owner, at, lambda now: [c for c in now if all(c is not n for n in nodes)]))
         nested.regrow(sim, table, owner, key, again.model, gone=frozenset(added))
-        raise ValueError(f"{doing}: node string:{lost.line % IMPORT_LINES}:{lost.col}: {lost.type} is no node a "
-                         "solid's children hold here (a Shape, a Pose, Transform or Group, a Solid or a light)")
+        scaled = node.nested and _nested_of(sim, node).scale not in (None, (1.0, 1.0, 1.0))
+        raise ValueError(f"{doing}: node string:{lost.line % IMPORT_LINES}:{lost.col}: {lost.type} is no node " + (
+            "under a scaled Transform here (only a Shape or a light is)" if scaled else
+            "a solid's children hold here (a Shape, a Pose, Transform or Group, a Solid or a light)"))
     return made_tops
 
 

@@ -609,6 +609,8 @@ class Converter:
         entry: dict[str, Any] = {"type": t}
         if posed:
             entry["pose"] = self.child_frame(node, frame).pose()
+        if t == "Transform":
+            self.written_scale(node, entry)
         if posed and t not in ("Pose", "Transform"):    # a Solid's or device's Physics (getCenterOfMass)
             entry.update(solid_mass(self, node))
         if t in ("HingeJoint", "SliderJoint"):
@@ -833,7 +835,7 @@ class Converter:
             self.solid(node, frame, owner, node.def_name, bounding=False)
         elif t in ("Pose", "Transform"):
             inner = self.child_frame(node, frame)
-            mark = self.solid_pose(node, inner, owner)
+            mark = self.solid_pose(node, inner, owner, frame)
             try:
                 for child in f.nodes("children"):
                     self.visit(child, inner, owner)
@@ -903,12 +905,13 @@ class Converter:
             self.drop(node, why, "robot" if robot_like else "node", named if isinstance(named, str) else t)
 
     # ------------------------------------------------------------ the Poses and Groups a Supervisor walks in a solid
-    def solid_pose(self, node: Node, inner: Frame, owner: Owner) -> int | None:
+    def solid_pose(self, node: Node, inner: Frame, owner: Owner, parent: Frame | None = None) -> int | None:
         """Record a Pose, Transform or Group inside a solid (``inner``: its frame there; a Group's is its
-        parent's) as the Supervisor node it is (schemas.world.SolidPose) and make it the parent of what is
-        walked inside it; returns the parent to restore (None: not recorded: outside a solid, or under a
-        scaled Transform, whose fields no longer map to its place rigidly)."""
-        if owner.kind != "solid" or not inner.rigid:
+        parent's; ``parent``: a Pose's or Transform's parent frame, None: ``inner``) as the Supervisor node it is
+        (schemas.world.SolidPose) and make it the parent of what is walked inside it; returns the parent to
+        restore (None: not recorded: outside a solid, or under a scaled Transform, whose fields no longer map to
+        its place rigidly; a scaled Transform itself is a node, its own frame rigid in its parent's)."""
+        if owner.kind != "solid" or not (parent if parent is not None else inner).rigid:
             return None
         poses = owner.data.setdefault("poses", [])
         above = self.pose_at.get(id(owner.data), -1)
@@ -917,6 +920,8 @@ class Converter:
             entry["parent"] = above
         if node.type != "Group":
             entry["pose"] = inner.pose()
+        if node.type == "Transform":
+            self.written_scale(node, entry)
         if self.nested_def(node):
             entry["def_name"] = node.def_name
         tags = self.inner_defs(node)
@@ -1082,6 +1087,13 @@ class Converter:
         if scale is None:
             scale = self.transform_scale(node) if node.type == "Transform" else (1.0, 1.0, 1.0)
         return frame.then(f.vec("translation", (0.0, 0.0, 0.0)), rotation, scale)
+
+    def written_scale(self, node: Node, entry: dict) -> None:
+        """A Transform node's ``scale`` as its world file writes it (Webots' reset of a zero component), in
+        ``entry`` when not 1 1 1 (the Supervisor's getField of a nested Transform reads it)."""
+        scale = self.transform_scale(node)
+        if scale != (1.0, 1.0, 1.0):
+            entry["scale"] = list(scale)
 
     def transform_scale(self, node: Node) -> tuple[float, float, float]:
         """A Transform's scale; a zero component is reset to 1 as Webots does (its warning)."""
