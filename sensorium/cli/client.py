@@ -47,6 +47,11 @@ def _print_script_traceback(exc: BaseException, script: str) -> None:
     target = os.path.realpath(script)
     while tb is not None and os.path.realpath(tb.tb_frame.f_code.co_filename) != target:
         tb = tb.tb_next
+    if tb is None and isinstance(exc, SyntaxError) and exc.filename and os.path.realpath(exc.filename) == target:
+        # the script did not compile: no frame of it ran, and its file, line and caret are the error's own
+        # (what `python script.py` prints), so none of the launcher's frames either
+        traceback.print_exception(type(exc), exc, None)
+        return
     traceback.print_exception(type(exc), exc, tb or exc.__traceback__)
 
 
