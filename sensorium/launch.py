@@ -712,7 +712,8 @@ class Launcher:
         quitting = self._quitting()         # as it ended (the world may reach its end while its output drains)
         if by_itself:               # it may never have attached (a crash at start): not waited for any more
             self._starting.discard(run.spec.robot)
-            self._exited[run.spec.robot] = time.monotonic()    # nor, attached, for its heartbeats to time out
+            if code != 0:           # a crash: nor, attached, for its heartbeats to time out (a status 0 may be
+                self._exited[run.spec.robot] = time.monotonic()  # a wrapper whose child attached, left running)
             self._wake_server()
         self._drain(run)
         # it ended by itself: the robot stays uncontrolled, the world goes on; a failure is said even when the
