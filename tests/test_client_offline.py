@@ -953,3 +953,23 @@ def test_a_controller_that_does_not_compile_shows_its_error_not_the_launchers_fr
     err = capsys.readouterr().err
     assert f'File "{script}", line 2' in err and "SyntaxError: invalid syntax" in err
     assert "Traceback" not in err and "runpy" not in err and "test_client_offline" not in err
+
+
+def test_launcher_options_after_the_scripts_own_arguments_are_the_scripts_with_a_note(capsys):
+    """`sensorium controller SCRIPT -v --url U` gave --url U to the script and attached to the default
+    URL, timing out there 10 s later without saying why; the script still gets them, and one line says so."""
+    import argparse
+
+    from sensorium.cli.client import _take_launcher_options
+
+    args = argparse.Namespace(args=["--robot", "scout", "-v", "--url", "tcp://127.0.0.1:5580"], robot=None, url=None)
+    assert _take_launcher_options(args) is None
+    assert (args.robot, args.url, args.args) == ("scout", None, ["-v", "--url", "tcp://127.0.0.1:5580"])
+    assert capsys.readouterr().err == ("sensorium controller: note: --url after the script's argument '-v' is passed "
+                                       "to the script, not taken by sensorium (give --robot/--url before the script's "
+                                       "arguments; `--` before them keeps them the script's without this note)\n")
+    for given in (["--url=tcp://h:1", "-v"], ["--", "-v", "--url", "x"], ["-v", "--speed", "2"]):
+        args = argparse.Namespace(args=given, robot=None, url=None)
+        assert _take_launcher_options(args) is None
+        assert capsys.readouterr().err == ""
+    assert args.args == ["-v", "--speed", "2"]

@@ -66,7 +66,8 @@ def _take_launcher_options(args: argparse.Namespace) -> str | None:
         head = rest[0]
         if head == "--":
             rest.pop(0)
-            break
+            args.args = rest
+            return None
         name, eq, value = head.partition("=")
         if name not in _LAUNCHER_OPTIONS:
             break
@@ -79,6 +80,11 @@ def _take_launcher_options(args: argparse.Namespace) -> str | None:
             rest.pop(0)
         setattr(args, name[2:], value)
     args.args = rest
+    late = [a for a in rest[1:] if a.partition("=")[0] in _LAUNCHER_OPTIONS]
+    if late:      # `SCRIPT -v --url U` attached to the default URL and timed out there, without a word
+        print(f"sensorium controller: note: {late[0].partition('=')[0]} after the script's argument {rest[0]!r} is "
+              "passed to the script, not taken by sensorium (give --robot/--url before the script's arguments; "
+              "`--` before them keeps them the script's without this note)", file=sys.stderr)
     return None
 
 
