@@ -539,15 +539,20 @@ class Launcher:
         self._starting: set[str] = set()         # the lockstep's: the world waits until these attach
         self.failed: dict[str, str] = {}          # robot -> controller whose process could not be started
         self._wake_server: Callable[[], None] = lambda: None
+        self._exited: dict[str, float] = {}
         self._quitting: Callable[[], bool] = lambda: False
         self._worker = threading.Thread(target=self._work, name="sensorium-launcher", daemon=True)
         self._worker.start()
 
-    def bind(self, starting: set[str], wake: Callable[[], None], quitting: Callable[[], bool]) -> None:
+    def bind(self, starting: set[str], wake: Callable[[], None], quitting: Callable[[], bool],
+             exited: dict[str, float] | None = None) -> None:
         """Serve this server (again after a reload): ``starting`` is its lockstep's set of robots
         whose controller was started and has not attached (the world waits for them), ``wake``
-        makes its loop look again, ``quitting`` says it is ending (no "exited" lines then)."""
+        makes its loop look again, ``quitting`` says it is ending (no "exited" lines then),
+        ``exited`` its lockstep's robots whose controller process ended by itself, and when
+        (``time.monotonic``, the server's clock): their sessions are dropped at once."""
         self._starting, self._wake_server, self._quitting = starting, wake, quitting
+        self._exited = exited if exited is not None else {}
 
     # ------------------------------------------------------------------ output
     def log(self, text: str) -> None:
@@ -707,6 +712,8 @@ class Launcher:
         quitting = self._quitting()         # as it ended (the world may reach its end while its output drains)
         if by_itself:               # it may never have attached (a crash at start): not waited for any more
             self._starting.discard(run.spec.robot)
+            if code != 0:           # a crash: nor, attached, for its heartbeats to time out (a status 0 may be
+                self._exited[run.spec.robot] = time.monotonic()  # a wrapper whose child attached, left running)
             self._wake_server()
         self._drain(run)
         # it ended by itself: the robot stays uncontrolled, the world goes on; a failure is said even when the
@@ -1012,6 +1019,10 @@ class ProjectRun:
         for p in self.options.extra_projects:
             if p not in self.projects:
                 self._say(f"sensorium run: extra project path {p} is not a folder: not looked in")
+        home = self.options.webots_home
+        if home is not None and self.webots is None:      # a mistyped --webots-home would pass unnoticed
+            self._say(f"sensorium run: --webots-home (or WEBOTS_HOME) {_one_line(home)} is not a folder: "
+                      "Webots' own projects are not looked in for controllers")
         launcher = Launcher(list(world_plan.specs), server.transport.rpc_endpoint, out=self.out, err=self.err,
                             grace_s=self.options.grace_s, serverkey=self._serverkey(),
                             attach_timeout_s=self.options.attach_timeout_s,
@@ -1030,7 +1041,8 @@ class ProjectRun:
                     break
                 server.core.launcher = launcher
                 lockstep = server.core.lockstep
-                launcher.bind(lockstep.starting, server.transport.wake, partial(getattr, lockstep, "shutting_down"))
+                launcher.bind(lockstep.starting, server.transport.wake, partial(getattr, lockstep, "shutting_down"),
+                              lockstep.exited)
                 lockstep.starting.update(world_plan.extern_waited)
                 lockstep.extern_synchronous = list(world_plan.extern_synchronous)
                 launcher.stop_server = server.stop

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import os
+import runpy
 import struct
 import subprocess
 import sys
@@ -936,3 +937,39 @@ def test_keyboard_mode_and_supervisor_refusal_offline(global_robot, capsys):
     assert sup.getFromDef("anything") is None and sup.getSelf() is None
     assert wb.wb_supervisor_node_get_field(1, "translation") is None
     assert "can only be used in a 'Supervisor' controller" in capsys.readouterr().err
+
+
+def test_a_controller_that_does_not_compile_shows_its_error_not_the_launchers_frames(tmp_path, capsys):
+    """A syntax error ran no frame of the script, so the launcher's frames (sensorium/cli/client.py,
+    runpy) were printed above it; now only the script's file, line and caret, as `python script.py`."""
+    from sensorium.cli.client import _print_script_traceback
+
+    script = tmp_path / "ctrl.py"
+    script.write_text("from controller import Robot\ndef (:\n")
+    try:
+        runpy.run_path(str(script), run_name="__main__")
+    except SyntaxError as exc:
+        _print_script_traceback(exc, str(script))
+    err = capsys.readouterr().err
+    assert f'File "{script}", line 2' in err and "SyntaxError: invalid syntax" in err
+    assert "Traceback" not in err and "runpy" not in err and "test_client_offline" not in err
+
+
+def test_launcher_options_after_the_scripts_own_arguments_are_the_scripts_with_a_note(capsys):
+    """`sensorium controller SCRIPT -v --url U` gave --url U to the script and attached to the default
+    URL, timing out there 10 s later without saying why; the script still gets them, and one line says so."""
+    import argparse
+
+    from sensorium.cli.client import _take_launcher_options
+
+    args = argparse.Namespace(args=["--robot", "scout", "-v", "--url", "tcp://127.0.0.1:5580"], robot=None, url=None)
+    assert _take_launcher_options(args) is None
+    assert (args.robot, args.url, args.args) == ("scout", None, ["-v", "--url", "tcp://127.0.0.1:5580"])
+    assert capsys.readouterr().err == ("sensorium controller: note: --url after the script's argument '-v' is passed "
+                                       "to the script, not taken by sensorium (give --robot/--url before the script's "
+                                       "arguments; `--` before them keeps them the script's without this note)\n")
+    for given in (["--url=tcp://h:1", "-v"], ["--", "-v", "--url", "x"], ["-v", "--speed", "2"]):
+        args = argparse.Namespace(args=given, robot=None, url=None)
+        assert _take_launcher_options(args) is None
+        assert capsys.readouterr().err == ""
+    assert args.args == ["-v", "--speed", "2"]

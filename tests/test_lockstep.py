@@ -334,3 +334,17 @@ def test_time_the_server_did_not_read_is_not_a_sessions_silence():
     ls.unheard(0.0, now=9.1)
     ls.unheard(-1.0, now=9.1)
     assert b.last_heard == 6.2
+
+
+def test_a_started_controller_that_exited_has_its_session_dropped_at_once_unless_one_attached_since() -> None:
+    """`sensorium run` marks a robot whose controller process ended by itself (Lockstep.exited, with the
+    time it ended): the session attached before then is dropped at the next scan, long before its
+    heartbeats would time out; a controller that attached after that end is another one and stays."""
+    ls = machine()
+    a = ls.attach("a", b"A", 0.0)
+    ls.exited["a"] = 1.0
+    assert ls.expire(1.5) == []                          # silence alone: 1.5 s is within liveness
+    assert ls.exited_sessions(1.5) == [a] and ls.session_for("a") is None and not ls.exited
+    b = ls.attach("b", b"B", 2.0)
+    ls.exited["b"] = 1.9                                 # the process that ended was not this session's
+    assert ls.exited_sessions(2.1) == [] and ls.session_for("b") is b and not ls.exited

@@ -174,6 +174,25 @@ def test_missing_file_is_one_line_naming_url_places_tag_and_remedy(tmp_path: Pat
         expanded(w)
 
 
+def test_a_mistyped_webots_home_is_named_in_the_missing_file_line(tmp_path: Path, monkeypatch) -> None:
+    """--webots-home /usr/local/webot (a typo) made the line say "give --webots-home DIR" to a user who
+    had given one: it now says what is wrong with the one given; a real installation adds nothing."""
+    monkeypatch.delenv("SENSORIUM_PROTO_PATH", raising=False)
+    w = world_file(tmp_path, "Gone { }\n", ["webots://projects/robots/gone/protos/Gone.proto"])
+    typo = tmp_path / "webot"
+    with pytest.raises(ProtoError) as exc:
+        expanded(w, webots_home=typo)
+    assert f"nothing is downloaded: the Webots installation given (--webots-home or WEBOTS_HOME) {typo} is not a " \
+           "folder; give --webots-home DIR" in str(exc.value)
+    (tmp_path / "notwebots").mkdir()
+    with pytest.raises(ProtoError, match="notwebots has no projects/ folder, so it is no Webots installation; give"):
+        expanded(w, webots_home=tmp_path / "notwebots")
+    with pytest.raises(ProtoError) as exc:
+        expanded(w, webots_home=fake_webots(tmp_path / "webots"))
+    assert "the Webots installation given" not in str(exc.value)
+    assert "nothing is downloaded: give --webots-home DIR" in str(exc.value)
+
+
 def test_missing_relative_file_names_the_place(tmp_path: Path) -> None:
     w = world_file(tmp_path, "Gone { }\n", ["protos/Gone.proto"])
     with pytest.raises(ProtoError, match=rf'"protos/Gone.proto" not found \(Webots R2023b\); looked in: {tmp_path}/protos/Gone.proto'):

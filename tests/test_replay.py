@@ -501,3 +501,19 @@ def test_cli_replay_stops_on_sigint_when_started_with_it_ignored(rec_path):
             code = None
     assert code is not None, "replay ignored SIGINT"
     assert "Traceback" not in proc.stderr(), proc.stderr()
+
+
+def test_cli_replay_on_a_port_in_use_says_which_and_what_to_do(rec_path, ctx):
+    """`sensorium replay` beside a running server said "cannot bind: Address already in use
+    (addr='tcp://...')"; it now says it as serve and run do: the endpoint, and the ports to change."""
+    path, _ = rec_path
+    busy = ctx.socket(zmq.PUB)
+    try:
+        port = busy.bind_to_random_port("tcp://127.0.0.1")
+        proc = subprocess.run(sensorium("replay", str(path), "--rpc", ANY, "--pub", f"tcp://127.0.0.1:{port}"),
+                              capture_output=True, text=True, timeout=60)
+    finally:
+        busy.close(linger=0)
+    assert proc.returncode == 1 and proc.stdout == ""
+    assert proc.stderr == (f"sensorium replay: cannot bind tcp://127.0.0.1:{port}: Address already in use (another "
+                           "server? choose other --rpc/--pub ports, or port 0 for free ones)\n")

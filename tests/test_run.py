@@ -283,6 +283,16 @@ def test_a_generic_robot_runs_without_a_controller_and_is_not_waited_for(tmp_pat
     assert err[-1] == "sensorium: stopped at 320 ms after 20 steps"
 
 
+def test_a_webots_home_that_is_not_a_folder_is_said(tmp_path: Path) -> None:
+    """A mistyped --webots-home was taken silently, and a controller it should have found was "not
+    found ... --webots-home DIR also looks in Webots' own projects": one line now says it is no folder."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "nowhere" }', {})
+    proc = run(world, "--until", "160", "--webots-home", str(tmp_path / "webot"), env={"WEBOTS_EXTRA_PROJECT_PATH": None})
+    assert proc.wait() == 1, proc.stderr()
+    assert (f"sensorium run: --webots-home (or WEBOTS_HOME) {tmp_path / 'webot'} is not a folder: Webots' own "
+            "projects are not looked in for controllers") in proc.stderr().splitlines()
+
+
 def test_a_controller_that_crashes_is_said_and_the_world_goes_on(tmp_path: Path) -> None:
     world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "beta" controller "quitter" }\n'
                               'Robot { name "gamma" controller "segv" }',
@@ -294,6 +304,26 @@ def test_a_controller_that_crashes_is_said_and_the_world_goes_on(tmp_path: Path)
     assert "sensorium run: 'quitter' controller of robot 'beta' exited with status: 3." in proc.stderr()
     assert "sensorium run: 'segv' controller of robot 'gamma' crashed (SIGSEGV)." in proc.stderr()
     assert "[alpha] alpha stepped 50 until 800" in proc.stdout().splitlines()
+
+
+def test_a_controller_killed_without_detaching_is_released_at_once_not_after_its_heartbeats(tmp_path: Path) -> None:
+    """A controller process that dies without detaching (SIGKILL, SIGSEGV) holds its robot's session,
+    and a synchronous one the world, until its heartbeats time out. `run` sees the process end, so the
+    session is dropped then: with --heartbeat-ms 20000 (60 s of silence before a drop) the world still
+    reaches --until within the test's wait, where it stood still for those 60 s before."""
+    world = project(tmp_path, 'Robot { name "alpha" controller "a" }\nRobot { name "beta" controller "dies" }',
+                    {"a.py": COUNTER.replace("{step}", "16"),
+                     "dies.py": "import os, signal\nfrom controller import Robot\nr = Robot()\nfor _ in range(5):\n"
+                                "    r.step(16)\nprint('dying at', round(r.getTime() * 1000))\n"
+                                "os.kill(os.getpid(), signal.SIGKILL)\n"})
+    proc = run(world, "--until", "800", "--heartbeat-ms", "20000")
+    assert proc.wait(30) == 0, proc.stderr()
+    assert "[beta] dying at 80" in proc.stdout().splitlines()
+    err = proc.stderr().splitlines()
+    assert "sensorium run: 'dies' controller of robot 'beta' crashed (SIGKILL)." in err
+    assert "sensorium: controller of 'beta' ended without detaching: session dropped, robot released" in err
+    assert "[alpha] alpha stepped 50 until 800" in proc.stdout().splitlines()
+    assert err[-1] == "sensorium: stopped at 800 ms after 50 steps"
 
 
 def test_the_world_goes_on_to_until_when_every_started_controller_has_ended(tmp_path: Path) -> None:

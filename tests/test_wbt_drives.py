@@ -1100,3 +1100,15 @@ def test_two_driven_wheels_and_a_steered_free_wheel_make_a_tricycle(tmp_path: Pa
         enc.enable(16)
         sim.run(9)                  # 10 steps rolled: the front wheel's ground speed R·ω / cos δ
         assert enc.value == pytest.approx(-R * 5.0 / math.cos(heading) * 0.16 / 0.08, abs=1e-9)
+
+
+def test_two_wheels_whose_motors_share_a_name_are_one_line_naming_it(tmp_path: Path) -> None:
+    """A copied HingeJoint whose motor kept the other wheel's name ended in "left_motor and right_motor
+    must have different names", which named neither the motor nor what to do."""
+    p = write(tmp_path, 'Robot { name "r" children [\n' + wheel("right wheel motor", 0, 0.026)
+              + wheel("right wheel motor", 0, -0.026) + '] }\n')
+    with pytest.raises(WorldError, match=r"line 3, column 1 .*differential_drive\): left_motor and right_motor are "
+                                         r"both 'right wheel motor': the left and right wheels each need a motor of "
+                                         r"its own name") as exc:
+        load_world(p)
+    assert "\n" not in str(exc.value)

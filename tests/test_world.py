@@ -381,3 +381,20 @@ def test_pydantics_own_message_that_says_got_still_shows_the_value() -> None:
     probs = _problems({"world_info": {"basic_time_step": 32.5}})
     assert probs == [("world_info.basic_time_step",
                       "Input should be a valid integer, got a number with a fractional part (got 32.5)")]
+
+
+def test_cli_info_names_each_robots_controller_and_its_arguments(tmp_path: Path) -> None:
+    """`sensorium info` listed a robot's devices but not which controller `run` would start for it."""
+    wbt = tmp_path / "w.wbt"
+    wbt.write_text('#VRML_SIM R2023b utf8\nWorldInfo { }\nRobot { name "a" controller "avoid" '
+                   'controllerArgs [ "0.5" "two words" ] }\nRobot { name "bare" }\n'
+                   'Robot { name "ext" controller "<extern>" synchronization FALSE }\n')
+    res = _cli("info", str(wbt))
+    assert res.returncode == 0, res.stderr
+    assert [line for line in res.stdout.splitlines() if line.startswith("  ") and line[2] != " "] == [
+        "  a: 0 devices, controller 'avoid' (controllerArgs '0.5' 'two words')",
+        "  bare: 0 devices, controller '<extern>' (no controller field: `run` gives it Webots' default '<generic>')",
+        "  ext (asynchronous): 0 devices, controller '<extern>'"]
+    robots = json.loads(_cli("info", "--json", str(wbt)).stdout)["robots"]
+    assert [(r["controller"], r["controller_args"], r["controller_given"]) for r in robots] == [
+        ("avoid", ["0.5", "two words"], True), ("<extern>", [], False), ("<extern>", [], True)]

@@ -47,6 +47,11 @@ def _print_script_traceback(exc: BaseException, script: str) -> None:
     target = os.path.realpath(script)
     while tb is not None and os.path.realpath(tb.tb_frame.f_code.co_filename) != target:
         tb = tb.tb_next
+    if tb is None and isinstance(exc, SyntaxError) and exc.filename and os.path.realpath(exc.filename) == target:
+        # the script did not compile: no frame of it ran, and its file, line and caret are the error's own
+        # (what `python script.py` prints), so none of the launcher's frames either
+        traceback.print_exception(type(exc), exc, None)
+        return
     traceback.print_exception(type(exc), exc, tb or exc.__traceback__)
 
 
@@ -61,7 +66,8 @@ def _take_launcher_options(args: argparse.Namespace) -> str | None:
         head = rest[0]
         if head == "--":
             rest.pop(0)
-            break
+            args.args = rest
+            return None
         name, eq, value = head.partition("=")
         if name not in _LAUNCHER_OPTIONS:
             break
@@ -74,6 +80,11 @@ def _take_launcher_options(args: argparse.Namespace) -> str | None:
             rest.pop(0)
         setattr(args, name[2:], value)
     args.args = rest
+    late = [a for a in rest[1:] if a.partition("=")[0] in _LAUNCHER_OPTIONS]
+    if late:      # `SCRIPT -v --url U` attached to the default URL and timed out there, without a word
+        print(f"sensorium controller: note: {late[0].partition('=')[0]} after the script's argument {rest[0]!r} is "
+              "passed to the script, not taken by sensorium (give --robot/--url before the script's arguments; "
+              "`--` before them keeps them the script's without this note)", file=sys.stderr)
     return None
 
 

@@ -144,7 +144,8 @@ def replay_cmd(args: argparse.Namespace) -> int:
         try:
             r.bind()
         except zmq.ZMQError as exc:
-            print(f"sensorium replay: cannot bind: {exc}", file=sys.stderr)
+            from sensorium.server.daemon.transport import bind_problem
+            print(f"sensorium replay: {bind_problem(exc)}", file=sys.stderr)
             return 1
         viewer = None
         if getattr(args, "foxglove", None):

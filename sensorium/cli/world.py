@@ -86,7 +86,12 @@ def info(args: argparse.Namespace) -> int:
     print(f"lights    {len(s['lights'])}: " + ", ".join(f"{x['name'] or '-'} ({x['type']}{'' if x['on'] else ', off'})" for x in s["lights"]))
     print(f"robots    {len(s['robots'])}")
     for r in s["robots"]:
-        print(f"  {r['name']}{'' if r['synchronization'] else ' (asynchronous)'}: {len(r['devices'])} devices")
+        given = "".join(f" {a!r}" for a in r["controller_args"])    # which controller `run` starts, and with what
+        controller = f"controller {r['controller']!r}{f' (controllerArgs{given})' if given else ''}"
+        if path.lower().endswith(".wbt") and not r["controller_given"]:
+            controller += " (no controller field: `run` gives it Webots' default '<generic>')"
+        print(f"  {r['name']}{'' if r['synchronization'] else ' (asynchronous)'}: {len(r['devices'])} devices, "
+              f"{controller}")
         print(f"    {'(drive)':<14} {r['drive']}")
         for d in r["devices"]:
             print(f"    {d['name']:<14} {d['summary']}")

@@ -1627,7 +1627,9 @@ class DifferentialDrive(Strict):
     @model_validator(mode="after")
     def _distinct(self) -> DifferentialDrive:
         if self.left_motor == self.right_motor:
-            raise ValueError("left_motor and right_motor must have different names")
+            raise ValueError(f"left_motor and right_motor are both {self.left_motor!r}: the left and right wheels "
+                             "each need a motor of its own name (Webots warns of the repeated name, and getDevice "
+                             "gives the first)")
         left, right = self.motor_names
         names = [*left, *right]
         if len(set(names)) != len(names):

@@ -132,6 +132,10 @@ class Lockstep:
         # robots whose controller `sensorium run` started and that have not attached yet: the world waits
         # for them, as Webots waits for the controllers it starts (set by the launcher's thread: one add/discard)
         self.starting: set[str] = set()
+        # robots whose controller process, started by `sensorium run`, ended by itself (a crash: no detach), and
+        # the wall time it was seen to end (the transport's clock): a session attached before then is that
+        # process's and is dropped at once, not after liveness_s of silence (set by the launcher's thread)
+        self.exited: dict[str, float] = {}
 
     # ------------------------------------------------------------------ sessions
     @property
@@ -240,6 +244,17 @@ class Lockstep:
         s = self.session(token)
         s.last_heard = now
         return s
+
+    def exited_sessions(self, now: float) -> list[Session]:
+        """Drop the sessions of the processes in :attr:`exited` (each as a silent one is dropped)."""
+        dead = []
+        for robot in list(self.exited):
+            ended_at = self.exited.pop(robot)
+            s = self._by_robot.get(robot)
+            if s is not None and s.attached_at <= ended_at:      # not a controller that attached since
+                self._drop(s, now)
+                dead.append(s)
+        return dead
 
     def expire(self, now: float) -> list[Session]:
         """Drop sessions not heard from for :attr:`liveness_s`; their pending steps are discarded."""

@@ -479,6 +479,10 @@ class Core(DeviceServices):
         self.lockstep.unheard(seconds, now)
 
     def expire(self, now: float) -> None:
+        if self.lockstep.exited:
+            for s in self.lockstep.exited_sessions(now):
+                self._released(s)
+                self.log(f"controller of {s.robot!r} ended without detaching: session dropped, robot released")
         for s in self.lockstep.expire(now):
             self._released(s)
             self.log(f"controller of {s.robot!r} silent for {self.lockstep.liveness_s:g} s: session dropped, robot released")

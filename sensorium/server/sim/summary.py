@@ -90,7 +90,8 @@ def world_summary(path: str | Path) -> dict:
         "lights": [{"name": lt.name, "type": lt.type, "on": lt.on} for lt in w.lights],
         "robots": [
             {"name": r.name, "synchronization": r.synchronization, "supervisor": r.supervisor,
-             "drive": drive_line(r),
+             "controller": r.controller, "controller_args": list(r.controller_args),
+             "controller_given": "controller" in r.model_fields_set, "drive": drive_line(r),
              "devices": [{"name": d.name, "device": d.device, "summary": device_line(d)} for d in r.devices]}
             for r in w.robots
         ],

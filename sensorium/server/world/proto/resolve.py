@@ -217,7 +217,24 @@ def missing_message(url: str, tried: list[str], tag: str | None, search: ProtoSe
            f"for a folder holding it (a project's protos/, an unpacked assets-{tag or 'RELEASE'}.zip)")
     if search.webots_home is None:
         how += "; WEBOTS_HOME is not set"
+    else:       # a mistyped --webots-home: say so, not only "give --webots-home", which the user did
+        problem = installation_problem(search.webots_home)
+        if problem:
+            how = f"the Webots installation given (--webots-home or WEBOTS_HOME) {problem}; " + how
     return f'"{_short(url)}" not found ({version}); looked in: {where}; nothing is downloaded: {how}'
+
+
+def installation_problem(home: Path) -> str | None:
+    """What makes ``home`` no Webots installation (a folder with ``projects/``, or a macOS
+    ``Webots.app``), said after its name; None when it looks like one."""
+    try:
+        if not home.is_dir():
+            return f"{_short(str(home))} is not a folder"
+        if (home / "projects").is_dir() or (home / "Contents" / "projects").is_dir():
+            return None
+    except OSError as exc:
+        return f"{_short(str(home))} cannot be read ({exc.strerror or exc})"
+    return f"{_short(str(home))} has no projects/ folder, so it is no Webots installation"
 
 
 def _short(text: str, limit: int = 200) -> str:
