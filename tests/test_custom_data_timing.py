@@ -54,6 +54,21 @@ def test_its_own_supervisor_set_reaches_the_cache_with_the_next_steps_answer(bos
     assert core.sim.robots["boss"].custom_data == "c"
 
 
+def test_a_supervisors_set_wins_over_its_own_set_custom_data_in_the_same_step(boss) -> None:
+    """Webots reads the controller's setCustomData with its step request and applies the Supervisor's queued
+    field set after it, at the start of the step: whichever came first here, the field ends with the set."""
+    core, field = boss
+    wb.wb_supervisor_field_set_sf_string(field, "d")
+    wb.wb_robot_set_custom_data("e")
+    assert wb.wb_robot_get_custom_data() == "e" and wb.wb_supervisor_field_get_sf_string(field) == "d"
+    assert wb.wb_robot_step(16) == 0 and wb.wb_robot_get_custom_data() == "d" == core.sim.robots["boss"].custom_data
+    wb.wb_robot_set_custom_data("f")
+    wb.wb_supervisor_field_set_sf_string(field, "g")
+    assert wb.wb_robot_step(16) == 0 and wb.wb_robot_get_custom_data() == "g"
+    wb.wb_robot_set_custom_data("h")                                # no set pending: its own value stays
+    assert wb.wb_robot_step(16) == 0 and wb.wb_robot_get_custom_data() == "h" == core.sim.robots["boss"].custom_data
+
+
 def test_a_reset_brings_the_world_files_value_with_the_next_steps_answer(boss) -> None:
     _, field = boss
     wb.wb_supervisor_field_set_sf_string(field, "b")

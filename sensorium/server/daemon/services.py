@@ -843,8 +843,12 @@ class Core(DeviceServices):
         return {"value": self.sim.robots[c.robot].custom_data}
 
     def _robot_set_custom_data(self, c: Call) -> dict:
-        self.sim.robots[c.robot].custom_data = c.args.value
         self._custom_sent[self._session(c).token] = c.args.value     # its controller has it (the field too)
+        if c.robot in self._custom_news and self._custom_news_ms.get(c.robot) == self.sim.time_ms:
+            # a Supervisor's set (or a reset) since the world last stepped: Webots applies it at the start of
+            # the next step, after this request's value, so it wins and reaches the controller with that step
+            return {"success": True}
+        self.sim.robots[c.robot].custom_data = c.args.value
         return {"success": True}
 
     def _robot_battery_sensor_enable(self, c: Call) -> dict:
