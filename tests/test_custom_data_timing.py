@@ -99,6 +99,12 @@ int main(void) {
   printf("step %s\n", wb_robot_get_custom_data());
   wb_robot_set_custom_data("c");
   printf("own %s field %s\n", wb_robot_get_custom_data(), wb_supervisor_field_get_sf_string(data));
+  wb_robot_step(16);
+  wb_supervisor_field_set_sf_string(data, "d");
+  wb_robot_set_custom_data("e");
+  printf("own %s field %s\n", wb_robot_get_custom_data(), wb_supervisor_field_get_sf_string(data));
+  wb_robot_step(16);
+  printf("step %s\n", wb_robot_get_custom_data());
   wb_robot_cleanup();
   return 0;
 }
@@ -118,4 +124,5 @@ def test_the_c_library_keeps_the_same_cache(tmp_path, clib) -> None:  # noqa: F8
         env = {**os.environ, "SENSORIUM_CONTROLLER_URL": f"{transport.rpc_endpoint}/boss"}
         done = subprocess.run([str(tmp_path / "boss" / "boss")], env=env, capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
-    assert done.stdout.splitlines() == ["set a", "step(0) a", "step b", "reset b field a", "step a", "own c field c"]
+    assert done.stdout.splitlines() == ["set a", "step(0) a", "step b", "reset b field a", "step a", "own c field c",
+                                     "own e field d", "step d"]
