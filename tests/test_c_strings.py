@@ -140,6 +140,7 @@ def test_node_and_field_lookups_and_string_fields_read_up_to_the_nul(served, cap
     assert lid is not None and wb.wb_supervisor_node_get_from_proto_def(crate, "LID\0tail") == lid
     wb.wb_supervisor_field_set_sf_string(custom, "gain=2\0stale bytes")
     assert wb.wb_supervisor_field_get_sf_string(custom) == "gain=2"
+    wb.wb_robot_step(16)          # (a set the same step would yield to the Supervisor's: test_custom_data_timing)
     wb.wb_robot_set_custom_data("gain=3\0")
     assert wb.wb_robot_get_custom_data() == "gain=3" == served.sim.robots["boss"].custom_data
 
@@ -246,6 +247,7 @@ def test_the_webots_classes_cut_where_webots_python_encodes_and_get_device_does_
     assert custom.getSFString() == "mode=1"
     custom.value = "mode=2\0tail"
     assert custom.value == "mode=2"
+    sup.step(16)                  # (a set the same step would yield to the Supervisor's: test_custom_data_timing)
     sup.setCustomData("mode=3\0tail")
     assert sup.getCustomData() == "mode=3" == custom.getSFString()
     assert sup.getUrdf("p_\0tail") == sup.getUrdf("p_")

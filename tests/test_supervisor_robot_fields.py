@@ -63,9 +63,13 @@ def test_custom_data_set_by_a_supervisor_reaches_the_robot_with_its_next_step(li
     # the supervisor's own field, set through its own node: its own next step reply carries it
     set_field(live, 1, "customData", "")
     assert live.step(A, "pioneer", {"duration": 32})["custom_data"] == ""
-    # a step(0) delivers it too (Webots' step(0) answers with what changed)
+    # Webots applies a Supervisor's field set at the start of the next physics step (processImmediateMessages)
+    # and sends the value with the answer after it: a step(0) before that step answers without it
     set_field(live, rover, "customData", "now")
-    assert live.ok(B, "/rover/robot/step", {"duration": 0})["custom_data"] == "now"
+    assert "custom_data" not in live.ok(B, "/rover/robot/step", {"duration": 0})
+    assert "custom_data" not in live.ok(B, "/rover/robot/step", {"duration": 0})
+    assert live.step(B, "rover", {"duration": 32})["custom_data"] == "now"
+    assert "custom_data" not in live.ok(B, "/rover/robot/step", {"duration": 0})
 
 
 def test_a_reset_sends_the_world_files_custom_data_again(live: Logged) -> None:

@@ -1267,7 +1267,8 @@ def wb_supervisor_simulation_reset() -> None:
             if dev.kind == "LED":
                 dev.value = 0
         r.motor_commands.clear()
-        r.custom_data = str(_call(r, "get_custom_data")["value"])     # a field of the robot: reset too
+        # the robot's customData is reset too; Webots resets at its next step and sends the value with that
+        # step's answer, so getCustomData() keeps the old value until step() returns (the server sends it)
 
 
 def wb_supervisor_simulation_set_mode(mode: int) -> None:

@@ -184,6 +184,7 @@ class Core(DeviceServices):
         self._seen: dict[str, dict[str, int]] = {}          # session token -> device path -> measurements
         self._custom_sent: dict[str, str] = {}    # session token -> the robot's customData its controller has
         self._custom_news: set[str] = set()       # robots whose customData a Supervisor's request changed
+        self._custom_news_ms: dict[str, int] = {}  # the simulated ms of each change (Webots: set at the next step)
         # texts sent to each robot's window side (window_send), for its controller's next step reply
         self._window_inbox: dict[str, deque[str]] = {name: deque() for name in sim.robots}
         self._window_chars: dict[str, int] = dict.fromkeys(sim.robots, 0)
@@ -541,6 +542,7 @@ class Core(DeviceServices):
         """The robot's customData when a Supervisor (or a reset) changed it since its controller last
         had it, else None: Webots sends it with the step's answer (WbRobot::updateData)."""
         self._custom_news.discard(session.robot)
+        self._custom_news_ms.pop(session.robot, None)
         data = self.sim.robots[session.robot].custom_data
         if self._custom_sent.get(session.token) == data:
             return None
@@ -718,7 +720,9 @@ class Core(DeviceServices):
             self._queue_packets(packets)
             self._draw(drawings)
             now: dict[str, Any] = {"status": 0, "time_ms": self.sim.time_ms, "values": self._new_values(s)}
-            data = self._custom_data_news(s) if c.robot in self._custom_news else None
+            # Webots applies a Supervisor's field set at the next physics step: a step(0) before it carries nothing
+            data = self._custom_data_news(s) if c.robot in self._custom_news \
+                and self._custom_news_ms.get(c.robot, -1) < self.sim.time_ms else None
             if data is not None:
                 now["custom_data"] = data
             if c.robot in self._window_news:
@@ -843,8 +847,12 @@ class Core(DeviceServices):
         return {"value": self.sim.robots[c.robot].custom_data}
 
     def _robot_set_custom_data(self, c: Call) -> dict:
-        self.sim.robots[c.robot].custom_data = c.args.value
         self._custom_sent[self._session(c).token] = c.args.value     # its controller has it (the field too)
+        if c.robot in self._custom_news and self._custom_news_ms.get(c.robot) == self.sim.time_ms:
+            # a Supervisor's set (or a reset) since the world last stepped: Webots applies it at the start of
+            # the next step, after this request's value, so it wins and reaches the controller with that step
+            return {"success": True}
+        self.sim.robots[c.robot].custom_data = c.args.value
         return {"success": True}
 
     def _robot_battery_sensor_enable(self, c: Call) -> dict:
@@ -963,6 +971,7 @@ class Core(DeviceServices):
             robot = self.sim.robots[name]
             if robot.custom_data != data:
                 self._custom_news.add(name)               # its controller gets it with its next step reply
+                self._custom_news_ms[name] = self.sim.time_ms
             if robot.controller != controller:
                 self._controller_changed(name, c)
         return out

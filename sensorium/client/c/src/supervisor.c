@@ -1833,15 +1833,8 @@ void wb_supervisor_simulation_reset(void) {
     } else if (d->kind == SN_LED)
       d->led_value = 0;
   }
-  /* the robot's customData is a field the reset restores too: read it again (the Python client does) */
-  if (sn_robot_call(rb, "robot/get_custom_data", 0, NULL, NULL, func, &rep) != 0)
-    return;
-  char *data = sn_strdup_obj(sn_get(rep.result, "value"));
-  sn_reply_free(&rep);
-  if (data != NULL) {
-    free(rb->custom_data);
-    rb->custom_data = data;
-  }
+  /* the robot's customData is reset too; Webots resets at its next step and sends the value with that step's
+     answer, so wb_robot_get_custom_data() keeps the old value until wb_robot_step() returns (the server sends it) */
 }
 
 static void args_mode(sn_req *r, const void *arg) {
