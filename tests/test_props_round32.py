@@ -238,3 +238,77 @@ def test_a_c_string_is_the_text_before_its_first_nul(text: str) -> None:
     assert "\0" not in cut and text.startswith(cut)
     assert cut == text or text[len(cut)] == "\0"
     assert c_string(text.encode()) == text.encode() and c_string(None) is None   # not a str: unchanged
+
+
+# ---------------------------------------------------------------- the Viewpoint's follow
+#
+# A Viewpoint following a top-level solid or a robot, moved by a Supervisor's translation sets, with
+# moveViewpoint calls (the one outside set of its position: the field is read only to a Supervisor) and resets
+# between random steps. Closed form (Webots' Tracking Shot,
+# WbViewpoint::updateFollowUp at once): after each step the view is where it stood before the step (as
+# written, or as moveViewpoint put it) plus the followed node's displacement since the step before (its world-file
+# place at load and after a reset); a reset puts the written position back.
+
+FOLLOW = """#VRML_SIM R2023b utf8
+WorldInfo {{ basicTimeStep 16 }}
+Viewpoint {{ orientation 0 0 1 0 position {view} follow "{follow}" }}
+DEF CRATE Solid {{ translation 1 2 0.5 name "crate" children [ Shape {{ geometry Box {{ size 0.2 0.2 0.2 }} }} ] }}
+DEF MOVER Robot {{ translation -1 0.5 0 name "mover" controller "<extern>" }}
+DEF OTHER Solid {{ translation 3 -2 0.1 name "other" children [ Shape {{ geometry Sphere {{ radius 0.1 }} }} ] }}
+DEF BOSS Robot {{ name "boss" supervisor TRUE controller "<extern>" }}
+"""
+FOLLOWED_AT = {"crate": (1.0, 2.0, 0.5), "mover": (-1.0, 0.5, 0.0)}
+
+
+def _boss(lv, item: str, args: dict | None = None):
+    from test_supervisor import A
+
+    return lv.ok(A, f"/boss/robot/{item}", args)
+
+
+follow_ops = st.one_of(
+    st.tuples(st.just("move"), places),
+    st.tuples(st.sampled_from(["moveViewpoint", "reset"]), st.sampled_from(["CRATE", "OTHER", "MOVER"])),
+    st.tuples(st.just("step"), st.integers(1, 3)))
+
+
+@pytest.mark.parametrize("examples", example_counts(100, 10))
+def test_the_viewpoint_moves_by_the_followed_nodes_displacement(tmp_path, examples) -> None:
+    from test_supervisor import A, Live
+
+    @settings(SETTINGS, max_examples=examples)
+    @given(follow=st.sampled_from(sorted(FOLLOWED_AT)), view=places, ops=st.lists(follow_ops, max_size=10))
+    def prop(follow, view, ops) -> None:
+        path = tmp_path / "follow.wbt"
+        path.write_text(FOLLOW.format(view=" ".join(map(_f, view)), follow=follow))
+        lv = Live(Simulation(load_world(path)))
+        lv.ok(A, "attach", {"robot": "boss"})
+        ids = {name: _boss(lv, "get_from_def", {"name": name})["node"] for name in ("CRATE", "MOVER", "OTHER")}
+        followed = ids[follow.upper()]
+        viewpoint = next(n for n in lv.sim.top_level.scenery if n.type == "Viewpoint")
+
+        def position() -> np.ndarray:
+            return np.asarray(viewpoint.fields["position"], dtype=float)
+
+        def at() -> np.ndarray:
+            return np.asarray(_boss(lv, "get_field", {"node": followed, "field": "translation"})["value"])
+
+        before = np.asarray(FOLLOWED_AT[follow])
+        for op, arg in ops:
+            if op == "move":
+                _boss(lv, "set_field", {"node": followed, "field": "translation", "value": list(arg)})
+            elif op == "moveViewpoint":
+                _boss(lv, "move_viewpoint", {"node": ids[arg]})
+            elif op == "reset":
+                _boss(lv, "simulation_reset")
+                assert np.array_equal(position(), view)
+                before = np.asarray(FOLLOWED_AT[follow])
+            else:
+                for _ in range(arg):
+                    stood = position()
+                    lv.step(A, "boss")
+                    now = at()
+                    assert np.abs(position() - (stood + (now - before))).max() <= 1e-12, (op, stood, now, before)
+                    before = now
+
+    prop()
