@@ -151,7 +151,8 @@ def check_legacy_world(tmp: Path, shapes: list, devices: dict, bound: int) -> No
     a, b = _poses(converted), _poses(by_hand)
     assert [n for n, _ in a] == [n for n, _ in b]
     for (name, (ta, ra)), (_, (tb, rb)) in zip(a, b, strict=True):
-        assert np.abs(ta - tb).max() <= 1e-12 and np.abs(ra - rb).max() <= 1e-12, name
+        # 1e-11: two axis-angle round trips of a near-identity turn differ by up to 1.1e-12 (found at 1,500 examples)
+        assert np.abs(ta - tb).max() <= 1e-12 and np.abs(ra - rb).max() <= 1e-11, name
     # the R2023b reading of the R2021b text: every rotation as written
     for kind, (place, axis, angle, *_) in devices.items():
         (d,) = [d for d in untouched.world.robots[0].devices if d.name == kind.lower()]
